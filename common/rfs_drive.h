@@ -1,0 +1,73 @@
+/* rfs_drive.h - differential-drive control: from the pose and a path to wheel speeds.
+ *
+ * Follows the waypoints of a planned path: turn on the spot when the heading error is
+ * large, otherwise drive forward with a proportional heading correction, slowing down
+ * towards the final waypoint; wheel speeds are limited in magnitude and in acceleration.
+ * The goal ends when reached (within `goal_tol`), abandoned after `timeout_us`, or
+ * abandoned as blocked when the robot has made less than `progress_min` of progress
+ * over `stall_us`. Defaults are a TurtleBot 2 (Kobuki): wheel base 0.23 m, 0.7 m/s.
+ */
+#ifndef RFS_DRIVE_H
+#define RFS_DRIVE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rfs_fix.h"
+#include "rfs_plan.h"
+#include "rfs_store.h"
+
+/// Drive configuration.
+typedef struct rfs_drive_cfg {
+    int32_t wheel_base_mm;     ///< distance between the wheels, mm (230)
+    int32_t v_max_mm_s;        ///< top wheel speed, mm/s (700)
+    int32_t accel_mm_s2;       ///< wheel acceleration limit, mm/s^2
+    rfs_q16_t goal_tol;        ///< metres Q16.16: goal reached within this distance
+    rfs_q16_t turn_in_place;   ///< radians Q16.16: heading error above which it turns on the spot
+    int64_t timeout_us;        ///< a goal is abandoned after this long
+    int64_t stall_us;          ///< window over which progress is required
+    rfs_q16_t progress_min;    ///< metres Q16.16 of progress required per stall window
+} rfs_drive_cfg_t;
+
+/// Outcome of one control update.
+typedef enum rfs_drive_status {
+    RFS_DRIVE_IDLE = 0,    ///< no goal
+    RFS_DRIVE_RUNNING,     ///< moving towards the goal
+    RFS_DRIVE_REACHED,     ///< within goal_tol of the final waypoint (wheels commanded 0)
+    RFS_DRIVE_TIMEOUT,     ///< abandoned: took longer than timeout_us
+    RFS_DRIVE_BLOCKED,     ///< abandoned: no progress
+} rfs_drive_status_t;
+
+/// Drive state, caller-owned.
+typedef struct rfs_drive {
+    rfs_drive_cfg_t cfg;           ///< configuration copied at init
+    rfs_path_t path;               ///< the path followed
+    uint16_t next;                 ///< index of the waypoint being approached
+    rfs_drive_status_t status;     ///< current status
+    int64_t start_us;              ///< when the goal was set
+    int64_t last_us;               ///< time of the last update (for acceleration limits)
+    int64_t stall_ref_us;          ///< start of the current progress window
+    rfs_q16_t stall_ref_dist;      ///< remaining distance at that time, metres Q16.16
+    int32_t left_mm_s;             ///< last commanded left wheel speed, mm/s
+    int32_t right_mm_s;            ///< last commanded right wheel speed, mm/s
+} rfs_drive_t;
+
+/// Defaults: TurtleBot 2 (Kobuki) base, 0.1 m goal tolerance, 30 s timeout.
+rfs_drive_cfg_t rfs_drive_cfg_default(void);
+
+/// Initialise idle. Returns 0, or -1 on a non-positive wheel base, speed, acceleration,
+/// tolerance or timeout.
+int rfs_drive_init(rfs_drive_t *d, const rfs_drive_cfg_t *cfg);
+
+/// Start following a path (copied) at time now_us.
+void rfs_drive_set_path(rfs_drive_t *d, const rfs_path_t *path, int64_t now_us);
+
+/// One control update: wheel speeds (mm/s, saturated to the limits) for the pose.
+/// Returns the status; REACHED/TIMEOUT/BLOCKED are reported once, then IDLE.
+rfs_drive_status_t rfs_drive_update(rfs_drive_t *d, const rfs_pose_t *pose, int64_t now_us,
+                                    int16_t *left_mm_s, int16_t *right_mm_s);
+
+/// Drop the goal and command zero at once (safety stop; no ramp).
+void rfs_drive_stop(rfs_drive_t *d, int64_t now_us);
+
+#endif /* RFS_DRIVE_H */

@@ -1,0 +1,315 @@
+/* rfs_fix.c - fixed-point arithmetic, wide integers and the PRNG (see rfs_fix.h). */
+#include "rfs_fix.h"
+
+#include "rfs_assert.h"
+
+uint64_t rfs_udiv64(uint64_t n, uint64_t d)
+{
+    if (d == 0u) {
+        return UINT64_MAX;
+    }
+    if (n < d) {
+        return 0u;
+    }
+    /* Align the divisor's top bit with the dividend's, then shift-subtract: as many
+     * rounds as the bit-length difference, never a libgcc call. */
+    int shift = __builtin_clzll(d) - __builtin_clzll(n);
+    uint64_t q = 0u;
+    d <<= shift;
+    for (; shift >= 0; --shift) {
+        q <<= 1;
+        if (n >= d) {
+            n -= d;
+            q |= 1u;
+        }
+        d >>= 1;
+    }
+    return q;
+}
+
+int64_t rfs_sdiv64_round(int64_t n, int64_t d)
+{
+    if (d == 0) {
+        return n > 0 ? INT64_MAX : (n < 0 ? INT64_MIN : 0);
+    }
+    bool neg = (n < 0) != (d < 0);
+    uint64_t un = n < 0 ? (uint64_t)0 - (uint64_t)n : (uint64_t)n;
+    uint64_t ud = d < 0 ? (uint64_t)0 - (uint64_t)d : (uint64_t)d;
+    uint64_t q = rfs_udiv64(un, ud);
+    uint64_t r = un - q * ud;
+    if (r >= ud - r) { /* r >= d/2 without overflow: round half away from zero */
+        q += 1u;
+    }
+    if (neg) {
+        return q > (uint64_t)INT64_MAX ? INT64_MIN : -(int64_t)q;
+    }
+    return q > (uint64_t)INT64_MAX ? INT64_MAX : (int64_t)q;
+}
+
+rfs_q16_t rfs_q16_div(rfs_q16_t a, rfs_q16_t b)
+{
+    if (b == 0) {
+        return a > 0 ? RFS_Q16_MAX : (a < 0 ? RFS_Q16_MIN : 0);
+    }
+    /* |a| << 16 < 2^47 and |b| >= 1: the quotient fits int64 and rounds exactly. */
+    return rfs_sat32(rfs_sdiv64_round((int64_t)a * 65536, b));
+}
+
+uint32_t rfs_isqrt32(uint32_t v)
+{
+    return rfs_isqrt64(v);
+}
+
+uint32_t rfs_isqrt64(uint64_t v)
+{
+    /* Digit-by-digit (base 4) square root: 32 rounds, exact floor. */
+    uint64_t rem = v;
+    uint64_t root = 0u;
+    uint64_t bit = (uint64_t)1 << 62;
+    while (bit > rem) {
+        bit >>= 2;
+    }
+    while (bit != 0u) {
+        if (rem >= root + bit) {
+            rem -= root + bit;
+            root = (root >> 1) + bit;
+        } else {
+            root >>= 1;
+        }
+        bit >>= 2;
+    }
+    return (uint32_t)root;
+}
+
+rfs_q16_t rfs_q16_sqrt(rfs_q16_t x)
+{
+    RFS_ASSERT(x >= 0);
+    return (rfs_q16_t)rfs_isqrt64((uint64_t)(uint32_t)x << 16);
+}
+
+/* e^-n in Q30 for n = 0..12 (round(exp(-n) * 2^30)). */
+static const int32_t k_exp_int_q30[13] = {
+    1073741824, 395007542, 145315154, 53458458, 19666268, 7234816, 2661540,
+    979126,     360200,    132510,    48748,    17933,    6597,
+};
+
+/* e^-(k/16) in Q30 for k = 0..15. */
+static const int32_t k_exp_frac_q30[16] = {
+    1073741824, 1008687096, 947573834, 890163238, 836230973, 785566300,
+    737971244,  693259826,  651257337, 611799650, 574732583, 539911296,
+    507199724,  476470046,  447602185, 420483340,
+};
+
+rfs_q16_t rfs_q16_exp_neg(rfs_q16_t x)
+{
+    if (x <= 0) {
+        return RFS_Q16_ONE;
+    }
+    int32_t n = x >> 16;
+    if (n > 12) {
+        return 0; /* e^-13 * 2^16 = 0.15 LSB */
+    }
+    uint32_t k = ((uint32_t)x >> 12) & 15u;
+    /* r in [0, 1/16) as Q30: the low 12 bits of Q16 shifted up by 14. */
+    int64_t r = (int64_t)((uint32_t)x & 0xFFFu) << 14;
+    int64_t r2 = (r * r) >> 30;
+    int64_t r3 = (r2 * r) >> 30;
+    /* 1 - r + r^2/2 - r^3/6 in Q30; truncation error < (1/16)^4/24 = 6e-7. */
+    int64_t poly = ((int64_t)1 << 30) - r + r2 / 2 - r3 / 6;
+    int64_t v = ((int64_t)k_exp_int_q30[n] * k_exp_frac_q30[k]) >> 30;
+    v = (v * poly) >> 30;
+    return (rfs_q16_t)((v + (1 << 13)) >> 14);
+}
+
+rfs_q16_t rfs_q16_log2(rfs_q16_t x)
+{
+    RFS_ASSERT(x > 0);
+    /* x = 2^e * m, m in [1, 2). Integer part: e = bitlen - 17 (Q16). */
+    int bitlen = 32 - __builtin_clz((uint32_t)x);
+    int32_t e = bitlen - 17;
+    /* Mantissa in Q30: shift x so its top bit lands at bit 30. */
+    uint64_t m = bitlen <= 31 ? (uint64_t)(uint32_t)x << (31 - bitlen)
+                              : (uint64_t)(uint32_t)x >> (bitlen - 31);
+    int32_t frac = 0;
+    for (int i = 0; i < 16; ++i) {
+        m = (m * m) >> 30; /* m^2 in Q30, m < 2 so m^2 < 4: fits 33 bits */
+        frac <<= 1;
+        if (m >= ((uint64_t)2 << 30)) {
+            m >>= 1;
+            frac |= 1;
+        }
+    }
+    return (rfs_q16_t)(e * 65536 + frac);
+}
+
+rfs_q16_t rfs_q16_db10(rfs_q16_t x)
+{
+    /* 10*log10(x) = log2(x) * 10*log10(2); 10*log10(2) = 3.0103 = 197290 in Q16. */
+    return rfs_q16_mul(rfs_q16_log2(x), 197290);
+}
+
+static rfs_i128_t u128_mul(uint64_t a, uint64_t b)
+{
+    uint64_t a0 = (uint32_t)a, a1 = a >> 32;
+    uint64_t b0 = (uint32_t)b, b1 = b >> 32;
+    uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
+    uint64_t mid = (p00 >> 32) + (uint32_t)p01 + (uint32_t)p10;
+    rfs_i128_t r;
+    r.lo = (mid << 32) | (uint32_t)p00;
+    r.hi = (int64_t)(p11 + (p01 >> 32) + (p10 >> 32) + (mid >> 32));
+    return r;
+}
+
+static rfs_i128_t i128_negate(rfs_i128_t a)
+{
+    rfs_i128_t r;
+    r.lo = ~a.lo + 1u;
+    r.hi = (int64_t)(~(uint64_t)a.hi + (r.lo == 0u ? 1u : 0u));
+    return r;
+}
+
+rfs_i128_t rfs_i128_mul(int64_t a, int64_t b)
+{
+    bool neg = (a < 0) != (b < 0);
+    uint64_t ua = a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a;
+    uint64_t ub = b < 0 ? (uint64_t)0 - (uint64_t)b : (uint64_t)b;
+    rfs_i128_t r = u128_mul(ua, ub);
+    return neg ? i128_negate(r) : r;
+}
+
+rfs_i128_t rfs_i128_add(rfs_i128_t a, rfs_i128_t b)
+{
+    rfs_i128_t r;
+    r.lo = a.lo + b.lo;
+    r.hi = (int64_t)((uint64_t)a.hi + (uint64_t)b.hi + (r.lo < a.lo ? 1u : 0u));
+    return r;
+}
+
+rfs_i128_t rfs_i128_sub(rfs_i128_t a, rfs_i128_t b)
+{
+    return rfs_i128_add(a, i128_negate(b));
+}
+
+/* Unsigned 128-bit helpers on (hi, lo) pairs, hi kept as uint64. */
+static int u128_cmp(uint64_t ah, uint64_t al, uint64_t bh, uint64_t bl)
+{
+    if (ah != bh) {
+        return ah < bh ? -1 : 1;
+    }
+    return al < bl ? -1 : (al > bl ? 1 : 0);
+}
+
+int64_t rfs_i128_div_shift(rfs_i128_t n, rfs_i128_t d, unsigned shift)
+{
+    RFS_ASSERT(shift <= 62u);
+    bool nneg = rfs_i128_neg(n), dneg = rfs_i128_neg(d);
+    if (nneg) {
+        n = i128_negate(n);
+    }
+    if (dneg) {
+        d = i128_negate(d);
+    }
+    uint64_t nh = (uint64_t)n.hi, nl = n.lo, dh = (uint64_t)d.hi, dl = d.lo;
+    if (dh == 0u && dl == 0u) {
+        if (nh == 0u && nl == 0u) {
+            return 0;
+        }
+        return nneg ? INT64_MIN : INT64_MAX;
+    }
+    /* Numerator times 2^shift needs up to 190 bits: keep it as three words. */
+    uint64_t w2 = shift ? nh >> (64u - shift) : 0u;
+    uint64_t w1 = shift ? (nh << shift) | (nl >> (64u - shift)) : nh;
+    uint64_t w0 = nl << shift;
+    /* Long division, one bit per round over 192 bits; remainder stays < 2 * d. */
+    uint64_t rh = 0u, rl = 0u, qh = 0u, ql = 0u;
+    bool overflow = false;
+    for (int i = 191; i >= 0; --i) {
+        uint64_t bit = i >= 128 ? (w2 >> (i - 128)) & 1u
+                     : i >= 64  ? (w1 >> (i - 64)) & 1u
+                                : (w0 >> i) & 1u;
+        uint64_t top = rh >> 63;
+        rh = (rh << 1) | (rl >> 63);
+        rl = (rl << 1) | bit;
+        if (qh >> 63) {
+            overflow = true;
+        }
+        qh = (qh << 1) | (ql >> 63);
+        ql <<= 1;
+        if (top || u128_cmp(rh, rl, dh, dl) >= 0) {
+            uint64_t borrow = rl < dl ? 1u : 0u;
+            rl -= dl;
+            rh = rh - dh - borrow;
+            ql |= 1u;
+        }
+    }
+    /* Round to nearest: remainder * 2 >= d. */
+    uint64_t r2h = (rh << 1) | (rl >> 63), r2l = rl << 1;
+    if ((rh >> 63) || u128_cmp(r2h, r2l, dh, dl) >= 0) {
+        ql += 1u;
+        if (ql == 0u) {
+            qh += 1u;
+        }
+    }
+    if (overflow || qh != 0u || ql > (uint64_t)INT64_MAX) {
+        return (nneg != dneg) ? INT64_MIN : INT64_MAX;
+    }
+    return (nneg != dneg) ? -(int64_t)ql : (int64_t)ql;
+}
+
+static uint64_t splitmix64(uint64_t *x)
+{
+    uint64_t z = (*x += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+void rfs_rng_seed(rfs_rng_t *rng, uint64_t seed)
+{
+    RFS_ASSERT(rng != 0);
+    uint64_t x = seed;
+    uint64_t a = splitmix64(&x), b = splitmix64(&x);
+    rng->s[0] = (uint32_t)a;
+    rng->s[1] = (uint32_t)(a >> 32);
+    rng->s[2] = (uint32_t)b;
+    rng->s[3] = (uint32_t)(b >> 32);
+    if ((rng->s[0] | rng->s[1] | rng->s[2] | rng->s[3]) == 0u) {
+        rng->s[0] = 1u;
+    }
+}
+
+static uint32_t rotl32(uint32_t x, int k)
+{
+    return (x << k) | (x >> (32 - k));
+}
+
+uint32_t rfs_rng_u32(rfs_rng_t *rng)
+{
+    uint32_t *s = rng->s;
+    uint32_t result = rotl32(s[0] + s[3], 7) + s[0];
+    uint32_t t = s[1] << 9;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = rotl32(s[3], 11);
+    return result;
+}
+
+uint32_t rfs_rng_below(rfs_rng_t *rng, uint32_t n)
+{
+    if (n == 0u) {
+        return 0u;
+    }
+    uint64_t m = (uint64_t)rfs_rng_u32(rng) * n;
+    uint32_t low = (uint32_t)m;
+    if (low < n) {
+        uint32_t threshold = (0u - n) % n;
+        while (low < threshold) {
+            m = (uint64_t)rfs_rng_u32(rng) * n;
+            low = (uint32_t)m;
+        }
+    }
+    return (uint32_t)(m >> 32);
+}

@@ -1,0 +1,100 @@
+/* rfs_map.h - the occupancy map as the core sees it: bit grids and legality (paper section 2).
+ *
+ * The host (or a firmware image) loads a ROS map_server map and hands the core two bit
+ * grids at the core's own resolution (default 0.1 m): `free` (1 = every fine cell under
+ * it is free; unknown is not free) and `wall` (1 = some fine cell under it is occupied).
+ * rfs_map_init() derives `legal` (1 = every cell within the clearance is free) into a
+ * third caller buffer. Bit (cx, cy) is bit (cx & 7) of byte (cy * stride + cx / 8);
+ * cell (0, 0) is the lower-left cell, whose lower-left corner is at the origin.
+ *
+ * "movements are restricted to legal movements, i.e., ones which are not part of a wall
+ * or outside of the known map": a point is legal when its cell is on the map and every
+ * cell within `clearance` of it is free; a straight move is legal when every cell its
+ * segment passes through is legal.
+ *
+ * The lattice: greedy grid search, epsilon candidates and path planning all use one
+ * lattice of points `grid` apart (default 0.25 m) with lattice point (0, 0) at the
+ * centre of the cell the origin is in... precisely at origin + grid/2 in x and y.
+ */
+#ifndef RFS_MAP_H
+#define RFS_MAP_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rfs_fix.h"
+
+/// Map configuration.
+typedef struct rfs_map_cfg {
+    rfs_q16_t clearance; ///< metres, Q16.16: free space required around a legal point (0.25)
+    rfs_q16_t grid;      ///< metres, Q16.16: lattice spacing for search and planning (0.25)
+} rfs_map_cfg_t;
+
+/// The map; the bit arrays are caller-owned and must outlive it.
+typedef struct rfs_map {
+    rfs_map_cfg_t cfg;     ///< configuration copied at init
+    uint16_t w;            ///< width, cells
+    uint16_t h;            ///< height, cells
+    uint16_t stride;       ///< bytes per row, (w + 7) / 8
+    rfs_q16_t res;         ///< metres per cell, Q16.16
+    rfs_q16_t origin_x;    ///< map frame x of the lower-left corner of cell (0, 0), metres Q16.16
+    rfs_q16_t origin_y;    ///< map frame y of that corner, metres Q16.16
+    const uint8_t *free;   ///< 1 = free, h * stride bytes
+    const uint8_t *wall;   ///< 1 = occupied, h * stride bytes; may be NULL
+    uint8_t *legal;        ///< 1 = legal (derived), h * stride bytes
+    uint16_t lw;           ///< lattice points along x
+    uint16_t lh;           ///< lattice points along y
+} rfs_map_t;
+
+/// Defaults: 0.25 m clearance, 0.25 m lattice.
+rfs_map_cfg_t rfs_map_cfg_default(void);
+
+/// Bytes of one bit grid of w x h cells.
+static inline uint32_t rfs_map_bytes(uint16_t w, uint16_t h)
+{
+    return (uint32_t)h * (uint32_t)((w + 7u) / 8u);
+}
+
+/// Validate and derive the legal grid. Returns 0, or -1 on zero size, res <= 0,
+/// clearance < 0, grid <= 0, a map wider than 65535 cells or larger than +-16 km, or a
+/// null free/legal array.
+int rfs_map_init(rfs_map_t *m, const rfs_map_cfg_t *cfg, uint16_t w, uint16_t h,
+                 rfs_q16_t res, rfs_q16_t origin_x, rfs_q16_t origin_y,
+                 const uint8_t *free_bits, const uint8_t *wall_bits, uint8_t *legal_bits);
+
+/// Cell of a point; false when off the map.
+bool rfs_map_cell(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, uint16_t *cx, uint16_t *cy);
+
+/// Bit test on one of the map's grids (no bounds check beyond an assert).
+static inline bool rfs_map_bit(const uint8_t *bits, uint16_t stride, uint16_t cx, uint16_t cy)
+{
+    return (bits[(uint32_t)cy * stride + (cx >> 3)] >> (cx & 7u)) & 1u;
+}
+
+/// Set or clear a bit in a grid (used by loaders and tests).
+void rfs_map_bit_set(uint8_t *bits, uint16_t stride, uint16_t cx, uint16_t cy, bool v);
+
+/// Point legality: on the map and clear of every non-free cell within the clearance.
+bool rfs_map_point_legal(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y);
+
+/// Straight-move legality: every cell the segment passes through is legal.
+bool rfs_map_segment_legal(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,
+                           rfs_q16_t y1);
+
+/// Walls crossed by the straight line: the number of runs of consecutive wall cells the
+/// segment passes through (0 when the map has no wall grid). Same rule as the simulator.
+uint16_t rfs_map_walls_crossed(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,
+                               rfs_q16_t y1);
+
+/// Position of lattice point (i, j), metres Q16.16.
+void rfs_map_lattice_point(const rfs_map_t *m, uint16_t i, uint16_t j, rfs_q16_t *x,
+                           rfs_q16_t *y);
+
+/// Nearest lattice point to (x, y), clamped to the lattice.
+void rfs_map_lattice_nearest(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, uint16_t *i,
+                             uint16_t *j);
+
+/// Lattice point legality (its position is a legal point).
+bool rfs_map_lattice_legal(const rfs_map_t *m, uint16_t i, uint16_t j);
+
+#endif /* RFS_MAP_H */

@@ -1,0 +1,56 @@
+/* rfs_model.h - the internal model interface (paper sections 3 and 5.2).
+ *
+ * "The concept of internal models is agnostic to the actual representation": the seeker
+ * sees a model only through these operations. A model learns from the stored samples
+ * (possibly around a query point: the local ridge uses the robot's position), predicts
+ * the target anywhere on the map, and may take several calls to learn so that a long
+ * fit can be sliced across control periods (budget = work units per call).
+ */
+#ifndef RFS_MODEL_H
+#define RFS_MODEL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rfs_fix.h"
+#include "rfs_map.h"
+#include "rfs_store.h"
+
+/// What a model learns from.
+typedef struct rfs_model_fit_in {
+    const rfs_sample_t *samples; ///< the stored samples
+    uint16_t n;                  ///< how many
+    rfs_q16_t qx;                ///< query point (robot position) x, metres Q16.16
+    rfs_q16_t qy;                ///< query point y, metres Q16.16
+    const rfs_map_t *map;        ///< the map (for map-aware models); may be NULL
+} rfs_model_fit_in_t;
+
+/// Result of one fit call.
+typedef enum rfs_fit_result {
+    RFS_FIT_DONE = 0, ///< the model is ready
+    RFS_FIT_MORE,     ///< call again with the same input (sliced learning)
+    RFS_FIT_FAILED,   ///< no model could be learnt (e.g. no samples); the model is invalid
+} rfs_fit_result_t;
+
+/// Operations of one kind of internal model.
+typedef struct rfs_model_ops {
+    const char *name; ///< short name, as on the command line ("ridge")
+    /// Discard the current model (it predicts nothing until the next fit is done).
+    void (*reset)(void *self);
+    /// Learn (or continue learning). budget: work units for this call, 0 = no limit.
+    rfs_fit_result_t (*fit)(void *self, const rfs_model_fit_in_t *in, uint32_t budget,
+                            rfs_rng_t *rng);
+    /// Predict the target at (x, y) in target units Q16.16; false when there is no model.
+    bool (*predict)(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *value);
+    /// Optional (may be NULL): where the model believes the maximum is, when it knows
+    /// better than a grid search (e.g. an estimated source position).
+    bool (*argmax)(const void *self, rfs_q16_t *x, rfs_q16_t *y);
+} rfs_model_ops_t;
+
+/// A model: its operations and its caller-owned state.
+typedef struct rfs_model {
+    const rfs_model_ops_t *ops; ///< operations
+    void *self;                 ///< state passed to every operation
+} rfs_model_t;
+
+#endif /* RFS_MODEL_H */

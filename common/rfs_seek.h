@@ -1,0 +1,167 @@
+/* rfs_seek.h - the meta-algorithm (paper section 2, Algorithm 1) as a control-loop core.
+ *
+ *   do random movement
+ *   while not at source:
+ *     parse messages
+ *     if |mean RSSI over last second - model prediction at current position| > threshold:
+ *       discard current model; learn new model on all available data
+ *     if random() > epsilon: go min(dist to goal, step width) towards the model's maximum
+ *     else: do random (novelty-driven) movement
+ *
+ * The application feeds poses and measurements as they arrive (rfs_seek_on_pose,
+ * rfs_seek_on_rssi) and calls rfs_seek_step() at its control rate (e.g. 20 Hz) with the
+ * current time and its randomness source; each call returns the wheel command. An
+ * iteration of the algorithm is one goal: it is decided when the previous goal ends
+ * (reached, timed out or blocked) and then driven to. The decision carries its reason.
+ * Wheels are commanded to zero while pose or measurements are stale.
+ */
+#ifndef RFS_SEEK_H
+#define RFS_SEEK_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rfs_drive.h"
+#include "rfs_fix.h"
+#include "rfs_map.h"
+#include "rfs_model.h"
+#include "rfs_plan.h"
+#include "rfs_rssi.h"
+#include "rfs_store.h"
+#include "rfs_target.h"
+
+/// Seeker configuration; rfs_seek_cfg_default() is exactly the paper's.
+typedef struct rfs_seek_cfg {
+    rfs_q16_t step;             ///< step width, metres Q16.16 (paper: 1 m)
+    rfs_q16_t initial_step_max; ///< longest initial random move, metres Q16.16 (2 x step)
+    rfs_q16_t error_threshold;  ///< relearn when |mean - prediction| exceeds this (3 dB)
+    rfs_q16_t eps_floor;        ///< epsilon = eps_amp * e^(-eps_rate * n) + eps_floor (0.1)
+    rfs_q16_t eps_amp;          ///< (0.9)
+    rfs_q16_t eps_rate;         ///< per iteration, Q16.16: ln(9/4)/5 so epsilon(5) = 0.5
+    rfs_q16_t novelty_radius;   ///< epsilon goals keep this far from past positions (0.5 m)
+    int64_t pose_timeout_us;    ///< pose older than this is stale: wheels stop (150 ms)
+    int64_t rssi_timeout_us;    ///< no measurement for this long is stale: wheels stop (150 ms)
+    uint32_t fit_budget;        ///< work units per control period for model learning (0 = all)
+    rfs_rssi_cfg_t rssi;        ///< averaging window (1 s)
+    rfs_store_cfg_t store;      ///< sample store (10,000 samples)
+    rfs_drive_cfg_t drive;      ///< drive control (TurtleBot 2)
+} rfs_seek_cfg_t;
+
+/// Caller-owned memory for the seeker's large arrays.
+typedef struct rfs_seek_mem {
+    rfs_sample_t *samples;     ///< cfg.store.capacity samples
+    rfs_pending_t *pending;    ///< pending measurements ring
+    uint16_t pending_cap;      ///< its capacity (>= 64; 256 for two 200 pkt/s sources)
+    uint8_t *plan_work;        ///< one byte per lattice point
+    uint32_t plan_work_bytes;  ///< its size
+    uint32_t *plan_queue;      ///< planner queue
+    uint32_t plan_queue_cap;   ///< its capacity
+    uint8_t *visited;          ///< one bit per lattice point: within the novelty radius of a past position
+    uint32_t visited_bytes;    ///< its size, (lw * lh + 7) / 8
+} rfs_seek_mem_t;
+
+/// Why an iteration chose its goal.
+typedef enum rfs_seek_kind {
+    RFS_SEEK_NONE = 0, ///< no decision
+    RFS_SEEK_INITIAL,  ///< the initial random move (up to initial_step_max)
+    RFS_SEEK_GREEDY,   ///< towards the model's maximum
+    RFS_SEEK_EPSILON,  ///< novelty-driven random move
+} rfs_seek_kind_t;
+
+/// Controller state.
+typedef enum rfs_seek_state {
+    RFS_SEEK_WAITING = 0, ///< no pose or no measurement yet
+    RFS_SEEK_STALE,       ///< inputs went stale: wheels stopped
+    RFS_SEEK_LEARNING,    ///< a sliced fit is in progress: wheels stopped
+    RFS_SEEK_DRIVING,     ///< following the current goal
+} rfs_seek_state_t;
+
+/// Fault flags (bits of rfs_seek_out_t.faults).
+enum {
+    RFS_SEEK_FAULT_POSE_STALE = 1u << 0, ///< no pose within pose_timeout_us
+    RFS_SEEK_FAULT_RSSI_STALE = 1u << 1, ///< no measurement within rssi_timeout_us
+    RFS_SEEK_FAULT_NO_GOAL = 1u << 2,    ///< no legal, reachable goal was found
+    RFS_SEEK_FAULT_OFF_MAP = 1u << 3,    ///< the robot's position is not on the known map
+};
+
+/// One iteration's decision and its reasons (for logs, status messages and plots).
+typedef struct rfs_seek_decision {
+    uint32_t iteration;        ///< n, counted from 0 (the initial move)
+    int64_t t_us;              ///< when it was decided, microseconds
+    rfs_seek_kind_t kind;      ///< initial, greedy or epsilon
+    bool relearned;            ///< the model was discarded and learnt again this iteration
+    bool line_search;          ///< the greedy step was illegal; the line search chose the goal
+    bool model_valid;          ///< a model existed for the check
+    bool mean_valid;           ///< a 1 s mean existed for the check
+    rfs_drive_status_t prev;   ///< how the previous goal ended
+    rfs_q16_t prediction;      ///< model prediction at the position (before relearning), target units
+    rfs_q16_t mean;            ///< 1 s mean of the target at decision time
+    rfs_q16_t epsilon;         ///< epsilon for this iteration, Q16.16
+    rfs_q16_t x, y;            ///< position at decision time, metres Q16.16
+    rfs_q16_t goal_x, goal_y;  ///< chosen goal, metres Q16.16
+    rfs_q16_t max_x, max_y;    ///< model maximum found by the grid search (greedy only)
+    rfs_q16_t path_len;        ///< planned path length, metres Q16.16
+    uint16_t samples;          ///< samples in the store
+} rfs_seek_decision_t;
+
+/// What one control period produces.
+typedef struct rfs_seek_out {
+    int16_t left_mm_s;          ///< left wheel speed command, mm/s
+    int16_t right_mm_s;         ///< right wheel speed command, mm/s
+    rfs_seek_state_t state;     ///< controller state
+    uint16_t faults;            ///< RFS_SEEK_FAULT_* bits
+    bool decided;               ///< a new decision was made this period
+    rfs_seek_decision_t decision; ///< the latest decision (new when `decided`)
+} rfs_seek_out_t;
+
+/// Number of sources the seeker keeps windows for.
+#define RFS_SEEK_MAX_SOURCES RFS_TARGET_MAX_SOURCES
+
+/// The seeker: every piece of state the meta-algorithm needs, caller-owned (~6 KB plus
+/// the arrays of rfs_seek_mem_t).
+typedef struct rfs_seek {
+    rfs_seek_cfg_t cfg;                       ///< configuration copied at init
+    const rfs_map_t *map;                     ///< the map
+    rfs_model_t model;                        ///< the internal model
+    const rfs_target_ops_t *target;           ///< the target function
+    rfs_rssi_t win[RFS_SEEK_MAX_SOURCES];     ///< 1 s windows per source
+    rfs_store_t store;                        ///< samples
+    rfs_plan_t plan;                          ///< planner
+    rfs_drive_t drive;                        ///< drive control
+    uint8_t *visited;                         ///< novelty bits, one per lattice point
+    rfs_pose_t pose;                          ///< latest pose
+    bool have_pose;                           ///< pose is valid
+    int64_t last_meas_us;                     ///< time of the latest accepted measurement
+    bool have_meas;                           ///< a measurement has been accepted
+    rfs_seek_state_t state;                   ///< controller state
+    uint32_t iteration;                       ///< next iteration number
+    bool fitting;                             ///< a sliced fit is in progress
+    rfs_seek_decision_t decision;             ///< latest decision
+    rfs_drive_status_t prev_status;           ///< how the last goal ended
+    uint32_t meas_rejected;                   ///< measurements with a bad source index
+} rfs_seek_t;
+
+/// The paper's parameters (section 2 and 5.2): the `meta` configuration.
+rfs_seek_cfg_t rfs_seek_cfg_default(void);
+
+/// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array
+/// is missing or too small for the map's lattice, or the target needs more sources than
+/// RFS_SEEK_MAX_SOURCES.
+int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map,
+                  rfs_model_t model, const rfs_target_ops_t *target, const rfs_seek_mem_t *mem);
+
+/// A pose arrived. false when rejected (older than the latest).
+bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng);
+
+/// A measurement from source `src` (index into the target's sources) arrived.
+/// false when rejected (bad source, out of order).
+bool rfs_seek_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm, rfs_rng_t *rng);
+
+/// One control period at now_us: decide when the current goal has ended, drive, and
+/// report. Cannot fail.
+void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out);
+
+/// epsilon(n) = eps_amp * e^(-eps_rate * n) + eps_floor, Q16.16.
+rfs_q16_t rfs_seek_epsilon(const rfs_seek_cfg_t *cfg, uint32_t n);
+
+#endif /* RFS_SEEK_H */

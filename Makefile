@@ -88,17 +88,69 @@ ALL_TARGETS += $(CORE_LIB)
 define cmocka_test
 $(BUILD)/tests/$(1): $(2) $$(CORE_LIB) $$(HOST_LIB_DEPS) tests/rfs_test.h
 	@mkdir -p $$(@D)
-	$$(CC) $$(HOST_CFLAGS) -Itests $(2) -o $$@ $$(HOST_LIB_DEPS) $$(CORE_LIB) -lcmocka $(3) $$(HOST_LDLIBS)
+	$$(HOST_LINK) $$(HOST_CFLAGS) -x c -Itests $(2) -x none -o $$@ $$(HOST_LIB_DEPS) $$(CORE_LIB) -lcmocka $(3) $$(HOST_LDLIBS)
 $(BUILD)/asan/tests/$(1): $(2) $$(CORE_ASAN_LIB) $$(HOST_ASAN_LIB_DEPS) tests/rfs_test.h
 	@mkdir -p $$(@D)
-	$$(CC) $$(HOST_CFLAGS) -O1 $$(SAN_FLAGS) -Itests $(2) -o $$@ $$(HOST_ASAN_LIB_DEPS) $$(CORE_ASAN_LIB) -lcmocka $(3) $$(HOST_LDLIBS)
+	$$(HOST_LINK) $$(HOST_CFLAGS) -O1 $$(SAN_FLAGS) -x c -Itests $(2) -x none -o $$@ $$(HOST_ASAN_LIB_DEPS) $$(CORE_ASAN_LIB) -lcmocka $(3) $$(HOST_LDLIBS)
 TEST_BINS += $(BUILD)/tests/$(1) $(BUILD)/asan/tests/$(1)
 endef
 
-HOST_LIB_DEPS :=
-HOST_ASAN_LIB_DEPS :=
+# --- host-side library and programs ---------------------------------------------------
+# Every host_sim/*.c and *.cpp is in librfs_host.a; host_sim/prog/<name>.c and
+# firmware/port/linux/prog/<name>.c become build/bin/<name>. Fragments add flags and
+# libraries (pkg-config) to HOST_CFLAGS / HOST_LDLIBS and generated sources to HOST_GEN.
+HOST_SRCS := $(sort $(wildcard host_sim/*.c))
+HOST_CXX_SRCS := $(sort $(wildcard host_sim/*.cpp))
+HOST_HDRS = $(wildcard host_sim/*.h) $(CORE_HDRS) $(HOST_GEN_HDRS)
+HOST_GEN_HDRS :=
+HOST_GEN_SRCS :=
+HOST_LIB := $(BUILD)/lib/librfs_host.a
+HOST_ASAN_LIB := $(BUILD)/asan/lib/librfs_host.a
+HOST_LIB_DEPS = $(if $(HOST_SRCS)$(HOST_CXX_SRCS),$(HOST_LIB))
+HOST_ASAN_LIB_DEPS = $(if $(HOST_SRCS)$(HOST_CXX_SRCS),$(HOST_ASAN_LIB))
+HOST_PROGS := $(patsubst %.c,$(BUILD)/bin/%,$(notdir $(wildcard host_sim/prog/*.c firmware/port/linux/prog/*.c)))
 
 include $(sort $(wildcard mk/*.mk))
+
+HOST_OBJS = $(HOST_SRCS:%.c=$(BUILD)/obj/%.o) $(HOST_CXX_SRCS:%.cpp=$(BUILD)/obj/%.o) $(HOST_GEN_SRCS:%.c=%.o)
+HOST_ASAN_OBJS = $(HOST_SRCS:%.c=$(BUILD)/asan/obj/%.o) $(HOST_CXX_SRCS:%.cpp=$(BUILD)/asan/obj/%.o) $(HOST_GEN_SRCS:%.c=%.asan.o)
+
+$(BUILD)/obj/host_sim/%.o: host_sim/%.c $(HOST_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) -c $< -o $@
+$(BUILD)/obj/host_sim/%.o: host_sim/%.cpp $(HOST_HDRS)
+	@mkdir -p $(@D)
+	$(CXX) $(HOST_CXXFLAGS) -c $< -o $@
+$(BUILD)/asan/obj/host_sim/%.o: host_sim/%.c $(HOST_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) -O1 $(SAN_FLAGS) -c $< -o $@
+$(BUILD)/asan/obj/host_sim/%.o: host_sim/%.cpp $(HOST_HDRS)
+	@mkdir -p $(@D)
+	$(CXX) $(HOST_CXXFLAGS) -O1 $(SAN_FLAGS) -c $< -o $@
+$(BUILD)/gen/%.o: $(BUILD)/gen/%.c $(HOST_GEN_HDRS)
+	$(CC) $(CSTD) $(OPT) -D_DEFAULT_SOURCE -I$(BUILD)/gen -c $< -o $@
+$(BUILD)/gen/%.asan.o: $(BUILD)/gen/%.c $(HOST_GEN_HDRS)
+	$(CC) $(CSTD) -O1 -g $(SAN_FLAGS) -D_DEFAULT_SOURCE -I$(BUILD)/gen -c $< -o $@
+
+$(HOST_LIB): $(HOST_OBJS)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
+$(HOST_ASAN_LIB): $(HOST_ASAN_OBJS)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
+
+# Programs link with g++ when the host library holds C++ (the Box2D adapter).
+HOST_LINK = $(if $(HOST_CXX_SRCS),$(CXX),$(CC))
+$(BUILD)/bin/%: host_sim/prog/%.c $(HOST_LIB_DEPS) $(CORE_LIB) $(HOST_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) -c $< -o $(BUILD)/obj/$*.main.o
+	$(HOST_LINK) -o $@ $(BUILD)/obj/$*.main.o $(HOST_LIB_DEPS) $(CORE_LIB) $(HOST_LDLIBS)
+$(BUILD)/bin/%: firmware/port/linux/prog/%.c $(HOST_LIB_DEPS) $(CORE_LIB) $(HOST_HDRS)
+	@mkdir -p $(@D) $(BUILD)/obj
+	$(CC) $(HOST_CFLAGS) -Ifirmware -Ifirmware/port/linux -c $< -o $(BUILD)/obj/$*.main.o
+	$(HOST_LINK) -o $@ $(BUILD)/obj/$*.main.o $(HOST_LIB_DEPS) $(CORE_LIB) $(HOST_LDLIBS)
+
+ALL_TARGETS += $(HOST_PROGS)
 
 CORE_TESTS := $(patsubst tests/common/%.c,%,$(wildcard tests/common/test_*.c))
 $(foreach t,$(CORE_TESTS),$(eval $(call cmocka_test,$(t),tests/common/$(t).c,)))

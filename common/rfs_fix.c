@@ -115,7 +115,7 @@ rfs_q16_t rfs_q16_exp_neg(rfs_q16_t x)
     int64_t r2 = (r * r) >> 30;
     int64_t r3 = (r2 * r) >> 30;
     /* 1 - r + r^2/2 - r^3/6 in Q30; truncation error < (1/16)^4/24 = 6e-7. */
-    int64_t poly = ((int64_t)1 << 30) - r + r2 / 2 - r3 / 6;
+    int64_t poly = ((int64_t)1 << 30) - r + (r2 >> 1) - ((r3 * 178956971) >> 30); /* 1/6 in Q30 */
     int64_t v = ((int64_t)k_exp_int_q30[n] * k_exp_frac_q30[k]) >> 30;
     v = (v * poly) >> 30;
     return (rfs_q16_t)((v + (1 << 13)) >> 14);

@@ -58,7 +58,12 @@ typedef struct rfs_seek_mem {
     uint32_t plan_queue_cap;   ///< its capacity
     uint8_t *visited;          ///< one bit per lattice point: within the novelty radius of a past position
     uint32_t visited_bytes;    ///< its size, (lw * lh + 7) / 8
+    uint8_t *reach;            ///< one bit per lattice point: reachable from the robot's position
+    uint32_t reach_bytes;      ///< its size, (lw * lh + 7) / 8
 } rfs_seek_mem_t;
+
+/// Bytes of one lattice bit array (visited, reach) for a map.
+uint32_t rfs_seek_lattice_bits_bytes(const rfs_map_t *map);
 
 /// Why an iteration chose its goal.
 typedef enum rfs_seek_kind {
@@ -114,6 +119,11 @@ typedef struct rfs_seek_out {
     rfs_seek_decision_t decision; ///< the latest decision (new when `decided`)
 } rfs_seek_out_t;
 
+/// Epsilon candidates lie within this many lattice steps (32 x 0.25 m = 8 m: e^-8 = 3e-4,
+/// the mass beyond is 0.3 % of the distribution); the weight table is indexed by di^2+dj^2.
+#define RFS_SEEK_EPS_RADIUS 32
+#define RFS_SEEK_EPS_TABLE (RFS_SEEK_EPS_RADIUS * RFS_SEEK_EPS_RADIUS + 1)
+
 /// Number of sources the seeker keeps windows for.
 #define RFS_SEEK_MAX_SOURCES RFS_TARGET_MAX_SOURCES
 
@@ -129,6 +139,11 @@ typedef struct rfs_seek {
     rfs_plan_t plan;                          ///< planner
     rfs_drive_t drive;                        ///< drive control
     uint8_t *visited;                         ///< novelty bits, one per lattice point
+    uint8_t *reach;                           ///< reachability bits, one per lattice point
+    uint32_t *queue;                          ///< flood-fill queue (shared with the planner)
+    uint32_t queue_cap;                       ///< its capacity
+    bool reach_valid;                         ///< reach holds the robot's component
+    uint16_t eps_w[RFS_SEEK_EPS_TABLE];       ///< e^(-d) by squared lattice offset, Q0.16
     rfs_pose_t pose;                          ///< latest pose
     bool have_pose;                           ///< pose is valid
     int64_t last_meas_us;                     ///< time of the latest accepted measurement
@@ -139,6 +154,10 @@ typedef struct rfs_seek {
     rfs_seek_decision_t decision;             ///< latest decision
     rfs_drive_status_t prev_status;           ///< how the last goal ended
     uint32_t meas_rejected;                   ///< measurements with a bad source index
+    bool resume;                              ///< a goal was interrupted by stale inputs
+    rfs_path_t resume_path;                   ///< the path to resume
+    uint16_t last_li, last_lj;                ///< lattice point of the last novelty update
+    bool have_last_l;                         ///< last_li/last_lj are valid
 } rfs_seek_t;
 
 /// The paper's parameters (section 2 and 5.2): the `meta` configuration.

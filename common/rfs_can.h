@@ -1,0 +1,282 @@
+/* rfs_can.h - the rfseek CAN protocol: frame layouts, ids, counters, checksums, time.
+ *
+ * Classic CAN 2.0A (11-bit ids, at most 8 data bytes). Every multi-byte field is
+ * little-endian (Intel byte order); signed fields are two's complement. The full
+ * layout, with bit positions, is in docs/CAN.md and can/rfseek.dbc.
+ *
+ * Rules common to every frame:
+ *   - data[0] bits 0..3: a 4-bit rolling counter, +1 (mod 16) per frame of that id;
+ *   - data[dlc-1]: CRC-8/SAE-J1850 (poly 0x1D, init 0xFF, xorout 0xFF, not reflected)
+ *     over the id (low byte, then high byte) followed by data[0 .. dlc-2]; covering
+ *     the id means a frame copied to the wrong id fails its check (AUTOSAR E2E style);
+ *   - the DLC is exact: a frame of a known id with another DLC is rejected.
+ * A receiver rejects bad DLC and checksum, rejects a repeated counter (a duplicate),
+ * and accepts but counts a counter jump (frames were lost).
+ *
+ * Time: frames that carry a timestamp carry the low 32 bits of the sender's time in
+ * microseconds (wraps every 71.6 minutes). Sender and receiver share an epoch (the
+ * robot's synchronised clock); the receiver unwraps the field to the int64 time
+ * nearest its own current time, so the clocks may disagree by up to +-35 minutes
+ * (rfs_can_unwrap_time). Frames older than max_age_us, further than max_future_us
+ * ahead, or older than the newest accepted frame of the same stream are dropped and
+ * counted: the core then sees the inputs go stale and stops the wheels.
+ *
+ * Frames (id: sender -> receiver, DLC):
+ *   0x100 WHEEL_CMD  controller -> motor controller, 6: wheel speeds mm/s
+ *   0x110 POSE_XY    localisation -> controller, 8: x, y in mm (int24)
+ *   0x111 POSE_TH    localisation -> controller, 8: heading (Q2.13 rad), time;
+ *                    a pose is the POSE_XY + POSE_TH pair with the same counter,
+ *                    XY sent first; it is complete when POSE_TH arrives
+ *   0x120 RSSI       radio module -> controller, 8: source, dBm, sequence, time
+ *   0x180 STATUS     controller -> anyone, 8: heartbeat with state, decision, faults
+ * Lower ids win arbitration: wheel commands first, then inputs, then the heartbeat.
+ */
+#ifndef RFS_CAN_H
+#define RFS_CAN_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rfs_fix.h"
+#include "rfs_seek.h"
+#include "rfs_store.h"
+
+/// One classic CAN frame in our own type (no <linux/can.h> in the core).
+typedef struct rfs_can_frame {
+    uint32_t id;     ///< 11-bit standard identifier (0 .. 0x7FF)
+    uint8_t dlc;     ///< data length, bytes (0 .. 8)
+    uint8_t data[8]; ///< payload; bytes past dlc are zero in frames we encode
+} rfs_can_frame_t;
+
+#define RFS_CAN_ID_WHEEL_CMD 0x100u ///< wheel command, controller -> motor controller
+#define RFS_CAN_ID_POSE_XY 0x110u   ///< pose, first half: position
+#define RFS_CAN_ID_POSE_TH 0x111u   ///< pose, second half: heading and time
+#define RFS_CAN_ID_RSSI 0x120u      ///< RSSI measurement from a radio module
+#define RFS_CAN_ID_STATUS 0x180u    ///< controller status / heartbeat
+
+#define RFS_CAN_DLC_WHEEL_CMD 6u ///< exact DLC of WHEEL_CMD
+#define RFS_CAN_DLC_POSE_XY 8u   ///< exact DLC of POSE_XY
+#define RFS_CAN_DLC_POSE_TH 8u   ///< exact DLC of POSE_TH
+#define RFS_CAN_DLC_RSSI 8u      ///< exact DLC of RSSI
+#define RFS_CAN_DLC_STATUS 8u    ///< exact DLC of STATUS
+
+#define RFS_CAN_ID_MAX 0x7FFu        ///< largest 11-bit id
+#define RFS_CAN_POS_MM_MAX 8388607   ///< int24 position limit, mm (+-8.4 km)
+#define RFS_CAN_POS_MM_MIN (-8388608) ///< int24 position limit, mm
+#define RFS_CAN_MAX_SOURCES 16u      ///< source ids are 4 bits
+
+/// WHEEL_CMD flags (data[0] bits 4..7).
+#define RFS_CAN_WHEEL_STOP 0x1u ///< the controller is not driving (stale, learning, waiting): speeds are 0
+
+/// Message index: one rolling counter and one set of statistics per frame id.
+typedef enum rfs_can_msg_idx {
+    RFS_CAN_IDX_WHEEL_CMD = 0,
+    RFS_CAN_IDX_POSE_XY,
+    RFS_CAN_IDX_POSE_TH,
+    RFS_CAN_IDX_RSSI,
+    RFS_CAN_IDX_STATUS,
+    RFS_CAN_NMSG ///< number of message ids
+} rfs_can_msg_idx_t;
+
+/// Result of decoding a frame. Every non-OK result is a counted drop.
+typedef enum rfs_can_err {
+    RFS_CAN_OK = 0,        ///< accepted
+    RFS_CAN_E_ID,          ///< not one of our ids (or not an 11-bit id)
+    RFS_CAN_E_DLC,         ///< DLC differs from the layout's
+    RFS_CAN_E_CHECKSUM,    ///< CRC-8 mismatch
+    RFS_CAN_E_RANGE,       ///< a field is out of its documented range (enum value, reserved bits)
+    RFS_CAN_E_REPEAT,      ///< counter equal to the previous frame's: a duplicate
+    RFS_CAN_E_PAIR,        ///< POSE_TH without a POSE_XY of the same counter
+    RFS_CAN_E_STALE,       ///< timestamp older than now - max_age_us
+    RFS_CAN_E_FUTURE,      ///< timestamp later than now + max_future_us
+    RFS_CAN_E_ORDER,       ///< timestamp older than the newest accepted of the same stream
+    RFS_CAN_NERR           ///< number of results
+} rfs_can_err_t;
+
+/// Wheel command payload.
+typedef struct rfs_can_wheel {
+    int16_t left_mm_s;  ///< left wheel speed, mm/s (int16, +-32.7 m/s)
+    int16_t right_mm_s; ///< right wheel speed, mm/s
+    uint8_t flags;      ///< RFS_CAN_WHEEL_* bits (4 bits)
+} rfs_can_wheel_t;
+
+/// Pose as carried on the bus (both halves).
+typedef struct rfs_can_pose {
+    int32_t x_mm;       ///< x, millimetres, map frame, int24 range
+    int32_t y_mm;       ///< y, millimetres, map frame, int24 range
+    int16_t theta_q13;  ///< heading, radians Q2.13 (step 1.22e-4 rad), (-pi, pi]
+    uint32_t t_us32;    ///< sender's time, low 32 bits of microseconds
+} rfs_can_pose_t;
+
+/// RSSI measurement as carried on the bus.
+typedef struct rfs_can_rssi {
+    uint8_t src;        ///< source id 0..15 (index into the target's sources)
+    int8_t dbm;         ///< received signal strength, dBm
+    uint8_t seq;        ///< radio module's packet sequence number, low 8 bits
+    uint32_t t_us32;    ///< sender's time of reception, low 32 bits of microseconds
+} rfs_can_rssi_t;
+
+/// Controller heartbeat.
+typedef struct rfs_can_status {
+    uint8_t state;       ///< rfs_seek_state_t, 0..3
+    uint8_t kind;        ///< rfs_seek_kind_t of the latest decision, 0..3
+    uint8_t prev;        ///< rfs_drive_status_t: how the previous goal ended, 0..4
+    bool relearned;      ///< the latest decision relearnt the model
+    bool line_search;    ///< the latest greedy goal came from the line search
+    uint8_t faults;      ///< RFS_SEEK_FAULT_* bits (low 8)
+    uint32_t iteration;  ///< iteration number of the latest decision
+} rfs_can_status_t;
+
+/// CRC-8/SAE-J1850 of n bytes (poly 0x1D, init 0xFF, xorout 0xFF). Check value:
+/// "123456789" gives 0x4B.
+uint8_t rfs_can_crc8(const uint8_t *p, uint32_t n);
+
+/// The checksum a frame with this id, dlc and data must carry in data[dlc-1].
+/// dlc must be 1..8.
+uint8_t rfs_can_checksum(uint32_t id, uint8_t dlc, const uint8_t *data);
+
+/// Encoders: fill f completely (id, exact DLC, payload, zero padding, checksum) with the
+/// given 4-bit counter (only its low 4 bits are used). Values out of a field's range are
+/// saturated (positions to int24) or masked (flags, enum values) - they cannot fail.
+void rfs_can_pack_wheel(const rfs_can_wheel_t *w, uint8_t counter, rfs_can_frame_t *f);
+/// Encode POSE_XY from p (x_mm, y_mm).
+void rfs_can_pack_pose_xy(const rfs_can_pose_t *p, uint8_t counter, rfs_can_frame_t *f);
+/// Encode POSE_TH from p (theta_q13, t_us32).
+void rfs_can_pack_pose_th(const rfs_can_pose_t *p, uint8_t counter, rfs_can_frame_t *f);
+/// Encode RSSI.
+void rfs_can_pack_rssi(const rfs_can_rssi_t *r, uint8_t counter, rfs_can_frame_t *f);
+/// Encode STATUS.
+void rfs_can_pack_status(const rfs_can_status_t *s, uint8_t counter, rfs_can_frame_t *f);
+
+/// Stateless decoders: check id, DLC, checksum and field ranges, then fill the payload
+/// and *counter. On error the outputs are untouched.
+rfs_can_err_t rfs_can_unpack_wheel(const rfs_can_frame_t *f, rfs_can_wheel_t *w, uint8_t *counter);
+/// Decode POSE_XY into p->x_mm, p->y_mm.
+rfs_can_err_t rfs_can_unpack_pose_xy(const rfs_can_frame_t *f, rfs_can_pose_t *p, uint8_t *counter);
+/// Decode POSE_TH into p->theta_q13, p->t_us32.
+rfs_can_err_t rfs_can_unpack_pose_th(const rfs_can_frame_t *f, rfs_can_pose_t *p, uint8_t *counter);
+/// Decode RSSI.
+rfs_can_err_t rfs_can_unpack_rssi(const rfs_can_frame_t *f, rfs_can_rssi_t *r, uint8_t *counter);
+/// Decode STATUS.
+rfs_can_err_t rfs_can_unpack_status(const rfs_can_frame_t *f, rfs_can_status_t *s, uint8_t *counter);
+
+/// Low 32 bits of a time in microseconds, as carried on the bus.
+static inline uint32_t rfs_can_wrap_time(int64_t t_us) { return (uint32_t)(uint64_t)t_us; }
+
+/// The int64 time t (microseconds) with (uint32)t == raw that is nearest ref_us:
+/// t - ref_us lies in [-2^31, 2^31). Saturates instead of overflowing near INT64 limits.
+int64_t rfs_can_unwrap_time(int64_t ref_us, uint32_t raw);
+
+/// Millimetres to metres Q16.16, rounded to nearest.
+/// Scaling and overflow: mm * 65536 in int64 (exact for int32 mm), / 1000 rounded;
+/// saturated to Q16.16 (+-32767 m; int24 mm input never saturates).
+rfs_q16_t rfs_can_mm_to_q16(int32_t mm);
+
+/// Metres Q16.16 to millimetres, rounded to nearest, saturated to the int24 range.
+/// Scaling and overflow: q * 1000 in int64 (exact), / 65536 rounded; int24-saturated.
+int32_t rfs_can_q16_to_mm(rfs_q16_t q);
+
+/// Heading Q16.16 radians to the bus's Q2.13, rounded to nearest, saturated to int16.
+/// Scaling and overflow: (q + 4) >> 3 in int64; |theta| <= pi gives |raw| <= 25736.
+int16_t rfs_can_q16_to_theta(rfs_q16_t q);
+
+/// Heading Q2.13 to Q16.16 (exact: << 3). Scaling and overflow: int16 << 3 fits int32.
+static inline rfs_q16_t rfs_can_theta_to_q16(int16_t theta_q13) { return (rfs_q16_t)theta_q13 * 8; }
+
+/// Bus pose to the core's pose; t_us is the unwrapped time (rfs_can_unwrap_time).
+rfs_pose_t rfs_can_pose_to_core(const rfs_can_pose_t *p, int64_t t_us);
+
+/// Core pose to the bus pose (rounded, saturated).
+rfs_can_pose_t rfs_can_pose_from_core(const rfs_pose_t *pose);
+
+/// Heartbeat and wheel command from one control period's output.
+void rfs_can_from_seek_out(const rfs_seek_out_t *out, rfs_can_status_t *status, rfs_can_wheel_t *wheel);
+
+/// Sender side: one rolling counter per message id.
+typedef struct rfs_can_tx {
+    uint8_t counter[RFS_CAN_NMSG]; ///< next counter to send per message, 0..15
+} rfs_can_tx_t;
+
+/// Start every counter at 0.
+void rfs_can_tx_init(rfs_can_tx_t *tx);
+
+/// Encode with the next counter of that message and advance it.
+void rfs_can_tx_wheel(rfs_can_tx_t *tx, const rfs_can_wheel_t *w, rfs_can_frame_t *f);
+/// Encode one pose as its two frames (XY then TH) with the same counter; advances both.
+void rfs_can_tx_pose(rfs_can_tx_t *tx, const rfs_can_pose_t *p, rfs_can_frame_t *xy, rfs_can_frame_t *th);
+/// Encode an RSSI measurement with the next counter.
+void rfs_can_tx_rssi(rfs_can_tx_t *tx, const rfs_can_rssi_t *r, rfs_can_frame_t *f);
+/// Encode a heartbeat with the next counter.
+void rfs_can_tx_status(rfs_can_tx_t *tx, const rfs_can_status_t *s, rfs_can_frame_t *f);
+
+/// Receiver configuration.
+typedef struct rfs_can_rx_cfg {
+    int64_t max_age_us;     ///< drop timestamped frames older than now - this (1 s: the RSSI window)
+    int64_t max_future_us;  ///< drop timestamped frames later than now + this (100 ms of clock skew)
+} rfs_can_rx_cfg_t;
+
+/// Per-message receive statistics.
+typedef struct rfs_can_rx_stats {
+    uint32_t accepted;      ///< frames accepted
+    uint32_t counter_jumps; ///< accepted frames whose counter was not previous + 1
+    uint32_t lost;          ///< frames missing according to the counter jumps (sum of gaps)
+} rfs_can_rx_stats_t;
+
+/// Receiver state: caller-owned, no pointers.
+typedef struct rfs_can_rx {
+    rfs_can_rx_cfg_t cfg;                      ///< configuration copied at init
+    rfs_can_rx_stats_t msg[RFS_CAN_NMSG];      ///< statistics per message id
+    uint32_t dropped[RFS_CAN_NERR];            ///< drops per reason (index 0 unused)
+    uint8_t last_counter[RFS_CAN_NMSG];        ///< last accepted counter per message
+    bool have_counter[RFS_CAN_NMSG];           ///< last_counter is valid
+    rfs_can_pose_t pending;                    ///< POSE_XY waiting for its POSE_TH
+    uint8_t pending_counter;                   ///< its counter
+    bool have_pending;                         ///< pending is valid
+    int64_t last_pose_us;                      ///< newest accepted pose time, microseconds
+    bool have_pose;                            ///< last_pose_us is valid
+    int64_t last_rssi_us[RFS_CAN_MAX_SOURCES]; ///< newest accepted RSSI time per source
+    uint16_t have_rssi;                        ///< bit per source: last_rssi_us valid
+    uint8_t last_seq[RFS_CAN_MAX_SOURCES];     ///< last RSSI sequence number per source
+    uint32_t rssi_seq_gaps;                    ///< radio packets missing by sequence number
+} rfs_can_rx_t;
+
+/// What a received frame produced.
+typedef enum rfs_can_msg_kind {
+    RFS_CAN_MSG_NONE = 0, ///< nothing complete (a dropped frame, or the first pose half)
+    RFS_CAN_MSG_WHEEL,    ///< a wheel command
+    RFS_CAN_MSG_POSE,     ///< a complete pose (in the core's units)
+    RFS_CAN_MSG_RSSI,     ///< an RSSI measurement with an unwrapped time
+    RFS_CAN_MSG_STATUS,   ///< a controller heartbeat
+} rfs_can_msg_kind_t;
+
+/// A decoded message, ready for the core.
+typedef struct rfs_can_msg {
+    rfs_can_msg_kind_t kind; ///< which member is valid
+    rfs_can_wheel_t wheel;   ///< RFS_CAN_MSG_WHEEL
+    rfs_pose_t pose;         ///< RFS_CAN_MSG_POSE: Q16.16 metres/radians, int64 us
+    rfs_can_status_t status; ///< RFS_CAN_MSG_STATUS
+    uint8_t rssi_src;        ///< RFS_CAN_MSG_RSSI: source id
+    int8_t rssi_dbm;         ///< RFS_CAN_MSG_RSSI: dBm
+    uint8_t rssi_seq;        ///< RFS_CAN_MSG_RSSI: sequence number
+    int64_t rssi_t_us;       ///< RFS_CAN_MSG_RSSI: unwrapped time, microseconds
+} rfs_can_msg_t;
+
+/// Defaults: max_age 1 s, max_future 100 ms.
+rfs_can_rx_cfg_t rfs_can_rx_cfg_default(void);
+
+/// Initialise. Returns 0, or -1 when max_age_us is not in (0, 1 h] or max_future_us is
+/// not in [0, 1 h] (unwrapping is unambiguous only within +-35 minutes).
+int rfs_can_rx_init(rfs_can_rx_t *rx, const rfs_can_rx_cfg_t *cfg);
+
+/// Decode one received frame at receiver time now_us (microseconds). Cannot fail: every
+/// rejection is returned and counted in rx->dropped[]; msg->kind says what is complete.
+rfs_can_err_t rfs_can_rx_frame(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int64_t now_us,
+                               rfs_can_msg_t *msg);
+
+/// Total frames dropped for any reason.
+uint32_t rfs_can_rx_dropped_total(const rfs_can_rx_t *rx);
+
+/// Short constant name of a result ("ok", "id", "dlc", "checksum", ...).
+const char *rfs_can_err_str(rfs_can_err_t e);
+
+#endif /* RFS_CAN_H */

@@ -1,0 +1,662 @@
+/* rfs_seek.c - the meta-algorithm (paper section 2) over the core's modules. */
+#include "rfs_seek.h"
+
+#include <string.h>
+
+#include "rfs_assert.h"
+
+/* ln(9/4) / 5 in Q16.16: epsilon(5) = 0.9 e^(-5a) + 0.1 = 0.5 (paper section 2). */
+#define EPS_RATE_PAPER ((rfs_q16_t)10629)
+/* Line-search candidates and epsilon redraws tried before giving up on an iteration. */
+#define GOAL_TRIES 6
+/* How far (lattice steps) an off-lattice or illegal start looks for a legal lattice point. */
+#define SNAP_RADIUS 6
+
+rfs_seek_cfg_t rfs_seek_cfg_default(void)
+{
+    rfs_seek_cfg_t c;
+    memset(&c, 0, sizeof c);
+    c.step = RFS_Q16_ONE;                   /* paper section 2: 1 m */
+    c.initial_step_max = RFS_Q16_INT(2);    /* "restricted to twice the regular step width" */
+    c.error_threshold = RFS_Q16_INT(3);     /* 3 dB */
+    c.eps_floor = RFS_Q16_FRAC(1, 10);      /* epsilon = 0.9 e^(-a n) + 0.1 */
+    c.eps_amp = RFS_Q16_FRAC(9, 10);
+    c.eps_rate = EPS_RATE_PAPER;
+    c.novelty_radius = RFS_Q16_HALF;        /* "about the size of the robot": 0.5 m */
+    c.pose_timeout_us = 150000;             /* + one 50 ms period: stopped within 200 ms */
+    c.rssi_timeout_us = 150000;
+    c.fit_budget = 0;
+    c.rssi = rfs_rssi_cfg_default();
+    c.store = rfs_store_cfg_default();      /* 10,000 samples (section 5.2) */
+    c.drive = rfs_drive_cfg_default();
+    return c;
+}
+
+uint32_t rfs_seek_lattice_bits_bytes(const rfs_map_t *map)
+{
+    return ((uint32_t)map->lw * map->lh + 7u) / 8u;
+}
+
+static bool bit_get(const uint8_t *bits, uint32_t i)
+{
+    return (bits[i >> 3] >> (i & 7u)) & 1u;
+}
+
+static void bit_set(uint8_t *bits, uint32_t i)
+{
+    bits[i >> 3] = (uint8_t)(bits[i >> 3] | (1u << (i & 7u)));
+}
+
+int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map,
+                  rfs_model_t model, const rfs_target_ops_t *target, const rfs_seek_mem_t *mem)
+{
+    RFS_ASSERT(s != 0 && cfg != 0 && map != 0 && mem != 0);
+    if (cfg->step <= 0 || cfg->initial_step_max <= 0 || cfg->error_threshold <= 0 ||
+        cfg->eps_floor < 0 || cfg->eps_amp < 0 ||
+        (int64_t)cfg->eps_floor + cfg->eps_amp > RFS_Q16_ONE || cfg->eps_rate < 0 ||
+        cfg->novelty_radius < 0 || cfg->pose_timeout_us <= 0 || cfg->rssi_timeout_us <= 0) {
+        return -1;
+    }
+    if (model.ops == 0 || model.ops->fit == 0 || model.ops->predict == 0 ||
+        model.ops->reset == 0 || target == 0 || target->nsources == 0 ||
+        target->nsources > RFS_SEEK_MAX_SOURCES) {
+        return -1;
+    }
+    uint32_t lbytes = rfs_seek_lattice_bits_bytes(map);
+    if (mem->visited == 0 || mem->visited_bytes < lbytes || mem->reach == 0 ||
+        mem->reach_bytes < lbytes) {
+        return -1;
+    }
+    memset(s, 0, sizeof *s);
+    s->cfg = *cfg;
+    s->map = map;
+    s->model = model;
+    s->target = target;
+    for (uint8_t i = 0; i < target->nsources; ++i) {
+        if (rfs_rssi_init(&s->win[i], &cfg->rssi) != 0) {
+            return -1;
+        }
+    }
+    if (rfs_store_init(&s->store, &cfg->store, mem->samples, mem->pending, mem->pending_cap) != 0 ||
+        rfs_plan_init(&s->plan, map, mem->plan_work, mem->plan_work_bytes, mem->plan_queue,
+                      mem->plan_queue_cap) != 0 ||
+        rfs_drive_init(&s->drive, &cfg->drive) != 0) {
+        return -1;
+    }
+    s->visited = mem->visited;
+    s->reach = mem->reach;
+    s->queue = mem->plan_queue;
+    s->queue_cap = mem->plan_queue_cap;
+    memset(s->visited, 0, lbytes);
+    memset(s->reach, 0, lbytes);
+    /* Epsilon weights e^(-d), d = grid * sqrt(q) for q = di^2 + dj^2 (section 2:
+     * P(x) proportional to e^(-|x - x0|)), tabulated once so a draw costs a lookup per
+     * candidate. Scaling: grid Q16 * isqrt(q << 32) Q16 -> Q32 >> 16 = Q16 metres. */
+    for (uint32_t q = 0; q < RFS_SEEK_EPS_TABLE; ++q) {
+        uint32_t root_q16 = rfs_isqrt64((uint64_t)q << 32);
+        rfs_q16_t d = rfs_sat32(((int64_t)map->cfg.grid * root_q16) >> 16);
+        rfs_q16_t w = rfs_q16_exp_neg(d);
+        s->eps_w[q] = (uint16_t)(w >= RFS_Q16_ONE ? 0xFFFFu : (uint32_t)w);
+    }
+    s->state = RFS_SEEK_WAITING;
+    s->prev_status = RFS_DRIVE_IDLE;
+    return 0;
+}
+
+rfs_q16_t rfs_seek_epsilon(const rfs_seek_cfg_t *cfg, uint32_t n)
+{
+    /* Scaling: rate (Q16) * n saturates at Q16 max, where e^-x is 0 anyway. */
+    int64_t x = (int64_t)cfg->eps_rate * (int64_t)(n > 65535u ? 65535u : n);
+    rfs_q16_t e = rfs_q16_exp_neg(rfs_sat32(x));
+    return rfs_q16_add(rfs_q16_mul(cfg->eps_amp, e), cfg->eps_floor);
+}
+
+/* Mark the lattice points within the novelty radius of (x, y) as visited. */
+static void mark_visited(rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y)
+{
+    const rfs_map_t *m = s->map;
+    uint16_t ci, cj;
+    rfs_map_lattice_nearest(m, x, y, &ci, &cj);
+    if (s->have_last_l && s->last_li == ci && s->last_lj == cj) {
+        return;
+    }
+    s->have_last_l = true;
+    s->last_li = ci;
+    s->last_lj = cj;
+    int32_t r = s->cfg.novelty_radius / m->cfg.grid + 1;
+    int64_t r2 = (int64_t)s->cfg.novelty_radius * s->cfg.novelty_radius;
+    for (int32_t dj = -r; dj <= r; ++dj) {
+        int32_t j = (int32_t)cj + dj;
+        if (j < 0 || j >= (int32_t)m->lh) {
+            continue;
+        }
+        for (int32_t di = -r; di <= r; ++di) {
+            int32_t i = (int32_t)ci + di;
+            if (i < 0 || i >= (int32_t)m->lw) {
+                continue;
+            }
+            rfs_q16_t px, py;
+            rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
+            int64_t dx = (int64_t)px - x, dy = (int64_t)py - y;
+            /* Q16 squared = Q32; compare with the radius squared (Q32). */
+            if (dx * dx + dy * dy <= r2) {
+                bit_set(s->visited, (uint32_t)j * m->lw + (uint32_t)i);
+            }
+        }
+    }
+}
+
+bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
+{
+    if (s->have_pose && pose->t_us <= s->pose.t_us) {
+        (void)rfs_store_add_pose(&s->store, pose, rng); /* counts the rejection */
+        return false;
+    }
+    (void)rfs_store_add_pose(&s->store, pose, rng);
+    s->pose = *pose;
+    s->have_pose = true;
+    mark_visited(s, pose->x, pose->y);
+    return true;
+}
+
+bool rfs_seek_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm, rfs_rng_t *rng)
+{
+    if (src >= s->target->nsources) {
+        s->meas_rejected++;
+        return false;
+    }
+    if (!rfs_rssi_push(&s->win[src], t_us, dbm)) {
+        return false;
+    }
+    if (!s->have_meas || t_us > s->last_meas_us) {
+        s->last_meas_us = t_us;
+    }
+    s->have_meas = true;
+    rfs_target_in_t in = { s->win, s->target->nsources, t_us };
+    rfs_q16_t v;
+    if (s->target->sample(&in, src, dbm, &v)) {
+        rfs_store_add_value(&s->store, t_us, v, rng);
+    }
+    return true;
+}
+
+/* Nearest legal lattice point to (x, y), searching rings up to SNAP_RADIUS; when
+ * need_reach, it must also be marked reachable. */
+static bool snap_legal(const rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y, bool need_reach,
+                       uint16_t *oi, uint16_t *oj)
+{
+    const rfs_map_t *m = s->map;
+    uint16_t ci, cj;
+    rfs_map_lattice_nearest(m, x, y, &ci, &cj);
+    for (int32_t r = 0; r <= SNAP_RADIUS; ++r) {
+        int64_t best = INT64_MAX;
+        for (int32_t dj = -r; dj <= r; ++dj) {
+            for (int32_t di = -r; di <= r; ++di) {
+                if (di != -r && di != r && dj != -r && dj != r) {
+                    continue; /* ring only */
+                }
+                int32_t i = (int32_t)ci + di, j = (int32_t)cj + dj;
+                if (i < 0 || j < 0 || i >= (int32_t)m->lw || j >= (int32_t)m->lh) {
+                    continue;
+                }
+                if (!rfs_map_lattice_legal(m, (uint16_t)i, (uint16_t)j)) {
+                    continue;
+                }
+                if (need_reach && !bit_get(s->reach, (uint32_t)j * m->lw + (uint32_t)i)) {
+                    continue;
+                }
+                int64_t d = (int64_t)di * di + (int64_t)dj * dj;
+                if (d < best) {
+                    best = d;
+                    *oi = (uint16_t)i;
+                    *oj = (uint16_t)j;
+                }
+            }
+        }
+        if (best != INT64_MAX) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/* Flood-fill the lattice points reachable from the robot (8-connected, an edge where
+ * the straight segment is legal), so that greedy maxima and epsilon goals never lie in
+ * a pocket of the map the robot cannot reach (SLAM maps have many). */
+static void compute_reach(rfs_seek_t *s)
+{
+    const rfs_map_t *m = s->map;
+    uint32_t lbytes = rfs_seek_lattice_bits_bytes(m);
+    memset(s->reach, 0, lbytes);
+    uint16_t si, sj;
+    if (!snap_legal(s, s->pose.x, s->pose.y, false, &si, &sj)) {
+        s->reach_valid = false;
+        return;
+    }
+    static const int8_t k_di[8] = { 1, -1, 0, 0, 1, 1, -1, -1 };
+    static const int8_t k_dj[8] = { 0, 0, 1, -1, 1, -1, 1, -1 };
+    uint32_t head = 0, count = 0;
+    uint32_t start = (uint32_t)sj * m->lw + si;
+    bit_set(s->reach, start);
+    s->queue[0] = start;
+    count = 1;
+    bool overflow = false;
+    while (count > 0) {
+        uint32_t idx = s->queue[head];
+        head = (head + 1u) % s->queue_cap;
+        count--;
+        uint16_t i = (uint16_t)(idx % m->lw), j = (uint16_t)(idx / m->lw);
+        rfs_q16_t x0, y0;
+        rfs_map_lattice_point(m, i, j, &x0, &y0);
+        for (int k = 0; k < 8; ++k) {
+            int32_t ni = (int32_t)i + k_di[k], nj = (int32_t)j + k_dj[k];
+            if (ni < 0 || nj < 0 || ni >= (int32_t)m->lw || nj >= (int32_t)m->lh) {
+                continue;
+            }
+            uint32_t nidx = (uint32_t)nj * m->lw + (uint32_t)ni;
+            if (bit_get(s->reach, nidx) || !rfs_map_lattice_legal(m, (uint16_t)ni, (uint16_t)nj)) {
+                continue;
+            }
+            rfs_q16_t x1, y1;
+            rfs_map_lattice_point(m, (uint16_t)ni, (uint16_t)nj, &x1, &y1);
+            if (!rfs_map_segment_legal(m, x0, y0, x1, y1)) {
+                continue;
+            }
+            bit_set(s->reach, nidx);
+            if (count == s->queue_cap) {
+                overflow = true; /* marked but not expanded: handled below */
+                continue;
+            }
+            s->queue[(head + count) % s->queue_cap] = nidx;
+            count++;
+        }
+    }
+    if (overflow) {
+        /* A queue too small for this map's frontier: fall back to "every legal point is
+         * reachable" rather than a wrong partial set; the planner still checks goals. */
+        for (uint16_t j = 0; j < m->lh; ++j) {
+            for (uint16_t i = 0; i < m->lw; ++i) {
+                if (rfs_map_lattice_legal(m, i, j)) {
+                    bit_set(s->reach, (uint32_t)j * m->lw + i);
+                }
+            }
+        }
+    }
+    s->reach_valid = true;
+}
+
+static bool reachable_point(const rfs_seek_t *s, uint16_t i, uint16_t j)
+{
+    return bit_get(s->reach, (uint32_t)j * s->map->lw + i);
+}
+
+/* Plan from the robot to (gx, gy) and start driving. false when there is no path. */
+static bool go_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, int64_t now_us)
+{
+    rfs_q16_t sx = s->pose.x, sy = s->pose.y;
+    if (!rfs_map_point_legal(s->map, sx, sy)) {
+        uint16_t i, j;
+        if (!snap_legal(s, sx, sy, false, &i, &j)) {
+            return false;
+        }
+        rfs_map_lattice_point(s->map, i, j, &sx, &sy);
+    }
+    rfs_path_t path;
+    if (!rfs_plan_path(&s->plan, sx, sy, gx, gy, &path)) {
+        return false;
+    }
+    s->decision.path_len = path.length;
+    rfs_drive_set_path(&s->drive, &path, now_us);
+    return true;
+}
+
+/* Initial random move: a uniformly chosen reachable lattice point within
+ * initial_step_max of the robot (paper: "restricted to twice the regular step width"). */
+static bool choose_initial(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
+{
+    const rfs_map_t *m = s->map;
+    uint16_t ci, cj;
+    rfs_map_lattice_nearest(m, s->pose.x, s->pose.y, &ci, &cj);
+    int32_t r = s->cfg.initial_step_max / m->cfg.grid;
+    int64_t r2 = (int64_t)s->cfg.initial_step_max * s->cfg.initial_step_max;
+    for (int attempt = 0; attempt < GOAL_TRIES; ++attempt) {
+        /* Count candidates, then pick the k-th: uniform without a candidate list. */
+        uint32_t n = 0;
+        for (int pass = 0; pass < 2; ++pass) {
+            uint32_t pick = pass ? rfs_rng_below(rng, n) : 0u, seen = 0;
+            for (int32_t dj = -r; dj <= r; ++dj) {
+                for (int32_t di = -r; di <= r; ++di) {
+                    int32_t i = (int32_t)ci + di, j = (int32_t)cj + dj;
+                    if ((di == 0 && dj == 0) || i < 0 || j < 0 || i >= (int32_t)m->lw ||
+                        j >= (int32_t)m->lh || !reachable_point(s, (uint16_t)i, (uint16_t)j)) {
+                        continue;
+                    }
+                    rfs_q16_t px, py;
+                    rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
+                    int64_t dx = (int64_t)px - s->pose.x, dy = (int64_t)py - s->pose.y;
+                    if (dx * dx + dy * dy > r2) {
+                        continue;
+                    }
+                    if (pass == 0) {
+                        n++;
+                    } else if (seen++ == pick) {
+                        s->decision.goal_x = px;
+                        s->decision.goal_y = py;
+                        if (go_to(s, px, py, now_us)) {
+                            return true;
+                        }
+                        goto next_attempt;
+                    }
+                }
+            }
+            if (n == 0) {
+                return false;
+            }
+        }
+    next_attempt:;
+    }
+    return false;
+}
+
+/* Epsilon step (paper section 2): a random reachable point at least the novelty radius
+ * from every past position, drawn with probability proportional to e^(-distance). */
+static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
+{
+    const rfs_map_t *m = s->map;
+    uint16_t ci, cj;
+    rfs_map_lattice_nearest(m, s->pose.x, s->pose.y, &ci, &cj);
+    const int32_t r = RFS_SEEK_EPS_RADIUS;
+    for (int attempt = 0; attempt < GOAL_TRIES; ++attempt) {
+        /* Scaling: weights Q0.16 <= 65535, at most 65^2 candidates: sum < 2^28. */
+        uint32_t total = 0;
+        for (int pass = 0; pass < 2; ++pass) {
+            uint32_t pick = pass ? rfs_rng_below(rng, total) : 0u, acc = 0;
+            for (int32_t dj = -r; dj <= r; ++dj) {
+                int32_t j = (int32_t)cj + dj;
+                if (j < 0 || j >= (int32_t)m->lh) {
+                    continue;
+                }
+                for (int32_t di = -r; di <= r; ++di) {
+                    int32_t i = (int32_t)ci + di;
+                    uint32_t q = (uint32_t)(di * di + dj * dj);
+                    if (i < 0 || i >= (int32_t)m->lw || q >= RFS_SEEK_EPS_TABLE) {
+                        continue;
+                    }
+                    uint32_t idx = (uint32_t)j * m->lw + (uint32_t)i;
+                    if (bit_get(s->visited, idx) || !bit_get(s->reach, idx)) {
+                        continue;
+                    }
+                    uint32_t w = s->eps_w[q];
+                    if (pass == 0) {
+                        total += w;
+                        continue;
+                    }
+                    acc += w;
+                    if (acc > pick) {
+                        rfs_q16_t px, py;
+                        rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
+                        s->decision.goal_x = px;
+                        s->decision.goal_y = py;
+                        if (go_to(s, px, py, now_us)) {
+                            return true;
+                        }
+                        bit_set(s->visited, idx); /* unreachable in practice: do not redraw it */
+                        goto next_attempt;
+                    }
+                }
+            }
+            if (total == 0) {
+                return false;
+            }
+        }
+    next_attempt:;
+    }
+    return false;
+}
+
+/* Greedy step (paper section 2): grid search over every reachable legal lattice point
+ * for the model's maximum; move min(distance, step) towards it; when that point is not
+ * legal, search the line to the maximum for the first legal point, before or after the
+ * obstacle. */
+static bool choose_greedy(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
+{
+    const rfs_map_t *m = s->map;
+    rfs_q16_t mx = 0, my = 0;
+    bool found = false;
+    if (s->model.ops->argmax != 0 && s->model.ops->argmax(s->model.self, &mx, &my)) {
+        found = true;
+    } else {
+        rfs_q16_t best = RFS_Q16_MIN;
+        for (uint16_t j = 0; j < m->lh; ++j) {
+            for (uint16_t i = 0; i < m->lw; ++i) {
+                if (!reachable_point(s, i, j)) {
+                    continue;
+                }
+                rfs_q16_t px, py, v;
+                rfs_map_lattice_point(m, i, j, &px, &py);
+                if (s->model.ops->predict(s->model.self, px, py, &v) && (!found || v > best)) {
+                    best = v;
+                    mx = px;
+                    my = py;
+                    found = true;
+                }
+            }
+        }
+    }
+    if (!found) {
+        return false;
+    }
+    s->decision.max_x = mx;
+    s->decision.max_y = my;
+    int64_t dx = (int64_t)mx - s->pose.x, dy = (int64_t)my - s->pose.y;
+    /* Scaling: Q16 differences up to 2^32; their squares in uint64 (Q32), root Q16. */
+    uint64_t d2 = (uint64_t)(dx * dx) + (uint64_t)(dy * dy);
+    rfs_q16_t dist = (rfs_q16_t)rfs_isqrt64(d2);
+    if (dist <= s->cfg.step) {
+        s->decision.goal_x = mx;
+        s->decision.goal_y = my;
+        return go_to(s, mx, my, now_us);
+    }
+    /* Point at fraction t (Q16) of the way to the maximum. */
+    rfs_q16_t t_step = rfs_q16_div(s->cfg.step, dist);
+    rfs_q16_t gx = rfs_sat32(s->pose.x + ((dx * t_step) >> 16));
+    rfs_q16_t gy = rfs_sat32(s->pose.y + ((dy * t_step) >> 16));
+    if (rfs_map_point_legal(m, gx, gy) && go_to(s, gx, gy, now_us)) {
+        s->decision.goal_x = gx;
+        s->decision.goal_y = gy;
+        return true;
+    }
+    /* Line search at the map resolution, alternating at random between in front of the
+     * step point (towards the robot) and beyond it (towards the maximum). */
+    s->decision.line_search = true;
+    rfs_q16_t dt = rfs_q16_div(m->res, dist);
+    if (dt <= 0) {
+        dt = 1;
+    }
+    for (int32_t k = 1; k < 65536; ++k) {
+        bool any = false;
+        bool beyond_first = (rfs_rng_u32(rng) & 1u) != 0u;
+        for (int side = 0; side < 2; ++side) {
+            bool beyond = (side == 0) == beyond_first;
+            int64_t t = (int64_t)t_step + (beyond ? (int64_t)k * dt : -(int64_t)k * dt);
+            if (t <= 0 || t > RFS_Q16_ONE) {
+                continue;
+            }
+            any = true;
+            gx = rfs_sat32(s->pose.x + ((dx * t) >> 16));
+            gy = rfs_sat32(s->pose.y + ((dy * t) >> 16));
+            if (rfs_map_point_legal(m, gx, gy) && go_to(s, gx, gy, now_us)) {
+                s->decision.goal_x = gx;
+                s->decision.goal_y = gy;
+                return true;
+            }
+        }
+        if (!any) {
+            break;
+        }
+    }
+    s->decision.goal_x = mx;
+    s->decision.goal_y = my;
+    return go_to(s, mx, my, now_us);
+}
+
+static void stop_wheels(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
+{
+    rfs_drive_stop(&s->drive, now_us);
+    out->left_mm_s = 0;
+    out->right_mm_s = 0;
+}
+
+/* Finish the decision after a (possibly sliced) fit: epsilon-greedy choice and goal. */
+static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
+{
+    rfs_seek_decision_t *d = &s->decision;
+    bool ok = false;
+    rfs_q16_t dummy;
+    bool model_ok = s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &dummy);
+    if (d->iteration == 0u) {
+        d->kind = RFS_SEEK_INITIAL;
+        ok = choose_initial(s, rng, now_us);
+    } else {
+        d->epsilon = rfs_seek_epsilon(&s->cfg, d->iteration);
+        /* "if random() > epsilon: greedy" (Algorithm 1). */
+        bool greedy = model_ok && rfs_rng_q16(rng) >= d->epsilon;
+        d->kind = greedy ? RFS_SEEK_GREEDY : RFS_SEEK_EPSILON;
+        ok = greedy ? choose_greedy(s, rng, now_us) : choose_epsilon(s, rng, now_us);
+        if (!ok && greedy) {
+            d->kind = RFS_SEEK_EPSILON; /* no reachable maximum: explore instead */
+            ok = choose_epsilon(s, rng, now_us);
+        }
+        if (!ok && !greedy && model_ok) {
+            d->kind = RFS_SEEK_GREEDY; /* nothing novel left within reach */
+            ok = choose_greedy(s, rng, now_us);
+        }
+    }
+    s->iteration++;
+    out->decided = true;
+    if (!ok) {
+        out->faults |= RFS_SEEK_FAULT_NO_GOAL;
+        d->goal_x = s->pose.x;
+        d->goal_y = s->pose.y;
+        stop_wheels(s, now_us, out);
+        s->state = RFS_SEEK_DRIVING; /* decide again next period */
+        return;
+    }
+    s->state = RFS_SEEK_DRIVING;
+    rfs_drive_status_t st = rfs_drive_update(&s->drive, &s->pose, now_us, &out->left_mm_s,
+                                             &out->right_mm_s);
+    if (st != RFS_DRIVE_RUNNING) {
+        s->prev_status = st;
+    }
+}
+
+/* Start an iteration: the relearn check, then (after learning) the step choice. */
+static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
+{
+    rfs_seek_decision_t *d = &s->decision;
+    memset(d, 0, sizeof *d);
+    d->iteration = s->iteration;
+    d->t_us = now_us;
+    d->prev = s->prev_status;
+    d->x = s->pose.x;
+    d->y = s->pose.y;
+    d->samples = s->store.count;
+    rfs_target_in_t in = { s->win, s->target->nsources, now_us };
+    d->mean_valid = s->target->mean(&in, &d->mean);
+    d->model_valid = s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &d->prediction);
+    bool relearn = !d->model_valid;
+    if (d->model_valid && d->mean_valid) {
+        relearn = rfs_q16_abs(rfs_q16_sub(d->mean, d->prediction)) > s->cfg.error_threshold;
+    }
+    if (relearn && s->store.count > 0u) {
+        d->relearned = true;
+        s->model.ops->reset(s->model.self);
+        s->fitting = true;
+    }
+    if (s->fitting) {
+        rfs_model_fit_in_t fin = { s->store.samples, s->store.count, s->pose.x, s->pose.y, s->map };
+        rfs_fit_result_t r = s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng);
+        if (r == RFS_FIT_MORE) {
+            s->state = RFS_SEEK_LEARNING;
+            stop_wheels(s, now_us, out);
+            return;
+        }
+        s->fitting = false;
+    }
+    finish_decision(s, now_us, rng, out);
+}
+
+void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
+{
+    out->left_mm_s = 0;
+    out->right_mm_s = 0;
+    out->faults = 0;
+    out->decided = false;
+    bool pose_stale = !s->have_pose || now_us - s->pose.t_us > s->cfg.pose_timeout_us;
+    bool meas_stale = !s->have_meas || now_us - s->last_meas_us > s->cfg.rssi_timeout_us;
+    if (pose_stale) {
+        out->faults |= RFS_SEEK_FAULT_POSE_STALE;
+    }
+    if (meas_stale) {
+        out->faults |= RFS_SEEK_FAULT_RSSI_STALE;
+    }
+    if (s->have_pose && !rfs_map_point_legal(s->map, s->pose.x, s->pose.y)) {
+        uint16_t ci, cj;
+        if (!rfs_map_cell(s->map, s->pose.x, s->pose.y, &ci, &cj)) {
+            out->faults |= RFS_SEEK_FAULT_OFF_MAP;
+        }
+    }
+    if (pose_stale || meas_stale) {
+        if (s->state == RFS_SEEK_DRIVING && s->drive.status == RFS_DRIVE_RUNNING) {
+            s->resume = true;
+            s->resume_path = s->drive.path;
+        }
+        if (s->state != RFS_SEEK_WAITING) {
+            s->state = RFS_SEEK_STALE;
+        }
+        stop_wheels(s, now_us, out);
+        goto report;
+    }
+    if (!s->reach_valid) {
+        compute_reach(s);
+    } else {
+        /* The robot is somewhere the flood fill did not reach (pushed, relocalised):
+         * recompute its reachable component. */
+        uint16_t si, sj;
+        if (!snap_legal(s, s->pose.x, s->pose.y, true, &si, &sj)) {
+            compute_reach(s);
+        }
+    }
+    if (s->resume) {
+        s->resume = false;
+        rfs_drive_set_path(&s->drive, &s->resume_path, now_us);
+        s->state = RFS_SEEK_DRIVING;
+    }
+    if (s->fitting) {
+        /* A sliced fit continues; the decision finishes when it is done. */
+        rfs_model_fit_in_t fin = { s->store.samples, s->store.count, s->pose.x, s->pose.y,
+                                   s->map };
+        rfs_fit_result_t r = s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng);
+        if (r == RFS_FIT_MORE) {
+            s->state = RFS_SEEK_LEARNING;
+            stop_wheels(s, now_us, out);
+            goto report;
+        }
+        s->fitting = false;
+        finish_decision(s, now_us, rng, out);
+        goto report;
+    }
+    if (s->drive.status == RFS_DRIVE_RUNNING) {
+        rfs_drive_status_t st = rfs_drive_update(&s->drive, &s->pose, now_us, &out->left_mm_s,
+                                                 &out->right_mm_s);
+        if (st == RFS_DRIVE_RUNNING) {
+            s->state = RFS_SEEK_DRIVING;
+            goto report;
+        }
+        s->prev_status = st;
+    }
+    decide(s, now_us, rng, out);
+report:
+    out->state = s->state;
+    out->decision = s->decision;
+}

@@ -1,0 +1,142 @@
+/* rfs_app.c - the application loop shared by every port (see rfs_app.h). */
+#include "rfs_app.h"
+
+#include <stddef.h>
+#include <string.h>
+
+#include "rfs_target.h"
+
+rfs_app_cfg_t rfs_app_cfg_default(void)
+{
+    rfs_app_cfg_t c;
+    memset(&c, 0, sizeof c);
+    c.seek = rfs_seek_cfg_default();
+    c.ridge = rfs_ridge_cfg_default();
+    c.map = rfs_map_cfg_default();
+    c.target = RFS_APP_TARGET_RSSI;
+    c.seed = 1u;
+    c.input_timeout_us = 150000;
+    c.node_id = 1u;
+    return c;
+}
+
+int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *map)
+{
+    if (a == NULL || cfg == NULL || map == NULL || map->free == NULL) {
+        return -1;
+    }
+    if (cfg->target > RFS_APP_TARGET_BRIDGE || cfg->input_timeout_us <= 0) {
+        return -1;
+    }
+    if (rfs_map_bytes(map->w, map->h) > RFS_APP_MAX_MAP_BYTES) {
+        return -1;
+    }
+    /* The samples are not cleared: 60 KB of memset is 15,000 stores the store never
+     * reads before writing (it counts what it holds). Everything else starts at zero. */
+    memset(a, 0, offsetof(rfs_app_t, samples));
+    a->cfg = *cfg;
+    if (rfs_map_init(&a->map, &cfg->map, map->w, map->h, map->res, map->origin_x,
+                     map->origin_y, map->free, map->wall, a->legal) != 0) {
+        return -1;
+    }
+    const uint32_t lattice = (uint32_t)a->map.lw * a->map.lh;
+    if (lattice > RFS_APP_MAX_LATTICE || cfg->seek.store.capacity > RFS_APP_MAX_SAMPLES) {
+        return -1;
+    }
+    if (rfs_ridge_init(&a->ridge, &cfg->ridge) != 0) {
+        return -1;
+    }
+    rfs_rng_seed(&a->rng, cfg->seed);
+    const rfs_seek_mem_t mem = {
+        .samples = a->samples,
+        .pending = a->pending,
+        .pending_cap = RFS_APP_PENDING,
+        .plan_work = a->plan_work,
+        .plan_work_bytes = RFS_APP_MAX_LATTICE,
+        .plan_queue = a->plan_queue,
+        .plan_queue_cap = RFS_APP_PLAN_QUEUE,
+        .visited = a->visited,
+        .visited_bytes = (uint32_t)sizeof a->visited,
+    };
+    const rfs_target_ops_t *target =
+        cfg->target == RFS_APP_TARGET_BRIDGE ? &rfs_target_bridge : &rfs_target_rssi;
+    if (rfs_seek_init(&a->seek, &cfg->seek, &a->map, rfs_ridge_model(&a->ridge), target,
+                      &mem) != 0) {
+        return -1;
+    }
+    a->after_reset = true;
+    return 0;
+}
+
+bool rfs_app_on_pose(rfs_app_t *a, const rfs_pose_t *pose, int64_t rx_us)
+{
+    a->pose_rx_us = rx_us;
+    a->have_pose_rx = true;
+    const bool ok = rfs_seek_on_pose(&a->seek, pose, &a->rng);
+    if (ok) {
+        a->stats.poses++;
+    } else {
+        a->stats.rejected++;
+    }
+    return ok;
+}
+
+bool rfs_app_on_rssi(rfs_app_t *a, uint8_t src, int64_t t_us, int8_t dbm, int64_t rx_us)
+{
+    a->rssi_rx_us = rx_us;
+    a->have_rssi_rx = true;
+    const bool ok = rfs_seek_on_rssi(&a->seek, src, t_us, dbm, &a->rng);
+    if (ok) {
+        a->stats.rssi++;
+    } else {
+        a->stats.rejected++;
+    }
+    return ok;
+}
+
+void rfs_app_set_bus_off(rfs_app_t *a, bool off)
+{
+    a->bus_off = off;
+}
+
+void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out)
+{
+    rfs_seek_out_t so;
+    rfs_seek_step(&a->seek, now_us, &a->rng, &so);
+
+    uint16_t faults = so.faults;
+    /* Received-time watchdogs on the inputs (issue 6 safety): independent of the sender
+     * time stamps the seeker judges, so a sender whose clock runs on while its frames
+     * stop arriving still stops the wheels. */
+    if (!a->have_pose_rx || now_us - a->pose_rx_us > a->cfg.input_timeout_us) {
+        faults |= RFS_APP_FAULT_POSE_LOST;
+    }
+    if (!a->have_rssi_rx || now_us - a->rssi_rx_us > a->cfg.input_timeout_us) {
+        faults |= RFS_APP_FAULT_RSSI_LOST;
+    }
+    if (a->bus_off) {
+        faults |= RFS_APP_FAULT_BUS_OFF;
+    }
+    if (a->after_reset) {
+        faults |= RFS_APP_FAULT_RESET;
+    }
+    if (a->bad_frame) {
+        faults |= RFS_APP_FAULT_BAD_FRAME;
+    }
+    const bool stop = (faults & (RFS_APP_FAULT_POSE_LOST | RFS_APP_FAULT_RSSI_LOST |
+                                 RFS_APP_FAULT_BUS_OFF | RFS_APP_FAULT_RESET)) != 0u;
+
+    memset(out, 0, sizeof *out);
+    out->t_us = now_us;
+    out->left_mm_s = stop ? 0 : so.left_mm_s;
+    out->right_mm_s = stop ? 0 : so.right_mm_s;
+    out->state = so.state;
+    out->faults = faults;
+    out->decided = so.decided;
+    out->decision = so.decision;
+
+    a->after_reset = false;
+    a->bad_frame = false;
+    a->stats.steps++;
+    a->last = *out;
+}

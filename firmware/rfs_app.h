@@ -1,0 +1,160 @@
+/* rfs_app.h - the application loop shared by every firmware port (issue 6).
+ *
+ * One rfs_app_t holds everything the controller needs at run time: the seeker
+ * (common/rfs_seek.h, paper section 2, Algorithm 1), the local ridge model (section
+ * 5.2.1), the random source and every large array, all as fixed-size members sized by the
+ * compile-time maxima below, so a port declares ONE static rfs_app_t and needs no heap.
+ *
+ * A port feeds what arrives, in arrival order, and calls rfs_app_step() at the control
+ * rate (RFS_APP_PERIOD_US):
+ *   - decoded inputs: rfs_app_on_pose(), rfs_app_on_rssi() (the Linux/LCM port), or
+ *   - raw CAN frames: rfs_app_on_can() (the STM32 and emulator ports; decoding by
+ *     common/rfs_can.h),
+ *   - transport state: rfs_app_set_bus_off() (bxCAN bus-off, SocketCAN error state).
+ * rfs_app_step() returns the wheel command and the status; rfs_app_frames() encodes them
+ * as the CAN frames of docs/CAN.md.
+ *
+ * Safety (issue 6): besides the seeker's own staleness rule on input timestamps, the
+ * application commands zero wheel speed whenever no pose or no RSSI frame has been
+ * RECEIVED for input_timeout_us of local time (150 ms < the 200 ms requirement), and
+ * while the bus is off. Zero output comes at once, without the drive's acceleration ramp.
+ * After a watchdog reset the port calls rfs_app_init() again: the first step outputs zero
+ * with RFS_APP_FAULT_RESET set. Driving resumes by itself when inputs return.
+ *
+ * Times: every *_us argument is int64 microseconds of ONE clock, the controller's. The
+ * ports translate sender timestamps into it (rfs_can time unwrapping); in a replay the
+ * recorded times are that clock.
+ */
+#ifndef RFS_APP_H
+#define RFS_APP_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rfs_fix.h"
+#include "rfs_map.h"
+#include "rfs_ridge.h"
+#include "rfs_seek.h"
+#include "rfs_store.h"
+
+/// Samples held for learning (paper section 5.2: at most 10,000), 6 bytes each.
+#define RFS_APP_MAX_SAMPLES 10000u
+/// Largest bit grid, bytes: 400 x 200 cells = a 40 x 20 m map at 0.1 m.
+#define RFS_APP_MAX_MAP_BYTES 10000u
+/// Largest lattice, points: a 40 x 20 m map at 0.25 m is 160 x 80 (+1 row and column).
+#define RFS_APP_MAX_LATTICE (161u * 81u)
+/// Planner queue entries (2 * (lw + lh) for the largest lattice, rounded up).
+#define RFS_APP_PLAN_QUEUE 512u
+/// Pending measurements waiting for a bracketing pose (>= 64 required by rfs_seek).
+#define RFS_APP_PENDING 64u
+/// Control period, microseconds (20 Hz).
+#define RFS_APP_PERIOD_US 50000
+
+/// Application fault bits, in the high byte of rfs_app_out_t.faults (the low byte holds
+/// the seeker's RFS_SEEK_FAULT_* bits).
+enum {
+    RFS_APP_FAULT_POSE_LOST = 1u << 8,  ///< no pose received for input_timeout_us
+    RFS_APP_FAULT_RSSI_LOST = 1u << 9,  ///< no RSSI received for input_timeout_us
+    RFS_APP_FAULT_BUS_OFF = 1u << 10,   ///< the CAN controller is bus-off
+    RFS_APP_FAULT_RESET = 1u << 11,     ///< first step after a (watchdog) reset
+    RFS_APP_FAULT_BAD_FRAME = 1u << 12, ///< a frame failed to decode since the last step
+};
+
+/// Which target function the seeker maximises (rfs_target.h).
+typedef enum rfs_app_target {
+    RFS_APP_TARGET_RSSI = 0,   ///< one source's RSSI (paper section 2)
+    RFS_APP_TARGET_BRIDGE = 1, ///< two sources, f = -|R1 - R2| - |R1 + R2| (section 6)
+} rfs_app_target_t;
+
+/// A map as the port holds it: bit grids at the core's resolution (rfs_map.h), e.g.
+/// const arrays in flash. free/wall must outlive the application.
+typedef struct rfs_app_map {
+    uint16_t w;            ///< width, cells
+    uint16_t h;            ///< height, cells
+    rfs_q16_t res;         ///< metres per cell, Q16.16
+    rfs_q16_t origin_x;    ///< x of the lower-left corner of cell (0, 0), metres Q16.16
+    rfs_q16_t origin_y;    ///< y of that corner, metres Q16.16
+    const uint8_t *free;   ///< 1 = free, rfs_map_bytes(w, h) bytes
+    const uint8_t *wall;   ///< 1 = occupied, same size; may be NULL
+} rfs_app_map_t;
+
+/// Application configuration.
+typedef struct rfs_app_cfg {
+    rfs_seek_cfg_t seek;        ///< seeker (rfs_seek_cfg_default(): the paper's numbers)
+    rfs_ridge_cfg_t ridge;      ///< local ridge (5 m radius, alpha 1)
+    rfs_map_cfg_t map;          ///< clearance and lattice (0.25 m, 0.25 m)
+    rfs_app_target_t target;    ///< target function
+    uint64_t seed;              ///< seed of the random source (epsilon moves, reservoir)
+    int64_t input_timeout_us;   ///< zero wheels when nothing was received for this long (150 ms)
+    uint8_t node_id;            ///< this controller's id in the status frame
+} rfs_app_cfg_t;
+
+/// What one control period produces (the content of the wheel command and status frames).
+typedef struct rfs_app_out {
+    int64_t t_us;               ///< time of the step, microseconds
+    int16_t left_mm_s;          ///< left wheel speed command, mm/s
+    int16_t right_mm_s;         ///< right wheel speed command, mm/s
+    rfs_seek_state_t state;     ///< seeker state
+    uint16_t faults;            ///< RFS_SEEK_FAULT_* | RFS_APP_FAULT_*
+    bool decided;               ///< a new decision was made this period
+    rfs_seek_decision_t decision; ///< the latest decision (new when `decided`)
+} rfs_app_out_t;
+
+/// Input and transport counters (for the status frame and the logs).
+typedef struct rfs_app_stats {
+    uint32_t poses;             ///< poses accepted by the seeker
+    uint32_t rssi;              ///< measurements accepted by the seeker
+    uint32_t rejected;          ///< inputs the seeker rejected (order, bad source)
+    uint32_t bad_frames;        ///< CAN frames that failed to decode (DLC, checksum)
+    uint32_t unknown_frames;    ///< CAN frames with ids that are not ours
+    uint32_t steps;             ///< control periods run
+} rfs_app_stats_t;
+
+/// The application: every byte the controller uses at run time (about 92 KB with the
+/// maxima above). Declare one static instance per port.
+typedef struct rfs_app {
+    rfs_app_cfg_t cfg;                              ///< configuration copied at init
+    rfs_seek_t seek;                                ///< the meta-algorithm
+    rfs_ridge_t ridge;                              ///< the local ridge model state
+    rfs_map_t map;                                  ///< the map (grids owned by the port)
+    rfs_rng_t rng;                                  ///< the random source
+    int64_t pose_rx_us;                             ///< local time the last pose arrived
+    int64_t rssi_rx_us;                             ///< local time the last RSSI arrived
+    bool have_pose_rx;                              ///< a pose has arrived since init
+    bool have_rssi_rx;                              ///< an RSSI has arrived since init
+    bool bus_off;                                   ///< the transport reports bus-off
+    bool after_reset;                               ///< no step has run since init
+    bool bad_frame;                                 ///< a frame failed since the last step
+    uint8_t tx_counter;                             ///< rolling counter of our frames
+    rfs_app_stats_t stats;                          ///< counters
+    rfs_app_out_t last;                             ///< output of the latest step
+    rfs_sample_t samples[RFS_APP_MAX_SAMPLES];      ///< the sample store
+    rfs_pending_t pending[RFS_APP_PENDING];         ///< measurements awaiting a pose
+    uint8_t legal[RFS_APP_MAX_MAP_BYTES];           ///< derived legal bits
+    uint8_t plan_work[RFS_APP_MAX_LATTICE];         ///< planner marks, one byte per point
+    uint32_t plan_queue[RFS_APP_PLAN_QUEUE];        ///< planner queue
+    uint8_t visited[(RFS_APP_MAX_LATTICE + 7u) / 8u]; ///< novelty bits, one per point
+} rfs_app_t;
+
+/// Defaults: the paper's configuration (rfs_seek_cfg_default, rfs_ridge_cfg_default,
+/// rfs_map_cfg_default), RSSI target, seed 1, 150 ms input timeout, node 1.
+rfs_app_cfg_t rfs_app_cfg_default(void);
+
+/// Initialise (also after a watchdog reset). Returns 0, or -1 when the map is larger
+/// than the compile-time maxima or invalid, or the seeker rejects the configuration.
+int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *map);
+
+/// A decoded pose arrived at local time rx_us. false when the seeker rejected it.
+bool rfs_app_on_pose(rfs_app_t *a, const rfs_pose_t *pose, int64_t rx_us);
+
+/// A decoded RSSI measurement (source index src, taken at t_us, dbm) arrived at local
+/// time rx_us. false when the seeker rejected it.
+bool rfs_app_on_rssi(rfs_app_t *a, uint8_t src, int64_t t_us, int8_t dbm, int64_t rx_us);
+
+/// The transport went bus-off (true) or recovered (false).
+void rfs_app_set_bus_off(rfs_app_t *a, bool off);
+
+/// One control period at local time now_us. Cannot fail.
+void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out);
+
+#endif /* RFS_APP_H */

@@ -1,0 +1,136 @@
+/* rfs_replay.h - the recorded stream format: timestamped inputs in, outputs out (issue 6).
+ *
+ * One format serves both directions, so the host build and the ARM image under qemu can
+ * be fed the same bytes and their outputs compared byte for byte:
+ *
+ *   stream  = header record*
+ *   header  = "RFSR" u16 version (1) u16 zero                      (8 bytes)
+ *   record  = u8 type, u8 len, len bytes of payload                (all little-endian)
+ *
+ * Input records (times are the controller's clock, int64 microseconds):
+ *   CFG      seed u64, target u8, node u8                              10
+ *   MAP      w u16, h u16, res q16, origin_x q16, origin_y q16,
+ *            has_wall u8                                               17
+ *   MAP_FREE offset u32, 1..RFS_REPLAY_CHUNK bytes of the free grid    5..
+ *   MAP_WALL offset u32, bytes of the wall grid                        5..
+ *   POSE     rx i64, t i64, x q16, y q16, theta q16                    28
+ *   RSSI     rx i64, t i64, src u8, dbm i8                             18
+ *   CAN      rx i64, id u32, dlc u8, data[8]                           21
+ *   STEP     now i64                          (run one control period)  8
+ *   BUS      now i64, off u8                  (bus-off entered / left)  9
+ *   RESET    now i64                          (watchdog reset: re-init) 8
+ *   END      (no payload)                                               0
+ * Output records:
+ *   OUT      t i64, left i16, right i16, state u8, faults u16, decided u8   16
+ *   DECISION iteration u32, t i64, kind u8, flags u8, prev u8,
+ *            prediction, mean, epsilon, x, y, goal_x, goal_y, max_x, max_y,
+ *            path_len (q16 each), samples u16                           57
+ *   CAN_TX   t i64, id u32, dlc u8, data[8]                             21
+ *
+ * The parser is portable C (no libc but memcpy/memset), works on a caller buffer that
+ * may end anywhere, checks every length, enum and range, and never reads past `len`.
+ */
+#ifndef RFS_REPLAY_H
+#define RFS_REPLAY_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rfs_app.h"
+#include "rfs_fix.h"
+#include "rfs_store.h"
+
+/// Stream header bytes.
+#define RFS_REPLAY_HEADER_LEN 8u
+/// Format version.
+#define RFS_REPLAY_VERSION 1u
+/// Most grid bytes in one MAP_FREE / MAP_WALL record.
+#define RFS_REPLAY_CHUNK 240u
+/// Longest encoded record (type, len, 255 bytes of payload).
+#define RFS_REPLAY_MAX_RECORD 257u
+
+/// Record types.
+typedef enum rfs_replay_type {
+    RFS_REPLAY_CFG = 0x01,
+    RFS_REPLAY_MAP = 0x02,
+    RFS_REPLAY_MAP_FREE = 0x03,
+    RFS_REPLAY_MAP_WALL = 0x04,
+    RFS_REPLAY_POSE = 0x10,
+    RFS_REPLAY_RSSI = 0x11,
+    RFS_REPLAY_CAN = 0x12,
+    RFS_REPLAY_STEP = 0x20,
+    RFS_REPLAY_BUS = 0x21,
+    RFS_REPLAY_RESET = 0x22,
+    RFS_REPLAY_END = 0x7F,
+    RFS_REPLAY_OUT = 0x80,
+    RFS_REPLAY_DECISION = 0x81,
+    RFS_REPLAY_CAN_TX = 0x82,
+} rfs_replay_type_t;
+
+/// Result of parsing.
+typedef enum rfs_replay_status {
+    RFS_REPLAY_OK = 0,     ///< one record decoded
+    RFS_REPLAY_NEED_MORE,  ///< the buffer ends inside a record: supply more bytes
+    RFS_REPLAY_BAD,        ///< malformed record (see rfs_replay_rec_t.error)
+} rfs_replay_status_t;
+
+/// A raw CAN frame as recorded (the same layout as rfs_can_frame_t).
+typedef struct rfs_replay_can {
+    uint32_t id;      ///< 11-bit identifier
+    uint8_t dlc;      ///< data length, 0..8
+    uint8_t data[8];  ///< payload
+} rfs_replay_can_t;
+
+/// One decoded record.
+typedef struct rfs_replay_rec {
+    rfs_replay_type_t type;   ///< record type
+    int64_t t_us;             ///< rx / step / output time, microseconds (0 for CFG, MAP, END)
+    union {
+        struct {
+            uint64_t seed;    ///< random seed
+            uint8_t target;   ///< rfs_app_target_t
+            uint8_t node;     ///< node id
+        } cfg;                ///< CFG
+        struct {
+            uint16_t w, h;    ///< cells
+            rfs_q16_t res;    ///< metres per cell, Q16.16
+            rfs_q16_t origin_x, origin_y; ///< metres, Q16.16
+            uint8_t has_wall; ///< 0 or 1
+        } map;                ///< MAP
+        struct {
+            uint32_t offset;  ///< byte offset into the grid
+            uint8_t n;        ///< bytes, 1..RFS_REPLAY_CHUNK
+            uint8_t bytes[RFS_REPLAY_CHUNK]; ///< grid bytes
+        } chunk;              ///< MAP_FREE, MAP_WALL
+        rfs_pose_t pose;      ///< POSE (pose.t_us is the sender's time stamp)
+        struct {
+            int64_t t_us;     ///< when measured, microseconds
+            uint8_t src;      ///< source index
+            int8_t dbm;       ///< dBm
+        } rssi;               ///< RSSI
+        rfs_replay_can_t can; ///< CAN, CAN_TX
+        uint8_t bus_off;      ///< BUS: 1 = entered bus-off, 0 = recovered
+        rfs_app_out_t out;    ///< OUT (decision unused) and DECISION (decision only)
+    } u;
+    const char *error;        ///< static reason when BAD
+} rfs_replay_rec_t;
+
+/// Write the 8-byte stream header into buf.
+void rfs_replay_header(uint8_t buf[RFS_REPLAY_HEADER_LEN]);
+
+/// Check a stream header. Returns 0, or -1 (bad magic or version).
+int rfs_replay_check_header(const uint8_t *buf, uint32_t len);
+
+/// Decode the record at the start of buf[0..len). On OK, *used is its size in bytes.
+rfs_replay_status_t rfs_replay_parse(const uint8_t *buf, uint32_t len, uint32_t *used,
+                                     rfs_replay_rec_t *rec);
+
+/// Encode a record into buf (cap >= RFS_REPLAY_MAX_RECORD is always enough). Returns
+/// the bytes written, 0 when the record is invalid or does not fit.
+uint32_t rfs_replay_encode(const rfs_replay_rec_t *rec, uint8_t *buf, uint32_t cap);
+
+/// Encode a step's output: OUT, then DECISION when out->decided. Returns bytes written
+/// (cap >= 2 * RFS_REPLAY_MAX_RECORD is always enough), 0 when it does not fit.
+uint32_t rfs_replay_encode_out(const rfs_app_out_t *out, uint8_t *buf, uint32_t cap);
+
+#endif /* RFS_REPLAY_H */

@@ -1,0 +1,350 @@
+/* hs_box2d.cpp - the Box2D 2.4 adapter behind hs_world.h (the only file including Box2D).
+ *
+ * Geometry: the map frame, metres, as in hs_map_t. Walls are static fixtures on two
+ * static bodies (collision and radio); the robot is a dynamic circle whose velocity is
+ * set before every step (unicycle from the wheel speeds, see hs_world.h).
+ */
+#include <box2d/box2d.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <utility>
+#include <vector>
+
+extern "C" {
+#include "hs_world.h"
+}
+
+namespace {
+
+constexpr uint16 CAT_COLLIDE = 0x0001; // walls the robot collides with
+constexpr uint16 CAT_RADIO = 0x0002;   // walls the radio counts; never collide
+constexpr uint16 CAT_ROBOT = 0x0004;
+
+bool cell_in(const hs_map_t *m, uint32_t x, uint32_t y, hs_world_kind_t kind)
+{
+    uint8_t c = m->cell[(size_t)y * m->w + x];
+    return kind == HS_WORLD_RADIO ? c == HS_CELL_OCC : c != HS_CELL_FREE;
+}
+
+// Collects, per radio fixture, the fraction at which a ray enters it.
+class HitCollector : public b2RayCastCallback {
+public:
+    std::vector<std::pair<b2Fixture *, float>> hits;
+    float ReportFixture(b2Fixture *f, const b2Vec2 &, const b2Vec2 &, float fraction) override
+    {
+        if (f->GetFilterData().categoryBits == CAT_RADIO) {
+            hits.emplace_back(f, fraction);
+        }
+        return 1.0f; // keep going: every wall on the segment counts
+    }
+};
+
+} // namespace
+
+struct hs_world {
+    hs_world_cfg_t cfg;
+    b2World *world;
+    b2Body *robot;
+    long n_collide;
+    long n_radio;
+    uint32_t w, h;
+    double res, ox, oy;
+    std::vector<uint8_t> cell; // copy of the map cells (for disc_blocked)
+};
+
+extern "C" hs_world_cfg_t hs_world_cfg_default(void)
+{
+    hs_world_cfg_t c;
+    c.robot_radius_m = 0.177; // TurtleBot 2 (Kobuki) footprint radius, turtlebot_navigation
+    c.robot_mass_kg = 6.3;    // Kobuki base mass, vendor data sheet
+    c.velocity_iters = 8;     // Box2D manual's recommendation
+    c.position_iters = 3;
+    c.wall_merge_gap_m = 0.1;
+    return c;
+}
+
+extern "C" long hs_world_merge_rects(const hs_map_t *m, hs_world_kind_t kind, hs_rect_t **out)
+{
+    *out = nullptr;
+    std::vector<hs_rect_t> done;
+    std::vector<hs_rect_t> open; // rectangles that end at the previous row, sorted by x0
+    std::vector<hs_rect_t> next;
+    try {
+        for (uint32_t y = 0; y < m->h; y++) {
+            next.clear();
+            size_t oi = 0;
+            uint32_t x = 0;
+            while (x < m->w) {
+                if (!cell_in(m, x, y, kind)) {
+                    x++;
+                    continue;
+                }
+                uint32_t x0 = x;
+                while (x < m->w && cell_in(m, x, y, kind)) {
+                    x++;
+                }
+                uint32_t wdt = x - x0;
+                // Open rectangles left of this run can no longer continue.
+                while (oi < open.size() && open[oi].x0 < x0) {
+                    done.push_back(open[oi++]);
+                }
+                if (oi < open.size() && open[oi].x0 == x0 && open[oi].w == wdt) {
+                    hs_rect_t r = open[oi++];
+                    r.h++;
+                    next.push_back(r);
+                } else {
+                    next.push_back(hs_rect_t{x0, y, wdt, 1});
+                }
+            }
+            while (oi < open.size()) {
+                done.push_back(open[oi++]);
+            }
+            open.swap(next);
+        }
+        for (const hs_rect_t &r : open) {
+            done.push_back(r);
+        }
+    } catch (const std::bad_alloc &) {
+        return -1;
+    }
+    if (done.empty()) {
+        return 0;
+    }
+    hs_rect_t *a = static_cast<hs_rect_t *>(malloc(done.size() * sizeof(hs_rect_t)));
+    if (!a) {
+        return -1;
+    }
+    memcpy(a, done.data(), done.size() * sizeof(hs_rect_t));
+    *out = a;
+    return (long)done.size();
+}
+
+static long add_walls(hs_world_t *w, const hs_map_t *m, b2Body *body, hs_world_kind_t kind)
+{
+    hs_rect_t *rects = nullptr;
+    long n = hs_world_merge_rects(m, kind, &rects);
+    for (long i = 0; i < n; i++) {
+        const hs_rect_t &r = rects[i];
+        float hx = (float)(0.5 * r.w * m->res);
+        float hy = (float)(0.5 * r.h * m->res);
+        b2Vec2 c((float)(m->origin_x + (r.x0 + 0.5 * r.w) * m->res),
+                 (float)(m->origin_y + (r.y0 + 0.5 * r.h) * m->res));
+        b2PolygonShape box;
+        box.SetAsBox(hx, hy, c, 0.0f);
+        b2FixtureDef fd;
+        fd.shape = &box;
+        fd.friction = 0.0f;
+        if (kind == HS_WORLD_RADIO) {
+            fd.isSensor = true;
+            fd.filter.categoryBits = CAT_RADIO;
+            fd.filter.maskBits = 0; // answers ray casts only
+        } else {
+            fd.filter.categoryBits = CAT_COLLIDE;
+            fd.filter.maskBits = CAT_ROBOT;
+        }
+        body->CreateFixture(&fd);
+    }
+    free(rects);
+    (void)w;
+    return n;
+}
+
+extern "C" hs_world_t *hs_world_create(const hs_map_t *m, const hs_world_cfg_t *cfg, char *err,
+                                       size_t errlen)
+{
+    hs_world_cfg_t c = cfg ? *cfg : hs_world_cfg_default();
+    if (!(c.robot_radius_m > 0.0) || !(c.robot_mass_kg > 0.0) || c.velocity_iters < 1 ||
+        c.position_iters < 1 || !(c.wall_merge_gap_m >= 0.0)) {
+        snprintf(err, errlen, "world: robot radius, mass and solver iterations must be positive");
+        return nullptr;
+    }
+    if (!m || !m->cell || m->w == 0 || m->h == 0 || !(m->res > 0.0)) {
+        snprintf(err, errlen, "world: empty map");
+        return nullptr;
+    }
+    hs_world_t *w = new (std::nothrow) hs_world();
+    if (!w) {
+        snprintf(err, errlen, "world: out of memory");
+        return nullptr;
+    }
+    try {
+        w->cfg = c;
+        w->w = m->w;
+        w->h = m->h;
+        w->res = m->res;
+        w->ox = m->origin_x;
+        w->oy = m->origin_y;
+        w->cell.assign(m->cell, m->cell + (size_t)m->w * m->h);
+        w->world = new b2World(b2Vec2(0.0f, 0.0f));
+        b2BodyDef sd;
+        sd.type = b2_staticBody;
+        b2Body *collide = w->world->CreateBody(&sd);
+        b2Body *radio = w->world->CreateBody(&sd);
+        w->n_collide = add_walls(w, m, collide, HS_WORLD_COLLIDE);
+        w->n_radio = add_walls(w, m, radio, HS_WORLD_RADIO);
+        if (w->n_collide < 0 || w->n_radio < 0) {
+            throw std::bad_alloc();
+        }
+        b2BodyDef bd;
+        bd.type = b2_dynamicBody;
+        bd.position.Set((float)m->origin_x, (float)m->origin_y);
+        w->robot = w->world->CreateBody(&bd);
+        b2CircleShape disc;
+        disc.m_radius = (float)c.robot_radius_m;
+        b2FixtureDef fd;
+        fd.shape = &disc;
+        fd.density = (float)(c.robot_mass_kg / (M_PI * c.robot_radius_m * c.robot_radius_m));
+        fd.friction = 0.0f;
+        fd.filter.categoryBits = CAT_ROBOT;
+        fd.filter.maskBits = CAT_COLLIDE;
+        w->robot->CreateFixture(&fd);
+    } catch (const std::bad_alloc &) {
+        hs_world_destroy(w);
+        snprintf(err, errlen, "world: out of memory");
+        return nullptr;
+    }
+    return w;
+}
+
+extern "C" void hs_world_destroy(hs_world_t *w)
+{
+    if (!w) {
+        return;
+    }
+    delete w->world;
+    delete w;
+}
+
+extern "C" long hs_world_rect_count(const hs_world_t *w, hs_world_kind_t kind)
+{
+    return kind == HS_WORLD_RADIO ? w->n_radio : w->n_collide;
+}
+
+extern "C" void hs_world_place_robot(hs_world_t *w, double x, double y, double theta)
+{
+    w->robot->SetTransform(b2Vec2((float)x, (float)y), (float)theta);
+    w->robot->SetLinearVelocity(b2Vec2(0.0f, 0.0f));
+    w->robot->SetAngularVelocity(0.0f);
+    w->robot->SetAwake(true);
+}
+
+extern "C" void hs_world_robot_pose(const hs_world_t *w, double *x, double *y, double *theta)
+{
+    b2Vec2 p = w->robot->GetPosition();
+    double a = std::remainder((double)w->robot->GetAngle(), 2.0 * M_PI);
+    if (a <= -M_PI) {
+        a += 2.0 * M_PI;
+    }
+    *x = p.x;
+    *y = p.y;
+    *theta = a;
+}
+
+extern "C" void hs_world_step(hs_world_t *w, double v_m_s, double omega_rad_s, double dt_s)
+{
+    float a = w->robot->GetAngle();
+    w->robot->SetLinearVelocity(
+        b2Vec2((float)(v_m_s * std::cos(a)), (float)(v_m_s * std::sin(a))));
+    w->robot->SetAngularVelocity((float)omega_rad_s);
+    w->robot->SetAwake(true);
+    w->world->Step((float)dt_s, w->cfg.velocity_iters, w->cfg.position_iters);
+    // Keep the heading bounded so float precision does not decay over a long run.
+    float ang = w->robot->GetAngle();
+    if (ang > 100.0f || ang < -100.0f) {
+        w->robot->SetTransform(w->robot->GetPosition(),
+                               (float)std::remainder((double)ang, 2.0 * M_PI));
+    }
+}
+
+extern "C" bool hs_world_robot_touching(const hs_world_t *w)
+{
+    for (b2ContactEdge *e = w->robot->GetContactList(); e; e = e->next) {
+        if (e->contact->IsTouching()) {
+            return true;
+        }
+    }
+    return false;
+}
+
+extern "C" unsigned hs_world_walls_crossed(const hs_world_t *w, double x0, double y0, double x1,
+                                           double y1)
+{
+    double len = std::hypot(x1 - x0, y1 - y0);
+    if (len <= 0.0) {
+        return 0;
+    }
+    b2Vec2 a((float)x0, (float)y0), b((float)x1, (float)y1);
+    HitCollector fwd, rev;
+    w->world->RayCast(&fwd, a, b);
+    w->world->RayCast(&rev, b, a);
+    // Interval of each fixture along the segment, as fractions from a: entry from the
+    // forward cast (0 when a is inside), exit from the reverse cast (1 when b is inside).
+    std::vector<std::pair<double, double>> iv;
+    iv.reserve(fwd.hits.size() + rev.hits.size());
+    for (const auto &h : fwd.hits) {
+        double out = 1.0;
+        for (const auto &r : rev.hits) {
+            if (r.first == h.first) {
+                out = 1.0 - r.second;
+                break;
+            }
+        }
+        iv.emplace_back(h.second, out);
+    }
+    for (const auto &r : rev.hits) {
+        bool seen = false;
+        for (const auto &h : fwd.hits) {
+            if (h.first == r.first) {
+                seen = true;
+                break;
+            }
+        }
+        if (!seen) {
+            iv.emplace_back(0.0, 1.0 - r.second);
+        }
+    }
+    if (iv.empty()) {
+        return 0;
+    }
+    std::sort(iv.begin(), iv.end());
+    double gap = w->cfg.wall_merge_gap_m / len;
+    unsigned n = 1;
+    double end = iv[0].second;
+    for (size_t i = 1; i < iv.size(); i++) {
+        if (iv[i].first > end + gap) {
+            n++;
+        }
+        end = std::max(end, iv[i].second);
+    }
+    return n;
+}
+
+extern "C" bool hs_world_disc_blocked(const hs_world_t *w, double x, double y)
+{
+    double r = w->cfg.robot_radius_m;
+    double fx0 = (x - r - w->ox) / w->res, fx1 = (x + r - w->ox) / w->res;
+    double fy0 = (y - r - w->oy) / w->res, fy1 = (y + r - w->oy) / w->res;
+    if (fx0 < 0.0 || fy0 < 0.0 || fx1 >= (double)w->w || fy1 >= (double)w->h) {
+        return true;
+    }
+    for (long cy = (long)fy0; cy <= (long)fy1; cy++) {
+        for (long cx = (long)fx0; cx <= (long)fx1; cx++) {
+            if (w->cell[(size_t)cy * w->w + (size_t)cx] == HS_CELL_FREE) {
+                continue;
+            }
+            // Nearest point of the cell to the disc centre.
+            double cx0 = w->ox + cx * w->res, cy0 = w->oy + cy * w->res;
+            double nx = std::min(std::max(x, cx0), cx0 + w->res);
+            double ny = std::min(std::max(y, cy0), cy0 + w->res);
+            if ((nx - x) * (nx - x) + (ny - y) * (ny - y) < r * r) {
+                return true;
+            }
+        }
+    }
+    return false;
+}

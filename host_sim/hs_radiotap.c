@@ -1,0 +1,257 @@
+/* hs_radiotap.c - radiotap and 802.11 header parsing (see hs_radiotap.h). */
+#include "hs_radiotap.h"
+
+#include <string.h>
+
+/* Default-namespace field bits with their alignment and size in bytes
+ * (https://www.radiotap.org/fields/defined). Alignment 0 = not a field we may skip:
+ * bit 18 (XChannel) is only "suggested" upstream, bit 28 (TLVs) has no fixed size. The
+ * same table as the Linux/Wireshark iterator for bits 0..22, so parsing stops where
+ * theirs does; 23..27 as radiotap.org defines them. */
+typedef struct rt_field {
+    uint8_t align; /* bytes, a power of two; 0 = unknown */
+    uint8_t size;  /* bytes */
+} rt_field_t;
+
+enum {
+    RT_TSFT = 0,
+    RT_FLAGS = 1,
+    RT_RATE = 2,
+    RT_CHANNEL = 3,
+    RT_DBM_ANTSIGNAL = 5,
+    RT_DBM_ANTNOISE = 6,
+    RT_ANTENNA = 11,
+    RT_MCS = 19,
+    RT_NS_RADIOTAP = 29,
+    RT_NS_VENDOR = 30,
+    RT_EXT = 31,
+    RT_HDR = 8, /* version, pad, it_len (LE16), it_present (LE32) */
+};
+
+static const rt_field_t k_fields[] = {
+    {8, 8},  /* 0 TSFT: u64 */
+    {1, 1},  /* 1 flags */
+    {1, 1},  /* 2 rate */
+    {2, 4},  /* 3 channel: u16 freq, u16 flags */
+    {2, 2},  /* 4 FHSS: u8 hop set, u8 pattern */
+    {1, 1},  /* 5 dBm antenna signal */
+    {1, 1},  /* 6 dBm antenna noise */
+    {2, 2},  /* 7 lock quality */
+    {2, 2},  /* 8 TX attenuation */
+    {2, 2},  /* 9 dB TX attenuation */
+    {1, 1},  /* 10 dBm TX power */
+    {1, 1},  /* 11 antenna */
+    {1, 1},  /* 12 dB antenna signal */
+    {1, 1},  /* 13 dB antenna noise */
+    {2, 2},  /* 14 RX flags */
+    {2, 2},  /* 15 TX flags */
+    {1, 1},  /* 16 RTS retries */
+    {1, 1},  /* 17 data retries */
+    {0, 0},  /* 18 XChannel: not a defined field */
+    {1, 3},  /* 19 MCS: known, flags, index */
+    {4, 8},  /* 20 A-MPDU status */
+    {2, 12}, /* 21 VHT */
+    {8, 12}, /* 22 timestamp: u64, u16, u8, u8 */
+    {2, 12}, /* 23 HE: six u16 */
+    {2, 12}, /* 24 HE-MU: u16 flags1, u16 flags2, u8 RU_channel1[4], u8 RU_channel2[4] */
+    {2, 6},  /* 25 HE-MU-other-user: u16, u16, u8, u8 */
+    {1, 1},  /* 26 0-length PSDU */
+    {2, 4},  /* 27 L-SIG: u16 data1, u16 data2 */
+};
+
+static uint16_t rd16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
+
+static uint32_t rd32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+
+static uint64_t rd64(const uint8_t *p) { return (uint64_t)rd32(p) | ((uint64_t)rd32(p + 4) << 32); }
+
+const char *hs_radiotap_status_str(hs_rt_status_t st)
+{
+    switch (st) {
+    case HS_RT_OK: return "ok";
+    case HS_RT_STOP_UNKNOWN: return "stopped at an unknown field";
+    case HS_RT_FIELD_OVERRUN: return "a field runs past it_len";
+    case HS_RT_ERR_SHORT: return "fewer than 8 bytes for the radiotap header";
+    case HS_RT_ERR_VERSION: return "radiotap version byte is not 0";
+    case HS_RT_ERR_LEN: return "radiotap it_len is below 8 or beyond the captured bytes";
+    case HS_RT_ERR_BITMAP: return "radiotap present bitmaps run past it_len";
+    }
+    return "unknown status";
+}
+
+/* Store a default-namespace field we use; `p` points at its `size` bytes. Repeated
+ * fields (per-chain signal, noise, antenna) keep the first value: the combined one. */
+static void rt_store(hs_radiotap_t *rt, unsigned bit, const uint8_t *p)
+{
+    switch (bit) {
+    case RT_TSFT:
+        if (!rt->has_tsft) { rt->has_tsft = true; rt->tsft_us = rd64(p); }
+        break;
+    case RT_FLAGS:
+        if (!rt->has_flags) { rt->has_flags = true; rt->flags = p[0]; }
+        break;
+    case RT_RATE:
+        if (!rt->has_rate) { rt->has_rate = true; rt->rate_500k = p[0]; }
+        break;
+    case RT_CHANNEL:
+        if (!rt->has_channel) { rt->has_channel = true; rt->freq_mhz = rd16(p); rt->chan_flags = rd16(p + 2); }
+        break;
+    case RT_DBM_ANTSIGNAL:
+        if (!rt->has_dbm_signal) { rt->has_dbm_signal = true; rt->dbm_signal = (int8_t)p[0]; }
+        if (rt->n_dbm_signal < UINT8_MAX) { rt->n_dbm_signal++; }
+        break;
+    case RT_DBM_ANTNOISE:
+        if (!rt->has_dbm_noise) { rt->has_dbm_noise = true; rt->dbm_noise = (int8_t)p[0]; }
+        break;
+    case RT_ANTENNA:
+        if (!rt->has_antenna) { rt->has_antenna = true; rt->antenna = p[0]; }
+        break;
+    case RT_MCS:
+        if (!rt->has_mcs) { rt->has_mcs = true; rt->mcs_known = p[0]; rt->mcs_flags = p[1]; rt->mcs_index = p[2]; }
+        break;
+    default:
+        break;
+    }
+}
+
+int hs_radiotap_parse(const uint8_t *buf, size_t len, hs_radiotap_t *rt)
+{
+    memset(rt, 0, sizeof(*rt));
+    if (len < RT_HDR) { rt->status = HS_RT_ERR_SHORT; return -1; }
+    if (buf[0] != 0) { rt->status = HS_RT_ERR_VERSION; return -1; }
+    const size_t it_len = rd16(buf + 2);
+    rt->it_len = (uint16_t)it_len;
+    if (it_len < RT_HDR || it_len > len) { rt->status = HS_RT_ERR_LEN; return -1; }
+
+    /* The present words: all inside it_len, the last one without bit 31. */
+    size_t words_end = 4;
+    for (;;) {
+        if (words_end + 4 > it_len) { rt->status = HS_RT_ERR_BITMAP; return -1; }
+        const uint32_t w = rd32(buf + words_end);
+        words_end += 4;
+        if (rt->n_present < UINT8_MAX) { rt->n_present++; }
+        if (!(w & (1u << RT_EXT))) { break; }
+    }
+
+    /* Walk the words. In a vendor namespace every field lies inside the data that was
+     * skipped by its skip_length, so only bits 29..31 matter there. */
+    size_t off = words_end;   /* next field, bytes from the start of the header */
+    bool vendor = false;      /* inside a vendor namespace */
+    unsigned base = 0;        /* namespace bit index of bit 0 of this word */
+    bool reset_on_ext = false;
+    for (size_t wo = 4; wo < words_end; wo += 4) {
+        const uint32_t w = rd32(buf + wo);
+        for (unsigned b = 0; b < RT_EXT; b++) {
+            if (!(w & (1u << b))) { continue; }
+            if (b == RT_NS_RADIOTAP) {
+                /* The next word restarts at bit 0 of the default namespace. */
+                vendor = false;
+                reset_on_ext = true;
+                continue;
+            }
+            if (b == RT_NS_VENDOR) {
+                /* OUI (3), sub-namespace (1), skip_length (LE16), aligned to 2; we know
+                 * no vendor namespace, so its data is skipped whole. */
+                off = (off + 1u) & ~(size_t)1u;
+                if (off + 6 > it_len) { rt->status = HS_RT_FIELD_OVERRUN; return 0; }
+                off += 6u + rd16(buf + off + 4);
+                if (off > it_len) { rt->status = HS_RT_FIELD_OVERRUN; return 0; }
+                vendor = true;
+                reset_on_ext = true;
+                if (rt->n_vendor < UINT8_MAX) { rt->n_vendor++; }
+                continue;
+            }
+            if (vendor) { continue; }
+            const unsigned idx = base + b;
+            if (idx >= sizeof(k_fields) / sizeof(k_fields[0]) || k_fields[idx].align == 0) {
+                /* Size and alignment unknown: nothing after it can be located. */
+                rt->status = HS_RT_STOP_UNKNOWN;
+                return 0;
+            }
+            const size_t a = k_fields[idx].align;
+            off = (off + a - 1u) & ~(a - 1u);
+            if (off + k_fields[idx].size > it_len) { rt->status = HS_RT_FIELD_OVERRUN; return 0; }
+            rt_store(rt, idx, buf + off);
+            off += k_fields[idx].size;
+        }
+        /* Bit 31 moves to the next word: bit 32 of the same namespace, or bit 0 after a
+         * namespace switch in this word. */
+        base = reset_on_ext ? 0u : base + 32u;
+        reset_on_ext = false;
+    }
+    rt->status = HS_RT_OK;
+    return 0;
+}
+
+/* Copy a 6-byte address if the frame holds it. */
+static bool wlan_addr(const uint8_t *frame, size_t len, size_t at, uint8_t out[6])
+{
+    if (at + 6 > len) { return false; }
+    memcpy(out, frame + at, 6);
+    return true;
+}
+
+int hs_wlan_parse(const uint8_t *frame, size_t len, hs_wlan_t *w)
+{
+    memset(w, 0, sizeof(*w));
+    if (len < 2) { return -1; }
+    w->fc = rd16(frame);
+    w->type = (uint8_t)((w->fc >> 2) & 3u);
+    w->subtype = (uint8_t)((w->fc >> 4) & 15u);
+    w->ds = (uint8_t)((w->fc >> 8) & 3u);
+    w->hdr_len = 2;
+    /* Address offsets: addr1 4, addr2 10, addr3 16, seq 22, addr4 24. */
+    switch (w->type) {
+    case HS_WLAN_MGMT:
+        /* DA, SA, BSSID: SA = TA = addr2 whatever the DS bits say. */
+        w->has_ta = wlan_addr(frame, len, 10, w->ta);
+        w->has_sa = w->has_ta;
+        if (w->has_sa) { memcpy(w->sa, w->ta, 6); w->hdr_len = 16; }
+        break;
+    case HS_WLAN_DATA: {
+        /* Table 9-30: ToDS/FromDS -> which address is the SA. */
+        static const uint8_t sa_at[4] = {10, 10, 16, 24};
+        w->has_ta = wlan_addr(frame, len, 10, w->ta);
+        w->has_sa = wlan_addr(frame, len, sa_at[w->ds], w->sa);
+        if (w->has_ta) { w->hdr_len = 16; }
+        break;
+    }
+    case HS_WLAN_CTRL:
+        /* RTS, PS-Poll, CF-End(+Ack), BlockAckReq, BlockAck carry RA then TA; ACK and
+         * CTS carry only RA. Wireshark gives none of them a wlan.sa. */
+        if (w->subtype == 8 || w->subtype == 9 || w->subtype == 10 || w->subtype == 11 ||
+            w->subtype == 14 || w->subtype == 15) {
+            w->has_ta = wlan_addr(frame, len, 10, w->ta);
+            if (w->has_ta) { w->hdr_len = 16; }
+        }
+        return 0;
+    default:
+        return 0;
+    }
+    if (len >= 24) {
+        const uint16_t sc = rd16(frame + 22);
+        w->has_seq = true;
+        w->seq = (uint16_t)(sc >> 4);
+        w->frag = (uint8_t)(sc & 15u);
+        w->hdr_len = 24;
+    }
+    if (w->type == HS_WLAN_DATA && w->ds == 3 && w->has_sa) { w->hdr_len = 30; }
+    return 0;
+}
+
+int hs_rt_frame_parse(const uint8_t *buf, size_t len, hs_rt_frame_t *f)
+{
+    memset(f, 0, sizeof(*f));
+    if (hs_radiotap_parse(buf, len, &f->rt) != 0) { return -1; }
+    size_t n = len - f->rt.it_len;
+    if (f->rt.has_flags && (f->rt.flags & HS_RT_FLAG_FCS)) {
+        /* The FCS is the last 4 bytes of the frame, not part of the MAC header. */
+        n = n >= 4 ? n - 4 : 0;
+    }
+    f->frame_len = (uint32_t)n;
+    f->wlan_ok = hs_wlan_parse(buf + f->rt.it_len, n, &f->wlan) == 0;
+    return 0;
+}

@@ -1,0 +1,121 @@
+/* hs_radiotap.h - radiotap and 802.11 MAC header parsing over a byte buffer (issue 5).
+ *
+ * Pure C, no libpcap, every read bounds-checked against the captured length, so it can
+ * run on anything a capture or the air hands us (the fuzz target drives it directly).
+ *
+ * Radiotap (https://www.radiotap.org): version byte 0, it_len within the capture, the
+ * chain of it_present words (bit 31 = another word follows), each field aligned to its
+ * natural size relative to the START of the radiotap header, radiotap-namespace restarts
+ * (bit 29: the next word starts again at bit 0 of the default namespace), vendor
+ * namespaces (bit 30: OUI, sub-namespace, skip_length; their data is skipped by length
+ * because we know none of them). A field we do not know ends the parse: its size and
+ * alignment are unknown, so nothing after it can be located; the fields already read are
+ * kept. This is the rule of the Linux/Wireshark radiotap iterator, so what we report
+ * equals tshark's radiotap.* fields.
+ *
+ * The RSSI the seeker uses (paper section 5.1) is the dBm antenna signal; with per-chain
+ * values (Linux mac80211 layout: a namespace restart per chain) the first value is the
+ * combined one and is the one reported.
+ */
+#ifndef HS_RADIOTAP_H
+#define HS_RADIOTAP_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/// Radiotap flags field bits used here.
+#define HS_RT_FLAG_FCS 0x10u     ///< frame includes the 4-byte FCS at its end
+#define HS_RT_FLAG_BADFCS 0x40u  ///< frame failed the FCS check
+
+/// Why a radiotap header was rejected or stopped early (hs_radiotap_t.status).
+typedef enum hs_rt_status {
+    HS_RT_OK = 0,          ///< every present field parsed
+    HS_RT_STOP_UNKNOWN,    ///< stopped at a field we do not know; fields before it kept
+    HS_RT_FIELD_OVERRUN,   ///< a field ran past it_len; fields before it kept
+    HS_RT_ERR_SHORT,       ///< fewer than 8 bytes captured
+    HS_RT_ERR_VERSION,     ///< version byte is not 0
+    HS_RT_ERR_LEN,         ///< it_len < 8 or larger than the captured bytes
+    HS_RT_ERR_BITMAP,      ///< present words run past it_len (bit 31 chain never ends)
+} hs_rt_status_t;
+
+/// What a radiotap header says; `has_*` tells which fields were present and read.
+typedef struct hs_radiotap {
+    hs_rt_status_t status;   ///< see hs_rt_status_t; >= HS_RT_ERR_SHORT means unusable
+    uint16_t it_len;         ///< radiotap header length, bytes (the 802.11 frame follows)
+    uint8_t n_present;       ///< number of it_present words
+    bool has_tsft;           ///< TSFT present
+    uint64_t tsft_us;        ///< MAC timer at the first bit of the MPDU, microseconds
+    bool has_flags;          ///< flags present
+    uint8_t flags;           ///< HS_RT_FLAG_* bits
+    bool has_rate;           ///< legacy rate present
+    uint8_t rate_500k;       ///< TX/RX rate, units of 500 kbit/s
+    bool has_channel;        ///< channel present
+    uint16_t freq_mhz;       ///< channel centre frequency, MHz
+    uint16_t chan_flags;     ///< channel flags bitmap
+    bool has_dbm_signal;     ///< dBm antenna signal present
+    int8_t dbm_signal;       ///< first (combined) dBm antenna signal, dBm
+    uint8_t n_dbm_signal;    ///< dBm antenna signal values seen (combined + per chain)
+    bool has_dbm_noise;      ///< dBm antenna noise present
+    int8_t dbm_noise;        ///< first dBm antenna noise, dBm
+    bool has_antenna;        ///< antenna index present
+    uint8_t antenna;         ///< first antenna index
+    bool has_mcs;            ///< MCS present
+    uint8_t mcs_known;       ///< MCS known bits
+    uint8_t mcs_flags;       ///< MCS flags (bandwidth, GI, format, FEC, STBC)
+    uint8_t mcs_index;       ///< MCS rate index
+    uint8_t n_vendor;        ///< vendor namespaces skipped
+} hs_radiotap_t;
+
+/// Parse the radiotap header at the start of `buf` (`len` captured bytes). Fills *rt
+/// and returns 0 when the header is usable (status HS_RT_OK, HS_RT_STOP_UNKNOWN or
+/// HS_RT_FIELD_OVERRUN; the 802.11 frame starts at it_len), -1 otherwise (status says
+/// why). Never reads outside buf[0, len).
+int hs_radiotap_parse(const uint8_t *buf, size_t len, hs_radiotap_t *rt);
+
+/// One line describing a status ("version byte is not 0", ...).
+const char *hs_radiotap_status_str(hs_rt_status_t st);
+
+/// 802.11 frame types (frame control bits 2-3).
+enum {
+    HS_WLAN_MGMT = 0, ///< management
+    HS_WLAN_CTRL = 1, ///< control
+    HS_WLAN_DATA = 2, ///< data
+    HS_WLAN_EXT = 3,  ///< extension
+};
+
+/// What the 802.11 MAC header says. Addresses follow IEEE 802.11-2020 Table 9-30 and
+/// Wireshark's wlan.ta / wlan.sa fields.
+typedef struct hs_wlan {
+    uint16_t fc;          ///< frame control, host order
+    uint8_t type;         ///< HS_WLAN_*
+    uint8_t subtype;      ///< subtype, 0..15
+    uint8_t ds;           ///< ToDS | FromDS << 1 (0..3)
+    bool has_ta;          ///< a transmitter address is in the frame
+    uint8_t ta[6];        ///< transmitter address (addr2)
+    bool has_sa;          ///< a source address is in the frame (wlan.sa)
+    uint8_t sa[6];        ///< source address
+    bool has_seq;         ///< a sequence control field is in the frame
+    uint16_t seq;         ///< sequence number, 0..4095 (for the packet delivery ratio)
+    uint8_t frag;         ///< fragment number, 0..15
+    uint16_t hdr_len;     ///< bytes of MAC header parsed (through the last address / seq)
+} hs_wlan_t;
+
+/// Parse the 802.11 MAC header of `frame` (`len` bytes, FCS already removed). Returns 0
+/// when at least the frame control was readable (fields that do not fit are reported
+/// absent: an ACK or a frame cut short has no SA), -1 when len < 2.
+int hs_wlan_parse(const uint8_t *frame, size_t len, hs_wlan_t *w);
+
+/// One parsed capture record: radiotap + 802.11, as the feeder needs it.
+typedef struct hs_rt_frame {
+    hs_radiotap_t rt;     ///< the radiotap header
+    hs_wlan_t wlan;       ///< the 802.11 header (valid when wlan_ok)
+    bool wlan_ok;         ///< an 802.11 header followed the radiotap header
+    uint32_t frame_len;   ///< 802.11 bytes after radiotap, FCS removed when flagged
+} hs_rt_frame_t;
+
+/// Parse a whole captured record. Returns 0 when the radiotap header was usable (the
+/// 802.11 part may still be absent: see wlan_ok), -1 otherwise.
+int hs_rt_frame_parse(const uint8_t *buf, size_t len, hs_rt_frame_t *f);
+
+#endif /* HS_RADIOTAP_H */

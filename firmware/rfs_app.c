@@ -64,6 +64,11 @@ int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *ma
                       &mem) != 0) {
         return -1;
     }
+    const rfs_can_rx_cfg_t rx_cfg = rfs_can_rx_cfg_default();
+    if (rfs_can_rx_init(&a->can_rx, &rx_cfg) != 0) {
+        return -1;
+    }
+    rfs_can_tx_init(&a->can_tx);
     a->after_reset = true;
     return 0;
 }
@@ -139,4 +144,59 @@ void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out)
     a->bad_frame = false;
     a->stats.steps++;
     a->last = *out;
+}
+
+rfs_can_err_t rfs_app_on_can(rfs_app_t *a, const rfs_can_frame_t *f, int64_t rx_us)
+{
+    rfs_can_msg_t msg;
+    const rfs_can_err_t e = rfs_can_rx_frame(&a->can_rx, f, rx_us, &msg);
+    if (e == RFS_CAN_E_ID) {
+        a->stats.unknown_frames++;
+        return e;
+    }
+    if (e != RFS_CAN_OK) {
+        a->stats.bad_frames++;
+        a->bad_frame = true;
+        return e;
+    }
+    if (msg.kind == RFS_CAN_MSG_POSE) {
+        (void)rfs_app_on_pose(a, &msg.pose, rx_us);
+    } else if (msg.kind == RFS_CAN_MSG_RSSI) {
+        (void)rfs_app_on_rssi(a, msg.rssi_src, msg.rssi_t_us, msg.rssi_dbm, rx_us);
+    }
+    return e;
+}
+
+uint8_t rfs_app_frames(rfs_app_t *a, const rfs_app_out_t *out, rfs_can_frame_t frames[2])
+{
+    rfs_can_wheel_t wheel;
+    wheel.left_mm_s = out->left_mm_s;
+    wheel.right_mm_s = out->right_mm_s;
+    /* STOP whenever the controller is not following a goal or a safety stop holds:
+     * the motor controller may brake instead of ramping. */
+    const bool moving = out->state == RFS_SEEK_DRIVING &&
+                        (out->faults & 0xFF00u & ~(uint32_t)RFS_APP_FAULT_BAD_FRAME) == 0u;
+    wheel.flags = moving ? 0u : RFS_CAN_WHEEL_STOP;
+
+    rfs_can_status_t st;
+    memset(&st, 0, sizeof st);
+    st.state = (uint8_t)out->state;
+    st.kind = (uint8_t)out->decision.kind;
+    st.prev = (uint8_t)out->decision.prev;
+    st.relearned = out->decision.relearned;
+    st.line_search = out->decision.line_search;
+    /* The frame carries the seeker's fault bits; lost inputs show as stale ones. */
+    uint8_t faults = (uint8_t)(out->faults & 0xFFu);
+    if ((out->faults & RFS_APP_FAULT_POSE_LOST) != 0u) {
+        faults |= RFS_SEEK_FAULT_POSE_STALE;
+    }
+    if ((out->faults & RFS_APP_FAULT_RSSI_LOST) != 0u) {
+        faults |= RFS_SEEK_FAULT_RSSI_STALE;
+    }
+    st.faults = faults;
+    st.iteration = out->decision.iteration;
+
+    rfs_can_tx_wheel(&a->can_tx, &wheel, &frames[0]);
+    rfs_can_tx_status(&a->can_tx, &st, &frames[1]);
+    return 2u;
 }

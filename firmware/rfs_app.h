@@ -31,6 +31,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "rfs_can.h"
 #include "rfs_fix.h"
 #include "rfs_map.h"
 #include "rfs_ridge.h"
@@ -125,7 +126,8 @@ typedef struct rfs_app {
     bool bus_off;                                   ///< the transport reports bus-off
     bool after_reset;                               ///< no step has run since init
     bool bad_frame;                                 ///< a frame failed since the last step
-    uint8_t tx_counter;                             ///< rolling counter of our frames
+    rfs_can_rx_t can_rx;                            ///< CAN receiver: counters, pose pairing
+    rfs_can_tx_t can_tx;                            ///< CAN sender: rolling counters
     rfs_app_stats_t stats;                          ///< counters
     rfs_app_out_t last;                             ///< output of the latest step
     rfs_sample_t samples[RFS_APP_MAX_SAMPLES];      ///< the sample store
@@ -156,5 +158,13 @@ void rfs_app_set_bus_off(rfs_app_t *a, bool off);
 
 /// One control period at local time now_us. Cannot fail.
 void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out);
+
+/// A raw CAN frame arrived at local time rx_us: decoded with rfs_can (pose pairs, RSSI;
+/// other ids counted as unknown) and fed to the seeker. Returns the decode result.
+rfs_can_err_t rfs_app_on_can(rfs_app_t *a, const rfs_can_frame_t *f, int64_t rx_us);
+
+/// Encode a step's output as its CAN frames, in sending order: frames[0] = WHEEL_CMD,
+/// frames[1] = STATUS. Advances the rolling counters. Returns 2.
+uint8_t rfs_app_frames(rfs_app_t *a, const rfs_app_out_t *out, rfs_can_frame_t frames[2]);
 
 #endif /* RFS_APP_H */

@@ -1,0 +1,536 @@
+/* rfs_can.c - the rfseek CAN protocol (layouts in docs/CAN.md and can/rfseek.dbc). */
+#include "rfs_can.h"
+
+#include <string.h>
+
+/* Byte helpers: every field is little-endian (Intel). */
+static void put_u16(uint8_t *p, uint16_t v)
+{
+    p[0] = (uint8_t)v;
+    p[1] = (uint8_t)(v >> 8);
+}
+
+static void put_u24(uint8_t *p, uint32_t v)
+{
+    p[0] = (uint8_t)v;
+    p[1] = (uint8_t)(v >> 8);
+    p[2] = (uint8_t)(v >> 16);
+}
+
+static void put_u32(uint8_t *p, uint32_t v)
+{
+    put_u16(p, (uint16_t)v);
+    put_u16(p + 2, (uint16_t)(v >> 16));
+}
+
+static uint16_t get_u16(const uint8_t *p)
+{
+    return (uint16_t)(p[0] | (p[1] << 8));
+}
+
+static uint32_t get_u32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+
+/* Sign-extend a 24-bit two's complement field. */
+static int32_t get_s24(const uint8_t *p)
+{
+    uint32_t v = (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16);
+    return (int32_t)(v ^ 0x800000u) - 0x800000;
+}
+
+static uint8_t crc8_update(uint8_t crc, uint8_t byte)
+{
+    crc ^= byte;
+    for (int b = 0; b < 8; b++) {
+        crc = (uint8_t)((crc & 0x80u) ? ((unsigned)crc << 1) ^ 0x1Du : (unsigned)crc << 1);
+    }
+    return crc;
+}
+
+uint8_t rfs_can_crc8(const uint8_t *p, uint32_t n)
+{
+    uint8_t crc = 0xFFu;
+    for (uint32_t i = 0; i < n; i++) {
+        crc = crc8_update(crc, p[i]);
+    }
+    return (uint8_t)(crc ^ 0xFFu);
+}
+
+uint8_t rfs_can_checksum(uint32_t id, uint8_t dlc, const uint8_t *data)
+{
+    uint8_t crc = 0xFFu;
+    crc = crc8_update(crc, (uint8_t)id);
+    crc = crc8_update(crc, (uint8_t)(id >> 8));
+    for (uint8_t i = 0; i + 1u < dlc; i++) {
+        crc = crc8_update(crc, data[i]);
+    }
+    return (uint8_t)(crc ^ 0xFFu);
+}
+
+/* Start a frame: id, DLC, zeroed payload, counter and flags nibble in data[0]. */
+static void frame_begin(rfs_can_frame_t *f, uint32_t id, uint8_t dlc, uint8_t counter, uint8_t high_nibble)
+{
+    memset(f, 0, sizeof(*f));
+    f->id = id;
+    f->dlc = dlc;
+    f->data[0] = (uint8_t)((counter & 0x0Fu) | ((high_nibble & 0x0Fu) << 4));
+}
+
+static void frame_seal(rfs_can_frame_t *f)
+{
+    f->data[f->dlc - 1u] = rfs_can_checksum(f->id, f->dlc, f->data);
+}
+
+/* Common checks of a received frame against one layout. */
+static rfs_can_err_t frame_check(const rfs_can_frame_t *f, uint32_t id, uint8_t dlc)
+{
+    if (f->id != id) {
+        return RFS_CAN_E_ID;
+    }
+    if (f->dlc != dlc) {
+        return RFS_CAN_E_DLC;
+    }
+    if (f->data[dlc - 1u] != rfs_can_checksum(f->id, f->dlc, f->data)) {
+        return RFS_CAN_E_CHECKSUM;
+    }
+    return RFS_CAN_OK;
+}
+
+static int32_t sat_s24(int32_t v)
+{
+    return v > RFS_CAN_POS_MM_MAX ? RFS_CAN_POS_MM_MAX : (v < RFS_CAN_POS_MM_MIN ? RFS_CAN_POS_MM_MIN : v);
+}
+
+void rfs_can_pack_wheel(const rfs_can_wheel_t *w, uint8_t counter, rfs_can_frame_t *f)
+{
+    frame_begin(f, RFS_CAN_ID_WHEEL_CMD, RFS_CAN_DLC_WHEEL_CMD, counter, w->flags);
+    put_u16(&f->data[1], (uint16_t)w->left_mm_s);
+    put_u16(&f->data[3], (uint16_t)w->right_mm_s);
+    frame_seal(f);
+}
+
+void rfs_can_pack_pose_xy(const rfs_can_pose_t *p, uint8_t counter, rfs_can_frame_t *f)
+{
+    frame_begin(f, RFS_CAN_ID_POSE_XY, RFS_CAN_DLC_POSE_XY, counter, 0);
+    put_u24(&f->data[1], (uint32_t)sat_s24(p->x_mm));
+    put_u24(&f->data[4], (uint32_t)sat_s24(p->y_mm));
+    frame_seal(f);
+}
+
+void rfs_can_pack_pose_th(const rfs_can_pose_t *p, uint8_t counter, rfs_can_frame_t *f)
+{
+    frame_begin(f, RFS_CAN_ID_POSE_TH, RFS_CAN_DLC_POSE_TH, counter, 0);
+    put_u16(&f->data[1], (uint16_t)p->theta_q13);
+    put_u32(&f->data[3], p->t_us32);
+    frame_seal(f);
+}
+
+void rfs_can_pack_rssi(const rfs_can_rssi_t *r, uint8_t counter, rfs_can_frame_t *f)
+{
+    frame_begin(f, RFS_CAN_ID_RSSI, RFS_CAN_DLC_RSSI, counter, r->src);
+    f->data[1] = (uint8_t)r->dbm;
+    f->data[2] = r->seq;
+    put_u32(&f->data[3], r->t_us32);
+    frame_seal(f);
+}
+
+void rfs_can_pack_status(const rfs_can_status_t *s, uint8_t counter, rfs_can_frame_t *f)
+{
+    frame_begin(f, RFS_CAN_ID_STATUS, RFS_CAN_DLC_STATUS, counter, (uint8_t)(s->state & 0x3u));
+    f->data[1] = (uint8_t)((s->kind & 0x3u) | ((s->relearned ? 1u : 0u) << 2) |
+                           ((s->line_search ? 1u : 0u) << 3) | ((s->prev & 0x7u) << 4));
+    f->data[2] = s->faults;
+    put_u32(&f->data[3], s->iteration);
+    frame_seal(f);
+}
+
+rfs_can_err_t rfs_can_unpack_wheel(const rfs_can_frame_t *f, rfs_can_wheel_t *w, uint8_t *counter)
+{
+    rfs_can_err_t e = frame_check(f, RFS_CAN_ID_WHEEL_CMD, RFS_CAN_DLC_WHEEL_CMD);
+    if (e != RFS_CAN_OK) {
+        return e;
+    }
+    if ((f->data[0] >> 4) & ~RFS_CAN_WHEEL_STOP) {
+        return RFS_CAN_E_RANGE;
+    }
+    w->flags = (uint8_t)(f->data[0] >> 4);
+    w->left_mm_s = (int16_t)get_u16(&f->data[1]);
+    w->right_mm_s = (int16_t)get_u16(&f->data[3]);
+    *counter = f->data[0] & 0x0Fu;
+    return RFS_CAN_OK;
+}
+
+rfs_can_err_t rfs_can_unpack_pose_xy(const rfs_can_frame_t *f, rfs_can_pose_t *p, uint8_t *counter)
+{
+    rfs_can_err_t e = frame_check(f, RFS_CAN_ID_POSE_XY, RFS_CAN_DLC_POSE_XY);
+    if (e != RFS_CAN_OK) {
+        return e;
+    }
+    if (f->data[0] >> 4) {
+        return RFS_CAN_E_RANGE;
+    }
+    p->x_mm = get_s24(&f->data[1]);
+    p->y_mm = get_s24(&f->data[4]);
+    *counter = f->data[0] & 0x0Fu;
+    return RFS_CAN_OK;
+}
+
+rfs_can_err_t rfs_can_unpack_pose_th(const rfs_can_frame_t *f, rfs_can_pose_t *p, uint8_t *counter)
+{
+    rfs_can_err_t e = frame_check(f, RFS_CAN_ID_POSE_TH, RFS_CAN_DLC_POSE_TH);
+    if (e != RFS_CAN_OK) {
+        return e;
+    }
+    int16_t theta = (int16_t)get_u16(&f->data[1]);
+    /* (-pi, pi] in Q2.13 is (-25736, 25736]; anything outside is a corrupt sender. */
+    if ((f->data[0] >> 4) || theta > 25736 || theta < -25736) {
+        return RFS_CAN_E_RANGE;
+    }
+    p->theta_q13 = theta;
+    p->t_us32 = get_u32(&f->data[3]);
+    *counter = f->data[0] & 0x0Fu;
+    return RFS_CAN_OK;
+}
+
+rfs_can_err_t rfs_can_unpack_rssi(const rfs_can_frame_t *f, rfs_can_rssi_t *r, uint8_t *counter)
+{
+    rfs_can_err_t e = frame_check(f, RFS_CAN_ID_RSSI, RFS_CAN_DLC_RSSI);
+    if (e != RFS_CAN_OK) {
+        return e;
+    }
+    r->src = (uint8_t)(f->data[0] >> 4);
+    r->dbm = (int8_t)f->data[1];
+    r->seq = f->data[2];
+    r->t_us32 = get_u32(&f->data[3]);
+    *counter = f->data[0] & 0x0Fu;
+    return RFS_CAN_OK;
+}
+
+rfs_can_err_t rfs_can_unpack_status(const rfs_can_frame_t *f, rfs_can_status_t *s, uint8_t *counter)
+{
+    rfs_can_err_t e = frame_check(f, RFS_CAN_ID_STATUS, RFS_CAN_DLC_STATUS);
+    if (e != RFS_CAN_OK) {
+        return e;
+    }
+    uint8_t prev = (uint8_t)((f->data[1] >> 4) & 0x7u);
+    if ((f->data[0] >> 6) || (f->data[1] & 0x80u) || prev > RFS_DRIVE_BLOCKED) {
+        return RFS_CAN_E_RANGE;
+    }
+    s->state = (uint8_t)((f->data[0] >> 4) & 0x3u);
+    s->kind = (uint8_t)(f->data[1] & 0x3u);
+    s->relearned = (f->data[1] & 0x4u) != 0;
+    s->line_search = (f->data[1] & 0x8u) != 0;
+    s->prev = prev;
+    s->faults = f->data[2];
+    s->iteration = get_u32(&f->data[3]);
+    *counter = f->data[0] & 0x0Fu;
+    return RFS_CAN_OK;
+}
+
+int64_t rfs_can_unwrap_time(int64_t ref_us, uint32_t raw)
+{
+    /* Difference modulo 2^32 reinterpreted as signed: in [-2^31, 2^31). */
+    int32_t d = (int32_t)(raw - (uint32_t)(uint64_t)ref_us);
+    if (d > 0 && ref_us > INT64_MAX - d) {
+        return INT64_MAX;
+    }
+    if (d < 0 && ref_us < INT64_MIN - d) {
+        return INT64_MIN;
+    }
+    return ref_us + d;
+}
+
+rfs_q16_t rfs_can_mm_to_q16(int32_t mm)
+{
+    return rfs_sat32(rfs_sdiv64_round((int64_t)mm * 65536, 1000));
+}
+
+int32_t rfs_can_q16_to_mm(rfs_q16_t q)
+{
+    return sat_s24((int32_t)rfs_sdiv64_round((int64_t)q * 1000, 65536));
+}
+
+int16_t rfs_can_q16_to_theta(rfs_q16_t q)
+{
+    return rfs_sat16(((int64_t)q + 4) >> 3);
+}
+
+rfs_pose_t rfs_can_pose_to_core(const rfs_can_pose_t *p, int64_t t_us)
+{
+    rfs_pose_t pose;
+    pose.t_us = t_us;
+    pose.x = rfs_can_mm_to_q16(p->x_mm);
+    pose.y = rfs_can_mm_to_q16(p->y_mm);
+    pose.theta = rfs_can_theta_to_q16(p->theta_q13);
+    return pose;
+}
+
+rfs_can_pose_t rfs_can_pose_from_core(const rfs_pose_t *pose)
+{
+    rfs_can_pose_t p;
+    p.x_mm = rfs_can_q16_to_mm(pose->x);
+    p.y_mm = rfs_can_q16_to_mm(pose->y);
+    p.theta_q13 = rfs_can_q16_to_theta(pose->theta);
+    p.t_us32 = rfs_can_wrap_time(pose->t_us);
+    return p;
+}
+
+void rfs_can_from_seek_out(const rfs_seek_out_t *out, rfs_can_status_t *status, rfs_can_wheel_t *wheel)
+{
+    status->state = (uint8_t)out->state;
+    status->kind = (uint8_t)out->decision.kind;
+    status->prev = (uint8_t)out->decision.prev;
+    status->relearned = out->decision.relearned;
+    status->line_search = out->decision.line_search;
+    status->faults = (uint8_t)out->faults;
+    status->iteration = out->decision.iteration;
+    wheel->left_mm_s = out->left_mm_s;
+    wheel->right_mm_s = out->right_mm_s;
+    wheel->flags = out->state == RFS_SEEK_DRIVING ? 0u : RFS_CAN_WHEEL_STOP;
+}
+
+void rfs_can_tx_init(rfs_can_tx_t *tx)
+{
+    memset(tx, 0, sizeof(*tx));
+}
+
+static uint8_t tx_next(rfs_can_tx_t *tx, rfs_can_msg_idx_t i)
+{
+    uint8_t c = tx->counter[i];
+    tx->counter[i] = (uint8_t)((c + 1u) & 0x0Fu);
+    return c;
+}
+
+void rfs_can_tx_wheel(rfs_can_tx_t *tx, const rfs_can_wheel_t *w, rfs_can_frame_t *f)
+{
+    rfs_can_pack_wheel(w, tx_next(tx, RFS_CAN_IDX_WHEEL_CMD), f);
+}
+
+void rfs_can_tx_pose(rfs_can_tx_t *tx, const rfs_can_pose_t *p, rfs_can_frame_t *xy, rfs_can_frame_t *th)
+{
+    /* Both halves carry one counter so the receiver can pair them. */
+    uint8_t c = tx_next(tx, RFS_CAN_IDX_POSE_XY);
+    tx->counter[RFS_CAN_IDX_POSE_TH] = tx->counter[RFS_CAN_IDX_POSE_XY];
+    rfs_can_pack_pose_xy(p, c, xy);
+    rfs_can_pack_pose_th(p, c, th);
+}
+
+void rfs_can_tx_rssi(rfs_can_tx_t *tx, const rfs_can_rssi_t *r, rfs_can_frame_t *f)
+{
+    rfs_can_pack_rssi(r, tx_next(tx, RFS_CAN_IDX_RSSI), f);
+}
+
+void rfs_can_tx_status(rfs_can_tx_t *tx, const rfs_can_status_t *s, rfs_can_frame_t *f)
+{
+    rfs_can_pack_status(s, tx_next(tx, RFS_CAN_IDX_STATUS), f);
+}
+
+rfs_can_rx_cfg_t rfs_can_rx_cfg_default(void)
+{
+    rfs_can_rx_cfg_t c;
+    c.max_age_us = 1000000;
+    c.max_future_us = 100000;
+    return c;
+}
+
+int rfs_can_rx_init(rfs_can_rx_t *rx, const rfs_can_rx_cfg_t *cfg)
+{
+    const int64_t hour_us = 3600LL * 1000000LL;
+    if (cfg->max_age_us <= 0 || cfg->max_age_us > hour_us || cfg->max_future_us < 0 ||
+        cfg->max_future_us > hour_us) {
+        return -1;
+    }
+    memset(rx, 0, sizeof(*rx));
+    rx->cfg = *cfg;
+    return 0;
+}
+
+static rfs_can_err_t drop(rfs_can_rx_t *rx, rfs_can_err_t e)
+{
+    if (rx->dropped[e] < UINT32_MAX) {
+        rx->dropped[e]++;
+    }
+    return e;
+}
+
+static void bump(uint32_t *v, uint32_t by)
+{
+    *v = (*v > UINT32_MAX - by) ? UINT32_MAX : *v + by;
+}
+
+/* Counter check: a repeat is a duplicate (reject); a jump is counted and accepted. */
+static rfs_can_err_t counter_check(const rfs_can_rx_t *rx, rfs_can_msg_idx_t i, uint8_t c)
+{
+    if (rx->have_counter[i] && c == rx->last_counter[i]) {
+        return RFS_CAN_E_REPEAT;
+    }
+    return RFS_CAN_OK;
+}
+
+static void counter_accept(rfs_can_rx_t *rx, rfs_can_msg_idx_t i, uint8_t c)
+{
+    if (rx->have_counter[i]) {
+        uint8_t gap = (uint8_t)((c - rx->last_counter[i] - 1u) & 0x0Fu);
+        if (gap != 0) {
+            bump(&rx->msg[i].counter_jumps, 1);
+            bump(&rx->msg[i].lost, gap);
+        }
+    }
+    rx->last_counter[i] = c;
+    rx->have_counter[i] = true;
+    bump(&rx->msg[i].accepted, 1);
+}
+
+/* Time window check of an unwrapped timestamp against now and the stream's newest. */
+static rfs_can_err_t time_check(const rfs_can_rx_t *rx, int64_t t, int64_t now_us, bool have_last, int64_t last)
+{
+    if (t < now_us - rx->cfg.max_age_us) {
+        return RFS_CAN_E_STALE;
+    }
+    if (t > now_us + rx->cfg.max_future_us) {
+        return RFS_CAN_E_FUTURE;
+    }
+    if (have_last && t < last) {
+        return RFS_CAN_E_ORDER;
+    }
+    return RFS_CAN_OK;
+}
+
+rfs_can_err_t rfs_can_rx_frame(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int64_t now_us, rfs_can_msg_t *msg)
+{
+    rfs_can_err_t e;
+    uint8_t c = 0;
+    msg->kind = RFS_CAN_MSG_NONE;
+    /* Keep the window arithmetic far from the int64 limits. */
+    const int64_t lim = (int64_t)1 << 60;
+    now_us = now_us > lim ? lim : (now_us < -lim ? -lim : now_us);
+    switch (f->id) {
+    case RFS_CAN_ID_WHEEL_CMD: {
+        rfs_can_wheel_t w;
+        e = rfs_can_unpack_wheel(f, &w, &c);
+        if (e == RFS_CAN_OK) {
+            e = counter_check(rx, RFS_CAN_IDX_WHEEL_CMD, c);
+        }
+        if (e != RFS_CAN_OK) {
+            return drop(rx, e);
+        }
+        counter_accept(rx, RFS_CAN_IDX_WHEEL_CMD, c);
+        msg->kind = RFS_CAN_MSG_WHEEL;
+        msg->wheel = w;
+        return RFS_CAN_OK;
+    }
+    case RFS_CAN_ID_STATUS: {
+        rfs_can_status_t s;
+        e = rfs_can_unpack_status(f, &s, &c);
+        if (e == RFS_CAN_OK) {
+            e = counter_check(rx, RFS_CAN_IDX_STATUS, c);
+        }
+        if (e != RFS_CAN_OK) {
+            return drop(rx, e);
+        }
+        counter_accept(rx, RFS_CAN_IDX_STATUS, c);
+        msg->kind = RFS_CAN_MSG_STATUS;
+        msg->status = s;
+        return RFS_CAN_OK;
+    }
+    case RFS_CAN_ID_POSE_XY: {
+        rfs_can_pose_t p;
+        e = rfs_can_unpack_pose_xy(f, &p, &c);
+        if (e == RFS_CAN_OK) {
+            e = counter_check(rx, RFS_CAN_IDX_POSE_XY, c);
+        }
+        if (e != RFS_CAN_OK) {
+            return drop(rx, e);
+        }
+        if (rx->have_pending) {
+            /* The previous XY never got its TH: that pose is lost. */
+            (void)drop(rx, RFS_CAN_E_PAIR);
+        }
+        counter_accept(rx, RFS_CAN_IDX_POSE_XY, c);
+        rx->pending.x_mm = p.x_mm;
+        rx->pending.y_mm = p.y_mm;
+        rx->pending_counter = c;
+        rx->have_pending = true;
+        return RFS_CAN_OK;
+    }
+    case RFS_CAN_ID_POSE_TH: {
+        rfs_can_pose_t p;
+        e = rfs_can_unpack_pose_th(f, &p, &c);
+        if (e == RFS_CAN_OK) {
+            e = counter_check(rx, RFS_CAN_IDX_POSE_TH, c);
+        }
+        if (e == RFS_CAN_OK && (!rx->have_pending || rx->pending_counter != c)) {
+            e = RFS_CAN_E_PAIR;
+        }
+        int64_t t = 0;
+        if (e == RFS_CAN_OK) {
+            t = rfs_can_unwrap_time(now_us, p.t_us32);
+            e = time_check(rx, t, now_us, rx->have_pose, rx->last_pose_us);
+        }
+        if (e != RFS_CAN_OK) {
+            if (e != RFS_CAN_E_PAIR && e != RFS_CAN_E_REPEAT) {
+                rx->have_pending = false;
+            }
+            return drop(rx, e);
+        }
+        counter_accept(rx, RFS_CAN_IDX_POSE_TH, c);
+        rx->have_pending = false;
+        p.x_mm = rx->pending.x_mm;
+        p.y_mm = rx->pending.y_mm;
+        rx->last_pose_us = t;
+        rx->have_pose = true;
+        msg->kind = RFS_CAN_MSG_POSE;
+        msg->pose = rfs_can_pose_to_core(&p, t);
+        return RFS_CAN_OK;
+    }
+    case RFS_CAN_ID_RSSI: {
+        rfs_can_rssi_t r;
+        e = rfs_can_unpack_rssi(f, &r, &c);
+        if (e == RFS_CAN_OK) {
+            e = counter_check(rx, RFS_CAN_IDX_RSSI, c);
+        }
+        int64_t t = 0;
+        if (e == RFS_CAN_OK) {
+            t = rfs_can_unwrap_time(now_us, r.t_us32);
+            e = time_check(rx, t, now_us, (rx->have_rssi >> r.src) & 1u, rx->last_rssi_us[r.src]);
+        }
+        if (e != RFS_CAN_OK) {
+            return drop(rx, e);
+        }
+        counter_accept(rx, RFS_CAN_IDX_RSSI, c);
+        if (((rx->have_rssi >> r.src) & 1u) && r.seq != rx->last_seq[r.src]) {
+            bump(&rx->rssi_seq_gaps, (uint8_t)(r.seq - rx->last_seq[r.src] - 1u));
+        }
+        rx->have_rssi = (uint16_t)(rx->have_rssi | (1u << r.src));
+        rx->last_rssi_us[r.src] = t;
+        rx->last_seq[r.src] = r.seq;
+        msg->kind = RFS_CAN_MSG_RSSI;
+        msg->rssi_src = r.src;
+        msg->rssi_dbm = r.dbm;
+        msg->rssi_seq = r.seq;
+        msg->rssi_t_us = t;
+        return RFS_CAN_OK;
+    }
+    default:
+        return drop(rx, RFS_CAN_E_ID);
+    }
+}
+
+uint32_t rfs_can_rx_dropped_total(const rfs_can_rx_t *rx)
+{
+    uint32_t n = 0;
+    for (unsigned i = 1; i < RFS_CAN_NERR; i++) {
+        bump(&n, rx->dropped[i]);
+    }
+    return n;
+}
+
+const char *rfs_can_err_str(rfs_can_err_t e)
+{
+    static const char *const names[RFS_CAN_NERR] = {
+        "ok", "id", "dlc", "checksum", "range", "repeat", "pair", "stale", "future", "order",
+    };
+    return (unsigned)e < RFS_CAN_NERR ? names[e] : "?";
+}

@@ -52,7 +52,9 @@ typedef struct rfs_drive {
     int32_t right_mm_s;            ///< last commanded right wheel speed, mm/s
 } rfs_drive_t;
 
-/// Defaults: TurtleBot 2 (Kobuki) base, 0.1 m goal tolerance, 30 s timeout.
+/// Defaults: TurtleBot 2 (Kobuki) base: 0.23 m, 0.7 m/s, 1 m/s^2 (the TurtleBot velocity
+/// smoother's accel_lim_v); 0.1 m goal tolerance, turn on the spot above 0.75 rad,
+/// 30 s timeout, blocked when less than 0.1 m of progress in 5 s.
 rfs_drive_cfg_t rfs_drive_cfg_default(void);
 
 /// Initialise idle. Returns 0, or -1 on a non-positive wheel base, speed, acceleration,

@@ -121,31 +121,41 @@ rfs_q16_t rfs_q16_exp_neg(rfs_q16_t x)
     return (rfs_q16_t)((v + (1 << 13)) >> 14);
 }
 
-rfs_q16_t rfs_q16_log2(rfs_q16_t x)
+/* log2(x) for x > 0 (x Q16.16) in Q43.20: the integer part from the bit length, 20
+ * fraction bits by repeated squaring of a Q31 mantissa in [1, 2) (squares < 2^64 in
+ * uint64, truncated). Error below 2^-19 (measured over the whole range by test_fix). */
+static int64_t log2_q20(rfs_q16_t x)
 {
-    RFS_ASSERT(x > 0);
-    /* x = 2^e * m, m in [1, 2). Integer part: e = bitlen - 17 (Q16). */
     int bitlen = 32 - __builtin_clz((uint32_t)x);
-    int32_t e = bitlen - 17;
-    /* Mantissa in Q30: shift x so its top bit lands at bit 30. */
-    uint64_t m = bitlen <= 31 ? (uint64_t)(uint32_t)x << (31 - bitlen)
-                              : (uint64_t)(uint32_t)x >> (bitlen - 31);
-    int32_t frac = 0;
-    for (int i = 0; i < 16; ++i) {
-        m = (m * m) >> 30; /* m^2 in Q30, m < 2 so m^2 < 4: fits 33 bits */
+    int64_t e = bitlen - 17;
+    /* Mantissa in Q31: the top bit of x lands at bit 31. */
+    uint64_t m = (uint64_t)(uint32_t)x << (32 - bitlen);
+    int64_t frac = 0;
+    for (int i = 0; i < 20; ++i) {
+        m = (m * m) >> 31; /* m < 2^32, m^2 < 2^64; result in [1, 4) Q31 */
         frac <<= 1;
-        if (m >= ((uint64_t)2 << 30)) {
+        if (m >= ((uint64_t)2 << 31)) {
             m >>= 1;
             frac |= 1;
         }
     }
-    return (rfs_q16_t)(e * 65536 + frac);
+    return e * ((int64_t)1 << 20) + frac;
+}
+
+rfs_q16_t rfs_q16_log2(rfs_q16_t x)
+{
+    RFS_ASSERT(x > 0);
+    /* Q20 to Q16, rounded to nearest (ties up). */
+    return (rfs_q16_t)((log2_q20(x) + 8) >> 4);
 }
 
 rfs_q16_t rfs_q16_db10(rfs_q16_t x)
 {
-    /* 10*log10(x) = log2(x) * 10*log10(2); 10*log10(2) = 3.0103 = 197290 in Q16. */
-    return rfs_q16_mul(rfs_q16_log2(x), 197290);
+    RFS_ASSERT(x > 0);
+    /* 10*log10(x) = log2(x) * 10*log10(2). 10*log10(2) = 3.01029996 = 808071242 in Q28
+     * (rounded). Scaling and overflow: |log2| < 17 in Q20 (< 2^25) x Q28 (< 2^30) =
+     * Q48 < 2^55 in int64; + 2^31, >> 32 rounds to Q16. */
+    return (rfs_q16_t)((log2_q20(x) * 808071242 + ((int64_t)1 << 31)) >> 32);
 }
 
 static rfs_i128_t u128_mul(uint64_t a, uint64_t b)

@@ -91,18 +91,22 @@ uint32_t rfs_isqrt64(uint64_t v);
 rfs_q16_t rfs_q16_sqrt(rfs_q16_t x);
 
 /// e^(-x) for x >= 0 in Q16.16, result in [0, 1] Q16.16; negative x is clamped to 0
-/// (result 1.0). Error <= 1 LSB (1.5e-5) over the whole input range (tested).
+/// (result 1.0). Error <= 0.55 LSB (8.4e-6) over the whole input range (tested
+/// exhaustively on [0, 13); above 13 the result is 0, off by < 0.15 LSB).
 /// Scaling and overflow: integer part from a Q30 table of e^-n (n <= 12, above that
 /// the result rounds to 0), the top 4 fraction bits from a Q30 table of e^-(k/16),
 /// the last 12 bits by a cubic Taylor term in Q30; products Q60 in int64 >> 30.
 rfs_q16_t rfs_q16_exp_neg(rfs_q16_t x);
 
-/// log2(x) for x > 0 in Q16.16, error <= 2 LSB; x <= 0 is a programmer error.
-/// Scaling and overflow: the integer part from the bit length; the fraction by
-/// 16 rounds of squaring a Q30 mantissa in [1, 2) (products Q60 in uint64).
+/// log2(x) for x > 0 in Q16.16, rounded to nearest: error <= 0.51 LSB (tested over the
+/// whole range); x <= 0 is a programmer error.
+/// Scaling and overflow: the integer part from the bit length; 20 fraction bits by
+/// squaring a Q31 mantissa in [1, 2) (squares < 2^64 in uint64), rounded to 16.
 rfs_q16_t rfs_q16_log2(rfs_q16_t x);
 
-/// 10*log10(x) for x > 0 in Q16.16 (decibels of a power ratio), error <= 3 LSB.
+/// 10*log10(x) for x > 0 in Q16.16 (decibels of a power ratio), error <= 0.75 LSB
+/// (tested); x <= 0 is a programmer error.
+/// Scaling and overflow: log2 in Q20 (< 2^25) times 10*log10(2) in Q28 = Q48 in int64.
 rfs_q16_t rfs_q16_db10(rfs_q16_t x);
 
 /// Signed 128-bit integer as two 64-bit halves (two's complement).

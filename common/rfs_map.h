@@ -8,13 +8,15 @@
  * cell (0, 0) is the lower-left cell, whose lower-left corner is at the origin.
  *
  * "movements are restricted to legal movements, i.e., ones which are not part of a wall
- * or outside of the known map": a point is legal when its cell is on the map and every
- * cell within `clearance` of it is free; a straight move is legal when every cell its
- * segment passes through is legal.
+ * or outside of the known map": a point is legal when its cell is legal, i.e. that cell
+ * and every cell whose square comes closer than `clearance` to the cell's centre are on
+ * the map and free; a straight move is legal when every cell its segment touches (closed
+ * squares: corners and edges count, so no squeezing between diagonal obstacles) is legal.
+ * The segment traversal is exact (integer arithmetic, docs/MAPS.md).
  *
  * The lattice: greedy grid search, epsilon candidates and path planning all use one
- * lattice of points `grid` apart (default 0.25 m) with lattice point (0, 0) at the
- * centre of the cell the origin is in... precisely at origin + grid/2 in x and y.
+ * lattice of points `grid` apart (default 0.25 m): point (i, j) is at origin + grid/2 +
+ * (i, j) * grid, and lw x lh points lie inside the map's extent.
  */
 #ifndef RFS_MAP_H
 #define RFS_MAP_H
@@ -56,8 +58,9 @@ static inline uint32_t rfs_map_bytes(uint16_t w, uint16_t h)
 }
 
 /// Validate and derive the legal grid. Returns 0, or -1 on zero size, res <= 0,
-/// clearance < 0, grid <= 0, a map wider than 65535 cells or larger than +-16 km, or a
-/// null free/legal array.
+/// clearance < 0 or above 64 m or 255 cells, grid <= 0, an extent (w * res or h * res)
+/// above 16384 m or a far corner outside Q16.16, a lattice above 65535 points per axis or
+/// empty, or a null free/legal array. free and wall may be const data (flash).
 int rfs_map_init(rfs_map_t *m, const rfs_map_cfg_t *cfg, uint16_t w, uint16_t h,
                  rfs_q16_t res, rfs_q16_t origin_x, rfs_q16_t origin_y,
                  const uint8_t *free_bits, const uint8_t *wall_bits, uint8_t *legal_bits);
@@ -82,7 +85,8 @@ bool rfs_map_segment_legal(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q
                            rfs_q16_t y1);
 
 /// Walls crossed by the straight line: the number of runs of consecutive wall cells the
-/// segment passes through (0 when the map has no wall grid). Same rule as the simulator.
+/// segment touches, in order along it (0 when the map has no wall grid). Endpoints off
+/// the map are clamped onto its edge first.
 uint16_t rfs_map_walls_crossed(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,
                                rfs_q16_t y1);
 

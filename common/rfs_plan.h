@@ -1,12 +1,17 @@
 /* rfs_plan.h - shortest paths on the map lattice (the paper's robot used the ROS
  * navigation stack; the controller plans for itself).
  *
- * Breadth-first wavefront over the legal lattice points (8-connected, an edge exists
- * when the straight segment between the two points is legal), from the goal's lattice
- * point outward until the start's is reached, with diagonal steps costing 3/2 of
- * straight ones (octile approximation). The path is then shortened by string pulling:
- * from each kept waypoint, the farthest later waypoint reachable by a legal straight
- * segment. Work memory is caller-owned: one byte per lattice point and a queue.
+ * Dijkstra over the legal lattice points (8-connected, an edge exists when the straight
+ * segment between the two points is legal), from the goal's lattice point outward until
+ * the start's is closed, with integer costs 2 for a straight and 3 for a diagonal step
+ * (octile, diagonal 1.5 instead of 1.414) so the priority queue is Dial's: four ring
+ * buffers, one per cost mod 4. The start and the goal join the lattice through the
+ * closest legal lattice point of their 3 x 3 neighbourhood that a legal segment reaches
+ * (a start inside the clearance zone: the closest legal one of its 5 x 5, unchecked, so
+ * the robot can get out). The lattice path is then shortened by string pulling: from
+ * each kept waypoint, the farthest later point of the path still reachable by a legal
+ * straight segment. A goal in line of sight gives a one-waypoint path without search.
+ * Work memory is caller-owned: one byte per lattice point and the queue (docs/MAPS.md).
  */
 #ifndef RFS_PLAN_H
 #define RFS_PLAN_H
@@ -25,8 +30,9 @@ typedef struct rfs_plan {
     const rfs_map_t *map;   ///< the map planned on
     uint8_t *work;          ///< lw * lh bytes: visit marks and back-pointers
     uint32_t *queue;        ///< wavefront queue of lattice indices
-    uint32_t queue_cap;     ///< its capacity (>= lw + lh is enough for most maps; 2*(lw+lh) safe)
+    uint32_t queue_cap;     ///< its capacity, split in four quarters (2 * (lw + lh) ample: docs/MAPS.md)
     uint32_t expanded;      ///< lattice points expanded by the last search (for benchmarks)
+    uint32_t queue_peak;    ///< most entries one of the four queue quarters held in the last search
 } rfs_plan_t;
 
 /// A planned path: waypoints in order, the last one the goal itself.
@@ -38,12 +44,13 @@ typedef struct rfs_path {
 } rfs_path_t;
 
 /// Bind work arrays to a map. Returns 0, or -1 when an array is null or too small
-/// (work must hold lw * lh bytes).
+/// (work must hold lw * lh bytes, the queue at least 8 entries).
 int rfs_plan_init(rfs_plan_t *p, const rfs_map_t *map, uint8_t *work, uint32_t work_bytes,
                   uint32_t *queue, uint32_t queue_cap);
 
 /// Plan from (x0, y0) to the legal point (x1, y1). Returns false when the goal is not
-/// legal or not reachable (or the queue overflowed, counted as unreachable).
+/// legal or not reachable, or the queue overflowed or the path needs more than
+/// RFS_PLAN_MAX_WAYPOINTS waypoints (both counted as unreachable; out->n is then 0).
 bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1,
                    rfs_path_t *out);
 

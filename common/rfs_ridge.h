@@ -22,6 +22,28 @@ typedef struct rfs_ridge_cfg {
     rfs_q16_t alpha;  ///< ridge penalty Q16.16, features in metres (1.0)
 } rfs_ridge_cfg_t;
 
+/// Running sums of a fit in progress, so a fit can be sliced across calls.
+/// u, v: sample position minus the fit centre, centimetres; z: sample value, Q9.6.
+/// Scaling and overflow: |u|, |v| <= radius <= 30,000 cm and |z| <= 2^15, so each
+/// product fits int32 and each sum of up to 65,535 of them fits its type (int32 for
+/// the first-order sums: 65,535 x 30,000 < 2^31).
+typedef struct rfs_ridge_acc {
+    rfs_q16_t qx;          ///< query x the sums belong to, metres Q16.16 (as passed to fit)
+    rfs_q16_t qy;          ///< query y, metres Q16.16
+    int32_t qx_cm;         ///< fit centre x, centimetres (query rounded to the sample grid)
+    int32_t qy_cm;         ///< fit centre y, centimetres
+    uint16_t next;         ///< index of the next sample to visit
+    uint16_t n;            ///< samples inside the radius so far
+    int32_t su;            ///< sum of u, cm
+    int32_t sv;            ///< sum of v, cm
+    int32_t sz;            ///< sum of z, Q9.6
+    int64_t suu;           ///< sum of u*u, cm^2
+    int64_t suv;           ///< sum of u*v, cm^2
+    int64_t svv;           ///< sum of v*v, cm^2
+    int64_t suz;           ///< sum of u*z, cm x Q9.6
+    int64_t svz;           ///< sum of v*z, cm x Q9.6
+} rfs_ridge_acc_t;
+
 /// Ridge state, caller-owned.
 typedef struct rfs_ridge {
     rfs_ridge_cfg_t cfg;   ///< configuration copied at init
@@ -32,6 +54,9 @@ typedef struct rfs_ridge {
     int64_t wx_q24;        ///< slope along x, target units per metre, Q40.24
     int64_t wy_q24;        ///< slope along y, target units per metre, Q40.24
     uint16_t n_used;       ///< samples inside the radius at the last fit
+    bool fast_predict;     ///< slopes fit int32 and the centre is within +-16 km (fast path)
+    bool fitting;          ///< a sliced fit is in progress (acc is live)
+    rfs_ridge_acc_t acc;   ///< sums of the fit in progress
 } rfs_ridge_t;
 
 /// Defaults: 5 m radius, alpha 1.0 (paper section 5.2.1).

@@ -1,10 +1,11 @@
 /* rfs_rssi.c - the exact 1-second mean per source (paper section 2; see rfs_rssi.h).
  *
- * Timestamps are kept as their low 32 bits. Every push drops the entries that left the
- * window ending at the pushed (newest) time, so every kept entry is younger than
- * window_us (<= 60 s) relative to last_us; a query at now_us >= last_us + window_us
- * finds nothing, and any other query sees ages below 2 * 60 s < 2^31 us. The 32-bit
- * differences are therefore exact, whatever the absolute time.
+ * Timestamps are kept as their low 32 bits. Every push and query advances a clock (the
+ * newest time seen) and drops the entries that left the window ending there, so kept
+ * entries are younger than window_us (<= 60 s) relative to the clock; a clock more than a
+ * window past the newest entry empties the ring, so every age computed is below
+ * 2 * 60 s < 2^31 us and the 32-bit differences are exact, whatever the absolute time.
+ * The running sum makes the usual query (now >= newest entry) O(1) amortised.
  */
 #include "rfs_rssi.h"
 
@@ -31,6 +32,7 @@ int rfs_rssi_init(rfs_rssi_t *w, const rfs_rssi_cfg_t *cfg)
     w->sum_dbm = 0;
     w->last_us = 0;
     w->has_last = false;
+    w->clock_us = 0;
     w->accepted = 0u;
     w->rejected_order = 0u;
     w->overflowed = 0u;
@@ -44,20 +46,22 @@ static void drop_oldest(rfs_rssi_t *w)
     w->count--;
 }
 
-/* Drop entries with t <= ref - window. Needs ref >= last_us - window (true for every
- * caller) so that ages fit the 32-bit difference. */
-static void expire(rfs_rssi_t *w, int64_t ref_us)
+/* Advance the clock to t_us (if later) and drop the entries with t <= clock - window.
+ * Kept entries lie in (old clock - window, last_us], so when the clock has moved less
+ * than a window past last_us every age below is < 2 * window < 2^31 us. */
+static void advance(rfs_rssi_t *w, int64_t t_us)
 {
-    if (!w->has_last) {
+    if (t_us <= w->clock_us) {
         return;
     }
-    if (ref_us - w->last_us >= (int64_t)w->cfg.window_us) {
+    w->clock_us = t_us;
+    if (t_us - w->last_us >= (int64_t)w->cfg.window_us) {
         w->head = 0u;
         w->count = 0u;
         w->sum_dbm = 0;
         return;
     }
-    uint32_t ref_lo = (uint32_t)ref_us;
+    uint32_t ref_lo = (uint32_t)t_us;
     while (w->count != 0u) {
         int32_t age = (int32_t)(ref_lo - w->t_lo[w->head]);
         if (age < (int32_t)w->cfg.window_us) {
@@ -67,55 +71,60 @@ static void expire(rfs_rssi_t *w, int64_t ref_us)
     }
 }
 
+static void count_up(uint32_t *c)
+{
+    if (*c != UINT32_MAX) {
+        (*c)++;
+    }
+}
+
 bool rfs_rssi_push(rfs_rssi_t *w, int64_t t_us, int8_t dbm)
 {
     RFS_ASSERT(w != 0);
     if (w->has_last && t_us < w->last_us) {
-        if (w->rejected_order != UINT32_MAX) {
-            w->rejected_order++;
-        }
+        count_up(&w->rejected_order);
         return false;
     }
-    expire(w, t_us);
+    count_up(&w->accepted);
+    if (!w->has_last) {
+        w->has_last = true;
+        w->clock_us = t_us;
+    }
+    advance(w, t_us);
+    w->last_us = t_us;
+    if (t_us <= w->clock_us - (int64_t)w->cfg.window_us) {
+        return true; /* a query already moved the window past it */
+    }
     if (w->count == RFS_RSSI_CAP) {
-        /* Still inside the window (expire ran): the mean loses it. */
+        /* Still inside the window: the mean loses it. */
         drop_oldest(w);
-        if (w->overflowed != UINT32_MAX) {
-            w->overflowed++;
-        }
+        count_up(&w->overflowed);
     }
     uint16_t idx = (uint16_t)((w->head + w->count) % RFS_RSSI_CAP);
     w->t_lo[idx] = (uint32_t)t_us;
     w->dbm[idx] = dbm;
     w->sum_dbm += dbm;
     w->count++;
-    w->last_us = t_us;
-    w->has_last = true;
-    if (w->accepted != UINT32_MAX) {
-        w->accepted++;
-    }
     return true;
 }
 
-/* Sum and count of the entries in (now - window, now]. When now_us >= last_us the kept
- * entries are exactly those (after expire); a query into the past also skips the
- * entries newer than now_us by a scan from the newest end (at most RFS_RSSI_CAP). */
+/* Sum and count of the kept entries in (now - window, now]. Every kept entry is newer
+ * than clock - window >= now - window; when now_us >= last_us all of them count,
+ * otherwise a scan (at most RFS_RSSI_CAP) skips the ones newer than now_us. */
 static uint16_t window_sum(rfs_rssi_t *w, int64_t now_us, int32_t *sum)
 {
+    *sum = 0;
     if (!w->has_last) {
-        *sum = 0;
         return 0u;
     }
+    advance(w, now_us);
     if (now_us >= w->last_us) {
-        expire(w, now_us);
         *sum = w->sum_dbm;
         return w->count;
     }
-    if (now_us < w->last_us - (int64_t)w->cfg.window_us) {
-        *sum = 0; /* the whole ring is newer than now_us */
-        return 0u;
+    if (now_us <= w->clock_us - (int64_t)w->cfg.window_us) {
+        return 0u; /* every kept entry is newer than now_us */
     }
-    expire(w, now_us);
     uint32_t now_lo = (uint32_t)now_us;
     int32_t s = 0;
     uint16_t n = 0u;
@@ -138,8 +147,14 @@ bool rfs_rssi_mean(rfs_rssi_t *w, int64_t now_us, rfs_q16_t *mean_db)
     if (n == 0u) {
         return false;
     }
-    /* |sum| <= 512 * 128 = 2^16, so sum * 2^16 <= 2^32: exact in int64. */
-    *mean_db = rfs_sat32(rfs_sdiv64_round((int64_t)sum * 65536, n));
+    /* Scaling and overflow: |sum| <= 512 * 128 = 2^16; |sum| = q n + r with r < n <= 512,
+     * so the fraction r * 2^16 + n / 2 < 2^26 and q * 2^16 <= 2^23: 32-bit divisions
+     * only (one instruction each on the Cortex-M4), rounded half away from zero. */
+    uint32_t mag = (uint32_t)(sum < 0 ? -sum : sum);
+    uint32_t q = mag / n, r = mag % n;
+    uint32_t frac = (r * 65536u + n / 2u) / n;
+    int32_t m = (int32_t)(q * 65536u + frac);
+    *mean_db = sum < 0 ? -m : m;
     return true;
 }
 

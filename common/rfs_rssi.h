@@ -5,6 +5,10 @@
  * measurements and reports the exact mean of those whose timestamp lies in
  * (now - window, now]. A measurement older than the newest accepted one of the same
  * source is rejected and counted (out of order); equal timestamps are accepted.
+ * Time only moves forward: entries are kept while inside the window ending at the newest
+ * time seen by a push or a query, so a query into the past covers (now - window, now]
+ * without what had already left that window, and a measurement that arrives after the
+ * window has passed it is accepted but not averaged.
  */
 #ifndef RFS_RSSI_H
 #define RFS_RSSI_H
@@ -33,6 +37,7 @@ typedef struct rfs_rssi {
     int32_t sum_dbm;               ///< sum of the kept entries, dBm
     int64_t last_us;               ///< newest accepted timestamp, microseconds
     bool has_last;                 ///< last_us is valid
+    int64_t clock_us;              ///< newest time seen by a push or query (valid with has_last)
     uint32_t accepted;             ///< measurements accepted
     uint32_t rejected_order;       ///< measurements rejected as out of order
     uint32_t overflowed;           ///< entries pushed out while still inside the window

@@ -57,6 +57,8 @@ int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *ma
         .plan_queue_cap = RFS_APP_PLAN_QUEUE,
         .visited = a->visited,
         .visited_bytes = (uint32_t)sizeof a->visited,
+        .reach = a->reach,
+        .reach_bytes = (uint32_t)sizeof a->reach,
     };
     const rfs_target_ops_t *target =
         cfg->target == RFS_APP_TARGET_BRIDGE ? &rfs_target_bridge : &rfs_target_rssi;

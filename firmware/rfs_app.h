@@ -40,11 +40,13 @@
 
 /// Samples held for learning (paper section 5.2: at most 10,000), 6 bytes each.
 #define RFS_APP_MAX_SAMPLES 10000u
-/// Largest bit grid, bytes: 400 x 200 cells = a 40 x 20 m map at 0.1 m.
-#define RFS_APP_MAX_MAP_BYTES 10000u
-/// Largest lattice, points: a 40 x 20 m map at 0.25 m is 160 x 80 (+1 row and column).
-#define RFS_APP_MAX_LATTICE (161u * 81u)
-/// Planner queue entries (2 * (lw + lh) for the largest lattice, rounded up).
+/// Largest bit grid, bytes (the derived legal grid lives in RAM): at 0.1 m cells e.g.
+/// 40 x 12.8 m or 25.6 x 20 m; a 40 x 20 m map fits at 0.125 m cells (320 x 160).
+/// Sized so the whole image stays inside the 96 KB static-RAM budget (docs/FIRMWARE.md).
+#define RFS_APP_MAX_MAP_BYTES 6400u
+/// Largest lattice, points: a 40 x 20 m map at 0.25 m is 160 x 80.
+#define RFS_APP_MAX_LATTICE (160u * 80u)
+/// Planner queue entries (2 * (lw + lh) = 480 for the largest lattice, rounded up).
 #define RFS_APP_PLAN_QUEUE 512u
 /// Pending measurements waiting for a bracketing pose (>= 64 required by rfs_seek).
 #define RFS_APP_PENDING 64u
@@ -111,7 +113,7 @@ typedef struct rfs_app_stats {
     uint32_t steps;             ///< control periods run
 } rfs_app_stats_t;
 
-/// The application: every byte the controller uses at run time (about 92 KB with the
+/// The application: every byte the controller uses at run time (about 93 KB with the
 /// maxima above). Declare one static instance per port.
 typedef struct rfs_app {
     rfs_app_cfg_t cfg;                              ///< configuration copied at init
@@ -136,6 +138,7 @@ typedef struct rfs_app {
     uint8_t plan_work[RFS_APP_MAX_LATTICE];         ///< planner marks, one byte per point
     uint32_t plan_queue[RFS_APP_PLAN_QUEUE];        ///< planner queue
     uint8_t visited[(RFS_APP_MAX_LATTICE + 7u) / 8u]; ///< novelty bits, one per point
+    uint8_t reach[(RFS_APP_MAX_LATTICE + 7u) / 8u];   ///< reachability bits, one per point
 } rfs_app_t;
 
 /// Defaults: the paper's configuration (rfs_seek_cfg_default, rfs_ridge_cfg_default,

@@ -2,6 +2,7 @@
  * memset, explicit little-endian byte handling, every length checked before a read. */
 #include "rfs_replay.h"
 
+#include <stddef.h>
 #include <string.h>
 
 static const uint8_t k_magic[4] = {'R', 'F', 'S', 'R'};
@@ -330,4 +331,170 @@ uint32_t rfs_replay_encode_out(const rfs_app_out_t *out, uint8_t *buf, uint32_t 
     rec.type = RFS_REPLAY_DECISION;
     const uint32_t m = rfs_replay_encode(&rec, buf + n, cap - n);
     return m == 0u ? 0u : n + m;
+}
+
+void rfs_replay_player_init(rfs_replay_player_t *p, rfs_app_t *app, const rfs_app_cfg_t *cfg,
+                            rfs_replay_write_fn write, void *write_ctx)
+{
+    memset(p, 0, offsetof(rfs_replay_player_t, free_bits));
+    p->app = app;
+    p->cfg = *cfg;
+    p->write = write;
+    p->write_ctx = write_ctx;
+    uint8_t h[RFS_REPLAY_HEADER_LEN];
+    rfs_replay_header(h);
+    write(write_ctx, h, sizeof h);
+}
+
+static bool fail(rfs_replay_player_t *p, rfs_replay_err_t e)
+{
+    p->error = e;
+    return false;
+}
+
+static bool start(rfs_replay_player_t *p)
+{
+    if (p->started) {
+        return true;
+    }
+    if (!p->have_map) {
+        return fail(p, RFS_REPLAY_E_NO_MAP);
+    }
+    if (rfs_app_init(p->app, &p->cfg, &p->map) != 0) {
+        return fail(p, RFS_REPLAY_E_INIT);
+    }
+    p->started = true;
+    return true;
+}
+
+static void emit_step(rfs_replay_player_t *p, int64_t now_us)
+{
+    rfs_app_out_t out;
+    rfs_app_step(p->app, now_us, &out);
+    uint8_t buf[2u * RFS_REPLAY_MAX_RECORD];
+    uint32_t n = rfs_replay_encode_out(&out, buf, sizeof buf);
+    p->write(p->write_ctx, buf, n);
+    rfs_can_frame_t f[2];
+    const uint8_t nf = rfs_app_frames(p->app, &out, f);
+    if (p->app->bus_off) {
+        return; /* the controller cannot send; the frames are not on the bus */
+    }
+    for (uint8_t i = 0; i < nf; i++) {
+        rfs_replay_rec_t rec;
+        memset(&rec, 0, sizeof rec);
+        rec.type = RFS_REPLAY_CAN_TX;
+        rec.t_us = now_us;
+        rec.u.can.id = f[i].id;
+        rec.u.can.dlc = f[i].dlc;
+        memcpy(rec.u.can.data, f[i].data, 8);
+        n = rfs_replay_encode(&rec, buf, sizeof buf);
+        p->write(p->write_ctx, buf, n);
+    }
+}
+
+bool rfs_replay_play(rfs_replay_player_t *p, const rfs_replay_rec_t *rec)
+{
+    if (p->error != RFS_REPLAY_E_NONE) {
+        return false;
+    }
+    switch (rec->type) {
+    case RFS_REPLAY_CFG:
+        if (p->started) {
+            return fail(p, RFS_REPLAY_E_ORDER);
+        }
+        p->cfg.seed = rec->u.cfg.seed;
+        p->cfg.target = (rfs_app_target_t)rec->u.cfg.target;
+        p->cfg.node_id = rec->u.cfg.node;
+        return true;
+    case RFS_REPLAY_MAP:
+        if (p->started) {
+            return fail(p, RFS_REPLAY_E_ORDER);
+        }
+        if (rfs_map_bytes(rec->u.map.w, rec->u.map.h) > RFS_APP_MAX_MAP_BYTES) {
+            return fail(p, RFS_REPLAY_E_MAP_SIZE);
+        }
+        p->map.w = rec->u.map.w;
+        p->map.h = rec->u.map.h;
+        p->map.res = rec->u.map.res;
+        p->map.origin_x = rec->u.map.origin_x;
+        p->map.origin_y = rec->u.map.origin_y;
+        p->map.free = p->free_bits;
+        p->map.wall = rec->u.map.has_wall ? p->wall_bits : NULL;
+        memset(p->free_bits, 0, sizeof p->free_bits);
+        memset(p->wall_bits, 0, sizeof p->wall_bits);
+        p->have_map = true;
+        return true;
+    case RFS_REPLAY_MAP_FREE:
+    case RFS_REPLAY_MAP_WALL: {
+        if (!p->have_map || p->started) {
+            return fail(p, RFS_REPLAY_E_CHUNK);
+        }
+        const uint32_t bytes = rfs_map_bytes(p->map.w, p->map.h);
+        if (rec->u.chunk.offset > bytes || rec->u.chunk.n > bytes - rec->u.chunk.offset) {
+            return fail(p, RFS_REPLAY_E_CHUNK);
+        }
+        uint8_t *dst = rec->type == RFS_REPLAY_MAP_FREE ? p->free_bits : p->wall_bits;
+        memcpy(dst + rec->u.chunk.offset, rec->u.chunk.bytes, rec->u.chunk.n);
+        return true;
+    }
+    case RFS_REPLAY_POSE:
+        if (!start(p)) {
+            return false;
+        }
+        (void)rfs_app_on_pose(p->app, &rec->u.pose, rec->t_us);
+        return true;
+    case RFS_REPLAY_RSSI:
+        if (!start(p)) {
+            return false;
+        }
+        (void)rfs_app_on_rssi(p->app, rec->u.rssi.src, rec->u.rssi.t_us, rec->u.rssi.dbm,
+                              rec->t_us);
+        return true;
+    case RFS_REPLAY_CAN: {
+        if (!start(p)) {
+            return false;
+        }
+        rfs_can_frame_t f;
+        f.id = rec->u.can.id;
+        f.dlc = rec->u.can.dlc;
+        memcpy(f.data, rec->u.can.data, 8);
+        (void)rfs_app_on_can(p->app, &f, rec->t_us);
+        return true;
+    }
+    case RFS_REPLAY_STEP:
+        if (!start(p)) {
+            return false;
+        }
+        emit_step(p, rec->t_us);
+        p->steps++;
+        return true;
+    case RFS_REPLAY_BUS:
+        if (!start(p)) {
+            return false;
+        }
+        rfs_app_set_bus_off(p->app, rec->u.bus_off != 0u);
+        return true;
+    case RFS_REPLAY_RESET:
+        /* A watchdog reset: every byte of RAM state is lost, the image boots again. */
+        p->started = false;
+        p->resets++;
+        return start(p);
+    case RFS_REPLAY_END:
+        return true;
+    default:
+        return fail(p, RFS_REPLAY_E_ORDER);
+    }
+}
+
+const char *rfs_replay_err_str(rfs_replay_err_t e)
+{
+    switch (e) {
+    case RFS_REPLAY_E_NONE: return "no error";
+    case RFS_REPLAY_E_MAP_SIZE: return "MAP larger than the image holds";
+    case RFS_REPLAY_E_CHUNK: return "map chunk outside the grid or before MAP";
+    case RFS_REPLAY_E_NO_MAP: return "input before the map";
+    case RFS_REPLAY_E_INIT: return "application rejected the map or configuration";
+    case RFS_REPLAY_E_ORDER: return "record out of place in an input stream";
+    default: return "unknown error";
+    }
 }

@@ -133,4 +133,48 @@ uint32_t rfs_replay_encode(const rfs_replay_rec_t *rec, uint8_t *buf, uint32_t c
 /// (cap >= 2 * RFS_REPLAY_MAX_RECORD is always enough), 0 when it does not fit.
 uint32_t rfs_replay_encode_out(const rfs_app_out_t *out, uint8_t *buf, uint32_t cap);
 
+/// Where a player writes its output bytes (a file, semihosting, a buffer).
+typedef void (*rfs_replay_write_fn)(void *ctx, const uint8_t *p, uint32_t n);
+
+/// Player errors (rfs_replay_player_t.error).
+typedef enum rfs_replay_err {
+    RFS_REPLAY_E_NONE = 0,
+    RFS_REPLAY_E_MAP_SIZE,    ///< MAP larger than the compile-time maxima
+    RFS_REPLAY_E_CHUNK,       ///< MAP_FREE / MAP_WALL outside the grid, or before MAP
+    RFS_REPLAY_E_NO_MAP,      ///< an input record came before MAP and its grids
+    RFS_REPLAY_E_INIT,        ///< rfs_app_init() rejected the map or configuration
+    RFS_REPLAY_E_ORDER,       ///< an output record (or CFG/MAP after inputs) in an input stream
+} rfs_replay_err_t;
+
+/// Plays an input stream into an application: the one driver loop shared by the host
+/// program and the emulator image, so both run the very same code. Caller-owned, ~20 KB
+/// (the map grids) plus the application it points to.
+typedef struct rfs_replay_player {
+    rfs_app_t *app;                           ///< the application driven
+    rfs_app_cfg_t cfg;                        ///< configuration (CFG overrides seed/target/node)
+    rfs_app_map_t map;                        ///< map header (MAP), grids below
+    bool have_map;                            ///< MAP seen
+    bool started;                             ///< rfs_app_init() done
+    rfs_replay_err_t error;                   ///< first error, playing stops
+    uint32_t steps;                           ///< STEP records played
+    uint32_t resets;                          ///< RESET records played
+    rfs_replay_write_fn write;                ///< output sink
+    void *write_ctx;                          ///< its context
+    uint8_t free_bits[RFS_APP_MAX_MAP_BYTES]; ///< free grid, filled by MAP_FREE
+    uint8_t wall_bits[RFS_APP_MAX_MAP_BYTES]; ///< wall grid, filled by MAP_WALL
+} rfs_replay_player_t;
+
+/// Start a player on `app` with the base configuration (CFG records override seed,
+/// target and node id). Writes the output stream header through `write`.
+void rfs_replay_player_init(rfs_replay_player_t *p, rfs_app_t *app, const rfs_app_cfg_t *cfg,
+                            rfs_replay_write_fn write, void *write_ctx);
+
+/// Play one decoded input record: feed the application, and for STEP write OUT (+
+/// DECISION) and, unless bus-off, the CAN_TX frames. Returns false once an error stopped
+/// the player (p->error says which).
+bool rfs_replay_play(rfs_replay_player_t *p, const rfs_replay_rec_t *rec);
+
+/// Short constant description of a player error.
+const char *rfs_replay_err_str(rfs_replay_err_t e);
+
 #endif /* RFS_REPLAY_H */

@@ -279,6 +279,9 @@ extern "C" unsigned hs_world_walls_crossed(const hs_world_t *w, double x0, doubl
         return 0;
     }
     b2Vec2 a((float)x0, (float)y0), b((float)x1, (float)y1);
+    if ((b - a).LengthSquared() <= 0.0f) {
+        return 0; // Box2D asserts on a zero-length ray (equal after rounding to float)
+    }
     HitCollector fwd, rev;
     w->world->RayCast(&fwd, a, b);
     w->world->RayCast(&rev, b, a);

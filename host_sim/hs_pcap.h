@@ -22,6 +22,7 @@ typedef struct hs_pcap_reader hs_pcap_reader_t;
 /// One captured packet; `data` stays valid until the next hs_pcap_next() or close.
 typedef struct hs_pcap_pkt {
     int64_t t_us;         ///< capture time, microseconds since the Unix epoch
+    int64_t t_ns;         ///< the same, nanoseconds (full resolution of a pcapng/ns file)
     uint32_t caplen;      ///< bytes captured (length of `data`)
     uint32_t origlen;     ///< bytes on the air as the capture header states them
     const uint8_t *data;  ///< captured bytes: radiotap header then the 802.11 frame

@@ -54,7 +54,7 @@ typedef struct hs_radio_cfg {
     double rx_min_dbm;       ///< lowest value the receiver reports (-100)
     double rx_max_dbm;       ///< highest value the receiver reports (-10)
     bool loss;               ///< packet loss near the sensitivity on
-    double sensitivity_dbm;  ///< signal at which half the packets are lost (-92)
+    double sensitivity_dbm;  ///< signal at which half the packets are lost (-95)
     double loss_width_db;    ///< logistic width of the loss curve, dB (1.5)
     double wall_cache_m;     ///< receiver cell size of the wall-count cache, metres (0.1)
 } hs_radio_cfg_t;

@@ -78,6 +78,7 @@ const char *hs_radiotap_status_str(hs_rt_status_t st)
     case HS_RT_ERR_VERSION: return "radiotap version byte is not 0";
     case HS_RT_ERR_LEN: return "radiotap it_len is below 8 or beyond the captured bytes";
     case HS_RT_ERR_BITMAP: return "radiotap present bitmaps run past it_len";
+    case HS_RT_ERR_NS_BOTH: return "radiotap present word selects both namespaces (bits 29 and 30)";
     }
     return "unknown status";
 }
@@ -132,6 +133,9 @@ int hs_radiotap_parse(const uint8_t *buf, size_t len, hs_radiotap_t *rt)
         if (words_end + 4 > it_len) { rt->status = HS_RT_ERR_BITMAP; return -1; }
         const uint32_t w = rd32(buf + words_end);
         words_end += 4;
+        /* Which namespace the next word is in would be ambiguous: the header is invalid
+         * (radiotap.org, "Extended presence masks"; Wireshark rejects it too). */
+        if ((w & (3u << RT_NS_RADIOTAP)) == (3u << RT_NS_RADIOTAP)) { rt->status = HS_RT_ERR_NS_BOTH; return -1; }
         if (rt->n_present < UINT8_MAX) { rt->n_present++; }
         if (!(w & (1u << RT_EXT))) { break; }
     }
@@ -186,14 +190,6 @@ int hs_radiotap_parse(const uint8_t *buf, size_t len, hs_radiotap_t *rt)
     return 0;
 }
 
-/* Copy a 6-byte address if the frame holds it. */
-static bool wlan_addr(const uint8_t *frame, size_t len, size_t at, uint8_t out[6])
-{
-    if (at + 6 > len) { return false; }
-    memcpy(out, frame + at, 6);
-    return true;
-}
-
 int hs_wlan_parse(const uint8_t *frame, size_t len, hs_wlan_t *w)
 {
     memset(w, 0, sizeof(*w));
@@ -202,43 +198,43 @@ int hs_wlan_parse(const uint8_t *frame, size_t len, hs_wlan_t *w)
     w->type = (uint8_t)((w->fc >> 2) & 3u);
     w->subtype = (uint8_t)((w->fc >> 4) & 15u);
     w->ds = (uint8_t)((w->fc >> 8) & 3u);
+    const bool order = (w->fc & 0x8000u) != 0;
     w->hdr_len = 2;
     /* Address offsets: addr1 4, addr2 10, addr3 16, seq 22, addr4 24. */
-    switch (w->type) {
-    case HS_WLAN_MGMT:
-        /* DA, SA, BSSID: SA = TA = addr2 whatever the DS bits say. */
-        w->has_ta = wlan_addr(frame, len, 10, w->ta);
-        w->has_sa = w->has_ta;
-        if (w->has_sa) { memcpy(w->sa, w->ta, 6); w->hdr_len = 16; }
-        break;
-    case HS_WLAN_DATA: {
-        /* Table 9-30: ToDS/FromDS -> which address is the SA. */
-        static const uint8_t sa_at[4] = {10, 10, 16, 24};
-        w->has_ta = wlan_addr(frame, len, 10, w->ta);
-        w->has_sa = wlan_addr(frame, len, sa_at[w->ds], w->sa);
-        if (w->has_ta) { w->hdr_len = 16; }
-        break;
-    }
-    case HS_WLAN_CTRL:
+    if (w->type == HS_WLAN_CTRL) {
         /* RTS, PS-Poll, CF-End(+Ack), BlockAckReq, BlockAck carry RA then TA; ACK and
-         * CTS carry only RA. Wireshark gives none of them a wlan.sa. */
-        if (w->subtype == 8 || w->subtype == 9 || w->subtype == 10 || w->subtype == 11 ||
-            w->subtype == 14 || w->subtype == 15) {
-            w->has_ta = wlan_addr(frame, len, 10, w->ta);
-            if (w->has_ta) { w->hdr_len = 16; }
+         * CTS carry only RA. None of them has a source address (Wireshark: no wlan.sa). */
+        const uint16_t with_ta = (1u << 8) | (1u << 9) | (1u << 10) | (1u << 11) | (1u << 14) | (1u << 15);
+        if ((with_ta & (1u << w->subtype)) && len >= 16) {
+            memcpy(w->ta, frame + 10, 6);
+            w->has_ta = true;
+            w->hdr_len = 16;
         }
         return 0;
-    default:
-        return 0;
     }
-    if (len >= 24) {
-        const uint16_t sc = rd16(frame + 22);
-        w->has_seq = true;
-        w->seq = (uint16_t)(sc >> 4);
-        w->frag = (uint8_t)(sc & 15u);
-        w->hdr_len = 24;
-    }
-    if (w->type == HS_WLAN_DATA && w->ds == 3 && w->has_sa) { w->hdr_len = 30; }
+    if (w->type != HS_WLAN_MGMT && w->type != HS_WLAN_DATA) { return 0; }
+    /* The MAC header through its QoS control must be there before any address counts
+     * (Wireshark adds wlan.sa only then): 24 bytes, + 6 for addr4 (data, ToDS and
+     * FromDS), + 2 QoS control (QoS data subtypes). A +HTC field (order bit) is not
+     * required: Wireshark reports the addresses of a frame cut inside it. */
+    size_t need = 24;
+    const bool qos = w->type == HS_WLAN_DATA && (w->subtype & 8u) != 0;
+    if (w->type == HS_WLAN_DATA && w->ds == 3) { need += 6; }
+    if (qos) { need += 2; }
+    if (len < need) { return 0; }
+    if (order && (w->type == HS_WLAN_MGMT || qos)) { need += 4; }
+    w->hdr_len = (uint16_t)need;
+    memcpy(w->ta, frame + 10, 6);
+    w->has_ta = true;
+    /* IEEE 802.11-2020 Table 9-30: which address is the SA for each ToDS/FromDS; a
+     * management frame's SA is addr2 whatever the DS bits. */
+    static const uint8_t sa_at[4] = {10, 10, 16, 24};
+    memcpy(w->sa, frame + (w->type == HS_WLAN_MGMT ? 10 : sa_at[w->ds]), 6);
+    w->has_sa = true;
+    const uint16_t sc = rd16(frame + 22);
+    w->has_seq = true;
+    w->seq = (uint16_t)(sc >> 4);
+    w->frag = (uint8_t)(sc & 15u);
     return 0;
 }
 
@@ -246,12 +242,12 @@ int hs_rt_frame_parse(const uint8_t *buf, size_t len, hs_rt_frame_t *f)
 {
     memset(f, 0, sizeof(*f));
     if (hs_radiotap_parse(buf, len, &f->rt) != 0) { return -1; }
-    size_t n = len - f->rt.it_len;
-    if (f->rt.has_flags && (f->rt.flags & HS_RT_FLAG_FCS)) {
-        /* The FCS is the last 4 bytes of the frame, not part of the MAC header. */
-        n = n >= 4 ? n - 4 : 0;
-    }
-    f->frame_len = (uint32_t)n;
+    const size_t n = len - f->rt.it_len;
+    /* The FCS is the last 4 bytes of the frame. Like Wireshark we still read the MAC
+     * header from every captured byte: a frame shorter than header + FCS is damaged
+     * either way, and this keeps our SA equal to tshark's wlan.sa. */
+    const bool fcs = f->rt.has_flags && (f->rt.flags & HS_RT_FLAG_FCS) != 0;
+    f->frame_len = (uint32_t)(fcs ? (n >= 4 ? n - 4 : 0) : n);
     f->wlan_ok = hs_wlan_parse(buf + f->rt.it_len, n, &f->wlan) == 0;
     return 0;
 }

@@ -24,6 +24,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/// Number of hs_rt_status_t values.
+#define HS_RT_N_STATUS 8
+
 /// Radiotap flags field bits used here.
 #define HS_RT_FLAG_FCS 0x10u     ///< frame includes the 4-byte FCS at its end
 #define HS_RT_FLAG_BADFCS 0x40u  ///< frame failed the FCS check
@@ -37,6 +40,7 @@ typedef enum hs_rt_status {
     HS_RT_ERR_VERSION,     ///< version byte is not 0
     HS_RT_ERR_LEN,         ///< it_len < 8 or larger than the captured bytes
     HS_RT_ERR_BITMAP,      ///< present words run past it_len (bit 31 chain never ends)
+    HS_RT_ERR_NS_BOTH,     ///< a present word sets both namespace bits 29 and 30
 } hs_rt_status_t;
 
 /// What a radiotap header says; `has_*` tells which fields were present and read.
@@ -98,12 +102,13 @@ typedef struct hs_wlan {
     bool has_seq;         ///< a sequence control field is in the frame
     uint16_t seq;         ///< sequence number, 0..4095 (for the packet delivery ratio)
     uint8_t frag;         ///< fragment number, 0..15
-    uint16_t hdr_len;     ///< bytes of MAC header parsed (through the last address / seq)
+    uint16_t hdr_len;     ///< MAC header length incl. +HTC, bytes (2 when incomplete)
 } hs_wlan_t;
 
 /// Parse the 802.11 MAC header of `frame` (`len` bytes, FCS already removed). Returns 0
-/// when at least the frame control was readable (fields that do not fit are reported
-/// absent: an ACK or a frame cut short has no SA), -1 when len < 2.
+/// when at least the frame control was readable, -1 when len < 2. Addresses and the
+/// sequence number count only when the whole MAC header is there (as Wireshark adds
+/// wlan.sa): an ACK, a CTS or a frame cut inside its header has no SA.
 int hs_wlan_parse(const uint8_t *frame, size_t len, hs_wlan_t *w);
 
 /// One parsed capture record: radiotap + 802.11, as the feeder needs it.
@@ -112,6 +117,7 @@ typedef struct hs_rt_frame {
     hs_wlan_t wlan;       ///< the 802.11 header (valid when wlan_ok)
     bool wlan_ok;         ///< an 802.11 header followed the radiotap header
     uint32_t frame_len;   ///< 802.11 bytes after radiotap, FCS removed when flagged
+                          ///< (the MAC header is parsed from all captured bytes)
 } hs_rt_frame_t;
 
 /// Parse a whole captured record. Returns 0 when the radiotap header was usable (the

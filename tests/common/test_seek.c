@@ -26,7 +26,7 @@ typedef struct world {
 } world_t;
 
 /* An open rectangle w_m x h_m metres with a one-cell border wall, plus an optional
- * vertical wall at x = wall_x from y = 0 to wall_y_top. */
+ * vertical wall one cell thick spanning x in [wall_x, wall_x + RES), y in [0, wall_y_top). */
 static void world_make(world_t *t, double w_m, double h_m, double wall_x, double wall_y_top)
 {
     memset(t, 0, sizeof *t);
@@ -39,9 +39,9 @@ static void world_make(world_t *t, double w_m, double h_m, double wall_x, double
     t->legal_bits = calloc(bytes, 1);
     for (uint16_t y = 0; y < t->h; ++y) {
         for (uint16_t x = 0; x < t->w; ++x) {
-            double cx = (x + 0.5) * RES, cy = (y + 0.5) * RES;
+            double cy = (y + 0.5) * RES;
             bool wall = x == 0 || y == 0 || x == t->w - 1 || y == t->h - 1;
-            if (wall_x > 0 && fabs(cx - wall_x) < RES / 2 && cy < wall_y_top) {
+            if (wall_x > 0 && x == (uint16_t)lround(wall_x / RES) && cy < wall_y_top) {
                 wall = true;
             }
             rfs_map_bit_set(t->free_bits, stride, x, y, !wall);
@@ -170,10 +170,12 @@ static void test_epsilon_goals_are_novel(void **state)
             for (int i = 0; i < np; ++i) {
                 assert_true(hypot(gx - xs[i], gy - ys[i]) >= 0.5 - 1e-4);
             }
+        }
+        if (out.decided) {
             rfs_drive_stop(&t.seek.drive, now); /* end the goal: decide again next step */
         }
     }
-    assert_true(decisions >= 20);
+    assert_true(decisions >= 30);
     world_free(&t);
 }
 
@@ -214,32 +216,27 @@ static void test_blocked_step_line_search(void **state)
     cfg.eps_amp = 0;
     cfg.eps_floor = 0;
     seek_make(&t, cfg, 3);
-    fixed_model_t fm = { 9.0, 3.0 };
+    fixed_model_t fm = { 9.125, 3.125 }; /* a lattice point: the grid maximum is exact */
     t.seek.model.ops = &fm_ops;
     t.seek.model.self = &fm;
     t.seek.iteration = 1; /* skip the initial random move */
     rfs_seek_out_t out;
-    /* Robot at (5.5, 3): one step towards (9, 3) lands at (6.5, 3), inside the clearance
-     * of... no: 0.5 m beyond the wall; legal points start 0.25 m + half a cell off it. */
-    feed(&t, 100000, 5.3, 3.0, 0, -50, &out);
+    /* Robot at x = 5.3: one step towards the maximum lands at 6.3, 0.2 m from the wall
+     * cell [6.0, 6.1): illegal. Reference (by hand): legal points keep 0.25 m from the
+     * wall, so the nearest legal points on the line are x <= 5.75 and x >= 6.35 (up to one
+     * cell of discretisation); the search steps 0.1 m from 6.3 both ways, so the first
+     * legal point is beyond the wall at 6.4 or 6.5. */
+    feed(&t, 100000, 5.3, 3.125, 0, -50, &out);
     assert_true(out.decided);
     assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
+    assert_true(out.decision.line_search);
+    assert_true(fabs(D(out.decision.max_x) - 9.125) < 1e-4);
+    assert_true(fabs(D(out.decision.max_y) - 3.125) < 1e-4);
     double gx = D(out.decision.goal_x), gy = D(out.decision.goal_y);
-    /* Independent reference: the wall cell spans x in [5.95, 6.05) (cell 59 at 0.1 m? the
-     * wall is the cell whose centre is within 0.05 of 6.0: cell 59 [5.9, 6.0) or 60). A
-     * legal point keeps 0.25 m from every non-free cell. */
-    assert_true(fabs(gy - 3.0) < 1e-3);
-    assert_true(gx < 5.3 + 1.0 + 1e-3);
-    bool before = gx < 6.0;
-    if (before) {
-        assert_true(gx <= 5.9 - 0.25 + 0.11);
-    } else {
-        assert_true(gx >= 6.1 + 0.25 - 0.11);
-    }
-    /* The planner must go around through the passage above y = 6 when beyond. */
-    if (!before) {
-        assert_true(D(out.decision.path_len) > 5.0);
-    }
+    assert_true(fabs(gy - 3.125) < 1e-3);
+    assert_true(gx >= 6.35 - 0.1 && gx <= 6.5 + 1e-3);
+    /* Beyond the wall: the planned path goes round its end at y = 6 and back. */
+    assert_true(D(out.decision.path_len) > 2 * (6.0 - 3.125));
     world_free(&t);
 }
 

@@ -1,0 +1,392 @@
+/* rfs_map.c - bit grids, legality and exact grid traversal (paper section 2: "movements
+ * are restricted to legal movements").
+ *
+ * Rules (docs/MAPS.md):
+ *  - Cell legality: cell c is legal when it and every cell whose square comes closer
+ *    than `clearance` to c's centre are on the map and free. Off-map counts as not free,
+ *    so cells within the clearance of the map edge are illegal.
+ *  - A point is legal when the cell it lies in is legal.
+ *  - A segment passes through every cell whose CLOSED square it touches (supercover):
+ *    a segment through a cell corner passes through all the cells sharing that corner,
+ *    and one running along a cell edge passes through the cells on both sides. This is
+ *    the conservative reading: a move never squeezes between two diagonal obstacles.
+ *    The traversal is exact (integer cross-multiplication, no rounding).
+ *  - Walls crossed: runs of consecutive wall cells in traversal order along the segment.
+ */
+#include "rfs_map.h"
+
+#include <string.h>
+
+/* The map extent is limited to 2^30 Q16 units (16384 m) per axis so that coordinates
+ * relative to the origin fit in 31 bits and the traversal's products fit in int64. */
+#define MAP_EXTENT_MAX ((int64_t)1 << 30)
+/* Clearance at most 64 m and 255 cells: keeps the mask loop short and its squares
+ * below 2^46. */
+#define CLEARANCE_MAX RFS_Q16_INT(64)
+#define CLEARANCE_CELLS_MAX 255
+
+rfs_map_cfg_t rfs_map_cfg_default(void)
+{
+    rfs_map_cfg_t c;
+    c.clearance = RFS_Q16_FRAC(1, 4);
+    c.grid = RFS_Q16_FRAC(1, 4);
+    return c;
+}
+
+void rfs_map_bit_set(uint8_t *bits, uint16_t stride, uint16_t cx, uint16_t cy, bool v)
+{
+    uint32_t i = (uint32_t)cy * stride + (cx >> 3);
+    uint8_t m = (uint8_t)(1u << (cx & 7u));
+    bits[i] = v ? (uint8_t)(bits[i] | m) : (uint8_t)(bits[i] & ~m);
+}
+
+/* Is offset (dx, dy) cells (dx, dy >= 0) within the clearance of a cell centre? The
+ * nearest point of the offset cell is (2dx-1)/2 and (2dy-1)/2 cells away (0 when the
+ * offset is 0). Scaling and overflow: terms are doubled distances in Q16 (res Q16 times
+ * a small integer, int64); a term >= 2*clearance excludes at once, so the squares are
+ * taken only below (2 * 64 m)^2 = 2^46 in Q32. */
+static bool mask_in(rfs_q16_t res, rfs_q16_t clearance, int32_t dx, int32_t dy)
+{
+    if (dx == 0 && dy == 0) {
+        return true;
+    }
+    int64_t lim = 2 * (int64_t)clearance;
+    int64_t ex = dx > 0 ? (int64_t)(2 * dx - 1) * res : 0;
+    int64_t ey = dy > 0 ? (int64_t)(2 * dy - 1) * res : 0;
+    if (ex >= lim || ey >= lim) {
+        return false;
+    }
+    return ex * ex + ey * ey < lim * lim;
+}
+
+/* Eight bits of a row starting at bit `pos` (may be negative); bits off the row
+ * (pos < 0 or >= w) read as 0. */
+static uint8_t row_get8(const uint8_t *row, uint16_t w, int32_t pos)
+{
+    int32_t lo = pos < 0 ? -pos : 0;                       /* first bit on the row */
+    int32_t hi = (int32_t)w - pos < 8 ? (int32_t)w - pos : 8; /* one past the last */
+    if (hi <= lo) {
+        return 0;
+    }
+    uint32_t v = 0;
+    int32_t q = pos >> 3; /* arithmetic shift: floor */
+    int32_t sh = pos & 7;
+    if (q >= 0) {
+        v = (uint32_t)row[q] >> sh;
+    }
+    if (sh != 0 && q + 1 >= 0 && q + 1 < (int32_t)((w + 7u) / 8u)) {
+        v |= (uint32_t)row[q + 1] << (8 - sh);
+    }
+    uint32_t mask = ((1u << hi) - 1u) & ~((1u << lo) - 1u);
+    return (uint8_t)(v & mask);
+}
+
+/* legal = erosion of free by the clearance mask, row by row: for every mask row dy with
+ * half-width k, AND in the free row cy + dy eroded horizontally by k. */
+static void derive_legal(rfs_map_t *m)
+{
+    int32_t kmax[CLEARANCE_CELLS_MAX + 2];
+    int32_t R = 0;
+    for (int32_t dy = 0; dy <= CLEARANCE_CELLS_MAX + 1; dy++) {
+        int32_t k = -1;
+        while (k + 1 <= CLEARANCE_CELLS_MAX + 1 && mask_in(m->res, m->cfg.clearance, k + 1, dy)) {
+            k++;
+        }
+        kmax[dy] = k;
+        if (k < 0) {
+            break;
+        }
+        R = dy;
+    }
+    for (uint16_t cy = 0; cy < m->h; cy++) {
+        uint8_t *out = m->legal + (uint32_t)cy * m->stride;
+        memset(out, 0xFF, m->stride);
+        for (int32_t dy = -R; dy <= R; dy++) {
+            int32_t ry = (int32_t)cy + dy;
+            int32_t k = kmax[dy < 0 ? -dy : dy];
+            if (ry < 0 || ry >= (int32_t)m->h) {
+                memset(out, 0, m->stride);
+                break;
+            }
+            const uint8_t *row = m->free + (uint32_t)ry * m->stride;
+            for (uint16_t b = 0; b < m->stride; b++) {
+                uint8_t acc = out[b];
+                for (int32_t d = -k; d <= k && acc; d++) {
+                    acc &= row_get8(row, m->w, (int32_t)b * 8 + d);
+                }
+                out[b] = acc;
+            }
+        }
+        /* Padding bits past w stay 0. */
+        if (m->w & 7u) {
+            out[m->stride - 1] &= (uint8_t)((1u << (m->w & 7u)) - 1u);
+        }
+    }
+}
+
+int rfs_map_init(rfs_map_t *m, const rfs_map_cfg_t *cfg, uint16_t w, uint16_t h,
+                 rfs_q16_t res, rfs_q16_t origin_x, rfs_q16_t origin_y,
+                 const uint8_t *free_bits, const uint8_t *wall_bits, uint8_t *legal_bits)
+{
+    if (m == 0 || cfg == 0 || free_bits == 0 || legal_bits == 0 || w == 0 || h == 0 ||
+        res <= 0 || cfg->clearance < 0 || cfg->clearance > CLEARANCE_MAX || cfg->grid <= 0) {
+        return -1;
+    }
+    int64_t wext = (int64_t)w * res;
+    int64_t hext = (int64_t)h * res;
+    if (wext > MAP_EXTENT_MAX || hext > MAP_EXTENT_MAX) {
+        return -1;
+    }
+    /* The far corner must be representable in Q16.16. */
+    if ((int64_t)origin_x + wext > INT32_MAX || (int64_t)origin_y + hext > INT32_MAX) {
+        return -1;
+    }
+    if ((uint32_t)cfg->clearance / (uint32_t)res > CLEARANCE_CELLS_MAX) {
+        return -1;
+    }
+    /* Lattice points grid/2 + i*grid inside the extent. */
+    int64_t half = cfg->grid / 2;
+    if (wext <= half || hext <= half) {
+        return -1;
+    }
+    uint32_t lw = (uint32_t)(wext - half - 1) / (uint32_t)cfg->grid + 1u;
+    uint32_t lh = (uint32_t)(hext - half - 1) / (uint32_t)cfg->grid + 1u;
+    if (lw > UINT16_MAX || lh > UINT16_MAX) {
+        return -1;
+    }
+    memset(m, 0, sizeof(*m));
+    m->cfg = *cfg;
+    m->w = w;
+    m->h = h;
+    m->stride = (uint16_t)((w + 7u) / 8u);
+    m->res = res;
+    m->origin_x = origin_x;
+    m->origin_y = origin_y;
+    m->free = free_bits;
+    m->wall = wall_bits;
+    m->legal = legal_bits;
+    m->lw = (uint16_t)lw;
+    m->lh = (uint16_t)lh;
+    derive_legal(m);
+    return 0;
+}
+
+bool rfs_map_cell(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, uint16_t *cx, uint16_t *cy)
+{
+    int64_t rx = (int64_t)x - m->origin_x;
+    int64_t ry = (int64_t)y - m->origin_y;
+    if (rx < 0 || ry < 0 || rx >= (int64_t)m->w * m->res || ry >= (int64_t)m->h * m->res) {
+        return false;
+    }
+    /* Both below 2^30: 32-bit division (hardware on Cortex-M4, no libgcc helper). */
+    *cx = (uint16_t)((uint32_t)rx / (uint32_t)m->res);
+    *cy = (uint16_t)((uint32_t)ry / (uint32_t)m->res);
+    return true;
+}
+
+bool rfs_map_point_legal(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y)
+{
+    uint16_t cx;
+    uint16_t cy;
+    if (!rfs_map_cell(m, x, y, &cx, &cy)) {
+        return false;
+    }
+    return rfs_map_bit(m->legal, m->stride, cx, cy);
+}
+
+/* --- exact supercover traversal ---------------------------------------------------- */
+
+typedef struct visitor {
+    const rfs_map_t *m;
+    bool walls;       /* count wall runs (else: check legality) */
+    bool legal;       /* legality so far */
+    bool in_wall;     /* previous visited cell was a wall */
+    uint16_t runs;    /* wall runs so far */
+} visitor_t;
+
+/* Visit cell (i, j); false stops the traversal. */
+static bool visit(visitor_t *v, int32_t i, int32_t j)
+{
+    const rfs_map_t *m = v->m;
+    bool on = i >= 0 && j >= 0 && i < (int32_t)m->w && j < (int32_t)m->h;
+    if (!v->walls) {
+        if (!on || !rfs_map_bit(m->legal, m->stride, (uint16_t)i, (uint16_t)j)) {
+            v->legal = false;
+            return false;
+        }
+        return true;
+    }
+    bool wall = on && rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)j);
+    if (wall && !v->in_wall && v->runs < UINT16_MAX) {
+        v->runs++;
+    }
+    v->in_wall = wall;
+    return true;
+}
+
+/* floor(a / r) and the smallest i with (i + 1) * r >= a, for |a| < 2^31, r > 0. */
+static int32_t fdiv(int64_t a, int32_t r)
+{
+    if (a >= 0) {
+        return (int32_t)((uint32_t)a / (uint32_t)r);
+    }
+    return -(int32_t)(((uint32_t)(-a) + (uint32_t)r - 1u) / (uint32_t)r);
+}
+
+static int32_t low_cell(int64_t a, int32_t r)
+{
+    /* ceil(a / r) - 1 */
+    return -fdiv(-a, r) - 1;
+}
+
+/* Traverse the closed supercover of the segment between two points given relative to
+ * the origin (each coordinate in [-2^30, 2^30]), in order along the segment.
+ * Scaling and overflow: coordinates are Q16 metres below 2^30 in magnitude, so
+ * y*dx and x*dy products are below 2^61 and (j + 1) * res * dx stays below 2^62. */
+static void traverse(visitor_t *v, int64_t X0, int64_t Y0, int64_t X1, int64_t Y1)
+{
+    const int32_t r = v->m->res;
+    if (X1 < X0 || (X1 == X0 && Y1 < Y0)) {
+        int64_t t = X0; X0 = X1; X1 = t;
+        t = Y0; Y0 = Y1; Y1 = t;
+    }
+    bool flip = Y1 < Y0;
+    if (flip) {
+        /* Mirror y: cell j' of -y is cell -1 - j' of y. */
+        Y0 = -Y0;
+        Y1 = -Y1;
+    }
+    const int64_t dx = X1 - X0;
+    const int64_t dy = Y1 - Y0;
+    const int32_t ia = low_cell(X0, r);
+    const int32_t ib = fdiv(X1, r);
+    if (dx == 0) {
+        int32_t ja = low_cell(Y0, r);
+        int32_t jb = fdiv(Y1, r);
+        for (int32_t i = ia; i <= ib; i++) {
+            for (int32_t j = ja; j <= jb; j++) {
+                if (!visit(v, i, flip ? -1 - j : j)) {
+                    return;
+                }
+            }
+        }
+        return;
+    }
+    const int64_t rdx = (int64_t)r * dx;
+    const int64_t y0dx = Y0 * dx;
+    int32_t jlo = low_cell(Y0, r);
+    int64_t blo = ((int64_t)jlo + 1) * r * dx; /* (jlo + 1) * r * dx */
+    int32_t jhi = jlo;
+    int64_t bhi = blo;                         /* (jhi + 1) * r * dx */
+    for (int32_t i = ia; i <= ib; i++) {
+        int64_t xl = (int64_t)i * r;
+        int64_t xr = xl + r;
+        if (xl < X0) {
+            xl = X0;
+        }
+        if (xr > X1) {
+            xr = X1;
+        }
+        int64_t nl = y0dx + (xl - X0) * dy; /* y(xl) * dx */
+        int64_t nr = y0dx + (xr - X0) * dy; /* y(xr) * dx */
+        while (blo < nl) {
+            jlo++;
+            blo += rdx;
+        }
+        if (jhi < jlo) {
+            jhi = jlo;
+            bhi = blo;
+        }
+        while (bhi <= nr) {
+            jhi++;
+            bhi += rdx;
+        }
+        for (int32_t j = jlo; j <= jhi; j++) {
+            if (!visit(v, i, flip ? -1 - j : j)) {
+                return;
+            }
+        }
+    }
+}
+
+bool rfs_map_segment_legal(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,
+                           rfs_q16_t y1)
+{
+    uint16_t cx;
+    uint16_t cy;
+    if (!rfs_map_cell(m, x0, y0, &cx, &cy) || !rfs_map_cell(m, x1, y1, &cx, &cy)) {
+        return false;
+    }
+    visitor_t v = {m, false, true, false, 0};
+    traverse(&v, (int64_t)x0 - m->origin_x, (int64_t)y0 - m->origin_y,
+             (int64_t)x1 - m->origin_x, (int64_t)y1 - m->origin_y);
+    return v.legal;
+}
+
+static int64_t clamp64(int64_t v, int64_t lo, int64_t hi)
+{
+    return v < lo ? lo : (v > hi ? hi : v);
+}
+
+uint16_t rfs_map_walls_crossed(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,
+                               rfs_q16_t y1)
+{
+    if (m->wall == 0) {
+        return 0;
+    }
+    /* Endpoints off the map are clamped onto its edge (the off-map part has no walls;
+     * the clamp moves them along the axes, an approximation documented in MAPS.md). */
+    int64_t we = (int64_t)m->w * m->res;
+    int64_t he = (int64_t)m->h * m->res;
+    visitor_t v = {m, true, true, false, 0};
+    traverse(&v, clamp64((int64_t)x0 - m->origin_x, 0, we),
+             clamp64((int64_t)y0 - m->origin_y, 0, he),
+             clamp64((int64_t)x1 - m->origin_x, 0, we),
+             clamp64((int64_t)y1 - m->origin_y, 0, he));
+    return v.runs;
+}
+
+/* --- lattice -------------------------------------------------------------------------- */
+
+void rfs_map_lattice_point(const rfs_map_t *m, uint16_t i, uint16_t j, rfs_q16_t *x,
+                           rfs_q16_t *y)
+{
+    /* Scaling and overflow: grid/2 + i*grid is inside the extent (< 2^30) for lattice
+     * indices; the sum with the origin is within the Q16 range checked at init. */
+    int64_t g = m->cfg.grid;
+    *x = rfs_sat32((int64_t)m->origin_x + g / 2 + (int64_t)i * g);
+    *y = rfs_sat32((int64_t)m->origin_y + g / 2 + (int64_t)j * g);
+}
+
+/* Nearest index to a relative coordinate a along an axis with n points. */
+static uint16_t nearest_index(int64_t a, rfs_q16_t grid, uint16_t n)
+{
+    /* round((a - grid/2) / grid) = floor(a / grid): point i owns [i*grid, (i+1)*grid). */
+    int64_t t = a;
+    if (t < 0) {
+        return 0;
+    }
+    if (t >= (int64_t)n * grid) {
+        return (uint16_t)(n - 1u);
+    }
+    uint32_t k = (uint32_t)t / (uint32_t)grid;
+    return (uint16_t)(k >= n ? n - 1u : k);
+}
+
+void rfs_map_lattice_nearest(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, uint16_t *i,
+                             uint16_t *j)
+{
+    *i = nearest_index((int64_t)x - m->origin_x, m->cfg.grid, m->lw);
+    *j = nearest_index((int64_t)y - m->origin_y, m->cfg.grid, m->lh);
+}
+
+bool rfs_map_lattice_legal(const rfs_map_t *m, uint16_t i, uint16_t j)
+{
+    if (i >= m->lw || j >= m->lh) {
+        return false;
+    }
+    rfs_q16_t x;
+    rfs_q16_t y;
+    rfs_map_lattice_point(m, i, j, &x, &y);
+    return rfs_map_point_legal(m, x, y);
+}

@@ -1,0 +1,94 @@
+/* rfs_models.c - the registry of internal models (see rfs_models.h). */
+#include "rfs_models.h"
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "rfs_knn.h"
+#include "rfs_mlp.h"
+#include "rfs_ridge.h"
+
+static int ridge_init_default(void *state)
+{
+    rfs_ridge_cfg_t c = rfs_ridge_cfg_default();
+    return rfs_ridge_init(state, &c);
+}
+
+static int mlp_init_default(void *state)
+{
+    rfs_mlp_cfg_t c = rfs_mlp_cfg_default();
+    return rfs_mlp_init(state, &c);
+}
+
+static int knn_init_default(void *state)
+{
+    rfs_knn_cfg_t c = rfs_knn_cfg_default();
+    return rfs_knn_init(state, &c);
+}
+
+static int radius_init_default(void *state)
+{
+    rfs_knn_cfg_t c = rfs_knn_cfg_radius_default();
+    return rfs_knn_init(state, &c);
+}
+
+/* The first row is the default model (the paper's main configuration). */
+static const rfs_models_entry_t k_models[] = {
+    {"ridge", &rfs_ridge_ops, (uint32_t)sizeof(rfs_ridge_t), ridge_init_default,
+     "local ridge regression, 5 m radius, alpha 1 (paper 5.2.1)"},
+    {"mlp", &rfs_mlp_ops, (uint32_t)sizeof(rfs_mlp_t), mlp_init_default,
+     "MLP 2-100-1, sigmoid, backprop rate 0.01 momentum 0.1, 3 epochs (paper 5.2.2)"},
+    {"knn", &rfs_knn_ops, (uint32_t)sizeof(rfs_knn_t), knn_init_default,
+     "k-nearest-neighbours regression, k = 5 (paper 5.2)"},
+    {"radius", &rfs_radius_ops, (uint32_t)sizeof(rfs_knn_t), radius_init_default,
+     "radius-neighbours regression, r = 1 m (paper 5.2)"},
+};
+
+#define N_MODELS (sizeof(k_models) / sizeof(k_models[0]))
+
+static bool same_name(const char *a, const char *b)
+{
+    while (*a != '\0' && *a == *b) {
+        ++a;
+        ++b;
+    }
+    return *a == *b;
+}
+
+const rfs_models_entry_t *rfs_models_lookup(const char *name)
+{
+    if (name == NULL) {
+        return NULL;
+    }
+    for (uint32_t i = 0u; i < N_MODELS; ++i) {
+        if (same_name(k_models[i].name, name)) {
+            return &k_models[i];
+        }
+    }
+    return NULL;
+}
+
+const rfs_model_ops_t *rfs_models_find(const char *name)
+{
+    const rfs_models_entry_t *e = rfs_models_lookup(name);
+    return e == NULL ? NULL : e->ops;
+}
+
+uint32_t rfs_models_count(void)
+{
+    return (uint32_t)N_MODELS;
+}
+
+const rfs_models_entry_t *rfs_models_at(uint32_t i)
+{
+    return i < N_MODELS ? &k_models[i] : NULL;
+}
+
+uint32_t rfs_models_max_state_bytes(void)
+{
+    uint32_t m = 0u;
+    for (uint32_t i = 0u; i < N_MODELS; ++i) {
+        m = k_models[i].state_bytes > m ? k_models[i].state_bytes : m;
+    }
+    return m;
+}

@@ -1,0 +1,46 @@
+/* rfs_models.h - the registry of internal models: one name -> operations, state size
+ * and default initialisation, so that the simulator, the feeder and the firmware pick
+ * a model the same way (`--model ridge|mlp|knn|radius`, `model:` in a scenario).
+ *
+ * The caller owns the state: it provides `state_bytes` bytes aligned to 8 (e.g. a
+ * static buffer or a union of the state types), calls init_default() on them, and
+ * builds the rfs_model_t from `ops` and that buffer. A new model is one more row in
+ * the table in rfs_models.c.
+ */
+#ifndef RFS_MODELS_H
+#define RFS_MODELS_H
+
+#include <stdint.h>
+
+#include "rfs_model.h"
+
+/// Alignment the state buffer needs, bytes (states hold int64_t fields).
+#define RFS_MODELS_STATE_ALIGN 8u
+
+/// One registered model.
+typedef struct rfs_models_entry {
+    const char *name;            ///< command-line name ("ridge"), same as ops->name
+    const rfs_model_ops_t *ops;  ///< its operations
+    uint32_t state_bytes;        ///< size of its state, bytes
+    /// Initialise a state of state_bytes bytes with the default (paper) configuration.
+    /// Returns 0 (the defaults are always valid).
+    int (*init_default)(void *state);
+    const char *summary;         ///< one line for --help
+} rfs_models_entry_t;
+
+/// The entry named `name` (NUL-terminated, exact match), or NULL when there is none.
+const rfs_models_entry_t *rfs_models_lookup(const char *name);
+
+/// The operations of the model named `name`, or NULL when there is none.
+const rfs_model_ops_t *rfs_models_find(const char *name);
+
+/// Number of registered models.
+uint32_t rfs_models_count(void);
+
+/// Entry i (0 <= i < rfs_models_count()), in the order --help lists them; NULL beyond.
+const rfs_models_entry_t *rfs_models_at(uint32_t i);
+
+/// The largest state_bytes of all entries (to size one buffer for any model).
+uint32_t rfs_models_max_state_bytes(void);
+
+#endif /* RFS_MODELS_H */

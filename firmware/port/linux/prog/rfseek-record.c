@@ -1,0 +1,410 @@
+/* rfseek-record - run a simulated mission with the firmware application loop as the
+ * controller and record its input stream (and its live output) in the replay format of
+ * firmware/rfs_replay.h (issue 6).
+ *
+ * The controller is the firmware's: every pose and RSSI measurement of the simulator is
+ * encoded as the CAN frames of docs/CAN.md, recorded, and played into rfs_app through
+ * rfs_replay_play() - the very code path of the emulator image - so the recorded stream,
+ * replayed anywhere, must reproduce the live outputs byte for byte.
+ *
+ * Faults for the safety tests are injected live and recorded:
+ *   --drop T0:T1    no pose or RSSI frame reaches the controller in [T0, T1) seconds
+ *   --drop-pose T0:T1, --drop-rssi T0:T1   only the poses / only the RSSI frames stop
+ *   --bus-off T0:T1 the controller's CAN is bus-off in [T0, T1): its frames do not leave
+ *   --reset T       a watchdog reset at T: the application starts from scratch
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "hs_scenario.h"
+#include "hs_sim.h"
+#include "rfs_app.h"
+#include "rfs_can.h"
+#include "rfs_replay.h"
+
+#define MAX_WINDOWS 8
+
+typedef struct window {
+    int64_t t0_us, t1_us;
+} window_t;
+
+typedef struct recorder {
+    FILE *in;                   /* the recorded input stream */
+    FILE *out;                  /* the live output stream, or NULL */
+    const char *in_path;
+    int write_failed;
+    rfs_app_t *app;
+    rfs_replay_player_t *player;
+    rfs_can_tx_t tx;            /* the senders' counters (localisation, radio module) */
+    uint8_t rssi_seq[RFS_CAN_MAX_SOURCES];
+    window_t drop[MAX_WINDOWS];
+    unsigned ndrop;
+    window_t drop_pose[MAX_WINDOWS];
+    unsigned ndrop_pose;
+    window_t drop_rssi[MAX_WINDOWS];
+    unsigned ndrop_rssi;
+    window_t busoff[MAX_WINDOWS];
+    unsigned nbusoff;
+    int64_t reset_us[MAX_WINDOWS];
+    unsigned nreset;
+    unsigned next_reset;
+    bool bus_off;
+    uint32_t records;
+} recorder_t;
+
+static void put(recorder_t *r, const rfs_replay_rec_t *rec)
+{
+    uint8_t buf[RFS_REPLAY_MAX_RECORD];
+    const uint32_t n = rfs_replay_encode(rec, buf, sizeof buf);
+    if (n == 0u || fwrite(buf, 1, n, r->in) != n) {
+        r->write_failed = 1;
+    }
+    r->records++;
+}
+
+/* Record an input and play it into the application. */
+static void feed(recorder_t *r, const rfs_replay_rec_t *rec)
+{
+    put(r, rec);
+    if (!rfs_replay_play(r->player, rec)) {
+        fprintf(stderr, "rfseek-record: %s: %s\n", r->in_path,
+                rfs_replay_err_str(r->player->error));
+        exit(1);
+    }
+}
+
+static void sink(void *ctx, const uint8_t *p, uint32_t n)
+{
+    recorder_t *r = ctx;
+    if (r->out != NULL && fwrite(p, 1, n, r->out) != n) {
+        r->write_failed = 1;
+    }
+}
+
+static bool in_window(const window_t *w, unsigned n, int64_t t)
+{
+    for (unsigned i = 0; i < n; i++) {
+        if (t >= w[i].t0_us && t < w[i].t1_us) {
+            return true;
+        }
+    }
+    return false;
+}
+
+static void feed_can(recorder_t *r, int64_t t_us, const rfs_can_frame_t *f)
+{
+    rfs_replay_rec_t rec;
+    memset(&rec, 0, sizeof rec);
+    rec.type = RFS_REPLAY_CAN;
+    rec.t_us = t_us;
+    rec.u.can.id = f->id;
+    rec.u.can.dlc = f->dlc;
+    memcpy(rec.u.can.data, f->data, 8);
+    feed(r, &rec);
+}
+
+static void on_pose(void *self, const rfs_pose_t *pose)
+{
+    recorder_t *r = self;
+    if (in_window(r->drop, r->ndrop, pose->t_us) ||
+        in_window(r->drop_pose, r->ndrop_pose, pose->t_us)) {
+        return;
+    }
+    const rfs_can_pose_t p = rfs_can_pose_from_core(pose);
+    rfs_can_frame_t xy, th;
+    rfs_can_tx_pose(&r->tx, &p, &xy, &th);
+    feed_can(r, pose->t_us, &xy);
+    feed_can(r, pose->t_us, &th);
+}
+
+static void on_rssi(void *self, uint8_t src, int64_t t_us, int8_t dbm)
+{
+    recorder_t *r = self;
+    if (in_window(r->drop, r->ndrop, t_us) || in_window(r->drop_rssi, r->ndrop_rssi, t_us) ||
+        src >= RFS_CAN_MAX_SOURCES) {
+        return;
+    }
+    const rfs_can_rssi_t m = {.src = src, .dbm = dbm, .seq = r->rssi_seq[src]++,
+                              .t_us32 = rfs_can_wrap_time(t_us)};
+    rfs_can_frame_t f;
+    rfs_can_tx_rssi(&r->tx, &m, &f);
+    feed_can(r, t_us, &f);
+}
+
+static void step(void *self, int64_t now_us, hs_ctrl_out_t *out)
+{
+    recorder_t *r = self;
+    rfs_replay_rec_t rec;
+    memset(&rec, 0, sizeof rec);
+    while (r->next_reset < r->nreset && now_us >= r->reset_us[r->next_reset]) {
+        rec.type = RFS_REPLAY_RESET;
+        rec.t_us = now_us;
+        feed(r, &rec);
+        r->next_reset++;
+        r->bus_off = false; /* a reset re-initialises the controller's CAN state */
+    }
+    const bool off = in_window(r->busoff, r->nbusoff, now_us);
+    if (off != r->bus_off) {
+        rec.type = RFS_REPLAY_BUS;
+        rec.t_us = now_us;
+        rec.u.bus_off = off ? 1u : 0u;
+        feed(r, &rec);
+        r->bus_off = off;
+    }
+    rec.type = RFS_REPLAY_STEP;
+    rec.t_us = now_us;
+    feed(r, &rec);
+
+    const rfs_app_out_t *o = &r->app->last;
+    memset(out, 0, sizeof *out);
+    /* While bus-off the command does not reach the motors: the motor controller keeps
+     * its last command until its own 200 ms timeout, which the simulator models; here
+     * the controller has already commanded zero, so nothing stale is pending. */
+    out->left_mm_s = r->bus_off ? 0 : o->left_mm_s;
+    out->right_mm_s = r->bus_off ? 0 : o->right_mm_s;
+    out->state = o->state;
+    out->faults = (uint16_t)(o->faults & 0xFFu);
+    out->decided = o->decided;
+    out->decision = o->decision;
+}
+
+static int parse_window(const char *s, window_t *w)
+{
+    char *end;
+    const double a = strtod(s, &end);
+    if (end == s || *end != ':') {
+        return -1;
+    }
+    const char *s2 = end + 1;
+    const double b = strtod(s2, &end);
+    if (end == s2 || *end != '\0' || a < 0 || b <= a || b > 1e6) {
+        return -1;
+    }
+    w->t0_us = (int64_t)(a * 1e6 + 0.5);
+    w->t1_us = (int64_t)(b * 1e6 + 0.5);
+    return 0;
+}
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: rfseek-record SCENARIO.yaml -o IN.rfsr [options]\n"
+            "Run a simulated mission with the firmware application loop as the controller\n"
+            "and record its input stream (CAN frames, control steps, injected faults).\n"
+            "  -o, --out FILE       recorded input stream (required)\n"
+            "  --live-out FILE      also write the live output stream\n"
+            "  --seed N             run seed (default: the scenario's)\n"
+            "  --max-time S         stop after S simulated seconds (default: the scenario's)\n"
+            "  --drop T0:T1         no pose/RSSI frames reach the controller in [T0, T1) s\n"
+            "  --drop-pose T0:T1    only the pose frames stop in [T0, T1) s\n"
+            "  --drop-rssi T0:T1    only the RSSI frames stop in [T0, T1) s\n"
+            "  --bus-off T0:T1      the controller's CAN is bus-off in [T0, T1) s\n"
+            "  --reset T            watchdog reset at T s\n"
+            "  -h, --help           this text\n");
+}
+
+static void die_opt(const char *opt, const char *val)
+{
+    fprintf(stderr, "rfseek-record: %s: bad value '%s'\n", opt, val);
+    exit(2);
+}
+
+int main(int argc, char **argv)
+{
+    static const struct option opts[] = {
+        {"out", required_argument, 0, 'o'},     {"live-out", required_argument, 0, 'l'},
+        {"seed", required_argument, 0, 's'},    {"max-time", required_argument, 0, 't'},
+        {"drop", required_argument, 0, 'd'},    {"bus-off", required_argument, 0, 'b'},
+        {"reset", required_argument, 0, 'r'},   {"help", no_argument, 0, 'h'},
+        {"drop-pose", required_argument, 0, 'P'}, {"drop-rssi", required_argument, 0, 'R'},
+        {0, 0, 0, 0}};
+    static recorder_t rec;
+    const char *out_path = NULL, *live_path = NULL;
+    bool have_seed = false;
+    unsigned long long seed = 0;
+    double max_time = -1;
+    int c;
+    while ((c = getopt_long(argc, argv, "o:h", opts, NULL)) != -1) {
+        char *end;
+        switch (c) {
+        case 'o': out_path = optarg; break;
+        case 'l': live_path = optarg; break;
+        case 's':
+            errno = 0;
+            seed = strtoull(optarg, &end, 0);
+            if (errno != 0 || end == optarg || *end != '\0') {
+                die_opt("--seed", optarg);
+            }
+            have_seed = true;
+            break;
+        case 't':
+            max_time = strtod(optarg, &end);
+            if (end == optarg || *end != '\0' || !(max_time > 0) || max_time > 1e5) {
+                die_opt("--max-time", optarg);
+            }
+            break;
+        case 'd':
+            if (rec.ndrop == MAX_WINDOWS || parse_window(optarg, &rec.drop[rec.ndrop++]) != 0) {
+                die_opt("--drop", optarg);
+            }
+            break;
+        case 'P':
+            if (rec.ndrop_pose == MAX_WINDOWS ||
+                parse_window(optarg, &rec.drop_pose[rec.ndrop_pose++]) != 0) {
+                die_opt("--drop-pose", optarg);
+            }
+            break;
+        case 'R':
+            if (rec.ndrop_rssi == MAX_WINDOWS ||
+                parse_window(optarg, &rec.drop_rssi[rec.ndrop_rssi++]) != 0) {
+                die_opt("--drop-rssi", optarg);
+            }
+            break;
+        case 'b':
+            if (rec.nbusoff == MAX_WINDOWS ||
+                parse_window(optarg, &rec.busoff[rec.nbusoff++]) != 0) {
+                die_opt("--bus-off", optarg);
+            }
+            break;
+        case 'r': {
+            const double t = strtod(optarg, &end);
+            if (rec.nreset == MAX_WINDOWS || end == optarg || *end != '\0' || t < 0 || t > 1e6) {
+                die_opt("--reset", optarg);
+            }
+            rec.reset_us[rec.nreset++] = (int64_t)(t * 1e6 + 0.5);
+            break;
+        }
+        case 'h': usage(stdout); return 0;
+        default: usage(stderr); return 2;
+        }
+    }
+    if (optind + 1 != argc || out_path == NULL) {
+        usage(stderr);
+        return 2;
+    }
+    const char *scn_path = argv[optind];
+    char err[512];
+    static hs_scenario_t sc;
+    if (hs_scenario_load(scn_path, &sc, err, sizeof err) != 0) {
+        fprintf(stderr, "rfseek-record: %s\n", err);
+        return 1;
+    }
+    if (max_time > 0) {
+        sc.stop_time_s = max_time;
+    }
+    static hs_sim_env_t env;
+    if (hs_sim_env_open(&env, &sc, err, sizeof err) != 0) {
+        fprintf(stderr, "rfseek-record: %s\n", err);
+        return 1;
+    }
+    const rfs_map_t *m = &env.core.map;
+    if (rfs_map_bytes(m->w, m->h) > RFS_APP_MAX_MAP_BYTES) {
+        fprintf(stderr, "rfseek-record: %s: map of %u x %u cells is larger than the image "
+                        "holds (%u bytes per grid)\n", scn_path, m->w, m->h,
+                RFS_APP_MAX_MAP_BYTES);
+        return 1;
+    }
+
+    /* Outputs go to temporary files renamed at the end: nothing half-written. */
+    char tmp_in[4096], tmp_out[4096];
+    snprintf(tmp_in, sizeof tmp_in, "%s.tmp.%ld", out_path, (long)getpid());
+    snprintf(tmp_out, sizeof tmp_out, "%s.tmp.%ld", live_path ? live_path : "", (long)getpid());
+    rec.in = fopen(tmp_in, "wb");
+    if (rec.in == NULL) {
+        fprintf(stderr, "rfseek-record: %s: %s\n", out_path, strerror(errno));
+        return 1;
+    }
+    if (live_path != NULL && (rec.out = fopen(tmp_out, "wb")) == NULL) {
+        fprintf(stderr, "rfseek-record: %s: %s\n", live_path, strerror(errno));
+        fclose(rec.in);
+        remove(tmp_in);
+        return 1;
+    }
+    rec.in_path = out_path;
+    static rfs_app_t app;
+    static rfs_replay_player_t player;
+    rec.app = &app;
+    rec.player = &player;
+    rfs_can_tx_init(&rec.tx);
+    const uint64_t run_seed = have_seed ? seed : sc.seed;
+
+    uint8_t hdr[RFS_REPLAY_HEADER_LEN];
+    rfs_replay_header(hdr);
+    if (fwrite(hdr, 1, sizeof hdr, rec.in) != sizeof hdr) {
+        rec.write_failed = 1;
+    }
+    const rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    rfs_replay_player_init(&player, &app, &cfg, sink, &rec);
+
+    rfs_replay_rec_t r;
+    memset(&r, 0, sizeof r);
+    r.type = RFS_REPLAY_CFG;
+    r.u.cfg.seed = run_seed;
+    r.u.cfg.target = sc.nsources == 2u ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
+    r.u.cfg.node = 1u;
+    feed(&rec, &r);
+    memset(&r, 0, sizeof r);
+    r.type = RFS_REPLAY_MAP;
+    r.u.map.w = m->w;
+    r.u.map.h = m->h;
+    r.u.map.res = m->res;
+    r.u.map.origin_x = m->origin_x;
+    r.u.map.origin_y = m->origin_y;
+    r.u.map.has_wall = env.core.wall_bits != NULL ? 1u : 0u;
+    feed(&rec, &r);
+    const uint32_t bytes = rfs_map_bytes(m->w, m->h);
+    for (int g = 0; g < 2; g++) {
+        const uint8_t *bits = g == 0 ? env.core.free_bits : env.core.wall_bits;
+        if (bits == NULL) {
+            continue;
+        }
+        for (uint32_t off = 0; off < bytes; off += RFS_REPLAY_CHUNK) {
+            memset(&r, 0, sizeof r);
+            r.type = g == 0 ? RFS_REPLAY_MAP_FREE : RFS_REPLAY_MAP_WALL;
+            r.u.chunk.offset = off;
+            r.u.chunk.n = (uint8_t)(bytes - off < RFS_REPLAY_CHUNK ? bytes - off : RFS_REPLAY_CHUNK);
+            memcpy(r.u.chunk.bytes, bits + off, r.u.chunk.n);
+            feed(&rec, &r);
+        }
+    }
+
+    hs_ctrl_t ctrl;
+    memset(&ctrl, 0, sizeof ctrl);
+    ctrl.name = "firmware";
+    ctrl.self = &rec;
+    ctrl.period_us = RFS_APP_PERIOD_US;
+    ctrl.on_pose = on_pose;
+    ctrl.on_rssi = on_rssi;
+    ctrl.step = step;
+    hs_sim_result_t res;
+    const int rc = hs_sim_run(&env, run_seed, &ctrl, NULL, &res, err, sizeof err);
+    memset(&r, 0, sizeof r);
+    r.type = RFS_REPLAY_END;
+    put(&rec, &r);
+    const int close_in = fclose(rec.in);
+    const int close_out = rec.out != NULL ? fclose(rec.out) : 0;
+    if (rc != 0 || rec.write_failed || close_in != 0 || close_out != 0) {
+        fprintf(stderr, "rfseek-record: %s: %s\n", rc != 0 ? scn_path : out_path,
+                rc != 0 ? err : "write failed");
+        remove(tmp_in);
+        if (live_path != NULL) {
+            remove(tmp_out);
+        }
+        return 1;
+    }
+    if (rename(tmp_in, out_path) != 0 || (live_path != NULL && rename(tmp_out, live_path) != 0)) {
+        fprintf(stderr, "rfseek-record: %s: %s\n", out_path, strerror(errno));
+        return 1;
+    }
+    printf("recorded %" PRIu32 " records, %" PRIu32 " steps, %.1f s simulated, %s, "
+           "%u decisions, final distance %.2f m\n",
+           rec.records, player.steps, res.sim_time_s, res.end, res.iterations,
+           res.final_distance_m);
+    hs_sim_env_close(&env);
+    return 0;
+}

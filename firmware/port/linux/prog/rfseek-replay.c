@@ -1,0 +1,253 @@
+/* rfseek-replay - the host build of the firmware application loop on a recorded stream
+ * (firmware/rfs_replay.h), and a printer for streams (issue 6).
+ *
+ *   rfseek-replay IN.rfsr -o OUT.rfso   play an input stream, write the output stream
+ *   rfseek-replay --print FILE          print any stream, one record per line (TSV)
+ *
+ * Playing runs rfs_replay_play(), the driver loop the emulator image runs, so the output
+ * must equal the emulator's byte for byte. Errors: one line naming the file, the byte
+ * offset and the reason; exit 1; no output file is left behind.
+ */
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "rfs_app.h"
+#include "rfs_replay.h"
+
+typedef struct sink_ctx {
+    FILE *f;
+    int failed;
+} sink_ctx_t;
+
+static void sink(void *ctx, const uint8_t *p, uint32_t n)
+{
+    sink_ctx_t *s = ctx;
+    if (fwrite(p, 1, n, s->f) != n) {
+        s->failed = 1;
+    }
+}
+
+static uint8_t *slurp(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (f == NULL) {
+        fprintf(stderr, "rfseek-replay: %s: %s\n", path, strerror(errno));
+        return NULL;
+    }
+    size_t cap = 1 << 16, n = 0;
+    uint8_t *buf = malloc(cap);
+    for (;;) {
+        if (buf == NULL) {
+            fprintf(stderr, "rfseek-replay: %s: out of memory\n", path);
+            fclose(f);
+            return NULL;
+        }
+        n += fread(buf + n, 1, cap - n, f);
+        if (n < cap) {
+            break;
+        }
+        cap *= 2;
+        uint8_t *nb = realloc(buf, cap);
+        if (nb == NULL) {
+            free(buf);
+        }
+        buf = nb;
+    }
+    const int bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        fprintf(stderr, "rfseek-replay: %s: read error\n", path);
+        free(buf);
+        return NULL;
+    }
+    *len = n;
+    return buf;
+}
+
+static const char *type_name(rfs_replay_type_t t)
+{
+    switch (t) {
+    case RFS_REPLAY_CFG: return "CFG";
+    case RFS_REPLAY_MAP: return "MAP";
+    case RFS_REPLAY_MAP_FREE: return "MAP_FREE";
+    case RFS_REPLAY_MAP_WALL: return "MAP_WALL";
+    case RFS_REPLAY_POSE: return "POSE";
+    case RFS_REPLAY_RSSI: return "RSSI";
+    case RFS_REPLAY_CAN: return "CAN";
+    case RFS_REPLAY_STEP: return "STEP";
+    case RFS_REPLAY_BUS: return "BUS";
+    case RFS_REPLAY_RESET: return "RESET";
+    case RFS_REPLAY_END: return "END";
+    case RFS_REPLAY_OUT: return "OUT";
+    case RFS_REPLAY_DECISION: return "DECISION";
+    case RFS_REPLAY_CAN_TX: return "CAN_TX";
+    default: return "?";
+    }
+}
+
+/* One line per record: type, time (us), then the fields. */
+static void print_rec(const rfs_replay_rec_t *r)
+{
+    printf("%s\t%" PRId64, type_name(r->type), r->t_us);
+    switch (r->type) {
+    case RFS_REPLAY_CFG:
+        printf("\tseed=%" PRIu64 "\ttarget=%u\tnode=%u", r->u.cfg.seed, r->u.cfg.target,
+               r->u.cfg.node);
+        break;
+    case RFS_REPLAY_MAP:
+        printf("\tw=%u\th=%u\tres_q16=%d\tox_q16=%d\toy_q16=%d\twall=%u", r->u.map.w,
+               r->u.map.h, r->u.map.res, r->u.map.origin_x, r->u.map.origin_y,
+               r->u.map.has_wall);
+        break;
+    case RFS_REPLAY_MAP_FREE:
+    case RFS_REPLAY_MAP_WALL:
+        printf("\toffset=%" PRIu32 "\tn=%u", r->u.chunk.offset, r->u.chunk.n);
+        break;
+    case RFS_REPLAY_POSE:
+        printf("\tt=%" PRId64 "\tx_q16=%d\ty_q16=%d\ttheta_q16=%d", r->u.pose.t_us, r->u.pose.x,
+               r->u.pose.y, r->u.pose.theta);
+        break;
+    case RFS_REPLAY_RSSI:
+        printf("\tt=%" PRId64 "\tsrc=%u\tdbm=%d", r->u.rssi.t_us, r->u.rssi.src, r->u.rssi.dbm);
+        break;
+    case RFS_REPLAY_CAN:
+    case RFS_REPLAY_CAN_TX:
+        printf("\tid=%03" PRIX32 "\tdlc=%u\tdata=", r->u.can.id, r->u.can.dlc);
+        for (unsigned i = 0; i < r->u.can.dlc; i++) {
+            printf("%02X", r->u.can.data[i]);
+        }
+        break;
+    case RFS_REPLAY_BUS:
+        printf("\toff=%u", r->u.bus_off);
+        break;
+    case RFS_REPLAY_OUT:
+        printf("\tleft=%d\tright=%d\tstate=%d\tfaults=0x%04x\tdecided=%d", r->u.out.left_mm_s,
+               r->u.out.right_mm_s, (int)r->u.out.state, r->u.out.faults, r->u.out.decided);
+        break;
+    case RFS_REPLAY_DECISION: {
+        const rfs_seek_decision_t *d = &r->u.out.decision;
+        printf("\titer=%" PRIu32 "\tkind=%d\trelearned=%d\tline_search=%d\tprev=%d"
+               "\tprediction_q16=%d\tmean_q16=%d\teps_q16=%d\tx_q16=%d\ty_q16=%d"
+               "\tgoal_x_q16=%d\tgoal_y_q16=%d\tsamples=%u",
+               d->iteration, (int)d->kind, d->relearned, d->line_search, (int)d->prev,
+               d->prediction, d->mean, d->epsilon, d->x, d->y, d->goal_x, d->goal_y,
+               d->samples);
+        break;
+    }
+    default:
+        break;
+    }
+    printf("\n");
+}
+
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: rfseek-replay IN.rfsr -o OUT.rfso\n"
+               "       rfseek-replay --print FILE\n"
+               "Play a recorded input stream through the host build of the firmware\n"
+               "application loop (the emulator image runs the same code), or print a stream.\n"
+               "  -o FILE      output stream (written to a temporary file, then renamed)\n"
+               "  --print      print every record of FILE as one TSV line\n"
+               "  -h, --help   this text\n");
+}
+
+int main(int argc, char **argv)
+{
+    const char *in_path = NULL, *out_path = NULL;
+    int print = 0;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0) {
+            usage(stdout);
+            return 0;
+        } else if (strcmp(argv[i], "--print") == 0) {
+            print = 1;
+        } else if (strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
+            out_path = argv[++i];
+        } else if (argv[i][0] == '-') {
+            fprintf(stderr, "rfseek-replay: %s: unknown option\n", argv[i]);
+            usage(stderr);
+            return 2;
+        } else if (in_path == NULL) {
+            in_path = argv[i];
+        } else {
+            usage(stderr);
+            return 2;
+        }
+    }
+    if (in_path == NULL || (print == 0) == (out_path == NULL)) {
+        usage(stderr);
+        return 2;
+    }
+    size_t len = 0;
+    uint8_t *buf = slurp(in_path, &len);
+    if (buf == NULL) {
+        return 1;
+    }
+    if (rfs_replay_check_header(buf, (uint32_t)(len < 8 ? len : 8)) != 0) {
+        fprintf(stderr, "rfseek-replay: %s: offset 0: not an rfseek stream (bad header)\n",
+                in_path);
+        free(buf);
+        return 1;
+    }
+    static rfs_app_t app;
+    static rfs_replay_player_t player;
+    sink_ctx_t sc = {0};
+    char tmp[4096];
+    if (!print) {
+        snprintf(tmp, sizeof tmp, "%s.tmp.%ld", out_path, (long)getpid());
+        sc.f = fopen(tmp, "wb");
+        if (sc.f == NULL) {
+            fprintf(stderr, "rfseek-replay: %s: %s\n", out_path, strerror(errno));
+            free(buf);
+            return 1;
+        }
+        const rfs_app_cfg_t cfg = rfs_app_cfg_default();
+        rfs_replay_player_init(&player, &app, &cfg, sink, &sc);
+    }
+    size_t pos = RFS_REPLAY_HEADER_LEN;
+    int rc = 0;
+    while (pos < len) {
+        rfs_replay_rec_t rec;
+        uint32_t used = 0;
+        const size_t left = len - pos;
+        const rfs_replay_status_t st =
+            rfs_replay_parse(buf + pos, (uint32_t)(left > 65536 ? 65536 : left), &used, &rec);
+        if (st != RFS_REPLAY_OK) {
+            fprintf(stderr, "rfseek-replay: %s: offset %zu: %s\n", in_path, pos,
+                    st == RFS_REPLAY_NEED_MORE ? "truncated record" : rec.error);
+            rc = 1;
+            break;
+        }
+        if (print) {
+            print_rec(&rec);
+        } else if (!rfs_replay_play(&player, &rec)) {
+            fprintf(stderr, "rfseek-replay: %s: offset %zu: %s\n", in_path, pos,
+                    rfs_replay_err_str(player.error));
+            rc = 1;
+            break;
+        }
+        pos += used;
+        if (rec.type == RFS_REPLAY_END) {
+            break;
+        }
+    }
+    free(buf);
+    if (!print) {
+        if (fclose(sc.f) != 0 || sc.failed) {
+            fprintf(stderr, "rfseek-replay: %s: write failed\n", out_path);
+            rc = 1;
+        }
+        if (rc != 0) {
+            remove(tmp);
+        } else if (rename(tmp, out_path) != 0) {
+            fprintf(stderr, "rfseek-replay: %s: %s\n", out_path, strerror(errno));
+            remove(tmp);
+            rc = 1;
+        }
+    }
+    return rc;
+}

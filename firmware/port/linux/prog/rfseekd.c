@@ -1,0 +1,486 @@
+/* rfseekd.c - the Linux port of the firmware (issue 4): the same application loop as the
+ * microcontroller (firmware/rfs_app.h), with pose and RSSI from LCM, wheel commands to
+ * SocketCAN (or the LCM fallback channel RFS_CAN_FALLBACK carrying raw CAN frames), the
+ * status to LCM, and runs recorded as LCM logs. See docs/CAN.md.
+ *
+ * Clocks: live, the controller steps at 20 Hz on CLOCK_REALTIME in microseconds (the
+ * LCM utime convention: senders share the robot's synchronised clock). With --clock-lcm
+ * it steps once per RFS_CLOCK message at that time (lock-step with a simulator). With
+ * --replay LOG it reads the log instead of LCM: with --clock-lcm the recorded clock
+ * messages drive the steps, otherwise a step runs at every 50 ms boundary of the event
+ * timestamps - either way the same log gives the same decisions every time.
+ */
+#include <errno.h>
+#include <inttypes.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "hs_can.h"
+#include "hs_lcm.h"
+#include "hs_map.h"
+#include "rfs_app.h"
+
+static const char usage_text[] =
+    "usage: rfseekd --map MAP.yaml [--lcm URL] [--can IFACE | --can-over-lcm] [options]\n"
+    "       rfseekd --map MAP.yaml --replay LOG [--clock-lcm] [options]\n"
+    "The rfseek controller as a Linux process: pose (RFS_POSE) and RSSI (RFS_RSSI) from LCM,\n"
+    "wheel commands to CAN, status to RFS_SEEKER_STATUS (and a copy on RFS_WHEEL_CMD).\n"
+    "  --map FILE        ROS map_server YAML (required)\n"
+    "  --res M           core map cell size, metres (default 0.1)\n"
+    "  --lcm URL         LCM provider (default: LCM's default udpm)\n"
+    "  --can IFACE       send WHEEL_CMD and STATUS frames on this SocketCAN interface\n"
+    "  --can-over-lcm    no SocketCAN: send the raw frames on LCM channel RFS_CAN_FALLBACK\n"
+    "  --clock-lcm       step once per RFS_CLOCK message (lock-step with a simulator)\n"
+    "  --replay LOG      read inputs from an LCM log instead of LCM (deterministic)\n"
+    "  --log FILE        record every input and output as an LCM log (lcm-logplayer)\n"
+    "  --decisions FILE  write one line per decision (default: stdout with --replay)\n"
+    "  --target NAME     rssi (default) or bridge\n"
+    "  --seed N          seed of the controller's random source (default 1)\n"
+    "  --duration S      stop after S seconds of controller time (default: run until signalled)\n"
+    "  --idle-exit MS    stop when no LCM message arrived for MS milliseconds\n"
+    "  --help            this text\n";
+
+typedef struct daemon {
+    rfs_app_t *app;
+    hs_lcm_t *lcm;
+    hs_can_t *can;
+    bool can_over_lcm;
+    bool clock_lcm;
+    bool replay;
+    hs_lcm_log_t *rec;
+    FILE *decisions;
+    int64_t next_step_us;   /* replay without clock: next 50 ms boundary */
+    bool have_time;
+    int64_t start_us;       /* first step's time */
+    bool started;
+    int64_t duration_us;    /* 0: unlimited */
+    bool done;
+    uint32_t steps;
+    uint32_t decided;
+    uint32_t bad_msgs;
+    uint32_t can_fail;
+    uint32_t clock_backwards;
+    int64_t last_clock_us;
+    int64_t last_now_us;    /* time of the latest step */
+    hs_can_link_t link;
+} daemon_t;
+
+static volatile sig_atomic_t g_stop;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    g_stop = 1;
+}
+
+static int64_t realtime_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
+static const char *kind_name(rfs_seek_kind_t k)
+{
+    switch (k) {
+    case RFS_SEEK_INITIAL: return "initial";
+    case RFS_SEEK_GREEDY: return "greedy";
+    case RFS_SEEK_EPSILON: return "epsilon";
+    default: return "none";
+    }
+}
+
+static void step(daemon_t *d, int64_t now_us)
+{
+    if (d->done) {
+        return;
+    }
+    if (!d->started) {
+        d->started = true;
+        d->start_us = now_us;
+    }
+    if (d->duration_us > 0 && now_us - d->start_us >= d->duration_us) {
+        d->done = true;
+        return;
+    }
+    if (d->can) {
+        hs_can_link_t link = hs_can_health(d->can, NULL);
+        if (link != d->link) {
+            fprintf(stderr, "rfseekd: CAN link %s\n",
+                    link == HS_CAN_LINK_OK ? "ok" : link == HS_CAN_LINK_PASSIVE ? "error-passive"
+                                                  : link == HS_CAN_LINK_BUS_OFF ? "bus-off: wheels stopped"
+                                                                                : "down: wheels stopped");
+            d->link = link;
+        }
+        rfs_app_set_bus_off(d->app, link == HS_CAN_LINK_BUS_OFF || link == HS_CAN_LINK_DOWN);
+    }
+    rfs_app_out_t out;
+    d->last_now_us = now_us;
+    rfs_app_step(d->app, now_us, &out);
+    d->steps++;
+    rfs_can_frame_t fr[2];
+    uint8_t n = rfs_app_frames(d->app, &out, fr);
+    for (uint8_t i = 0; i < n; i++) {
+        int r = 0;
+        if (d->can) {
+            r = hs_can_send(d->can, &fr[i]);
+        } else if (d->can_over_lcm && d->lcm) {
+            r = hs_lcm_pub_can(d->lcm, now_us, &fr[i]);
+        }
+        if (r != 0 && d->can_fail++ == 0) {
+            fprintf(stderr, "rfseekd: a CAN frame could not be sent (counted; retrying with backoff)\n");
+        }
+    }
+    rfs_seek_out_t so;
+    memset(&so, 0, sizeof so);
+    so.left_mm_s = out.left_mm_s;
+    so.right_mm_s = out.right_mm_s;
+    so.state = out.state;
+    so.faults = out.faults;
+    so.decided = out.decided;
+    so.decision = out.decision;
+    rfs_can_wheel_t w = {out.left_mm_s, out.right_mm_s,
+                         (uint8_t)(out.state == RFS_SEEK_DRIVING ? 0u : RFS_CAN_WHEEL_STOP)};
+    if (d->lcm) {
+        (void)hs_lcm_pub_wheel(d->lcm, now_us, &w);
+        (void)hs_lcm_pub_status(d->lcm, now_us, &so);
+    }
+    if (out.decided && d->decisions) {
+        const rfs_seek_decision_t *x = &out.decision;
+        d->decided++;
+        fprintf(d->decisions,
+                "decision t=%" PRId64 " n=%" PRIu32 " kind=%s relearn=%d line_search=%d prev=%d pred_q16=%" PRId32
+                " mean_q16=%" PRId32 " eps_q16=%" PRId32 " x_q16=%" PRId32 " y_q16=%" PRId32 " goal_q16=%" PRId32
+                ",%" PRId32 " samples=%u\n",
+                x->t_us, x->iteration, kind_name(x->kind), x->relearned, x->line_search, (int)x->prev,
+                x->prediction, x->mean, x->epsilon, x->x, x->y, x->goal_x, x->goal_y, (unsigned)x->samples);
+    }
+}
+
+/* Replay without clock messages: run every step whose time lies before t_us. */
+static void advance_to(daemon_t *d, int64_t t_us)
+{
+    if (!d->replay || d->clock_lcm) {
+        return;
+    }
+    if (!d->have_time) {
+        d->have_time = true;
+        d->next_step_us = t_us - (t_us % RFS_APP_PERIOD_US) + RFS_APP_PERIOD_US;
+        return;
+    }
+    while (d->next_step_us <= t_us && !d->done) {
+        step(d, d->next_step_us);
+        d->next_step_us += RFS_APP_PERIOD_US;
+    }
+}
+
+/* Receive time of an input: its own time in lock-step and replay (the simulated clock),
+ * the local clock when live. */
+static int64_t rx_time(const daemon_t *d, int64_t t_us)
+{
+    if (!d->clock_lcm && !d->replay) {
+        return realtime_us();
+    }
+    /* A late (out-of-order) input arrives now, not at its stamp. */
+    return d->started && t_us < d->last_now_us ? d->last_now_us : t_us;
+}
+
+static void on_pose(void *ctx, const rfs_pose_t *pose)
+{
+    daemon_t *d = ctx;
+    advance_to(d, pose->t_us);
+    (void)rfs_app_on_pose(d->app, pose, rx_time(d, pose->t_us));
+}
+
+static void on_rssi(void *ctx, uint8_t src, int64_t t_us, int8_t dbm, uint32_t seq)
+{
+    daemon_t *d = ctx;
+    (void)seq;
+    advance_to(d, t_us);
+    (void)rfs_app_on_rssi(d->app, src, t_us, dbm, rx_time(d, t_us));
+}
+
+static void on_clock(void *ctx, int64_t t_us)
+{
+    daemon_t *d = ctx;
+    if (d->steps > 0 && t_us <= d->last_clock_us) {
+        if (d->clock_backwards++ == 0) {
+            fprintf(stderr, "rfseekd: RFS_CLOCK: time %" PRId64 " not after %" PRId64 " (dropped, counted)\n", t_us,
+                    d->last_clock_us);
+        }
+        return;
+    }
+    d->last_clock_us = t_us;
+    step(d, t_us);
+}
+
+static void on_bad(void *ctx, const char *why)
+{
+    daemon_t *d = ctx;
+    d->bad_msgs++;
+    fprintf(stderr, "rfseekd: dropped LCM message: %s\n", why);
+}
+
+static int die(const char *msg, const char *arg)
+{
+    fprintf(stderr, "rfseekd: %s%s\n", msg, arg ? arg : "");
+    return 2;
+}
+
+static bool parse_i64(const char *s, int64_t lo, int64_t hi, int64_t *v)
+{
+    char *end;
+    errno = 0;
+    long long x = strtoll(s, &end, 10);
+    if (errno || end == s || *end != '\0' || x < lo || x > hi) {
+        return false;
+    }
+    *v = x;
+    return true;
+}
+
+static bool is_value_option(const char *a)
+{
+    static const char *const opts[] = {"--map", "--lcm", "--can", "--replay", "--log", "--decisions",
+                                       "--target", "--res", "--seed", "--duration", "--idle-exit"};
+    for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++) {
+        if (strcmp(a, opts[i]) == 0) {
+            return true;
+        }
+    }
+    return false;
+}
+
+int main(int argc, char **argv)
+{
+    const char *map_path = NULL, *url = NULL, *can_if = NULL, *replay = NULL, *log_path = NULL, *dec_path = NULL;
+    const char *target = "rssi";
+    double res = 0.1;
+    int64_t seed = 1, duration_s = 0, idle_ms = 0;
+    bool can_over_lcm = false, clock_lcm = false;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            fputs(usage_text, stdout);
+            return 0;
+        } else if (strcmp(a, "--can-over-lcm") == 0) {
+            can_over_lcm = true;
+        } else if (strcmp(a, "--clock-lcm") == 0) {
+            clock_lcm = true;
+        } else if (!is_value_option(a)) {
+            return die("unknown option (see --help): ", a);
+        } else if (v == NULL) {
+            return die("missing value for option ", a);
+        } else if (strcmp(a, "--map") == 0) {
+            map_path = v, i++;
+        } else if (strcmp(a, "--lcm") == 0) {
+            url = v, i++;
+        } else if (strcmp(a, "--can") == 0) {
+            can_if = v, i++;
+        } else if (strcmp(a, "--replay") == 0) {
+            replay = v, i++;
+        } else if (strcmp(a, "--log") == 0) {
+            log_path = v, i++;
+        } else if (strcmp(a, "--decisions") == 0) {
+            dec_path = v, i++;
+        } else if (strcmp(a, "--target") == 0) {
+            target = v, i++;
+            if (strcmp(target, "rssi") != 0 && strcmp(target, "bridge") != 0) {
+                return die("--target: expected rssi or bridge, got ", target);
+            }
+        } else if (strcmp(a, "--res") == 0) {
+            char *end;
+            res = strtod(v, &end);
+            if (*end != '\0' || !(res >= 0.01 && res <= 1.0)) {
+                return die("--res: expected metres in [0.01, 1], got ", v);
+            }
+            i++;
+        } else if (strcmp(a, "--seed") == 0) {
+            if (!parse_i64(v, 0, INT64_MAX, &seed)) {
+                return die("--seed: expected a non-negative integer, got ", v);
+            }
+            i++;
+        } else if (strcmp(a, "--duration") == 0) {
+            if (!parse_i64(v, 1, 86400 * 365, &duration_s)) {
+                return die("--duration: expected whole seconds >= 1, got ", v);
+            }
+            i++;
+        } else if (strcmp(a, "--idle-exit") == 0) {
+            if (!parse_i64(v, 1, 86400000, &idle_ms)) {
+                return die("--idle-exit: expected milliseconds >= 1, got ", v);
+            }
+            i++;
+        } else {
+            return die("unknown option (see --help): ", a);
+        }
+    }
+    if (!map_path) {
+        return die("--map MAP.yaml is required (see --help)", NULL);
+    }
+    if (can_if && can_over_lcm) {
+        return die("--can and --can-over-lcm exclude each other", NULL);
+    }
+    if (replay && (can_if || can_over_lcm)) {
+        return die("--replay sends no CAN frames: drop --can / --can-over-lcm", NULL);
+    }
+
+    char err[256];
+    hs_map_t m;
+    memset(&m, 0, sizeof m);
+    hs_core_map_t core;
+    memset(&core, 0, sizeof core);
+    rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.seed = (uint64_t)seed;
+    cfg.target = strcmp(target, "bridge") == 0 ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
+    if (hs_map_load(map_path, &m, err, sizeof err) != 0 || hs_map_to_core(&m, res, &cfg.map, &core, err, sizeof err) != 0) {
+        hs_map_free(&m);
+        fprintf(stderr, "rfseekd: %s\n", err);
+        return 1;
+    }
+    rfs_app_map_t am = {core.map.w, core.map.h, core.map.res, core.map.origin_x, core.map.origin_y, core.free_bits,
+                        core.wall_bits};
+    daemon_t d;
+    memset(&d, 0, sizeof d);
+    d.app = malloc(sizeof *d.app);
+    if (!d.app || rfs_app_init(d.app, &cfg, &am) != 0) {
+        fprintf(stderr, "rfseekd: %s: the map (%u x %u cells at %.2f m) exceeds the controller's limits "
+                        "(%u bytes per grid, %u lattice points)\n",
+                map_path, core.map.w, core.map.h, res, RFS_APP_MAX_MAP_BYTES, RFS_APP_MAX_LATTICE);
+        free(d.app);
+        hs_core_map_free(&core);
+        hs_map_free(&m);
+        return 1;
+    }
+    d.can_over_lcm = can_over_lcm;
+    d.clock_lcm = clock_lcm;
+    d.replay = replay != NULL;
+    d.duration_us = duration_s * 1000000;
+    d.decisions = replay ? stdout : NULL;
+    int rc = 0;
+    hs_lcm_log_t *in = NULL;
+    if (dec_path && !(d.decisions = fopen(dec_path, "w"))) {
+        fprintf(stderr, "rfseekd: %s: cannot write\n", dec_path);
+        rc = 1;
+        goto out;
+    }
+    hs_lcm_handlers_t h;
+    memset(&h, 0, sizeof h);
+    h.ctx = &d;
+    h.on_pose = on_pose;
+    h.on_rssi = on_rssi;
+    h.on_clock = clock_lcm ? on_clock : NULL;
+    h.on_bad = on_bad;
+    if (log_path && !(d.rec = hs_lcm_log_open(log_path, "w", err, sizeof err))) {
+        fprintf(stderr, "rfseekd: %s\n", err);
+        rc = 1;
+        goto out;
+    }
+    if (!replay || url) {
+        /* In replay, LCM (when given) only carries the outputs. */
+        hs_lcm_handlers_t none;
+        memset(&none, 0, sizeof none);
+        d.lcm = hs_lcm_open(url, replay ? &none : &h, err, sizeof err);
+        if (!d.lcm) {
+            fprintf(stderr, "rfseekd: %s\n", err);
+            rc = 1;
+            goto out;
+        }
+        hs_lcm_record(d.lcm, d.rec);
+    }
+    if (can_if) {
+        const uint32_t ids[] = {RFS_CAN_ID_WHEEL_CMD, RFS_CAN_ID_STATUS};
+        d.can = hs_can_open(can_if, ids, 2, err, sizeof err);
+        if (!d.can) {
+            fprintf(stderr, "rfseekd: %s\n", err);
+            rc = 1;
+            goto out;
+        }
+    }
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
+    if (replay) {
+        in = hs_lcm_log_open(replay, "r", err, sizeof err);
+        if (!in) {
+            fprintf(stderr, "rfseekd: %s\n", err);
+            rc = 1;
+            goto out;
+        }
+        hs_lcm_stats_t st;
+        memset(&st, 0, sizeof st);
+        int64_t t;
+        while (!g_stop && !d.done && hs_lcm_log_next(in, &h, &st, &t) == 1) {
+        }
+    } else if (clock_lcm) {
+        int64_t idle_since = realtime_us();
+        while (!g_stop && !d.done) {
+            int r = hs_lcm_handle(d.lcm, 100);
+            if (r < 0) {
+                /* LCM's file:// provider reports the end of its log this way. */
+                if (url && strncmp(url, "file://", 7) == 0) {
+                    break;
+                }
+                fprintf(stderr, "rfseekd: %s: LCM receive failed\n", url ? url : "(default URL)");
+                rc = 1;
+                break;
+            }
+            int64_t now = realtime_us();
+            if (r > 0) {
+                idle_since = now;
+            } else if (idle_ms > 0 && now - idle_since >= idle_ms * 1000) {
+                break;
+            }
+        }
+    } else {
+        int64_t next = realtime_us();
+        int64_t idle_since = next;
+        while (!g_stop && !d.done) {
+            int64_t now = realtime_us();
+            if (now >= next) {
+                step(&d, now);
+                next += RFS_APP_PERIOD_US;
+                if (next < now) {
+                    next = now + RFS_APP_PERIOD_US; /* overrun: skip, do not burst */
+                }
+                continue;
+            }
+            int r = hs_lcm_handle(d.lcm, (int)((next - now + 999) / 1000));
+            if (r < 0) {
+                if (url && strncmp(url, "file://", 7) == 0) {
+                    break;
+                }
+                fprintf(stderr, "rfseekd: %s: LCM receive failed\n", url ? url : "(default URL)");
+                rc = 1;
+                break;
+            }
+            if (r > 0) {
+                idle_since = realtime_us();
+            } else if (idle_ms > 0 && realtime_us() - idle_since >= idle_ms * 1000) {
+                break;
+            }
+        }
+    }
+    fprintf(stderr, "rfseekd: %" PRIu32 " steps, %" PRIu32 " decisions, %" PRIu32 " bad messages, %" PRIu32
+                    " CAN send failures, seeker rejected %" PRIu32 " inputs\n",
+            d.steps, d.decided, d.bad_msgs, d.can_fail, d.app->stats.rejected);
+out:
+    if (in) {
+        hs_lcm_log_close(in);
+    }
+    if (d.rec && hs_lcm_log_close(d.rec) != 0) {
+        fprintf(stderr, "rfseekd: %s: could not finish the log\n", log_path);
+        rc = 1;
+    }
+    if (d.decisions && d.decisions != stdout) {
+        fclose(d.decisions);
+    }
+    hs_can_close(d.can);
+    hs_lcm_close(d.lcm);
+    free(d.app);
+    hs_core_map_free(&core);
+    hs_map_free(&m);
+    return rc;
+}

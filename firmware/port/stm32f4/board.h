@@ -1,0 +1,51 @@
+/* board.h - STM32F405 board support for the firmware: clocks, time base, watchdog.
+ *
+ * Clock tree (RM0090 6.2): HSE RFS_BOARD_HSE_HZ (8 MHz) -> PLL (M = HSE/1 MHz, N = 336,
+ * P = 2) = 168 MHz SYSCLK; AHB /1, APB1 /4 = 42 MHz (bxCAN), APB2 /2 = 84 MHz; flash
+ * 5 wait states. SysTick runs from the core clock and interrupts every millisecond;
+ * rfs_board_now_us() combines the millisecond count with the current count down value.
+ * The independent watchdog (LSI 32 kHz nominal, /8, reload 1999) fires after 500 ms
+ * without rfs_board_kick() (340 .. 940 ms over the LSI's 17 .. 47 kHz range). It must
+ * outlast the longest control iteration: the first one after boot runs the seeker's
+ * reachability flood fill, 16.7 million instructions (~100 ms at 168 MHz; docs/
+ * PERFORMANCE.md). While the loop is busy no command is sent and the motor controller's
+ * own 200 ms command timeout stops the wheels; once the watchdog has fired, the image
+ * boots (rfs_app_init: 6.3 million instructions, ~40 ms) and its first command is zero.
+ */
+#ifndef RFS_BOARD_H
+#define RFS_BOARD_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#ifndef RFS_BOARD_HSE_HZ
+#define RFS_BOARD_HSE_HZ 8000000u ///< external crystal, Hz
+#endif
+#define RFS_BOARD_SYSCLK_HZ 168000000u ///< core clock, Hz
+#define RFS_BOARD_PCLK1_HZ 42000000u   ///< APB1 clock (bxCAN), Hz
+#define RFS_BOARD_IWDG_PR 1u          ///< LSI / 8 (RM0090 21.4.2)
+#define RFS_BOARD_IWDG_RELOAD 1999u    ///< (1999 + 1) / (32 kHz / 8) = 500 ms
+
+/// Start HSE and the PLL and switch SYSCLK to 168 MHz. Returns 0, or -1 when HSE or
+/// the PLL does not become ready (the board then runs on HSI 16 MHz).
+int rfs_board_clock_init(void);
+
+/// Start SysTick: one interrupt per millisecond at core_hz.
+void rfs_board_time_init(uint32_t core_hz);
+
+/// Microseconds since rfs_board_time_init().
+int64_t rfs_board_now_us(void);
+
+/// true when the last reset came from the independent watchdog (then clears the flags).
+bool rfs_board_reset_was_watchdog(void);
+
+/// Start the independent watchdog (it cannot be stopped afterwards).
+void rfs_board_watchdog_start(void);
+
+/// Reload the watchdog.
+void rfs_board_kick(void);
+
+/// Route CAN1 to PB8/PB9 and clock it.
+void rfs_board_can_pins(void);
+
+#endif /* RFS_BOARD_H */

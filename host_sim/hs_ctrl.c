@@ -1,0 +1,150 @@
+/* hs_ctrl.c - the in-process controller: the core's rfs_seek behind hs_ctrl.h. */
+#include "hs_ctrl.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rfs_ridge.h"
+
+typedef struct inproc {
+    rfs_seek_t seek;
+    rfs_ridge_t ridge;
+    rfs_rng_t rng;
+    rfs_seek_mem_t mem;
+} inproc_t;
+
+hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void)
+{
+    hs_ctrl_inproc_cfg_t c;
+    c.seek = rfs_seek_cfg_default();
+    c.model = "ridge";
+    c.target = "rssi";
+    c.seed = 1;
+    c.period_us = 50000;
+    return c;
+}
+
+bool hs_ctrl_model_known(const char *name)
+{
+    return name && strcmp(name, "ridge") == 0;
+}
+
+static void ip_on_pose(void *self, const rfs_pose_t *pose)
+{
+    inproc_t *p = self;
+    rfs_seek_on_pose(&p->seek, pose, &p->rng);
+}
+
+static void ip_on_rssi(void *self, uint8_t src, int64_t t_us, int8_t dbm)
+{
+    inproc_t *p = self;
+    rfs_seek_on_rssi(&p->seek, src, t_us, dbm, &p->rng);
+}
+
+static void ip_step(void *self, int64_t now_us, hs_ctrl_out_t *out)
+{
+    inproc_t *p = self;
+    rfs_seek_step(&p->seek, now_us, &p->rng, out);
+}
+
+static bool ip_predict(void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *v)
+{
+    inproc_t *p = self;
+    const rfs_model_t *m = &p->seek.model;
+    return m->ops->predict(m->self, x, y, v);
+}
+
+static void ip_close(void *self)
+{
+    inproc_t *p = self;
+    if (!p) {
+        return;
+    }
+    free(p->mem.samples);
+    free(p->mem.pending);
+    free(p->mem.plan_work);
+    free(p->mem.plan_queue);
+    free(p->mem.visited);
+    free(p->mem.reach);
+    free(p);
+}
+
+int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs_map_t *map,
+                        char *err, size_t errlen)
+{
+    memset(c, 0, sizeof *c);
+    const rfs_target_ops_t *target = NULL;
+    if (cfg->target && strcmp(cfg->target, "rssi") == 0) {
+        target = &rfs_target_rssi;
+    } else if (cfg->target && strcmp(cfg->target, "bridge") == 0) {
+        target = &rfs_target_bridge;
+    } else {
+        snprintf(err, errlen, "target: unknown '%s' (rssi, bridge)", cfg->target ? cfg->target : "");
+        return -1;
+    }
+    if (!hs_ctrl_model_known(cfg->model)) {
+        snprintf(err, errlen, "model: unknown '%s' (ridge)", cfg->model ? cfg->model : "");
+        return -1;
+    }
+    if (cfg->period_us <= 0) {
+        snprintf(err, errlen, "controller: period must be positive");
+        return -1;
+    }
+    inproc_t *p = calloc(1, sizeof *p);
+    if (!p) {
+        snprintf(err, errlen, "controller: out of memory");
+        return -1;
+    }
+    uint32_t lat = (uint32_t)map->lw * map->lh;
+    p->mem.samples = calloc(cfg->seek.store.capacity ? cfg->seek.store.capacity : 1,
+                            sizeof(rfs_sample_t));
+    p->mem.pending_cap = 1024; // two 200 pkt/s sources across a 0.5 s pose gap, with margin
+    p->mem.pending = calloc(p->mem.pending_cap, sizeof(rfs_pending_t));
+    p->mem.plan_work_bytes = lat;
+    p->mem.plan_work = calloc(lat, 1);
+    p->mem.plan_queue_cap = lat; // never overflows: each lattice point is queued once
+    p->mem.plan_queue = calloc(lat, sizeof(uint32_t));
+    p->mem.visited_bytes = rfs_seek_lattice_bits_bytes(map);
+    p->mem.visited = calloc(p->mem.visited_bytes, 1);
+    p->mem.reach_bytes = rfs_seek_lattice_bits_bytes(map);
+    p->mem.reach = calloc(p->mem.reach_bytes, 1);
+    if (!p->mem.samples || !p->mem.pending || !p->mem.plan_work || !p->mem.plan_queue ||
+        !p->mem.visited || !p->mem.reach) {
+        ip_close(p);
+        snprintf(err, errlen, "controller: out of memory");
+        return -1;
+    }
+    rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
+    if (rfs_ridge_init(&p->ridge, &rc) != 0) {
+        ip_close(p);
+        snprintf(err, errlen, "model: ridge configuration rejected");
+        return -1;
+    }
+    if (rfs_seek_init(&p->seek, &cfg->seek, map, rfs_ridge_model(&p->ridge), target, &p->mem) !=
+        0) {
+        ip_close(p);
+        snprintf(err, errlen, "controller: the core rejected the seeker configuration");
+        return -1;
+    }
+    rfs_rng_seed(&p->rng, cfg->seed);
+    c->name = "meta";
+    c->self = p;
+    c->period_us = cfg->period_us;
+    c->on_pose = ip_on_pose;
+    c->on_rssi = ip_on_rssi;
+    c->step = ip_step;
+    c->predict = ip_predict;
+    c->close = ip_close;
+    return 0;
+}
+
+void hs_ctrl_close(hs_ctrl_t *c)
+{
+    if (c && c->close) {
+        c->close(c->self);
+    }
+    if (c) {
+        memset(c, 0, sizeof *c);
+    }
+}

@@ -1,0 +1,37 @@
+/* hs_ctrl_lcm.h - the controller in a separate process (issue 4): an hs_ctrl_t that
+ * publishes the simulated sensors on LCM and takes the wheel commands from CAN.
+ *
+ * on_pose / on_rssi publish RFS_POSE / RFS_RSSI. step(now) publishes RFS_CLOCK(now) and
+ * waits for the controller process (rfseekd --clock-lcm) to answer that step: the
+ * WHEEL_CMD frame arrives as the simulated motor controller node would see it - from
+ * SocketCAN when an interface is given, else from the clearly named LCM fallback channel
+ * RFS_CAN_FALLBACK carrying raw CAN frames - and the decision record from
+ * RFS_SEEKER_STATUS. Lock-step keeps the two-process run deterministic. When no answer
+ * comes within reply_timeout_ms the step commands zero and counts a timeout.
+ */
+#ifndef HS_CTRL_LCM_H
+#define HS_CTRL_LCM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "hs_ctrl.h"
+
+/// Configuration of the two-process controller.
+typedef struct hs_ctrl_lcm_cfg {
+    const char *lcm_url;     ///< LCM provider (udpm://... in a private netns for tests)
+    const char *can_iface;   ///< SocketCAN interface for wheel commands; NULL: RFS_CAN_FALLBACK
+    int64_t period_us;       ///< control period, microseconds (50,000)
+    int reply_timeout_ms;    ///< wait for the controller's answer to one step (5,000)
+} hs_ctrl_lcm_cfg_t;
+
+/// Defaults: LCM's default URL, the LCM fallback for CAN, 20 Hz, 5 s reply timeout.
+hs_ctrl_lcm_cfg_t hs_ctrl_lcm_cfg_default(void);
+
+/// Open. Returns 0, or -1 with err = "lcm: ..." / "can: ..." (one line).
+int hs_ctrl_lcm_open(hs_ctrl_t *c, const hs_ctrl_lcm_cfg_t *cfg, char *err, size_t errlen);
+
+/// Steps that got no answer in time (the wheels were commanded to zero).
+uint32_t hs_ctrl_lcm_timeouts(const hs_ctrl_t *c);
+
+#endif /* HS_CTRL_LCM_H */

@@ -1,0 +1,502 @@
+/* hs_lcm_adapt.c - LCM behind host_sim/hs_lcm.h; the only file with LCM headers and the
+ * lcm-gen types (generated from lcm/<type>.lcm into $(BUILD)/gen at build time). */
+#include "hs_lcm.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <lcm/eventlog.h>
+#include <lcm/lcm.h>
+
+#include "rfseek_can_frame_t.h"
+#include "rfseek_clock_t.h"
+#include "rfseek_pose_t.h"
+#include "rfseek_rssi_t.h"
+#include "rfseek_seeker_status_t.h"
+#include "rfseek_wheel_cmd_t.h"
+
+struct hs_lcm {
+    lcm_t *lcm;             /* the connection */
+    hs_lcm_handlers_t h;    /* callbacks */
+    hs_lcm_stats_t stats;   /* counters */
+    hs_lcm_log_t *rec;      /* recording target, or NULL */
+};
+
+struct hs_lcm_log {
+    lcm_eventlog_t *ev;     /* the file */
+    char *path;             /* final path (writing) */
+    char *tmp;              /* temporary path while writing, or NULL when reading */
+    int64_t last_us;        /* latest event timestamp written */
+};
+
+/* Largest encoded message we accept (a status with a short reason string). */
+#define HS_LCM_MAX_MSG 4096
+
+static void bad(hs_lcm_stats_t *s, const hs_lcm_handlers_t *h, const char *ch, const char *fmt, double v)
+{
+    char why[120];
+    snprintf(why, sizeof why, fmt, v);
+    if (s) {
+        snprintf(s->last_error, sizeof s->last_error, "%s: %s", ch, why);
+        if (s->bad < UINT32_MAX) {
+            s->bad++;
+        }
+    }
+    if (h->on_bad) {
+        char line[200];
+        snprintf(line, sizeof line, "%s: %s", ch, why);
+        h->on_bad(h->ctx, line);
+    }
+}
+
+static void good(hs_lcm_stats_t *s)
+{
+    if (s && s->received < UINT32_MAX) {
+        s->received++;
+    }
+}
+
+/* Metres (or radians) as double to Q16.16, rounded to nearest; false when not finite or
+ * outside the Q16.16 range. Exact for doubles that came from Q16.16. */
+static bool q16_of(double v, rfs_q16_t *q)
+{
+    if (!isfinite(v) || fabs(v) > 40000.0) {
+        return false;
+    }
+    long long r = llround(v * 65536.0);
+    if (r > INT32_MAX || r < INT32_MIN) {
+        return false;
+    }
+    *q = (rfs_q16_t)r;
+    return true;
+}
+
+static double dbl_of(rfs_q16_t q)
+{
+    return (double)q / 65536.0;
+}
+
+/* Decode one message of a known channel and deliver it; bad ones are counted. The
+ * decoder's byte count must equal the message length (no truncation, no trailing junk;
+ * the type fingerprint is checked by the generated decoder). */
+static void dispatch(const hs_lcm_handlers_t *h, hs_lcm_stats_t *s, const char *ch, const void *data, int len)
+{
+    if (len < 0 || len > HS_LCM_MAX_MSG) {
+        bad(s, h, ch, "message of %.0f bytes is too long", (double)len);
+        return;
+    }
+    if (strcmp(ch, HS_LCM_CH_POSE) == 0 && h->on_pose) {
+        rfseek_pose_t m;
+        int n = rfseek_pose_t_decode(data, 0, len, &m);
+        if (n < 0 || n != len) {
+            bad(s, h, ch, "truncated, oversized or not an rfseek.pose_t (%.0f bytes)", (double)len);
+            return;
+        }
+        rfs_pose_t p;
+        p.t_us = m.utime;
+        if (!q16_of(m.x, &p.x) || !q16_of(m.y, &p.y)) {
+            bad(s, h, ch, "x or y is not a finite position within +-32768 m (x = %g)", m.x);
+            return;
+        }
+        if (!isfinite(m.theta) || fabs(m.theta) > 1e6) {
+            bad(s, h, ch, "theta is not finite (%g)", m.theta);
+            return;
+        }
+        /* Normalise to [-pi, pi]: localisers publish unwrapped headings. */
+        double th = remainder(m.theta, 2.0 * M_PI);
+        p.theta = (rfs_q16_t)llround(th * 65536.0);
+        good(s);
+        h->on_pose(h->ctx, &p);
+    } else if (strcmp(ch, HS_LCM_CH_RSSI) == 0 && h->on_rssi) {
+        rfseek_rssi_t m;
+        int n = rfseek_rssi_t_decode(data, 0, len, &m);
+        if (n < 0 || n != len) {
+            bad(s, h, ch, "truncated, oversized or not an rfseek.rssi_t (%.0f bytes)", (double)len);
+            return;
+        }
+        if (m.source < 0 || m.source >= (int)RFS_CAN_MAX_SOURCES) {
+            bad(s, h, ch, "source %.0f out of range 0..15", m.source);
+            return;
+        }
+        if (m.dbm < -128 || m.dbm > 127) {
+            bad(s, h, ch, "dbm %.0f out of range -128..127", m.dbm);
+            return;
+        }
+        good(s);
+        h->on_rssi(h->ctx, (uint8_t)m.source, m.utime, (int8_t)m.dbm, (uint32_t)m.seq);
+    } else if (strcmp(ch, HS_LCM_CH_CLOCK) == 0 && h->on_clock) {
+        rfseek_clock_t m;
+        int n = rfseek_clock_t_decode(data, 0, len, &m);
+        if (n < 0 || n != len) {
+            bad(s, h, ch, "truncated, oversized or not an rfseek.clock_t (%.0f bytes)", (double)len);
+            return;
+        }
+        good(s);
+        h->on_clock(h->ctx, m.utime);
+    } else if (strcmp(ch, HS_LCM_CH_WHEEL) == 0 && h->on_wheel) {
+        rfseek_wheel_cmd_t m;
+        int n = rfseek_wheel_cmd_t_decode(data, 0, len, &m);
+        if (n < 0 || n != len) {
+            bad(s, h, ch, "truncated, oversized or not an rfseek.wheel_cmd_t (%.0f bytes)", (double)len);
+            return;
+        }
+        rfs_can_wheel_t w = {m.left_mm_s, m.right_mm_s, (uint8_t)(m.stop ? RFS_CAN_WHEEL_STOP : 0)};
+        good(s);
+        h->on_wheel(h->ctx, m.utime, &w);
+    } else if (strcmp(ch, HS_LCM_CH_STATUS) == 0 && h->on_status) {
+        rfseek_seeker_status_t m;
+        int n = rfseek_seeker_status_t_decode(data, 0, len, &m);
+        if (n < 0 || n != len) {
+            if (n >= 0) {
+                rfseek_seeker_status_t_decode_cleanup(&m);
+            }
+            bad(s, h, ch, "truncated, oversized or not an rfseek.seeker_status_t (%.0f bytes)", (double)len);
+            return;
+        }
+        rfs_seek_out_t o;
+        memset(&o, 0, sizeof o);
+        rfs_seek_decision_t *d = &o.decision;
+        bool ok = m.state >= 0 && m.state <= RFS_SEEK_DRIVING && m.kind >= 0 && m.kind <= RFS_SEEK_EPSILON &&
+                  m.prev >= 0 && m.prev <= RFS_DRIVE_BLOCKED && m.faults >= 0 && m.faults <= 0xFFFF &&
+                  q16_of(m.prediction, &d->prediction) && q16_of(m.mean, &d->mean) &&
+                  q16_of(m.epsilon, &d->epsilon) && q16_of(m.x, &d->x) && q16_of(m.y, &d->y) &&
+                  q16_of(m.goal_x, &d->goal_x) && q16_of(m.goal_y, &d->goal_y) && q16_of(m.max_x, &d->max_x) &&
+                  q16_of(m.max_y, &d->max_y) && q16_of(m.path_len, &d->path_len) && m.samples >= 0 &&
+                  m.samples <= 0xFFFF;
+        if (!ok) {
+            rfseek_seeker_status_t_decode_cleanup(&m);
+            bad(s, h, ch, "a field is out of range or not finite (state %.0f)", m.state);
+            return;
+        }
+        o.left_mm_s = m.left_mm_s;
+        o.right_mm_s = m.right_mm_s;
+        o.state = (rfs_seek_state_t)m.state;
+        o.faults = (uint16_t)m.faults;
+        o.decided = m.decided;
+        d->iteration = (uint32_t)m.iteration;
+        d->t_us = m.decision_utime;
+        d->kind = (rfs_seek_kind_t)m.kind;
+        d->relearned = m.model_updated;
+        d->line_search = m.line_search;
+        d->model_valid = m.model_valid;
+        d->mean_valid = m.mean_valid;
+        d->prev = (rfs_drive_status_t)m.prev;
+        d->samples = (uint16_t)m.samples;
+        int64_t t = m.utime;
+        rfseek_seeker_status_t_decode_cleanup(&m);
+        good(s);
+        h->on_status(h->ctx, t, &o);
+    } else if (strcmp(ch, HS_LCM_CH_CAN_FALLBACK) == 0 && h->on_can) {
+        rfseek_can_frame_t m;
+        int n = rfseek_can_frame_t_decode(data, 0, len, &m);
+        if (n < 0 || n != len) {
+            bad(s, h, ch, "truncated, oversized or not an rfseek.can_frame_t (%.0f bytes)", (double)len);
+            return;
+        }
+        if (m.id < 0 || m.id > (int32_t)RFS_CAN_ID_MAX || m.dlc < 0 || m.dlc > 8) {
+            bad(s, h, ch, "id or dlc out of range (id %.0f)", m.id);
+            return;
+        }
+        rfs_can_frame_t f;
+        memset(&f, 0, sizeof f);
+        f.id = (uint32_t)m.id;
+        f.dlc = (uint8_t)m.dlc;
+        memcpy(f.data, m.data, (size_t)m.dlc);
+        good(s);
+        h->on_can(h->ctx, m.utime, &f);
+    }
+}
+
+static void log_event(hs_lcm_log_t *log, int64_t t_us, const char *ch, const void *data, int len)
+{
+    if (log == NULL || log->tmp == NULL) {
+        return;
+    }
+    lcm_eventlog_event_t ev;
+    memset(&ev, 0, sizeof ev);
+    ev.timestamp = t_us;
+    ev.channellen = (int32_t)strlen(ch);
+    ev.channel = (char *)ch;
+    ev.datalen = len;
+    ev.data = (void *)data;
+    lcm_eventlog_write_event(log->ev, &ev);
+    log->last_us = t_us;
+}
+
+static void on_msg(const lcm_recv_buf_t *rbuf, const char *ch, void *user)
+{
+    hs_lcm_t *l = user;
+    /* Record with the message's own utime when it decodes far enough, else the receive time. */
+    int64_t t = rbuf->recv_utime;
+    if (rbuf->data_size >= 16) {
+        const uint8_t *p = rbuf->data;
+        int64_t u = 0;
+        for (int i = 0; i < 8; i++) {
+            u = (int64_t)((uint64_t)u << 8 | p[8 + i]); /* after the 8-byte fingerprint, big-endian */
+        }
+        t = u;
+    }
+    log_event(l->rec, t, ch, rbuf->data, (int)rbuf->data_size);
+    dispatch(&l->h, &l->stats, ch, rbuf->data, (int)rbuf->data_size);
+}
+
+hs_lcm_t *hs_lcm_open(const char *url, const hs_lcm_handlers_t *h, char *err, size_t errlen)
+{
+    hs_lcm_t *l = calloc(1, sizeof *l);
+    if (!l) {
+        snprintf(err, errlen, "lcm: %s: out of memory", url ? url : "(default)");
+        return NULL;
+    }
+    l->lcm = lcm_create(url);
+    if (!l->lcm) {
+        snprintf(err, errlen, "lcm: %s: cannot open this provider (bad URL, no multicast route, or no file)",
+                 url ? url : "(default)");
+        free(l);
+        return NULL;
+    }
+    if (h) {
+        l->h = *h;
+    }
+    const struct {
+        const char *ch;
+        bool on;
+    } subs[] = {
+        {HS_LCM_CH_POSE, l->h.on_pose != NULL},   {HS_LCM_CH_RSSI, l->h.on_rssi != NULL},
+        {HS_LCM_CH_CLOCK, l->h.on_clock != NULL}, {HS_LCM_CH_WHEEL, l->h.on_wheel != NULL},
+        {HS_LCM_CH_STATUS, l->h.on_status != NULL}, {HS_LCM_CH_CAN_FALLBACK, l->h.on_can != NULL},
+    };
+    for (size_t i = 0; i < sizeof subs / sizeof subs[0]; i++) {
+        if (subs[i].on && lcm_subscribe(l->lcm, subs[i].ch, on_msg, l) == NULL) {
+            snprintf(err, errlen, "lcm: %s: cannot subscribe to %s", url ? url : "(default)", subs[i].ch);
+            lcm_destroy(l->lcm);
+            free(l);
+            return NULL;
+        }
+    }
+    return l;
+}
+
+void hs_lcm_record(hs_lcm_t *l, hs_lcm_log_t *log)
+{
+    l->rec = log;
+}
+
+/* Encode with the generated encoder into a stack buffer, record, publish. */
+#define HS_LCM_PUBLISH(l, ch, type, msgp, t_us)                                            \
+    do {                                                                                   \
+        uint8_t buf_[HS_LCM_MAX_MSG];                                                      \
+        int n_ = type##_encoded_size(msgp);                                                \
+        if (n_ <= 0 || n_ > (int)sizeof buf_ || type##_encode(buf_, 0, n_, msgp) != n_) { \
+            return -1;                                                                     \
+        }                                                                                  \
+        log_event((l)->rec, (t_us), (ch), buf_, n_);                                       \
+        return lcm_publish((l)->lcm, (ch), buf_, (unsigned)n_) == 0 ? 0 : -1;              \
+    } while (0)
+
+int hs_lcm_pub_pose(hs_lcm_t *l, const rfs_pose_t *pose)
+{
+    rfseek_pose_t m = {pose->t_us, dbl_of(pose->x), dbl_of(pose->y), dbl_of(pose->theta)};
+    HS_LCM_PUBLISH(l, HS_LCM_CH_POSE, rfseek_pose_t, &m, pose->t_us);
+}
+
+int hs_lcm_pub_rssi(hs_lcm_t *l, uint8_t src, int64_t t_us, int8_t dbm, uint32_t seq)
+{
+    rfseek_rssi_t m = {t_us, src, dbm, (int32_t)seq};
+    HS_LCM_PUBLISH(l, HS_LCM_CH_RSSI, rfseek_rssi_t, &m, t_us);
+}
+
+int hs_lcm_pub_clock(hs_lcm_t *l, int64_t t_us)
+{
+    rfseek_clock_t m = {t_us};
+    HS_LCM_PUBLISH(l, HS_LCM_CH_CLOCK, rfseek_clock_t, &m, t_us);
+}
+
+int hs_lcm_pub_wheel(hs_lcm_t *l, int64_t t_us, const rfs_can_wheel_t *w)
+{
+    rfseek_wheel_cmd_t m = {t_us, w->left_mm_s, w->right_mm_s, (w->flags & RFS_CAN_WHEEL_STOP) != 0};
+    HS_LCM_PUBLISH(l, HS_LCM_CH_WHEEL, rfseek_wheel_cmd_t, &m, t_us);
+}
+
+static const char *reason_of(const rfs_seek_decision_t *d)
+{
+    static const char *const names[4][2][2] = {
+        {{"none", "none+line-search"}, {"none+relearn", "none+relearn+line-search"}},
+        {{"initial", "initial+line-search"}, {"initial+relearn", "initial+relearn+line-search"}},
+        {{"greedy", "greedy+line-search"}, {"greedy+relearn", "greedy+relearn+line-search"}},
+        {{"epsilon", "epsilon+line-search"}, {"epsilon+relearn", "epsilon+relearn+line-search"}},
+    };
+    unsigned k = (unsigned)d->kind < 4 ? (unsigned)d->kind : 0;
+    return names[k][d->relearned ? 1 : 0][d->line_search ? 1 : 0];
+}
+
+int hs_lcm_pub_status(hs_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out)
+{
+    const rfs_seek_decision_t *d = &out->decision;
+    rfseek_seeker_status_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = t_us;
+    m.state = (int8_t)out->state;
+    m.faults = out->faults;
+    m.left_mm_s = out->left_mm_s;
+    m.right_mm_s = out->right_mm_s;
+    m.decided = out->decided;
+    m.iteration = (int32_t)d->iteration;
+    m.decision_utime = d->t_us;
+    m.kind = (int8_t)d->kind;
+    m.reason = (char *)reason_of(d);
+    m.model_updated = d->relearned;
+    m.line_search = d->line_search;
+    m.model_valid = d->model_valid;
+    m.mean_valid = d->mean_valid;
+    m.prev = (int8_t)d->prev;
+    m.prediction = dbl_of(d->prediction);
+    m.mean = dbl_of(d->mean);
+    m.epsilon = dbl_of(d->epsilon);
+    m.x = dbl_of(d->x);
+    m.y = dbl_of(d->y);
+    m.goal_x = dbl_of(d->goal_x);
+    m.goal_y = dbl_of(d->goal_y);
+    m.max_x = dbl_of(d->max_x);
+    m.max_y = dbl_of(d->max_y);
+    m.path_len = dbl_of(d->path_len);
+    m.samples = d->samples;
+    HS_LCM_PUBLISH(l, HS_LCM_CH_STATUS, rfseek_seeker_status_t, &m, t_us);
+}
+
+int hs_lcm_pub_can(hs_lcm_t *l, int64_t t_us, const rfs_can_frame_t *f)
+{
+    rfseek_can_frame_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = t_us;
+    m.id = (int32_t)f->id;
+    m.dlc = (int8_t)(f->dlc > 8 ? 8 : f->dlc);
+    memcpy(m.data, f->data, 8);
+    HS_LCM_PUBLISH(l, HS_LCM_CH_CAN_FALLBACK, rfseek_can_frame_t, &m, t_us);
+}
+
+int hs_lcm_pub_raw(hs_lcm_t *l, int64_t t_us, const char *channel, const void *data, size_t len)
+{
+    if (len > (size_t)HS_LCM_MAX_MSG * 16) {
+        return -1;
+    }
+    log_event(l->rec, t_us, channel, data, (int)len);
+    return lcm_publish(l->lcm, channel, data, (unsigned)len) == 0 ? 0 : -1;
+}
+
+int hs_lcm_handle(hs_lcm_t *l, int timeout_ms)
+{
+    int r = lcm_handle_timeout(l->lcm, timeout_ms < 0 ? 0 : timeout_ms);
+    return r > 0 ? 1 : (r == 0 ? 0 : -1);
+}
+
+void hs_lcm_get_stats(const hs_lcm_t *l, hs_lcm_stats_t *s)
+{
+    *s = l->stats;
+}
+
+void hs_lcm_close(hs_lcm_t *l)
+{
+    if (!l) {
+        return;
+    }
+    lcm_destroy(l->lcm);
+    free(l);
+}
+
+hs_lcm_log_t *hs_lcm_log_open(const char *path, const char *mode, char *err, size_t errlen)
+{
+    bool w = strcmp(mode, "w") == 0;
+    if (!w && strcmp(mode, "r") != 0) {
+        snprintf(err, errlen, "%s: mode must be r or w", path);
+        return NULL;
+    }
+    hs_lcm_log_t *log = calloc(1, sizeof *log);
+    if (!log) {
+        snprintf(err, errlen, "%s: out of memory", path);
+        return NULL;
+    }
+    log->path = strdup(path);
+    if (w) {
+        size_t n = strlen(path) + 5;
+        log->tmp = malloc(n);
+        if (log->tmp) {
+            snprintf(log->tmp, n, "%s.tmp", path);
+        }
+    }
+    if (!log->path || (w && !log->tmp)) {
+        snprintf(err, errlen, "%s: out of memory", path);
+        free(log->path);
+        free(log->tmp);
+        free(log);
+        return NULL;
+    }
+    log->ev = lcm_eventlog_create(w ? log->tmp : path, w ? "w" : "r");
+    if (!log->ev) {
+        snprintf(err, errlen, "%s: cannot open for %s", w ? log->tmp : path, w ? "writing" : "reading");
+        free(log->path);
+        free(log->tmp);
+        free(log);
+        return NULL;
+    }
+    return log;
+}
+
+int hs_lcm_log_next(hs_lcm_log_t *log, const hs_lcm_handlers_t *h, hs_lcm_stats_t *stats, int64_t *t_us)
+{
+    lcm_eventlog_event_t *ev = lcm_eventlog_read_next_event(log->ev);
+    if (!ev) {
+        return 0;
+    }
+    if (t_us) {
+        *t_us = ev->timestamp;
+    }
+    char ch[64];
+    size_t cl = ev->channellen > 0 && (size_t)ev->channellen < sizeof ch ? (size_t)ev->channellen : 0;
+    memcpy(ch, ev->channel, cl);
+    ch[cl] = '\0';
+    dispatch(h, stats, ch, ev->data, ev->datalen);
+    lcm_eventlog_free_event(ev);
+    return 1;
+}
+
+int hs_lcm_log_next_raw(hs_lcm_log_t *log, int64_t *t_us, char *channel, size_t chcap, void *data, size_t cap,
+                        size_t *len)
+{
+    lcm_eventlog_event_t *ev = lcm_eventlog_read_next_event(log->ev);
+    if (!ev) {
+        return 0;
+    }
+    *t_us = ev->timestamp;
+    size_t cl = ev->channellen > 0 ? (size_t)ev->channellen : 0;
+    if (chcap > 0) {
+        cl = cl < chcap - 1 ? cl : chcap - 1;
+        memcpy(channel, ev->channel, cl);
+        channel[cl] = '\0';
+    }
+    size_t dl = ev->datalen > 0 ? (size_t)ev->datalen : 0;
+    memcpy(data, ev->data, dl < cap ? dl : cap);
+    *len = dl;
+    lcm_eventlog_free_event(ev);
+    return 1;
+}
+
+int hs_lcm_log_close(hs_lcm_log_t *log)
+{
+    if (!log) {
+        return 0;
+    }
+    int rc = 0;
+    if (log->tmp) {
+        rc = fflush(log->ev->f) == 0 ? 0 : -1;
+    }
+    lcm_eventlog_destroy(log->ev);
+    if (log->tmp && rc == 0 && rename(log->tmp, log->path) != 0) {
+        rc = -1;
+    }
+    free(log->path);
+    free(log->tmp);
+    free(log);
+    return rc;
+}

@@ -1,0 +1,385 @@
+/* hs_radio.c - indoor radio model (see hs_radio.h and docs/RADIO_MODEL.md). */
+#include "hs_radio.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/// Sine table size for the per-packet fading sum: phase error <= pi / 4096 rad.
+#define SIN_N 4096u
+#define SIN_MASK (SIN_N - 1u)
+
+typedef struct fading_wave {
+    double kx;  ///< x wavenumber in table steps per metre
+    double ky;  ///< y wavenumber in table steps per metre
+    double ph;  ///< phase in table steps
+} fading_wave_t;
+
+typedef struct radio_src {
+    hs_radio_src_t s;
+    float *shadow;         ///< gw * gh values, dB
+    fading_wave_t *waves;  ///< fading_waves plane waves
+    int8_t *walls;         ///< cw * ch cached wall counts, -1 = not yet known
+} radio_src_t;
+
+struct hs_radio {
+    hs_radio_cfg_t cfg;
+    unsigned nsrc;
+    radio_src_t src[HS_RADIO_MAX_SOURCES];
+    double x0, y0;            ///< lower-left of the area, metres
+    uint32_t gw, gh;          ///< shadow grid points
+    uint32_t cw, ch;          ///< wall cache cells
+    double k_steps;           ///< wavenumber 2 pi / lambda in table steps per metre
+    float sin_tab[SIN_N];     ///< sin(2 pi i / SIN_N)
+    hs_radio_walls_fn walls_fn;
+    void *walls_ctx;
+};
+
+hs_radio_cfg_t hs_radio_cfg_default(void)
+{
+    hs_radio_cfg_t c;
+    memset(&c, 0, sizeof c);
+    c.pathloss = true;
+    c.exponent = 3.0;                          // ITU-R P.1238-12 table 2, office, 2.4 GHz: N = 30
+    c.ref_dist_m = 1.0;                        // P.1238's reference distance
+    c.ref_loss_db = 20.0 * log10(2400.0) - 28.0; // P.1238 eq. (1) at d = 1 m: 39.6 dB
+    c.walls = true;
+    c.wall_db = 5.0;                           // ns-3 buildings model, internal wall loss
+    c.shadowing = true;
+    c.shadow_sigma_db = 4.0;                   // issue 3 default (indoor 3-6 dB)
+    c.shadow_dcorr_m = 5.0;                    // Gudmundson 1991 form, indoor scale
+    c.shadow_grid_m = 0.25;
+    c.shadow_waves = 256;
+    c.fading = true;
+    c.wavelength_m = 0.125;                    // 2.4 GHz: c / f = 0.1249 m
+    c.rician_k_db = 6.0;
+    c.fading_waves = 32;
+    c.noise = true;
+    c.noise_sigma_db = 4.0;                    // paper section 5: measured 4 dB
+    c.quantise = true;
+    c.clip = true;
+    c.rx_min_dbm = -100.0;
+    c.rx_max_dbm = -10.0;
+    c.loss = true;
+    c.sensitivity_dbm = -95.0;
+    c.loss_width_db = 1.5;
+    c.wall_cache_m = 0.1;
+    return c;
+}
+
+int hs_radio_cfg_check(const hs_radio_cfg_t *c, char *err, size_t errlen)
+{
+#define BAD(field, why) do { snprintf(err, errlen, "%s: %s", field, why); return -1; } while (0)
+    if (!(c->exponent >= 0.0 && c->exponent <= 10.0)) BAD("radio.pathloss.exponent", "must be in [0, 10]");
+    if (!(c->ref_dist_m > 0.0 && c->ref_dist_m <= 100.0)) BAD("radio.pathloss.ref_dist_m", "must be in (0, 100]");
+    if (!isfinite(c->ref_loss_db)) BAD("radio.pathloss.ref_loss_db", "must be a number");
+    if (!(c->wall_db >= 0.0 && c->wall_db <= 100.0)) BAD("radio.walls.db_per_wall", "must be in [0, 100]");
+    if (!(c->shadow_sigma_db >= 0.0 && c->shadow_sigma_db <= 30.0)) BAD("radio.shadowing.sigma_db", "must be in [0, 30]");
+    if (!(c->shadow_dcorr_m > 0.0 && c->shadow_dcorr_m <= 1000.0)) BAD("radio.shadowing.dcorr_m", "must be in (0, 1000]");
+    if (!(c->shadow_grid_m >= 0.01 && c->shadow_grid_m <= 10.0)) BAD("radio.shadowing.grid_m", "must be in [0.01, 10]");
+    if (c->shadow_waves < 1 || c->shadow_waves > 100000) BAD("radio.shadowing.waves", "must be in [1, 100000]");
+    if (!(c->wavelength_m >= 0.001 && c->wavelength_m <= 10.0)) BAD("radio.fading.wavelength_m", "must be in [0.001, 10]");
+    if (!(c->rician_k_db >= -50.0 && c->rician_k_db <= 50.0)) BAD("radio.fading.rician_k_db", "must be in [-50, 50]");
+    if (c->fading_waves < 1 || c->fading_waves > 4096) BAD("radio.fading.waves", "must be in [1, 4096]");
+    if (!(c->noise_sigma_db >= 0.0 && c->noise_sigma_db <= 30.0)) BAD("radio.noise.sigma_db", "must be in [0, 30]");
+    if (!(c->rx_min_dbm >= -127.0 && c->rx_max_dbm <= 127.0 && c->rx_min_dbm < c->rx_max_dbm))
+        BAD("radio.receiver", "need -127 <= min_dbm < max_dbm <= 127");
+    if (!(c->sensitivity_dbm >= -200.0 && c->sensitivity_dbm <= 100.0)) BAD("radio.receiver.sensitivity_dbm", "must be in [-200, 100]");
+    if (!(c->loss_width_db > 0.0 && c->loss_width_db <= 50.0)) BAD("radio.receiver.loss_width_db", "must be in (0, 50]");
+    if (!(c->wall_cache_m >= 0.01 && c->wall_cache_m <= 10.0)) BAD("radio.walls.cache_m", "must be in [0.01, 10]");
+#undef BAD
+    return 0;
+}
+
+double hs_radio_uniform(rfs_rng_t *rng)
+{
+    uint64_t hi = rfs_rng_u32(rng) >> 5, lo = rfs_rng_u32(rng) >> 6; // 27 + 26 bits
+    return ((double)hi * 67108864.0 + (double)lo) * (1.0 / 9007199254740992.0);
+}
+
+double hs_radio_gauss(rfs_rng_t *rng)
+{
+    double u1 = hs_radio_uniform(rng), u2 = hs_radio_uniform(rng);
+    return sqrt(-2.0 * log(1.0 - u1)) * cos(2.0 * M_PI * u2);
+}
+
+/// Seed of one field: the run seed mixed with a field tag and the source index, so each
+/// field is independent of the per-packet stream and of the other sources.
+static void field_rng(rfs_rng_t *rng, uint64_t seed, unsigned tag, unsigned s)
+{
+    rfs_rng_seed(rng, seed ^ (0x9E3779B97F4A7C15ull * (uint64_t)(tag * 64u + s + 1u)));
+}
+
+/// Tabulate sigma * sqrt(2/M) * sum_i cos(k_i . x + phi_i) with the k_i drawn from the
+/// normalised spectrum of sigma^2 exp(-r / d_c) in 2-D, whose radial CDF is
+/// F(k) = 1 - (1 + (k d_c)^2)^-1/2 (inverted in closed form). Covariance of the sum:
+/// sigma^2 E[cos(k . r)] = sigma^2 exp(-|r| / d_c). Rows and columns are separable:
+/// e^{j k.x} = e^{j kx x} e^{j ky y}.
+static int make_shadow(hs_radio_t *r, radio_src_t *rs, uint64_t seed, unsigned s)
+{
+    const hs_radio_cfg_t *c = &r->cfg;
+    size_t n = (size_t)r->gw * r->gh;
+    rs->shadow = calloc(n, sizeof(float));
+    double *acc = calloc(n, sizeof(double));
+    double *cxr = malloc(sizeof(double) * r->gw * 2), *cyr = malloc(sizeof(double) * r->gh * 2);
+    if (!rs->shadow || !acc || !cxr || !cyr) {
+        free(acc); free(cxr); free(cyr);
+        return -1;
+    }
+    rfs_rng_t rng;
+    field_rng(&rng, seed, 1, s);
+    for (uint32_t i = 0; i < c->shadow_waves; i++) {
+        double u = hs_radio_uniform(&rng);
+        double k = sqrt(1.0 / ((1.0 - u) * (1.0 - u)) - 1.0) / c->shadow_dcorr_m;
+        double a = 2.0 * M_PI * hs_radio_uniform(&rng);
+        double ph = 2.0 * M_PI * hs_radio_uniform(&rng);
+        double kx = k * cos(a), ky = k * sin(a);
+        for (uint32_t gx = 0; gx < r->gw; gx++) {
+            double p = kx * (gx * c->shadow_grid_m) + ph;
+            cxr[2 * gx] = cos(p);
+            cxr[2 * gx + 1] = sin(p);
+        }
+        for (uint32_t gy = 0; gy < r->gh; gy++) {
+            double p = ky * (gy * c->shadow_grid_m);
+            cyr[2 * gy] = cos(p);
+            cyr[2 * gy + 1] = sin(p);
+        }
+        for (uint32_t gy = 0; gy < r->gh; gy++) {
+            double yc = cyr[2 * gy], ys = cyr[2 * gy + 1];
+            double *row = acc + (size_t)gy * r->gw;
+            for (uint32_t gx = 0; gx < r->gw; gx++) {
+                row[gx] += cxr[2 * gx] * yc - cxr[2 * gx + 1] * ys; // cos(px + py)
+            }
+        }
+    }
+    double scale = c->shadow_sigma_db * sqrt(2.0 / c->shadow_waves);
+    for (size_t i = 0; i < n; i++) {
+        rs->shadow[i] = (float)(acc[i] * scale);
+    }
+    free(acc); free(cxr); free(cyr);
+    return 0;
+}
+
+static int make_fading(hs_radio_t *r, radio_src_t *rs, uint64_t seed, unsigned s)
+{
+    const hs_radio_cfg_t *c = &r->cfg;
+    rs->waves = malloc(sizeof(fading_wave_t) * c->fading_waves);
+    if (!rs->waves) {
+        return -1;
+    }
+    rfs_rng_t rng;
+    field_rng(&rng, seed, 2, s);
+    for (uint32_t i = 0; i < c->fading_waves; i++) {
+        double a = 2.0 * M_PI * hs_radio_uniform(&rng);
+        rs->waves[i].kx = r->k_steps * cos(a);
+        rs->waves[i].ky = r->k_steps * sin(a);
+        rs->waves[i].ph = SIN_N * hs_radio_uniform(&rng);
+    }
+    return 0;
+}
+
+hs_radio_t *hs_radio_create(const hs_radio_cfg_t *cfg, const hs_radio_src_t *src,
+                            unsigned nsrc, double x0, double y0, double x1, double y1,
+                            uint64_t seed, hs_radio_walls_fn walls, void *walls_ctx,
+                            char *err, size_t errlen)
+{
+    if (hs_radio_cfg_check(cfg, err, errlen) != 0) {
+        return NULL;
+    }
+    if (nsrc == 0 || nsrc > HS_RADIO_MAX_SOURCES) {
+        snprintf(err, errlen, "sources: need 1 to %u", HS_RADIO_MAX_SOURCES);
+        return NULL;
+    }
+    if (!(x1 > x0 && y1 > y0) || x1 - x0 > 10000.0 || y1 - y0 > 10000.0) {
+        snprintf(err, errlen, "radio: area must be non-empty and under 10 km");
+        return NULL;
+    }
+    hs_radio_t *r = calloc(1, sizeof *r);
+    if (!r) {
+        snprintf(err, errlen, "radio: out of memory");
+        return NULL;
+    }
+    r->cfg = *cfg;
+    r->nsrc = nsrc;
+    r->x0 = x0;
+    r->y0 = y0;
+    r->gw = (uint32_t)ceil((x1 - x0) / cfg->shadow_grid_m) + 2;
+    r->gh = (uint32_t)ceil((y1 - y0) / cfg->shadow_grid_m) + 2;
+    r->cw = (uint32_t)ceil((x1 - x0) / cfg->wall_cache_m) + 1;
+    r->ch = (uint32_t)ceil((y1 - y0) / cfg->wall_cache_m) + 1;
+    r->k_steps = SIN_N / cfg->wavelength_m; // 2 pi / lambda rad/m = SIN_N / lambda steps/m
+    r->walls_fn = walls;
+    r->walls_ctx = walls_ctx;
+    for (unsigned i = 0; i < SIN_N; i++) {
+        r->sin_tab[i] = (float)sin(2.0 * M_PI * i / SIN_N);
+    }
+    for (unsigned s = 0; s < nsrc; s++) {
+        radio_src_t *rs = &r->src[s];
+        rs->s = src[s];
+        int bad = 0;
+        if (cfg->shadowing) {
+            bad |= make_shadow(r, rs, seed, s);
+        }
+        if (cfg->fading) {
+            bad |= make_fading(r, rs, seed, s);
+        }
+        if (cfg->walls && walls) {
+            rs->walls = malloc((size_t)r->cw * r->ch);
+            if (rs->walls) {
+                memset(rs->walls, -1, (size_t)r->cw * r->ch);
+            } else {
+                bad = -1;
+            }
+        }
+        if (bad) {
+            hs_radio_destroy(r);
+            snprintf(err, errlen, "radio: out of memory");
+            return NULL;
+        }
+    }
+    return r;
+}
+
+void hs_radio_destroy(hs_radio_t *r)
+{
+    if (!r) {
+        return;
+    }
+    for (unsigned s = 0; s < r->nsrc; s++) {
+        free(r->src[s].shadow);
+        free(r->src[s].waves);
+        free(r->src[s].walls);
+    }
+    free(r);
+}
+
+unsigned hs_radio_walls(hs_radio_t *r, unsigned s, double x, double y)
+{
+    radio_src_t *rs = &r->src[s];
+    if (!r->cfg.walls || !r->walls_fn) {
+        return 0;
+    }
+    long cx = lround((x - r->x0) / r->cfg.wall_cache_m);
+    long cy = lround((y - r->y0) / r->cfg.wall_cache_m);
+    if (cx < 0 || cy < 0 || cx >= (long)r->cw || cy >= (long)r->ch) {
+        return r->walls_fn(r->walls_ctx, x, y, rs->s.x, rs->s.y);
+    }
+    int8_t *slot = &rs->walls[(size_t)cy * r->cw + (size_t)cx];
+    if (*slot < 0) {
+        // The count from the cache cell's centre stands for the whole cell.
+        unsigned n = r->walls_fn(r->walls_ctx, r->x0 + cx * r->cfg.wall_cache_m,
+                                 r->y0 + cy * r->cfg.wall_cache_m, rs->s.x, rs->s.y);
+        *slot = (int8_t)(n > 127 ? 127 : n);
+    }
+    return (unsigned)*slot;
+}
+
+double hs_radio_shadow_db(const hs_radio_t *r, unsigned s, double x, double y)
+{
+    const radio_src_t *rs = &r->src[s];
+    if (!r->cfg.shadowing) {
+        return 0.0;
+    }
+    double fx = (x - r->x0) / r->cfg.shadow_grid_m, fy = (y - r->y0) / r->cfg.shadow_grid_m;
+    double maxx = r->gw - 1.001, maxy = r->gh - 1.001;
+    fx = fx < 0.0 ? 0.0 : (fx > maxx ? maxx : fx);
+    fy = fy < 0.0 ? 0.0 : (fy > maxy ? maxy : fy);
+    uint32_t ix = (uint32_t)fx, iy = (uint32_t)fy;
+    double ax = fx - ix, ay = fy - iy;
+    const float *p = rs->shadow + (size_t)iy * r->gw + ix;
+    double a = p[0] + ax * (p[1] - p[0]);
+    double b = p[r->gw] + ax * (p[r->gw + 1] - p[r->gw]);
+    return a + ay * (b - a);
+}
+
+double hs_radio_fading_db(const hs_radio_t *r, unsigned s, double x, double y, bool los)
+{
+    const radio_src_t *rs = &r->src[s];
+    const hs_radio_cfg_t *c = &r->cfg;
+    if (!c->fading) {
+        return 0.0;
+    }
+    double re = 0.0, im = 0.0;
+    for (uint32_t i = 0; i < c->fading_waves; i++) {
+        const fading_wave_t *w = &rs->waves[i];
+        uint32_t idx = (uint32_t)(int64_t)(w->kx * x + w->ky * y + w->ph);
+        re += r->sin_tab[(idx + SIN_N / 4u) & SIN_MASK];
+        im += r->sin_tab[idx & SIN_MASK];
+    }
+    double scat = 1.0 / sqrt((double)c->fading_waves);
+    re *= scat;
+    im *= scat;
+    if (los) {
+        double k = pow(10.0, c->rician_k_db / 10.0);
+        double a = sqrt(k / (k + 1.0)), b = sqrt(1.0 / (k + 1.0));
+        double d = hypot(x - rs->s.x, y - rs->s.y);
+        uint32_t idx = (uint32_t)(int64_t)(r->k_steps * d);
+        re = a * r->sin_tab[(idx + SIN_N / 4u) & SIN_MASK] + b * re;
+        im = a * r->sin_tab[idx & SIN_MASK] + b * im;
+    }
+    double p = re * re + im * im;
+    return 10.0 * log10(p > 1e-6 ? p : 1e-6); // deepest fade -60 dB
+}
+
+static double mean_walls(hs_radio_t *r, unsigned s, double x, double y, unsigned *nw)
+{
+    const radio_src_t *rs = &r->src[s];
+    const hs_radio_cfg_t *c = &r->cfg;
+    double p = rs->s.tx_dbm;
+    if (c->pathloss) {
+        double d = hypot(x - rs->s.x, y - rs->s.y);
+        if (d < c->ref_dist_m) {
+            d = c->ref_dist_m;
+        }
+        p -= c->ref_loss_db + 10.0 * c->exponent * log10(d / c->ref_dist_m);
+    }
+    *nw = hs_radio_walls(r, s, x, y);
+    p -= c->wall_db * *nw;
+    p += hs_radio_shadow_db(r, s, x, y);
+    return p;
+}
+
+double hs_radio_mean_dbm(hs_radio_t *r, unsigned s, double x, double y)
+{
+    unsigned nw;
+    return mean_walls(r, s, x, y, &nw);
+}
+
+double hs_radio_signal_dbm(hs_radio_t *r, unsigned s, double x, double y)
+{
+    unsigned nw;
+    double p = mean_walls(r, s, x, y, &nw);
+    bool los = !(r->cfg.walls && r->walls_fn) ? true : nw == 0;
+    return p + hs_radio_fading_db(r, s, x, y, los);
+}
+
+double hs_radio_pdr(const hs_radio_cfg_t *cfg, double p_dbm)
+{
+    if (!cfg->loss) {
+        return 1.0;
+    }
+    return 1.0 / (1.0 + exp(-(p_dbm - cfg->sensitivity_dbm) / cfg->loss_width_db));
+}
+
+bool hs_radio_packet(hs_radio_t *r, unsigned s, double x, double y, rfs_rng_t *rng, int *dbm)
+{
+    const hs_radio_cfg_t *c = &r->cfg;
+    double p = hs_radio_signal_dbm(r, s, x, y);
+    if (c->loss && hs_radio_uniform(rng) >= hs_radio_pdr(c, p)) {
+        return false;
+    }
+    if (c->noise) {
+        p += c->noise_sigma_db * hs_radio_gauss(rng);
+    }
+    if (c->clip) {
+        p = p < c->rx_min_dbm ? c->rx_min_dbm : (p > c->rx_max_dbm ? c->rx_max_dbm : p);
+    }
+    if (c->quantise) {
+        p = floor(p + 0.5);
+    }
+    // int8 range whatever the switches: the core takes int8_t dBm.
+    p = p < -127.0 ? -127.0 : (p > 127.0 ? 127.0 : p);
+    *dbm = (int)lrint(p);
+    return true;
+}

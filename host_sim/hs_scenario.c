@@ -1,0 +1,469 @@
+/* hs_scenario.c - scenario YAML loader (see hs_scenario.h). */
+#include "hs_scenario.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <yaml.h>
+
+typedef struct pctx {
+    yaml_document_t doc;
+    const char *file;
+    char *err;
+    size_t errlen;
+} pctx_t;
+
+static int fail(pctx_t *p, const yaml_node_t *n, const char *fmt, ...)
+{
+    char msg[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    if (n) {
+        snprintf(p->err, p->errlen, "%s:%lu: %s", p->file, (unsigned long)n->start_mark.line + 1,
+                 msg);
+    } else {
+        snprintf(p->err, p->errlen, "%s: %s", p->file, msg);
+    }
+    return -1;
+}
+
+static const char *scalar(const yaml_node_t *n)
+{
+    return n && n->type == YAML_SCALAR_NODE ? (const char *)n->data.scalar.value : NULL;
+}
+
+/// The mapping must be a mapping whose keys are unique scalars from `allowed`.
+static int check_keys(pctx_t *p, yaml_node_t *m, const char *where, const char *const *allowed)
+{
+    if (!m || m->type != YAML_MAPPING_NODE) {
+        return fail(p, m, "%s: expected a mapping", where);
+    }
+    for (yaml_node_pair_t *a = m->data.mapping.pairs.start; a < m->data.mapping.pairs.top; a++) {
+        yaml_node_t *k = yaml_document_get_node(&p->doc, a->key);
+        const char *ks = scalar(k);
+        if (!ks) {
+            return fail(p, k, "%s: keys must be plain words", where);
+        }
+        bool ok = false;
+        for (const char *const *w = allowed; *w; w++) {
+            ok |= strcmp(*w, ks) == 0;
+        }
+        if (!ok) {
+            return fail(p, k, "%s: unknown key '%s'", where, ks);
+        }
+        for (yaml_node_pair_t *b = m->data.mapping.pairs.start; b < a; b++) {
+            if (strcmp(scalar(yaml_document_get_node(&p->doc, b->key)), ks) == 0) {
+                return fail(p, k, "%s: duplicate key '%s'", where, ks);
+            }
+        }
+    }
+    return 0;
+}
+
+static yaml_node_t *get(pctx_t *p, yaml_node_t *m, const char *key)
+{
+    for (yaml_node_pair_t *a = m->data.mapping.pairs.start; a < m->data.mapping.pairs.top; a++) {
+        const char *ks = scalar(yaml_document_get_node(&p->doc, a->key));
+        if (ks && strcmp(ks, key) == 0) {
+            return yaml_document_get_node(&p->doc, a->value);
+        }
+    }
+    return NULL;
+}
+
+static int to_num(pctx_t *p, yaml_node_t *n, const char *where, double lo, double hi, double *out)
+{
+    const char *s = scalar(n);
+    if (!s || !*s) {
+        return fail(p, n, "%s: expected a number", where);
+    }
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (*end != '\0' || errno != 0 || !isfinite(v)) {
+        return fail(p, n, "%s: '%s' is not a number", where, s);
+    }
+    if (v < lo || v > hi) {
+        return fail(p, n, "%s: %g is out of range [%g, %g]", where, v, lo, hi);
+    }
+    *out = v;
+    return 0;
+}
+
+/// Optional number field `key` of mapping m.
+static int num(pctx_t *p, yaml_node_t *m, const char *where, const char *key, double lo,
+               double hi, double *out)
+{
+    yaml_node_t *n = get(p, m, key);
+    if (!n) {
+        return 0;
+    }
+    char w[128];
+    snprintf(w, sizeof w, "%s.%s", where, key);
+    return to_num(p, n, w, lo, hi, out);
+}
+
+static int boolean(pctx_t *p, yaml_node_t *m, const char *where, const char *key, bool *out)
+{
+    yaml_node_t *n = get(p, m, key);
+    if (!n) {
+        return 0;
+    }
+    const char *s = scalar(n);
+    if (s && (strcmp(s, "true") == 0 || strcmp(s, "yes") == 0 || strcmp(s, "on") == 0)) {
+        *out = true;
+    } else if (s && (strcmp(s, "false") == 0 || strcmp(s, "no") == 0 || strcmp(s, "off") == 0)) {
+        *out = false;
+    } else {
+        return fail(p, n, "%s.%s: expected true or false", where, key);
+    }
+    return 0;
+}
+
+static int str(pctx_t *p, yaml_node_t *m, const char *where, const char *key, char *out,
+               size_t cap)
+{
+    yaml_node_t *n = get(p, m, key);
+    if (!n) {
+        return 0;
+    }
+    const char *s = scalar(n);
+    if (!s || !*s) {
+        return fail(p, n, "%s.%s: expected a word", where, key);
+    }
+    if (strlen(s) >= cap) {
+        return fail(p, n, "%s.%s: longer than %zu characters", where, key, cap - 1);
+    }
+    snprintf(out, cap, "%s", s);
+    return 0;
+}
+
+/// A [x, y] pair (required when `need`).
+static int xy(pctx_t *p, yaml_node_t *m, const char *where, const char *key, bool need,
+              double *x, double *y, bool *present)
+{
+    yaml_node_t *n = get(p, m, key);
+    if (present) {
+        *present = n != NULL;
+    }
+    if (!n) {
+        return need ? fail(p, m, "%s: missing '%s'", where, key) : 0;
+    }
+    if (n->type != YAML_SEQUENCE_NODE ||
+        n->data.sequence.items.top - n->data.sequence.items.start != 2) {
+        return fail(p, n, "%s.%s: expected [x, y] in metres", where, key);
+    }
+    char w[128];
+    snprintf(w, sizeof w, "%s.%s", where, key);
+    if (to_num(p, yaml_document_get_node(&p->doc, n->data.sequence.items.start[0]), w, -1e5, 1e5,
+               x) != 0 ||
+        to_num(p, yaml_document_get_node(&p->doc, n->data.sequence.items.start[1]), w, -1e5, 1e5,
+               y) != 0) {
+        return -1;
+    }
+    return 0;
+}
+
+int hs_scenario_parse_mac(const char *s, uint8_t mac[6])
+{
+    unsigned v[6];
+    char tail;
+    if (!s || sscanf(s, "%2x:%2x:%2x:%2x:%2x:%2x%c", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5],
+                     &tail) != 6 || strlen(s) != 17) {
+        return -1;
+    }
+    for (int i = 0; i < 6; i++) {
+        mac[i] = (uint8_t)v[i];
+    }
+    return 0;
+}
+
+void hs_scenario_defaults(hs_scenario_t *sc)
+{
+    memset(sc, 0, sizeof *sc);
+    sc->seed = 1;
+    snprintf(sc->model, sizeof sc->model, "ridge");
+    snprintf(sc->target, sizeof sc->target, "rssi");
+    snprintf(sc->strategy, sizeof sc->strategy, "meta");
+    sc->pose_rate_hz = 10.0;          // a localisation system's usual rate (amcl-like)
+    sc->pose_sigma_xy_m = 0.05;
+    sc->pose_sigma_theta_rad = 0.02;
+    sc->radio = hs_radio_cfg_default();
+    sc->motor = hs_motor_cfg_default();
+    sc->stop_radius_m = 1.5;          // issue 3 stop condition
+    sc->stop_distance_m = 150.0;
+    sc->stop_time_s = 900.0;
+    sc->physics_hz = 50.0;
+    sc->core_res_m = 0.1;
+    sc->clearance_m = 0.25;           // paper defaults (PREAMBLE): 0.25 m clearance
+}
+
+static int parse_radio(pctx_t *p, yaml_node_t *r, hs_radio_cfg_t *c)
+{
+    static const char *const top[] = {"pathloss", "walls", "shadowing", "fading", "noise",
+                                      "receiver", NULL};
+    if (check_keys(p, r, "radio", top) != 0) {
+        return -1;
+    }
+    yaml_node_t *n;
+    if ((n = get(p, r, "pathloss"))) {
+        static const char *const k[] = {"enabled", "exponent", "ref_dist_m", "ref_loss_db", NULL};
+        if (check_keys(p, n, "radio.pathloss", k) || boolean(p, n, "radio.pathloss", "enabled", &c->pathloss) ||
+            num(p, n, "radio.pathloss", "exponent", 0, 10, &c->exponent) ||
+            num(p, n, "radio.pathloss", "ref_dist_m", 1e-3, 100, &c->ref_dist_m) ||
+            num(p, n, "radio.pathloss", "ref_loss_db", -200, 200, &c->ref_loss_db)) {
+            return -1;
+        }
+    }
+    if ((n = get(p, r, "walls"))) {
+        static const char *const k[] = {"enabled", "db_per_wall", "cache_m", NULL};
+        if (check_keys(p, n, "radio.walls", k) || boolean(p, n, "radio.walls", "enabled", &c->walls) ||
+            num(p, n, "radio.walls", "db_per_wall", 0, 100, &c->wall_db) ||
+            num(p, n, "radio.walls", "cache_m", 0.01, 10, &c->wall_cache_m)) {
+            return -1;
+        }
+    }
+    if ((n = get(p, r, "shadowing"))) {
+        static const char *const k[] = {"enabled", "sigma_db", "dcorr_m", "grid_m", "waves", NULL};
+        double waves = c->shadow_waves;
+        if (check_keys(p, n, "radio.shadowing", k) ||
+            boolean(p, n, "radio.shadowing", "enabled", &c->shadowing) ||
+            num(p, n, "radio.shadowing", "sigma_db", 0, 30, &c->shadow_sigma_db) ||
+            num(p, n, "radio.shadowing", "dcorr_m", 0.01, 1000, &c->shadow_dcorr_m) ||
+            num(p, n, "radio.shadowing", "grid_m", 0.01, 10, &c->shadow_grid_m) ||
+            num(p, n, "radio.shadowing", "waves", 1, 100000, &waves)) {
+            return -1;
+        }
+        c->shadow_waves = (uint32_t)waves;
+    }
+    if ((n = get(p, r, "fading"))) {
+        static const char *const k[] = {"enabled", "wavelength_m", "rician_k_db", "waves", NULL};
+        double waves = c->fading_waves;
+        if (check_keys(p, n, "radio.fading", k) || boolean(p, n, "radio.fading", "enabled", &c->fading) ||
+            num(p, n, "radio.fading", "wavelength_m", 0.001, 10, &c->wavelength_m) ||
+            num(p, n, "radio.fading", "rician_k_db", -50, 50, &c->rician_k_db) ||
+            num(p, n, "radio.fading", "waves", 1, 4096, &waves)) {
+            return -1;
+        }
+        c->fading_waves = (uint32_t)waves;
+    }
+    if ((n = get(p, r, "noise"))) {
+        static const char *const k[] = {"enabled", "sigma_db", NULL};
+        if (check_keys(p, n, "radio.noise", k) || boolean(p, n, "radio.noise", "enabled", &c->noise) ||
+            num(p, n, "radio.noise", "sigma_db", 0, 30, &c->noise_sigma_db)) {
+            return -1;
+        }
+    }
+    if ((n = get(p, r, "receiver"))) {
+        static const char *const k[] = {"quantise", "clip", "min_dbm", "max_dbm", "loss",
+                                        "sensitivity_dbm", "loss_width_db", NULL};
+        if (check_keys(p, n, "radio.receiver", k) ||
+            boolean(p, n, "radio.receiver", "quantise", &c->quantise) ||
+            boolean(p, n, "radio.receiver", "clip", &c->clip) ||
+            num(p, n, "radio.receiver", "min_dbm", -127, 127, &c->rx_min_dbm) ||
+            num(p, n, "radio.receiver", "max_dbm", -127, 127, &c->rx_max_dbm) ||
+            boolean(p, n, "radio.receiver", "loss", &c->loss) ||
+            num(p, n, "radio.receiver", "sensitivity_dbm", -200, 100, &c->sensitivity_dbm) ||
+            num(p, n, "radio.receiver", "loss_width_db", 0.01, 50, &c->loss_width_db)) {
+            return -1;
+        }
+        if (c->rx_min_dbm >= c->rx_max_dbm) {
+            return fail(p, n, "radio.receiver: min_dbm must be below max_dbm");
+        }
+    }
+    return 0;
+}
+
+static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
+{
+    static const char *const top[] = {"map", "seed", "model", "target", "strategy", "sources",
+                                      "start", "localisation", "radio", "motor", "stop", "sim",
+                                      NULL};
+    if (check_keys(p, root, "scenario", top) != 0) {
+        return -1;
+    }
+    yaml_node_t *n = get(p, root, "map");
+    const char *mp = scalar(n);
+    if (!mp || !*mp) {
+        return fail(p, n ? n : root, "map: missing (path of a map_server YAML)");
+    }
+    if (mp[0] == '/') {
+        snprintf(sc->map_path, sizeof sc->map_path, "%s", mp);
+    } else {
+        const char *slash = strrchr(p->file, '/');
+        int dl = slash ? (int)(slash - p->file + 1) : 0;
+        if ((size_t)dl + strlen(mp) + 1 > sizeof sc->map_path) {
+            return fail(p, n, "map: path too long");
+        }
+        snprintf(sc->map_path, sizeof sc->map_path, "%.*s%s", dl, p->file, mp);
+    }
+    if ((n = get(p, root, "seed"))) {
+        const char *s = scalar(n);
+        char *end;
+        errno = 0;
+        unsigned long long v = s && *s && *s != '-' ? strtoull(s, &end, 10) : 0;
+        if (!s || !*s || *s == '-' || *end != '\0' || errno != 0) {
+            return fail(p, n, "seed: expected a non-negative integer");
+        }
+        sc->seed = v;
+    }
+    if (str(p, root, "scenario", "model", sc->model, sizeof sc->model) ||
+        str(p, root, "scenario", "target", sc->target, sizeof sc->target) ||
+        str(p, root, "scenario", "strategy", sc->strategy, sizeof sc->strategy)) {
+        return -1;
+    }
+    if (strcmp(sc->target, "rssi") != 0 && strcmp(sc->target, "bridge") != 0) {
+        return fail(p, get(p, root, "target"), "target: '%s' is not rssi or bridge", sc->target);
+    }
+    n = get(p, root, "sources");
+    if (!n || n->type != YAML_SEQUENCE_NODE) {
+        return fail(p, n ? n : root, "sources: missing (a list of 1 or 2 sources)");
+    }
+    long ns = n->data.sequence.items.top - n->data.sequence.items.start;
+    if (ns < 1 || ns > (long)HS_SCN_MAX_SOURCES) {
+        return fail(p, n, "sources: %ld given, need 1 or %u", ns, HS_SCN_MAX_SOURCES);
+    }
+    sc->nsources = (unsigned)ns;
+    for (long i = 0; i < ns; i++) {
+        yaml_node_t *s = yaml_document_get_node(&p->doc, n->data.sequence.items.start[i]);
+        static const char *const k[] = {"name", "position", "mac", "rate_hz", "tx_dbm", NULL};
+        char where[32];
+        snprintf(where, sizeof where, "sources[%ld]", i);
+        hs_scn_source_t *src = &sc->src[i];
+        snprintf(src->name, sizeof src->name, "src%ld", i);
+        src->rate_hz = 200.0; // paper section 5: about 200 packets/s
+        src->tx_dbm = 20.0;   // a typical 2.4 GHz access point (100 mW)
+        src->mac[0] = 0x02;   // locally administered, unique per index
+        src->mac[5] = (uint8_t)(i + 1);
+        if (check_keys(p, s, where, k) || str(p, s, where, "name", src->name, sizeof src->name) ||
+            xy(p, s, where, "position", true, &src->x, &src->y, NULL) ||
+            num(p, s, where, "rate_hz", 0.1, 10000, &src->rate_hz) ||
+            num(p, s, where, "tx_dbm", -50, 50, &src->tx_dbm)) {
+            return -1;
+        }
+        yaml_node_t *m = get(p, s, "mac");
+        if (m && hs_scenario_parse_mac(scalar(m), src->mac) != 0) {
+            return fail(p, m, "%s.mac: expected aa:bb:cc:dd:ee:ff", where);
+        }
+    }
+    if (strcmp(sc->target, "bridge") == 0 && sc->nsources != 2) {
+        return fail(p, get(p, root, "target"), "target: bridge needs exactly 2 sources");
+    }
+    if (strcmp(sc->target, "rssi") == 0 && sc->nsources != 1) {
+        return fail(p, get(p, root, "target"), "target: rssi needs exactly 1 source");
+    }
+    n = get(p, root, "start");
+    if (!n) {
+        return fail(p, root, "start: missing ({position: [x, y], theta: radians})");
+    }
+    {
+        static const char *const k[] = {"position", "theta", NULL};
+        if (check_keys(p, n, "start", k) ||
+            xy(p, n, "start", "position", true, &sc->start_x, &sc->start_y, NULL) ||
+            num(p, n, "start", "theta", -7, 7, &sc->start_theta)) {
+            return -1;
+        }
+    }
+    if ((n = get(p, root, "localisation"))) {
+        static const char *const k[] = {"rate_hz", "sigma_xy_m", "sigma_theta_rad", NULL};
+        if (check_keys(p, n, "localisation", k) ||
+            num(p, n, "localisation", "rate_hz", 1, 1000, &sc->pose_rate_hz) ||
+            num(p, n, "localisation", "sigma_xy_m", 0, 10, &sc->pose_sigma_xy_m) ||
+            num(p, n, "localisation", "sigma_theta_rad", 0, 3, &sc->pose_sigma_theta_rad)) {
+            return -1;
+        }
+    }
+    if ((n = get(p, root, "radio")) && parse_radio(p, n, &sc->radio) != 0) {
+        return -1;
+    }
+    if ((n = get(p, root, "motor"))) {
+        static const char *const k[] = {"accel_m_s2", "timeout_ms", "v_max_m_s", "wheel_base_m",
+                                        NULL};
+        double to_ms = sc->motor.timeout_us / 1000.0;
+        if (check_keys(p, n, "motor", k) ||
+            num(p, n, "motor", "accel_m_s2", 0.01, 100, &sc->motor.accel_m_s2) ||
+            num(p, n, "motor", "timeout_ms", 1, 100000, &to_ms) ||
+            num(p, n, "motor", "v_max_m_s", 0.01, 10, &sc->motor.v_max_m_s) ||
+            num(p, n, "motor", "wheel_base_m", 0.01, 10, &sc->motor.wheel_base_m)) {
+            return -1;
+        }
+        sc->motor.timeout_us = (int64_t)llround(to_ms * 1000.0);
+    }
+    if ((n = get(p, root, "stop"))) {
+        static const char *const k[] = {"radius_m", "max_distance_m", "max_time_s", "goal", NULL};
+        if (check_keys(p, n, "stop", k) || num(p, n, "stop", "radius_m", 0, 1e4, &sc->stop_radius_m) ||
+            num(p, n, "stop", "max_distance_m", 0, 1e6, &sc->stop_distance_m) ||
+            num(p, n, "stop", "max_time_s", 0, 1e7, &sc->stop_time_s) ||
+            xy(p, n, "stop", "goal", false, &sc->goal_x, &sc->goal_y, &sc->has_goal)) {
+            return -1;
+        }
+        if (sc->stop_distance_m == 0.0 && sc->stop_time_s == 0.0) {
+            return fail(p, n, "stop: max_distance_m and max_time_s are both off: a run that "
+                              "never reaches the goal would never end");
+        }
+    }
+    if (!sc->has_goal && sc->nsources == 1) {
+        sc->goal_x = sc->src[0].x;
+        sc->goal_y = sc->src[0].y;
+    }
+    if ((n = get(p, root, "sim"))) {
+        static const char *const k[] = {"physics_hz", "core_res_m", "clearance_m", NULL};
+        if (check_keys(p, n, "sim", k) || num(p, n, "sim", "physics_hz", 10, 1000, &sc->physics_hz) ||
+            num(p, n, "sim", "core_res_m", 0.02, 1, &sc->core_res_m) ||
+            num(p, n, "sim", "clearance_m", 0, 5, &sc->clearance_m)) {
+            return -1;
+        }
+    }
+    char rerr[256];
+    if (hs_radio_cfg_check(&sc->radio, rerr, sizeof rerr) != 0) {
+        return fail(p, get(p, root, "radio"), "%s", rerr);
+    }
+    return 0;
+}
+
+int hs_scenario_load(const char *path, hs_scenario_t *sc, char *err, size_t errlen)
+{
+    hs_scenario_defaults(sc);
+    if (strlen(path) >= sizeof sc->path) {
+        snprintf(err, errlen, "%s: path too long", path);
+        return -1;
+    }
+    snprintf(sc->path, sizeof sc->path, "%s", path);
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, errlen, "%s: %s", path, strerror(errno));
+        return -1;
+    }
+    pctx_t p = {.file = path, .err = err, .errlen = errlen};
+    yaml_parser_t parser;
+    if (!yaml_parser_initialize(&parser)) {
+        fclose(f);
+        snprintf(err, errlen, "%s: out of memory", path);
+        return -1;
+    }
+    yaml_parser_set_input_file(&parser, f);
+    int rc = -1;
+    if (!yaml_parser_load(&parser, &p.doc)) {
+        snprintf(err, errlen, "%s:%lu: YAML syntax error: %s", path,
+                 (unsigned long)parser.problem_mark.line + 1,
+                 parser.problem ? parser.problem : "unknown");
+        yaml_parser_delete(&parser);
+        fclose(f);
+        return -1;
+    }
+    yaml_node_t *root = yaml_document_get_root_node(&p.doc);
+    if (!root) {
+        snprintf(err, errlen, "%s: empty file", path);
+    } else {
+        rc = parse_root(&p, root, sc);
+    }
+    yaml_document_delete(&p.doc);
+    yaml_parser_delete(&parser);
+    fclose(f);
+    return rc;
+}

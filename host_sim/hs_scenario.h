@@ -1,0 +1,84 @@
+/* hs_scenario.h - simulator scenario files (YAML, libyaml), docs/SIMULATOR.md.
+ *
+ *   map: maps/office.yaml          # ROS map_server YAML, relative to this file (required)
+ *   seed: 1
+ *   model: ridge                   # internal model (paper section 5.2)
+ *   target: rssi                   # rssi (one source) or bridge (two, paper section 6)
+ *   strategy: meta                 # placeholder for the baselines of issue 7
+ *   sources:                       # required, 1 or 2
+ *     - name: ap
+ *       position: [30.0, 8.0]      # metres, map frame
+ *       mac: "02:00:00:00:00:01"
+ *       rate_hz: 200               # packets per second (paper section 5)
+ *       tx_dbm: 20
+ *   start: {position: [5.0, 2.0], theta: 0.0}   # required
+ *   localisation: {rate_hz: 10, sigma_xy_m: 0.05, sigma_theta_rad: 0.02}
+ *   radio: {pathloss: {...}, walls: {...}, shadowing: {...}, fading: {...}, noise: {...},
+ *           receiver: {...}}       # every part has `enabled`; see docs/RADIO_MODEL.md
+ *   motor: {accel_m_s2: 1.0, timeout_ms: 200}
+ *   stop: {radius_m: 1.5, max_distance_m: 150, max_time_s: 900, goal: [x, y]}
+ *   sim: {physics_hz: 50, core_res_m: 0.1, clearance_m: 0.25}
+ *
+ * Unknown keys anywhere are errors. Errors are one line "file:line: field: reason".
+ * Checks that need the map (positions inside walls, a stop condition that can never
+ * trigger) are done by hs_sim_env_open().
+ */
+#ifndef HS_SCENARIO_H
+#define HS_SCENARIO_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "hs_motor.h"
+#include "hs_radio.h"
+
+/// Most sources a scenario may have (the core's targets combine at most two).
+#define HS_SCN_MAX_SOURCES 2u
+
+/// One source.
+typedef struct hs_scn_source {
+    char name[32];       ///< label for logs
+    double x, y;         ///< position, metres (map frame)
+    uint8_t mac[6];      ///< MAC address (for pcap output)
+    double rate_hz;      ///< packets per second (200)
+    double tx_dbm;       ///< transmit power, dBm (20)
+} hs_scn_source_t;
+
+/// A loaded scenario.
+typedef struct hs_scenario {
+    char path[1024];              ///< the scenario file
+    char map_path[1024];          ///< the map YAML, resolved against the scenario's folder
+    uint64_t seed;                ///< default seed (1)
+    char model[32];               ///< internal model name ("ridge")
+    char target[16];              ///< target name ("rssi"; "bridge" with two sources)
+    char strategy[32];            ///< strategy name ("meta")
+    unsigned nsources;            ///< sources
+    hs_scn_source_t src[HS_SCN_MAX_SOURCES]; ///< the sources
+    double start_x, start_y;      ///< robot start, metres
+    double start_theta;           ///< robot start heading, radians
+    double pose_rate_hz;          ///< localisation rate (10)
+    double pose_sigma_xy_m;       ///< localisation noise per axis, metres (0.05)
+    double pose_sigma_theta_rad;  ///< heading noise, radians (0.02)
+    hs_radio_cfg_t radio;         ///< radio model
+    hs_motor_cfg_t motor;         ///< motor-controller model
+    double stop_radius_m;         ///< reached within this of the goal (1.5; 0 = off)
+    double stop_distance_m;       ///< stop after this much travel (150; 0 = off)
+    double stop_time_s;           ///< stop after this much simulated time (900; 0 = off)
+    bool has_goal;                ///< goal given explicitly
+    double goal_x, goal_y;        ///< goal for stop_radius_m (default: the first source)
+    double physics_hz;            ///< physics steps per second (50)
+    double core_res_m;            ///< core map resolution, metres (0.1)
+    double clearance_m;           ///< core legality clearance, metres (0.25)
+} hs_scenario_t;
+
+/// Defaults for everything optional (map, sources and start still missing).
+void hs_scenario_defaults(hs_scenario_t *sc);
+
+/// Load and check a scenario file. Returns 0, or -1 with err = "file:line: reason".
+int hs_scenario_load(const char *path, hs_scenario_t *sc, char *err, size_t errlen);
+
+/// Parse "aa:bb:cc:dd:ee:ff"; 0 or -1.
+int hs_scenario_parse_mac(const char *s, uint8_t mac[6]);
+
+#endif /* HS_SCENARIO_H */

@@ -1,0 +1,668 @@
+/* hs_sim.c - the simulator's run loop (see hs_sim.h). */
+#include "hs_sim.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "hs_motor.h"
+#include "hs_radio.h"
+#include "hs_world.h"
+
+// --- shortest path on the core's legal grid -----------------------------------------
+
+typedef struct heap_item {
+    double d;
+    uint32_t i;
+} heap_item_t;
+
+typedef struct heap {
+    heap_item_t *a;
+    size_t n, cap;
+} heap_t;
+
+static int heap_push(heap_t *h, double d, uint32_t i)
+{
+    if (h->n == h->cap) {
+        size_t nc = h->cap ? h->cap * 2 : 1024;
+        heap_item_t *na = realloc(h->a, nc * sizeof *na);
+        if (!na) {
+            return -1;
+        }
+        h->a = na;
+        h->cap = nc;
+    }
+    size_t k = h->n++;
+    while (k > 0 && h->a[(k - 1) / 2].d > d) {
+        h->a[k] = h->a[(k - 1) / 2];
+        k = (k - 1) / 2;
+    }
+    h->a[k] = (heap_item_t){d, i};
+    return 0;
+}
+
+static heap_item_t heap_pop(heap_t *h)
+{
+    heap_item_t top = h->a[0], last = h->a[--h->n];
+    size_t k = 0;
+    for (;;) {
+        size_t c = 2 * k + 1;
+        if (c >= h->n) {
+            break;
+        }
+        if (c + 1 < h->n && h->a[c + 1].d < h->a[c].d) {
+            c++;
+        }
+        if (h->a[c].d >= last.d) {
+            break;
+        }
+        h->a[k] = h->a[c];
+        k = c;
+    }
+    if (h->n > 0) {
+        h->a[k] = last;
+    }
+    return top;
+}
+
+static bool legal_cell(const rfs_map_t *m, long x, long y)
+{
+    return x >= 0 && y >= 0 && x < m->w && y < m->h &&
+           rfs_map_bit(m->legal, m->stride, (uint16_t)x, (uint16_t)y);
+}
+
+/// Dijkstra over legal cells, 16-connected (straight, diagonal and knight moves, each at
+/// its Euclidean length; a move is allowed when the cells it passes through are legal).
+/// The 16-neighbourhood overestimates any-angle lengths by at most 2.7 %.
+/// Fills dist (metres, INFINITY = unreachable) from the start cell. 0 or -1 (memory).
+static int legal_dijkstra(const rfs_map_t *m, long sx, long sy, double *dist)
+{
+    static const int mv[16][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {1, -1}, {-1, 1},
+                                  {-1, -1}, {2, 1}, {2, -1}, {-2, 1}, {-2, -1}, {1, 2},
+                                  {1, -2}, {-1, 2}, {-1, -2}};
+    size_t n = (size_t)m->w * m->h;
+    double res = m->res / 65536.0;
+    for (size_t i = 0; i < n; i++) {
+        dist[i] = INFINITY;
+    }
+    if (!legal_cell(m, sx, sy)) {
+        return 0;
+    }
+    heap_t h = {0};
+    dist[(size_t)sy * m->w + sx] = 0.0;
+    if (heap_push(&h, 0.0, (uint32_t)(sy * m->w + sx)) != 0) {
+        return -1;
+    }
+    while (h.n > 0) {
+        heap_item_t it = heap_pop(&h);
+        if (it.d > dist[it.i]) {
+            continue;
+        }
+        long x = it.i % m->w, y = it.i / m->w;
+        for (int k = 0; k < 16; k++) {
+            int dx = mv[k][0], dy = mv[k][1];
+            long nx = x + dx, ny = y + dy;
+            if (!legal_cell(m, nx, ny)) {
+                continue;
+            }
+            // Cells the move passes through: both neighbours of a diagonal (no corner
+            // cutting), the two cells beside the midpoint of a knight move.
+            if (abs(dx) == 1 && abs(dy) == 1 &&
+                (!legal_cell(m, x + dx, y) || !legal_cell(m, x, y + dy))) {
+                continue;
+            }
+            if (abs(dx) == 2 && (!legal_cell(m, x + dx / 2, y) || !legal_cell(m, x + dx / 2, y + dy))) {
+                continue;
+            }
+            if (abs(dy) == 2 && (!legal_cell(m, x, y + dy / 2) || !legal_cell(m, x + dx, y + dy / 2))) {
+                continue;
+            }
+            double nd = it.d + res * sqrt((double)(dx * dx + dy * dy));
+            size_t ni = (size_t)ny * m->w + (size_t)nx;
+            if (nd < dist[ni]) {
+                dist[ni] = nd;
+                if (heap_push(&h, nd, (uint32_t)ni) != 0) {
+                    free(h.a);
+                    return -1;
+                }
+            }
+        }
+    }
+    free(h.a);
+    return 0;
+}
+
+// --- environment ------------------------------------------------------------------------
+
+static bool cell_of(const hs_map_t *m, double x, double y, uint32_t *cx, uint32_t *cy)
+{
+    double fx = (x - m->origin_x) / m->res, fy = (y - m->origin_y) / m->res;
+    if (!(fx >= 0.0 && fy >= 0.0 && fx < m->w && fy < m->h)) {
+        return false;
+    }
+    *cx = (uint32_t)fx;
+    *cy = (uint32_t)fy;
+    return true;
+}
+
+static int check_point(const hs_sim_env_t *e, const char *field, double x, double y, char *err,
+                       size_t errlen)
+{
+    uint32_t cx, cy;
+    if (!cell_of(&e->map, x, y, &cx, &cy)) {
+        snprintf(err, errlen, "%s: %s: (%.2f, %.2f) is off the map", e->sc.path, field, x, y);
+        return -1;
+    }
+    uint8_t c = e->map.cell[(size_t)cy * e->map.w + cx];
+    if (c != HS_CELL_FREE) {
+        snprintf(err, errlen, "%s: %s: (%.2f, %.2f) is inside a wall (%s cell)", e->sc.path,
+                 field, x, y, c == HS_CELL_OCC ? "occupied" : "unknown");
+        return -1;
+    }
+    return 0;
+}
+
+int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t errlen)
+{
+    memset(e, 0, sizeof *e);
+    e->sc = *sc;
+    char merr[512];
+    if (hs_map_load(sc->map_path, &e->map, merr, sizeof merr) != 0) {
+        snprintf(err, errlen, "%s: map: %s", sc->path, merr);
+        return -1;
+    }
+    e->x0 = e->map.origin_x;
+    e->y0 = e->map.origin_y;
+    e->x1 = e->map.origin_x + e->map.w * e->map.res;
+    e->y1 = e->map.origin_y + e->map.h * e->map.res;
+    rfs_map_cfg_t mc = rfs_map_cfg_default();
+    mc.clearance = (rfs_q16_t)lround(sc->clearance_m * 65536.0);
+    if (hs_map_to_core(&e->map, sc->core_res_m, &mc, &e->core, merr, sizeof merr) != 0) {
+        snprintf(err, errlen, "%s: map: %s: %s", sc->path, sc->map_path, merr);
+        hs_sim_env_close(e);
+        return -1;
+    }
+    for (unsigned s = 0; s < sc->nsources; s++) {
+        char f[48];
+        snprintf(f, sizeof f, "sources[%u].position", s);
+        if (check_point(e, f, sc->src[s].x, sc->src[s].y, err, errlen) != 0) {
+            hs_sim_env_close(e);
+            return -1;
+        }
+    }
+    if (check_point(e, "start.position", sc->start_x, sc->start_y, err, errlen) != 0) {
+        hs_sim_env_close(e);
+        return -1;
+    }
+    const rfs_map_t *cm = &e->core.map;
+    rfs_q16_t qx = (rfs_q16_t)lround(sc->start_x * 65536.0);
+    rfs_q16_t qy = (rfs_q16_t)lround(sc->start_y * 65536.0);
+    if (!rfs_map_point_legal(cm, qx, qy)) {
+        snprintf(err, errlen,
+                 "%s: start.position: (%.2f, %.2f) is closer than the clearance (%.2f m) to a "
+                 "wall or unknown cell",
+                 sc->path, sc->start_x, sc->start_y, sc->clearance_m);
+        hs_sim_env_close(e);
+        return -1;
+    }
+    e->shortest_path_m = NAN;
+    e->shortest_to_stop_m = NAN;
+    bool has_goal = sc->has_goal || sc->nsources == 1;
+    if (has_goal && sc->stop_radius_m > 0.0) {
+        double *dist = malloc(sizeof(double) * cm->w * cm->h);
+        if (!dist) {
+            snprintf(err, errlen, "%s: out of memory", sc->path);
+            hs_sim_env_close(e);
+            return -1;
+        }
+        double res = cm->res / 65536.0;
+        long sx = (long)((sc->start_x - e->x0) / res), sy = (long)((sc->start_y - e->y0) / res);
+        if (legal_dijkstra(cm, sx, sy, dist) != 0) {
+            free(dist);
+            snprintf(err, errlen, "%s: out of memory", sc->path);
+            hs_sim_env_close(e);
+            return -1;
+        }
+        // Nearest reachable cell to the goal, and the shortest path into the stop radius.
+        double best_gd = INFINITY, best_path = INFINITY, stop_path = INFINITY;
+        for (long y = 0; y < cm->h; y++) {
+            for (long x = 0; x < cm->w; x++) {
+                double d = dist[(size_t)y * cm->w + x];
+                if (!isfinite(d)) {
+                    continue;
+                }
+                double gx = e->x0 + (x + 0.5) * res - sc->goal_x;
+                double gy = e->y0 + (y + 0.5) * res - sc->goal_y;
+                double gd = sqrt(gx * gx + gy * gy);
+                if (gd < best_gd - 1e-9 || (fabs(gd - best_gd) <= 1e-9 && d < best_path)) {
+                    best_gd = gd;
+                    best_path = d;
+                }
+                if (gd <= sc->stop_radius_m && d < stop_path) {
+                    stop_path = d;
+                }
+            }
+        }
+        free(dist);
+        if (!isfinite(stop_path)) {
+            snprintf(err, errlen,
+                     "%s: stop.radius_m: the robot can never get within %.2f m of the goal "
+                     "(%.2f, %.2f): the nearest point it can reach is %.2f m away",
+                     sc->path, sc->stop_radius_m, sc->goal_x, sc->goal_y, best_gd);
+            hs_sim_env_close(e);
+            return -1;
+        }
+        e->shortest_path_m = best_path;
+        e->shortest_to_stop_m = stop_path;
+    }
+    return 0;
+}
+
+void hs_sim_env_close(hs_sim_env_t *e)
+{
+    hs_core_map_free(&e->core);
+    hs_map_free(&e->map);
+}
+
+// --- the run loop -------------------------------------------------------------------------
+
+static unsigned walls_cb(void *ctx, double x0, double y0, double x1, double y1)
+{
+    return hs_world_walls_crossed(ctx, x0, y0, x1, y1);
+}
+
+static const char *kind_name(rfs_seek_kind_t k)
+{
+    switch (k) {
+    case RFS_SEEK_INITIAL: return "initial";
+    case RFS_SEEK_GREEDY: return "greedy";
+    case RFS_SEEK_EPSILON: return "epsilon";
+    default: return "none";
+    }
+}
+
+static const char *prev_name(rfs_drive_status_t s)
+{
+    switch (s) {
+    case RFS_DRIVE_REACHED: return "reached";
+    case RFS_DRIVE_TIMEOUT: return "timeout";
+    case RFS_DRIVE_BLOCKED: return "blocked";
+    case RFS_DRIVE_RUNNING: return "running";
+    default: return "start";
+    }
+}
+
+static double q16d(rfs_q16_t v)
+{
+    return v / 65536.0;
+}
+
+static rfs_q16_t dq16(double v)
+{
+    double s = v * 65536.0;
+    return s >= 2147483647.0 ? INT32_MAX : (s <= -2147483648.0 ? INT32_MIN : (rfs_q16_t)lround(s));
+}
+
+static double wrap_pi(double a)
+{
+    a = remainder(a, 2.0 * M_PI);
+    return a <= -M_PI ? a + 2.0 * M_PI : a;
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+enum { EV_PACKET = 0, EV_POSE = 1, EV_CTRL = 2 };
+
+int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_sim_io_t *io,
+               hs_sim_result_t *res, char *err, size_t errlen)
+{
+    const hs_scenario_t *sc = &e->sc;
+    double t_wall0 = now_s();
+    memset(res, 0, sizeof *res);
+    res->seed = seed;
+    char werr[256];
+    hs_world_t *world = hs_world_create(&e->map, NULL, werr, sizeof werr);
+    if (!world) {
+        snprintf(err, errlen, "%s: %s", sc->path, werr);
+        return -1;
+    }
+    hs_world_place_robot(world, sc->start_x, sc->start_y, sc->start_theta);
+    hs_radio_src_t rs[HS_SCN_MAX_SOURCES];
+    for (unsigned s = 0; s < sc->nsources; s++) {
+        rs[s] = (hs_radio_src_t){sc->src[s].x, sc->src[s].y, sc->src[s].tx_dbm};
+    }
+    hs_radio_t *radio = hs_radio_create(&sc->radio, rs, sc->nsources, e->x0, e->y0, e->x1, e->y1,
+                                        seed, walls_cb, world, werr, sizeof werr);
+    if (!radio) {
+        hs_world_destroy(world);
+        snprintf(err, errlen, "%s: %s", sc->path, werr);
+        return -1;
+    }
+    hs_motor_t motor;
+    if (hs_motor_init(&motor, &sc->motor) != 0) {
+        hs_radio_destroy(radio);
+        hs_world_destroy(world);
+        snprintf(err, errlen, "%s: motor: parameters must be positive", sc->path);
+        return -1;
+    }
+    // Independent streams: packets (loss and noise) and localisation noise.
+    rfs_rng_t rng_pkt, rng_pose;
+    rfs_rng_seed(&rng_pkt, seed ^ 0x5A17C0FFEE000001ull);
+    rfs_rng_seed(&rng_pose, seed ^ 0x5A17C0FFEE000002ull);
+
+    const int64_t dt_us = (int64_t)llround(1e6 / sc->physics_hz);
+    const double dt_s = dt_us * 1e-6;
+    const double pose_period_us = 1e6 / sc->pose_rate_hz;
+    double pkt_period_us[HS_SCN_MAX_SOURCES];
+    uint64_t pkt_k[HS_SCN_MAX_SOURCES] = {0};
+    double pkt_off_us[HS_SCN_MAX_SOURCES];
+    uint16_t seq[HS_SCN_MAX_SOURCES] = {0};
+    for (unsigned s = 0; s < sc->nsources; s++) {
+        pkt_period_us[s] = 1e6 / sc->src[s].rate_hz;
+        pkt_off_us[s] = pkt_period_us[s] * (s + 0.5) / sc->nsources; // sources interleave
+    }
+    uint64_t pose_k = 1, ctrl_k = 1;
+    const int64_t stop_t_us = sc->stop_time_s > 0.0 ? (int64_t)llround(sc->stop_time_s * 1e6) : INT64_MAX;
+    const bool has_goal = sc->has_goal || sc->nsources == 1;
+
+    if (io && io->log) {
+        fprintf(io->log, "iteration\tt_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\tkind\treason\t"
+                         "relearned\tprediction_db\tmean_db\tepsilon\tgoal_x_m\tgoal_y_m\t"
+                         "max_x_m\tmax_y_m\tpath_m\tsamples\ttravelled_m\n");
+    }
+    if (io && io->samples) {
+        fprintf(io->samples, "t_s\tsrc\tx_m\ty_m\ttravelled_m\tdbm\n");
+    }
+    if (io && io->track) {
+        fprintf(io->track, "t_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\test_theta_rad\ttouching\n");
+    }
+
+    double px, py, pth;
+    hs_world_robot_pose(world, &px, &py, &pth);
+    int64_t t = 0;
+    double travelled = 0.0;
+    const char *end = "time";
+    for (;;) {
+        double v, w;
+        hs_motor_update(&motor, t + dt_us, dt_s, &v, &w);
+        hs_world_step(world, v, w, dt_s);
+        double nx, ny, nth;
+        hs_world_robot_pose(world, &nx, &ny, &nth);
+        double seg = hypot(nx - px, ny - py);
+        const int64_t t1 = t + dt_us;
+        const double dth = wrap_pi(nth - pth);
+        for (;;) {
+            // Next event in (t, t1]: packets, then poses, then control at equal times.
+            int64_t te = INT64_MAX;
+            int kind = -1;
+            unsigned which = 0;
+            for (unsigned s = 0; s < sc->nsources; s++) {
+                int64_t ts = (int64_t)llround(pkt_off_us[s] + pkt_k[s] * pkt_period_us[s]);
+                if (ts < te) {
+                    te = ts;
+                    kind = EV_PACKET;
+                    which = s;
+                }
+            }
+            int64_t tp = (int64_t)llround(pose_k * pose_period_us);
+            if (tp < te) {
+                te = tp;
+                kind = EV_POSE;
+            }
+            int64_t tc = (int64_t)ctrl_k * ctrl->period_us;
+            if (tc < te) {
+                te = tc;
+                kind = EV_CTRL;
+            }
+            if (te > t1) {
+                break;
+            }
+            double a = (double)(te - t) / (double)dt_us;
+            double ex = px + a * (nx - px), ey = py + a * (ny - py);
+            double etr = travelled + a * seg;
+            if (kind == EV_PACKET) {
+                unsigned s = which;
+                pkt_k[s]++;
+                int dbm = 0;
+                bool got = hs_radio_packet(radio, s, ex, ey, &rng_pkt, &dbm);
+                res->packets_sent++;
+                if (io && io->on_packet) {
+                    io->on_packet(io->packet_ctx, s, te, seq[s], got, dbm);
+                }
+                seq[s] = (uint16_t)((seq[s] + 1u) & 0x0FFFu); // 802.11 sequence numbers: 12 bits
+                if (got) {
+                    res->packets_received++;
+                    ctrl->on_rssi(ctrl->self, (uint8_t)s, te, (int8_t)dbm);
+                    if (io && io->samples) {
+                        fprintf(io->samples, "%.6f\t%u\t%.3f\t%.3f\t%.3f\t%d\n", te * 1e-6, s, ex,
+                                ey, etr, dbm);
+                    }
+                }
+            } else if (kind == EV_POSE) {
+                pose_k++;
+                double eth = wrap_pi(pth + a * dth);
+                double mx = ex + sc->pose_sigma_xy_m * hs_radio_gauss(&rng_pose);
+                double my = ey + sc->pose_sigma_xy_m * hs_radio_gauss(&rng_pose);
+                double mth = wrap_pi(eth + sc->pose_sigma_theta_rad * hs_radio_gauss(&rng_pose));
+                rfs_pose_t pose = {te, dq16(mx), dq16(my), dq16(mth)};
+                ctrl->on_pose(ctrl->self, &pose);
+                if (io && io->track) {
+                    fprintf(io->track, "%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%.4f\t%d\n", te * 1e-6,
+                            ex, ey, eth, mx, my, mth, hs_world_robot_touching(world) ? 1 : 0);
+                }
+            } else {
+                ctrl_k++;
+                hs_ctrl_out_t out;
+                memset(&out, 0, sizeof out);
+                ctrl->step(ctrl->self, te, &out);
+                hs_motor_command(&motor, te, out.left_mm_s, out.right_mm_s);
+                if (out.decided) {
+                    const rfs_seek_decision_t *d = &out.decision;
+                    res->iterations++;
+                    res->model_updates += d->relearned ? 1u : 0u;
+                    res->greedy += d->kind == RFS_SEEK_GREEDY ? 1u : 0u;
+                    res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
+                    if (io && io->log) {
+                        char reason[96];
+                        snprintf(reason, sizeof reason, "prev=%s%s%s%s", prev_name(d->prev),
+                                 d->line_search ? ",line_search" : "",
+                                 d->model_valid ? "" : ",no_model",
+                                 d->mean_valid ? "" : ",no_mean");
+                        double pred = d->model_valid ? q16d(d->prediction) : NAN;
+                        double mean = d->mean_valid ? q16d(d->mean) : NAN;
+                        fprintf(io->log,
+                                "%u\t%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%s\t%s\t%d\t%.3f\t%.3f\t"
+                                "%.4f\t%.3f\t%.3f\t%.3f\t%.3f\t%.3f\t%u\t%.3f\n",
+                                d->iteration, te * 1e-6, ex, ey, wrap_pi(pth + a * dth),
+                                q16d(d->x), q16d(d->y), kind_name(d->kind), reason,
+                                d->relearned ? 1 : 0, pred, mean, q16d(d->epsilon),
+                                q16d(d->goal_x), q16d(d->goal_y), q16d(d->max_x), q16d(d->max_y),
+                                q16d(d->path_len), d->samples, etr);
+                    }
+                }
+            }
+        }
+        travelled += seg;
+        px = nx;
+        py = ny;
+        pth = nth;
+        t = t1;
+        if (has_goal && sc->stop_radius_m > 0.0 &&
+            hypot(px - sc->goal_x, py - sc->goal_y) <= sc->stop_radius_m) {
+            end = "reached";
+            res->reached = true;
+            break;
+        }
+        if (sc->stop_distance_m > 0.0 && travelled >= sc->stop_distance_m) {
+            end = "distance";
+            break;
+        }
+        if (t >= stop_t_us) {
+            end = "time";
+            break;
+        }
+    }
+    res->end = end;
+    res->sim_time_s = t * 1e-6;
+    res->distance_travelled_m = travelled;
+    res->shortest_path_m = e->shortest_path_m;
+    res->shortest_to_stop_m = e->shortest_to_stop_m;
+    res->final_x = px;
+    res->final_y = py;
+    res->final_distance_m = has_goal ? hypot(px - sc->goal_x, py - sc->goal_y) : NAN;
+    res->motor_timeouts = motor.timeouts;
+    hs_radio_destroy(radio);
+    hs_world_destroy(world);
+    res->wall_time_s = now_s() - t_wall0;
+    return 0;
+}
+
+int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *io,
+                      hs_sim_result_t *res, char *err, size_t errlen)
+{
+    hs_ctrl_inproc_cfg_t cc = hs_ctrl_inproc_cfg_default();
+    cc.model = e->sc.model;
+    cc.target = e->sc.target;
+    cc.seed = seed ^ 0x5A17C0FFEE000003ull;
+    hs_ctrl_t ctrl;
+    char cerr[256];
+    if (hs_ctrl_inproc_open(&ctrl, &cc, &e->core.map, cerr, sizeof cerr) != 0) {
+        snprintf(err, errlen, "%s: %s", e->sc.path, cerr);
+        return -1;
+    }
+    int rc = hs_sim_run(e, seed, &ctrl, io, res, err, errlen);
+    hs_ctrl_close(&ctrl);
+    return rc;
+}
+
+int hs_sim_field(const hs_sim_env_t *e, uint64_t seed, unsigned src, double step_m, FILE *f,
+                 char *err, size_t errlen)
+{
+    const hs_scenario_t *sc = &e->sc;
+    if (src >= sc->nsources || !(step_m > 0.0)) {
+        snprintf(err, errlen, "field: bad source or step");
+        return -1;
+    }
+    char werr[256];
+    hs_world_t *world = hs_world_create(&e->map, NULL, werr, sizeof werr);
+    if (!world) {
+        snprintf(err, errlen, "%s: %s", sc->path, werr);
+        return -1;
+    }
+    hs_radio_src_t rs[HS_SCN_MAX_SOURCES];
+    for (unsigned s = 0; s < sc->nsources; s++) {
+        rs[s] = (hs_radio_src_t){sc->src[s].x, sc->src[s].y, sc->src[s].tx_dbm};
+    }
+    hs_radio_t *radio = hs_radio_create(&sc->radio, rs, sc->nsources, e->x0, e->y0, e->x1, e->y1,
+                                        seed, walls_cb, world, werr, sizeof werr);
+    if (!radio) {
+        hs_world_destroy(world);
+        snprintf(err, errlen, "%s: %s", sc->path, werr);
+        return -1;
+    }
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, seed ^ 0x5A17C0FFEE000004ull);
+    fprintf(f, "x_m\ty_m\twalls\tmean_dbm\tsignal_dbm\tdbm\n");
+    for (double y = e->y0 + 0.5 * step_m; y < e->y1; y += step_m) {
+        for (double x = e->x0 + 0.5 * step_m; x < e->x1; x += step_m) {
+            uint32_t cx, cy;
+            if (!cell_of(&e->map, x, y, &cx, &cy) ||
+                e->map.cell[(size_t)cy * e->map.w + cx] != HS_CELL_FREE) {
+                continue;
+            }
+            int dbm;
+            bool got = hs_radio_packet(radio, src, x, y, &rng, &dbm);
+            fprintf(f, "%.3f\t%.3f\t%u\t%.2f\t%.2f\t", x, y, hs_radio_walls(radio, src, x, y),
+                    hs_radio_mean_dbm(radio, src, x, y), hs_radio_signal_dbm(radio, src, x, y));
+            if (got) {
+                fprintf(f, "%d\n", dbm);
+            } else {
+                fprintf(f, "\n");
+            }
+        }
+    }
+    hs_radio_destroy(radio);
+    hs_world_destroy(world);
+    return 0;
+}
+
+static void json_num(FILE *f, const char *key, double v, bool last)
+{
+    if (isfinite(v)) {
+        fprintf(f, "  \"%s\": %.3f%s\n", key, v, last ? "" : ",");
+    } else {
+        fprintf(f, "  \"%s\": null%s\n", key, last ? "" : ",");
+    }
+}
+
+void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t *r)
+{
+    fprintf(f, "{\n");
+    fprintf(f, "  \"scenario\": \"%s\",\n", e->sc.path);
+    fprintf(f, "  \"seed\": %llu,\n", (unsigned long long)r->seed);
+    fprintf(f, "  \"model\": \"%s\",\n", e->sc.model);
+    fprintf(f, "  \"strategy\": \"%s\",\n", e->sc.strategy);
+    fprintf(f, "  \"target\": \"%s\",\n", e->sc.target);
+    fprintf(f, "  \"map\": \"%s\",\n", e->sc.map_path);
+    fprintf(f, "  \"start\": [%.3f, %.3f],\n", e->sc.start_x, e->sc.start_y);
+    fprintf(f, "  \"sources\": [");
+    for (unsigned s = 0; s < e->sc.nsources; s++) {
+        fprintf(f, "%s[%.3f, %.3f]", s ? ", " : "", e->sc.src[s].x, e->sc.src[s].y);
+    }
+    fprintf(f, "],\n");
+    fprintf(f, "  \"reached\": %s,\n", r->reached ? "true" : "false");
+    fprintf(f, "  \"end\": \"%s\",\n", r->end);
+    json_num(f, "sim_time_s", r->sim_time_s, false);
+    json_num(f, "distance_travelled_m", r->distance_travelled_m, false);
+    json_num(f, "shortest_path_m", r->shortest_path_m, false);
+    json_num(f, "shortest_to_stop_m", r->shortest_to_stop_m, false);
+    json_num(f, "final_distance_m", r->final_distance_m, false);
+    json_num(f, "final_x_m", r->final_x, false);
+    json_num(f, "final_y_m", r->final_y, false);
+    fprintf(f, "  \"iterations\": %u,\n", r->iterations);
+    fprintf(f, "  \"model_updates\": %u,\n", r->model_updates);
+    fprintf(f, "  \"greedy\": %u,\n", r->greedy);
+    fprintf(f, "  \"epsilon\": %u,\n", r->epsilon);
+    fprintf(f, "  \"packets_sent\": %llu,\n", (unsigned long long)r->packets_sent);
+    fprintf(f, "  \"packets_received\": %llu,\n", (unsigned long long)r->packets_received);
+    fprintf(f, "  \"motor_timeouts\": %u\n", r->motor_timeouts);
+    fprintf(f, "}\n");
+}
+
+void hs_sim_table_header(FILE *f)
+{
+    fprintf(f, "seed\treached\tend\tsim_time_s\tdistance_travelled_m\tshortest_path_m\t"
+               "shortest_to_stop_m\tfinal_distance_m\tfinal_x_m\tfinal_y_m\titerations\t"
+               "model_updates\tgreedy\tepsilon\tpackets_sent\tpackets_received\n");
+}
+
+/// %.3f, or "nan" for a value that does not exist (no goal).
+static void tsv_num(FILE *f, double v)
+{
+    if (isfinite(v)) {
+        fprintf(f, "\t%.3f", v);
+    } else {
+        fprintf(f, "\tnan");
+    }
+}
+
+void hs_sim_table_row(FILE *f, const hs_sim_result_t *r)
+{
+    fprintf(f, "%llu\t%d\t%s", (unsigned long long)r->seed, r->reached ? 1 : 0, r->end);
+    tsv_num(f, r->sim_time_s);
+    tsv_num(f, r->distance_travelled_m);
+    tsv_num(f, r->shortest_path_m);
+    tsv_num(f, r->shortest_to_stop_m);
+    tsv_num(f, r->final_distance_m);
+    tsv_num(f, r->final_x);
+    tsv_num(f, r->final_y);
+    fprintf(f, "\t%u\t%u\t%u\t%u\t%llu\t%llu\n", r->iterations, r->model_updates, r->greedy,
+            r->epsilon, (unsigned long long)r->packets_sent,
+            (unsigned long long)r->packets_received);
+}

@@ -1,0 +1,100 @@
+/* hs_sim.h - the simulator's run loop: world, radio, motor and localisation around a
+ * controller (hs_ctrl.h), in simulated time (docs/SIMULATOR.md).
+ *
+ * Time advances in physics ticks (default 20 ms). Each tick: the motor model turns the
+ * commands received so far into a body velocity, Box2D moves the robot, and then every
+ * sensor and control event inside the tick is delivered in time order at the robot
+ * position interpolated to its timestamp: packets (each source at its rate), poses at
+ * 10 Hz with Gaussian noise, and control periods; a control period's wheel command
+ * reaches the motor model at once and takes effect from the next tick (<= 20 ms
+ * latency, like a CAN round trip). Equal times: packets, then poses, then control.
+ *
+ * Everything random comes from the run seed: radio fields, packet loss and noise, pose
+ * noise, and the controller's own seed. Same seed, same bytes.
+ */
+#ifndef HS_SIM_H
+#define HS_SIM_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "hs_ctrl.h"
+#include "hs_map.h"
+#include "hs_scenario.h"
+
+/// What stays the same for every seed of a scenario: the map, its core grids, and the
+/// shortest path from the start to the goal.
+typedef struct hs_sim_env {
+    hs_scenario_t sc;          ///< the scenario
+    hs_map_t map;              ///< the map at its own resolution
+    hs_core_map_t core;        ///< the core's grids (core_res_m, clearance_m)
+    double shortest_path_m;    ///< start to the legal point nearest the goal, around walls (NaN: no goal)
+    double shortest_to_stop_m; ///< start to the first legal point within stop_radius_m (NaN: no goal)
+    double x0, y0, x1, y1;     ///< the map's extent, metres
+} hs_sim_env_t;
+
+/// Per-run outputs; any may be NULL.
+typedef struct hs_sim_io {
+    FILE *log;       ///< per-iteration decisions (TSV)
+    FILE *samples;   ///< every received packet (TSV)
+    FILE *track;     ///< robot pose at each localisation message (TSV)
+    /// Every simulated packet (received or lost), e.g. for a pcap writer. May be NULL.
+    void (*on_packet)(void *ctx, unsigned src, int64_t t_us, uint16_t seq, bool received,
+                      int dbm);
+    void *packet_ctx;  ///< passed to on_packet
+} hs_sim_io_t;
+
+/// Outcome of one run (summary.json).
+typedef struct hs_sim_result {
+    uint64_t seed;               ///< the run's seed
+    bool reached;                ///< ended within stop_radius_m of the goal
+    const char *end;             ///< "reached", "distance", "time"
+    double sim_time_s;           ///< simulated time, seconds
+    double distance_travelled_m; ///< path length of the true robot position, metres
+    double shortest_path_m;      ///< from hs_sim_env_t
+    double shortest_to_stop_m;   ///< from hs_sim_env_t
+    double final_distance_m;     ///< from the goal at the end (NaN: no goal)
+    double final_x, final_y;     ///< final true position, metres
+    uint32_t iterations;         ///< decisions made
+    uint32_t model_updates;      ///< decisions with the model relearnt
+    uint32_t greedy, epsilon;    ///< decisions of each kind
+    uint64_t packets_sent;       ///< packets simulated
+    uint64_t packets_received;   ///< packets delivered to the controller
+    uint32_t motor_timeouts;     ///< times the motor model stopped on a missing command
+    double wall_time_s;          ///< host time the run took (not part of determinism)
+} hs_sim_result_t;
+
+/// Load the map, build the core grids and check the scenario against them (sources and
+/// start in free space, start legal, goal reachable within the stop radius). Returns 0, or
+/// -1 with err = "file: field: reason".
+int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t errlen);
+
+/// Release (safe on a zeroed env).
+void hs_sim_env_close(hs_sim_env_t *e);
+
+/// Run one mission with a controller. Returns 0, or -1 with err (world or radio setup).
+int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_sim_io_t *io,
+               hs_sim_result_t *res, char *err, size_t errlen);
+
+/// Run one mission with the in-process controller (the scenario's model and target,
+/// controller seeded from `seed`).
+int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *io,
+                      hs_sim_result_t *res, char *err, size_t errlen);
+
+/// Write the simulated field of source `src` for `seed` (the same fields as a run with
+/// that seed) on every free point of a grid `step_m` apart, as TSV: x_m, y_m, walls,
+/// mean_dbm (no fading), signal_dbm (with fading), dbm of one packet (empty when lost).
+/// Returns 0, or -1 with err.
+int hs_sim_field(const hs_sim_env_t *e, uint64_t seed, unsigned src, double step_m, FILE *f,
+                 char *err, size_t errlen);
+
+/// Write summary.json of a run to f.
+void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t *r);
+
+/// Header line and one row of the batch table (TSV).
+void hs_sim_table_header(FILE *f);
+void hs_sim_table_row(FILE *f, const hs_sim_result_t *r);
+
+#endif /* HS_SIM_H */

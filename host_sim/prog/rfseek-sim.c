@@ -1,0 +1,530 @@
+/* rfseek-sim - run the seeker in the simulated world (issue 3, docs/SIMULATOR.md).
+ *
+ *   rfseek-sim SCENARIO [--seed N] [--out DIR] [--samples] [--field] [--pcap FILE]
+ *   rfseek-sim SCENARIO --seeds A..B [--jobs N] [--out DIR]
+ *   rfseek-sim SCENARIO --seeds A..B --emit-jobs --out DIR
+ *
+ * Output directories are written under DIR.tmp-PID and renamed to DIR only when complete,
+ * so an error never leaves a half-written DIR behind.
+ */
+#include <errno.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "hs_pcap.h"
+#include "hs_sim.h"
+
+static const char *prog = "rfseek-sim";
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: %s SCENARIO [options]\n"
+            "Run the seeker (core in-process) in the simulated world of SCENARIO (YAML).\n"
+            "\n"
+            "  --seed N        run seed (default: the scenario's seed)\n"
+            "  --out DIR       write log.tsv, track.tsv, summary.json (and samples.tsv) to DIR;\n"
+            "                  without it a single run prints summary.json on stdout\n"
+            "  --samples       also write every received packet to DIR/samples.tsv\n"
+            "                  (always written for a single run with --out)\n"
+            "  --field         also write the simulated field of source 0 to DIR/field.tsv\n"
+            "  --pcap FILE     write every received packet as a radiotap pcap (single run)\n"
+            "  --seeds A..B    run seeds A to B (inclusive) and write one table\n"
+            "                  (DIR/runs.tsv with --out, else stdout); per-seed logs in DIR/seed-N/\n"
+            "  --jobs N        worker processes for --seeds (default: all cores)\n"
+            "  --emit-jobs     print one command per seed (for GNU parallel or a Slurm array)\n"
+            "                  instead of running; merge with scripts/merge_runs.py DIR\n"
+            "  --quiet         no progress bar\n"
+            "  --bench         with --seeds: run them one after another in this process without\n"
+            "                  output files and print the real-time factor (make bench-sim)\n"
+            "  --help          this text\n"
+            "Errors: one line on stderr, exit status 1, no output directory left behind.\n",
+            prog);
+}
+
+static int die(const char *fmt, const char *a, const char *b)
+{
+    fprintf(stderr, "%s: ", prog);
+    fprintf(stderr, fmt, a, b);
+    fputc('\n', stderr);
+    return 1;
+}
+
+static int parse_u64(const char *s, uint64_t *v)
+{
+    if (!s || !*s || *s == '-' || *s == '+') {
+        return -1;
+    }
+    char *end;
+    errno = 0;
+    unsigned long long x = strtoull(s, &end, 10);
+    if (*end != '\0' || errno != 0) {
+        return -1;
+    }
+    *v = x;
+    return 0;
+}
+
+static int parse_range(const char *s, uint64_t *a, uint64_t *b)
+{
+    const char *dots = s ? strstr(s, "..") : NULL;
+    if (!dots || dots == s) {
+        return -1;
+    }
+    char first[32];
+    size_t n = (size_t)(dots - s);
+    if (n >= sizeof first) {
+        return -1;
+    }
+    memcpy(first, s, n);
+    first[n] = '\0';
+    if (parse_u64(first, a) != 0 || parse_u64(dots + 2, b) != 0 || *b < *a) {
+        return -1;
+    }
+    return 0;
+}
+
+/// Remove a directory tree we created (only regular files and directories).
+static void rm_tree(const char *path)
+{
+    char cmd[PATH_MAX + 32];
+    // Our own temporary directory only; quoted for spaces.
+    if (strchr(path, '\'') == NULL) {
+        if (snprintf(cmd, sizeof cmd, "rm -rf -- '%s'", path) >= (int)sizeof cmd ||
+            system(cmd) != 0) {
+            fprintf(stderr, "%s: could not remove %s\n", prog, path);
+        }
+    }
+}
+
+static FILE *open_in(const char *dir, const char *name)
+{
+    char p[PATH_MAX + 64];
+    if (snprintf(p, sizeof p, "%s/%s", dir, name) >= (int)sizeof p) {
+        errno = ENAMETOOLONG;
+        return NULL;
+    }
+    return fopen(p, "w");
+}
+
+typedef struct pcap_ctx {
+    hs_pcap_writer_t *w;
+    const hs_scenario_t *sc;
+    int failed;
+} pcap_ctx_t;
+
+static void on_packet(void *ctx, unsigned src, int64_t t_us, uint16_t seq, bool received,
+                      int dbm)
+{
+    pcap_ctx_t *p = ctx;
+    static const uint8_t bssid[6] = {0x02, 0x00, 0x00, 0x00, 0xbb, 0x01};
+    if (received && p->w &&
+        hs_pcap_writer_frame(p->w, t_us, p->sc->src[src].mac, bssid, seq, (int8_t)dbm, 2437) != 0) {
+        p->failed = 1;
+    }
+}
+
+/// One run into dir (NULL: summary to stdout). Returns 0 or 1.
+static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool samples,
+                   bool field, const char *pcap, hs_sim_result_t *res)
+{
+    char err[1024];
+    hs_sim_io_t io = {0};
+    pcap_ctx_t pc = {.sc = &env->sc};
+    int rc = 0;
+    if (dir) {
+        io.log = open_in(dir, "log.tsv");
+        io.track = open_in(dir, "track.tsv");
+        if (samples) {
+            io.samples = open_in(dir, "samples.tsv");
+        }
+        if (!io.log || !io.track || (samples && !io.samples)) {
+            fprintf(stderr, "%s: %s: %s\n", prog, dir, strerror(errno));
+            rc = 1;
+        }
+    }
+    if (rc == 0 && pcap) {
+        pc.w = hs_pcap_writer_open(pcap, err, sizeof err);
+        if (!pc.w) {
+            fprintf(stderr, "%s: %s\n", prog, err);
+            rc = 1;
+        }
+        io.on_packet = on_packet;
+        io.packet_ctx = &pc;
+    }
+    if (rc == 0 && hs_sim_run_inproc(env, seed, &io, res, err, sizeof err) != 0) {
+        fprintf(stderr, "%s: %s\n", prog, err);
+        rc = 1;
+    }
+    if (rc == 0 && field && dir) {
+        FILE *f = open_in(dir, "field.tsv");
+        if (!f || hs_sim_field(env, seed, 0, 0.1, f, err, sizeof err) != 0) {
+            fprintf(stderr, "%s: %s\n", prog, f ? err : strerror(errno));
+            rc = 1;
+        }
+        if (f && fclose(f) != 0) {
+            rc = 1;
+        }
+    }
+    if (rc == 0) {
+        FILE *s = dir ? open_in(dir, "summary.json") : stdout;
+        if (!s) {
+            fprintf(stderr, "%s: %s/summary.json: %s\n", prog, dir, strerror(errno));
+            rc = 1;
+        } else {
+            hs_sim_write_summary(s, env, res);
+            if (dir && fclose(s) != 0) {
+                rc = 1;
+            }
+        }
+    }
+    FILE *fs[3] = {io.log, io.track, io.samples};
+    for (int i = 0; i < 3; i++) {
+        if (fs[i] && fclose(fs[i]) != 0) {
+            fprintf(stderr, "%s: %s: write failed\n", prog, dir);
+            rc = 1;
+        }
+    }
+    if (pc.w) {
+        if (hs_pcap_writer_close(pc.w) != 0 || pc.failed) {
+            fprintf(stderr, "%s: %s: write failed\n", prog, pcap);
+            rc = 1;
+        }
+    }
+    return rc;
+}
+
+/// Result record a worker sends to the parent (end encoded as an index).
+typedef struct wire_res {
+    hs_sim_result_t r;
+    int end;  ///< 0 reached, 1 distance, 2 time, -1 error
+} wire_res_t;
+
+static const char *end_names[3] = {"reached", "distance", "time"};
+
+static void progress(uint64_t done, uint64_t total, uint64_t reached)
+{
+    int width = 40, fill = (int)(width * done / (total ? total : 1));
+    fprintf(stderr, "\r[%.*s%*s] %llu/%llu seeds, %llu reached", fill,
+            "########################################", width - fill, "",
+            (unsigned long long)done, (unsigned long long)total, (unsigned long long)reached);
+    fflush(stderr);
+}
+
+static int run_batch(const hs_sim_env_t *env, uint64_t a, uint64_t b, int jobs, const char *dir,
+                     bool samples, bool quiet)
+{
+    uint64_t total = b - a + 1;
+    if ((uint64_t)jobs > total) {
+        jobs = (int)total;
+    }
+    hs_sim_result_t *all = calloc(total, sizeof *all);
+    bool *have = calloc(total, sizeof *have);
+    pid_t *pids = calloc((size_t)jobs, sizeof *pids);
+    int fds[2];
+    if (!all || !have || !pids || pipe(fds) != 0) {
+        free(all); free(have); free(pids);
+        fprintf(stderr, "%s: out of memory\n", prog);
+        return 1;
+    }
+    fflush(stdout);
+    fflush(stderr);
+    for (int j = 0; j < jobs; j++) {
+        pid_t pid = fork();
+        if (pid < 0) {
+            fprintf(stderr, "%s: fork: %s\n", prog, strerror(errno));
+            for (int k = 0; k < j; k++) {
+                kill(pids[k], SIGTERM);
+            }
+            return 1;
+        }
+        if (pid == 0) {
+            close(fds[0]);
+            for (uint64_t s = a + (uint64_t)j; s <= b; s += (uint64_t)jobs) {
+                wire_res_t w;
+                memset(&w, 0, sizeof w);
+                char sub[PATH_MAX + 64];
+                const char *sd = NULL;
+                if (dir) {
+                    if (snprintf(sub, sizeof sub, "%s/seed-%llu", dir, (unsigned long long)s) >=
+                            (int)sizeof sub ||
+                        mkdir(sub, 0777) != 0) {
+                        fprintf(stderr, "%s: %s: %s\n", prog, sub, strerror(errno));
+                        w.end = -1;
+                    }
+                    sd = sub;
+                }
+                if (w.end == 0) {
+                    FILE *devnull = NULL;
+                    if (!sd) {
+                        devnull = freopen("/dev/null", "w", stdout); // no per-seed JSON on stdout
+                        (void)devnull;
+                    }
+                    if (run_one(env, s, sd, samples, false, NULL, &w.r) != 0) {
+                        w.end = -1;
+                    } else {
+                        w.end = w.r.reached ? 0 : (strcmp(w.r.end, "distance") == 0 ? 1 : 2);
+                    }
+                }
+                w.r.seed = s;
+                w.r.end = NULL;
+                if (write(fds[1], &w, sizeof w) != (ssize_t)sizeof w || w.end < 0) {
+                    _exit(1);
+                }
+            }
+            _exit(0);
+        }
+        pids[j] = pid;
+    }
+    close(fds[1]);
+    uint64_t done = 0, reached = 0;
+    int rc = 0;
+    wire_res_t w;
+    if (!quiet) {
+        progress(0, total, 0);
+    }
+    while (read(fds[0], &w, sizeof w) == (ssize_t)sizeof w) {
+        if (w.end < 0) {
+            rc = 1;
+            break;
+        }
+        uint64_t i = w.r.seed - a;
+        all[i] = w.r;
+        all[i].end = end_names[w.end];
+        have[i] = true;
+        done++;
+        reached += w.r.reached ? 1u : 0u;
+        if (!quiet) {
+            progress(done, total, reached);
+        }
+    }
+    if (!quiet) {
+        fputc('\n', stderr);
+    }
+    close(fds[0]);
+    for (int j = 0; j < jobs; j++) {
+        int st;
+        if (rc != 0) {
+            kill(pids[j], SIGTERM);
+        }
+        waitpid(pids[j], &st, 0);
+        if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+            rc = 1;
+        }
+    }
+    if (rc == 0 && done != total) {
+        fprintf(stderr, "%s: a worker ended early (%llu of %llu seeds)\n", prog,
+                (unsigned long long)done, (unsigned long long)total);
+        rc = 1;
+    }
+    if (rc == 0) {
+        FILE *t = dir ? open_in(dir, "runs.tsv") : stdout;
+        if (!t) {
+            fprintf(stderr, "%s: %s/runs.tsv: %s\n", prog, dir, strerror(errno));
+            rc = 1;
+        } else {
+            hs_sim_table_header(t);
+            for (uint64_t i = 0; i < total; i++) {
+                hs_sim_table_row(t, &all[i]);
+            }
+            if (dir && fclose(t) != 0) {
+                rc = 1;
+            }
+        }
+    }
+    free(all); free(have); free(pids);
+    return rc;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/// Sequential runs in this process, no outputs: simulated time over host time of
+/// hs_sim_run (world, radio and controller set-up included; map loading excluded).
+static int run_bench(const hs_sim_env_t *env, uint64_t a, uint64_t b)
+{
+    uint64_t n = b - a + 1;
+    double *rtf = calloc(n, sizeof *rtf), sim = 0.0, wall = 0.0;
+    uint64_t pkts = 0;
+    if (!rtf) {
+        return die("out of memory%s%s", "", "");
+    }
+    for (uint64_t s = a; s <= b; s++) {
+        hs_sim_result_t r;
+        char err[1024];
+        if (hs_sim_run_inproc(env, s, NULL, &r, err, sizeof err) != 0) {
+            free(rtf);
+            fprintf(stderr, "%s: %s\n", prog, err);
+            return 1;
+        }
+        rtf[s - a] = r.sim_time_s / r.wall_time_s;
+        sim += r.sim_time_s;
+        wall += r.wall_time_s;
+        pkts += r.packets_sent;
+    }
+    qsort(rtf, n, sizeof *rtf, cmp_double);
+    printf("runs %llu  simulated %.1f s  host %.3f s  packets %llu\n", (unsigned long long)n, sim,
+           wall, (unsigned long long)pkts);
+    printf("real-time factor: overall %.0fx, median per run %.0fx (min %.0fx, max %.0fx)\n",
+           sim / wall, n % 2 ? rtf[n / 2] : 0.5 * (rtf[n / 2 - 1] + rtf[n / 2]), rtf[0],
+           rtf[n - 1]);
+    free(rtf);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *scenario = NULL, *out = NULL, *pcap = NULL, *seeds = NULL;
+    uint64_t seed = 0;
+    bool has_seed = false, samples = false, field = false, emit = false, quiet = false;
+    bool bench = false;
+    long jobs = sysconf(_SC_NPROCESSORS_ONLN);
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        bool more = i + 1 < argc;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            return 0;
+        } else if (strcmp(a, "--seed") == 0) {
+            if (!more || parse_u64(argv[++i], &seed) != 0) {
+                return die("--seed: expected a non-negative integer%s%s", "", "");
+            }
+            has_seed = true;
+        } else if (strcmp(a, "--out") == 0) {
+            if (!more || !*argv[i + 1]) {
+                return die("--out: expected a directory%s%s", "", "");
+            }
+            out = argv[++i];
+        } else if (strcmp(a, "--pcap") == 0) {
+            if (!more || !*argv[i + 1]) {
+                return die("--pcap: expected a file name%s%s", "", "");
+            }
+            pcap = argv[++i];
+        } else if (strcmp(a, "--seeds") == 0) {
+            if (!more) {
+                return die("--seeds: expected A..B%s%s", "", "");
+            }
+            seeds = argv[++i];
+        } else if (strcmp(a, "--jobs") == 0) {
+            uint64_t j;
+            if (!more || parse_u64(argv[++i], &j) != 0 || j < 1 || j > 1024) {
+                return die("--jobs: expected a number from 1 to 1024%s%s", "", "");
+            }
+            jobs = (long)j;
+        } else if (strcmp(a, "--samples") == 0) {
+            samples = true;
+        } else if (strcmp(a, "--field") == 0) {
+            field = true;
+        } else if (strcmp(a, "--emit-jobs") == 0) {
+            emit = true;
+        } else if (strcmp(a, "--quiet") == 0) {
+            quiet = true;
+        } else if (strcmp(a, "--bench") == 0) {
+            bench = true;
+        } else if (a[0] == '-' && a[1] != '\0') {
+            return die("unknown option '%s' (see --help)%s", a, "");
+        } else if (!scenario) {
+            scenario = a;
+        } else {
+            return die("unexpected argument '%s' (one scenario only)%s", a, "");
+        }
+    }
+    if (!scenario) {
+        usage(stderr);
+        return 1;
+    }
+    uint64_t sa = 0, sb = 0;
+    if (seeds && parse_range(seeds, &sa, &sb) != 0) {
+        return die("--seeds: '%s' is not A..B with A <= B%s", seeds, "");
+    }
+    if (seeds && has_seed) {
+        return die("--seed and --seeds exclude each other%s%s", "", "");
+    }
+    if (emit && (!seeds || !out)) {
+        return die("--emit-jobs needs --seeds A..B and --out DIR%s%s", "", "");
+    }
+    if (bench && (!seeds || out || emit)) {
+        return die("--bench needs --seeds A..B and no --out or --emit-jobs%s%s", "", "");
+    }
+    if (pcap && seeds) {
+        return die("--pcap is for a single run, not --seeds%s%s", "", "");
+    }
+    if (jobs < 1) {
+        jobs = 1;
+    }
+    if (out) {
+        struct stat st;
+        if (stat(out, &st) == 0) {
+            return die("%s: already exists (choose a new --out directory)%s", out, "");
+        }
+    }
+
+    char err[1024];
+    hs_scenario_t sc;
+    if (hs_scenario_load(scenario, &sc, err, sizeof err) != 0) {
+        fprintf(stderr, "%s: %s\n", prog, err);
+        return 1;
+    }
+    if (emit) {
+        // The same runs, one command per seed; scripts/merge_runs.py DIR merges them.
+        char self[PATH_MAX], scn[PATH_MAX];
+        ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+        if (n <= 0 || !realpath(scenario, scn)) {
+            return die("cannot resolve the program or scenario path%s%s", "", "");
+        }
+        self[n] = '\0';
+        for (uint64_t s = sa; s <= sb; s++) {
+            printf("%s %s --seed %llu --out %s/seed-%llu\n", self, scn, (unsigned long long)s,
+                   out, (unsigned long long)s);
+        }
+        return 0;
+    }
+    hs_sim_env_t env;
+    if (hs_sim_env_open(&env, &sc, err, sizeof err) != 0) {
+        fprintf(stderr, "%s: %s\n", prog, err);
+        return 1;
+    }
+    if (bench) {
+        int brc = run_bench(&env, sa, sb);
+        hs_sim_env_close(&env);
+        return brc;
+    }
+    char tmp[PATH_MAX + 64];
+    if (out) {
+        if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", out, (long)getpid()) >= (int)sizeof tmp ||
+            mkdir(tmp, 0777) != 0) {
+            fprintf(stderr, "%s: %s: %s\n", prog, tmp, strerror(errno));
+            hs_sim_env_close(&env);
+            return 1;
+        }
+    }
+    int rc;
+    if (seeds) {
+        rc = run_batch(&env, sa, sb, (int)jobs, out ? tmp : NULL, samples, quiet);
+    } else {
+        hs_sim_result_t res;
+        rc = run_one(&env, has_seed ? seed : sc.seed, out ? tmp : NULL, out != NULL, field, pcap,
+                     &res);
+    }
+    hs_sim_env_close(&env);
+    if (out) {
+        if (rc == 0 && rename(tmp, out) != 0) {
+            fprintf(stderr, "%s: %s: %s\n", prog, out, strerror(errno));
+            rc = 1;
+        }
+        if (rc != 0) {
+            rm_tree(tmp);
+        }
+    }
+    return rc;
+}

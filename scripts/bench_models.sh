@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Instruction counts of the internal models (docs/PERFORMANCE.md, "Models"): callgrind,
+# host x86-64, exact. Usage: scripts/bench_models.sh BUILD_DIR
+set -euo pipefail
+build=${1:-build}
+bin=$build/bin/bench_models
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+ir() { # ir OUTNAME ARGS...: instructions inside the instrumented region
+    local name=$1; shift
+    valgrind --tool=callgrind --instr-atstart=no --callgrind-out-file="$tmp/$name.cg" \
+        "$bin" "$@" >"$tmp/$name.out" 2>"$tmp/$name.log"
+    callgrind_annotate "$tmp/$name.cg" 2>/dev/null | awk '/PROGRAM TOTALS/ {gsub(",","",$1); print $1}'
+}
+echo "models: 10,000 samples over 40 x 20 m; grid search = 12,800 lattice points (0.25 m)"
+echo "  host x86-64 instructions (callgrind, exact)"
+printf "  %-7s %15s %15s %13s\n" model "full relearn" "grid search" "per point"
+for m in ridge mlp knn radius; do
+    r=$(ir "r_$m" relearn "$m")
+    g=$(ir "g_$m" grid "$m")
+    printf "  %-7s %15s %15s %13s\n" "$m" "$r" "$g" "$(awk -v g="$g" 'BEGIN{printf "%.0f", g/12800}')"
+done
+for b in 100 1000; do
+    s=$(ir "s_mlp_$b" slice mlp "$b")
+    calls=$(awk '/^calls/ {print $2}' "$tmp/s_mlp_$b.out")
+    echo "  mlp first slice of budget $b sample-updates: $s instructions; whole fit in $calls calls"
+done
+s=$(ir s_knn slice knn 2000)
+calls=$(awk '/^calls/ {print $2}' "$tmp/s_knn.out")
+echo "  knn first slice of budget 2000 units: $s instructions; whole fit in $calls calls"

@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# demo.sh - run the default scenario and draw the paper's figures 2 to 4 (make demo).
+#   scripts/demo.sh [OUTDIR]      (default out/demo; uses $BUILD/bin/rfseek-sim)
+# The run goes to OUTDIR/run (replaced), the figures to OUTDIR/*.png.
+set -euo pipefail
+OUT=${1:-out/demo}
+SIM=${BUILD:-build}/bin/rfseek-sim
+SEED=${SEED:-1}
+mkdir -p "$OUT"
+rm -rf -- "$OUT/run"
+"$SIM" scenarios/default.yaml --seed "$SEED" --field --out "$OUT/run" >/dev/null
+/usr/bin/python3 scripts/plot_run.py "$OUT/run" --outdir "$OUT"
+echo "demo: $(grep -E '"(reached|distance_travelled_m|shortest_path_m|model_updates)"' "$OUT/run/summary.json" | tr -d ' \n')"
+echo "demo: figures in $OUT: trajectory.png rssi.png hexbin.png"

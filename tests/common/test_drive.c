@@ -1,0 +1,279 @@
+/* test_drive.c - rfs_drive in closed loop with unicycle kinematics integrated in double
+ * here: v = (l + r) / 2, omega = (r - l) / b, 1 ms Euler sub-steps, control at 50 Hz.
+ * Checks: goals are reached (within goal_tol, wheels stopped), wheel speeds never exceed
+ * v_max, no wheel changes faster than accel * dt, intermediate waypoints are passed,
+ * timeouts and blocked robots are reported once.
+ */
+#include "rfs_test.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rfs_drive.h"
+
+#define DT_US 20000
+
+typedef struct sim {
+    double x, y, th;      /* metres, radians */
+    double min_wp_dist[RFS_PLAN_MAX_WAYPOINTS];
+    int16_t l, r;         /* last command, mm/s */
+    int violations_speed;
+    int violations_accel;
+    double travelled;
+    int64_t t;
+} sim_t;
+
+static rfs_q16_t q16(double v)
+{
+    return (rfs_q16_t)llround(v * 65536.0);
+}
+
+static rfs_pose_t pose_of(const sim_t *s)
+{
+    rfs_pose_t p;
+    double th = atan2(sin(s->th), cos(s->th));
+    p.t_us = s->t;
+    p.x = q16(s->x);
+    p.y = q16(s->y);
+    p.theta = q16(th);
+    return p;
+}
+
+/* Run until the drive reports an end or max_s elapses; frozen: the robot does not move. */
+static rfs_drive_status_t run(rfs_drive_t *d, sim_t *s, const rfs_path_t *path, double max_s,
+                              bool frozen, int64_t *end_us)
+{
+    const double b = d->cfg.wheel_base_mm / 1000.0;
+    for (int k = 0; k < path->n; k++) {
+        s->min_wp_dist[k] = 1e9;
+    }
+    while (s->t < (int64_t)(max_s * 1e6)) {
+        rfs_pose_t p = pose_of(s);
+        int16_t l;
+        int16_t r;
+        rfs_drive_status_t st = rfs_drive_update(d, &p, s->t, &l, &r);
+        if (abs(l) > d->cfg.v_max_mm_s || abs(r) > d->cfg.v_max_mm_s) {
+            s->violations_speed++;
+        }
+        double lim = d->cfg.accel_mm_s2 * (DT_US / 1e6) + 1.0;
+        if (fabs((double)l - s->l) > lim || fabs((double)r - s->r) > lim) {
+            s->violations_accel++;
+        }
+        s->l = l;
+        s->r = r;
+        if (st != RFS_DRIVE_RUNNING) {
+            *end_us = s->t;
+            return st;
+        }
+        for (int sub = 0; sub < DT_US / 1000; sub++) {
+            if (frozen) {
+                break;
+            }
+            double v = (l + r) / 2000.0;
+            double w = (r - l) / 1000.0 / b;
+            s->x += v * cos(s->th) * 1e-3;
+            s->y += v * sin(s->th) * 1e-3;
+            s->th += w * 1e-3;
+            s->travelled += fabs(v) * 1e-3;
+        }
+        for (int k = 0; k < path->n; k++) {
+            s->min_wp_dist[k] = fmin(s->min_wp_dist[k], hypot(s->x - path->x[k] / 65536.0,
+                                                               s->y - path->y[k] / 65536.0));
+        }
+        s->t += DT_US;
+    }
+    *end_us = s->t;
+    return RFS_DRIVE_RUNNING;
+}
+
+static rfs_path_t one_goal(double x, double y)
+{
+    rfs_path_t p;
+    memset(&p, 0, sizeof(p));
+    p.x[0] = q16(x);
+    p.y[0] = q16(y);
+    p.n = 1;
+    return p;
+}
+
+static void start(rfs_drive_t *d, sim_t *s, double x, double y, double th)
+{
+    rfs_drive_cfg_t cfg = rfs_drive_cfg_default();
+    assert_int_equal(rfs_drive_init(d, &cfg), 0);
+    memset(s, 0, sizeof(*s));
+    s->x = x;
+    s->y = y;
+    s->th = th;
+}
+
+/* Straight ahead, behind, and random goals from random headings: all reached. */
+static void test_reaches_goals(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    int64_t end;
+    srand(4);
+    for (int k = 0; k < 40; k++) {
+        double th = (k == 0) ? 0.0 : (k == 1 ? 0.0 : (rand() / (double)RAND_MAX) * 6.283 - 3.1416);
+        double gx = (k == 0) ? 3.0 : (k == 1 ? -2.0 : (rand() / (double)RAND_MAX) * 8.0 - 4.0);
+        double gy = (k <= 1) ? 0.0 : (rand() / (double)RAND_MAX) * 8.0 - 4.0;
+        start(&d, &s, 0.0, 0.0, th);
+        rfs_path_t p = one_goal(gx, gy);
+        rfs_drive_set_path(&d, &p, 0);
+        rfs_drive_status_t st = run(&d, &s, &p, 60.0, false, &end);
+        assert_int_equal(st, RFS_DRIVE_REACHED);
+        assert_true(hypot(s.x - gx, s.y - gy) <= 0.1 + 1e-3);
+        assert_int_equal(s.l, 0);
+        assert_int_equal(s.r, 0);
+        assert_int_equal(s.violations_speed, 0);
+        assert_int_equal(s.violations_accel, 0);
+        /* Not much longer than the straight line (turning on the spot travels ~0). */
+        assert_true(s.travelled <= hypot(gx, gy) * 1.15 + 0.3);
+        /* The time is physically plausible: at least distance / v_max. */
+        assert_true(end / 1e6 >= (hypot(gx, gy) - 0.1) / 0.7);
+        /* REACHED is reported once, then IDLE with wheels at 0. */
+        rfs_pose_t pp = pose_of(&s);
+        int16_t l;
+        int16_t r;
+        assert_int_equal(rfs_drive_update(&d, &pp, end + DT_US, &l, &r), RFS_DRIVE_IDLE);
+        assert_int_equal(l, 0);
+        assert_int_equal(r, 0);
+    }
+    /* Straight 3 m: the top speed is reached and the run takes about the ideal time of a
+     * trapezoid profile (accelerate at 1 m/s^2, cruise at 0.7 m/s, brake at 0.5 m/s^2). */
+    start(&d, &s, 0.0, 0.0, 0.0);
+    rfs_path_t p = one_goal(3.0, 0.0);
+    rfs_drive_set_path(&d, &p, 0);
+    assert_int_equal(run(&d, &s, &p, 60.0, false, &end), RFS_DRIVE_REACHED);
+    double ideal = 0.7 / 1.0 + 0.7 / 0.5 + (3.0 - 0.7 * 0.7 / 2 - 0.7 * 0.7 / 1.0) / 0.7;
+    assert_true(end / 1e6 > ideal - 0.5 && end / 1e6 < ideal + 1.0);
+}
+
+/* A path with a right-angle corner: the corner waypoint is passed closely. */
+static void test_follows_waypoints(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    int64_t end;
+    start(&d, &s, 0.0, 0.0, 0.0);
+    rfs_path_t p;
+    memset(&p, 0, sizeof(p));
+    p.x[0] = q16(3.0);
+    p.y[0] = q16(0.0);
+    p.x[1] = q16(3.0);
+    p.y[1] = q16(3.0);
+    p.x[2] = q16(1.0);
+    p.y[2] = q16(4.0);
+    p.n = 3;
+    rfs_drive_set_path(&d, &p, 0);
+    assert_int_equal(run(&d, &s, &p, 60.0, false, &end), RFS_DRIVE_REACHED);
+    assert_true(s.min_wp_dist[0] < 0.25);
+    assert_true(s.min_wp_dist[1] < 0.25);
+    assert_true(hypot(s.x - 1.0, s.y - 4.0) <= 0.1 + 1e-3);
+    assert_int_equal(s.violations_speed, 0);
+    assert_int_equal(s.violations_accel, 0);
+}
+
+/* A goal that cannot be reached in time: TIMEOUT after timeout_us, once. */
+static void test_timeout(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    int64_t end;
+    rfs_drive_cfg_t cfg = rfs_drive_cfg_default();
+    cfg.timeout_us = 2000000;
+    assert_int_equal(rfs_drive_init(&d, &cfg), 0);
+    memset(&s, 0, sizeof(s));
+    rfs_path_t p = one_goal(10.0, 0.0);
+    rfs_drive_set_path(&d, &p, 0);
+    assert_int_equal(run(&d, &s, &p, 60.0, false, &end), RFS_DRIVE_TIMEOUT);
+    assert_true(end > 2000000 && end <= 2000000 + DT_US);
+    rfs_pose_t pp = pose_of(&s);
+    int16_t l;
+    int16_t r;
+    assert_int_equal(rfs_drive_update(&d, &pp, end + DT_US, &l, &r), RFS_DRIVE_IDLE);
+    /* Abandoned: the wheels ramp down within the acceleration limit. */
+    assert_true(l < s.l && l >= s.l - 21);
+}
+
+/* A robot that cannot move (against a wall): BLOCKED after the stall window. */
+static void test_blocked(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    int64_t end;
+    start(&d, &s, 0.0, 0.0, 0.0);
+    rfs_path_t p = one_goal(5.0, 0.0);
+    rfs_drive_set_path(&d, &p, 0);
+    assert_int_equal(run(&d, &s, &p, 60.0, true, &end), RFS_DRIVE_BLOCKED);
+    assert_true(end >= d.cfg.stall_us && end <= d.cfg.stall_us + 2 * DT_US);
+    /* Moving normally it is not blocked. */
+    start(&d, &s, 0.0, 0.0, 0.0);
+    rfs_drive_set_path(&d, &p, 0);
+    assert_int_equal(run(&d, &s, &p, 60.0, false, &end), RFS_DRIVE_REACHED);
+}
+
+/* Stop: zero at once, idle. */
+static void test_stop(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    int64_t end;
+    start(&d, &s, 0.0, 0.0, 0.0);
+    rfs_path_t p = one_goal(5.0, 0.0);
+    rfs_drive_set_path(&d, &p, 0);
+    assert_int_equal(run(&d, &s, &p, 1.0, false, &end), RFS_DRIVE_RUNNING);
+    assert_true(s.l > 500);
+    rfs_drive_stop(&d, end);
+    rfs_pose_t pp = pose_of(&s);
+    int16_t l;
+    int16_t r;
+    assert_int_equal(rfs_drive_update(&d, &pp, end + DT_US, &l, &r), RFS_DRIVE_IDLE);
+    assert_int_equal(l, 0);
+    assert_int_equal(r, 0);
+}
+
+static void test_init_rejects(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    rfs_drive_cfg_t c = rfs_drive_cfg_default();
+    assert_int_equal(c.wheel_base_mm, 230);
+    assert_int_equal(c.v_max_mm_s, 700);
+    rfs_drive_cfg_t b = c;
+    b.wheel_base_mm = 0;
+    assert_int_equal(rfs_drive_init(&d, &b), -1);
+    b = c;
+    b.v_max_mm_s = -1;
+    assert_int_equal(rfs_drive_init(&d, &b), -1);
+    b = c;
+    b.accel_mm_s2 = 0;
+    assert_int_equal(rfs_drive_init(&d, &b), -1);
+    b = c;
+    b.goal_tol = 0;
+    assert_int_equal(rfs_drive_init(&d, &b), -1);
+    b = c;
+    b.timeout_us = 0;
+    assert_int_equal(rfs_drive_init(&d, &b), -1);
+    assert_int_equal(rfs_drive_init(&d, &c), 0);
+    assert_int_equal(d.status, RFS_DRIVE_IDLE);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_reaches_goals),
+        cmocka_unit_test(test_follows_waypoints),
+        cmocka_unit_test(test_timeout),
+        cmocka_unit_test(test_blocked),
+        cmocka_unit_test(test_stop),
+        cmocka_unit_test(test_init_rejects),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Bad input to rfseek-feed (run on its ASan+UBSan build): damaged captures give one clear
+# error line naming the file and a non-zero exit, or a counted skip; never a crash.
+# usage: bad_input.sh FEED GENDIR   (GENDIR from scripts/gen_captures.py)
+set -uo pipefail
+feed=$1 gen=$2
+mal=tests/data/captures/malformed
+fail=0
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+mac=02:aa:bb:cc:00:01
+# expect NAME RC STDERR_REGEX -- ARGS...
+expect() {
+    local name=$1 want_rc=$2 re=$3; shift 4
+    "$feed" "$@" >"$tmp/out" 2>"$tmp/err"
+    local rc=$?
+    local lines; lines=$(grep -c . "$tmp/err")
+    if grep -qE 'Sanitizer|runtime error' "$tmp/err"; then
+        echo "FAIL $name: sanitizer report"; head -5 "$tmp/err"; fail=1
+    elif [ "$rc" -ne "$want_rc" ]; then
+        echo "FAIL $name: exit $rc, want $want_rc"; head -3 "$tmp/err"; fail=1
+    elif ! grep -qE -- "$re" "$tmp/err"; then
+        echo "FAIL $name: stderr does not match /$re/:"; head -3 "$tmp/err"; fail=1
+    else
+        echo "PASS $name: exit $rc, $(head -1 "$tmp/err")"
+    fi
+}
+expect empty 1 "empty.pcap: cannot read capture: truncated dump file" -- "$gen/bad/empty.pcap" --mac $mac
+expect short_file_header 1 "short_header.pcap: cannot read capture: truncated dump file" -- "$gen/bad/short_header.pcap" --mac $mac
+expect not_a_capture 1 "not_a_capture.pcap: cannot read capture: unknown file format" -- "$gen/bad/not_a_capture.pcap" --mac $mac
+expect linktype_105 1 "linktype_105.pcap: link type 105 \(IEEE802_11\) is not 127" -- "$gen/bad/linktype_105.pcap" --mac $mac
+expect linktype_1 1 "linktype_1.pcap: link type 1 \(EN10MB\) is not 127" -- "$gen/bad/linktype_1.pcap" --mac $mac
+expect cut_record 1 "cut_record.pcap: truncated dump file.*after 19 packets" -- "$gen/bad/cut_record.pcap" --mac $mac
+expect cut_record_header 1 "cut_record_header.pcap: truncated dump file.*after 0 packets" -- "$gen/bad/cut_record_header.pcap" --mac $mac
+expect missing_file 1 "nonexistent.pcap: cannot read capture: .*No such file" -- "$tmp/nonexistent.pcap" --mac $mac
+# the 11 records of radiotap_lies: each lie counted, 3 usable frames with a signal
+expect radiotap_lies 0 "11 packets, 3 lines; 3 note: a field runs past it_len; 1 skipped: fewer than 8 bytes.*; 1 skipped: radiotap version byte is not 0; 2 skipped: radiotap it_len .*; 1 skipped: radiotap present bitmaps run past it_len; 1 skipped: no 802.11 header; 1 skipped: no source address; 1 skipped: matching source without dBm signal" -- "$gen/bad/radiotap_lies.pcap" --mac $mac --stats
+for f in "$mal"/*.pcap; do
+    expect "malformed/$(basename "$f")" 0 "1 packets, 0 lines; 1 skipped: radiotap version byte is not 0; 1 note: cut by the snap length" -- "$f" --mac 90:a4:de:c0:46:11 --stats
+done
+# options
+expect no_args 2 "no CAPTURE given" --
+expect no_mac 2 "no --mac given" -- "$gen/ds.pcap"
+expect bad_mac 2 "--mac: '02:aa:bb:cc:00' is not a MAC address" -- "$gen/ds.pcap" --mac 02:aa:bb:cc:00
+expect bad_mac_hex 2 "--mac: '02:aa:bb:cc:00:0g' is not a MAC address" -- "$gen/ds.pcap" --mac 02:aa:bb:cc:00:0g
+expect bad_format 2 "--format: 'csv' is not supported" -- "$gen/ds.pcap" --mac $mac --format csv
+expect unknown_option 2 "unknown option '--frobnicate'" -- "$gen/ds.pcap" --mac $mac --frobnicate
+expect mac_missing_value 2 "--mac needs a value" -- "$gen/ds.pcap" --mac
+"$feed" --help | grep -q '^usage: rfseek-feed CAPTURE --mac MAC' && echo "PASS help" || { echo "FAIL help"; fail=1; }
+# --output: written through a temporary file, nothing left behind on failure
+"$feed" "$gen/ds.pcap" --mac $mac --output "$tmp/ok.tsv" && [ "$(wc -l < "$tmp/ok.tsv")" -eq 80 ] && [ ! -e "$tmp/ok.tsv.tmp" ] \
+    && echo "PASS output: 80 lines in the file, no temporary left" || { echo "FAIL output"; fail=1; }
+"$feed" "$gen/bad/cut_record.pcap" --mac $mac --output "$tmp/bad.tsv" 2>/dev/null
+if [ $? -ne 0 ] && [ ! -e "$tmp/bad.tsv" ] && [ ! -e "$tmp/bad.tsv.tmp" ]; then echo "PASS output_on_error: no file written"
+else echo "FAIL output_on_error: a file was left"; fail=1; fi
+exit $fail

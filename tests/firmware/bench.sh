@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# bench.sh BUILD - instruction counts of the Cortex-M4 image under qemu -icount (issue 6).
+# With -icount shift=7 each instruction advances the virtual clock by 128 ns; SysTick
+# counts the 168 MHz core clock of qemu's STM32F405 model, so 21.504 ticks elapse per
+# instruction and a tick difference converts to an exact instruction count. The image
+# calibrates with 1,000 NOPs; this script converts and prints the table of
+# docs/PERFORMANCE.md. Flash and static RAM come from the hardware image's link.
+set -euo pipefail
+B=${1:-build}
+out=$(timeout 300 qemu-system-arm -M netduinoplus2 -nographic -monitor none -serial null \
+    -semihosting-config enable=on,target=native -icount shift=7 -kernel "$B/firmware/bench.elf" 2>&1)
+echo "$out" | awk -F'\t' '
+    $1 == "calib_empty" { e = $2 } $1 == "calib_nop1000" { per = ($2 - e) / 1000 }
+    NF == 3 { name[++n] = $1; t[n] = $2; c[n] = $3 }
+    END {
+        printf "SysTick ticks per instruction: %.3f (1,000 NOPs; %d ticks of measurement overhead)\n", per, e
+        printf "%-34s %14s %12s\n", "measurement", "instructions", "ms@168MHz"
+        for (i = 1; i <= n; i++) {
+            if (name[i] ~ /^calib/) continue
+            if (t[i] == 0) { printf "%-34s %14s\n", name[i], c[i]; continue }
+            ins = (t[i] - e) / per; r = int(ins + 0.5)
+            # Exact unless SysTick wrapped (every 2^24 ticks, 780,190 instructions): then
+            # the count includes the few instructions of each wrap interrupt.
+            if (t[i] < 16777216 && (ins - r > 0.05 || r - ins > 0.05)) bad = bad " " name[i]
+            printf "%-34s %14d %12.3f\n", name[i], r, r / 168000
+            if (name[i] == "worst_iteration") worst = r
+        }
+        printf "(counts over 780,190 instructions include ~10 instructions per SysTick wrap interrupt)\n"
+        printf "worst-case control iteration: %d instructions, target 500000: %s\n", worst, worst <= 500000 ? "met" : "MISSED"
+        if (bad != "") { printf "non-integral instruction counts:%s\n", bad; exit 1 }
+    }'
+scripts/fw_budget.sh "$B/firmware/firmware.elf"

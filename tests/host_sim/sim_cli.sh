@@ -1,0 +1,134 @@
+#!/usr/bin/env bash
+# sim_cli.sh - rfseek-sim from the command line: bad input (one error line, exit 1, no
+# output directory left behind), outputs, determinism byte for byte, the batch mode, the
+# job list + merge step, and the pcap output read back by tshark.
+#   tests/host_sim/sim_cli.sh build/bin/rfseek-sim        (from the repository root)
+set -uo pipefail
+SIM=${1:?usage: sim_cli.sh path/to/rfseek-sim}
+T=$(mktemp -d /tmp/rfs_sim_cli.XXXXXX)
+trap 'rm -rf -- "$T"' EXIT
+fails=0
+pass() { echo "PASS $1"; }
+fail() { echo "FAIL $1${2:+: $2}"; fails=$((fails + 1)); }
+OPEN_MAP=$(realpath scenarios/maps/open.yaml)
+
+# bad NAME EXPECTED-TEXT ARGS...: exit 1, exactly one stderr line containing the text, and
+# no output directory (T/out*) left behind.
+bad() {
+    local name=$1 want=$2
+    shift 2
+    "$SIM" "$@" >"$T/stdout" 2>"$T/stderr"
+    local rc=$? lines
+    lines=$(wc -l <"$T/stderr")
+    if [ $rc -ne 1 ]; then rm -rf "$T"/out*; fi
+    if [ $rc -ne 1 ]; then fail "$name" "exit $rc"; return; fi
+    if [ "$lines" -ne 1 ]; then fail "$name" "$lines stderr lines: $(head -c 300 "$T/stderr")"; return; fi
+    if ! grep -qF -- "$want" "$T/stderr"; then fail "$name" "stderr '$(cat "$T/stderr")' lacks '$want'"; return; fi
+    if compgen -G "$T/out*" >/dev/null; then fail "$name" "left $(ls -d "$T"/out*)"; rm -rf "$T"/out*; return; fi
+    pass "$name"
+}
+
+scn() { # scn NAME TEXT: a scenario on the open map
+    printf '%s' "$2" | sed "s|@MAP@|$OPEN_MAP|" >"$T/$1"
+}
+BASE='map: @MAP@
+sources:
+  - position: [15.0, 10.0]
+start: {position: [5.0, 10.0]}
+'
+
+# --- help and usage --------------------------------------------------------------------
+if "$SIM" --help | grep -q -- '--seeds A..B'; then pass help; else fail help; fi
+"$SIM" >/dev/null 2>&1; [ $? -eq 1 ] && pass no_args || fail no_args
+
+# --- bad input ---------------------------------------------------------------------------
+bad missing_scenario "$T/none.yaml: No such file or directory" "$T/none.yaml" --out "$T/out"
+printf 'map: [1, 2\n' >"$T/syntax.yaml"
+bad malformed_scenario "syntax.yaml:2: YAML syntax error" "$T/syntax.yaml" --out "$T/out"
+scn unknown.yaml "${BASE}colour: red
+"
+bad unknown_key "unknown.yaml:5: scenario: unknown key 'colour'" "$T/unknown.yaml" --out "$T/out"
+printf '%s' "$BASE" | sed "s|@MAP@|$T/nomap/map.yaml|" >"$T/nomap.yaml"
+bad missing_map "nomap.yaml: map: $T/nomap/map.yaml" "$T/nomap.yaml" --out "$T/out"
+mkdir -p "$T/badmap"
+printf 'image: x.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n' >"$T/badmap/map.yaml"
+printf 'P5\n10 10\n255\nshort' >"$T/badmap/x.pgm"
+printf '%s' "$BASE" | sed "s|@MAP@|$T/badmap/map.yaml|" >"$T/badmap.yaml"
+bad malformed_map "badmap.yaml: map: " "$T/badmap.yaml" --out "$T/out"
+scn src_wall.yaml "${BASE/15.0, 10.0/0.0, 10.0}"
+bad source_in_wall "sources[0].position: (0.00, 10.00) is inside a wall" "$T/src_wall.yaml" --out "$T/out"
+scn src_off.yaml "${BASE/15.0, 10.0/40.0, 10.0}"
+bad source_off_map "sources[0].position: (40.00, 10.00) is off the map" "$T/src_off.yaml" --out "$T/out"
+scn start_wall.yaml "${BASE/start: \{position: \[5.0, 10.0\]\}/start: {position: [20.0, 10.0]}}"
+bad start_in_wall "start.position: (20.00, 10.00) is inside a wall" "$T/start_wall.yaml" --out "$T/out"
+scn start_off.yaml "${BASE/start: \{position: \[5.0, 10.0\]\}/start: {position: [5.0, -4.0]}}"
+bad start_off_map "start.position: (5.00, -4.00) is off the map" "$T/start_off.yaml" --out "$T/out"
+scn never.yaml "${BASE}stop: {max_distance_m: 0, max_time_s: 0}
+"
+bad stop_never_ends "would never end" "$T/never.yaml" --out "$T/out"
+scn radius.yaml "${BASE/15.0, 10.0/19.85, 10.0}stop: {radius_m: 0.1}
+"
+bad stop_never_reached "stop.radius_m: the robot can never get within 0.10 m" "$T/radius.yaml" --out "$T/out"
+bad unknown_option "unknown option '--colour'" scenarios/open.yaml --colour --out "$T/out"
+bad bad_seed "--seed: expected a non-negative integer" scenarios/open.yaml --seed x --out "$T/out"
+bad bad_seeds "--seeds: '5..2' is not A..B" scenarios/open.yaml --seeds 5..2 --out "$T/out"
+bad emit_needs_out "--emit-jobs needs --seeds A..B and --out DIR" scenarios/open.yaml --seeds 1..2 --emit-jobs
+mkdir "$T/exists"
+"$SIM" scenarios/open.yaml --out "$T/exists" >/dev/null 2>"$T/stderr"
+if [ $? -eq 1 ] && grep -q "already exists" "$T/stderr" && [ -z "$(ls "$T/exists")" ]; then
+    pass out_exists; else fail out_exists; fi
+rmdir "$T/exists"
+
+# --- a single run: files, JSON, determinism ---------------------------------------------
+"$SIM" scenarios/default.yaml --seed 3 --out "$T/run_a" 2>"$T/stderr" &&
+"$SIM" scenarios/default.yaml --seed 3 --out "$T/run_b" 2>>"$T/stderr"
+if [ $? -eq 0 ] && [ -s "$T/run_a/log.tsv" ] && [ -s "$T/run_a/samples.tsv" ] &&
+   [ -s "$T/run_a/track.tsv" ] && [ -s "$T/run_a/summary.json" ]; then
+    pass single_run_files; else fail single_run_files "$(cat "$T/stderr")"; fi
+if /usr/bin/python3 - "$T/run_a/summary.json" <<'EOF'
+import json, sys
+s = json.load(open(sys.argv[1]))
+need = ["reached", "sim_time_s", "distance_travelled_m", "shortest_path_m",
+        "final_distance_m", "iterations", "model_updates"]
+assert all(k in s for k in need), s
+assert isinstance(s["reached"], bool) and s["iterations"] > 0 and s["seed"] == 3
+assert 20.0 < s["shortest_path_m"] < 25.0
+EOF
+then pass summary_json; else fail summary_json; fi
+same=1
+for f in log.tsv samples.tsv track.tsv summary.json; do
+    cmp -s "$T/run_a/$f" "$T/run_b/$f" || same=0
+done
+[ $same -eq 1 ] && pass deterministic_bytes || fail deterministic_bytes
+"$SIM" scenarios/default.yaml --seed 4 --out "$T/run_c" 2>/dev/null
+cmp -s "$T/run_a/samples.tsv" "$T/run_c/samples.tsv" && fail seeds_differ || pass seeds_differ
+# Log columns the issue asks for.
+head -1 "$T/run_a/log.tsv" | grep -q $'t_s\tx_m\ty_m\ttheta_rad' &&
+head -1 "$T/run_a/log.tsv" | grep -q $'kind\treason\trelearned\tprediction_db\tmean_db' &&
+    pass log_columns || fail log_columns
+
+# --- batch, job list, merge ----------------------------------------------------------------
+"$SIM" scenarios/open.yaml --seeds 1..4 --jobs 2 --quiet --out "$T/batch" 2>"$T/stderr"
+if [ $? -eq 0 ] && [ "$(wc -l <"$T/batch/runs.tsv")" -eq 5 ]; then pass batch_table; else fail batch_table "$(cat "$T/stderr")"; fi
+"$SIM" scenarios/open.yaml --seed 3 --out "$T/single3" 2>/dev/null
+cmp -s "$T/batch/seed-3/summary.json" "$T/single3/summary.json" &&
+cmp -s "$T/batch/seed-3/log.tsv" "$T/single3/log.tsv" && pass batch_equals_single || fail batch_equals_single
+"$SIM" scenarios/open.yaml --seeds 1..4 --jobs 1 --quiet >"$T/stdout_table" 2>/dev/null
+cmp -s "$T/stdout_table" "$T/batch/runs.tsv" && pass batch_jobs_independent || fail batch_jobs_independent
+"$SIM" scenarios/open.yaml --seeds 1..4 --emit-jobs --out "$T/jobs" >"$T/jobs.txt"
+if [ "$(wc -l <"$T/jobs.txt")" -eq 4 ] && mkdir "$T/jobs" && bash "$T/jobs.txt" >/dev/null 2>&1 &&
+   scripts/merge_runs.py "$T/jobs" && cmp -s "$T/jobs/runs.tsv" "$T/batch/runs.tsv"; then
+    pass emit_jobs_merge; else fail emit_jobs_merge; fi
+
+# --- pcap output read back by tshark ----------------------------------------------------------
+if command -v tshark >/dev/null; then
+    "$SIM" scenarios/open.yaml --seed 2 --out "$T/pc" --pcap "$T/pc.pcap" >/dev/null 2>&1
+    got=$(tshark -r "$T/pc.pcap" -T fields -e radiotap.dbm_antsignal 2>/dev/null | wc -l)
+    want=$(/usr/bin/python3 -c "import json;print(json.load(open('$T/pc/summary.json'))['packets_received'])")
+    first_t=$(tshark -r "$T/pc.pcap" -c 3 -T fields -e radiotap.dbm_antsignal 2>/dev/null | tr '\n' ' ')
+    first_s=$(awk -F'\t' 'NR>1 && NR<=4 {printf "%s ", $6}' "$T/pc/samples.tsv")
+    if [ "$got" -eq "$want" ] && [ "$first_t" = "$first_s" ]; then pass pcap_tshark; else
+        fail pcap_tshark "tshark $got frames vs $want; '$first_t' vs '$first_s'"; fi
+fi
+
+[ $fails -eq 0 ]

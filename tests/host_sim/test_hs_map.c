@@ -1,0 +1,273 @@
+/* test_hs_map.c - the ROS map_server loader and the conversion to the core's grids.
+ *
+ * Independent references: the cell counts of the three real maps are the table in
+ * /work/shared/data/README.md (counted there with a separate PGM reader); orientation
+ * and thresholds are checked on a 4 x 3 image whose pixel values are written here; the
+ * conservative resampling is recomputed here by 2 x 2 blocks on the Willow Garage map.
+ * Bad input: every fixture in tests/data/maps_bad gives -1 and one line naming the file.
+ */
+#include "rfs_test.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "hs_map.h"
+
+#define BAD "tests/data/maps_bad/"
+
+static const char *maps_dir(void)
+{
+    const char *d = getenv("RFS_MAPS_DIR");
+    return d != NULL ? d : "/work/shared/data/maps";
+}
+
+static void load_real(const char *name, hs_map_t *m)
+{
+    char path[512];
+    char err[512] = "";
+    snprintf(path, sizeof(path), "%s/%s", maps_dir(), name);
+    int rc = hs_map_load(path, m, err, sizeof(err));
+    if (rc != 0) {
+        print_error("%s\n", err);
+    }
+    assert_int_equal(rc, 0);
+}
+
+/* The README's table: size, resolution, origin, and occupied / free / unknown counts. */
+static void test_real_maps_counts(void **state)
+{
+    (void)state;
+    struct {
+        const char *yaml;
+        uint32_t w, h;
+        double res, ox, oy;
+        uint32_t occ, fre, unk;
+    } t[3] = {
+        {"willow-full-0.05.yaml", 1165, 945, 0.05, 0.0, 0.0, 13459, 549308, 538158},
+        {"3ne.yaml", 1857, 573, 0.05, -60.45, -23.4, 34019, 456354, 573688},
+        {"intel.yaml", 579, 581, 0.1, 0.0, 0.0, 29942, 192948, 113509},
+    };
+    for (int k = 0; k < 3; k++) {
+        hs_map_t m;
+        load_real(t[k].yaml, &m);
+        assert_int_equal(m.w, t[k].w);
+        assert_int_equal(m.h, t[k].h);
+        assert_true(m.res == t[k].res);
+        assert_true(m.origin_x == t[k].ox && m.origin_y == t[k].oy);
+        uint32_t f;
+        uint32_t o;
+        uint32_t u;
+        hs_map_count(&m, &f, &o, &u);
+        assert_int_equal(o, t[k].occ);
+        assert_int_equal(f, t[k].fre);
+        assert_int_equal(u, t[k].unk);
+        hs_map_free(&m);
+    }
+}
+
+/* Row 0 of the PGM is the top of the map; thresholds; negate; P2 and P5 agree. */
+static void test_orientation_thresholds_negate(void **state)
+{
+    (void)state;
+    /* ok.pgm, rows top to bottom: [254 254 0 205] [254 254 254 254] [0 0 205 254].
+     * p = (255 - v) / 255: 254 -> 0.004 free, 0 -> 1.0 occupied, 205 -> 0.196 (not
+     * < 0.196, not > 0.65): unknown. */
+    hs_map_t m;
+    char err[512] = "";
+    assert_int_equal(hs_map_load(BAD "ok.yaml", &m, err, sizeof(err)), 0);
+    assert_int_equal(m.w, 4);
+    assert_int_equal(m.h, 3);
+    const uint8_t want[3][4] = {
+        /* bottom row (PGM row 2) first */
+        {HS_CELL_OCC, HS_CELL_OCC, HS_CELL_UNKNOWN, HS_CELL_FREE},
+        {HS_CELL_FREE, HS_CELL_FREE, HS_CELL_FREE, HS_CELL_FREE},
+        {HS_CELL_FREE, HS_CELL_FREE, HS_CELL_OCC, HS_CELL_UNKNOWN},
+    };
+    for (int y = 0; y < 3; y++) {
+        for (int x = 0; x < 4; x++) {
+            assert_int_equal(m.cell[y * 4 + x], want[y][x]);
+        }
+    }
+    hs_map_free(&m);
+
+    /* The same image as P2 with negate 1 in a temporary directory: p = v / 255, so
+     * 254 -> occupied, 0 -> free, 205 (0.804) -> occupied. */
+    char dir[] = "/tmp/rfs_hs_map_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char yp[256];
+    char ip[256];
+    snprintf(yp, sizeof(yp), "%s/n.yaml", dir);
+    snprintf(ip, sizeof(ip), "%s/n.pgm", dir);
+    FILE *f = fopen(ip, "w");
+    assert_non_null(f);
+    fputs("P2\n4 3\n255\n254 254 0 205\n254 254 254 254\n0 0 205 254\n", f);
+    fclose(f);
+    f = fopen(yp, "w");
+    assert_non_null(f);
+    fputs("image: n.pgm\nresolution: 0.5\norigin: [1.5, -2, 0]\nnegate: 1\n"
+          "occupied_thresh: 0.65\nfree_thresh: 0.196\nmode: trinary\n", f);
+    fclose(f);
+    assert_int_equal(hs_map_load(yp, &m, err, sizeof(err)), 0);
+    assert_true(m.origin_x == 1.5 && m.origin_y == -2.0 && m.res == 0.5 && m.negate == 1);
+    for (int y = 0; y < 3; y++) {
+        for (int x = 0; x < 4; x++) {
+            uint8_t w = want[y][x];
+            uint8_t neg = w == HS_CELL_FREE ? HS_CELL_OCC : HS_CELL_FREE;
+            if (w == HS_CELL_UNKNOWN) {
+                neg = HS_CELL_OCC;
+            }
+            assert_int_equal(m.cell[y * 4 + x], neg);
+        }
+    }
+    hs_map_free(&m);
+    remove(yp);
+    remove(ip);
+    rmdir(dir);
+}
+
+/* Each bad fixture: -1, one line "file: reason" naming the right file and reason. */
+static void test_bad_input(void **state)
+{
+    (void)state;
+    struct {
+        const char *yaml;
+        const char *file; /* the file the message must name */
+        const char *reason;
+    } t[] = {
+        {BAD "missing.yaml", BAD "missing.yaml", "cannot open"},
+        {BAD "malformed.yaml", BAD "malformed.yaml", "malformed YAML"},
+        {BAD "truncated.yaml", BAD "truncated.yaml", "malformed YAML at line 4"},
+        {BAD "notmapping.yaml", BAD "notmapping.yaml", "mapping"},
+        {BAD "image_not_found.yaml", BAD "nothere.pgm", "cannot open"},
+        {BAD "image_truncated.yaml", BAD "truncated.pgm", "truncated"},
+        {BAD "image_oversize.yaml", BAD "oversize.pgm", "after the 4 x 3 raster"},
+        {BAD "image_badheader.yaml", BAD "badheader.pgm", "header"},
+        {BAD "image_notpgm.yaml", BAD "notpgm.pgm", "not a PGM"},
+        {BAD "image_badpixel.yaml", BAD "badpixel.pgm", "bad pixel value"},
+        {BAD "res_zero.yaml", BAD "res_zero.yaml", "resolution: must be > 0"},
+        {BAD "res_negative.yaml", BAD "res_negative.yaml", "resolution: must be > 0"},
+        {BAD "res_text.yaml", BAD "res_text.yaml", "resolution: a number expected"},
+        {BAD "thresh_order.yaml", BAD "thresh_order.yaml", "out of order"},
+        {BAD "thresh_range.yaml", BAD "thresh_range.yaml", "[0, 1]"},
+        {BAD "mode_scale.yaml", BAD "mode_scale.yaml", "mode: 'scale' not supported"},
+        {BAD "negate_bad.yaml", BAD "negate_bad.yaml", "negate: 0 or 1 expected"},
+        {BAD "yaw.yaml", BAD "yaw.yaml", "yaw 0.5 unsupported"},
+        {BAD "origin_short.yaml", BAD "origin_short.yaml", "origin: a list of three numbers"},
+        {BAD "missing_free.yaml", BAD "missing_free.yaml", "missing key 'free_thresh'"},
+    };
+    for (size_t k = 0; k < sizeof(t) / sizeof(t[0]); k++) {
+        hs_map_t m;
+        char err[512] = "";
+        int rc = hs_map_load(t[k].yaml, &m, err, sizeof(err));
+        print_message("%s -> %s\n", t[k].yaml, err);
+        assert_int_equal(rc, -1);
+        assert_null(m.cell);
+        char prefix[300];
+        snprintf(prefix, sizeof(prefix), "%s: ", t[k].file);
+        assert_true(strncmp(err, prefix, strlen(prefix)) == 0);
+        assert_non_null(strstr(err, t[k].reason));
+        assert_null(strchr(err, '\n'));
+    }
+}
+
+/* Intel at its own 0.1 m: one fine cell per core cell, so the core's free and wall bits
+ * count exactly the README's free and occupied cells. */
+static void test_core_same_resolution(void **state)
+{
+    (void)state;
+    hs_map_t m;
+    load_real("intel.yaml", &m);
+    hs_core_map_t c;
+    char err[512] = "";
+    assert_int_equal(hs_map_to_core(&m, 0.1, NULL, &c, err, sizeof(err)), 0);
+    assert_int_equal(c.map.w, 579);
+    assert_int_equal(c.map.h, 581);
+    uint32_t nf = 0;
+    uint32_t nw = 0;
+    for (uint16_t y = 0; y < c.map.h; y++) {
+        for (uint16_t x = 0; x < c.map.w; x++) {
+            nf += rfs_map_bit(c.free_bits, c.map.stride, x, y);
+            nw += rfs_map_bit(c.wall_bits, c.map.stride, x, y);
+        }
+    }
+    assert_int_equal(nf, 192948);
+    assert_int_equal(nw, 29942);
+    hs_core_map_free(&c);
+    hs_map_free(&m);
+}
+
+/* Willow at 0.05 m to 0.1 m: each core cell is a 2 x 2 block (the last column half off
+ * the image, which is not free). Free = all four free; wall = any occupied. */
+static void test_core_conservative(void **state)
+{
+    (void)state;
+    hs_map_t m;
+    load_real("willow-full-0.05.yaml", &m);
+    hs_core_map_t c;
+    char err[512] = "";
+    assert_int_equal(hs_map_to_core(&m, 0.1, NULL, &c, err, sizeof(err)), 0);
+    assert_int_equal(c.map.w, (1165 + 1) / 2);
+    assert_int_equal(c.map.h, (945 + 1) / 2);
+    uint32_t mism = 0;
+    uint32_t nfree = 0;
+    for (uint32_t y = 0; y < c.map.h; y++) {
+        for (uint32_t x = 0; x < c.map.w; x++) {
+            int all_free = 1;
+            int any_occ = 0;
+            for (uint32_t dy = 0; dy < 2; dy++) {
+                for (uint32_t dx = 0; dx < 2; dx++) {
+                    uint32_t fx = 2 * x + dx;
+                    uint32_t fy = 2 * y + dy;
+                    if (fx >= m.w || fy >= m.h) {
+                        all_free = 0;
+                        continue;
+                    }
+                    uint8_t s = m.cell[fy * m.w + fx];
+                    all_free &= s == HS_CELL_FREE;
+                    any_occ |= s == HS_CELL_OCC;
+                }
+            }
+            nfree += (uint32_t)all_free;
+            mism += rfs_map_bit(c.free_bits, c.map.stride, (uint16_t)x, (uint16_t)y) != all_free;
+            mism += rfs_map_bit(c.wall_bits, c.map.stride, (uint16_t)x, (uint16_t)y) != any_occ;
+        }
+    }
+    assert_int_equal(mism, 0);
+    assert_true(nfree > 100000);
+    /* The core map's origin and resolution are the Q16 roundings of the yaml's. */
+    assert_int_equal(c.map.res, 6554);
+    assert_int_equal(c.map.origin_x, 0);
+    hs_core_map_free(&c);
+    hs_map_free(&m);
+}
+
+/* Bad core conversions: resolution <= 0; a grid above 65535 cells. */
+static void test_core_rejects(void **state)
+{
+    (void)state;
+    hs_map_t m;
+    load_real("intel.yaml", &m);
+    hs_core_map_t c;
+    char err[512] = "";
+    assert_int_equal(hs_map_to_core(&m, 0.0, NULL, &c, err, sizeof(err)), -1);
+    assert_non_null(strstr(err, "map: core resolution"));
+    assert_int_equal(hs_map_to_core(&m, 0.0005, NULL, &c, err, sizeof(err)), -1);
+    assert_non_null(strstr(err, "does not fit"));
+    assert_null(c.free_bits);
+    hs_map_free(&m);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_real_maps_counts),
+        cmocka_unit_test(test_orientation_thresholds_negate),
+        cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_core_same_resolution),
+        cmocka_unit_test(test_core_conservative),
+        cmocka_unit_test(test_core_rejects),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,307 @@
+/* test_sim.c - scenarios, the motor model and the run loop (hs_scenario.h, hs_motor.h,
+ * hs_sim.h): bad input gives one clear error, the motor model's limits and timeout, every
+ * seed of the open scenario reaches the source 10 m away, and runs are deterministic.
+ * Run from the repository root (make test does).
+ */
+#include "rfs_test.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "hs_motor.h"
+#include "hs_scenario.h"
+#include "hs_sim.h"
+
+static char tmpdir[64];
+static char open_map[PATH_MAX];
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/rfs_test_sim_XXXXXX");
+    if (!mkdtemp(tmpdir) || !realpath("scenarios/maps/open.yaml", open_map)) {
+        return -1;
+    }
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf -- '%s'", tmpdir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+/// Write a scenario file; "@MAP@" in text becomes the open map's absolute path.
+static const char *scn(const char *name, const char *text)
+{
+    static char path[PATH_MAX];
+    snprintf(path, sizeof path, "%s/%s", tmpdir, name);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    const char *at = strstr(text, "@MAP@");
+    if (at) {
+        fprintf(f, "%.*s%s%s", (int)(at - text), text, open_map, at + 5);
+    } else {
+        fputs(text, f);
+    }
+    fclose(f);
+    return path;
+}
+
+static const char *GOOD =
+    "map: @MAP@\n"
+    "seed: 42\n"
+    "sources:\n"
+    "  - name: ap\n"
+    "    position: [15.0, 10.0]\n"
+    "    mac: \"02:aa:bb:cc:dd:01\"\n"
+    "    rate_hz: 100\n"
+    "    tx_dbm: 17\n"
+    "start: {position: [5.0, 10.0], theta: 1.0}\n"
+    "radio:\n"
+    "  shadowing: {enabled: false, sigma_db: 6}\n"
+    "  walls: {db_per_wall: 3}\n"
+    "stop: {radius_m: 2.0, max_time_s: 60}\n";
+
+static void test_scenario_good(void **state)
+{
+    (void)state;
+    hs_scenario_t sc;
+    char err[512];
+    assert_int_equal(hs_scenario_load(scn("good.yaml", GOOD), &sc, err, sizeof err), 0);
+    assert_string_equal(sc.map_path, open_map);
+    assert_true(sc.seed == 42);
+    assert_int_equal(sc.nsources, 1);
+    assert_true(sc.src[0].x == 15.0 && sc.src[0].y == 10.0);
+    assert_true(sc.src[0].rate_hz == 100.0 && sc.src[0].tx_dbm == 17.0);
+    assert_int_equal(sc.src[0].mac[1], 0xaa);
+    assert_int_equal(sc.src[0].mac[5], 0x01);
+    assert_true(sc.start_theta == 1.0);
+    assert_false(sc.radio.shadowing);
+    assert_true(sc.radio.shadow_sigma_db == 6.0);
+    assert_true(sc.radio.wall_db == 3.0);
+    assert_true(sc.radio.fading); // untouched defaults stay
+    assert_true(sc.stop_radius_m == 2.0 && sc.stop_time_s == 60.0 && sc.stop_distance_m == 150.0);
+    assert_true(sc.goal_x == 15.0 && sc.goal_y == 10.0);
+    assert_string_equal(sc.model, "ridge");
+}
+
+/// Each bad scenario: -1 and one line naming the file, the line and the field.
+static void expect_bad(const char *name, const char *text, const char *want)
+{
+    hs_scenario_t sc;
+    char err[512] = "";
+    const char *path = scn(name, text);
+    int rc = hs_scenario_load(path, &sc, err, sizeof err);
+    if (rc == 0) {
+        // Checks that need the map happen when the environment opens.
+        hs_sim_env_t env;
+        rc = hs_sim_env_open(&env, &sc, err, sizeof err);
+        if (rc == 0) {
+            hs_sim_env_close(&env);
+        }
+    }
+    if (rc != -1 || !strstr(err, want) || !strstr(err, name) || strchr(err, '\n')) {
+        print_error("%s: got rc %d, err '%s', wanted '%s'\n", name, rc, err, want);
+        fail();
+    }
+}
+
+static void test_scenario_bad(void **state)
+{
+    (void)state;
+    expect_bad("empty.yaml", "", "empty file");
+    expect_bad("syntax.yaml", "map: [1, 2\nseed: 1\n", "YAML syntax error");
+    expect_bad("unknown_top.yaml", "map: @MAP@\nsources: []\nstart: {}\ncolour: red\n",
+               "unknown key 'colour'");
+    expect_bad("unknown_radio.yaml",
+               "map: @MAP@\nsources:\n  - position: [15, 10]\nstart: {position: [5, 10]}\n"
+               "radio:\n  fading: {enabled: true, doppler: 3}\n",
+               ":6: radio.fading: unknown key 'doppler'");
+    expect_bad("dup.yaml", "map: @MAP@\nseed: 1\nseed: 2\n", "duplicate key 'seed'");
+    expect_bad("nomap.yaml", "seed: 1\n", "map: missing");
+    expect_bad("badnum.yaml",
+               "map: @MAP@\nsources:\n  - position: [15, ten]\nstart: {position: [5, 10]}\n",
+               "sources[0].position: 'ten' is not a number");
+    expect_bad("range.yaml",
+               "map: @MAP@\nsources:\n  - position: [15, 10]\n    rate_hz: -5\n"
+               "start: {position: [5, 10]}\n",
+               "sources[0].rate_hz: -5 is out of range");
+    expect_bad("mac.yaml",
+               "map: @MAP@\nsources:\n  - position: [15, 10]\n    mac: 02:00\n"
+               "start: {position: [5, 10]}\n",
+               "sources[0].mac: expected aa:bb:cc:dd:ee:ff");
+    expect_bad("nostart.yaml", "map: @MAP@\nsources:\n  - position: [15, 10]\n", "start: missing");
+    expect_bad("never.yaml",
+               "map: @MAP@\nsources:\n  - position: [15, 10]\nstart: {position: [5, 10]}\n"
+               "stop: {max_distance_m: 0, max_time_s: 0}\n",
+               "would never end");
+    expect_bad("bridge1.yaml",
+               "map: @MAP@\ntarget: bridge\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "bridge needs exactly 2 sources");
+    // Checks against the map.
+    expect_bad("mapfile.yaml",
+               "map: /nonexistent/map.yaml\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "/nonexistent/map.yaml");
+    expect_bad("src_off.yaml",
+               "map: @MAP@\nsources:\n  - position: [35, 10]\nstart: {position: [5, 10]}\n",
+               "sources[0].position: (35.00, 10.00) is off the map");
+    expect_bad("src_wall.yaml",
+               "map: @MAP@\nsources:\n  - position: [0.0, 10]\nstart: {position: [5, 10]}\n",
+               "sources[0].position: (0.00, 10.00) is inside a wall");
+    expect_bad("start_wall.yaml",
+               "map: @MAP@\nsources:\n  - position: [15, 10]\nstart: {position: [20.0, 5]}\n",
+               "start.position: (20.00, 5.00) is inside a wall");
+    expect_bad("start_off.yaml",
+               "map: @MAP@\nsources:\n  - position: [15, 10]\nstart: {position: [-3, 5]}\n",
+               "start.position: (-3.00, 5.00) is off the map");
+    expect_bad("start_close.yaml",
+               "map: @MAP@\nsources:\n  - position: [15, 10]\nstart: {position: [0.2, 5]}\n",
+               "start.position: (0.20, 5.00) is closer than the clearance");
+    // The source 0.1 m from the wall: the robot (0.25 m clearance) gets no closer than
+    // about 0.3 m, so a 0.1 m radius can never trigger.
+    expect_bad("radius.yaml",
+               "map: @MAP@\nsources:\n  - position: [19.85, 10]\nstart: {position: [5, 10]}\n"
+               "stop: {radius_m: 0.1}\n",
+               "stop.radius_m: the robot can never get within 0.10 m");
+}
+
+static void test_scenario_missing_file(void **state)
+{
+    (void)state;
+    hs_scenario_t sc;
+    char err[512];
+    assert_int_equal(hs_scenario_load("/nonexistent/s.yaml", &sc, err, sizeof err), -1);
+    assert_string_equal(err, "/nonexistent/s.yaml: No such file or directory");
+}
+
+/// Motor model: acceleration limit, saturation, and the 200 ms command timeout.
+static void test_motor(void **state)
+{
+    (void)state;
+    hs_motor_t m;
+    hs_motor_cfg_t c = hs_motor_cfg_default();
+    assert_int_equal(hs_motor_init(&m, &c), 0);
+    double v, w;
+    hs_motor_command(&m, 0, 500, 500);
+    // 1 m/s^2: after 0.1 s the wheels do 0.1 m/s; mean over the tick 0.05 m/s.
+    hs_motor_update(&m, 100000, 0.1, &v, &w);
+    assert_true(fabs(v - 0.05) < 1e-12 && fabs(w) < 1e-12);
+    for (int i = 2; i <= 10; i++) {
+        hs_motor_command(&m, i * 100000 - 50000, 500, 500);
+        hs_motor_update(&m, i * 100000, 0.1, &v, &w);
+    }
+    assert_true(fabs(m.vl - 0.5) < 1e-12 && fabs(m.vr - 0.5) < 1e-12);
+    // No new command: still driving 200 ms after the last one (at 0.95 s) ...
+    hs_motor_update(&m, 1100000, 0.1, &v, &w);
+    assert_true(fabs(m.vl - 0.5) < 1e-12);
+    hs_motor_update(&m, 1150000, 0.05, &v, &w);
+    assert_true(fabs(m.vl - 0.5) < 1e-12);
+    // ... and braking once more than 200 ms have passed.
+    hs_motor_update(&m, 1200000, 0.05, &v, &w);
+    assert_true(fabs(m.vl - 0.45) < 1e-12);
+    assert_int_equal(m.timeouts, 1);
+    // Saturation to 0.7 m/s and the turn rate of opposite wheels: 2 v / 0.23 m.
+    hs_motor_command(&m, 1200000, -2000, 2000);
+    for (int i = 1; i <= 30; i++) {
+        hs_motor_command(&m, 1200000 + i * 100000, -2000, 2000);
+        hs_motor_update(&m, 1200000 + i * 100000, 0.1, &v, &w);
+    }
+    assert_true(fabs(m.vr - 0.7) < 1e-12 && fabs(m.vl + 0.7) < 1e-12);
+    assert_true(fabs(w - 1.4 / 0.23) < 1e-9 && fabs(v) < 1e-12);
+    c.accel_m_s2 = 0;
+    assert_int_equal(hs_motor_init(&m, &c), -1);
+}
+
+static int load_env(const char *path, hs_sim_env_t *env)
+{
+    hs_scenario_t sc;
+    char err[512];
+    if (hs_scenario_load(path, &sc, err, sizeof err) != 0 ||
+        hs_sim_env_open(env, &sc, err, sizeof err) != 0) {
+        print_error("%s\n", err);
+        return -1;
+    }
+    return 0;
+}
+
+/// The open hall, source 10 m away: every one of 20 seeds reaches it.
+static void test_open_all_seeds_reach(void **state)
+{
+    (void)state;
+    hs_sim_env_t env;
+    assert_int_equal(load_env("scenarios/open.yaml", &env), 0);
+    // Shortest path: the straight 10 m line (the 16-neighbourhood is exact along an axis).
+    assert_true(fabs(env.shortest_path_m - 10.0) < 0.06);
+    for (uint64_t seed = 1; seed <= 20; seed++) {
+        hs_sim_result_t r;
+        char err[512];
+        assert_int_equal(hs_sim_run_inproc(&env, seed, NULL, &r, err, sizeof err), 0);
+        if (!r.reached) {
+            print_error("seed %llu: not reached (%s, %.1f m travelled, %.1f m away)\n",
+                        (unsigned long long)seed, r.end, r.distance_travelled_m,
+                        r.final_distance_m);
+        }
+        assert_true(r.reached);
+        assert_true(r.final_distance_m <= 1.5);
+        assert_true(r.distance_travelled_m >= 10.0 - 1.5 - 0.3);
+        assert_true(r.iterations > 0);
+        // 200 packets per second over the whole run, no loss at these levels.
+        assert_true(llabs((long long)r.packets_sent - (long long)(r.sim_time_s * 200.0)) <= 2);
+    }
+    hs_sim_env_close(&env);
+}
+
+/// Everything a run writes, in memory.
+static void run_to_memory(const hs_sim_env_t *env, uint64_t seed, char **buf, size_t *len)
+{
+    FILE *f = open_memstream(buf, len);
+    assert_non_null(f);
+    hs_sim_io_t io = {.log = f, .samples = f, .track = f};
+    hs_sim_result_t r;
+    char err[512];
+    assert_int_equal(hs_sim_run_inproc(env, seed, &io, &r, err, sizeof err), 0);
+    r.wall_time_s = 0.0; // host time is not part of the output
+    hs_sim_write_summary(f, env, &r);
+    fclose(f);
+}
+
+static void test_deterministic(void **state)
+{
+    (void)state;
+    hs_sim_env_t env;
+    assert_int_equal(load_env("scenarios/default.yaml", &env), 0);
+    char *a, *b, *c;
+    size_t la, lb, lc;
+    run_to_memory(&env, 7, &a, &la);
+    run_to_memory(&env, 7, &b, &lb);
+    run_to_memory(&env, 8, &c, &lc);
+    assert_true(la > 100000);
+    assert_true(la == lb && memcmp(a, b, la) == 0);
+    assert_false(la == lc && memcmp(a, c, la) == 0);
+    free(a);
+    free(b);
+    free(c);
+    hs_sim_env_close(&env);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_scenario_good),
+        cmocka_unit_test(test_scenario_bad),
+        cmocka_unit_test(test_scenario_missing_file),
+        cmocka_unit_test(test_motor),
+        cmocka_unit_test(test_open_all_seeds_reach),
+        cmocka_unit_test(test_deterministic),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}

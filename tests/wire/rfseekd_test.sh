@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# rfseekd (issue 4): command line errors, malformed LCM input, stale inputs stop the wheels,
+# deterministic replay, logs readable by lcm-logplayer; then the two-process run (udpm in
+# a private network namespace) when this user may create one.
+# usage: tests/wire/rfseekd_test.sh BUILD
+set -uo pipefail
+build=${1:?usage: rfseekd_test.sh BUILD}
+d=$build/bin/rfseekd tool=$build/tests/wire/lcm_tool
+map=scenarios/maps/office.yaml
+w=$build/tests/wire/rfseekd
+rm -rf "$w" && mkdir -p "$w"
+fails=0
+pass() { echo "PASS $1"; }
+fail() { echo "FAIL $1"; fails=$((fails + 1)); }
+# expect_err NAME WANT_RC PATTERN ARGS...: one error line matching PATTERN, that exit code
+expect_err() {
+    local name=$1 want=$2 pat=$3; shift 3
+    "$d" "$@" > "$w/out" 2> "$w/err"; local rc=$?
+    if [ $rc -eq "$want" ] && [ "$(wc -l < "$w/err")" -eq 1 ] && grep -q -- "$pat" "$w/err"; then pass "$name"
+    else fail "$name (rc $rc, stderr: $(head -3 "$w/err"))"; fi
+}
+
+"$d" --help > "$w/help" && grep -q -- '--can-over-lcm' "$w/help" && pass rfseekd-help || fail rfseekd-help
+expect_err rfseekd-unknown-option 2 "unknown option (see --help): --bogus" --bogus
+expect_err rfseekd-map-required 2 "--map MAP.yaml is required" --lcm memq://
+expect_err rfseekd-missing-map 1 "nope.yaml" --map "$w/nope.yaml" --lcm memq://
+expect_err rfseekd-bad-seed 2 "--seed: expected a non-negative integer, got x" --map $map --seed x
+expect_err rfseekd-can-exclusive 2 "exclude each other" --map $map --can vcan0 --can-over-lcm
+expect_err rfseekd-missing-iface 1 "can: rfsnope0: no such interface" --map $map --lcm memq:// --can rfsnope0
+expect_err rfseekd-missing-log 1 "$w/none.lcmlog" --map $map --replay "$w/none.lcmlog"
+"$d" --map $map --lcm memq:// --log "$w/sub/x.lcmlog" > /dev/null 2> "$w/err"
+[ $? -eq 1 ] && grep -q "x.lcmlog.tmp: cannot open for writing" "$w/err" && [ ! -e "$w/sub/x.lcmlog" ] \
+    && pass rfseekd-unwritable-log || fail "rfseekd-unwritable-log ($(cat "$w/err"))"
+
+# A crafted input log: malformed messages are dropped with one line each, the controller
+# keeps running, and the wheels stop within 200 ms of the inputs stopping at 3 s.
+"$tool" mklog "$w/in.lcmlog" || fail lcm-mklog
+for i in 1 2; do
+    "$d" --map $map --replay "$w/in.lcmlog" --clock-lcm --lcm memq:// --log "$w/out$i.lcmlog" \
+        > "$w/dec$i.txt" 2> "$w/err$i.txt" || fail "rfseekd-replay-run-$i"
+    "$tool" dump "$w/out$i.lcmlog" > "$w/status$i.txt" || fail "lcm-dump-$i"
+done
+for pat in "RFS_POSE: truncated, oversized or not an rfseek.pose_t (37 bytes)" \
+           "RFS_POSE: x or y is not a finite position" "RFS_RSSI: source 99 out of range 0..15" \
+           "RFS_POSE: truncated, oversized or not an rfseek.pose_t (16 bytes)" \
+           "RFS_RSSI: truncated, oversized or not an rfseek.rssi_t (5 bytes)" \
+           "RFS_CLOCK: time 1000000 not after 2000000"; do
+    grep -qF "$pat" "$w/err1.txt" && pass "rfseekd-bad-input: $pat" || fail "rfseekd-bad-input: $pat"
+done
+grep -q "81 steps, 1 decisions, 5 bad messages, 0 CAN send failures, seeker rejected 1 inputs" "$w/err1.txt" \
+    && pass rfseekd-bad-input-counted || fail "rfseekd-bad-input-counted ($(tail -1 "$w/err1.txt"))"
+# STATUS t state left right faults decided
+awk '$2 < 3000000 && ($4 != 0 || $5 != 0) {moving++}
+     $2 >= 3000000 && ($4 != 0 || $5 != 0) {last_moving = $2}
+     $2 >= 3200000 && ($4 != 0 || $5 != 0) {late++}
+     END {exit !(moving > 10 && late == 0)}' "$w/status1.txt" \
+    && pass "rfseekd-stale-inputs-stop-wheels (<= 200 ms after the last input)" \
+    || fail "rfseekd-stale-inputs-stop-wheels ($(awk '$2 >= 2900000' "$w/status1.txt" | head -8 | tr '\n' ';'))"
+awk '$2 >= 3200000 && (int($6 / 256) % 4) != 3 {bad++} END {exit bad > 0}' "$w/status1.txt" \
+    && pass rfseekd-stale-faults-reported || fail rfseekd-stale-faults-reported
+cmp -s "$w/dec1.txt" "$w/dec2.txt" && cmp -s "$w/status1.txt" "$w/status2.txt" && [ -s "$w/status1.txt" ] \
+    && pass "rfseekd-replay-deterministic ($(wc -l < "$w/status1.txt") steps)" || fail rfseekd-replay-deterministic
+timeout 60 lcm-logplayer -l memq:// -s 1000 "$w/out1.lcmlog" > /dev/null 2>&1 \
+    && pass rfseekd-log-plays-in-lcm-logplayer || fail rfseekd-log-plays-in-lcm-logplayer
+
+# Two processes over udpm://, only inside a network namespace we create and delete.
+ns=rfswire$$
+if ! ip netns add "$ns" 2>/dev/null; then
+    echo "SKIP two-process run: cannot create a network namespace (needs root)"
+    exit $((fails > 0))
+fi
+trap 'ip netns del "$ns" 2>/dev/null' EXIT
+ip netns exec "$ns" ip link set lo up && ip netns exec "$ns" ip route add 224.0.0.0/4 dev lo \
+    || { fail "netns setup"; exit 1; }
+url='udpm://239.255.76.67:7667?ttl=0'
+ip netns exec "$ns" timeout 300 "$d" --map $map --lcm "$url" --can-over-lcm --clock-lcm --log "$w/run.lcmlog" \
+    --decisions "$w/live.txt" --idle-exit 3000 2> "$w/d.err" &
+dpid=$!
+sleep 0.5
+ip netns exec "$ns" timeout 300 "$build/bin/rfseek-sim-lcm" scenarios/default.yaml --lcm "$url" \
+    > "$w/summary.json" 2> "$w/sim.err"
+src=$?
+wait $dpid
+drc=$?
+ip netns del "$ns"; trap - EXIT
+ip netns list | grep -q "^$ns" && fail "netns $ns left behind"
+if [ $src -eq 0 ] && [ $drc -eq 0 ] && grep -q '"reached": true' "$w/summary.json"; then
+    pass "two-process-run-reaches-source ($(grep -E '"(sim_time_s|iterations)"' "$w/summary.json" | tr -d ' \n'))"
+else
+    fail "two-process-run-reaches-source (sim rc $src, rfseekd rc $drc: $(cat "$w/sim.err" "$w/d.err" | head -5))"
+fi
+"$d" --map $map --replay "$w/run.lcmlog" --clock-lcm > "$w/replay1.txt" 2>/dev/null
+"$d" --map $map --replay "$w/run.lcmlog" --clock-lcm > "$w/replay2.txt" 2>/dev/null
+if [ -s "$w/live.txt" ] && cmp -s "$w/live.txt" "$w/replay1.txt" && cmp -s "$w/replay1.txt" "$w/replay2.txt"; then
+    pass "two-process-replay-same-decisions ($(wc -l < "$w/live.txt") decisions, live = replay = replay)"
+else
+    fail two-process-replay-same-decisions
+fi
+"$d" --map $map --lcm "file://$PWD/$w/run.lcmlog?speed=0" --clock-lcm --decisions "$w/replay3.txt" \
+    --idle-exit 2000 2>/dev/null
+cmp -s "$w/live.txt" "$w/replay3.txt" && pass "two-process-replay-through-lcm-file-provider" \
+    || fail two-process-replay-through-lcm-file-provider
+exit $((fails > 0))

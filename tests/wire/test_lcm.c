@@ -1,0 +1,262 @@
+/* test_lcm.c - the LCM adapter (host_sim/hs_lcm.h) over memq:// and log files. */
+#include "rfs_test.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "hs_lcm.h"
+
+typedef struct rx {
+    rfs_pose_t pose;
+    int poses;
+    uint8_t src;
+    int64_t rssi_t;
+    int8_t dbm;
+    uint32_t seq;
+    int rssis;
+    int64_t clock_t;
+    int clocks;
+    rfs_can_wheel_t wheel;
+    int64_t wheel_t;
+    rfs_seek_out_t status;
+    int64_t status_t;
+    int statuses;
+    rfs_can_frame_t frame;
+    int frames;
+    char bad[200];
+    int bads;
+} rx_t;
+
+static void on_pose(void *c, const rfs_pose_t *p) { rx_t *r = c; r->pose = *p; r->poses++; }
+static void on_rssi(void *c, uint8_t s, int64_t t, int8_t d, uint32_t q)
+{
+    rx_t *r = c;
+    r->src = s, r->rssi_t = t, r->dbm = d, r->seq = q, r->rssis++;
+}
+static void on_clock(void *c, int64_t t) { rx_t *r = c; r->clock_t = t; r->clocks++; }
+static void on_wheel(void *c, int64_t t, const rfs_can_wheel_t *w) { rx_t *r = c; r->wheel = *w; r->wheel_t = t; }
+static void on_status(void *c, int64_t t, const rfs_seek_out_t *o) { rx_t *r = c; r->status = *o; r->status_t = t; r->statuses++; }
+static void on_can(void *c, int64_t t, const rfs_can_frame_t *f) { (void)t; rx_t *r = c; r->frame = *f; r->frames++; }
+static void on_bad(void *c, const char *why)
+{
+    rx_t *r = c;
+    snprintf(r->bad, sizeof r->bad, "%s", why);
+    r->bads++;
+}
+
+static hs_lcm_handlers_t handlers(rx_t *r)
+{
+    hs_lcm_handlers_t h = {r, on_pose, on_rssi, on_clock, on_wheel, on_status, on_can, on_bad};
+    return h;
+}
+
+static hs_lcm_t *open_memq(rx_t *r)
+{
+    memset(r, 0, sizeof *r);
+    hs_lcm_handlers_t h = handlers(r);
+    char err[200];
+    hs_lcm_t *l = hs_lcm_open("memq://", &h, err, sizeof err);
+    assert_non_null(l);
+    return l;
+}
+
+static void drain(hs_lcm_t *l)
+{
+    while (hs_lcm_handle(l, 0) == 1) {
+    }
+}
+
+static void pose_round_trips_exactly_and_heading_is_normalised(void **state)
+{
+    (void)state;
+    rx_t r;
+    hs_lcm_t *l = open_memq(&r);
+    rfs_pose_t p = {-123456789012LL, -2147418112 /* -32767 m */, 98305, -205887};
+
+    assert_int_equal(hs_lcm_pub_pose(l, &p), 0);
+    drain(l);
+
+    assert_int_equal(r.poses, 1);
+    assert_int_equal(r.pose.t_us, -123456789012LL);
+    assert_int_equal(r.pose.x, -2147418112);
+    assert_int_equal(r.pose.y, 98305);
+    assert_int_equal(r.pose.theta, -205887);
+    /* 4 rad wraps to 4 - 2 pi (double-precision reference). */
+    rfs_pose_t q = {1, 0, 0, 4 * 65536};
+    hs_lcm_pub_pose(l, &q);
+    drain(l);
+    assert_int_equal(r.pose.theta, (int32_t)llround((4.0 - 2.0 * M_PI) * 65536.0));
+    hs_lcm_close(l);
+}
+
+static void every_type_round_trips(void **state)
+{
+    (void)state;
+    rx_t r;
+    hs_lcm_t *l = open_memq(&r);
+    rfs_can_wheel_t w = {-32768, 32767, RFS_CAN_WHEEL_STOP};
+    rfs_seek_out_t o;
+    memset(&o, 0, sizeof o);
+    o.left_mm_s = -5;
+    o.right_mm_s = 7;
+    o.state = RFS_SEEK_DRIVING;
+    o.faults = 0x0301;
+    o.decided = true;
+    o.decision.iteration = 12;
+    o.decision.t_us = 987654321;
+    o.decision.kind = RFS_SEEK_GREEDY;
+    o.decision.relearned = true;
+    o.decision.mean_valid = true;
+    o.decision.prev = RFS_DRIVE_TIMEOUT;
+    o.decision.prediction = -3932161;
+    o.decision.mean = -4000000;
+    o.decision.epsilon = 32768;
+    o.decision.goal_x = 1;
+    o.decision.max_y = -1;
+    o.decision.path_len = 655360;
+    o.decision.samples = 10000;
+    rfs_can_frame_t f = {0x120, 8, {1, 2, 3, 4, 5, 6, 7, 8}};
+
+    hs_lcm_pub_rssi(l, 15, 42, -128, 0xFFFFFFFFu);
+    hs_lcm_pub_clock(l, 50000);
+    hs_lcm_pub_wheel(l, 60000, &w);
+    hs_lcm_pub_status(l, 70000, &o);
+    hs_lcm_pub_can(l, 80000, &f);
+    drain(l);
+
+    assert_int_equal(r.src, 15);
+    assert_int_equal(r.rssi_t, 42);
+    assert_int_equal(r.dbm, -128);
+    assert_int_equal(r.seq, 0xFFFFFFFFu);
+    assert_int_equal(r.clock_t, 50000);
+    assert_int_equal(r.wheel.left_mm_s, -32768);
+    assert_int_equal(r.wheel.right_mm_s, 32767);
+    assert_int_equal(r.wheel.flags, RFS_CAN_WHEEL_STOP);
+    assert_int_equal(r.status_t, 70000);
+    const rfs_seek_decision_t *a = &r.status.decision, *b = &o.decision;
+    assert_int_equal(a->iteration, b->iteration);
+    assert_int_equal(a->t_us, b->t_us);
+    assert_int_equal(a->kind, b->kind);
+    assert_int_equal(a->relearned, b->relearned);
+    assert_int_equal(a->line_search, b->line_search);
+    assert_int_equal(a->model_valid, b->model_valid);
+    assert_int_equal(a->mean_valid, b->mean_valid);
+    assert_int_equal(a->prev, b->prev);
+    assert_int_equal(a->prediction, b->prediction);
+    assert_int_equal(a->mean, b->mean);
+    assert_int_equal(a->epsilon, b->epsilon);
+    assert_int_equal(a->x, b->x);
+    assert_int_equal(a->y, b->y);
+    assert_int_equal(a->goal_x, b->goal_x);
+    assert_int_equal(a->goal_y, b->goal_y);
+    assert_int_equal(a->max_x, b->max_x);
+    assert_int_equal(a->max_y, b->max_y);
+    assert_int_equal(a->path_len, b->path_len);
+    assert_int_equal(a->samples, b->samples);
+    assert_int_equal(r.status.faults, 0x0301);
+    assert_int_equal(r.status.state, RFS_SEEK_DRIVING);
+    assert_true(r.status.decided);
+    assert_int_equal(r.frames, 1);
+    assert_int_equal(r.frame.id, 0x120);
+    assert_int_equal(r.frame.dlc, 8);
+    assert_memory_equal(r.frame.data, f.data, 8);
+    hs_lcm_stats_t st;
+    hs_lcm_get_stats(l, &st);
+    assert_int_equal(st.received, 5);
+    assert_int_equal(st.bad, 0);
+    hs_lcm_close(l);
+}
+
+static void malformed_messages_are_dropped_and_described(void **state)
+{
+    (void)state;
+    rx_t r;
+    hs_lcm_t *l = open_memq(&r);
+    const uint8_t junk[7] = {0xDE, 0xAD, 0xBE, 0xEF, 0, 1, 2};
+
+    hs_lcm_pub_raw(l, 0, HS_LCM_CH_POSE, junk, sizeof junk);
+    hs_lcm_pub_raw(l, 0, HS_LCM_CH_STATUS, junk, 0);
+    drain(l);
+
+    assert_int_equal(r.poses, 0);
+    assert_int_equal(r.statuses, 0);
+    assert_int_equal(r.bads, 2);
+    assert_string_equal(r.bad, "RFS_SEEKER_STATUS: truncated, oversized or not an rfseek.seeker_status_t (0 bytes)");
+    hs_lcm_stats_t st;
+    hs_lcm_get_stats(l, &st);
+    assert_int_equal(st.bad, 2);
+    assert_string_equal(st.last_error, r.bad);
+    hs_lcm_close(l);
+}
+
+static void log_is_written_atomically_and_reads_back(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/rfs_test_lcm_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    unlink(path);
+    char err[200];
+    hs_lcm_log_t *log = hs_lcm_log_open(path, "w", err, sizeof err);
+    assert_non_null(log);
+    rx_t r;
+    hs_lcm_t *l = open_memq(&r);
+    hs_lcm_record(l, log);
+    rfs_pose_t p = {1000, 65536, -65536, 0};
+    hs_lcm_pub_pose(l, &p);
+    hs_lcm_pub_clock(l, 2000);
+    drain(l); /* received messages are recorded too */
+    hs_lcm_record(l, NULL);
+
+    assert_int_equal(access(path, F_OK), -1); /* nothing at PATH before close */
+    assert_int_equal(hs_lcm_log_close(log), 0);
+    assert_int_equal(access(path, F_OK), 0);
+
+    log = hs_lcm_log_open(path, "r", err, sizeof err);
+    assert_non_null(log);
+    rx_t back;
+    memset(&back, 0, sizeof back);
+    hs_lcm_handlers_t h = handlers(&back);
+    int64_t t;
+    int n = 0;
+    while (hs_lcm_log_next(log, &h, NULL, &t) == 1) {
+        n++;
+    }
+    hs_lcm_log_close(log);
+    unlink(path);
+    hs_lcm_close(l);
+    assert_int_equal(n, 4); /* 2 published + 2 received */
+    assert_int_equal(back.poses, 2);
+    assert_int_equal(back.pose.x, 65536);
+    assert_int_equal(back.pose.y, -65536);
+    assert_int_equal(back.clocks, 2);
+    assert_int_equal(back.clock_t, 2000);
+}
+
+static void bad_url_and_unreadable_log_give_one_line(void **state)
+{
+    (void)state;
+    char err[200];
+    hs_lcm_t *l = hs_lcm_open("nosuch://x", NULL, err, sizeof err);
+    assert_null(l);
+    assert_string_equal(err, "lcm: nosuch://x: cannot open this provider (bad URL, no multicast route, or no file)");
+    hs_lcm_log_t *g = hs_lcm_log_open("/nonexistent/dir/x.lcmlog", "r", err, sizeof err);
+    assert_null(g);
+    assert_string_equal(err, "/nonexistent/dir/x.lcmlog: cannot open for reading");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(pose_round_trips_exactly_and_heading_is_normalised),
+        cmocka_unit_test(every_type_round_trips),
+        cmocka_unit_test(malformed_messages_are_dropped_and_described),
+        cmocka_unit_test(log_is_written_atomically_and_reads_back),
+        cmocka_unit_test(bad_url_and_unreadable_log_give_one_line),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

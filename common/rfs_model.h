@@ -45,6 +45,11 @@ typedef struct rfs_model_ops {
     /// Optional (may be NULL): where the model believes the maximum is, when it knows
     /// better than a grid search (e.g. an estimated source position).
     bool (*argmax)(const void *self, rfs_q16_t *x, rfs_q16_t *y);
+    /// Optional (may be NULL): predict n points (x0 + k*dx, y), k = 0..n-1, into out[];
+    /// false when there is no model. Lets the grid search run without a call per point
+    /// (a plane is evaluated with one addition per point).
+    bool (*predict_row)(const void *self, rfs_q16_t x0, rfs_q16_t y, rfs_q16_t dx, uint16_t n,
+                        rfs_q16_t *out);
 } rfs_model_ops_t;
 
 /// A model: its operations and its caller-owned state.

@@ -122,8 +122,8 @@ typedef struct ridge_blk {
  * far samples before uu + vv (then < 2^31) is compared. Scaling and overflow: the caller
  * bounds the block length so that K * r^2 and K * r * 2^15 stay below 2^31. */
 __attribute__((noinline)) static void accumulate_block(ridge_blk_t *b, const rfs_sample_t *p,
-                                                       const rfs_sample_t *end,
-                             int32_t qx, int32_t qy, uint32_t r2)
+                                                       const rfs_sample_t *end, int32_t qx,
+                                                       int32_t qy, uint32_t r2)
 {
     int32_t su = 0, sv = 0, szn = 0, suu = 0, suv = 0, svv = 0, suz = 0, svz = 0;
     for (; p != end; ++p) {

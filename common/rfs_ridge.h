@@ -6,6 +6,19 @@
  * Sums are accumulated exactly in int64 with coordinates in centimetres centred on the
  * query point, the 2 x 2 system is solved exactly in 128-bit integers (Cramer's rule),
  * and the plane predicts anywhere on the map.
+ *
+ * Exactness: the samples are what the store holds (cm, Q9.6), the query is rounded to
+ * the nearest centimetre, a sample is used when its distance is <= radius (integer test
+ * in cm^2), and alpha * 10^4 cm^2 is rounded to an integer (exact for alpha = 1.0 and any
+ * multiple of 1/16). On that data the only differences from scikit-learn's double
+ * solution are the rounding of the slopes to Q40.24 and of the centre value to Q16.16:
+ * tested on 120 random data sets to within 3e-4 dB everywhere on a +-300 m map
+ * (tests/common/test_ridge.c; the issue asks for 0.05 dB).
+ *
+ * Work: fit() with budget 0 visits every sample; with budget > 0 it visits at most
+ * `budget` samples per call and returns RFS_FIT_MORE until the last call, which solves
+ * (a few thousand instructions). A call with a different query point, or with fewer
+ * samples than already visited, restarts the fit. The model is invalid while fitting.
  */
 #ifndef RFS_RIDGE_H
 #define RFS_RIDGE_H

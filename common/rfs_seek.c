@@ -9,6 +9,8 @@
 #define EPS_RATE_PAPER ((rfs_q16_t)10629)
 /* Line-search candidates and epsilon redraws tried before giving up on an iteration. */
 #define GOAL_TRIES 6
+/* Lattice points predicted per predict_row call in the grid search (stack buffer). */
+#define RFS_SEEK_ROW_CHUNK 64
 /* How far (lattice steps) an off-lattice or illegal start looks for a legal lattice point. */
 #define SNAP_RADIUS 6
 
@@ -426,19 +428,51 @@ static bool choose_greedy(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     if (s->model.ops->argmax != 0 && s->model.ops->argmax(s->model.self, &mx, &my)) {
         found = true;
     } else {
+        /* Row by row, in chunks, so that a model with predict_row costs one call per chunk
+         * and the lattice coordinates advance by addition. */
         rfs_q16_t best = RFS_Q16_MIN;
+        rfs_q16_t row[RFS_SEEK_ROW_CHUNK];
+        const rfs_model_ops_t *ops = s->model.ops;
         for (uint16_t j = 0; j < m->lh; ++j) {
-            for (uint16_t i = 0; i < m->lw; ++i) {
-                if (!reachable_point(s, i, j)) {
+            rfs_q16_t x0, py;
+            rfs_map_lattice_point(m, 0, j, &x0, &py);
+            const uint8_t *rbits = s->reach;
+            uint32_t base = (uint32_t)j * m->lw;
+            for (uint16_t i0 = 0; i0 < m->lw; i0 = (uint16_t)(i0 + RFS_SEEK_ROW_CHUNK)) {
+                uint16_t n = (uint16_t)(m->lw - i0 < RFS_SEEK_ROW_CHUNK ? m->lw - i0
+                                                                        : RFS_SEEK_ROW_CHUNK);
+                rfs_q16_t cx0 = x0 + (rfs_q16_t)i0 * m->cfg.grid;
+                bool any = false;
+                for (uint16_t k = 0; k < n; ++k) {
+                    uint32_t idx = base + i0 + k;
+                    if ((rbits[idx >> 3] >> (idx & 7u)) & 1u) {
+                        any = true;
+                        break;
+                    }
+                }
+                if (!any) {
                     continue;
                 }
-                rfs_q16_t px, py, v;
-                rfs_map_lattice_point(m, i, j, &px, &py);
-                if (s->model.ops->predict(s->model.self, px, py, &v) && (!found || v > best)) {
-                    best = v;
-                    mx = px;
-                    my = py;
-                    found = true;
+                if (ops->predict_row != 0) {
+                    if (!ops->predict_row(s->model.self, cx0, py, m->cfg.grid, n, row)) {
+                        return false;
+                    }
+                } else {
+                    for (uint16_t k = 0; k < n; ++k) {
+                        if (!ops->predict(s->model.self, cx0 + (rfs_q16_t)k * m->cfg.grid, py,
+                                          &row[k])) {
+                            return false;
+                        }
+                    }
+                }
+                for (uint16_t k = 0; k < n; ++k) {
+                    uint32_t idx = base + i0 + k;
+                    if (((rbits[idx >> 3] >> (idx & 7u)) & 1u) && (!found || row[k] > best)) {
+                        best = row[k];
+                        mx = cx0 + (rfs_q16_t)k * m->cfg.grid;
+                        my = py;
+                        found = true;
+                    }
                 }
             }
         }

@@ -42,7 +42,7 @@ typedef struct rfs_pending {
 /// Store configuration.
 typedef struct rfs_store_cfg {
     uint16_t capacity;     ///< samples kept for learning (paper: 10,000)
-    int64_t max_gap_us;    ///< poses further apart than this do not bracket (0.5 s)
+    int64_t max_gap_us;    ///< poses further apart than this do not bracket (0.5 s; <= 60 s)
 } rfs_store_cfg_t;
 
 /// The sample store; samples and pending queue live in caller-owned arrays.
@@ -68,7 +68,7 @@ typedef struct rfs_store {
 rfs_store_cfg_t rfs_store_cfg_default(void);
 
 /// Initialise an empty store over caller arrays. Returns 0, or -1 on a null array,
-/// zero capacity or max_gap_us <= 0.
+/// zero capacity or pending_cap, or max_gap_us outside (0, 60 s].
 int rfs_store_init(rfs_store_t *s, const rfs_store_cfg_t *cfg, rfs_sample_t *samples,
                    rfs_pending_t *pending, uint16_t pending_cap);
 
@@ -76,7 +76,11 @@ int rfs_store_init(rfs_store_t *s, const rfs_store_cfg_t *cfg, rfs_sample_t *sam
 /// pending measurement it brackets into a sample. Returns false when rejected.
 bool rfs_store_add_pose(rfs_store_t *s, const rfs_pose_t *pose, rfs_rng_t *rng);
 
-/// Add a measurement of value v (Q16.16, saturated to Q9.6) taken at t_us.
+/// Add a measurement of value v (Q16.16, rounded and saturated to Q9.6) taken at t_us.
+/// Bracketed: a sample now (position interpolated, rounded to the centimetre, saturated
+/// to +-327.67 m). Older than the oldest pose kept: dropped_early. Newer than the newest
+/// pose (or no pose yet): queued until a pose brackets it (dropped_pending when the
+/// queue is full). Between poses more than max_gap_us apart: dropped_gap.
 void rfs_store_add_value(rfs_store_t *s, int64_t t_us, rfs_q16_t v, rfs_rng_t *rng);
 
 /// Interpolate the position at t_us from the pose history. false when not bracketed.

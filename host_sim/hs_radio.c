@@ -21,6 +21,7 @@ typedef struct radio_src {
     float *shadow;         ///< gw * gh values, dB
     fading_wave_t *waves;  ///< fading_waves plane waves
     int8_t *walls;         ///< cw * ch cached wall counts, -1 = not yet known
+    bool walls_owned;      ///< walls was allocated here (not lent by the caller)
 } radio_src_t;
 
 struct hs_radio {
@@ -34,6 +35,10 @@ struct hs_radio {
     float sin_tab[SIN_N];     ///< sin(2 pi i / SIN_N)
     hs_radio_walls_fn walls_fn;
     void *walls_ctx;
+    double los_a, los_b;      ///< Rician amplitudes sqrt(K/(K+1)), sqrt(1/(K+1))
+    double scat;              ///< 1 / sqrt(fading_waves)
+    double spare;             ///< second normal variate of the last Box-Muller pair
+    bool has_spare;           ///< spare is valid
 };
 
 hs_radio_cfg_t hs_radio_cfg_default(void)
@@ -49,7 +54,7 @@ hs_radio_cfg_t hs_radio_cfg_default(void)
     c.shadowing = true;
     c.shadow_sigma_db = 4.0;                   // issue 3 default (indoor 3-6 dB)
     c.shadow_dcorr_m = 5.0;                    // Gudmundson 1991 form, indoor scale
-    c.shadow_grid_m = 0.25;
+    c.shadow_grid_m = 0.5;                     // d_c / 10: bilinear error small at lags >= 0.5 m
     c.shadow_waves = 256;
     c.fading = true;
     c.wavelength_m = 0.125;                    // 2.4 GHz: c / f = 0.1249 m
@@ -211,6 +216,10 @@ hs_radio_t *hs_radio_create(const hs_radio_cfg_t *cfg, const hs_radio_src_t *src
     r->k_steps = SIN_N / cfg->wavelength_m; // 2 pi / lambda rad/m = SIN_N / lambda steps/m
     r->walls_fn = walls;
     r->walls_ctx = walls_ctx;
+    double k = pow(10.0, cfg->rician_k_db / 10.0);
+    r->los_a = sqrt(k / (k + 1.0));
+    r->los_b = sqrt(1.0 / (k + 1.0));
+    r->scat = 1.0 / sqrt((double)cfg->fading_waves);
     for (unsigned i = 0; i < SIN_N; i++) {
         r->sin_tab[i] = (float)sin(2.0 * M_PI * i / SIN_N);
     }
@@ -226,6 +235,7 @@ hs_radio_t *hs_radio_create(const hs_radio_cfg_t *cfg, const hs_radio_src_t *src
         }
         if (cfg->walls && walls) {
             rs->walls = malloc((size_t)r->cw * r->ch);
+            rs->walls_owned = true;
             if (rs->walls) {
                 memset(rs->walls, -1, (size_t)r->cw * r->ch);
             } else {
@@ -249,7 +259,9 @@ void hs_radio_destroy(hs_radio_t *r)
     for (unsigned s = 0; s < r->nsrc; s++) {
         free(r->src[s].shadow);
         free(r->src[s].waves);
-        free(r->src[s].walls);
+        if (r->src[s].walls_owned) {
+            free(r->src[s].walls);
+        }
     }
     free(r);
 }
@@ -260,12 +272,12 @@ unsigned hs_radio_walls(hs_radio_t *r, unsigned s, double x, double y)
     if (!r->cfg.walls || !r->walls_fn) {
         return 0;
     }
-    long cx = lround((x - r->x0) / r->cfg.wall_cache_m);
-    long cy = lround((y - r->y0) / r->cfg.wall_cache_m);
-    if (cx < 0 || cy < 0 || cx >= (long)r->cw || cy >= (long)r->ch) {
+    double fx = (x - r->x0) / r->cfg.wall_cache_m + 0.5, fy = (y - r->y0) / r->cfg.wall_cache_m + 0.5;
+    if (!(fx >= 0.0 && fy >= 0.0 && fx < (double)r->cw && fy < (double)r->ch)) {
         return r->walls_fn(r->walls_ctx, x, y, rs->s.x, rs->s.y);
     }
-    int8_t *slot = &rs->walls[(size_t)cy * r->cw + (size_t)cx];
+    size_t cx = (size_t)fx, cy = (size_t)fy; // nearest cache point (x, y >= 0: truncation floors)
+    int8_t *slot = &rs->walls[cy * r->cw + cx];
     if (*slot < 0) {
         // The count from the cache cell's centre stands for the whole cell.
         unsigned n = r->walls_fn(r->walls_ctx, r->x0 + cx * r->cfg.wall_cache_m,
@@ -273,6 +285,27 @@ unsigned hs_radio_walls(hs_radio_t *r, unsigned s, double x, double y)
         *slot = (int8_t)(n > 127 ? 127 : n);
     }
     return (unsigned)*slot;
+}
+
+size_t hs_radio_wall_cache_bytes(const hs_radio_cfg_t *cfg, double x0, double y0, double x1,
+                                 double y1)
+{
+    size_t cw = (size_t)ceil((x1 - x0) / cfg->wall_cache_m) + 1;
+    size_t ch = (size_t)ceil((y1 - y0) / cfg->wall_cache_m) + 1;
+    return cw * ch;
+}
+
+void hs_radio_use_wall_cache(hs_radio_t *r, unsigned s, int8_t *cache)
+{
+    radio_src_t *rs = &r->src[s];
+    if (!r->cfg.walls || !r->walls_fn) {
+        return;
+    }
+    if (rs->walls_owned) {
+        free(rs->walls);
+    }
+    rs->walls = cache;
+    rs->walls_owned = false;
 }
 
 double hs_radio_shadow_db(const hs_radio_t *r, unsigned s, double x, double y)
@@ -307,12 +340,10 @@ double hs_radio_fading_db(const hs_radio_t *r, unsigned s, double x, double y, b
         re += r->sin_tab[(idx + SIN_N / 4u) & SIN_MASK];
         im += r->sin_tab[idx & SIN_MASK];
     }
-    double scat = 1.0 / sqrt((double)c->fading_waves);
-    re *= scat;
-    im *= scat;
+    re *= r->scat;
+    im *= r->scat;
     if (los) {
-        double k = pow(10.0, c->rician_k_db / 10.0);
-        double a = sqrt(k / (k + 1.0)), b = sqrt(1.0 / (k + 1.0));
+        double a = r->los_a, b = r->los_b;
         double d = hypot(x - rs->s.x, y - rs->s.y);
         uint32_t idx = (uint32_t)(int64_t)(r->k_steps * d);
         re = a * r->sin_tab[(idx + SIN_N / 4u) & SIN_MASK] + b * re;
@@ -366,11 +397,24 @@ bool hs_radio_packet(hs_radio_t *r, unsigned s, double x, double y, rfs_rng_t *r
 {
     const hs_radio_cfg_t *c = &r->cfg;
     double p = hs_radio_signal_dbm(r, s, x, y);
-    if (c->loss && hs_radio_uniform(rng) >= hs_radio_pdr(c, p)) {
+    // 32 random bits are plenty for a delivery probability.
+    if (c->loss && rfs_rng_u32(rng) * (1.0 / 4294967296.0) >= hs_radio_pdr(c, p)) {
         return false;
     }
     if (c->noise) {
-        p += c->noise_sigma_db * hs_radio_gauss(rng);
+        double g;
+        if (r->has_spare) {
+            g = r->spare;
+            r->has_spare = false;
+        } else {
+            // Box-Muller gives two independent normals; keep the second for the next packet.
+            double u1 = hs_radio_uniform(rng), u2 = hs_radio_uniform(rng);
+            double rad = sqrt(-2.0 * log(1.0 - u1));
+            g = rad * cos(2.0 * M_PI * u2);
+            r->spare = rad * sin(2.0 * M_PI * u2);
+            r->has_spare = true;
+        }
+        p += c->noise_sigma_db * g;
     }
     if (c->clip) {
         p = p < c->rx_min_dbm ? c->rx_min_dbm : (p > c->rx_max_dbm ? c->rx_max_dbm : p);

@@ -41,7 +41,7 @@ typedef struct hs_radio_cfg {
     bool shadowing;          ///< Gudmundson shadowing on
     double shadow_sigma_db;  ///< its standard deviation, dB (4)
     double shadow_dcorr_m;   ///< its decorrelation distance, metres (5)
-    double shadow_grid_m;    ///< tabulation grid, metres (0.25)
+    double shadow_grid_m;    ///< tabulation grid, metres (0.5)
     uint32_t shadow_waves;   ///< plane waves summed for the field (256)
     bool fading;             ///< small-scale fading on
     double wavelength_m;     ///< carrier wavelength, metres (0.125: 2.4 GHz)
@@ -93,6 +93,15 @@ void hs_radio_destroy(hs_radio_t *r);
 
 /// Walls between the receiver at (x, y) and source s (cached per receiver cell).
 unsigned hs_radio_walls(hs_radio_t *r, unsigned s, double x, double y);
+
+/// Bytes of one source's wall-count cache for an area (hs_radio_use_wall_cache).
+size_t hs_radio_wall_cache_bytes(const hs_radio_cfg_t *cfg, double x0, double y0, double x1,
+                                 double y1);
+
+/// Use a caller-owned wall-count cache for source s (hs_radio_wall_cache_bytes() bytes,
+/// initialised to -1 = unknown), so that runs of the same geometry share the ray casts:
+/// the caller guarantees the same walls, area, wall_cache_m and source position.
+void hs_radio_use_wall_cache(hs_radio_t *r, unsigned s, int8_t *cache);
 
 /// Shadowing of source s at (x, y), dB (0 when off).
 double hs_radio_shadow_db(const hs_radio_t *r, unsigned s, double x, double y);

@@ -206,6 +206,17 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
         hs_sim_env_close(e);
         return -1;
     }
+    // Wall counts depend on the geometry only, not on the seed: one cache for all runs.
+    size_t wcb = hs_radio_wall_cache_bytes(&sc->radio, e->x0, e->y0, e->x1, e->y1);
+    for (unsigned s = 0; s < sc->nsources; s++) {
+        e->wall_cache[s] = malloc(wcb);
+        if (!e->wall_cache[s]) {
+            snprintf(err, errlen, "%s: out of memory", sc->path);
+            hs_sim_env_close(e);
+            return -1;
+        }
+        memset(e->wall_cache[s], -1, wcb);
+    }
     e->shortest_path_m = NAN;
     e->shortest_to_stop_m = NAN;
     bool has_goal = sc->has_goal || sc->nsources == 1;
@@ -261,6 +272,10 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
 
 void hs_sim_env_close(hs_sim_env_t *e)
 {
+    for (unsigned s = 0; s < HS_SCN_MAX_SOURCES; s++) {
+        free(e->wall_cache[s]);
+        e->wall_cache[s] = NULL;
+    }
     hs_core_map_free(&e->core);
     hs_map_free(&e->map);
 }
@@ -343,6 +358,9 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
         hs_world_destroy(world);
         snprintf(err, errlen, "%s: %s", sc->path, werr);
         return -1;
+    }
+    for (unsigned s = 0; s < sc->nsources; s++) {
+        hs_radio_use_wall_cache(radio, s, e->wall_cache[s]);
     }
     hs_motor_t motor;
     if (hs_motor_init(&motor, &sc->motor) != 0) {
@@ -565,6 +583,9 @@ int hs_sim_field(const hs_sim_env_t *e, uint64_t seed, unsigned src, double step
         hs_world_destroy(world);
         snprintf(err, errlen, "%s: %s", sc->path, werr);
         return -1;
+    }
+    for (unsigned s = 0; s < sc->nsources; s++) {
+        hs_radio_use_wall_cache(radio, s, e->wall_cache[s]);
     }
     rfs_rng_t rng;
     rfs_rng_seed(&rng, seed ^ 0x5A17C0FFEE000004ull);

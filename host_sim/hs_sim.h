@@ -33,6 +33,7 @@ typedef struct hs_sim_env {
     double shortest_path_m;    ///< start to the legal point nearest the goal, around walls (NaN: no goal)
     double shortest_to_stop_m; ///< start to the first legal point within stop_radius_m (NaN: no goal)
     double x0, y0, x1, y1;     ///< the map's extent, metres
+    int8_t *wall_cache[HS_SCN_MAX_SOURCES]; ///< wall counts per receiver cell, shared by runs
 } hs_sim_env_t;
 
 /// Per-run outputs; any may be NULL.

@@ -7,10 +7,13 @@ FEED := $(BUILD)/feed
 FEED_SRCS := host_sim/hs_pcap.c host_sim/hs_radiotap.c
 FEED_HDRS := host_sim/hs_pcap.h host_sim/hs_radiotap.h
 
-# rfseek-feed under ASan+UBSan, from our own sources only, for the bad-input tests.
-$(FEED)/asan/rfseek-feed: host_sim/prog/rfseek-feed.c $(FEED_SRCS) $(FEED_HDRS)
+# rfseek-feed under ASan+UBSan (the host and core libraries' ASan builds: --pose runs the
+# simulator's controller), for the bad-input and replay tests.
+# (Depends on the plain build too, so generated headers added by later fragments exist.)
+$(FEED)/asan/rfseek-feed: host_sim/prog/rfseek-feed.c $(HOST_ASAN_LIB) $(CORE_ASAN_LIB) $(BUILD)/bin/rfseek-feed
 	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) -O1 $(SAN_FLAGS) $< $(FEED_SRCS) -o $@ $(PCAP_LIBS)
+	$(CC) $(HOST_CFLAGS) -O1 $(SAN_FLAGS) -c $< -o $(FEED)/asan/rfseek-feed.o
+	$(HOST_LINK) $(SAN_FLAGS) -o $@ $(FEED)/asan/rfseek-feed.o $(HOST_ASAN_LIB) $(CORE_ASAN_LIB) $(HOST_LDLIBS)
 
 # Writes radiotap captures through hs_pcap_writer (bench input, writer cross-check).
 $(FEED)/feed_writegen: tests/feed/feed_writegen.c $(FEED_SRCS) $(FEED_HDRS)
@@ -35,6 +38,7 @@ $(FEED)/fuzz_radiotap: tests/fuzz/fuzz_radiotap.c host_sim/hs_radiotap.c host_si
 TEST_DEPS += $(BUILD)/bin/rfseek-feed $(FEED)/asan/rfseek-feed $(FEED)/gen/.stamp $(FEED)/fuzz_radiotap
 TEST_SCRIPTS += "tests/feed/cross_check.sh $(BUILD)/bin/rfseek-feed tests/data/captures/*.pcap $(FEED)/gen/*.pcap $(FEED)/gen/*.pcapng"
 TEST_SCRIPTS += "tests/feed/bad_input.sh $(FEED)/asan/rfseek-feed $(FEED)/gen"
+TEST_SCRIPTS += "$(PYTHON) tests/feed/replay_test.py $(FEED)/asan/rfseek-feed"
 TEST_SCRIPTS += "tests/feed/run_fuzz.sh $(FEED)/fuzz_radiotap $(FEED)/fuzz-corpus tests/fuzz/corpus/radiotap 20000"
 
 # CMocka tests of our modules, linked with our sources only (not all of librfs_host.a),

@@ -65,6 +65,8 @@ typedef struct feed_stats {
     uint64_t no_signal;               /* ... but no dBm antenna signal */
     uint64_t lines;                   /* lines printed */
     uint64_t caplen_short;            /* records captured shorter than on the air */
+    uint64_t replay_before;           /* replay: matching frames before the first pose */
+    uint64_t replay_after;            /* replay: ... after the last pose or the stop */
 } feed_stats_t;
 
 static int parse_mac(const char *s, uint8_t mac[6])
@@ -134,6 +136,8 @@ static void print_stats(const char *name, const feed_stats_t *st)
         {st->no_sa, "skipped: no source address"},
         {st->no_signal, "skipped: matching source without dBm signal"},
         {st->caplen_short, "note: cut by the snap length"},
+        {st->replay_before, "replay: not fed, before the first pose"},
+        {st->replay_after, "replay: not fed, after the last pose or the stop"},
     };
     for (size_t i = 0; i < sizeof(rest) / sizeof(rest[0]); i++) {
         if (rest[i].n != 0) { fprintf(stderr, "; %llu %s", (unsigned long long)rest[i].n, rest[i].what); }
@@ -141,20 +145,485 @@ static void print_stats(const char *name, const feed_stats_t *st)
     fputc('\n', stderr);
 }
 
+/* Called for each frame from one of the MACs (index m) that carries a signal. */
+typedef int (*feed_fn)(void *ctx, int m, const hs_pcap_pkt_t *pkt, const hs_rt_frame_t *f);
+
+/* Read every packet, count why packets give nothing, call fn for the matching ones.
+ * Returns 0, or 1 after a read error (message on stderr) or when fn failed. */
+static int scan_capture(hs_pcap_reader_t *r, const uint8_t (*macs)[6], int n_macs, feed_stats_t *st,
+                        feed_fn fn, void *ctx)
+{
+    char err[512];
+    for (;;) {
+        hs_pcap_pkt_t pkt;
+        const int got = hs_pcap_next(r, &pkt, err, sizeof(err));
+        if (got == 2) { continue; }
+        if (got == 0) { return 0; }
+        if (got < 0) {
+            fprintf(stderr, "rfseek-feed: %s (after %llu packets)\n", err, (unsigned long long)st->packets);
+            return 1;
+        }
+        st->packets++;
+        if (pkt.caplen < pkt.origlen) { st->caplen_short++; }
+        hs_rt_frame_t f;
+        const int prc = hs_rt_frame_parse(pkt.data, pkt.caplen, &f);
+        st->rt_bad[f.rt.status]++;
+        if (prc != 0) { continue; }
+        if (!f.wlan_ok) { st->no_wlan++; continue; }
+        if (!f.wlan.has_sa) { st->no_sa++; continue; }
+        int m = 0;
+        while (m < n_macs && memcmp(macs[m], f.wlan.sa, 6) != 0) { m++; }
+        if (m == n_macs) { continue; }
+        st->sa_match++;
+        if (!f.rt.has_dbm_signal) { st->no_signal++; continue; }
+        if (fn(ctx, m, &pkt, &f) != 0) { return 1; }
+        st->lines++;
+    }
+}
+
+/* --- TSV mode ----------------------------------------------------------------------- */
+
+typedef struct tsv_ctx {
+    FILE *out;
+    bool live; /* flush each line: a live reader wants it at once */
+} tsv_ctx_t;
+
+static int tsv_line(void *ctx, int m, const hs_pcap_pkt_t *pkt, const hs_rt_frame_t *f)
+{
+    tsv_ctx_t *c = ctx;
+    (void)m;
+    char line[64];
+    const size_t len = format_line(line, pkt->t_ns, f->wlan.sa, f->rt.dbm_signal);
+    fwrite(line, 1, len, c->out);
+    if (c->live) { fflush(c->out); }
+    return 0;
+}
+
+static int run_tsv(hs_pcap_reader_t *r, const char *output, bool live, const uint8_t (*macs)[6],
+                   int n_macs, feed_stats_t *st)
+{
+    char *tmp = NULL;
+    FILE *out = stdout;
+    if (output != NULL) {
+        const size_t n = strlen(output);
+        tmp = malloc(n + 5);
+        if (tmp == NULL) { fprintf(stderr, "rfseek-feed: out of memory\n"); return 1; }
+        memcpy(tmp, output, n);
+        memcpy(tmp + n, ".tmp", 5);
+        out = fopen(tmp, "w");
+        if (out == NULL) {
+            fprintf(stderr, "rfseek-feed: %s: cannot create: %s\n", tmp, strerror(errno));
+            free(tmp);
+            return 1;
+        }
+    }
+    static char obuf[1 << 16];
+    setvbuf(out, obuf, _IOFBF, sizeof(obuf));
+    tsv_ctx_t c = {out, live};
+    int rc = scan_capture(r, macs, n_macs, st, tsv_line, &c);
+    if (fflush(out) != 0 || ferror(out)) {
+        fprintf(stderr, "rfseek-feed: %s: write error: %s\n", output != NULL ? tmp : "stdout", strerror(errno));
+        rc = 1;
+    }
+    if (output != NULL) {
+        if (fclose(out) != 0) { rc = 1; }
+        if (rc == 0 && rename(tmp, output) != 0) {
+            fprintf(stderr, "rfseek-feed: %s: cannot rename to %s: %s\n", tmp, output, strerror(errno));
+            rc = 1;
+        }
+        if (rc != 0) { (void)remove(tmp); }
+        free(tmp);
+    }
+    return rc;
+}
+
+/* --- replay mode (--pose) ------------------------------------------------------------ */
+
+typedef struct rp_pose {
+    int64_t t_us;       /* capture clock, microseconds since the epoch */
+    double x, y, theta; /* map frame: metres, metres, radians */
+} rp_pose_t;
+
+typedef struct rp_pkt {
+    int64_t t_us; /* capture clock, microseconds since the epoch */
+    uint8_t src;  /* source index (scenario order) */
+    int8_t dbm;   /* first (combined) dBm antenna signal */
+    uint16_t seq; /* 802.11 sequence number */
+} rp_pkt_t;
+
+typedef struct rp_vec {
+    rp_pkt_t *v;
+    size_t n, cap;
+} rp_vec_t;
+
+static int rp_collect(void *ctx, int m, const hs_pcap_pkt_t *pkt, const hs_rt_frame_t *f)
+{
+    rp_vec_t *vec = ctx;
+    if (vec->n == vec->cap) {
+        const size_t cap = vec->cap ? vec->cap * 2 : 1024;
+        rp_pkt_t *nv = realloc(vec->v, cap * sizeof(*nv));
+        if (nv == NULL) { fprintf(stderr, "rfseek-feed: out of memory\n"); return 1; }
+        vec->v = nv;
+        vec->cap = cap;
+    }
+    vec->v[vec->n++] = (rp_pkt_t){pkt->t_us, (uint8_t)m, f->rt.dbm_signal, f->wlan.seq};
+    return 0;
+}
+
+/* Read the pose CSV: header "t_us,x_m,y_m,theta_rad", then one pose per line, times
+ * strictly increasing, finite coordinates. One error line "file:line: reason". */
+static int read_poses(const char *path, rp_pose_t **out, size_t *n_out, char *err, size_t errlen)
+{
+    FILE *fp = fopen(path, "r");
+    if (fp == NULL) {
+        snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+        return -1;
+    }
+    rp_pose_t *v = NULL;
+    size_t n = 0, cap = 0;
+    char line[512];
+    unsigned long ln = 0;
+    int rc = 0;
+    while (fgets(line, sizeof(line), fp) != NULL) {
+        ln++;
+        const size_t len = strlen(line);
+        if (len == sizeof(line) - 1 && line[len - 1] != '\n') {
+            snprintf(err, errlen, "%s:%lu: line longer than %zu bytes", path, ln, sizeof(line) - 2);
+            rc = -1;
+            break;
+        }
+        line[strcspn(line, "\r\n")] = '\0';
+        if (ln == 1) {
+            if (strcmp(line, "t_us,x_m,y_m,theta_rad") != 0) {
+                snprintf(err, errlen, "%s:1: header must be 't_us,x_m,y_m,theta_rad'", path);
+                rc = -1;
+                break;
+            }
+            continue;
+        }
+        if (line[0] == '\0') { continue; }
+        rp_pose_t p;
+        char *e = NULL;
+        errno = 0;
+        p.t_us = strtoll(line, &e, 10);
+        if (e == line || *e != ',' || errno != 0) {
+            snprintf(err, errlen, "%s:%lu: t_us: not an integer number of microseconds", path, ln);
+            rc = -1;
+            break;
+        }
+        double *fields[3] = {&p.x, &p.y, &p.theta};
+        static const char *names[3] = {"x_m", "y_m", "theta_rad"};
+        for (int k = 0; k < 3 && rc == 0; k++) {
+            const char *b = e + 1;
+            *fields[k] = strtod(b, &e);
+            if (e == b || (k < 2 ? *e != ',' : *e != '\0') || !isfinite(*fields[k])) {
+                snprintf(err, errlen, "%s:%lu: %s: not a finite number%s", path, ln, names[k],
+                         k < 2 ? " followed by ','" : " at the end of the line");
+                rc = -1;
+            }
+        }
+        if (rc != 0) { break; }
+        if (n > 0 && p.t_us <= v[n - 1].t_us) {
+            snprintf(err, errlen, "%s:%lu: t_us: %lld is not after the previous pose (%lld)", path, ln,
+                     (long long)p.t_us, (long long)v[n - 1].t_us);
+            rc = -1;
+            break;
+        }
+        if (n == cap) {
+            cap = cap ? cap * 2 : 1024;
+            rp_pose_t *nv = realloc(v, cap * sizeof(*nv));
+            if (nv == NULL) { snprintf(err, errlen, "%s: out of memory", path); rc = -1; break; }
+            v = nv;
+        }
+        v[n++] = p;
+    }
+    if (rc == 0 && ferror(fp)) { snprintf(err, errlen, "%s: read error", path); rc = -1; }
+    if (rc == 0 && n < 2) { snprintf(err, errlen, "%s: fewer than 2 poses", path); rc = -1; }
+    fclose(fp);
+    if (rc != 0) { free(v); return -1; }
+    *out = v;
+    *n_out = n;
+    return 0;
+}
+
+static double rp_wrap(double a)
+{
+    while (a > M_PI) { a -= 2.0 * M_PI; }
+    while (a <= -M_PI) { a += 2.0 * M_PI; }
+    return a;
+}
+
+static rfs_q16_t rp_q16(double v) { return (rfs_q16_t)llround(v * 65536.0); }
+
+static double rp_d(rfs_q16_t v) { return (double)v / 65536.0; }
+
+/* Same names as the simulator's log. */
+static const char *rp_kind(rfs_seek_kind_t k)
+{
+    switch (k) {
+    case RFS_SEEK_INITIAL: return "initial";
+    case RFS_SEEK_GREEDY: return "greedy";
+    case RFS_SEEK_EPSILON: return "epsilon";
+    default: return "none";
+    }
+}
+
+static const char *rp_prev(rfs_drive_status_t s)
+{
+    switch (s) {
+    case RFS_DRIVE_REACHED: return "reached";
+    case RFS_DRIVE_TIMEOUT: return "timeout";
+    case RFS_DRIVE_BLOCKED: return "blocked";
+    case RFS_DRIVE_RUNNING: return "running";
+    default: return "start";
+    }
+}
+
+static FILE *rp_open(const char *dir, const char *name)
+{
+    char p[4096];
+    if (snprintf(p, sizeof(p), "%s/%s", dir, name) >= (int)sizeof(p)) { return NULL; }
+    return fopen(p, "w");
+}
+
+static void rp_rmdir(const char *dir)
+{
+    static const char *names[] = {"log.tsv", "samples.tsv", "track.tsv", "summary.json"};
+    char p[4096];
+    for (size_t i = 0; i < sizeof(names) / sizeof(names[0]); i++) {
+        if (snprintf(p, sizeof(p), "%s/%s", dir, names[i]) < (int)sizeof(p)) { (void)remove(p); }
+    }
+    (void)rmdir(dir);
+}
+
+typedef struct rp_opts {
+    const char *capture, *poses, *scenario, *out;
+    bool has_seed;
+    uint64_t seed;
+} rp_opts_t;
+
+/* Replay: packets, poses and control periods in time order (equal times: packets, then
+ * poses, then control, as the simulator), time counted from the first pose. The robot's
+ * position at any instant is the recorded pose interpolated linearly (theta along the
+ * shorter arc); the controller's wheel commands go nowhere. Ends at the last pose, or
+ * when the robot comes within the stop radius of the goal. */
+static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6], int n_macs,
+                      feed_stats_t *st)
+{
+    char err[1200];
+    hs_scenario_t sc;
+    if (hs_scenario_load(o->scenario, &sc, err, sizeof(err)) != 0) {
+        fprintf(stderr, "rfseek-feed: %s\n", err);
+        return 1;
+    }
+    if (n_macs == 0) {
+        for (unsigned i = 0; i < sc.nsources; i++) { memcpy(macs[i], sc.src[i].mac, 6); }
+        n_macs = (int)sc.nsources;
+    } else if ((unsigned)n_macs != sc.nsources) {
+        fprintf(stderr, "rfseek-feed: --mac: %d addresses given, scenario %s has %u sources\n", n_macs,
+                o->scenario, sc.nsources);
+        return 2;
+    }
+    rp_pose_t *poses = NULL;
+    size_t n_poses = 0;
+    if (read_poses(o->poses, &poses, &n_poses, err, sizeof(err)) != 0) {
+        fprintf(stderr, "rfseek-feed: %s\n", err);
+        return 1;
+    }
+    rp_vec_t pk = {NULL, 0, 0};
+    if (scan_capture(r, (const uint8_t(*)[6])macs, n_macs, st, rp_collect, &pk) != 0) {
+        free(poses);
+        free(pk.v);
+        return 1;
+    }
+    hs_sim_env_t env;
+    if (hs_sim_env_open(&env, &sc, err, sizeof(err)) != 0) {
+        fprintf(stderr, "rfseek-feed: %s\n", err);
+        free(poses);
+        free(pk.v);
+        return 1;
+    }
+    hs_ctrl_inproc_cfg_t cc = hs_ctrl_inproc_cfg_default();
+    cc.model = sc.model;
+    cc.target = sc.target;
+    cc.seed = o->has_seed ? o->seed : sc.seed;
+    hs_ctrl_t ctrl;
+    char cerr[256];
+    int rc = 0;
+    if (hs_ctrl_inproc_open(&ctrl, &cc, &env.core.map, cerr, sizeof(cerr)) != 0) {
+        fprintf(stderr, "rfseek-feed: %s: %s\n", o->scenario, cerr);
+        hs_sim_env_close(&env);
+        free(poses);
+        free(pk.v);
+        return 1;
+    }
+    char tmp[4096];
+    snprintf(tmp, sizeof(tmp), "%s.tmp-%ld", o->out, (long)getpid());
+    if (mkdir(tmp, 0777) != 0) {
+        fprintf(stderr, "rfseek-feed: %s: cannot create: %s\n", tmp, strerror(errno));
+        rc = 1;
+    }
+    FILE *flog = rc == 0 ? rp_open(tmp, "log.tsv") : NULL;
+    FILE *fsam = rc == 0 ? rp_open(tmp, "samples.tsv") : NULL;
+    FILE *ftrk = rc == 0 ? rp_open(tmp, "track.tsv") : NULL;
+    if (rc == 0 && (flog == NULL || fsam == NULL || ftrk == NULL)) {
+        fprintf(stderr, "rfseek-feed: %s: cannot create the logs: %s\n", tmp, strerror(errno));
+        rc = 1;
+    }
+    hs_sim_result_t res;
+    memset(&res, 0, sizeof(res));
+    res.seed = cc.seed;
+    uint64_t before = 0, after = 0;
+    if (rc == 0) {
+        fprintf(flog, "iteration\tt_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\tkind\treason\t"
+                      "relearned\tprediction_db\tmean_db\tepsilon\tgoal_x_m\tgoal_y_m\t"
+                      "max_x_m\tmax_y_m\tpath_m\tsamples\ttravelled_m\n");
+        fprintf(fsam, "t_s\tsrc\tx_m\ty_m\ttravelled_m\tdbm\n");
+        fprintf(ftrk, "t_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\test_theta_rad\ttouching\n");
+        const int64_t t0 = poses[0].t_us;
+        const int64_t t_end = poses[n_poses - 1].t_us - t0;
+        const bool has_goal = sc.has_goal || sc.nsources == 1;
+        /* Per-source sequence tracking: frames lost = gaps in the 12-bit numbers. */
+        bool seen[FEED_MAX_MACS] = {false};
+        uint16_t last_seq[FEED_MAX_MACS] = {0};
+        uint64_t lost = 0;
+        size_t pi = 0, qi = 0; /* next packet, next pose */
+        size_t seg = 0;        /* poses[seg], poses[seg + 1] bracket the current time */
+        double travelled_at_seg = 0.0;
+        uint64_t ctrl_k = 1;
+        const char *end = "time";
+        double fx = poses[0].x, fy = poses[0].y;
+        int64_t t_last = 0;
+        while (pi < pk.n && pk.v[pi].t_us < t0) { pi++; before++; }
+        for (;;) {
+            int64_t te = INT64_MAX;
+            int kind = -1;
+            if (pi < pk.n) { te = pk.v[pi].t_us - t0; kind = 0; }
+            if (qi < n_poses && poses[qi].t_us - t0 < te) { te = poses[qi].t_us - t0; kind = 1; }
+            const int64_t tc = (int64_t)ctrl_k * ctrl.period_us;
+            if (tc < te) { te = tc; kind = 2; }
+            if (te > t_end || kind < 0) { break; }
+            t_last = te;
+            /* The recorded robot position at te. */
+            while (seg + 2 < n_poses && poses[seg + 1].t_us - t0 <= te) {
+                travelled_at_seg += hypot(poses[seg + 1].x - poses[seg].x, poses[seg + 1].y - poses[seg].y);
+                seg++;
+            }
+            const rp_pose_t *pa = &poses[seg], *pb = &poses[seg + 1];
+            const double a = (double)(te - (pa->t_us - t0)) / (double)(pb->t_us - pa->t_us);
+            const double ex = pa->x + a * (pb->x - pa->x), ey = pa->y + a * (pb->y - pa->y);
+            const double eth = rp_wrap(pa->theta + a * rp_wrap(pb->theta - pa->theta));
+            const double etr = travelled_at_seg + a * hypot(pb->x - pa->x, pb->y - pa->y);
+            fx = ex;
+            fy = ey;
+            if (kind == 0) {
+                const rp_pkt_t *p = &pk.v[pi++];
+                if (seen[p->src]) {
+                    const unsigned d = (unsigned)(p->seq - last_seq[p->src]) & 0x0fffu;
+                    if (d >= 2u && d <= 2048u) { lost += d - 1u; }
+                }
+                seen[p->src] = true;
+                last_seq[p->src] = p->seq;
+                res.packets_received++;
+                ctrl.on_rssi(ctrl.self, p->src, te, p->dbm);
+                fprintf(fsam, "%.6f\t%u\t%.3f\t%.3f\t%.3f\t%d\n", te * 1e-6, (unsigned)p->src, ex, ey, etr,
+                        (int)p->dbm);
+            } else if (kind == 1) {
+                const rp_pose_t *q = &poses[qi++];
+                rfs_pose_t pose = {te, rp_q16(q->x), rp_q16(q->y), rp_q16(rp_wrap(q->theta))};
+                ctrl.on_pose(ctrl.self, &pose);
+                fprintf(ftrk, "%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%.4f\t0\n", te * 1e-6, q->x, q->y,
+                        rp_wrap(q->theta), q->x, q->y, rp_wrap(q->theta));
+            } else {
+                ctrl_k++;
+                hs_ctrl_out_t out;
+                memset(&out, 0, sizeof(out));
+                ctrl.step(ctrl.self, te, &out);
+                if (out.decided) {
+                    const rfs_seek_decision_t *d = &out.decision;
+                    res.iterations++;
+                    res.model_updates += d->relearned ? 1u : 0u;
+                    res.greedy += d->kind == RFS_SEEK_GREEDY ? 1u : 0u;
+                    res.epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
+                    char reason[96];
+                    snprintf(reason, sizeof(reason), "prev=%s%s%s%s", rp_prev(d->prev),
+                             d->line_search ? ",line_search" : "", d->model_valid ? "" : ",no_model",
+                             d->mean_valid ? "" : ",no_mean");
+                    fprintf(flog,
+                            "%u\t%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%s\t%s\t%d\t%.3f\t%.3f\t"
+                            "%.4f\t%.3f\t%.3f\t%.3f\t%.3f\t%.3f\t%u\t%.3f\n",
+                            d->iteration, te * 1e-6, ex, ey, eth, rp_d(d->x), rp_d(d->y), rp_kind(d->kind),
+                            reason, d->relearned ? 1 : 0, d->model_valid ? rp_d(d->prediction) : NAN,
+                            d->mean_valid ? rp_d(d->mean) : NAN, rp_d(d->epsilon), rp_d(d->goal_x),
+                            rp_d(d->goal_y), rp_d(d->max_x), rp_d(d->max_y), rp_d(d->path_len), d->samples,
+                            etr);
+                }
+            }
+            if (has_goal && sc.stop_radius_m > 0.0 && hypot(ex - sc.goal_x, ey - sc.goal_y) <= sc.stop_radius_m) {
+                end = "reached";
+                res.reached = true;
+                res.distance_travelled_m = etr;
+                break;
+            }
+            res.distance_travelled_m = etr;
+        }
+        after = pk.n - pi;
+        res.end = end;
+        res.sim_time_s = t_last * 1e-6;
+        res.shortest_path_m = env.shortest_path_m;
+        res.shortest_to_stop_m = env.shortest_to_stop_m;
+        res.final_x = fx;
+        res.final_y = fy;
+        res.final_distance_m = has_goal ? hypot(fx - sc.goal_x, fy - sc.goal_y) : NAN;
+        res.packets_sent = res.packets_received + lost; /* from the sequence-number gaps */
+        FILE *fsum = rp_open(tmp, "summary.json");
+        if (fsum == NULL) {
+            fprintf(stderr, "rfseek-feed: %s/summary.json: %s\n", tmp, strerror(errno));
+            rc = 1;
+        } else {
+            hs_sim_write_summary(fsum, &env, &res);
+            if (fclose(fsum) != 0) { rc = 1; }
+        }
+    }
+    if (flog != NULL && (ferror(flog) || fclose(flog) != 0)) { rc = 1; }
+    if (fsam != NULL && (ferror(fsam) || fclose(fsam) != 0)) { rc = 1; }
+    if (ftrk != NULL && (ferror(ftrk) || fclose(ftrk) != 0)) { rc = 1; }
+    if (rc == 0 && rename(tmp, o->out) != 0) {
+        fprintf(stderr, "rfseek-feed: %s: cannot rename to %s: %s\n", tmp, o->out, strerror(errno));
+        rc = 1;
+    }
+    if (rc != 0) { rp_rmdir(tmp); }
+    if (rc == 0 && st != NULL) {
+        st->replay_before = before;
+        st->replay_after = after;
+    }
+    hs_ctrl_close(&ctrl);
+    hs_sim_env_close(&env);
+    free(poses);
+    free(pk.v);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
-    const char *capture = NULL;
     const char *output = NULL;
+    rp_opts_t ro;
+    memset(&ro, 0, sizeof(ro));
     uint8_t macs[FEED_MAX_MACS][6];
     int n_macs = 0;
     bool stats = false;
     bool live = false;
+    static const char *const k_valued[] = {"--mac", "--format", "--output", "--pose", "--scenario", "--out", "--seed"};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
+        bool valued = false;
+        for (size_t k = 0; k < sizeof(k_valued) / sizeof(k_valued[0]); k++) {
+            valued = valued || strcmp(a, k_valued[k]) == 0;
+        }
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             fputs(k_usage, stdout);
             return 0;
-        } else if (strcmp(a, "--mac") == 0 || strcmp(a, "--format") == 0 || strcmp(a, "--output") == 0) {
+        } else if (valued) {
             if (i + 1 >= argc) {
                 fprintf(stderr, "rfseek-feed: %s needs a value (see --help)\n", a);
                 return 2;
@@ -175,8 +644,23 @@ int main(int argc, char **argv)
                     fprintf(stderr, "rfseek-feed: --format: '%s' is not supported (tsv)\n", v);
                     return 2;
                 }
-            } else {
+            } else if (strcmp(a, "--output") == 0) {
                 output = v;
+            } else if (strcmp(a, "--pose") == 0) {
+                ro.poses = v;
+            } else if (strcmp(a, "--scenario") == 0) {
+                ro.scenario = v;
+            } else if (strcmp(a, "--out") == 0) {
+                ro.out = v;
+            } else {
+                char *e = NULL;
+                errno = 0;
+                ro.seed = strtoull(v, &e, 10);
+                if (e == v || *e != '\0' || errno != 0 || v[0] == '-') {
+                    fprintf(stderr, "rfseek-feed: --seed: '%s' is not a non-negative integer\n", v);
+                    return 2;
+                }
+                ro.has_seed = true;
             }
         } else if (strcmp(a, "--stats") == 0) {
             stats = true;
@@ -185,91 +669,47 @@ int main(int argc, char **argv)
         } else if (a[0] == '-' && a[1] != '\0') {
             fprintf(stderr, "rfseek-feed: unknown option '%s' (see --help)\n", a);
             return 2;
-        } else if (capture == NULL) {
-            capture = a;
+        } else if (ro.capture == NULL) {
+            ro.capture = a;
         } else {
-            fprintf(stderr, "rfseek-feed: more than one capture given ('%s' and '%s')\n", capture, a);
+            fprintf(stderr, "rfseek-feed: more than one capture given ('%s' and '%s')\n", ro.capture, a);
             return 2;
         }
     }
-    if (capture == NULL || n_macs == 0) {
-        fprintf(stderr, "rfseek-feed: %s (see --help)\n", capture == NULL ? "no CAPTURE given" : "no --mac given");
+    const bool replay = ro.poses != NULL;
+    if (ro.capture == NULL) {
+        fprintf(stderr, "rfseek-feed: no CAPTURE given (see --help)\n");
+        return 2;
+    }
+    if (replay && (ro.scenario == NULL || ro.out == NULL)) {
+        fprintf(stderr, "rfseek-feed: --pose needs --scenario and --out (see --help)\n");
+        return 2;
+    }
+    if (!replay && (ro.scenario != NULL || ro.out != NULL || ro.has_seed)) {
+        fprintf(stderr, "rfseek-feed: --scenario, --out and --seed only go with --pose (see --help)\n");
+        return 2;
+    }
+    if (replay && (output != NULL || live)) {
+        fprintf(stderr, "rfseek-feed: --output and --live do not go with --pose (see --help)\n");
+        return 2;
+    }
+    if (!replay && n_macs == 0) {
+        fprintf(stderr, "rfseek-feed: no --mac given (see --help)\n");
         return 2;
     }
 
     char err[512];
-    hs_pcap_reader_t *r = live ? hs_pcap_open_live(capture, err, sizeof(err))
-                               : hs_pcap_open_offline(capture, err, sizeof(err));
+    hs_pcap_reader_t *r = live ? hs_pcap_open_live(ro.capture, err, sizeof(err))
+                               : hs_pcap_open_offline(ro.capture, err, sizeof(err));
     if (r == NULL) {
         fprintf(stderr, "rfseek-feed: %s\n", err);
         return 1;
     }
-    char *tmp = NULL;
-    FILE *out = stdout;
-    if (output != NULL) {
-        const size_t n = strlen(output);
-        tmp = malloc(n + 5);
-        if (tmp == NULL) { hs_pcap_close(r); fprintf(stderr, "rfseek-feed: out of memory\n"); return 1; }
-        memcpy(tmp, output, n);
-        memcpy(tmp + n, ".tmp", 5);
-        out = fopen(tmp, "w");
-        if (out == NULL) {
-            fprintf(stderr, "rfseek-feed: %s: cannot create: %s\n", tmp, strerror(errno));
-            hs_pcap_close(r);
-            free(tmp);
-            return 1;
-        }
-    }
-    static char obuf[1 << 16];
-    setvbuf(out, obuf, _IOFBF, sizeof(obuf));
-
     feed_stats_t st;
     memset(&st, 0, sizeof(st));
-    int rc = 0;
-    for (;;) {
-        hs_pcap_pkt_t pkt;
-        const int got = hs_pcap_next(r, &pkt, err, sizeof(err));
-        if (got == 2) { fflush(out); continue; }
-        if (got == 0) { break; }
-        if (got < 0) {
-            fprintf(stderr, "rfseek-feed: %s (after %llu packets)\n", err, (unsigned long long)st.packets);
-            rc = 1;
-            break;
-        }
-        st.packets++;
-        if (pkt.caplen < pkt.origlen) { st.caplen_short++; }
-        hs_rt_frame_t f;
-        if (hs_rt_frame_parse(pkt.data, pkt.caplen, &f) != 0) {
-            st.rt_bad[f.rt.status]++;
-            continue;
-        }
-        st.rt_bad[f.rt.status]++;
-        if (!f.wlan_ok) { st.no_wlan++; continue; }
-        if (!f.wlan.has_sa) { st.no_sa++; continue; }
-        int m = 0;
-        while (m < n_macs && memcmp(macs[m], f.wlan.sa, 6) != 0) { m++; }
-        if (m == n_macs) { continue; }
-        st.sa_match++;
-        if (!f.rt.has_dbm_signal) { st.no_signal++; continue; }
-        char line[64];
-        const size_t len = format_line(line, pkt.t_ns, f.wlan.sa, f.rt.dbm_signal);
-        fwrite(line, 1, len, out);
-        st.lines++;
-    }
+    const int rc = replay ? run_replay(&ro, r, macs, n_macs, &st)
+                          : run_tsv(r, output, live, (const uint8_t(*)[6])macs, n_macs, &st);
     hs_pcap_close(r);
-    if (fflush(out) != 0 || ferror(out)) {
-        fprintf(stderr, "rfseek-feed: %s: write error: %s\n", output != NULL ? tmp : "stdout", strerror(errno));
-        rc = 1;
-    }
-    if (output != NULL) {
-        if (fclose(out) != 0) { rc = 1; }
-        if (rc == 0 && rename(tmp, output) != 0) {
-            fprintf(stderr, "rfseek-feed: %s: cannot rename to %s: %s\n", tmp, output, strerror(errno));
-            rc = 1;
-        }
-        if (rc != 0) { (void)remove(tmp); }
-        free(tmp);
-    }
-    if (stats) { print_stats(capture, &st); }
+    if (stats) { print_stats(ro.capture, &st); }
     return rc;
 }

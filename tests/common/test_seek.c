@@ -203,7 +203,9 @@ static bool fm_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *v)
     return true;
 }
 
-static const rfs_model_ops_t fm_ops = { "fixed", fm_reset, fm_fit, fm_predict, 0 };
+static const rfs_model_ops_t fm_ops = {
+    .name = "fixed", .reset = fm_reset, .fit = fm_fit, .predict = fm_predict,
+};
 
 /* Greedy step blocked by a wall: the line search picks the first legal point on the line
  * to the maximum, in front of or beyond the wall (paper section 2). */

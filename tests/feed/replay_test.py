@@ -1,0 +1,170 @@
+#!/usr/bin/env python3
+"""rfseek-feed --pose: replay a recorded run through the seeker (issue 5).
+
+Builds a capture (pure python pcap bytes) and a pose CSV for scenarios/default.yaml: the
+robot drives east along the corridor from the start at 0.5 m/s for 30 s, poses at 10 Hz;
+the source sends 50 frames/s with a log-distance signal, every 10th frame lost (a gap in
+the sequence numbers), plus frames before the first pose, after the last one and from
+another transmitter. Checks, against values computed here in double precision:
+samples.tsv positions (linear interpolation of the poses at each frame's time), dBm and
+times; track.tsv; summary.json (packets received and sent from the sequence gaps,
+distance travelled, end, final position); log.tsv's header is the simulator's and the
+first decision is the initial move. Then bad pose files and options.
+usage: replay_test.py FEED
+"""
+import json
+import math
+import os
+import struct
+import subprocess
+import sys
+import tempfile
+
+FEED = sys.argv[1]
+SCEN = "scenarios/default.yaml"
+SRC_MAC = bytes.fromhex("020000000001")
+OTHER = bytes.fromhex("020000000099")
+BSSID = bytes.fromhex("0a1b2c3d4e5f")
+SOURCE_XY = (27.5, 10.0)
+T0 = 1700000000000000  # first pose, microseconds since the epoch
+fails = 0
+
+
+def check(name, ok, detail=""):
+    global fails
+    print(("PASS " if ok else "FAIL ") + name + ("" if ok else ": " + detail))
+    fails += 0 if ok else 1
+
+
+def record(t_us, mac, seq, dbm):
+    rt = struct.pack("<BBHI", 0, 0, 9, 0x20) + struct.pack("<b", dbm)
+    hdr = struct.pack("<BB", 0x08, 0x01) + b"\0\0" + BSSID + mac + BSSID + struct.pack("<H", (seq & 0xFFF) << 4)
+    data = rt + hdr
+    return struct.pack("<IIII", t_us // 1000000, t_us % 1000000, len(data), len(data)) + data
+
+
+def pose_at(poses, t):
+    for (ta, xa, ya, _), (tb, xb, yb, _) in zip(poses, poses[1:]):
+        if ta <= t <= tb:
+            a = (t - ta) / (tb - ta)
+            return xa + a * (xb - xa), ya + a * (yb - ya)
+    raise ValueError(t)
+
+
+def main():
+    tmp = tempfile.mkdtemp(prefix="rfs_replay_")
+    poses = [(T0 + k * 100000, 8.0 + 0.05 * k, 6.0, 0.0) for k in range(301)]  # 30 s
+    with open(os.path.join(tmp, "poses.csv"), "w") as f:
+        f.write("t_us,x_m,y_m,theta_rad\n")
+        for t, x, y, th in poses:
+            f.write("%d,%.6f,%.6f,%.6f\n" % (t, x, y, th))
+    recs = []
+    want = []  # (t_rel_s, x, y, dbm) for frames inside the poses' span
+    seq = 100
+    sent_in = received_in = 0
+    for k in range(-20, 1510):
+        t = T0 + k * 20000 + 7
+        seq = (seq + 1) & 0xFFF
+        inside = T0 <= t <= poses[-1][0]
+        if k % 10 == 3:
+            sent_in += inside
+            continue  # lost
+        if inside:
+            x, y = pose_at(poses, t)
+            d = max(1.0, math.hypot(x - SOURCE_XY[0], y - SOURCE_XY[1]))
+            dbm = int(round(-40 - 30 * math.log10(d)))
+            want.append(((t - T0) / 1e6, x, y, dbm))
+            sent_in += 1
+            received_in += 1
+        else:
+            dbm = -70
+        recs.append(record(t, SRC_MAC, seq, dbm))
+        if k % 7 == 0:
+            recs.append(record(t + 1, OTHER, k, -30))
+    cap = os.path.join(tmp, "run.pcap")
+    with open(cap, "wb") as f:
+        f.write(struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 127) + b"".join(recs))
+
+    out = os.path.join(tmp, "out")
+    p = subprocess.run([FEED, cap, "--pose", os.path.join(tmp, "poses.csv"), "--scenario", SCEN,
+                        "--out", out, "--seed", "3", "--stats"], capture_output=True, text=True)
+    check("replay exits 0", p.returncode == 0, p.stderr.strip())
+    if p.returncode != 0:
+        return
+    check("replay output complete, no temporary left",
+          sorted(os.listdir(out)) == ["log.tsv", "samples.tsv", "summary.json", "track.tsv"]
+          and not any(n.startswith("out.tmp") for n in os.listdir(tmp)), str(os.listdir(tmp)))
+    with open(os.path.join(out, "samples.tsv")) as f:
+        rows = [l.rstrip("\n").split("\t") for l in f]
+    check("samples header", rows[0] == ["t_s", "src", "x_m", "y_m", "travelled_m", "dbm"], str(rows[0]))
+    rows = rows[1:]
+    check("samples: one per received frame in the poses' span", len(rows) == len(want),
+          "%d rows, want %d" % (len(rows), len(want)))
+    bad = [(r, w) for r, w in zip(rows, want)
+           if abs(float(r[0]) - w[0]) > 1e-6 or r[1] != "0" or abs(float(r[2]) - w[1]) > 0.0006
+           or abs(float(r[3]) - w[2]) > 0.0006 or int(r[5]) != w[3]
+           or abs(float(r[4]) - (w[1] - 8.0)) > 0.0006]
+    check("samples: time, interpolated position, travelled and dBm equal the reference", not bad,
+          str(bad[:2]))
+    with open(os.path.join(out, "track.tsv")) as f:
+        trk = f.read().splitlines()
+    check("track: one row per pose", len(trk) == 1 + len(poses), str(len(trk)))
+    with open(os.path.join(out, "summary.json")) as f:
+        sm = json.load(f)
+    check("summary: packets_received", sm["packets_received"] == received_in,
+          "%s want %d" % (sm["packets_received"], received_in))
+    check("summary: packets_sent from the sequence gaps", sm["packets_sent"] == sent_in,
+          "%s want %d" % (sm["packets_sent"], sent_in))
+    check("summary: distance travelled 15 m", abs(sm["distance_travelled_m"] - 15.0) < 0.002,
+          str(sm["distance_travelled_m"]))
+    check("summary: ends at the last pose, not reached", sm["end"] == "time" and sm["reached"] is False
+          and abs(sm["final_x_m"] - 23.0) < 0.002 and abs(sm["sim_time_s"] - 30.0) < 1e-3, str(sm))
+    check("summary: final distance to the goal",
+          abs(sm["final_distance_m"] - math.hypot(23.0 - 27.5, 6.0 - 10.0)) < 0.002, str(sm["final_distance_m"]))
+    check("summary: the seeker decided", sm["iterations"] >= 1 and sm["seed"] == 3, str(sm))
+    with open(os.path.join(out, "log.tsv")) as f:
+        log = [l.rstrip("\n").split("\t") for l in f]
+    sim_header = ("iteration\tt_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\tkind\treason\trelearned\t"
+                  "prediction_db\tmean_db\tepsilon\tgoal_x_m\tgoal_y_m\tmax_x_m\tmax_y_m\tpath_m\t"
+                  "samples\ttravelled_m").split("\t")
+    check("log: the simulator's header", log[0] == sim_header, str(log[0]))
+    check("log: one row per decision, first the initial move",
+          len(log) - 1 == sm["iterations"] and log[1][0] == "0" and log[1][7] == "initial", str(log[:2]))
+    check("stats: frames outside the poses counted",
+          "not fed, before the first pose" in p.stderr and "not fed, after the last pose" in p.stderr, p.stderr)
+
+    # bad input: one line naming file:line, exit 1, nothing written
+    def bad(name, text, rc, pattern, extra=()):
+        path = os.path.join(tmp, name + ".csv")
+        with open(path, "w") as f:
+            f.write(text)
+        o = os.path.join(tmp, "bad-" + name)
+        q = subprocess.run([FEED, cap, "--pose", path, "--scenario", SCEN, "--out", o] + list(extra),
+                           capture_output=True, text=True)
+        err = q.stderr.strip()
+        check("bad %s: exit %d, '%s', nothing written" % (name, rc, pattern),
+              q.returncode == rc and pattern in err and len(err.splitlines()) == 1
+              and not any(n.startswith("bad-" + name) for n in os.listdir(tmp)), "%d %s" % (q.returncode, err))
+
+    good = "t_us,x_m,y_m,theta_rad\n%d,8,6,0\n%d,9,6,0\n" % (T0, T0 + 1000000)
+    bad("header", "t,x,y,theta\n1,2,3,4\n", 1, "header.csv:1: header must be 't_us,x_m,y_m,theta_rad'")
+    bad("order", "t_us,x_m,y_m,theta_rad\n%d,8,6,0\n%d,9,6,0\n" % (T0, T0), 1,
+        "order.csv:3: t_us: %d is not after the previous pose" % T0)
+    bad("number", "t_us,x_m,y_m,theta_rad\n%d,8,abc,0\n" % T0, 1, "number.csv:2: y_m: not a finite number")
+    bad("nan", "t_us,x_m,y_m,theta_rad\n%d,8,6,nan\n" % T0, 1, "nan.csv:2: theta_rad: not a finite number")
+    bad("short", "t_us,x_m,y_m,theta_rad\n%d,8,6,0\n" % T0, 1, "short.csv: fewer than 2 poses")
+    bad("macs", good, 2, "--mac: 2 addresses given", ["--mac", "02:00:00:00:00:01", "--mac", "02:00:00:00:00:02"])
+    bad("seed", good, 2, "--seed: '-1' is not a non-negative integer", ["--seed", "-1"])
+    q = subprocess.run([FEED, cap, "--pose", "x.csv"], capture_output=True, text=True)
+    check("--pose without --scenario/--out", q.returncode == 2 and "--pose needs --scenario and --out" in q.stderr,
+          q.stderr)
+    q = subprocess.run([FEED, cap, "--mac", "02:00:00:00:00:01", "--out", "x"], capture_output=True, text=True)
+    check("--out without --pose", q.returncode == 2 and "only go with --pose" in q.stderr, q.stderr)
+    if os.environ.get("KEEP") is None:
+        subprocess.run(["rm", "-rf", tmp])
+    else:
+        print("kept " + tmp)
+
+
+main()
+sys.exit(1 if fails else 0)

@@ -2,7 +2,8 @@
  * sample store), for callgrind (`make bench-data`, docs/PERFORMANCE.md "data").
  *
  *   bench_ridge fit N [spread_cm]   one ridge fit over N samples (default: all within 5 m)
- *   bench_ridge predict N           N predictions
+ *   bench_ridge predict N           N predictions, one call each
+ *   bench_ridge row N               N predictions in rows of 160 (predict_row)
  *   bench_ridge rssi N              N pushes + means at 400 packets/s
  *   bench_ridge store N             N measurements + poses at 400/s and 10 Hz
  * Collection is toggled on around the measured calls only (CALLGRIND_TOGGLE_COLLECT), so callgrind
@@ -20,9 +21,10 @@
 
 static int usage(FILE *f, int rc)
 {
-    fprintf(f, "usage: bench_ridge fit|predict|rssi|store N [spread_cm]\n"
+    fprintf(f, "usage: bench_ridge fit|predict|row|rssi|store N [spread_cm]\n"
                "  fit N [spread_cm]  one ridge fit over N samples within +-spread_cm (350)\n"
-               "  predict N          N predictions of a fitted model\n"
+               "  predict N          N predictions of a fitted model, one call each\n"
+               "  row N              N predictions in rows of 160 (predict_row)\n"
                "  rssi N             N pushes and means of one window (400 packets/s)\n"
                "  store N            N measurements with poses at 10 Hz\n");
     return rc;
@@ -69,8 +71,10 @@ int main(int argc, char **argv)
     rfs_rng_t g;
     rfs_rng_seed(&g, 42u);
     int64_t check = 0;
-    if (strcmp(argv[1], "fit") == 0 || strcmp(argv[1], "predict") == 0) {
+    if (strcmp(argv[1], "fit") == 0 || strcmp(argv[1], "predict") == 0 ||
+        strcmp(argv[1], "row") == 0) {
         bool fit = strcmp(argv[1], "fit") == 0;
+        bool row = strcmp(argv[1], "row") == 0;
         uint32_t ns = fit ? (uint32_t)n : 10000u;
         rfs_sample_t *s = make_samples(ns, (int32_t)spread, &g);
         rfs_ridge_t r;
@@ -88,7 +92,17 @@ int main(int argc, char **argv)
             CALLGRIND_TOGGLE_COLLECT;
         }
         check = res * 1000003 + r.icpt + r.wx_q24 + r.wy_q24;
-        if (!fit) {
+        if (row) {
+            /* rows of 160 points 0.25 m apart (a 40 m wide map), N points in all */
+            static rfs_q16_t out[160];
+            CALLGRIND_TOGGLE_COLLECT;
+            for (long i = 0; i < n; i += 160) {
+                uint16_t len = (uint16_t)(n - i < 160 ? n - i : 160);
+                rfs_ridge_ops.predict_row(&r, 0, (rfs_q16_t)((i / 160) * 16384), 16384, len, out);
+                check += out[0] + out[len - 1];
+            }
+            CALLGRIND_TOGGLE_COLLECT;
+        } else if (!fit) {
             rfs_q16_t v = 0;
             CALLGRIND_TOGGLE_COLLECT;
             rfs_q16_t x = 0, y = 0;

@@ -8,8 +8,9 @@
 #ifndef RFS_ASSERT_H
 #define RFS_ASSERT_H
 
-/// Called when an RFS_ASSERT fails; weak default traps. Replace it by defining it.
-void rfs_assert_failed(const char *file, int line);
+/// Called when an RFS_ASSERT fails; weak default traps. Replace it by defining it; it must
+/// not return (reset, halt, or abort()).
+_Noreturn void rfs_assert_failed(const char *file, int line);
 
 /// Check a programmer-error precondition (never a check on outside input).
 #define RFS_ASSERT(cond) \

@@ -132,8 +132,12 @@ typedef struct rfs_can_status {
 uint8_t rfs_can_crc8(const uint8_t *p, uint32_t n);
 
 /// The checksum a frame with this id, dlc and data must carry in data[dlc-1].
-/// dlc must be 1..8.
+/// dlc must be 1..8. Table-driven (256-byte const table).
 uint8_t rfs_can_checksum(uint32_t id, uint8_t dlc, const uint8_t *data);
+
+/// The same checksum computed bit by bit (no table: 256 bytes less flash, about 6x the
+/// instructions; docs/PERFORMANCE.md). Identical results.
+uint8_t rfs_can_checksum_bitwise(uint32_t id, uint8_t dlc, const uint8_t *data);
 
 /// Encoders: fill f completely (id, exact DLC, payload, zero padding, checksum) with the
 /// given 4-bit counter (only its low 4 bits are used). Values out of a field's range are

@@ -1,15 +1,20 @@
 /* rfs_drive.c - differential-drive path following (docs/MAPS.md, "Drive control").
  *
- * Per update: advance past waypoints within `switch` distance; take the bearing to the
- * waypoint being approached (CORDIC atan2) and the heading error e. When |e| exceeds
- * turn_in_place, turn on the spot (omega = 3 e, wheels at most v_max / 2); otherwise
- * drive at v = min(v_max, sqrt(2 a/2 d + v_corner^2)) (1 - |e| / turn_in_place) with
- * omega = 2.5 e, where d is the
- * distance to the waypoint and v_corner = v_max cos(turn at the waypoint) (0 at the
- * goal), so the robot arrives at the goal slowly and brakes for corners with half the
- * acceleration limit in reserve for steering. Wheel speeds are scaled together to
- * v_max, then each is moved towards its target by at most accel * dt. Within goal_tol
- * of the goal both wheels ramp to 0 and the goal is REACHED when they are 0.
+ * Per update: advance past waypoints within SWITCH_DIST; take the bearing to the
+ * waypoint being approached (CORDIC atan2) and the heading error e.
+ *  - When a path starts, or |e| exceeds turn_in_place, turn on the spot until
+ *    |e| < turn_in_place / 16: omega = 3 e, wheels at most v_max / 2 and slow enough to
+ *    stop within the remaining angle.
+ *  - Otherwise drive at v = clamp(sqrt(2 (a/2) d + v_corner^2), 0.05 m/s, v_max) times
+ *    (1 - |e| / turn_in_place)^2, with omega = 2.5 e. d is the distance left to where the
+ *    waypoint counts as passed (SWITCH_DIST before it, or half the goal tolerance before
+ *    the goal); v_corner = v_max (1 - turn / turn_in_place)^2 for the turn at that
+ *    waypoint (0 at the goal and for turns it will make on the spot). So the robot
+ *    brakes for corners, arrives slowly, keeps half the acceleration for steering, and
+ *    stays within 0.07 m of the planned polyline (clearance 0.25 m - radius 0.177 m).
+ *  - Both wheel targets are scaled together to v_max, then each wheel moves towards its
+ *    target by at most accel * dt. Within goal_tol of the goal both wheels ramp to 0 and
+ *    the goal is REACHED when they are 0.
  */
 #include "rfs_drive.h"
 
@@ -17,8 +22,12 @@
 
 #define PI_Q16 ((rfs_q16_t)205887)
 #define TWO_PI_Q16 ((int64_t)411775)
-/* Waypoints other than the goal count as passed within this distance. */
-#define SWITCH_DIST RFS_Q16_FRAC(1, 5)
+/* Waypoints other than the goal count as passed within this distance. Small, because
+ * switching early cuts the corner: the robot must stay within clearance - radius
+ * (0.25 - 0.177 m) of the planned, legal polyline (tested: within 0.07 m). */
+#define SWITCH_DIST RFS_Q16_FRAC(1, 50)
+/* Slowest forward speed when heading is right, mm/s (stops within 1.3 mm). */
+#define V_CREEP 50
 /* Steering gains, 1/s in Q16.16. */
 #define K_HEADING RFS_Q16_FRAC(5, 2)
 #define K_TURN RFS_Q16_INT(3)
@@ -68,6 +77,8 @@ void rfs_drive_set_path(rfs_drive_t *d, const rfs_path_t *path, int64_t now_us)
     d->last_us = now_us;
     d->stall_ref_us = now_us;
     d->stall_ref_dist = RFS_Q16_MAX;
+    /* From rest, face the first waypoint before driving off (no departure at an angle). */
+    d->turning = true;
 }
 
 void rfs_drive_stop(rfs_drive_t *d, int64_t now_us)
@@ -233,7 +244,14 @@ rfs_drive_status_t rfs_drive_update(rfs_drive_t *d, const rfs_pose_t *pose, int6
             int32_t half_base = c->wheel_base_mm / 2;
             int32_t v = 0;
             int32_t w_mm = 0; /* omega * wheel_base / 2, mm/s */
+            /* Hysteresis: once turning on the spot, keep turning until the error is
+             * below turn_in_place / 16, so the robot never drives off while rotating. */
             if (rfs_q16_abs(e) > c->turn_in_place) {
+                d->turning = true;
+            } else if (rfs_q16_abs(e) < c->turn_in_place / 16) {
+                d->turning = false;
+            }
+            if (d->turning) {
                 w_mm = (int32_t)(((int64_t)rfs_q16_mul(K_TURN, e) * half_base) >> 16);
                 /* Cap: v_max / 2, and a wheel speed that can stop within the remaining
                  * arc |e| * b / 2 at half the acceleration limit (no overshoot). */
@@ -245,24 +263,29 @@ rfs_drive_status_t rfs_drive_update(rfs_drive_t *d, const rfs_pose_t *pose, int6
             } else {
                 int32_t v_end = 0;
                 if (d->next < last) {
-                    /* Corner speed: v_max * cos(angle between the approach and the next leg). */
+                    /* Corner speed: v_max (1 - theta / turn_in_place)^2 for a turn of
+                     * theta between the approach and the next leg; 0 from turn_in_place
+                     * on, where the robot will turn on the spot. */
                     int64_t ux = q16_to_mm(ex);
                     int64_t uy = q16_to_mm(ey);
                     int64_t wx = q16_to_mm((int64_t)d->path.x[d->next + 1] - d->path.x[d->next]);
                     int64_t wy = q16_to_mm((int64_t)d->path.y[d->next + 1] - d->path.y[d->next]);
-                    int64_t dot = ux * wx + uy * wy;
-                    int64_t nu = rfs_isqrt64((uint64_t)(ux * ux + uy * uy));
-                    int64_t nw = rfs_isqrt64((uint64_t)(wx * wx + wy * wy));
-                    if (dot > 0 && nu > 0 && nw > 0) {
-                        v_end = (int32_t)rfs_sdiv64_round(dot * c->v_max_mm_s, nu * nw);
+                    rfs_q16_t theta = rfs_q16_abs(atan2_q16(ux * wy - uy * wx, ux * wx + uy * wy));
+                    if (theta < c->turn_in_place) {
+                        rfs_q16_t f = rfs_q16_div(c->turn_in_place - theta, c->turn_in_place);
+                        v_end = (int32_t)(((int64_t)rfs_q16_mul(f, f) * c->v_max_mm_s) >> 16);
                     }
                 }
-                v = brake_speed(c->accel_mm_s2, q16_to_mm(dn), v_end);
+                /* Brake to v_end where the waypoint counts as passed (or at half the
+                 * goal tolerance), not at the waypoint itself: no overshoot at corners. */
+                rfs_q16_t stop_at = d->next < last ? SWITCH_DIST : c->goal_tol / 2;
+                v = brake_speed(c->accel_mm_s2, q16_to_mm((int64_t)dn - stop_at), v_end);
+                v = v < V_CREEP ? V_CREEP : v;
                 v = v > c->v_max_mm_s ? c->v_max_mm_s : v;
                 /* Fade the forward speed in as the heading error closes, so the switch
                  * from turning on the spot is smooth. */
-                v = (int32_t)rfs_sdiv64_round((int64_t)v * (c->turn_in_place - rfs_q16_abs(e)),
-                                              c->turn_in_place);
+                rfs_q16_t fade = rfs_q16_div(c->turn_in_place - rfs_q16_abs(e), c->turn_in_place);
+                v = (int32_t)(((int64_t)rfs_q16_mul(fade, fade) * v) >> 16);
                 w_mm = (int32_t)(((int64_t)rfs_q16_mul(K_HEADING, e) * half_base) >> 16);
             }
             tl = v - w_mm;

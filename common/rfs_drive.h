@@ -50,6 +50,7 @@ typedef struct rfs_drive {
     rfs_q16_t stall_ref_dist;      ///< remaining distance at that time, metres Q16.16
     int32_t left_mm_s;             ///< last commanded left wheel speed, mm/s
     int32_t right_mm_s;            ///< last commanded right wheel speed, mm/s
+    bool turning;                  ///< turning on the spot until the heading error is small
 } rfs_drive_t;
 
 /// Defaults: TurtleBot 2 (Kobuki) base: 0.23 m, 0.7 m/s, 1 m/s^2 (the TurtleBot velocity

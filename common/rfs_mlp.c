@@ -299,12 +299,41 @@ static void start_fit(rfs_mlp_t *m, const rfs_sample_t *samples, uint16_t n, rfs
     memset(m->mb_q24, 0, sizeof(m->mb_q24));
     memset(m->mv_q24, 0, sizeof(m->mv_q24));
     m->mc_q24 = 0;
-    for (uint16_t i = 0u; i < n; ++i) {
-        m->order[i] = i;
+    uint8_t h = 1u;
+    while (((uint32_t)1 << (2u * h)) < n) {
+        ++h;
     }
+    m->half_bits = h;
     m->fit_n = n;
     m->pos = 0u;
     m->epoch = 0u;
+}
+
+/* The round function of the Feistel network (see rfs_mlp.h). */
+static uint32_t feistel_f(uint32_t k, uint32_t r, uint32_t mask)
+{
+    uint32_t x = (k ^ r) * 0x9E3779B1u;
+    x ^= x >> 15;
+    x *= 0x85EBCA6Bu;
+    x ^= x >> 13;
+    return x & mask;
+}
+
+/* Position p of the epoch -> sample index, a bijection of [0, fit_n). The Feistel
+ * network permutes [0, 4^h); cycle walking maps it back into [0, fit_n). */
+static uint16_t permute(const rfs_mlp_t *m, uint16_t p)
+{
+    uint32_t h = m->half_bits, mask = ((uint32_t)1 << h) - 1u, i = p;
+    do {
+        uint32_t l = i >> h, r = i & mask;
+        for (unsigned k = 0u; k < 4u; ++k) {
+            uint32_t t = l ^ feistel_f(m->key[k], r, mask);
+            l = r;
+            r = t;
+        }
+        i = (l << h) | r;
+    } while (i >= m->fit_n);
+    return (uint16_t)i;
 }
 
 static void mlp_reset(void *self)
@@ -342,15 +371,12 @@ static rfs_fit_result_t mlp_fit(void *self, const rfs_model_fit_in_t *in, uint32
             return RFS_FIT_MORE;
         }
         if (m->pos == 0u) {
-            /* Fisher-Yates, as PyBrain reshuffles at every epoch. */
-            for (uint16_t i = (uint16_t)(m->fit_n - 1u); i > 0u; --i) {
-                uint16_t k = (uint16_t)rfs_rng_below(rng, (uint32_t)i + 1u);
-                uint16_t tmp = m->order[i];
-                m->order[i] = m->order[k];
-                m->order[k] = tmp;
+            /* A fresh order every epoch, as PyBrain reshuffles at every epoch. */
+            for (unsigned r = 0u; r < 4u; ++r) {
+                m->key[r] = rfs_rng_u32(rng);
             }
         }
-        train_one(m, &in->samples[m->order[m->pos]]);
+        train_one(m, &in->samples[permute(m, m->pos)]);
         m->pos++;
         m->updates++;
     }

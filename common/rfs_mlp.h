@@ -17,14 +17,23 @@
  *   then v[j] for each j; then c. Each weight takes two rfs_rng_u32() values, i.e. four
  *   16-bit uniforms u1..u4 (low half first), w = ((u1 + u2 + u3 + u4) / 65536 - 2) * sqrt(3)
  *   (Irwin-Hall: mean 0, variance 1, as PyBrain's randn initialisation);
- *   each epoch: order[i] = i before the first epoch, then a Fisher-Yates shuffle
- *   for i = n-1 down to 1: j = rfs_rng_below(rng, i + 1), swap order[i], order[j].
+ *   each epoch: four keys k0..k3 = rfs_rng_u32(); the epoch visits the samples in the
+ *   order p = 0..n-1 -> perm(p), a keyed pseudo-random permutation (below).
+ *
+ * The shuffle is a permutation computed on the fly rather than a Fisher-Yates shuffle of
+ * an index array, so that the state needs no 20 KB order array: a 4-round Feistel
+ * network on 2h bits (h = smallest with 4^h >= n, h >= 1), halves L = i >> h and
+ * R = i & (2^h - 1), each round (L, R) = (R, L ^ F(k_r, R)) with
+ *   F(k, r) = mix(k ^ r) & (2^h - 1),  mix(x): x *= 0x9E3779B1; x ^= x >> 15;
+ *                                      x *= 0x85EBCA6B; x ^= x >> 13   (uint32),
+ * result (L << h) | R, applied again while the result is >= n (cycle walking; on average
+ * fewer than 4 applications).
  *
  * Sliced learning: one work unit is one sample-update (forward, backward, weight update:
  * about 100 x 20 multiplications). fit(budget) performs at most `budget` of them per call
- * and returns RFS_FIT_MORE until the last epoch is done. The standardisation pass and
- * each epoch's shuffle are done whole inside the call that starts them (a few
- * instructions per sample: about 1/50 of an epoch).
+ * and returns RFS_FIT_MORE until the last epoch is done. The standardisation pass is
+ * done whole inside the call that starts the fit (about 20 instructions per sample,
+ * under 1/500 of an epoch).
  */
 #ifndef RFS_MLP_H
 #define RFS_MLP_H
@@ -50,7 +59,7 @@ typedef struct rfs_mlp_cfg {
                            ///< (10,000; the store is a uniform random subset already)
 } rfs_mlp_cfg_t;
 
-/// MLP state, caller-owned (about 23 KB: weights, momenta and the sample order).
+/// MLP state, caller-owned (about 3.3 KB: weights and momenta).
 typedef struct rfs_mlp {
     rfs_mlp_cfg_t cfg;                           ///< configuration copied at init
     bool valid;                                  ///< a trained network exists
@@ -75,7 +84,8 @@ typedef struct rfs_mlp {
     uint16_t pos;                                ///< next position in the epoch
     uint8_t epoch;                               ///< current epoch, 0-based
     uint32_t updates;                            ///< sample-updates done by the last fit call
-    uint16_t order[RFS_MLP_MAX_SAMPLES];         ///< sample order of the current epoch
+    uint32_t key[4];                             ///< permutation keys of the current epoch
+    uint8_t half_bits;                           ///< h: bits of each Feistel half
 } rfs_mlp_t;
 
 /// Defaults: 100 hidden units, 3 epochs, rate 0.01, momentum 0.1, 10,000 samples

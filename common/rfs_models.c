@@ -6,6 +6,7 @@
 
 #include "rfs_knn.h"
 #include "rfs_mlp.h"
+#include "rfs_pathloss.h"
 #include "rfs_ridge.h"
 
 static int ridge_init_default(void *state)
@@ -32,6 +33,12 @@ static int radius_init_default(void *state)
     return rfs_knn_init(state, &c);
 }
 
+static int pathloss_init_default(void *state)
+{
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    return rfs_pathloss_init(state, &c);
+}
+
 /* The first row is the default model (the paper's main configuration). */
 static const rfs_models_entry_t k_models[] = {
     {"ridge", &rfs_ridge_ops, (uint32_t)sizeof(rfs_ridge_t), ridge_init_default,
@@ -42,6 +49,8 @@ static const rfs_models_entry_t k_models[] = {
      "k-nearest-neighbours regression, k = 5 (paper 5.2)"},
     {"radius", &rfs_radius_ops, (uint32_t)sizeof(rfs_knn_t), radius_init_default,
      "radius-neighbours regression, r = 1 m (paper 5.2)"},
+    {"pathloss", &rfs_pathloss_ops, (uint32_t)sizeof(rfs_pathloss_t), pathloss_init_default,
+     "map-aware log-distance + walls fit, source search (issue 10, beyond the paper)"},
 };
 
 #define N_MODELS (sizeof(k_models) / sizeof(k_models[0]))

@@ -118,8 +118,9 @@ typedef struct ridge_blk {
 /* The hot loop of the common case (query within the int16 centimetre box, so |u|, |v| <=
  * 65,535 and their squares fit uint32): one block of samples with every sum in 32 bits
  * (one MLA or ADD each on the Cortex-M4, few enough accumulators to stay in registers).
- * The radius test uses the squares it needs anyway: uu <= r2 and vv <= r2 rule out the
- * far samples before uu + vv (then < 2^31) is compared. Scaling and overflow: the caller
+ * The radius test uses the squares it needs anyway: their uint32 sum wraps only for far
+ * samples (then it is below uu), otherwise it is compared with r2 < 2^31, which also
+ * bounds uu and vv for the int32 sums. Scaling and overflow: the caller
  * bounds the block length so that K * r^2 and K * r * 2^15 stay below 2^31. */
 __attribute__((noinline)) static void accumulate_block(ridge_blk_t *b, const rfs_sample_t *p,
                                                        const rfs_sample_t *end, int32_t qx,
@@ -130,7 +131,8 @@ __attribute__((noinline)) static void accumulate_block(ridge_blk_t *b, const rfs
         int32_t u = (int32_t)p->x_cm - qx;
         int32_t v = (int32_t)p->y_cm - qy;
         uint32_t uu = (uint32_t)u * (uint32_t)u, vv = (uint32_t)v * (uint32_t)v;
-        if (uu > r2 || vv > r2 || uu + vv > r2) {
+        uint32_t d2 = uu + vv;
+        if (d2 < uu || d2 > r2) { /* wrapped (far away), or outside the radius */
             continue;
         }
         int32_t z = p->v_q6;
@@ -333,12 +335,61 @@ static bool ridge_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t 
     return predict_wide(r, (int64_t)x - r->qx, (int64_t)y - r->qy, value);
 }
 
+/* A row of predictions (x0 + k dx, y), k = 0..n-1, for the grid search: the same values
+ * as ridge_predict() point by point, with the x term advanced by one exact 64-bit
+ * addition per point. Scaling and overflow: when both ends of the row (and y) are inside
+ * the fast path's +-16,384 m, every x in between is too, so each running sum equals the
+ * fast path's exact sum (< 2^63); otherwise every point goes through ridge_predict(). */
+static bool ridge_predict_row(const void *self, rfs_q16_t x0, rfs_q16_t y, rfs_q16_t dx,
+                              uint16_t n, rfs_q16_t *out)
+{
+    const rfs_ridge_t *r = (const rfs_ridge_t *)self;
+    if (!r->valid) {
+        return false;
+    }
+    if (n == 0u) {
+        return true;
+    }
+    const int64_t lim = (int64_t)1 << 30;
+    const int64_t xl = (int64_t)x0 + (int64_t)(n - 1u) * dx;
+    if (!r->fast_predict || x0 < -lim || x0 >= lim || xl < -lim || xl >= lim || y < -lim ||
+        y >= lim) {
+        for (uint16_t k = 0u; k < n; ++k) {
+            (void)ridge_predict(r, (rfs_q16_t)(x0 + (int64_t)k * dx), y, &out[k]);
+        }
+        return true;
+    }
+    const int32_t wx = (int32_t)r->wx_q24, wy = (int32_t)r->wy_q24;
+    int64_t acc = (int64_t)wx * (x0 - r->qx) + (int64_t)wy * (y - r->qy) + ((int64_t)1 << 23);
+    const int64_t step = (int64_t)wx * dx;
+    /* The row is linear, so when neither end saturates no point does: then the loop
+     * is one 64-bit addition, a shift and an addition per point. */
+    const int64_t v0 = (int64_t)r->icpt + (acc >> 24);
+    const int64_t vl = (int64_t)r->icpt + ((acc + step * (int64_t)(n - 1u)) >> 24);
+    if (v0 >= INT32_MIN && v0 <= INT32_MAX && vl >= INT32_MIN && vl <= INT32_MAX) {
+        const int64_t icpt = r->icpt;
+        out[0] = (rfs_q16_t)v0;
+        for (uint16_t k = 1u; k < n; ++k) { /* never steps past the last point */
+            acc += step;
+            out[k] = (rfs_q16_t)(icpt + (acc >> 24)); /* between v0 and vl: fits */
+        }
+        return true;
+    }
+    out[0] = rfs_sat32(v0);
+    for (uint16_t k = 1u; k < n; ++k) {
+        acc += step;
+        out[k] = rfs_sat32((int64_t)r->icpt + (acc >> 24));
+    }
+    return true;
+}
+
 const rfs_model_ops_t rfs_ridge_ops = {
     .name = "ridge",
     .reset = ridge_reset,
     .fit = ridge_fit,
     .predict = ridge_predict,
     .argmax = 0,
+    .predict_row = ridge_predict_row,
 };
 
 rfs_model_t rfs_ridge_model(rfs_ridge_t *r)

@@ -55,7 +55,17 @@ struct hs_world {
     uint32_t w, h;
     double res, ox, oy;
     std::vector<uint8_t> cell; // copy of the map cells (for disc_blocked)
+    // Free-space cache for the fast path of hs_world_step: per CLEAR_M cell, 1 when a
+    // disc of radius + CLEAR_MARGIN anywhere in it touches nothing, 0 when it may,
+    // -1 not yet known.
+    mutable std::vector<int8_t> clear;
+    uint32_t cw, ch;
 };
+
+namespace {
+constexpr double CLEAR_M = 0.1;       // cache cell, metres
+constexpr double CLEAR_MARGIN = 0.05; // > one step of travel (0.7 m/s x 20 ms) plus Box2D's skin
+}
 
 extern "C" hs_world_cfg_t hs_world_cfg_default(void)
 {
@@ -180,6 +190,9 @@ extern "C" hs_world_t *hs_world_create(const hs_map_t *m, const hs_world_cfg_t *
         w->ox = m->origin_x;
         w->oy = m->origin_y;
         w->cell.assign(m->cell, m->cell + (size_t)m->w * m->h);
+        w->cw = (uint32_t)std::ceil(m->w * m->res / CLEAR_M);
+        w->ch = (uint32_t)std::ceil(m->h * m->res / CLEAR_M);
+        w->clear.assign((size_t)w->cw * w->ch, -1);
         w->world = new b2World(b2Vec2(0.0f, 0.0f));
         // No time-of-impact sub-stepping: at 0.7 m/s and 50 Hz the robot moves 1.4 cm per
         // step, far less than the thinnest wall (one 5 cm cell), so it cannot tunnel.
@@ -239,8 +252,11 @@ extern "C" void hs_world_place_robot(hs_world_t *w, double x, double y, double t
 extern "C" void hs_world_robot_pose(const hs_world_t *w, double *x, double *y, double *theta)
 {
     b2Vec2 p = w->robot->GetPosition();
-    double a = std::remainder((double)w->robot->GetAngle(), 2.0 * M_PI);
-    if (a <= -M_PI) {
+    double a = w->robot->GetAngle(); // kept within +-100 rad by hs_world_step
+    while (a > M_PI) {
+        a -= 2.0 * M_PI;
+    }
+    while (a <= -M_PI) {
         a += 2.0 * M_PI;
     }
     *x = p.x;
@@ -248,9 +264,45 @@ extern "C" void hs_world_robot_pose(const hs_world_t *w, double *x, double *y, d
     *theta = a;
 }
 
+/// true when no wall can be within CLEAR_MARGIN of the robot anywhere in its cache cell.
+static bool disc_blocked_r(const hs_world_t *w, double x, double y, double r);
+
+static bool robot_clear(const hs_world_t *w)
+{
+    b2Vec2 p = w->robot->GetPosition();
+    double fx = (p.x - w->ox) / CLEAR_M, fy = (p.y - w->oy) / CLEAR_M;
+    if (!(fx >= 0.0 && fy >= 0.0 && fx < w->cw && fy < w->ch)) {
+        return false;
+    }
+    size_t i = (size_t)fy * w->cw + (size_t)fx;
+    if (w->clear[i] < 0) {
+        // Disc around the cache cell's centre covering every position in the cell.
+        double cx = w->ox + ((size_t)fx + 0.5) * CLEAR_M, cy = w->oy + ((size_t)fy + 0.5) * CLEAR_M;
+        double r = w->cfg.robot_radius_m + CLEAR_MARGIN + CLEAR_M * M_SQRT1_2;
+        w->clear[i] = disc_blocked_r(w, cx, cy, r) ? 0 : 1;
+    }
+    return w->clear[i] == 1;
+}
+
 extern "C" void hs_world_step(hs_world_t *w, double v_m_s, double omega_rad_s, double dt_s)
 {
     float a = w->robot->GetAngle();
+    if (std::fabs(v_m_s) * dt_s < CLEAR_MARGIN && robot_clear(w)) {
+        // Fast path far from walls: nothing can collide within this step, so integrate
+        // the unicycle as Box2D's own integrator would (semi-implicit Euler with the
+        // velocity set from the heading at the start of the step).
+        b2Vec2 p = w->robot->GetPosition();
+        b2Vec2 vel((float)(v_m_s * std::cos(a)), (float)(v_m_s * std::sin(a)));
+        b2Vec2 np = p + (float)dt_s * vel;
+        float na = a + (float)(dt_s * omega_rad_s);
+        if (na > 10.0f || na < -10.0f) {
+            na = (float)std::remainder((double)na, 2.0 * M_PI);
+        }
+        w->robot->SetTransform(np, na);
+        w->robot->SetLinearVelocity(vel);
+        w->robot->SetAngularVelocity((float)omega_rad_s);
+        return;
+    }
     w->robot->SetLinearVelocity(
         b2Vec2((float)(v_m_s * std::cos(a)), (float)(v_m_s * std::sin(a))));
     w->robot->SetAngularVelocity((float)omega_rad_s);
@@ -258,7 +310,7 @@ extern "C" void hs_world_step(hs_world_t *w, double v_m_s, double omega_rad_s, d
     w->world->Step((float)dt_s, w->cfg.velocity_iters, w->cfg.position_iters);
     // Keep the heading bounded so float precision does not decay over a long run.
     float ang = w->robot->GetAngle();
-    if (ang > 100.0f || ang < -100.0f) {
+    if (ang > 10.0f || ang < -10.0f) {
         w->robot->SetTransform(w->robot->GetPosition(),
                                (float)std::remainder((double)ang, 2.0 * M_PI));
     }
@@ -266,6 +318,9 @@ extern "C" void hs_world_step(hs_world_t *w, double v_m_s, double omega_rad_s, d
 
 extern "C" bool hs_world_robot_touching(const hs_world_t *w)
 {
+    if (robot_clear(w)) {
+        return false; // contacts are not updated on the fast path; none can touch here
+    }
     for (b2ContactEdge *e = w->robot->GetContactList(); e; e = e->next) {
         if (e->contact->IsTouching()) {
             return true;
@@ -332,7 +387,11 @@ extern "C" unsigned hs_world_walls_crossed(const hs_world_t *w, double x0, doubl
 
 extern "C" bool hs_world_disc_blocked(const hs_world_t *w, double x, double y)
 {
-    double r = w->cfg.robot_radius_m;
+    return disc_blocked_r(w, x, y, w->cfg.robot_radius_m);
+}
+
+static bool disc_blocked_r(const hs_world_t *w, double x, double y, double r)
+{
     double fx0 = (x - r - w->ox) / w->res, fx1 = (x + r - w->ox) / w->res;
     double fy0 = (y - r - w->oy) / w->res, fy1 = (y + r - w->oy) / w->res;
     if (fx0 < 0.0 || fy0 < 0.0 || fx1 >= (double)w->w || fy1 >= (double)w->h) {

@@ -112,7 +112,8 @@ double hs_radio_fading_db(const hs_radio_t *r, unsigned s, double x, double y, b
 /// Large-scale mean signal (path loss, walls, shadowing; no fading), dBm.
 double hs_radio_mean_dbm(hs_radio_t *r, unsigned s, double x, double y);
 
-/// Signal before measurement noise (mean plus fading), dBm.
+/// Signal before measurement noise (mean plus fading), dBm, evaluated at the corner of the
+/// 5 mm cell (x, y) lies in (a receiver moving a few mm between packets reuses it).
 double hs_radio_signal_dbm(hs_radio_t *r, unsigned s, double x, double y);
 
 /// Packet delivery probability at signal p_dbm (1 when loss is off).

@@ -319,10 +319,16 @@ static rfs_q16_t dq16(double v)
     return s >= 2147483647.0 ? INT32_MAX : (s <= -2147483648.0 ? INT32_MIN : (rfs_q16_t)lround(s));
 }
 
+/// Angle into (-pi, pi]; the inputs here are within a few turns of it.
 static double wrap_pi(double a)
 {
-    a = remainder(a, 2.0 * M_PI);
-    return a <= -M_PI ? a + 2.0 * M_PI : a;
+    while (a > M_PI) {
+        a -= 2.0 * M_PI;
+    }
+    while (a <= -M_PI) {
+        a += 2.0 * M_PI;
+    }
+    return a;
 }
 
 static double now_s(void)
@@ -332,13 +338,20 @@ static double now_s(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
+static double cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
 enum { EV_PACKET = 0, EV_POSE = 1, EV_CTRL = 2 };
 
 int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_sim_io_t *io,
                hs_sim_result_t *res, char *err, size_t errlen)
 {
     const hs_scenario_t *sc = &e->sc;
-    double t_wall0 = now_s();
+    double t_wall0 = now_s(), t_cpu0 = cpu_s();
     memset(res, 0, sizeof *res);
     res->seed = seed;
     char werr[256];
@@ -386,6 +399,14 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
         pkt_off_us[s] = pkt_period_us[s] * (s + 0.5) / sc->nsources; // sources interleave
     }
     uint64_t pose_k = 1, ctrl_k = 1;
+    // Next event times, microseconds: k-th event of a stream at round(offset + k * period)
+    // (no drift), recomputed only when the event is consumed.
+    int64_t next_pkt[HS_SCN_MAX_SOURCES];
+    for (unsigned s = 0; s < sc->nsources; s++) {
+        next_pkt[s] = (int64_t)llround(pkt_off_us[s]);
+    }
+    int64_t next_pose = (int64_t)llround(pose_period_us);
+    int64_t next_ctrl = ctrl->period_us;
     const int64_t stop_t_us = sc->stop_time_s > 0.0 ? (int64_t)llround(sc->stop_time_s * 1e6) : INT64_MAX;
     const bool has_goal = sc->has_goal || sc->nsources == 1;
 
@@ -412,7 +433,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
         hs_world_step(world, v, w, dt_s);
         double nx, ny, nth;
         hs_world_robot_pose(world, &nx, &ny, &nth);
-        double seg = hypot(nx - px, ny - py);
+        double seg = sqrt((nx - px) * (nx - px) + (ny - py) * (ny - py));
         const int64_t t1 = t + dt_us;
         const double dth = wrap_pi(nth - pth);
         for (;;) {
@@ -421,21 +442,18 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
             int kind = -1;
             unsigned which = 0;
             for (unsigned s = 0; s < sc->nsources; s++) {
-                int64_t ts = (int64_t)llround(pkt_off_us[s] + pkt_k[s] * pkt_period_us[s]);
-                if (ts < te) {
-                    te = ts;
+                if (next_pkt[s] < te) {
+                    te = next_pkt[s];
                     kind = EV_PACKET;
                     which = s;
                 }
             }
-            int64_t tp = (int64_t)llround(pose_k * pose_period_us);
-            if (tp < te) {
-                te = tp;
+            if (next_pose < te) {
+                te = next_pose;
                 kind = EV_POSE;
             }
-            int64_t tc = (int64_t)ctrl_k * ctrl->period_us;
-            if (tc < te) {
-                te = tc;
+            if (next_ctrl < te) {
+                te = next_ctrl;
                 kind = EV_CTRL;
             }
             if (te > t1) {
@@ -447,6 +465,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
             if (kind == EV_PACKET) {
                 unsigned s = which;
                 pkt_k[s]++;
+                next_pkt[s] = (int64_t)llround(pkt_off_us[s] + pkt_k[s] * pkt_period_us[s]);
                 int dbm = 0;
                 bool got = hs_radio_packet(radio, s, ex, ey, &rng_pkt, &dbm);
                 res->packets_sent++;
@@ -464,6 +483,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
                 }
             } else if (kind == EV_POSE) {
                 pose_k++;
+                next_pose = (int64_t)llround(pose_k * pose_period_us);
                 double eth = wrap_pi(pth + a * dth);
                 double mx = ex + sc->pose_sigma_xy_m * hs_radio_gauss(&rng_pose);
                 double my = ey + sc->pose_sigma_xy_m * hs_radio_gauss(&rng_pose);
@@ -476,6 +496,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
                 }
             } else {
                 ctrl_k++;
+                next_ctrl = (int64_t)ctrl_k * ctrl->period_us;
                 hs_ctrl_out_t out;
                 memset(&out, 0, sizeof out);
                 ctrl->step(ctrl->self, te, &out);
@@ -538,6 +559,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     hs_radio_destroy(radio);
     hs_world_destroy(world);
     res->wall_time_s = now_s() - t_wall0;
+    res->cpu_time_s = cpu_s() - t_cpu0;
     return 0;
 }
 

@@ -65,6 +65,7 @@ typedef struct hs_sim_result {
     uint64_t packets_received;   ///< packets delivered to the controller
     uint32_t motor_timeouts;     ///< times the motor model stopped on a missing command
     double wall_time_s;          ///< host time the run took (not part of determinism)
+    double cpu_time_s;           ///< CPU time of this process during the run
 } hs_sim_result_t;
 
 /// Load the map, build the core grids and check the scenario against them (sources and

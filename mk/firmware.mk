@@ -74,8 +74,17 @@ $(BUILD)/asan/tests/test_bxcan: tests/firmware/test_bxcan.c $(BUILD)/asan/obj/fi
 TEST_BINS += $(BUILD)/tests/test_bxcan $(BUILD)/asan/tests/test_bxcan
 $(eval $(call cmocka_test,test_replay,tests/firmware/test_replay.c,))
 TEST_DEPS += firmware $(BUILD)/bin/rfseek-replay $(BUILD)/bin/rfseek-record
-TEST_SCRIPTS += tests/firmware/bit_identical.sh $(BUILD)
-TEST_SCRIPTS += tests/firmware/safety.sh $(BUILD)
+TEST_SCRIPTS += 'tests/firmware/bit_identical.sh $(BUILD)'
+TEST_SCRIPTS += 'tests/firmware/safety.sh $(BUILD)'
+
+# libFuzzer target over the stream parser and the player (clang only, like feed's).
+FW_FUZZ_CC ?= clang
+$(FW)/fuzz_replay: tests/fuzz/fuzz_replay.c $(FW_PORTABLE) $(CORE_SRCS) $(FW_HDRS) $(CORE_HDRS)
+	@mkdir -p $(@D)
+	$(FW_FUZZ_CC) -std=c11 -g -O1 -Icommon -Ifirmware -fsanitize=fuzzer,address,undefined \
+		-fno-sanitize-recover=all tests/fuzz/fuzz_replay.c $(FW_PORTABLE) $(CORE_SRCS) -o $@
+TEST_DEPS += $(FW)/fuzz_replay
+TEST_SCRIPTS += 'tests/firmware/run_fuzz_replay.sh $(FW)/fuzz_replay $(FW)/fuzz-corpus tests/fuzz/corpus/replay 2000'
 
 # --- bench -------------------------------------------------------------------------------
 .PHONY: bench-firmware

@@ -10,7 +10,7 @@ endif
 
 # rfseek-map on a real map and on bad input: one error line, non-zero exit.
 ifneq ($(wildcard tests/host_sim/test_rfseek_map.sh),)
-TEST_SCRIPTS += tests/host_sim/test_rfseek_map.sh $(BUILD)/bin/rfseek-map
+TEST_SCRIPTS += 'tests/host_sim/test_rfseek_map.sh $(BUILD)/bin/rfseek-map'
 endif
 
 # `make bench`: planner and legal-grid figures on the office scenario map and on the

@@ -36,3 +36,12 @@ $(WIRE_LCM_TOOL): tests/wire/lcm_tool.c $(HOST_LIB_DEPS) $(CORE_LIB) $(HOST_HDRS
 TEST_DEPS += $(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm
 TEST_SCRIPTS += 'tests/wire/rfseekd_test.sh $(BUILD)'
 $(eval $(call cmocka_test,test_lcm,tests/wire/test_lcm.c,))
+
+# --- bench: codec instructions (callgrind), two-process overhead ----------------------
+$(BUILD)/tests/wire/bench_can: tests/wire/bench_can.c $(CORE_LIB) $(CORE_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) $< -o $@ $(CORE_LIB)
+.PHONY: bench-wire
+bench-wire: $(BUILD)/tests/wire/bench_can $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm $(BUILD)/bin/rfseek-sim
+	@tests/wire/bench_wire.sh $(BUILD)
+BENCH_TARGETS += bench-wire

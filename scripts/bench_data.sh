@@ -16,12 +16,16 @@ per() { awk -v a="$1" -v b="$2" -v n="$3" 'BEGIN{printf "%.1f", (b - a) / n}'; }
 f0=$(ir fit 0); f10=$(ir fit 10000); f20=$(ir fit 20000)
 o10=$(ir fit 10000 16000) # spread +-160 m: nearly every sample outside the 5 m radius
 p0=$(ir predict 0); p12=$(ir predict 12800)
+# instructions inside ridge_predict alone (all its lines, inlined helpers included)
+pf=$(callgrind_annotate --auto=no "$tmp/cg.out" 2>/dev/null | awk '/:ridge_predict( |$)/ && $1 ~ /^[0-9,]+$/ {gsub(",","",$1); s += $1} END {print s + 0}')
+w0=$(ir row 0); w12=$(ir row 12800)
 r1=$(ir rssi 1000); r5=$(ir rssi 5000)
 s1=$(ir store 1000); s5=$(ir store 5000)
 echo "data path, host x86-64 instructions (callgrind, exact):"
 echo "  ridge fit, 10,000 samples all within 5 m: $f10 ($(per 0 "$f10" 10000) per sample incl. solve; marginal $(per "$f10" "$f20" 10000) per sample; empty fit $f0)"
 echo "  ridge fit, 10,000 samples mostly outside the radius: $o10 ($(per 0 "$o10" 10000) per sample)"
-echo "  ridge predict: $(per "$p0" "$p12" 12800) per point (12,800-point grid: $((p12 - p0)))"
+echo "  ridge predict: $(per 0 "$pf" 12800) per point inside ridge_predict; $(per "$p0" "$p12" 12800) with the caller's loop (12,800-point grid)"
+echo "  ridge predict_row: $(per "$w0" "$w12" 12800) per point in rows of 160 (12,800-point grid: $((w12 - w0)))"
 echo "  rssi push + mean at 400 packets/s: $(per "$r1" "$r5" 4000) per packet"
 echo "  store add_value (+ a pose every 40): $(per "$s1" "$s5" 4000) per measurement"
 arm=$build/arm/lib/librfs_core.a

@@ -168,6 +168,40 @@ static void run_bench(const hs_core_map_t *c, long n)
            peak, 4 * peak, cap_doc, doc_fail, reach);
     printf("bench path   mean planned length / straight line %.3f\n", reach ? ratio_sum / reach : 0.0);
     printf("bench legal  median %.2f ms to derive the legal grid (rfs_map_init)\n", tl[3] * 1e3);
+    /* What planning buys over straight moves only: goals a greedy step (<= 1 m) or an
+     * epsilon step (mostly within a few metres) away, from random legal points. */
+    const double radii[3] = {1.0, 3.0, 10.0};
+    for (int ri = 0; ri < 3; ri++) {
+        int32_t rl = (int32_t)lround(radii[ri] / (m->cfg.grid / 65536.0));
+        uint32_t los = 0;
+        uint32_t planned = 0;
+        uint32_t none = 0;
+        long got = 0;
+        while (got < n) {
+            uint16_t i0 = (uint16_t)rfs_rng_below(&rng, m->lw), j0 = (uint16_t)rfs_rng_below(&rng, m->lh);
+            int32_t i1 = i0 + (int32_t)rfs_rng_below(&rng, 2u * (uint32_t)rl + 1u) - rl;
+            int32_t j1 = j0 + (int32_t)rfs_rng_below(&rng, 2u * (uint32_t)rl + 1u) - rl;
+            if ((i1 - i0) * (i1 - i0) + (j1 - j0) * (j1 - j0) > rl * rl || (i1 == i0 && j1 == j0) ||
+                i1 < 0 || j1 < 0 || i1 >= m->lw || j1 >= m->lh || !rfs_map_lattice_legal(m, i0, j0) ||
+                !rfs_map_lattice_legal(m, (uint16_t)i1, (uint16_t)j1)) {
+                continue;
+            }
+            rfs_q16_t x0, y0, x1, y1;
+            rfs_map_lattice_point(m, i0, j0, &x0, &y0);
+            rfs_map_lattice_point(m, (uint16_t)i1, (uint16_t)j1, &x1, &y1);
+            rfs_path_t path;
+            if (rfs_map_segment_legal(m, x0, y0, x1, y1)) {
+                los++;
+            } else if (rfs_plan_path(&big, x0, y0, x1, y1, &path)) {
+                planned++;
+            } else {
+                none++;
+            }
+            got++;
+        }
+        printf("bench goals  within %4.1f m: %5.1f %% in line of sight, %5.1f %% need a planned path, "
+               "%5.1f %% unreachable\n", radii[ri], 100.0 * los / n, 100.0 * planned / n, 100.0 * none / n);
+    }
     free(work);
     free(queue);
     free(legal);

@@ -354,7 +354,7 @@ static int cmp_double(const void *a, const void *b)
 static int run_bench(const hs_sim_env_t *env, uint64_t a, uint64_t b)
 {
     uint64_t n = b - a + 1;
-    double *rtf = calloc(n, sizeof *rtf), sim = 0.0, wall = 0.0;
+    double *rtf = calloc(n, sizeof *rtf), sim = 0.0, wall = 0.0, cpu = 0.0;
     uint64_t pkts = 0;
     if (!rtf) {
         return die("out of memory%s%s", "", "");
@@ -370,11 +370,13 @@ static int run_bench(const hs_sim_env_t *env, uint64_t a, uint64_t b)
         rtf[s - a] = r.sim_time_s / r.wall_time_s;
         sim += r.sim_time_s;
         wall += r.wall_time_s;
+        cpu += r.cpu_time_s;
         pkts += r.packets_sent;
     }
     qsort(rtf, n, sizeof *rtf, cmp_double);
-    printf("runs %llu  simulated %.1f s  host %.3f s  packets %llu\n", (unsigned long long)n, sim,
-           wall, (unsigned long long)pkts);
+    printf("runs %llu  simulated %.1f s  host %.3f s (cpu %.3f s)  packets %llu\n",
+           (unsigned long long)n, sim, wall, cpu, (unsigned long long)pkts);
+    printf("real-time factor by cpu time: %.0fx\n", sim / cpu);
     printf("real-time factor: overall %.0fx, median per run %.0fx (min %.0fx, max %.0fx)\n",
            sim / wall, n % 2 ? rtf[n / 2] : 0.5 * (rtf[n / 2 - 1] + rtf[n / 2]), rtf[0],
            rtf[n - 1]);

@@ -32,6 +32,23 @@ static void crc8_matches_catalogue_check_value(void **state)
     assert_int_equal(crc, 0x4B);
 }
 
+static void table_and_bitwise_checksums_agree(void **state)
+{
+    (void)state;
+    /* Every single-byte payload under two ids, and a walking pattern at every DLC. */
+    for (unsigned v = 0; v < 256; v++) {
+        uint8_t d[2] = {(uint8_t)v, 0};
+        assert_int_equal(rfs_can_checksum(0x100, 2, d), rfs_can_checksum_bitwise(0x100, 2, d));
+        assert_int_equal(rfs_can_checksum(0x7FF, 2, d), rfs_can_checksum_bitwise(0x7FF, 2, d));
+    }
+    uint8_t d[8] = {0x01, 0x23, 0x45, 0x67, 0x89, 0xAB, 0xCD, 0xEF};
+    for (uint8_t dlc = 1; dlc <= 8; dlc++) {
+        assert_int_equal(rfs_can_checksum(0x120, dlc, d), rfs_can_checksum_bitwise(0x120, dlc, d));
+    }
+    /* An id-only frame (DLC 1) is the CRC of the two id bytes: 0x20 0x01 (Python reference). */
+    assert_int_equal(rfs_can_checksum(0x120, 1, d), 0xD6);
+}
+
 static void wheel_bytes_match_python_reference(void **state)
 {
     (void)state;
@@ -492,6 +509,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(crc8_matches_catalogue_check_value),
+        cmocka_unit_test(table_and_bitwise_checksums_agree),
         cmocka_unit_test(wheel_bytes_match_python_reference),
         cmocka_unit_test(pose_bytes_match_python_reference),
         cmocka_unit_test(rssi_and_status_bytes_match_python_reference),

@@ -21,8 +21,32 @@ typedef struct sim {
     int violations_speed;
     int violations_accel;
     double travelled;
+    double max_off_path;  /* largest distance from the start -> waypoints polyline */
+    double x0, y0;        /* where the path started */
+    double max_off_x, max_off_y; /* where the robot was furthest off */
     int64_t t;
 } sim_t;
+
+static double seg_dist(double px, double py, double ax, double ay, double bx, double by)
+{
+    double dx = bx - ax, dy = by - ay;
+    double l2 = dx * dx + dy * dy;
+    double u = l2 > 0 ? ((px - ax) * dx + (py - ay) * dy) / l2 : 0.0;
+    u = u < 0 ? 0 : (u > 1 ? 1 : u);
+    return hypot(px - ax - u * dx, py - ay - u * dy);
+}
+
+static double path_dist(const sim_t *s, const rfs_path_t *p)
+{
+    double best = 1e9, ax = s->x0, ay = s->y0;
+    for (int k = 0; k < p->n; k++) {
+        double bx = p->x[k] / 65536.0, by = p->y[k] / 65536.0;
+        best = fmin(best, seg_dist(s->x, s->y, ax, ay, bx, by));
+        ax = bx;
+        ay = by;
+    }
+    return best;
+}
 
 static rfs_q16_t q16(double v)
 {
@@ -48,6 +72,9 @@ static rfs_drive_status_t run(rfs_drive_t *d, sim_t *s, const rfs_path_t *path, 
     for (int k = 0; k < path->n; k++) {
         s->min_wp_dist[k] = 1e9;
     }
+    s->x0 = s->x;
+    s->y0 = s->y;
+    s->max_off_path = 0;
     while (s->t < (int64_t)(max_s * 1e6)) {
         rfs_pose_t p = pose_of(s);
         int16_t l;
@@ -76,6 +103,12 @@ static rfs_drive_status_t run(rfs_drive_t *d, sim_t *s, const rfs_path_t *path, 
             s->y += v * sin(s->th) * 1e-3;
             s->th += w * 1e-3;
             s->travelled += fabs(v) * 1e-3;
+            double off = path_dist(s, path);
+            if (off > s->max_off_path) {
+                s->max_off_path = off;
+                s->max_off_x = s->x;
+                s->max_off_y = s->y;
+            }
         }
         for (int k = 0; k < path->n; k++) {
             s->min_wp_dist[k] = fmin(s->min_wp_dist[k], hypot(s->x - path->x[k] / 65536.0,
@@ -170,11 +203,59 @@ static void test_follows_waypoints(void **state)
     p.n = 3;
     rfs_drive_set_path(&d, &p, 0);
     assert_int_equal(run(&d, &s, &p, 60.0, false, &end), RFS_DRIVE_REACHED);
-    assert_true(s.min_wp_dist[0] < 0.25);
-    assert_true(s.min_wp_dist[1] < 0.25);
+    /* Corners are not cut by more than the clearance margin allows: the clearance is
+     * 0.25 m and the Kobuki's radius 0.177 m, so the robot must stay within 0.07 m of
+     * the planned (legal) polyline. */
+    print_message("corner distances %.3f %.3f, max off path %.3f m\n", s.min_wp_dist[0],
+                  s.min_wp_dist[1], s.max_off_path);
+    assert_true(s.min_wp_dist[0] < 0.1);
+    assert_true(s.min_wp_dist[1] < 0.1);
+    assert_true(s.max_off_path < 0.07);
     assert_true(hypot(s.x - 1.0, s.y - 4.0) <= 0.1 + 1e-3);
     assert_int_equal(s.violations_speed, 0);
     assert_int_equal(s.violations_accel, 0);
+}
+
+/* Random polylines of five waypoints with turns up to 150 degrees: all reached, the
+ * robot never more than 0.07 m off the polyline. */
+static void test_random_polylines(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    int64_t end;
+    srand(11);
+    double worst = 0;
+    for (int k = 0; k < 20; k++) {
+        start(&d, &s, 0.0, 0.0, (rand() / (double)RAND_MAX) * 6.283 - 3.1416);
+        rfs_path_t p;
+        memset(&p, 0, sizeof(p));
+        double x = 0, y = 0, h = (rand() / (double)RAND_MAX) * 6.283;
+        for (int w = 0; w < 5; w++) {
+            double len = 0.3 + (rand() / (double)RAND_MAX) * 3.0;
+            x += len * cos(h);
+            y += len * sin(h);
+            p.x[w] = q16(x);
+            p.y[w] = q16(y);
+            h += ((rand() / (double)RAND_MAX) * 2.0 - 1.0) * 2.6;
+        }
+        p.n = 5;
+        rfs_drive_set_path(&d, &p, 0);
+        assert_int_equal(run(&d, &s, &p, 120.0, false, &end), RFS_DRIVE_REACHED);
+        assert_true(hypot(s.x - x, s.y - y) <= 0.1 + 1e-3);
+        assert_int_equal(s.violations_speed, 0);
+        assert_int_equal(s.violations_accel, 0);
+        worst = fmax(worst, s.max_off_path);
+        if (getenv("DRIVE_DEBUG")) {
+            print_message("path %d: off %.3f at (%.2f, %.2f), end (%.2f, %.2f)\n", k, s.max_off_path,
+                          s.max_off_x, s.max_off_y, x, y);
+            for (int w = 0; w < p.n; w++) {
+                print_message("   wp (%.2f, %.2f)\n", p.x[w] / 65536.0, p.y[w] / 65536.0);
+            }
+        }
+    }
+    print_message("worst distance off the polyline %.3f m\n", worst);
+    assert_true(worst < 0.07);
 }
 
 /* A goal that cannot be reached in time: TIMEOUT after timeout_us, once. */
@@ -270,6 +351,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reaches_goals),
         cmocka_unit_test(test_follows_waypoints),
+        cmocka_unit_test(test_random_polylines),
         cmocka_unit_test(test_timeout),
         cmocka_unit_test(test_blocked),
         cmocka_unit_test(test_stop),

@@ -22,7 +22,13 @@
 
 #define NSETS 120
 #define NPRED_GRID 11
-#define NPRED (NPRED_GRID * NPRED_GRID + 16)
+#define NPRED_NEAR 16
+#define NPRED_FAR 8
+/* The last four far points are a row crossing +16,384 m (the row prediction's fallback). */
+#define FAR_ROW_X0 RFS_Q16_INT(16000)
+#define FAR_ROW_DX RFS_Q16_INT(200)
+#define FAR_ROW_Y RFS_Q16_INT(100)
+#define NPRED (NPRED_GRID * NPRED_GRID + NPRED_NEAR + NPRED_FAR)
 #define MAXN 65535
 
 typedef struct dataset {
@@ -83,7 +89,7 @@ static void make_set(dataset_t *d, int kind, rfs_rng_t *g)
         gy = rand_range(g, -20, 20);
         break;
     case 7: n = 10000u; break;                                     /* full store */
-    case 8: d->alpha = RFS_Q16_FRAC(1, 2); break;                  /* other alphas */
+    case 8: d->alpha = RFS_Q16_FRAC(1, 2); d->radius_cm = 1000; spread = 1300; break; /* alpha, radius */
     case 9: d->alpha = RFS_Q16_INT(3); n = 1u + rfs_rng_below(g, 20u); break;
     case 10: n = 2u; spread = 5; break;                           /* two close samples */
     case 11: /* a query beyond the int16 centimetre range (> 327.67 m): the general pass */
@@ -141,6 +147,17 @@ static void make_set(dataset_t *d, int kind, rfs_rng_t *g)
             k++;
         }
     }
+    /* Far outside any map, to the ends of Q16.16 (the 128-bit prediction path). */
+    static const rfs_q16_t far[NPRED_FAR][2] = {
+        {RFS_Q16_INT(20000), RFS_Q16_INT(20000)}, {RFS_Q16_INT(-20000), RFS_Q16_INT(15000)},
+        {INT32_MAX, INT32_MIN}, {INT32_MIN, 0},
+        {FAR_ROW_X0, FAR_ROW_Y}, {FAR_ROW_X0 + FAR_ROW_DX, FAR_ROW_Y},
+        {FAR_ROW_X0 + 2 * FAR_ROW_DX, FAR_ROW_Y}, {FAR_ROW_X0 + 3 * FAR_ROW_DX, FAR_ROW_Y}};
+    for (int j = 0; j < NPRED_FAR; ++j) {
+        d->px[k] = far[j][0];
+        d->py[k] = far[j][1];
+        k++;
+    }
     while (k < NPRED) {
         d->px[k] = (rfs_q16_t)(((int64_t)d->qx_cm * 65536) / 100) + (rfs_q16_t)rand_range(g, -655360, 655360);
         d->py[k] = (rfs_q16_t)(((int64_t)d->qy_cm * 65536) / 100) + (rfs_q16_t)rand_range(g, -655360, 655360);
@@ -196,7 +213,8 @@ static void run_reference(dataset_t *d, int nsets)
     unlink(out);
 }
 
-/* Fit (budget 0 = at once, else sliced) and return the worst error against the reference. */
+/* Fit (budget 0 = at once, else sliced) and return the worst error against the reference
+ * over the +-300 m map (the far points are checked against their own bound here). */
 static double check_set(const dataset_t *d, uint32_t budget)
 {
     rfs_ridge_t r;
@@ -225,6 +243,7 @@ static double check_set(const dataset_t *d, uint32_t budget)
     if (d->none) {
         assert_int_equal(res, RFS_FIT_FAILED);
         assert_false(m.ops->predict(m.self, 0, 0, &v));
+        assert_false(m.ops->predict_row(m.self, 0, 0, RFS_Q16_ONE, 1, &v));
         return 0.0;
     }
     assert_int_equal(res, RFS_FIT_DONE);
@@ -237,7 +256,14 @@ static double check_set(const dataset_t *d, uint32_t budget)
             continue;
         }
         double e = fabs(got - want);
-        if (e > worst) {
+        /* The slopes' Q24 rounding grows with the distance from the centre: for the
+         * points far off the map the bound is 1e-4 dB + 3.5e-8 dB per metre of |dx|+|dy|
+         * (0.5 LSB of Q24 is 3e-8 dB/m); on the +-300 m map it is TIGHT_TOL_DB. */
+        if (j >= NPRED_GRID * NPRED_GRID && j < NPRED_GRID * NPRED_GRID + NPRED_FAR) {
+            double dist = fabs(d->px[j] / 65536.0 - d->qx_cm / 100.0) +
+                          fabs(d->py[j] / 65536.0 - d->qy_cm / 100.0);
+            assert_true(e <= 1e-4 + 3.5e-8 * dist);
+        } else if (e > worst) {
             worst = e;
         }
         if (e > TOL_DB) {
@@ -245,6 +271,39 @@ static double check_set(const dataset_t *d, uint32_t budget)
                         d->qy_cm, j, got, want);
         }
         assert_true(e <= TOL_DB);
+    }
+    /* predict_row over each grid row and the far row: the same values as point by point */
+    rfs_q16_t row[NPRED_GRID];
+    for (int iy = 0; iy < NPRED_GRID; ++iy) {
+        const int j0 = iy * NPRED_GRID;
+        assert_true(m.ops->predict_row(m.self, d->px[j0], d->py[j0], RFS_Q16_INT(60),
+                                       NPRED_GRID, row));
+        for (int ix = 0; ix < NPRED_GRID; ++ix) {
+            rfs_q16_t v1;
+            assert_true(m.ops->predict(m.self, d->px[j0 + ix], d->py[j0 + ix], &v1));
+            assert_int_equal(row[ix], v1);
+            double want = d->ref[j0 + ix];
+            if (want <= 32767.0 && want >= -32768.0) {
+                assert_true(fabs(row[ix] / 65536.0 - want) <= TIGHT_TOL_DB);
+            }
+        }
+    }
+    const int jr = NPRED_GRID * NPRED_GRID + NPRED_FAR - 4;
+    assert_true(m.ops->predict_row(m.self, FAR_ROW_X0, FAR_ROW_Y, FAR_ROW_DX, 4, row));
+    for (int k = 0; k < 4; ++k) {
+        rfs_q16_t v1;
+        assert_true(m.ops->predict(m.self, d->px[jr + k], d->py[jr + k], &v1));
+        assert_int_equal(row[k], v1);
+    }
+    /* a long row inside the fast range that saturates for the steeper models */
+    rfs_q16_t lrow[64];
+    assert_true(m.ops->predict_row(m.self, RFS_Q16_INT(-15000), RFS_Q16_INT(-15000),
+                                   RFS_Q16_INT(470), 64, lrow));
+    for (int k = 0; k < 64; ++k) {
+        rfs_q16_t v1;
+        assert_true(m.ops->predict(m.self, RFS_Q16_INT(-15000) + k * RFS_Q16_INT(470),
+                                   RFS_Q16_INT(-15000), &v1));
+        assert_int_equal(lrow[k], v1);
     }
     return worst;
 }
@@ -304,6 +363,13 @@ static void test_two_points_closed_form(void **state)
     assert_true(fabs(v / 65536.0 - (-50.0 - 20.0)) <= 2.0 / 65536.0);
     assert_true(fabs(r.wx_q24 / 16777216.0 - (-20.0 / 3.0)) <= 1.0 / 16777216.0);
     assert_int_equal(r.wy_q24, 0);
+    /* a row: -50 - 20/3 * x at x = -1, 0, 1, 2 m; an empty row is fine */
+    rfs_q16_t row[4];
+    assert_true(rfs_ridge_ops.predict_row(&r, -RFS_Q16_ONE, RFS_Q16_INT(9), RFS_Q16_ONE, 4, row));
+    for (int k = 0; k < 4; ++k) {
+        assert_true(fabs(row[k] / 65536.0 - (-50.0 - 20.0 / 3.0 * (k - 1))) <= 1.5 / 65536.0);
+    }
+    assert_true(rfs_ridge_ops.predict_row(&r, 0, 0, RFS_Q16_ONE, 0, row));
 }
 
 static void test_radius_inclusive_and_reset(void **state)

@@ -32,6 +32,10 @@ expect linktype_1 1 "linktype_1.pcap: link type 1 \(EN10MB\) is not 127" -- "$ge
 expect cut_record 1 "cut_record.pcap: truncated dump file.*after 19 packets" -- "$gen/bad/cut_record.pcap" --mac $mac
 expect cut_record_header 1 "cut_record_header.pcap: truncated dump file.*after 0 packets" -- "$gen/bad/cut_record_header.pcap" --mac $mac
 expect missing_file 1 "nonexistent.pcap: cannot read capture: .*No such file" -- "$tmp/nonexistent.pcap" --mac $mac
+# live: the same link-type rule on an interface (loopback: Ethernet framing; without the
+# privilege to capture, the activation error instead), and an interface that does not exist
+expect live_loopback 1 "lo: (link type 1 \(EN10MB\) is not 127|cannot activate interface: .*(ermission|not permitted))" -- lo --live --mac $mac
+expect live_no_interface 1 "nosuchif0: cannot activate interface" -- nosuchif0 --live --mac $mac
 # the 11 records of radiotap_lies: each lie counted, 3 usable frames with a signal
 expect radiotap_lies 0 "11 packets, 3 lines; 3 note: a field runs past it_len; 1 skipped: fewer than 8 bytes.*; 1 skipped: radiotap version byte is not 0; 2 skipped: radiotap it_len .*; 1 skipped: radiotap present bitmaps run past it_len; 1 skipped: no 802.11 header; 1 skipped: no source address; 1 skipped: matching source without dBm signal" -- "$gen/bad/radiotap_lies.pcap" --mac $mac --stats
 for f in "$mal"/*.pcap; do

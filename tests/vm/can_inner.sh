@@ -46,6 +46,26 @@ if [ $rc -ne 0 ] || grep -q '^FAIL' $w/faults.txt || ! grep -q '^PASS can-busoff
     fails=$((fails + 1))
 fi
 
+# 4. The simulator and rfseekd as two processes, wheel commands over SocketCAN (vcan0),
+#    pose/RSSI/clock/status over udpm on loopback (a VM or a namespace of our own).
+if command -v rfseekd >/dev/null && command -v rfseek-sim-lcm >/dev/null && [ -f $d/scn/default.yaml ]; then
+    ip link set lo up; ip route add 224.0.0.0/4 dev lo 2>/dev/null
+    url='udpm://239.255.76.67:7667?ttl=0'
+    rfseekd --map $d/scn/maps/office.yaml --lcm "$url" --can vcan0 --clock-lcm --idle-exit 5000 \
+        > /dev/null 2> $w/d.err &
+    dpid=$!
+    sleep 1
+    rfseek-sim-lcm $d/scn/default.yaml --lcm "$url" --can vcan0 --timeout-ms 20000 > $w/summary.json 2> $w/s.err
+    src=$?
+    wait $dpid
+    if [ $src -eq 0 ] && grep -q '"reached": true' $w/summary.json; then
+        ok "can-two-process-socketcan-reaches-source ($(grep sim_time_s $w/summary.json | tr -d ' ,'))"
+    else
+        bad can-two-process-socketcan-reaches-source; cat $w/s.err $w/d.err | head -5
+    fi
+    tail -1 $w/d.err
+fi
+
 ip link del dev vcan0
 rm -rf $w
 if [ $fails -eq 0 ]; then echo "RFS-VM-VERDICT: PASS"; else echo "RFS-VM-VERDICT: FAIL ($fails)"; fi

@@ -74,6 +74,14 @@ copy_dyn() {  # a host program plus the shared libraries ldd lists
     done
 }
 copy_dyn candump; copy_dyn cansend; copy_dyn ip
+# The two-process run over SocketCAN (optional: when the programs and the map exist).
+if [ -x "$build/bin/rfseekd" ] && [ -x "$build/bin/rfseek-sim-lcm" ] && [ -f "$here/../../scenarios/maps/office.pgm" ]; then
+    PATH="$build/bin:$PATH" copy_dyn rfseekd
+    PATH="$build/bin:$PATH" copy_dyn rfseek-sim-lcm
+    mkdir -p "$root/data/scn/maps"
+    cp "$here/../../scenarios/default.yaml" "$root/data/scn/"
+    cp "$here/../../scenarios/maps/office.yaml" "$here/../../scenarios/maps/office.pgm" "$root/data/scn/maps/"
+fi
 cat > "$root/init" <<'INIT'
 #!/bin/busybox sh
 /bin/busybox --install -s /bin
@@ -90,7 +98,7 @@ if command -v cpio >/dev/null; then mkcpio() { cpio -o -H newc --quiet; }; else 
 
 # Boot; qemu exits 0 either way, the verdict is in the serial log.
 log=$vm/serial.log
-timeout 180 qemu-system-x86_64 -accel tcg -M pc -m 256M -nographic -kernel "$kdir/vmlinuz" \
+timeout 400 qemu-system-x86_64 -accel tcg -M pc -m 256M -nographic -kernel "$kdir/vmlinuz" \
     -initrd "$vm/initramfs.gz" -append 'console=ttyS0 panic=-1 quiet' -no-reboot > "$log" 2>&1
 rc=$?
 tr -d '\r' < "$log" > "$log.txt"

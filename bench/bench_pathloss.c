@@ -1,0 +1,159 @@
+/* bench_pathloss.c - instructions per relearn of the path-loss model, for callgrind
+ * (`make bench-pathloss`, docs/PERFORMANCE.md "Pathloss model").
+ *
+ * Workload: the map MAP at the core's 0.1 m grid, N samples at random legal points of
+ * it (the worst case for the bins: the whole floor visited), valued by the model with the
+ * source at (SX, SY), P0 -40 dB, n 3, W 5 dB plus 4 dB Gaussian noise.
+ *   bench_pathloss MAP relearn N          one whole fit (budget 0)
+ *   bench_pathloss MAP slice N BUDGET     only the first fit call with that budget (the
+ *                                         heaviest: it also bins), and the number of calls
+ *   bench_pathloss MAP predict N          one prediction (the relearn check)
+ * Collection is toggled on around the measured calls only, so callgrind with
+ * --collect-atstart=no counts exactly them. Prints the estimate so nothing is elided.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <valgrind/callgrind.h>
+
+#include "hs_map.h"
+#include "rfs_pathloss.h"
+
+#define SX 27.5
+#define SY 10.0
+
+static int usage(FILE *f, int rc)
+{
+    fprintf(f, "usage: bench_pathloss MAP.yaml relearn|slice|predict N [BUDGET]\n"
+               "  relearn N        one whole fit over N samples (1..65535)\n"
+               "  slice N BUDGET   the first fit call with BUDGET (bin, candidate) units\n"
+               "  predict N        one prediction after a fit\n");
+    return rc;
+}
+
+static double gauss(rfs_rng_t *r)
+{
+    double u1 = ((double)rfs_rng_u32(r) + 1.0) / 4294967297.0;
+    double u2 = (double)rfs_rng_u32(r) / 4294967296.0;
+    return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
+}
+
+static long parse(const char *s, const char *name, long lo, long hi)
+{
+    char *end = NULL;
+    long v = strtol(s, &end, 10);
+    if (*s == '\0' || *end != '\0' || v < lo || v > hi) {
+        fprintf(stderr, "bench_pathloss: %s: not an integer in %ld..%ld: '%s'\n", name, lo, hi, s);
+        exit(2);
+    }
+    return v;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc >= 2 && strcmp(argv[1], "--help") == 0) {
+        return usage(stdout, 0);
+    }
+    if (argc < 4) {
+        return usage(stderr, 2);
+    }
+    const char *mode = argv[2];
+    long n = parse(argv[3], "N", 1, 65535);
+    long budget = 0;
+    if (strcmp(mode, "slice") == 0) {
+        if (argc < 5) {
+            return usage(stderr, 2);
+        }
+        budget = parse(argv[4], "BUDGET", 1, 100000000);
+    } else if (strcmp(mode, "relearn") != 0 && strcmp(mode, "predict") != 0) {
+        return usage(stderr, 2);
+    }
+    char err[256];
+    hs_map_t hm;
+    hs_core_map_t cm;
+    memset(&hm, 0, sizeof(hm));
+    memset(&cm, 0, sizeof(cm));
+    if (hs_map_load(argv[1], &hm, err, sizeof(err)) != 0 ||
+        hs_map_to_core(&hm, 0.1, NULL, &cm, err, sizeof(err)) != 0) {
+        fprintf(stderr, "bench_pathloss: %s\n", err);
+        return 1;
+    }
+    const rfs_map_t *m = &cm.map;
+    rfs_sample_t *s = malloc((size_t)n * sizeof(*s));
+    rfs_pathloss_t *p = malloc(sizeof(*p));
+    if (s == NULL || p == NULL) {
+        fprintf(stderr, "bench_pathloss: out of memory\n");
+        return 1;
+    }
+    rfs_rng_t r;
+    rfs_rng_seed(&r, 7);
+    double w_m = m->w * (m->res / 65536.0), h_m = m->h * (m->res / 65536.0);
+    rfs_q16_t qsx = (rfs_q16_t)lround(SX * 65536.0), qsy = (rfs_q16_t)lround(SY * 65536.0);
+    for (long i = 0; i < n;) {
+        double x = m->origin_x / 65536.0 + w_m * (rfs_rng_u32(&r) / 4294967296.0);
+        double y = m->origin_y / 65536.0 + h_m * (rfs_rng_u32(&r) / 4294967296.0);
+        rfs_q16_t qx = (rfs_q16_t)lround(x * 65536.0), qy = (rfs_q16_t)lround(y * 65536.0);
+        if (!rfs_map_point_legal(m, qx, qy)) {
+            continue;
+        }
+        double d = hypot(x - SX, y - SY);
+        int k = rfs_map_walls_crossed(m, qx, qy, qsx, qsy);
+        double v = -40.0 - 30.0 * log10(d < 1.0 ? 1.0 : d) - 5.0 * k + 4.0 * gauss(&r);
+        s[i].x_cm = (int16_t)lround(x * 100.0);
+        s[i].y_cm = (int16_t)lround(y * 100.0);
+        s[i].v_q6 = (int16_t)lround(v * 64.0);
+        ++i;
+    }
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    if (rfs_pathloss_init(p, &c) != 0) {
+        fprintf(stderr, "bench_pathloss: default configuration rejected\n");
+        return 1;
+    }
+    rfs_model_fit_in_t in = {s, (uint16_t)n, 0, 0, m};
+    rfs_fit_result_t res;
+    long calls = 1;
+    if (strcmp(mode, "slice") == 0) {
+        CALLGRIND_TOGGLE_COLLECT;
+        res = rfs_pathloss_ops.fit(p, &in, (uint32_t)budget, &r);
+        CALLGRIND_TOGGLE_COLLECT;
+        while (res == RFS_FIT_MORE) {
+            res = rfs_pathloss_ops.fit(p, &in, (uint32_t)budget, &r);
+            ++calls;
+        }
+    } else if (strcmp(mode, "relearn") == 0) {
+        CALLGRIND_TOGGLE_COLLECT;
+        res = rfs_pathloss_ops.fit(p, &in, 0, &r);
+        CALLGRIND_TOGGLE_COLLECT;
+    } else {
+        res = rfs_pathloss_ops.fit(p, &in, 0, &r);
+    }
+    rfs_q16_t v = 0;
+    if (strcmp(mode, "predict") == 0) {
+        CALLGRIND_TOGGLE_COLLECT;
+        rfs_pathloss_ops.predict(p, RFS_Q16_INT(8), RFS_Q16_INT(6), &v);
+        CALLGRIND_TOGGLE_COLLECT;
+    }
+    rfs_pathloss_est_t e;
+    if (res != RFS_FIT_DONE || !rfs_pathloss_estimate(p, &e)) {
+        fprintf(stderr, "bench_pathloss: fit failed\n");
+        return 1;
+    }
+    uint16_t ncx, ncy;
+    rfs_pathloss_surface_size(p, &ncx, &ncy);
+    printf("calls %ld\n", calls);
+    printf("bins %u\n", e.bins);
+    printf("candidates %u\n", e.candidates);
+    printf("units %lu\n", (unsigned long)e.candidates * e.bins);
+    printf("coarse %u x %u\n", ncx, ncy);
+    printf("state_bytes %zu\n", sizeof(rfs_pathloss_t));
+    printf("estimate %.3f %.3f n %.3f W %.3f P0 %.3f rms %.3f spread %.1f m2 predict %.3f\n",
+           e.sx / 65536.0, e.sy / 65536.0, e.n / 65536.0, e.w / 65536.0, e.p0 / 65536.0,
+           e.rms / 65536.0, e.spread_m2 / 65536.0, v / 65536.0);
+    free(p);
+    free(s);
+    hs_core_map_free(&cm);
+    hs_map_free(&hm);
+    return 0;
+}

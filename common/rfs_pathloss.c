@@ -1,0 +1,650 @@
+/* rfs_pathloss.c - the map-aware path-loss model (issue 10; see rfs_pathloss.h).
+ *
+ * For a candidate source s every bin b has a distance term L_b = 10 log10(max(d, 1 m))
+ * and a wall count k_b. With count weights c_b and bin means z_b, the least-squares fit
+ * of z = P0 - n L - W k eliminates P0 by centring (P0 = mean z + n mean L + W mean k)
+ * and leaves a 2 x 2 system in (n, W):
+ *
+ *   [ Sll + lam   Slk       ] [n]   [ -Slz + lam n_prior ]
+ *   [ Slk         Skk + lam ] [W] = [ -Skz + lam w_prior ]
+ *
+ * (S.. the count-weighted centred sums, lam the prior's weight). The matrix is positive
+ * definite (lam > 0), so the box-constrained minimum is the unconstrained one when it is
+ * inside the box, else the best of the four edges' clamped 1-D minima (exact for a
+ * convex quadratic). Centred values are rounded to Q8 (1/256 dB) so every sum fits
+ * int64; the solve is in 128 bits.
+ */
+#include "rfs_pathloss.h"
+
+#include <string.h>
+
+#include "rfs_assert.h"
+
+/// 10 log10(2) / 2 in Q2.30 (1.50514998...): 10 log10(d) per log2(d^2).
+#define DB_PER_LOG2_SQ_Q30 1616142483LL
+/// Lattice spacing without a map, metres Q16.16 (the map default).
+#define NOMAP_GRID RFS_Q16_FRAC(1, 4)
+/// Wall counts saturate here.
+#define WALLS_MAX 255u
+
+rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
+{
+    rfs_pathloss_cfg_t c;
+    c.bin = RFS_Q16_ONE;
+    c.coarse = RFS_Q16_INT(2);
+    c.fine = RFS_Q16_HALF;
+    c.top = 3u;
+    c.n_min = RFS_Q16_FRAC(3, 2);
+    c.n_max = RFS_Q16_INT(5);
+    c.w_min = 0;
+    c.w_max = RFS_Q16_INT(15);
+    c.n_prior = RFS_Q16_INT(3);  /* ITU-R P.1238 office, 2.4 GHz */
+    c.w_prior = RFS_Q16_INT(5);  /* ns-3 buildings model, per wall */
+    c.prior_weight = RFS_Q16_ONE;
+    c.huber = RFS_Q16_INT(6);    /* about 1.5 x the 4 dB shadowing of the paper's office */
+    c.spread_k = RFS_Q16_INT(6); /* chi-square, 2 degrees of freedom, 95 %: 5.99 */
+    c.margin = RFS_Q16_INT(20);
+    return c;
+}
+
+int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg)
+{
+    if (p == 0 || cfg == 0) {
+        return -1;
+    }
+    const rfs_pathloss_cfg_t *c = cfg;
+    bool ok = c->bin >= RFS_Q16_FRAC(1, 10) && c->bin <= RFS_Q16_INT(16) && c->coarse > 0 &&
+              c->coarse <= RFS_Q16_INT(64) && c->fine > 0 && c->fine <= c->coarse &&
+              c->top >= 1u && c->top <= RFS_PATHLOSS_MAX_TOP && c->n_min > 0 &&
+              c->n_min <= c->n_max && c->n_max <= RFS_Q16_INT(10) && c->w_min >= 0 &&
+              c->w_min <= c->w_max && c->w_max <= RFS_Q16_INT(60) && c->n_prior >= c->n_min &&
+              c->n_prior <= c->n_max && c->w_prior >= c->w_min && c->w_prior <= c->w_max &&
+              c->prior_weight > 0 && c->prior_weight <= RFS_Q16_INT(10000) && c->huber > 0 &&
+              c->huber <= RFS_Q16_INT(100) && c->spread_k >= 0 &&
+              c->spread_k <= RFS_Q16_INT(1000) && c->margin >= 0 &&
+              c->margin <= RFS_Q16_INT(100);
+    if (!ok) {
+        return -1;
+    }
+    memset(p, 0, sizeof(*p));
+    p->cfg = *cfg;
+    return 0;
+}
+
+static void pathloss_reset(void *self)
+{
+    rfs_pathloss_t *p = (rfs_pathloss_t *)self;
+    RFS_ASSERT(p != 0);
+    p->valid = false;
+    p->phase = RFS_PATHLOSS_IDLE;
+}
+
+rfs_q16_t rfs_pathloss_db_dist(uint64_t d2_q32)
+{
+    const uint64_t one = (uint64_t)1 << 32; /* 1 m^2 */
+    uint64_t v = d2_q32 < one ? one : d2_q32;
+    /* floor(log2(v)) without a libgcc helper (no 64-bit clz on the Cortex-M4). */
+    uint32_t bl = 0u;
+    uint64_t t = v;
+    for (uint32_t s = 32u; s != 0u; s >>= 1) {
+        if ((t >> s) != 0u) {
+            t >>= s;
+            bl += s;
+        }
+    }
+    uint32_t m = bl >= 16u ? (uint32_t)(v >> (bl - 16u)) : (uint32_t)(v << (16u - bl));
+    int64_t lg = ((int64_t)bl - 32) * 65536 + rfs_q16_log2((rfs_q16_t)m);
+    return (rfs_q16_t)((lg * DB_PER_LOG2_SQ_Q30 + ((int64_t)1 << 29)) >> 30);
+}
+
+/* floor(a / b) for b > 0. */
+static int32_t floor_div(int32_t a, int32_t b)
+{
+    int32_t q = a / b;
+    return (a % b != 0 && a < 0) ? q - 1 : q;
+}
+
+/* Centimetres to metres Q16.16, rounded. |cm| < 2^22: product < 2^38. */
+static rfs_q16_t cm_to_q16(int32_t cm)
+{
+    return rfs_sat32(rfs_sdiv64_round((int64_t)cm * 65536, 100));
+}
+
+static uint32_t bin_hash(int16_t kx, int16_t ky)
+{
+    uint32_t h = (uint32_t)(uint16_t)kx * 0x9E3779B1u + (uint32_t)(uint16_t)ky * 0x85EBCA77u;
+    return h >> 22; /* 10 bits: RFS_PATHLOSS_HASH = 1024 */
+}
+
+/* Put the samples into bins of bin_cm, doubling it until at most MAX_BINS are used. */
+static void bin_samples(rfs_pathloss_t *p, const rfs_sample_t *smp, uint16_t n)
+{
+    _Static_assert(RFS_PATHLOSS_HASH == 1024u, "bin_hash yields 10 bits");
+    int32_t bin_cm = (int32_t)(((int64_t)p->cfg.bin * 100 + 32768) >> 16);
+    for (;;) {
+        bool ok = true;
+        memset(p->hash, 0, sizeof(p->hash));
+        p->nbins = 0u;
+        for (uint32_t i = 0u; i < n && ok; ++i) {
+            int16_t kx = (int16_t)floor_div(smp[i].x_cm, bin_cm);
+            int16_t ky = (int16_t)floor_div(smp[i].y_cm, bin_cm);
+            uint32_t h = bin_hash(kx, ky);
+            while (p->hash[h] != 0u) {
+                const rfs_pathloss_bin_t *b = &p->bins[p->hash[h] - 1u];
+                if (b->kx == kx && b->ky == ky) {
+                    break;
+                }
+                h = (h + 1u) & (RFS_PATHLOSS_HASH - 1u);
+            }
+            if (p->hash[h] == 0u) {
+                if (p->nbins == RFS_PATHLOSS_MAX_BINS) {
+                    ok = false;
+                    break;
+                }
+                rfs_pathloss_bin_t *nb = &p->bins[p->nbins];
+                memset(nb, 0, sizeof(*nb));
+                nb->kx = kx;
+                nb->ky = ky;
+                p->hash[h] = (uint16_t)(++p->nbins);
+            }
+            rfs_pathloss_bin_t *b = &p->bins[p->hash[h] - 1u];
+            b->sx_cm += smp[i].x_cm;
+            b->sy_cm += smp[i].y_cm;
+            b->sv_q6 += smp[i].v_q6;
+            b->count++;
+        }
+        if (ok) {
+            break;
+        }
+        bin_cm *= 2; /* 100 cm doubled 10 times covers the whole +-327 m sample range */
+    }
+    p->bin_cm = bin_cm;
+    /* Scaling and overflow: n <= 65,535 values of |v| <= 2^15: the sum fits int64 (and
+     * int32); the mean times 2^10 is Q16. */
+    int64_t sum = 0;
+    for (uint32_t b = 0u; b < p->nbins; ++b) {
+        sum += p->bins[b].sv_q6;
+    }
+    p->total = n;
+    p->mz_q16 = (int32_t)rfs_sdiv64_round(sum * 1024, (int64_t)n);
+    for (uint32_t b = 0u; b < p->nbins; ++b) {
+        rfs_pathloss_bin_t *bb = &p->bins[b];
+        bb->sx_cm = (int32_t)rfs_sdiv64_round(bb->sx_cm, bb->count);
+        bb->sy_cm = (int32_t)rfs_sdiv64_round(bb->sy_cm, bb->count);
+        bb->dz_q16 = (int32_t)(rfs_sdiv64_round((int64_t)bb->sv_q6 * 1024, bb->count) - p->mz_q16);
+        bb->x = cm_to_q16(bb->sx_cm);
+        bb->y = cm_to_q16(bb->sy_cm);
+    }
+}
+
+/* The candidate lattice: the map's legal lattice, or the bins' extent plus the margin. */
+static void setup_lattice(rfs_pathloss_t *p, const rfs_map_t *m)
+{
+    rfs_pathloss_lat_t *l = &p->lat;
+    if (m != 0) {
+        rfs_map_lattice_point(m, 0, 0, &l->ox, &l->oy);
+        l->grid = m->cfg.grid;
+        l->lw = m->lw;
+        l->lh = m->lh;
+    } else {
+        int32_t x0 = INT32_MAX, y0 = INT32_MAX, x1 = INT32_MIN, y1 = INT32_MIN;
+        for (uint32_t b = 0u; b < p->nbins; ++b) {
+            const rfs_pathloss_bin_t *bb = &p->bins[b];
+            x0 = bb->x < x0 ? bb->x : x0;
+            y0 = bb->y < y0 ? bb->y : y0;
+            x1 = bb->x > x1 ? bb->x : x1;
+            y1 = bb->y > y1 ? bb->y : y1;
+        }
+        /* Scaling: centroids are within +-328 m, the margin <= 100 m: Q16 spans < 2^27. */
+        l->grid = NOMAP_GRID;
+        l->ox = x0 - p->cfg.margin;
+        l->oy = y0 - p->cfg.margin;
+        l->lw = (uint16_t)((x1 + p->cfg.margin - l->ox) / l->grid + 1);
+        l->lh = (uint16_t)((y1 + p->cfg.margin - l->oy) / l->grid + 1);
+    }
+    int32_t cs = (int32_t)rfs_sdiv64_round(p->cfg.coarse, l->grid);
+    cs = cs < 1 ? 1 : cs;
+    for (;;) {
+        l->ncx = (uint16_t)((l->lw - 1u) / (uint32_t)cs + 1u);
+        l->ncy = (uint16_t)((l->lh - 1u) / (uint32_t)cs + 1u);
+        if ((uint32_t)l->ncx * l->ncy <= RFS_PATHLOSS_MAX_COARSE) {
+            break;
+        }
+        cs++;
+    }
+    l->cs = (uint16_t)cs;
+    l->c0i = (uint16_t)(((uint32_t)l->lw - 1u - (uint32_t)(l->ncx - 1u) * (uint32_t)cs) / 2u);
+    l->c0j = (uint16_t)(((uint32_t)l->lh - 1u - (uint32_t)(l->ncy - 1u) * (uint32_t)cs) / 2u);
+    int32_t fs = (int32_t)rfs_sdiv64_round(p->cfg.fine, l->grid);
+    fs = fs < 1 ? 1 : fs;
+    if (fs > cs / 2) {
+        fs = cs / 2 < 1 ? 1 : cs / 2;
+    }
+    l->fs = (uint16_t)fs;
+}
+
+static void lattice_xy(const rfs_pathloss_lat_t *l, uint16_t i, uint16_t j, rfs_q16_t *x,
+                       rfs_q16_t *y)
+{
+    *x = rfs_sat32((int64_t)l->ox + (int64_t)i * l->grid);
+    *y = rfs_sat32((int64_t)l->oy + (int64_t)j * l->grid);
+}
+
+/* dx^2 + dy^2 for differences of Q16 values (|d| < 2^32): Q32 in uint64, saturated. */
+static uint64_t sq_sum(int64_t dx, int64_t dy)
+{
+    uint64_t ax = (uint64_t)(dx < 0 ? -dx : dx), ay = (uint64_t)(dy < 0 ? -dy : dy);
+    uint64_t a = ax * ax, b = ay * ay;
+    return a > UINT64_MAX - b ? UINT64_MAX : a + b;
+}
+
+static bool cand_legal(const rfs_pathloss_t *p, int32_t i, int32_t j)
+{
+    if (i < 0 || j < 0 || i >= (int32_t)p->lat.lw || j >= (int32_t)p->lat.lh) {
+        return false;
+    }
+    return p->map == 0 || rfs_map_lattice_legal(p->map, (uint16_t)i, (uint16_t)j);
+}
+
+static rfs_i128_t i128_of(int64_t v)
+{
+    return rfs_i128_mul(v, 1);
+}
+
+/* F(n, W) = M11 n^2 + 2 M12 n W + M22 W^2 - 2 (R1 n + R2 W), Q48 in 128 bits: the LS
+ * objective up to a constant. Scaling: M Q16 < 2^46, n, W Q16 < 2^23: n^2 < 2^46,
+ * products < 2^92; R Q16 < 2^50 times n 2^17 < 2^90. */
+static rfs_i128_t objective(const int64_t M[3], const int64_t R[2], int32_t n, int32_t w)
+{
+    rfs_i128_t f = rfs_i128_mul(M[0], (int64_t)n * n);
+    f = rfs_i128_add(f, rfs_i128_mul(M[1], 2 * (int64_t)n * w));
+    f = rfs_i128_add(f, rfs_i128_mul(M[2], (int64_t)w * w));
+    f = rfs_i128_sub(f, rfs_i128_mul(R[0], (int64_t)n * 131072));
+    return rfs_i128_sub(f, rfs_i128_mul(R[1], (int64_t)w * 131072));
+}
+
+/* Minimiser of the 1-D quadratic along one variable with the other fixed at v, clamped:
+ * (r * 2^16 - m12 v) / m, Q16. Scaling: r < 2^50 times 2^16 and m12 v < 2^69: 128 bits. */
+static int32_t edge_min(int64_t r, int64_t m12, int32_t v, int64_t m, int32_t lo, int32_t hi)
+{
+    rfs_i128_t num = rfs_i128_sub(rfs_i128_mul(r, 65536), rfs_i128_mul(m12, v));
+    int64_t x = rfs_i128_div_shift(num, i128_of(m), 0u);
+    return x < lo ? lo : (x > hi ? hi : (int32_t)x);
+}
+
+/* Box-constrained least squares in (n, W); M = {M11, M12, M22}, R = right-hand side,
+ * both Q16 (see the file comment). M is positive definite. */
+static void solve_nw(const rfs_pathloss_cfg_t *c, const int64_t M[3], const int64_t R[2],
+                     int32_t *n_out, int32_t *w_out)
+{
+    rfs_i128_t det = rfs_i128_sub(rfs_i128_mul(M[0], M[2]), rfs_i128_mul(M[1], M[1]));
+    rfs_i128_t nn = rfs_i128_sub(rfs_i128_mul(R[0], M[2]), rfs_i128_mul(M[1], R[1]));
+    rfs_i128_t nw = rfs_i128_sub(rfs_i128_mul(M[0], R[1]), rfs_i128_mul(M[1], R[0]));
+    int64_t n = rfs_i128_div_shift(nn, det, 16u);
+    int64_t w = rfs_i128_div_shift(nw, det, 16u);
+    if (n >= c->n_min && n <= c->n_max && w >= c->w_min && w <= c->w_max) {
+        *n_out = (int32_t)n;
+        *w_out = (int32_t)w;
+        return;
+    }
+    /* The four edges: n at a bound with W free, W at a bound with n free. */
+    int32_t en[4], ew[4];
+    en[0] = c->n_min;
+    en[1] = c->n_max;
+    ew[0] = edge_min(R[1], M[1], en[0], M[2], c->w_min, c->w_max);
+    ew[1] = edge_min(R[1], M[1], en[1], M[2], c->w_min, c->w_max);
+    ew[2] = c->w_min;
+    ew[3] = c->w_max;
+    en[2] = edge_min(R[0], M[1], ew[2], M[0], c->n_min, c->n_max);
+    en[3] = edge_min(R[0], M[1], ew[3], M[0], c->n_min, c->n_max);
+    uint32_t best = 0u;
+    rfs_i128_t fb = objective(M, R, en[0], ew[0]);
+    for (uint32_t e = 1u; e < 4u; ++e) {
+        rfs_i128_t f = objective(M, R, en[e], ew[e]);
+        if (rfs_i128_neg(rfs_i128_sub(f, fb))) {
+            fb = f;
+            best = e;
+        }
+    }
+    *n_out = en[best];
+    *w_out = ew[best];
+}
+
+/* Fit (P0, n, W) for the source at lattice point (li, lj) and its Huber loss.
+ * Scaling and overflow (|L| < 64 dB, so L Q16 < 2^22; counts sum to <= 65,535 = 2^16;
+ * |dz| < 2^10 dB, Q16 < 2^26): centred values in Q8 are below 2^15 (l), 2^16 (k) and
+ * c dz < 2^34 (e); the sums c l^2, c l k, c k^2 stay below 2^16 x 2^32 = 2^48 and
+ * l e, k e below 2^16 x 2^34 = 2^50, all in int64. */
+static void eval(rfs_pathloss_t *p, uint16_t li, uint16_t lj, rfs_pathloss_cand_t *out)
+{
+    const rfs_pathloss_cfg_t *c = &p->cfg;
+    rfs_q16_t sx, sy;
+    lattice_xy(&p->lat, li, lj, &sx, &sy);
+    int64_t sl = 0, sk = 0;
+    for (uint32_t b = 0u; b < p->nbins; ++b) {
+        const rfs_pathloss_bin_t *bb = &p->bins[b];
+        int64_t dx = (int64_t)bb->x - sx, dy = (int64_t)bb->y - sy;
+        int32_t L = rfs_pathloss_db_dist(sq_sum(dx, dy));
+        uint32_t k = 0u;
+        if (p->map != 0) {
+            k = rfs_map_walls_crossed(p->map, bb->x, bb->y, sx, sy);
+            k = k > WALLS_MAX ? WALLS_MAX : k;
+        }
+        p->l_q16[b] = L;
+        p->k[b] = (uint8_t)k;
+        sl += (int64_t)bb->count * L;
+        sk += (int64_t)bb->count * (int64_t)k;
+    }
+    const int64_t tot = (int64_t)p->total;
+    const int32_t ml = (int32_t)rfs_sdiv64_round(sl, tot);
+    const int32_t mk = (int32_t)rfs_sdiv64_round(sk * 65536, tot);
+    int64_t all = 0, alk = 0, akk = 0, bl = 0, bk = 0;
+    for (uint32_t b = 0u; b < p->nbins; ++b) {
+        const rfs_pathloss_bin_t *bb = &p->bins[b];
+        int64_t cnt = bb->count;
+        int64_t l8 = ((int64_t)p->l_q16[b] - ml + 128) >> 8;
+        int64_t k8 = ((int64_t)p->k[b] * 65536 - mk + 128) >> 8;
+        int64_t e8 = (cnt * bb->dz_q16 + 128) >> 8;
+        all += cnt * l8 * l8;
+        alk += cnt * l8 * k8;
+        akk += cnt * k8 * k8;
+        bl += l8 * e8;
+        bk += k8 * e8;
+    }
+    /* The prior: lam (n - n_prior)^2 + lam (W - w_prior)^2, lam in the units of M (Q16). */
+    const int64_t lam = c->prior_weight;
+    const int64_t M[3] = {all + lam, alk, akk + lam};
+    const int64_t R[2] = {-bl + ((lam * c->n_prior + 32768) >> 16),
+                          -bk + ((lam * c->w_prior + 32768) >> 16)};
+    int32_t n, w;
+    solve_nw(c, M, R, &n, &w);
+    /* Huber loss of the bins' mean residuals z_b - P0 + n L_b + W k_b
+     * = dz_b + n (L_b - mean L) + W (k_b - mean k), Q16, then Q8 (saturated to 2^24). */
+    const int64_t d8 = ((int64_t)c->huber + 128) >> 8;
+    int64_t loss = 0;
+    for (uint32_t b = 0u; b < p->nbins; ++b) {
+        const rfs_pathloss_bin_t *bb = &p->bins[b];
+        int64_t r = (int64_t)bb->dz_q16 +
+                    (((int64_t)n * ((int64_t)p->l_q16[b] - ml) +
+                      (int64_t)w * ((int64_t)p->k[b] * 65536 - mk) + 32768) >> 16);
+        int64_t a = (r < 0 ? -r : r);
+        a = (a + 128) >> 8;
+        a = a > ((int64_t)1 << 24) ? ((int64_t)1 << 24) : a;
+        int64_t h = a <= d8 ? (a * a) >> 1 : d8 * a - ((d8 * d8) >> 1);
+        loss += (int64_t)bb->count * h;
+    }
+    out->loss = loss;
+    out->sx = sx;
+    out->sy = sy;
+    out->li = li;
+    out->lj = lj;
+    out->n = n;
+    out->w = w;
+    out->p0 = rfs_sat32((int64_t)p->mz_q16 +
+                        (((int64_t)n * ml + (int64_t)w * mk + 32768) >> 16));
+    p->candidates++;
+}
+
+/* Mean Huber loss per sample, dB^2 Q16, saturated below NO_LOSS. */
+static uint32_t mean_loss(const rfs_pathloss_t *p, int64_t loss)
+{
+    uint64_t m = rfs_udiv64((uint64_t)loss, p->total);
+    return m >= RFS_PATHLOSS_NO_LOSS ? RFS_PATHLOSS_NO_LOSS - 1u : (uint32_t)m;
+}
+
+static void consider(rfs_pathloss_t *p, const rfs_pathloss_cand_t *cd)
+{
+    if (cd->loss < p->cur.loss) {
+        p->cur = *cd;
+    }
+}
+
+/* Keep the best `top` coarse candidates, best first (ties: the earlier one). */
+static void keep_top(rfs_pathloss_t *p, const rfs_pathloss_cand_t *cd)
+{
+    uint32_t k = p->ntop;
+    if (k == p->cfg.top && cd->loss >= p->top[k - 1u].loss) {
+        return;
+    }
+    if (k == p->cfg.top) {
+        k--;
+    }
+    while (k > 0u && cd->loss < p->top[k - 1u].loss) {
+        p->top[k] = p->top[k - 1u];
+        k--;
+    }
+    p->top[k] = *cd;
+    if (p->ntop < p->cfg.top) {
+        p->ntop++;
+    }
+}
+
+/* True when lattice point (i, j) was a candidate of an earlier phase: a coarse point, or
+ * on the refinement sub-lattice within the box of one of the first `ncentres` top ones. */
+static bool seen_before(const rfs_pathloss_t *p, int32_t i, int32_t j, uint32_t ncentres)
+{
+    const rfs_pathloss_lat_t *l = &p->lat;
+    int32_t ci = i - l->c0i, cj = j - l->c0j;
+    if (ci >= 0 && cj >= 0 && ci % l->cs == 0 && cj % l->cs == 0) {
+        return true;
+    }
+    const int32_t r1 = l->cs / 2;
+    for (uint32_t k = 0u; k < ncentres; ++k) {
+        int32_t a = i - p->top[k].li, b = j - p->top[k].lj;
+        if (a >= -r1 && a <= r1 && b >= -r1 && b <= r1 && a % l->fs == 0 && b % l->fs == 0) {
+            return true;
+        }
+    }
+    return false;
+}
+
+static void finish(rfs_pathloss_t *p)
+{
+    const rfs_pathloss_lat_t *l = &p->lat;
+    p->best = p->cur;
+    /* Spread region: mean loss <= best (1 + spread_k / bins). */
+    uint64_t bm = mean_loss(p, p->best.loss);
+    uint64_t thr = bm + rfs_udiv64(bm * (uint64_t)p->cfg.spread_k, (uint64_t)p->nbins * 65536u);
+    /* At least the best coarse point: the surface cannot resolve a smaller region. */
+    uint64_t tc = mean_loss(p, p->top[0].loss);
+    thr = thr > tc ? thr : tc;
+    uint32_t cnt = 0u;
+    for (uint32_t c = 0u; c < (uint32_t)l->ncx * l->ncy; ++c) {
+        cnt += (p->surface[c] != RFS_PATHLOSS_NO_LOSS && p->surface[c] <= thr) ? 1u : 0u;
+    }
+    /* Scaling: cell side cs * grid < 2^22 (Q16 <= 64 m); its square Q32 >> 16 fits. */
+    int64_t side = (int64_t)l->cs * l->grid;
+    int64_t cell = (side * side + 32768) >> 16;
+    p->spread_m2 = rfs_sat32(cell * cnt);
+    p->used_bins = p->nbins;
+    p->used_bin_cm = p->bin_cm;
+    p->phase = RFS_PATHLOSS_IDLE;
+    p->valid = true;
+}
+
+static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, uint32_t budget,
+                                     rfs_rng_t *rng)
+{
+    rfs_pathloss_t *p = (rfs_pathloss_t *)self;
+    (void)rng;
+    RFS_ASSERT(p != 0 && in != 0 && (in->samples != 0 || in->n == 0u));
+    if (p->phase == RFS_PATHLOSS_IDLE) {
+        p->valid = false;
+        if (in->n == 0u) {
+            return RFS_FIT_FAILED;
+        }
+        p->map = in->map;
+        bin_samples(p, in->samples, in->n);
+        setup_lattice(p, in->map);
+        p->phase = RFS_PATHLOSS_COARSE;
+        p->pos = 0u;
+        p->ntop = 0u;
+        p->candidates = 0u;
+        p->cur.loss = INT64_MAX;
+    }
+    const rfs_pathloss_lat_t *l = &p->lat;
+    const int32_t r1 = l->cs / 2, m1 = r1 / l->fs, side1 = 2 * m1 + 1;
+    const int32_t r2 = l->fs / 2, side2 = 2 * r2 + 1;
+    uint32_t used = 0u;
+    for (;;) {
+        if (budget != 0u && used >= budget) {
+            return RFS_FIT_MORE;
+        }
+        rfs_pathloss_cand_t cd;
+        if (p->phase == RFS_PATHLOSS_COARSE) {
+            uint32_t nc = (uint32_t)l->ncx * l->ncy;
+            if (p->pos >= nc) {
+                if (p->ntop == 0u) {
+                    p->phase = RFS_PATHLOSS_IDLE;
+                    return RFS_FIT_FAILED; /* no legal candidate on the map */
+                }
+                p->phase = RFS_PATHLOSS_REFINE;
+                p->pos = 0u;
+                continue;
+            }
+            uint32_t c = p->pos++;
+            int32_t i = l->c0i + (int32_t)(c % l->ncx) * l->cs;
+            int32_t j = l->c0j + (int32_t)(c / l->ncx) * l->cs;
+            p->surface[c] = RFS_PATHLOSS_NO_LOSS;
+            if (!cand_legal(p, i, j)) {
+                continue;
+            }
+            eval(p, (uint16_t)i, (uint16_t)j, &cd);
+            used += p->nbins;
+            p->surface[c] = mean_loss(p, cd.loss);
+            consider(p, &cd);
+            keep_top(p, &cd);
+        } else if (p->phase == RFS_PATHLOSS_REFINE) {
+            uint32_t per = (uint32_t)(side1 * side1);
+            if (p->pos >= p->ntop * per) {
+                p->phase = RFS_PATHLOSS_FINAL;
+                p->fc_i = p->cur.li;
+                p->fc_j = p->cur.lj;
+                p->pos = 0u;
+                continue;
+            }
+            uint32_t k = p->pos / per, rem = p->pos % per;
+            p->pos++;
+            int32_t i = p->top[k].li + ((int32_t)(rem % (uint32_t)side1) - m1) * l->fs;
+            int32_t j = p->top[k].lj + ((int32_t)(rem / (uint32_t)side1) - m1) * l->fs;
+            if (!cand_legal(p, i, j) || seen_before(p, i, j, k)) {
+                continue;
+            }
+            if (i == p->top[k].li && j == p->top[k].lj) {
+                continue;
+            }
+            eval(p, (uint16_t)i, (uint16_t)j, &cd);
+            used += p->nbins;
+            consider(p, &cd);
+        } else {
+            if (p->pos >= (uint32_t)(side2 * side2)) {
+                finish(p);
+                return RFS_FIT_DONE;
+            }
+            uint32_t rem = p->pos++;
+            int32_t i = p->fc_i + (int32_t)(rem % (uint32_t)side2) - r2;
+            int32_t j = p->fc_j + (int32_t)(rem / (uint32_t)side2) - r2;
+            if ((i == p->fc_i && j == p->fc_j) || !cand_legal(p, i, j) ||
+                seen_before(p, i, j, p->ntop)) {
+                continue;
+            }
+            eval(p, (uint16_t)i, (uint16_t)j, &cd);
+            used += p->nbins;
+            consider(p, &cd);
+        }
+    }
+}
+
+/* Prediction P0 - n 10 log10(max(d, 1 m)) - W walls at (x, y): one logarithm and one wall
+ * count. Scaling and overflow: Q16 differences < 2^32, their squares (Q32 m^2) summed in
+ * uint64, saturated (sq_sum); n L and W k products < 2^45 in int64, saturated. */
+static bool pathloss_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *value)
+{
+    const rfs_pathloss_t *p = (const rfs_pathloss_t *)self;
+    if (!p->valid) {
+        return false;
+    }
+    int64_t dx = (int64_t)x - p->best.sx, dy = (int64_t)y - p->best.sy;
+    int64_t L = rfs_pathloss_db_dist(sq_sum(dx, dy));
+    int64_t k = 0;
+    if (p->map != 0) {
+        k = rfs_map_walls_crossed(p->map, x, y, p->best.sx, p->best.sy);
+        k = k > (int64_t)WALLS_MAX ? (int64_t)WALLS_MAX : k;
+    }
+    int64_t v = (int64_t)p->best.p0 - (((int64_t)p->best.n * L + 32768) >> 16) - p->best.w * k;
+    *value = rfs_sat32(v);
+    return true;
+}
+
+static bool pathloss_argmax(const void *self, rfs_q16_t *x, rfs_q16_t *y)
+{
+    const rfs_pathloss_t *p = (const rfs_pathloss_t *)self;
+    if (!p->valid) {
+        return false;
+    }
+    *x = p->best.sx;
+    *y = p->best.sy;
+    return true;
+}
+
+const rfs_model_ops_t rfs_pathloss_ops = {
+    .name = "pathloss",
+    .reset = pathloss_reset,
+    .fit = pathloss_fit,
+    .predict = pathloss_predict,
+    .argmax = pathloss_argmax,
+    .predict_row = 0,
+};
+
+rfs_model_t rfs_pathloss_model(rfs_pathloss_t *p)
+{
+    rfs_model_t m;
+    m.ops = &rfs_pathloss_ops;
+    m.self = p;
+    return m;
+}
+
+bool rfs_pathloss_estimate(const rfs_pathloss_t *p, rfs_pathloss_est_t *est)
+{
+    RFS_ASSERT(p != 0 && est != 0);
+    if (!p->valid) {
+        return false;
+    }
+    est->sx = p->best.sx;
+    est->sy = p->best.sy;
+    est->p0 = p->best.p0;
+    est->n = p->best.n;
+    est->w = p->best.w;
+    uint32_t m2 = mean_loss(p, p->best.loss);
+    est->rms = rfs_q16_sqrt(m2 > (uint32_t)INT32_MAX / 2u ? INT32_MAX : (rfs_q16_t)(2u * m2));
+    est->spread_m2 = p->spread_m2;
+    est->bins = p->used_bins;
+    est->bin = cm_to_q16(p->used_bin_cm);
+    est->candidates = p->candidates;
+    return true;
+}
+
+void rfs_pathloss_surface_size(const rfs_pathloss_t *p, uint16_t *ncx, uint16_t *ncy)
+{
+    RFS_ASSERT(p != 0 && ncx != 0 && ncy != 0);
+    *ncx = p->valid ? p->lat.ncx : 0u;
+    *ncy = p->valid ? p->lat.ncy : 0u;
+}
+
+bool rfs_pathloss_residual_at(const rfs_pathloss_t *p, uint16_t ci, uint16_t cj, rfs_q16_t *x,
+                              rfs_q16_t *y, rfs_q16_t *rms)
+{
+    RFS_ASSERT(p != 0 && x != 0 && y != 0 && rms != 0);
+    const rfs_pathloss_lat_t *l = &p->lat;
+    if (!p->valid || ci >= l->ncx || cj >= l->ncy) {
+        return false;
+    }
+    lattice_xy(l, (uint16_t)(l->c0i + ci * l->cs), (uint16_t)(l->c0j + cj * l->cs), x, y);
+    uint32_t m = p->surface[(uint32_t)cj * l->ncx + ci];
+    if (m == RFS_PATHLOSS_NO_LOSS) {
+        return false;
+    }
+    /* sqrt(2 m): 2 m saturated to the Q16 range (181 dB). */
+    *rms = rfs_q16_sqrt(m > (uint32_t)INT32_MAX / 2u ? INT32_MAX : (rfs_q16_t)(2u * m));
+    return true;
+}

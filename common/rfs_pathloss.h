@@ -1,0 +1,204 @@
+/* rfs_pathloss.h - a map-aware, physics-informed internal model (issue 10; paper section 3:
+ * "representations of varying complexity ... depending on the available resources and
+ * prior knowledge").
+ *
+ * The signal at position x from a source at s is modelled as
+ *
+ *   z(x) = P0 - 10 n log10(max(|x - s|, 1 m)) - W walls(x, s)          [dB]
+ *
+ * with walls() the wall runs the straight line crosses on the core grid
+ * (rfs_map_walls_crossed: the rule the simulator's radio model uses). For a fixed s the
+ * model is linear in (P0, n, W): fit() solves the least-squares problem in closed form
+ * for every candidate s, with n and W bounded to [n_min, n_max] and [w_min, w_max]
+ * (exact box-constrained solution of the 2 x 2 quadratic after eliminating P0) and a
+ * weak prior (n_prior, w_prior, weight prior_weight samples) so that W stays defined
+ * when every sample sees the same number of walls. The estimate is the candidate with
+ * the least Huber loss of its residuals.
+ *
+ * Samples are first aggregated into square bins (1 m; at most RFS_PATHLOSS_MAX_BINS = 512, the
+ * bin doubles when there are more): each bin is its sample count, mean value and
+ * centroid, so the cost of a candidate does not grow with the number of samples.
+ * Candidates are legal lattice points, searched coarse to fine: every `coarse` (2 m),
+ * then the neighbourhood (+-coarse/2) of the best `top` (3) at `fine` (0.5 m), then the
+ * neighbours of the best at the lattice spacing (0.25 m). Without a map (fit_in.map NULL)
+ * the candidates cover the samples' extent plus `margin` on a 0.25 m lattice, no walls.
+ *
+ * Uncertainty: the mean Huber loss of every coarse candidate is kept (the residual
+ * surface, rfs_pathloss_residual_at(), for heat maps) and the estimate reports the area
+ * of coarse candidates whose loss is within spread_k / bins of the best's (relative):
+ * a likelihood-ratio region that counts each bin as one independent observation.
+ *
+ * Work: one unit is one (bin, candidate) pair (a wall count and a logarithm). fit() with
+ * budget 0 does everything; with budget > 0 it evaluates candidates until that many
+ * units are used (at least one candidate) and returns RFS_FIT_MORE until the search is
+ * done. The first call also bins the samples (about 60 instructions per sample). The
+ * model is invalid while a fit is in progress; a sliced fit keeps the bins of its first
+ * call, so samples added meanwhile are used by the next relearn.
+ */
+#ifndef RFS_PATHLOSS_H
+#define RFS_PATHLOSS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rfs_fix.h"
+#include "rfs_map.h"
+#include "rfs_model.h"
+
+/// Most sample bins (the bin size doubles until the samples fit).
+#define RFS_PATHLOSS_MAX_BINS 512u
+/// Slots of the bin hash table (a power of two, twice the bins).
+#define RFS_PATHLOSS_HASH (2u * RFS_PATHLOSS_MAX_BINS)
+/// Most coarse candidates (the coarse spacing grows until the map fits).
+#define RFS_PATHLOSS_MAX_COARSE 1024u
+/// Most coarse candidates refined.
+#define RFS_PATHLOSS_MAX_TOP 4u
+/// Surface value of a coarse point that is not a candidate (illegal).
+#define RFS_PATHLOSS_NO_LOSS UINT32_MAX
+
+/// Configuration; rfs_pathloss_cfg_default() gives the values in the comments.
+typedef struct rfs_pathloss_cfg {
+    rfs_q16_t bin;          ///< metres Q16.16: side of a sample bin (1 m), 0.1..16 m
+    rfs_q16_t coarse;       ///< metres Q16.16: coarse candidate spacing (2 m)
+    rfs_q16_t fine;         ///< metres Q16.16: refinement spacing (0.5 m)
+    uint8_t top;            ///< coarse candidates refined (3), 1..RFS_PATHLOSS_MAX_TOP
+    rfs_q16_t n_min;        ///< path-loss exponent bounds, Q16.16 (1.5)
+    rfs_q16_t n_max;        ///< (5.0)
+    rfs_q16_t w_min;        ///< loss per wall bounds, dB Q16.16 (0)
+    rfs_q16_t w_max;        ///< (15 dB)
+    rfs_q16_t n_prior;      ///< prior exponent, Q16.16 (3.0: ITU-R P.1238 office)
+    rfs_q16_t w_prior;      ///< prior loss per wall, dB Q16.16 (5 dB: ns-3 buildings)
+    rfs_q16_t prior_weight; ///< weight of the prior, samples x dB^2, Q16.16 (1.0), > 0
+    rfs_q16_t huber;        ///< Huber threshold on a bin's mean residual, dB Q16.16 (6 dB)
+    rfs_q16_t spread_k;     ///< spread region: loss <= best (1 + spread_k / bins) (6.0)
+    rfs_q16_t margin;       ///< metres Q16.16: candidates beyond the samples without a map (20 m)
+} rfs_pathloss_cfg_t;
+
+/// One sample bin. Scaling: sums of up to 65,535 samples of int16 fit int32.
+typedef struct rfs_pathloss_bin {
+    int32_t sx_cm;   ///< sum of x, centimetres; centroid x after binning
+    int32_t sy_cm;   ///< sum of y, centimetres; centroid y after binning
+    int32_t sv_q6;   ///< sum of values, Q9.6
+    int32_t dz_q16;  ///< mean value minus the mean over all samples, target units Q16.16
+    rfs_q16_t x;     ///< centroid x, metres Q16.16
+    rfs_q16_t y;     ///< centroid y, metres Q16.16
+    uint16_t count;  ///< samples in the bin
+    int16_t kx;      ///< bin index along x (floor(x / bin))
+    int16_t ky;      ///< bin index along y
+} rfs_pathloss_bin_t;
+
+/// One evaluated candidate source and its fit.
+typedef struct rfs_pathloss_cand {
+    int64_t loss;    ///< sum over bins of count x Huber(mean residual), dB^2 Q16 (Q8 x Q8)
+    rfs_q16_t sx;    ///< source x, metres Q16.16
+    rfs_q16_t sy;    ///< source y, metres Q16.16
+    uint16_t li;     ///< its lattice index along x
+    uint16_t lj;     ///< its lattice index along y
+    rfs_q16_t p0;    ///< signal at 1 m, target units Q16.16
+    rfs_q16_t n;     ///< path-loss exponent, Q16.16
+    rfs_q16_t w;     ///< loss per wall, dB Q16.16
+} rfs_pathloss_cand_t;
+
+/// The candidate lattice: the map's, or a virtual one without a map.
+typedef struct rfs_pathloss_lat {
+    rfs_q16_t ox;    ///< x of point (0, 0), metres Q16.16
+    rfs_q16_t oy;    ///< y of point (0, 0), metres Q16.16
+    rfs_q16_t grid;  ///< spacing, metres Q16.16
+    uint16_t lw;     ///< points along x
+    uint16_t lh;     ///< points along y
+    uint16_t cs;     ///< coarse spacing, lattice steps
+    uint16_t c0i;    ///< lattice index of coarse point (0, 0) along x
+    uint16_t c0j;    ///< along y
+    uint16_t ncx;    ///< coarse points along x
+    uint16_t ncy;    ///< coarse points along y
+    uint16_t fs;     ///< refinement spacing, lattice steps
+} rfs_pathloss_lat_t;
+
+/// Search phases of a (sliced) fit.
+typedef enum rfs_pathloss_phase {
+    RFS_PATHLOSS_IDLE = 0, ///< no fit in progress
+    RFS_PATHLOSS_COARSE,   ///< coarse candidates
+    RFS_PATHLOSS_REFINE,   ///< around the best coarse candidates at the fine spacing
+    RFS_PATHLOSS_FINAL,    ///< around the best at the lattice spacing
+} rfs_pathloss_phase_t;
+
+/// What the model believes (rfs_pathloss_estimate()).
+typedef struct rfs_pathloss_est {
+    rfs_q16_t sx;         ///< estimated source x, metres Q16.16
+    rfs_q16_t sy;         ///< estimated source y, metres Q16.16
+    rfs_q16_t p0;         ///< signal at 1 m, target units Q16.16
+    rfs_q16_t n;          ///< path-loss exponent, Q16.16
+    rfs_q16_t w;          ///< loss per wall, dB Q16.16
+    rfs_q16_t rms;        ///< residual, sqrt(2 x mean Huber loss) (= RMS when all < huber), dB Q16.16
+    rfs_q16_t spread_m2;  ///< area of coarse candidates in the spread region, m^2 Q16.16
+    uint16_t bins;        ///< bins used
+    rfs_q16_t bin;        ///< bin side used, metres Q16.16
+    uint32_t candidates;  ///< candidates evaluated
+} rfs_pathloss_est_t;
+
+/// State, caller-owned (about 23 KB).
+typedef struct rfs_pathloss {
+    rfs_pathloss_cfg_t cfg;                       ///< configuration copied at init
+    bool valid;                                   ///< a model exists
+    const rfs_map_t *map;                         ///< map of the last fit (NULL: no walls)
+    rfs_pathloss_cand_t best;                     ///< the model: estimate and its fit
+    rfs_q16_t spread_m2;                          ///< area of the spread region, m^2 Q16.16
+    uint32_t candidates;                          ///< candidates evaluated (last or current fit)
+    uint16_t used_bins;                           ///< bins of the last finished fit
+    int32_t used_bin_cm;                          ///< their side, centimetres
+    /* --- fit in progress (and its bins, which the estimate reports) --- */
+    rfs_pathloss_phase_t phase;                   ///< search phase
+    uint32_t pos;                                 ///< position within the phase
+    rfs_pathloss_lat_t lat;                       ///< candidate lattice
+    uint16_t nbins;                               ///< bins in use
+    int32_t bin_cm;                               ///< bin side in use, centimetres
+    uint32_t total;                               ///< samples binned (sum of counts)
+    int32_t mz_q16;                               ///< mean of all samples, target units Q16.16
+    uint8_t ntop;                                 ///< coarse candidates kept in top[]
+    rfs_pathloss_cand_t top[RFS_PATHLOSS_MAX_TOP]; ///< best coarse candidates, best first
+    rfs_pathloss_cand_t cur;                      ///< best so far
+    uint16_t fc_i;                                ///< centre of the final phase, lattice x
+    uint16_t fc_j;                                ///< lattice y
+    rfs_pathloss_bin_t bins[RFS_PATHLOSS_MAX_BINS]; ///< sample bins
+    uint16_t hash[RFS_PATHLOSS_HASH];             ///< bin index + 1 by hashed cell, 0 = empty
+    int32_t l_q16[RFS_PATHLOSS_MAX_BINS];         ///< scratch: 10 log10(d) per bin, dB Q16.16
+    uint8_t k[RFS_PATHLOSS_MAX_BINS];             ///< scratch: walls per bin
+    uint32_t surface[RFS_PATHLOSS_MAX_COARSE];    ///< mean Huber loss per sample of each coarse
+                                                  ///< point, dB^2 Q16.16; NO_LOSS = no candidate
+} rfs_pathloss_t;
+
+/// Defaults (see rfs_pathloss_cfg_t).
+rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void);
+
+/// Initialise without a model. Returns 0, or -1 on bin outside [0.1, 16] m, coarse or fine
+/// outside (0, 64] m or fine > coarse, top outside 1..RFS_PATHLOSS_MAX_TOP, n bounds not
+/// 0 < n_min <= n_max <= 10, W bounds not 0 <= w_min <= w_max <= 60 dB, priors outside
+/// their bounds, prior_weight outside (0, 10^4], huber outside (0, 100] dB, spread_k
+/// outside [0, 1000], or margin outside [0, 100] m.
+int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg);
+
+/// The model interface of a path-loss state.
+rfs_model_t rfs_pathloss_model(rfs_pathloss_t *p);
+
+/// Operations (also reachable through rfs_pathloss_model()).
+extern const rfs_model_ops_t rfs_pathloss_ops;
+
+/// The current estimate; false when there is no model.
+bool rfs_pathloss_estimate(const rfs_pathloss_t *p, rfs_pathloss_est_t *est);
+
+/// Size of the residual surface (coarse candidate grid) of the last fit; 0 x 0 when none.
+void rfs_pathloss_surface_size(const rfs_pathloss_t *p, uint16_t *ncx, uint16_t *ncy);
+
+/// Coarse point (ci, cj): its position (metres Q16.16) and residual sqrt(2 x mean Huber
+/// loss) in dB Q16.16. false when there is no model, (ci, cj) is outside the surface or
+/// the point was not a candidate (not legal); the position is set whenever in range.
+bool rfs_pathloss_residual_at(const rfs_pathloss_t *p, uint16_t ci, uint16_t cj, rfs_q16_t *x,
+                              rfs_q16_t *y, rfs_q16_t *rms);
+
+/// 10 log10(max(d, 1 m)) for a squared distance d2 in m^2 Q32.32 (the square of a Q16.16
+/// difference), dB Q16.16, error < 1e-4 dB.
+/// Scaling and overflow: log2 of d2 from its bit length and a Q16 mantissa in [1, 2)
+/// (rfs_q16_log2), minus 32 (Q32), times 10 log10(2) / 2 in Q30: < 2^53 in int64.
+rfs_q16_t rfs_pathloss_db_dist(uint64_t d2_q32);
+
+#endif /* RFS_PATHLOSS_H */

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# bench_sim.sh - simulator figures for docs/PERFORMANCE.md (make bench-sim).
+#   scripts/bench_sim.sh build/bin/rfseek-sim
+# 1. Real-time factor of one robot with one 200 pkt/s source, the core in-process, on one
+#    core: the default scenario, seeds 1..20 run one after another in one process
+#    (three repetitions; the median of the three overall factors is reported).
+# 2. Wall time of a 200-seed batch of the default scenario on 2 cores (--jobs 2).
+set -euo pipefail
+SIM=${1:?usage: bench_sim.sh path/to/rfseek-sim}
+echo "bench-sim: load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
+rtfs=() cpus=()
+for rep in 1 2 3; do
+    out=$("$SIM" scenarios/default.yaml --seeds 1..20 --bench)
+    echo "$out" | sed "s/^/bench-sim: rep $rep: /"
+    rtfs+=("$(echo "$out" | sed -nE 's/.*overall ([0-9]+)x.*/\1/p')")
+    cpus+=("$(echo "$out" | sed -nE 's/.*by cpu time: ([0-9]+)x.*/\1/p')")
+done
+med=$(printf '%s\n' "${rtfs[@]}" | sort -n | sed -n 2p)
+medc=$(printf '%s\n' "${cpus[@]}" | sort -n | sed -n 2p)
+echo "bench-sim: real-time factor (default scenario, 1 robot, 1 x 200 pkt/s, 1 core): median ${med}x by wall time, ${medc}x by cpu time"
+start=$(date +%s.%N)
+"$SIM" scenarios/default.yaml --seeds 1..200 --jobs 2 --quiet >/dev/null
+end=$(date +%s.%N)
+echo "bench-sim: 200-seed batch of the default scenario on 2 cores: $(awk "BEGIN{printf \"%.1f\", $end - $start}") s wall"
+echo "bench-sim: load average after: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -1,0 +1,352 @@
+/* ref_pathloss.h - a double-precision reference of the path-loss model's search
+ * (common/rfs_pathloss.h), for tests/common/test_pathloss.c.
+ *
+ * The same definition computed another way: bins found by a linear search, centroids
+ * rounded to the centimetre as the definition says (the store's unit), distances and logarithms in double, the constrained least
+ * squares by direct minimisation of the sum of squared residuals over the interior
+ * solution, the four edges and the four corners of the (n, W) box, and the Huber loss
+ * in double. Only the wall counts come from the core (rfs_map_walls_crossed, tested in
+ * test_map.c), because they are the model's definition of a wall.
+ */
+#ifndef REF_PATHLOSS_H
+#define REF_PATHLOSS_H
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rfs_map.h"
+#include "rfs_store.h"
+
+#define REF_PL_MAX_BINS 512
+#define REF_PL_MAX_COARSE 1024
+
+typedef struct ref_pl_cfg {
+    double bin, coarse, fine;
+    int top;
+    double n_min, n_max, w_min, w_max, n_prior, w_prior, prior_weight, huber, margin;
+} ref_pl_cfg_t;
+
+typedef struct ref_pl_bin {
+    long kx, ky;
+    double sx, sy, sv; /* sums, then centroid (m) and mean (dB) */
+    double x, y, z;
+    long count;
+} ref_pl_bin_t;
+
+typedef struct ref_pl {
+    /* inputs */
+    ref_pl_cfg_t cfg;
+    const rfs_map_t *map;
+    /* bins */
+    ref_pl_bin_t bins[REF_PL_MAX_BINS];
+    int nbins;
+    double bin_m;
+    long total;
+    /* lattice */
+    double ox, oy, grid;
+    int lw, lh, cs, c0i, c0j, ncx, ncy, fs;
+    /* result */
+    double sx, sy, p0, n, w, loss;
+    int li, lj;
+    double surface[REF_PL_MAX_COARSE]; /* sqrt(2 mean loss), dB; NAN: no candidate */
+    int candidates;
+    unsigned char *seen; /* lattice points evaluated */
+    double L[REF_PL_MAX_BINS];
+    int K[REF_PL_MAX_BINS];
+} ref_pl_t;
+
+static inline ref_pl_cfg_t ref_pl_cfg_default(void)
+{
+    ref_pl_cfg_t c = {1.0, 2.0, 0.5, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 1.0, 6.0, 20.0};
+    return c;
+}
+
+static inline void ref_pl_bin_samples(ref_pl_t *r, const rfs_sample_t *s, int n)
+{
+    long bin_cm = lround(r->cfg.bin * 100.0);
+    for (;;) {
+        bool ok = true;
+        r->nbins = 0;
+        for (int i = 0; i < n && ok; ++i) {
+            long kx = (long)floor((double)s[i].x_cm / (double)bin_cm);
+            long ky = (long)floor((double)s[i].y_cm / (double)bin_cm);
+            int b = 0;
+            while (b < r->nbins && (r->bins[b].kx != kx || r->bins[b].ky != ky)) {
+                ++b;
+            }
+            if (b == r->nbins) {
+                if (r->nbins == REF_PL_MAX_BINS) {
+                    ok = false;
+                    break;
+                }
+                memset(&r->bins[b], 0, sizeof(r->bins[b]));
+                r->bins[b].kx = kx;
+                r->bins[b].ky = ky;
+                r->nbins++;
+            }
+            r->bins[b].sx += s[i].x_cm / 100.0;
+            r->bins[b].sy += s[i].y_cm / 100.0;
+            r->bins[b].sv += s[i].v_q6 / 64.0;
+            r->bins[b].count++;
+        }
+        if (ok) {
+            break;
+        }
+        bin_cm *= 2;
+    }
+    r->bin_m = bin_cm / 100.0;
+    r->total = n;
+    for (int b = 0; b < r->nbins; ++b) {
+        ref_pl_bin_t *bb = &r->bins[b];
+        bb->x = round(bb->sx * 100.0 / bb->count) / 100.0;
+        bb->y = round(bb->sy * 100.0 / bb->count) / 100.0;
+        bb->z = bb->sv / bb->count;
+    }
+}
+
+static inline void ref_pl_lattice(ref_pl_t *r)
+{
+    if (r->map != NULL) {
+        r->grid = r->map->cfg.grid / 65536.0;
+        r->ox = r->map->origin_x / 65536.0 + r->grid / 2;
+        r->oy = r->map->origin_y / 65536.0 + r->grid / 2;
+        r->lw = r->map->lw;
+        r->lh = r->map->lh;
+    } else {
+        double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
+        for (int b = 0; b < r->nbins; ++b) {
+            x0 = fmin(x0, r->bins[b].x);
+            y0 = fmin(y0, r->bins[b].y);
+            x1 = fmax(x1, r->bins[b].x);
+            y1 = fmax(y1, r->bins[b].y);
+        }
+        r->grid = 0.25;
+        r->ox = x0 - r->cfg.margin;
+        r->oy = y0 - r->cfg.margin;
+        r->lw = (int)floor((x1 - x0 + 2 * r->cfg.margin) / r->grid) + 1;
+        r->lh = (int)floor((y1 - y0 + 2 * r->cfg.margin) / r->grid) + 1;
+    }
+    int cs = (int)lround(r->cfg.coarse / r->grid);
+    cs = cs < 1 ? 1 : cs;
+    for (;;) {
+        r->ncx = (r->lw - 1) / cs + 1;
+        r->ncy = (r->lh - 1) / cs + 1;
+        if (r->ncx * r->ncy <= REF_PL_MAX_COARSE) {
+            break;
+        }
+        cs++;
+    }
+    r->cs = cs;
+    r->c0i = (r->lw - 1 - (r->ncx - 1) * cs) / 2;
+    r->c0j = (r->lh - 1 - (r->ncy - 1) * cs) / 2;
+    int fs = (int)lround(r->cfg.fine / r->grid);
+    fs = fs < 1 ? 1 : fs;
+    if (fs > cs / 2) {
+        fs = cs / 2 < 1 ? 1 : cs / 2;
+    }
+    r->fs = fs;
+}
+
+static inline bool ref_pl_legal(const ref_pl_t *r, int i, int j)
+{
+    if (i < 0 || j < 0 || i >= r->lw || j >= r->lh) {
+        return false;
+    }
+    return r->map == NULL || rfs_map_lattice_legal(r->map, (uint16_t)i, (uint16_t)j);
+}
+
+/* Sum of count-weighted squared residuals plus the prior, at (n, w), P0 optimal. */
+static inline double ref_pl_sse(const ref_pl_t *r, double n, double w, double *p0)
+{
+    double sc = 0, sr = 0;
+    for (int b = 0; b < r->nbins; ++b) {
+        sc += r->bins[b].count;
+        sr += r->bins[b].count * (r->bins[b].z + n * r->L[b] + w * r->K[b]);
+    }
+    double P0 = sr / sc;
+    double e = 0;
+    for (int b = 0; b < r->nbins; ++b) {
+        double d = r->bins[b].z - (P0 - n * r->L[b] - w * r->K[b]);
+        e += r->bins[b].count * d * d;
+    }
+    e += r->cfg.prior_weight * ((n - r->cfg.n_prior) * (n - r->cfg.n_prior) +
+                                (w - r->cfg.w_prior) * (w - r->cfg.w_prior));
+    *p0 = P0;
+    return e;
+}
+
+static inline double ref_pl_clamp(double v, double lo, double hi)
+{
+    return v < lo ? lo : (v > hi ? hi : v);
+}
+
+/* Fit and Huber loss of candidate (i, j). */
+static inline double ref_pl_eval(ref_pl_t *r, int i, int j, double *pn, double *pw, double *pp0)
+{
+    double sx = r->ox + i * r->grid, sy = r->oy + j * r->grid;
+    rfs_q16_t qx = (rfs_q16_t)lround(sx * 65536.0), qy = (rfs_q16_t)lround(sy * 65536.0);
+    for (int b = 0; b < r->nbins; ++b) {
+        double d = hypot(r->bins[b].x - sx, r->bins[b].y - sy);
+        r->L[b] = 10.0 * log10(d < 1.0 ? 1.0 : d);
+        int k = 0;
+        if (r->map != NULL) {
+            k = rfs_map_walls_crossed(r->map, (rfs_q16_t)lround(r->bins[b].x * 65536.0),
+                                      (rfs_q16_t)lround(r->bins[b].y * 65536.0), qx, qy);
+        }
+        r->K[b] = k > 255 ? 255 : k;
+    }
+    /* Normal equations of the centred problem with the prior, solved directly. */
+    double sc = 0, ml = 0, mk = 0, mz = 0;
+    for (int b = 0; b < r->nbins; ++b) {
+        double c = r->bins[b].count;
+        sc += c;
+        ml += c * r->L[b];
+        mk += c * r->K[b];
+        mz += c * r->bins[b].z;
+    }
+    ml /= sc;
+    mk /= sc;
+    mz /= sc;
+    double a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0;
+    for (int b = 0; b < r->nbins; ++b) {
+        double c = r->bins[b].count, l = r->L[b] - ml, k = r->K[b] - mk, z = r->bins[b].z - mz;
+        a11 += c * l * l;
+        a12 += c * l * k;
+        a22 += c * k * k;
+        b1 -= c * l * z;
+        b2 -= c * k * z;
+    }
+    const ref_pl_cfg_t *cf = &r->cfg;
+    a11 += cf->prior_weight;
+    a22 += cf->prior_weight;
+    b1 += cf->prior_weight * cf->n_prior;
+    b2 += cf->prior_weight * cf->w_prior;
+    double det = a11 * a22 - a12 * a12;
+    double n = (b1 * a22 - a12 * b2) / det, w = (a11 * b2 - a12 * b1) / det;
+    if (!(n >= cf->n_min && n <= cf->n_max && w >= cf->w_min && w <= cf->w_max)) {
+        /* Edges and corners; the least SSE wins. */
+        double cn[8], cw[8];
+        cn[0] = cf->n_min;
+        cw[0] = ref_pl_clamp((b2 - a12 * cn[0]) / a22, cf->w_min, cf->w_max);
+        cn[1] = cf->n_max;
+        cw[1] = ref_pl_clamp((b2 - a12 * cn[1]) / a22, cf->w_min, cf->w_max);
+        cw[2] = cf->w_min;
+        cn[2] = ref_pl_clamp((b1 - a12 * cw[2]) / a11, cf->n_min, cf->n_max);
+        cw[3] = cf->w_max;
+        cn[3] = ref_pl_clamp((b1 - a12 * cw[3]) / a11, cf->n_min, cf->n_max);
+        cn[4] = cf->n_min; cw[4] = cf->w_min;
+        cn[5] = cf->n_min; cw[5] = cf->w_max;
+        cn[6] = cf->n_max; cw[6] = cf->w_min;
+        cn[7] = cf->n_max; cw[7] = cf->w_max;
+        double best = INFINITY, p0;
+        for (int e = 0; e < 8; ++e) {
+            double s = ref_pl_sse(r, cn[e], cw[e], &p0);
+            if (s < best) {
+                best = s;
+                n = cn[e];
+                w = cw[e];
+            }
+        }
+    }
+    double p0 = mz + n * ml + w * mk;
+    double loss = 0;
+    for (int b = 0; b < r->nbins; ++b) {
+        double res = fabs(r->bins[b].z - (p0 - n * r->L[b] - w * r->K[b]));
+        double h = res <= cf->huber ? 0.5 * res * res : cf->huber * (res - 0.5 * cf->huber);
+        loss += r->bins[b].count * h;
+    }
+    *pn = n;
+    *pw = w;
+    *pp0 = p0;
+    r->candidates++;
+    r->seen[(size_t)j * r->lw + i] = 1;
+    return loss;
+}
+
+/* Evaluate (i, j) unless it was evaluated or is not legal; keep the best (strictly less). */
+static inline double ref_pl_try(ref_pl_t *r, int i, int j)
+{
+    if (!ref_pl_legal(r, i, j) || r->seen[(size_t)j * r->lw + i]) {
+        return INFINITY;
+    }
+    double n, w, p0;
+    double loss = ref_pl_eval(r, i, j, &n, &w, &p0);
+    if (loss < r->loss) {
+        r->loss = loss;
+        r->n = n;
+        r->w = w;
+        r->p0 = p0;
+        r->li = i;
+        r->lj = j;
+        r->sx = r->ox + i * r->grid;
+        r->sy = r->oy + j * r->grid;
+    }
+    return loss;
+}
+
+/* The whole search; false when there are no samples or no legal candidate. */
+static inline bool ref_pl_fit(ref_pl_t *r, const rfs_sample_t *s, int n, const rfs_map_t *map,
+                              const ref_pl_cfg_t *cfg)
+{
+    memset(r, 0, sizeof(*r));
+    r->cfg = *cfg;
+    r->map = map;
+    r->loss = INFINITY;
+    if (n <= 0) {
+        return false;
+    }
+    ref_pl_bin_samples(r, s, n);
+    ref_pl_lattice(r);
+    r->seen = calloc((size_t)r->lw * r->lh, 1);
+    int ti[8], tj[8];
+    double tl[8];
+    int nt = 0;
+    for (int c = 0; c < r->ncx * r->ncy; ++c) {
+        int i = r->c0i + (c % r->ncx) * r->cs, j = r->c0j + (c / r->ncx) * r->cs;
+        double loss = ref_pl_try(r, i, j);
+        r->surface[c] = isinf(loss) ? NAN : sqrt(2.0 * loss / (double)r->total);
+        if (isinf(loss)) {
+            continue;
+        }
+        /* insertion into the top list, ties keep the earlier */
+        int k = nt < cfg->top ? nt : cfg->top - 1;
+        if (nt == cfg->top && loss >= tl[k]) {
+            continue;
+        }
+        while (k > 0 && loss < tl[k - 1]) {
+            tl[k] = tl[k - 1];
+            ti[k] = ti[k - 1];
+            tj[k] = tj[k - 1];
+            k--;
+        }
+        tl[k] = loss;
+        ti[k] = i;
+        tj[k] = j;
+        nt = nt < cfg->top ? nt + 1 : nt;
+    }
+    if (nt == 0) {
+        free(r->seen);
+        return false;
+    }
+    int r1 = r->cs / 2, m1 = r1 / r->fs;
+    for (int k = 0; k < nt; ++k) {
+        for (int b = -m1; b <= m1; ++b) {
+            for (int a = -m1; a <= m1; ++a) {
+                ref_pl_try(r, ti[k] + a * r->fs, tj[k] + b * r->fs);
+            }
+        }
+    }
+    int ci = r->li, cj = r->lj, r2 = r->fs / 2;
+    for (int b = -r2; b <= r2; ++b) {
+        for (int a = -r2; a <= r2; ++a) {
+            ref_pl_try(r, ci + a, cj + b);
+        }
+    }
+    free(r->seen);
+    r->seen = NULL;
+    return true;
+}
+
+#endif /* REF_PATHLOSS_H */

@@ -1,0 +1,503 @@
+/* test_pathloss.c - the map-aware path-loss model (common/rfs_pathloss).
+ *
+ * Data: an office built here (30 x 16 m, 0.1 m cells: a corridor between two rows of
+ * rooms, doors 1 m wide) and samples at random legal positions whose values follow the
+ * model with a known source, P0, n and W plus small Gaussian noise. Expected values come
+ * from the truth that generated the data and from the double-precision reference of
+ * the same search (ref_pathloss.h), never from the code under test.
+ */
+#include "rfs_test.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ref_pathloss.h"
+#include "rfs_models.h"
+#include "rfs_pathloss.h"
+
+#define MW 300
+#define MH 160
+#define RES_Q16 6554 /* 0.1 m as the map loader rounds it */
+#define NS 2000
+
+typedef struct fixture {
+    uint8_t free_bits[MH * ((MW + 7) / 8)];
+    uint8_t wall_bits[MH * ((MW + 7) / 8)];
+    uint8_t legal_bits[MH * ((MW + 7) / 8)];
+    rfs_map_t map;
+    rfs_sample_t s[NS];
+    rfs_pathloss_t pl;
+    ref_pl_t ref;
+} fixture_t;
+
+static bool is_wall(int i, int j)
+{
+    if (i == 0 || j == 0 || i == MW - 1 || j == MH - 1) {
+        return true;
+    }
+    bool door = (i >= 40 && i < 50) || (i >= 140 && i < 150) || (i >= 240 && i < 250);
+    if ((j == 70 || j == 90) && !door) {
+        return true;
+    }
+    return (i == 100 || i == 200) && (j < 70 || j > 90);
+}
+
+static int setup(void **state)
+{
+    fixture_t *f = calloc(1, sizeof(*f));
+    assert_non_null(f);
+    uint16_t stride = (MW + 7) / 8;
+    for (int j = 0; j < MH; ++j) {
+        for (int i = 0; i < MW; ++i) {
+            rfs_map_bit_set(f->wall_bits, stride, (uint16_t)i, (uint16_t)j, is_wall(i, j));
+            rfs_map_bit_set(f->free_bits, stride, (uint16_t)i, (uint16_t)j, !is_wall(i, j));
+        }
+    }
+    rfs_map_cfg_t mc = rfs_map_cfg_default();
+    assert_int_equal(rfs_map_init(&f->map, &mc, MW, MH, RES_Q16, 0, 0, f->free_bits,
+                                  f->wall_bits, f->legal_bits), 0);
+    *state = f;
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    free(*state);
+    return 0;
+}
+
+static double gauss(rfs_rng_t *r)
+{
+    double u1 = ((double)rfs_rng_u32(r) + 1.0) / 4294967297.0;
+    double u2 = (double)rfs_rng_u32(r) / 4294967296.0;
+    return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
+}
+
+typedef struct truth {
+    double sx, sy, p0, n, w, noise;
+} truth_t;
+
+/* n samples at random legal points of the map (or anywhere in [0, 30] x [0, 16] m when
+ * map is NULL), valued by the model with the truth's parameters; walls counted from the
+ * sample's exact position to the source. */
+static void make_samples(rfs_sample_t *s, int n, const rfs_map_t *map, const truth_t *t,
+                         uint64_t seed)
+{
+    rfs_rng_t r;
+    rfs_rng_seed(&r, seed);
+    rfs_q16_t qsx = (rfs_q16_t)lround(t->sx * 65536.0), qsy = (rfs_q16_t)lround(t->sy * 65536.0);
+    for (int i = 0; i < n;) {
+        int xc = (int)rfs_rng_below(&r, 3001), yc = (int)rfs_rng_below(&r, 1601);
+        rfs_q16_t qx = (rfs_q16_t)lround(xc / 100.0 * 65536.0);
+        rfs_q16_t qy = (rfs_q16_t)lround(yc / 100.0 * 65536.0);
+        if (map != NULL && !rfs_map_point_legal(map, qx, qy)) {
+            continue;
+        }
+        double d = hypot(xc / 100.0 - t->sx, yc / 100.0 - t->sy);
+        int k = map != NULL ? rfs_map_walls_crossed(map, qx, qy, qsx, qsy) : 0;
+        double v = t->p0 - 10.0 * t->n * log10(d < 1.0 ? 1.0 : d) - t->w * k + t->noise * gauss(&r);
+        s[i].x_cm = (int16_t)xc;
+        s[i].y_cm = (int16_t)yc;
+        s[i].v_q6 = (int16_t)lround(v * 64.0);
+        ++i;
+    }
+}
+
+static rfs_pathloss_est_t fit_default(fixture_t *f, int n, const rfs_map_t *map, uint32_t budget,
+                                      int *calls)
+{
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    assert_int_equal(rfs_pathloss_init(&f->pl, &c), 0);
+    rfs_model_t m = rfs_pathloss_model(&f->pl);
+    rfs_model_fit_in_t in = {f->s, (uint16_t)n, 0, 0, map};
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 1);
+    rfs_fit_result_t r;
+    int k = 0;
+    do {
+        r = m.ops->fit(m.self, &in, budget, &rng);
+        ++k;
+    } while (r == RFS_FIT_MORE && k < 100000);
+    assert_int_equal(r, RFS_FIT_DONE);
+    if (calls != NULL) {
+        *calls = k;
+    }
+    rfs_pathloss_est_t e;
+    assert_true(rfs_pathloss_estimate(&f->pl, &e));
+    return e;
+}
+
+static const truth_t k_office = {15.125, 3.375, -35.0, 3.0, 5.0, 0.3};
+
+/* --- configuration --------------------------------------------------------------------- */
+
+static void init_rejects_bad_configurations(void **state)
+{
+    fixture_t *f = *state;
+    rfs_pathloss_cfg_t good = rfs_pathloss_cfg_default();
+    rfs_pathloss_cfg_t bad[12];
+    for (int i = 0; i < 12; ++i) {
+        bad[i] = good;
+    }
+    bad[0].bin = RFS_Q16_FRAC(1, 20);
+    bad[1].coarse = 0;
+    bad[2].fine = RFS_Q16_INT(3);            /* finer than coarse is required */
+    bad[3].top = 0;
+    bad[4].top = RFS_PATHLOSS_MAX_TOP + 1u;
+    bad[5].n_min = 0;
+    bad[6].n_max = RFS_Q16_INT(1);           /* below n_min */
+    bad[7].w_min = -1;
+    bad[8].n_prior = RFS_Q16_INT(6);         /* outside [n_min, n_max] */
+    bad[9].prior_weight = 0;
+    bad[10].huber = 0;
+    bad[11].margin = RFS_Q16_INT(101);
+
+    assert_int_equal(rfs_pathloss_init(&f->pl, &good), 0);
+    for (int i = 0; i < 12; ++i) {
+        if (rfs_pathloss_init(&f->pl, &bad[i]) != -1) {
+            fail_msg("bad configuration %d accepted", i);
+        }
+    }
+    assert_int_equal(rfs_pathloss_init(NULL, &good), -1);
+    assert_int_equal(rfs_pathloss_init(&f->pl, NULL), -1);
+}
+
+static void no_samples_no_model(void **state)
+{
+    fixture_t *f = *state;
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    assert_int_equal(rfs_pathloss_init(&f->pl, &c), 0);
+    rfs_model_fit_in_t in = {f->s, 0, 0, 0, &f->map};
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 1);
+    rfs_q16_t v, x, y;
+    rfs_pathloss_est_t e;
+
+    rfs_fit_result_t r = rfs_pathloss_ops.fit(&f->pl, &in, 0, &rng);
+
+    assert_int_equal(r, RFS_FIT_FAILED);
+    assert_false(rfs_pathloss_ops.predict(&f->pl, 0, 0, &v));
+    assert_false(rfs_pathloss_ops.argmax(&f->pl, &x, &y));
+    assert_false(rfs_pathloss_estimate(&f->pl, &e));
+}
+
+/* --- arithmetic ------------------------------------------------------------------------ */
+
+static void db_dist_matches_double(void **state)
+{
+    (void)state;
+    rfs_rng_t r;
+    rfs_rng_seed(&r, 3);
+    double worst = 0;
+    for (int i = 0; i < 20000; ++i) {
+        /* log-uniform squared distances from 2^-32 m^2 to (30 km)^2, Q32 */
+        double e = (double)rfs_rng_u32(&r) / 4294967296.0 * 61.7;
+        uint64_t d2 = (uint64_t)pow(2.0, e);
+        double d = sqrt((double)d2 / 4294967296.0);
+        double want = 10.0 * log10(d < 1.0 ? 1.0 : d);
+
+        double got = rfs_pathloss_db_dist(d2) / 65536.0;
+
+        worst = fmax(worst, fabs(got - want));
+    }
+    if (worst > 1e-4) {
+        fail_msg("10 log10(d) off by %.2e dB", worst);
+    }
+    assert_int_equal(rfs_pathloss_db_dist(0), 0);
+    assert_int_equal(rfs_pathloss_db_dist((uint64_t)1 << 32), 0);
+    /* the largest input, (65536 m)^2: 10 log10(65536) = 48.16 dB */
+    assert_true(labs(rfs_pathloss_db_dist(UINT64_MAX) - lround(10.0 * log10(65536.0) * 65536.0)) <= 2);
+}
+
+/* --- the fit against the truth and against the reference -------------------------------- */
+
+static void fit_recovers_source_n_and_w(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+
+    rfs_pathloss_est_t e = fit_default(f, NS, &f->map, 0, NULL);
+
+    double ex = e.sx / 65536.0 - k_office.sx, ey = e.sy / 65536.0 - k_office.sy;
+    if (fabs(ex) > 0.25 + 1e-4 || fabs(ey) > 0.25 + 1e-4) {
+        fail_msg("source (%.3f, %.3f), truth (%.3f, %.3f)", e.sx / 65536.0, e.sy / 65536.0,
+                 k_office.sx, k_office.sy);
+    }
+    if (fabs(e.n / 65536.0 - k_office.n) > 0.1 * k_office.n) {
+        fail_msg("n %.3f, truth %.3f", e.n / 65536.0, k_office.n);
+    }
+    if (fabs(e.w / 65536.0 - k_office.w) > 0.1 * k_office.w) {
+        fail_msg("W %.3f, truth %.3f", e.w / 65536.0, k_office.w);
+    }
+    assert_true(e.bins > 100 && e.bins <= RFS_PATHLOSS_MAX_BINS);
+    assert_int_equal(e.bin, RFS_Q16_ONE);
+    assert_true(e.rms < RFS_Q16_INT(2));
+}
+
+/* Compare everything the core reports with the double reference on the same data. */
+static void expect_same_as_reference(fixture_t *f, int n, const rfs_map_t *map,
+                                     const ref_pl_cfg_t *rc, double n_tol)
+{
+    rfs_pathloss_est_t e = fit_default(f, n, map, 0, NULL);
+    assert_true(ref_pl_fit(&f->ref, f->s, n, map, rc));
+    const ref_pl_t *r = &f->ref;
+
+    if (fabs(e.sx / 65536.0 - r->sx) > 1e-3 || fabs(e.sy / 65536.0 - r->sy) > 1e-3) {
+        fail_msg("source (%.3f, %.3f), reference (%.3f, %.3f)", e.sx / 65536.0, e.sy / 65536.0,
+                 r->sx, r->sy);
+    }
+    if (fabs(e.n / 65536.0 - r->n) > n_tol || fabs(e.w / 65536.0 - r->w) > 10 * n_tol ||
+        fabs(e.p0 / 65536.0 - r->p0) > 20 * n_tol) {
+        fail_msg("n %.4f W %.4f P0 %.4f, reference %.4f %.4f %.4f", e.n / 65536.0,
+                 e.w / 65536.0, e.p0 / 65536.0, r->n, r->w, r->p0);
+    }
+    assert_int_equal(e.bins, r->nbins);
+    assert_int_equal(e.candidates, (uint32_t)r->candidates);
+    uint16_t ncx, ncy;
+    rfs_pathloss_surface_size(&f->pl, &ncx, &ncy);
+    assert_int_equal(ncx, r->ncx);
+    assert_int_equal(ncy, r->ncy);
+    double worst = 0;
+    for (int cj = 0; cj < ncy; ++cj) {
+        for (int ci = 0; ci < ncx; ++ci) {
+            rfs_q16_t x, y, rms;
+            bool ok = rfs_pathloss_residual_at(&f->pl, (uint16_t)ci, (uint16_t)cj, &x, &y, &rms);
+            double want = r->surface[cj * ncx + ci];
+            if (ok == isnan(want)) {
+                fail_msg("coarse (%d, %d): candidate %d, reference %d", ci, cj, ok, !isnan(want));
+            }
+            assert_true(fabs(x / 65536.0 - (r->ox + (r->c0i + ci * r->cs) * r->grid)) < 1e-4);
+            assert_true(fabs(y / 65536.0 - (r->oy + (r->c0j + cj * r->cs) * r->grid)) < 1e-4);
+            if (ok) {
+                worst = fmax(worst, fabs(rms / 65536.0 - want));
+            }
+        }
+    }
+    if (worst > 0.02) {
+        fail_msg("residual surface off by %.4f dB", worst);
+    }
+}
+
+static void same_cell_as_double_reference_office(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+
+    expect_same_as_reference(f, NS, &f->map, &rc, 0.01);
+}
+
+/* A weaker robot's view: few samples along the corridor and one room, 1.5 dB noise. */
+static void same_cell_as_double_reference_sparse_noisy(void **state)
+{
+    fixture_t *f = *state;
+    truth_t t = {24.875, 12.625, -40.0, 2.5, 7.0, 1.5};
+    make_samples(f->s, 300, &f->map, &t, 5);
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+
+    expect_same_as_reference(f, 300, &f->map, &rc, 0.01);
+}
+
+/* An exponent outside the bounds: the constrained solution sits on n = n_max. */
+static void exponent_clamped_like_reference(void **state)
+{
+    fixture_t *f = *state;
+    truth_t t = {5.125, 12.125, -20.0, 6.5, 4.0, 0.3};
+    make_samples(f->s, 1000, &f->map, &t, 9);
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+
+    expect_same_as_reference(f, 1000, &f->map, &rc, 0.01);
+
+    rfs_pathloss_est_t e;
+    assert_true(rfs_pathloss_estimate(&f->pl, &e));
+    assert_int_equal(e.n, rfs_pathloss_cfg_default().n_max);
+    assert_true(fabs(f->ref.n - 5.0) < 1e-12);
+}
+
+/* Without a map: free-space log-distance, candidates around the samples. */
+static void no_map_recovers_source(void **state)
+{
+    fixture_t *f = *state;
+    truth_t t = {21.0, 6.0, -30.0, 2.0, 0.0, 0.3};
+    make_samples(f->s, 800, NULL, &t, 13);
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+
+    expect_same_as_reference(f, 800, NULL, &rc, 0.01);
+
+    rfs_pathloss_est_t e;
+    assert_true(rfs_pathloss_estimate(&f->pl, &e));
+    assert_true(fabs(e.sx / 65536.0 - t.sx) <= 0.25 && fabs(e.sy / 65536.0 - t.sy) <= 0.25);
+    assert_true(fabs(e.n / 65536.0 - t.n) < 0.1 * t.n);
+}
+
+/* Samples over 300 x 300 m need more than 256 one-metre bins: the bin doubles. */
+static void bins_grow_when_samples_spread(void **state)
+{
+    fixture_t *f = *state;
+    rfs_rng_t r;
+    rfs_rng_seed(&r, 17);
+    for (int i = 0; i < NS; ++i) {
+        f->s[i].x_cm = (int16_t)(rfs_rng_below(&r, 30001) - 15000);
+        f->s[i].y_cm = (int16_t)(rfs_rng_below(&r, 30001) - 15000);
+        double d = hypot(f->s[i].x_cm / 100.0 - 20.0, f->s[i].y_cm / 100.0 + 30.0);
+        f->s[i].v_q6 = (int16_t)lround((-30.0 - 25.0 * log10(d < 1 ? 1 : d)) * 64.0);
+    }
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+
+    expect_same_as_reference(f, NS, NULL, &rc, 0.01);
+
+    rfs_pathloss_est_t e;
+    assert_true(rfs_pathloss_estimate(&f->pl, &e));
+    assert_true(e.bins <= RFS_PATHLOSS_MAX_BINS);
+    assert_true(fabs(e.bin / 65536.0 - f->ref.bin_m) < 1e-4);
+    assert_true(f->ref.bin_m >= 16.0);
+}
+
+/* --- slicing, prediction, uncertainty -------------------------------------------------- */
+
+static void sliced_fit_equals_whole_fit(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+    rfs_pathloss_est_t whole = fit_default(f, NS, &f->map, 0, NULL);
+    rfs_pathloss_cand_t best = f->pl.best;
+    int calls = 0;
+
+    rfs_pathloss_est_t sliced = fit_default(f, NS, &f->map, 2000, &calls);
+
+    assert_memory_equal(&f->pl.best, &best, sizeof(best));
+    assert_int_equal(sliced.spread_m2, whole.spread_m2);
+    assert_int_equal(sliced.candidates, whole.candidates);
+    /* each call evaluates candidates until 2000 (bin, candidate) pairs are used */
+    uint32_t units = whole.candidates * whole.bins;
+    assert_true((uint32_t)calls >= units / (2000u + whole.bins));
+    assert_true((uint32_t)calls <= units / 2000u + 2u);
+}
+
+static void model_invalid_while_slicing(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+    (void)fit_default(f, NS, &f->map, 0, NULL);
+    rfs_model_fit_in_t in = {f->s, NS, 0, 0, &f->map};
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 1);
+    rfs_q16_t v;
+
+    rfs_fit_result_t r = rfs_pathloss_ops.fit(&f->pl, &in, 100, &rng);
+    bool during = rfs_pathloss_ops.predict(&f->pl, 0, 0, &v);
+    rfs_pathloss_ops.reset(&f->pl);
+    bool after_reset = rfs_pathloss_ops.predict(&f->pl, 0, 0, &v);
+    rfs_fit_result_t r2 = rfs_pathloss_ops.fit(&f->pl, &in, 0, &rng);
+
+    assert_int_equal(r, RFS_FIT_MORE);
+    assert_false(during);
+    assert_false(after_reset);
+    assert_int_equal(r2, RFS_FIT_DONE);
+}
+
+static void predict_is_the_fitted_formula(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+    rfs_pathloss_est_t e = fit_default(f, NS, &f->map, 0, NULL);
+    const double px[5] = {1.3, 15.0, 28.4, 4.6, 15.125};
+    const double py[5] = {1.2, 8.0, 14.7, 12.9, 3.375};
+    rfs_q16_t ax, ay;
+
+    assert_true(rfs_pathloss_ops.argmax(&f->pl, &ax, &ay));
+    assert_int_equal(ax, e.sx);
+    assert_int_equal(ay, e.sy);
+    for (int i = 0; i < 5; ++i) {
+        rfs_q16_t qx = (rfs_q16_t)lround(px[i] * 65536.0), qy = (rfs_q16_t)lround(py[i] * 65536.0);
+        double d = hypot(px[i] - e.sx / 65536.0, py[i] - e.sy / 65536.0);
+        int k = rfs_map_walls_crossed(&f->map, qx, qy, e.sx, e.sy);
+        double want = e.p0 / 65536.0 - 10.0 * (e.n / 65536.0) * log10(d < 1 ? 1 : d) -
+                      (e.w / 65536.0) * k;
+        rfs_q16_t v;
+
+        assert_true(rfs_pathloss_ops.predict(&f->pl, qx, qy, &v));
+
+        if (fabs(v / 65536.0 - want) > 0.01) {
+            fail_msg("predict (%.2f, %.2f) = %.4f, formula %.4f", px[i], py[i], v / 65536.0, want);
+        }
+        /* and close to the truth that made the data */
+        double dt = hypot(px[i] - k_office.sx, py[i] - k_office.sy);
+        int kt = rfs_map_walls_crossed(&f->map, qx, qy, (rfs_q16_t)lround(k_office.sx * 65536.0),
+                                       (rfs_q16_t)lround(k_office.sy * 65536.0));
+        double truth = k_office.p0 - 10.0 * k_office.n * log10(dt < 1 ? 1 : dt) - k_office.w * kt;
+        if (fabs(v / 65536.0 - truth) > 1.5) {
+            fail_msg("predict (%.2f, %.2f) = %.3f, truth %.3f", px[i], py[i], v / 65536.0, truth);
+        }
+    }
+}
+
+static void residual_surface_and_spread(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+    rfs_pathloss_est_t e = fit_default(f, NS, &f->map, 0, NULL);
+    uint16_t ncx, ncy;
+    rfs_pathloss_surface_size(&f->pl, &ncx, &ncy);
+    double best = INFINITY, bx = 0, by = 0;
+    int walls = 0;
+
+    for (uint16_t cj = 0; cj < ncy; ++cj) {
+        for (uint16_t ci = 0; ci < ncx; ++ci) {
+            rfs_q16_t x, y, rms;
+            if (!rfs_pathloss_residual_at(&f->pl, ci, cj, &x, &y, &rms)) {
+                walls += !rfs_map_point_legal(&f->map, x, y);
+                continue;
+            }
+            if (rms / 65536.0 < best) {
+                best = rms / 65536.0;
+                bx = x / 65536.0;
+                by = y / 65536.0;
+            }
+        }
+    }
+    rfs_q16_t x, y, rms;
+
+    /* the least residual of the coarse grid is the coarse point nearest the truth */
+    assert_true(fabs(bx - k_office.sx) <= 1.0 && fabs(by - k_office.sy) <= 1.0);
+    assert_true(best >= e.rms / 65536.0 - 1e-4);
+    assert_true(walls > 0);
+    assert_false(rfs_pathloss_residual_at(&f->pl, ncx, 0, &x, &y, &rms));
+    /* with 0.3 dB noise the region is one or two coarse cells of 4 m^2 */
+    assert_true(e.spread_m2 >= RFS_Q16_INT(4) && e.spread_m2 <= RFS_Q16_INT(8));
+}
+
+/* The registry knows the model by its command-line name. */
+static void registered_as_pathloss(void **state)
+{
+    (void)state;
+    const rfs_models_entry_t *e = rfs_models_lookup("pathloss");
+
+    assert_non_null(e);
+    assert_ptr_equal(e->ops, &rfs_pathloss_ops);
+    assert_int_equal(e->state_bytes, sizeof(rfs_pathloss_t));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(init_rejects_bad_configurations, setup, teardown),
+        cmocka_unit_test_setup_teardown(no_samples_no_model, setup, teardown),
+        cmocka_unit_test(db_dist_matches_double),
+        cmocka_unit_test_setup_teardown(fit_recovers_source_n_and_w, setup, teardown),
+        cmocka_unit_test_setup_teardown(same_cell_as_double_reference_office, setup, teardown),
+        cmocka_unit_test_setup_teardown(same_cell_as_double_reference_sparse_noisy, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(exponent_clamped_like_reference, setup, teardown),
+        cmocka_unit_test_setup_teardown(no_map_recovers_source, setup, teardown),
+        cmocka_unit_test_setup_teardown(bins_grow_when_samples_spread, setup, teardown),
+        cmocka_unit_test_setup_teardown(sliced_fit_equals_whole_fit, setup, teardown),
+        cmocka_unit_test_setup_teardown(model_invalid_while_slicing, setup, teardown),
+        cmocka_unit_test_setup_teardown(predict_is_the_fitted_formula, setup, teardown),
+        cmocka_unit_test_setup_teardown(residual_surface_and_spread, setup, teardown),
+        cmocka_unit_test(registered_as_pathloss),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

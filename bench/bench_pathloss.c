@@ -8,6 +8,12 @@
  *   bench_pathloss MAP slice N BUDGET     only the first fit call with that budget (the
  *                                         heaviest: it also bins), and the number of calls
  *   bench_pathloss MAP predict N          one prediction (the relearn check)
+ *   bench_pathloss MAP path N             a mission: a random walk of 1 m steps from
+ *                                         (8, 6) m, 40 samples a step, N steps; one
+ *                                         relearn at the end from a fresh state
+ *   bench_pathloss MAP pathwarm N         the same walk; a fit after N - 5 steps (not
+ *                                         counted), then the relearn after N steps with
+ *                                         the wall-count cache warm
  * Collection is toggled on around the measured calls only, so callgrind with
  * --collect-atstart=no counts exactly them. Prints the estimate so nothing is elided.
  */
@@ -29,7 +35,9 @@ static int usage(FILE *f, int rc)
     fprintf(f, "usage: bench_pathloss MAP.yaml relearn|slice|predict N [BUDGET]\n"
                "  relearn N        one whole fit over N samples (1..65535)\n"
                "  slice N BUDGET   the first fit call with BUDGET (bin, candidate) units\n"
-               "  predict N        one prediction after a fit\n");
+               "  predict N        one prediction after a fit\n"
+               "  path N           relearn after a random walk of N 1 m steps (fresh state)\n"
+               "  pathwarm N       the same, with the cache warmed 5 steps before\n");
     return rc;
 }
 
@@ -67,7 +75,8 @@ int main(int argc, char **argv)
             return usage(stderr, 2);
         }
         budget = parse(argv[4], "BUDGET", 1, 100000000);
-    } else if (strcmp(mode, "relearn") != 0 && strcmp(mode, "predict") != 0) {
+    } else if (strcmp(mode, "relearn") != 0 && strcmp(mode, "predict") != 0 &&
+               strcmp(mode, "path") != 0 && strcmp(mode, "pathwarm") != 0) {
         return usage(stderr, 2);
     }
     char err[256];
@@ -81,6 +90,11 @@ int main(int argc, char **argv)
         return 1;
     }
     const rfs_map_t *m = &cm.map;
+    bool walk = strncmp(mode, "path", 4) == 0;
+    long steps = n;
+    if (walk) {
+        n = steps * 40 > 65535 ? 65535 : steps * 40;
+    }
     rfs_sample_t *s = malloc((size_t)n * sizeof(*s));
     rfs_pathloss_t *p = malloc(sizeof(*p));
     if (s == NULL || p == NULL) {
@@ -91,11 +105,39 @@ int main(int argc, char **argv)
     rfs_rng_seed(&r, 7);
     double w_m = m->w * (m->res / 65536.0), h_m = m->h * (m->res / 65536.0);
     rfs_q16_t qsx = (rfs_q16_t)lround(SX * 65536.0), qsy = (rfs_q16_t)lround(SY * 65536.0);
+    double px = 8.0, py = 6.0, tx = px, ty = py;
     for (long i = 0; i < n;) {
-        double x = m->origin_x / 65536.0 + w_m * (rfs_rng_u32(&r) / 4294967296.0);
-        double y = m->origin_y / 65536.0 + h_m * (rfs_rng_u32(&r) / 4294967296.0);
+        double x, y;
+        if (walk) {
+            if (i % 40 == 0) {
+                /* next 1 m step: a random legal direction */
+                for (int tries = 0; tries < 1000; ++tries) {
+                    double a = 6.283185307179586 * (rfs_rng_u32(&r) / 4294967296.0);
+                    tx = px + cos(a);
+                    ty = py + sin(a);
+                    if (rfs_map_segment_legal(m, (rfs_q16_t)lround(px * 65536.0),
+                                              (rfs_q16_t)lround(py * 65536.0),
+                                              (rfs_q16_t)lround(tx * 65536.0),
+                                              (rfs_q16_t)lround(ty * 65536.0))) {
+                        break;
+                    }
+                    tx = px;
+                    ty = py;
+                }
+            }
+            double t = (i % 40 + 1) / 40.0;
+            x = px + (tx - px) * t;
+            y = py + (ty - py) * t;
+            if (i % 40 == 39) {
+                px = tx;
+                py = ty;
+            }
+        } else {
+            x = m->origin_x / 65536.0 + w_m * (rfs_rng_u32(&r) / 4294967296.0);
+            y = m->origin_y / 65536.0 + h_m * (rfs_rng_u32(&r) / 4294967296.0);
+        }
         rfs_q16_t qx = (rfs_q16_t)lround(x * 65536.0), qy = (rfs_q16_t)lround(y * 65536.0);
-        if (!rfs_map_point_legal(m, qx, qy)) {
+        if (!walk && !rfs_map_point_legal(m, qx, qy)) {
             continue;
         }
         double d = hypot(x - SX, y - SY);
@@ -122,7 +164,14 @@ int main(int argc, char **argv)
             res = rfs_pathloss_ops.fit(p, &in, (uint32_t)budget, &r);
             ++calls;
         }
-    } else if (strcmp(mode, "relearn") == 0) {
+    } else if (strcmp(mode, "pathwarm") == 0) {
+        rfs_model_fit_in_t early = in;
+        early.n = (uint16_t)(n > 200 ? n - 200 : 1);
+        res = rfs_pathloss_ops.fit(p, &early, 0, &r);
+        CALLGRIND_TOGGLE_COLLECT;
+        res = rfs_pathloss_ops.fit(p, &in, 0, &r);
+        CALLGRIND_TOGGLE_COLLECT;
+    } else if (strcmp(mode, "relearn") == 0 || strcmp(mode, "path") == 0) {
         CALLGRIND_TOGGLE_COLLECT;
         res = rfs_pathloss_ops.fit(p, &in, 0, &r);
         CALLGRIND_TOGGLE_COLLECT;
@@ -145,7 +194,8 @@ int main(int argc, char **argv)
     printf("calls %ld\n", calls);
     printf("bins %u\n", e.bins);
     printf("candidates %u\n", e.candidates);
-    printf("units %lu\n", (unsigned long)e.candidates * e.bins);
+    printf("walls_counted %u\n", e.walls_counted);
+    printf("walls_cached %u\n", e.walls_cached);
     printf("coarse %u x %u\n", ncx, ncy);
     printf("state_bytes %zu\n", sizeof(rfs_pathloss_t));
     printf("estimate %.3f %.3f n %.3f W %.3f P0 %.3f rms %.3f spread %.1f m2 predict %.3f\n",

@@ -81,32 +81,36 @@ static uint8_t row_get8(const uint8_t *row, uint16_t w, int32_t pos)
     return (uint8_t)(v & mask);
 }
 
-/* legal = erosion of free by the clearance mask, row by row: for every mask row dy with
- * half-width k, AND in the free row cy + dy eroded horizontally by k. */
+/* Half-width in cells of the clearance mask's row dy (dy >= 0), or -1 when the row is
+ * entirely outside the clearance. */
+static int32_t mask_half_width(const rfs_map_t *m, int32_t dy)
+{
+    int32_t k = -1;
+    while (k + 1 <= CLEARANCE_CELLS_MAX + 1 && mask_in(m->res, m->cfg.clearance, k + 1, dy)) {
+        k++;
+    }
+    return k;
+}
+
+/* legal = erosion of free by the clearance mask: for every mask row dy with half-width
+ * k, AND into each legal row cy the free row cy + dy eroded horizontally by k (rows off
+ * the map are all 0). Loops run mask row by mask row so no table is needed: the stack
+ * stays small on the microcontroller (2.5 KB in all). */
 static void derive_legal(rfs_map_t *m)
 {
-    int32_t kmax[CLEARANCE_CELLS_MAX + 2];
     int32_t R = 0;
-    for (int32_t dy = 0; dy <= CLEARANCE_CELLS_MAX + 1; dy++) {
-        int32_t k = -1;
-        while (k + 1 <= CLEARANCE_CELLS_MAX + 1 && mask_in(m->res, m->cfg.clearance, k + 1, dy)) {
-            k++;
-        }
-        kmax[dy] = k;
-        if (k < 0) {
-            break;
-        }
-        R = dy;
+    while (R < CLEARANCE_CELLS_MAX + 1 && mask_half_width(m, R + 1) >= 0) {
+        R++;
     }
-    for (uint16_t cy = 0; cy < m->h; cy++) {
-        uint8_t *out = m->legal + (uint32_t)cy * m->stride;
-        memset(out, 0xFF, m->stride);
-        for (int32_t dy = -R; dy <= R; dy++) {
+    memset(m->legal, 0xFF, (uint32_t)m->h * m->stride);
+    for (int32_t dy = -R; dy <= R; dy++) {
+        int32_t k = mask_half_width(m, dy < 0 ? -dy : dy);
+        for (uint16_t cy = 0; cy < m->h; cy++) {
+            uint8_t *out = m->legal + (uint32_t)cy * m->stride;
             int32_t ry = (int32_t)cy + dy;
-            int32_t k = kmax[dy < 0 ? -dy : dy];
             if (ry < 0 || ry >= (int32_t)m->h) {
                 memset(out, 0, m->stride);
-                break;
+                continue;
             }
             const uint8_t *row = m->free + (uint32_t)ry * m->stride;
             for (uint16_t b = 0; b < m->stride; b++) {
@@ -117,9 +121,11 @@ static void derive_legal(rfs_map_t *m)
                 out[b] = acc;
             }
         }
-        /* Padding bits past w stay 0. */
-        if (m->w & 7u) {
-            out[m->stride - 1] &= (uint8_t)((1u << (m->w & 7u)) - 1u);
+    }
+    /* Padding bits past w stay 0. */
+    if (m->w & 7u) {
+        for (uint16_t cy = 0; cy < m->h; cy++) {
+            m->legal[(uint32_t)cy * m->stride + m->stride - 1u] &= (uint8_t)((1u << (m->w & 7u)) - 1u);
         }
     }
 }

@@ -24,15 +24,16 @@
 #define DB_PER_LOG2_SQ_Q30 1616142483LL
 /// Lattice spacing without a map, metres Q16.16 (the map default).
 #define NOMAP_GRID RFS_Q16_FRAC(1, 4)
-/// Wall counts saturate here.
-#define WALLS_MAX 255u
+/// Wall counts saturate here (4 bits in the cache; 15 walls are 75 dB at 5 dB each).
+#define WALLS_MAX 15u
+/// Cached wall counts per work unit.
+#define CACHED_PER_UNIT 32u
 
 rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
 {
     rfs_pathloss_cfg_t c;
     c.bin = RFS_Q16_ONE;
     c.coarse = RFS_Q16_INT(2);
-    c.fine = RFS_Q16_HALF;
     c.top = 3u;
     c.n_min = RFS_Q16_FRAC(3, 2);
     c.n_max = RFS_Q16_INT(5);
@@ -54,7 +55,7 @@ int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg)
     }
     const rfs_pathloss_cfg_t *c = cfg;
     bool ok = c->bin >= RFS_Q16_FRAC(1, 10) && c->bin <= RFS_Q16_INT(16) && c->coarse > 0 &&
-              c->coarse <= RFS_Q16_INT(64) && c->fine > 0 && c->fine <= c->coarse &&
+              c->coarse <= RFS_Q16_INT(64) &&
               c->top >= 1u && c->top <= RFS_PATHLOSS_MAX_TOP && c->n_min > 0 &&
               c->n_min <= c->n_max && c->n_max <= RFS_Q16_INT(10) && c->w_min >= 0 &&
               c->w_min <= c->w_max && c->w_max <= RFS_Q16_INT(60) && c->n_prior >= c->n_min &&
@@ -174,6 +175,75 @@ static void bin_samples(rfs_pathloss_t *p, const rfs_sample_t *smp, uint16_t n)
         bb->dz_q16 = (int32_t)(rfs_sdiv64_round((int64_t)bb->sv_q6 * 1024, bb->count) - p->mz_q16);
         bb->x = cm_to_q16(bb->sx_cm);
         bb->y = cm_to_q16(bb->sy_cm);
+        bb->wx = bb->x;
+        bb->wy = bb->y;
+        bb->row = RFS_PATHLOSS_NO_ROW;
+        uint16_t cx, cy;
+        if (p->map != 0 && rfs_map_cell(p->map, bb->x, bb->y, &cx, &cy)) {
+            /* Scaling: cell corner + half a cell is inside the map's Q16 extent. */
+            const rfs_map_t *m = p->map;
+            bb->wx = rfs_sat32((int64_t)m->origin_x + (int64_t)cx * m->res + m->res / 2);
+            bb->wy = rfs_sat32((int64_t)m->origin_y + (int64_t)cy * m->res + m->res / 2);
+        }
+    }
+}
+
+static uint32_t cell_hash(uint16_t cx, uint16_t cy)
+{
+    return ((uint32_t)cx * 0x9E3779B1u + (uint32_t)cy * 0x85EBCA77u) >> 22; /* 10 bits */
+}
+
+static void cache_clear(rfs_pathloss_t *p)
+{
+    p->nrows = 0u;
+    memset(p->row_hash, 0, sizeof(p->row_hash));
+}
+
+/* Give every bin on the map its wall-count cache row (found by its origin's core cell, or
+ * new), after clearing the cache when it belongs to another map or lattice. */
+static void cache_assign(rfs_pathloss_t *p)
+{
+    _Static_assert(RFS_PATHLOSS_CACHE_HASH == 1024u, "cell_hash yields 10 bits");
+    _Static_assert(RFS_PATHLOSS_CACHE_ROWS >= RFS_PATHLOSS_MAX_BINS, "a row for every bin");
+    if (p->map == 0) {
+        return;
+    }
+    if (p->cache_map != p->map || memcmp(&p->cache_lat, &p->lat, sizeof(p->lat)) != 0) {
+        cache_clear(p);
+        p->cache_map = p->map;
+        p->cache_lat = p->lat;
+    }
+    for (uint32_t b = 0u; b < p->nbins; ++b) {
+        rfs_pathloss_bin_t *bb = &p->bins[b];
+        uint16_t cx, cy;
+        if (!rfs_map_cell(p->map, bb->x, bb->y, &cx, &cy)) {
+            continue;
+        }
+        uint32_t h = cell_hash(cx, cy);
+        while (p->row_hash[h] != 0u) {
+            const rfs_pathloss_row_t *r = &p->rows[p->row_hash[h] - 1u];
+            if (r->cx == cx && r->cy == cy) {
+                break;
+            }
+            h = (h + 1u) & (RFS_PATHLOSS_CACHE_HASH - 1u);
+        }
+        if (p->row_hash[h] == 0u) {
+            if (p->nrows == RFS_PATHLOSS_CACHE_ROWS) {
+                /* Full of origins no bin uses any more: start again (rows >= bins). */
+                cache_clear(p);
+                for (uint32_t c = 0u; c < b; ++c) {
+                    p->bins[c].row = RFS_PATHLOSS_NO_ROW;
+                }
+                b = UINT32_MAX; /* the loop's ++ restarts it at 0 */
+                continue;
+            }
+            rfs_pathloss_row_t *r = &p->rows[p->nrows];
+            r->cx = cx;
+            r->cy = cy;
+            r->filled = 0u;
+            p->row_hash[h] = (uint16_t)(++p->nrows);
+        }
+        bb->row = (uint16_t)(p->row_hash[h] - 1u);
     }
 }
 
@@ -215,12 +285,6 @@ static void setup_lattice(rfs_pathloss_t *p, const rfs_map_t *m)
     l->cs = (uint16_t)cs;
     l->c0i = (uint16_t)(((uint32_t)l->lw - 1u - (uint32_t)(l->ncx - 1u) * (uint32_t)cs) / 2u);
     l->c0j = (uint16_t)(((uint32_t)l->lh - 1u - (uint32_t)(l->ncy - 1u) * (uint32_t)cs) / 2u);
-    int32_t fs = (int32_t)rfs_sdiv64_round(p->cfg.fine, l->grid);
-    fs = fs < 1 ? 1 : fs;
-    if (fs > cs / 2) {
-        fs = cs / 2 < 1 ? 1 : cs / 2;
-    }
-    l->fs = (uint16_t)fs;
 }
 
 static void lattice_xy(const rfs_pathloss_lat_t *l, uint16_t i, uint16_t j, rfs_q16_t *x,
@@ -315,7 +379,8 @@ static void solve_nw(const rfs_pathloss_cfg_t *c, const int64_t M[3], const int6
  * |dz| < 2^10 dB, Q16 < 2^26): centred values in Q8 are below 2^15 (l), 2^16 (k) and
  * c dz < 2^34 (e); the sums c l^2, c l k, c k^2 stay below 2^16 x 2^32 = 2^48 and
  * l e, k e below 2^16 x 2^34 = 2^50, all in int64. */
-static void eval(rfs_pathloss_t *p, uint16_t li, uint16_t lj, rfs_pathloss_cand_t *out)
+static void eval(rfs_pathloss_t *p, uint16_t li, uint16_t lj, int32_t col,
+                 rfs_pathloss_cand_t *out)
 {
     const rfs_pathloss_cfg_t *c = &p->cfg;
     rfs_q16_t sx, sy;
@@ -327,8 +392,22 @@ static void eval(rfs_pathloss_t *p, uint16_t li, uint16_t lj, rfs_pathloss_cand_
         int32_t L = rfs_pathloss_db_dist(sq_sum(dx, dy));
         uint32_t k = 0u;
         if (p->map != 0) {
-            k = rfs_map_walls_crossed(p->map, bb->x, bb->y, sx, sy);
-            k = k > WALLS_MAX ? WALLS_MAX : k;
+            rfs_pathloss_row_t *r = bb->row != RFS_PATHLOSS_NO_ROW ? &p->rows[bb->row] : 0;
+            bool cacheable = r != 0 && col >= 0 && col < (int32_t)RFS_PATHLOSS_CACHE_COLS;
+            uint8_t *cell = cacheable ? &p->walls[bb->row][col / 2] : 0;
+            const unsigned shift = (unsigned)(col & 1) * 4u;
+            if (cacheable && col < (int32_t)r->filled) {
+                k = (*cell >> shift) & 0xFu;
+                p->walls_cached++;
+            } else {
+                k = rfs_map_walls_crossed(p->map, bb->wx, bb->wy, sx, sy);
+                k = k > WALLS_MAX ? WALLS_MAX : k;
+                p->walls_counted++;
+                if (cacheable && col == (int32_t)r->filled) {
+                    *cell = (uint8_t)((*cell & ~(0xFu << shift)) | (k << shift));
+                    r->filled++;
+                }
+            }
         }
         p->l_q16[b] = L;
         p->k[b] = (uint8_t)k;
@@ -385,6 +464,15 @@ static void eval(rfs_pathloss_t *p, uint16_t li, uint16_t lj, rfs_pathloss_cand_
     p->candidates++;
 }
 
+/* eval() and the work units it used: wall counts computed, plus cached ones / 32, plus 1. */
+static uint32_t eval_units(rfs_pathloss_t *p, uint16_t li, uint16_t lj, int32_t col,
+                           rfs_pathloss_cand_t *out)
+{
+    uint32_t counted = p->walls_counted, cached = p->walls_cached;
+    eval(p, li, lj, col, out);
+    return (p->walls_counted - counted) + (p->walls_cached - cached) / CACHED_PER_UNIT + 1u;
+}
+
 /* Mean Huber loss per sample, dB^2 Q16, saturated below NO_LOSS. */
 static uint32_t mean_loss(const rfs_pathloss_t *p, int64_t loss)
 {
@@ -419,21 +507,24 @@ static void keep_top(rfs_pathloss_t *p, const rfs_pathloss_cand_t *cd)
     }
 }
 
-/* True when lattice point (i, j) was a candidate of an earlier phase: a coarse point, or
- * on the refinement sub-lattice within the box of one of the first `ncentres` top ones. */
-static bool seen_before(const rfs_pathloss_t *p, int32_t i, int32_t j, uint32_t ncentres)
+/* True when lattice point (i, j) was evaluated in this fit: a coarse point, or one of the
+ * remembered refinement points (remembered here when it was not). */
+static bool seen_before(rfs_pathloss_t *p, int32_t i, int32_t j)
 {
     const rfs_pathloss_lat_t *l = &p->lat;
     int32_t ci = i - l->c0i, cj = j - l->c0j;
     if (ci >= 0 && cj >= 0 && ci % l->cs == 0 && cj % l->cs == 0) {
         return true;
     }
-    const int32_t r1 = l->cs / 2;
-    for (uint32_t k = 0u; k < ncentres; ++k) {
-        int32_t a = i - p->top[k].li, b = j - p->top[k].lj;
-        if (a >= -r1 && a <= r1 && b >= -r1 && b <= r1 && a % l->fs == 0 && b % l->fs == 0) {
+    for (uint32_t k = 0u; k < p->nvis; ++k) {
+        if (p->vis_i[k] == i && p->vis_j[k] == j) {
             return true;
         }
+    }
+    if (p->nvis < RFS_PATHLOSS_MAX_VISITED) {
+        p->vis_i[p->nvis] = (uint16_t)i;
+        p->vis_j[p->nvis] = (uint16_t)j;
+        p->nvis++;
     }
     return false;
 }
@@ -476,21 +567,24 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
         p->map = in->map;
         bin_samples(p, in->samples, in->n);
         setup_lattice(p, in->map);
+        cache_assign(p);
+        p->col = 0u;
+        p->walls_counted = 0u;
+        p->walls_cached = 0u;
         p->phase = RFS_PATHLOSS_COARSE;
         p->pos = 0u;
         p->ntop = 0u;
+        p->nvis = 0u;
         p->candidates = 0u;
         p->cur.loss = INT64_MAX;
     }
     const rfs_pathloss_lat_t *l = &p->lat;
-    const int32_t r1 = l->cs / 2, m1 = r1 / l->fs, side1 = 2 * m1 + 1;
-    const int32_t r2 = l->fs / 2, side2 = 2 * r2 + 1;
     uint32_t used = 0u;
     for (;;) {
         if (budget != 0u && used >= budget) {
             return RFS_FIT_MORE;
         }
-        rfs_pathloss_cand_t cd;
+        int32_t i, j;
         if (p->phase == RFS_PATHLOSS_COARSE) {
             uint32_t nc = (uint32_t)l->ncx * l->ncy;
             if (p->pos >= nc) {
@@ -499,59 +593,52 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
                     return RFS_FIT_FAILED; /* no legal candidate on the map */
                 }
                 p->phase = RFS_PATHLOSS_REFINE;
+                p->step = (uint16_t)(l->cs / 2u < 1u ? 1u : l->cs / 2u);
                 p->pos = 0u;
                 continue;
             }
             uint32_t c = p->pos++;
-            int32_t i = l->c0i + (int32_t)(c % l->ncx) * l->cs;
-            int32_t j = l->c0j + (int32_t)(c / l->ncx) * l->cs;
+            i = l->c0i + (int32_t)(c % l->ncx) * l->cs;
+            j = l->c0j + (int32_t)(c / l->ncx) * l->cs;
             p->surface[c] = RFS_PATHLOSS_NO_LOSS;
             if (!cand_legal(p, i, j)) {
                 continue;
             }
-            eval(p, (uint16_t)i, (uint16_t)j, &cd);
-            used += p->nbins;
+            rfs_pathloss_cand_t cd;
+            used += eval_units(p, (uint16_t)i, (uint16_t)j, (int32_t)p->col++, &cd);
             p->surface[c] = mean_loss(p, cd.loss);
             consider(p, &cd);
             keep_top(p, &cd);
-        } else if (p->phase == RFS_PATHLOSS_REFINE) {
-            uint32_t per = (uint32_t)(side1 * side1);
-            if (p->pos >= p->ntop * per) {
-                p->phase = RFS_PATHLOSS_FINAL;
-                p->fc_i = p->cur.li;
-                p->fc_j = p->cur.lj;
-                p->pos = 0u;
-                continue;
-            }
-            uint32_t k = p->pos / per, rem = p->pos % per;
-            p->pos++;
-            int32_t i = p->top[k].li + ((int32_t)(rem % (uint32_t)side1) - m1) * l->fs;
-            int32_t j = p->top[k].lj + ((int32_t)(rem / (uint32_t)side1) - m1) * l->fs;
-            if (!cand_legal(p, i, j) || seen_before(p, i, j, k)) {
-                continue;
-            }
-            if (i == p->top[k].li && j == p->top[k].lj) {
-                continue;
-            }
-            eval(p, (uint16_t)i, (uint16_t)j, &cd);
-            used += p->nbins;
-            consider(p, &cd);
-        } else {
-            if (p->pos >= (uint32_t)(side2 * side2)) {
+            continue;
+        }
+        /* Refinement: the 3 x 3 neighbourhood at p->step around each top candidate
+         * (REFINE) or around the best so far (FINE), row by row. */
+        if (p->phase == RFS_PATHLOSS_REFINE && p->pos >= 9u * p->ntop) {
+            p->phase = RFS_PATHLOSS_FINE;
+            p->pos = 9u;
+        }
+        if (p->phase == RFS_PATHLOSS_FINE && p->pos >= 9u) {
+            if (p->step <= 1u) {
                 finish(p);
                 return RFS_FIT_DONE;
             }
-            uint32_t rem = p->pos++;
-            int32_t i = p->fc_i + (int32_t)(rem % (uint32_t)side2) - r2;
-            int32_t j = p->fc_j + (int32_t)(rem / (uint32_t)side2) - r2;
-            if ((i == p->fc_i && j == p->fc_j) || !cand_legal(p, i, j) ||
-                seen_before(p, i, j, p->ntop)) {
-                continue;
-            }
-            eval(p, (uint16_t)i, (uint16_t)j, &cd);
-            used += p->nbins;
-            consider(p, &cd);
+            p->step = (uint16_t)(p->step / 2u);
+            p->fc_i = p->cur.li;
+            p->fc_j = p->cur.lj;
+            p->pos = 0u;
         }
+        uint32_t k = p->pos / 9u, rem = p->pos % 9u;
+        p->pos++;
+        int32_t ci = p->phase == RFS_PATHLOSS_REFINE ? p->top[k].li : p->fc_i;
+        int32_t cj = p->phase == RFS_PATHLOSS_REFINE ? p->top[k].lj : p->fc_j;
+        i = ci + ((int32_t)(rem % 3u) - 1) * p->step;
+        j = cj + ((int32_t)(rem / 3u) - 1) * p->step;
+        if (rem == 4u || !cand_legal(p, i, j) || seen_before(p, i, j)) {
+            continue;
+        }
+        rfs_pathloss_cand_t cd;
+        used += eval_units(p, (uint16_t)i, (uint16_t)j, -1, &cd);
+        consider(p, &cd);
     }
 }
 
@@ -621,6 +708,8 @@ bool rfs_pathloss_estimate(const rfs_pathloss_t *p, rfs_pathloss_est_t *est)
     est->bins = p->used_bins;
     est->bin = cm_to_q16(p->used_bin_cm);
     est->candidates = p->candidates;
+    est->walls_counted = p->walls_counted;
+    est->walls_cached = p->walls_cached;
     return true;
 }
 

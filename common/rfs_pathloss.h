@@ -19,8 +19,9 @@
  * bin doubles when there are more): each bin is its sample count, mean value and
  * centroid, so the cost of a candidate does not grow with the number of samples.
  * Candidates are legal lattice points, searched coarse to fine: every `coarse` (2 m),
- * then the neighbourhood (+-coarse/2) of the best `top` (3) at `fine` (0.5 m), then the
- * neighbours of the best at the lattice spacing (0.25 m). Without a map (fit_in.map NULL)
+ * then the 8 neighbours of each of the best `top` (3) at half that spacing (1 m), then
+ * the 8 neighbours of the best so far at half the spacing again, down to the lattice
+ * spacing (0.5 m, 0.25 m). A point is evaluated once per fit. Without a map (fit_in.map NULL)
  * the candidates cover the samples' extent plus `margin` on a 0.25 m lattice, no walls.
  *
  * Uncertainty: the mean Huber loss of every coarse candidate is kept (the residual
@@ -28,7 +29,14 @@
  * of coarse candidates whose loss is within spread_k / bins of the best's (relative):
  * a likelihood-ratio region that counts each bin as one independent observation.
  *
- * Work: one unit is one (bin, candidate) pair (a wall count and a logarithm). fit() with
+ * Wall counts start at the centre of the core cell that holds the bin's centroid. Those
+ * of the coarse candidates are cached across fits (RFS_PATHLOSS_CACHE_ROWS origins x
+ * the first RFS_PATHLOSS_CACHE_COLS legal coarse candidates, 4 bits each, so counts
+ * saturate at 15 walls): bins are fixed cells, so a relearn counts walls only for bins
+ * that are new or whose centroid moved to another core cell, and for the refinement.
+ * The cache is cleared when the map or the coarse lattice changes, or when it is full.
+ *
+ * Work: one unit is one wall count (a cached one is 1/32 unit). fit() with
  * budget 0 does everything; with budget > 0 it evaluates candidates until that many
  * units are used (at least one candidate) and returns RFS_FIT_MORE until the search is
  * done. The first call also bins the samples (about 60 instructions per sample). The
@@ -53,6 +61,15 @@
 #define RFS_PATHLOSS_MAX_COARSE 1024u
 /// Most coarse candidates refined.
 #define RFS_PATHLOSS_MAX_TOP 4u
+/// Most refinement points remembered to evaluate each once (more are re-evaluated).
+#define RFS_PATHLOSS_MAX_VISITED 128u
+/// Wall-count origins cached (rows) and legal coarse candidates per origin (columns).
+#define RFS_PATHLOSS_CACHE_ROWS 512u
+#define RFS_PATHLOSS_CACHE_COLS 128u
+/// Slots of the cache's hash table (a power of two, twice the rows).
+#define RFS_PATHLOSS_CACHE_HASH (2u * RFS_PATHLOSS_CACHE_ROWS)
+/// No cache row.
+#define RFS_PATHLOSS_NO_ROW UINT16_MAX
 /// Surface value of a coarse point that is not a candidate (illegal).
 #define RFS_PATHLOSS_NO_LOSS UINT32_MAX
 
@@ -60,7 +77,6 @@
 typedef struct rfs_pathloss_cfg {
     rfs_q16_t bin;          ///< metres Q16.16: side of a sample bin (1 m), 0.1..16 m
     rfs_q16_t coarse;       ///< metres Q16.16: coarse candidate spacing (2 m)
-    rfs_q16_t fine;         ///< metres Q16.16: refinement spacing (0.5 m)
     uint8_t top;            ///< coarse candidates refined (3), 1..RFS_PATHLOSS_MAX_TOP
     rfs_q16_t n_min;        ///< path-loss exponent bounds, Q16.16 (1.5)
     rfs_q16_t n_max;        ///< (5.0)
@@ -82,6 +98,9 @@ typedef struct rfs_pathloss_bin {
     int32_t dz_q16;  ///< mean value minus the mean over all samples, target units Q16.16
     rfs_q16_t x;     ///< centroid x, metres Q16.16
     rfs_q16_t y;     ///< centroid y, metres Q16.16
+    rfs_q16_t wx;    ///< wall-count origin x (centre of the centroid's core cell), metres Q16.16
+    rfs_q16_t wy;    ///< wall-count origin y, metres Q16.16
+    uint16_t row;    ///< its wall-count cache row, RFS_PATHLOSS_NO_ROW when none
     uint16_t count;  ///< samples in the bin
     int16_t kx;      ///< bin index along x (floor(x / bin))
     int16_t ky;      ///< bin index along y
@@ -111,15 +130,21 @@ typedef struct rfs_pathloss_lat {
     uint16_t c0j;    ///< along y
     uint16_t ncx;    ///< coarse points along x
     uint16_t ncy;    ///< coarse points along y
-    uint16_t fs;     ///< refinement spacing, lattice steps
 } rfs_pathloss_lat_t;
+
+/// One cached wall-count origin: a core cell.
+typedef struct rfs_pathloss_row {
+    uint16_t cx;     ///< core cell x
+    uint16_t cy;     ///< core cell y
+    uint8_t filled;  ///< columns counted so far (in coarse order)
+} rfs_pathloss_row_t;
 
 /// Search phases of a (sliced) fit.
 typedef enum rfs_pathloss_phase {
     RFS_PATHLOSS_IDLE = 0, ///< no fit in progress
     RFS_PATHLOSS_COARSE,   ///< coarse candidates
-    RFS_PATHLOSS_REFINE,   ///< around the best coarse candidates at the fine spacing
-    RFS_PATHLOSS_FINAL,    ///< around the best at the lattice spacing
+    RFS_PATHLOSS_REFINE,   ///< around the best coarse candidates at half the coarse spacing
+    RFS_PATHLOSS_FINE,     ///< around the best so far, halving the spacing to the lattice's
 } rfs_pathloss_phase_t;
 
 /// What the model believes (rfs_pathloss_estimate()).
@@ -134,9 +159,11 @@ typedef struct rfs_pathloss_est {
     uint16_t bins;        ///< bins used
     rfs_q16_t bin;        ///< bin side used, metres Q16.16
     uint32_t candidates;  ///< candidates evaluated
+    uint32_t walls_counted; ///< wall counts computed by the last fit
+    uint32_t walls_cached;  ///< wall counts the last fit read from the cache
 } rfs_pathloss_est_t;
 
-/// State, caller-owned (about 23 KB).
+/// State, caller-owned (about 65 KB, 40 KB of it the wall-count cache).
 typedef struct rfs_pathloss {
     rfs_pathloss_cfg_t cfg;                       ///< configuration copied at init
     bool valid;                                   ///< a model exists
@@ -157,12 +184,26 @@ typedef struct rfs_pathloss {
     uint8_t ntop;                                 ///< coarse candidates kept in top[]
     rfs_pathloss_cand_t top[RFS_PATHLOSS_MAX_TOP]; ///< best coarse candidates, best first
     rfs_pathloss_cand_t cur;                      ///< best so far
-    uint16_t fc_i;                                ///< centre of the final phase, lattice x
+    uint16_t fc_i;                                ///< centre of the fine level, lattice x
     uint16_t fc_j;                                ///< lattice y
+    uint16_t step;                                ///< spacing of the fine level, lattice steps
+    uint16_t nvis;                                ///< refinement points remembered
+    uint16_t vis_i[RFS_PATHLOSS_MAX_VISITED];     ///< their lattice x
+    uint16_t vis_j[RFS_PATHLOSS_MAX_VISITED];     ///< their lattice y
     rfs_pathloss_bin_t bins[RFS_PATHLOSS_MAX_BINS]; ///< sample bins
     uint16_t hash[RFS_PATHLOSS_HASH];             ///< bin index + 1 by hashed cell, 0 = empty
     int32_t l_q16[RFS_PATHLOSS_MAX_BINS];         ///< scratch: 10 log10(d) per bin, dB Q16.16
     uint8_t k[RFS_PATHLOSS_MAX_BINS];             ///< scratch: walls per bin
+    uint32_t col;                                 ///< legal coarse candidates so far (cache column)
+    uint32_t walls_counted;                       ///< wall counts computed by this fit
+    uint32_t walls_cached;                        ///< wall counts read from the cache by this fit
+    const rfs_map_t *cache_map;                   ///< map the cache belongs to (NULL: empty)
+    rfs_pathloss_lat_t cache_lat;                 ///< coarse lattice the cache belongs to
+    uint16_t nrows;                               ///< cache rows in use
+    uint16_t row_hash[RFS_PATHLOSS_CACHE_HASH];   ///< row + 1 by hashed core cell, 0 = empty
+    rfs_pathloss_row_t rows[RFS_PATHLOSS_CACHE_ROWS]; ///< cached origins
+    uint8_t walls[RFS_PATHLOSS_CACHE_ROWS][RFS_PATHLOSS_CACHE_COLS / 2u]; ///< 4-bit counts,
+                                                  ///< column c in the low nibble when even
     uint32_t surface[RFS_PATHLOSS_MAX_COARSE];    ///< mean Huber loss per sample of each coarse
                                                   ///< point, dB^2 Q16.16; NO_LOSS = no candidate
 } rfs_pathloss_t;
@@ -170,8 +211,8 @@ typedef struct rfs_pathloss {
 /// Defaults (see rfs_pathloss_cfg_t).
 rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void);
 
-/// Initialise without a model. Returns 0, or -1 on bin outside [0.1, 16] m, coarse or fine
-/// outside (0, 64] m or fine > coarse, top outside 1..RFS_PATHLOSS_MAX_TOP, n bounds not
+/// Initialise without a model. Returns 0, or -1 on bin outside [0.1, 16] m, coarse
+/// outside (0, 64] m, top outside 1..RFS_PATHLOSS_MAX_TOP, n bounds not
 /// 0 < n_min <= n_max <= 10, W bounds not 0 <= w_min <= w_max <= 60 dB, priors outside
 /// their bounds, prior_weight outside (0, 10^4], huber outside (0, 100] dB, spread_k
 /// outside [0, 1000], or margin outside [0, 100] m.

@@ -93,11 +93,23 @@ static void cb_step(void *self, int64_t now_us, hs_ctrl_out_t *out)
             break;
         }
         if (s->can) {
+            /* Two sources: take what CAN holds, then wait briefly on LCM; the status
+             * normally arrives just after the wheel frame. */
             rfs_can_frame_t f;
             while (hs_can_recv(s->can, &f, 0) == 1) {
                 on_frame(s, &f);
             }
-            (void)hs_lcm_handle(s->lcm, left > 2 ? 2 : (int)left);
+            answered = s->have_status && s->status_t_us == now_us && s->wheels_rx != wheels0;
+            if (answered) {
+                break;
+            }
+            if (s->wheels_rx == wheels0) {
+                if (hs_can_recv(s->can, &f, 1) == 1) {
+                    on_frame(s, &f);
+                }
+            } else {
+                (void)hs_lcm_handle(s->lcm, 1);
+            }
         } else {
             (void)hs_lcm_handle(s->lcm, (int)(left > 100 ? 100 : left));
         }

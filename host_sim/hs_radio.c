@@ -25,6 +25,7 @@ typedef struct radio_src {
     int64_t memo_qx;       ///< receiver position of the memoised signal, memo_m units
     int64_t memo_qy;
     double memo_dbm;       ///< signal (before noise) there
+    double memo_mean_dbm;  ///< local mean (no fading) there
     bool memo_valid;       ///< memo holds a value
 } radio_src_t;
 
@@ -402,6 +403,7 @@ double hs_radio_signal_dbm(hs_radio_t *r, unsigned s, double x, double y)
     bool los = !(r->cfg.walls && r->walls_fn) ? true : nw == 0;
     rs->memo_qx = qx;
     rs->memo_qy = qy;
+    rs->memo_mean_dbm = p;
     rs->memo_dbm = p + hs_radio_fading_db(r, s, x, y, los);
     rs->memo_valid = true;
     return rs->memo_dbm;
@@ -419,10 +421,15 @@ bool hs_radio_packet(hs_radio_t *r, unsigned s, double x, double y, rfs_rng_t *r
 {
     const hs_radio_cfg_t *c = &r->cfg;
     double p = hs_radio_signal_dbm(r, s, x, y);
+    // Reception follows the local mean (path loss, walls, shadowing), not the narrowband
+    // fade: an 802.11 frame spans 20 MHz, far more than the few-MHz coherence bandwidth
+    // of an indoor channel, so a fade at one frequency does not stop it. (With fades in
+    // the loss decision a robot that stops in a deep fade never hears another packet.)
+    double p_rx = c->fading ? r->src[s].memo_mean_dbm : p;
     // 32 random bits are plenty for a delivery probability; 30 widths above the
     // sensitivity the loss probability (1e-13) is below their resolution: no draw.
-    if (c->loss && p < c->sensitivity_dbm + 30.0 * c->loss_width_db &&
-        rfs_rng_u32(rng) * (1.0 / 4294967296.0) >= hs_radio_pdr(c, p)) {
+    if (c->loss && p_rx < c->sensitivity_dbm + 30.0 * c->loss_width_db &&
+        rfs_rng_u32(rng) * (1.0 / 4294967296.0) >= hs_radio_pdr(c, p_rx)) {
         return false;
     }
     if (c->noise) {

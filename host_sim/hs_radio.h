@@ -13,8 +13,9 @@
  *           (plane waves at wavelength 12.5 cm; Rician with K in line of sight, Rayleigh
  *           (K = 0) when a wall is crossed)
  *
- * Each packet: lost with probability 1 - PDR(P), PDR(P) = 1 / (1 + exp(-(P - S) / w))
- * (S = sensitivity, where half the packets arrive); else reported as
+ * Each packet: lost with probability 1 - PDR(M), PDR(M) = 1 / (1 + exp(-(M - S) / w))
+ * with M the local mean (P without F: a 20 MHz frame does not fade with one frequency;
+ * S = sensitivity, where half the packets arrive); else reported as
  * clip(round(P + N(0, sigma_noise)), rx_min, rx_max) whole dBm.
  *
  * Fields are generated once per (seed, source): returning to a place gives the same
@@ -116,7 +117,7 @@ double hs_radio_mean_dbm(hs_radio_t *r, unsigned s, double x, double y);
 /// 5 mm cell (x, y) lies in (a receiver moving a few mm between packets reuses it).
 double hs_radio_signal_dbm(hs_radio_t *r, unsigned s, double x, double y);
 
-/// Packet delivery probability at signal p_dbm (1 when loss is off).
+/// Packet delivery probability at local mean signal p_dbm (1 when loss is off).
 double hs_radio_pdr(const hs_radio_cfg_t *cfg, double p_dbm);
 
 /// One packet of source s received at (x, y): false when lost; else *dbm is the reported

@@ -1,6 +1,6 @@
 /* rfseek-sim-lcm.c - the simulator with the controller in a separate process (issue 4).
  *
- *   rfseek-sim-lcm SCENARIO [--lcm URL] [--can IFACE] [--seed N] [--timeout-ms N]
+ *   rfseek-sim-lcm SCENARIO [--lcm URL] [--can IFACE] [--seed N] [--timeout-ms N] [--max-time S]
  *
  * Runs the scenario like rfseek-sim, but the controller is rfseekd --clock-lcm in another
  * process: poses and RSSI go out on LCM, one RFS_CLOCK per control period, and the
@@ -17,12 +17,13 @@
 #include "hs_sim.h"
 
 static const char usage_text[] =
-    "usage: rfseek-sim-lcm SCENARIO [--lcm URL] [--can IFACE] [--seed N] [--timeout-ms N]\n"
+    "usage: rfseek-sim-lcm SCENARIO [--lcm URL] [--can IFACE] [--seed N] [--timeout-ms N] [--max-time S]\n"
     "Simulate SCENARIO with the controller running as a separate process (rfseekd --clock-lcm).\n"
     "  --lcm URL        LCM provider shared with rfseekd (default: LCM's default)\n"
     "  --can IFACE      take wheel commands from SocketCAN (default: LCM channel RFS_CAN_FALLBACK)\n"
     "  --seed N         run seed (default: the scenario's)\n"
     "  --timeout-ms N   wait this long for the controller's answer to a step (default 5000)\n"
+    "  --max-time S     stop after S simulated seconds (overrides the scenario's stop time)\n"
     "  --help           this text\n";
 
 int main(int argc, char **argv)
@@ -30,6 +31,7 @@ int main(int argc, char **argv)
     const char *scn = NULL;
     hs_ctrl_lcm_cfg_t cfg = hs_ctrl_lcm_cfg_default();
     long long seed = -1;
+    double max_time = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -51,6 +53,13 @@ int main(int argc, char **argv)
             seed = strtoll(v, &end, 10);
             if (errno || *end || seed < 0) {
                 fprintf(stderr, "rfseek-sim-lcm: --seed: '%s' is not a non-negative integer\n", v);
+                return 2;
+            }
+            i++;
+        } else if (strcmp(a, "--max-time") == 0) {
+            max_time = strtod(v, &end);
+            if (*end || !(max_time > 0 && max_time <= 86400)) {
+                fprintf(stderr, "rfseek-sim-lcm: --max-time: '%s' is not seconds in (0, 86400]\n", v);
                 return 2;
             }
             i++;
@@ -76,6 +85,9 @@ int main(int argc, char **argv)
     if (hs_scenario_load(scn, &sc, err, sizeof err) != 0) {
         fprintf(stderr, "rfseek-sim-lcm: %s\n", err);
         return 1;
+    }
+    if (max_time > 0) {
+        sc.stop_time_s = max_time;
     }
     hs_sim_env_t env;
     memset(&env, 0, sizeof env);

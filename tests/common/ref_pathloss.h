@@ -5,8 +5,10 @@
  * rounded to the centimetre as the definition says (the store's unit), distances and logarithms in double, the constrained least
  * squares by direct minimisation of the sum of squared residuals over the interior
  * solution, the four edges and the four corners of the (n, W) box, and the Huber loss
- * in double. Only the wall counts come from the core (rfs_map_walls_crossed, tested in
- * test_map.c), because they are the model's definition of a wall.
+ * in double. Only the wall counts come from the core (rfs_map_walls_crossed and
+ * rfs_map_cell, tested in test_map.c), because they are the model's definition of a
+ * wall: counted from the centre of the core cell holding the bin's centroid, saturated
+ * at 15. No cache.
  */
 #ifndef REF_PATHLOSS_H
 #define REF_PATHLOSS_H
@@ -23,7 +25,7 @@
 #define REF_PL_MAX_COARSE 1024
 
 typedef struct ref_pl_cfg {
-    double bin, coarse, fine;
+    double bin, coarse;
     int top;
     double n_min, n_max, w_min, w_max, n_prior, w_prior, prior_weight, huber, margin;
 } ref_pl_cfg_t;
@@ -46,7 +48,7 @@ typedef struct ref_pl {
     long total;
     /* lattice */
     double ox, oy, grid;
-    int lw, lh, cs, c0i, c0j, ncx, ncy, fs;
+    int lw, lh, cs, c0i, c0j, ncx, ncy;
     /* result */
     double sx, sy, p0, n, w, loss;
     int li, lj;
@@ -59,7 +61,7 @@ typedef struct ref_pl {
 
 static inline ref_pl_cfg_t ref_pl_cfg_default(void)
 {
-    ref_pl_cfg_t c = {1.0, 2.0, 0.5, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 1.0, 6.0, 20.0};
+    ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 1.0, 6.0, 20.0};
     return c;
 }
 
@@ -141,12 +143,6 @@ static inline void ref_pl_lattice(ref_pl_t *r)
     r->cs = cs;
     r->c0i = (r->lw - 1 - (r->ncx - 1) * cs) / 2;
     r->c0j = (r->lh - 1 - (r->ncy - 1) * cs) / 2;
-    int fs = (int)lround(r->cfg.fine / r->grid);
-    fs = fs < 1 ? 1 : fs;
-    if (fs > cs / 2) {
-        fs = cs / 2 < 1 ? 1 : cs / 2;
-    }
-    r->fs = fs;
 }
 
 static inline bool ref_pl_legal(const ref_pl_t *r, int i, int j)
@@ -192,10 +188,17 @@ static inline double ref_pl_eval(ref_pl_t *r, int i, int j, double *pn, double *
         r->L[b] = 10.0 * log10(d < 1.0 ? 1.0 : d);
         int k = 0;
         if (r->map != NULL) {
-            k = rfs_map_walls_crossed(r->map, (rfs_q16_t)lround(r->bins[b].x * 65536.0),
-                                      (rfs_q16_t)lround(r->bins[b].y * 65536.0), qx, qy);
+            rfs_q16_t bx = (rfs_q16_t)lround(r->bins[b].x * 65536.0);
+            rfs_q16_t by = (rfs_q16_t)lround(r->bins[b].y * 65536.0);
+            uint16_t cx, cy;
+            if (rfs_map_cell(r->map, bx, by, &cx, &cy)) {
+                double res = r->map->res / 65536.0;
+                bx = (rfs_q16_t)lround((r->map->origin_x / 65536.0 + (cx + 0.5) * res) * 65536.0);
+                by = (rfs_q16_t)lround((r->map->origin_y / 65536.0 + (cy + 0.5) * res) * 65536.0);
+            }
+            k = rfs_map_walls_crossed(r->map, bx, by, qx, qy);
         }
-        r->K[b] = k > 255 ? 255 : k;
+        r->K[b] = k > 15 ? 15 : k;
     }
     /* Normal equations of the centred problem with the prior, solved directly. */
     double sc = 0, ml = 0, mk = 0, mz = 0;
@@ -330,18 +333,23 @@ static inline bool ref_pl_fit(ref_pl_t *r, const rfs_sample_t *s, int n, const r
         free(r->seen);
         return false;
     }
-    int r1 = r->cs / 2, m1 = r1 / r->fs;
+    /* 8 neighbours of each top candidate at half the coarse spacing, then of the best so
+     * far at half the spacing again, down to one lattice step */
+    int h = r->cs / 2 < 1 ? 1 : r->cs / 2;
     for (int k = 0; k < nt; ++k) {
-        for (int b = -m1; b <= m1; ++b) {
-            for (int a = -m1; a <= m1; ++a) {
-                ref_pl_try(r, ti[k] + a * r->fs, tj[k] + b * r->fs);
+        for (int b = -1; b <= 1; ++b) {
+            for (int a = -1; a <= 1; ++a) {
+                ref_pl_try(r, ti[k] + a * h, tj[k] + b * h);
             }
         }
     }
-    int ci = r->li, cj = r->lj, r2 = r->fs / 2;
-    for (int b = -r2; b <= r2; ++b) {
-        for (int a = -r2; a <= r2; ++a) {
-            ref_pl_try(r, ci + a, cj + b);
+    while (h > 1) {
+        h /= 2;
+        int ci = r->li, cj = r->lj;
+        for (int b = -1; b <= 1; ++b) {
+            for (int a = -1; a <= 1; ++a) {
+                ref_pl_try(r, ci + a * h, cj + b * h);
+            }
         }
     }
     free(r->seen);

@@ -143,7 +143,7 @@ static void init_rejects_bad_configurations(void **state)
     }
     bad[0].bin = RFS_Q16_FRAC(1, 20);
     bad[1].coarse = 0;
-    bad[2].fine = RFS_Q16_INT(3);            /* finer than coarse is required */
+    bad[2].coarse = RFS_Q16_INT(65);
     bad[3].top = 0;
     bad[4].top = RFS_PATHLOSS_MAX_TOP + 1u;
     bad[5].n_min = 0;
@@ -370,10 +370,50 @@ static void sliced_fit_equals_whole_fit(void **state)
     assert_memory_equal(&f->pl.best, &best, sizeof(best));
     assert_int_equal(sliced.spread_m2, whole.spread_m2);
     assert_int_equal(sliced.candidates, whole.candidates);
-    /* each call evaluates candidates until 2000 (bin, candidate) pairs are used */
-    uint32_t units = whole.candidates * whole.bins;
-    assert_true((uint32_t)calls >= units / (2000u + whole.bins));
+    /* a fresh state: no cached wall counts, one unit per (bin, candidate) pair plus one
+     * per candidate; each call evaluates candidates until 2000 units are used */
+    assert_int_equal(sliced.walls_cached, 0);
+    assert_int_equal(sliced.walls_counted, sliced.candidates * sliced.bins);
+    uint32_t units = sliced.walls_counted + sliced.candidates;
+    assert_true((uint32_t)calls >= units / (2000u + sliced.bins + 1u));
     assert_true((uint32_t)calls <= units / 2000u + 2u);
+}
+
+static int by_x(const void *a, const void *b)
+{
+    return ((const rfs_sample_t *)a)->x_cm - ((const rfs_sample_t *)b)->x_cm;
+}
+
+/* The wall-count cache: a relearn with more samples reads the coarse candidates' counts
+ * of the old bins and gives exactly what a fresh state gives. */
+static void cached_relearn_equals_fresh(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+    /* west half first: the relearn adds samples east of them, so most old bins keep
+     * their samples and centroids */
+    qsort(f->s, NS, sizeof(f->s[0]), by_x);
+    (void)fit_default(f, NS / 2, &f->map, 0, NULL);   /* warms the cache */
+    rfs_pathloss_t *warm = malloc(sizeof(*warm));
+    assert_non_null(warm);
+    memcpy(warm, &f->pl, sizeof(*warm));
+    rfs_model_fit_in_t in = {f->s, NS, 0, 0, &f->map};
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 1);
+    rfs_pathloss_est_t ew;
+
+    rfs_fit_result_t r = rfs_pathloss_ops.fit(warm, &in, 0, &rng);
+    rfs_pathloss_est_t ef = fit_default(f, NS, &f->map, 0, NULL); /* fresh */
+
+    assert_int_equal(r, RFS_FIT_DONE);
+    assert_true(rfs_pathloss_estimate(warm, &ew));
+    assert_memory_equal(&warm->best, &f->pl.best, sizeof(f->pl.best));
+    assert_memory_equal(warm->surface, f->pl.surface, sizeof(f->pl.surface));
+    assert_int_equal(ew.candidates, ef.candidates);
+    assert_int_equal(ew.walls_counted + ew.walls_cached, ef.walls_counted + ef.walls_cached);
+    /* the coarse counts of the west half's bins came from the cache */
+    assert_true(ew.walls_cached > ef.walls_counted / 4u);
+    free(warm);
 }
 
 static void model_invalid_while_slicing(void **state)
@@ -494,6 +534,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(no_map_recovers_source, setup, teardown),
         cmocka_unit_test_setup_teardown(bins_grow_when_samples_spread, setup, teardown),
         cmocka_unit_test_setup_teardown(sliced_fit_equals_whole_fit, setup, teardown),
+        cmocka_unit_test_setup_teardown(cached_relearn_equals_fresh, setup, teardown),
         cmocka_unit_test_setup_teardown(model_invalid_while_slicing, setup, teardown),
         cmocka_unit_test_setup_teardown(predict_is_the_fitted_formula, setup, teardown),
         cmocka_unit_test_setup_teardown(residual_surface_and_spread, setup, teardown),

@@ -148,9 +148,11 @@ static void step(daemon_t *d, int64_t now_us)
         (void)hs_lcm_pub_wheel(d->lcm, now_us, &w);
         (void)hs_lcm_pub_status(d->lcm, now_us, &so);
     }
+    if (out.decided) {
+        d->decided++;
+    }
     if (out.decided && d->decisions) {
         const rfs_seek_decision_t *x = &out.decision;
-        d->decided++;
         fprintf(d->decisions,
                 "decision t=%" PRId64 " n=%" PRIu32 " kind=%s relearn=%d line_search=%d prev=%d pred_q16=%" PRId32
                 " mean_q16=%" PRId32 " eps_q16=%" PRId32 " x_q16=%" PRId32 " y_q16=%" PRId32 " goal_q16=%" PRId32

@@ -1,0 +1,159 @@
+#!/usr/bin/env python3
+"""make_corpus.py - write the seed corpora of the fuzz targets (issue 9, docs/RELIABILITY.md).
+
+    /usr/bin/python3 tests/fuzz/make_corpus.py [tests/fuzz/corpus]
+
+Seeds are built here from the documented formats (docs/CAN.md, the ROS map_server
+convention, docs/SIMULATOR.md, the LCM wire format), not by the code under test:
+  can/       12-byte frame records (see fuzz_can.c): pose pairs, RSSI, wheel, status
+  map/       YAML + "#PGM\\n" + PGM: tests/data/maps_bad fixtures and small P2/P5 images
+  scenario/  the scenarios/*.yaml files and a few hand-written edge cases
+  lcm/       one message per channel (LCM encoding: 8-byte fingerprint, big-endian fields;
+             fingerprints computed with lcm-gen's hash) and small LCM logs
+"""
+import os
+import struct
+import sys
+
+OUT = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "corpus")
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+
+
+def put(sub, name, data):
+    d = os.path.join(OUT, sub)
+    os.makedirs(d, exist_ok=True)
+    with open(os.path.join(d, name), "wb") as f:
+        f.write(data)
+
+
+# --- CAN: records ctrl, dt (ms, LE u16), dlc, data[8] -----------------------------------
+# ctrl bit 0 = fix the checksum; bits 1..3 = id index (0 wheel, 1 xy, 2 th, 3 rssi, 4 status).
+T0 = 5_000_000_000  # the harness's start time, microseconds
+
+
+def rec(idx, dt_ms, dlc, payload, fix=True):
+    data = bytes(payload) + bytes(8 - len(payload))
+    return bytes([(idx << 1) | (1 if fix else 0)]) + struct.pack("<H", dt_ms) + bytes([dlc]) + data
+
+
+def s24(v):
+    return struct.pack("<i", v)[:3]
+
+
+def pose(counter, x_mm, y_mm, th_q13, t_us, dt_ms=100):
+    t32 = t_us & 0xFFFFFFFF
+    return (rec(1, dt_ms, 8, bytes([counter & 15]) + s24(x_mm) + s24(y_mm)) +
+            rec(2, 0, 8, bytes([counter & 15]) + struct.pack("<hI", th_q13, t32)))
+
+
+def rssi(counter, src, dbm, seq, t_us, dt_ms=5):
+    return rec(3, dt_ms, 8, bytes([(counter & 15) | (src << 4), dbm & 0xFF, seq & 0xFF]) +
+               struct.pack("<I", t_us & 0xFFFFFFFF))
+
+
+stream = b""
+now = T0
+for i in range(12):
+    now += 100_000
+    stream += pose(i, 8000 + 100 * i, 6000, 1000 * (i - 6), now)
+    for k in range(3):
+        now += 5_000
+        stream += rssi(3 * i + k, 0, -60 - k, 3 * i + k, now - 1000)
+put("can", "stream_pose_rssi", stream)
+put("can", "wheel", rec(0, 20, 6, [0x10, 0x2c, 0x01, 0xd4, 0xfe]) + rec(0, 20, 6, [0x01, 0, 0, 0, 0]))
+put("can", "status", rec(4, 100, 8, [0x30, 0x26, 0x05, 7, 0, 0, 0]) + rec(4, 100, 8, [0x01, 0x00, 0, 8, 0, 0, 0]))
+put("can", "pose_wrap", pose(0, -8388608, 8388607, 25736, T0 + 2**32 + 100_000) +
+    pose(1, 0, 0, -25736, T0 - 5_000_000))
+put("can", "repeat_unpaired", pose(3, 1, 2, 3, T0 + 100_000) + pose(3, 1, 2, 3, T0 + 200_000) +
+    rec(2, 0, 8, [0x05, 0, 0]) + rec(1, 1, 8, [0x06]) + rec(1, 1, 8, [0x07]))
+put("can", "bad_dlc_crc", rec(3, 1, 7, [0], fix=True) + rec(3, 1, 8, [0] * 8, fix=False) +
+    rec(5, 1, 8, [0xff, 0x07, 0, 0, 0, 0, 0, 0]) + rec(7, 1, 15, [0x11, 0x01]))
+
+# --- map: YAML "#PGM\n" PGM -------------------------------------------------------------
+MAP_YAML = ("image: m.pgm\nresolution: 0.05\norigin: [-1.0, 2.5, 0.0]\nnegate: 0\n"
+            "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
+p5 = b"P5\n# test\n4 3\n255\n" + bytes([254, 254, 0, 205, 254, 254, 254, 254, 0, 0, 205, 254])
+p2 = b"P2\n3 2\n15\n15 0 7\n15 15 0\n"
+p5_16 = b"P5 2 2 65535\n" + struct.pack(">4H", 65535, 0, 30000, 65535)
+put("map", "p5", MAP_YAML.encode() + b"#PGM\n" + p5)
+put("map", "p2", MAP_YAML.replace("negate: 0", "negate: true").encode() + b"#PGM\n" + p2)
+put("map", "p5_16bit", MAP_YAML.encode() + b"#PGM\n" + p5_16)
+put("map", "flow_style", b"{image: m.pgm, resolution: 1, origin: [0, 0, 0], occupied_thresh: 0.9,"
+    b" free_thresh: 0.1, negate: 0, mode: trinary}\n#PGM\n" + p2)
+bad = os.path.join(ROOT, "tests", "data", "maps_bad")
+if os.path.isdir(bad):
+    for name in sorted(os.listdir(bad)):
+        if not name.endswith(".yaml"):
+            continue
+        text = open(os.path.join(bad, name), "rb").read()
+        img = b""
+        for line in text.decode(errors="replace").splitlines():
+            if line.startswith("image:"):
+                ref = line.split(":", 1)[1].strip()
+                if os.path.exists(os.path.join(bad, ref)):
+                    img = open(os.path.join(bad, ref), "rb").read()
+                text = text.replace(ref.encode(), b"m.pgm")
+        put("map", "bad_" + name[:-5], text + b"#PGM\n" + img)
+
+# --- scenario -----------------------------------------------------------------------------
+scn = os.path.join(ROOT, "scenarios")
+for name in sorted(os.listdir(scn)):
+    if name.endswith(".yaml"):
+        put("scenario", name[:-5], open(os.path.join(scn, name), "rb").read())
+put("scenario", "minimal", b"map: m.yaml\nsources:\n  - {position: [1, 2]}\nstart: {position: [0, 0]}\n")
+put("scenario", "bridge_two", b"map: m.yaml\ntarget: bridge\nsources:\n  - {name: a, position: [1, 2],"
+    b" mac: '02:00:00:00:00:0a'}\n  - {name: b, position: [3, 4], rate_hz: 50, tx_dbm: 10}\n"
+    b"start: {position: [0, 0], theta: 3.14}\nstop: {goal: [2, 3], radius_m: 0}\n")
+put("scenario", "anchors", b"base: &b {position: [1, 2]}\nmap: m.yaml\nsources: [*b, *b, *b]\n"
+    b"start: {position: [0, 0]}\n")
+
+# --- LCM: fingerprint + big-endian fields ----------------------------------------------------
+def lcm_hash(fields):
+    """lcm-gen's fingerprint of a struct of primitive, fixed-size fields (lcmgen.c)."""
+    def upd(v, c):
+        v = (((v << 8) & 0xFFFFFFFFFFFFFFFF) ^ (v >> 55 if v < 2**63 else ((v - 2**64) >> 55) & 0xFFFFFFFFFFFFFFFF)) + c
+        return v & 0xFFFFFFFFFFFFFFFF
+
+    def upd_s(v, s):
+        v = upd(v, len(s))
+        for ch in s.encode():
+            v = upd(v, ch if ch < 128 else ch - 256)
+        return v
+
+    v = 0x12345678
+    for name, typ, ndim in fields:
+        v = upd_s(v, name)
+        v = upd_s(v, typ)
+        v = upd(v, ndim)
+        if ndim:
+            v = upd(v, 0)       # LCM_CONST dimension
+            v = upd_s(v, "8")
+    return ((v << 1) & 0xFFFFFFFFFFFFFFFF) + ((v >> 63) & 1)
+
+
+POSE = [("utime", "int64_t", 0), ("x", "double", 0), ("y", "double", 0), ("theta", "double", 0)]
+RSSI = [("utime", "int64_t", 0), ("source", "int16_t", 0), ("dbm", "int16_t", 0), ("seq", "int32_t", 0)]
+CLOCK = [("utime", "int64_t", 0)]
+WHEEL = [("utime", "int64_t", 0), ("left_mm_s", "int16_t", 0), ("right_mm_s", "int16_t", 0),
+         ("stop", "boolean", 0)]
+CAN = [("utime", "int64_t", 0), ("id", "int32_t", 0), ("dlc", "int8_t", 0), ("data", "byte", 1)]
+msgs = {
+    0: struct.pack(">Q", lcm_hash(POSE)) + struct.pack(">qddd", 1_000_000, 8.0, 6.0, 7.0),
+    1: struct.pack(">Q", lcm_hash(RSSI)) + struct.pack(">qhhi", 1_000_000, 0, -60, 7),
+    2: struct.pack(">Q", lcm_hash(CLOCK)) + struct.pack(">q", 2_000_000),
+    3: struct.pack(">Q", lcm_hash(WHEEL)) + struct.pack(">qhhb", 1_000_000, 300, -300, 0),
+    5: struct.pack(">Q", lcm_hash(CAN)) + struct.pack(">qib", 1_000_000, 0x120, 8) + bytes(range(8)),
+}
+for sel, m in msgs.items():
+    put("lcm", "msg_%d" % sel, bytes([sel]) + m)
+put("lcm", "msg_4_garbage", bytes([4]) + b"\x00" * 40)
+
+
+def log_event(num, t, ch, data):
+    return struct.pack(">IqqII", 0xEDA1DA01, num, t, len(ch), len(data)) + ch.encode() + data
+
+
+names = ["RFS_POSE", "RFS_RSSI", "RFS_CLOCK", "RFS_WHEEL_CMD", "RFS_SEEKER_STATUS", "RFS_CAN_FALLBACK"]
+log = b"".join(log_event(i, 1_000_000 + i, names[sel], m) for i, (sel, m) in enumerate(msgs.items()))
+put("lcm", "log_all", b"\x80" + log)
+put("lcm", "log_unknown_channel", b"\x80" + log_event(0, 5, "OTHER", b"abc") + log_event(1, 6, "RFS_POSE", b"x"))

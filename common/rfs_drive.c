@@ -67,7 +67,9 @@ int rfs_drive_init(rfs_drive_t *d, const rfs_drive_cfg_t *cfg)
 
 void rfs_drive_set_path(rfs_drive_t *d, const rfs_path_t *path, int64_t now_us)
 {
-    d->path = *path;
+    if (path != &d->path) {
+        d->path = *path;
+    }
     if (d->path.n > RFS_PLAN_MAX_WAYPOINTS) {
         d->path.n = RFS_PLAN_MAX_WAYPOINTS;
     }

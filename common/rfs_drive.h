@@ -62,7 +62,9 @@ rfs_drive_cfg_t rfs_drive_cfg_default(void);
 /// tolerance or timeout.
 int rfs_drive_init(rfs_drive_t *d, const rfs_drive_cfg_t *cfg);
 
-/// Start following a path (copied) at time now_us.
+/// Start following a path (copied) at time now_us. path may be &d->path itself: planning
+/// straight into it saves a 520-byte rfs_path_t on the caller's stack (the firmware's
+/// stack is 2.5 KB).
 void rfs_drive_set_path(rfs_drive_t *d, const rfs_path_t *path, int64_t now_us);
 
 /// One control update: wheel speeds (mm/s, saturated to the limits) for the pose.

@@ -581,7 +581,9 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
     const rfs_pathloss_lat_t *l = &p->lat;
     uint32_t used = 0u;
     for (;;) {
-        if (budget != 0u && used >= budget) {
+        /* Stop before a candidate that could overrun the budget (at most one wall count
+         * per bin), but evaluate at least one per call. */
+        if (budget != 0u && used != 0u && used + p->nbins + 1u > budget) {
             return RFS_FIT_MORE;
         }
         int32_t i, j;

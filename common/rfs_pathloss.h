@@ -15,14 +15,15 @@
  * when every sample sees the same number of walls. The estimate is the candidate with
  * the least Huber loss of its residuals.
  *
- * Samples are first aggregated into square bins (1 m; at most RFS_PATHLOSS_MAX_BINS = 512, the
- * bin doubles when there are more): each bin is its sample count, mean value and
- * centroid, so the cost of a candidate does not grow with the number of samples.
- * Candidates are legal lattice points, searched coarse to fine: every `coarse` (2 m),
- * then the 8 neighbours of each of the best `top` (3) at half that spacing (1 m), then
- * the 8 neighbours of the best so far at half the spacing again, down to the lattice
- * spacing (0.5 m, 0.25 m). A point is evaluated once per fit. Without a map (fit_in.map NULL)
- * the candidates cover the samples' extent plus `margin` on a 0.25 m lattice, no walls.
+ * Samples are first aggregated into square bins (1 m; at most RFS_PATHLOSS_MAX_BINS,
+ * the bin doubles when there are more): each bin is its sample count, mean value and
+ * centroid (rounded to the centimetre), so the cost of a candidate does not grow with
+ * the number of samples. Candidates are legal lattice points, searched coarse to fine:
+ * every `coarse` (2 m), then the 8 neighbours of each of the best `top` (3) at half that
+ * spacing (1 m), then the 8 neighbours of the best so far at half the spacing again,
+ * down to the lattice spacing (0.5 m, 0.25 m). A point is evaluated once per fit.
+ * Without a map (fit_in.map NULL) the candidates cover the samples' extent plus
+ * `margin` on a 0.25 m lattice, and there are no walls.
  *
  * Uncertainty: the mean Huber loss of every coarse candidate is kept (the residual
  * surface, rfs_pathloss_residual_at(), for heat maps) and the estimate reports the area
@@ -36,10 +37,11 @@
  * that are new or whose centroid moved to another core cell, and for the refinement.
  * The cache is cleared when the map or the coarse lattice changes, or when it is full.
  *
- * Work: one unit is one wall count (a cached one is 1/32 unit). fit() with
- * budget 0 does everything; with budget > 0 it evaluates candidates until that many
- * units are used (at least one candidate) and returns RFS_FIT_MORE until the search is
- * done. The first call also bins the samples (about 60 instructions per sample). The
+ * Work: one unit is one computed wall count (a cached one is 1/32 unit). fit() with
+ * budget 0 does everything; with budget > 0 it stops before a candidate that could
+ * overrun the budget (a candidate costs at most bins + 1 units; at least one candidate
+ * per call) and returns RFS_FIT_MORE until the search is done. The first call also bins
+ * the samples (about 100 instructions per sample). The
  * model is invalid while a fit is in progress; a sliced fit keeps the bins of its first
  * call, so samples added meanwhile are used by the next relearn.
  */
@@ -163,7 +165,7 @@ typedef struct rfs_pathloss_est {
     uint32_t walls_cached;  ///< wall counts the last fit read from the cache
 } rfs_pathloss_est_t;
 
-/// State, caller-owned (about 65 KB, 40 KB of it the wall-count cache).
+/// State, caller-owned (about 66 KB, 37 KB of it the wall-count cache).
 typedef struct rfs_pathloss {
     rfs_pathloss_cfg_t cfg;                       ///< configuration copied at init
     bool valid;                                   ///< a model exists

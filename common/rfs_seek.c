@@ -31,6 +31,9 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.rssi = rfs_rssi_cfg_default();
     c.store = rfs_store_cfg_default();      /* 10,000 samples (section 5.2) */
     c.drive = rfs_drive_cfg_default();
+    c.strategy = RFS_SEEK_META;
+    c.tumble_better = RFS_Q16_FRAC(1, 5);   /* E. coli runs on while things improve */
+    c.tumble_worse = RFS_Q16_ONE;           /* and tumbles when they do not */
     return c;
 }
 
@@ -56,7 +59,10 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
     if (cfg->step <= 0 || cfg->initial_step_max <= 0 || cfg->error_threshold <= 0 ||
         cfg->eps_floor < 0 || cfg->eps_amp < 0 ||
         (int64_t)cfg->eps_floor + cfg->eps_amp > RFS_Q16_ONE || cfg->eps_rate < 0 ||
-        cfg->novelty_radius < 0 || cfg->pose_timeout_us <= 0 || cfg->rssi_timeout_us <= 0) {
+        cfg->novelty_radius < 0 || cfg->pose_timeout_us <= 0 || cfg->rssi_timeout_us <= 0 ||
+        (uint32_t)cfg->strategy >= (uint32_t)RFS_SEEK_STRATEGY_COUNT ||
+        cfg->tumble_better < 0 || cfg->tumble_better > RFS_Q16_ONE || cfg->tumble_worse < 0 ||
+        cfg->tumble_worse > RFS_Q16_ONE) {
         return -1;
     }
     if (model.ops == 0 || model.ops->fit == 0 || model.ops->predict == 0 ||
@@ -303,12 +309,13 @@ static bool go_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, int64_t now_us)
         }
         rfs_map_lattice_point(s->map, i, j, &sx, &sy);
     }
-    rfs_path_t path;
-    if (!rfs_plan_path(&s->plan, sx, sy, gx, gy, &path)) {
+    /* Plan straight into the drive's own path: a 520-byte rfs_path_t on the stack would
+     * overflow the microcontroller's 2.5 KB stack during a decision. */
+    if (!rfs_plan_path(&s->plan, sx, sy, gx, gy, &s->drive.path)) {
         return false;
     }
-    s->decision.path_len = path.length;
-    rfs_drive_set_path(&s->drive, &path, now_us);
+    s->decision.path_len = s->drive.path.length;
+    rfs_drive_set_path(&s->drive, &s->drive.path, now_us);
     return true;
 }
 
@@ -541,6 +548,284 @@ static void stop_wheels(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     out->right_mm_s = 0;
 }
 
+static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t *out);
+
+/* ---- Baseline strategies (issue 7) ------------------------------------------------- */
+
+/* cos(2 pi k / 16), Q16.16; sin(2 pi k / 16) = cos(2 pi (k - 4) / 16). */
+static const rfs_q16_t k_cos16[16] = { 65536,  60547,  46341,  25080, 0, -25080, -46341, -60547,
+                                      -65536, -60547, -46341, -25080, 0,  25080,  46341,  60547 };
+
+static rfs_q16_t sin16(uint8_t h)
+{
+    return k_cos16[(h + 12u) & 15u];
+}
+
+static const char *const k_strategy_names[RFS_SEEK_STRATEGY_COUNT] = {
+    "meta", "meta-global", "fd-gradient", "plane-gradient", "chemotaxis",
+};
+
+const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)
+{
+    return (uint32_t)st < (uint32_t)RFS_SEEK_STRATEGY_COUNT ? k_strategy_names[st] : "?";
+}
+
+static bool same_str(const char *a, const char *b)
+{
+    while (*a != '\0' && *a == *b) {
+        ++a;
+        ++b;
+    }
+    return *a == *b;
+}
+
+bool rfs_seek_strategy_parse(const char *name, rfs_seek_strategy_t *st)
+{
+    if (name == 0) {
+        return false;
+    }
+    for (uint32_t i = 0; i < (uint32_t)RFS_SEEK_STRATEGY_COUNT; ++i) {
+        if (same_str(name, k_strategy_names[i])) {
+            *st = (rfs_seek_strategy_t)i;
+            return true;
+        }
+    }
+    return false;
+}
+
+const char *rfs_seek_kind_name(rfs_seek_kind_t k)
+{
+    switch (k) {
+    case RFS_SEEK_INITIAL: return "initial";
+    case RFS_SEEK_GREEDY: return "greedy";
+    case RFS_SEEK_EPSILON: return "epsilon";
+    case RFS_SEEK_PROBE: return "probe";
+    case RFS_SEEK_GRADIENT: return "gradient";
+    case RFS_SEEK_RUN: return "run";
+    case RFS_SEEK_TUMBLE: return "tumble";
+    default: return "none";
+    }
+}
+
+bool rfs_seek_unit(rfs_q16_t gx, rfs_q16_t gy, rfs_q16_t *ux, rfs_q16_t *uy)
+{
+    int64_t x = gx, y = gy;
+    uint64_t n2 = (uint64_t)(x * x) + (uint64_t)(y * y);
+    if (n2 == 0u) {
+        return false;
+    }
+    uint32_t n = rfs_isqrt64(n2);
+    if (n == 0u) {
+        n = 1u;
+    }
+    int64_t a = rfs_sdiv64_round(x * 65536, (int64_t)n);
+    int64_t b = rfs_sdiv64_round(y * 65536, (int64_t)n);
+    /* The root is rounded down, so a component may come out a little above one. */
+    *ux = (rfs_q16_t)(a > RFS_Q16_ONE ? RFS_Q16_ONE : (a < -RFS_Q16_ONE ? -RFS_Q16_ONE : a));
+    *uy = (rfs_q16_t)(b > RFS_Q16_ONE ? RFS_Q16_ONE : (b < -RFS_Q16_ONE ? -RFS_Q16_ONE : b));
+    return true;
+}
+
+/* (bx, by) + step * (ux, uy), metres Q16.16. Scaling: step Q16 * u Q16 = Q32 >> 16. */
+static void step_point(const rfs_seek_t *s, rfs_q16_t bx, rfs_q16_t by, rfs_q16_t ux,
+                       rfs_q16_t uy, rfs_q16_t *gx, rfs_q16_t *gy)
+{
+    *gx = rfs_sat32((int64_t)bx + (((int64_t)s->cfg.step * ux) >> 16));
+    *gy = rfs_sat32((int64_t)by + (((int64_t)s->cfg.step * uy) >> 16));
+}
+
+/* A gradient step: one step from (bx, by) along the unit vector u; when that point is
+ * illegal or has no path, the nearest reachable legal lattice point around it (so a
+ * gradient pressed against a wall slides along it, as the map legality of section 2). */
+static bool go_step(rfs_seek_t *s, rfs_q16_t bx, rfs_q16_t by, rfs_q16_t ux, rfs_q16_t uy,
+                    int64_t now_us)
+{
+    rfs_q16_t gx, gy;
+    step_point(s, bx, by, ux, uy, &gx, &gy);
+    s->decision.goal_x = gx;
+    s->decision.goal_y = gy;
+    if (rfs_map_point_legal(s->map, gx, gy) && go_to(s, gx, gy, now_us)) {
+        return true;
+    }
+    uint16_t i, j;
+    if (!snap_legal(s, gx, gy, true, &i, &j)) {
+        return false;
+    }
+    rfs_map_lattice_point(s->map, i, j, &gx, &gy);
+    s->decision.goal_x = gx;
+    s->decision.goal_y = gy;
+    return go_to(s, gx, gy, now_us);
+}
+
+/* One step from the robot in heading h (sixteenths of a turn); the goal must be legal
+ * and have a path (position is used for nothing else). */
+static bool go_heading(rfs_seek_t *s, uint8_t h, int64_t now_us)
+{
+    rfs_q16_t gx, gy;
+    step_point(s, s->pose.x, s->pose.y, k_cos16[h & 15u], sin16(h), &gx, &gy);
+    s->decision.goal_x = gx;
+    s->decision.goal_y = gy;
+    return rfs_map_point_legal(s->map, gx, gy) && go_to(s, gx, gy, now_us);
+}
+
+/* A tumble: a uniformly drawn new heading (other than the current one when `change`),
+ * redrawn while it points into a wall; the sixteen headings in turn as a last resort. */
+static bool go_random_heading(rfs_seek_t *s, bool change, rfs_rng_t *rng, int64_t now_us)
+{
+    for (int attempt = 0; attempt < 32; ++attempt) {
+        uint8_t h = change ? (uint8_t)((s->heading + 1u + rfs_rng_below(rng, 15u)) & 15u)
+                           : (uint8_t)rfs_rng_below(rng, 16u);
+        if (go_heading(s, h, now_us)) {
+            s->heading = h;
+            return true;
+        }
+    }
+    for (uint8_t h = 0; h < 16u; ++h) {
+        if (go_heading(s, h, now_us)) {
+            s->heading = h;
+            return true;
+        }
+    }
+    return false;
+}
+
+/* fd-gradient: a probe to p + step along axis (0 = x, 1 = y), or p - step when that is
+ * illegal or has no path. Returns the direction used (+1, -1) or 0 when neither works. */
+static int8_t fd_probe(rfs_seek_t *s, int axis, int64_t now_us)
+{
+    for (int8_t sg = 1; sg >= -1; sg = (int8_t)(sg - 2)) {
+        rfs_q16_t gx = s->fd_px, gy = s->fd_py;
+        rfs_q16_t d = sg > 0 ? s->cfg.step : -s->cfg.step;
+        if (axis == 0) {
+            gx = rfs_q16_add(gx, d);
+        } else {
+            gy = rfs_q16_add(gy, d);
+        }
+        s->decision.goal_x = gx;
+        s->decision.goal_y = gy;
+        if (rfs_map_point_legal(s->map, gx, gy) && go_to(s, gx, gy, now_us)) {
+            return sg;
+        }
+    }
+    return 0;
+}
+
+/* fd-gradient (issue 7 a): the 1 s mean at p, at p + step x and at p + step y (each
+ * after standing still for one averaging window, rfs_seek_step), then one step from p
+ * along the estimated gradient ((m_x - m_0) / step, (m_y - m_0) / step). An axis whose
+ * probe point is illegal in both directions contributes no component. */
+static void decide_fd(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
+{
+    rfs_seek_decision_t *d = &s->decision;
+    bool ok = false;
+    s->dwell_done = false;
+    if (!d->mean_valid) {
+        /* Nothing heard for a whole window: no difference to take; move and try again. */
+        s->fd_phase = 0;
+        d->kind = RFS_SEEK_TUMBLE;
+        ok = go_random_heading(s, false, rng, now_us);
+        end_decision(s, ok, now_us, out);
+        return;
+    }
+    rfs_q16_t my = 0;
+    if (s->fd_phase == 0) {
+        s->fd_px = s->pose.x;
+        s->fd_py = s->pose.y;
+        s->fd_m0 = d->mean;
+    } else if (s->fd_phase == 1) {
+        s->fd_mx = d->mean;
+    } else {
+        my = d->mean;
+    }
+    if (s->fd_phase == 0) {
+        s->fd_sx = fd_probe(s, 0, now_us);
+        s->fd_phase = 1;
+        if (s->fd_sx != 0) {
+            d->kind = RFS_SEEK_PROBE;
+            ok = true;
+        } else {
+            s->fd_mx = s->fd_m0;
+        }
+    }
+    if (!ok && s->fd_phase == 1) {
+        s->fd_sy = fd_probe(s, 1, now_us);
+        s->fd_phase = 2;
+        if (s->fd_sy != 0) {
+            d->kind = RFS_SEEK_PROBE;
+            ok = true;
+        } else {
+            my = s->fd_m0;
+        }
+    }
+    if (!ok && s->fd_phase == 2) {
+        s->fd_phase = 0;
+        /* The common 1 / step factor does not change the direction. */
+        rfs_q16_t gx = rfs_q16_sub(s->fd_mx, s->fd_m0), gy = rfs_q16_sub(my, s->fd_m0);
+        gx = s->fd_sx < 0 ? -gx : (s->fd_sx == 0 ? 0 : gx);
+        gy = s->fd_sy < 0 ? -gy : (s->fd_sy == 0 ? 0 : gy);
+        rfs_q16_t ux, uy;
+        d->kind = RFS_SEEK_GRADIENT;
+        if (rfs_seek_unit(gx, gy, &ux, &uy)) {
+            ok = go_step(s, s->fd_px, s->fd_py, ux, uy, now_us);
+        }
+        if (!ok) {
+            d->kind = RFS_SEEK_TUMBLE; /* flat or blocked: a random step */
+            ok = go_random_heading(s, false, rng, now_us);
+        }
+    }
+    end_decision(s, ok, now_us, out);
+}
+
+/* plane-gradient (issue 7 b, the gradient view of paper section 4.1): the model (refit
+ * at every step by decide()) is followed one step along its gradient, taken as central
+ * differences one step either side (exact for the ridge plane). No epsilon, no check. */
+static bool choose_plane(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t now_us)
+{
+    rfs_seek_decision_t *d = &s->decision;
+    const rfs_model_t *m = &s->model;
+    rfs_q16_t h = s->cfg.step, x = s->pose.x, y = s->pose.y;
+    rfs_q16_t xp, xm, yp, ym, ux, uy;
+    d->kind = RFS_SEEK_GRADIENT;
+    if (model_ok && m->ops->predict(m->self, rfs_q16_add(x, h), y, &xp) &&
+        m->ops->predict(m->self, rfs_q16_sub(x, h), y, &xm) &&
+        m->ops->predict(m->self, x, rfs_q16_add(y, h), &yp) &&
+        m->ops->predict(m->self, x, rfs_q16_sub(y, h), &ym) &&
+        rfs_seek_unit(rfs_q16_sub(xp, xm), rfs_q16_sub(yp, ym), &ux, &uy) &&
+        go_step(s, x, y, ux, uy, now_us)) {
+        return true;
+    }
+    d->kind = RFS_SEEK_TUMBLE; /* no model, a flat one, or blocked: a random step */
+    return go_random_heading(s, false, rng, now_us);
+}
+
+/* chemotaxis (issue 7 c): run-and-tumble on the change of the 1 s mean since the last
+ * decision. After a rise it runs on in its heading (tumbling with tumble_better), after
+ * a fall it tumbles with tumble_worse. Its decisions use no position; the position only
+ * checks that a step is legal and plans it. */
+static void decide_chemo(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
+{
+    rfs_seek_decision_t *d = &s->decision;
+    bool tumble = true;
+    if (d->mean_valid && s->have_prev_mean && d->iteration > 0u) {
+        rfs_q16_t p = d->mean > s->prev_mean ? s->cfg.tumble_better : s->cfg.tumble_worse;
+        tumble = rfs_rng_q16(rng) < p;
+    }
+    if (d->mean_valid) {
+        s->prev_mean = d->mean;
+        s->have_prev_mean = true;
+    }
+    bool ok = false;
+    if (!tumble) {
+        d->kind = RFS_SEEK_RUN;
+        ok = go_heading(s, s->heading, now_us);
+    }
+    if (!ok) {
+        d->kind = RFS_SEEK_TUMBLE;
+        ok = go_random_heading(s, d->iteration > 0u, rng, now_us);
+    }
+    end_decision(s, ok, now_us, out);
+}
+
 /* Finish the decision after a (possibly sliced) fit: epsilon-greedy choice and goal. */
 static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
 {
@@ -551,6 +836,8 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
     if (d->iteration == 0u) {
         d->kind = RFS_SEEK_INITIAL;
         ok = choose_initial(s, rng, now_us);
+    } else if (s->cfg.strategy == RFS_SEEK_PLANE_GRADIENT) {
+        ok = choose_plane(s, model_ok, rng, now_us);
     } else {
         d->epsilon = rfs_seek_epsilon(&s->cfg, d->iteration);
         /* "if random() > epsilon: greedy" (Algorithm 1). */
@@ -566,6 +853,13 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
             ok = choose_greedy(s, rng, now_us);
         }
     }
+    end_decision(s, ok, now_us, out);
+}
+
+/* Count the decision, report it, and start driving (or flag that there is no goal). */
+static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t *out)
+{
+    rfs_seek_decision_t *d = &s->decision;
     s->iteration++;
     out->decided = true;
     if (!ok) {
@@ -597,10 +891,21 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     d->samples = s->store.count;
     rfs_target_in_t in = { s->win, s->target->nsources, now_us };
     d->mean_valid = s->target->mean(&in, &d->mean);
+    if (s->cfg.strategy == RFS_SEEK_FD_GRADIENT) {
+        decide_fd(s, now_us, rng, out);
+        return;
+    }
+    if (s->cfg.strategy == RFS_SEEK_CHEMOTAXIS) {
+        decide_chemo(s, now_us, rng, out);
+        return;
+    }
     d->model_valid = s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &d->prediction);
     bool relearn = !d->model_valid;
     if (d->model_valid && d->mean_valid) {
         relearn = rfs_q16_abs(rfs_q16_sub(d->mean, d->prediction)) > s->cfg.error_threshold;
+    }
+    if (s->cfg.strategy == RFS_SEEK_PLANE_GRADIENT) {
+        relearn = true; /* issue 7 b: the local fit is redone at every step */
     }
     if (relearn && s->store.count > 0u) {
         d->relearned = true;
@@ -688,6 +993,18 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
             goto report;
         }
         s->prev_status = st;
+    }
+    if (s->cfg.strategy == RFS_SEEK_FD_GRADIENT) {
+        /* fd-gradient measures standing still: one whole window at each point. */
+        if (!s->dwell_done) {
+            s->dwell_done = true;
+            s->dwell_until_us = now_us + (int64_t)s->cfg.rssi.window_us;
+        }
+        if (now_us < s->dwell_until_us) {
+            stop_wheels(s, now_us, out);
+            s->state = RFS_SEEK_DRIVING;
+            goto report;
+        }
     }
     decide(s, now_us, rng, out);
 report:

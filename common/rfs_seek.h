@@ -30,6 +30,17 @@
 #include "rfs_store.h"
 #include "rfs_target.h"
 
+/// How the seeker chooses its goals (issue 7). Every strategy uses the same sensors,
+/// step width, map legality and path planner; only the decision rule differs.
+typedef enum rfs_seek_strategy {
+    RFS_SEEK_META = 0,       ///< the meta-algorithm, paper section 2 (default)
+    RFS_SEEK_META_GLOBAL,    ///< the same; the caller gives the model a map-wide radius
+    RFS_SEEK_FD_GRADIENT,    ///< finite differences: 1 s means at p, p + step x, p + step y
+    RFS_SEEK_PLANE_GRADIENT, ///< refit every step, always a step along the model's gradient
+    RFS_SEEK_CHEMOTAXIS,     ///< run-and-tumble on the change of the 1 s mean, no position
+    RFS_SEEK_STRATEGY_COUNT  ///< number of strategies (not a strategy)
+} rfs_seek_strategy_t;
+
 /// Seeker configuration; rfs_seek_cfg_default() is exactly the paper's.
 typedef struct rfs_seek_cfg {
     rfs_q16_t step;             ///< step width, metres Q16.16 (paper: 1 m)
@@ -45,6 +56,9 @@ typedef struct rfs_seek_cfg {
     rfs_rssi_cfg_t rssi;        ///< averaging window (1 s)
     rfs_store_cfg_t store;      ///< sample store (10,000 samples)
     rfs_drive_cfg_t drive;      ///< drive control (TurtleBot 2)
+    rfs_seek_strategy_t strategy; ///< decision rule (RFS_SEEK_META: the paper's)
+    rfs_q16_t tumble_better;    ///< chemotaxis: P(tumble) after the mean rose, Q16.16 (0.2)
+    rfs_q16_t tumble_worse;     ///< chemotaxis: P(tumble) after it fell or stayed, Q16.16 (1.0)
 } rfs_seek_cfg_t;
 
 /// Caller-owned memory for the seeker's large arrays.
@@ -71,6 +85,10 @@ typedef enum rfs_seek_kind {
     RFS_SEEK_INITIAL,  ///< the initial random move (up to initial_step_max)
     RFS_SEEK_GREEDY,   ///< towards the model's maximum
     RFS_SEEK_EPSILON,  ///< novelty-driven random move
+    RFS_SEEK_PROBE,    ///< fd-gradient: to p + step along one axis, to measure there
+    RFS_SEEK_GRADIENT, ///< fd- or plane-gradient: a step along the estimated gradient
+    RFS_SEEK_RUN,      ///< chemotaxis: a step on in the same heading
+    RFS_SEEK_TUMBLE,   ///< chemotaxis (or a gradient without direction): a new random heading
 } rfs_seek_kind_t;
 
 /// Controller state.
@@ -158,6 +176,16 @@ typedef struct rfs_seek {
     rfs_path_t resume_path;                   ///< the path to resume
     uint16_t last_li, last_lj;                ///< lattice point of the last novelty update
     bool have_last_l;                         ///< last_li/last_lj are valid
+    /* Baseline strategies (issue 7). */
+    bool dwell_done;                          ///< fd: the robot has stood one window here
+    int64_t dwell_until_us;                   ///< fd: wheels stay stopped until then, microseconds
+    uint8_t fd_phase;                         ///< fd: 0 at p, 1 at the x probe, 2 at the y probe
+    int8_t fd_sx, fd_sy;                      ///< fd: probe direction per axis (+1, -1; 0 = none)
+    rfs_q16_t fd_px, fd_py;                   ///< fd: the point p, metres Q16.16
+    rfs_q16_t fd_m0, fd_mx;                   ///< fd: 1 s means at p and at the x probe, target units
+    uint8_t heading;                          ///< chemotaxis: heading, sixteenths of a turn
+    bool have_prev_mean;                      ///< chemotaxis: prev_mean is valid
+    rfs_q16_t prev_mean;                      ///< chemotaxis: 1 s mean at the last decision
 } rfs_seek_t;
 
 /// The paper's parameters (section 2 and 5.2): the `meta` configuration.
@@ -182,5 +210,21 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
 
 /// epsilon(n) = eps_amp * e^(-eps_rate * n) + eps_floor, Q16.16.
 rfs_q16_t rfs_seek_epsilon(const rfs_seek_cfg_t *cfg, uint32_t n);
+
+/// Name of a strategy as on the command line ("meta", "meta-global", "fd-gradient",
+/// "plane-gradient", "chemotaxis"); "?" for a value out of range.
+const char *rfs_seek_strategy_name(rfs_seek_strategy_t st);
+
+/// The strategy named `name` (NUL-terminated, exact). false when there is none.
+bool rfs_seek_strategy_parse(const char *name, rfs_seek_strategy_t *st);
+
+/// Name of a decision kind for logs ("initial", "greedy", "epsilon", "probe", "gradient",
+/// "run", "tumble"; "none").
+const char *rfs_seek_kind_name(rfs_seek_kind_t k);
+
+/// Unit vector along (gx, gy) (any common scale, |g| < 2^31), Q16.16; false when g = 0.
+/// Scaling and overflow: squares in uint64 (< 2^63), root Q16 of the same scale as g,
+/// quotient (g << 16) / |g| in int64, |u| <= 1.
+bool rfs_seek_unit(rfs_q16_t gx, rfs_q16_t gy, rfs_q16_t *ux, rfs_q16_t *uy);
 
 #endif /* RFS_SEEK_H */

@@ -8,7 +8,7 @@
 #include "rfs_assert.h"
 
 /// Largest bracketing gap init accepts: keeps the interpolation product
-/// (dx < 2^33 Q16) x (dt <= 6e7 us < 2^26) below 2^59, exact in int64.
+/// (|dx| < 2^32 Q16) x (dt <= 6e7 us < 2^26) below 2^58, exact in int64.
 #define STORE_MAX_GAP_US 60000000
 
 rfs_store_cfg_t rfs_store_cfg_default(void)
@@ -70,9 +70,9 @@ typedef enum {
     BRACKET_GAP,   ///< the bracketing poses are more than max_gap_us apart
 } bracket_t;
 
-/* Scaling and overflow: a + (b - a) * dt / span with b - a < 2^33 (Q16.16) and
- * dt <= span <= STORE_MAX_GAP_US < 2^26: product < 2^59 in int64, rounded to nearest.
- * The result lies between a and b, so it fits Q16.16. */
+/* Scaling and overflow: a + (b - a) * dt / span with |b - a| < 2^32 (Q16.16) and
+ * dt <= span <= STORE_MAX_GAP_US < 2^26: product < 2^58 in int64, rounded to nearest
+ * once. The result lies between a and b, so it fits Q16.16. */
 static rfs_q16_t lerp(rfs_q16_t a, rfs_q16_t b, int64_t dt, int64_t span)
 {
     return (rfs_q16_t)(a + rfs_sdiv64_round(((int64_t)b - a) * dt, span));

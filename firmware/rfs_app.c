@@ -20,6 +20,13 @@ rfs_app_cfg_t rfs_app_cfg_default(void)
     return c;
 }
 
+rfs_app_cfg_t rfs_app_cfg_mcu(void)
+{
+    rfs_app_cfg_t c = rfs_app_cfg_default();
+    c.seek.fit_budget = RFS_APP_MCU_FIT_BUDGET;
+    return c;
+}
+
 int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *map)
 {
     if (a == NULL || cfg == NULL || map == NULL || map->free == NULL) {

@@ -50,6 +50,9 @@
 #define RFS_APP_PLAN_QUEUE 512u
 /// Pending measurements waiting for a bracketing pose (>= 64 required by rfs_seek).
 #define RFS_APP_PENDING 64u
+/// Samples the MCU configuration learns per control period: the 10,000-sample fit spread
+/// over four periods keeps every period under 500,000 instructions (docs/PERFORMANCE.md).
+#define RFS_APP_MCU_FIT_BUDGET 2500u
 /// Control period, microseconds (20 Hz).
 #define RFS_APP_PERIOD_US 50000
 
@@ -144,6 +147,11 @@ typedef struct rfs_app {
 /// Defaults: the paper's configuration (rfs_seek_cfg_default, rfs_ridge_cfg_default,
 /// rfs_map_cfg_default), RSSI target, seed 1, 150 ms input timeout, node 1.
 rfs_app_cfg_t rfs_app_cfg_default(void);
+
+/// The microcontroller configuration: the defaults with the fit sliced over control
+/// periods (seek.fit_budget = RFS_APP_MCU_FIT_BUDGET). Decisions are the same; a relearn
+/// keeps the wheels stopped for three more periods (150 ms).
+rfs_app_cfg_t rfs_app_cfg_mcu(void);
 
 /// Initialise (also after a watchdog reset). Returns 0, or -1 when the map is larger
 /// than the compile-time maxima or invalid, or the seeker rejects the configuration.

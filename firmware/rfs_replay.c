@@ -53,7 +53,7 @@ int rfs_replay_check_header(const uint8_t *buf, uint32_t len)
 static int payload_len(uint8_t type)
 {
     switch (type) {
-    case RFS_REPLAY_CFG: return 10;
+    case RFS_REPLAY_CFG: return 14;
     case RFS_REPLAY_MAP: return 17;
     case RFS_REPLAY_MAP_FREE:
     case RFS_REPLAY_MAP_WALL: return -1;
@@ -142,6 +142,7 @@ rfs_replay_status_t rfs_replay_parse(const uint8_t *buf, uint32_t len, uint32_t 
         rec->u.cfg.seed = rd64(p);
         rec->u.cfg.target = p[8];
         rec->u.cfg.node = p[9];
+        rec->u.cfg.fit_budget = rd32(p + 10);
         if (rec->u.cfg.target > (uint8_t)RFS_APP_TARGET_BRIDGE) {
             return bad(rec, "CFG target out of range");
         }
@@ -244,6 +245,7 @@ uint32_t rfs_replay_encode(const rfs_replay_rec_t *rec, uint8_t *buf, uint32_t c
         p = wr64(p, rec->u.cfg.seed);
         *p++ = rec->u.cfg.target;
         *p++ = rec->u.cfg.node;
+        p = wr32(p, rec->u.cfg.fit_budget);
         break;
     case RFS_REPLAY_MAP:
         p = wr16(p, rec->u.map.w);
@@ -405,6 +407,7 @@ bool rfs_replay_play(rfs_replay_player_t *p, const rfs_replay_rec_t *rec)
         p->cfg.seed = rec->u.cfg.seed;
         p->cfg.target = (rfs_app_target_t)rec->u.cfg.target;
         p->cfg.node_id = rec->u.cfg.node;
+        p->cfg.seek.fit_budget = rec->u.cfg.fit_budget;
         return true;
     case RFS_REPLAY_MAP:
         if (p->started) {

@@ -8,7 +8,7 @@
  *   record  = u8 type, u8 len, len bytes of payload                (all little-endian)
  *
  * Input records (times are the controller's clock, int64 microseconds):
- *   CFG      seed u64, target u8, node u8                              10
+ *   CFG      seed u64, target u8, node u8, fit_budget u32                  14
  *   MAP      w u16, h u16, res q16, origin_x q16, origin_y q16,
  *            has_wall u8                                               17
  *   MAP_FREE offset u32, 1..RFS_REPLAY_CHUNK bytes of the free grid    5..
@@ -90,6 +90,7 @@ typedef struct rfs_replay_rec {
             uint64_t seed;    ///< random seed
             uint8_t target;   ///< rfs_app_target_t
             uint8_t node;     ///< node id
+            uint32_t fit_budget; ///< samples learnt per control period (0 = all at once)
         } cfg;                ///< CFG
         struct {
             uint16_t w, h;    ///< cells
@@ -151,7 +152,7 @@ typedef enum rfs_replay_err {
 /// (the map grids) plus the application it points to.
 typedef struct rfs_replay_player {
     rfs_app_t *app;                           ///< the application driven
-    rfs_app_cfg_t cfg;                        ///< configuration (CFG overrides seed/target/node)
+    rfs_app_cfg_t cfg;                        ///< configuration (CFG overrides seed, target, node, fit budget)
     rfs_app_map_t map;                        ///< map header (MAP), grids below
     bool have_map;                            ///< MAP seen
     bool started;                             ///< rfs_app_init() done
@@ -165,7 +166,7 @@ typedef struct rfs_replay_player {
 } rfs_replay_player_t;
 
 /// Start a player on `app` with the base configuration (CFG records override seed,
-/// target and node id). Writes the output stream header through `write`.
+/// target, node id and fit budget). Writes the output stream header through `write`.
 void rfs_replay_player_init(rfs_replay_player_t *p, rfs_app_t *app, const rfs_app_cfg_t *cfg,
                             rfs_replay_write_fn write, void *write_ctx);
 

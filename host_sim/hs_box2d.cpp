@@ -134,7 +134,7 @@ extern "C" long hs_world_merge_rects(const hs_map_t *m, hs_world_kind_t kind, hs
     return (long)done.size();
 }
 
-static long add_walls(hs_world_t *w, const hs_map_t *m, b2Body *body, hs_world_kind_t kind)
+static long add_walls(const hs_map_t *m, b2Body *body, hs_world_kind_t kind)
 {
     hs_rect_t *rects = nullptr;
     long n = hs_world_merge_rects(m, kind, &rects);
@@ -160,7 +160,6 @@ static long add_walls(hs_world_t *w, const hs_map_t *m, b2Body *body, hs_world_k
         body->CreateFixture(&fd);
     }
     free(rects);
-    (void)w;
     return n;
 }
 
@@ -201,8 +200,8 @@ extern "C" hs_world_t *hs_world_create(const hs_map_t *m, const hs_world_cfg_t *
         sd.type = b2_staticBody;
         b2Body *collide = w->world->CreateBody(&sd);
         b2Body *radio = w->world->CreateBody(&sd);
-        w->n_collide = add_walls(w, m, collide, HS_WORLD_COLLIDE);
-        w->n_radio = add_walls(w, m, radio, HS_WORLD_RADIO);
+        w->n_collide = add_walls(m, collide, HS_WORLD_COLLIDE);
+        w->n_radio = add_walls(m, radio, HS_WORLD_RADIO);
         if (w->n_collide < 0 || w->n_radio < 0) {
             throw std::bad_alloc();
         }

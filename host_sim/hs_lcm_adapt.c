@@ -443,9 +443,42 @@ hs_lcm_log_t *hs_lcm_log_open(const char *path, const char *mode, char *err, siz
     return log;
 }
 
+/* LCM's reader callocs the event's data length as read from the file (up to 2 GiB) before
+ * reading it: a corrupt or truncated log costs that much memory, or crashes where calloc
+ * fails (found by tests/fuzz/fuzz_lcm.c). Peek at the next header the way LCM finds it
+ * (scan for the magic) and report the end when its lengths run past the end of the file -
+ * LCM would return no event for it either. */
+static bool event_fits(hs_lcm_log_t *log)
+{
+    FILE *f = log->ev->f;
+    off_t pos = ftello(f);
+    bool ok = false;
+    if (pos >= 0 && fseeko(f, 0, SEEK_END) == 0) {
+        off_t end = ftello(f);
+        uint8_t b[24];
+        uint32_t magic = 0;
+        int c = EOF;
+        if (fseeko(f, pos, SEEK_SET) == 0) {
+            while (magic != 0xEDA1DA01u && (c = fgetc(f)) != EOF) {
+                magic = (magic << 8) | (uint32_t)c;
+            }
+        }
+        if (c != EOF && fread(b, 1, sizeof b, f) == sizeof b) {
+            uint32_t cl = (uint32_t)b[16] << 24 | (uint32_t)b[17] << 16 | (uint32_t)b[18] << 8 | b[19];
+            uint32_t dl = (uint32_t)b[20] << 24 | (uint32_t)b[21] << 16 | (uint32_t)b[22] << 8 | b[23];
+            off_t at = ftello(f);
+            ok = at >= 0 && cl < 1000u && dl <= INT32_MAX && (uint64_t)cl + dl <= (uint64_t)(end - at);
+        }
+    }
+    if (pos < 0 || fseeko(f, pos, SEEK_SET) != 0) {
+        return false;
+    }
+    return ok;
+}
+
 int hs_lcm_log_next(hs_lcm_log_t *log, const hs_lcm_handlers_t *h, hs_lcm_stats_t *stats, int64_t *t_us)
 {
-    lcm_eventlog_event_t *ev = lcm_eventlog_read_next_event(log->ev);
+    lcm_eventlog_event_t *ev = event_fits(log) ? lcm_eventlog_read_next_event(log->ev) : NULL;
     if (!ev) {
         return 0;
     }
@@ -464,7 +497,7 @@ int hs_lcm_log_next(hs_lcm_log_t *log, const hs_lcm_handlers_t *h, hs_lcm_stats_
 int hs_lcm_log_next_raw(hs_lcm_log_t *log, int64_t *t_us, char *channel, size_t chcap, void *data, size_t cap,
                         size_t *len)
 {
-    lcm_eventlog_event_t *ev = lcm_eventlog_read_next_event(log->ev);
+    lcm_eventlog_event_t *ev = event_fits(log) ? lcm_eventlog_read_next_event(log->ev) : NULL;
     if (!ev) {
         return 0;
     }

@@ -95,8 +95,10 @@ int hs_sim_field(const hs_sim_env_t *e, uint64_t seed, unsigned src, double step
 /// Write summary.json of a run to f.
 void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t *r);
 
-/// Header line and one row of the batch table (TSV).
+/// Header line of the batch table (TSV; scripts/merge_runs.py writes the same).
 void hs_sim_table_header(FILE *f);
+
+/// One row of the batch table ("nan" where a value does not exist).
 void hs_sim_table_row(FILE *f, const hs_sim_result_t *r);
 
 #endif /* HS_SIM_H */

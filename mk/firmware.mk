@@ -51,9 +51,9 @@ $(FW_CORE_LIB): $(FW_CORE_OBJS)
 $(FW)/firmware.elf: $(FW_STM32_SRCS:%.c=$(FW)/obj/%.o) $(FW)/obj/fw_map.o $(FW_CORE_LIB) firmware/port/stm32f4/stm32f405.ld
 	$(ARM_CC) $(FW_LDFLAGS) -Wl,-Map=$(FW)/firmware.map -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
 $(FW)/qemu.elf: $(FW_QEMU_SRCS:%.c=$(FW)/obj/%.o) $(FW_CORE_LIB) firmware/port/stm32f4/stm32f405.ld
-	$(ARM_CC) $(FW_LDFLAGS) -Wl,--defsym=RFS_RAM_BUDGET=192K -Wl,--defsym=RFS_FLASH_BUDGET=1024K -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
+	$(ARM_CC) $(FW_LDFLAGS) -Wl,--defsym=RFS_RAM_BUDGET=192K -Wl,--defsym=RFS_FLASH_BUDGET=1024K -Wl,--defsym=RFS_STACK_SIZE=16K -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
 $(FW)/bench.elf: $(FW_BENCH_SRCS:%.c=$(FW)/obj/%.o) $(FW_CORE_LIB) firmware/port/stm32f4/stm32f405.ld
-	$(ARM_CC) $(FW_LDFLAGS) -Wl,--defsym=RFS_RAM_BUDGET=192K -Wl,--defsym=RFS_FLASH_BUDGET=1024K -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
+	$(ARM_CC) $(FW_LDFLAGS) -Wl,--defsym=RFS_RAM_BUDGET=192K -Wl,--defsym=RFS_FLASH_BUDGET=1024K -Wl,--defsym=RFS_STACK_SIZE=16K -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
 $(FW)/%.bin: $(FW)/%.elf
 	arm-none-eabi-objcopy -O binary $< $@
 

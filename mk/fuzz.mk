@@ -29,12 +29,15 @@ $(FUZZ_DIR)/fuzz_scenario: tests/fuzz/fuzz_scenario.c $(FUZZ_SCN_SRCS) $(CORE_SR
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_SCN_SRCS) $(CORE_SRCS) -o $@ $(FUZZ_YAML_LIBS) -lm
 
-# The lcm-gen sources (from mk/wire.mk's rule) have unused parameters: no -Werror for them.
-FUZZ_LCM_GEN_OBJS = $(patsubst $(BUILD)/gen/%.c,$(FUZZ_DIR)/gen/%.o,$(HOST_GEN_SRCS))
-$(FUZZ_DIR)/gen/%.o: $(BUILD)/gen/%.c $(HOST_GEN_HDRS)
+# The lcm-gen sources (from mk/wire.mk's rule, which is read after this file) have unused
+# parameters: no -Werror for them.
+FUZZ_LCM_NAMES := $(patsubst lcm/%.lcm,rfseek_%,$(sort $(wildcard lcm/*.lcm)))
+FUZZ_LCM_GEN_OBJS := $(FUZZ_LCM_NAMES:%=$(FUZZ_DIR)/gen/%.o)
+FUZZ_LCM_GEN_HDRS := $(FUZZ_LCM_NAMES:%=$(BUILD)/gen/%.h)
+$(FUZZ_DIR)/gen/%.o: $(BUILD)/gen/%.c $(FUZZ_LCM_GEN_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(CSTD) -g -O1 -I$(BUILD)/gen $(FUZZ_SAN) -fsanitize=fuzzer-no-link -c $< -o $@
-$(FUZZ_DIR)/fuzz_lcm: tests/fuzz/fuzz_lcm.c host_sim/hs_lcm_adapt.c $(FUZZ_LCM_GEN_OBJS) $(CORE_SRCS) $(FUZZ_HDRS) $(HOST_GEN_HDRS)
+$(FUZZ_DIR)/fuzz_lcm: tests/fuzz/fuzz_lcm.c host_sim/hs_lcm_adapt.c $(FUZZ_LCM_GEN_OBJS) $(CORE_SRCS) $(FUZZ_HDRS) $(FUZZ_LCM_GEN_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< host_sim/hs_lcm_adapt.c $(FUZZ_LCM_GEN_OBJS) $(CORE_SRCS) -o $@ $(FUZZ_LCM_LIBS) -lm
 

@@ -45,3 +45,10 @@ $(BUILD)/tests/wire/bench_can: tests/wire/bench_can.c $(CORE_LIB) $(CORE_HDRS)
 bench-wire: $(BUILD)/tests/wire/bench_can $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm $(BUILD)/bin/rfseek-sim
 	@tests/wire/bench_wire.sh $(BUILD)
 BENCH_TARGETS += bench-wire
+
+# rfseekd under ASan+UBSan, for the malformed-input replay in tests/wire/rfseekd_test.sh.
+$(BUILD)/asan/bin/rfseekd: firmware/port/linux/prog/rfseekd.c $(HOST_ASAN_LIB_DEPS) $(CORE_ASAN_LIB) $(HOST_HDRS)
+	@mkdir -p $(@D)
+	$(HOST_LINK) $(HOST_CFLAGS) -O1 $(SAN_FLAGS) -Ifirmware -Ifirmware/port/linux -x c $< -x none -o $@ \
+		$(HOST_ASAN_LIB_DEPS) $(CORE_ASAN_LIB) $(HOST_LDLIBS)
+TEST_DEPS += $(BUILD)/asan/bin/rfseekd

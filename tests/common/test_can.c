@@ -456,6 +456,60 @@ static void rx_counts_unknown_ids_short_frames_and_seq_gaps(void **state)
     assert_string_equal(rfs_can_err_str(RFS_CAN_E_CHECKSUM), "checksum");
 }
 
+static void random_frames_are_all_accounted_for(void **state)
+{
+    (void)state;
+    rfs_can_rx_t rx = rx_fixture();
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 4);
+    const uint32_t ids[] = {0x100, 0x110, 0x111, 0x120, 0x180, 0x7FF, 0x12345678u};
+    uint32_t ok = 0, none = 0, errs[RFS_CAN_NERR] = {0};
+    const uint32_t n = 200000;
+    for (uint32_t i = 0; i < n; i++) {
+        rfs_can_frame_t f;
+        f.id = ids[rfs_rng_below(&rng, 7)];
+        f.dlc = (uint8_t)rfs_rng_below(&rng, 10); /* 9 is an invalid DLC */
+        for (int b = 0; b < 8; b++) {
+            f.data[b] = (uint8_t)rfs_rng_u32(&rng);
+        }
+        /* Half the frames get a valid checksum so the later checks run too. */
+        if (f.dlc >= 1 && f.dlc <= 8 && (i & 1)) {
+            f.data[f.dlc - 1] = rfs_can_checksum(f.id, f.dlc, f.data);
+        }
+        rfs_can_msg_t m;
+        int64_t now = (int64_t)rfs_rng_u32(&rng) * 1000;
+
+        rfs_can_err_t e = rfs_can_rx_frame(&rx, &f, now, &m);
+
+        if (e == RFS_CAN_OK) {
+            ok++;
+            none += m.kind == RFS_CAN_MSG_NONE;
+        } else {
+            errs[e]++;
+            assert_int_equal(m.kind, RFS_CAN_MSG_NONE);
+        }
+    }
+    uint32_t accepted = 0;
+    for (unsigned i = 0; i < RFS_CAN_NMSG; i++) {
+        accepted += rx.msg[i].accepted;
+    }
+    /* Every frame is either accepted (counted per id) or dropped (counted per reason).
+     * An XY half replaced by the next before its TH half is one more PAIR count on a
+     * frame that was itself accepted. */
+    assert_int_equal(accepted, ok);
+    for (unsigned e = 1; e < RFS_CAN_NERR; e++) {
+        if (e == RFS_CAN_E_PAIR) {
+            assert_true(rx.dropped[e] >= errs[e]);
+        } else {
+            assert_int_equal(rx.dropped[e], errs[e]);
+        }
+    }
+    assert_int_equal(errs[RFS_CAN_OK], 0);
+    assert_true(ok > 100);
+    assert_true(errs[RFS_CAN_E_CHECKSUM] > 1000 && errs[RFS_CAN_E_DLC] > 1000 && errs[RFS_CAN_E_ID] > 1000);
+    assert_true(none > 0);
+}
+
 static void rx_init_validates_config(void **state)
 {
     (void)state;
@@ -526,6 +580,7 @@ int main(void)
         cmocka_unit_test(rx_rejects_unpaired_pose_halves),
         cmocka_unit_test(rx_drops_stale_future_and_out_of_order_times),
         cmocka_unit_test(rx_counts_unknown_ids_short_frames_and_seq_gaps),
+        cmocka_unit_test(random_frames_are_all_accounted_for),
         cmocka_unit_test(rx_init_validates_config),
         cmocka_unit_test(seek_output_maps_to_status_and_wheels),
     };

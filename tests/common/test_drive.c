@@ -258,6 +258,21 @@ static void test_random_polylines(void **state)
     assert_true(worst < 0.07);
 }
 
+/* A path planned straight into the drive's own path buffer (no stack copy) works. */
+static void test_set_path_in_place(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    int64_t end;
+    start(&d, &s, 0.0, 0.0, 0.0);
+    d.path = one_goal(2.0, 1.0);
+    rfs_drive_set_path(&d, &d.path, 0);
+    rfs_path_t p = one_goal(2.0, 1.0);
+    assert_int_equal(run(&d, &s, &p, 60.0, false, &end), RFS_DRIVE_REACHED);
+    assert_true(hypot(s.x - 2.0, s.y - 1.0) <= 0.1 + 1e-3);
+}
+
 /* A goal that cannot be reached in time: TIMEOUT after timeout_us, once. */
 static void test_timeout(void **state)
 {
@@ -352,6 +367,7 @@ int main(void)
         cmocka_unit_test(test_reaches_goals),
         cmocka_unit_test(test_follows_waypoints),
         cmocka_unit_test(test_random_polylines),
+        cmocka_unit_test(test_set_path_in_place),
         cmocka_unit_test(test_timeout),
         cmocka_unit_test(test_blocked),
         cmocka_unit_test(test_stop),

@@ -24,9 +24,11 @@ echo "$out" | awk -F'\t' '
             if (t[i] < 16777216 && (ins - r > 0.05 || r - ins > 0.05)) bad = bad " " name[i]
             printf "%-34s %14d %12.3f\n", name[i], r, r / 168000
             if (name[i] == "worst_iteration") worst = r
+            if (name[i] == "sliced_worst_period") sliced = r
         }
         printf "(counts over 780,190 instructions include ~10 instructions per SysTick wrap interrupt)\n"
-        printf "worst-case control iteration: %d instructions, target 500000: %s\n", worst, worst <= 500000 ? "met" : "MISSED"
+        printf "worst-case control period, faithful configuration (fit in one period): %d instructions, target 500000: %s\n", worst, worst <= 500000 ? "met" : "MISSED"
+        printf "worst-case control period, MCU configuration (fit_budget 2500): %d instructions, target 500000: %s\n", sliced, sliced <= 500000 ? "met" : "MISSED"
         if (bad != "") { printf "non-integral instruction counts:%s\n", bad; exit 1 }
     }'
 scripts/fw_budget.sh "$B/firmware/firmware.elf"

@@ -19,7 +19,7 @@ qemu() { # qemu IN OUT -> exit status of the image
 }
 
 if ! "$bin/rfseek-record" scenarios/default.yaml -o "$tmp/in.rfsr" --live-out "$tmp/live.rfso" \
-        --max-time 120 --drop 20:22 --bus-off 35:36 --reset 50 >"$tmp/record.txt"; then
+        --max-time 120 --drop 20:22 --bus-off 35:36 --reset 50 --fit-budget 2500 >"$tmp/record.txt"; then
     fail record "rfseek-record failed"; exit 1
 fi
 "$bin/rfseek-replay" "$tmp/in.rfsr" -o "$tmp/host.rfso" && cmp -s "$tmp/live.rfso" "$tmp/host.rfso" \
@@ -37,7 +37,8 @@ nrel=$(grep '^DECISION' "$tmp/qemu.txt" | grep -c 'relearned=1'); ntx=$(grep -c 
     && pass "outputs are not trivial ($nd decisions, $nrel relearned, $nm moving steps, $ntx frames)" \
     || fail "outputs are not trivial" "$nd decisions, $nrel relearned, $nm moving steps, $ntx frames"
 
-# A second, fault-free mission to the end (reached, distance or time limit).
+# A second, fault-free mission to the end (reached, distance or time limit), in the
+# faithful configuration (the fit in one period).
 if "$bin/rfseek-record" scenarios/default.yaml -o "$tmp/m.rfsr" --seed 7 >"$tmp/m.txt" \
         && "$bin/rfseek-replay" "$tmp/m.rfsr" -o "$tmp/m_host.rfso" && qemu m.rfsr m_qemu.rfso \
         && cmp "$tmp/m_host.rfso" "$tmp/m_qemu.rfso"; then

@@ -127,6 +127,7 @@ static void test_every_type_round_trips(void **state)
     r.u.cfg.seed = 0x1122334455667788ULL;
     r.u.cfg.target = 1;
     r.u.cfg.node = 9;
+    r.u.cfg.fit_budget = 2500;
     roundtrip(&r);
     memset(&r, 0, sizeof r);
     r.type = RFS_REPLAY_MAP;
@@ -199,7 +200,7 @@ static void test_malformed_records_are_rejected(void **state)
     uint8_t out[18] = {0x80, 16};
     uint8_t dec[59] = {0x81, 57};
     uint8_t map[19] = {0x02, 17, 0, 0, 10, 0, 0, 0x10, 0, 0};
-    uint8_t cfg[12] = {0x01, 10};
+    uint8_t cfg[16] = {0x01, 14};
 
     expect_bad(unknown, 2);
     expect_bad(step7, 9);
@@ -230,7 +231,7 @@ static void test_malformed_records_are_rejected(void **state)
     map[2 + 16] = 2; /* has_wall */
     expect_bad(map, 19);
     cfg[2 + 8] = 2; /* target */
-    expect_bad(cfg, 12);
+    expect_bad(cfg, 16);
 }
 
 static void test_random_bytes_never_overrun(void **state)

@@ -293,6 +293,34 @@ static void test_deterministic(void **state)
     hs_sim_env_close(&env);
 }
 
+/// Every shipped scenario opens; the bridge scenario runs with packets from both sources.
+static void test_shipped_scenarios(void **state)
+{
+    (void)state;
+    static const char *const names[] = {"default", "open", "lshape", "bridge", "willow", "3ne",
+                                        "intel"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        char path[128];
+        snprintf(path, sizeof path, "scenarios/%s.yaml", names[i]);
+        hs_sim_env_t env;
+        assert_int_equal(load_env(path, &env), 0);
+        bool bridge = strcmp(names[i], "bridge") == 0;
+        assert_true(bridge ? isnan(env.shortest_path_m) : env.shortest_path_m > 9.0);
+        if (bridge) {
+            // 20 simulated seconds: 2 sources x 200 packets/s.
+            env.sc.stop_time_s = 20.0;
+            hs_sim_result_t r;
+            char err[512];
+            assert_int_equal(hs_sim_run_inproc(&env, 1, NULL, &r, err, sizeof err), 0);
+            assert_string_equal(r.end, "time");
+            assert_true(llabs((long long)r.packets_sent - 8000) <= 2);
+            assert_true(r.packets_received > 7000);
+            assert_true(r.iterations > 0);
+        }
+        hs_sim_env_close(&env);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -302,6 +330,7 @@ int main(void)
         cmocka_unit_test(test_motor),
         cmocka_unit_test(test_open_all_seeds_reach),
         cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_shipped_scenarios),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -81,6 +81,48 @@ static void report(const char *name, uint64_t t, uint32_t count)
         report((name), t1_ - t0_, (count));        \
     } while (0)
 
+/* Stack depth of a call: paint the free stack below the caller's SP, run, scan. */
+extern uint32_t _sstack;
+#define STACK_PAINT 0xA5A5A5A5u
+
+static uintptr_t stack_paint(void)
+{
+    uintptr_t sp;
+    __asm__ volatile("mov %0, sp" : "=r"(sp));
+    for (uint32_t *p = &_sstack; (uintptr_t)p < sp - 32u; p++) {
+        *p = STACK_PAINT;
+    }
+    return sp;
+}
+
+static uint32_t stack_depth(uintptr_t sp)
+{
+    const uint32_t *p = &_sstack;
+    while ((uintptr_t)p < sp && *p == STACK_PAINT) {
+        p++;
+    }
+    return (uint32_t)(sp - (uintptr_t)p);
+}
+
+/* 10,000 samples inside 4.9 m of (20, 10); the field rises towards +x (-60 dBm at the
+ * robot, +1 dB per metre, +-1 dB noise), so the maximum is at the east wall. */
+static void fill_store(rfs_store_t *st, uint64_t seed)
+{
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, seed);
+    while (st->count < RFS_APP_MAX_SAMPLES) {
+        const int32_t dx = (int32_t)rfs_rng_below(&rng, 981u) - 490; /* cm */
+        const int32_t dy = (int32_t)rfs_rng_below(&rng, 981u) - 490;
+        if (dx * dx + dy * dy > 490 * 490) {
+            continue;
+        }
+        const rfs_sample_t smp = {.x_cm = (int16_t)(2000 + dx), .y_cm = (int16_t)(1000 + dy),
+                                  .v_q6 = (int16_t)((-60 * 64) + (dx * 64) / 100 +
+                                                    (int32_t)rfs_rng_below(&rng, 128u) - 64)};
+        rfs_store_offer(st, smp, &rng);
+    }
+}
+
 static void nops_1000(void)
 {
     __asm__ volatile(".rept 1000\n\tnop\n\t.endr" ::: "memory");
@@ -109,7 +151,9 @@ int main(void)
     cfg.seek.eps_amp = 0; /* epsilon = 0: the greedy branch, the expensive one, for certain */
     cfg.seek.eps_floor = 0;
     int rc = -1;
+    uintptr_t sp0 = stack_paint();
     MEASURE("app_init", 1, rc = rfs_app_init(&s_app, &cfg, &map));
+    report("stack_bytes_app_init", 0, stack_depth(sp0));
     if (rc != 0) {
         rfs_sh_puts("bench: rfs_app_init failed\n");
         rfs_sh_exit(1);
@@ -129,24 +173,10 @@ int main(void)
         }
     }
 
-    /* 10,000 samples inside 4.9 m of the robot at (20, 10); the field rises towards +x
-     * (-60 dBm at the robot, +1 dB per metre), so the maximum is at the east wall. */
     const rfs_q16_t rx = RFS_Q16_INT(20), ry = RFS_Q16_INT(10);
     rfs_rng_t rng;
-    rfs_rng_seed(&rng, 42u);
-    uint32_t n = 0;
-    while (s_app.seek.store.count < RFS_APP_MAX_SAMPLES) {
-        const int32_t dx = (int32_t)rfs_rng_below(&rng, 981u) - 490; /* cm */
-        const int32_t dy = (int32_t)rfs_rng_below(&rng, 981u) - 490;
-        if (dx * dx + dy * dy > 490 * 490) {
-            continue;
-        }
-        const rfs_sample_t smp = {.x_cm = (int16_t)(2000 + dx), .y_cm = (int16_t)(1000 + dy),
-                                  .v_q6 = (int16_t)((-60 * 64) + (dx * 64) / 100 +
-                                                    (int32_t)rfs_rng_below(&rng, 128u) - 64)};
-        rfs_store_offer(&s_app.seek.store, smp, &rng);
-        n++;
-    }
+    rfs_rng_seed(&rng, 43u);
+    fill_store(&s_app.seek.store, 42u);
     report("samples", 0, s_app.seek.store.count);
 
     /* Boot: the first period with a pose and a measurement: reachability flood fill,
@@ -156,7 +186,9 @@ int main(void)
     rfs_app_on_pose(&s_app, &pose0, t);
     rfs_app_on_rssi(&s_app, 0, t, -60, t);
     rfs_app_out_t out;
+    sp0 = stack_paint();
     MEASURE("first_iteration", 1, rfs_app_step(&s_app, t, &out));
+    report("stack_bytes_first_iteration", 0, stack_depth(sp0));
 
     /* The worst case: the goal ended, the model no longer fits (discarded), iteration 1. */
     rfs_drive_stop(&s_app.seek.drive, t);
@@ -165,7 +197,9 @@ int main(void)
     const rfs_pose_t pose1 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
     rfs_app_on_pose(&s_app, &pose1, t);
     rfs_app_on_rssi(&s_app, 0, t, -60, t);
+    sp0 = stack_paint();
     MEASURE("worst_iteration", 1, rfs_app_step(&s_app, t, &out));
+    report("stack_bytes_worst_iteration", 0, stack_depth(sp0));
     report("worst_decided_greedy_relearned", 0,
            (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_GREEDY &&
                       out.decision.relearned));
@@ -208,25 +242,38 @@ int main(void)
     MEASURE("phase_relearn", 1, (void)rfs_ridge_ops.fit(ridge, &fin, 0, &rng));
     report("ridge_samples_used", 0, ridge->n_used);
 
-    /* Grid search: the model at every reachable lattice point (as choose_greedy does). */
+    /* Grid search: the model at every reachable lattice point, as choose_greedy does it
+     * (rfs_seek.c: rows in chunks of 64, one predict_row call per chunk when the model
+     * has it, else one predict per point). */
     const rfs_map_t *m = &s_app.map;
     rfs_q16_t best = RFS_Q16_MIN, bx = 0, by = 0;
     uint32_t points = 0;
+    static rfs_q16_t row[64];
     MEASURE("phase_grid_search", 1, {
         for (uint16_t j = 0; j < m->lh; ++j) {
-            for (uint16_t i = 0; i < m->lw; ++i) {
-                const uint32_t idx = (uint32_t)j * m->lw + i; /* the seeker's reach bits */
-                if (((s_app.reach[idx >> 3] >> (idx & 7u)) & 1u) == 0u) {
-                    continue;
+            rfs_q16_t x0, py;
+            rfs_map_lattice_point(m, 0, j, &x0, &py);
+            const uint32_t base = (uint32_t)j * m->lw;
+            for (uint16_t i0 = 0; i0 < m->lw; i0 = (uint16_t)(i0 + 64u)) {
+                const uint16_t cn = (uint16_t)((uint32_t)(m->lw - i0) < 64u ? (uint32_t)(m->lw - i0) : 64u);
+                const rfs_q16_t cx0 = x0 + (rfs_q16_t)i0 * m->cfg.grid;
+                if (rfs_ridge_ops.predict_row != 0) {
+                    (void)rfs_ridge_ops.predict_row(ridge, cx0, py, m->cfg.grid, cn, row);
+                } else {
+                    for (uint16_t k = 0; k < cn; ++k) {
+                        (void)rfs_ridge_ops.predict(ridge, cx0 + (rfs_q16_t)k * m->cfg.grid, py,
+                                                    &row[k]);
+                    }
                 }
-                rfs_q16_t px, py, v;
-                rfs_map_lattice_point(m, i, j, &px, &py);
-                if (rfs_ridge_ops.predict(ridge, px, py, &v) && v > best) {
-                    best = v;
-                    bx = px;
-                    by = py;
+                for (uint16_t k = 0; k < cn; ++k) {
+                    const uint32_t idx = base + i0 + k;
+                    if (((s_app.reach[idx >> 3] >> (idx & 7u)) & 1u) && row[k] > best) {
+                        best = row[k];
+                        bx = cx0 + (rfs_q16_t)k * m->cfg.grid;
+                        by = py;
+                    }
+                    points += (s_app.reach[idx >> 3] >> (idx & 7u)) & 1u;
                 }
-                points++;
             }
         }
     });
@@ -302,6 +349,49 @@ int main(void)
     /* The CAN side of a period: decode one RSSI frame, encode the two output frames. */
     rfs_can_frame_t fr[2];
     MEASURE("phase_can_out_frames", 1, (void)rfs_app_frames(&s_app, &out, fr));
-    (void)n;
+
+    /* Beside the faithful configuration: the same worst case with the fit sliced over
+     * control periods (cfg.seek.fit_budget = 2,500 samples per period; the wheels stay
+     * stopped while learning). Every period until the decision is measured; the largest
+     * is the worst-case period of this configuration. */
+    cfg.seek.fit_budget = 2500u;
+    if (rfs_app_init(&s_app, &cfg, &map) != 0) {
+        rfs_sh_exit(1);
+    }
+    fill_store(&s_app.seek.store, 42u);
+    t = 1000000;
+    rfs_app_on_pose(&s_app, &pose0, t);
+    rfs_app_on_rssi(&s_app, 0, t, -60, t);
+    for (int k = 0; k < 20 && !(k > 0 && out.decided); k++) {
+        rfs_app_step(&s_app, t, &out); /* boot: flood fill, first (sliced) fit, initial move */
+        t += RFS_APP_PERIOD_US;
+        const rfs_pose_t pk = {.t_us = t, .x = rx, .y = ry, .theta = 0};
+        rfs_app_on_pose(&s_app, &pk, t);
+        rfs_app_on_rssi(&s_app, 0, t, -60, t);
+    }
+    rfs_drive_stop(&s_app.seek.drive, t);
+    s_app.seek.model.ops->reset(s_app.seek.model.self);
+    uint64_t worst_slice = 0;
+    uint32_t periods = 0;
+    out.decided = false;
+    while (!out.decided && periods < 20u) {
+        t += RFS_APP_PERIOD_US;
+        const rfs_pose_t pk = {.t_us = t, .x = rx, .y = ry, .theta = 0};
+        rfs_app_on_pose(&s_app, &pk, t);
+        rfs_app_on_rssi(&s_app, 0, t, -60, t);
+        const uint64_t a = ticks();
+        rfs_app_step(&s_app, t, &out);
+        const uint64_t b = ticks();
+        report("sliced_fit_period", b - a, 1);
+        if (b - a > worst_slice) {
+            worst_slice = b - a;
+        }
+        periods++;
+    }
+    report("sliced_worst_period", worst_slice, 1);
+    report("sliced_decided_greedy_relearned", 0,
+           (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_GREEDY &&
+                      out.decision.relearned));
+    report("sliced_goal_x_cm", 0, (uint32_t)((out.decision.goal_x * 100) >> 16));
     rfs_sh_exit(0);
 }

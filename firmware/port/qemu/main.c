@@ -19,6 +19,49 @@
 static rfs_app_t s_app;
 static rfs_replay_player_t s_player;
 
+/* Stack high-water mark: the stack is painted at start and scanned at the end (the
+ * figure that sizes the hardware image's stack, docs/FIRMWARE.md). */
+extern uint32_t _sstack, _estack;
+#define STACK_PAINT 0xA5A5A5A5u
+
+static void stack_paint(void)
+{
+    uintptr_t sp;
+    __asm__ volatile("mov %0, sp" : "=r"(sp));
+    for (uint32_t *p = &_sstack; (uintptr_t)p < sp - 64u; p++) {
+        *p = STACK_PAINT;
+    }
+}
+
+static uint32_t stack_used(void)
+{
+    const uint32_t *p = &_sstack;
+    while (p < &_estack && *p == STACK_PAINT) {
+        p++;
+    }
+    return (uint32_t)((uintptr_t)&_estack - (uintptr_t)p);
+}
+
+/* A fault (a stack overflow runs off the bottom of SRAM) ends the run loudly. */
+void HardFault_Handler(void);
+void HardFault_Handler(void)
+{
+    rfs_sh_puts("rfseek-qemu: HardFault (stack overflow or bad access)\n");
+    rfs_sh_exit(1);
+}
+
+static void put_u32(uint32_t v)
+{
+    char buf[12];
+    int i = 11;
+    buf[i] = '\0';
+    do {
+        buf[--i] = (char)('0' + (int)(v % 10u));
+        v /= 10u;
+    } while (v != 0u);
+    rfs_sh_puts(&buf[i]);
+}
+
 /* Output buffering: semihosting calls are slow in the emulator (a trap each). */
 typedef struct out_sink {
     int32_t fd;
@@ -81,6 +124,7 @@ static int args(char *cmd, char **in, char **out)
 
 int main(void)
 {
+    stack_paint();
     static char cmd[256];
     char *in_name, *out_name;
     if (rfs_sh_cmdline(cmd, sizeof cmd) != 0 || args(cmd, &in_name, &out_name) != 0) {
@@ -142,5 +186,8 @@ int main(void)
     if (s_out.failed) {
         die("output: write error");
     }
+    rfs_sh_puts("rfseek-qemu: stack used ");
+    put_u32(stack_used());
+    rfs_sh_puts(" bytes\n");
     rfs_sh_exit(0);
 }

@@ -35,7 +35,7 @@ int main(void)
     rfs_board_can_pins();
     const bool can_ok = rfs_bxcan_init(&s_can, (rfs_bxcan_regs_t *)RFS_BXCAN1_BASE, &can_cfg,
                                        NULL, NULL) == 0;
-    const rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    const rfs_app_cfg_t cfg = rfs_app_cfg_mcu();
     if (rfs_app_init(&s_app, &cfg, &rfs_fw_map) != 0 || !can_ok) {
         for (;;) {
             /* Unusable: no watchdog kick, the board resets and tries again. */

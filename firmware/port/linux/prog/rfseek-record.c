@@ -205,6 +205,8 @@ static void usage(FILE *f)
             "  --drop-rssi T0:T1    only the RSSI frames stop in [T0, T1) s\n"
             "  --bus-off T0:T1      the controller's CAN is bus-off in [T0, T1) s\n"
             "  --reset T            watchdog reset at T s\n"
+            "  --fit-budget N       samples learnt per control period (0: all; the MCU\n"
+            "                       configuration uses 2500)\n"
             "  -h, --help           this text\n");
 }
 
@@ -222,12 +224,14 @@ int main(int argc, char **argv)
         {"drop", required_argument, 0, 'd'},    {"bus-off", required_argument, 0, 'b'},
         {"reset", required_argument, 0, 'r'},   {"help", no_argument, 0, 'h'},
         {"drop-pose", required_argument, 0, 'P'}, {"drop-rssi", required_argument, 0, 'R'},
+        {"fit-budget", required_argument, 0, 'f'},
         {0, 0, 0, 0}};
     static recorder_t rec;
     const char *out_path = NULL, *live_path = NULL;
     bool have_seed = false;
     unsigned long long seed = 0;
     double max_time = -1;
+    uint32_t fit_budget = 0;
     int c;
     while ((c = getopt_long(argc, argv, "o:h", opts, NULL)) != -1) {
         char *end;
@@ -271,6 +275,15 @@ int main(int argc, char **argv)
                 die_opt("--bus-off", optarg);
             }
             break;
+        case 'f': {
+            errno = 0;
+            const unsigned long v = strtoul(optarg, &end, 0);
+            if (errno != 0 || end == optarg || *end != '\0' || v > 100000ul) {
+                die_opt("--fit-budget", optarg);
+            }
+            fit_budget = (uint32_t)v;
+            break;
+        }
         case 'r': {
             const double t = strtod(optarg, &end);
             if (rec.nreset == MAX_WINDOWS || end == optarg || *end != '\0' || t < 0 || t > 1e6) {
@@ -347,6 +360,7 @@ int main(int argc, char **argv)
     r.u.cfg.seed = run_seed;
     r.u.cfg.target = sc.nsources == 2u ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
     r.u.cfg.node = 1u;
+    r.u.cfg.fit_budget = fit_budget;
     feed(&rec, &r);
     memset(&r, 0, sizeof r);
     r.type = RFS_REPLAY_MAP;

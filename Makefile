@@ -173,8 +173,13 @@ deps:
 test: deps
 	@$(MAKE) --no-print-directory test-only
 
-test-only: all check-core $(TEST_BINS) $(TEST_DEPS)
-	@scripts/run_tests.sh $(TEST_BINS) -- $(TEST_SCRIPTS)
+CORE_CHECK_LIBS := $(CORE_LIB) $(BUILD)/m32/lib/librfs_core.a $(BUILD)/arm/lib/librfs_core.a
+TEST_SCRIPTS += "scripts/check_core_symbols.sh nm $(CORE_LIB)"
+TEST_SCRIPTS += "scripts/check_core_symbols.sh nm $(BUILD)/m32/lib/librfs_core.a"
+TEST_SCRIPTS += "scripts/check_core_symbols.sh arm-none-eabi-nm $(BUILD)/arm/lib/librfs_core.a"
+
+test-only: all $(CORE_CHECK_LIBS) $(TEST_BINS) $(TEST_DEPS)
+	@BUILD=$(BUILD) scripts/run_tests.sh $(TEST_BINS) -- $(TEST_SCRIPTS)
 
 bench: all $(BENCH_TARGETS)
 

@@ -41,7 +41,10 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
     c.w_max = RFS_Q16_INT(15);
     c.n_prior = RFS_Q16_INT(3);  /* ITU-R P.1238 office, 2.4 GHz */
     c.w_prior = RFS_Q16_INT(5);  /* ns-3 buildings model, per wall */
-    c.prior_weight = RFS_Q16_ONE;
+    c.bin_cap = 5u;
+    /* Strong enough to hold n and W near physics when the robot has seen little: 3000
+     * weight x dB^2 is about 60 capped bins missing by a 3 dB RMS per unit of n. */
+    c.prior_weight = RFS_Q16_INT(3000);
     c.huber = RFS_Q16_INT(6);    /* about 1.5 x the 4 dB shadowing of the paper's office */
     c.spread_k = RFS_Q16_INT(6); /* chi-square, 2 degrees of freedom, 95 %: 5.99 */
     c.margin = RFS_Q16_INT(20);
@@ -54,7 +57,8 @@ int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg)
         return -1;
     }
     const rfs_pathloss_cfg_t *c = cfg;
-    bool ok = c->bin >= RFS_Q16_FRAC(1, 10) && c->bin <= RFS_Q16_INT(16) && c->coarse > 0 &&
+    bool ok = c->bin >= RFS_Q16_FRAC(1, 10) && c->bin <= RFS_Q16_INT(16) && c->bin_cap > 0 &&
+              c->coarse > 0 &&
               c->coarse <= RFS_Q16_INT(64) &&
               c->top >= 1u && c->top <= RFS_PATHLOSS_MAX_TOP && c->n_min > 0 &&
               c->n_min <= c->n_max && c->n_max <= RFS_Q16_INT(10) && c->w_min >= 0 &&
@@ -160,19 +164,26 @@ static void bin_samples(rfs_pathloss_t *p, const rfs_sample_t *smp, uint16_t n)
         bin_cm *= 2; /* 100 cm doubled 10 times covers the whole +-327 m sample range */
     }
     p->bin_cm = bin_cm;
-    /* Scaling and overflow: n <= 65,535 values of |v| <= 2^15: the sum fits int64 (and
-     * int32); the mean times 2^10 is Q16. */
+    /* Bin means (Q16), then their weighted mean. Scaling and overflow: a bin sums at most
+     * 65,535 values of |v| <= 2^15 (int32); times 2^10 in int64 is Q16; weights <= 65,535
+     * times |mean| < 2^25 summed over <= 512 bins stay below 2^50. */
     int64_t sum = 0;
+    uint32_t wsum = 0u;
     for (uint32_t b = 0u; b < p->nbins; ++b) {
-        sum += p->bins[b].sv_q6;
+        rfs_pathloss_bin_t *bb = &p->bins[b];
+        uint32_t wt = bb->count < p->cfg.bin_cap ? bb->count : p->cfg.bin_cap;
+        bb->dz_q16 = (int32_t)rfs_sdiv64_round((int64_t)bb->sv_q6 * 1024, bb->count);
+        sum += (int64_t)wt * bb->dz_q16;
+        wsum += wt;
     }
-    p->total = n;
-    p->mz_q16 = (int32_t)rfs_sdiv64_round(sum * 1024, (int64_t)n);
+    p->total = wsum;
+    p->mz_q16 = (int32_t)rfs_sdiv64_round(sum, (int64_t)wsum);
     for (uint32_t b = 0u; b < p->nbins; ++b) {
         rfs_pathloss_bin_t *bb = &p->bins[b];
         bb->sx_cm = (int32_t)rfs_sdiv64_round(bb->sx_cm, bb->count);
         bb->sy_cm = (int32_t)rfs_sdiv64_round(bb->sy_cm, bb->count);
-        bb->dz_q16 = (int32_t)(rfs_sdiv64_round((int64_t)bb->sv_q6 * 1024, bb->count) - p->mz_q16);
+        bb->dz_q16 -= p->mz_q16;
+        bb->count = (uint16_t)(bb->count < p->cfg.bin_cap ? bb->count : p->cfg.bin_cap);
         bb->x = cm_to_q16(bb->sx_cm);
         bb->y = cm_to_q16(bb->sy_cm);
         bb->wx = bb->x;

@@ -8,12 +8,13 @@
  *
  * with walls() the wall runs the straight line crosses on the core grid
  * (rfs_map_walls_crossed: the rule the simulator's radio model uses). For a fixed s the
- * model is linear in (P0, n, W): fit() solves the least-squares problem in closed form
- * for every candidate s, with n and W bounded to [n_min, n_max] and [w_min, w_max]
- * (exact box-constrained solution of the 2 x 2 quadratic after eliminating P0) and a
- * weak prior (n_prior, w_prior, weight prior_weight samples) so that W stays defined
- * when every sample sees the same number of walls. The estimate is the candidate with
- * the least Huber loss of its residuals.
+ * model is linear in (P0, n, W): fit() solves the weighted least-squares problem in
+ * closed form for every candidate s, with n and W bounded to [n_min, n_max] and
+ * [w_min, w_max] (exact box-constrained solution of the 2 x 2 quadratic after
+ * eliminating P0) and a prior pulling them towards (n_prior, w_prior) with weight
+ * prior_weight, which also keeps W defined when every bin sees the same number of walls.
+ * Each bin weighs min(samples, bin_cap). The estimate is the candidate with the least
+ * weighted Huber loss of the bins' mean residuals.
  *
  * Samples are first aggregated into square bins (1 m; at most RFS_PATHLOSS_MAX_BINS,
  * the bin doubles when there are more): each bin is its sample count, mean value and
@@ -86,7 +87,9 @@ typedef struct rfs_pathloss_cfg {
     rfs_q16_t w_max;        ///< (15 dB)
     rfs_q16_t n_prior;      ///< prior exponent, Q16.16 (3.0: ITU-R P.1238 office)
     rfs_q16_t w_prior;      ///< prior loss per wall, dB Q16.16 (5 dB: ns-3 buildings)
-    rfs_q16_t prior_weight; ///< weight of the prior, samples x dB^2, Q16.16 (1.0), > 0
+    uint16_t bin_cap;       ///< a bin weighs min(samples, bin_cap) (5): shadowing makes a
+                            ///< place one observation however long the robot stays
+    rfs_q16_t prior_weight; ///< weight of the prior, weight x dB^2, Q16.16 (3000), > 0
     rfs_q16_t huber;        ///< Huber threshold on a bin's mean residual, dB Q16.16 (6 dB)
     rfs_q16_t spread_k;     ///< spread region: loss <= best (1 + spread_k / bins) (6.0)
     rfs_q16_t margin;       ///< metres Q16.16: candidates beyond the samples without a map (20 m)
@@ -103,7 +106,7 @@ typedef struct rfs_pathloss_bin {
     rfs_q16_t wx;    ///< wall-count origin x (centre of the centroid's core cell), metres Q16.16
     rfs_q16_t wy;    ///< wall-count origin y, metres Q16.16
     uint16_t row;    ///< its wall-count cache row, RFS_PATHLOSS_NO_ROW when none
-    uint16_t count;  ///< samples in the bin
+    uint16_t count;  ///< samples in the bin; after binning its weight, min(samples, bin_cap)
     int16_t kx;      ///< bin index along x (floor(x / bin))
     int16_t ky;      ///< bin index along y
 } rfs_pathloss_bin_t;
@@ -156,7 +159,8 @@ typedef struct rfs_pathloss_est {
     rfs_q16_t p0;         ///< signal at 1 m, target units Q16.16
     rfs_q16_t n;          ///< path-loss exponent, Q16.16
     rfs_q16_t w;          ///< loss per wall, dB Q16.16
-    rfs_q16_t rms;        ///< residual, sqrt(2 x mean Huber loss) (= RMS when all < huber), dB Q16.16
+    rfs_q16_t rms;        ///< sqrt(2 x mean Huber loss) (the RMS residual when all are
+                          ///< below the Huber threshold), dB Q16.16
     rfs_q16_t spread_m2;  ///< area of coarse candidates in the spread region, m^2 Q16.16
     uint16_t bins;        ///< bins used
     rfs_q16_t bin;        ///< bin side used, metres Q16.16
@@ -181,7 +185,7 @@ typedef struct rfs_pathloss {
     rfs_pathloss_lat_t lat;                       ///< candidate lattice
     uint16_t nbins;                               ///< bins in use
     int32_t bin_cm;                               ///< bin side in use, centimetres
-    uint32_t total;                               ///< samples binned (sum of counts)
+    uint32_t total;                               ///< weight of all bins (sum of min(count, cap))
     int32_t mz_q16;                               ///< mean of all samples, target units Q16.16
     uint8_t ntop;                                 ///< coarse candidates kept in top[]
     rfs_pathloss_cand_t top[RFS_PATHLOSS_MAX_TOP]; ///< best coarse candidates, best first
@@ -214,7 +218,7 @@ typedef struct rfs_pathloss {
 rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void);
 
 /// Initialise without a model. Returns 0, or -1 on bin outside [0.1, 16] m, coarse
-/// outside (0, 64] m, top outside 1..RFS_PATHLOSS_MAX_TOP, n bounds not
+/// outside (0, 64] m, bin_cap 0, top outside 1..RFS_PATHLOSS_MAX_TOP, n bounds not
 /// 0 < n_min <= n_max <= 10, W bounds not 0 <= w_min <= w_max <= 60 dB, priors outside
 /// their bounds, prior_weight outside (0, 10^4], huber outside (0, 100] dB, spread_k
 /// outside [0, 1000], or margin outside [0, 100] m.

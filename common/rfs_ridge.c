@@ -10,8 +10,9 @@
  *
  * with w in dB per metre and lam = alpha * 10^4 (alpha in m^2, lam in cm^2; rounded to
  * an integer, exact for alpha = 1.0 and any multiple of 1/16). Cramer's rule in 128 bits
- * gives the slopes rounded once to Q40.24; the intercept at the centre is rounded once
- * to Q16.16. The only inexactness against double is those two roundings.
+ * gives the slopes rounded once to Q40.24 (twice, < 1 LSB, for numerators beyond 2^121,
+ * which only 65,535 samples at the largest radius reach); the intercept at the centre is
+ * rounded once to Q16.16. Those roundings are the only inexactness against double.
  */
 #include "rfs_ridge.h"
 

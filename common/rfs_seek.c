@@ -610,10 +610,15 @@ const char *rfs_seek_kind_name(rfs_seek_kind_t k)
 bool rfs_seek_unit(rfs_q16_t gx, rfs_q16_t gy, rfs_q16_t *ux, rfs_q16_t *uy)
 {
     int64_t x = gx, y = gy;
-    uint64_t n2 = (uint64_t)(x * x) + (uint64_t)(y * y);
-    if (n2 == 0u) {
+    if (x == 0 && y == 0) {
         return false;
     }
+    /* Scale both up until the larger is at least 2^29, so the root keeps 29 bits. */
+    while (x < (1 << 29) && x > -(1 << 29) && y < (1 << 29) && y > -(1 << 29)) {
+        x *= 2;
+        y *= 2;
+    }
+    uint64_t n2 = (uint64_t)(x * x) + (uint64_t)(y * y);
     uint32_t n = rfs_isqrt64(n2);
     if (n == 0u) {
         n = 1u;
@@ -636,7 +641,9 @@ static void step_point(const rfs_seek_t *s, rfs_q16_t bx, rfs_q16_t by, rfs_q16_
 
 /* A gradient step: one step from (bx, by) along the unit vector u; when that point is
  * illegal or has no path, the nearest reachable legal lattice point around it (so a
- * gradient pressed against a wall slides along it, as the map legality of section 2). */
+ * gradient pressed against a wall slides along it, as the map legality of section 2);
+ * false when that is within a quarter step of the robot (blocked).
+ * Scaling: Q16 differences squared in int64 (Q32), |d| < 2^32 on any legal map. */
 static bool go_step(rfs_seek_t *s, rfs_q16_t bx, rfs_q16_t by, rfs_q16_t ux, rfs_q16_t uy,
                     int64_t now_us)
 {
@@ -652,6 +659,13 @@ static bool go_step(rfs_seek_t *s, rfs_q16_t bx, rfs_q16_t by, rfs_q16_t ux, rfs
         return false;
     }
     rfs_map_lattice_point(s->map, i, j, &gx, &gy);
+    /* Snapped back to (nearly) where the robot stands: the step is blocked; the caller
+     * takes a random step instead of deciding the same stuck step at every period. */
+    int64_t dx = (int64_t)gx - s->pose.x, dy = (int64_t)gy - s->pose.y;
+    int64_t q = s->cfg.step / 4;
+    if (dx * dx + dy * dy < q * q) {
+        return false;
+    }
     s->decision.goal_x = gx;
     s->decision.goal_y = gy;
     return go_to(s, gx, gy, now_us);
@@ -949,6 +963,7 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
         if (s->state == RFS_SEEK_DRIVING && s->drive.status == RFS_DRIVE_RUNNING) {
             s->resume = true;
             s->resume_path = s->drive.path;
+            s->resume_start_us = s->drive.start_us;
         }
         if (s->state != RFS_SEEK_WAITING) {
             s->state = RFS_SEEK_STALE;
@@ -969,6 +984,9 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     if (s->resume) {
         s->resume = false;
         rfs_drive_set_path(&s->drive, &s->resume_path, now_us);
+        /* The goal's timeout keeps counting from when it was set: a goal interrupted
+         * again and again by stale inputs must still end. */
+        s->drive.start_us = s->resume_start_us;
         s->state = RFS_SEEK_DRIVING;
     }
     if (s->fitting) {

@@ -174,6 +174,7 @@ typedef struct rfs_seek {
     uint32_t meas_rejected;                   ///< measurements with a bad source index
     bool resume;                              ///< a goal was interrupted by stale inputs
     rfs_path_t resume_path;                   ///< the path to resume
+    int64_t resume_start_us;                  ///< when the interrupted goal was set, microseconds
     uint16_t last_li, last_lj;                ///< lattice point of the last novelty update
     bool have_last_l;                         ///< last_li/last_lj are valid
     /* Baseline strategies (issue 7). */
@@ -222,9 +223,10 @@ bool rfs_seek_strategy_parse(const char *name, rfs_seek_strategy_t *st);
 /// "run", "tumble"; "none").
 const char *rfs_seek_kind_name(rfs_seek_kind_t k);
 
-/// Unit vector along (gx, gy) (any common scale, |g| < 2^31), Q16.16; false when g = 0.
-/// Scaling and overflow: squares in uint64 (< 2^63), root Q16 of the same scale as g,
-/// quotient (g << 16) / |g| in int64, |u| <= 1.
+/// Unit vector along (gx, gy) (any common scale), Q16.16; false when g = 0.
+/// Scaling and overflow: g is doubled until max(|gx|, |gy|) >= 2^29 (< 2^31 after), so
+/// the squares sum below 2^63 in uint64 and the root keeps 29 bits; (g << 16) / |g| in
+/// int64; components clamped to [-1, 1].
 bool rfs_seek_unit(rfs_q16_t gx, rfs_q16_t gy, rfs_q16_t *ux, rfs_q16_t *uy);
 
 #endif /* RFS_SEEK_H */

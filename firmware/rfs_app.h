@@ -46,8 +46,8 @@
 #define RFS_APP_MAX_MAP_BYTES 6400u
 /// Largest lattice, points: a 40 x 20 m map at 0.25 m is 160 x 80.
 #define RFS_APP_MAX_LATTICE (160u * 80u)
-/// Planner queue entries (2 * (lw + lh) = 480 for the largest lattice, rounded up).
-#define RFS_APP_PLAN_QUEUE 512u
+/// Planner queue entries: 2 * (lw + lh) for the largest lattice (rfs_plan.h: "safe").
+#define RFS_APP_PLAN_QUEUE 480u
 /// Pending measurements waiting for a bracketing pose (>= 64 required by rfs_seek).
 #define RFS_APP_PENDING 64u
 /// Samples the MCU configuration learns per control period: the 10,000-sample fit spread
@@ -116,7 +116,7 @@ typedef struct rfs_app_stats {
     uint32_t steps;             ///< control periods run
 } rfs_app_stats_t;
 
-/// The application: every byte the controller uses at run time (about 93 KB with the
+/// The application: every byte the controller uses at run time (about 95 KB with the
 /// maxima above). Declare one static instance per port.
 typedef struct rfs_app {
     rfs_app_cfg_t cfg;                              ///< configuration copied at init

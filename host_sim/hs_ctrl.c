@@ -5,11 +5,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <math.h>
+
+#include "rfs_models.h"
 #include "rfs_ridge.h"
 
 typedef struct inproc {
     rfs_seek_t seek;
-    rfs_ridge_t ridge;
+    void *model_state; // rfs_models_max_state_bytes(), aligned to RFS_MODELS_STATE_ALIGN
     rfs_rng_t rng;
     rfs_seek_mem_t mem;
 } inproc_t;
@@ -27,7 +30,7 @@ hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void)
 
 bool hs_ctrl_model_known(const char *name)
 {
-    return name && strcmp(name, "ridge") == 0;
+    return name && rfs_models_lookup(name) != NULL;
 }
 
 static void ip_on_pose(void *self, const rfs_pose_t *pose)
@@ -67,6 +70,7 @@ static void ip_close(void *self)
     free(p->mem.plan_queue);
     free(p->mem.visited);
     free(p->mem.reach);
+    free(p->model_state);
     free(p);
 }
 
@@ -84,7 +88,12 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
         return -1;
     }
     if (!hs_ctrl_model_known(cfg->model)) {
-        snprintf(err, errlen, "model: unknown '%s' (ridge)", cfg->model ? cfg->model : "");
+        snprintf(err, errlen, "model: unknown '%s' (ridge, mlp, knn, radius, pathloss)",
+                 cfg->model ? cfg->model : "");
+        return -1;
+    }
+    if ((unsigned)cfg->seek.strategy >= (unsigned)RFS_SEEK_STRATEGY_COUNT) {
+        snprintf(err, errlen, "strategy: out of range");
         return -1;
     }
     if (cfg->period_us <= 0) {
@@ -115,20 +124,34 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
         snprintf(err, errlen, "controller: out of memory");
         return -1;
     }
-    rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
-    if (rfs_ridge_init(&p->ridge, &rc) != 0) {
+    const rfs_models_entry_t *me = rfs_models_lookup(cfg->model);
+    size_t sbytes = (rfs_models_max_state_bytes() + RFS_MODELS_STATE_ALIGN - 1u) /
+                    RFS_MODELS_STATE_ALIGN * RFS_MODELS_STATE_ALIGN;
+    p->model_state = aligned_alloc(RFS_MODELS_STATE_ALIGN, sbytes);
+    if (!p->model_state || me->init_default(p->model_state) != 0) {
         ip_close(p);
-        snprintf(err, errlen, "model: ridge configuration rejected");
+        snprintf(err, errlen, "model: %s: initialisation failed", cfg->model);
         return -1;
     }
-    if (rfs_seek_init(&p->seek, &cfg->seek, map, rfs_ridge_model(&p->ridge), target, &p->mem) !=
-        0) {
+    if (cfg->seek.strategy == RFS_SEEK_META_GLOBAL && me->ops == &rfs_ridge_ops) {
+        // issue 7 e: the local ridge with a radius covering the whole map (ridge limit 300 m).
+        double diag = hypot((double)map->w, (double)map->h) * map->res / 65536.0 + 1.0;
+        rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
+        rc.radius = (rfs_q16_t)lround(fmin(diag, 300.0) * 65536.0);
+        if (rfs_ridge_init(p->model_state, &rc) != 0) {
+            ip_close(p);
+            snprintf(err, errlen, "model: ridge: map-wide radius rejected");
+            return -1;
+        }
+    }
+    rfs_model_t model = {me->ops, p->model_state};
+    if (rfs_seek_init(&p->seek, &cfg->seek, map, model, target, &p->mem) != 0) {
         ip_close(p);
         snprintf(err, errlen, "controller: the core rejected the seeker configuration");
         return -1;
     }
     rfs_rng_seed(&p->rng, cfg->seed);
-    c->name = "meta";
+    c->name = rfs_seek_strategy_name(cfg->seek.strategy);
     c->self = p;
     c->period_us = cfg->period_us;
     c->on_pose = ip_on_pose;

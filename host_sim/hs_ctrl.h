@@ -48,7 +48,7 @@ typedef struct hs_ctrl {
 /// Configuration of the in-process controller over rfs_seek.
 typedef struct hs_ctrl_inproc_cfg {
     rfs_seek_cfg_t seek;    ///< seeker configuration (rfs_seek_cfg_default(): the paper's)
-    const char *model;      ///< internal model by name: "ridge" (paper section 5.2.1)
+    const char *model;      ///< internal model by name (rfs_models.h): "ridge" is the paper's
     const char *target;     ///< target by name: "rssi" (one source) or "bridge" (two)
     uint64_t seed;          ///< seed of the controller's own randomness (epsilon moves)
     int64_t period_us;      ///< control period, microseconds (50,000)
@@ -62,7 +62,7 @@ hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void);
 int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs_map_t *map,
                         char *err, size_t errlen);
 
-/// true when `name` is a model hs_ctrl_inproc_open() knows.
+/// true when `name` is a model hs_ctrl_inproc_open() knows (the rfs_models registry).
 bool hs_ctrl_model_known(const char *name);
 
 /// Close any controller (calls its close callback; safe on a zeroed one).

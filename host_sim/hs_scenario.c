@@ -9,6 +9,8 @@
 #include <string.h>
 #include <yaml.h>
 
+#include "rfs_models.h"
+
 typedef struct pctx {
     yaml_document_t doc;
     const char *file;
@@ -316,6 +318,17 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
         str(p, root, "scenario", "target", sc->target, sizeof sc->target) ||
         str(p, root, "scenario", "strategy", sc->strategy, sizeof sc->strategy)) {
         return -1;
+    }
+    if (!rfs_models_lookup(sc->model)) {
+        char names[256] = "";
+        size_t used = 0;
+        for (uint32_t i = 0; i < rfs_models_count() && used < sizeof names; i++) {
+            int k = snprintf(names + used, sizeof names - used, "%s%s", i ? ", " : "",
+                             rfs_models_at(i)->name);
+            used += k > 0 ? (size_t)k : 0;
+        }
+        return fail(p, get(p, root, "model"), "model: '%s' is not a known model (%s)", sc->model,
+                    names);
     }
     if (strcmp(sc->target, "rssi") != 0 && strcmp(sc->target, "bridge") != 0) {
         return fail(p, get(p, root, "target"), "target: '%s' is not rssi or bridge", sc->target);

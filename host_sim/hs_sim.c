@@ -293,7 +293,7 @@ static const char *kind_name(rfs_seek_kind_t k)
     case RFS_SEEK_INITIAL: return "initial";
     case RFS_SEEK_GREEDY: return "greedy";
     case RFS_SEEK_EPSILON: return "epsilon";
-    default: return "none";
+    default: return rfs_seek_kind_name(k); // baseline strategies (issue 7)
     }
 }
 
@@ -569,6 +569,14 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     hs_ctrl_inproc_cfg_t cc = hs_ctrl_inproc_cfg_default();
     cc.model = e->sc.model;
     cc.target = e->sc.target;
+    if (strcmp(e->sc.target, "bridge") == 0) {
+        cc.seek.error_threshold = RFS_Q16_INT(7); // paper section 6: 7 for the noisier target
+    }
+    if (!rfs_seek_strategy_parse(e->sc.strategy, &cc.seek.strategy)) {
+        snprintf(err, errlen, "%s: strategy: unknown '%s' (meta, meta-global, fd-gradient, "
+                 "plane-gradient, chemotaxis)", e->sc.path, e->sc.strategy);
+        return -1;
+    }
     cc.seed = seed ^ 0x5A17C0FFEE000003ull;
     hs_ctrl_t ctrl;
     char cerr[256];

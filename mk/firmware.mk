@@ -50,8 +50,10 @@ $(FW_CORE_LIB): $(FW_CORE_OBJS)
 
 $(FW)/firmware.elf: $(FW_STM32_SRCS:%.c=$(FW)/obj/%.o) $(FW)/obj/fw_map.o $(FW_CORE_LIB) firmware/port/stm32f4/stm32f405.ld
 	$(ARM_CC) $(FW_LDFLAGS) -Wl,-Map=$(FW)/firmware.map -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
+# The emulator image: the hardware stack plus the player's ~1.5 KB, so an overflow of the
+# application's path faults here too (the stack sits below .data/.bss).
 $(FW)/qemu.elf: $(FW_QEMU_SRCS:%.c=$(FW)/obj/%.o) $(FW_CORE_LIB) firmware/port/stm32f4/stm32f405.ld
-	$(ARM_CC) $(FW_LDFLAGS) -Wl,--defsym=RFS_RAM_BUDGET=192K -Wl,--defsym=RFS_FLASH_BUDGET=1024K -Wl,--defsym=RFS_STACK_SIZE=16K -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
+	$(ARM_CC) $(FW_LDFLAGS) -Wl,--defsym=RFS_RAM_BUDGET=192K -Wl,--defsym=RFS_FLASH_BUDGET=1024K -Wl,--defsym=RFS_STACK_SIZE=4K -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
 $(FW)/bench.elf: $(FW_BENCH_SRCS:%.c=$(FW)/obj/%.o) $(FW_CORE_LIB) firmware/port/stm32f4/stm32f405.ld
 	$(ARM_CC) $(FW_LDFLAGS) -Wl,--defsym=RFS_RAM_BUDGET=192K -Wl,--defsym=RFS_FLASH_BUDGET=1024K -Wl,--defsym=RFS_STACK_SIZE=16K -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
 $(FW)/%.bin: $(FW)/%.elf
@@ -73,9 +75,11 @@ $(BUILD)/asan/tests/test_bxcan: tests/firmware/test_bxcan.c $(BUILD)/asan/obj/fi
 	$(CC) $(HOST_CFLAGS) -O1 $(SAN_FLAGS) -Itests tests/firmware/test_bxcan.c $(BUILD)/asan/obj/firmware/port/stm32f4/rfs_bxcan.o -o $@ $(CORE_ASAN_LIB) -lcmocka
 TEST_BINS += $(BUILD)/tests/test_bxcan $(BUILD)/asan/tests/test_bxcan
 $(eval $(call cmocka_test,test_replay,tests/firmware/test_replay.c,))
+$(eval $(call cmocka_test,test_app,tests/firmware/test_app.c,))
 TEST_DEPS += firmware $(BUILD)/bin/rfseek-replay $(BUILD)/bin/rfseek-record
 TEST_SCRIPTS += 'tests/firmware/bit_identical.sh $(BUILD)'
 TEST_SCRIPTS += 'tests/firmware/safety.sh $(BUILD)'
+TEST_SCRIPTS += 'tests/firmware/budget.sh $(BUILD)'
 
 # libFuzzer target over the stream parser and the player (clang only, like feed's).
 FW_FUZZ_CC ?= clang

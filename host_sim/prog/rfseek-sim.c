@@ -35,12 +35,17 @@ static void usage(FILE *f)
             "  --samples       also write every received packet to DIR/samples.tsv\n"
             "                  (always written for a single run with --out)\n"
             "  --field         also write the simulated field of source 0 to DIR/field.tsv\n"
+            "                  (and of a second source to DIR/field1.tsv)\n"
             "  --pcap FILE     write every received packet as a radiotap pcap (single run)\n"
             "  --seeds A..B    run seeds A to B (inclusive) and write one table\n"
             "                  (DIR/runs.tsv with --out, else stdout); per-seed logs in DIR/seed-N/\n"
             "  --jobs N        worker processes for --seeds (default: all cores)\n"
             "  --emit-jobs     print one command per seed (for GNU parallel or a Slurm array)\n"
             "                  instead of running; merge with scripts/merge_runs.py DIR\n"
+            "  --strategy NAME seeking strategy, overriding the scenario's: meta, meta-global,\n"
+            "                  fd-gradient, plane-gradient, chemotaxis (docs/RESULTS.md)\n"
+            "  --model NAME    internal model, overriding the scenario's: ridge, mlp, knn,\n"
+            "                  radius, pathloss\n"
             "  --quiet         no progress bar\n"
             "  --bench         with --seeds: run them one after another in this process without\n"
             "                  output files and print the real-time factor (make bench-sim)\n"
@@ -163,9 +168,10 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         fprintf(stderr, "%s: %s\n", prog, err);
         rc = 1;
     }
-    if (rc == 0 && field && dir) {
-        FILE *f = open_in(dir, "field.tsv");
-        if (!f || hs_sim_field(env, seed, 0, 0.1, f, err, sizeof err) != 0) {
+    // field.tsv for source 0 and field1.tsv for a second source (bridging, issue 7).
+    for (unsigned src = 0; rc == 0 && field && dir && src < env->sc.nsources; src++) {
+        FILE *f = open_in(dir, src == 0 ? "field.tsv" : "field1.tsv");
+        if (!f || hs_sim_field(env, seed, src, 0.1, f, err, sizeof err) != 0) {
             fprintf(stderr, "%s: %s\n", prog, f ? err : strerror(errno));
             rc = 1;
         }
@@ -387,6 +393,7 @@ static int run_bench(const hs_sim_env_t *env, uint64_t a, uint64_t b)
 int main(int argc, char **argv)
 {
     const char *scenario = NULL, *out = NULL, *pcap = NULL, *seeds = NULL;
+    const char *strategy = NULL, *model = NULL;
     uint64_t seed = 0;
     bool has_seed = false, samples = false, field = false, emit = false, quiet = false;
     bool bench = false;
@@ -429,6 +436,11 @@ int main(int argc, char **argv)
             field = true;
         } else if (strcmp(a, "--emit-jobs") == 0) {
             emit = true;
+        } else if (strcmp(a, "--strategy") == 0 || strcmp(a, "--model") == 0) {
+            if (!more || !*argv[i + 1]) {
+                return die("%s: expected a name%s", a, "");
+            }
+            *(a[2] == 's' ? &strategy : &model) = argv[++i];
         } else if (strcmp(a, "--quiet") == 0) {
             quiet = true;
         } else if (strcmp(a, "--bench") == 0) {
@@ -477,6 +489,21 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s: %s\n", prog, err);
         return 1;
     }
+    rfs_seek_strategy_t st_check;
+    if (strategy && (strlen(strategy) >= sizeof sc.strategy ||
+                     !rfs_seek_strategy_parse(strategy, &st_check))) {
+        return die("--strategy: unknown '%s' (meta, meta-global, fd-gradient, plane-gradient, "
+                   "chemotaxis)%s", strategy, "");
+    }
+    if (model && (strlen(model) >= sizeof sc.model || !hs_ctrl_model_known(model))) {
+        return die("--model: unknown '%s' (ridge, mlp, knn, radius, pathloss)%s", model, "");
+    }
+    if (strategy) {
+        snprintf(sc.strategy, sizeof sc.strategy, "%s", strategy);
+    }
+    if (model) {
+        snprintf(sc.model, sizeof sc.model, "%s", model);
+    }
     if (emit) {
         // The same runs, one command per seed; scripts/merge_runs.py DIR merges them.
         char self[PATH_MAX], scn[PATH_MAX];
@@ -486,8 +513,8 @@ int main(int argc, char **argv)
         }
         self[n] = '\0';
         for (uint64_t s = sa; s <= sb; s++) {
-            printf("%s %s --seed %llu --out %s/seed-%llu\n", self, scn, (unsigned long long)s,
-                   out, (unsigned long long)s);
+            printf("%s %s --seed %llu --out %s/seed-%llu --strategy %s --model %s\n", self, scn,
+                   (unsigned long long)s, out, (unsigned long long)s, sc.strategy, sc.model);
         }
         return 0;
     }

@@ -2,13 +2,13 @@
  * (common/rfs_pathloss.h), for tests/common/test_pathloss.c.
  *
  * The same definition computed another way: bins found by a linear search, centroids
- * rounded to the centimetre as the definition says (the store's unit), distances and logarithms in double, the constrained least
- * squares by direct minimisation of the sum of squared residuals over the interior
- * solution, the four edges and the four corners of the (n, W) box, and the Huber loss
- * in double. Only the wall counts come from the core (rfs_map_walls_crossed and
- * rfs_map_cell, tested in test_map.c), because they are the model's definition of a
- * wall: counted from the centre of the core cell holding the bin's centroid, saturated
- * at 15. No cache.
+ * rounded to the centimetre as the definition says (the store's unit), distances and
+ * logarithms in double, the constrained least squares by direct minimisation of the sum
+ * of squared residuals over the interior solution, the four edges and the four corners
+ * of the (n, W) box, the Huber loss in double, and a bitmap of evaluated points. Only
+ * the wall counts come from the core (rfs_map_walls_crossed and rfs_map_cell, tested in
+ * test_map.c), because they are the model's definition of a wall: counted from the
+ * centre of the core cell holding the bin's centroid, saturated at 15. No cache.
  */
 #ifndef REF_PATHLOSS_H
 #define REF_PATHLOSS_H
@@ -28,6 +28,7 @@ typedef struct ref_pl_cfg {
     double bin, coarse;
     int top;
     double n_min, n_max, w_min, w_max, n_prior, w_prior, prior_weight, huber, margin;
+    long bin_cap;
 } ref_pl_cfg_t;
 
 typedef struct ref_pl_bin {
@@ -61,7 +62,7 @@ typedef struct ref_pl {
 
 static inline ref_pl_cfg_t ref_pl_cfg_default(void)
 {
-    ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 1.0, 6.0, 20.0};
+    ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5};
     return c;
 }
 
@@ -99,12 +100,15 @@ static inline void ref_pl_bin_samples(ref_pl_t *r, const rfs_sample_t *s, int n)
         bin_cm *= 2;
     }
     r->bin_m = bin_cm / 100.0;
-    r->total = n;
+    r->total = 0;
     for (int b = 0; b < r->nbins; ++b) {
         ref_pl_bin_t *bb = &r->bins[b];
         bb->x = round(bb->sx * 100.0 / bb->count) / 100.0;
         bb->y = round(bb->sy * 100.0 / bb->count) / 100.0;
         bb->z = bb->sv / bb->count;
+        /* from here on, count is the bin's weight */
+        bb->count = bb->count < r->cfg.bin_cap ? bb->count : r->cfg.bin_cap;
+        r->total += bb->count;
     }
 }
 

@@ -106,11 +106,28 @@ static void make_samples(rfs_sample_t *s, int n, const rfs_map_t *map, const tru
     }
 }
 
-static rfs_pathloss_est_t fit_default(fixture_t *f, int n, const rfs_map_t *map, uint32_t budget,
-                                      int *calls)
+/* The estimator without its strong prior: a prior of weight 1 and every sample counted
+ * (bin_cap at its maximum), for checks against the truth that generated the data. */
+static rfs_pathloss_cfg_t weak_cfg(void)
 {
     rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
-    assert_int_equal(rfs_pathloss_init(&f->pl, &c), 0);
+    c.prior_weight = RFS_Q16_ONE;
+    c.bin_cap = UINT16_MAX;
+    return c;
+}
+
+static ref_pl_cfg_t weak_ref(void)
+{
+    ref_pl_cfg_t c = ref_pl_cfg_default();
+    c.prior_weight = 1.0;
+    c.bin_cap = UINT16_MAX;
+    return c;
+}
+
+static rfs_pathloss_est_t fit_with(fixture_t *f, const rfs_pathloss_cfg_t *c, int n,
+                                   const rfs_map_t *map, uint32_t budget, int *calls)
+{
+    assert_int_equal(rfs_pathloss_init(&f->pl, c), 0);
     rfs_model_t m = rfs_pathloss_model(&f->pl);
     rfs_model_fit_in_t in = {f->s, (uint16_t)n, 0, 0, map};
     rfs_rng_t rng;
@@ -130,7 +147,15 @@ static rfs_pathloss_est_t fit_default(fixture_t *f, int n, const rfs_map_t *map,
     return e;
 }
 
-static const truth_t k_office = {15.125, 3.375, -35.0, 3.0, 5.0, 0.3};
+static rfs_pathloss_est_t fit_default(fixture_t *f, int n, const rfs_map_t *map, uint32_t budget,
+                                      int *calls)
+{
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    return fit_with(f, &c, n, map, budget, calls);
+}
+
+/* n and W away from the default prior (3, 5 dB), so that recovering them means something. */
+static const truth_t k_office = {15.125, 3.375, -35.0, 2.6, 6.5, 0.3};
 
 /* --- configuration --------------------------------------------------------------------- */
 
@@ -138,8 +163,8 @@ static void init_rejects_bad_configurations(void **state)
 {
     fixture_t *f = *state;
     rfs_pathloss_cfg_t good = rfs_pathloss_cfg_default();
-    rfs_pathloss_cfg_t bad[12];
-    for (int i = 0; i < 12; ++i) {
+    rfs_pathloss_cfg_t bad[13];
+    for (int i = 0; i < 13; ++i) {
         bad[i] = good;
     }
     bad[0].bin = RFS_Q16_FRAC(1, 20);
@@ -154,9 +179,10 @@ static void init_rejects_bad_configurations(void **state)
     bad[9].prior_weight = 0;
     bad[10].huber = 0;
     bad[11].margin = RFS_Q16_INT(101);
+    bad[12].bin_cap = 0;
 
     assert_int_equal(rfs_pathloss_init(&f->pl, &good), 0);
-    for (int i = 0; i < 12; ++i) {
+    for (int i = 0; i < 13; ++i) {
         if (rfs_pathloss_init(&f->pl, &bad[i]) != -1) {
             fail_msg("bad configuration %d accepted", i);
         }
@@ -209,7 +235,8 @@ static void db_dist_matches_double(void **state)
     assert_int_equal(rfs_pathloss_db_dist(0), 0);
     assert_int_equal(rfs_pathloss_db_dist((uint64_t)1 << 32), 0);
     /* the largest input, (65536 m)^2: 10 log10(65536) = 48.16 dB */
-    assert_true(labs(rfs_pathloss_db_dist(UINT64_MAX) - lround(10.0 * log10(65536.0) * 65536.0)) <= 2);
+    long want = lround(10.0 * log10(65536.0) * 65536.0);
+    assert_true(labs(rfs_pathloss_db_dist(UINT64_MAX) - want) <= 2);
 }
 
 /* --- the fit against the truth and against the reference -------------------------------- */
@@ -218,8 +245,9 @@ static void fit_recovers_source_n_and_w(void **state)
 {
     fixture_t *f = *state;
     make_samples(f->s, NS, &f->map, &k_office, 11);
+    rfs_pathloss_cfg_t c = weak_cfg();
 
-    rfs_pathloss_est_t e = fit_default(f, NS, &f->map, 0, NULL);
+    rfs_pathloss_est_t e = fit_with(f, &c, NS, &f->map, 0, NULL);
 
     double ex = e.sx / 65536.0 - k_office.sx, ey = e.sy / 65536.0 - k_office.sy;
     if (fabs(ex) > 0.25 + 1e-4 || fabs(ey) > 0.25 + 1e-4) {
@@ -238,10 +266,10 @@ static void fit_recovers_source_n_and_w(void **state)
 }
 
 /* Compare everything the core reports with the double reference on the same data. */
-static void expect_same_as_reference(fixture_t *f, int n, const rfs_map_t *map,
-                                     const ref_pl_cfg_t *rc, double n_tol)
+static void expect_same_as_reference(fixture_t *f, const rfs_pathloss_cfg_t *c, int n,
+                                     const rfs_map_t *map, const ref_pl_cfg_t *rc, double n_tol)
 {
-    rfs_pathloss_est_t e = fit_default(f, n, map, 0, NULL);
+    rfs_pathloss_est_t e = fit_with(f, c, n, map, 0, NULL);
     assert_true(ref_pl_fit(&f->ref, f->s, n, map, rc));
     const ref_pl_t *r = &f->ref;
 
@@ -285,9 +313,29 @@ static void same_cell_as_double_reference_office(void **state)
 {
     fixture_t *f = *state;
     make_samples(f->s, NS, &f->map, &k_office, 11);
-    ref_pl_cfg_t rc = ref_pl_cfg_default();
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default(), cw = weak_cfg();
+    ref_pl_cfg_t rc = ref_pl_cfg_default(), rw = weak_ref();
 
-    expect_same_as_reference(f, NS, &f->map, &rc, 0.01);
+    expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
+    expect_same_as_reference(f, &cw, NS, &f->map, &rw, 0.01);
+}
+
+/* The default configuration on the same data: the prior (3, 5 dB) pulls n and W from
+ * the truth (2.6, 6.5 dB) towards itself, the source stays within one lattice cell. */
+static void default_prior_shrinks_towards_physics(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+
+    rfs_pathloss_est_t e = fit_default(f, NS, &f->map, 0, NULL);
+
+    assert_true(fabs(e.sx / 65536.0 - k_office.sx) <= 0.25 + 1e-4);
+    assert_true(fabs(e.sy / 65536.0 - k_office.sy) <= 0.25 + 1e-4);
+    double n = e.n / 65536.0, w = e.w / 65536.0;
+    if (!(n > k_office.n && n < 3.0 && w < k_office.w && w > 5.0)) {
+        fail_msg("n %.3f W %.3f: not between the truth (%.1f, %.1f) and the prior (3, 5)", n, w,
+                 k_office.n, k_office.w);
+    }
 }
 
 /* A weaker robot's view: few samples along the corridor and one room, 1.5 dB noise. */
@@ -296,9 +344,10 @@ static void same_cell_as_double_reference_sparse_noisy(void **state)
     fixture_t *f = *state;
     truth_t t = {24.875, 12.625, -40.0, 2.5, 7.0, 1.5};
     make_samples(f->s, 300, &f->map, &t, 5);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
     ref_pl_cfg_t rc = ref_pl_cfg_default();
 
-    expect_same_as_reference(f, 300, &f->map, &rc, 0.01);
+    expect_same_as_reference(f, &c, 300, &f->map, &rc, 0.01);
 }
 
 /* An exponent outside the bounds: the constrained solution sits on n = n_max. */
@@ -307,9 +356,10 @@ static void exponent_clamped_like_reference(void **state)
     fixture_t *f = *state;
     truth_t t = {5.125, 12.125, -20.0, 6.5, 4.0, 0.3};
     make_samples(f->s, 1000, &f->map, &t, 9);
-    ref_pl_cfg_t rc = ref_pl_cfg_default();
+    rfs_pathloss_cfg_t c = weak_cfg();
+    ref_pl_cfg_t rc = weak_ref();
 
-    expect_same_as_reference(f, 1000, &f->map, &rc, 0.01);
+    expect_same_as_reference(f, &c, 1000, &f->map, &rc, 0.01);
 
     rfs_pathloss_est_t e;
     assert_true(rfs_pathloss_estimate(&f->pl, &e));
@@ -323,9 +373,10 @@ static void no_map_recovers_source(void **state)
     fixture_t *f = *state;
     truth_t t = {21.0, 6.0, -30.0, 2.0, 0.0, 0.3};
     make_samples(f->s, 800, NULL, &t, 13);
-    ref_pl_cfg_t rc = ref_pl_cfg_default();
+    rfs_pathloss_cfg_t c = weak_cfg();
+    ref_pl_cfg_t rc = weak_ref();
 
-    expect_same_as_reference(f, 800, NULL, &rc, 0.01);
+    expect_same_as_reference(f, &c, 800, NULL, &rc, 0.01);
 
     rfs_pathloss_est_t e;
     assert_true(rfs_pathloss_estimate(&f->pl, &e));
@@ -345,9 +396,10 @@ static void bins_grow_when_samples_spread(void **state)
         double d = hypot(f->s[i].x_cm / 100.0 - 20.0, f->s[i].y_cm / 100.0 + 30.0);
         f->s[i].v_q6 = (int16_t)lround((-30.0 - 25.0 * log10(d < 1 ? 1 : d)) * 64.0);
     }
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
     ref_pl_cfg_t rc = ref_pl_cfg_default();
 
-    expect_same_as_reference(f, NS, NULL, &rc, 0.01);
+    expect_same_as_reference(f, &c, NS, NULL, &rc, 0.01);
 
     rfs_pathloss_est_t e;
     assert_true(rfs_pathloss_estimate(&f->pl, &e));
@@ -444,7 +496,8 @@ static void predict_is_the_fitted_formula(void **state)
 {
     fixture_t *f = *state;
     make_samples(f->s, NS, &f->map, &k_office, 11);
-    rfs_pathloss_est_t e = fit_default(f, NS, &f->map, 0, NULL);
+    rfs_pathloss_cfg_t c = weak_cfg();
+    rfs_pathloss_est_t e = fit_with(f, &c, NS, &f->map, 0, NULL);
     const double px[5] = {1.3, 15.0, 28.4, 4.6, 15.125};
     const double py[5] = {1.2, 8.0, 14.7, 12.9, 3.375};
     rfs_q16_t ax, ay;
@@ -620,6 +673,7 @@ int main(void)
         cmocka_unit_test(db_dist_matches_double),
         cmocka_unit_test_setup_teardown(fit_recovers_source_n_and_w, setup, teardown),
         cmocka_unit_test_setup_teardown(same_cell_as_double_reference_office, setup, teardown),
+        cmocka_unit_test_setup_teardown(default_prior_shrinks_towards_physics, setup, teardown),
         cmocka_unit_test_setup_teardown(same_cell_as_double_reference_sparse_noisy, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(exponent_clamped_like_reference, setup, teardown),

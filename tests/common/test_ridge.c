@@ -394,6 +394,25 @@ static void test_radius_inclusive_and_reset(void **state)
     assert_string_equal(m.ops->name, "ridge");
 }
 
+/* A sample 655.36 m away (u^2 + v^2 just above 2^32) must not wrap into the radius. */
+static void test_far_sample_not_wrapped_into_radius(void **state)
+{
+    (void)state;
+    /* query (-300 m, -300 m); sample at (+327.67 m, -111.51 m): u = 62,767 cm,
+     * v = 18,849 cm, u^2 + v^2 = 2^32 + 13,794 cm^2 (655.36 m) */
+    rfs_sample_t s[2] = {{-30000, -30000, -20 * 64}, {32767, -11151, -120 * 64}};
+    rfs_ridge_t r;
+    rfs_ridge_cfg_t cfg = rfs_ridge_cfg_default();
+    assert_int_equal(rfs_ridge_init(&r, &cfg), 0);
+    rfs_model_fit_in_t in = {.samples = s, .n = 2, .qx = RFS_Q16_INT(-300),
+                             .qy = RFS_Q16_INT(-300), .map = NULL};
+    assert_int_equal(rfs_ridge_ops.fit(&r, &in, 0u, NULL), RFS_FIT_DONE);
+    assert_int_equal(r.n_used, 1);
+    rfs_q16_t v;
+    assert_true(rfs_ridge_ops.predict(&r, 0, 0, &v));
+    assert_int_equal(v, RFS_Q16_INT(-20));
+}
+
 static void test_init_validation(void **state)
 {
     (void)state;
@@ -443,6 +462,7 @@ int main(void)
         cmocka_unit_test(test_init_validation),
         cmocka_unit_test(test_two_points_closed_form),
         cmocka_unit_test(test_radius_inclusive_and_reset),
+        cmocka_unit_test(test_far_sample_not_wrapped_into_radius),
         cmocka_unit_test(test_sliced_restart_on_new_query),
         cmocka_unit_test(test_against_sklearn),
     };

@@ -163,21 +163,28 @@ static void test_drops_counted(void **state)
     }
     assert_int_equal(f->s.pending_count, PCAP);
     assert_int_equal(f->s.dropped_pending, 5u);
-    /* the next pose is 0.6 s later (> 0.5 s gap): every pending one is a gap drop */
-    rfs_pose_t p1 = pose(601000, 2.0, 1.0);
+    /* the next pose is 0.500001 s later (> 0.5 s gap): every pending one is a gap drop */
+    rfs_pose_t p1 = pose(501001, 2.0, 1.0);
     assert_true(rfs_store_add_pose(&f->s, &p1, &f->rng));
     assert_int_equal(f->s.dropped_gap, PCAP);
     assert_int_equal(f->s.pending_count, 0);
     assert_int_equal(f->s.count, 1);
     /* eight more poses fill the history (8 kept) and push p1 out: 0.65 s is now early */
     for (int i = 1; i <= 8; ++i) {
-        rfs_pose_t p = pose(601000 + i * 100000, 2.0, 1.0);
+        rfs_pose_t p = pose(501001 + i * 100000, 2.0, 1.0);
         assert_true(rfs_store_add_pose(&f->s, &p, &f->rng));
     }
-    rfs_store_add_value(&f->s, 601000 + 50000, RFS_Q16_INT(-40), &f->rng);
+    rfs_store_add_value(&f->s, 501001 + 50000, RFS_Q16_INT(-40), &f->rng);
     assert_int_equal(f->s.dropped_early, 3u);
-    rfs_store_add_value(&f->s, 601000 + 150000, RFS_Q16_INT(-40), &f->rng);
+    rfs_store_add_value(&f->s, 501001 + 150000, RFS_Q16_INT(-40), &f->rng);
     assert_int_equal(f->s.count, 2);
+    /* exactly max_gap apart still brackets */
+    rfs_pose_t pg = pose(1301001 + 500000, 4.0, 1.0);
+    assert_true(rfs_store_add_pose(&f->s, &pg, &f->rng));
+    rfs_store_add_value(&f->s, 1301001 + 250000, RFS_Q16_INT(-40), &f->rng);
+    assert_int_equal(f->s.count, 3);
+    assert_int_equal(f->s.samples[2].x_cm, 300);
+    assert_int_equal(f->s.dropped_gap, PCAP);
 }
 
 /* Two sources interleaving out of time order in the pending queue. */

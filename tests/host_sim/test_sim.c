@@ -137,6 +137,10 @@ static void test_scenario_bad(void **state)
                "map: @MAP@\nsources:\n  - position: [15, 10]\n    mac: 02:00\n"
                "start: {position: [5, 10]}\n",
                "sources[0].mac: expected aa:bb:cc:dd:ee:ff");
+    expect_bad("model.yaml",
+               "map: @MAP@\nmodel: foo\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "model.yaml:2: model: 'foo' is not a known model");
     expect_bad("nostart.yaml", "map: @MAP@\nsources:\n  - position: [15, 10]\n", "start: missing");
     expect_bad("never.yaml",
                "map: @MAP@\nsources:\n  - position: [15, 10]\nstart: {position: [5, 10]}\n"

@@ -7,10 +7,10 @@
  * The independent watchdog (LSI 32 kHz nominal, /8, reload 1999) fires after 500 ms
  * without rfs_board_kick() (340 .. 940 ms over the LSI's 17 .. 47 kHz range). It must
  * outlast the longest control iteration: the first one after boot runs the seeker's
- * reachability flood fill, 16.7 million instructions (~100 ms at 168 MHz; docs/
+ * reachability flood fill, 16.5 million instructions (~100 ms at 168 MHz; docs/
  * PERFORMANCE.md). While the loop is busy no command is sent and the motor controller's
  * own 200 ms command timeout stops the wheels; once the watchdog has fired, the image
- * boots (rfs_app_init: 6.3 million instructions, ~40 ms) and its first command is zero.
+ * boots (rfs_app_init: 7.6 million instructions, ~45 ms) and its first command is zero.
  */
 #ifndef RFS_BOARD_H
 #define RFS_BOARD_H

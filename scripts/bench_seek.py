@@ -1,0 +1,708 @@
+#!/usr/bin/python3
+"""bench_seek.py - the seeking-efficacy benchmark (issue 7): docs/RESULTS.md + figures.
+
+Runs every strategy on every shipped scenario with the simulator's batch mode
+(rfseek-sim --seeds A..B --jobs N), the default scenario at other shadowing and noise
+levels, the internal models, and the bridging target; then writes the tables
+(docs/RESULTS.md) and figures (docs/figures/seek_*.png).
+
+  scripts/bench_seek.py [--seeds 200] [--model-seeds 200] [--slow-model-seeds 10]
+                        [--jobs 2] [--bin build/bin/rfseek-sim]
+  scripts/bench_seek.py --smoke --bin build-x/bin/rfseek-sim    (2 seeds, a self-check)
+
+Definitions (also written into RESULTS.md):
+  success      within the stop radius (1.5 m) of the source before 150 m of travel
+               (and 900 s), as the simulator reports it ("reached").
+  ratio        distance travelled / shortest path around walls (start to the legal point
+               nearest the source), median over the successful runs.
+  epsilon %    travel during iterations whose decision was an epsilon step (from the
+               per-iteration log: odometry at each decision), over all travel.
+  detour %     sum over iterations of (planned path length - straight line from the
+               position at the decision to the goal), over the sum of planned path
+               lengths: the part of the planned travel spent going around walls.
+Everything goes to a temporary directory first; RESULTS.md is written to a temporary
+file and renamed.
+"""
+import argparse
+import glob
+import math
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+STRATEGIES = ["meta", "meta-global", "fd-gradient", "plane-gradient", "chemotaxis"]
+SCENARIOS = ["default", "open", "lshape", "willow", "3ne", "intel"]
+MODELS = ["ridge", "mlp", "knn", "radius", "pathloss"]
+SLOW_MODELS = {"mlp", "knn"}
+
+# Labelled regions (name, x0, y0, x1, y1), first match wins; scripts/make_maps.py built
+# these floors. Real floors (willow, 3ne, intel) have no labels: their failed runs are
+# classified by the walls between the end point and the source (simulator geometry).
+OFFICE = [("corridor", 0, 5, 35, 7)] + [
+    ("room %s%d" % (side, i), 5 * i, y0, 5 * i + 5, y0 + 5)
+    for i in range(7) for side, y0 in (("S", 0), ("N", 7))]
+LSHAPE = ([("corridor", 0, 4, 24, 6), ("corridor", 24, 4, 26, 24)] +
+          [("room S%d" % i, 5 * i, 0, 5 * i + 5, 4) for i in range(4)] +
+          [("room N%d" % i, 5 * i, 6, 5 * i + 5, 10) for i in range(4)] +
+          [("room E0", 20, 0, 24, 4), ("room E1", 26, 0, 30, 4), ("room W0", 20, 6, 24, 10),
+           ("room W1", 20, 10, 24, 14), ("room W2", 20, 14, 24, 18), ("room W3", 20, 18, 24, 24),
+           ("room E2", 26, 4, 30, 10), ("room E3", 26, 10, 30, 14), ("room E4", 26, 14, 30, 18),
+           ("room E5", 26, 18, 30, 24)])
+REGIONS = {"default": OFFICE, "bridge": OFFICE, "lshape": LSHAPE,
+           "open": [("room", -1, -1, 21, 21)]}
+
+
+def log(msg):
+    sys.stderr.write(msg + "\n")
+    sys.stderr.flush()
+
+
+def wilson(k, n, z=1.959964):
+    if n == 0:
+        return (float("nan"),) * 3
+    p = k / n
+    den = 1 + z * z / n
+    c = (p + z * z / (2 * n)) / den
+    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
+    return p, max(0.0, c - h), min(1.0, c + h)
+
+
+def read_tsv(path):
+    with open(path) as f:
+        head = f.readline().rstrip("\n").split("\t")
+        rows = []
+        for line in f:
+            v = line.rstrip("\n").split("\t")
+            rows.append(dict(zip(head, v)))
+    return rows
+
+
+def fnum(s):
+    try:
+        return float(s)
+    except (TypeError, ValueError):
+        return float("nan")
+
+
+def scenario_path(name):
+    return os.path.join("scenarios", name + ".yaml")
+
+
+def leg_stats(logrows, total):
+    """(epsilon travel m, planned path m, planned detour m) of one run's log."""
+    eps = 0.0
+    path = 0.0
+    detour = 0.0
+    for i, r in enumerate(logrows):
+        t0 = fnum(r["travelled_m"])
+        t1 = fnum(logrows[i + 1]["travelled_m"]) if i + 1 < len(logrows) else total
+        if r["kind"] == "epsilon":
+            eps += max(0.0, t1 - t0)
+        p = fnum(r["path_m"])
+        if p > 0:
+            straight = math.hypot(fnum(r["goal_x_m"]) - fnum(r["est_x_m"]),
+                                  fnum(r["goal_y_m"]) - fnum(r["est_y_m"]))
+            path += p
+            detour += max(0.0, p - straight)
+    return eps, path, detour
+
+
+def run_batch(args, tmp, scen_file, strategy, model, seeds, tag, keep):
+    """One rfseek-sim batch; returns a list of per-run dicts. keep: seeds whose logs stay."""
+    out = os.path.join(tmp, tag)
+    cmd = [args.bin, scen_file, "--seeds", "1..%d" % seeds, "--jobs", str(args.jobs),
+           "--out", out, "--strategy", strategy, "--model", model]
+    if args.quiet:
+        cmd.append("--quiet")
+    subprocess.run(cmd, check=True)
+    runs = read_tsv(os.path.join(out, "runs.tsv"))
+    res = []
+    for r in runs:
+        seed = int(r["seed"])
+        sd = os.path.join(out, "seed-%d" % seed)
+        total = fnum(r["distance_travelled_m"])
+        lg = read_tsv(os.path.join(sd, "log.tsv"))
+        eps, path, detour = leg_stats(lg, total)
+        res.append({
+            "seed": seed, "reached": r["reached"] == "1", "end": r["end"],
+            "dist": total, "shortest": fnum(r["shortest_path_m"]),
+            "final_d": fnum(r["final_distance_m"]), "fx": fnum(r["final_x_m"]),
+            "fy": fnum(r["final_y_m"]), "updates": int(r["model_updates"]),
+            "iters": int(r["iterations"]), "eps_m": eps, "path_m": path, "detour_m": detour,
+        })
+        if seed not in keep:
+            shutil.rmtree(sd)
+    return res
+
+
+def summarise(res):
+    n = len(res)
+    k = sum(r["reached"] for r in res)
+    p, lo, hi = wilson(k, n)
+    dist = np.array([r["dist"] for r in res])
+    ok = [r for r in res if r["reached"]]
+    ratio = np.array([r["dist"] / r["shortest"] for r in ok]) if ok else np.array([np.nan])
+    tot = dist.sum()
+    path = sum(r["path_m"] for r in res)
+    return {
+        "n": n, "k": k, "p": p, "lo": lo, "hi": hi,
+        "med": float(np.median(dist)), "p90": float(np.percentile(dist, 90)),
+        "med_ok": float(np.median([r["dist"] for r in ok])) if ok else float("nan"),
+        "ratio": float(np.median(ratio)),
+        "updates": float(np.median([r["updates"] for r in res])),
+        "eps": 100.0 * sum(r["eps_m"] for r in res) / tot if tot > 0 else float("nan"),
+        "detour": 100.0 * sum(r["detour_m"] for r in res) / path if path > 0 else float("nan"),
+    }
+
+
+def fmt(v, nd=1):
+    return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else "%.*f" % (nd, v)
+
+
+def row(label, s):
+    return ("| %s | %d | %d | **%.1f** (%.1f-%.1f) | %s | %s | %s | %s | %s | %s |" %
+            (label, s["n"], s["k"], 100 * s["p"], 100 * s["lo"], 100 * s["hi"], fmt(s["med"]),
+             fmt(s["p90"]), fmt(s["ratio"], 2), fmt(s["updates"], 0), fmt(s["eps"]),
+             fmt(s["detour"])))
+
+
+HEAD = ("| %s | runs | reached | success %% (95%% Wilson CI) | median travel m "
+        "| p90 travel m | median ratio to shortest (successful) | median model updates "
+        "| epsilon travel %% | detour %% |\n|---|---|---|---|---|---|---|---|---|---|")
+
+
+def load_map(scen_file):
+    """(occupancy image as float array, extent [x0, x1, y0, y1]) of a scenario's map."""
+    mp = None
+    d = os.path.dirname(scen_file)
+    with open(scen_file) as f:
+        for line in f:
+            if line.startswith("map:"):
+                mp = os.path.join(d, line.split(":", 1)[1].split("#")[0].strip())
+    meta = {}
+    with open(mp) as f:
+        for line in f:
+            line = line.split("#")[0]
+            if ":" in line:
+                k, v = line.split(":", 1)
+                meta[k.strip()] = v.strip()
+    res = float(meta["resolution"])
+    ox, oy = [float(x) for x in meta["origin"].strip("[]").split(",")[:2]]
+    with open(os.path.join(os.path.dirname(mp), meta["image"]), "rb") as f:
+        data = f.read()
+    # P5 header: magic, width, height, maxval, separated by whitespace and comments.
+    fields, pos = [], 0
+    while len(fields) < 4:
+        while data[pos:pos + 1].isspace():
+            pos += 1
+        if data[pos:pos + 1] == b"#":
+            pos = data.index(b"\n", pos) + 1
+            continue
+        end = pos
+        while not data[end:end + 1].isspace():
+            end += 1
+        fields.append(data[pos:end])
+        pos = end
+    w, h = int(fields[1]), int(fields[2])
+    img = np.frombuffer(data[pos + 1:pos + 1 + w * h], dtype=np.uint8).reshape(h, w)
+    return img, [ox, ox + w * res, oy, oy + h * res]
+
+
+def scenario_sources(scen_file):
+    src, start = [], None
+    with open(scen_file) as f:
+        for line in f:
+            s = line.strip()
+            if s.startswith("position:"):
+                src.append([float(x) for x in s.split("[")[1].split("]")[0].split(",")])
+            if s.startswith("start:"):
+                start = [float(x) for x in s.split("[")[1].split("]")[0].split(",")]
+    return src, start
+
+
+def region_of(scen, x, y, src, walls_at):
+    regs = REGIONS.get(scen)
+    if regs:
+        def lab(px, py):
+            for name, x0, y0, x1, y1 in regs:
+                if x0 <= px <= x1 and y0 <= py <= y1:
+                    return name
+            return "outside"
+        here, there = lab(x, y), lab(src[0], src[1])
+        if here == there:
+            return "source room"
+        return "corridor" if here == "corridor" else "another room"
+    wl = walls_at(x, y)
+    return "line of sight (0 walls)" if wl == 0 else ("1 wall" if wl == 1 else ">= 2 walls")
+
+
+def walls_lookup(field_tsv):
+    a = np.loadtxt(field_tsv, skiprows=1, usecols=(0, 1, 2, 3))
+
+    def f(x, y):
+        i = np.argmin((a[:, 0] - x) ** 2 + (a[:, 1] - y) ** 2)
+        return int(a[i, 2])
+    return f
+
+
+def single_run(args, scen_file, seed, out, strategy="meta", field=False):
+    cmd = [args.bin, scen_file, "--seed", str(seed), "--out", out, "--strategy", strategy]
+    if field:
+        cmd.append("--field")
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+
+
+def make_variant(tmp, shadow, noise):
+    """The default scenario with other shadowing / noise sigmas (absolute map path)."""
+    src = scenario_path("default")
+    out = []
+    with open(src) as f:
+        for line in f:
+            s = line.strip()
+            if s.startswith("map:"):
+                line = "map: %s\n" % os.path.abspath(os.path.join("scenarios", s[4:].strip()))
+            elif s.startswith("shadowing:"):
+                line = ("  shadowing: {enabled: %s, sigma_db: %.1f, dcorr_m: 5.0}\n" %
+                        ("true" if shadow > 0 else "false", max(shadow, 1.0)))
+            elif s.startswith("noise:"):
+                line = "  noise: {enabled: true, sigma_db: %.1f}\n" % noise
+            out.append(line)
+    p = os.path.join(tmp, "default-sh%g-n%g.yaml" % (shadow, noise))
+    with open(p, "w") as f:
+        f.writelines(out)
+    return p
+
+
+# ---- figures ---------------------------------------------------------------------------
+
+def fig_trajectories(figdir, tmp, tags, scen, nseeds):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    img, ext = load_map(scenario_path(scen))
+    src, start = scenario_sources(scenario_path(scen))
+    out = []
+    for st in STRATEGIES:
+        d = os.path.join(tmp, tags[(scen, st)])
+        npan = min(5, nseeds)
+        fig, axs = plt.subplots(npan, 1, figsize=(8, 2.6 * npan), squeeze=False)
+        for k, ax in enumerate(axs[:, 0]):
+            sd = os.path.join(d, "seed-%d" % (k + 1))
+            ax.imshow(img, cmap="gray", extent=ext, origin="upper", vmin=0, vmax=255)
+            tr = np.loadtxt(os.path.join(sd, "track.tsv"), skiprows=1, usecols=(1, 2))
+            lg = read_tsv(os.path.join(sd, "log.tsv"))
+            ax.plot(tr[:, 0], tr[:, 1], "-", color="tab:blue", lw=0.8)
+            up = [(fnum(r["x_m"]), fnum(r["y_m"])) for r in lg if r["relearned"] == "1"]
+            if up:
+                u = np.array(up)
+                ax.plot(u[:, 0], u[:, 1], "o", ms=3, mfc="none", color="tab:red",
+                        label="model update")
+            ep = [(fnum(r["x_m"]), fnum(r["y_m"])) for r in lg if r["kind"] in
+                  ("epsilon", "tumble")]
+            if ep:
+                u = np.array(ep)
+                ax.plot(u[:, 0], u[:, 1], "x", ms=3, color="tab:orange",
+                        label="epsilon / tumble step")
+            ax.plot(src[0][0], src[0][1], "*", ms=12, color="gold", mec="k", label="source")
+            ax.plot(start[0], start[1], "s", ms=6, color="tab:green", label="start")
+            summ = read_tsv(os.path.join(d, "runs.tsv"))[k]
+            ax.set_title("%s, seed %d: %s after %.0f m, %s model updates" %
+                         (st, k + 1, summ["end"], fnum(summ["distance_travelled_m"]),
+                          summ["model_updates"]), fontsize=9)
+            ax.set_xlim(ext[0], ext[1])
+            ax.set_ylim(ext[2], ext[3])
+            if k == 0:
+                ax.legend(fontsize=7, loc="upper left", ncol=4)
+        fig.tight_layout()
+        p = os.path.join(figdir, "seek_traj_%s.png" % st)
+        fig.savefig(p + ".tmp.png", dpi=80)
+        os.replace(p + ".tmp.png", p)
+        plt.close(fig)
+        out.append(p)
+    return out
+
+
+def fig_rssi(figdir, tmp, args, scen):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axs = plt.subplots(len(STRATEGIES), 1, figsize=(8, 12), sharex=True)
+    for ax, st in zip(axs, STRATEGIES):
+        d = os.path.join(tmp, "rssi-%s" % st)
+        single_run(args, scenario_path(scen), 1, d, st)
+        a = np.loadtxt(os.path.join(d, "samples.tsv"), skiprows=1, usecols=(4, 5))
+        ax.plot(a[:, 0], a[:, 1], ",", color="0.6", alpha=0.5)
+        b = np.floor(a[:, 0])
+        xs = np.unique(b)
+        ma = [a[b == x, 1].mean() for x in xs]
+        ax.plot(xs + 0.5, ma, "-", color="tab:blue", lw=1.2, label="1 m moving average")
+        ax.set_ylabel("RSSI dBm")
+        ax.set_title("%s, %s, seed 1" % (scen, st), fontsize=9)
+        ax.legend(fontsize=7, loc="lower right")
+    axs[-1].set_xlabel("distance travelled, m")
+    fig.tight_layout()
+    p = os.path.join(figdir, "seek_rssi_vs_distance.png")
+    fig.savefig(p + ".tmp.png", dpi=80)
+    os.replace(p + ".tmp.png", p)
+    plt.close(fig)
+    return p
+
+
+def fig_noise(figdir, sweep):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axs = plt.subplots(1, 2, figsize=(10, 4), sharey=True)
+    for ax, key, lab in ((axs[0], "shadow", "shadowing sigma, dB (noise 4 dB)"),
+                         (axs[1], "noise", "measurement noise sigma, dB (shadowing 4 dB)")):
+        for st in STRATEGIES:
+            pts = sorted(sweep[key][st].items())
+            xs = [x for x, _ in pts]
+            ps = np.array([100 * s["p"] for _, s in pts])
+            lo = np.array([100 * s["lo"] for _, s in pts])
+            hi = np.array([100 * s["hi"] for _, s in pts])
+            ax.errorbar(xs, ps, yerr=[ps - lo, hi - ps], marker="o", capsize=3, label=st)
+        ax.set_xlabel(lab)
+        ax.set_xticks([0, 2, 4, 8])
+        ax.grid(alpha=0.3)
+    axs[0].set_ylabel("success rate %, 95% Wilson CI")
+    axs[0].legend(fontsize=8)
+    fig.suptitle("default office scenario")
+    fig.tight_layout()
+    p = os.path.join(figdir, "seek_success_vs_noise.png")
+    fig.savefig(p + ".tmp.png", dpi=80)
+    os.replace(p + ".tmp.png", p)
+    plt.close(fig)
+    return p
+
+
+def fig_bridge(figdir, field, settle, src):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    x, y, f = field
+    fig, ax = plt.subplots(figsize=(10, 4))
+    sc = ax.scatter(x, y, c=f, s=1, cmap="viridis", marker="s", linewidths=0)
+    fig.colorbar(sc, ax=ax, label="true f = -|R1-R2| - |R1+R2|, dB (seed 1 field, no fading)")
+    s = np.array(settle)
+    ax.plot(s[:, 0], s[:, 1], "r.", ms=4, label="where runs settled (all seeds)")
+    i = int(np.argmax(f))
+    ax.plot(x[i], y[i], "w*", ms=14, mec="k", label="best point of f (seed 1)")
+    for k, (sx, sy) in enumerate(src):
+        ax.plot(sx, sy, "^", color="orange", ms=10, mec="k", label="source" if k == 0 else None)
+    ax.set_aspect("equal")
+    ax.legend(fontsize=7, loc="upper left", ncol=2)
+    ax.set_title("bridging (paper section 6, cf. fig. 7): settling points of meta")
+    fig.tight_layout()
+    p = os.path.join(figdir, "seek_bridge.png")
+    fig.savefig(p + ".tmp.png", dpi=80)
+    os.replace(p + ".tmp.png", p)
+    plt.close(fig)
+    return p
+
+
+# ---- the benchmark ---------------------------------------------------------------------
+
+def bridging(args, tmp, seeds):
+    """Settle points of meta on the bridge scenario vs the best point of each seed's f."""
+    scen = scenario_path("bridge")
+
+    def one(seed):
+        d = os.path.join(tmp, "bridge-%d" % seed)
+        single_run(args, scen, seed, d, "meta", field=True)
+        a = np.loadtxt(os.path.join(d, "field.tsv"), skiprows=1, usecols=(0, 1, 3))
+        b = np.loadtxt(os.path.join(d, "field1.tsv"), skiprows=1, usecols=(0, 1, 3))
+        f = -np.abs(a[:, 2] - b[:, 2]) - np.abs(a[:, 2] + b[:, 2])
+        s = read_tsv(os.path.join(d, "track.tsv"))
+        fx, fy = fnum(s[-1]["x_m"]), fnum(s[-1]["y_m"])
+        i = int(np.argmax(f))
+        j = int(np.argmin((a[:, 0] - fx) ** 2 + (a[:, 1] - fy) ** 2))
+        keep = (a[:, 0], a[:, 1], f) if seed == 1 else None
+        shutil.rmtree(d)
+        return seed, fx, fy, math.hypot(fx - a[i, 0], fy - a[i, 1]), f[j], f[i], keep
+
+    with ThreadPoolExecutor(max_workers=args.jobs) as ex:
+        out = []
+        for k, r in enumerate(ex.map(one, range(1, seeds + 1))):
+            out.append(r)
+            sys.stderr.write("\rbridging %d/%d seeds" % (k + 1, seeds))
+        sys.stderr.write("\n")
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--bin", default="build/bin/rfseek-sim", help="rfseek-sim to run")
+    ap.add_argument("--seeds", type=int, default=200, help="seeds per strategy x scenario")
+    ap.add_argument("--noise-seeds", type=int, default=None, help="seeds per noise point")
+    ap.add_argument("--model-seeds", type=int, default=None, help="seeds per model x scenario")
+    ap.add_argument("--slow-model-seeds", type=int, default=10, help="seeds for mlp and knn")
+    ap.add_argument("--bridge-seeds", type=int, default=None, help="seeds for bridging")
+    ap.add_argument("--jobs", type=int, default=2, help="worker processes (both cores: 2)")
+    ap.add_argument("--results", default="docs/RESULTS.md", help="markdown output")
+    ap.add_argument("--figures", default="docs/figures", help="figure directory")
+    ap.add_argument("--quiet", action="store_true", help="no per-batch progress bars")
+    ap.add_argument("--smoke", action="store_true",
+                    help="2 seeds, default scenario only, output to a temporary directory; "
+                         "prints PASS/FAIL bench-seek-smoke")
+    args = ap.parse_args()
+    if not os.access(args.bin, os.X_OK):
+        sys.stderr.write("bench_seek.py: %s: not an executable (build it first)\n" % args.bin)
+        return 1
+    if args.seeds < 1 or args.jobs < 1:
+        sys.stderr.write("bench_seek.py: --seeds and --jobs must be at least 1\n")
+        return 1
+    scenarios = ["default"] if args.smoke else SCENARIOS
+    if args.smoke:
+        args.seeds, args.slow_model_seeds, args.quiet = 2, 0, True
+    ns = args.noise_seeds or args.seeds
+    ms = args.model_seeds or args.seeds
+    bs = args.bridge_seeds or args.seeds
+    tmp = tempfile.mkdtemp(prefix="bench_seek.")
+    smoke_dir = tempfile.mkdtemp(prefix="bench_seek_out.") if args.smoke else None
+    results = os.path.join(smoke_dir, "RESULTS.md") if args.smoke else args.results
+    figdir = os.path.join(smoke_dir, "figures") if args.smoke else args.figures
+    os.makedirs(figdir, exist_ok=True)
+    t_all = time.time()
+    try:
+        # 1. every strategy on every scenario
+        tags, table = {}, {}
+        jobs = [(sc, st) for sc in scenarios for st in STRATEGIES]
+        t0 = time.time()
+        for i, (sc, st) in enumerate(jobs):
+            log("[%d/%d] %s on %s, %d seeds (%.0f s so far)" % (i + 1, len(jobs), st, sc,
+                                                                 args.seeds, time.time() - t0))
+            tag = "%s-%s" % (sc, st)
+            tags[(sc, st)] = tag
+            keep = set(range(1, 6)) if sc == "default" else set()
+            table[(sc, st)] = run_batch(args, tmp, scenario_path(sc), st, "ridge", args.seeds,
+                                        tag, keep)
+        t_sweep = time.time() - t0
+        # 2. shadowing and noise on the default scenario (4/4 is the default itself)
+        sweep = {"shadow": {st: {} for st in STRATEGIES}, "noise": {st: {} for st in STRATEGIES}}
+        variants = [(0, 4), (8, 4), (4, 2), (4, 8)]
+        t0 = time.time()
+        for st in STRATEGIES:
+            base = summarise(table[("default", st)]) if ns == args.seeds else None
+            for sh, no in [(4, 4)] + variants:
+                if (sh, no) == (4, 4) and base is not None:
+                    s = base
+                else:
+                    log("noise sweep: %s at shadowing %g dB, noise %g dB" % (st, sh, no))
+                    sf = make_variant(tmp, sh, no)
+                    tag = "var-%s-%g-%g" % (st, sh, no)
+                    s = summarise(run_batch(args, tmp, sf, st, "ridge", ns, tag, set()))
+                if no == 4:
+                    sweep["shadow"][st][sh] = s
+                if sh == 4:
+                    sweep["noise"][st][no] = s
+        t_noise = time.time() - t0
+        # 3. internal models under meta
+        mtab = {}
+        t0 = time.time()
+        for sc in scenarios:
+            for m in MODELS:
+                n = args.slow_model_seeds if m in SLOW_MODELS else ms
+                if n == 0:
+                    mtab[(sc, m)] = None
+                    continue
+                if m == "ridge" and n == args.seeds:
+                    mtab[(sc, m)] = summarise(table[(sc, "meta")])
+                    continue
+                log("models: %s on %s, %d seeds" % (m, sc, n))
+                mtab[(sc, m)] = summarise(run_batch(args, tmp, scenario_path(sc), "meta", m, n,
+                                                    "model-%s-%s" % (sc, m), set()))
+        t_models = time.time() - t0
+        # 4. bridging
+        t0 = time.time()
+        br = bridging(args, tmp, 2 if args.smoke else bs)
+        t_bridge = time.time() - t0
+        # 5. figures
+        figs = fig_trajectories(figdir, tmp, tags, "default", args.seeds)
+        figs.append(fig_rssi(figdir, tmp, args, "default"))
+        figs.append(fig_noise(figdir, sweep))
+        src, _ = scenario_sources(scenario_path("bridge"))
+        figs.append(fig_bridge(figdir, br[0][6], [(r[1], r[2]) for r in br], src))
+        # failure analysis needs the walls for the unlabelled floors
+        walls = {}
+        for sc in scenarios:
+            if sc not in REGIONS:
+                d = os.path.join(tmp, "field-%s" % sc)
+                single_run(args, scenario_path(sc), 1, d, "meta", field=True)
+                walls[sc] = walls_lookup(os.path.join(d, "field.tsv"))
+        t_total = time.time() - t_all
+        write_results(args, results, scenarios, table, sweep, mtab, br, walls, figs,
+                      dict(sweep=t_sweep, noise=t_noise, models=t_models, bridge=t_bridge,
+                           total=t_total), ns, ms, bs)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    if args.smoke:
+        with open(results) as f:
+            text = f.read()
+        ok = all(("| %s |" % st) in text for st in STRATEGIES) and all(
+            os.path.getsize(p) > 10000 for p in glob.glob(os.path.join(figdir, "*.png"))) and \
+            len(glob.glob(os.path.join(figdir, "*.png"))) == len(STRATEGIES) + 3
+        shutil.rmtree(smoke_dir, ignore_errors=True)
+        print("%s bench-seek-smoke" % ("PASS" if ok else "FAIL"))
+        return 0 if ok else 1
+    log("wrote %s (%.0f s)" % (results, time.time() - t_all))
+    return 0
+
+
+def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, times, ns, ms, bs):
+    L = []
+    A = L.append
+    A("# Seeking efficacy (issue 7)\n")
+    A("Produced by `make bench-seek` (`%s scripts/bench_seek.py --seeds %d --jobs %d "
+      "--slow-model-seeds %d%s%s%s`), simulator `rfseek-sim` in-process core, fixed point. "
+      "Seeds 1..N of every scenario; the same seeds for every strategy, so differences "
+      "between rows are paired." % (sys.executable, args.seeds, args.jobs,
+                                    args.slow_model_seeds,
+                                    " --noise-seeds %d" % ns if ns != args.seeds else "",
+                                    " --model-seeds %d" % ms if ms != args.seeds else "",
+                                    " --bridge-seeds %d" % bs if bs != args.seeds else ""))
+    A("")
+    A("**Definitions.** *Success*: within 1.5 m of the source before 150 m of travel (and "
+      "900 s). *Travel*: path length of the true robot position. *Ratio*: travel / "
+      "shortest path from the start around walls (with 0.25 m clearance), median over the "
+      "successful runs. *Model updates*: decisions at which the model was relearnt "
+      "(plane-gradient relearns at every step by definition; fd-gradient and chemotaxis "
+      "have no model). *Epsilon travel %*: travel during iterations that were epsilon "
+      "steps, over all travel (only meta and meta-global take epsilon steps). *Detour %*: "
+      "sum over iterations of (planned path length - straight line from the decision "
+      "position to the goal) over the sum of planned path lengths, i.e. the part of the "
+      "planned travel spent going around walls and obstacles.\n")
+    A("**Strategies** (common/rfs_seek.c; same sensors, 1 m step, map legality and path "
+      "planner): `meta` the paper's meta-algorithm with the paper's defaults (local ridge "
+      "5 m, alpha 1, 3 dB threshold, epsilon(5) = 0.5); `meta-global` the same with the "
+      "ridge radius covering the map; `fd-gradient` 1 s means standing at p, p + 1 m x and "
+      "p + 1 m y (or - 1 m where + is illegal), then a 1 m step from p along the estimated "
+      "gradient; `plane-gradient` the local ridge refit at every step and a 1 m step along "
+      "its gradient, no epsilon and no check (section 4.1's view); `chemotaxis` "
+      "run-and-tumble on the change of the 1 s mean between decisions (tumble with "
+      "p = 0.2 after a rise, always after a fall; 16 headings), position used only for "
+      "legality and planning. A gradient step whose end point is illegal goes to the "
+      "nearest reachable legal lattice point around it.\n")
+    A("## Every strategy on every shipped scenario (shadowing and noise as the scenario "
+      "file says; default: 4 dB / 4 dB)\n")
+    for sc in scenarios:
+        A("### %s\n" % sc)
+        A(HEAD % "strategy")
+        for st in STRATEGIES:
+            A(row(st, summarise(table[(sc, st)])))
+        A("")
+    # where meta does not win
+    A("### Where meta does not win\n")
+    notes = []
+    for sc in scenarios:
+        m = summarise(table[(sc, "meta")])
+        for st in STRATEGIES[1:]:
+            o = summarise(table[(sc, st)])
+            if o["p"] >= m["p"]:
+                sig = " (CIs overlap)" if o["lo"] <= m["hi"] else " (CIs do not overlap)"
+                notes.append("- %s: `%s` %.1f %% >= `meta` %.1f %%%s" %
+                             (sc, st, 100 * o["p"], 100 * m["p"], sig))
+    A("\n".join(notes) if notes else "- meta has the highest success rate in every scenario.")
+    A("")
+    A("## Default scenario at other shadowing and noise levels\n")
+    A("Generated scenario variants of scenarios/default.yaml (shadowing correlation 5 m; "
+      "shadowing 0 dB = shadowing disabled). %d seeds each.\n" % ns)
+    for key, lab in (("shadow", "shadowing dB (noise 4 dB)"),
+                     ("noise", "noise dB (shadowing 4 dB)")):
+        A(HEAD % ("strategy, " + lab))
+        for st in STRATEGIES:
+            for x, s in sorted(sweep[key][st].items()):
+                A(row("%s, %g" % (st, x), s))
+        A("")
+    A("![success vs shadowing and noise](figures/seek_success_vs_noise.png)\n")
+    A("## Failure analysis\n")
+    A("Where failed runs ended and how close they came (final straight-line distance to "
+      "the source). Labelled regions: the office (default) floor: corridor y 5..7 m, 5 m "
+      "rooms either side; lshape: the corridors and rooms of scripts/make_maps.py; open: "
+      "one hall. The real floors (willow, 3ne, intel) carry no room labels: their end "
+      "points are classed by the walls the straight line to the source crosses "
+      "(simulator geometry).\n")
+    A("| scenario | strategy | failed | end region counts | median final distance m | "
+      "min final distance m |\n|---|---|---|---|---|---|")
+    for sc in scenarios:
+        src, _ = scenario_sources(scenario_path(sc))
+        for st in STRATEGIES:
+            fails = [r for r in table[(sc, st)] if not r["reached"]]
+            if not fails:
+                A("| %s | %s | 0 | - | - | - |" % (sc, st))
+                continue
+            cnt = {}
+            for r in fails:
+                k = region_of(sc, r["fx"], r["fy"], src[0], walls.get(sc))
+                cnt[k] = cnt.get(k, 0) + 1
+            fd = [r["final_d"] for r in fails]
+            A("| %s | %s | %d | %s | %.1f | %.1f |" %
+              (sc, st, len(fails), ", ".join("%s %d" % kv for kv in sorted(cnt.items())),
+               float(np.median(fd)), float(np.min(fd))))
+    A("")
+    A("## Bridging (paper section 6)\n")
+    d = np.array([r[3] for r in br])
+    fr = np.array([r[4] for r in br])
+    fb = np.array([r[5] for r in br])
+    A("scenarios/bridge.yaml: two sources in different rooms of the office floor, target "
+      "f = -|R1 - R2| - |R1 + R2|, error threshold 7 (the paper's value for this noisier "
+      "target; rfseek-sim sets it for target: bridge), strategy meta, %d seeds, each run "
+      "ending on 150 m or 600 s. *Settle point*: the robot's position at the end of the "
+      "run. *True f*: from each seed's mean field (path loss, walls and that seed's "
+      "shadowing; no fading, no noise) of both sources on a 0.1 m grid of free cells.\n"
+      % len(br))
+    A("| quantity | median | p10 | p90 |\n|---|---|---|---|")
+    A("| distance from the settle point to the best point of the true f, m | %.1f | %.1f | "
+      "%.1f |" % (np.median(d), np.percentile(d, 10), np.percentile(d, 90)))
+    A("| f at the settle point, dB | %.1f | %.1f | %.1f |" %
+      (np.median(fr), np.percentile(fr, 10), np.percentile(fr, 90)))
+    A("| best f of the field, dB | %.1f | %.1f | %.1f |" %
+      (np.median(fb), np.percentile(fb, 10), np.percentile(fb, 90)))
+    A("| shortfall f(best) - f(settle), dB | %.1f | %.1f | %.1f |" %
+      (np.median(fb - fr), np.percentile(fb - fr, 10), np.percentile(fb - fr, 90)))
+    A("| runs settling within 3 m of the best point | %d of %d | | |" %
+      (int((d <= 3.0).sum()), len(d)))
+    A("")
+    A("![bridging](figures/seek_bridge.png)\n")
+    A("## Internal models (strategy meta)\n")
+    A("Models from the registry common/rfs_models.h (`--model NAME`). %d seeds each, "
+      "except mlp and knn: %d seeds (they are slow in the simulator: the MLP's sliced "
+      "training and the kNN's grid search over every lattice point cost seconds per run); "
+      "their CIs are correspondingly wide. The ridge rows are the meta rows above.\n"
+      % (ms, args.slow_model_seeds))
+    for sc in scenarios:
+        A("### %s\n" % sc)
+        A(HEAD % "model")
+        for m in MODELS:
+            A(row(m, mtab[(sc, m)]) if mtab[(sc, m)] else "| %s | 0 | not run |" % m)
+        A("")
+    A("## Figures\n")
+    for st in STRATEGIES:
+        A("Five runs of `%s` on the default office (seeds 1-5; red circles: model updates; "
+          "orange crosses: epsilon or tumble steps):\n\n![%s](figures/seek_traj_%s.png)\n"
+          % (st, st, st))
+    A("RSSI against distance travelled (every received packet, grey; 1 m moving average, "
+      "blue), seed 1 of each strategy on the default office:\n\n"
+      "![rssi](figures/seek_rssi_vs_distance.png)\n")
+    A("## Wall time of the benchmark\n")
+    A("On this machine (2 cores, shared with other builds while it ran), `--jobs %d`: "
+      "strategy sweep (%d scenarios x %d strategies x %d seeds) %.0f s; noise sweep %.0f s; "
+      "models %.0f s; bridging %.0f s; whole benchmark including figures %.0f s (%.1f min)."
+      % (args.jobs, len(scenarios), len(STRATEGIES), args.seeds, times["sweep"],
+         times["noise"], times["models"], times["bridge"], times["total"],
+         times["total"] / 60))
+    A("")
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write("\n".join(L))
+    os.replace(tmp, path)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,213 @@
+/* test_app.c - the application loop (firmware/rfs_app.h) on the host: configuration and
+ * map checks, the safety stops (input lost, bus-off, reset) against the requirement of
+ * issue 6 (zero wheels within 200 ms), CAN in and out through common/rfs_can.h's own
+ * decoders. */
+#include "rfs_test.h"
+
+#include <string.h>
+
+#include "rfs_app.h"
+#include "rfs_can.h"
+
+#define W 200u /* 20 x 10 m at 0.1 m */
+#define H 100u
+static uint8_t s_free[(W + 7u) / 8u * H];
+static rfs_app_t s_app;
+
+static rfs_app_map_t room(void)
+{
+    memset(s_free, 0, sizeof s_free);
+    for (uint16_t y = 1; y < H - 1u; y++) {
+        for (uint16_t x = 1; x < W - 1u; x++) {
+            rfs_map_bit_set(s_free, (W + 7u) / 8u, x, y, true);
+        }
+    }
+    const rfs_app_map_t m = {.w = W, .h = H, .res = RFS_Q16_FRAC(1, 10), .origin_x = 0,
+                             .origin_y = 0, .free = s_free, .wall = NULL};
+    return m;
+}
+
+/* Feed 10 Hz poses at (5, 5) and 200/s packets up to t_end, stepping at 20 Hz; returns the
+ * number of steps with non-zero wheels. The robot is held in place: it turns or drives
+ * towards its goal without reaching it. */
+static int run(int64_t t0, int64_t t_end, bool poses, bool rssi, rfs_app_out_t *last)
+{
+    int moving = 0;
+    for (int64_t t = t0; t < t_end; t += 5000) {
+        if (poses && t % 100000 == 0) {
+            const rfs_pose_t p = {.t_us = t, .x = RFS_Q16_INT(5), .y = RFS_Q16_INT(5), .theta = 0};
+            rfs_app_on_pose(&s_app, &p, t);
+        }
+        if (rssi) {
+            rfs_app_on_rssi(&s_app, 0, t, (int8_t)(-60 - (t / 5000) % 3), t);
+        }
+        if (t % RFS_APP_PERIOD_US == 0) {
+            rfs_app_step(&s_app, t, last);
+            moving += (last->left_mm_s != 0 || last->right_mm_s != 0);
+        }
+    }
+    return moving;
+}
+
+static void test_init_checks_configuration_and_map(void **state)
+{
+    (void)state;
+    rfs_app_cfg_t c = rfs_app_cfg_default();
+    rfs_app_map_t m = room();
+    rfs_app_map_t big = m;
+    big.w = 1000; /* 125 bytes x 100 rows = 12,500 > 6,400 */
+
+    assert_int_equal(rfs_app_init(&s_app, &c, &big), -1);
+    c.target = (rfs_app_target_t)2;
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), -1);
+    c = rfs_app_cfg_default();
+    c.input_timeout_us = 0;
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), -1);
+    c = rfs_app_cfg_default();
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    assert_int_equal(rfs_app_cfg_mcu().seek.fit_budget, 2500u);
+    assert_int_equal(rfs_app_cfg_default().seek.fit_budget, 0u);
+}
+
+static void test_first_step_after_reset_is_zero_and_flagged(void **state)
+{
+    (void)state;
+    const rfs_app_cfg_t c = rfs_app_cfg_default();
+    const rfs_app_map_t m = room();
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    rfs_app_out_t o;
+
+    rfs_app_step(&s_app, 0, &o);
+
+    assert_int_equal(o.left_mm_s, 0);
+    assert_int_equal(o.right_mm_s, 0);
+    assert_true(o.faults & RFS_APP_FAULT_RESET);
+    assert_true(o.faults & RFS_APP_FAULT_POSE_LOST);
+    rfs_app_step(&s_app, 50000, &o);
+    assert_false(o.faults & RFS_APP_FAULT_RESET);
+}
+
+static void test_wheels_stop_within_200_ms_of_lost_inputs_and_resume(void **state)
+{
+    (void)state;
+    const rfs_app_cfg_t c = rfs_app_cfg_default();
+    const rfs_app_map_t m = room();
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    rfs_app_out_t o;
+    assert_true(run(0, 2000000, true, true, &o) > 0);
+    assert_true(o.left_mm_s != 0 || o.right_mm_s != 0); /* driving when the poses stop */
+
+    /* Poses stop after the one at 1.9 s; RSSI continues. From 2.1 s on: zero. */
+    run(2000000, 2100000, false, true, &o);
+    assert_int_equal(run(2100000, 3000000, false, true, &o), 0);
+    assert_true(o.faults & RFS_APP_FAULT_POSE_LOST);
+    assert_int_equal(o.left_mm_s, 0);
+
+    /* Poses return: driving resumes. */
+    assert_true(run(3000000, 6000000, true, true, &o) > 0);
+
+    /* RSSI stops after 5.995 s, poses continue: zero from 6.195 s. */
+    run(6000000, 6200000, true, false, &o);
+    assert_int_equal(run(6200000, 7000000, true, false, &o), 0);
+    assert_true(o.faults & RFS_APP_FAULT_RSSI_LOST);
+}
+
+static void test_bus_off_stops_at_once_and_recovers(void **state)
+{
+    (void)state;
+    const rfs_app_cfg_t c = rfs_app_cfg_default();
+    const rfs_app_map_t m = room();
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    rfs_app_out_t o;
+    run(0, 2000000, true, true, &o);
+    assert_true(o.left_mm_s != 0 || o.right_mm_s != 0);
+
+    rfs_app_set_bus_off(&s_app, true);
+    assert_int_equal(run(2000000, 2500000, true, true, &o), 0);
+    assert_true(o.faults & RFS_APP_FAULT_BUS_OFF);
+    rfs_app_set_bus_off(&s_app, false);
+    assert_true(run(2500000, 5000000, true, true, &o) > 0);
+    assert_false(o.faults & RFS_APP_FAULT_BUS_OFF);
+}
+
+static void test_frames_decode_with_the_protocol_decoders(void **state)
+{
+    (void)state;
+    const rfs_app_cfg_t c = rfs_app_cfg_default();
+    const rfs_app_map_t m = room();
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    rfs_app_out_t o;
+    memset(&o, 0, sizeof o);
+    o.left_mm_s = -123;
+    o.right_mm_s = 456;
+    o.state = RFS_SEEK_DRIVING;
+    o.faults = RFS_APP_FAULT_RSSI_LOST;
+    o.decision.iteration = 77;
+    o.decision.kind = RFS_SEEK_EPSILON;
+    rfs_can_frame_t f[2];
+
+    assert_int_equal(rfs_app_frames(&s_app, &o, f), 2);
+
+    rfs_can_wheel_t w;
+    rfs_can_status_t st;
+    uint8_t ctr = 99;
+    assert_int_equal(rfs_can_unpack_wheel(&f[0], &w, &ctr), RFS_CAN_OK);
+    assert_int_equal(f[0].id, 0x100);
+    assert_int_equal(w.left_mm_s, -123);
+    assert_int_equal(w.right_mm_s, 456);
+    assert_int_equal(w.flags, RFS_CAN_WHEEL_STOP); /* a safety stop holds */
+    assert_int_equal(ctr, 0);
+    assert_int_equal(rfs_can_unpack_status(&f[1], &st, &ctr), RFS_CAN_OK);
+    assert_int_equal(st.state, 3);
+    assert_int_equal(st.kind, 3);
+    assert_int_equal(st.iteration, 77);
+    assert_int_equal(st.faults, RFS_SEEK_FAULT_RSSI_STALE);
+    rfs_app_frames(&s_app, &o, f);
+    assert_int_equal(rfs_can_unpack_wheel(&f[0], &w, &ctr), RFS_CAN_OK);
+    assert_int_equal(ctr, 1); /* rolling counter */
+}
+
+static void test_can_inputs_are_decoded_or_counted(void **state)
+{
+    (void)state;
+    const rfs_app_cfg_t c = rfs_app_cfg_default();
+    const rfs_app_map_t m = room();
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    rfs_can_tx_t tx;
+    rfs_can_tx_init(&tx);
+    const rfs_pose_t pose = {.t_us = 100000, .x = RFS_Q16_INT(5), .y = RFS_Q16_INT(5), .theta = 0};
+    const rfs_can_pose_t cp = rfs_can_pose_from_core(&pose);
+    rfs_can_frame_t xy, th, r, unknown = {0x7AB, 2, {1, 2}};
+    rfs_can_tx_pose(&tx, &cp, &xy, &th);
+    const rfs_can_rssi_t cr = {.src = 0, .dbm = -61, .seq = 0, .t_us32 = 100000};
+    rfs_can_tx_rssi(&tx, &cr, &r);
+
+    assert_int_equal(rfs_app_on_can(&s_app, &xy, 100000), RFS_CAN_OK);
+    assert_int_equal(rfs_app_on_can(&s_app, &th, 100000), RFS_CAN_OK);
+    assert_int_equal(rfs_app_on_can(&s_app, &r, 100000), RFS_CAN_OK);
+    assert_int_equal(s_app.stats.poses, 1);
+    assert_int_equal(s_app.stats.rssi, 1);
+    assert_int_equal(rfs_app_on_can(&s_app, &unknown, 100000), RFS_CAN_E_ID);
+    assert_int_equal(s_app.stats.unknown_frames, 1);
+    r.data[2] ^= 0x01; /* checksum no longer matches */
+    assert_int_equal(rfs_app_on_can(&s_app, &r, 100000), RFS_CAN_E_CHECKSUM);
+    assert_int_equal(s_app.stats.bad_frames, 1);
+    rfs_app_out_t o;
+    rfs_app_step(&s_app, 100000, &o);
+    assert_true(o.faults & RFS_APP_FAULT_BAD_FRAME);
+    rfs_app_step(&s_app, 150000, &o);
+    assert_false(o.faults & RFS_APP_FAULT_BAD_FRAME);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_init_checks_configuration_and_map),
+        cmocka_unit_test(test_first_step_after_reset_is_zero_and_flagged),
+        cmocka_unit_test(test_wheels_stop_within_200_ms_of_lost_inputs_and_resume),
+        cmocka_unit_test(test_bus_off_stops_at_once_and_recovers),
+        cmocka_unit_test(test_frames_decode_with_the_protocol_decoders),
+        cmocka_unit_test(test_can_inputs_are_decoded_or_counted),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -484,7 +484,7 @@ static uint32_t eval_units(rfs_pathloss_t *p, uint16_t li, uint16_t lj, int32_t 
     return (p->walls_counted - counted) + (p->walls_cached - cached) / CACHED_PER_UNIT + 1u;
 }
 
-/* Mean Huber loss per sample, dB^2 Q16, saturated below NO_LOSS. */
+/* Mean Huber loss per unit weight, dB^2 Q16, saturated below NO_LOSS. */
 static uint32_t mean_loss(const rfs_pathloss_t *p, int64_t loss)
 {
     uint64_t m = rfs_udiv64((uint64_t)loss, p->total);

@@ -210,8 +210,9 @@ typedef struct rfs_pathloss {
     rfs_pathloss_row_t rows[RFS_PATHLOSS_CACHE_ROWS]; ///< cached origins
     uint8_t walls[RFS_PATHLOSS_CACHE_ROWS][RFS_PATHLOSS_CACHE_COLS / 2u]; ///< 4-bit counts,
                                                   ///< column c in the low nibble when even
-    uint32_t surface[RFS_PATHLOSS_MAX_COARSE];    ///< mean Huber loss per sample of each coarse
-                                                  ///< point, dB^2 Q16.16; NO_LOSS = no candidate
+    uint32_t surface[RFS_PATHLOSS_MAX_COARSE];    ///< mean Huber loss per unit weight of
+                                                  ///< each coarse point, dB^2 Q16.16;
+                                                  ///< NO_LOSS = no candidate
 } rfs_pathloss_t;
 
 /// Defaults (see rfs_pathloss_cfg_t).

@@ -165,13 +165,14 @@ static void accumulate(rfs_ridge_acc_t *a, const rfs_sample_t *smp, uint32_t fro
         return;
     }
     /* Block length: K r^2 < 2^31 (squares and u v) and K r 2^15 < 2^31 (u z). r <= 30,000
-     * gives K >= 2; the paper's 5 m gives K = 127. */
+     * gives K >= 2; the paper's 5 m gives K = 127. A radius below half a centimetre rounds
+     * to r = 0: only samples exactly at the query count, every product is 0. */
     const uint32_t r = (uint32_t)r_cm;
     uint32_t k = RIDGE_BLOCK_MAX;
-    if (k > 0x7FFFFFFFu / (r * r)) {
+    if (r != 0u && k > 0x7FFFFFFFu / (r * r)) {
         k = 0x7FFFFFFFu / (r * r);
     }
-    if (k > 0xFFFFu / r) {
+    if (r != 0u && k > 0xFFFFu / r) {
         k = 0xFFFFu / r;
     }
     while (from < to) {

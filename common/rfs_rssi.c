@@ -46,6 +46,12 @@ static void drop_oldest(rfs_rssi_t *w)
     w->count--;
 }
 
+/* later - earlier >= window for later >= earlier, without overflow at any int64 times. */
+static bool window_apart(int64_t later, int64_t earlier, uint32_t window_us)
+{
+    return (uint64_t)later - (uint64_t)earlier >= window_us;
+}
+
 /* Advance the clock to t_us (if later) and drop the entries with t <= clock - window.
  * Kept entries lie in (old clock - window, last_us], so when the clock has moved less
  * than a window past last_us every age below is < 2 * window < 2^31 us. */
@@ -55,7 +61,7 @@ static void advance(rfs_rssi_t *w, int64_t t_us)
         return;
     }
     w->clock_us = t_us;
-    if (t_us - w->last_us >= (int64_t)w->cfg.window_us) {
+    if (window_apart(t_us, w->last_us, w->cfg.window_us)) { /* t_us > clock >= last_us */
         w->head = 0u;
         w->count = 0u;
         w->sum_dbm = 0;
@@ -92,7 +98,7 @@ bool rfs_rssi_push(rfs_rssi_t *w, int64_t t_us, int8_t dbm)
     }
     advance(w, t_us);
     w->last_us = t_us;
-    if (t_us <= w->clock_us - (int64_t)w->cfg.window_us) {
+    if (window_apart(w->clock_us, t_us, w->cfg.window_us)) { /* clock >= t_us here */
         return true; /* a query already moved the window past it */
     }
     if (w->count == RFS_RSSI_CAP) {
@@ -122,7 +128,7 @@ static uint16_t window_sum(rfs_rssi_t *w, int64_t now_us, int32_t *sum)
         *sum = w->sum_dbm;
         return w->count;
     }
-    if (now_us <= w->clock_us - (int64_t)w->cfg.window_us) {
+    if (window_apart(w->clock_us, now_us, w->cfg.window_us)) { /* clock >= now_us here */
         return 0u; /* every kept entry is newer than now_us */
     }
     uint32_t now_lo = (uint32_t)now_us;

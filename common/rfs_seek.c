@@ -10,7 +10,7 @@
 /* Line-search candidates and epsilon redraws tried before giving up on an iteration. */
 #define GOAL_TRIES 6
 /* Lattice points predicted per predict_row call in the grid search (stack buffer). */
-#define RFS_SEEK_ROW_CHUNK 64
+#define RFS_SEEK_ROW_CHUNK 16
 /* How far (lattice steps) an off-lattice or illegal start looks for a legal lattice point. */
 #define SNAP_RADIUS 6
 

@@ -102,10 +102,11 @@ static bracket_t interpolate(const rfs_store_t *s, int64_t t_us, rfs_q16_t *x, r
             return BRACKET_OK;
         }
         const rfs_pose_t *p1 = pose_at(s, (uint8_t)(i + 1));
-        int64_t span = p1->t_us - p0->t_us;
-        if (span > s->cfg.max_gap_us) {
+        /* p1 is newer than p0: the unsigned difference is exact at any int64 times */
+        if ((uint64_t)p1->t_us - (uint64_t)p0->t_us > (uint64_t)s->cfg.max_gap_us) {
             return BRACKET_GAP;
         }
+        int64_t span = p1->t_us - p0->t_us;
         int64_t dt = t_us - p0->t_us;
         *x = lerp(p0->x, p1->x, dt, span);
         *y = lerp(p0->y, p1->y, dt, span);

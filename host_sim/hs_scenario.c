@@ -281,11 +281,61 @@ static int parse_radio(pctx_t *p, yaml_node_t *r, hs_radio_cfg_t *c)
     return 0;
 }
 
+/// faults: a list of {kind, start_s, duration_s, ...} (hs_faults.h, docs/FAULTS.md).
+static int parse_faults(pctx_t *p, yaml_node_t *n, hs_scenario_t *sc)
+{
+    if (n->type != YAML_SEQUENCE_NODE) {
+        return fail(p, n, "faults: expected a list of faults");
+    }
+    long nf = n->data.sequence.items.top - n->data.sequence.items.start;
+    if (nf > (long)HS_FAULTS_MAX) {
+        return fail(p, n, "faults: %ld given, at most %u", nf, HS_FAULTS_MAX);
+    }
+    static const char *const k[] = {"kind", "start_s", "duration_s", "offset", "position",
+                                    "theta", "lag_s", "probability", "source", NULL};
+    for (long i = 0; i < nf; i++) {
+        yaml_node_t *f = yaml_document_get_node(&p->doc, n->data.sequence.items.start[i]);
+        char where[32], kind[32] = "";
+        snprintf(where, sizeof where, "faults[%ld]", i);
+        if (check_keys(p, f, where, k) || str(p, f, where, "kind", kind, sizeof kind)) {
+            return -1;
+        }
+        hs_fault_kind_t fk;
+        if (!hs_faults_kind_parse(kind, &fk)) {
+            return fail(p, get(p, f, "kind") ? get(p, f, "kind") : f,
+                        "%s.kind: '%s' is not a fault (rssi_silence, rssi_past, rssi_reorder, "
+                        "pose_jump, pose_past, pose_reorder, can_drop, bus_off, source_move, "
+                        "kidnap)", where, kind);
+        }
+        hs_fault_t *ft = &sc->faults.f[i];
+        *ft = hs_faults_default(fk);
+        double src = 0.0;
+        bool need_pos = fk == HS_FAULT_SOURCE_MOVE || fk == HS_FAULT_KIDNAP;
+        if (num(p, f, where, "start_s", 0, 1e6, &ft->start_s) ||
+            num(p, f, where, "duration_s", 0, 1e6, &ft->duration_s) ||
+            num(p, f, where, "theta", -7, 7, &ft->theta) ||
+            num(p, f, where, "lag_s", 0, 3600, &ft->lag_s) ||
+            num(p, f, where, "probability", 0, 1, &ft->probability) ||
+            num(p, f, where, "source", 0, HS_SCN_MAX_SOURCES - 1, &src) ||
+            (fk == HS_FAULT_POSE_JUMP && xy(p, f, where, "offset", false, &ft->x, &ft->y, NULL)) ||
+            (need_pos && xy(p, f, where, "position", true, &ft->x, &ft->y, NULL))) {
+            return -1;
+        }
+        ft->source = (unsigned)src;
+        char ferr[256];
+        if (src != (double)ft->source || hs_faults_check(ft, sc->nsources, ferr, sizeof ferr) != 0) {
+            return fail(p, f, "%s.%s", where, src != (double)ft->source ? "source: expected an index" : ferr);
+        }
+    }
+    sc->faults.n = (unsigned)nf;
+    return 0;
+}
+
 static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
 {
     static const char *const top[] = {"map", "seed", "model", "target", "strategy", "sources",
                                       "start", "localisation", "radio", "motor", "stop", "sim",
-                                      NULL};
+                                      "faults", NULL};
     if (check_keys(p, root, "scenario", top) != 0) {
         return -1;
     }
@@ -431,6 +481,9 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
             num(p, n, "sim", "clearance_m", 0, 5, &sc->clearance_m)) {
             return -1;
         }
+    }
+    if ((n = get(p, root, "faults")) && parse_faults(p, n, sc) != 0) {
+        return -1;
     }
     char rerr[256];
     if (hs_radio_cfg_check(&sc->radio, rerr, sizeof rerr) != 0) {

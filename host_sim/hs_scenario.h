@@ -18,6 +18,8 @@
  *   motor: {accel_m_s2: 1.0, timeout_ms: 200}
  *   stop: {radius_m: 1.5, max_distance_m: 150, max_time_s: 900, goal: [x, y]}
  *   sim: {physics_hz: 50, core_res_m: 0.1, clearance_m: 0.25}
+ *   faults:                        # optional fault schedule (docs/FAULTS.md)
+ *     - {kind: rssi_silence, start_s: 30, duration_s: 30}
  *
  * Unknown keys anywhere are errors. Errors are one line "file:line: field: reason".
  * Checks that need the map (positions inside walls, a stop condition that can never
@@ -30,6 +32,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "hs_faults.h"
 #include "hs_motor.h"
 #include "hs_radio.h"
 
@@ -70,6 +73,7 @@ typedef struct hs_scenario {
     double physics_hz;            ///< physics steps per second (50)
     double core_res_m;            ///< core map resolution, metres (0.1)
     double clearance_m;           ///< core legality clearance, metres (0.25)
+    hs_faults_cfg_t faults;       ///< fault schedule (none by default; docs/FAULTS.md)
 } hs_scenario_t;
 
 /// Defaults for everything optional (map, sources and start still missing).

@@ -195,6 +195,15 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
         hs_sim_env_close(e);
         return -1;
     }
+    for (unsigned i = 0; i < sc->faults.n; i++) {
+        char f[48];
+        snprintf(f, sizeof f, "faults[%u].position", i);
+        if (hs_faults_one_shot(sc->faults.f[i].kind) &&
+            check_point(e, f, sc->faults.f[i].x, sc->faults.f[i].y, err, errlen) != 0) {
+            hs_sim_env_close(e);
+            return -1;
+        }
+    }
     const rfs_map_t *cm = &e->core.map;
     rfs_q16_t qx = (rfs_q16_t)lround(sc->start_x * 65536.0);
     rfs_q16_t qy = (rfs_q16_t)lround(sc->start_y * 65536.0);
@@ -386,6 +395,11 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     rfs_rng_t rng_pkt, rng_pose;
     rfs_rng_seed(&rng_pkt, seed ^ 0x5A17C0FFEE000001ull);
     rfs_rng_seed(&rng_pose, seed ^ 0x5A17C0FFEE000002ull);
+    // Fault injection (hs_faults.h): inputs, commands and world events pass its hooks.
+    hs_faults_run_t fr;
+    hs_faults_start(&fr, &sc->faults, seed, io ? io->faults : NULL);
+    hs_faults_msg_t fm[2];
+    double goal_x = sc->goal_x, goal_y = sc->goal_y; // a moved source takes its goal along
 
     const int64_t dt_us = (int64_t)llround(1e6 / sc->physics_hz);
     const double dt_s = dt_us * 1e-6;
@@ -430,6 +444,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     for (;;) {
         double v, w;
         hs_motor_update(&motor, t + dt_us, dt_s, &v, &w);
+        hs_faults_motor(&fr, t, motor.timed_out); // the target this tick, [t, t + dt]
         hs_world_step(world, v, w, dt_s);
         double nx, ny, nth;
         hs_world_robot_pose(world, &nx, &ny, &nth);
@@ -475,7 +490,10 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
                 seq[s] = (uint16_t)((seq[s] + 1u) & 0x0FFFu); // 802.11 sequence numbers: 12 bits
                 if (got) {
                     res->packets_received++;
-                    ctrl->on_rssi(ctrl->self, (uint8_t)s, te, (int8_t)dbm);
+                    unsigned nm = hs_faults_rssi(&fr, te, (uint8_t)s, (int8_t)dbm, fm);
+                    for (unsigned k = 0; k < nm; k++) {
+                        ctrl->on_rssi(ctrl->self, fm[k].src, fm[k].t_us, fm[k].dbm);
+                    }
                     if (io && io->samples) {
                         fprintf(io->samples, "%.6f\t%u\t%.3f\t%.3f\t%.3f\t%d\n", te * 1e-6, s, ex,
                                 ey, etr, dbm);
@@ -489,7 +507,10 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
                 double my = ey + sc->pose_sigma_xy_m * hs_radio_gauss(&rng_pose);
                 double mth = wrap_pi(eth + sc->pose_sigma_theta_rad * hs_radio_gauss(&rng_pose));
                 rfs_pose_t pose = {te, dq16(mx), dq16(my), dq16(mth)};
-                ctrl->on_pose(ctrl->self, &pose);
+                unsigned nm = hs_faults_pose(&fr, &pose, fm);
+                for (unsigned k = 0; k < nm; k++) {
+                    ctrl->on_pose(ctrl->self, &fm[k].pose);
+                }
                 if (io && io->track) {
                     fprintf(io->track, "%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%.4f\t%d\n", te * 1e-6,
                             ex, ey, eth, mx, my, mth, hs_world_robot_touching(world) ? 1 : 0);
@@ -500,7 +521,9 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
                 hs_ctrl_out_t out;
                 memset(&out, 0, sizeof out);
                 ctrl->step(ctrl->self, te, &out);
-                hs_motor_command(&motor, te, out.left_mm_s, out.right_mm_s);
+                if (hs_faults_cmd(&fr, te, &out)) {
+                    hs_motor_command(&motor, te, out.left_mm_s, out.right_mm_s);
+                }
                 if (out.decided) {
                     const rfs_seek_decision_t *d = &out.decision;
                     res->iterations++;
@@ -532,8 +555,40 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
         py = ny;
         pth = nth;
         t = t1;
+        hs_faults_event_t fev;
+        while (hs_faults_next_event(&fr, t, &fev)) {
+            if (fev.kind == HS_FAULT_KIDNAP) {
+                // Carried away between two ticks: no travel, the wheels keep their command.
+                hs_world_place_robot(world, fev.x, fev.y, fev.theta);
+                hs_world_robot_pose(world, &px, &py, &pth);
+                continue;
+            }
+            rs[fev.source].x = fev.x;
+            rs[fev.source].y = fev.y;
+            hs_radio_t *moved = hs_radio_create(&sc->radio, rs, sc->nsources, e->x0, e->y0,
+                                                e->x1, e->y1, seed, walls_cb, world, werr,
+                                                sizeof werr);
+            if (!moved) {
+                hs_radio_destroy(radio);
+                hs_world_destroy(world);
+                snprintf(err, errlen, "%s: %s", sc->path, werr);
+                return -1;
+            }
+            // Same seed, same fields; the shared wall caches hold only unmoved sources.
+            for (unsigned k = 0; k < sc->nsources; k++) {
+                if (sc->src[k].x == rs[k].x && sc->src[k].y == rs[k].y) {
+                    hs_radio_use_wall_cache(moved, k, e->wall_cache[k]);
+                }
+            }
+            hs_radio_destroy(radio);
+            radio = moved;
+            if (fev.source == 0 && !sc->has_goal) {
+                goal_x = fev.x;
+                goal_y = fev.y;
+            }
+        }
         if (has_goal && sc->stop_radius_m > 0.0 &&
-            hypot(px - sc->goal_x, py - sc->goal_y) <= sc->stop_radius_m) {
+            hypot(px - goal_x, py - goal_y) <= sc->stop_radius_m) {
             end = "reached";
             res->reached = true;
             break;
@@ -554,7 +609,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     res->shortest_to_stop_m = e->shortest_to_stop_m;
     res->final_x = px;
     res->final_y = py;
-    res->final_distance_m = has_goal ? hypot(px - sc->goal_x, py - sc->goal_y) : NAN;
+    res->final_distance_m = has_goal ? hypot(px - goal_x, py - goal_y) : NAN;
     res->motor_timeouts = motor.timeouts;
     hs_radio_destroy(radio);
     hs_world_destroy(world);

@@ -45,6 +45,7 @@ typedef struct hs_sim_io {
     void (*on_packet)(void *ctx, unsigned src, int64_t t_us, uint16_t seq, bool received,
                       int dbm);
     void *packet_ctx;  ///< passed to on_packet
+    FILE *faults;      ///< fault-injection log (hs_faults.h: inputs, commands, events) or NULL
 } hs_sim_io_t;
 
 /// Outcome of one run (summary.json).

@@ -11,7 +11,7 @@ SEEK_JOBS ?= 2
 bench-seek: $(BUILD)/bin/rfseek-sim
 	$(PYTHON) scripts/bench_seek.py --bin $(BUILD)/bin/rfseek-sim --seeds $(SEEK_SEEDS) \
 		--model-seeds $(SEEK_MODEL_SEEDS) --slow-model-seeds $(SEEK_SLOW_SEEDS) \
-		--jobs $(SEEK_JOBS) --quiet
+		--jobs $(SEEK_JOBS)
 
 TEST_SCRIPTS += "$(PYTHON) scripts/bench_seek.py --smoke --jobs 2 --bin $(BUILD)/bin/rfseek-sim"
 TEST_SCRIPTS += "tests/host_sim/strategy_cli.sh $(BUILD)/bin/rfseek-sim"

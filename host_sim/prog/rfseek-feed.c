@@ -312,6 +312,7 @@ static int read_poses(const char *path, rp_pose_t **out, size_t *n_out, char *er
             rc = -1;
             break;
         }
+        // cppcheck-suppress uninitvar ; only addresses are taken; each field is written below
         double *fields[3] = {&p.x, &p.y, &p.theta};
         static const char *names[3] = {"x_m", "y_m", "theta_rad"};
         for (int k = 0; k < 3 && rc == 0; k++) {

@@ -46,6 +46,7 @@ static void usage(FILE *f)
             "                  fd-gradient, plane-gradient, chemotaxis (docs/RESULTS.md)\n"
             "  --model NAME    internal model, overriding the scenario's: ridge, mlp, knn,\n"
             "                  radius, pathloss\n"
+            "  --no-faults     ignore the scenario's fault schedule (docs/FAULTS.md)\n"
             "  --quiet         no progress bar\n"
             "  --bench         with --seeds: run them one after another in this process without\n"
             "                  output files and print the real-time factor (make bench-sim)\n"
@@ -150,7 +151,11 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         if (samples) {
             io.samples = open_in(dir, "samples.tsv");
         }
-        if (!io.log || !io.track || (samples && !io.samples)) {
+        bool faults = env->sc.faults.n > 0; // docs/FAULTS.md: the injector's own log
+        if (faults) {
+            io.faults = open_in(dir, "faults.tsv");
+        }
+        if (!io.log || !io.track || (samples && !io.samples) || (faults && !io.faults)) {
             fprintf(stderr, "%s: %s: %s\n", prog, dir, strerror(errno));
             rc = 1;
         }
@@ -191,8 +196,8 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
             }
         }
     }
-    FILE *fs[3] = {io.log, io.track, io.samples};
-    for (int i = 0; i < 3; i++) {
+    FILE *fs[4] = {io.log, io.track, io.samples, io.faults};
+    for (int i = 0; i < 4; i++) {
         if (fs[i] && fclose(fs[i]) != 0) {
             fprintf(stderr, "%s: %s: write failed\n", prog, dir);
             rc = 1;
@@ -396,7 +401,7 @@ int main(int argc, char **argv)
     const char *strategy = NULL, *model = NULL;
     uint64_t seed = 0;
     bool has_seed = false, samples = false, field = false, emit = false, quiet = false;
-    bool bench = false;
+    bool bench = false, no_faults = false;
     long jobs = sysconf(_SC_NPROCESSORS_ONLN);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -441,6 +446,8 @@ int main(int argc, char **argv)
                 return die("%s: expected a name%s", a, "");
             }
             *(a[2] == 's' ? &strategy : &model) = argv[++i];
+        } else if (strcmp(a, "--no-faults") == 0) {
+            no_faults = true;
         } else if (strcmp(a, "--quiet") == 0) {
             quiet = true;
         } else if (strcmp(a, "--bench") == 0) {
@@ -504,6 +511,9 @@ int main(int argc, char **argv)
     if (model) {
         snprintf(sc.model, sizeof sc.model, "%s", model);
     }
+    if (no_faults) {
+        sc.faults.n = 0;
+    }
     if (emit) {
         // The same runs, one command per seed; scripts/merge_runs.py DIR merges them.
         char self[PATH_MAX], scn[PATH_MAX];
@@ -513,8 +523,9 @@ int main(int argc, char **argv)
         }
         self[n] = '\0';
         for (uint64_t s = sa; s <= sb; s++) {
-            printf("%s %s --seed %llu --out %s/seed-%llu --strategy %s --model %s\n", self, scn,
-                   (unsigned long long)s, out, (unsigned long long)s, sc.strategy, sc.model);
+            printf("%s %s --seed %llu --out %s/seed-%llu --strategy %s --model %s%s\n", self,
+                   scn, (unsigned long long)s, out, (unsigned long long)s, sc.strategy, sc.model,
+                   no_faults ? " --no-faults" : "");
         }
         return 0;
     }

@@ -413,6 +413,28 @@ static void test_far_sample_not_wrapped_into_radius(void **state)
     assert_int_equal(v, RFS_Q16_INT(-20));
 }
 
+/* The smallest radius init accepts (one Q16.16 step, below half a centimetre): only
+ * samples exactly at the query (to the centimetre) are used; no division by zero. */
+static void test_tiny_radius(void **state)
+{
+    (void)state;
+    rfs_sample_t s[3] = {{100, 200, -30 * 64}, {101, 200, -90 * 64}, {100, 200, -40 * 64}};
+    rfs_ridge_t r;
+    rfs_ridge_cfg_t cfg = rfs_ridge_cfg_default();
+    cfg.radius = 1;
+    assert_int_equal(rfs_ridge_init(&r, &cfg), 0);
+    rfs_model_fit_in_t in = {.samples = s, .n = 3, .qx = RFS_Q16_INT(1), .qy = RFS_Q16_INT(2),
+                             .map = NULL};
+    assert_int_equal(rfs_ridge_ops.fit(&r, &in, 0u, NULL), RFS_FIT_DONE);
+    assert_int_equal(r.n_used, 2);
+    rfs_q16_t v;
+    assert_true(rfs_ridge_ops.predict(&r, RFS_Q16_INT(50), 0, &v));
+    assert_int_equal(v, RFS_Q16_INT(-35));
+    /* the same beyond +-327.67 m (the general pass) */
+    in.qx = RFS_Q16_INT(400);
+    assert_int_equal(rfs_ridge_ops.fit(&r, &in, 0u, NULL), RFS_FIT_FAILED);
+}
+
 static void test_init_validation(void **state)
 {
     (void)state;
@@ -463,6 +485,7 @@ int main(void)
         cmocka_unit_test(test_two_points_closed_form),
         cmocka_unit_test(test_radius_inclusive_and_reset),
         cmocka_unit_test(test_far_sample_not_wrapped_into_radius),
+        cmocka_unit_test(test_tiny_radius),
         cmocka_unit_test(test_sliced_restart_on_new_query),
         cmocka_unit_test(test_against_sklearn),
     };

@@ -243,6 +243,28 @@ static void test_extremes(void **state)
     }
 }
 
+/* Timestamps at the ends of int64 (fuzzed or corrupt input): no overflow, sane answers. */
+static void test_int64_extremes(void **state)
+{
+    (void)state;
+    rfs_rssi_t w;
+    rfs_rssi_cfg_t c = rfs_rssi_cfg_default();
+    assert_int_equal(rfs_rssi_init(&w, &c), 0);
+    rfs_q16_t m;
+    assert_true(rfs_rssi_push(&w, INT64_MIN, -50));
+    assert_true(rfs_rssi_mean(&w, INT64_MIN, &m));
+    assert_int_equal(m, -50 * 65536);
+    assert_false(rfs_rssi_mean(&w, INT64_MIN + 1000000, &m)); /* one window later */
+    assert_true(rfs_rssi_push(&w, INT64_MAX, -60));
+    assert_false(rfs_rssi_mean(&w, INT64_MIN, &m)); /* the far past: nothing kept there */
+    assert_true(rfs_rssi_mean(&w, INT64_MAX, &m));
+    assert_int_equal(m, -60 * 65536);
+    assert_true(rfs_rssi_push(&w, INT64_MAX, -70));
+    assert_int_equal(rfs_rssi_count(&w, INT64_MAX), 2);
+    assert_false(rfs_rssi_push(&w, INT64_MAX - 1, -70)); /* out of order */
+    assert_int_equal(w.rejected_order, 1u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -253,6 +275,7 @@ int main(void)
         cmocka_unit_test(test_stream_across_2_32_us),
         cmocka_unit_test(test_overflow_counted),
         cmocka_unit_test(test_extremes),
+        cmocka_unit_test(test_int64_extremes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -187,6 +187,26 @@ static void test_drops_counted(void **state)
     assert_int_equal(f->s.dropped_gap, PCAP);
 }
 
+/* Pose times at the ends of int64 (fuzzed or corrupt input): the gap is detected
+ * without overflow, and poses 1 us apart still interpolate. */
+static void test_int64_extreme_times(void **state)
+{
+    fixture_t *f = *state;
+    rfs_pose_t p0 = pose(INT64_MIN, 0.0, 0.0), p1 = pose(INT64_MAX - 2, 1.0, 0.0);
+    assert_true(rfs_store_add_pose(&f->s, &p0, &f->rng));
+    rfs_store_add_value(&f->s, 0, RFS_Q16_INT(-50), &f->rng);
+    assert_int_equal(f->s.pending_count, 1);
+    assert_true(rfs_store_add_pose(&f->s, &p1, &f->rng));
+    assert_int_equal(f->s.dropped_gap, 1u);
+    rfs_pose_t p2 = pose(INT64_MAX, 3.0, 0.0);
+    assert_true(rfs_store_add_pose(&f->s, &p2, &f->rng));
+    rfs_store_add_value(&f->s, INT64_MAX - 1, RFS_Q16_INT(-50), &f->rng);
+    assert_int_equal(f->s.count, 1);
+    assert_int_equal(f->s.samples[0].x_cm, 200);
+    rfs_store_add_value(&f->s, INT64_MAX, RFS_Q16_INT(-50), &f->rng);
+    assert_int_equal(f->s.samples[1].x_cm, 300);
+}
+
 /* Two sources interleaving out of time order in the pending queue. */
 static void test_pending_unsorted(void **state)
 {
@@ -306,6 +326,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_interpolation_random, setup, teardown),
         cmocka_unit_test_setup_teardown(test_drops_counted, setup, teardown),
         cmocka_unit_test_setup_teardown(test_pending_unsorted, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_int64_extreme_times, setup, teardown),
         cmocka_unit_test_setup_teardown(test_saturation, setup, teardown),
         cmocka_unit_test(test_reservoir_uniform),
         cmocka_unit_test_setup_teardown(test_reservoir_keeps_all_below_capacity, setup, teardown),

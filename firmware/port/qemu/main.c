@@ -36,6 +36,7 @@ static void stack_paint(void)
 static uint32_t stack_used(void)
 {
     const uint32_t *p = &_sstack;
+    // cppcheck-suppress comparePointers ; _sstack.._estack are one region (linker script)
     while (p < &_estack && *p == STACK_PAINT) {
         p++;
     }

@@ -37,9 +37,11 @@ __attribute__((section(".isr_vector"), used)) void (*const g_vectors[16 + 82])(v
 void Reset_Handler(void)
 {
     uint32_t *src = &_sidata;
+    // cppcheck-suppress comparePointers ; _sdata.._edata are one region (linker script)
     for (uint32_t *dst = &_sdata; dst < &_edata;) {
         *dst++ = *src++;
     }
+    // cppcheck-suppress comparePointers ; _sbss.._ebss are one region (linker script)
     for (uint32_t *dst = &_sbss; dst < &_ebss;) {
         *dst++ = 0u;
     }

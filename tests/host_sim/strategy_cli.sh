@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# strategy_cli.sh SIM - rfseek-sim's --strategy / --model options (issue 7) and the
+# benchmark script's own input check: bad names give one error line and exit 1; good
+# names run and are reported in summary.json.
+set -u
+sim=${1:?usage: strategy_cli.sh path/to/rfseek-sim}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fails=0
+check() { if eval "$2"; then echo "PASS $1"; else echo "FAIL $1"; fails=$((fails + 1)); fi; }
+
+"$sim" scenarios/default.yaml --seed 1 --strategy gradient >"$tmp/o" 2>"$tmp/e"
+rc=$?
+check strategy-unknown-exit '[ $rc -eq 1 ]'
+check strategy-unknown-one-line '[ "$(wc -l <"$tmp/e")" -eq 1 ] && grep -q "^rfseek-sim: --strategy: unknown .gradient." "$tmp/e"'
+check strategy-unknown-no-stdout '[ ! -s "$tmp/o" ]'
+
+"$sim" scenarios/default.yaml --seed 1 --model ridge2 >"$tmp/o" 2>"$tmp/e"
+rc=$?
+check model-unknown-exit '[ $rc -eq 1 ]'
+check model-unknown-one-line '[ "$(wc -l <"$tmp/e")" -eq 1 ] && grep -q "^rfseek-sim: --model: unknown .ridge2." "$tmp/e"'
+
+"$sim" scenarios/default.yaml --seed 1 --strategy >"$tmp/o" 2>"$tmp/e"
+check strategy-missing-name '[ $? -eq 1 ] && [ "$(wc -l <"$tmp/e")" -eq 1 ]'
+
+# A scenario naming an unknown strategy is rejected when the run starts.
+sed -e 's/^strategy: meta$/strategy: spiral/' -e "s|^map: |map: $PWD/scenarios/|" \
+    scenarios/default.yaml >"$tmp/bad.yaml"
+"$sim" "$tmp/bad.yaml" --seed 1 >"$tmp/o" 2>"$tmp/e"
+rc=$?
+check scenario-strategy-unknown '[ $rc -eq 1 ] && [ "$(wc -l <"$tmp/e")" -eq 1 ] && grep -q "strategy: unknown .spiral." "$tmp/e"'
+
+for st in fd-gradient chemotaxis plane-gradient meta-global; do
+    "$sim" scenarios/open.yaml --seed 2 --strategy "$st" --out "$tmp/run-$st" 2>"$tmp/e"
+    rc=$?
+    check "run-$st" '[ $rc -eq 0 ] && grep -q "\"strategy\": \"$st\"" "$tmp/run-$st/summary.json"'
+done
+# The decision kinds of each strategy appear in its log (and only those).
+check log-kinds-fd '[ -z "$(cut -f8 "$tmp/run-fd-gradient/log.tsv" | tail -n +2 | sort -u | grep -vx -e probe -e gradient -e tumble)" ] && cut -f8 "$tmp/run-fd-gradient/log.tsv" | grep -qx probe'
+check log-kinds-chemo '[ -z "$(cut -f8 "$tmp/run-chemotaxis/log.tsv" | tail -n +2 | sort -u | grep -vx -e run -e tumble)" ]'
+check log-kinds-plane '[ -z "$(cut -f8 "$tmp/run-plane-gradient/log.tsv" | tail -n +2 | sort -u | grep -vx -e initial -e gradient -e tumble)" ]'
+
+"$sim" scenarios/open.yaml --seed 2 --model pathloss --out "$tmp/run-pl" 2>"$tmp/e"
+check run-model-pathloss '[ $? -eq 0 ] && grep -q "\"model\": \"pathloss\"" "$tmp/run-pl/summary.json"'
+
+/usr/bin/python3 scripts/bench_seek.py --bin "$tmp/nonexistent" >"$tmp/o" 2>"$tmp/e"
+rc=$?
+check bench-bad-bin '[ $rc -eq 1 ] && [ "$(wc -l <"$tmp/e")" -eq 1 ] && grep -q "nonexistent: not an executable" "$tmp/e"'
+[ $fails -eq 0 ]

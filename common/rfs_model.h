@@ -50,6 +50,11 @@ typedef struct rfs_model_ops {
     /// (a plane is evaluated with one addition per point).
     bool (*predict_row)(const void *self, rfs_q16_t x0, rfs_q16_t y, rfs_q16_t dx, uint16_t n,
                         rfs_q16_t *out);
+    /// Optional (may be NULL): for a model whose predictions along a line of constant y
+    /// never decrease in one direction (a plane: the ridge), that direction: +1 towards
+    /// larger x, -1 towards smaller x, 0 constant. The grid search then evaluates only the
+    /// ends of each lattice row and finds exactly the maximum a full scan finds.
+    int (*row_monotone)(const void *self);
 } rfs_model_ops_t;
 
 /// A model: its operations and its caller-owned state.

@@ -423,6 +423,128 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     return false;
 }
 
+static bool reach_bit(const uint8_t *bits, uint32_t idx)
+{
+    return (bits[idx >> 3] >> (idx & 7u)) & 1u;
+}
+
+/* Full scan: row by row, in chunks, so that a model with predict_row costs one call per
+ * chunk and the lattice coordinates advance by addition. First strict maximum in row-major
+ * order wins. */
+static bool grid_max_scan(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
+{
+    const rfs_map_t *m = s->map;
+    const rfs_model_ops_t *ops = s->model.ops;
+    rfs_q16_t best = RFS_Q16_MIN;
+    rfs_q16_t row[RFS_SEEK_ROW_CHUNK];
+    bool found = false;
+    for (uint16_t j = 0; j < m->lh; ++j) {
+        rfs_q16_t x0, py;
+        rfs_map_lattice_point(m, 0, j, &x0, &py);
+        uint32_t base = (uint32_t)j * m->lw;
+        for (uint16_t i0 = 0; i0 < m->lw; i0 = (uint16_t)(i0 + RFS_SEEK_ROW_CHUNK)) {
+            uint16_t n = (uint16_t)(m->lw - i0 < RFS_SEEK_ROW_CHUNK ? m->lw - i0
+                                                                    : RFS_SEEK_ROW_CHUNK);
+            rfs_q16_t cx0 = x0 + (rfs_q16_t)i0 * m->cfg.grid;
+            bool any = false;
+            for (uint16_t k = 0; k < n && !any; ++k) {
+                any = reach_bit(s->reach, base + i0 + k);
+            }
+            if (!any) {
+                continue;
+            }
+            if (ops->predict_row != 0) {
+                if (!ops->predict_row(s->model.self, cx0, py, m->cfg.grid, n, row)) {
+                    return false;
+                }
+            } else {
+                for (uint16_t k = 0; k < n; ++k) {
+                    if (!ops->predict(s->model.self, cx0 + (rfs_q16_t)k * m->cfg.grid, py,
+                                      &row[k])) {
+                        return false;
+                    }
+                }
+            }
+            for (uint16_t k = 0; k < n; ++k) {
+                if (reach_bit(s->reach, base + i0 + k) && (!found || row[k] > best)) {
+                    best = row[k];
+                    *mx = cx0 + (rfs_q16_t)k * m->cfg.grid;
+                    *my = py;
+                    found = true;
+                }
+            }
+        }
+    }
+    return found;
+}
+
+/* For a model monotone along rows (a plane), the maximum of a row's reachable points is
+ * at one end; walking back from the high end over equal predictions gives the first of
+ * the tied points, so the result is exactly grid_max_scan()'s. */
+static bool grid_max_rows(const rfs_seek_t *s, int dir, rfs_q16_t *mx, rfs_q16_t *my)
+{
+    const rfs_map_t *m = s->map;
+    const rfs_model_ops_t *ops = s->model.ops;
+    rfs_q16_t best = RFS_Q16_MIN;
+    bool found = false;
+    for (uint16_t j = 0; j < m->lh; ++j) {
+        rfs_q16_t x0, py;
+        rfs_map_lattice_point(m, 0, j, &x0, &py);
+        uint32_t base = (uint32_t)j * m->lw;
+        int32_t first = -1, last = -1;
+        for (uint16_t i = 0; i < m->lw; ++i) {
+            if (reach_bit(s->reach, base + i)) {
+                if (first < 0) {
+                    first = i;
+                }
+                last = i;
+            }
+        }
+        if (first < 0) {
+            continue;
+        }
+        int32_t pick = dir > 0 ? last : first;
+        rfs_q16_t v;
+        if (!ops->predict(s->model.self, x0 + (rfs_q16_t)pick * m->cfg.grid, py, &v)) {
+            return false;
+        }
+        if (dir > 0) {
+            for (int32_t i = pick - 1; i >= first; --i) {
+                rfs_q16_t w;
+                if (!reach_bit(s->reach, base + (uint32_t)i)) {
+                    continue;
+                }
+                if (!ops->predict(s->model.self, x0 + (rfs_q16_t)i * m->cfg.grid, py, &w) ||
+                    w != v) {
+                    break;
+                }
+                pick = i;
+            }
+        }
+        if (!found || v > best) {
+            best = v;
+            *mx = x0 + (rfs_q16_t)pick * m->cfg.grid;
+            *my = py;
+            found = true;
+        }
+    }
+    return found;
+}
+
+bool rfs_seek_grid_max(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
+{
+    const rfs_model_ops_t *ops = s->model.ops;
+    if (ops->row_monotone != 0) {
+        return grid_max_rows(s, ops->row_monotone(s->model.self), mx, my);
+    }
+    return grid_max_scan(s, mx, my);
+}
+
+bool rfs_seek_grid_max_scan(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
+{
+    return grid_max_scan(s, mx, my);
+}
+
 /* Greedy step (paper section 2): grid search over every reachable legal lattice point
  * for the model's maximum; move min(distance, step) towards it; when that point is not
  * legal, search the line to the maximum for the first legal point, before or after the
@@ -435,54 +557,7 @@ static bool choose_greedy(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     if (s->model.ops->argmax != 0 && s->model.ops->argmax(s->model.self, &mx, &my)) {
         found = true;
     } else {
-        /* Row by row, in chunks, so that a model with predict_row costs one call per chunk
-         * and the lattice coordinates advance by addition. */
-        rfs_q16_t best = RFS_Q16_MIN;
-        rfs_q16_t row[RFS_SEEK_ROW_CHUNK];
-        const rfs_model_ops_t *ops = s->model.ops;
-        for (uint16_t j = 0; j < m->lh; ++j) {
-            rfs_q16_t x0, py;
-            rfs_map_lattice_point(m, 0, j, &x0, &py);
-            const uint8_t *rbits = s->reach;
-            uint32_t base = (uint32_t)j * m->lw;
-            for (uint16_t i0 = 0; i0 < m->lw; i0 = (uint16_t)(i0 + RFS_SEEK_ROW_CHUNK)) {
-                uint16_t n = (uint16_t)(m->lw - i0 < RFS_SEEK_ROW_CHUNK ? m->lw - i0
-                                                                        : RFS_SEEK_ROW_CHUNK);
-                rfs_q16_t cx0 = x0 + (rfs_q16_t)i0 * m->cfg.grid;
-                bool any = false;
-                for (uint16_t k = 0; k < n; ++k) {
-                    uint32_t idx = base + i0 + k;
-                    if ((rbits[idx >> 3] >> (idx & 7u)) & 1u) {
-                        any = true;
-                        break;
-                    }
-                }
-                if (!any) {
-                    continue;
-                }
-                if (ops->predict_row != 0) {
-                    if (!ops->predict_row(s->model.self, cx0, py, m->cfg.grid, n, row)) {
-                        return false;
-                    }
-                } else {
-                    for (uint16_t k = 0; k < n; ++k) {
-                        if (!ops->predict(s->model.self, cx0 + (rfs_q16_t)k * m->cfg.grid, py,
-                                          &row[k])) {
-                            return false;
-                        }
-                    }
-                }
-                for (uint16_t k = 0; k < n; ++k) {
-                    uint32_t idx = base + i0 + k;
-                    if (((rbits[idx >> 3] >> (idx & 7u)) & 1u) && (!found || row[k] > best)) {
-                        best = row[k];
-                        mx = cx0 + (rfs_q16_t)k * m->cfg.grid;
-                        my = py;
-                        found = true;
-                    }
-                }
-            }
-        }
+        found = rfs_seek_grid_max(s, &mx, &my);
     }
     if (!found) {
         return false;

@@ -209,6 +209,14 @@ bool rfs_seek_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm, rfs_
 /// report. Cannot fail.
 void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out);
 
+/// The model's maximum over the reachable legal lattice (the greedy grid search, paper
+/// section 2): first strict maximum in row-major order. Uses the model's row_monotone
+/// shortcut when it has one. false when there is no model or no reachable point.
+bool rfs_seek_grid_max(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my);
+
+/// The same search by evaluating every point (the reference for the shortcut).
+bool rfs_seek_grid_max_scan(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my);
+
 /// epsilon(n) = eps_amp * e^(-eps_rate * n) + eps_floor, Q16.16.
 rfs_q16_t rfs_seek_epsilon(const rfs_seek_cfg_t *cfg, uint32_t n);
 

@@ -204,8 +204,11 @@ rfs_drive_status_t rfs_drive_update(rfs_drive_t *d, const rfs_pose_t *pose, int6
                                     int16_t *left_mm_s, int16_t *right_mm_s)
 {
     const rfs_drive_cfg_t *c = &d->cfg;
-    int64_t dt = now_us - d->last_us;
-    dt = dt < 0 ? 0 : (dt > DT_MAX_US ? DT_MAX_US : dt);
+    /* Difference without signed overflow at extreme timestamps (clamped to [0, DT_MAX]). */
+    int64_t dt = now_us <= d->last_us ? 0
+               : ((uint64_t)now_us - (uint64_t)d->last_us > (uint64_t)DT_MAX_US
+                      ? DT_MAX_US
+                      : (int64_t)((uint64_t)now_us - (uint64_t)d->last_us));
     d->last_us = now_us;
     /* Scaling: accel (mm/s^2, <= 1e5) * dt (us, <= 2e5) < 2^35, / 1e6 without libgcc. */
     int32_t step = (int32_t)rfs_udiv64((uint64_t)c->accel_mm_s2 * (uint64_t)dt, 1000000u);
@@ -223,7 +226,7 @@ rfs_drive_status_t rfs_drive_update(rfs_drive_t *d, const rfs_pose_t *pose, int6
             d->stall_ref_dist = dn;
         }
         bool at_goal = d->next == last && dn <= c->goal_tol;
-        if (now_us - d->start_us > c->timeout_us) {
+        if (now_us > d->start_us && (uint64_t)now_us - (uint64_t)d->start_us > (uint64_t)c->timeout_us) {
             result = RFS_DRIVE_TIMEOUT;
         } else if (at_goal) {
             if (d->left_mm_s == 0 && d->right_mm_s == 0) {
@@ -233,7 +236,8 @@ rfs_drive_status_t rfs_drive_update(rfs_drive_t *d, const rfs_pose_t *pose, int6
             if (d->stall_ref_dist == RFS_Q16_MAX) {
                 d->stall_ref_dist = dn;
                 d->stall_ref_us = now_us;
-            } else if (now_us - d->stall_ref_us >= c->stall_us) {
+            } else if (now_us >= d->stall_ref_us &&
+                       (uint64_t)now_us - (uint64_t)d->stall_ref_us >= (uint64_t)c->stall_us) {
                 if ((int64_t)d->stall_ref_dist - dn < c->progress_min) {
                     result = RFS_DRIVE_BLOCKED;
                 }

@@ -219,6 +219,7 @@ static void scan_cell_k(const rfs_knn_t *s, uint32_t cell, int32_t qx, int32_t q
 {
     for (uint32_t i = s->start[cell]; i < s->start[cell + 1u]; ++i) {
         int64_t d2 = dist2(&s->pts[i], qx, qy);
+        // NOLINTNEXTLINE(clang-analyzer-core.UndefinedBinaryOperatorResult): valid needs n >= 1, so k >= 1
         if (b->m == b->k && d2 >= b->d2[b->m - 1u]) {
             continue;
         }
@@ -259,6 +260,7 @@ static bool predict_k(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t *val
             }
         }
         int64_t reach = (int64_t)r * c8;
+        // NOLINTNEXTLINE(clang-analyzer-core.UndefinedBinaryOperatorResult): valid needs n >= 1, so k >= 1
         if (b.m == b.k && reach * reach >= b.d2[b.m - 1u]) {
             break;
         }

@@ -204,6 +204,14 @@ static uint32_t cell_hash(uint16_t cx, uint16_t cy)
     return ((uint32_t)cx * 0x9E3779B1u + (uint32_t)cy * 0x85EBCA77u) >> 22; /* 10 bits */
 }
 
+/* Field by field: the core may call no memcmp (only memcpy/memset/memmove). */
+static bool same_lattice(const rfs_pathloss_lat_t *a, const rfs_pathloss_lat_t *b)
+{
+    return a->ox == b->ox && a->oy == b->oy && a->grid == b->grid && a->lw == b->lw &&
+           a->lh == b->lh && a->cs == b->cs && a->c0i == b->c0i && a->c0j == b->c0j &&
+           a->ncx == b->ncx && a->ncy == b->ncy;
+}
+
 static void cache_clear(rfs_pathloss_t *p)
 {
     p->nrows = 0u;
@@ -219,7 +227,7 @@ static void cache_assign(rfs_pathloss_t *p)
     if (p->map == 0) {
         return;
     }
-    if (p->cache_map != p->map || memcmp(&p->cache_lat, &p->lat, sizeof(p->lat)) != 0) {
+    if (p->cache_map != p->map || !same_lattice(&p->cache_lat, &p->lat)) {
         cache_clear(p);
         p->cache_map = p->map;
         p->cache_lat = p->lat;

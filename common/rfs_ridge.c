@@ -385,6 +385,14 @@ static bool ridge_predict_row(const void *self, rfs_q16_t x0, rfs_q16_t y, rfs_q
     return true;
 }
 
+/* A plane's predictions along a row never decrease towards the sign of its x slope: one
+ * rounding of an affine function of x, then saturation, both monotone. */
+static int ridge_row_monotone(const void *self)
+{
+    const rfs_ridge_t *r = (const rfs_ridge_t *)self;
+    return r->wx_q24 > 0 ? 1 : (r->wx_q24 < 0 ? -1 : 0);
+}
+
 const rfs_model_ops_t rfs_ridge_ops = {
     .name = "ridge",
     .reset = ridge_reset,
@@ -392,6 +400,7 @@ const rfs_model_ops_t rfs_ridge_ops = {
     .predict = ridge_predict,
     .argmax = 0,
     .predict_row = ridge_predict_row,
+    .row_monotone = ridge_row_monotone,
 };
 
 rfs_model_t rfs_ridge_model(rfs_ridge_t *r)

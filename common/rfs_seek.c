@@ -1014,14 +1014,34 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     finish_decision(s, now_us, rng, out);
 }
 
+/* |a - b| > limit, without signed overflow at extreme timestamps. */
+static bool apart(int64_t a, int64_t b, int64_t limit)
+{
+    uint64_t d = a >= b ? (uint64_t)a - (uint64_t)b : (uint64_t)b - (uint64_t)a;
+    return d > (uint64_t)limit;
+}
+
+/* a - b saturated to [0, INT64_MAX]. */
+static int64_t elapsed(int64_t a, int64_t b)
+{
+    if (a <= b) {
+        return 0;
+    }
+    uint64_t d = (uint64_t)a - (uint64_t)b;
+    return d > (uint64_t)INT64_MAX ? INT64_MAX : (int64_t)d;
+}
+
 void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
 {
     out->left_mm_s = 0;
     out->right_mm_s = 0;
     out->faults = 0;
     out->decided = false;
-    bool pose_stale = !s->have_pose || now_us - s->pose.t_us > s->cfg.pose_timeout_us;
-    bool meas_stale = !s->have_meas || now_us - s->last_meas_us > s->cfg.rssi_timeout_us;
+    /* A newest stamp further ahead of now than the timeout is stale too (a clock jump,
+     * issue 9): while it is the newest, every real input is rejected as out of order and
+     * the pose would freeze with the wheels still driving. */
+    bool pose_stale = !s->have_pose || apart(now_us, s->pose.t_us, s->cfg.pose_timeout_us);
+    bool meas_stale = !s->have_meas || apart(now_us, s->last_meas_us, s->cfg.rssi_timeout_us);
     if (pose_stale) {
         out->faults |= RFS_SEEK_FAULT_POSE_STALE;
     }
@@ -1038,7 +1058,7 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
         if (s->state == RFS_SEEK_DRIVING && s->drive.status == RFS_DRIVE_RUNNING) {
             s->resume = true;
             s->resume_path = s->drive.path;
-            s->resume_start_us = s->drive.start_us;
+            s->resume_start_us = elapsed(now_us, s->drive.start_us); /* driven so far */
         }
         if (s->state != RFS_SEEK_WAITING) {
             s->state = RFS_SEEK_STALE;
@@ -1059,9 +1079,12 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     if (s->resume) {
         s->resume = false;
         rfs_drive_set_path(&s->drive, &s->resume_path, now_us);
-        /* The goal's timeout keeps counting from when it was set: a goal interrupted
-         * again and again by stale inputs must still end. */
-        s->drive.start_us = s->resume_start_us;
+        /* The goal's timeout counts driving time only: the time it was driven before
+         * the interruption still counts (a goal interrupted again and again must still
+         * end), the stale time does not (after a 30 s silence, issue 9, the goal would
+         * otherwise time out the moment it resumes). */
+        s->drive.start_us = now_us >= INT64_MIN + s->resume_start_us ? now_us - s->resume_start_us
+                                                                     : INT64_MIN;
         s->state = RFS_SEEK_DRIVING;
     }
     if (s->fitting) {

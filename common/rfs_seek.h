@@ -174,7 +174,7 @@ typedef struct rfs_seek {
     uint32_t meas_rejected;                   ///< measurements with a bad source index
     bool resume;                              ///< a goal was interrupted by stale inputs
     rfs_path_t resume_path;                   ///< the path to resume
-    int64_t resume_start_us;                  ///< when the interrupted goal was set, microseconds
+    int64_t resume_start_us;                  ///< how long the interrupted goal had been driven, microseconds
     uint16_t last_li, last_lj;                ///< lattice point of the last novelty update
     bool have_last_l;                         ///< last_li/last_lj are valid
     /* Baseline strategies (issue 7). */

@@ -27,6 +27,36 @@ rfs_app_cfg_t rfs_app_cfg_mcu(void)
     return c;
 }
 
+uint32_t rfs_app_model_capacity(const rfs_app_cfg_t *cfg)
+{
+    return cfg->model_state != NULL ? cfg->model_state_bytes : RFS_APP_MODEL_BYTES;
+}
+
+bool rfs_app_model_fits(const rfs_app_cfg_t *cfg)
+{
+    return cfg->model == NULL || cfg->model->state_bytes <= rfs_app_model_capacity(cfg);
+}
+
+/* The configured model on its state: the ridge with cfg->ridge (the paper's numbers by
+ * default, so a NULL model and the "ridge" entry decide alike), any other with its
+ * registry defaults. */
+static int app_model_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, rfs_model_t *model)
+{
+    void *state = cfg->model_state != NULL ? cfg->model_state : (void *)&a->ridge;
+    if (!rfs_app_model_fits(cfg) ||
+        (cfg->model_state != NULL &&
+         ((uintptr_t)cfg->model_state & (uintptr_t)(RFS_MODELS_STATE_ALIGN - 1u)) != 0u)) {
+        return -1;
+    }
+    if (cfg->model == NULL || cfg->model->ops == &rfs_ridge_ops) {
+        *model = rfs_ridge_model((rfs_ridge_t *)state);
+        return rfs_ridge_init((rfs_ridge_t *)state, &cfg->ridge);
+    }
+    model->ops = cfg->model->ops;
+    model->self = state;
+    return cfg->model->init_default(state);
+}
+
 int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *map)
 {
     if (a == NULL || cfg == NULL || map == NULL || map->free == NULL) {
@@ -52,7 +82,8 @@ int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *ma
     if (lattice > RFS_APP_MAX_LATTICE || cfg->seek.store.capacity > RFS_APP_MAX_SAMPLES) {
         return -1;
     }
-    if (rfs_ridge_init(&a->ridge, &cfg->ridge) != 0) {
+    rfs_model_t model;
+    if (app_model_init(a, cfg, &model) != 0) {
         return -1;
     }
     rfs_rng_seed(&a->rng, cfg->seed);
@@ -71,7 +102,7 @@ int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *ma
     };
     const rfs_target_ops_t *target =
         cfg->target == RFS_APP_TARGET_BRIDGE ? &rfs_target_bridge : &rfs_target_rssi;
-    if (rfs_seek_init(&a->seek, &cfg->seek, &a->map, rfs_ridge_model(&a->ridge), target,
+    if (rfs_seek_init(&a->seek, &cfg->seek, &a->map, model, target,
                       &mem) != 0) {
         return -1;
     }

@@ -34,6 +34,7 @@
 #include "rfs_can.h"
 #include "rfs_fix.h"
 #include "rfs_map.h"
+#include "rfs_models.h"
 #include "rfs_ridge.h"
 #include "rfs_seek.h"
 #include "rfs_store.h"
@@ -53,6 +54,9 @@
 /// Samples the MCU configuration learns per control period: the 10,000-sample fit spread
 /// over four periods keeps every period under 500,000 instructions (docs/PERFORMANCE.md).
 #define RFS_APP_MCU_FIT_BUDGET 2500u
+/// Model state built into rfs_app_t, bytes: the local ridge's (the MLP's 3.3 KB does not
+/// fit the MCU's RAM budget next to the maxima above; docs/MODELS.md).
+#define RFS_APP_MODEL_BYTES ((uint32_t)sizeof(rfs_ridge_t))
 /// Control period, microseconds (20 Hz).
 #define RFS_APP_PERIOD_US 50000
 
@@ -85,8 +89,21 @@ typedef struct rfs_app_map {
 } rfs_app_map_t;
 
 /// Application configuration.
+///
+/// The internal model (docs/MODELS.md, "Choosing a model") is chosen by a registry entry,
+/// `model = rfs_models_lookup(name)`, the same names as the simulator and the feeder;
+/// NULL is the paper's local ridge. Its state lives in the application's own
+/// RFS_APP_MODEL_BYTES (enough for the ridge only: the static-RAM budget has no room
+/// for more) or in a buffer the port provides (model_state, aligned to
+/// RFS_MODELS_STATE_ALIGN); rfs_app_init() rejects a model whose state does not fit
+/// (rfs_app_model_fits() says which). The ridge uses `ridge`, every other model its
+/// registry defaults. Registry lookups stay in the ports, so an image that never names
+/// another model links none of their code.
 typedef struct rfs_app_cfg {
     rfs_seek_cfg_t seek;        ///< seeker (rfs_seek_cfg_default(): the paper's numbers)
+    const rfs_models_entry_t *model; ///< internal model (rfs_models_lookup()); NULL = ridge
+    void *model_state;          ///< port's buffer for the model state; NULL = the built-in one
+    uint32_t model_state_bytes; ///< its size, bytes (0 with model_state NULL)
     rfs_ridge_cfg_t ridge;      ///< local ridge (5 m radius, alpha 1)
     rfs_map_cfg_t map;          ///< clearance and lattice (0.25 m, 0.25 m)
     rfs_app_target_t target;    ///< target function
@@ -121,7 +138,7 @@ typedef struct rfs_app_stats {
 typedef struct rfs_app {
     rfs_app_cfg_t cfg;                              ///< configuration copied at init
     rfs_seek_t seek;                                ///< the meta-algorithm
-    rfs_ridge_t ridge;                              ///< the local ridge model state
+    rfs_ridge_t ridge;                              ///< built-in model state (the local ridge's)
     rfs_map_t map;                                  ///< the map (grids owned by the port)
     rfs_rng_t rng;                                  ///< the random source
     int64_t pose_rx_us;                             ///< local time the last pose arrived
@@ -153,8 +170,16 @@ rfs_app_cfg_t rfs_app_cfg_default(void);
 /// keeps the wheels stopped for three more periods (150 ms).
 rfs_app_cfg_t rfs_app_cfg_mcu(void);
 
+/// Bytes of model state the configuration provides (model_state_bytes, or
+/// RFS_APP_MODEL_BYTES without a port buffer).
+uint32_t rfs_app_model_capacity(const rfs_app_cfg_t *cfg);
+
+/// true when cfg->model's state fits the configured state buffer (NULL: the ridge, fits).
+bool rfs_app_model_fits(const rfs_app_cfg_t *cfg);
+
 /// Initialise (also after a watchdog reset). Returns 0, or -1 when the map is larger
-/// than the compile-time maxima or invalid, or the seeker rejects the configuration.
+/// than the compile-time maxima or invalid, the model's state does not fit (or the
+/// buffer is misaligned), or the seeker rejects the configuration.
 int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *map);
 
 /// A decoded pose arrived at local time rx_us. false when the seeker rejected it.

@@ -53,7 +53,7 @@ int rfs_replay_check_header(const uint8_t *buf, uint32_t len)
 static int payload_len(uint8_t type)
 {
     switch (type) {
-    case RFS_REPLAY_CFG: return 14;
+    case RFS_REPLAY_CFG: return -3; /* 14, plus a model name of 1..15 bytes */
     case RFS_REPLAY_MAP: return 17;
     case RFS_REPLAY_MAP_FREE:
     case RFS_REPLAY_MAP_WALL: return -1;
@@ -129,6 +129,9 @@ rfs_replay_status_t rfs_replay_parse(const uint8_t *buf, uint32_t len, uint32_t 
     if (want >= 0 && n != (uint8_t)want) {
         return bad(rec, "wrong record length for its type");
     }
+    if (want == -3 && (n < 14u || n > 14u + RFS_REPLAY_MODEL_NAME_MAX)) {
+        return bad(rec, "CFG length out of range");
+    }
     if (want == -1 && (n < 5u || n > 4u + RFS_REPLAY_CHUNK)) {
         return bad(rec, "map chunk length out of range");
     }
@@ -145,6 +148,12 @@ rfs_replay_status_t rfs_replay_parse(const uint8_t *buf, uint32_t len, uint32_t 
         rec->u.cfg.fit_budget = rd32(p + 10);
         if (rec->u.cfg.target > (uint8_t)RFS_APP_TARGET_BRIDGE) {
             return bad(rec, "CFG target out of range");
+        }
+        for (uint8_t i = 14u; i < n; i++) {
+            if (p[i] <= 0x20u || p[i] >= 0x7Fu) {
+                return bad(rec, "CFG model name not printable");
+            }
+            rec->u.cfg.model[i - 14u] = (char)p[i];
         }
         break;
     case RFS_REPLAY_MAP:
@@ -246,6 +255,9 @@ uint32_t rfs_replay_encode(const rfs_replay_rec_t *rec, uint8_t *buf, uint32_t c
         *p++ = rec->u.cfg.target;
         *p++ = rec->u.cfg.node;
         p = wr32(p, rec->u.cfg.fit_budget);
+        for (uint32_t i = 0; i < RFS_REPLAY_MODEL_NAME_MAX && rec->u.cfg.model[i] != '\0'; i++) {
+            *p++ = (uint8_t)rec->u.cfg.model[i];
+        }
         break;
     case RFS_REPLAY_MAP:
         p = wr16(p, rec->u.map.w);
@@ -408,6 +420,15 @@ bool rfs_replay_play(rfs_replay_player_t *p, const rfs_replay_rec_t *rec)
         p->cfg.target = (rfs_app_target_t)rec->u.cfg.target;
         p->cfg.node_id = rec->u.cfg.node;
         p->cfg.seek.fit_budget = rec->u.cfg.fit_budget;
+        if (rec->u.cfg.model[0] != '\0') {
+            p->cfg.model = rfs_models_lookup(rec->u.cfg.model);
+            if (p->cfg.model == NULL) {
+                return fail(p, RFS_REPLAY_E_MODEL);
+            }
+            if (!rfs_app_model_fits(&p->cfg)) {
+                return fail(p, RFS_REPLAY_E_MODEL_SIZE);
+            }
+        }
         return true;
     case RFS_REPLAY_MAP:
         if (p->started) {
@@ -498,6 +519,8 @@ const char *rfs_replay_err_str(rfs_replay_err_t e)
     case RFS_REPLAY_E_NO_MAP: return "input before the map";
     case RFS_REPLAY_E_INIT: return "application rejected the map or configuration";
     case RFS_REPLAY_E_ORDER: return "record out of place in an input stream";
+    case RFS_REPLAY_E_MODEL: return "CFG names an unknown model";
+    case RFS_REPLAY_E_MODEL_SIZE: return "CFG model's state is larger than the image holds";
     default: return "unknown error";
     }
 }

@@ -8,7 +8,8 @@
  *   record  = u8 type, u8 len, len bytes of payload                (all little-endian)
  *
  * Input records (times are the controller's clock, int64 microseconds):
- *   CFG      seed u64, target u8, node u8, fit_budget u32                  14
+ *   CFG      seed u64, target u8, node u8, fit_budget u32,
+ *            [model name, 1..15 bytes, no NUL: rfs_models.h]          14..29
  *   MAP      w u16, h u16, res q16, origin_x q16, origin_y q16,
  *            has_wall u8                                               17
  *   MAP_FREE offset u32, 1..RFS_REPLAY_CHUNK bytes of the free grid    5..
@@ -46,6 +47,8 @@
 #define RFS_REPLAY_VERSION 1u
 /// Most grid bytes in one MAP_FREE / MAP_WALL record.
 #define RFS_REPLAY_CHUNK 240u
+/// Longest model name a CFG record carries, bytes (without the NUL).
+#define RFS_REPLAY_MODEL_NAME_MAX 15u
 /// Longest encoded record (type, len, 255 bytes of payload).
 #define RFS_REPLAY_MAX_RECORD 257u
 
@@ -91,6 +94,9 @@ typedef struct rfs_replay_rec {
             uint8_t target;   ///< rfs_app_target_t
             uint8_t node;     ///< node id
             uint32_t fit_budget; ///< samples learnt per control period (0 = all at once)
+            /// internal model by registry name, NUL-terminated; "" = the player's base
+            /// configuration (the local ridge)
+            char model[RFS_REPLAY_MODEL_NAME_MAX + 1u];
         } cfg;                ///< CFG
         struct {
             uint16_t w, h;    ///< cells
@@ -145,6 +151,8 @@ typedef enum rfs_replay_err {
     RFS_REPLAY_E_NO_MAP,      ///< an input record came before MAP and its grids
     RFS_REPLAY_E_INIT,        ///< rfs_app_init() rejected the map or configuration
     RFS_REPLAY_E_ORDER,       ///< an output record (or CFG/MAP after inputs) in an input stream
+    RFS_REPLAY_E_MODEL,       ///< CFG names a model the registry does not know
+    RFS_REPLAY_E_MODEL_SIZE,  ///< CFG names a model whose state the image cannot hold
 } rfs_replay_err_t;
 
 /// Plays an input stream into an application: the one driver loop shared by the host
@@ -152,7 +160,7 @@ typedef enum rfs_replay_err {
 /// (the map grids) plus the application it points to.
 typedef struct rfs_replay_player {
     rfs_app_t *app;                           ///< the application driven
-    rfs_app_cfg_t cfg;                        ///< configuration (CFG overrides seed, target, node, fit budget)
+    rfs_app_cfg_t cfg;                        ///< configuration (CFG overrides seed, target, node, fit budget, model)
     rfs_app_map_t map;                        ///< map header (MAP), grids below
     bool have_map;                            ///< MAP seen
     bool started;                             ///< rfs_app_init() done
@@ -166,7 +174,9 @@ typedef struct rfs_replay_player {
 } rfs_replay_player_t;
 
 /// Start a player on `app` with the base configuration (CFG records override seed,
-/// target, node id and fit budget). Writes the output stream header through `write`.
+/// target, node id, fit budget and, when they name one, the model: its state goes into
+/// the base configuration's model_state buffer, or the application's built-in one).
+/// Writes the output stream header through `write`.
 void rfs_replay_player_init(rfs_replay_player_t *p, rfs_app_t *app, const rfs_app_cfg_t *cfg,
                             rfs_replay_write_fn write, void *write_ctx);
 

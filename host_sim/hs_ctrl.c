@@ -8,6 +8,7 @@
 #include <math.h>
 
 #include "rfs_models.h"
+#include "rfs_pdr.h"
 #include "rfs_ridge.h"
 
 typedef struct inproc {
@@ -83,8 +84,11 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
         target = &rfs_target_rssi;
     } else if (cfg->target && strcmp(cfg->target, "bridge") == 0) {
         target = &rfs_target_bridge;
+    } else if (cfg->target && strcmp(cfg->target, "pdr") == 0) {
+        // The caller feeds rfs_pdr_value() percentages as the measurements (rfs_pdr.h).
+        target = &rfs_target_pdr;
     } else {
-        snprintf(err, errlen, "target: unknown '%s' (rssi, bridge)", cfg->target ? cfg->target : "");
+        snprintf(err, errlen, "target: unknown '%s' (rssi, bridge, pdr)", cfg->target ? cfg->target : "");
         return -1;
     }
     if (!hs_ctrl_model_known(cfg->model)) {

@@ -49,7 +49,8 @@ typedef struct hs_ctrl {
 typedef struct hs_ctrl_inproc_cfg {
     rfs_seek_cfg_t seek;    ///< seeker configuration (rfs_seek_cfg_default(): the paper's)
     const char *model;      ///< internal model by name (rfs_models.h): "ridge" is the paper's
-    const char *target;     ///< target by name: "rssi" (one source) or "bridge" (two)
+    const char *target;     ///< target by name: "rssi" (one source), "bridge" (two) or
+                            ///< "pdr" (one; measurements are rfs_pdr_value() percentages)
     uint64_t seed;          ///< seed of the controller's own randomness (epsilon moves)
     int64_t period_us;      ///< control period, microseconds (50,000)
 } hs_ctrl_inproc_cfg_t;

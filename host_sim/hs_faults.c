@@ -9,6 +9,7 @@
 static const char *const kind_names[HS_FAULT_KIND_COUNT] = {
     "rssi_silence", "rssi_past", "rssi_reorder", "pose_jump", "pose_past",
     "pose_reorder", "can_drop",  "bus_off",      "source_move", "kidnap",
+    "rssi_future",  "pose_future",
 };
 
 const char *hs_faults_kind_name(hs_fault_kind_t k)
@@ -74,6 +75,11 @@ int hs_faults_check(const hs_fault_t *f, unsigned nsources, char *err, size_t er
     if ((f->kind == HS_FAULT_RSSI_PAST || f->kind == HS_FAULT_POSE_PAST) &&
         !(f->lag_s > 0.0 && f->lag_s <= 3600.0)) {
         snprintf(err, errlen, "lag_s: must be in (0, 3600] seconds");
+        return -1;
+    }
+    if ((f->kind == HS_FAULT_RSSI_FUTURE || f->kind == HS_FAULT_POSE_FUTURE) &&
+        !(f->lag_s > 0.0 && f->lag_s <= 3600.0)) {
+        snprintf(err, errlen, "lead_s: must be in (0, 3600] seconds");
         return -1;
     }
     if (f->kind == HS_FAULT_CAN_DROP && !(f->probability >= 0.0 && f->probability <= 1.0)) {
@@ -206,6 +212,10 @@ unsigned hs_faults_rssi(hs_faults_run_t *r, int64_t t_us, uint8_t src, int8_t db
     if (past) {
         m.t_us -= us_of(past->lag_s);
     }
+    const hs_fault_t *future = active(r, HS_FAULT_RSSI_FUTURE, t_us);
+    if (future) {
+        m.t_us += us_of(future->lag_s);
+    }
     unsigned n = reorder(active(r, HS_FAULT_RSSI_REORDER, t_us) != NULL, &r->rssi_held,
                          &r->held_rssi, &m, out);
     for (unsigned i = 0; i < n; i++) {
@@ -230,6 +240,10 @@ unsigned hs_faults_pose(hs_faults_run_t *r, const rfs_pose_t *pose, hs_faults_ms
     const hs_fault_t *past = active(r, HS_FAULT_POSE_PAST, t_us);
     if (past) {
         m.pose.t_us -= us_of(past->lag_s);
+    }
+    const hs_fault_t *future = active(r, HS_FAULT_POSE_FUTURE, t_us);
+    if (future) {
+        m.pose.t_us += us_of(future->lag_s);
     }
     m.t_us = m.pose.t_us;
     unsigned n = reorder(active(r, HS_FAULT_POSE_REORDER, t_us) != NULL, &r->pose_held,

@@ -7,7 +7,7 @@
  *
  *   - between the sensors and the controller: every RSSI packet and every localisation
  *     pose passes hs_faults_rssi() / hs_faults_pose(), which may drop it (silence), delay
- *     its timestamp into the past, swap it with the next one (out of order) or offset the
+ *     its timestamp into the past (or the future), swap it with the next one (out of order) or offset the
  *     pose (a 3 m re-localisation jump);
  *   - between the controller and the motor model (where the CAN bus is on the robot):
  *     every wheel command passes hs_faults_cmd(), which may lose it (send failures, bus-off);
@@ -44,6 +44,8 @@ typedef enum hs_fault_kind {
     HS_FAULT_BUS_OFF,          ///< "bus_off": no wheel command delivered
     HS_FAULT_SOURCE_MOVE,      ///< "source_move": source `source` moves to `position` (one-shot)
     HS_FAULT_KIDNAP,           ///< "kidnap": the robot is carried to `position`, `theta` (one-shot)
+    HS_FAULT_RSSI_FUTURE,      ///< "rssi_future": packet timestamps lead_s in the future
+    HS_FAULT_POSE_FUTURE,      ///< "pose_future": pose timestamps lead_s in the future
     HS_FAULT_KIND_COUNT        ///< number of kinds (not a kind)
 } hs_fault_kind_t;
 
@@ -57,7 +59,8 @@ typedef struct hs_fault {
     double duration_s;     ///< how long it lasts, seconds (0 for the one-shot kinds)
     double x, y;           ///< pose_jump: offset, metres; source_move, kidnap: position, metres
     double theta;          ///< kidnap: heading after the move, radians
-    double lag_s;          ///< *_past: how far in the past timestamps are, seconds
+    double lag_s;          ///< *_past: how far in the past timestamps are, seconds;
+                           ///< *_future: how far in the future (YAML `lead_s`), seconds
     double probability;    ///< can_drop: probability a command is lost, [0, 1]
     unsigned source;       ///< source_move: index of the source (scenario order)
 } hs_fault_t;

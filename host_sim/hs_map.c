@@ -369,7 +369,7 @@ int hs_map_load(const char *yaml_path, hs_map_t *m, char *err, size_t errlen)
     if (rc != 0) {
         return -1;
     }
-    uint8_t *cell = malloc((size_t)w * h);
+    uint8_t *cell = malloc((size_t)w * h); // NOLINT(clang-analyzer-optin.portability.UnixAPI): pgm_decode gives w, h >= 1
     if (cell == NULL) {
         free(pix);
         return fail(err, errlen, ipath, "out of memory");

@@ -149,7 +149,7 @@ hs_pcap_writer_t *hs_pcap_writer_open(const char *path, char *err, size_t errlen
         return NULL;
     }
     memcpy(w->path, path, n + 1);
-    memcpy(w->tmp, path, n);
+    memcpy(w->tmp, path, n); // NOLINT(bugprone-not-null-terminated-result): ".tmp" and its NUL follow
     memcpy(w->tmp + n, ".tmp", 5);
     w->dead = pcap_open_dead_with_tstamp_precision(DLT_IEEE802_11_RADIO, 65535, PCAP_TSTAMP_PRECISION_MICRO);
     if (w->dead == NULL) {

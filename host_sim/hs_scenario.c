@@ -175,6 +175,15 @@ int hs_scenario_parse_mac(const char *s, uint8_t mac[6])
 {
     unsigned v[6];
     char tail;
+    // %2x alone would accept a sign or blanks ("-1:00:00:00:00:00"): check every character.
+    for (int i = 0; s && i < 17; i++) {
+        const char c = s[i];
+        const bool hex = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F');
+        if (i % 3 == 2 ? c != ':' : !hex) {
+            return -1;
+        }
+    }
+    // NOLINTNEXTLINE(cert-err34-c): every character was checked above, %2x cannot overflow
     if (!s || sscanf(s, "%2x:%2x:%2x:%2x:%2x:%2x%c", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5],
                      &tail) != 6 || strlen(s) != 17) {
         return -1;
@@ -292,7 +301,7 @@ static int parse_faults(pctx_t *p, yaml_node_t *n, hs_scenario_t *sc)
         return fail(p, n, "faults: %ld given, at most %u", nf, HS_FAULTS_MAX);
     }
     static const char *const k[] = {"kind", "start_s", "duration_s", "offset", "position",
-                                    "theta", "lag_s", "probability", "source", NULL};
+                                    "theta", "lag_s", "lead_s", "probability", "source", NULL};
     for (long i = 0; i < nf; i++) {
         yaml_node_t *f = yaml_document_get_node(&p->doc, n->data.sequence.items.start[i]);
         char where[32], kind[32] = "";
@@ -304,8 +313,8 @@ static int parse_faults(pctx_t *p, yaml_node_t *n, hs_scenario_t *sc)
         if (!hs_faults_kind_parse(kind, &fk)) {
             return fail(p, get(p, f, "kind") ? get(p, f, "kind") : f,
                         "%s.kind: '%s' is not a fault (rssi_silence, rssi_past, rssi_reorder, "
-                        "pose_jump, pose_past, pose_reorder, can_drop, bus_off, source_move, "
-                        "kidnap)", where, kind);
+                        "rssi_future, pose_jump, pose_past, pose_reorder, pose_future, can_drop, "
+                        "bus_off, source_move, kidnap)", where, kind);
         }
         hs_fault_t *ft = &sc->faults.f[i];
         *ft = hs_faults_default(fk);
@@ -315,6 +324,7 @@ static int parse_faults(pctx_t *p, yaml_node_t *n, hs_scenario_t *sc)
             num(p, f, where, "duration_s", 0, 1e6, &ft->duration_s) ||
             num(p, f, where, "theta", -7, 7, &ft->theta) ||
             num(p, f, where, "lag_s", 0, 3600, &ft->lag_s) ||
+            num(p, f, where, "lead_s", 0, 3600, &ft->lag_s) ||
             num(p, f, where, "probability", 0, 1, &ft->probability) ||
             num(p, f, where, "source", 0, HS_SCN_MAX_SOURCES - 1, &src) ||
             (fk == HS_FAULT_POSE_JUMP && xy(p, f, where, "offset", false, &ft->x, &ft->y, NULL)) ||
@@ -380,8 +390,10 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
         return fail(p, get(p, root, "model"), "model: '%s' is not a known model (%s)", sc->model,
                     names);
     }
-    if (strcmp(sc->target, "rssi") != 0 && strcmp(sc->target, "bridge") != 0) {
-        return fail(p, get(p, root, "target"), "target: '%s' is not rssi or bridge", sc->target);
+    if (strcmp(sc->target, "rssi") != 0 && strcmp(sc->target, "bridge") != 0 &&
+        strcmp(sc->target, "pdr") != 0) {
+        return fail(p, get(p, root, "target"), "target: '%s' is not rssi, bridge or pdr",
+                    sc->target);
     }
     n = get(p, root, "sources");
     if (!n || n->type != YAML_SEQUENCE_NODE) {
@@ -417,8 +429,8 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
     if (strcmp(sc->target, "bridge") == 0 && sc->nsources != 2) {
         return fail(p, get(p, root, "target"), "target: bridge needs exactly 2 sources");
     }
-    if (strcmp(sc->target, "rssi") == 0 && sc->nsources != 1) {
-        return fail(p, get(p, root, "target"), "target: rssi needs exactly 1 source");
+    if (strcmp(sc->target, "bridge") != 0 && sc->nsources != 1) {
+        return fail(p, get(p, root, "target"), "target: %s needs exactly 1 source", sc->target);
     }
     n = get(p, root, "start");
     if (!n) {

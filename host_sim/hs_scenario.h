@@ -3,7 +3,8 @@
  *   map: maps/office.yaml          # ROS map_server YAML, relative to this file (required)
  *   seed: 1
  *   model: ridge                   # internal model (paper section 5.2)
- *   target: rssi                   # rssi (one source) or bridge (two, paper section 6)
+ *   target: rssi                   # rssi (one source), bridge (two, paper section 6) or
+ *                                  # pdr (one: packet delivery ratio, rfs_pdr.h)
  *   strategy: meta                 # placeholder for the baselines of issue 7
  *   sources:                       # required, 1 or 2
  *     - name: ap
@@ -54,7 +55,7 @@ typedef struct hs_scenario {
     char map_path[1024];          ///< the map YAML, resolved against the scenario's folder
     uint64_t seed;                ///< default seed (1)
     char model[32];               ///< internal model name ("ridge")
-    char target[16];              ///< target name ("rssi"; "bridge" with two sources)
+    char target[16];              ///< target name ("rssi"; "bridge" with two sources; "pdr")
     char strategy[32];            ///< strategy name ("meta")
     unsigned nsources;            ///< sources
     hs_scn_source_t src[HS_SCN_MAX_SOURCES]; ///< the sources

@@ -6,9 +6,9 @@ rfseek-sim twice side by side in one invocation: with the fault and with --no-fa
 base scenario, byte for byte), and prints one Markdown row per fault:
 
   reached with / without the fault, runs still going when the fault began ("exercised"),
-  wheel commands given while the newest pose or
-  RSSI the controller had received was more than 200 ms old and how many of those were
-  non-zero (must be 0), and the longest time from the last delivered wheel command to the
+  wheel commands given while the newest pose or RSSI timestamp the controller had received
+  was more than 200 ms from now (old, or ahead after a clock jump) and how many of those
+  were non-zero (must be 0), and the longest time from the last delivered wheel command to the
   motor model stopping the wheels (must be <= 200 ms).
 
 Command ages are measured here (awk over each run's faults.tsv) from the timestamps of
@@ -33,7 +33,8 @@ $2 == "pose" { if ($3 + 0 > pm) pm = $3 + 0; next }
 $2 == "rssi" { if ($3 + 0 > rm) rm = $3 + 0; next }
 $2 == "cmd" {
     n++
-    if ($1 - pm > 0.2 + 1e-6 || $1 - rm > 0.2 + 1e-6) { st++; if ($3 != 0 || $4 != 0) mv++ }
+    a = $1 - pm; b = $1 - rm; if (a < 0) a = -a; if (b < 0) b = -b
+    if (a > 0.2 + 1e-6 || b > 0.2 + 1e-6) { st++; if ($3 != 0 || $4 != 0) mv++ }
     if ($5 == 1) ld = $1 + 0
     next
 }

@@ -27,6 +27,8 @@
 #include "hs_radiotap.h"
 #include "hs_scenario.h"
 #include "hs_sim.h"
+#include "rfs_models.h"
+#include "rfs_pdr.h"
 
 #define FEED_MAX_MACS 8
 
@@ -34,7 +36,7 @@ static const char k_usage[] =
     "usage: rfseek-feed CAPTURE --mac MAC [--mac MAC2 ...] [--format tsv] [--stats]\n"
     "                   [--output FILE] [--live]\n"
     "       rfseek-feed CAPTURE --pose POSES.csv --scenario SCENARIO.yaml --out DIR\n"
-    "                   [--mac MAC ...] [--seed N] [--stats]\n"
+    "                   [--mac MAC ...] [--seed N] [--model NAME] [--target rssi|pdr] [--stats]\n"
     "Print epoch_seconds<TAB>source_mac<TAB>dbm for every 802.11 frame in CAPTURE (a .pcap\n"
     "or .pcapng with radiotap headers, link type 127) whose source address (as tshark's\n"
     "wlan.sa) is one of the MACs and that carries a dBm antenna signal (the combined value\n"
@@ -53,6 +55,11 @@ static const char k_usage[] =
     "  --out DIR      replay: write log.tsv, samples.tsv, track.tsv, summary.json (as\n"
     "                 rfseek-sim) into DIR (via DIR.tmp-PID, renamed when complete)\n"
     "  --seed N       replay: seed of the controller's randomness (default: the scenario's)\n"
+    "  --model NAME   replay: internal model, overriding the scenario's: ridge, mlp, knn,\n"
+    "                 radius, pathloss (docs/MODELS.md)\n"
+    "  --target T     replay: what the seeker maximises, overriding the scenario's: rssi, or\n"
+    "                 pdr (the packet delivery ratio over 1 s from the 802.11 sequence numbers\n"
+    "                 of the matching frames; samples.tsv then holds the percentages fed)\n"
     "  --help         this text\n"
     "Exit 0 on success, 1 on a bad capture or I/O error, 2 on bad options.\n";
 
@@ -75,6 +82,7 @@ static int parse_mac(const char *s, uint8_t mac[6])
     unsigned v[6];
     char sep[5];
     char tail;
+    // NOLINTNEXTLINE(cert-err34-c): the digits and separators are checked below, %2x cannot overflow
     const int n = sscanf(s, "%2x%c%2x%c%2x%c%2x%c%2x%c%2x%c", &v[0], &sep[0], &v[1], &sep[1], &v[2],
                          &sep[2], &v[3], &sep[3], &v[4], &sep[4], &v[5], &tail);
     if (n != 11 || strlen(s) != 17) { return -1; }
@@ -249,7 +257,7 @@ typedef struct rp_pkt {
     int64_t t_us; /* capture clock, microseconds since the epoch */
     uint8_t src;  /* source index (scenario order) */
     int8_t dbm;   /* first (combined) dBm antenna signal */
-    uint16_t seq; /* 802.11 sequence number */
+    uint16_t seq_ctrl; /* 802.11 Sequence Control: number << 4 | fragment */
 } rp_pkt_t;
 
 typedef struct rp_vec {
@@ -267,7 +275,8 @@ static int rp_collect(void *ctx, int m, const hs_pcap_pkt_t *pkt, const hs_rt_fr
         vec->v = nv;
         vec->cap = cap;
     }
-    vec->v[vec->n++] = (rp_pkt_t){pkt->t_us, (uint8_t)m, f->rt.dbm_signal, f->wlan.seq};
+    vec->v[vec->n++] = (rp_pkt_t){pkt->t_us, (uint8_t)m, f->rt.dbm_signal,
+                                  (uint16_t)(f->wlan.seq << 4 | f->wlan.frag)};
     return 0;
 }
 
@@ -400,6 +409,7 @@ static void rp_rmdir(const char *dir)
 
 typedef struct rp_opts {
     const char *capture, *poses, *scenario, *out;
+    const char *model, *target; /* overrides of the scenario's, or NULL */
     bool has_seed;
     uint64_t seed;
 } rp_opts_t;
@@ -418,6 +428,16 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
         fprintf(stderr, "rfseek-feed: %s\n", err);
         return 1;
     }
+    if (o->model != NULL) { snprintf(sc.model, sizeof(sc.model), "%s", o->model); }
+    if (o->target != NULL) {
+        if (sc.nsources != 1) {
+            fprintf(stderr, "rfseek-feed: --target: %s needs exactly 1 source, scenario %s has %u\n",
+                    o->target, o->scenario, sc.nsources);
+            return 2;
+        }
+        snprintf(sc.target, sizeof(sc.target), "%s", o->target);
+    }
+    const bool pdr_target = strcmp(sc.target, "pdr") == 0;
     if (n_macs == 0) {
         for (unsigned i = 0; i < sc.nsources; i++) { memcpy(macs[i], sc.src[i].mac, 6); }
         n_macs = (int)sc.nsources;
@@ -480,7 +500,7 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
         fprintf(flog, "iteration\tt_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\tkind\treason\t"
                       "relearned\tprediction_db\tmean_db\tepsilon\tgoal_x_m\tgoal_y_m\t"
                       "max_x_m\tmax_y_m\tpath_m\tsamples\ttravelled_m\n");
-        fprintf(fsam, "t_s\tsrc\tx_m\ty_m\ttravelled_m\tdbm\n");
+        fprintf(fsam, "t_s\tsrc\tx_m\ty_m\ttravelled_m\t%s\n", pdr_target ? "pdr_pct" : "dbm");
         fprintf(ftrk, "t_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\test_theta_rad\ttouching\n");
         const int64_t t0 = poses[0].t_us;
         const int64_t t_end = poses[n_poses - 1].t_us - t0;
@@ -489,6 +509,10 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
         bool seen[FEED_MAX_MACS] = {false};
         uint16_t last_seq[FEED_MAX_MACS] = {0};
         uint64_t lost = 0;
+        /* Target "pdr": one delivery window (1 s) per source, fed from Sequence Control. */
+        rfs_pdr_t pdr[FEED_MAX_MACS];
+        const rfs_pdr_cfg_t pdr_cfg = rfs_pdr_cfg_default();
+        for (int k = 0; k < n_macs; k++) { (void)rfs_pdr_init(&pdr[k], &pdr_cfg); }
         size_t pi = 0, qi = 0; /* next packet, next pose */
         size_t seg = 0;        /* poses[seg], poses[seg + 1] bracket the current time */
         double travelled_at_seg = 0.0;
@@ -520,16 +544,23 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
             fy = ey;
             if (kind == 0) {
                 const rp_pkt_t *p = &pk.v[pi++];
+                const uint16_t seq = (uint16_t)(p->seq_ctrl >> 4);
                 if (seen[p->src]) {
-                    const unsigned d = (unsigned)(p->seq - last_seq[p->src]) & 0x0fffu;
+                    const unsigned d = (unsigned)(seq - last_seq[p->src]) & 0x0fffu;
                     if (d >= 2u && d <= 2048u) { lost += d - 1u; }
                 }
                 seen[p->src] = true;
-                last_seq[p->src] = p->seq;
+                last_seq[p->src] = seq;
                 res.packets_received++;
-                ctrl.on_rssi(ctrl.self, p->src, te, p->dbm);
-                fprintf(fsam, "%.6f\t%u\t%.3f\t%.3f\t%.3f\t%d\n", te * 1e-6, (unsigned)p->src, ex, ey, etr,
-                        (int)p->dbm);
+                int8_t meas = p->dbm;
+                /* A retransmission or later fragment is not a new frame: no new ratio. */
+                const bool fed = !pdr_target || (rfs_pdr_push_seq_ctrl(&pdr[p->src], te, p->seq_ctrl) &&
+                                                 rfs_pdr_value(&pdr[p->src], te, &meas));
+                if (fed) {
+                    ctrl.on_rssi(ctrl.self, p->src, te, meas);
+                    fprintf(fsam, "%.6f\t%u\t%.3f\t%.3f\t%.3f\t%d\n", te * 1e-6, (unsigned)p->src, ex, ey,
+                            etr, (int)meas);
+                }
             } else if (kind == 1) {
                 const rp_pose_t *q = &poses[qi++];
                 rfs_pose_t pose = {te, rp_q16(q->x), rp_q16(q->y), rp_q16(rp_wrap(q->theta))};
@@ -615,7 +646,8 @@ int main(int argc, char **argv)
     int n_macs = 0;
     bool stats = false;
     bool live = false;
-    static const char *const k_valued[] = {"--mac", "--format", "--output", "--pose", "--scenario", "--out", "--seed"};
+    static const char *const k_valued[] = {"--mac",  "--format", "--output", "--pose", "--scenario",
+                                           "--out",  "--seed",   "--model",  "--target"};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         bool valued = false;
@@ -654,6 +686,18 @@ int main(int argc, char **argv)
                 ro.scenario = v;
             } else if (strcmp(a, "--out") == 0) {
                 ro.out = v;
+            } else if (strcmp(a, "--model") == 0) {
+                if (rfs_models_lookup(v) == NULL) {
+                    fprintf(stderr, "rfseek-feed: --model: unknown '%s' (ridge, mlp, knn, radius, pathloss)\n", v);
+                    return 2;
+                }
+                ro.model = v;
+            } else if (strcmp(a, "--target") == 0) {
+                if (strcmp(v, "rssi") != 0 && strcmp(v, "pdr") != 0) {
+                    fprintf(stderr, "rfseek-feed: --target: unknown '%s' (rssi, pdr)\n", v);
+                    return 2;
+                }
+                ro.target = v;
             } else {
                 char *e = NULL;
                 errno = 0;
@@ -687,8 +731,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "rfseek-feed: --pose needs --scenario and --out (see --help)\n");
         return 2;
     }
-    if (!replay && (ro.scenario != NULL || ro.out != NULL || ro.has_seed)) {
-        fprintf(stderr, "rfseek-feed: --scenario, --out and --seed only go with --pose (see --help)\n");
+    if (!replay && (ro.scenario != NULL || ro.out != NULL || ro.has_seed || ro.model != NULL ||
+                    ro.target != NULL)) {
+        fprintf(stderr, "rfseek-feed: --scenario, --out, --seed, --model and --target only go with --pose "
+                        "(see --help)\n");
         return 2;
     }
     if (replay && (output != NULL || live)) {

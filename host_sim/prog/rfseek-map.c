@@ -104,10 +104,10 @@ static void run_bench(const hs_core_map_t *c, long n)
     uint32_t lat = (uint32_t)m->lw * m->lh;
     uint32_t cap_big = 4u * lat + 64u;
     uint32_t cap_doc = 2u * ((uint32_t)m->lw + m->lh);
-    uint8_t *work = malloc(lat);
+    uint8_t *work = malloc(lat); // NOLINT(clang-analyzer-optin.portability.UnixAPI): an initialised map has lw, lh >= 1
     uint32_t *queue = malloc(cap_big * sizeof(*queue));
-    uint8_t *legal = malloc(rfs_map_bytes(m->w, m->h));
-    double *t = malloc((size_t)n * sizeof(*t));
+    uint8_t *legal = malloc(rfs_map_bytes(m->w, m->h)); // NOLINT(clang-analyzer-optin.portability.UnixAPI): w, h >= 1
+    double *t = malloc((size_t)n * sizeof(*t)); // NOLINT(clang-analyzer-optin.portability.UnixAPI): --bench N is 1..1000000
     double *e = malloc((size_t)n * sizeof(*e));
     if (work == NULL || queue == NULL || legal == NULL || t == NULL || e == NULL) {
         fprintf(stderr, "rfseek-map: out of memory for --bench\n");

@@ -254,6 +254,7 @@ static int run_batch(const hs_sim_env_t *env, uint64_t a, uint64_t b, int jobs, 
             for (int k = 0; k < j; k++) {
                 kill(pids[k], SIGTERM);
             }
+            free(all); free(have); free(pids);
             return 1;
         }
         if (pid == 0) {

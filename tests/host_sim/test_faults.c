@@ -7,7 +7,8 @@
  * commands, that the wheels are commanded to zero whenever the newest input the core was
  * given is more than 200 ms old (the issue's bound), that the motor model stops the wheels
  * within 200 ms of the last delivered command on a bus-off, and that the run still reaches
- * the source. Input age is computed here from the delivered timestamps, not taken from the
+ * the source. An input stamped more than 200 ms in the future counts as stale as well: it
+ * freezes the controller's view just like an old one. Input age is computed here from the delivered timestamps, not taken from the
  * core's fault flags.
  */
 #include "rfs_test.h"
@@ -307,8 +308,10 @@ static void measure(FILE *log, double bus_off_start_s, measured_t *m)
             int l = atoi(f[2]), r = atoi(f[3]);
             bool delivered = atoi(f[4]) != 0;
             m->cmds++;
-            // 1 us of slack for the 6-decimal timestamps in the log.
-            if (t - pose_max > 0.2 + 1e-6 || t - rssi_max > 0.2 + 1e-6) {
+            // Stale: the newest stamp is more than 200 ms from now, either way (a stamp
+            // from the future freezes the input just as well). 1 us of slack for the
+            // 6-decimal timestamps in the log.
+            if (fabs(t - pose_max) > 0.2 + 1e-6 || fabs(t - rssi_max) > 0.2 + 1e-6) {
                 m->stale_cmds++;
                 m->stale_moving += (l != 0 || r != 0) ? 1u : 0u;
             }
@@ -336,8 +339,8 @@ static void measure(FILE *log, double bus_off_start_s, measured_t *m)
 }
 
 /// Run scenarios/faults/open-NAME.yaml with `seed`, logging into a temporary file.
-static void run_fault(const char *name, uint64_t seed, hs_sim_result_t *res, FILE **log,
-                      hs_scenario_t *sc_out)
+static void run_fault_io(const char *name, uint64_t seed, hs_sim_result_t *res, FILE **log,
+                         hs_scenario_t *sc_out, FILE *decisions)
 {
     char path[256], err[1024];
     snprintf(path, sizeof path, "scenarios/faults/open-%s.yaml", name);
@@ -355,12 +358,19 @@ static void run_fault(const char *name, uint64_t seed, hs_sim_result_t *res, FIL
     hs_sim_io_t io;
     memset(&io, 0, sizeof io);
     io.faults = *log;
+    io.log = decisions;
     if (hs_sim_run_inproc(&env, seed, &io, res, err, sizeof err) != 0) {
         fail_msg("%s", err);
     }
     hs_sim_env_close(&env);
     fflush(*log);
     *sc_out = sc;
+}
+
+static void run_fault(const char *name, uint64_t seed, hs_sim_result_t *res, FILE **log,
+                      hs_scenario_t *sc_out)
+{
+    run_fault_io(name, seed, res, log, sc_out, NULL);
 }
 
 /// The checks every fault shares: the run reached the source, no command moved the
@@ -373,7 +383,7 @@ static void common_checks(const char *name, const hs_sim_result_t *res, const me
     }
     assert_true(m->cmds > 100);
     if (m->stale_moving != 0) {
-        fail_msg("%s: %u wheel commands non-zero with inputs older than 200 ms", name,
+        fail_msg("%s: %u wheel commands non-zero with an input stamp over 200 ms from now", name,
                  m->stale_moving);
     }
 }
@@ -393,6 +403,8 @@ static void test_stale_input_faults_stop_the_wheels_and_recover(void **state)
         {"pose_reorder", 1},   // 100 ms poses stay within 200 ms even when swapped
         {"rssi_reorder", 1},
         {"pose_jump", 1},
+        {"pose_future", 90},   // one pose 5 s ahead: stale until its stamp, 4.8 s at least
+        {"rssi_future", 90},
     };
     for (unsigned i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         hs_sim_result_t res;
@@ -489,6 +501,56 @@ static void test_moved_source_is_found_at_its_new_place(void **state)
     assert_true(hypot(res.final_x - f->x, res.final_y - f->y) <= sc.stop_radius_m + 1e-9);
 }
 
+/* After a 30 s RSSI silence the core resumes the goal it was driving (rfs_seek.c
+ * `resume`). The goal's 30 s timeout (rfs_drive_cfg_default) counts driving time only:
+ * in seed 1 the goal was set 3 s before the silence, so when inputs return it must end
+ * as reached (or blocked), not be abandoned as timed out (33 s after it was set). */
+static void test_goal_resumes_after_silence(void **state)
+{
+    (void)state;
+    FILE *dec = tmpfile();
+    assert_non_null(dec);
+    hs_sim_result_t res;
+    FILE *log;
+    hs_scenario_t sc;
+    run_fault_io("rssi_silence", 1, &res, &log, &sc, dec);
+    fclose(log);
+    const double t0 = sc.faults.f[0].start_s, t1 = t0 + sc.faults.f[0].duration_s;
+    rewind(dec);
+    char line[1024];
+    assert_non_null(fgets(line, sizeof line, dec)); // header
+    double last_before = -1.0, first_after = -1.0;
+    char reason_after[128] = "";
+    while (fgets(line, sizeof line, dec)) {
+        // Columns: iteration, t_s, x_m, y_m, theta_rad, est_x_m, est_y_m, kind, reason, ...
+        char *f[10];
+        unsigned n = 0;
+        for (char *p = line; n < 10 && p; n++) {
+            f[n] = p;
+            p = strchr(p, '\t');
+            if (p) {
+                *p++ = '\0';
+            }
+        }
+        assert_true(n == 10);
+        double t = strtod(f[1], NULL);
+        if (t < t0) {
+            last_before = t;
+        } else if (t >= t1 && first_after < 0.0) {
+            first_after = t;
+            snprintf(reason_after, sizeof reason_after, "%s", f[8]);
+        }
+    }
+    fclose(dec);
+    // The goal before the silence was young (set less than 30 s of driving before).
+    assert_true(last_before > t0 - 30.0 && last_before < t0);
+    assert_true(first_after >= t1);
+    if (strstr(reason_after, "prev=timeout")) {
+        fail_msg("resumed goal abandoned at once: first decision at %.2f s (%s)", first_after,
+                 reason_after);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -506,6 +568,7 @@ int main(void)
         cmocka_unit_test(test_can_send_failures_are_survived),
         cmocka_unit_test(test_kidnapped_robot_still_reaches_the_source),
         cmocka_unit_test(test_moved_source_is_found_at_its_new_place),
+        cmocka_unit_test(test_goal_resumes_after_silence),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -13,11 +13,16 @@
 #include <string.h>
 
 #include "rfs_app.h"
+#include "rfs_mlp.h"
 #include "rfs_replay.h"
 #include "semihost.h"
 
 static rfs_app_t s_app;
 static rfs_replay_player_t s_player;
+/* State for the model a CFG record names: the MLP's 3.3 KB holds the ridge and the MLP
+ * (the emulator's RAM budget has the room the hardware image lacks); a stream naming
+ * knn, radius or pathloss stops with "CFG model's state is larger than the image holds". */
+static uint64_t s_model[(sizeof(rfs_mlp_t) + 7u) / 8u];
 
 /* Stack high-water mark: the stack is painted at start and scanned at the end (the
  * figure that sizes the hardware image's stack, docs/FIRMWARE.md). */
@@ -146,7 +151,9 @@ int main(void)
     if (got != (int32_t)RFS_REPLAY_HEADER_LEN || rfs_replay_check_header(buf, (uint32_t)got) != 0) {
         die("input: not an rfseek stream (bad header)");
     }
-    const rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.model_state = s_model;
+    cfg.model_state_bytes = (uint32_t)sizeof s_model;
     rfs_replay_player_init(&s_player, &s_app, &cfg, sink, &s_out);
 
     bool eof = false, ended = false;

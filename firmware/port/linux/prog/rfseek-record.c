@@ -207,6 +207,9 @@ static void usage(FILE *f)
             "  --reset T            watchdog reset at T s\n"
             "  --fit-budget N       samples learnt per control period (0: all; the MCU\n"
             "                       configuration uses 2500)\n"
+            "  --model NAME         internal model, overriding the scenario's: ridge, mlp, knn,\n"
+            "                       radius, pathloss (recorded in the CFG record; the emulator\n"
+            "                       image holds ridge and mlp)\n"
             "  -h, --help           this text\n");
 }
 
@@ -224,7 +227,7 @@ int main(int argc, char **argv)
         {"drop", required_argument, 0, 'd'},    {"bus-off", required_argument, 0, 'b'},
         {"reset", required_argument, 0, 'r'},   {"help", no_argument, 0, 'h'},
         {"drop-pose", required_argument, 0, 'P'}, {"drop-rssi", required_argument, 0, 'R'},
-        {"fit-budget", required_argument, 0, 'f'},
+        {"fit-budget", required_argument, 0, 'f'}, {"model", required_argument, 0, 'm'},
         {0, 0, 0, 0}};
     static recorder_t rec;
     const char *out_path = NULL, *live_path = NULL;
@@ -232,6 +235,7 @@ int main(int argc, char **argv)
     unsigned long long seed = 0;
     double max_time = -1;
     uint32_t fit_budget = 0;
+    const char *model_name = NULL;
     int c;
     while ((c = getopt_long(argc, argv, "o:h", opts, NULL)) != -1) {
         char *end;
@@ -292,6 +296,15 @@ int main(int argc, char **argv)
             rec.reset_us[rec.nreset++] = (int64_t)(t * 1e6 + 0.5);
             break;
         }
+        case 'm':
+            if (rfs_models_lookup(optarg) == NULL ||
+                strlen(optarg) > RFS_REPLAY_MODEL_NAME_MAX) {
+                fprintf(stderr, "rfseek-record: --model: unknown '%s' (ridge, mlp, knn, radius, "
+                                "pathloss)\n", optarg);
+                return 2;
+            }
+            model_name = optarg;
+            break;
         case 'h': usage(stdout); return 0;
         default: usage(stderr); return 2;
         }
@@ -309,6 +322,14 @@ int main(int argc, char **argv)
     }
     if (max_time > 0) {
         sc.stop_time_s = max_time;
+    }
+    if (strcmp(sc.target, "pdr") == 0) {
+        fprintf(stderr, "rfseek-record: %s: target: pdr is not available on the firmware (the CAN "
+                        "RSSI frame carries no sequence number; docs/MODELS.md)\n", scn_path);
+        return 1;
+    }
+    if (model_name == NULL) {
+        model_name = sc.model; // checked against the registry by the scenario loader
     }
     static hs_sim_env_t env;
     if (hs_sim_env_open(&env, &sc, err, sizeof err) != 0) {
@@ -351,7 +372,17 @@ int main(int argc, char **argv)
     if (fwrite(hdr, 1, sizeof hdr, rec.in) != sizeof hdr) {
         rec.write_failed = 1;
     }
-    const rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    // The host holds every model (the CFG record names it; the emulator may refuse it).
+    const uint32_t model_bytes = (rfs_models_max_state_bytes() + 7u) & ~7u;
+    static uint64_t *model_state;
+    model_state = aligned_alloc(RFS_MODELS_STATE_ALIGN, model_bytes);
+    if (model_state == NULL) {
+        fprintf(stderr, "rfseek-record: out of memory\n");
+        return 1;
+    }
+    rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.model_state = model_state;
+    cfg.model_state_bytes = model_bytes;
     rfs_replay_player_init(&player, &app, &cfg, sink, &rec);
 
     rfs_replay_rec_t r;
@@ -361,6 +392,10 @@ int main(int argc, char **argv)
     r.u.cfg.target = sc.nsources == 2u ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
     r.u.cfg.node = 1u;
     r.u.cfg.fit_budget = fit_budget;
+    if (strcmp(model_name, "ridge") != 0) { // the ridge is every player's base: a v1 CFG
+        const size_t n = strlen(model_name); // registry names are <= 15 bytes (checked above)
+        memcpy(r.u.cfg.model, model_name, n < RFS_REPLAY_MODEL_NAME_MAX ? n : RFS_REPLAY_MODEL_NAME_MAX);
+    }
     feed(&rec, &r);
     memset(&r, 0, sizeof r);
     r.type = RFS_REPLAY_MAP;

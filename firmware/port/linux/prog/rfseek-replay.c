@@ -97,6 +97,9 @@ static void print_rec(const rfs_replay_rec_t *r)
     case RFS_REPLAY_CFG:
         printf("\tseed=%" PRIu64 "\ttarget=%u\tnode=%u", r->u.cfg.seed, r->u.cfg.target,
                r->u.cfg.node);
+        if (r->u.cfg.model[0] != '\0') {
+            printf("\tmodel=%s", r->u.cfg.model);
+        }
         break;
     case RFS_REPLAY_MAP:
         printf("\tw=%u\th=%u\tres_q16=%d\tox_q16=%d\toy_q16=%d\twall=%u", r->u.map.w,
@@ -205,7 +208,20 @@ int main(int argc, char **argv)
             free(buf);
             return 1;
         }
-        const rfs_app_cfg_t cfg = rfs_app_cfg_default();
+        // The host holds every model a CFG record may name (rfs_models.h).
+        static uint64_t *model_state;
+        const uint32_t mb = (rfs_models_max_state_bytes() + 7u) & ~7u;
+        model_state = aligned_alloc(RFS_MODELS_STATE_ALIGN, mb);
+        if (model_state == NULL) {
+            fprintf(stderr, "rfseek-replay: out of memory\n");
+            fclose(sc.f);
+            remove(tmp);
+            free(buf);
+            return 1;
+        }
+        rfs_app_cfg_t cfg = rfs_app_cfg_default();
+        cfg.model_state = model_state;
+        cfg.model_state_bytes = mb;
         rfs_replay_player_init(&player, &app, &cfg, sink, &sc);
     }
     size_t pos = RFS_REPLAY_HEADER_LEN;

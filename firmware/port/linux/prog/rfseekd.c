@@ -38,6 +38,8 @@ static const char usage_text[] =
     "  --log FILE        record every input and output as an LCM log (lcm-logplayer)\n"
     "  --decisions FILE  write one line per decision (default: stdout with --replay)\n"
     "  --target NAME     rssi (default) or bridge\n"
+    "  --model NAME      internal model: ridge (default, the paper's), mlp, knn, radius,\n"
+    "                    pathloss (docs/MODELS.md; the STM32 image holds the ridge only)\n"
     "  --seed N          seed of the controller's random source (default 1)\n"
     "  --duration S      stop after S seconds of controller time (default: run until signalled)\n"
     "  --idle-exit MS    stop when no LCM message arrived for MS milliseconds\n"
@@ -247,7 +249,8 @@ static bool parse_i64(const char *s, int64_t lo, int64_t hi, int64_t *v)
 static bool is_value_option(const char *a)
 {
     static const char *const opts[] = {"--map", "--lcm", "--can", "--replay", "--log", "--decisions",
-                                       "--target", "--res", "--seed", "--duration", "--idle-exit"};
+                                       "--target", "--res", "--seed", "--duration", "--idle-exit",
+                                       "--model"};
     for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++) {
         if (strcmp(a, opts[i]) == 0) {
             return true;
@@ -260,6 +263,7 @@ int main(int argc, char **argv)
 {
     const char *map_path = NULL, *url = NULL, *can_if = NULL, *replay = NULL, *log_path = NULL, *dec_path = NULL;
     const char *target = "rssi";
+    const rfs_models_entry_t *model = NULL; // NULL: the application's built-in ridge
     double res = 0.1;
     int64_t seed = 1, duration_s = 0, idle_ms = 0;
     bool can_over_lcm = false, clock_lcm = false;
@@ -273,7 +277,7 @@ int main(int argc, char **argv)
             can_over_lcm = true;
         } else if (strcmp(a, "--clock-lcm") == 0) {
             clock_lcm = true;
-        } else if (!is_value_option(a)) {
+        } else if (!is_value_option(a)) { // NOLINT(bugprone-branch-clone): same message as the guard at the end
             return die("unknown option (see --help): ", a);
         } else if (v == NULL) {
             return die("missing value for option ", a);
@@ -293,6 +297,11 @@ int main(int argc, char **argv)
             target = v, i++;
             if (strcmp(target, "rssi") != 0 && strcmp(target, "bridge") != 0) {
                 return die("--target: expected rssi or bridge, got ", target);
+            }
+        } else if (strcmp(a, "--model") == 0) {
+            model = rfs_models_lookup(v), i++;
+            if (model == NULL) {
+                return die("--model: expected ridge, mlp, knn, radius or pathloss, got ", v);
             }
         } else if (strcmp(a, "--res") == 0) {
             char *end;
@@ -343,6 +352,22 @@ int main(int argc, char **argv)
         fprintf(stderr, "rfseekd: %s\n", err);
         return 1;
     }
+    // The Linux port holds any model: its state in a heap buffer of the model's size.
+    void *model_state = NULL;
+    if (model != NULL) {
+        size_t mb = (model->state_bytes + RFS_MODELS_STATE_ALIGN - 1u) / RFS_MODELS_STATE_ALIGN *
+                    RFS_MODELS_STATE_ALIGN;
+        model_state = aligned_alloc(RFS_MODELS_STATE_ALIGN, mb);
+        if (model_state == NULL) {
+            fprintf(stderr, "rfseekd: --model %s: out of memory\n", model->name);
+            hs_core_map_free(&core);
+            hs_map_free(&m);
+            return 1;
+        }
+        cfg.model = model;
+        cfg.model_state = model_state;
+        cfg.model_state_bytes = (uint32_t)mb;
+    }
     rfs_app_map_t am = {core.map.w, core.map.h, core.map.res, core.map.origin_x, core.map.origin_y, core.free_bits,
                         core.wall_bits};
     daemon_t d;
@@ -353,6 +378,7 @@ int main(int argc, char **argv)
                         "(%u bytes per grid, %u lattice points)\n",
                 map_path, core.map.w, core.map.h, res, RFS_APP_MAX_MAP_BYTES, RFS_APP_MAX_LATTICE);
         free(d.app);
+        free(model_state);
         hs_core_map_free(&core);
         hs_map_free(&m);
         return 1;
@@ -482,6 +508,7 @@ out:
     hs_can_close(d.can);
     hs_lcm_close(d.lcm);
     free(d.app);
+    free(model_state);
     hs_core_map_free(&core);
     hs_map_free(&m);
     return rc;

@@ -1,0 +1,173 @@
+/* test_app_models.c - the model chosen by configuration in the firmware (issue 8):
+ * rfs_app_cfg_t.model through the registry, the state-size check that keeps a model out
+ * of an image that cannot hold it, and the CFG record's optional model name (byte layout
+ * written out by hand from the format in firmware/rfs_replay.h). */
+#include "rfs_test.h"
+
+#include <string.h>
+
+#include "rfs_app.h"
+#include "rfs_knn.h"
+#include "rfs_mlp.h"
+#include "rfs_replay.h"
+
+#define W 200u /* 20 x 10 m at 0.1 m */
+#define H 100u
+static uint8_t s_free[(W + 7u) / 8u * H];
+static rfs_app_t s_app;
+static uint64_t s_state[(sizeof(rfs_mlp_t) + 7u) / 8u]; /* an image holding ridge and mlp */
+
+static rfs_app_map_t room(void)
+{
+    memset(s_free, 0, sizeof s_free);
+    for (uint16_t y = 1; y < H - 1u; y++) {
+        for (uint16_t x = 1; x < W - 1u; x++) {
+            rfs_map_bit_set(s_free, (W + 7u) / 8u, x, y, true);
+        }
+    }
+    const rfs_app_map_t m = {.w = W, .h = H, .res = RFS_Q16_FRAC(1, 10), .origin_x = 0,
+                             .origin_y = 0, .free = s_free, .wall = NULL};
+    return m;
+}
+
+static void test_built_in_state_holds_the_ridge_only(void **state)
+{
+    (void)state;
+    const rfs_app_map_t m = room();
+    rfs_app_cfg_t c = rfs_app_cfg_default();
+    assert_null(c.model);
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    assert_ptr_equal(s_app.seek.model.ops, &rfs_ridge_ops);
+    assert_ptr_equal(s_app.seek.model.self, &s_app.ridge);
+    assert_int_equal(rfs_app_model_capacity(&c), sizeof(rfs_ridge_t));
+
+    c.model = rfs_models_lookup("ridge");
+    assert_true(rfs_app_model_fits(&c));
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    assert_ptr_equal(s_app.seek.model.ops, &rfs_ridge_ops);
+
+    /* 3,292 bytes of MLP state do not fit the ridge's 120: init refuses. */
+    c.model = rfs_models_lookup("mlp");
+    assert_false(rfs_app_model_fits(&c));
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), -1);
+    c.model = rfs_models_lookup("knn");
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), -1);
+}
+
+static void test_port_buffer_holds_what_fits(void **state)
+{
+    (void)state;
+    const rfs_app_map_t m = room();
+    rfs_app_cfg_t c = rfs_app_cfg_default();
+    c.model_state = s_state;
+    c.model_state_bytes = (uint32_t)sizeof s_state;
+    c.model = rfs_models_lookup("mlp");
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    assert_ptr_equal(s_app.seek.model.ops, &rfs_mlp_ops);
+    assert_ptr_equal(s_app.seek.model.self, s_state);
+    /* The ridge goes into the port's buffer too, with cfg.ridge. */
+    c.model = NULL;
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    assert_ptr_equal(s_app.seek.model.ops, &rfs_ridge_ops);
+    assert_ptr_equal(s_app.seek.model.self, s_state);
+    /* knn (76 KB) does not fit 3.3 KB; a misaligned buffer is refused. */
+    c.model = rfs_models_lookup("knn");
+    assert_true(sizeof(rfs_knn_t) > sizeof s_state);
+    assert_false(rfs_app_model_fits(&c));
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), -1);
+    c.model = rfs_models_lookup("mlp");
+    c.model_state = (uint8_t *)s_state + 4;
+    c.model_state_bytes = (uint32_t)sizeof s_state - 8u;
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), -1);
+}
+
+static void test_cfg_model_name_bytes(void **state)
+{
+    (void)state;
+    rfs_replay_rec_t r;
+    memset(&r, 0, sizeof r);
+    r.type = RFS_REPLAY_CFG;
+    r.u.cfg.seed = 7;
+    r.u.cfg.target = 0;
+    r.u.cfg.node = 1;
+    r.u.cfg.fit_budget = 2500;
+    memcpy(r.u.cfg.model, "mlp", 3);
+    /* type 0x01, len 17: seed u64 LE, target, node, fit_budget u32 LE (2500 = 0x09C4), "mlp" */
+    static const uint8_t want[] = {0x01, 17, 7, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0xC4, 0x09, 0, 0,
+                                   'm', 'l', 'p'};
+    uint8_t buf[64];
+    assert_int_equal(rfs_replay_encode(&r, buf, sizeof buf), sizeof want);
+    assert_memory_equal(buf, want, sizeof want);
+    rfs_replay_rec_t back;
+    uint32_t used = 0;
+    assert_int_equal(rfs_replay_parse(want, sizeof want, &used, &back), RFS_REPLAY_OK);
+    assert_int_equal(used, sizeof want);
+    assert_string_equal(back.u.cfg.model, "mlp");
+    assert_int_equal(back.u.cfg.fit_budget, 2500);
+
+    /* Without a name: the 14-byte CFG of format version 1, name empty. */
+    static const uint8_t v1[] = {0x01, 14, 7, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0xC4, 0x09, 0, 0};
+    assert_int_equal(rfs_replay_parse(v1, sizeof v1, &used, &back), RFS_REPLAY_OK);
+    assert_string_equal(back.u.cfg.model, "");
+    memset(r.u.cfg.model, 0, sizeof r.u.cfg.model);
+    assert_int_equal(rfs_replay_encode(&r, buf, sizeof buf), sizeof v1);
+    assert_memory_equal(buf, v1, sizeof v1);
+
+    /* Bad: a name of 16 bytes (length 30), a control byte in the name. */
+    uint8_t big[32] = {0x01, 30};
+    memset(big + 2, 'a', 30);
+    big[11] = 0; /* target */
+    assert_int_equal(rfs_replay_parse(big, sizeof big, &used, &back), RFS_REPLAY_BAD);
+    assert_string_equal(back.error, "CFG length out of range");
+    uint8_t ctl[sizeof want];
+    memcpy(ctl, want, sizeof want);
+    ctl[17] = 0x00;
+    assert_int_equal(rfs_replay_parse(ctl, sizeof ctl, &used, &back), RFS_REPLAY_BAD);
+    assert_string_equal(back.error, "CFG model name not printable");
+}
+
+static void sink(void *ctx, const uint8_t *p, uint32_t n)
+{
+    (void)ctx;
+    (void)p;
+    (void)n;
+}
+
+static void test_player_applies_or_refuses_the_model(void **state)
+{
+    (void)state;
+    static rfs_replay_player_t p;
+    rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.model_state = s_state;
+    cfg.model_state_bytes = (uint32_t)sizeof s_state;
+    rfs_replay_rec_t r;
+    memset(&r, 0, sizeof r);
+    r.type = RFS_REPLAY_CFG;
+    static const char *const names[3] = {"mlp", "svm", "knn"};
+    static const rfs_replay_err_t want[3] = {RFS_REPLAY_E_NONE, RFS_REPLAY_E_MODEL,
+                                             RFS_REPLAY_E_MODEL_SIZE};
+    for (int i = 0; i < 3; i++) {
+        rfs_replay_player_init(&p, &s_app, &cfg, sink, NULL);
+        memset(r.u.cfg.model, 0, sizeof r.u.cfg.model);
+        memcpy(r.u.cfg.model, names[i], 3);
+        assert_int_equal(rfs_replay_play(&p, &r), want[i] == RFS_REPLAY_E_NONE);
+        assert_int_equal(p.error, want[i]);
+    }
+    rfs_replay_player_init(&p, &s_app, &cfg, sink, NULL);
+    memcpy(r.u.cfg.model, "mlp", 3);
+    assert_true(rfs_replay_play(&p, &r));
+    assert_ptr_equal(p.cfg.model, rfs_models_lookup("mlp"));
+    assert_string_equal(rfs_replay_err_str(RFS_REPLAY_E_MODEL_SIZE),
+                        "CFG model's state is larger than the image holds");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_built_in_state_holds_the_ridge_only),
+        cmocka_unit_test(test_port_buffer_holds_what_fits),
+        cmocka_unit_test(test_cfg_model_name_bytes),
+        cmocka_unit_test(test_player_applies_or_refuses_the_model),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

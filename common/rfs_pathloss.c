@@ -42,9 +42,12 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
     c.n_prior = RFS_Q16_INT(3);  /* ITU-R P.1238 office, 2.4 GHz */
     c.w_prior = RFS_Q16_INT(5);  /* ns-3 buildings model, per wall */
     c.bin_cap = 5u;
-    /* Strong enough to hold n and W near physics when the robot has seen little: 3000
-     * weight x dB^2 is about 60 capped bins missing by a 3 dB RMS per unit of n. */
+    /* Strong enough to hold n near physics when the robot has seen little: 3000 weight x
+     * dB^2 is about 60 capped bins missing by a 3 dB RMS per unit of n. The loss per
+     * wall varies more between buildings (and SLAM maps mark clutter as walls), so its
+     * prior is ten times weaker (docs/PATHLOSS.md has the simulator runs behind both). */
     c.prior_weight = RFS_Q16_INT(3000);
+    c.w_prior_weight = RFS_Q16_INT(300);
     c.huber = RFS_Q16_INT(6);    /* about 1.5 x the 4 dB shadowing of the paper's office */
     c.spread_k = RFS_Q16_INT(6); /* chi-square, 2 degrees of freedom, 95 %: 5.99 */
     c.margin = RFS_Q16_INT(20);
@@ -64,7 +67,8 @@ int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg)
               c->n_min <= c->n_max && c->n_max <= RFS_Q16_INT(10) && c->w_min >= 0 &&
               c->w_min <= c->w_max && c->w_max <= RFS_Q16_INT(60) && c->n_prior >= c->n_min &&
               c->n_prior <= c->n_max && c->w_prior >= c->w_min && c->w_prior <= c->w_max &&
-              c->prior_weight > 0 && c->prior_weight <= RFS_Q16_INT(10000) && c->huber > 0 &&
+              c->prior_weight > 0 && c->prior_weight <= RFS_Q16_INT(10000) &&
+              c->w_prior_weight > 0 && c->w_prior_weight <= RFS_Q16_INT(10000) && c->huber > 0 &&
               c->huber <= RFS_Q16_INT(100) && c->spread_k >= 0 &&
               c->spread_k <= RFS_Q16_INT(1000) && c->margin >= 0 &&
               c->margin <= RFS_Q16_INT(100);
@@ -449,11 +453,12 @@ static void eval(rfs_pathloss_t *p, uint16_t li, uint16_t lj, int32_t col,
         bl += l8 * e8;
         bk += k8 * e8;
     }
-    /* The prior: lam (n - n_prior)^2 + lam (W - w_prior)^2, lam in the units of M (Q16). */
-    const int64_t lam = c->prior_weight;
-    const int64_t M[3] = {all + lam, alk, akk + lam};
+    /* The prior: lam (n - n_prior)^2 + lamw (W - w_prior)^2, in the units of M (Q16).
+     * Scaling: lam, lamw < 2^30 times a prior < 2^22 (Q16 <= 60): < 2^52. */
+    const int64_t lam = c->prior_weight, lamw = c->w_prior_weight;
+    const int64_t M[3] = {all + lam, alk, akk + lamw};
     const int64_t R[2] = {-bl + ((lam * c->n_prior + 32768) >> 16),
-                          -bk + ((lam * c->w_prior + 32768) >> 16)};
+                          -bk + ((lamw * c->w_prior + 32768) >> 16)};
     int32_t n, w;
     solve_nw(c, M, R, &n, &w);
     /* Huber loss of the bins' mean residuals z_b - P0 + n L_b + W k_b

@@ -11,8 +11,9 @@
  * model is linear in (P0, n, W): fit() solves the weighted least-squares problem in
  * closed form for every candidate s, with n and W bounded to [n_min, n_max] and
  * [w_min, w_max] (exact box-constrained solution of the 2 x 2 quadratic after
- * eliminating P0) and a prior pulling them towards (n_prior, w_prior) with weight
- * prior_weight, which also keeps W defined when every bin sees the same number of walls.
+ * eliminating P0) and a prior pulling them towards (n_prior, w_prior) with weights
+ * prior_weight and w_prior_weight, which also keeps W defined when every bin sees the
+ * same number of walls.
  * Each bin weighs min(samples, bin_cap). The estimate is the candidate with the least
  * weighted Huber loss of the bins' mean residuals.
  *
@@ -89,7 +90,8 @@ typedef struct rfs_pathloss_cfg {
     rfs_q16_t w_prior;      ///< prior loss per wall, dB Q16.16 (5 dB: ns-3 buildings)
     uint16_t bin_cap;       ///< a bin weighs min(samples, bin_cap) (5): shadowing makes a
                             ///< place one observation however long the robot stays
-    rfs_q16_t prior_weight; ///< weight of the prior, weight x dB^2, Q16.16 (3000), > 0
+    rfs_q16_t prior_weight; ///< weight of the n prior, weight x dB^2, Q16.16 (3000), > 0
+    rfs_q16_t w_prior_weight; ///< weight of the W prior, weight x dB^2, Q16.16 (300), > 0
     rfs_q16_t huber;        ///< Huber threshold on a bin's mean residual, dB Q16.16 (6 dB)
     rfs_q16_t spread_k;     ///< spread region: loss <= best (1 + spread_k / bins) (6.0)
     rfs_q16_t margin;       ///< metres Q16.16: candidates beyond the samples without a map (20 m)
@@ -221,7 +223,7 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void);
 /// Initialise without a model. Returns 0, or -1 on bin outside [0.1, 16] m, coarse
 /// outside (0, 64] m, bin_cap 0, top outside 1..RFS_PATHLOSS_MAX_TOP, n bounds not
 /// 0 < n_min <= n_max <= 10, W bounds not 0 <= w_min <= w_max <= 60 dB, priors outside
-/// their bounds, prior_weight outside (0, 10^4], huber outside (0, 100] dB, spread_k
+/// their bounds, prior_weight or w_prior_weight outside (0, 10^4], huber outside (0, 100] dB, spread_k
 /// outside [0, 1000], or margin outside [0, 100] m.
 int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg);
 

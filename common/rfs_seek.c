@@ -13,6 +13,8 @@
 #define RFS_SEEK_ROW_CHUNK 16
 /* How far (lattice steps) an off-lattice or illegal start looks for a legal lattice point. */
 #define SNAP_RADIUS 6
+/* Wait before deciding again after no goal could be found, microseconds (one window). */
+#define NO_GOAL_RETRY_US 1000000
 
 rfs_seek_cfg_t rfs_seek_cfg_default(void)
 {
@@ -545,6 +547,45 @@ bool rfs_seek_grid_max_scan(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
     return grid_max_scan(s, mx, my);
 }
 
+/* meta-path (an improvement beside the paper): plan to the maximum and keep the first
+ * `step` metres of the path, so a greedy step goes round walls the way the planner does
+ * instead of straight at the maximum with a line search; with a model that knows where
+ * its maximum is (argmax: the pathloss model's estimated source, issue 10) the goal is
+ * that point itself, reached through the planner. The cut point lies on a legal segment
+ * of the path. Scaling: waypoint offsets (Q16, < 2^32) times the remaining length
+ * (Q16, < 2^16 m) < 2^63; segment lengths by rfs_isqrt64 of Q32 squares. */
+static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool whole,
+                              int64_t now_us)
+{
+    if (!go_to(s, mx, my, now_us)) {
+        return false;
+    }
+    rfs_path_t *p = &s->drive.path;
+    int64_t px = s->pose.x, py = s->pose.y;
+    int64_t left = whole ? INT32_MAX : s->cfg.step;
+    for (uint16_t k = 0; k < p->n; ++k) {
+        int64_t dx = (int64_t)p->x[k] - px, dy = (int64_t)p->y[k] - py;
+        int64_t len = (int64_t)rfs_isqrt64((uint64_t)(dx * dx) + (uint64_t)(dy * dy));
+        if (len >= left) {
+            if (len > 0) {
+                p->x[k] = rfs_sat32(px + rfs_sdiv64_round(dx * left, len));
+                p->y[k] = rfs_sat32(py + rfs_sdiv64_round(dy * left, len));
+            }
+            p->n = (uint16_t)(k + 1u);
+            p->length = s->cfg.step;
+            break;
+        }
+        left -= len;
+        px = p->x[k];
+        py = p->y[k];
+    }
+    s->decision.goal_x = p->x[p->n - 1u];
+    s->decision.goal_y = p->y[p->n - 1u];
+    s->decision.path_len = p->length;
+    rfs_drive_set_path(&s->drive, p, now_us);
+    return true;
+}
+
 /* Greedy step (paper section 2): grid search over every reachable legal lattice point
  * for the model's maximum; move min(distance, step) towards it; when that point is not
  * legal, search the line to the maximum for the first legal point, before or after the
@@ -554,8 +595,10 @@ static bool choose_greedy(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     const rfs_map_t *m = s->map;
     rfs_q16_t mx = 0, my = 0;
     bool found = false;
+    bool known = false;
     if (s->model.ops->argmax != 0 && s->model.ops->argmax(s->model.self, &mx, &my)) {
         found = true;
+        known = true;
     } else {
         found = rfs_seek_grid_max(s, &mx, &my);
     }
@@ -564,6 +607,9 @@ static bool choose_greedy(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     }
     s->decision.max_x = mx;
     s->decision.max_y = my;
+    if (s->cfg.strategy == RFS_SEEK_META_PATH) {
+        return greedy_along_path(s, mx, my, known, now_us);
+    }
     int64_t dx = (int64_t)mx - s->pose.x, dy = (int64_t)my - s->pose.y;
     /* Scaling: Q16 differences up to 2^32; their squares in uint64 (Q32), root Q16. */
     uint64_t d2 = (uint64_t)(dx * dx) + (uint64_t)(dy * dy);
@@ -637,7 +683,7 @@ static rfs_q16_t sin16(uint8_t h)
 }
 
 static const char *const k_strategy_names[RFS_SEEK_STRATEGY_COUNT] = {
-    "meta", "meta-global", "fd-gradient", "plane-gradient", "chemotaxis",
+    "meta", "meta-global", "fd-gradient", "plane-gradient", "chemotaxis", "meta-path",
 };
 
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)
@@ -956,7 +1002,11 @@ static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t 
         d->goal_x = s->pose.x;
         d->goal_y = s->pose.y;
         stop_wheels(s, now_us, out);
-        s->state = RFS_SEEK_DRIVING; /* decide again next period */
+        s->state = RFS_SEEK_DRIVING;
+        /* Decide again after NO_GOAL_RETRY_US, not at every period: a robot from where
+         * nothing can be planned would otherwise relearn and search the whole lattice
+         * (and plan every line-search point) 20 times a second while standing still. */
+        s->retry_after_us = now_us + NO_GOAL_RETRY_US;
         return;
     }
     s->state = RFS_SEEK_DRIVING;
@@ -1109,6 +1159,11 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
             goto report;
         }
         s->prev_status = st;
+    }
+    if (now_us < s->retry_after_us) {
+        out->faults |= RFS_SEEK_FAULT_NO_GOAL;
+        stop_wheels(s, now_us, out);
+        goto report;
     }
     if (s->cfg.strategy == RFS_SEEK_FD_GRADIENT) {
         /* fd-gradient measures standing still: one whole window at each point. */

@@ -38,6 +38,8 @@ typedef enum rfs_seek_strategy {
     RFS_SEEK_FD_GRADIENT,    ///< finite differences: 1 s means at p, p + step x, p + step y
     RFS_SEEK_PLANE_GRADIENT, ///< refit every step, always a step along the model's gradient
     RFS_SEEK_CHEMOTAXIS,     ///< run-and-tumble on the change of the 1 s mean, no position
+    RFS_SEEK_META_PATH,      ///< meta, but a greedy step walks `step` along the planned path
+                             ///< to the maximum instead of a straight step + line search
     RFS_SEEK_STRATEGY_COUNT  ///< number of strategies (not a strategy)
 } rfs_seek_strategy_t;
 
@@ -187,6 +189,7 @@ typedef struct rfs_seek {
     uint8_t heading;                          ///< chemotaxis: heading, sixteenths of a turn
     bool have_prev_mean;                      ///< chemotaxis: prev_mean is valid
     rfs_q16_t prev_mean;                      ///< chemotaxis: 1 s mean at the last decision
+    int64_t retry_after_us;                   ///< no goal was found: next decision not before, us
 } rfs_seek_t;
 
 /// The paper's parameters (section 2 and 5.2): the `meta` configuration.

@@ -316,6 +316,25 @@ static int parse_faults(pctx_t *p, yaml_node_t *n, hs_scenario_t *sc)
                         "rssi_future, pose_jump, pose_past, pose_reorder, pose_future, can_drop, "
                         "bus_off, source_move, kidnap)", where, kind);
         }
+        // Parameters a kind does not use are errors, not silently ignored.
+        static const struct {
+            const char *key;
+            unsigned kinds; // bit per hs_fault_kind_t
+        } use[] = {
+            {"offset", 1u << HS_FAULT_POSE_JUMP},
+            {"lag_s", 1u << HS_FAULT_RSSI_PAST | 1u << HS_FAULT_POSE_PAST},
+            {"lead_s", 1u << HS_FAULT_RSSI_FUTURE | 1u << HS_FAULT_POSE_FUTURE},
+            {"probability", 1u << HS_FAULT_CAN_DROP},
+            {"source", 1u << HS_FAULT_SOURCE_MOVE},
+            {"position", 1u << HS_FAULT_SOURCE_MOVE | 1u << HS_FAULT_KIDNAP},
+            {"theta", 1u << HS_FAULT_KIDNAP},
+        };
+        for (size_t u = 0; u < sizeof use / sizeof use[0]; u++) {
+            if (get(p, f, use[u].key) && !(use[u].kinds & (1u << fk))) {
+                return fail(p, get(p, f, use[u].key), "%s.%s: does not apply to %s", where,
+                            use[u].key, kind);
+            }
+        }
         hs_fault_t *ft = &sc->faults.f[i];
         *ft = hs_faults_default(fk);
         double src = 0.0;

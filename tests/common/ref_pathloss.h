@@ -29,6 +29,7 @@ typedef struct ref_pl_cfg {
     int top;
     double n_min, n_max, w_min, w_max, n_prior, w_prior, prior_weight, huber, margin;
     long bin_cap;
+    double w_prior_weight;
 } ref_pl_cfg_t;
 
 typedef struct ref_pl_bin {
@@ -62,7 +63,7 @@ typedef struct ref_pl {
 
 static inline ref_pl_cfg_t ref_pl_cfg_default(void)
 {
-    ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5};
+    ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5, 300.0};
     return c;
 }
 
@@ -171,8 +172,8 @@ static inline double ref_pl_sse(const ref_pl_t *r, double n, double w, double *p
         double d = r->bins[b].z - (P0 - n * r->L[b] - w * r->K[b]);
         e += r->bins[b].count * d * d;
     }
-    e += r->cfg.prior_weight * ((n - r->cfg.n_prior) * (n - r->cfg.n_prior) +
-                                (w - r->cfg.w_prior) * (w - r->cfg.w_prior));
+    e += r->cfg.prior_weight * (n - r->cfg.n_prior) * (n - r->cfg.n_prior) +
+         r->cfg.w_prior_weight * (w - r->cfg.w_prior) * (w - r->cfg.w_prior);
     *p0 = P0;
     return e;
 }
@@ -227,9 +228,9 @@ static inline double ref_pl_eval(ref_pl_t *r, int i, int j, double *pn, double *
     }
     const ref_pl_cfg_t *cf = &r->cfg;
     a11 += cf->prior_weight;
-    a22 += cf->prior_weight;
+    a22 += cf->w_prior_weight;
     b1 += cf->prior_weight * cf->n_prior;
-    b2 += cf->prior_weight * cf->w_prior;
+    b2 += cf->w_prior_weight * cf->w_prior;
     double det = a11 * a22 - a12 * a12;
     double n = (b1 * a22 - a12 * b2) / det, w = (a11 * b2 - a12 * b1) / det;
     if (!(n >= cf->n_min && n <= cf->n_max && w >= cf->w_min && w <= cf->w_max)) {

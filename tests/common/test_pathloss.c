@@ -112,6 +112,7 @@ static rfs_pathloss_cfg_t weak_cfg(void)
 {
     rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
     c.prior_weight = RFS_Q16_ONE;
+    c.w_prior_weight = RFS_Q16_ONE;
     c.bin_cap = UINT16_MAX;
     return c;
 }
@@ -120,6 +121,7 @@ static ref_pl_cfg_t weak_ref(void)
 {
     ref_pl_cfg_t c = ref_pl_cfg_default();
     c.prior_weight = 1.0;
+    c.w_prior_weight = 1.0;
     c.bin_cap = UINT16_MAX;
     return c;
 }
@@ -163,8 +165,8 @@ static void init_rejects_bad_configurations(void **state)
 {
     fixture_t *f = *state;
     rfs_pathloss_cfg_t good = rfs_pathloss_cfg_default();
-    rfs_pathloss_cfg_t bad[13];
-    for (int i = 0; i < 13; ++i) {
+    rfs_pathloss_cfg_t bad[14];
+    for (int i = 0; i < 14; ++i) {
         bad[i] = good;
     }
     bad[0].bin = RFS_Q16_FRAC(1, 20);
@@ -180,9 +182,10 @@ static void init_rejects_bad_configurations(void **state)
     bad[10].huber = 0;
     bad[11].margin = RFS_Q16_INT(101);
     bad[12].bin_cap = 0;
+    bad[13].w_prior_weight = 0;
 
     assert_int_equal(rfs_pathloss_init(&f->pl, &good), 0);
-    for (int i = 0; i < 13; ++i) {
+    for (int i = 0; i < 14; ++i) {
         if (rfs_pathloss_init(&f->pl, &bad[i]) != -1) {
             fail_msg("bad configuration %d accepted", i);
         }

@@ -391,6 +391,39 @@ static void test_chemotaxis_ignores_position(void **state)
     assert_true(tumbles > 0 && tumbles < 11); /* both runs and tumbles happened */
 }
 
+/* A robot with nowhere to go (a 0.8 m box: one legal lattice point) reports NO_GOAL, keeps
+ * its wheels stopped and decides again only after a second, not at every period. */
+static void test_no_goal_backs_off(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 0.8, 0.8);
+    seek_make(&t, rfs_seek_cfg_default(), 1);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 0.4, .y = 0.4 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 0, 2000000, &out));
+    assert_true(out.faults & RFS_SEEK_FAULT_NO_GOAL);
+    int64_t t0 = r.t_us;
+    r.pending = false;
+    /* The periods in between: no decision, wheels stopped, the fault still reported. */
+    for (int k = 1; k < 20; ++k) {
+        r.t_us += 50000;
+        rfs_pose_t p = { r.t_us, Q(0.4), Q(0.4), 0 };
+        rfs_seek_on_pose(&t.seek, &p, &t.rng);
+        rfs_seek_on_rssi(&t.seek, 0, r.t_us, -60, &t.rng);
+        rfs_seek_step(&t.seek, r.t_us, &t.rng, &out);
+        assert_false(out.decided);
+        assert_int_equal(out.left_mm_s, 0);
+        assert_int_equal(out.right_mm_s, 0);
+        assert_true(out.faults & RFS_SEEK_FAULT_NO_GOAL);
+    }
+    assert_true(next_decision(&t, &r, &f, 0, 2000000, &out));
+    assert_int_equal(r.t_us - t0, 1000000);
+    assert_int_equal(out.decision.iteration, 1);
+    world_free(&t);
+}
+
 /* Names round-trip and the unit vector against double precision. */
 static void test_names_and_unit(void **state)
 {
@@ -441,6 +474,7 @@ int main(void)
         cmocka_unit_test(test_plane_gradient_follows_plane),
         cmocka_unit_test(test_chemotaxis_run_and_tumble),
         cmocka_unit_test(test_chemotaxis_ignores_position),
+        cmocka_unit_test(test_no_goal_backs_off),
         cmocka_unit_test(test_names_and_unit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -5,7 +5,7 @@
  *
  * Beyond ASan/UBSan it checks the header's promises: failure gives one non-empty error
  * line; success gives 1..HS_SCN_MAX_SOURCES sources, finite positions and rates,
- * NUL-terminated names, and a map path.
+ * NUL-terminated names, and a map path. The raw input also goes through the MAC parser.
  */
 #include <math.h>
 #include <stddef.h>
@@ -20,8 +20,33 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static hs_scenario_t g_sc; /* 2 KiB of paths: keep it off the fuzzer's stack */
 
+/* The MAC parser on the raw input: accepted only for exactly "hh:hh:hh:hh:hh:hh", with the
+ * bytes an independent hex decode gives (found: %2x once let "-1:..." through). */
+static void check_mac(const uint8_t *data, size_t size)
+{
+    char s[32];
+    const size_t n = size < sizeof s - 1u ? size : sizeof s - 1u;
+    memcpy(s, data, n);
+    s[n] = '\0';
+    uint8_t mac[6];
+    if (hs_scenario_parse_mac(s, mac) != 0) { return; }
+    if (strlen(s) != 17u) { abort(); }
+    for (int i = 0; i < 17; i++) {
+        const char c = s[i];
+        const int d = (c >= '0' && c <= '9') ? c - '0' : (c >= 'a' && c <= 'f') ? c - 'a' + 10
+                    : (c >= 'A' && c <= 'F') ? c - 'A' + 10 : -1;
+        if (i % 3 == 2 ? c != ':' : d < 0) { abort(); }
+        if (i % 3 == 1) {
+            const char h = s[i - 1];
+            const int dh = (h >= '0' && h <= '9') ? h - '0' : (h | 0x20) - 'a' + 10;
+            if (mac[i / 3] != (uint8_t)(dh * 16 + d)) { abort(); }
+        }
+    }
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
+    check_mac(data, size);
     const char *path = fuzz_tmp_write(0, "s.yaml", data, size);
     char err[512] = "";
     if (hs_scenario_load(path, &g_sc, err, sizeof err) != 0) {

@@ -104,6 +104,8 @@ put("scenario", "minimal", b"map: m.yaml\nsources:\n  - {position: [1, 2]}\nstar
 put("scenario", "bridge_two", b"map: m.yaml\ntarget: bridge\nsources:\n  - {name: a, position: [1, 2],"
     b" mac: '02:00:00:00:00:0a'}\n  - {name: b, position: [3, 4], rate_hz: 50, tx_dbm: 10}\n"
     b"start: {position: [0, 0], theta: 3.14}\nstop: {goal: [2, 3], radius_m: 0}\n")
+put("scenario", "mac_signed", b"-1:00:00:00:00:00")  # once accepted as ff:00:... (%2x took the sign)
+put("scenario", "mac_upper", b"02:00:00:00:00:0A")
 put("scenario", "anchors", b"base: &b {position: [1, 2]}\nmap: m.yaml\nsources: [*b, *b, *b]\n"
     b"start: {position: [0, 0]}\n")
 

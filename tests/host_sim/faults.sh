@@ -108,6 +108,12 @@ bad faults-zero-duration "faults[0].duration_s: must be in (0, 1e6]" 'faults:
 bad faults-probability "faults[0].probability: 2 is out of range" 'faults:
   - {kind: can_drop, probability: 2}
 '
+bad faults-lead-zero "faults[0].lead_s: must be in (0, 3600]" 'faults:
+  - {kind: pose_future, duration_s: 0.1, lead_s: 0}
+'
+bad faults-key-not-for-kind "faults[0].offset: does not apply to bus_off" 'faults:
+  - {kind: bus_off, offset: [3.0, 0.0]}
+'
 bad faults-too-many "faults: 9 given, at most 8" 'faults:
   - {kind: bus_off}
   - {kind: bus_off}

@@ -480,6 +480,55 @@ static bool grid_max_scan(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
     return found;
 }
 
+/* First set bit in [from, to), or -1; whole zero bytes are skipped at once. */
+static int32_t first_set(const uint8_t *b, uint32_t from, uint32_t to)
+{
+    uint32_t i = from;
+    for (; i < to && (i & 7u) != 0u; ++i) {
+        if (reach_bit(b, i)) {
+            return (int32_t)i;
+        }
+    }
+    for (; i + 8u <= to; i += 8u) {
+        uint32_t v = b[i >> 3];
+        if (v != 0u) {
+            return (int32_t)(i + (uint32_t)__builtin_ctz(v));
+        }
+    }
+    for (; i < to; ++i) {
+        if (reach_bit(b, i)) {
+            return (int32_t)i;
+        }
+    }
+    return -1;
+}
+
+/* Last set bit in [from, to), or -1. */
+static int32_t last_set(const uint8_t *b, uint32_t from, uint32_t to)
+{
+    uint32_t i = to;
+    while (i > from && (i & 7u) != 0u) {
+        --i;
+        if (reach_bit(b, i)) {
+            return (int32_t)i;
+        }
+    }
+    while (i >= from + 8u) {
+        uint32_t v = b[(i >> 3) - 1u];
+        if (v != 0u) {
+            return (int32_t)(i - 8u + (uint32_t)(31 - __builtin_clz(v)));
+        }
+        i -= 8u;
+    }
+    while (i > from) {
+        --i;
+        if (reach_bit(b, i)) {
+            return (int32_t)i;
+        }
+    }
+    return -1;
+}
+
 /* For a model monotone along rows (a plane), the maximum of a row's reachable points is
  * at one end; walking back from the high end over equal predictions gives the first of
  * the tied points, so the result is exactly grid_max_scan()'s. */
@@ -493,15 +542,10 @@ static bool grid_max_rows(const rfs_seek_t *s, int dir, rfs_q16_t *mx, rfs_q16_t
         rfs_q16_t x0, py;
         rfs_map_lattice_point(m, 0, j, &x0, &py);
         uint32_t base = (uint32_t)j * m->lw;
-        int32_t first = -1, last = -1;
-        for (uint16_t i = 0; i < m->lw; ++i) {
-            if (reach_bit(s->reach, base + i)) {
-                if (first < 0) {
-                    first = i;
-                }
-                last = i;
-            }
-        }
+        int32_t first = first_set(s->reach, base, base + m->lw);
+        int32_t last = first < 0 ? -1 : last_set(s->reach, base, base + m->lw);
+        first = first < 0 ? -1 : first - (int32_t)base;
+        last = last < 0 ? -1 : last - (int32_t)base;
         if (first < 0) {
             continue;
         }

@@ -59,6 +59,13 @@ static bool ip_predict(void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *v)
     return m->ops->predict(m->self, x, y, v);
 }
 
+static const rfs_pathloss_t *ip_pathloss(void *self)
+{
+    inproc_t *p = self;
+    return p->seek.model.ops == &rfs_pathloss_ops ? (const rfs_pathloss_t *)p->seek.model.self
+                                                  : NULL;
+}
+
 static void ip_close(void *self)
 {
     inproc_t *p = self;
@@ -163,6 +170,7 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
     c->step = ip_step;
     c->predict = ip_predict;
     c->close = ip_close;
+    c->pathloss = ip_pathloss;
     return 0;
 }
 

@@ -21,6 +21,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "rfs_pathloss.h"
 #include "rfs_seek.h"
 
 /// What one control period produces: the core's own output record (wheel command in
@@ -43,6 +44,9 @@ typedef struct hs_ctrl {
     bool (*predict)(void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *value);
     /// Release everything the controller holds (self included). May be NULL.
     void (*close)(void *self);
+    /// Optional (may be NULL): the path-loss model's state when the controller's model is
+    /// "pathloss" (issue 10: estimate and residual surface for logs and plots), else NULL.
+    const rfs_pathloss_t *(*pathloss)(void *self);
 } hs_ctrl_t;
 
 /// Configuration of the in-process controller over rfs_seek.

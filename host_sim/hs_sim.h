@@ -46,6 +46,9 @@ typedef struct hs_sim_io {
                       int dbm);
     void *packet_ctx;  ///< passed to on_packet
     FILE *faults;      ///< fault-injection log (hs_faults.h: inputs, commands, events) or NULL
+    /// Residual surface of the path-loss model's last fit (TSV: x_m, y_m, residual_db per
+    /// coarse candidate), written at the end of the run; only a header for other models.
+    FILE *residual;
 } hs_sim_io_t;
 
 /// Outcome of one run (summary.json).
@@ -67,6 +70,14 @@ typedef struct hs_sim_result {
     uint32_t motor_timeouts;     ///< times the motor model stopped on a missing command
     double wall_time_s;          ///< host time the run took (not part of determinism)
     double cpu_time_s;           ///< CPU time of this process during the run
+    /// The path-loss model's final estimate (issue 10); false for other models or no fit.
+    bool est_valid;
+    double est_x, est_y;         ///< estimated source, metres
+    double est_n;                ///< path-loss exponent
+    double est_w_db;             ///< loss per wall, dB
+    double est_p0;               ///< signal at 1 m, target units (dBm for rssi)
+    double est_area_m2;          ///< uncertainty: area of the spread region, m^2
+    double est_error_m;          ///< distance from the first source's true position, metres
 } hs_sim_result_t;
 
 /// Load the map, build the core grids and check the scenario against them (sources and

@@ -357,6 +357,48 @@ static double cpu_s(void)
 
 enum { EV_PACKET = 0, EV_POSE = 1, EV_CTRL = 2 };
 
+/// The path-loss model's estimate (issue 10), when the controller's model is "pathloss"
+/// and has one.
+static bool pathloss_estimate(const hs_ctrl_t *ctrl, rfs_pathloss_est_t *est)
+{
+    const rfs_pathloss_t *pl = ctrl->pathloss ? ctrl->pathloss(ctrl->self) : NULL;
+    return pl && rfs_pathloss_estimate(pl, est);
+}
+
+/// The last six log.tsv columns and the end of the row: estimated source (m), n, W (dB),
+/// P0 and the spread area (m^2); "nan" for other models or before the first fit.
+static void log_estimate(FILE *f, const hs_ctrl_t *ctrl)
+{
+    rfs_pathloss_est_t est;
+    if (pathloss_estimate(ctrl, &est)) {
+        fprintf(f, "\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%.3f\n", q16d(est.sx), q16d(est.sy),
+                q16d(est.n), q16d(est.w), q16d(est.p0), q16d(est.spread_m2));
+    } else {
+        fprintf(f, "\tnan\tnan\tnan\tnan\tnan\tnan\n");
+    }
+}
+
+/// residual.tsv: every coarse candidate of the last fit with its residual
+/// sqrt(2 x mean Huber loss) in dB (rfs_pathloss_residual_at()); header only without one.
+static void write_residual(FILE *f, const hs_ctrl_t *ctrl)
+{
+    fprintf(f, "x_m\ty_m\tresidual_db\n");
+    const rfs_pathloss_t *pl = ctrl->pathloss ? ctrl->pathloss(ctrl->self) : NULL;
+    if (!pl) {
+        return;
+    }
+    uint16_t ncx, ncy;
+    rfs_pathloss_surface_size(pl, &ncx, &ncy);
+    for (uint16_t cj = 0; cj < ncy; cj++) {
+        for (uint16_t ci = 0; ci < ncx; ci++) {
+            rfs_q16_t x, y, r;
+            if (rfs_pathloss_residual_at(pl, ci, cj, &x, &y, &r)) {
+                fprintf(f, "%.3f\t%.3f\t%.3f\n", q16d(x), q16d(y), q16d(r));
+            }
+        }
+    }
+}
+
 int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_sim_io_t *io,
                hs_sim_result_t *res, char *err, size_t errlen)
 {
@@ -445,7 +487,8 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     if (io && io->log) {
         fprintf(io->log, "iteration\tt_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\tkind\treason\t"
                          "relearned\tprediction_db\tmean_db\tepsilon\tgoal_x_m\tgoal_y_m\t"
-                         "max_x_m\tmax_y_m\tpath_m\tsamples\ttravelled_m\n");
+                         "max_x_m\tmax_y_m\tpath_m\tsamples\ttravelled_m\t"
+                         "est_src_x_m\test_src_y_m\test_n\test_w_db\test_p0\test_area_m2\n");
     }
     if (io && io->samples) {
         fprintf(io->samples, "t_s\tsrc\tx_m\ty_m\ttravelled_m\tdbm\n");
@@ -564,12 +607,13 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
                         double mean = d->mean_valid ? q16d(d->mean) : NAN;
                         fprintf(io->log,
                                 "%u\t%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%s\t%s\t%d\t%.3f\t%.3f\t"
-                                "%.4f\t%.3f\t%.3f\t%.3f\t%.3f\t%.3f\t%u\t%.3f\n",
+                                "%.4f\t%.3f\t%.3f\t%.3f\t%.3f\t%.3f\t%u\t%.3f",
                                 d->iteration, te * 1e-6, ex, ey, wrap_pi(pth + a * dth),
                                 q16d(d->x), q16d(d->y), kind_name(d->kind), reason,
                                 d->relearned ? 1 : 0, pred, mean, q16d(d->epsilon),
                                 q16d(d->goal_x), q16d(d->goal_y), q16d(d->max_x), q16d(d->max_y),
                                 q16d(d->path_len), d->samples, etr);
+                        log_estimate(io->log, ctrl);
                     }
                 }
             }
@@ -636,6 +680,24 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     res->final_y = py;
     res->final_distance_m = has_goal ? hypot(px - goal_x, py - goal_y) : NAN;
     res->motor_timeouts = motor.timeouts;
+    rfs_pathloss_est_t est;
+    res->est_valid = pathloss_estimate(ctrl, &est);
+    if (res->est_valid) {
+        res->est_x = q16d(est.sx);
+        res->est_y = q16d(est.sy);
+        res->est_n = q16d(est.n);
+        res->est_w_db = q16d(est.w);
+        res->est_p0 = q16d(est.p0);
+        res->est_area_m2 = q16d(est.spread_m2);
+        // Against source 0 where it is now (a moved source takes its error along).
+        res->est_error_m = hypot(res->est_x - rs[0].x, res->est_y - rs[0].y);
+    } else {
+        res->est_x = res->est_y = res->est_n = res->est_w_db = NAN;
+        res->est_p0 = res->est_area_m2 = res->est_error_m = NAN;
+    }
+    if (io && io->residual) {
+        write_residual(io->residual, ctrl);
+    }
     free(pdr);
     hs_radio_destroy(radio);
     hs_world_destroy(world);
@@ -765,7 +827,15 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
     fprintf(f, "  \"epsilon\": %u,\n", r->epsilon);
     fprintf(f, "  \"packets_sent\": %llu,\n", (unsigned long long)r->packets_sent);
     fprintf(f, "  \"packets_received\": %llu,\n", (unsigned long long)r->packets_received);
-    fprintf(f, "  \"motor_timeouts\": %u\n", r->motor_timeouts);
+    fprintf(f, "  \"motor_timeouts\": %u,\n", r->motor_timeouts);
+    // issue 10: the path-loss model's final estimate (null for other models).
+    json_num(f, "est_src_x_m", r->est_valid ? r->est_x : NAN, false);
+    json_num(f, "est_src_y_m", r->est_valid ? r->est_y : NAN, false);
+    json_num(f, "est_n", r->est_valid ? r->est_n : NAN, false);
+    json_num(f, "est_w_db", r->est_valid ? r->est_w_db : NAN, false);
+    json_num(f, "est_p0", r->est_valid ? r->est_p0 : NAN, false);
+    json_num(f, "est_area_m2", r->est_valid ? r->est_area_m2 : NAN, false);
+    json_num(f, "est_error_m", r->est_valid ? r->est_error_m : NAN, true);
     fprintf(f, "}\n");
 }
 

@@ -31,7 +31,8 @@ static void usage(FILE *f)
             "\n"
             "  --seed N        run seed (default: the scenario's seed)\n"
             "  --out DIR       write log.tsv, track.tsv, summary.json (and samples.tsv) to DIR;\n"
-            "                  without it a single run prints summary.json on stdout\n"
+            "                  without it a single run prints summary.json on stdout; with\n"
+            "                  --model pathloss also residual.tsv (the fit's residual surface)\n"
             "  --samples       also write every received packet to DIR/samples.tsv\n"
             "                  (always written for a single run with --out)\n"
             "  --field         also write the simulated field of source 0 to DIR/field.tsv\n"
@@ -155,7 +156,11 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         if (faults) {
             io.faults = open_in(dir, "faults.tsv");
         }
-        if (!io.log || !io.track || (samples && !io.samples) || (faults && !io.faults)) {
+        if (strcmp(env->sc.model, "pathloss") == 0) { // issue 10: the last fit's surface
+            io.residual = open_in(dir, "residual.tsv");
+        }
+        if (!io.log || !io.track || (samples && !io.samples) || (faults && !io.faults) ||
+            (strcmp(env->sc.model, "pathloss") == 0 && !io.residual)) {
             fprintf(stderr, "%s: %s: %s\n", prog, dir, strerror(errno));
             rc = 1;
         }
@@ -196,8 +201,8 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
             }
         }
     }
-    FILE *fs[4] = {io.log, io.track, io.samples, io.faults};
-    for (int i = 0; i < 4; i++) {
+    FILE *fs[5] = {io.log, io.track, io.samples, io.faults, io.residual};
+    for (int i = 0; i < 5; i++) {
         if (fs[i] && fclose(fs[i]) != 0) {
             fprintf(stderr, "%s: %s: write failed\n", prog, dir);
             rc = 1;

@@ -155,10 +155,14 @@ void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out)
     /* Received-time watchdogs on the inputs (issue 6 safety): independent of the sender
      * time stamps the seeker judges, so a sender whose clock runs on while its frames
      * stop arriving still stops the wheels. */
-    if (!a->have_pose_rx || now_us - a->pose_rx_us > a->cfg.input_timeout_us) {
+    /* Differences in uint64 only when now > rx (exact there): recorded times are outside
+     * input, and now - rx overflowed int64 for extreme ones (tests/fuzz/fuzz_replay.c). */
+    if (!a->have_pose_rx || (now_us > a->pose_rx_us &&
+                             (uint64_t)now_us - (uint64_t)a->pose_rx_us > (uint64_t)a->cfg.input_timeout_us)) {
         faults |= RFS_APP_FAULT_POSE_LOST;
     }
-    if (!a->have_rssi_rx || now_us - a->rssi_rx_us > a->cfg.input_timeout_us) {
+    if (!a->have_rssi_rx || (now_us > a->rssi_rx_us &&
+                             (uint64_t)now_us - (uint64_t)a->rssi_rx_us > (uint64_t)a->cfg.input_timeout_us)) {
         faults |= RFS_APP_FAULT_RSSI_LOST;
     }
     if (a->bus_off) {

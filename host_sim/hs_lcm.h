@@ -19,6 +19,7 @@
 #include <stdint.h>
 
 #include "rfs_can.h"
+#include "rfs_pathloss.h"
 #include "rfs_seek.h"
 
 #define HS_LCM_CH_POSE "RFS_POSE"                 ///< pose channel
@@ -73,6 +74,10 @@ int hs_lcm_pub_clock(hs_lcm_t *l, int64_t t_us);
 int hs_lcm_pub_wheel(hs_lcm_t *l, int64_t t_us, const rfs_can_wheel_t *w);
 /// Publish a status (decision record and command of one control step).
 int hs_lcm_pub_status(hs_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out);
+/// Publish a status with the path-loss model's estimate (issue 10); est NULL publishes
+/// est_valid false and zero estimate fields, like hs_lcm_pub_status().
+int hs_lcm_pub_status_est(hs_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out,
+                          const rfs_pathloss_est_t *est);
 /// Publish a raw CAN frame on the fallback channel.
 int hs_lcm_pub_can(hs_lcm_t *l, int64_t t_us, const rfs_can_frame_t *f);
 

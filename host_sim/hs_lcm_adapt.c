@@ -78,6 +78,21 @@ static double dbl_of(rfs_q16_t q)
     return (double)q / 65536.0;
 }
 
+/* The path-loss estimate of a status (issue 10): every field a Q16.16 value, the area not
+ * negative; all zero when est_valid is false. */
+static bool est_ok(const rfseek_seeker_status_t *m)
+{
+    const double v[7] = {m->est_x, m->est_y, m->est_n, m->est_w, m->est_p0, m->est_rms,
+                         m->est_area};
+    for (int i = 0; i < 7; i++) {
+        rfs_q16_t q;
+        if (!q16_of(v[i], &q) || (!m->est_valid && q != 0)) {
+            return false;
+        }
+    }
+    return m->est_area >= 0.0 && m->est_rms >= 0.0;
+}
+
 /* Decode one message of a known channel and deliver it; bad ones are counted. The
  * decoder's byte count must equal the message length (no truncation, no trailing junk;
  * the type fingerprint is checked by the generated decoder). */
@@ -164,7 +179,7 @@ static void dispatch(const hs_lcm_handlers_t *h, hs_lcm_stats_t *s, const char *
                   q16_of(m.epsilon, &d->epsilon) && q16_of(m.x, &d->x) && q16_of(m.y, &d->y) &&
                   q16_of(m.goal_x, &d->goal_x) && q16_of(m.goal_y, &d->goal_y) && q16_of(m.max_x, &d->max_x) &&
                   q16_of(m.max_y, &d->max_y) && q16_of(m.path_len, &d->path_len) && m.samples >= 0 &&
-                  m.samples <= 0xFFFF;
+                  m.samples <= 0xFFFF && est_ok(&m);
         if (!ok) {
             rfseek_seeker_status_t_decode_cleanup(&m);
             bad(s, h, ch, "a field is out of range or not finite (state %.0f)", m.state);
@@ -333,6 +348,12 @@ static const char *reason_of(const rfs_seek_decision_t *d)
 
 int hs_lcm_pub_status(hs_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out)
 {
+    return hs_lcm_pub_status_est(l, t_us, out, NULL);
+}
+
+int hs_lcm_pub_status_est(hs_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out,
+                          const rfs_pathloss_est_t *est)
+{
     const rfs_seek_decision_t *d = &out->decision;
     rfseek_seeker_status_t m;
     memset(&m, 0, sizeof m);
@@ -362,6 +383,16 @@ int hs_lcm_pub_status(hs_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out)
     m.max_y = dbl_of(d->max_y);
     m.path_len = dbl_of(d->path_len);
     m.samples = d->samples;
+    if (est) { // issue 10: the path-loss model's estimate (memset left them 0 otherwise)
+        m.est_valid = true;
+        m.est_x = dbl_of(est->sx);
+        m.est_y = dbl_of(est->sy);
+        m.est_n = dbl_of(est->n);
+        m.est_w = dbl_of(est->w);
+        m.est_p0 = dbl_of(est->p0);
+        m.est_rms = dbl_of(est->rms);
+        m.est_area = dbl_of(est->spread_m2);
+    }
     HS_LCM_PUBLISH(l, HS_LCM_CH_STATUS, rfseek_seeker_status_t, &m, t_us);
 }
 

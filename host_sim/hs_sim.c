@@ -365,9 +365,7 @@ static bool pathloss_estimate(const hs_ctrl_t *ctrl, rfs_pathloss_est_t *est)
     return pl && rfs_pathloss_estimate(pl, est);
 }
 
-/// The last six log.tsv columns and the end of the row: estimated source (m), n, W (dB),
-/// P0 and the spread area (m^2); "nan" for other models or before the first fit.
-static void log_estimate(FILE *f, const hs_ctrl_t *ctrl)
+void hs_sim_log_estimate(FILE *f, const hs_ctrl_t *ctrl)
 {
     rfs_pathloss_est_t est;
     if (pathloss_estimate(ctrl, &est)) {
@@ -375,6 +373,25 @@ static void log_estimate(FILE *f, const hs_ctrl_t *ctrl)
                 q16d(est.n), q16d(est.w), q16d(est.p0), q16d(est.spread_m2));
     } else {
         fprintf(f, "\tnan\tnan\tnan\tnan\tnan\tnan\n");
+    }
+}
+
+void hs_sim_result_estimate(hs_sim_result_t *r, const hs_ctrl_t *ctrl, double src_x,
+                            double src_y)
+{
+    rfs_pathloss_est_t est;
+    r->est_valid = pathloss_estimate(ctrl, &est);
+    if (r->est_valid) {
+        r->est_x = q16d(est.sx);
+        r->est_y = q16d(est.sy);
+        r->est_n = q16d(est.n);
+        r->est_w_db = q16d(est.w);
+        r->est_p0 = q16d(est.p0);
+        r->est_area_m2 = q16d(est.spread_m2);
+        r->est_error_m = hypot(r->est_x - src_x, r->est_y - src_y);
+    } else {
+        r->est_x = r->est_y = r->est_n = r->est_w_db = NAN;
+        r->est_p0 = r->est_area_m2 = r->est_error_m = NAN;
     }
 }
 
@@ -488,7 +505,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
         fprintf(io->log, "iteration\tt_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\tkind\treason\t"
                          "relearned\tprediction_db\tmean_db\tepsilon\tgoal_x_m\tgoal_y_m\t"
                          "max_x_m\tmax_y_m\tpath_m\tsamples\ttravelled_m\t"
-                         "est_src_x_m\test_src_y_m\test_n\test_w_db\test_p0\test_area_m2\n");
+                         HS_SIM_LOG_EST_COLUMNS "\n");
     }
     if (io && io->samples) {
         fprintf(io->samples, "t_s\tsrc\tx_m\ty_m\ttravelled_m\tdbm\n");
@@ -613,7 +630,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
                                 d->relearned ? 1 : 0, pred, mean, q16d(d->epsilon),
                                 q16d(d->goal_x), q16d(d->goal_y), q16d(d->max_x), q16d(d->max_y),
                                 q16d(d->path_len), d->samples, etr);
-                        log_estimate(io->log, ctrl);
+                        hs_sim_log_estimate(io->log, ctrl);
                     }
                 }
             }
@@ -680,21 +697,8 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     res->final_y = py;
     res->final_distance_m = has_goal ? hypot(px - goal_x, py - goal_y) : NAN;
     res->motor_timeouts = motor.timeouts;
-    rfs_pathloss_est_t est;
-    res->est_valid = pathloss_estimate(ctrl, &est);
-    if (res->est_valid) {
-        res->est_x = q16d(est.sx);
-        res->est_y = q16d(est.sy);
-        res->est_n = q16d(est.n);
-        res->est_w_db = q16d(est.w);
-        res->est_p0 = q16d(est.p0);
-        res->est_area_m2 = q16d(est.spread_m2);
-        // Against source 0 where it is now (a moved source takes its error along).
-        res->est_error_m = hypot(res->est_x - rs[0].x, res->est_y - rs[0].y);
-    } else {
-        res->est_x = res->est_y = res->est_n = res->est_w_db = NAN;
-        res->est_p0 = res->est_area_m2 = res->est_error_m = NAN;
-    }
+    // Against source 0 where it is now (a moved source takes its error along).
+    hs_sim_result_estimate(res, ctrl, rs[0].x, rs[0].y);
     if (io && io->residual) {
         write_residual(io->residual, ctrl);
     }

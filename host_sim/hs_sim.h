@@ -104,6 +104,19 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
 int hs_sim_field(const hs_sim_env_t *e, uint64_t seed, unsigned src, double step_m, FILE *f,
                  char *err, size_t errlen);
 
+/// The last columns of log.tsv (issue 10): the path-loss model's estimate at a decision.
+#define HS_SIM_LOG_EST_COLUMNS "est_src_x_m\test_src_y_m\test_n\test_w_db\test_p0\test_area_m2"
+
+/// End a log.tsv decision row: a tab, the HS_SIM_LOG_EST_COLUMNS values (source m, n,
+/// W dB, P0, spread area m^2) and a newline; "nan" unless the controller's model is
+/// "pathloss" and has a fit.
+void hs_sim_log_estimate(FILE *f, const hs_ctrl_t *ctrl);
+
+/// Fill r->est_* from the controller's path-loss estimate (est_valid false and NaN for
+/// other models), the error against the true source position (src_x, src_y), metres.
+void hs_sim_result_estimate(hs_sim_result_t *r, const hs_ctrl_t *ctrl, double src_x,
+                            double src_y);
+
 /// Write summary.json of a run to f.
 void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t *r);
 

@@ -2,6 +2,8 @@
 # demo.sh - run the default scenario and draw the paper's figures 2 to 4 (make demo).
 #   scripts/demo.sh [OUTDIR]      (default out/demo; uses $BUILD/bin/rfseek-sim)
 # The run goes to OUTDIR/run (replaced), the figures to OUTDIR/*.png.
+# A second run with the map-aware path-loss model (issue 10: --model pathloss --strategy
+# meta-path) goes to OUTDIR/pathloss/run, its figures (with residual.png) to OUTDIR/pathloss.
 set -euo pipefail
 OUT=${1:-out/demo}
 SIM=${BUILD:-build}/bin/rfseek-sim
@@ -12,3 +14,10 @@ rm -rf -- "$OUT/run"
 /usr/bin/python3 scripts/plot_run.py "$OUT/run" --outdir "$OUT"
 echo "demo: $(grep -E '"(reached|distance_travelled_m|shortest_path_m|model_updates)"' "$OUT/run/summary.json" | tr -d ' \n')"
 echo "demo: figures in $OUT: trajectory.png rssi.png hexbin.png"
+mkdir -p "$OUT/pathloss"
+rm -rf -- "$OUT/pathloss/run"
+"$SIM" scenarios/default.yaml --seed "$SEED" --model pathloss --strategy meta-path \
+    --out "$OUT/pathloss/run" >/dev/null
+/usr/bin/python3 scripts/plot_run.py "$OUT/pathloss/run" --outdir "$OUT/pathloss"
+echo "demo (pathloss): $(grep -E '"(reached|distance_travelled_m|shortest_path_m|est_error_m|est_area_m2)"' "$OUT/pathloss/run/summary.json" | tr -d ' \n')"
+echo "demo: figures in $OUT/pathloss: trajectory.png rssi.png residual.png"

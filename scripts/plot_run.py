@@ -11,6 +11,10 @@ and field.tsv when run with --field). Writes into DIR (default RUNDIR):
                   moving average over 1 m                               (paper figs. 3, 4 bottom)
   hexbin.png      hexagonal histogram of the simulated field: mean RSSI per hexagon of
                   about 0.6 m (larger than the wavelength, as the paper's) (paper fig. 2)
+  residual.png    with residual.tsv (--model pathloss, issue 10): the path-loss fit's RMS
+                  residual over the coarse candidate source positions as a heat map on the
+                  map, with the true source (red star), the final estimate (white cross),
+                  its uncertainty area and the trajectory
 Images are written to a temporary name and renamed.
 """
 import json
@@ -146,7 +150,56 @@ def main(argv):
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
         save(fig, os.path.join(outdir, "hexbin.png"))
+
+    rp = os.path.join(run, "residual.tsv")
+    if os.path.exists(rp):
+        plot_residual(rp, s, img, ext, sources, x, y, os.path.join(outdir, "residual.png"))
     return 0
+
+
+def plot_residual(path, s, img, ext, sources, tx, ty, out):
+    """Heat map of residual.tsv (one value per coarse candidate on a regular lattice)."""
+    rh, rr = read_tsv(path)
+    if not rr:
+        return  # no fit: nothing to draw
+    try:
+        rx, ry, rv = col(rh, rr, "x_m"), col(rh, rr, "y_m"), col(rh, rr, "residual_db")
+    except (ValueError, IndexError) as e:
+        die("%s: %s" % (path, e))
+    xs, ys = np.unique(rx), np.unique(ry)
+    dx = np.min(np.diff(xs)) if len(xs) > 1 else 1.0
+    dy = np.min(np.diff(ys)) if len(ys) > 1 else dx
+    nx, ny = int(round((xs[-1] - xs[0]) / dx)) + 1, int(round((ys[-1] - ys[0]) / dy)) + 1
+    grid = np.full((ny, nx), np.nan)
+    grid[np.rint((ry - ys[0]) / dy).astype(int), np.rint((rx - xs[0]) / dx).astype(int)] = rv
+    fig, ax = plt.subplots(figsize=(10, 10 * (ext[3] - ext[2]) / (ext[1] - ext[0]) + 1))
+    ax.imshow(img, cmap="gray", extent=ext, vmin=0, vmax=255)
+    # Cells centred on the candidates; illegal points stay transparent.
+    pc = ax.imshow(np.ma.masked_invalid(grid), origin="lower", cmap="magma_r", alpha=0.75,
+                   extent=[xs[0] - dx / 2, xs[0] + (nx - 0.5) * dx,
+                           ys[0] - dy / 2, ys[0] + (ny - 0.5) * dy],
+                   interpolation="nearest")
+    fig.colorbar(pc, ax=ax, label="RMS residual of the fit [dB]", shrink=0.7)
+    # Walls again on top so the rooms stay visible through the heat map.
+    ax.imshow(np.ma.masked_where(img > 100, img), cmap="gray", extent=ext, vmin=0, vmax=255)
+    ax.plot(tx, ty, "-", color="tab:cyan", lw=1.0, label="trajectory")
+    ax.plot(sources[:, 0], sources[:, 1], "*", color="red", ms=18, label="source")
+    title = "path-loss residual surface (%d candidates, best %.2f dB)" % (len(rv), np.min(rv))
+    if s.get("est_src_x_m") is not None:
+        ax.plot(s["est_src_x_m"], s["est_src_y_m"], "P", color="white", mec="black", ms=14,
+                label="estimate (n %.2f, W %.1f dB)" % (s["est_n"], s["est_w_db"]))
+        # The uncertainty area drawn as a circle of the same area.
+        ax.add_patch(plt.Circle((s["est_src_x_m"], s["est_src_y_m"]),
+                                np.sqrt(s["est_area_m2"] / np.pi), fill=False, ec="white",
+                                ls="--", lw=1.2, label="uncertainty %.0f m^2" % s["est_area_m2"]))
+        title += ", error %.2f m" % s["est_error_m"]
+    ax.set_xlim(ext[0], ext[1])
+    ax.set_ylim(ext[2], ext[3])
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(title)
+    ax.legend(loc="upper left", fontsize=8)
+    save(fig, out)
 
 
 if __name__ == "__main__":

@@ -499,7 +499,7 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
     if (rc == 0) {
         fprintf(flog, "iteration\tt_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\tkind\treason\t"
                       "relearned\tprediction_db\tmean_db\tepsilon\tgoal_x_m\tgoal_y_m\t"
-                      "max_x_m\tmax_y_m\tpath_m\tsamples\ttravelled_m\n");
+                      "max_x_m\tmax_y_m\tpath_m\tsamples\ttravelled_m\t" HS_SIM_LOG_EST_COLUMNS "\n");
         fprintf(fsam, "t_s\tsrc\tx_m\ty_m\ttravelled_m\t%s\n", pdr_target ? "pdr_pct" : "dbm");
         fprintf(ftrk, "t_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\test_theta_rad\ttouching\n");
         const int64_t t0 = poses[0].t_us;
@@ -584,12 +584,13 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
                              d->mean_valid ? "" : ",no_mean");
                     fprintf(flog,
                             "%u\t%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%s\t%s\t%d\t%.3f\t%.3f\t"
-                            "%.4f\t%.3f\t%.3f\t%.3f\t%.3f\t%.3f\t%u\t%.3f\n",
+                            "%.4f\t%.3f\t%.3f\t%.3f\t%.3f\t%.3f\t%u\t%.3f",
                             d->iteration, te * 1e-6, ex, ey, eth, rp_d(d->x), rp_d(d->y), rp_kind(d->kind),
                             reason, d->relearned ? 1 : 0, d->model_valid ? rp_d(d->prediction) : NAN,
                             d->mean_valid ? rp_d(d->mean) : NAN, rp_d(d->epsilon), rp_d(d->goal_x),
                             rp_d(d->goal_y), rp_d(d->max_x), rp_d(d->max_y), rp_d(d->path_len), d->samples,
                             etr);
+                    hs_sim_log_estimate(flog, &ctrl); /* issue 10: path-loss estimate or nan */
                 }
             }
             if (has_goal && sc.stop_radius_m > 0.0 && hypot(ex - sc.goal_x, ey - sc.goal_y) <= sc.stop_radius_m) {
@@ -609,6 +610,7 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
         res.final_y = fy;
         res.final_distance_m = has_goal ? hypot(fx - sc.goal_x, fy - sc.goal_y) : NAN;
         res.packets_sent = res.packets_received + lost; /* from the sequence-number gaps */
+        hs_sim_result_estimate(&res, &ctrl, sc.src[0].x, sc.src[0].y); /* issue 10 */
         FILE *fsum = rp_open(tmp, "summary.json");
         if (fsum == NULL) {
             fprintf(stderr, "rfseek-feed: %s/summary.json: %s\n", tmp, strerror(errno));

@@ -126,7 +126,8 @@ def main():
         log = [l.rstrip("\n").split("\t") for l in f]
     sim_header = ("iteration\tt_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\tkind\treason\trelearned\t"
                   "prediction_db\tmean_db\tepsilon\tgoal_x_m\tgoal_y_m\tmax_x_m\tmax_y_m\tpath_m\t"
-                  "samples\ttravelled_m").split("\t")
+                  "samples\ttravelled_m\test_src_x_m\test_src_y_m\test_n\test_w_db\test_p0\t"
+                  "est_area_m2").split("\t")
     check("log: the simulator's header", log[0] == sim_header, str(log[0]))
     check("log: one row per decision, first the initial move",
           len(log) - 1 == sm["iterations"] and log[1][0] == "0" and log[1][7] == "initial", str(log[:2]))

@@ -8,6 +8,7 @@
 # target with executions, executions/s and coverage; exits non-zero on any FAIL.
 set -uo pipefail
 usage() { echo "usage: run_all.sh BUILD (--runs N | --seconds S) NAME..." >&2; exit 2; }
+[ "${1:-}" = --help ] && { sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
 [ $# -ge 4 ] || usage
 build=$1 mode=$2 amount=$3; shift 3
 case $mode in

@@ -148,7 +148,11 @@ static void step(daemon_t *d, int64_t now_us)
                          (uint8_t)(out.state == RFS_SEEK_DRIVING ? 0u : RFS_CAN_WHEEL_STOP)};
     if (d->lcm) {
         (void)hs_lcm_pub_wheel(d->lcm, now_us, &w);
-        (void)hs_lcm_pub_status(d->lcm, now_us, &so);
+        // issue 10: the path-loss model's estimate and uncertainty when that is the model.
+        const rfs_model_t *mdl = &d->app->seek.model;
+        rfs_pathloss_est_t est;
+        bool pl = mdl->ops == &rfs_pathloss_ops && rfs_pathloss_estimate(mdl->self, &est);
+        (void)hs_lcm_pub_status_est(d->lcm, now_us, &so, pl ? &est : NULL);
     }
     if (out.decided) {
         d->decided++;

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# status_est.sh - rfseekd puts the path-loss model's estimate in its LCM seeker status
+# (issue 10): a two-process run (rfseek-sim-lcm + rfseekd --model pathloss, udpm:// inside a
+# network namespace we create and delete) recorded as an LCM log, decoded by hand in
+# tests/host_sim/status_est_check.py; the same inputs replayed with the ridge carry none.
+#   tests/host_sim/status_est.sh BUILD        (from the repository root)
+set -uo pipefail
+build=${1:?usage: status_est.sh BUILD}
+d=$build/bin/rfseekd
+map=scenarios/maps/office.yaml
+w=$(mktemp -d /tmp/rfs_status_est.XXXXXX)
+ns=rfsplh$$
+trap 'ip netns del "$ns" 2>/dev/null; rm -rf -- "$w"' EXIT
+fails=0
+pass() { echo "PASS $1"; }
+fail() { echo "FAIL $1"; fails=$((fails + 1)); }
+if ! ip netns add "$ns" 2>/dev/null; then
+    echo "SKIP status_est: cannot create a network namespace (needs root)"
+    exit 0
+fi
+ip netns exec "$ns" ip link set lo up && ip netns exec "$ns" ip route add 224.0.0.0/4 dev lo \
+    || { fail "netns setup"; exit 1; }
+url='udpm://239.255.76.67:7667?ttl=0'
+ip netns exec "$ns" timeout 120 "$d" --map $map --model pathloss --lcm "$url" --can-over-lcm \
+    --clock-lcm --log "$w/run.lcmlog" --decisions "$w/live.txt" --idle-exit 3000 2> "$w/d.err" &
+dpid=$!
+sleep 0.5
+ip netns exec "$ns" timeout 120 "$build/bin/rfseek-sim-lcm" scenarios/default.yaml --lcm "$url" \
+    --max-time 60 > "$w/summary.json" 2> "$w/sim.err"
+src=$?
+wait $dpid
+drc=$?
+ip netns del "$ns"
+[ $src -eq 0 ] && [ $drc -eq 0 ] && [ -s "$w/run.lcmlog" ] && pass status_est_two_process_run \
+    || fail "status_est_two_process_run (sim rc $src, rfseekd rc $drc: $(head -3 "$w/sim.err" "$w/d.err"))"
+# The office map is 36 x 12 m.
+/usr/bin/python3 tests/host_sim/status_est_check.py "$w/run.lcmlog" pathloss 36 12 || fails=$((fails + 1))
+"$d" --map $map --model ridge --replay "$w/run.lcmlog" --clock-lcm --lcm memq:// --log "$w/ridge.lcmlog" \
+    > /dev/null 2> "$w/r.err" && pass status_est_ridge_replay || fail "status_est_ridge_replay ($(head -2 "$w/r.err"))"
+/usr/bin/python3 tests/host_sim/status_est_check.py "$w/ridge.lcmlog" none || fails=$((fails + 1))
+exit $((fails > 0))

@@ -4,7 +4,8 @@
 # `make test` runs a 5-seed version.
 SWEEP_SIM := $(BUILD)/asan/bin/rfseek-sim
 SWEEP_SEEDS ?= 200
-SWEEP_SCENARIOS ?= scenarios/default.yaml
+# Faults enabled (issue 9): the office with each fault of scenarios/faults/, and without.
+SWEEP_SCENARIOS ?= scenarios/default.yaml $(sort $(wildcard scenarios/faults/office-*.yaml))
 
 # rfseek-sim linked against the ASan+UBSan builds of the host and core libraries.
 # (Depends on the plain program too, so generated headers of later fragments exist.)
@@ -18,4 +19,4 @@ sweep: $(SWEEP_SIM)
 	@scripts/san_sweep.sh $(SWEEP_SIM) $(SWEEP_SEEDS) $(SWEEP_SCENARIOS)
 
 TEST_DEPS += $(SWEEP_SIM)
-TEST_SCRIPTS += "scripts/san_sweep.sh $(SWEEP_SIM) 5 scenarios/default.yaml"
+TEST_SCRIPTS += "scripts/san_sweep.sh $(SWEEP_SIM) 3 scenarios/default.yaml scenarios/faults/office-kidnap.yaml scenarios/faults/office-rssi_silence.yaml scenarios/faults/office-bus_off.yaml"

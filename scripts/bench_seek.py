@@ -338,10 +338,14 @@ def fig_rssi(figdir, tmp, args, scen):
         single_run(args, scenario_path(scen), 1, d, st)
         a = np.loadtxt(os.path.join(d, "samples.tsv"), skiprows=1, usecols=(4, 5))
         ax.plot(a[:, 0], a[:, 1], ",", color="0.6", alpha=0.5)
-        b = np.floor(a[:, 0])
-        xs = np.unique(b)
-        ma = [a[b == x, 1].mean() for x in xs]
-        ax.plot(xs + 0.5, ma, "-", color="tab:blue", lw=1.2, label="1 m moving average")
+        # Moving average over a sliding 1 m window of distance (odometry is monotonic).
+        c = np.concatenate([[0.0], np.cumsum(a[:, 1])])
+        xs = np.arange(0.5, a[-1, 0] - 0.5 + 1e-9, 0.1)
+        lo = np.searchsorted(a[:, 0], xs - 0.5)
+        hi = np.searchsorted(a[:, 0], xs + 0.5)
+        ok = hi > lo
+        ma = (c[hi[ok]] - c[lo[ok]]) / (hi[ok] - lo[ok])
+        ax.plot(xs[ok], ma, "-", color="tab:blue", lw=1.2, label="1 m moving average")
         ax.set_ylabel("RSSI dBm")
         ax.set_title("%s, %s, seed 1" % (scen, st), fontsize=9)
         ax.legend(fontsize=7, loc="lower right")
@@ -540,6 +544,10 @@ def main():
         write_results(args, results, scenarios, table, sweep, mtab, br, walls, figs,
                       dict(sweep=t_sweep, noise=t_noise, models=t_models, bridge=t_bridge,
                            total=t_total), ns, ms, bs)
+    except BaseException:
+        if smoke_dir:
+            shutil.rmtree(smoke_dir, ignore_errors=True)
+        raise
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     if args.smoke:
@@ -674,7 +682,8 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
     A("Models from the registry common/rfs_models.h (`--model NAME`). %d seeds each, "
       "except mlp and knn: %d seeds (they are slow in the simulator: the MLP's sliced "
       "training and the kNN's grid search over every lattice point cost seconds per run); "
-      "their CIs are correspondingly wide. The ridge rows are the meta rows above.\n"
+      "their CIs are correspondingly wide. The ridge rows are the meta runs above (seeds "
+      "1..N of the same runs).\n"
       % (ms, args.slow_model_seeds))
     for sc in scenarios:
         A("### %s\n" % sc)

@@ -460,6 +460,12 @@ int hs_map_to_core(const hs_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
         return fail(err, errlen, "map", "core grid %.0f x %.0f cells at %g m does not fit 1..65535",
                     cwd, chd, core_res);
     }
+    /* 2^26 cells (8 MB per bit grid, e.g. 800 x 800 m at 0.1 m): a larger floor is a
+     * wrong resolution in the YAML, not a building, and would take minutes to derive. */
+    if (cwd * chd > 67108864.0) {
+        return fail(err, errlen, "map", "core grid %.0f x %.0f cells at %g m is over the 2^26-cell limit",
+                    cwd, chd, core_res);
+    }
     uint16_t cw = (uint16_t)cwd;
     uint16_t ch = (uint16_t)chd;
     uint32_t bytes = rfs_map_bytes(cw, ch);

@@ -157,18 +157,6 @@ static rfs_q16_t wrap_pi(int64_t a)
     return (rfs_q16_t)a;
 }
 
-/* Distance in Q16 metres (see rfs_plan.c: differences clamped to 2^31, isqrt of Q32). */
-static rfs_q16_t dist_q16(rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1)
-{
-    int64_t dx = (int64_t)x1 - x0;
-    int64_t dy = (int64_t)y1 - y0;
-    uint64_t ax = (uint64_t)(dx < 0 ? -dx : dx);
-    uint64_t ay = (uint64_t)(dy < 0 ? -dy : dy);
-    ax = ax > 0x80000000u ? 0x80000000u : ax;
-    ay = ay > 0x80000000u ? 0x80000000u : ay;
-    uint32_t d = rfs_isqrt64(ax * ax + ay * ay);
-    return d > (uint32_t)INT32_MAX ? INT32_MAX : (rfs_q16_t)d;
-}
 
 /* Q16 metres to millimetres (int64, exact to 1/65 mm, rounded). */
 static int64_t q16_to_mm(int64_t v)
@@ -218,10 +206,10 @@ rfs_drive_status_t rfs_drive_update(rfs_drive_t *d, const rfs_pose_t *pose, int6
 
     if (d->status == RFS_DRIVE_RUNNING) {
         uint16_t last = (uint16_t)(d->path.n - 1u);
-        rfs_q16_t dn = dist_q16(pose->x, pose->y, d->path.x[d->next], d->path.y[d->next]);
+        rfs_q16_t dn = rfs_q16_dist(pose->x, pose->y, d->path.x[d->next], d->path.y[d->next]);
         while (d->next < last && dn < SWITCH_DIST) {
             d->next++;
-            dn = dist_q16(pose->x, pose->y, d->path.x[d->next], d->path.y[d->next]);
+            dn = rfs_q16_dist(pose->x, pose->y, d->path.x[d->next], d->path.y[d->next]);
             d->stall_ref_us = now_us;
             d->stall_ref_dist = dn;
         }

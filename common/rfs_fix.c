@@ -87,6 +87,18 @@ rfs_q16_t rfs_q16_sqrt(rfs_q16_t x)
     return (rfs_q16_t)rfs_isqrt64((uint64_t)(uint32_t)x << 16);
 }
 
+rfs_q16_t rfs_q16_dist(rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1)
+{
+    int64_t dx = (int64_t)x1 - x0;
+    int64_t dy = (int64_t)y1 - y0;
+    uint64_t ax = (uint64_t)(dx < 0 ? -dx : dx);
+    uint64_t ay = (uint64_t)(dy < 0 ? -dy : dy);
+    ax = ax > 0x80000000u ? 0x80000000u : ax;
+    ay = ay > 0x80000000u ? 0x80000000u : ay;
+    uint32_t d = rfs_isqrt64(ax * ax + ay * ay);
+    return d > (uint32_t)INT32_MAX ? INT32_MAX : (rfs_q16_t)d;
+}
+
 /* e^-n in Q30 for n = 0..12 (round(exp(-n) * 2^30)). */
 static const int32_t k_exp_int_q30[13] = {
     1073741824, 395007542, 145315154, 53458458, 19666268, 7234816, 2661540,

@@ -90,6 +90,12 @@ uint32_t rfs_isqrt64(uint64_t v);
 /// root is Q16.16. Negative input is a programmer error (asserts), 0 gives 0.
 rfs_q16_t rfs_q16_sqrt(rfs_q16_t x);
 
+/// Distance between (x0, y0) and (x1, y1), Q16.16 (metres), floor of the exact value.
+/// Scaling and overflow: differences of Q16 values fit in 33 bits; each is clamped to 2^31
+/// (the result saturates near 46 km) so the Q32 squares sum in uint64; the integer square
+/// root of a Q32 value is Q16.
+rfs_q16_t rfs_q16_dist(rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1);
+
 /// e^(-x) for x >= 0 in Q16.16, result in [0, 1] Q16.16; negative x is clamped to 0
 /// (result 1.0). Error <= 0.55 LSB (8.4e-6) over the whole input range (tested
 /// exhaustively on [0, 13); above 13 the result is 0, off by < 0.15 LSB).

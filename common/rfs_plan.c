@@ -43,21 +43,6 @@ int rfs_plan_init(rfs_plan_t *p, const rfs_map_t *map, uint8_t *work, uint32_t w
     return 0;
 }
 
-/* Distance between two points, metres Q16.16.
- * Scaling and overflow: differences of Q16 values fit in 33 bits; their squares (Q32)
- * are summed in uint64 after clamping each difference to 2^31 (saturating at 46 km);
- * the integer square root of a Q32 value is Q16. */
-static rfs_q16_t dist_q16(rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1)
-{
-    int64_t dx = (int64_t)x1 - x0;
-    int64_t dy = (int64_t)y1 - y0;
-    uint64_t ax = (uint64_t)(dx < 0 ? -dx : dx);
-    uint64_t ay = (uint64_t)(dy < 0 ? -dy : dy);
-    ax = ax > 0x80000000u ? 0x80000000u : ax;
-    ay = ay > 0x80000000u ? 0x80000000u : ay;
-    uint32_t d = rfs_isqrt64(ax * ax + ay * ay);
-    return d > (uint32_t)INT32_MAX ? INT32_MAX : (rfs_q16_t)d;
-}
 
 /* Choose the lattice point that connects (x, y) to the lattice: among the 3 x 3 points
  * around the nearest one, the closest legal point joined by a legal segment. When the
@@ -89,7 +74,7 @@ static bool connect(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, bool allow_esc
             if (!escape && !rfs_map_segment_legal(m, x, y, px, py)) {
                 continue;
             }
-            rfs_q16_t d = dist_q16(x, y, px, py);
+            rfs_q16_t d = rfs_q16_dist(x, y, px, py);
             if (d < best) {
                 best = d;
                 *idx = (uint32_t)j * m->lw + (uint32_t)i;
@@ -228,7 +213,7 @@ static void emit(puller_t *pl, rfs_q16_t x, rfs_q16_t y)
     pl->out->x[pl->out->n] = x;
     pl->out->y[pl->out->n] = y;
     pl->out->n++;
-    pl->len += dist_q16(pl->ax, pl->ay, x, y);
+    pl->len += rfs_q16_dist(pl->ax, pl->ay, x, y);
     pl->ax = x;
     pl->ay = y;
 }
@@ -268,7 +253,7 @@ bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_
         out->x[0] = x1;
         out->y[0] = y1;
         out->n = 1;
-        out->length = dist_q16(x0, y0, x1, y1);
+        out->length = rfs_q16_dist(x0, y0, x1, y1);
         return true;
     }
     uint32_t s_idx;

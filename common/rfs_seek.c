@@ -597,7 +597,7 @@ bool rfs_seek_grid_max_scan(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
  * its maximum is (argmax: the pathloss model's estimated source, issue 10) the goal is
  * that point itself, reached through the planner. The cut point lies on a legal segment
  * of the path. Scaling: waypoint offsets (Q16, < 2^32) times the remaining length
- * (Q16, < 2^16 m) < 2^63; segment lengths by rfs_isqrt64 of Q32 squares. */
+ * (Q16, < 2^16 m) < 2^63; segment lengths by rfs_q16_dist(). */
 static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool whole,
                               int64_t now_us)
 {
@@ -609,7 +609,7 @@ static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool wh
     int64_t left = whole ? INT32_MAX : s->cfg.step;
     for (uint16_t k = 0; k < p->n; ++k) {
         int64_t dx = (int64_t)p->x[k] - px, dy = (int64_t)p->y[k] - py;
-        int64_t len = (int64_t)rfs_isqrt64((uint64_t)(dx * dx) + (uint64_t)(dy * dy));
+        int64_t len = rfs_q16_dist((rfs_q16_t)px, (rfs_q16_t)py, p->x[k], p->y[k]);
         if (len >= left) {
             if (len > 0) {
                 p->x[k] = rfs_sat32(px + rfs_sdiv64_round(dx * left, len));
@@ -655,9 +655,7 @@ static bool choose_greedy(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
         return greedy_along_path(s, mx, my, known, now_us);
     }
     int64_t dx = (int64_t)mx - s->pose.x, dy = (int64_t)my - s->pose.y;
-    /* Scaling: Q16 differences up to 2^32; their squares in uint64 (Q32), root Q16. */
-    uint64_t d2 = (uint64_t)(dx * dx) + (uint64_t)(dy * dy);
-    rfs_q16_t dist = (rfs_q16_t)rfs_isqrt64(d2);
+    rfs_q16_t dist = rfs_q16_dist(s->pose.x, s->pose.y, mx, my);
     if (dist <= s->cfg.step) {
         s->decision.goal_x = mx;
         s->decision.goal_y = my;

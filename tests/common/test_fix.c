@@ -491,6 +491,35 @@ static void test_rng_uniform(void **state)
     assert_true(c < chi2_q(255, 3.0902) && c > chi2_q(255, -3.0902));
 }
 
+/* rfs_q16_dist against double: the floor of the exact distance (error < 1 LSB) over
+ * random points across the whole Q16 range, and saturation at the clamp. */
+static void test_q16_dist(void **state)
+{
+    (void)state;
+    rfs_rng_t r;
+    rfs_rng_seed(&r, 2024);
+    for (int k = 0; k < 200000; ++k) {
+        int32_t sh = (int32_t)(rfs_rng_u32(&r) % 31u);
+        rfs_q16_t p[4];
+        for (int i = 0; i < 4; ++i) {
+            p[i] = (rfs_q16_t)((int32_t)rfs_rng_u32(&r) >> sh);
+        }
+        double dx = (double)p[2] - p[0], dy = (double)p[3] - p[1];
+        if (fabs(dx) > 2147483648.0 || fabs(dy) > 2147483648.0) {
+            continue; /* clamped: checked below */
+        }
+        double ref = sqrt(dx * dx + dy * dy);
+        double got = rfs_q16_dist(p[0], p[1], p[2], p[3]);
+        if (ref >= 2147483647.0) {
+            assert_int_equal(rfs_q16_dist(p[0], p[1], p[2], p[3]), INT32_MAX);
+        } else {
+            assert_true(got <= ref + 1e-6 && got > ref - 1.0);
+        }
+    }
+    assert_int_equal(rfs_q16_dist(0, 0, 3 * 65536, 4 * 65536), 5 * 65536);
+    assert_int_equal(rfs_q16_dist(INT32_MIN, INT32_MIN, INT32_MAX, INT32_MAX), INT32_MAX);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -499,6 +528,7 @@ int main(void)
         cmocka_unit_test(test_div64),
         cmocka_unit_test(test_isqrt),
         cmocka_unit_test(test_q16_sqrt),
+        cmocka_unit_test(test_q16_dist),
         cmocka_unit_test(test_exp_neg),
         cmocka_unit_test(test_log2_db10),
         cmocka_unit_test(test_i128),

@@ -10,6 +10,50 @@
 #include "hs_radio.h"
 #include "hs_world.h"
 #include "rfs_pdr.h"
+#include "rfs_plan.h"
+
+// --- can the core's planner get into the stop radius? --------------------------------
+// The cell-level check below connects legal cells through gaps one cell wide; the
+// controller plans on the 0.25 m lattice, whose edges need a legal straight segment
+// between lattice points, so a door that narrow is shut for it. 1 = some lattice point
+// within `radius` of (gx, gy) is reachable from (sx, sy), 0 = none, -1 = out of memory.
+static int lattice_reaches(const rfs_map_t *m, double sx, double sy, double gx, double gy,
+                           double radius)
+{
+    uint32_t n = (uint32_t)m->lw * m->lh;
+    uint8_t *work = malloc(n ? n : 1);
+    uint32_t *queue = malloc(sizeof(uint32_t) * (n ? n : 1));
+    rfs_path_t *path = malloc(sizeof *path);
+    rfs_plan_t plan;
+    int found = -1;
+    if (work && queue && path && rfs_plan_init(&plan, m, work, n, queue, n) == 0) {
+        found = 0;
+        double g = m->cfg.grid / 65536.0;
+        long r = (long)ceil(radius / g) + 1;
+        uint16_t ci, cj;
+        rfs_map_lattice_nearest(m, (rfs_q16_t)lround(gx * 65536.0), (rfs_q16_t)lround(gy * 65536.0),
+                                &ci, &cj);
+        for (long j = (long)cj - r; j <= (long)cj + r && !found; j++) {
+            for (long i = (long)ci - r; i <= (long)ci + r && !found; i++) {
+                if (i < 0 || j < 0 || i >= m->lw || j >= m->lh ||
+                    !rfs_map_lattice_legal(m, (uint16_t)i, (uint16_t)j)) {
+                    continue;
+                }
+                rfs_q16_t px, py;
+                rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
+                if (hypot(px / 65536.0 - gx, py / 65536.0 - gy) > radius) {
+                    continue;
+                }
+                found = rfs_plan_path(&plan, (rfs_q16_t)lround(sx * 65536.0),
+                                      (rfs_q16_t)lround(sy * 65536.0), px, py, path) ? 1 : 0;
+            }
+        }
+    }
+    free(work);
+    free(queue);
+    free(path);
+    return found;
+}
 
 // --- shortest path on the core's legal grid -----------------------------------------
 
@@ -271,6 +315,21 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
                      "%s: stop.radius_m: the robot can never get within %.2f m of the goal "
                      "(%.2f, %.2f): the nearest point it can reach is %.2f m away",
                      sc->path, sc->stop_radius_m, sc->goal_x, sc->goal_y, best_gd);
+            hs_sim_env_close(e);
+            return -1;
+        }
+        int lr = lattice_reaches(cm, sc->start_x, sc->start_y, sc->goal_x, sc->goal_y,
+                                 sc->stop_radius_m);
+        if (lr <= 0) {
+            if (lr < 0) {
+                snprintf(err, errlen, "%s: out of memory", sc->path);
+            } else {
+                snprintf(err, errlen,
+                         "%s: stop.radius_m: the controller's planner (0.25 m lattice) cannot get "
+                         "within %.2f m of the goal (%.2f, %.2f): a door on the way is too narrow "
+                         "for the clearance on the core grid",
+                         sc->path, sc->stop_radius_m, sc->goal_x, sc->goal_y);
+            }
             hs_sim_env_close(e);
             return -1;
         }

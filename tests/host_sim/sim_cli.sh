@@ -69,6 +69,11 @@ bad stop_never_ends "would never end" "$T/never.yaml" --out "$T/out"
 scn radius.yaml "${BASE/15.0, 10.0/19.85, 10.0}stop: {radius_m: 0.1}
 "
 bad stop_never_reached "stop.radius_m: the robot can never get within 0.10 m" "$T/radius.yaml" --out "$T/out"
+# A source the 0.1 m cell grid reaches through a one-cell gap but the controller's 0.25 m
+# lattice cannot (willow's sealed office at (19.4, 3.0), the original scenario's source).
+sed -e "s|^map: .*|map: $(realpath scenarios/maps/willow-full-0.05.yaml)|" \
+    -e 's/position: \[25.0, 3.3\]/position: [19.4, 3.0]/' scenarios/willow.yaml >"$T/sealed.yaml"
+bad stop_lattice_unreachable "the controller's planner (0.25 m lattice) cannot get within 1.50 m" "$T/sealed.yaml" --out "$T/out"
 bad unknown_option "unknown option '--colour'" scenarios/open.yaml --colour --out "$T/out"
 bad bad_seed "--seed: expected a non-negative integer" scenarios/open.yaml --seed x --out "$T/out"
 bad bad_seeds "--seeds: '5..2' is not A..B" scenarios/open.yaml --seeds 5..2 --out "$T/out"

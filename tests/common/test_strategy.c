@@ -12,84 +12,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "rfs_ridge.h"
-#include "rfs_seek.h"
 
-#define RES 0.1
-#define Q(v) ((rfs_q16_t)lround((v) * 65536.0))
-#define D(q) ((double)(q) / 65536.0)
+#include "seek_world.h"
+
 #define PI 3.14159265358979323846
-
-typedef struct world {
-    uint16_t w, h;
-    uint8_t *free_bits, *wall_bits, *legal_bits;
-    rfs_map_t map;
-    rfs_seek_mem_t mem;
-    rfs_sample_t *samples;
-    rfs_pending_t *pending;
-    rfs_ridge_t ridge;
-    rfs_seek_t seek;
-    rfs_rng_t rng;
-} world_t;
-
-/* An open rectangle w_m x h_m metres with a one-cell border wall. */
-static void world_make(world_t *t, double w_m, double h_m)
-{
-    memset(t, 0, sizeof *t);
-    t->w = (uint16_t)lround(w_m / RES);
-    t->h = (uint16_t)lround(h_m / RES);
-    uint32_t bytes = rfs_map_bytes(t->w, t->h);
-    uint16_t stride = (uint16_t)((t->w + 7) / 8);
-    t->free_bits = calloc(bytes, 1);
-    t->wall_bits = calloc(bytes, 1);
-    t->legal_bits = calloc(bytes, 1);
-    for (uint16_t y = 0; y < t->h; ++y) {
-        for (uint16_t x = 0; x < t->w; ++x) {
-            bool wall = x == 0 || y == 0 || x == t->w - 1 || y == t->h - 1;
-            rfs_map_bit_set(t->free_bits, stride, x, y, !wall);
-            rfs_map_bit_set(t->wall_bits, stride, x, y, wall);
-        }
-    }
-    rfs_map_cfg_t mc = rfs_map_cfg_default();
-    assert_int_equal(rfs_map_init(&t->map, &mc, t->w, t->h, Q(RES), 0, 0, t->free_bits,
-                                  t->wall_bits, t->legal_bits), 0);
-}
-
-static void seek_make(world_t *t, rfs_seek_cfg_t cfg, uint64_t seed)
-{
-    uint32_t lpts = (uint32_t)t->map.lw * t->map.lh;
-    t->samples = calloc(cfg.store.capacity, sizeof *t->samples);
-    t->pending = calloc(256, sizeof *t->pending);
-    t->mem.samples = t->samples;
-    t->mem.pending = t->pending;
-    t->mem.pending_cap = 256;
-    t->mem.plan_work = calloc(lpts, 1);
-    t->mem.plan_work_bytes = lpts;
-    t->mem.plan_queue_cap = lpts;
-    t->mem.plan_queue = calloc(lpts, sizeof(uint32_t));
-    t->mem.visited_bytes = rfs_seek_lattice_bits_bytes(&t->map);
-    t->mem.visited = calloc(t->mem.visited_bytes, 1);
-    t->mem.reach_bytes = t->mem.visited_bytes;
-    t->mem.reach = calloc(t->mem.reach_bytes, 1);
-    rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
-    assert_int_equal(rfs_ridge_init(&t->ridge, &rc), 0);
-    assert_int_equal(rfs_seek_init(&t->seek, &cfg, &t->map, rfs_ridge_model(&t->ridge),
-                                   &rfs_target_rssi, &t->mem), 0);
-    rfs_rng_seed(&t->rng, seed);
-}
-
-static void world_free(world_t *t)
-{
-    free(t->free_bits);
-    free(t->wall_bits);
-    free(t->legal_bits);
-    free(t->samples);
-    free(t->pending);
-    free(t->mem.plan_work);
-    free(t->mem.plan_queue);
-    free(t->mem.visited);
-    free(t->mem.reach);
-}
 
 /* The synthetic field, dB, in double precision. */
 typedef struct field {
@@ -168,7 +94,7 @@ static void test_fd_gradient_direction(void **state)
 {
     (void)state;
     world_t t;
-    world_make(&t, 20.0, 20.0);
+    world_make(&t, 20.0, 20.0, 0, 0);
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     cfg.strategy = RFS_SEEK_FD_GRADIENT;
     seek_make(&t, cfg, 7);
@@ -213,7 +139,7 @@ static void test_fd_gradient_probe_flips_at_wall(void **state)
 {
     (void)state;
     world_t t;
-    world_make(&t, 10.0, 12.0);
+    world_make(&t, 10.0, 12.0, 0, 0);
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     cfg.strategy = RFS_SEEK_FD_GRADIENT;
     seek_make(&t, cfg, 3);
@@ -291,7 +217,7 @@ static void test_plane_gradient_follows_plane(void **state)
 {
     (void)state;
     world_t t;
-    world_make(&t, 30.0, 30.0);
+    world_make(&t, 30.0, 30.0, 0, 0);
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     cfg.strategy = RFS_SEEK_PLANE_GRADIENT;
     seek_make(&t, cfg, 11);
@@ -324,7 +250,7 @@ static void test_chemotaxis_run_and_tumble(void **state)
 {
     (void)state;
     world_t t;
-    world_make(&t, 60.0, 60.0);
+    world_make(&t, 60.0, 60.0, 0, 0);
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     cfg.strategy = RFS_SEEK_CHEMOTAXIS;
     cfg.tumble_better = 0;
@@ -368,7 +294,7 @@ static void test_chemotaxis_ignores_position(void **state)
     double heads[2][12];
     for (int run = 0; run < 2; ++run) {
         world_t t;
-        world_make(&t, 60.0, 60.0);
+        world_make(&t, 60.0, 60.0, 0, 0);
         rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
         cfg.strategy = RFS_SEEK_CHEMOTAXIS;
         seek_make(&t, cfg, 99);
@@ -397,7 +323,7 @@ static void test_no_goal_backs_off(void **state)
 {
     (void)state;
     world_t t;
-    world_make(&t, 0.8, 0.8);
+    world_make(&t, 0.8, 0.8, 0, 0);
     seek_make(&t, rfs_seek_cfg_default(), 1);
     field_t f = { .kind = 2, .scripted = -60.0 };
     run_t r = { .x = 0.4, .y = 0.4 };
@@ -452,7 +378,7 @@ static void test_names_and_unit(void **state)
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     assert_int_equal(cfg.strategy, RFS_SEEK_META); /* the paper's is the default */
     world_t t;
-    world_make(&t, 5.0, 5.0);
+    world_make(&t, 5.0, 5.0, 0, 0);
     cfg.strategy = RFS_SEEK_STRATEGY_COUNT;
     uint32_t lpts = (uint32_t)t.map.lw * t.map.lh;
     uint8_t *bits = calloc(lpts, 1);

@@ -39,7 +39,7 @@ TEST_DEPS += $(BUILD)/bin/rfseek-feed $(FEED)/asan/rfseek-feed $(FEED)/gen/.stam
 TEST_SCRIPTS += "tests/feed/cross_check.sh $(BUILD)/bin/rfseek-feed tests/data/captures/*.pcap $(FEED)/gen/*.pcap $(FEED)/gen/*.pcapng"
 TEST_SCRIPTS += "tests/feed/bad_input.sh $(FEED)/asan/rfseek-feed $(FEED)/gen"
 TEST_SCRIPTS += "$(PYTHON) tests/feed/replay_test.py $(FEED)/asan/rfseek-feed"
-TEST_SCRIPTS += "tests/feed/run_fuzz.sh $(FEED)/fuzz_radiotap $(FEED)/fuzz-corpus tests/fuzz/corpus/radiotap 20000"
+TEST_SCRIPTS += "tests/fuzz/run_one.sh $(FEED)/fuzz_radiotap $(FEED)/fuzz-corpus tests/fuzz/corpus/radiotap 20000"
 
 # CMocka tests of our modules, linked with our sources only (not all of librfs_host.a),
 # plain and under ASan+UBSan.

@@ -88,7 +88,7 @@ $(FW)/fuzz_replay: tests/fuzz/fuzz_replay.c $(FW_PORTABLE) $(CORE_SRCS) $(FW_HDR
 	$(FW_FUZZ_CC) -std=c11 -g -O1 -Icommon -Ifirmware -fsanitize=fuzzer,address,undefined \
 		-fno-sanitize-recover=all tests/fuzz/fuzz_replay.c $(FW_PORTABLE) $(CORE_SRCS) -o $@
 TEST_DEPS += $(FW)/fuzz_replay
-TEST_SCRIPTS += 'tests/firmware/run_fuzz_replay.sh $(FW)/fuzz_replay $(FW)/fuzz-corpus tests/fuzz/corpus/replay 2000'
+TEST_SCRIPTS += 'tests/fuzz/run_one.sh $(FW)/fuzz_replay $(FW)/fuzz-corpus tests/fuzz/corpus/replay 2000'
 
 # --- bench -------------------------------------------------------------------------------
 .PHONY: bench-firmware

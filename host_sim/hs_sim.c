@@ -475,21 +475,23 @@ static void write_residual(FILE *f, const hs_ctrl_t *ctrl)
     }
 }
 
-int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_sim_io_t *io,
-               hs_sim_result_t *res, char *err, size_t errlen)
+/* The Box2D world (with the robot at its start pose when place_robot) and the radio model
+ * over it, sharing the environment's wall-count caches. rs receives the radio's sources
+ * (the run edits it when a fault moves a source). NULL with err set on failure. */
+static hs_radio_t *world_radio_open(const hs_sim_env_t *e, uint64_t seed, bool place_robot,
+                                    hs_radio_src_t rs[HS_SCN_MAX_SOURCES],
+                                    hs_world_t **world_out, char *err, size_t errlen)
 {
     const hs_scenario_t *sc = &e->sc;
-    double t_wall0 = now_s(), t_cpu0 = cpu_s();
-    memset(res, 0, sizeof *res);
-    res->seed = seed;
     char werr[256];
     hs_world_t *world = hs_world_create(&e->map, NULL, werr, sizeof werr);
     if (!world) {
         snprintf(err, errlen, "%s: %s", sc->path, werr);
-        return -1;
+        return NULL;
     }
-    hs_world_place_robot(world, sc->start_x, sc->start_y, sc->start_theta);
-    hs_radio_src_t rs[HS_SCN_MAX_SOURCES];
+    if (place_robot) {
+        hs_world_place_robot(world, sc->start_x, sc->start_y, sc->start_theta);
+    }
     for (unsigned s = 0; s < sc->nsources; s++) {
         rs[s] = (hs_radio_src_t){sc->src[s].x, sc->src[s].y, sc->src[s].tx_dbm};
     }
@@ -498,10 +500,28 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     if (!radio) {
         hs_world_destroy(world);
         snprintf(err, errlen, "%s: %s", sc->path, werr);
-        return -1;
+        return NULL;
     }
     for (unsigned s = 0; s < sc->nsources; s++) {
         hs_radio_use_wall_cache(radio, s, e->wall_cache[s]);
+    }
+    *world_out = world;
+    return radio;
+}
+
+int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_sim_io_t *io,
+               hs_sim_result_t *res, char *err, size_t errlen)
+{
+    const hs_scenario_t *sc = &e->sc;
+    double t_wall0 = now_s(), t_cpu0 = cpu_s();
+    memset(res, 0, sizeof *res);
+    res->seed = seed;
+    char werr[256];
+    hs_radio_src_t rs[HS_SCN_MAX_SOURCES];
+    hs_world_t *world;
+    hs_radio_t *radio = world_radio_open(e, seed, true, rs, &world, err, errlen);
+    if (!radio) {
+        return -1;
     }
     hs_motor_t motor;
     if (hs_motor_init(&motor, &sc->motor) != 0) {
@@ -803,25 +823,11 @@ int hs_sim_field(const hs_sim_env_t *e, uint64_t seed, unsigned src, double step
         snprintf(err, errlen, "field: bad source or step");
         return -1;
     }
-    char werr[256];
-    hs_world_t *world = hs_world_create(&e->map, NULL, werr, sizeof werr);
-    if (!world) {
-        snprintf(err, errlen, "%s: %s", sc->path, werr);
-        return -1;
-    }
     hs_radio_src_t rs[HS_SCN_MAX_SOURCES];
-    for (unsigned s = 0; s < sc->nsources; s++) {
-        rs[s] = (hs_radio_src_t){sc->src[s].x, sc->src[s].y, sc->src[s].tx_dbm};
-    }
-    hs_radio_t *radio = hs_radio_create(&sc->radio, rs, sc->nsources, e->x0, e->y0, e->x1, e->y1,
-                                        seed, walls_cb, world, werr, sizeof werr);
+    hs_world_t *world;
+    hs_radio_t *radio = world_radio_open(e, seed, false, rs, &world, err, errlen);
     if (!radio) {
-        hs_world_destroy(world);
-        snprintf(err, errlen, "%s: %s", sc->path, werr);
         return -1;
-    }
-    for (unsigned s = 0; s < sc->nsources; s++) {
-        hs_radio_use_wall_cache(radio, s, e->wall_cache[s]);
     }
     rfs_rng_t rng;
     rfs_rng_seed(&rng, seed ^ 0x5A17C0FFEE000004ull);

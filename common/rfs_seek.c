@@ -36,7 +36,21 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.strategy = RFS_SEEK_META;
     c.tumble_better = RFS_Q16_FRAC(1, 5);   /* E. coli runs on while things improve */
     c.tumble_worse = RFS_Q16_ONE;           /* and tumbles when they do not */
+    c.recheck_dist = 0;                     /* the paper checks when a step ends */
+    c.eps_by_travel = false;                /* and counts epsilon's n in iterations */
     return c;
+}
+
+void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy)
+{
+    RFS_ASSERT(cfg != 0);
+    bool path = strategy == RFS_SEEK_META_PATH;
+    cfg->strategy = strategy;
+    /* A meta-path greedy leg walks the whole planned path: check the model every step of
+     * it, as the paper does after each 1 m step, and anneal epsilon by the steps' worth
+     * of travel, not by the few long iterations. */
+    cfg->recheck_dist = path ? cfg->step : 0;
+    cfg->eps_by_travel = path;
 }
 
 uint32_t rfs_seek_lattice_bits_bytes(const rfs_map_t *map)
@@ -64,7 +78,7 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         cfg->novelty_radius < 0 || cfg->pose_timeout_us <= 0 || cfg->rssi_timeout_us <= 0 ||
         (uint32_t)cfg->strategy >= (uint32_t)RFS_SEEK_STRATEGY_COUNT ||
         cfg->tumble_better < 0 || cfg->tumble_better > RFS_Q16_ONE || cfg->tumble_worse < 0 ||
-        cfg->tumble_worse > RFS_Q16_ONE) {
+        cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0) {
         return -1;
     }
     if (model.ops == 0 || model.ops->fit == 0 || model.ops->predict == 0 ||
@@ -1004,6 +1018,52 @@ static void decide_chemo(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek
 }
 
 /* Finish the decision after a (possibly sliced) fit: epsilon-greedy choice and goal. */
+/* Add the straight distance from the last check point to the pose to the travel and
+ * make the pose the check point. Scaling: each leg < 2^16 m in Q16.16 (rfs_q16_dist),
+ * the sum saturates far beyond any mission (2^47 m). */
+static void count_travel(rfs_seek_t *s)
+{
+    if (s->have_chk) {
+        int64_t leg = rfs_q16_dist(s->chk_x, s->chk_y, s->pose.x, s->pose.y);
+        s->travel = s->travel < ((int64_t)1 << 62) ? s->travel + leg : s->travel;
+    }
+    s->have_chk = true;
+    s->chk_x = s->pose.x;
+    s->chk_y = s->pose.y;
+}
+
+/* Epsilon's n: the iteration (paper), or with eps_by_travel the larger of it and the
+ * whole steps travelled. Scaling: travel (Q16) / step (Q16, > 0) is whole steps. */
+static uint32_t epsilon_index(const rfs_seek_t *s)
+{
+    uint32_t n = s->decision.iteration;
+    if (s->cfg.eps_by_travel) {
+        int64_t steps = s->travel / s->cfg.step;
+        uint32_t t = steps > (int64_t)UINT32_MAX ? UINT32_MAX : (uint32_t)steps;
+        n = t > n ? t : n;
+    }
+    return n;
+}
+
+/* recheck_dist: while a greedy leg is driven, every recheck_dist of travel, the relearn
+ * check of Algorithm 1 (|1 s mean - prediction| > threshold). true when it fails: the
+ * leg is abandoned and the next iteration relearns. */
+static bool recheck_fails(rfs_seek_t *s, int64_t now_us)
+{
+    if (s->cfg.recheck_dist <= 0 || s->decision.kind != RFS_SEEK_GREEDY || !s->have_chk ||
+        rfs_q16_dist(s->chk_x, s->chk_y, s->pose.x, s->pose.y) < s->cfg.recheck_dist) {
+        return false;
+    }
+    count_travel(s);
+    rfs_target_in_t in = { s->win, s->target->nsources, now_us };
+    rfs_q16_t mean, pred;
+    if (!s->target->mean(&in, &mean) ||
+        !s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &pred)) {
+        return false;
+    }
+    return rfs_q16_abs(rfs_q16_sub(mean, pred)) > s->cfg.error_threshold;
+}
+
 static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
 {
     rfs_seek_decision_t *d = &s->decision;
@@ -1016,9 +1076,12 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
     } else if (s->cfg.strategy == RFS_SEEK_PLANE_GRADIENT) {
         ok = choose_plane(s, model_ok, rng, now_us);
     } else {
-        d->epsilon = rfs_seek_epsilon(&s->cfg, d->iteration);
-        /* "if random() > epsilon: greedy" (Algorithm 1). */
-        bool greedy = model_ok && rfs_rng_q16(rng) >= d->epsilon;
+        d->epsilon = rfs_seek_epsilon(&s->cfg, epsilon_index(s));
+        /* "if random() > epsilon: greedy" (Algorithm 1). A leg abandoned by a failed
+         * recheck continues greedily on the relearnt model: the draw was made when the
+         * leg began. */
+        bool greedy = model_ok && (s->replan || rfs_rng_q16(rng) >= d->epsilon);
+        s->replan = false;
         d->kind = greedy ? RFS_SEEK_GREEDY : RFS_SEEK_EPSILON;
         ok = greedy ? choose_greedy(s, rng, now_us) : choose_epsilon(s, rng, now_us);
         if (!ok && greedy) {
@@ -1070,6 +1133,7 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     d->x = s->pose.x;
     d->y = s->pose.y;
     d->samples = s->store.count;
+    count_travel(s);
     rfs_target_in_t in = { s->win, s->target->nsources, now_us };
     d->mean_valid = s->target->mean(&in, &d->mean);
     if (s->cfg.strategy == RFS_SEEK_FD_GRADIENT) {
@@ -1192,6 +1256,11 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
         s->fitting = false;
         finish_decision(s, now_us, rng, out);
         goto report;
+    }
+    if (s->drive.status == RFS_DRIVE_RUNNING && recheck_fails(s, now_us)) {
+        rfs_drive_stop(&s->drive, now_us);
+        s->prev_status = RFS_DRIVE_RUNNING; /* abandoned while running: the model failed */
+        s->replan = true;
     }
     if (s->drive.status == RFS_DRIVE_RUNNING) {
         rfs_drive_status_t st = rfs_drive_update(&s->drive, &s->pose, now_us, &out->left_mm_s,

@@ -61,6 +61,12 @@ typedef struct rfs_seek_cfg {
     rfs_seek_strategy_t strategy; ///< decision rule (RFS_SEEK_META: the paper's)
     rfs_q16_t tumble_better;    ///< chemotaxis: P(tumble) after the mean rose, Q16.16 (0.2)
     rfs_q16_t tumble_worse;     ///< chemotaxis: P(tumble) after it fell or stayed, Q16.16 (1.0)
+    /* Improvements beside the paper (docs/STRATEGIES.md); 0 / false is the paper's rule. */
+    rfs_q16_t recheck_dist;     ///< run the relearn check again after every this many metres
+                                ///< of a greedy leg and decide anew when it fails, Q16.16
+                                ///< (0: only when a goal ends, the paper's)
+    bool eps_by_travel;         ///< epsilon's n = max(iteration, metres travelled / step):
+                                ///< one long leg anneals as much as the 1 m steps it replaces
 } rfs_seek_cfg_t;
 
 /// Caller-owned memory for the seeker's large arrays.
@@ -190,10 +196,20 @@ typedef struct rfs_seek {
     bool have_prev_mean;                      ///< chemotaxis: prev_mean is valid
     rfs_q16_t prev_mean;                      ///< chemotaxis: 1 s mean at the last decision
     int64_t retry_after_us;                   ///< no goal was found: next decision not before, us
+    /* Improvements (cfg.recheck_dist, cfg.eps_by_travel). */
+    bool have_chk;                            ///< chk_x/chk_y are valid
+    rfs_q16_t chk_x, chk_y;                   ///< position of the last check, metres Q16.16
+    int64_t travel;                           ///< straight distance summed over checks, metres Q16.16
+    bool replan;                              ///< a recheck failed: relearn and go greedy again
 } rfs_seek_t;
 
 /// The paper's parameters (section 2 and 5.2): the `meta` configuration.
 rfs_seek_cfg_t rfs_seek_cfg_default(void);
+
+/// Choose a strategy with its named preset: sets cfg->strategy and the improvement
+/// fields, on for RFS_SEEK_META_PATH (recheck_dist = cfg->step, eps_by_travel), the
+/// paper's (0, false) for every other strategy.
+void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 
 /// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array
 /// is missing or too small for the map's lattice, or the target needs more sources than

@@ -198,6 +198,9 @@ void hs_scenario_defaults(hs_scenario_t *sc)
 {
     memset(sc, 0, sizeof *sc);
     sc->seed = 1;
+    sc->seek_recheck_m = -1.0;
+    sc->seek_eps_by_travel = -1;
+    sc->seek_eps_rate = -1.0;
     snprintf(sc->model, sizeof sc->model, "ridge");
     snprintf(sc->target, sizeof sc->target, "rssi");
     snprintf(sc->strategy, sizeof sc->strategy, "meta");
@@ -364,7 +367,7 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
 {
     static const char *const top[] = {"map", "seed", "model", "target", "strategy", "sources",
                                       "start", "localisation", "radio", "motor", "stop", "sim",
-                                      "faults", NULL};
+                                      "faults", "seek", NULL};
     if (check_keys(p, root, "scenario", top) != 0) {
         return -1;
     }
@@ -397,6 +400,20 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
         str(p, root, "scenario", "target", sc->target, sizeof sc->target) ||
         str(p, root, "scenario", "strategy", sc->strategy, sizeof sc->strategy)) {
         return -1;
+    }
+    if ((n = get(p, root, "seek"))) {
+        static const char *const k[] = {"recheck_m", "eps_by_travel", "eps_rate", NULL};
+        bool ebt = false;
+        bool has_ebt = get(p, n, "eps_by_travel") != NULL;
+        if (check_keys(p, n, "seek", k) ||
+            num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
+            num(p, n, "seek", "eps_rate", 0, 100, &sc->seek_eps_rate) ||
+            boolean(p, n, "seek", "eps_by_travel", &ebt)) {
+            return -1;
+        }
+        if (has_ebt) {
+            sc->seek_eps_by_travel = ebt ? 1 : 0;
+        }
     }
     if (!rfs_models_lookup(sc->model)) {
         char names[256] = "";

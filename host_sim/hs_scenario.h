@@ -5,7 +5,10 @@
  *   model: ridge                   # internal model (paper section 5.2)
  *   target: rssi                   # rssi (one source), bridge (two, paper section 6) or
  *                                  # pdr (one: packet delivery ratio, rfs_pdr.h)
- *   strategy: meta                 # placeholder for the baselines of issue 7
+ *   strategy: meta                 # meta (the paper), meta-global, fd-gradient,
+ *                                  # plane-gradient, chemotaxis, meta-path
+ *   seek: {recheck_m: 1.0, eps_by_travel: true, eps_rate: 0.162}  # optional: override the strategy's
+ *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2
  *     - name: ap
  *       position: [30.0, 8.0]      # metres, map frame
@@ -57,6 +60,11 @@ typedef struct hs_scenario {
     char model[32];               ///< internal model name ("ridge")
     char target[16];              ///< target name ("rssi"; "bridge" with two sources; "pdr")
     char strategy[32];            ///< strategy name ("meta")
+    double seek_recheck_m;        ///< seek.recheck_m: relearn check every this many metres
+                                  ///< of a greedy leg (-1 = the strategy's preset)
+    int seek_eps_by_travel;       ///< seek.eps_by_travel: 0 / 1 (-1 = the strategy's preset)
+    double seek_eps_rate;         ///< seek.eps_rate: epsilon's decay per iteration (-1 = the
+                                  ///< paper's ln(9/4)/5, epsilon(5) = 0.5)
     unsigned nsources;            ///< sources
     hs_scn_source_t src[HS_SCN_MAX_SOURCES]; ///< the sources
     double start_x, start_y;      ///< robot start, metres

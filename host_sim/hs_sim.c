@@ -798,10 +798,21 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     if (strcmp(e->sc.target, "bridge") == 0) {
         cc.seek.error_threshold = RFS_Q16_INT(7); // paper section 6: 7 for the noisier target
     }
-    if (!rfs_seek_strategy_parse(e->sc.strategy, &cc.seek.strategy)) {
+    rfs_seek_strategy_t st;
+    if (!rfs_seek_strategy_parse(e->sc.strategy, &st)) {
         snprintf(err, errlen, "%s: strategy: unknown '%s' (meta, meta-global, fd-gradient, "
-                 "plane-gradient, chemotaxis)", e->sc.path, e->sc.strategy);
+                 "plane-gradient, chemotaxis, meta-path)", e->sc.path, e->sc.strategy);
         return -1;
+    }
+    rfs_seek_cfg_use_strategy(&cc.seek, st);
+    if (e->sc.seek_recheck_m >= 0.0) {
+        cc.seek.recheck_dist = (rfs_q16_t)lround(e->sc.seek_recheck_m * 65536.0);
+    }
+    if (e->sc.seek_eps_rate >= 0.0) {
+        cc.seek.eps_rate = (rfs_q16_t)lround(e->sc.seek_eps_rate * 65536.0);
+    }
+    if (e->sc.seek_eps_by_travel >= 0) {
+        cc.seek.eps_by_travel = e->sc.seek_eps_by_travel != 0;
     }
     cc.seed = seed ^ 0x5A17C0FFEE000003ull;
     hs_ctrl_t ctrl;

@@ -44,7 +44,8 @@ static void usage(FILE *f)
             "  --emit-jobs     print one command per seed (for GNU parallel or a Slurm array)\n"
             "                  instead of running; merge with scripts/merge_runs.py DIR\n"
             "  --strategy NAME seeking strategy, overriding the scenario's: meta, meta-global,\n"
-            "                  fd-gradient, plane-gradient, chemotaxis (docs/RESULTS.md)\n"
+            "                  fd-gradient, plane-gradient, chemotaxis, meta-path\n"
+            "                  (docs/STRATEGIES.md, docs/RESULTS.md)\n"
             "  --model NAME    internal model, overriding the scenario's: ridge, mlp, knn,\n"
             "                  radius, pathloss\n"
             "  --no-faults     ignore the scenario's fault schedule (docs/FAULTS.md)\n"
@@ -506,7 +507,7 @@ int main(int argc, char **argv)
     if (strategy && (strlen(strategy) >= sizeof sc.strategy ||
                      !rfs_seek_strategy_parse(strategy, &st_check))) {
         return die("--strategy: unknown '%s' (meta, meta-global, fd-gradient, plane-gradient, "
-                   "chemotaxis)%s", strategy, "");
+                   "chemotaxis, meta-path)%s", strategy, "");
     }
     if (model && (strlen(model) >= sizeof sc.model || !hs_ctrl_model_known(model))) {
         return die("--model: unknown '%s' (ridge, mlp, knn, radius, pathloss)%s", model, "");

@@ -350,13 +350,142 @@ static void test_no_goal_backs_off(void **state)
     world_free(&t);
 }
 
+
+/* The meta-path preset: its improvements are on, every other strategy keeps the paper's
+ * rule, and a negative recheck distance is refused. */
+static void test_meta_path_preset(void **state)
+{
+    (void)state;
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    assert_int_equal(cfg.recheck_dist, 0);
+    assert_false(cfg.eps_by_travel);
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    assert_int_equal(cfg.strategy, RFS_SEEK_META_PATH);
+    assert_int_equal(cfg.recheck_dist, cfg.step);
+    assert_true(cfg.eps_by_travel);
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META);
+    assert_int_equal(cfg.recheck_dist, 0);
+    assert_false(cfg.eps_by_travel);
+    world_t t;
+    world_make(&t, 5.0, 5.0, 0, 0);
+    cfg.recheck_dist = -1;
+    uint32_t lpts = (uint32_t)t.map.lw * t.map.lh;
+    uint8_t *bits = calloc(lpts, 1);
+    rfs_seek_mem_t mem = { .visited = bits, .visited_bytes = lpts, .reach = bits,
+                           .reach_bytes = lpts };
+    rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
+    rfs_ridge_init(&t.ridge, &rc);
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, rfs_ridge_model(&t.ridge),
+                                   &rfs_target_rssi, &mem), -1);
+    free(bits);
+    world_free(&t);
+}
+
+/* eps_by_travel: epsilon's n is the larger of the iteration and the whole steps of
+ * straight travel between decision points, summed here in double precision; the
+ * epsilon reported equals 0.9 e^(-a n) + 0.1 with a = ln(9/4) / 5 in double. */
+static void test_eps_by_travel(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 30.0, 30.0, 0, 0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    cfg.recheck_dist = 0; /* this test: the index alone */
+    seek_make(&t, cfg, 5);
+    field_t f = { .kind = 0, .sx = 24.0, .sy = 24.0 };
+    run_t r = { .x = 6.0, .y = 6.0 };
+    rfs_seek_out_t out;
+    double travel = 0.0, px = 0.0, py = 0.0;
+    int checked = 0, beyond = 0;
+    for (int k = 0; k <= 30; ++k) {
+        assert_true(next_decision(&t, &r, &f, 1000000, 60000000, &out));
+        double x = D(out.decision.x), y = D(out.decision.y);
+        if (k > 0) {
+            travel += hypot(x - px, y - py);
+        }
+        px = x;
+        py = y;
+        if (k == 0) {
+            continue;
+        }
+        double whole = floor(travel);
+        if (travel - whole < 1e-3 || travel - whole > 1.0 - 1e-3) {
+            continue; /* too close to a step boundary to call in fixed point */
+        }
+        double n = whole > (double)out.decision.iteration ? whole : (double)out.decision.iteration;
+        beyond += whole > (double)out.decision.iteration;
+        double want = 0.9 * exp(-log(9.0 / 4.0) / 5.0 * n) + 0.1;
+        assert_true(fabs(D(out.decision.epsilon) - want) < 2e-4);
+        checked++;
+    }
+    assert_true(checked >= 20);
+    assert_true(beyond >= 5); /* the travel, not the iteration, set n in some */
+    world_free(&t);
+}
+
+/* recheck_dist: a greedy leg whose 1 s mean departs from the model by more than the
+ * threshold after recheck_dist of travel is abandoned (prev = running) and the next
+ * decision relearns and goes greedy again without an epsilon draw; with recheck_dist 0
+ * (the paper) the same leg runs to its end. epsilon is fixed at 0.5 so that an
+ * unforced decision is greedy only about half the time. */
+static void run_recheck(double recheck_m, int *jumps, int *jumps_abandoned, int *normal_eps)
+{
+    world_t t;
+    world_make(&t, 30.0, 30.0, 0, 0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    cfg.recheck_dist = Q(recheck_m);
+    cfg.eps_by_travel = false;
+    cfg.eps_amp = 0;
+    cfg.eps_floor = RFS_Q16_HALF;
+    seek_make(&t, cfg, 9);
+    field_t f = { .kind = 1, .a = -80.0, .bx = 0.5, .by = 0.5 };
+    run_t r = { .x = 5.0, .y = 5.0 };
+    rfs_seek_out_t out;
+    *jumps = *jumps_abandoned = *normal_eps = 0;
+    bool jumped = false;
+    for (int k = 0; k < 80; ++k) {
+        assert_true(next_decision(&t, &r, &f, 1500000, 60000000, &out));
+        const rfs_seek_decision_t *d = &out.decision;
+        if (d->prev == RFS_DRIVE_RUNNING) {
+            /* Abandoned by a failed check: relearnt, greedy without a draw. */
+            assert_true(recheck_m > 0.0);
+            assert_true(d->relearned);
+            assert_int_equal(d->kind, RFS_SEEK_GREEDY);
+            *jumps_abandoned += jumped;
+        } else if (k > 1) {
+            *normal_eps += d->kind == RFS_SEEK_EPSILON;
+        }
+        /* Every third greedy leg: the field jumps by 12 dB while it is driven (the
+         * teleported robot appears at the goal, 1 m away, with a 1 s mean 12 dB off). */
+        jumped = d->kind == RFS_SEEK_GREEDY && k % 3 == 0 && d->prev != RFS_DRIVE_RUNNING;
+        *jumps += jumped;
+        f.a = jumped ? -68.0 : -80.0;
+    }
+    world_free(&t);
+}
+
+static void test_recheck_abandons_leg(void **state)
+{
+    (void)state;
+    int jumps, ab, ne;
+    run_recheck(0.5, &jumps, &ab, &ne);
+    assert_true(jumps >= 5);
+    assert_int_equal(ab, jumps); /* every leg driven through a jump is abandoned */
+    assert_true(ne >= 10);       /* unforced decisions still explore */
+    run_recheck(0.0, &jumps, &ab, &ne);
+    assert_true(jumps >= 5);
+    assert_int_equal(ab, 0);     /* the paper's rule runs every leg to its end */
+}
+
 /* Names round-trip and the unit vector against double precision. */
 static void test_names_and_unit(void **state)
 {
     (void)state;
     static const char *names[] = { "meta", "meta-global", "fd-gradient", "plane-gradient",
-                                   "chemotaxis" };
-    for (int i = 0; i < 5; ++i) {
+                                   "chemotaxis", "meta-path" };
+    for (int i = 0; i < 6; ++i) {
         rfs_seek_strategy_t st;
         assert_true(rfs_seek_strategy_parse(names[i], &st));
         assert_int_equal((int)st, i);
@@ -402,6 +531,9 @@ int main(void)
         cmocka_unit_test(test_chemotaxis_ignores_position),
         cmocka_unit_test(test_no_goal_backs_off),
         cmocka_unit_test(test_names_and_unit),
+        cmocka_unit_test(test_meta_path_preset),
+        cmocka_unit_test(test_eps_by_travel),
+        cmocka_unit_test(test_recheck_abandons_leg),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -90,6 +90,14 @@ static void test_scenario_good(void **state)
     assert_true(sc.stop_radius_m == 2.0 && sc.stop_time_s == 60.0 && sc.stop_distance_m == 150.0);
     assert_true(sc.goal_x == 15.0 && sc.goal_y == 10.0);
     assert_string_equal(sc.model, "ridge");
+    assert_true(sc.seek_recheck_m == -1.0 && sc.seek_eps_by_travel == -1 && sc.seek_eps_rate == -1.0);
+    // seek: overrides of the strategy's preset.
+    char text[2048];
+    snprintf(text, sizeof text, "%sstrategy: meta-path\nseek: {recheck_m: 0.5, eps_by_travel: false, "
+             "eps_rate: 0.3}\n", GOOD);
+    assert_int_equal(hs_scenario_load(scn("seek.yaml", text), &sc, err, sizeof err), 0);
+    assert_string_equal(sc.strategy, "meta-path");
+    assert_true(sc.seek_recheck_m == 0.5 && sc.seek_eps_by_travel == 0 && sc.seek_eps_rate == 0.3);
 }
 
 /// Each bad scenario: -1 and one line naming the file, the line and the field.
@@ -141,6 +149,18 @@ static void test_scenario_bad(void **state)
                "map: @MAP@\nmodel: foo\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",
                "model.yaml:2: model: 'foo' is not a known model");
+    expect_bad("seek_key.yaml",
+               "map: @MAP@\nseek: {recheck: 1}\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "seek_key.yaml:2: seek: unknown key 'recheck'");
+    expect_bad("seek_range.yaml",
+               "map: @MAP@\nseek: {recheck_m: -1}\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "seek.recheck_m: -1 is out of range");
+    expect_bad("seek_bool.yaml",
+               "map: @MAP@\nseek: {eps_by_travel: maybe}\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "seek.eps_by_travel: expected true or false");
     expect_bad("nostart.yaml", "map: @MAP@\nsources:\n  - position: [15, 10]\n", "start: missing");
     expect_bad("never.yaml",
                "map: @MAP@\nsources:\n  - position: [15, 10]\nstart: {position: [5, 10]}\n"

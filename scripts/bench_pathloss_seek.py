@@ -28,7 +28,13 @@ BREAKS = [
     ("default, source in the corridor (20, 6)", "scenarios/default.yaml",
      [(r"position: \[27\.5, 10\.0\]", "position: [20.0, 6.0]")]),
 ]
-CONFIGS = [("meta", "ridge"), ("meta-path", "pathloss")]
+# (strategy, model, label, extra scenario text): meta-path's preset improvements
+# (recheck every step of a greedy leg, epsilon annealed by travel; docs/STRATEGIES.md) are
+# also run switched off, so each row shows what they bring.
+CONFIGS = [("meta", "ridge", "meta + ridge", ""),
+           ("meta-path", "pathloss", "meta-path + pathloss, improvements off",
+            "seek: {recheck_m: 0, eps_by_travel: false}\n"),
+           ("meta-path", "pathloss", "meta-path + pathloss", "")]
 
 
 def wilson(k, n, z=1.96):
@@ -58,10 +64,10 @@ def run(sim, scenario, strategy, model, seeds):
             "updates": statistics.median(int(r["model_updates"]) for r in rows)}
 
 
-def scenario_file(path, edits, tmpdir):
-    if not edits:
+def scenario_file(path, edits, tmpdir, extra=""):
+    if not edits and not extra:
         return path
-    text = open(path).read()
+    text = open(path).read() + extra
     for pat, rep in edits:
         text, n = re.subn(pat, rep, text)
         if n != 1:
@@ -89,10 +95,10 @@ def main():
             lines.append("| scenario | strategy + model | success (95% CI) | median travel / shortest path | p90 | median model updates |")
             lines.append("|---|---|---|---|---|---|")
             for label, path, edits in rows:
-                scen = scenario_file(path, edits, tmps)
-                for strategy, model in CONFIGS:
+                for strategy, model, name, extra in CONFIGS:
+                    scen = scenario_file(path, edits, tmps, extra)
                     r = run(a.sim, scen, strategy, model, a.seeds)
-                    lines.append(f"| {label} | {strategy} + {model} | {r['k']}/{r['n']} = {100*r['k']/r['n']:.0f}% ({100*r['lo']:.0f}-{100*r['hi']:.0f}%) | {r['ratio']:.2f} | {r['p90']:.2f} | {r['updates']:.0f} |")
+                    lines.append(f"| {label} | {name} | {r['k']}/{r['n']} = {100*r['k']/r['n']:.0f}% ({100*r['lo']:.0f}-{100*r['hi']:.0f}%) | {r['ratio']:.2f} | {r['p90']:.2f} | {r['updates']:.0f} |")
                     print(lines[-1], flush=True)
     finally:
         for t in tmps:
@@ -105,7 +111,10 @@ shadowing, 4 dB measurement noise unless the row says otherwise), success = with
 the source before 150 m of travel or 15 simulated minutes. Travel ratios are over all runs
 (a failed run counts its 150 m). `meta + ridge` is the paper's algorithm with its own
 parameters; `meta-path + pathloss` is the improvement (docs/PATHLOSS.md, docs/STRATEGIES.md):
-the pathloss model's estimated source is the greedy goal, reached through the planner.
+the pathloss model's estimated source is the greedy goal, reached through the planner, with
+meta-path's two preset improvements (the relearn check after every metre of a greedy leg,
+epsilon annealed by the metres travelled); "improvements off" is the same without them
+(`seek: {recheck_m: 0, eps_by_travel: false}` added to the scenario).
 
 Command: `/usr/bin/python3 scripts/bench_pathloss_seek.py --seeds {a.seeds}` (wall time
 {wall:.0f} s on this 2-core machine, shared with other work while it ran).

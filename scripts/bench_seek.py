@@ -36,7 +36,15 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-STRATEGIES = ["meta", "meta-global", "fd-gradient", "plane-gradient", "chemotaxis"]
+STRATEGIES = ["meta", "meta-global", "fd-gradient", "plane-gradient", "chemotaxis", "meta-path"]
+# The strategies' internal model: the local ridge (the paper's), except meta-path, the
+# improvement of issue 10, which runs with the map-aware path-loss model.
+STRAT_MODEL = {"meta-path": "pathloss"}
+BASELINES = ["meta-global", "fd-gradient", "plane-gradient", "chemotaxis"]
+
+
+def model_of(st):
+    return STRAT_MODEL.get(st, "ridge")
 SCENARIOS = ["default", "open", "lshape", "willow", "3ne", "intel"]
 MODELS = ["ridge", "mlp", "knn", "radius", "pathloss"]
 SLOW_MODELS = {"mlp", "knn"}
@@ -252,7 +260,8 @@ def walls_lookup(field_tsv):
 
 
 def single_run(args, scen_file, seed, out, strategy="meta", field=False):
-    cmd = [args.bin, scen_file, "--seed", str(seed), "--out", out, "--strategy", strategy]
+    cmd = [args.bin, scen_file, "--seed", str(seed), "--out", out, "--strategy", strategy,
+           "--model", model_of(strategy)]
     if field:
         cmd.append("--field")
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
@@ -386,7 +395,7 @@ def fig_noise(figdir, sweep):
     return p
 
 
-def fig_bridge(figdir, field, settle, src):
+def fig_bridge(figdir, field, settle, src, settle_path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -395,14 +404,16 @@ def fig_bridge(figdir, field, settle, src):
     sc = ax.scatter(x, y, c=f, s=1, cmap="viridis", marker="s", linewidths=0)
     fig.colorbar(sc, ax=ax, label="true f = -|R1-R2| - |R1+R2|, dB (seed 1 field, no fading)")
     s = np.array(settle)
-    ax.plot(s[:, 0], s[:, 1], "r.", ms=4, label="where runs settled (all seeds)")
+    ax.plot(s[:, 0], s[:, 1], "r.", ms=4, label="meta + ridge: where runs settled")
+    s = np.array(settle_path)
+    ax.plot(s[:, 0], s[:, 1], "c.", ms=4, label="meta-path + pathloss: where runs settled")
     i = int(np.argmax(f))
     ax.plot(x[i], y[i], "w*", ms=14, mec="k", label="best point of f (seed 1)")
     for k, (sx, sy) in enumerate(src):
         ax.plot(sx, sy, "^", color="orange", ms=10, mec="k", label="source" if k == 0 else None)
     ax.set_aspect("equal")
     ax.legend(fontsize=7, loc="upper left", ncol=2)
-    ax.set_title("bridging (paper section 6, cf. fig. 7): settling points of meta")
+    ax.set_title("bridging (paper section 6, cf. fig. 7): where the runs settled")
     fig.tight_layout()
     p = os.path.join(figdir, "seek_bridge.png")
     fig.savefig(p + ".tmp.png", dpi=80)
@@ -413,13 +424,13 @@ def fig_bridge(figdir, field, settle, src):
 
 # ---- the benchmark ---------------------------------------------------------------------
 
-def bridging(args, tmp, seeds):
-    """Settle points of meta on the bridge scenario vs the best point of each seed's f."""
+def bridging(args, tmp, seeds, strategy="meta"):
+    """Settle points of a strategy on the bridge scenario vs the best point of each seed's f."""
     scen = scenario_path("bridge")
 
     def one(seed):
-        d = os.path.join(tmp, "bridge-%d" % seed)
-        single_run(args, scen, seed, d, "meta", field=True)
+        d = os.path.join(tmp, "bridge-%s-%d" % (strategy, seed))
+        single_run(args, scen, seed, d, strategy, field=True)
         a = np.loadtxt(os.path.join(d, "field.tsv"), skiprows=1, usecols=(0, 1, 3))
         b = np.loadtxt(os.path.join(d, "field1.tsv"), skiprows=1, usecols=(0, 1, 3))
         f = -np.abs(a[:, 2] - b[:, 2]) - np.abs(a[:, 2] + b[:, 2])
@@ -435,7 +446,7 @@ def bridging(args, tmp, seeds):
         out = []
         for k, r in enumerate(ex.map(one, range(1, seeds + 1))):
             out.append(r)
-            sys.stderr.write("\rbridging %d/%d seeds" % (k + 1, seeds))
+            sys.stderr.write("\rbridging (%s) %d/%d seeds" % (strategy, k + 1, seeds))
         sys.stderr.write("\n")
     return out
 
@@ -485,8 +496,8 @@ def main():
             tag = "%s-%s" % (sc, st)
             tags[(sc, st)] = tag
             keep = set(range(1, 6)) if sc == "default" else set()
-            table[(sc, st)] = run_batch(args, tmp, scenario_path(sc), st, "ridge", args.seeds,
-                                        tag, keep)
+            table[(sc, st)] = run_batch(args, tmp, scenario_path(sc), st, model_of(st),
+                                        args.seeds, tag, keep)
         t_sweep = time.time() - t0
         # 2. shadowing and noise on the default scenario (4/4 is the default itself)
         sweep = {"shadow": {st: {} for st in STRATEGIES}, "noise": {st: {} for st in STRATEGIES}}
@@ -501,7 +512,7 @@ def main():
                     log("noise sweep: %s at shadowing %g dB, noise %g dB" % (st, sh, no))
                     sf = make_variant(tmp, sh, no)
                     tag = "var-%s-%g-%g" % (st, sh, no)
-                    s = summarise(run_batch(args, tmp, sf, st, "ridge", ns, tag, set()))
+                    s = summarise(run_batch(args, tmp, sf, st, model_of(st), ns, tag, set()))
                 if no == 4:
                     sweep["shadow"][st][sh] = s
                 if sh == 4:
@@ -526,13 +537,15 @@ def main():
         # 4. bridging
         t0 = time.time()
         br = bridging(args, tmp, 2 if args.smoke else bs)
+        brp = bridging(args, tmp, 2 if args.smoke else bs, "meta-path")
         t_bridge = time.time() - t0
         # 5. figures
         figs = fig_trajectories(figdir, tmp, tags, "default", args.seeds)
         figs.append(fig_rssi(figdir, tmp, args, "default"))
         figs.append(fig_noise(figdir, sweep))
         src, _ = scenario_sources(scenario_path("bridge"))
-        figs.append(fig_bridge(figdir, br[0][6], [(r[1], r[2]) for r in br], src))
+        figs.append(fig_bridge(figdir, br[0][6], [(r[1], r[2]) for r in br], src,
+                               [(r[1], r[2]) for r in brp]))
         # failure analysis needs the walls for the unlabelled floors
         walls = {}
         for sc in scenarios:
@@ -541,7 +554,7 @@ def main():
                 single_run(args, scenario_path(sc), 1, d, "meta", field=True)
                 walls[sc] = walls_lookup(os.path.join(d, "field.tsv"))
         t_total = time.time() - t_all
-        write_results(args, results, scenarios, table, sweep, mtab, br, walls, figs,
+        write_results(args, results, scenarios, table, sweep, mtab, (br, brp), walls, figs,
                       dict(sweep=t_sweep, noise=t_noise, models=t_models, bridge=t_bridge,
                            total=t_total), ns, ms, bs)
     except BaseException:
@@ -596,27 +609,34 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
       "run-and-tumble on the change of the 1 s mean between decisions (tumble with "
       "p = 0.2 after a rise, always after a fall; 16 headings), position used only for "
       "legality and planning. A gradient step whose end point is illegal goes to the "
-      "nearest reachable legal lattice point around it.\n")
+      "nearest reachable legal lattice point around it. `meta-path` (the improvement of "
+      "issue 10, docs/STRATEGIES.md, docs/PATHLOSS.md) runs with the map-aware path-loss "
+      "model instead of the ridge: the estimated source is the greedy goal, walked along "
+      "the planned path with the relearn check after every metre and epsilon annealed by "
+      "the metres travelled; it is not a baseline but the improvement, measured beside "
+      "the paper's `meta`.\n")
     A("## Every strategy on every shipped scenario (shadowing and noise as the scenario "
       "file says; default: 4 dB / 4 dB)\n")
     for sc in scenarios:
         A("### %s\n" % sc)
         A(HEAD % "strategy")
         for st in STRATEGIES:
-            A(row(st, summarise(table[(sc, st)])))
+            A(row(st if st not in STRAT_MODEL else "%s + %s" % (st, STRAT_MODEL[st]),
+                  summarise(table[(sc, st)])))
         A("")
     # where meta does not win
     A("### Where meta does not win\n")
     notes = []
     for sc in scenarios:
         m = summarise(table[(sc, "meta")])
-        for st in STRATEGIES[1:]:
+        for st in BASELINES:
             o = summarise(table[(sc, st)])
             if o["p"] >= m["p"]:
                 sig = " (CIs overlap)" if o["lo"] <= m["hi"] else " (CIs do not overlap)"
                 notes.append("- %s: `%s` %.1f %% >= `meta` %.1f %%%s" %
                              (sc, st, 100 * o["p"], 100 * m["p"], sig))
-    A("\n".join(notes) if notes else "- meta has the highest success rate in every scenario.")
+    A("\n".join(notes) if notes else "- meta has a higher success rate than every baseline "
+      "(meta-global, fd-gradient, plane-gradient, chemotaxis) in every scenario.")
     A("")
     A("## Default scenario at other shadowing and noise levels\n")
     A("Generated scenario variants of scenarios/default.yaml (shadowing correlation 5 m; "
@@ -655,28 +675,31 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
                float(np.median(fd)), float(np.min(fd))))
     A("")
     A("## Bridging (paper section 6)\n")
-    d = np.array([r[3] for r in br])
-    fr = np.array([r[4] for r in br])
-    fb = np.array([r[5] for r in br])
     A("scenarios/bridge.yaml: two sources in different rooms of the office floor, target "
       "f = -|R1 - R2| - |R1 + R2|, error threshold 7 (the paper's value for this noisier "
-      "target; rfseek-sim sets it for target: bridge), strategy meta, %d seeds, each run "
-      "ending on 150 m or 600 s. *Settle point*: the robot's position at the end of the "
-      "run. *True f*: from each seed's mean field (path loss, walls and that seed's "
-      "shadowing; no fading, no noise) of both sources on a 0.1 m grid of free cells.\n"
-      % len(br))
-    A("| quantity | median | p10 | p90 |\n|---|---|---|---|")
-    A("| distance from the settle point to the best point of the true f, m | %.1f | %.1f | "
-      "%.1f |" % (np.median(d), np.percentile(d, 10), np.percentile(d, 90)))
-    A("| f at the settle point, dB | %.1f | %.1f | %.1f |" %
-      (np.median(fr), np.percentile(fr, 10), np.percentile(fr, 90)))
-    A("| best f of the field, dB | %.1f | %.1f | %.1f |" %
-      (np.median(fb), np.percentile(fb, 10), np.percentile(fb, 90)))
-    A("| shortfall f(best) - f(settle), dB | %.1f | %.1f | %.1f |" %
-      (np.median(fb - fr), np.percentile(fb - fr, 10), np.percentile(fb - fr, 90)))
-    A("| runs settling within 3 m of the best point | %d of %d | | |" %
-      (int((d <= 3.0).sum()), len(d)))
-    A("")
+      "target; rfseek-sim sets it for target: bridge), %d seeds, each run ending on 150 m "
+      "or 600 s. *Settle point*: the robot's position at the end of the run. *True f*: "
+      "from each seed's mean field (path loss, walls and that seed's shadowing; no "
+      "fading, no noise) of both sources on a 0.1 m grid of free cells. `meta + ridge` is "
+      "the paper's; `meta-path + pathloss` shows where the path-loss model breaks: it "
+      "fits one point source, and f is not a path-loss field.\n" % len(br[0]))
+    for name, rows in (("meta + ridge", br[0]), ("meta-path + pathloss", br[1])):
+        d = np.array([r[3] for r in rows])
+        fr = np.array([r[4] for r in rows])
+        fb = np.array([r[5] for r in rows])
+        A("### %s\n" % name)
+        A("| quantity | median | p10 | p90 |\n|---|---|---|---|")
+        A("| distance from the settle point to the best point of the true f, m | %.1f | %.1f | "
+          "%.1f |" % (np.median(d), np.percentile(d, 10), np.percentile(d, 90)))
+        A("| f at the settle point, dB | %.1f | %.1f | %.1f |" %
+          (np.median(fr), np.percentile(fr, 10), np.percentile(fr, 90)))
+        A("| best f of the field, dB | %.1f | %.1f | %.1f |" %
+          (np.median(fb), np.percentile(fb, 10), np.percentile(fb, 90)))
+        A("| shortfall f(best) - f(settle), dB | %.1f | %.1f | %.1f |" %
+          (np.median(fb - fr), np.percentile(fb - fr, 10), np.percentile(fb - fr, 90)))
+        A("| runs settling within 3 m of the best point | %d of %d | | |" %
+          (int((d <= 3.0).sum()), len(d)))
+        A("")
     A("![bridging](figures/seek_bridge.png)\n")
     A("## Internal models (strategy meta)\n")
     A("Models from the registry common/rfs_models.h (`--model NAME`). %d seeds each, "

@@ -1033,12 +1033,13 @@ static void count_travel(rfs_seek_t *s)
 }
 
 /* Epsilon's n: the iteration (paper), or with eps_by_travel the larger of it and the
- * whole steps travelled. Scaling: travel (Q16) / step (Q16, > 0) is whole steps. */
+ * whole steps travelled. Scaling: travel (Q16, >= 0) / step (Q16, > 0) is whole steps,
+ * floor, by rfs_udiv64 (no libgcc division on 32-bit targets). */
 static uint32_t epsilon_index(const rfs_seek_t *s)
 {
     uint32_t n = s->decision.iteration;
     if (s->cfg.eps_by_travel) {
-        int64_t steps = s->travel / s->cfg.step;
+        int64_t steps = (int64_t)rfs_udiv64((uint64_t)s->travel, (uint64_t)s->cfg.step);
         uint32_t t = steps > (int64_t)UINT32_MAX ? UINT32_MAX : (uint32_t)steps;
         n = t > n ? t : n;
     }

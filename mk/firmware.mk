@@ -32,7 +32,7 @@ FW_STM32_SRCS := firmware/port/stm32f4/startup.c firmware/port/stm32f4/board.c \
 FW_QEMU_SRCS := firmware/port/stm32f4/startup.c firmware/port/qemu/semihost.c \
 	firmware/port/qemu/main.c firmware/rfs_app.c firmware/rfs_replay.c
 FW_BENCH_SRCS := firmware/port/stm32f4/startup.c firmware/port/qemu/semihost.c \
-	firmware/port/qemu/bench.c firmware/rfs_app.c
+	firmware/port/qemu/bench_clock.c firmware/port/qemu/bench.c firmware/rfs_app.c
 FW_ALL_HDRS := $(CORE_HDRS) $(FW_HDRS) $(wildcard firmware/port/*/*.h)
 
 $(FW)/obj/%.o: %.c $(FW_ALL_HDRS)

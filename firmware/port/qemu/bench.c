@@ -1,11 +1,8 @@
 /* bench.c - instruction counts of the control loop on the Cortex-M4 image (issue 6).
  *
  * Run under qemu-system-arm -M netduinoplus2 -icount shift=7 (tests/firmware/bench.sh):
- * with -icount every instruction advances the virtual clock by exactly 2^7 ns, and
- * SysTick (core clock, 168 MHz in qemu's model) counts that clock, so a SysTick
- * difference is an exact function of the instructions executed: 21.504 ticks per
- * instruction, more than one, so the count is recovered exactly. The image calibrates
- * this itself with a block of 1,000 NOPs and prints raw tick counts; bench.sh converts.
+ * SysTick counts instructions exactly (bench_clock.h: the method, the 1,000-NOP
+ * calibration); the image prints raw tick counts, bench.sh converts.
  *
  * The worst case of issue 6: a 40 x 20 m map (0.125 m cells, 0.25 m lattice: 160 x 80
  * points, all legal but a wall round the edge), 10,000 samples all inside the 5 m radius,
@@ -16,6 +13,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "bench_clock.h"
 #include "rfs_app.h"
 #include "rfs_drive.h"
 #include "rfs_plan.h"
@@ -23,7 +21,6 @@
 #include "rfs_rssi.h"
 #include "rfs_store.h"
 #include "semihost.h"
-#include "stm32f4_regs.h"
 
 #define MAP_W 320u
 #define MAP_H 160u
@@ -33,76 +30,6 @@ static rfs_app_t s_app;
 static uint8_t s_free[MAP_STRIDE * MAP_H];
 static uint8_t s_wall[MAP_STRIDE * MAP_H];
 static rfs_rssi_t s_win;
-static volatile uint32_t s_wraps;
-
-void SysTick_Handler(void);
-void SysTick_Handler(void)
-{
-    s_wraps = s_wraps + 1u;
-}
-
-static uint64_t ticks(void)
-{
-    uint32_t w, v;
-    do {
-        w = s_wraps;
-        v = SYST_CVR;
-    } while (w != s_wraps);
-    return (uint64_t)w * 0x1000000u + (0xFFFFFFu - v);
-}
-
-static void put_u64(uint64_t v)
-{
-    char buf[24];
-    int i = 23;
-    buf[i] = '\0';
-    do {
-        buf[--i] = (char)('0' + (int)(v % 10u));
-        v /= 10u;
-    } while (v != 0u);
-    rfs_sh_puts(&buf[i]);
-}
-
-static void report(const char *name, uint64_t t, uint32_t count)
-{
-    rfs_sh_puts(name);
-    rfs_sh_puts("\t");
-    put_u64(t);
-    rfs_sh_puts("\t");
-    put_u64(count);
-    rfs_sh_puts("\n");
-}
-
-#define MEASURE(name, count, ...)                  \
-    do {                                           \
-        const uint64_t t0_ = ticks();              \
-        __VA_ARGS__;                               \
-        const uint64_t t1_ = ticks();              \
-        report((name), t1_ - t0_, (count));        \
-    } while (0)
-
-/* Stack depth of a call: paint the free stack below the caller's SP, run, scan. */
-extern uint32_t _sstack;
-#define STACK_PAINT 0xA5A5A5A5u
-
-static uintptr_t stack_paint(void)
-{
-    uintptr_t sp;
-    __asm__ volatile("mov %0, sp" : "=r"(sp));
-    for (uint32_t *p = &_sstack; (uintptr_t)p < sp - 32u; p++) {
-        *p = STACK_PAINT;
-    }
-    return sp;
-}
-
-static uint32_t stack_depth(uintptr_t sp)
-{
-    const uint32_t *p = &_sstack;
-    while ((uintptr_t)p < sp && *p == STACK_PAINT) {
-        p++;
-    }
-    return (uint32_t)(sp - (uintptr_t)p);
-}
 
 /* 10,000 samples inside 4.9 m of (20, 10); the field rises towards +x (-60 dBm at the
  * robot, +1 dB per metre, +-1 dB noise), so the maximum is at the east wall. */
@@ -123,20 +50,9 @@ static void fill_store(rfs_store_t *st, uint64_t seed)
     }
 }
 
-static void nops_1000(void)
-{
-    __asm__ volatile(".rept 1000\n\tnop\n\t.endr" ::: "memory");
-}
-
 int main(void)
 {
-    SYST_RVR = 0xFFFFFFu;
-    SYST_CVR = 0u;
-    SYST_CSR = SYST_CSR_ENABLE | SYST_CSR_TICKINT | SYST_CSR_CLKSOURCE;
-
-    /* Calibration: an empty region and 1,000 NOPs. */
-    MEASURE("calib_empty", 1, (void)0);
-    MEASURE("calib_nop1000", 1000, nops_1000());
+    rfs_bc_start(); /* SysTick, and the calibration lines */
 
     /* The map: free inside, a one-cell wall round the edge. */
     for (uint16_t y = 0; y < MAP_H; y++) {
@@ -151,14 +67,14 @@ int main(void)
     cfg.seek.eps_amp = 0; /* epsilon = 0: the greedy branch, the expensive one, for certain */
     cfg.seek.eps_floor = 0;
     int rc = -1;
-    uintptr_t sp0 = stack_paint();
-    MEASURE("app_init", 1, rc = rfs_app_init(&s_app, &cfg, &map));
-    report("stack_bytes_app_init", 0, stack_depth(sp0));
+    uintptr_t sp0 = rfs_bc_stack_paint();
+    RFS_BC_MEASURE("app_init", 1, rc = rfs_app_init(&s_app, &cfg, &map));
+    rfs_bc_report("stack_bytes_app_init", 0, rfs_bc_stack_depth(sp0));
     if (rc != 0) {
         rfs_sh_puts("bench: rfs_app_init failed\n");
         rfs_sh_exit(1);
     }
-    report("lattice_points", 0, (uint32_t)s_app.map.lw * s_app.map.lh);
+    rfs_bc_report("lattice_points", 0, (uint32_t)s_app.map.lw * s_app.map.lh);
 
     /* Boot with an empty store: the reachability flood fill and the initial move only. */
     {
@@ -167,7 +83,7 @@ int main(void)
         rfs_app_on_pose(&s_app, &pb, tb);
         rfs_app_on_rssi(&s_app, 0, tb, -60, tb);
         rfs_app_out_t ob;
-        MEASURE("boot_iteration_no_samples", 1, rfs_app_step(&s_app, tb, &ob));
+        RFS_BC_MEASURE("boot_iteration_no_samples", 1, rfs_app_step(&s_app, tb, &ob));
         if (rfs_app_init(&s_app, &cfg, &map) != 0) {
             rfs_sh_exit(1);
         }
@@ -177,7 +93,7 @@ int main(void)
     rfs_rng_t rng;
     rfs_rng_seed(&rng, 43u);
     fill_store(&s_app.seek.store, 42u);
-    report("samples", 0, s_app.seek.store.count);
+    rfs_bc_report("samples", 0, s_app.seek.store.count);
 
     /* Boot: the first period with a pose and a measurement: reachability flood fill,
      * first fit, the initial move. */
@@ -186,9 +102,9 @@ int main(void)
     rfs_app_on_pose(&s_app, &pose0, t);
     rfs_app_on_rssi(&s_app, 0, t, -60, t);
     rfs_app_out_t out;
-    sp0 = stack_paint();
-    MEASURE("first_iteration", 1, rfs_app_step(&s_app, t, &out));
-    report("stack_bytes_first_iteration", 0, stack_depth(sp0));
+    sp0 = rfs_bc_stack_paint();
+    RFS_BC_MEASURE("first_iteration", 1, rfs_app_step(&s_app, t, &out));
+    rfs_bc_report("stack_bytes_first_iteration", 0, rfs_bc_stack_depth(sp0));
 
     /* The worst case: the goal ended, the model no longer fits (discarded), iteration 1. */
     rfs_drive_stop(&s_app.seek.drive, t);
@@ -197,21 +113,21 @@ int main(void)
     const rfs_pose_t pose1 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
     rfs_app_on_pose(&s_app, &pose1, t);
     rfs_app_on_rssi(&s_app, 0, t, -60, t);
-    sp0 = stack_paint();
-    MEASURE("worst_iteration", 1, rfs_app_step(&s_app, t, &out));
-    report("stack_bytes_worst_iteration", 0, stack_depth(sp0));
-    report("worst_decided_greedy_relearned", 0,
-           (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_GREEDY &&
-                      out.decision.relearned));
-    report("worst_goal_x_cm", 0, (uint32_t)((out.decision.goal_x * 100) >> 16));
-    report("worst_samples", 0, out.decision.samples);
+    sp0 = rfs_bc_stack_paint();
+    RFS_BC_MEASURE("worst_iteration", 1, rfs_app_step(&s_app, t, &out));
+    rfs_bc_report("stack_bytes_worst_iteration", 0, rfs_bc_stack_depth(sp0));
+    rfs_bc_report("worst_decided_greedy_relearned", 0,
+                  (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_GREEDY &&
+                             out.decision.relearned));
+    rfs_bc_report("worst_goal_x_cm", 0, (uint32_t)((out.decision.goal_x * 100) >> 16));
+    rfs_bc_report("worst_samples", 0, out.decision.samples);
 
     /* An ordinary period while driving the goal just chosen. */
     t += RFS_APP_PERIOD_US;
     const rfs_pose_t pose2 = {.t_us = t, .x = rx + 1000, .y = ry, .theta = 0};
     rfs_app_on_pose(&s_app, &pose2, t);
     rfs_app_on_rssi(&s_app, 0, t, -60, t);
-    MEASURE("driving_iteration", 1, rfs_app_step(&s_app, t, &out));
+    RFS_BC_MEASURE("driving_iteration", 1, rfs_app_step(&s_app, t, &out));
 
     /* Phases alone. Averaging: one packet into a full 1 s window (200 packets/s), then
      * the 1 s mean. */
@@ -221,26 +137,26 @@ int main(void)
         (void)rfs_rssi_push(&s_win, 5000 * i, (int8_t)(-60 - (i & 7)));
     }
     rfs_q16_t mean;
-    MEASURE("phase_averaging_push", 1, (void)rfs_rssi_push(&s_win, 1000000, -61));
-    MEASURE("phase_averaging_mean", 1, (void)rfs_rssi_mean(&s_win, 1000000, &mean));
+    RFS_BC_MEASURE("phase_averaging_push", 1, (void)rfs_rssi_push(&s_win, 1000000, -61));
+    RFS_BC_MEASURE("phase_averaging_mean", 1, (void)rfs_rssi_mean(&s_win, 1000000, &mean));
 
     /* Sample store: 20 measurements (0.1 s at 200 packets/s) wait for the next pose, which
      * turns them into samples of the full reservoir. */
     rfs_store_t *st = &s_app.seek.store;
     int64_t ts = t + 5000;
-    MEASURE("phase_store_value", 1, rfs_store_add_value(st, ts, RFS_Q16_INT(-60), &rng));
+    RFS_BC_MEASURE("phase_store_value", 1, rfs_store_add_value(st, ts, RFS_Q16_INT(-60), &rng));
     for (int i = 1; i < 20; i++) {
         rfs_store_add_value(st, ts + 5000 * i, RFS_Q16_INT(-60), &rng);
     }
     const rfs_pose_t pose3 = {.t_us = t + 100000, .x = rx, .y = ry, .theta = 0};
-    MEASURE("phase_store_pose_20", 20, (void)rfs_store_add_pose(st, &pose3, &rng));
+    RFS_BC_MEASURE("phase_store_pose_20", 20, (void)rfs_store_add_pose(st, &pose3, &rng));
 
     /* Relearn: the local ridge on 10,000 samples, all inside the radius. */
     rfs_ridge_t *ridge = &s_app.ridge;
     const rfs_model_fit_in_t fin = {st->samples, st->count, rx, ry, &s_app.map};
     rfs_ridge_ops.reset(ridge);
-    MEASURE("phase_relearn", 1, (void)rfs_ridge_ops.fit(ridge, &fin, 0, &rng));
-    report("ridge_samples_used", 0, ridge->n_used);
+    RFS_BC_MEASURE("phase_relearn", 1, (void)rfs_ridge_ops.fit(ridge, &fin, 0, &rng));
+    rfs_bc_report("ridge_samples_used", 0, ridge->n_used);
 
     /* Grid search: the model at every reachable lattice point, as choose_greedy does it
      * (rfs_seek.c: rows in chunks of 64, one predict_row call per chunk when the model
@@ -249,7 +165,7 @@ int main(void)
     rfs_q16_t best = RFS_Q16_MIN, bx = 0, by = 0;
     uint32_t points = 0;
     static rfs_q16_t row[64];
-    MEASURE("phase_grid_search", 1, {
+    RFS_BC_MEASURE("phase_grid_search", 1, {
         for (uint16_t j = 0; j < m->lh; ++j) {
             rfs_q16_t x0, py;
             rfs_map_lattice_point(m, 0, j, &x0, &py);
@@ -277,8 +193,8 @@ int main(void)
             }
         }
     });
-    report("grid_points_searched", 0, points);
-    report("grid_max_x_cm", 0, (uint32_t)((bx * 100) >> 16));
+    rfs_bc_report("grid_points_searched", 0, points);
+    rfs_bc_report("grid_max_x_cm", 0, (uint32_t)((bx * 100) >> 16));
     (void)by;
 
     /* A proposal, measured beside the faithful search: for a model that is affine in
@@ -287,7 +203,7 @@ int main(void)
      * rightmost reachable point: 2 predictions per row instead of one per point, the
      * same maximum value exactly. */
     rfs_q16_t best2 = RFS_Q16_MIN;
-    MEASURE("proposal_grid_search_row_ends", 1, {
+    RFS_BC_MEASURE("proposal_grid_search_row_ends", 1, {
         for (uint16_t j = 0; j < m->lh; ++j) {
             const uint32_t row = (uint32_t)j * m->lw;
             int32_t lo = -1, hi = -1;
@@ -318,7 +234,7 @@ int main(void)
             }
         }
     });
-    report("proposal_same_max_value", 0, best2 == best ? 1u : 0u);
+    rfs_bc_report("proposal_same_max_value", 0, best2 == best ? 1u : 0u);
 
     /* A proposal: the fit sliced over control periods (cfg.seek.fit_budget samples per
      * period, here 2,500: four periods). */
@@ -326,29 +242,29 @@ int main(void)
     rfs_fit_result_t fres = RFS_FIT_MORE;
     uint32_t slices = 0;
     while (fres == RFS_FIT_MORE && slices < 100u) {
-        MEASURE("proposal_relearn_slice_2500", 1, fres = rfs_ridge_ops.fit(ridge, &fin, 2500u, &rng));
+        RFS_BC_MEASURE("proposal_relearn_slice_2500", 1, fres = rfs_ridge_ops.fit(ridge, &fin, 2500u, &rng));
         slices++;
     }
 
     /* Step choice: the point 1 m towards the maximum, its legality, the path to it. */
     rfs_path_t path;
     bool ok = false;
-    MEASURE("phase_step_choice", 1, {
+    RFS_BC_MEASURE("phase_step_choice", 1, {
         const rfs_q16_t gx = rx + RFS_Q16_ONE;
         ok = rfs_map_point_legal(m, gx, ry) && rfs_plan_path(&s_app.seek.plan, rx, ry, gx, ry, &path);
     });
-    report("step_path_ok", 0, ok ? 1u : 0u);
+    rfs_bc_report("step_path_ok", 0, ok ? 1u : 0u);
 
     /* Drive control: one update following that path. */
     rfs_drive_t *dr = &s_app.seek.drive;
     rfs_drive_set_path(dr, &path, t);
     const rfs_pose_t pose4 = {.t_us = t + 50000, .x = rx, .y = ry, .theta = 0};
     int16_t l, r;
-    MEASURE("phase_drive_control", 1, (void)rfs_drive_update(dr, &pose4, t + 50000, &l, &r));
+    RFS_BC_MEASURE("phase_drive_control", 1, (void)rfs_drive_update(dr, &pose4, t + 50000, &l, &r));
 
     /* The CAN side of a period: decode one RSSI frame, encode the two output frames. */
     rfs_can_frame_t fr[2];
-    MEASURE("phase_can_out_frames", 1, (void)rfs_app_frames(&s_app, &out, fr));
+    RFS_BC_MEASURE("phase_can_out_frames", 1, (void)rfs_app_frames(&s_app, &out, fr));
 
     /* Beside the faithful configuration: the same worst case with the fit sliced over
      * control periods (cfg.seek.fit_budget = 2,500 samples per period; the wheels stay
@@ -379,19 +295,19 @@ int main(void)
         const rfs_pose_t pk = {.t_us = t, .x = rx, .y = ry, .theta = 0};
         rfs_app_on_pose(&s_app, &pk, t);
         rfs_app_on_rssi(&s_app, 0, t, -60, t);
-        const uint64_t a = ticks();
+        const uint64_t a = rfs_bc_ticks();
         rfs_app_step(&s_app, t, &out);
-        const uint64_t b = ticks();
-        report("sliced_fit_period", b - a, 1);
+        const uint64_t b = rfs_bc_ticks();
+        rfs_bc_report("sliced_fit_period", b - a, 1);
         if (b - a > worst_slice) {
             worst_slice = b - a;
         }
         periods++;
     }
-    report("sliced_worst_period", worst_slice, 1);
-    report("sliced_decided_greedy_relearned", 0,
-           (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_GREEDY &&
-                      out.decision.relearned));
-    report("sliced_goal_x_cm", 0, (uint32_t)((out.decision.goal_x * 100) >> 16));
+    rfs_bc_report("sliced_worst_period", worst_slice, 1);
+    rfs_bc_report("sliced_decided_greedy_relearned", 0,
+                  (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_GREEDY &&
+                             out.decision.relearned));
+    rfs_bc_report("sliced_goal_x_cm", 0, (uint32_t)((out.decision.goal_x * 100) >> 16));
     rfs_sh_exit(0);
 }

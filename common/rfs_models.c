@@ -39,18 +39,31 @@ static int pathloss_init_default(void *state)
     return rfs_pathloss_init(state, &c);
 }
 
-/* The first row is the default model (the paper's main configuration). */
+/* The first row is the default model (the paper's main configuration).
+ *
+ * The last column, mcu_fit_budget, is measured (make bench-models-m4, 10,000 samples;
+ * docs/PERFORMANCE.md, "Models on the Cortex-M4"): the largest round budget whose
+ * heaviest slice stays under 16,800,000 Cortex-M4 instructions, half the 200 ms deadline
+ * at 168 MHz, the other half left for the rest of the period and cycles > instructions.
+ * - ridge, knn, radius: 2,500 samples, 74 k / 147 k instructions: also inside issue 6's
+ *   500,000 per period.
+ * - mlp: 700 sample-updates, 16.3 M (about 23,000 per update; the first slice also
+ *   standardises the samples); 800 would be 18.6 M.
+ * - pathloss: 500 wall counts, 11.3 M. A call evaluates at least one whole candidate
+ *   (bins + 1 <= RFS_PATHLOSS_MAX_BINS + 1 = 513 wall counts), so every budget up to 512
+ *   costs at most one candidate per call; above it calls take several smaller
+ *   candidates: 800 reached 18.0 M with 1,000 samples. */
 static const rfs_models_entry_t k_models[] = {
     {"ridge", &rfs_ridge_ops, (uint32_t)sizeof(rfs_ridge_t), ridge_init_default,
-     "local ridge regression, 5 m radius, alpha 1 (paper 5.2.1)"},
+     "local ridge regression, 5 m radius, alpha 1 (paper 5.2.1)", 2500u},
     {"mlp", &rfs_mlp_ops, (uint32_t)sizeof(rfs_mlp_t), mlp_init_default,
-     "MLP 2-100-1, sigmoid, backprop rate 0.01 momentum 0.1, 3 epochs (paper 5.2.2)"},
+     "MLP 2-100-1, sigmoid, backprop rate 0.01 momentum 0.1, 3 epochs (paper 5.2.2)", 700u},
     {"knn", &rfs_knn_ops, (uint32_t)sizeof(rfs_knn_t), knn_init_default,
-     "k-nearest-neighbours regression, k = 5 (paper 5.2)"},
+     "k-nearest-neighbours regression, k = 5 (paper 5.2)", 2500u},
     {"radius", &rfs_radius_ops, (uint32_t)sizeof(rfs_knn_t), radius_init_default,
-     "radius-neighbours regression, r = 1 m (paper 5.2)"},
+     "radius-neighbours regression, r = 1 m (paper 5.2)", 2500u},
     {"pathloss", &rfs_pathloss_ops, (uint32_t)sizeof(rfs_pathloss_t), pathloss_init_default,
-     "map-aware log-distance + walls fit, source search (issue 10, beyond the paper)"},
+     "map-aware log-distance + walls fit, source search (issue 10, beyond the paper)", 500u},
 };
 
 #define N_MODELS (sizeof(k_models) / sizeof(k_models[0]))

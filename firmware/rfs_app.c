@@ -24,7 +24,19 @@ rfs_app_cfg_t rfs_app_cfg_mcu(void)
 {
     rfs_app_cfg_t c = rfs_app_cfg_default();
     c.seek.fit_budget = RFS_APP_MCU_FIT_BUDGET;
+    c.fit_budget_by_model = true;
     return c;
+}
+
+uint32_t rfs_app_fit_budget(const rfs_app_cfg_t *cfg)
+{
+    if (!cfg->fit_budget_by_model) {
+        return cfg->seek.fit_budget;
+    }
+    /* A work unit is each model's own (a sample, a sample-update, a wall count), so the
+     * slice that keeps the deadline is measured per model (docs/PERFORMANCE.md, "Models
+     * on the Cortex-M4"). Only the entry's field is read: no registry code is linked. */
+    return cfg->model != NULL ? cfg->model->mcu_fit_budget : RFS_APP_MCU_FIT_BUDGET;
 }
 
 uint32_t rfs_app_model_capacity(const rfs_app_cfg_t *cfg)
@@ -74,6 +86,7 @@ int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *ma
      * stores at every boot. */
     memset(a, 0, offsetof(rfs_app_t, samples));
     a->cfg = *cfg;
+    a->cfg.seek.fit_budget = rfs_app_fit_budget(cfg);
     if (rfs_map_init(&a->map, &cfg->map, map->w, map->h, map->res, map->origin_x,
                      map->origin_y, map->free, map->wall, a->legal) != 0) {
         return -1;
@@ -102,7 +115,7 @@ int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *ma
     };
     const rfs_target_ops_t *target =
         cfg->target == RFS_APP_TARGET_BRIDGE ? &rfs_target_bridge : &rfs_target_rssi;
-    if (rfs_seek_init(&a->seek, &cfg->seek, &a->map, model, target,
+    if (rfs_seek_init(&a->seek, &a->cfg.seek, &a->map, model, target,
                       &mem) != 0) {
         return -1;
     }

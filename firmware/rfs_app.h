@@ -51,8 +51,11 @@
 #define RFS_APP_PLAN_QUEUE 480u
 /// Pending measurements waiting for a bracketing pose (>= 64 required by rfs_seek).
 #define RFS_APP_PENDING 64u
-/// Samples the MCU configuration learns per control period: the 10,000-sample fit spread
-/// over four periods keeps every period under 500,000 instructions (docs/PERFORMANCE.md).
+/// Work units the MCU configuration learns per control period with the built-in local
+/// ridge (the "ridge" registry entry's mcu_fit_budget, tested equal): 2,500 samples, the
+/// 10,000-sample fit spread over four periods keeps every period under 500,000
+/// instructions (docs/PERFORMANCE.md). Other models have their own budget in the registry
+/// (rfs_models_entry_t.mcu_fit_budget; rfs_app_fit_budget()).
 #define RFS_APP_MCU_FIT_BUDGET 2500u
 /// Model state built into rfs_app_t, bytes: the local ridge's (the MLP's 3.3 KB does not
 /// fit the MCU's RAM budget next to the maxima above; docs/MODELS.md).
@@ -110,6 +113,11 @@ typedef struct rfs_app_cfg {
     uint64_t seed;              ///< seed of the random source (epsilon moves, reservoir)
     int64_t input_timeout_us;   ///< zero wheels when nothing was received for this long (150 ms)
     uint8_t node_id;            ///< this controller's id in the status frame
+    /// true (rfs_app_cfg_mcu()): rfs_app_init() replaces seek.fit_budget by the configured
+    /// model's registry budget (mcu_fit_budget; RFS_APP_MCU_FIT_BUDGET for a NULL model),
+    /// so a port that sets `model` after taking the MCU defaults gets that model's slice
+    /// size. false (rfs_app_cfg_default(), replays): seek.fit_budget is used as given.
+    bool fit_budget_by_model;
 } rfs_app_cfg_t;
 
 /// What one control period produces (the content of the wheel command and status frames).
@@ -166,9 +174,16 @@ typedef struct rfs_app {
 rfs_app_cfg_t rfs_app_cfg_default(void);
 
 /// The microcontroller configuration: the defaults with the fit sliced over control
-/// periods (seek.fit_budget = RFS_APP_MCU_FIT_BUDGET). Decisions are the same; a relearn
-/// keeps the wheels stopped for three more periods (150 ms).
+/// periods so that no period's slice of a relearn comes near the 200 ms safety deadline
+/// (issues 8, 10): fit_budget_by_model set, and seek.fit_budget = RFS_APP_MCU_FIT_BUDGET
+/// (the ridge's; rfs_app_init() takes another model's from the registry). Decisions are
+/// the same; a ridge relearn keeps the wheels stopped for three more periods (150 ms).
 rfs_app_cfg_t rfs_app_cfg_mcu(void);
+
+/// The fit budget (work units per control period) rfs_app_init() gives the seeker for
+/// cfg: with fit_budget_by_model, cfg->model's mcu_fit_budget (RFS_APP_MCU_FIT_BUDGET for
+/// NULL, the built-in ridge); otherwise cfg->seek.fit_budget.
+uint32_t rfs_app_fit_budget(const rfs_app_cfg_t *cfg);
 
 /// Bytes of model state the configuration provides (model_state_bytes, or
 /// RFS_APP_MODEL_BYTES without a port buffer).

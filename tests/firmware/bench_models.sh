@@ -3,19 +3,25 @@
 # (BUILD/firmware/bench_models.elf under qemu-system-arm -M netduinoplus2 -icount shift=7;
 # firmware/port/qemu/bench_models.c, models_work.c).
 #
-#   check  (make test) 200 samples, the image's "sum_*" lines (samples, predictions after a
-#          whole and after a sliced relearn, the grid search's maximum, pathloss's argmax)
+#   check  (make test) 1,000 samples, the image's "sum_*" lines (samples, predictions after
+#          a whole and after a sliced relearn, the grid search's maximum, pathloss's argmax)
 #          must equal the host twin's (BUILD/tests/bench_models_host: the same run on the
 #          host build of the core) bit for bit; the baked office map must be the host
-#          loader's. PASS/FAIL lines, non-zero exit on a failure.
+#          loader's; every registered model's heaviest fit slice at its registry budget
+#          (rfs_models_entry_t.mcu_fit_budget) must stay under the 200 ms deadline,
+#          33,600,000 instructions at 168 MHz (exact counts under -icount, not wall time).
+#          PASS/FAIL lines, non-zero exit on a failure.
 #   bench  (make bench-models-m4) 10,000 samples; SysTick ticks converted to instructions
 #          with the image's 1,000-NOP calibration (21.504 ticks per instruction: each
 #          instruction advances qemu's virtual clock 2^7 ns, SysTick counts 168 MHz), the
-#          table of docs/PERFORMANCE.md, "Models on the Cortex-M4".
+#          table of docs/PERFORMANCE.md, "Models on the Cortex-M4". Further arguments
+#          MODEL:BUDGET (up to 8) add sliced relearns at those budgets (how the registry
+#          budgets were chosen), e.g. bench BUILD mlp:600 mlp:800.
 set -euo pipefail
 mode=${1:-}
 B=${2:-build}
-if [ "$mode" = --help ]; then sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
+shift 2 || shift $#
+if [ "$mode" = --help ]; then sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0; fi
 elf=$B/firmware/bench_models.elf
 run_image() { # run_image APPEND OUT: the image's console into OUT, its exit status returned
     timeout "$3" qemu-system-arm -M netduinoplus2 -nographic -monitor none -serial null \
@@ -27,12 +33,15 @@ trap 'rm -rf "$tmp"' EXIT
 
 case "$mode" in
 check)
+    # 1,000 samples: enough that every model's registry budget slices its fit (the MLP's
+    # 3 epochs are 3,000 sample-updates), about 3 s.
+    n=1000
     fail=0
     pass() { echo "PASS bench_models_m4 $1"; }
     bad() { echo "FAIL bench_models_m4 $1"; fail=1; }
-    if run_image "200 quick" "$tmp/m4" 60; then pass "image runs (200 samples)"; else
-        bad "image exit status $? (200 samples)"; sed 's/^/  /' "$tmp/m4" | tail -5; fi
-    if "$B/tests/bench_models_host" 200 quick --office scenarios/maps/office.yaml >"$tmp/host"; then
+    if run_image "$n quick" "$tmp/m4" 60; then pass "image runs ($n samples)"; else
+        bad "image exit status $? ($n samples)"; sed 's/^/  /' "$tmp/m4" | tail -5; fi
+    if "$B/tests/bench_models_host" "$n" quick --office scenarios/maps/office.yaml >"$tmp/host"; then
         pass "host twin runs"; else bad "host twin exit status $?"; fi
     grep '^sum_' "$tmp/m4" | cut -f1,3 | sort >"$tmp/m4.sums" || true
     grep '^sum_' "$tmp/host" | cut -f1,3 | sort >"$tmp/host.sums" || true
@@ -51,13 +60,36 @@ check)
                    END { if (n == 0) exit 1; for (m in s) if (s[m] != w[m]) exit 1 }' "$tmp/m4.sums"; then
         pass "sliced relearn equals the whole relearn on the Cortex-M4"; else
         bad "a sliced relearn differs from the whole one on the Cortex-M4"; fi
+    # The 200 ms safety deadline (issues 8, 10) at every model's registry budget, from the
+    # exact instruction count of its heaviest slice; every model the host twin runs has one.
+    if awk -F'\t' -v models="$models" '
+        $1 == "calib_empty" { e = $2 } $1 == "calib_nop1000" { per = ($2 - e) / 1000 }
+        NF == 3 { v[$1] = $2 }
+        $1 ~ /^mcu_budget_/ { m = substr($1, 12); b[m] = $3; order[++k] = m }
+        END {
+            if (per <= 0 || k != models) { print "  " k " models with a registry budget of " models; exit 1 }
+            for (i = 1; i <= k; i++) {
+                m = order[i]; w = "slice_worst_" m "_" b[m]
+                if (b[m] == 0 || !(w in v)) { print "  " m ": no sliced relearn at budget " b[m]; bad = 1; continue }
+                ins = int((v[w] - e) / per + 0.5)
+                printf "  %-9s budget %5d: heaviest slice %10d instructions, %5.1f %% of 33,600,000 (200 ms at 168 MHz)\n", m, b[m], ins, ins / 336000
+                if (ins >= 33600000) bad = 1
+            }
+            exit bad
+        }' "$tmp/m4" >"$tmp/deadline"; then
+        pass "every model's heaviest slice at its registry budget meets the 200 ms deadline"
+        cat "$tmp/deadline"
+    else
+        bad "a model's heaviest slice at its registry budget misses the 200 ms deadline:"
+        cat "$tmp/deadline"
+    fi
     if grep -q $'^office_map_same_as_host_loader\t0\t1$' "$tmp/host"; then
         pass "baked office map equals the host loader's (bench_pathloss's map)"; else
         bad "baked office map differs from the host loader's"; fi
     exit $fail
     ;;
 bench)
-    if ! run_image "10000" "$tmp/m4" 900; then
+    if ! run_image "10000${*:+ $*}" "$tmp/m4" 900; then
         echo "bench_models.sh: the image failed:"; tail -5 "$tmp/m4"; exit 1
     fi
     awk -F'\t' '
@@ -86,13 +118,27 @@ bench)
             if (g ~ /^argmax/ && ("grid_" m in v))
                 printf "%-9s %7s %14s %9s %14d %10s %12s   rfs_seek_grid_max, for reference\n", "", "", "", "", ins("grid_" m), ms(ins("grid_" m)), "(" val["points_" m] ")"
         }
-        printf "\nsliced relearn: heaviest slice (exact), slices, all slices (to ~calls/20)\n"
-        printf "%-9s %7s %14s %9s %7s %14s %8s %6s\n", "model", "budget", "heaviest slice", "ms", "slices", "all slices", "200 ms", "500 k"
+        printf "\nsliced relearn: heaviest slice (exact), slices, all slices (to ~calls/20); registry = mcu_fit_budget\n"
+        printf "%-9s %7s %14s %9s %7s %14s %8s %6s %6s\n", "model", "budget", "heaviest slice", "ms", "slices", "all slices", "200 ms", "50 %", "500 k"
         for (k = 1; k <= ns; k++) {
             s = sl[k]; m = s; sub(/_[0-9]+$/, "", m); b = s; sub(/.*_/, "", b)
             w = ins("slice_worst_" s)
             t = int((v["slice_total_" s] - c["slice_total_" s] * e) / per + 0.5)
-            printf "%-9s %7d %14d %9s %7d %14d %8s %6s\n", m, b, w, ms(w), val["slices_" s], t, fits(w, 33600000), fits(w, 500000)
+            printf "%-9s %7d %14d %9s %7d %14d %8s %6s %6s%s\n", m, b, w, ms(w), val["slices_" s], t, fits(w, 33600000), fits(w, 16800000), fits(w, 500000),
+                (b == val["mcu_budget_" m] ? "  registry" : "")
+        }
+        printf "\nat the registry budgets (the firmware'"'"'s MCU configuration), 200 ms = 33,600,000 instructions;\n"
+        printf "the decision runs in the period of the last slice: last slice + grid search (argmax for pathloss)\n"
+        for (k = 1; k <= nm; k++) {
+            m = model[k]; s = m "_" val["mcu_budget_" m]
+            if (!(("slice_worst_" s) in v)) { printf "  %-9s no registry budget measured\n", m; continue }
+            w = ins("slice_worst_" s)
+            printf "  %-9s budget %5d: heaviest slice %10d instructions = %6s ms, %4.1f %% of the deadline: %s\n", m, val["mcu_budget_" m], w, ms(w), w / 336000,
+                w < 33600000 ? "meets 200 ms" : "MISSES 200 ms"
+            g = ("argmax_" m in v) ? "argmax_" m : "grid_" m
+            d = ins("slice_last_" s) + ins(g)
+            printf "  %-9s %12s last slice + %-6s %10d instructions = %6s ms, %4.1f %% of the deadline: %s\n", "", "", (g ~ /^argmax/ ? "argmax" : "grid"), d, ms(d), d / 336000,
+                d < 33600000 ? "meets 200 ms" : "MISSES 200 ms"
         }
         printf "\n160 x 80 predictions, bench/bench_models.c loop (instructions per point):\n"
         for (k = 1; k <= nm; k++) {

@@ -1,7 +1,9 @@
 /* test_app_models.c - the model chosen by configuration in the firmware (issue 8):
  * rfs_app_cfg_t.model through the registry, the state-size check that keeps a model out
- * of an image that cannot hold it, and the CFG record's optional model name (byte layout
- * written out by hand from the format in firmware/rfs_replay.h). */
+ * of an image that cannot hold it, the CFG record's optional model name (byte layout
+ * written out by hand from the format in firmware/rfs_replay.h), and the MCU
+ * configuration's per-model fit budget (issues 8, 10; its deadline is checked on the
+ * Cortex-M4 by tests/firmware/bench_models.sh). */
 #include "rfs_test.h"
 
 #include <string.h>
@@ -161,6 +163,85 @@ static void test_player_applies_or_refuses_the_model(void **state)
                         "CFG model's state is larger than the image holds");
 }
 
+/* The MCU configuration slices each model's relearn by that model's registry budget
+ * (issues 8, 10: a work unit is a sample for the ridge, a sample-update for the MLP, a
+ * wall count for pathloss); the other configurations keep the budget they are given. */
+static void test_mcu_fit_budget_is_the_model_s(void **state)
+{
+    (void)state;
+    const rfs_app_map_t m = room();
+    const rfs_models_entry_t *mlp = rfs_models_lookup("mlp");
+    assert_non_null(mlp);
+    /* The ridge's registry budget is the firmware's long-standing one. */
+    assert_int_equal(rfs_models_lookup("ridge")->mcu_fit_budget, RFS_APP_MCU_FIT_BUDGET);
+    for (uint32_t i = 0; i < rfs_models_count(); i++) {
+        assert_true(rfs_models_at(i)->mcu_fit_budget > 0u); /* 0 would be one whole fit */
+    }
+
+    /* The MCU defaults, the model chosen afterwards (the ports' order). */
+    rfs_app_cfg_t c = rfs_app_cfg_mcu();
+    c.model_state = s_state;
+    c.model_state_bytes = (uint32_t)sizeof s_state;
+    c.model = mlp;
+    assert_int_equal(rfs_app_fit_budget(&c), mlp->mcu_fit_budget);
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    assert_int_equal(s_app.seek.cfg.fit_budget, mlp->mcu_fit_budget);
+    assert_int_equal(s_app.cfg.seek.fit_budget, mlp->mcu_fit_budget);
+
+    /* The built-in ridge (NULL) and its registry entry: 2,500 samples. */
+    c.model = NULL;
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    assert_int_equal(s_app.seek.cfg.fit_budget, 2500u);
+    c.model = rfs_models_lookup("ridge");
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    assert_int_equal(s_app.seek.cfg.fit_budget, 2500u);
+
+    /* Without fit_budget_by_model the given budget stands (host defaults: 0, whole fit;
+     * a replay's recorded budget). */
+    c.fit_budget_by_model = false;
+    c.model = mlp;
+    c.seek.fit_budget = 123u;
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    assert_int_equal(s_app.seek.cfg.fit_budget, 123u);
+    rfs_app_cfg_t d = rfs_app_cfg_default();
+    assert_false(d.fit_budget_by_model);
+    d.model_state = s_state;
+    d.model_state_bytes = (uint32_t)sizeof s_state;
+    d.model = mlp;
+    assert_int_equal(rfs_app_init(&s_app, &d, &m), 0);
+    assert_int_equal(s_app.seek.cfg.fit_budget, 0u);
+}
+
+/* At its registry budget the MLP's relearn takes ceil(epochs n / budget) calls: the budget
+ * counts sample-updates (3 epochs, paper 5.2.2), so no call does more than budget. */
+static void test_mlp_budget_counts_sample_updates(void **state)
+{
+    (void)state;
+    const rfs_models_entry_t *e = rfs_models_lookup("mlp");
+    static rfs_sample_t smp[1000];
+    rfs_rng_t r;
+    rfs_rng_seed(&r, 3);
+    for (uint32_t i = 0; i < 1000u; i++) {
+        smp[i].x_cm = (int16_t)rfs_rng_below(&r, 2001);
+        smp[i].y_cm = (int16_t)rfs_rng_below(&r, 1001);
+        smp[i].v_q6 = (int16_t)(-64 * 40 - (int32_t)rfs_rng_below(&r, 64 * 20));
+    }
+    const uint32_t ns[3] = {100u, 700u, 1000u};
+    for (int k = 0; k < 3; k++) {
+        assert_int_equal(e->init_default(s_state), 0);
+        const rfs_model_fit_in_t in = {.samples = smp, .n = (uint16_t)ns[k]};
+        uint32_t calls = 0;
+        rfs_fit_result_t res;
+        do {
+            res = e->ops->fit(s_state, &in, e->mcu_fit_budget, &r);
+            calls++;
+        } while (res == RFS_FIT_MORE && calls < 100u);
+        assert_int_equal(res, RFS_FIT_DONE);
+        const uint32_t updates = 3u * ns[k];
+        assert_int_equal(calls, (updates + e->mcu_fit_budget - 1u) / e->mcu_fit_budget);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -168,6 +249,8 @@ int main(void)
         cmocka_unit_test(test_port_buffer_holds_what_fits),
         cmocka_unit_test(test_cfg_model_name_bytes),
         cmocka_unit_test(test_player_applies_or_refuses_the_model),
+        cmocka_unit_test(test_mcu_fit_budget_is_the_model_s),
+        cmocka_unit_test(test_mlp_budget_counts_sample_updates),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -16,22 +16,18 @@
 extern const rfs_app_map_t rfs_mw_box_map;
 extern const rfs_app_map_t rfs_mw_office_map;
 
-/* The fit budget of the firmware's MCU configuration (rfs_app_cfg_mcu(): one number for
- * every model; the simulator's default is 0, the whole fit at once). */
-#define MW_BUDGET RFS_APP_MCU_FIT_BUDGET
-
-/* Extra budgets measured beside it (not in the check run): the per-model figures the
- * model documents suggest for a 50 ms or 200 ms period (docs/MODELS.md: MLP ~30
- * sample-updates; docs/PATHLOSS.md: pathloss 300 and 1,500 wall counts), and for the MLP
- * 10 (its first slice also standardises: the largest budget whose heaviest slice stays
- * near 0.5 M instructions) and 1,000 (near the 200 ms deadline). */
-typedef struct mw_extra {
+/* Comparison budgets measured beside each model's registry budget (mcu_fit_budget, the
+ * firmware's MCU configuration; not in the check run): the single budget every model had
+ * before the per-model ones (2,500, RFS_APP_MCU_FIT_BUDGET, now the ridge's), the MLP's
+ * issue-6 figure (10 sample-updates: its heaviest slice near 0.5 M instructions) and
+ * docs/PATHLOSS.md's 50 ms figure (300 wall counts). */
+typedef struct mw_cmp {
     const char *model;
     uint32_t budget;
-} mw_extra_t;
+} mw_cmp_t;
 
-static const mw_extra_t k_extra[] = {
-    {"mlp", 10u}, {"mlp", 30u}, {"mlp", 1000u}, {"pathloss", 300u}, {"pathloss", 1500u},
+static const mw_cmp_t k_cmp[] = {
+    {"mlp", 10u}, {"mlp", 2500u}, {"pathloss", 300u}, {"pathloss", 2500u},
 };
 
 /* Prediction points of the cross-check sums: 11 x 6 over the field (every 4 m), 8 x 3
@@ -221,17 +217,21 @@ static void sliced(const rfs_models_entry_t *e, void *st, const rfs_model_fit_in
     rfs_rng_t rng = *rng0;
     (void)e->init_default(st);
     rfs_fit_result_t r = RFS_FIT_MORE;
-    uint64_t worst = 0, total = 0;
+    uint64_t worst = 0, total = 0, last = 0;
     uint32_t calls = 0;
     while (r == RFS_FIT_MORE && calls < 1000000u) {
         const uint64_t t0 = rfs_bc_ticks();
         r = e->ops->fit(st, in, budget, &rng);
         const uint64_t t1 = rfs_bc_ticks();
-        worst = t1 - t0 > worst ? t1 - t0 : worst;
-        total += t1 - t0;
+        last = t1 - t0;
+        worst = last > worst ? last : worst;
+        total += last;
         calls++;
     }
     rfs_bc_report(name3(nb, sizeof nb, "slice_worst", e->name, budget), worst, 1);
+    /* The seeker decides in the period of the last slice (rfs_seek.c decide()): that
+     * period also runs the grid search or argmax. */
+    rfs_bc_report(name3(nb, sizeof nb, "slice_last", e->name, budget), last, 1);
     rfs_bc_report(name3(nb, sizeof nb, "slice_total", e->name, budget), total, calls);
     rfs_bc_report(name3(nb, sizeof nb, "slices", e->name, budget), 0, calls);
     rfs_bc_report(name3(nb, sizeof nb, "sum_sliced", e->name, budget), 0,
@@ -333,16 +333,23 @@ static int run_model(rfs_mw_mem_t *mem, const rfs_models_entry_t *e, uint32_t n,
         predict_loop(e, st);
     }
 
-    /* Sliced at the firmware's budget, then the documented per-model budgets. */
-    sliced(e, st, &in, MW_BUDGET, &rng0, floor);
-    for (uint32_t k = 0; (flags & RFS_MW_QUICK) == 0u && k < sizeof k_extra / sizeof k_extra[0]; ++k) {
-        const char *a = k_extra[k].model, *b = e->name;
+    /* Sliced at the registry budget (the firmware's), then the comparison budgets, then
+     * the port's extra ones. */
+    rfs_bc_report(name2(nb, sizeof nb, "mcu_budget", e->name), 0, e->mcu_fit_budget);
+    sliced(e, st, &in, e->mcu_fit_budget, &rng0, floor);
+    for (uint32_t k = 0; (flags & RFS_MW_QUICK) == 0u && k < sizeof k_cmp / sizeof k_cmp[0]; ++k) {
+        const char *a = k_cmp[k].model, *b = e->name;
         while (*a != '\0' && *a == *b) {
             ++a;
             ++b;
         }
-        if (*a == '\0' && *b == '\0') {
-            sliced(e, st, &in, k_extra[k].budget, &rng0, floor);
+        if (*a == '\0' && *b == '\0' && k_cmp[k].budget != e->mcu_fit_budget) {
+            sliced(e, st, &in, k_cmp[k].budget, &rng0, floor);
+        }
+    }
+    for (uint32_t k = 0; k < mem->n_extra && k < RFS_MW_MAX_EXTRA; ++k) {
+        if (mem->extra[k].model == e && mem->extra[k].budget != 0u) {
+            sliced(e, st, &in, mem->extra[k].budget, &rng0, floor);
         }
     }
     return 0;

@@ -16,8 +16,14 @@
  * Reachability for rfs_seek_grid_max: every legal lattice point (both maps are one
  * connected floor; the seeker's flood fill is internal to rfs_seek).
  *
- * Lines printed (rfs_bc_report): measurements "<what>_<model>" with ticks; values with
- * ticks 0: "state_bytes_<model>", "slices_<model>_<budget>", "points_<model>", and the
+ * Sliced relearns: at each model's registry budget (rfs_models_entry_t.mcu_fit_budget,
+ * the firmware's MCU configuration; also in the check run), then, without RFS_MW_QUICK,
+ * the fixed comparison budgets of models_work.c, then the port's extra[] pairs.
+ *
+ * Lines printed (rfs_bc_report): measurements "<what>_<model>" with ticks (a sliced
+ * relearn: "slice_worst_", "slice_last_", "slice_total_<model>_<budget>"); values with
+ * ticks 0: "state_bytes_<model>", "slices_<model>_<budget>", "points_<model>",
+ * "mcu_budget_<model>" (the registry budget; its slice lines follow), and the
  * cross-check sums "sum_*" (FNV-1a 32 of the samples, of predictions after a whole fit
  * and after a sliced one, of the grid maximum), which host and Cortex-M4 must print alike.
  */
@@ -29,6 +35,7 @@
 #include "rfs_knn.h"
 #include "rfs_map.h"
 #include "rfs_mlp.h"
+#include "rfs_models.h"
 #include "rfs_pathloss.h"
 #include "rfs_ridge.h"
 #include "rfs_seek.h"
@@ -51,8 +58,19 @@ typedef union rfs_mw_state {
     uint64_t align;          ///< RFS_MODELS_STATE_ALIGN
 } rfs_mw_state_t;
 
+/// Most extra (model, budget) pairs a run measures beside the registry's budgets.
+#define RFS_MW_MAX_EXTRA 8u
+
+/// One extra sliced relearn: `model`'s fit at `budget` work units per call.
+typedef struct rfs_mw_extra {
+    const rfs_models_entry_t *model; ///< registry entry
+    uint32_t budget;                 ///< work units per call (> 0)
+} rfs_mw_extra_t;
+
 /// Everything the run needs, in one object the port places (static RAM on the M4).
 typedef struct rfs_mw_mem {
+    rfs_mw_extra_t extra[RFS_MW_MAX_EXTRA];    ///< extra budgets to measure (the port's options)
+    uint32_t n_extra;                          ///< how many of extra[] are set
     rfs_mw_state_t state;                      ///< the model being measured
     rfs_sample_t samples[RFS_MW_MAX_SAMPLES];  ///< the workload's samples
     uint8_t legal[RFS_MW_MAX_MAP_BYTES];       ///< the map's derived legal grid
@@ -67,7 +85,7 @@ typedef struct rfs_mw_mem {
 
 /// Run flags.
 #define RFS_MW_QUICK 1u ///< skip the timing-only extras (the 160 x 80 loop, the pathloss
-                        ///< full grid scan, the extra slice budgets): the check run
+                        ///< full grid scan, the fixed comparison budgets): the check run
 
 /// Run every registered model on its workload with n samples (1..RFS_MW_MAX_SAMPLES),
 /// printing the lines above. Returns 0, or -1 after printing "error <reason>" (n out of

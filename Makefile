@@ -84,12 +84,14 @@ check-core: $(CORE_LIB) $(BUILD)/m32/lib/librfs_core.a $(BUILD)/arm/lib/librfs_c
 ALL_TARGETS += $(CORE_LIB)
 
 # --- CMocka tests of the core: tests/common/test_<module>.c ------------------------
+# Tests include their fixtures and double-precision references (tests/*/*.h).
+TEST_HDRS := $(wildcard tests/*/*.h)
 # $(call cmocka_test,NAME,SOURCES,EXTRA_LIBS) defines build/tests/NAME and its ASan twin.
 define cmocka_test
-$(BUILD)/tests/$(1): $(2) $$(CORE_LIB) $$(HOST_LIB_DEPS) tests/rfs_test.h
+$(BUILD)/tests/$(1): $(2) $$(CORE_LIB) $$(HOST_LIB_DEPS) tests/rfs_test.h $$(TEST_HDRS)
 	@mkdir -p $$(@D)
 	$$(HOST_LINK) $$(HOST_CFLAGS) -x c -Itests $(2) -x none -o $$@ $$(HOST_LIB_DEPS) $$(CORE_LIB) -lcmocka $(3) $$(HOST_LDLIBS)
-$(BUILD)/asan/tests/$(1): $(2) $$(CORE_ASAN_LIB) $$(HOST_ASAN_LIB_DEPS) tests/rfs_test.h
+$(BUILD)/asan/tests/$(1): $(2) $$(CORE_ASAN_LIB) $$(HOST_ASAN_LIB_DEPS) tests/rfs_test.h $$(TEST_HDRS)
 	@mkdir -p $$(@D)
 	$$(HOST_LINK) $$(HOST_CFLAGS) -O1 $$(SAN_FLAGS) -x c -Itests $(2) -x none -o $$@ $$(HOST_ASAN_LIB_DEPS) $$(CORE_ASAN_LIB) -lcmocka $(3) $$(HOST_LDLIBS)
 TEST_BINS += $(BUILD)/tests/$(1) $(BUILD)/asan/tests/$(1)

@@ -95,6 +95,13 @@ typedef struct rfs_pathloss_cfg {
     rfs_q16_t huber;        ///< Huber threshold on a bin's mean residual, dB Q16.16 (6 dB)
     rfs_q16_t spread_k;     ///< spread region: loss <= best (1 + spread_k / bins) (6.0)
     rfs_q16_t margin;       ///< metres Q16.16: candidates beyond the samples without a map (20 m)
+    rfs_q16_t p0_min;       ///< target units Q16.16: weakest plausible signal at 1 m (-45 dBm;
+                            ///< INT32_MIN: no floor). A candidate whose fit needs a weaker
+                            ///< P0 adds total weight x Huber(p0_min - P0) to its loss
+    rfs_q16_t hold_k;       ///< a relearn keeps the previous fit's source when its loss is
+                            ///< within best (1 + hold_k / bins) (2.0; 0: off, always the
+                            ///< least loss): no jumping between sources the data cannot
+                            ///< tell apart. Needs the same map as the previous fit
 } rfs_pathloss_cfg_t;
 
 /// One sample bin. Scaling: sums of up to 65,535 samples of int16 fit int32.
@@ -152,6 +159,7 @@ typedef enum rfs_pathloss_phase {
     RFS_PATHLOSS_COARSE,   ///< coarse candidates
     RFS_PATHLOSS_REFINE,   ///< around the best coarse candidates at half the coarse spacing
     RFS_PATHLOSS_FINE,     ///< around the best so far, halving the spacing to the lattice's
+    RFS_PATHLOSS_HOLD,     ///< the previous fit's source, kept when still as good (hold_k)
 } rfs_pathloss_phase_t;
 
 /// What the model believes (rfs_pathloss_estimate()).
@@ -175,6 +183,8 @@ typedef struct rfs_pathloss_est {
 typedef struct rfs_pathloss {
     rfs_pathloss_cfg_t cfg;                       ///< configuration copied at init
     bool valid;                                   ///< a model exists
+    bool have_prev;                               ///< best holds a finished fit (for hold_k)
+    const rfs_map_t *prev_map;                    ///< the map of that fit
     const rfs_map_t *map;                         ///< map of the last fit (NULL: no walls)
     rfs_pathloss_cand_t best;                     ///< the model: estimate and its fit
     rfs_q16_t spread_m2;                          ///< area of the spread region, m^2 Q16.16

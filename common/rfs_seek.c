@@ -612,11 +612,48 @@ bool rfs_seek_grid_max_scan(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
  * that point itself, reached through the planner. The cut point lies on a legal segment
  * of the path. Scaling: waypoint offsets (Q16, < 2^32) times the remaining length
  * (Q16, < 2^16 m) < 2^63; segment lengths by rfs_q16_dist(). */
+/* The reachable legal lattice point nearest to (x, y), by a scan of the reach bits
+ * (lw x lh points; squared lattice offsets < 2^32 in int64). false when none. */
+static bool nearest_reachable(const rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *ox,
+                              rfs_q16_t *oy)
+{
+    const rfs_map_t *m = s->map;
+    uint16_t ci, cj;
+    rfs_map_lattice_nearest(m, x, y, &ci, &cj);
+    int64_t best = INT64_MAX;
+    uint16_t bi = 0, bj = 0;
+    for (uint16_t j = 0; j < m->lh; ++j) {
+        for (uint16_t i = 0; i < m->lw; ++i) {
+            if (!reachable_point(s, i, j)) {
+                continue;
+            }
+            int64_t di = (int64_t)i - ci, dj = (int64_t)j - cj;
+            int64_t d = di * di + dj * dj;
+            if (d < best) {
+                best = d;
+                bi = i;
+                bj = j;
+            }
+        }
+    }
+    if (best == INT64_MAX) {
+        return false;
+    }
+    rfs_map_lattice_point(m, bi, bj, ox, oy);
+    return true;
+}
+
 static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool whole,
                               int64_t now_us)
 {
     if (!go_to(s, mx, my, now_us)) {
-        return false;
+        /* The maximum is where the robot cannot go (a room whose door the clearance does
+         * not pass, a spot off the free space): head for the reachable point nearest to
+         * it rather than giving the iteration to a random epsilon move. */
+        rfs_q16_t nx, ny;
+        if (!nearest_reachable(s, mx, my, &nx, &ny) || !go_to(s, nx, ny, now_us)) {
+            return false;
+        }
     }
     rfs_path_t *p = &s->drive.path;
     int64_t px = s->pose.x, py = s->pose.y;

@@ -30,6 +30,7 @@ typedef struct ref_pl_cfg {
     double n_min, n_max, w_min, w_max, n_prior, w_prior, prior_weight, huber, margin;
     long bin_cap;
     double w_prior_weight;
+    double p0_min; /* weakest plausible P0; a fit below adds total x Huber(p0_min - P0) */
 } ref_pl_cfg_t;
 
 typedef struct ref_pl_bin {
@@ -63,7 +64,7 @@ typedef struct ref_pl {
 
 static inline ref_pl_cfg_t ref_pl_cfg_default(void)
 {
-    ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5, 300.0};
+    ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5, 300.0, -45.0};
     return c;
 }
 
@@ -264,6 +265,10 @@ static inline double ref_pl_eval(ref_pl_t *r, int i, int j, double *pn, double *
         double res = fabs(r->bins[b].z - (p0 - n * r->L[b] - w * r->K[b]));
         double h = res <= cf->huber ? 0.5 * res * res : cf->huber * (res - 0.5 * cf->huber);
         loss += r->bins[b].count * h;
+    }
+    if (p0 < cf->p0_min) {
+        double a = cf->p0_min - p0;
+        loss += (double)r->total * (a <= cf->huber ? 0.5 * a * a : cf->huber * (a - 0.5 * cf->huber));
     }
     *pn = n;
     *pw = w;

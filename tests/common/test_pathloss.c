@@ -323,6 +323,80 @@ static void same_cell_as_double_reference_office(void **state)
     expect_same_as_reference(f, &cw, NS, &f->map, &rw, 0.01);
 }
 
+
+/* hold_k: a relearn keeps the previous fit's source while its loss is within
+ * best x (1 + hold_k / bins), best being the new search's least loss. Expected decisions
+ * from the double-precision reference: its search on the new data gives the best, its
+ * evaluation of the previous source that source's loss. Pairs of noisy data sets from
+ * sources 0-2.7 m apart give both outcomes. */
+static void relearn_holds_previous_source(void **state)
+{
+    fixture_t *f = *state;
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+    int kept = 0, replaced = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        truth_t a = k_office, b = k_office;
+        a.noise = b.noise = 6.0;
+        b.sx += 0.25 * (double)(trial % 10);
+        b.sy += 0.5 * (double)(trial / 10);
+        const int n = 80;
+        make_samples(f->s, n, &f->map, &a, 100 + (uint64_t)trial);
+        rfs_pathloss_est_t ea = fit_with(f, &c, n, &f->map, 0, NULL);
+        make_samples(f->s, n, &f->map, &b, 200 + (uint64_t)trial);
+        rfs_model_t m = rfs_pathloss_model(&f->pl);
+        rfs_model_fit_in_t in = {f->s, (uint16_t)n, 0, 0, &f->map};
+        rfs_rng_t rng;
+        rfs_rng_seed(&rng, 1);
+        m.ops->reset(m.self);
+        assert_int_equal(m.ops->fit(m.self, &in, 0, &rng), RFS_FIT_DONE);
+        rfs_pathloss_est_t eb;
+        assert_true(rfs_pathloss_estimate(&f->pl, &eb));
+        assert_true(ref_pl_fit(&f->ref, f->s, n, &f->map, &rc));
+        ref_pl_t *r = &f->ref;
+        int ai = (int)lround((ea.sx / 65536.0 - r->ox) / r->grid);
+        int aj = (int)lround((ea.sy / 65536.0 - r->oy) / r->grid);
+        double nn, ww, pp;
+        double best = r->loss, rsx = r->sx, rsy = r->sy;
+        r->seen = calloc((size_t)r->lw * r->lh, 1); /* ref_pl_fit freed its own */
+        assert_non_null(r->seen);
+        double la = ref_pl_eval(r, ai, aj, &nn, &ww, &pp);
+        free(r->seen);
+        r->seen = NULL;
+        bool moved = fabs(rsx - ea.sx / 65536.0) > 1e-3 || fabs(rsy - ea.sy / 65536.0) > 1e-3;
+        if (!moved) {
+            continue; /* the new search found the old source itself: nothing to hold */
+        }
+        double margin = best * 6.0 / r->nbins;
+        if (fabs(la - (best + margin)) < 1e-3 * best) {
+            continue; /* too close to the threshold to call in fixed point */
+        }
+        bool keep = la <= best + margin;
+        double wx = keep ? ea.sx / 65536.0 : rsx, wy = keep ? ea.sy / 65536.0 : rsy;
+        if (fabs(eb.sx / 65536.0 - wx) > 1e-3 || fabs(eb.sy / 65536.0 - wy) > 1e-3) {
+            fail_msg("trial %d: (%.3f, %.3f), expected (%.3f, %.3f) (%s)", trial,
+                     eb.sx / 65536.0, eb.sy / 65536.0, wx, wy, keep ? "kept" : "replaced");
+        }
+        kept += keep;
+        replaced += !keep;
+    }
+    print_message("hold: %d kept, %d replaced\n", kept, replaced);
+    assert_true(kept >= 2);
+    assert_true(replaced >= 2);
+}
+
+/* p0_min: the fixed-point search equals the double reference with the floor off too. */
+static void p0_floor_off_same_as_reference(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+    c.p0_min = INT32_MIN;
+    rc.p0_min = -INFINITY;
+    expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
+}
+
 /* The default configuration on the same data: the prior (3, 5 dB) pulls n and W from
  * the truth (2.6, 6.5 dB) towards itself, the source stays within one lattice cell. */
 static void default_prior_shrinks_towards_physics(void **state)
@@ -688,6 +762,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(predict_is_the_fitted_formula, setup, teardown),
         cmocka_unit_test_setup_teardown(residual_surface_and_spread, setup, teardown),
         cmocka_unit_test_setup_teardown(closed_loop_finds_the_room, setup, teardown),
+        cmocka_unit_test_setup_teardown(relearn_holds_previous_source, setup, teardown),
+        cmocka_unit_test_setup_teardown(p0_floor_off_same_as_reference, setup, teardown),
         cmocka_unit_test(registered_as_pathloss),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

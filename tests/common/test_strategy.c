@@ -479,6 +479,96 @@ static void test_recheck_abandons_leg(void **state)
     assert_int_equal(ab, 0);     /* the paper's rule runs every leg to its end */
 }
 
+
+/* A model that knows its maximum (like the path-loss model's estimated source): a
+ * constant prediction and a fixed argmax. */
+typedef struct fixed_model {
+    bool valid;
+    rfs_q16_t mx, my;
+} fixed_model_t;
+
+static void fixed_reset(void *self)
+{
+    ((fixed_model_t *)self)->valid = false;
+}
+
+static rfs_fit_result_t fixed_fit(void *self, const rfs_model_fit_in_t *in, uint32_t budget,
+                                  rfs_rng_t *rng)
+{
+    (void)in;
+    (void)budget;
+    (void)rng;
+    ((fixed_model_t *)self)->valid = true;
+    return RFS_FIT_DONE;
+}
+
+static bool fixed_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *value)
+{
+    (void)x;
+    (void)y;
+    *value = RFS_Q16_INT(-60);
+    return ((const fixed_model_t *)self)->valid;
+}
+
+static bool fixed_argmax(const void *self, rfs_q16_t *x, rfs_q16_t *y)
+{
+    const fixed_model_t *m = self;
+    *x = m->mx;
+    *y = m->my;
+    return m->valid;
+}
+
+static const rfs_model_ops_t k_fixed_ops = {
+    .name = "fixed", .reset = fixed_reset, .fit = fixed_fit, .predict = fixed_predict,
+    .argmax = fixed_argmax,
+};
+
+/* meta-path, a maximum the robot cannot reach (beyond a wall that seals the map): the
+ * greedy goal is the reachable lattice point nearest to it (found here by brute force in
+ * double over the legal lattice points on the robot's side), not an epsilon move. */
+static void test_meta_path_unreachable_maximum(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 20.0, 10.0, 10.0, 10.0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    cfg.eps_amp = 0;
+    cfg.eps_floor = 0; /* every decision after the first is greedy */
+    seek_make(&t, cfg, 3);
+    fixed_model_t fm = { false, Q(15.0), Q(5.3) };
+    rfs_model_t model = { &k_fixed_ops, &fm };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.0, .y = 5.0 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.kind, RFS_SEEK_INITIAL);
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
+    assert_true(fabs(D(out.decision.max_x) - 15.0) < 1e-4);
+    double best = INFINITY, bx = 0, by = 0;
+    for (uint16_t j = 0; j < t.map.lh; ++j) {
+        for (uint16_t i = 0; i < t.map.lw; ++i) {
+            rfs_q16_t px, py;
+            rfs_map_lattice_point(&t.map, i, j, &px, &py);
+            if (!rfs_map_lattice_legal(&t.map, i, j) || D(px) > 10.0) {
+                continue;
+            }
+            double d = hypot(D(px) - 15.0, D(py) - 5.3);
+            if (d < best - 1e-9) {
+                best = d;
+                bx = D(px);
+                by = D(py);
+            }
+        }
+    }
+    assert_true(fabs(D(out.decision.goal_x) - bx) < 1e-4);
+    assert_true(fabs(D(out.decision.goal_y) - by) < 1e-4);
+    assert_true(bx < 10.0 && bx > 9.0); /* against the wall, on the robot's side */
+    world_free(&t);
+}
+
 /* Names round-trip and the unit vector against double precision. */
 static void test_names_and_unit(void **state)
 {
@@ -534,6 +624,7 @@ int main(void)
         cmocka_unit_test(test_meta_path_preset),
         cmocka_unit_test(test_eps_by_travel),
         cmocka_unit_test(test_recheck_abandons_leg),
+        cmocka_unit_test(test_meta_path_unreachable_maximum),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

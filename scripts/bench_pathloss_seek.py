@@ -114,7 +114,7 @@ parameters; `meta-path + pathloss` is the improvement (docs/PATHLOSS.md, docs/ST
 the pathloss model's estimated source is the greedy goal, reached through the planner, with
 meta-path's two preset improvements (the relearn check after every metre of a greedy leg,
 epsilon annealed by the metres travelled); "improvements off" is the same without them
-(`seek: {recheck_m: 0, eps_by_travel: false}` added to the scenario).
+(`seek: {{recheck_m: 0, eps_by_travel: false}}` added to the scenario).
 
 Command: `/usr/bin/python3 scripts/bench_pathloss_seek.py --seeds {a.seeds}` (wall time
 {wall:.0f} s on this 2-core machine, shared with other work while it ran).

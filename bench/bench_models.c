@@ -6,11 +6,22 @@
  * log-distance field with 4 dB noise; the grid search predicts at every point of the
  * 0.25 m lattice of that area (160 x 80 = 12,800 points), as the core bench does.
  *   bench_models relearn MODEL        one full fit (budget 0)
- *   bench_models grid MODEL           a full fit (not counted), then the grid search
+ *   bench_models grid MODEL           a full fit (not counted), then a prediction at
+ *                                     every lattice point (the cost of the full scan)
+ *   bench_models scan MODEL           a full fit (not counted), then the seeker's full
+ *                                     scan, rfs_seek_grid_max_scan()
+ *   bench_models search MODEL         a full fit (not counted), then the seeker's grid
+ *                                     search, rfs_seek_grid_max() (its shortcuts: rows for
+ *                                     ridge, branch and bound for knn and radius); every
+ *                                     lattice point of the open 40 x 20 m map reachable
  *   bench_models slice MODEL BUDGET   only the first fit call with that budget (the
  *                                     heaviest: it also standardises / copies), and the
  *                                     number of calls a whole fit takes
- * MODEL is a name of the registry (ridge, mlp, knn, radius).
+ * MODEL is a name of the registry (ridge, mlp, knn, radius). scan and search take an
+ * optional third word `path`: the 10,000 samples then lie along a robot's path instead
+ * (a random walk of 1 m legs, 200 samples per metre in runs of 20 at one position as a
+ * 10 Hz pose and 200 packets/s give, targets rounded to whole dB as the receiver
+ * reports them): dense and noisy, as in the simulator.
  */
 #include <math.h>
 #include <stdio.h>
@@ -20,6 +31,7 @@
 #include <valgrind/callgrind.h>
 
 #include "rfs_models.h"
+#include "rfs_seek.h"
 
 #define N 10000u
 #define GRID_W 160
@@ -27,12 +39,43 @@
 
 static void usage(FILE *f)
 {
-    fprintf(f, "usage: bench_models relearn MODEL | grid MODEL | slice MODEL BUDGET\n"
+    fprintf(f, "usage: bench_models relearn MODEL | grid MODEL | scan MODEL | search MODEL |\n"
+               "                    slice MODEL BUDGET\n"
                "MODEL: one of");
     for (uint32_t i = 0; i < rfs_models_count(); ++i) {
         fprintf(f, " %s", rfs_models_at(i)->name);
     }
     fprintf(f, "\n");
+}
+
+/* Samples along a robot path (see the header comment). */
+static void make_path_samples(rfs_sample_t *s)
+{
+    rfs_rng_t r;
+    rfs_rng_seed(&r, 7);
+    double x = 5.0, y = 5.0, hx = 1.0, hy = 0.0;
+    for (uint32_t i = 0; i < N; i += 20u) {
+        if (i % 200u == 0u) { /* a new 1 m leg: turn by up to 90 degrees, stay inside */
+            double a = atan2(hy, hx) + ((double)rfs_rng_below(&r, 181) - 90.0) * 0.0174533;
+            hx = cos(a);
+            hy = sin(a);
+            if (x + hx < 0.5 || x + hx > 39.5 || y + hy < 0.5 || y + hy > 19.5) {
+                hx = -hx;
+                hy = -hy;
+            }
+        }
+        x += hx * 0.1;
+        y += hy * 0.1;
+        for (uint32_t k = i; k < i + 20u && k < N; ++k) {
+            double u1 = ((double)rfs_rng_u32(&r) + 1.0) / 4294967297.0;
+            double u2 = (double)rfs_rng_u32(&r) / 4294967296.0;
+            double z = sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
+            double d = hypot(x - 30.0, y - 12.0);
+            s[k].x_cm = (int16_t)lround(x * 100.0);
+            s[k].y_cm = (int16_t)lround(y * 100.0);
+            s[k].v_q6 = (int16_t)(lround(-30.0 - 30.0 * log10(d + 1.0) + 4.0 * z) * 64);
+        }
+    }
 }
 
 static void make_samples(rfs_sample_t *s)
@@ -48,6 +91,54 @@ static void make_samples(rfs_sample_t *s)
         double d = hypot(s[i].x_cm / 100.0 - 30.0, s[i].y_cm / 100.0 - 12.0);
         s[i].v_q6 = (int16_t)lround((-30.0 - 20.0 * log10(d + 1.0) + 4.0 * z) * 64.0);
     }
+}
+
+/* The seeker's grid search over an open 40 x 20 m map (0.1 m cells, no walls) whose
+ * 0.25 m lattice is the 160 x 80 points above, every point marked reachable; only the
+ * search itself is counted. */
+static bool seek_search(const rfs_models_entry_t *e, void *state, bool pruned, rfs_q16_t *mx,
+                        rfs_q16_t *my)
+{
+    enum { W = 400, H = 200 };
+    static uint8_t free_bits[W / 8 * H], legal_bits[W / 8 * H];
+    memset(free_bits, 0xFF, sizeof free_bits);
+    rfs_map_cfg_t mc = rfs_map_cfg_default();
+    static rfs_map_t map;
+    if (rfs_map_init(&map, &mc, W, H, RFS_Q16_ONE / 10 + 1, 0, 0, free_bits, NULL,
+                     legal_bits) != 0) {
+        return false;
+    }
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    uint32_t lpts = (uint32_t)map.lw * map.lh, bits = rfs_seek_lattice_bits_bytes(&map);
+    rfs_seek_mem_t mem = {
+        .samples = calloc(cfg.store.capacity, sizeof(rfs_sample_t)),
+        .pending = calloc(256, sizeof(rfs_pending_t)),
+        .pending_cap = 256,
+        .plan_work = calloc(lpts, 1),
+        .plan_work_bytes = lpts,
+        .plan_queue = calloc(lpts, sizeof(uint32_t)),
+        .plan_queue_cap = lpts,
+        .visited = calloc(bits, 1),
+        .visited_bytes = bits,
+        .reach = calloc(bits, 1),
+        .reach_bytes = bits,
+    };
+    static rfs_seek_t seek;
+    rfs_model_t model = {.ops = e->ops, .self = state};
+    bool ok = rfs_seek_init(&seek, &cfg, &map, model, &rfs_target_rssi, &mem) == 0;
+    if (ok) {
+        memset(mem.reach, 0xFF, bits); /* caller-owned: every point reachable */
+        CALLGRIND_START_INSTRUMENTATION;
+        ok = pruned ? rfs_seek_grid_max(&seek, mx, my) : rfs_seek_grid_max_scan(&seek, mx, my);
+        CALLGRIND_STOP_INSTRUMENTATION;
+    }
+    free(mem.samples);
+    free(mem.pending);
+    free(mem.plan_work);
+    free(mem.plan_queue);
+    free(mem.visited);
+    free(mem.reach);
+    return ok;
 }
 
 int main(int argc, char **argv)
@@ -73,7 +164,8 @@ int main(int argc, char **argv)
             fprintf(stderr, "bench_models: BUDGET: not an integer in 1..1000000\n");
             return 2;
         }
-    } else if (strcmp(argv[1], "relearn") != 0 && strcmp(argv[1], "grid") != 0) {
+    } else if (strcmp(argv[1], "relearn") != 0 && strcmp(argv[1], "grid") != 0 &&
+               strcmp(argv[1], "scan") != 0 && strcmp(argv[1], "search") != 0) {
         usage(stderr);
         return 2;
     }
@@ -83,7 +175,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_models: setup failed\n");
         return 1;
     }
-    make_samples(s);
+    bool path = argc >= 4 && strcmp(argv[3], "path") == 0;
+    if (path) {
+        make_path_samples(s);
+    } else {
+        make_samples(s);
+    }
     rfs_rng_t rng;
     rfs_rng_seed(&rng, 42);
     rfs_model_fit_in_t in = {.samples = s, .n = N, .qx = RFS_Q16_INT(20), .qy = RFS_Q16_INT(10),
@@ -105,6 +202,12 @@ int main(int argc, char **argv)
         }
         printf("calls %u\n", calls);
         check = r;
+    } else if (strcmp(argv[1], "scan") == 0 || strcmp(argv[1], "search") == 0) {
+        e->ops->fit(state, &in, 0u, &rng);
+        rfs_q16_t mx = 0, my = 0;
+        bool ok = seek_search(e, state, strcmp(argv[1], "search") == 0, &mx, &my);
+        printf("max %d %d\n", mx, my);
+        check = ok;
     } else {
         e->ops->fit(state, &in, 0u, &rng);
         rfs_q16_t best = RFS_Q16_MIN;

@@ -13,8 +13,14 @@
  * fit() copies the samples (up to RFS_KNN_MAX_SAMPLES) into the state, because the
  * store keeps changing while the model is used, and sorts them into a uniform grid of
  * at most RFS_KNN_GRID x RFS_KNN_GRID cells over their bounding box (cell side at least
- * cfg.cell), so a query visits nearby cells only. Distances are exact integers: sample
+ * cfg.cell), so a query visits nearby cells only, and skips any cell too far to hold one
+ * of its k nearest (which keeps every tie decision). Distances are exact integers: sample
  * positions in centimetres, the query rounded to 1/256 cm.
+ *
+ * Both modes give the model interface's `bound`: an upper bound of predict() over a box,
+ * bit for bit (k-neighbours: the mean of the k largest targets among the samples that can
+ * be a neighbour of some point of the box; radius: only when one sample covers the whole
+ * box, else false), for the seeker's branch-and-bound grid search (docs/MODELS.md).
  *
  * Sliced learning: one work unit is one sample copied, counted or placed, or one grid
  * cell visited (exactly 3 n + 3 cells + 1 units per fit); fit(budget) does at most

@@ -55,6 +55,14 @@ typedef struct rfs_model_ops {
     /// larger x, -1 towards smaller x, 0 constant. The grid search then evaluates only the
     /// ends of each lattice row and finds exactly the maximum a full scan finds.
     int (*row_monotone)(const void *self);
+    /// Optional (may be NULL): an upper bound of the model over the closed box
+    /// [x0, x1] x [y0, y1] (metres Q16.16, x0 <= x1, y0 <= y1). true promises, bit for bit,
+    /// that predict() (and predict_row()) succeeds at every point of the box and returns
+    /// at most *ub there; false = no such promise (no model, or a point may have no
+    /// prediction). Lets the grid search skip whole blocks of the lattice and still find
+    /// exactly the full scan's maximum (branch and bound, issue 8).
+    bool (*bound)(const void *self, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1,
+                  rfs_q16_t *ub);
 } rfs_model_ops_t;
 
 /// A model: its operations and its caller-owned state.

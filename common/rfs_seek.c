@@ -591,11 +591,277 @@ static bool grid_max_rows(const rfs_seek_t *s, int dir, rfs_q16_t *mx, rfs_q16_t
     return found;
 }
 
+/* Branch and bound over the lattice (issue 8), for a model with a bound over a box:
+ * tiles of RFS_SEEK_ROW_CHUNK x RFS_SEEK_ROW_CHUNK points, aligned with the full scan's
+ * chunks (a tile row is one chunk), split into quadrants (see bb_node()).
+ * A node is skipped when its bound cannot beat the best so far in the scan's own order
+ * (bound < best, or == best and the node's first point comes after the best's), so the
+ * answer is exactly grid_max_scan()'s, ties included. The scan also fails when any point
+ * of a chunk holding a reachable point has no prediction ("P-points"): a true bound
+ * promises predictions over its box, and every P-point outside such a box is predicted
+ * here, so this search fails exactly when the scan does. The GRID_BB_SEEDS tiles whose
+ * middle point predicts highest go first, to find a high maximum early; then every other
+ * tile in row-major order. No memory beyond the stack (about 200 bytes). */
+/* Nodes without a bound are split down to this many points. */
+#define GRID_BB_LEAF 4
+/* Tiles searched first. */
+#define GRID_BB_SEEDS 4
+
+_Static_assert(RFS_SEEK_ROW_CHUNK <= 32, "one bit per tile row in a uint32_t");
+
+typedef struct grid_bb {
+    const rfs_seek_t *s;
+    rfs_q16_t x0;      /* x of lattice column 0, metres Q16.16 */
+    rfs_q16_t best;    /* best prediction so far, target units Q16.16 */
+    uint32_t best_idx; /* its row-major lattice index */
+    bool found;        /* best is valid */
+} grid_bb_t;
+
+/* Lattice columns [i0, i0 + w), rows [j0, j0 + h), inside one tile whose row rj0 is bit 0
+ * of the P-row mask. */
+typedef struct grid_node {
+    uint16_t i0, j0, w, h, rj0;
+} grid_node_t;
+
+static bool bb_reach_any(const rfs_seek_t *s, const grid_node_t *nd)
+{
+    for (uint16_t j = nd->j0; j < nd->j0 + nd->h; ++j) {
+        uint32_t base = (uint32_t)j * s->map->lw + nd->i0;
+        if (first_set(s->reach, base, base + nd->w) >= 0) {
+            return true;
+        }
+    }
+    return false;
+}
+
+static uint32_t bb_rows(const grid_node_t *nd)
+{
+    uint32_t ones = nd->h >= 32u ? 0xFFFFFFFFu : (1u << nd->h) - 1u;
+    return ones << (nd->j0 - nd->rj0);
+}
+
+/* Scaling: lattice coordinates as grid_max_scan() forms them (x0 + i * grid < 2^31). */
+static bool bb_bound(const grid_bb_t *bb, const grid_node_t *nd, rfs_q16_t *ub)
+{
+    const rfs_map_t *m = bb->s->map;
+    rfs_q16_t xa, ya, xb, yb;
+    rfs_map_lattice_point(m, 0, nd->j0, &xa, &ya);
+    rfs_map_lattice_point(m, 0, (uint16_t)(nd->j0 + nd->h - 1u), &xb, &yb);
+    xa = bb->x0 + (rfs_q16_t)nd->i0 * m->cfg.grid;
+    xb = bb->x0 + (rfs_q16_t)(nd->i0 + nd->w - 1u) * m->cfg.grid;
+    return bb->s->model.ops->bound(bb->s->model.self, xa, ya, xb, yb, ub);
+}
+
+static bool bb_prunable(const grid_bb_t *bb, const grid_node_t *nd, rfs_q16_t ub)
+{
+    uint32_t first = (uint32_t)nd->j0 * bb->s->map->lw + nd->i0;
+    return bb->found && (ub < bb->best || (ub == bb->best && first > bb->best_idx));
+}
+
+static void bb_consider(grid_bb_t *bb, rfs_q16_t v, uint32_t idx)
+{
+    if (!bb->found || v > bb->best || (v == bb->best && idx < bb->best_idx)) {
+        bb->best = v;
+        bb->best_idx = idx;
+        bb->found = true;
+    }
+}
+
+/* Predict the node's P-rows: the reachable points as candidates, and, unless `known`
+ * (a bound promised predictions here), the others only to fail as the scan would. A
+ * model with predict_row gets the scan's very call (the whole chunk), so the values are
+ * the scan's bit for bit. */
+static bool bb_leaf(grid_bb_t *bb, const grid_node_t *nd, uint32_t pmask, bool known)
+{
+    const rfs_seek_t *s = bb->s;
+    const rfs_map_t *m = s->map;
+    const rfs_model_ops_t *ops = s->model.ops;
+    rfs_q16_t row[RFS_SEEK_ROW_CHUNK];
+    uint16_t c0 = (uint16_t)(nd->i0 - nd->i0 % RFS_SEEK_ROW_CHUNK);
+    uint16_t cn = (uint16_t)(m->lw - c0 < RFS_SEEK_ROW_CHUNK ? m->lw - c0 : RFS_SEEK_ROW_CHUNK);
+    for (uint16_t j = nd->j0; j < nd->j0 + nd->h; ++j) {
+        if (((pmask >> (j - nd->rj0)) & 1u) == 0u) {
+            continue;
+        }
+        rfs_q16_t x, py;
+        rfs_map_lattice_point(m, 0, j, &x, &py);
+        uint32_t base = (uint32_t)j * m->lw;
+        if (ops->predict_row != 0 &&
+            !ops->predict_row(s->model.self, bb->x0 + (rfs_q16_t)c0 * m->cfg.grid, py,
+                              m->cfg.grid, cn, row)) {
+            return false;
+        }
+        for (uint16_t i = nd->i0; i < nd->i0 + nd->w; ++i) {
+            bool r = reach_bit(s->reach, base + i);
+            rfs_q16_t v;
+            if (!r && known) {
+                continue;
+            }
+            if (ops->predict_row != 0) {
+                v = row[i - c0];
+            } else if (!ops->predict(s->model.self, bb->x0 + (rfs_q16_t)i * m->cfg.grid, py,
+                                     &v)) {
+                return false;
+            }
+            if (r) {
+                bb_consider(bb, v, base + i);
+            }
+        }
+    }
+    return true;
+}
+
+/* Search a node holding P-points; known: a bound promised predictions over it, own: the
+ * node's own bound did (and did not prune it). A node with its own bound is scanned whole:
+ * splitting it costs four bounds, each several predictions' work, and on robot-path
+ * samples (dense, noisy) the children's bounds rarely prune (docs/PERFORMANCE.md,
+ * "Models"). A node without one (radius: a sample may not cover it) is split down to
+ * GRID_BB_LEAF points, where smaller boxes can be covered. Children with a bound go
+ * highest first (the tie rule does not depend on the order). */
+static bool bb_node(grid_bb_t *bb, const grid_node_t *nd, uint32_t pmask, bool known, bool own)
+{
+    if (own || (uint32_t)nd->w * nd->h <= GRID_BB_LEAF) {
+        return bb_leaf(bb, nd, pmask, known);
+    }
+    uint16_t hw = (uint16_t)((nd->w + 1u) / 2u), hh = (uint16_t)((nd->h + 1u) / 2u);
+    grid_node_t ch[4];
+    rfs_q16_t ub[4];
+    bool ok[4];
+    uint32_t order[4], n = 0;
+    for (uint32_t q = 0; q < 4u; ++q) {
+        grid_node_t c = *nd;
+        c.i0 = (uint16_t)(nd->i0 + ((q & 1u) ? hw : 0u));
+        c.w = (uint16_t)((q & 1u) ? nd->w - hw : hw);
+        c.j0 = (uint16_t)(nd->j0 + ((q & 2u) ? hh : 0u));
+        c.h = (uint16_t)((q & 2u) ? nd->h - hh : hh);
+        if (c.w == 0u || c.h == 0u || (pmask & bb_rows(&c)) == 0u) {
+            continue;
+        }
+        ok[q] = bb_bound(bb, &c, &ub[q]);
+        if ((known || ok[q]) && !bb_reach_any(bb->s, &c)) {
+            continue; /* every point has a prediction and none is a candidate */
+        }
+        ch[q] = c;
+        uint32_t at = n++;
+        while (at > 0u && ok[q] &&
+               (!ok[order[at - 1u]] || ub[order[at - 1u]] < ub[q])) {
+            order[at] = order[at - 1u];
+            --at;
+        }
+        order[at] = q;
+    }
+    for (uint32_t k = 0; k < n; ++k) {
+        uint32_t q = order[k];
+        if (ok[q] && bb_prunable(bb, &ch[q], ub[q])) {
+            continue;
+        }
+        if (!bb_node(bb, &ch[q], pmask, known || ok[q], ok[q])) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/* Tile (ti, tj) and its P-row mask: bit r set when chunk row r holds a reachable point. */
+static uint32_t bb_tile(const rfs_seek_t *s, uint16_t ti, uint16_t tj, grid_node_t *nd)
+{
+    const rfs_map_t *m = s->map;
+    nd->i0 = (uint16_t)(ti * RFS_SEEK_ROW_CHUNK);
+    nd->j0 = (uint16_t)(tj * RFS_SEEK_ROW_CHUNK);
+    nd->rj0 = nd->j0;
+    nd->w = (uint16_t)(m->lw - nd->i0 < RFS_SEEK_ROW_CHUNK ? m->lw - nd->i0 : RFS_SEEK_ROW_CHUNK);
+    nd->h = (uint16_t)(m->lh - nd->j0 < RFS_SEEK_ROW_CHUNK ? m->lh - nd->j0 : RFS_SEEK_ROW_CHUNK);
+    uint32_t pmask = 0u;
+    for (uint16_t r = 0; r < nd->h; ++r) {
+        uint32_t base = (uint32_t)(nd->j0 + r) * m->lw + nd->i0;
+        if (first_set(s->reach, base, base + nd->w) >= 0) {
+            pmask |= 1u << r;
+        }
+    }
+    return pmask;
+}
+
+static bool grid_max_bb(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
+{
+    const rfs_map_t *m = s->map;
+    grid_bb_t bb = {.s = s, .best = RFS_Q16_MIN, .best_idx = 0u, .found = false};
+    rfs_q16_t py;
+    rfs_map_lattice_point(m, 0, 0, &bb.x0, &py);
+    uint16_t tw = (uint16_t)((m->lw + RFS_SEEK_ROW_CHUNK - 1u) / RFS_SEEK_ROW_CHUNK);
+    uint16_t th = (uint16_t)((m->lh + RFS_SEEK_ROW_CHUNK - 1u) / RFS_SEEK_ROW_CHUNK);
+    uint32_t seed[GRID_BB_SEEDS]; /* tile numbers, highest bound first */
+    rfs_q16_t seed_ub[GRID_BB_SEEDS];
+    uint32_t ns = 0;
+    grid_node_t nd;
+    rfs_q16_t ub;
+    for (uint32_t t = 0; t < (uint32_t)tw * th; ++t) {
+        uint32_t pmask = bb_tile(s, (uint16_t)(t % tw), (uint16_t)(t / tw), &nd);
+        if (pmask == 0u) {
+            continue;
+        }
+        /* Seeds by the prediction at the tile's middle point (a bound costs more). */
+        uint16_t mi = (uint16_t)(nd.i0 + nd.w / 2u), mj = (uint16_t)(nd.j0 + nd.h / 2u);
+        rfs_q16_t cx, cy;
+        rfs_map_lattice_point(m, 0, mj, &cx, &cy);
+        cx = bb.x0 + (rfs_q16_t)mi * m->cfg.grid;
+        if (!s->model.ops->predict(s->model.self, cx, cy, &ub)) {
+            if ((pmask >> (mj - nd.j0)) & 1u) {
+                return false; /* a P-point without a prediction: the scan fails too */
+            }
+            continue;
+        }
+        if (ns == GRID_BB_SEEDS && ub <= seed_ub[ns - 1u]) {
+            continue;
+        }
+        uint32_t at = ns < GRID_BB_SEEDS ? ns++ : ns - 1u;
+        while (at > 0u && seed_ub[at - 1u] < ub) {
+            seed[at] = seed[at - 1u];
+            seed_ub[at] = seed_ub[at - 1u];
+            --at;
+        }
+        seed[at] = t;
+        seed_ub[at] = ub;
+    }
+    for (uint32_t k = 0; k < ns; ++k) {
+        uint32_t pmask = bb_tile(s, (uint16_t)(seed[k] % tw), (uint16_t)(seed[k] / tw), &nd);
+        bool ok = bb_bound(&bb, &nd, &ub);
+        if ((!ok || !bb_prunable(&bb, &nd, ub)) && !bb_node(&bb, &nd, pmask, ok, ok)) {
+            return false;
+        }
+    }
+    for (uint32_t t = 0; t < (uint32_t)tw * th; ++t) {
+        bool seeded = false;
+        for (uint32_t k = 0; k < ns; ++k) {
+            seeded = seeded || seed[k] == t;
+        }
+        uint32_t pmask = bb_tile(s, (uint16_t)(t % tw), (uint16_t)(t / tw), &nd);
+        if (seeded || pmask == 0u) {
+            continue;
+        }
+        bool ok = bb_bound(&bb, &nd, &ub);
+        if (ok && bb_prunable(&bb, &nd, ub)) {
+            continue;
+        }
+        if (!bb_node(&bb, &nd, pmask, ok, ok)) {
+            return false;
+        }
+    }
+    if (bb.found) {
+        uint16_t i = (uint16_t)(bb.best_idx % m->lw), j = (uint16_t)(bb.best_idx / m->lw);
+        rfs_map_lattice_point(m, 0, j, mx, my);
+        *mx = bb.x0 + (rfs_q16_t)i * m->cfg.grid;
+    }
+    return bb.found;
+}
+
 bool rfs_seek_grid_max(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
 {
     const rfs_model_ops_t *ops = s->model.ops;
     if (ops->row_monotone != 0) {
         return grid_max_rows(s, ops->row_monotone(s->model.self), mx, my);
+    }
+    if (ops->bound != 0) {
+        return grid_max_bb(s, mx, my);
     }
     return grid_max_scan(s, mx, my);
 }

@@ -14,11 +14,36 @@ ir() { # ir OUTNAME ARGS...: instructions inside the instrumented region
 }
 echo "models: 10,000 samples over 40 x 20 m; grid search = 12,800 lattice points (0.25 m)"
 echo "  host x86-64 instructions (callgrind, exact)"
-printf "  %-7s %15s %15s %13s\n" model "full relearn" "grid search" "per point"
+echo "  predict all: a prediction at every point; full scan: rfs_seek_grid_max_scan();"
+echo "  search: rfs_seek_grid_max() (row shortcut for ridge, branch and bound for knn/radius)"
+printf "  %-7s %13s %13s %9s %13s %13s %7s\n" model "full relearn" "predict all" "/point" \
+    "full scan" "search" "ratio"
 for m in ridge mlp knn radius; do
     r=$(ir "r_$m" relearn "$m")
     g=$(ir "g_$m" grid "$m")
-    printf "  %-7s %15s %15s %13s\n" "$m" "$r" "$g" "$(awk -v g="$g" 'BEGIN{printf "%.0f", g/12800}')"
+    sc=$(ir "sc_$m" scan "$m")
+    se=$(ir "se_$m" search "$m")
+    # the three searches must agree on the maximum
+    if ! cmp -s <(grep '^max' "$tmp/sc_$m.out") <(grep '^max' "$tmp/se_$m.out"); then
+        echo "bench_models: $m: search and full scan disagree" >&2
+        exit 1
+    fi
+    printf "  %-7s %13s %13s %9s %13s %13s %7s\n" "$m" "$r" "$g" \
+        "$(awk -v g="$g" 'BEGIN{printf "%.0f", g/12800}')" "$sc" "$se" \
+        "$(awk -v a="$sc" -v b="$se" 'BEGIN{printf "%.1fx", a/b}')"
+done
+echo "  the same 10,000 samples along a robot path (dense, noisy, whole dB: bench/bench_models.c)"
+printf "  %-7s %13s %13s %7s\n" model "full scan" "search" "ratio"
+for m in knn radius; do
+    sc=$(ir "pc_$m" scan "$m" path)
+    se=$(ir "pe_$m" search "$m" path)
+    if ! cmp -s <(grep '^max' "$tmp/pc_$m.out") <(grep '^max' "$tmp/pe_$m.out")
+    then
+        echo "bench_models: $m on a path: search and full scan disagree" >&2
+        exit 1
+    fi
+    printf "  %-7s %13s %13s %7s\n" "$m" "$sc" "$se" \
+        "$(awk -v a="$sc" -v b="$se" 'BEGIN{printf "%.1fx", a/b}')"
 done
 for b in 100 1000; do
     s=$(ir "s_mlp_$b" slice mlp "$b")

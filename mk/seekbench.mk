@@ -1,10 +1,10 @@
 # Seeking-efficacy benchmark (issue 7): every strategy on every shipped scenario, noise
 # and shadowing sweeps, internal models, bridging -> docs/RESULTS.md, docs/figures/seek_*.
 # Not part of `make test` (minutes); a 2-seed smoke run of the same script is.
-#   make bench-seek [SEEK_SEEDS=200] [SEEK_MODEL_SEEDS=200] [SEEK_SLOW_SEEDS=10] [SEEK_JOBS=2]
+#   make bench-seek [SEEK_SEEDS=200] [SEEK_MODEL_SEEDS=200] [SEEK_SLOW_SEEDS=30] [SEEK_JOBS=2]
 SEEK_SEEDS ?= 200
 SEEK_MODEL_SEEDS ?= $(SEEK_SEEDS)
-SEEK_SLOW_SEEDS ?= 10
+SEEK_SLOW_SEEDS ?= 30
 SEEK_JOBS ?= 2
 
 .PHONY: bench-seek

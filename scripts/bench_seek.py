@@ -6,7 +6,7 @@ Runs every strategy on every shipped scenario with the simulator's batch mode
 levels, the internal models, and the bridging target; then writes the tables
 (docs/RESULTS.md) and figures (docs/figures/seek_*.png).
 
-  scripts/bench_seek.py [--seeds 200] [--model-seeds 200] [--slow-model-seeds 10]
+  scripts/bench_seek.py [--seeds 200] [--model-seeds 200] [--slow-model-seeds 30]
                         [--jobs 2] [--bin build/bin/rfseek-sim]
   scripts/bench_seek.py --smoke --bin build-x/bin/rfseek-sim    (2 seeds, a self-check)
 
@@ -457,7 +457,7 @@ def main():
     ap.add_argument("--seeds", type=int, default=200, help="seeds per strategy x scenario")
     ap.add_argument("--noise-seeds", type=int, default=None, help="seeds per noise point")
     ap.add_argument("--model-seeds", type=int, default=None, help="seeds per model x scenario")
-    ap.add_argument("--slow-model-seeds", type=int, default=10, help="seeds for mlp and knn")
+    ap.add_argument("--slow-model-seeds", type=int, default=30, help="seeds for mlp and knn")
     ap.add_argument("--bridge-seeds", type=int, default=None, help="seeds for bridging")
     ap.add_argument("--jobs", type=int, default=2, help="worker processes (both cores: 2)")
     ap.add_argument("--results", default="docs/RESULTS.md", help="markdown output")
@@ -703,10 +703,11 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
     A("![bridging](figures/seek_bridge.png)\n")
     A("## Internal models (strategy meta)\n")
     A("Models from the registry common/rfs_models.h (`--model NAME`). %d seeds each, "
-      "except mlp and knn: %d seeds (they are slow in the simulator: the MLP's sliced "
-      "training and the kNN's grid search over every lattice point cost seconds per run); "
-      "their CIs are correspondingly wide. The ridge rows are the meta runs above (seeds "
-      "1..N of the same runs).\n"
+      "except mlp and knn: %d seeds (a run costs 1-4 s of CPU: the MLP's training of 3 "
+      "epochs over up to 10,000 samples at every relearn, the kNN's grid search over "
+      "every lattice point), so their CIs are wider. The ridge rows are the meta runs "
+      "above (seeds 1..N of the same runs). `meta-path` with the path-loss model is in "
+      "the strategy tables above.\n"
       % (ms, args.slow_model_seeds))
     for sc in scenarios:
         A("### %s\n" % sc)

@@ -667,7 +667,7 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
              * below 2^53 (weights <= 2^16 times Huber values < 2^36, plus the P0 term);
              * (loss / bins) * hold_k (Q16 <= 2^22) saturates rather than wrap. */
             rfs_pathloss_cand_t cd;
-            used += eval_units(p, p->best.li, p->best.lj, -1, &cd);
+            (void)eval_units(p, p->best.li, p->best.lj, -1, &cd); /* the fit ends here */
             uint64_t per = rfs_udiv64((uint64_t)p->cur.loss, p->nbins);
             uint64_t thr = per >= ((uint64_t)1 << 41)
                                ? UINT64_MAX

@@ -204,6 +204,20 @@ bool rfs_seek_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm, rfs_
     return true;
 }
 
+/* A receiver report is a measurement without a value (issue 10): it keeps the stream
+ * fresh and touches neither the 1 s windows nor the store. Ordering as for measurements
+ * (rfs_rssi_push): older than the newest report is rejected, equal is accepted. */
+bool rfs_seek_on_receiver(rfs_seek_t *s, int64_t t_us)
+{
+    if (s->have_rx && t_us < s->last_rx_us) {
+        s->rx_rejected = s->rx_rejected < UINT32_MAX ? s->rx_rejected + 1u : UINT32_MAX;
+        return false;
+    }
+    s->last_rx_us = t_us;
+    s->have_rx = true;
+    return true;
+}
+
 /* Nearest legal lattice point to (x, y), searching rings up to SNAP_RADIUS; when
  * need_reach, it must also be marked reachable. */
 static bool snap_legal(const rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y, bool need_reach,
@@ -1481,6 +1495,27 @@ static bool apart(int64_t a, int64_t b, int64_t limit)
     return d > (uint64_t)limit;
 }
 
+/* b - a > limit: stamp b further ahead of now a than limit (a clock jump, issue 9). */
+static bool ahead(int64_t a, int64_t b, int64_t limit)
+{
+    return b > a && apart(a, b, limit);
+}
+
+/* The measurement stream is stale when neither a measurement nor a receiver report
+ * (issue 10) lies within rssi_timeout_us of now, or when either newest stamp lies further
+ * ahead than that: the feed's clock jumped, and while it is the newest every real input
+ * is rejected as out of order. Without reports (have_rx false) this is exactly the
+ * measurement-only rule: stale when there is none or it is apart from now. */
+static bool meas_stale(const rfs_seek_t *s, int64_t now_us)
+{
+    int64_t lim = s->cfg.rssi_timeout_us;
+    bool meas_fresh = s->have_meas && !apart(now_us, s->last_meas_us, lim);
+    bool rx_fresh = s->have_rx && !apart(now_us, s->last_rx_us, lim);
+    bool jumped = (s->have_meas && ahead(now_us, s->last_meas_us, lim)) ||
+                  (s->have_rx && ahead(now_us, s->last_rx_us, lim));
+    return jumped || !(meas_fresh || rx_fresh);
+}
+
 /* a - b saturated to [0, INT64_MAX]. */
 static int64_t elapsed(int64_t a, int64_t b)
 {
@@ -1501,11 +1536,11 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
      * issue 9): while it is the newest, every real input is rejected as out of order and
      * the pose would freeze with the wheels still driving. */
     bool pose_stale = !s->have_pose || apart(now_us, s->pose.t_us, s->cfg.pose_timeout_us);
-    bool meas_stale = !s->have_meas || apart(now_us, s->last_meas_us, s->cfg.rssi_timeout_us);
+    bool rssi_stale = meas_stale(s, now_us);
     if (pose_stale) {
         out->faults |= RFS_SEEK_FAULT_POSE_STALE;
     }
-    if (meas_stale) {
+    if (rssi_stale) {
         out->faults |= RFS_SEEK_FAULT_RSSI_STALE;
     }
     if (s->have_pose && !rfs_map_point_legal(s->map, s->pose.x, s->pose.y)) {
@@ -1514,7 +1549,7 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
             out->faults |= RFS_SEEK_FAULT_OFF_MAP;
         }
     }
-    if (pose_stale || meas_stale) {
+    if (pose_stale || rssi_stale) {
         if (s->state == RFS_SEEK_DRIVING && s->drive.status == RFS_DRIVE_RUNNING) {
             s->resume = true;
             s->resume_path = s->drive.path;

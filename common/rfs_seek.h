@@ -13,7 +13,9 @@
  * current time and its randomness source; each call returns the wheel command. An
  * iteration of the algorithm is one goal: it is decided when the previous goal ends
  * (reached, timed out or blocked) and then driven to. The decision carries its reason.
- * Wheels are commanded to zero while pose or measurements are stale.
+ * Wheels are commanded to zero while pose or measurements are stale. A receiver that
+ * reports itself up (rfs_seek_on_receiver) keeps the measurement stream fresh without
+ * packets: in a radio dead zone "no packet here" is an observation, not a failed sensor.
  */
 #ifndef RFS_SEEK_H
 #define RFS_SEEK_H
@@ -53,7 +55,8 @@ typedef struct rfs_seek_cfg {
     rfs_q16_t eps_rate;         ///< per iteration, Q16.16: ln(9/4)/5 so epsilon(5) = 0.5
     rfs_q16_t novelty_radius;   ///< epsilon goals keep this far from past positions (0.5 m)
     int64_t pose_timeout_us;    ///< pose older than this is stale: wheels stop (150 ms)
-    int64_t rssi_timeout_us;    ///< no measurement for this long is stale: wheels stop (150 ms)
+    int64_t rssi_timeout_us;    ///< no measurement and no receiver report for this long is
+                                ///< stale: wheels stop (150 ms)
     uint32_t fit_budget;        ///< work units per control period for model learning (0 = all)
     rfs_rssi_cfg_t rssi;        ///< averaging window (1 s)
     rfs_store_cfg_t store;      ///< sample store (10,000 samples)
@@ -101,7 +104,7 @@ typedef enum rfs_seek_kind {
 
 /// Controller state.
 typedef enum rfs_seek_state {
-    RFS_SEEK_WAITING = 0, ///< no pose or no measurement yet
+    RFS_SEEK_WAITING = 0, ///< no pose, or neither a measurement nor a receiver report yet
     RFS_SEEK_STALE,       ///< inputs went stale: wheels stopped
     RFS_SEEK_LEARNING,    ///< a sliced fit is in progress: wheels stopped
     RFS_SEEK_DRIVING,     ///< following the current goal
@@ -110,7 +113,8 @@ typedef enum rfs_seek_state {
 /// Fault flags (bits of rfs_seek_out_t.faults).
 enum {
     RFS_SEEK_FAULT_POSE_STALE = 1u << 0, ///< no pose within pose_timeout_us
-    RFS_SEEK_FAULT_RSSI_STALE = 1u << 1, ///< no measurement within rssi_timeout_us
+    RFS_SEEK_FAULT_RSSI_STALE = 1u << 1, ///< no measurement nor receiver report within
+                                         ///< rssi_timeout_us (or one stamped beyond it ahead)
     RFS_SEEK_FAULT_NO_GOAL = 1u << 2,    ///< no legal, reachable goal was found
     RFS_SEEK_FAULT_OFF_MAP = 1u << 3,    ///< the robot's position is not on the known map
 };
@@ -174,6 +178,9 @@ typedef struct rfs_seek {
     bool have_pose;                           ///< pose is valid
     int64_t last_meas_us;                     ///< time of the latest accepted measurement
     bool have_meas;                           ///< a measurement has been accepted
+    int64_t last_rx_us;                       ///< latest accepted receiver report, microseconds
+    bool have_rx;                             ///< a receiver report has been accepted
+    uint32_t rx_rejected;                     ///< receiver reports older than the latest
     rfs_seek_state_t state;                   ///< controller state
     uint32_t iteration;                       ///< next iteration number
     bool fitting;                             ///< a sliced fit is in progress
@@ -223,6 +230,14 @@ bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng);
 /// A measurement from source `src` (index into the target's sources) arrived.
 /// false when rejected (bad source, out of order).
 bool rfs_seek_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm, rfs_rng_t *rng);
+
+/// The receiver is up and listening at t_us, whether or not it heard a packet (a
+/// heartbeat, e.g. once per control period). Keeps the measurement stream fresh like a
+/// measurement does, but adds no sample and never makes a 1 s mean valid: in a radio
+/// dead zone the current goal is driven on and decisions are made without a mean.
+/// false when rejected (older than the latest report; equal stamps are accepted, as for
+/// measurements). A caller that never calls it gets the measurement-only rule.
+bool rfs_seek_on_receiver(rfs_seek_t *s, int64_t t_us);
 
 /// One control period at now_us: decide when the current goal has ended, drive, and
 /// report. Cannot fail.

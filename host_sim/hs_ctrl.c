@@ -46,6 +46,12 @@ static void ip_on_rssi(void *self, uint8_t src, int64_t t_us, int8_t dbm)
     rfs_seek_on_rssi(&p->seek, src, t_us, dbm, &p->rng);
 }
 
+static void ip_on_receiver(void *self, int64_t t_us)
+{
+    inproc_t *p = self;
+    rfs_seek_on_receiver(&p->seek, t_us);
+}
+
 static void ip_step(void *self, int64_t now_us, hs_ctrl_out_t *out)
 {
     inproc_t *p = self;
@@ -167,6 +173,7 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
     c->period_us = cfg->period_us;
     c->on_pose = ip_on_pose;
     c->on_rssi = ip_on_rssi;
+    c->on_receiver = ip_on_receiver;
     c->step = ip_step;
     c->predict = ip_predict;
     c->close = ip_close;

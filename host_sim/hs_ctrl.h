@@ -37,6 +37,9 @@ typedef struct hs_ctrl {
     void (*on_pose)(void *self, const rfs_pose_t *pose);
     /// A received packet from source `src` (index in scenario order) at t_us with dbm.
     void (*on_rssi)(void *self, uint8_t src, int64_t t_us, int8_t dbm);
+    /// Optional (may be NULL): the receiver is up and listening at t_us, packet or not
+    /// (issue 10: a heartbeat keeps a radio dead zone from reading as a failed sensor).
+    void (*on_receiver)(void *self, int64_t t_us);
     /// One control period at now_us: the wheel command and the latest decision.
     void (*step)(void *self, int64_t now_us, hs_ctrl_out_t *out);
     /// Optional (may be NULL): the model's prediction at (x, y) in target units Q16.16,

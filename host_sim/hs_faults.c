@@ -151,8 +151,8 @@ void hs_faults_start(hs_faults_run_t *r, const hs_faults_cfg_t *cfg, uint64_t se
     r->log = log;
     rfs_rng_seed(&r->rng, seed ^ 0x5A17C0FFEE000005ull);
     if (log) {
-        // Columns by event: rssi t_stamp src dbm; pose t_stamp x y theta; cmd left right
-        // delivered state faults; motor stopped; fault_begin/fault_end kind index;
+        // Columns by event: rssi t_stamp src dbm; pose t_stamp x y theta; receiver t_stamp;
+        // cmd left right delivered state faults; motor stopped; fault_begin/fault_end kind index;
         // kidnap/source_move x y theta|source.
         fprintf(log, "t_s\tevent\ta\tb\tc\td\te\n");
     }
@@ -222,6 +222,30 @@ unsigned hs_faults_rssi(hs_faults_run_t *r, int64_t t_us, uint8_t src, int8_t db
         log_rssi(r, t_us, &out[i]);
     }
     return n;
+}
+
+bool hs_faults_receiver(hs_faults_run_t *r, int64_t t_us, int64_t *stamp_us)
+{
+    windows(r, t_us);
+    if (active(r, HS_FAULT_RSSI_SILENCE, t_us)) {
+        return false;
+    }
+    // The same feed and clock as the packets; reordering swaps packets, not the feed's
+    // own liveness, so a heartbeat is never held back.
+    int64_t ts = t_us;
+    const hs_fault_t *past = active(r, HS_FAULT_RSSI_PAST, t_us);
+    if (past) {
+        ts -= us_of(past->lag_s);
+    }
+    const hs_fault_t *future = active(r, HS_FAULT_RSSI_FUTURE, t_us);
+    if (future) {
+        ts += us_of(future->lag_s);
+    }
+    if (r->log) {
+        fprintf(r->log, "%.6f\treceiver\t%.6f\t\t\t\t\n", t_us * 1e-6, ts * 1e-6);
+    }
+    *stamp_us = ts;
+    return true;
 }
 
 unsigned hs_faults_pose(hs_faults_run_t *r, const rfs_pose_t *pose, hs_faults_msg_t out[2])

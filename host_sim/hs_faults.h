@@ -126,6 +126,12 @@ void hs_faults_start(hs_faults_run_t *r, const hs_faults_cfg_t *cfg, uint64_t se
 unsigned hs_faults_rssi(hs_faults_run_t *r, int64_t t_us, uint8_t src, int8_t dbm,
                         hs_faults_msg_t out[2]);
 
+/// The simulated receiver reports itself up at t_us (issue 10, the controller's heartbeat).
+/// true with *stamp_us = the timestamp the controller sees, as a packet's would be (lagged
+/// by rssi_past, led by rssi_future); false during rssi_silence: a dead receiver or feed
+/// sends no heartbeat either. Logged as a `receiver` row.
+bool hs_faults_receiver(hs_faults_run_t *r, int64_t t_us, int64_t *stamp_us);
+
 /// A localisation pose (time in pose->t_us) was produced. Writes the poses to deliver now,
 /// in order, to out[0..1] and returns how many (0, 1 or 2).
 unsigned hs_faults_pose(hs_faults_run_t *r, const rfs_pose_t *pose, hs_faults_msg_t out[2]);

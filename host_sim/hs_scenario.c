@@ -208,6 +208,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->pose_sigma_xy_m = 0.05;
     sc->pose_sigma_theta_rad = 0.02;
     sc->radio = hs_radio_cfg_default();
+    sc->rx_heartbeat = true;          // issue 10: a listening receiver reports itself up
     sc->motor = hs_motor_cfg_default();
     sc->stop_radius_m = 1.5;          // issue 3 stop condition
     sc->stop_distance_m = 150.0;
@@ -217,7 +218,9 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->clearance_m = 0.25;           // paper defaults (PREAMBLE): 0.25 m clearance
 }
 
-static int parse_radio(pctx_t *p, yaml_node_t *r, hs_radio_cfg_t *c)
+/// radio: the radio model, and radio.receiver.heartbeat (the controller's receiver
+/// reports, issue 10), which belongs to the run rather than to the radio model.
+static int parse_radio(pctx_t *p, yaml_node_t *r, hs_radio_cfg_t *c, bool *heartbeat)
 {
     static const char *const top[] = {"pathloss", "walls", "shadowing", "fading", "noise",
                                       "receiver", NULL};
@@ -275,7 +278,7 @@ static int parse_radio(pctx_t *p, yaml_node_t *r, hs_radio_cfg_t *c)
     }
     if ((n = get(p, r, "receiver"))) {
         static const char *const k[] = {"quantise", "clip", "min_dbm", "max_dbm", "loss",
-                                        "sensitivity_dbm", "loss_width_db", NULL};
+                                        "sensitivity_dbm", "loss_width_db", "heartbeat", NULL};
         if (check_keys(p, n, "radio.receiver", k) ||
             boolean(p, n, "radio.receiver", "quantise", &c->quantise) ||
             boolean(p, n, "radio.receiver", "clip", &c->clip) ||
@@ -283,7 +286,8 @@ static int parse_radio(pctx_t *p, yaml_node_t *r, hs_radio_cfg_t *c)
             num(p, n, "radio.receiver", "max_dbm", -127, 127, &c->rx_max_dbm) ||
             boolean(p, n, "radio.receiver", "loss", &c->loss) ||
             num(p, n, "radio.receiver", "sensitivity_dbm", -200, 100, &c->sensitivity_dbm) ||
-            num(p, n, "radio.receiver", "loss_width_db", 0.01, 50, &c->loss_width_db)) {
+            num(p, n, "radio.receiver", "loss_width_db", 0.01, 50, &c->loss_width_db) ||
+            boolean(p, n, "radio.receiver", "heartbeat", heartbeat)) {
             return -1;
         }
         if (c->rx_min_dbm >= c->rx_max_dbm) {
@@ -489,7 +493,7 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
             return -1;
         }
     }
-    if ((n = get(p, root, "radio")) && parse_radio(p, n, &sc->radio) != 0) {
+    if ((n = get(p, root, "radio")) && parse_radio(p, n, &sc->radio, &sc->rx_heartbeat) != 0) {
         return -1;
     }
     if ((n = get(p, root, "motor"))) {

@@ -18,7 +18,9 @@
  *   start: {position: [5.0, 2.0], theta: 0.0}   # required
  *   localisation: {rate_hz: 10, sigma_xy_m: 0.05, sigma_theta_rad: 0.02}
  *   radio: {pathloss: {...}, walls: {...}, shadowing: {...}, fading: {...}, noise: {...},
- *           receiver: {...}}       # every part has `enabled`; see docs/RADIO_MODEL.md
+ *           receiver: {...}}       # every part has `enabled`; see docs/RADIO_MODEL.md;
+ *                                  # receiver: {heartbeat: true} reports the receiver up to
+ *                                  # the controller every period (false: packets only)
  *   motor: {accel_m_s2: 1.0, timeout_ms: 200}
  *   stop: {radius_m: 1.5, max_distance_m: 150, max_time_s: 900, goal: [x, y]}
  *   sim: {physics_hz: 50, core_res_m: 0.1, clearance_m: 0.25}
@@ -73,6 +75,8 @@ typedef struct hs_scenario {
     double pose_sigma_xy_m;       ///< localisation noise per axis, metres (0.05)
     double pose_sigma_theta_rad;  ///< heading noise, radians (0.02)
     hs_radio_cfg_t radio;         ///< radio model
+    bool rx_heartbeat;            ///< radio.receiver.heartbeat: the controller is told the
+                                  ///< receiver is up every control period (true; issue 10)
     hs_motor_cfg_t motor;         ///< motor-controller model
     double stop_radius_m;         ///< reached within this of the goal (1.5; 0 = off)
     double stop_distance_m;       ///< stop after this much travel (150; 0 = off)

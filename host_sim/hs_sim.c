@@ -681,6 +681,12 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
             } else {
                 ctrl_k++;
                 next_ctrl = (int64_t)ctrl_k * ctrl->period_us;
+                // The receiver is up unless a fault silenced it (issue 10): in a dead zone
+                // the controller hears "listening, nothing heard", not a failed sensor.
+                int64_t rx_us;
+                if (sc->rx_heartbeat && ctrl->on_receiver && hs_faults_receiver(&fr, te, &rx_us)) {
+                    ctrl->on_receiver(ctrl->self, rx_us);
+                }
                 hs_ctrl_out_t out;
                 memset(&out, 0, sizeof out);
                 ctrl->step(ctrl->self, te, &out);

@@ -24,13 +24,14 @@ import subprocess
 import sys
 import tempfile
 
-# Per faults.tsv: commands, commands with an input older than 200 ms, non-zero ones among
-# them, and the longest wait from the last delivered command to a motor timeout (seconds).
+# Per faults.tsv: commands, commands with an input older than 200 ms (a receiver heartbeat,
+# issue 10, keeps the RSSI stream fresh like a packet), non-zero ones among them, and the
+# longest wait from the last delivered command to a motor timeout (seconds).
 AWK = r'''
 BEGIN { FS = "\t"; pm = -1e18; rm = -1e18; ld = -1e18; worst = 0 }
 NR == 1 { next }
 $2 == "pose" { if ($3 + 0 > pm) pm = $3 + 0; next }
-$2 == "rssi" { if ($3 + 0 > rm) rm = $3 + 0; next }
+$2 == "rssi" || $2 == "receiver" { if ($3 + 0 > rm) rm = $3 + 0; next }
 $2 == "cmd" {
     n++
     a = $1 - pm; b = $1 - rm; if (a < 0) a = -a; if (b < 0) b = -b

@@ -264,6 +264,215 @@ static void test_stale_inputs_stop_wheels(void **state)
     world_free(&t);
 }
 
+/* Dead zones (issue 10): the receiver reports itself up every period, with no packet.
+ * Twin seekers, same seed and the same poses: A keeps getting packets, B only receiver
+ * reports after the first second. Until A decides anew, B must drive exactly as A (the
+ * goal and the drive law do not depend on the packets), with no stale flag. */
+static void test_heartbeat_keeps_goal_without_packets(void **state)
+{
+    (void)state;
+    world_t a, b;
+    world_make(&a, 10, 10, 0, 0);
+    world_make(&b, 10, 10, 0, 0);
+    seek_make(&a, rfs_seek_cfg_default(), 11);
+    seek_make(&b, rfs_seek_cfg_default(), 11);
+    rfs_seek_out_t oa, ob;
+    int64_t now = 0;
+    for (int k = 0; k < 20; ++k) { /* 1 s at 20 Hz with packets and reports */
+        now += 50000;
+        assert_true(rfs_seek_on_receiver(&a.seek, now));
+        assert_true(rfs_seek_on_receiver(&b.seek, now));
+        feed(&a, now, 5.0, 5.0, 0, -40, &oa);
+        feed(&b, now, 5.0, 5.0, 0, -40, &ob);
+    }
+    /* The robot stands still, so the initial goal (>= 0.5 m away) is still being driven. */
+    assert_int_equal(ob.state, RFS_SEEK_DRIVING);
+    assert_int_equal(ob.decision.kind, RFS_SEEK_INITIAL);
+    double gx = D(ob.decision.goal_x), gy = D(ob.decision.goal_y);
+    assert_true(hypot(gx - 5.0, gy - 5.0) > 0.2);
+    int moving = 0;
+    for (int k = 0; k < 60; ++k) { /* 3 s: B hears nothing, its receiver is up */
+        now += 50000;
+        rfs_pose_t p = pose_at(now, 5.0, 5.0, 0);
+        assert_true(rfs_seek_on_pose(&b.seek, &p, &b.rng));
+        assert_true(rfs_seek_on_receiver(&b.seek, now));
+        rfs_seek_step(&b.seek, now, &b.rng, &ob);
+        feed(&a, now, 5.0, 5.0, 0, -40, &oa);
+        assert_int_equal(ob.faults & RFS_SEEK_FAULT_RSSI_STALE, 0);
+        assert_int_equal(ob.state, RFS_SEEK_DRIVING);
+        assert_false(ob.decided);
+        assert_false(oa.decided);
+        assert_int_equal(ob.left_mm_s, oa.left_mm_s);
+        assert_int_equal(ob.right_mm_s, oa.right_mm_s);
+        moving += (ob.left_mm_s != 0 || ob.right_mm_s != 0);
+    }
+    assert_int_equal(moving, 60);
+    /* The goal is reached with no packet for 3 s: the next decision has no 1 s mean
+     * (decide() skips the relearn comparison; with no model yet it learns one from the
+     * stored samples, as without a mean) and gives a new goal. */
+    for (int k = 0; k < 20 && !ob.decided; ++k) { /* the wheels ramp down, then it ends */
+        now += 50000;
+        rfs_pose_t p = pose_at(now, gx, gy, 0);
+        rfs_seek_on_pose(&b.seek, &p, &b.rng);
+        assert_true(rfs_seek_on_receiver(&b.seek, now));
+        rfs_seek_step(&b.seek, now, &b.rng, &ob);
+        assert_int_equal(ob.faults & RFS_SEEK_FAULT_RSSI_STALE, 0);
+    }
+    assert_true(ob.decided);
+    assert_int_equal(ob.decision.prev, RFS_DRIVE_REACHED);
+    assert_false(ob.decision.mean_valid);
+    assert_int_equal(ob.decision.iteration, 1);
+    assert_int_equal(ob.faults & (RFS_SEEK_FAULT_RSSI_STALE | RFS_SEEK_FAULT_NO_GOAL), 0);
+    assert_true(hypot(D(ob.decision.goal_x) - gx, D(ob.decision.goal_y) - gy) > 0.2);
+    world_free(&a);
+    world_free(&b);
+}
+
+/* Neither packets nor receiver reports: the wheels are at zero within 200 ms of the last
+ * input, with the RSSI fault flag (issue 6), while poses keep coming; and again when the
+ * reports stop after a stretch of reports without packets. */
+static void test_no_packet_no_heartbeat_stops_wheels(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 10, 10, 0, 0);
+    seek_make(&t, rfs_seek_cfg_default(), 11);
+    rfs_seek_out_t out;
+    int64_t now = 0;
+    for (int k = 0; k < 20; ++k) {
+        now += 50000;
+        rfs_seek_on_receiver(&t.seek, now);
+        feed(&t, now, 5.0, 5.0, 0, -40, &out);
+    }
+    assert_true(out.left_mm_s != 0 || out.right_mm_s != 0);
+    for (int phase = 0; phase < 2; ++phase) {
+        /* phase 0: both stop at once; phase 1: 1 s of reports only, then they stop. */
+        int64_t last_input = now;
+        if (phase == 1) {
+            for (int k = 0; k < 20; ++k) {
+                now += 50000;
+                rfs_pose_t p = pose_at(now, 5.0, 5.0, 0);
+                rfs_seek_on_pose(&t.seek, &p, &t.rng);
+                rfs_seek_on_receiver(&t.seek, now);
+                rfs_seek_step(&t.seek, now, &t.rng, &out);
+                assert_int_equal(out.faults & RFS_SEEK_FAULT_RSSI_STALE, 0);
+                assert_true(out.left_mm_s != 0 || out.right_mm_s != 0);
+            }
+            last_input = now;
+        }
+        int64_t stopped_at = -1;
+        for (int k = 0; k < 10; ++k) { /* 500 ms of poses only */
+            now += 50000;
+            rfs_pose_t p = pose_at(now, 5.0, 5.0, 0);
+            rfs_seek_on_pose(&t.seek, &p, &t.rng);
+            rfs_seek_step(&t.seek, now, &t.rng, &out);
+            bool zero = out.left_mm_s == 0 && out.right_mm_s == 0;
+            if (zero && (out.faults & RFS_SEEK_FAULT_RSSI_STALE) && stopped_at < 0) {
+                stopped_at = now;
+            }
+            if (stopped_at >= 0) { /* and they stay stopped */
+                assert_true(zero);
+                assert_int_equal(out.state, RFS_SEEK_STALE);
+                assert_int_equal(out.faults & RFS_SEEK_FAULT_POSE_STALE, 0);
+            }
+        }
+        assert_true(stopped_at > last_input);
+        assert_true(stopped_at - last_input <= 200000);
+        /* Inputs return (packets): the interrupted goal is driven again (the first
+         * period restarts the drive's ramp at zero). */
+        for (int k = 0; k < 2; ++k) {
+            now += 50000;
+            feed(&t, now, 5.0, 5.0, 0, -40, &out);
+            assert_int_equal(out.state, RFS_SEEK_DRIVING);
+            assert_false(out.decided);
+        }
+        assert_true(out.left_mm_s != 0 || out.right_mm_s != 0);
+    }
+    world_free(&t);
+}
+
+/* A receiver report is no measurement: a seeker that only ever hears reports has no
+ * sample, no 1 s mean at any decision, and never relearns; it explores (the initial move,
+ * then epsilon moves with no model). */
+static void test_heartbeat_never_makes_a_mean(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 10, 10, 0, 0);
+    seek_make(&t, rfs_seek_cfg_default(), 5);
+    rfs_seek_out_t out;
+    int64_t now = 0;
+    unsigned decisions = 0, moving = 0;
+    double x = 5.0, y = 5.0, gx = 5.0, gy = 5.0;
+    for (int k = 0; k < 400; ++k) { /* 20 s; the robot jumps to a goal once it moves */
+        now += 50000;
+        rfs_pose_t p = pose_at(now, x, y, 0);
+        rfs_seek_on_pose(&t.seek, &p, &t.rng);
+        assert_true(rfs_seek_on_receiver(&t.seek, now));
+        rfs_seek_step(&t.seek, now, &t.rng, &out);
+        assert_int_equal(out.faults & RFS_SEEK_FAULT_RSSI_STALE, 0);
+        if (out.left_mm_s != 0 || out.right_mm_s != 0) {
+            moving++;
+            x = gx;
+            y = gy;
+        }
+        if (out.decided) {
+            assert_false(out.decision.mean_valid);
+            assert_false(out.decision.model_valid);
+            assert_false(out.decision.relearned);
+            assert_int_equal(out.decision.kind, decisions == 0 ? RFS_SEEK_INITIAL : RFS_SEEK_EPSILON);
+            decisions++;
+            gx = D(out.decision.goal_x);
+            gy = D(out.decision.goal_y);
+        }
+    }
+    assert_true(decisions >= 3);
+    assert_true(moving > 0);
+    assert_int_equal(t.seek.store.count, 0);
+    rfs_q16_t mean;
+    assert_false(rfs_rssi_mean(&t.seek.win[0], now, &mean));
+    world_free(&t);
+}
+
+/* Report stamps follow the measurements' rules (issue 9): older than the newest is
+ * rejected, equal accepted; a newest report further ahead than the timeout (a clock jump)
+ * is stale even while packets are fresh, until the clock reaches it. */
+static void test_heartbeat_stamps(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 10, 10, 0, 0);
+    seek_make(&t, rfs_seek_cfg_default(), 11);
+    rfs_seek_out_t out;
+    int64_t now = 0;
+    for (int k = 0; k < 20; ++k) {
+        now += 50000;
+        assert_true(rfs_seek_on_receiver(&t.seek, now));
+        feed(&t, now, 5.0, 5.0, 0, -40, &out);
+    }
+    assert_true(rfs_seek_on_receiver(&t.seek, now));          /* equal: accepted */
+    assert_false(rfs_seek_on_receiver(&t.seek, now - 1));     /* older: rejected */
+    assert_int_equal(t.seek.rx_rejected, 1);
+    int64_t jump = now + 5000000;                             /* 5 s ahead */
+    assert_true(rfs_seek_on_receiver(&t.seek, jump));
+    int stale = 0;
+    while (now < jump + 500000) {
+        now += 50000;
+        assert_false(rfs_seek_on_receiver(&t.seek, now < jump ? now : jump - 1));
+        feed(&t, now, 5.0, 5.0, 0, -40, &out);
+        bool flagged = (out.faults & RFS_SEEK_FAULT_RSSI_STALE) != 0;
+        /* Stale exactly while the report is more than 150 ms ahead of now. */
+        assert_int_equal(flagged, jump - now > 150000);
+        if (flagged) {
+            assert_int_equal(out.left_mm_s, 0);
+            assert_int_equal(out.right_mm_s, 0);
+            stale++;
+        }
+    }
+    assert_int_equal(stale, 96); /* now = jump - 4.95 s ... jump - 0.2 s, every 50 ms */
+    world_free(&t);
+}
+
 /* Closed loop: a 20 x 20 m hall, source 10 m away, path loss 40 + 30 log10(d) dB with
  * 4 dB Gaussian noise (double precision world, unicycle kinematics), 200 packets/s,
  * 10 Hz poses, 20 Hz control. The seeker must come within 1.5 m. */
@@ -327,6 +536,10 @@ int main(void)
         cmocka_unit_test(test_epsilon_goals_are_novel),
         cmocka_unit_test(test_blocked_step_line_search),
         cmocka_unit_test(test_stale_inputs_stop_wheels),
+        cmocka_unit_test(test_heartbeat_keeps_goal_without_packets),
+        cmocka_unit_test(test_no_packet_no_heartbeat_stops_wheels),
+        cmocka_unit_test(test_heartbeat_never_makes_a_mean),
+        cmocka_unit_test(test_heartbeat_stamps),
         cmocka_unit_test(test_grid_max_row_shortcut),
         cmocka_unit_test(test_closed_loop_reaches_source),
     };

@@ -459,8 +459,12 @@ static bool reach_bit(const uint8_t *bits, uint32_t idx)
 }
 
 /* Full scan: row by row, in chunks, so that a model with predict_row costs one call per
- * chunk and the lattice coordinates advance by addition. First strict maximum in row-major
- * order wins. */
+ * chunk and the lattice coordinates advance by addition. The paper's greedy step takes
+ * the argmax of the model over the reachable points (section 2); a point where the model
+ * has no prediction (radius: no sample within the radius, scikit-learn's NaN) is skipped,
+ * and the search fails only when no reachable point has one. predict_row returning false
+ * means no point of its chunk has a prediction (rfs_model.h: no model). First strict
+ * maximum in row-major order wins. Unreachable points are not predicted. */
 static bool grid_max_scan(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
 {
     const rfs_map_t *m = s->map;
@@ -483,21 +487,24 @@ static bool grid_max_scan(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
             if (!any) {
                 continue;
             }
-            if (ops->predict_row != 0) {
-                if (!ops->predict_row(s->model.self, cx0, py, m->cfg.grid, n, row)) {
-                    return false;
-                }
-            } else {
-                for (uint16_t k = 0; k < n; ++k) {
-                    if (!ops->predict(s->model.self, cx0 + (rfs_q16_t)k * m->cfg.grid, py,
-                                      &row[k])) {
-                        return false;
-                    }
-                }
+            bool have_row = ops->predict_row != 0 &&
+                            ops->predict_row(s->model.self, cx0, py, m->cfg.grid, n, row);
+            if (ops->predict_row != 0 && !have_row) {
+                continue;
             }
             for (uint16_t k = 0; k < n; ++k) {
-                if (reach_bit(s->reach, base + i0 + k) && (!found || row[k] > best)) {
-                    best = row[k];
+                rfs_q16_t v;
+                if (!reach_bit(s->reach, base + i0 + k)) {
+                    continue;
+                }
+                if (have_row) {
+                    v = row[k];
+                } else if (!ops->predict(s->model.self, cx0 + (rfs_q16_t)k * m->cfg.grid, py,
+                                         &v)) {
+                    continue;
+                }
+                if (!found || v > best) {
+                    best = v;
                     *mx = cx0 + (rfs_q16_t)k * m->cfg.grid;
                     *my = py;
                     found = true;
@@ -610,16 +617,27 @@ static bool grid_max_rows(const rfs_seek_t *s, int dir, rfs_q16_t *mx, rfs_q16_t
  * chunks (a tile row is one chunk), split into quadrants (see bb_node()).
  * A node is skipped when its bound cannot beat the best so far in the scan's own order
  * (bound < best, or == best and the node's first point comes after the best's), so the
- * answer is exactly grid_max_scan()'s, ties included. The scan also fails when any point
- * of a chunk holding a reachable point has no prediction ("P-points"): a true bound
- * promises predictions over its box, and every P-point outside such a box is predicted
- * here, so this search fails exactly when the scan does. The GRID_BB_SEEDS tiles whose
- * middle point predicts highest go first, to find a high maximum early; then every other
- * tile in row-major order. No memory beyond the stack (about 200 bytes). */
-/* Nodes without a bound are split down to this many points. */
-#define GRID_BB_LEAF 4
+ * answer is exactly grid_max_scan()'s, ties included: the first reachable point of
+ * greatest prediction in row-major order, points without a prediction skipped, false
+ * only when no reachable point has one. A bound that returns false promises nothing
+ * (some point may have no prediction): such a node is split and its reachable points
+ * are predicted one by one. The GRID_BB_SEEDS tiles whose middle point predicts highest
+ * go first, to find a high maximum early; then every other tile in row-major order. No
+ * memory beyond the stack (about 250 bytes). */
+/* Nodes without a bound are split down to this many points (4 x 4): down to 2 x 2 costs
+ * more than it saves on robot-path samples, where most small boxes near the path get no
+ * radius bound either (docs/PERFORMANCE.md, "Models"). */
+#define GRID_BB_LEAF 16
 /* Tiles searched first. */
 #define GRID_BB_SEEDS 4
+/* Split depths told apart when counting bounds (tile, 8 x 8, 4 x 4, smaller). */
+#define GRID_BB_DEPTHS 4u
+/* Bounds at a depth stop being asked for, for the rest of the search, once this many
+ * have been asked and fewer than one in four pruned its node: a radius bound is refused
+ * on every box wider than twice the radius and on most boxes along a robot's path, a
+ * k-neighbours bound on robot-path samples rarely prunes, and each costs a read of the
+ * samples around its box (docs/PERFORMANCE.md, "Models"). */
+#define GRID_BB_ASK 8u
 
 _Static_assert(RFS_SEEK_ROW_CHUNK <= 32, "one bit per tile row in a uint32_t");
 
@@ -629,12 +647,15 @@ typedef struct grid_bb {
     rfs_q16_t best;    /* best prediction so far, target units Q16.16 */
     uint32_t best_idx; /* its row-major lattice index */
     bool found;        /* best is valid */
+    uint32_t asked[GRID_BB_DEPTHS];  /* bounds asked for at each split depth (0: tile) */
+    uint32_t pruned[GRID_BB_DEPTHS]; /* nodes there skipped by their bound */
 } grid_bb_t;
 
 /* Lattice columns [i0, i0 + w), rows [j0, j0 + h), inside one tile whose row rj0 is bit 0
- * of the P-row mask. */
+ * of the row mask (rows holding a reachable point). */
 typedef struct grid_node {
     uint16_t i0, j0, w, h, rj0;
+    uint16_t depth; /* splits below its tile */
 } grid_node_t;
 
 static bool bb_reach_any(const rfs_seek_t *s, const grid_node_t *nd)
@@ -654,10 +675,19 @@ static uint32_t bb_rows(const grid_node_t *nd)
     return ones << (nd->j0 - nd->rj0);
 }
 
-/* Scaling: lattice coordinates as grid_max_scan() forms them (x0 + i * grid < 2^31). */
-static bool bb_bound(const grid_bb_t *bb, const grid_node_t *nd, rfs_q16_t *ub)
+/* The model's bound over the node, or false without asking when bounds at this depth have
+ * rarely pruned in this search (GRID_BB_ASK). Not asking only costs pruning: a node
+ * without a bound is searched point by point, so the answer is the same.
+ * Scaling: lattice coordinates as grid_max_scan() forms them (x0 + i * grid < 2^31);
+ * the counts are below the lattice's point count (< 2^32). */
+static bool bb_bound(grid_bb_t *bb, const grid_node_t *nd, rfs_q16_t *ub)
 {
     const rfs_map_t *m = bb->s->map;
+    uint32_t d = nd->depth < GRID_BB_DEPTHS ? nd->depth : GRID_BB_DEPTHS - 1u;
+    if (bb->asked[d] >= GRID_BB_ASK && bb->pruned[d] * 4u < bb->asked[d]) {
+        return false;
+    }
+    bb->asked[d]++;
     rfs_q16_t xa, ya, xb, yb;
     rfs_map_lattice_point(m, 0, nd->j0, &xa, &ya);
     rfs_map_lattice_point(m, 0, (uint16_t)(nd->j0 + nd->h - 1u), &xb, &yb);
@@ -666,10 +696,12 @@ static bool bb_bound(const grid_bb_t *bb, const grid_node_t *nd, rfs_q16_t *ub)
     return bb->s->model.ops->bound(bb->s->model.self, xa, ya, xb, yb, ub);
 }
 
-static bool bb_prunable(const grid_bb_t *bb, const grid_node_t *nd, rfs_q16_t ub)
+static bool bb_prunable(grid_bb_t *bb, const grid_node_t *nd, rfs_q16_t ub)
 {
     uint32_t first = (uint32_t)nd->j0 * bb->s->map->lw + nd->i0;
-    return bb->found && (ub < bb->best || (ub == bb->best && first > bb->best_idx));
+    bool skip = bb->found && (ub < bb->best || (ub == bb->best && first > bb->best_idx));
+    bb->pruned[nd->depth < GRID_BB_DEPTHS ? nd->depth : GRID_BB_DEPTHS - 1u] += skip;
+    return skip;
 }
 
 static void bb_consider(grid_bb_t *bb, rfs_q16_t v, uint32_t idx)
@@ -681,11 +713,10 @@ static void bb_consider(grid_bb_t *bb, rfs_q16_t v, uint32_t idx)
     }
 }
 
-/* Predict the node's P-rows: the reachable points as candidates, and, unless `known`
- * (a bound promised predictions here), the others only to fail as the scan would. A
- * model with predict_row gets the scan's very call (the whole chunk), so the values are
- * the scan's bit for bit. */
-static bool bb_leaf(grid_bb_t *bb, const grid_node_t *nd, uint32_t pmask, bool known)
+/* Predict the node's reachable points and take those with a prediction as candidates.
+ * A model with predict_row gets the scan's very call (the whole chunk), so the values are
+ * the scan's bit for bit; false from it skips the row as the scan skips the chunk. */
+static void bb_leaf(grid_bb_t *bb, const grid_node_t *nd, uint32_t rmask)
 {
     const rfs_seek_t *s = bb->s;
     const rfs_map_t *m = s->map;
@@ -694,48 +725,47 @@ static bool bb_leaf(grid_bb_t *bb, const grid_node_t *nd, uint32_t pmask, bool k
     uint16_t c0 = (uint16_t)(nd->i0 - nd->i0 % RFS_SEEK_ROW_CHUNK);
     uint16_t cn = (uint16_t)(m->lw - c0 < RFS_SEEK_ROW_CHUNK ? m->lw - c0 : RFS_SEEK_ROW_CHUNK);
     for (uint16_t j = nd->j0; j < nd->j0 + nd->h; ++j) {
-        if (((pmask >> (j - nd->rj0)) & 1u) == 0u) {
+        uint32_t base = (uint32_t)j * m->lw;
+        if (((rmask >> (j - nd->rj0)) & 1u) == 0u ||
+            first_set(s->reach, base + nd->i0, base + nd->i0 + nd->w) < 0) {
             continue;
         }
         rfs_q16_t x, py;
         rfs_map_lattice_point(m, 0, j, &x, &py);
-        uint32_t base = (uint32_t)j * m->lw;
         if (ops->predict_row != 0 &&
             !ops->predict_row(s->model.self, bb->x0 + (rfs_q16_t)c0 * m->cfg.grid, py,
                               m->cfg.grid, cn, row)) {
-            return false;
+            continue;
         }
         for (uint16_t i = nd->i0; i < nd->i0 + nd->w; ++i) {
-            bool r = reach_bit(s->reach, base + i);
             rfs_q16_t v;
-            if (!r && known) {
+            if (!reach_bit(s->reach, base + i)) {
                 continue;
             }
             if (ops->predict_row != 0) {
                 v = row[i - c0];
             } else if (!ops->predict(s->model.self, bb->x0 + (rfs_q16_t)i * m->cfg.grid, py,
                                      &v)) {
-                return false;
+                continue;
             }
-            if (r) {
-                bb_consider(bb, v, base + i);
-            }
+            bb_consider(bb, v, base + i);
         }
     }
-    return true;
 }
 
-/* Search a node holding P-points; known: a bound promised predictions over it, own: the
- * node's own bound did (and did not prune it). A node with its own bound is scanned whole:
- * splitting it costs four bounds, each several predictions' work, and on robot-path
- * samples (dense, noisy) the children's bounds rarely prune (docs/PERFORMANCE.md,
- * "Models"). A node without one (radius: a sample may not cover it) is split down to
- * GRID_BB_LEAF points, where smaller boxes can be covered. Children with a bound go
- * highest first (the tie rule does not depend on the order). */
-static bool bb_node(grid_bb_t *bb, const grid_node_t *nd, uint32_t pmask, bool known, bool own)
+/* Search a node holding reachable points; own: the node's own bound promised predictions
+ * over it (and did not prune it). A node with its own bound is scanned whole: splitting it
+ * costs four bounds, each several predictions' work, and on robot-path samples (dense,
+ * noisy) the children's bounds rarely prune (docs/PERFORMANCE.md, "Models"). A node
+ * without one (radius: a sample may not cover it) is split down to GRID_BB_LEAF points,
+ * where smaller boxes can be covered. Children without a reachable point are dropped
+ * before their bound is asked; children with a bound go highest first (the tie rule does
+ * not depend on the order). */
+static void bb_node(grid_bb_t *bb, const grid_node_t *nd, uint32_t rmask, bool own)
 {
     if (own || (uint32_t)nd->w * nd->h <= GRID_BB_LEAF) {
-        return bb_leaf(bb, nd, pmask, known);
+        bb_leaf(bb, nd, rmask);
+        return;
     }
     uint16_t hw = (uint16_t)((nd->w + 1u) / 2u), hh = (uint16_t)((nd->h + 1u) / 2u);
     grid_node_t ch[4];
@@ -748,13 +778,12 @@ static bool bb_node(grid_bb_t *bb, const grid_node_t *nd, uint32_t pmask, bool k
         c.w = (uint16_t)((q & 1u) ? nd->w - hw : hw);
         c.j0 = (uint16_t)(nd->j0 + ((q & 2u) ? hh : 0u));
         c.h = (uint16_t)((q & 2u) ? nd->h - hh : hh);
-        if (c.w == 0u || c.h == 0u || (pmask & bb_rows(&c)) == 0u) {
+        c.depth = (uint16_t)(nd->depth + 1u);
+        if (c.w == 0u || c.h == 0u || (rmask & bb_rows(&c)) == 0u ||
+            !bb_reach_any(bb->s, &c)) {
             continue;
         }
         ok[q] = bb_bound(bb, &c, &ub[q]);
-        if ((known || ok[q]) && !bb_reach_any(bb->s, &c)) {
-            continue; /* every point has a prediction and none is a candidate */
-        }
         ch[q] = c;
         uint32_t at = n++;
         while (at > 0u && ok[q] &&
@@ -769,30 +798,28 @@ static bool bb_node(grid_bb_t *bb, const grid_node_t *nd, uint32_t pmask, bool k
         if (ok[q] && bb_prunable(bb, &ch[q], ub[q])) {
             continue;
         }
-        if (!bb_node(bb, &ch[q], pmask, known || ok[q], ok[q])) {
-            return false;
-        }
+        bb_node(bb, &ch[q], rmask, ok[q]);
     }
-    return true;
 }
 
-/* Tile (ti, tj) and its P-row mask: bit r set when chunk row r holds a reachable point. */
+/* Tile (ti, tj) and its row mask: bit r set when chunk row r holds a reachable point. */
 static uint32_t bb_tile(const rfs_seek_t *s, uint16_t ti, uint16_t tj, grid_node_t *nd)
 {
     const rfs_map_t *m = s->map;
     nd->i0 = (uint16_t)(ti * RFS_SEEK_ROW_CHUNK);
     nd->j0 = (uint16_t)(tj * RFS_SEEK_ROW_CHUNK);
     nd->rj0 = nd->j0;
+    nd->depth = 0u;
     nd->w = (uint16_t)(m->lw - nd->i0 < RFS_SEEK_ROW_CHUNK ? m->lw - nd->i0 : RFS_SEEK_ROW_CHUNK);
     nd->h = (uint16_t)(m->lh - nd->j0 < RFS_SEEK_ROW_CHUNK ? m->lh - nd->j0 : RFS_SEEK_ROW_CHUNK);
-    uint32_t pmask = 0u;
+    uint32_t rmask = 0u;
     for (uint16_t r = 0; r < nd->h; ++r) {
         uint32_t base = (uint32_t)(nd->j0 + r) * m->lw + nd->i0;
         if (first_set(s->reach, base, base + nd->w) >= 0) {
-            pmask |= 1u << r;
+            rmask |= 1u << r;
         }
     }
-    return pmask;
+    return rmask;
 }
 
 static bool grid_max_bb(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
@@ -809,19 +836,17 @@ static bool grid_max_bb(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
     grid_node_t nd;
     rfs_q16_t ub;
     for (uint32_t t = 0; t < (uint32_t)tw * th; ++t) {
-        uint32_t pmask = bb_tile(s, (uint16_t)(t % tw), (uint16_t)(t / tw), &nd);
-        if (pmask == 0u) {
+        uint32_t rmask = bb_tile(s, (uint16_t)(t % tw), (uint16_t)(t / tw), &nd);
+        if (rmask == 0u) {
             continue;
         }
-        /* Seeds by the prediction at the tile's middle point (a bound costs more). */
+        /* Seeds by the prediction at the tile's middle point (a bound costs more); a
+         * middle point without one makes no seed (the tile is searched in order). */
         uint16_t mi = (uint16_t)(nd.i0 + nd.w / 2u), mj = (uint16_t)(nd.j0 + nd.h / 2u);
         rfs_q16_t cx, cy;
         rfs_map_lattice_point(m, 0, mj, &cx, &cy);
         cx = bb.x0 + (rfs_q16_t)mi * m->cfg.grid;
         if (!s->model.ops->predict(s->model.self, cx, cy, &ub)) {
-            if ((pmask >> (mj - nd.j0)) & 1u) {
-                return false; /* a P-point without a prediction: the scan fails too */
-            }
             continue;
         }
         if (ns == GRID_BB_SEEDS && ub <= seed_ub[ns - 1u]) {
@@ -837,10 +862,10 @@ static bool grid_max_bb(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
         seed_ub[at] = ub;
     }
     for (uint32_t k = 0; k < ns; ++k) {
-        uint32_t pmask = bb_tile(s, (uint16_t)(seed[k] % tw), (uint16_t)(seed[k] / tw), &nd);
+        uint32_t rmask = bb_tile(s, (uint16_t)(seed[k] % tw), (uint16_t)(seed[k] / tw), &nd);
         bool ok = bb_bound(&bb, &nd, &ub);
-        if ((!ok || !bb_prunable(&bb, &nd, ub)) && !bb_node(&bb, &nd, pmask, ok, ok)) {
-            return false;
+        if (!ok || !bb_prunable(&bb, &nd, ub)) {
+            bb_node(&bb, &nd, rmask, ok);
         }
     }
     for (uint32_t t = 0; t < (uint32_t)tw * th; ++t) {
@@ -848,17 +873,15 @@ static bool grid_max_bb(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
         for (uint32_t k = 0; k < ns; ++k) {
             seeded = seeded || seed[k] == t;
         }
-        uint32_t pmask = bb_tile(s, (uint16_t)(t % tw), (uint16_t)(t / tw), &nd);
-        if (seeded || pmask == 0u) {
+        uint32_t rmask = bb_tile(s, (uint16_t)(t % tw), (uint16_t)(t / tw), &nd);
+        if (seeded || rmask == 0u) {
             continue;
         }
         bool ok = bb_bound(&bb, &nd, &ub);
         if (ok && bb_prunable(&bb, &nd, ub)) {
             continue;
         }
-        if (!bb_node(&bb, &nd, pmask, ok, ok)) {
-            return false;
-        }
+        bb_node(&bb, &nd, rmask, ok);
     }
     if (bb.found) {
         uint16_t i = (uint16_t)(bb.best_idx % m->lw), j = (uint16_t)(bb.best_idx / m->lw);

@@ -245,7 +245,8 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
 
 /// The model's maximum over the reachable legal lattice (the greedy grid search, paper
 /// section 2): first strict maximum in row-major order. Uses the model's row_monotone
-/// shortcut when it has one. false when there is no model or no reachable point.
+/// shortcut when it has one. Points without a prediction are skipped; false when no
+/// reachable point has one (no model, no reachable point).
 bool rfs_seek_grid_max(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my);
 
 /// The same search by evaluating every point (the reference for the shortcut).

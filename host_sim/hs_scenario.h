@@ -7,7 +7,8 @@
  *                                  # pdr (one: packet delivery ratio, rfs_pdr.h)
  *   strategy: meta                 # meta (the paper), meta-global, fd-gradient,
  *                                  # plane-gradient, chemotaxis, meta-path
- *   seek: {recheck_m: 1.0, eps_by_travel: true, eps_rate: 0.162}  # optional: override the strategy's
+ *   seek: {recheck_m: 1.0, eps_by_travel: true, eps_rate: 0.162}
+ *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2
  *     - name: ap

@@ -5,8 +5,10 @@
  * precision here (every sample, exact squared distances, the most favourable choice at a
  * tie), at many queries inside each box, and against predict() bit for bit. The pruned
  * search is checked against the full scan (rfs_seek_grid_max_scan: same success, same
- * point, ties included) over many random sample sets, reachability patterns and both
- * modes, and its maximum against the brute force.
+ * point, ties included) over many random sample sets, reachability patterns, both modes
+ * and random holes (points without a prediction, which both searches skip), and both
+ * against a brute force that skips such points: radius exactly, k-neighbours within the
+ * range a tie allows; they fail only when no reachable point has a prediction.
  */
 #include "rfs_test.h"
 
@@ -397,103 +399,294 @@ static void set_reach(world_t *t, uint32_t kind, rfs_rng_t *r)
     }
 }
 
-/* The brute-force maximum over reachable lattice points: the largest "lo" (a value the
- * model must reach there whatever its tie choice) and the largest "hi". */
-static void ref_grid_max(const world_t *t, const rfs_knn_cfg_t *c, uint32_t n, double *lo_max,
-                         double *hi_max)
+/* A model with holes: the kNN / radius model with a prediction removed at chosen lattice
+ * points (as radius loses it where no sample lies within the radius), and a bound that
+ * refuses any box holding a hole (it could not promise a prediction there). Lets the
+ * search meet holes where the model itself would predict, in both modes. */
+typedef struct holey {
+    const rfs_knn_t *knn;
+    const uint8_t *holes; /* one bit per lattice point, row-major; set = no prediction */
+    uint16_t lw, lh;
+    rfs_q16_t x0, y0, grid; /* lattice point (0, 0) and spacing, metres Q16.16 */
+} holey_t;
+
+static holey_t g_holey;
+static uint8_t g_holes[(MAXN * 64u) / 8u];
+
+static bool holey_at(const holey_t *h, rfs_q16_t x, rfs_q16_t y)
 {
+    int64_t i = ((int64_t)x - h->x0) / h->grid, j = ((int64_t)y - h->y0) / h->grid;
+    assert_true(i >= 0 && j >= 0 && i < h->lw && j < h->lh);
+    assert_true(h->x0 + i * h->grid == x && h->y0 + j * h->grid == y); /* a lattice point */
+    uint32_t idx = (uint32_t)(j * h->lw + i);
+    return (h->holes[idx >> 3] >> (idx & 7u)) & 1u;
+}
+
+static bool holey_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *value)
+{
+    const holey_t *h = self;
+    return !holey_at(h, x, y) && rfs_knn_ops.predict(h->knn, x, y, value);
+}
+
+static bool holey_bound(const void *self, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,
+                        rfs_q16_t y1, rfs_q16_t *ub)
+{
+    const holey_t *h = self;
+    for (rfs_q16_t y = y0; y <= y1; y += h->grid) {
+        for (rfs_q16_t x = x0; x <= x1; x += h->grid) {
+            if (holey_at(h, x, y)) {
+                return false;
+            }
+        }
+    }
+    return rfs_knn_ops.bound(h->knn, x0, y0, x1, y1, ub);
+}
+
+static const rfs_model_ops_t holey_ops = {
+    .name = "holey",
+    .predict = holey_predict,
+    .bound = holey_bound,
+};
+
+/* Random holes: each lattice point with probability pct %. */
+static void make_holes(const world_t *t, uint32_t pct, rfs_rng_t *r)
+{
+    uint32_t n = (uint32_t)t->map.lw * t->map.lh;
+    assert_true(n <= sizeof g_holes * 8u);
+    memset(g_holes, 0, sizeof g_holes);
+    for (uint32_t idx = 0; idx < n; ++idx) {
+        if (rfs_rng_below(r, 100) < pct) {
+            g_holes[idx >> 3] |= (uint8_t)(1u << (idx & 7u));
+        }
+    }
+    rfs_q16_t x1, y1;
+    g_holey = (holey_t){.knn = &g_knn, .holes = g_holes, .lw = t->map.lw, .lh = t->map.lh,
+                        .grid = t->map.cfg.grid};
+    rfs_map_lattice_point(&t->map, 0, 0, &g_holey.x0, &g_holey.y0);
+    rfs_map_lattice_point(&t->map, (uint16_t)(t->map.lw - 1u), (uint16_t)(t->map.lh - 1u), &x1,
+                          &y1);
+    assert_true(x1 == g_holey.x0 + (t->map.lw - 1) * g_holey.grid);
+    assert_true(y1 == g_holey.y0 + (t->map.lh - 1) * g_holey.grid);
+}
+
+static bool hole_bit(uint32_t idx)
+{
+    return (g_holes[idx >> 3] >> (idx & 7u)) & 1u;
+}
+
+static bool reach_at(const world_t *t, uint32_t idx)
+{
+    return (t->mem.reach[idx >> 3] >> (idx & 7u)) & 1u;
+}
+
+/* How many samples lie within r8 (cm Q8) of the query, by brute force. */
+static double ref_radius_count(uint32_t n, double r8, double qx, double qy)
+{
+    double c = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        double dx = g_s[i].x_cm * 256.0 - qx, dy = g_s[i].y_cm * 256.0 - qy;
+        c += dx * dx + dy * dy <= r8 * r8;
+    }
+    return c;
+}
+
+/* The brute-force maximum over reachable lattice points with a prediction (not a hole;
+ * radius: a sample within the radius): k-neighbours, the largest "lo" (a value the model
+ * must reach there whatever its tie choice) and the largest "hi"; radius, the exact
+ * Q16.16 value (the mean rounded half away from zero, rfs_knn.h) and the first point in
+ * row-major order that has it. false when no reachable point has a prediction. */
+static bool ref_grid_max(const world_t *t, const rfs_knn_cfg_t *c, uint32_t n, bool holes,
+                         double *lo_max, double *hi_max, rfs_q16_t *rx, rfs_q16_t *ry)
+{
+    bool any = false;
     *lo_max = -INFINITY;
     *hi_max = -INFINITY;
     for (uint16_t j = 0; j < t->map.lh; ++j) {
         for (uint16_t i = 0; i < t->map.lw; ++i) {
             uint32_t idx = (uint32_t)j * t->map.lw + i;
-            if (!((t->mem.reach[idx >> 3] >> (idx & 7u)) & 1u)) {
+            if (!reach_at(t, idx) || (holes && hole_bit(idx))) {
                 continue;
             }
             rfs_q16_t x, y;
             rfs_map_lattice_point(&t->map, i, j, &x, &y);
             double lo, hi;
-            ref_k(n, c->k, q8(x), q8(y), &lo, &hi);
+            if (c->mode == RFS_KNN_RADIUS) {
+                double mean, count;
+                if (!ref_radius(n, D(c->radius) * 25600.0, q8(x), q8(y), &mean)) {
+                    continue;
+                }
+                count = ref_radius_count(n, D(c->radius) * 25600.0, q8(x), q8(y));
+                double v = round(mean * count * 64.0) * 1024.0 / count; /* sum: integer */
+                lo = hi = (v < 0 ? -floor(-v + 0.5) : floor(v + 0.5)) / 65536.0;
+            } else {
+                ref_k(n, c->k, q8(x), q8(y), &lo, &hi);
+            }
+            if (!any || hi > *hi_max) {
+                *rx = x;
+                *ry = y;
+            }
             *lo_max = fmax(*lo_max, lo);
             *hi_max = fmax(*hi_max, hi);
+            any = true;
         }
     }
+    return any;
 }
 
 /* The pruned search finds exactly the full scan's point (or fails exactly when it does),
  * over maps whose lattice is and is not a multiple of the tile, sample sets with and
- * without many equal predictions, every reachability pattern and both modes. */
+ * without many equal predictions, every reachability pattern, both modes and random holes
+ * (none, 3 %, 40 %); both are checked against the brute force: radius exactly (the first
+ * point of greatest prediction, skipping points without one), k-neighbours within the
+ * range a tie allows. */
 static void pruned_search_equals_full_scan(void **state)
 {
     (void)state;
     static const double sizes[][2] = {{12.0, 8.0}, {9.3, 7.1}, {20.0, 5.0}};
+    static const uint32_t hole_pct[] = {0, 3, 40};
     rfs_rng_t r;
     rfs_rng_seed(&r, 4242);
-    uint32_t found = 0, failed = 0, radius_found = 0, brute = 0;
+    uint32_t found = 0, failed = 0, radius_found = 0, holes_found = 0, brute = 0;
     for (uint32_t m = 0; m < 3; ++m) {
         world_t t;
         world_make(&t, sizes[m][0], sizes[m][1], m == 0 ? 6.0 : 0.0, 6.0);
         seek_make(&t, rfs_seek_cfg_default(), 5);
         for (uint32_t trial = 0; trial < 90; ++trial) {
             bool radius = trial % 3u == 2u;
+            uint32_t pct = hole_pct[(trial / 4u) % 3u];
             uint32_t n = radius ? (trial % 2u ? 2500u : 300u) : 20u + rfs_rng_below(&r, 1500);
+            if (radius && trial % 8u == 2u) {
+                n = 5u + rfs_rng_below(&r, 40); /* sparse: most points without a sample */
+            }
             make_samples(n, trial % 4u, sizes[m][0], sizes[m][1], trial % 2u ? 2u : 0u, &r);
             rfs_knn_cfg_t c = radius ? rfs_knn_cfg_radius_default() : rfs_knn_cfg_default();
             c.k = (uint8_t)(1u + rfs_rng_below(&r, 12));
             c.radius = trial % 4u == 2u ? Q(2.5) : Q(1.0);
             fit(&c, n);
-            t.seek.model = rfs_knn_model(&g_knn);
+            make_holes(&t, pct, &r);
+            t.seek.model = pct ? (rfs_model_t){.ops = &holey_ops, .self = &g_holey}
+                               : rfs_knn_model(&g_knn);
             set_reach(&t, trial % 4u, &r);
-            rfs_q16_t ax = 0, ay = 0, bx = 0, by = 0;
+            bool check = radius || (trial % 5u == 0u && n <= 600u);
+            double lo_max = 0, hi_max = 0;
+            rfs_q16_t ax = 0, ay = 0, bx = 0, by = 0, rx = 0, ry = 0;
+            bool want = check && ref_grid_max(&t, &c, n, pct > 0u, &lo_max, &hi_max, &rx, &ry);
 
             bool a = rfs_seek_grid_max(&t.seek, &ax, &ay);
             bool b = rfs_seek_grid_max_scan(&t.seek, &bx, &by);
 
             assert_int_equal(a, b);
+            if (check) {
+                assert_int_equal(a, want);
+            }
             if (!a) {
                 failed++;
                 continue;
             }
             found++;
             radius_found += radius;
+            holes_found += pct > 0u;
             if (ax != bx || ay != by) {
                 fail_msg("map %u trial %u: pruned (%.3f, %.3f), full scan (%.3f, %.3f)", m,
                          trial, D(ax), D(ay), D(bx), D(by));
             }
-            if (!radius && trial % 5u == 0u && n <= 600u) {
-                double lo_max, hi_max;
-                rfs_q16_t v;
-                ref_grid_max(&t, &c, n, &lo_max, &hi_max);
-                assert_true(rfs_knn_ops.predict(&g_knn, ax, ay, &v));
-                assert_true(v / 65536.0 >= lo_max - 0.5 / 65536.0 - 1e-9);
-                assert_true(v / 65536.0 <= hi_max + 0.5 / 65536.0 + 1e-9);
-                brute++;
+            if (!check) {
+                continue;
             }
+            rfs_q16_t v;
+            assert_true(t.seek.model.ops->predict(t.seek.model.self, ax, ay, &v));
+            if (radius && (ax != rx || ay != ry || D(v) != hi_max)) {
+                fail_msg("map %u trial %u: search (%.3f, %.3f) = %.6f, brute force (%.3f, "
+                         "%.3f) = %.6f", m, trial, D(ax), D(ay), D(v), D(rx), D(ry), hi_max);
+            }
+            assert_true(v / 65536.0 >= lo_max - 0.5 / 65536.0 - 1e-9);
+            assert_true(v / 65536.0 <= hi_max + 0.5 / 65536.0 + 1e-9);
+            brute++;
         }
         world_free(&t);
     }
-    assert_true(found > 150u && failed > 10u && radius_found > 10u && brute > 5u);
+    assert_true(found > 150u && failed > 5u && radius_found > 40u && holes_found > 80u &&
+                brute > 60u);
 }
 
-/* Without a model both searches fail. */
+/* Radius samples along a short robot walk in one corner of an open map: most reachable
+ * points have no sample within 1 m, yet the search yields the brute-force maximum (the
+ * greedy step of the paper, section 2, over the points the model predicts at). */
+static void radius_with_holes_still_has_maximum(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 12.0, 8.0, 0.0, 0.0);
+    seek_make(&t, rfs_seek_cfg_default(), 5);
+    rfs_rng_t r;
+    rfs_rng_seed(&r, 8);
+    make_samples(400, 1, 3.0, 2.0, 0, &r); /* a walk over [0, 3] x [0, 2] m */
+    rfs_knn_cfg_t c = rfs_knn_cfg_radius_default();
+    fit(&c, 400);
+    t.seek.model = rfs_knn_model(&g_knn);
+    set_reach(&t, 0, &r);
+    uint32_t holes = 0, points = (uint32_t)t.map.lw * t.map.lh;
+    for (uint16_t j = 0; j < t.map.lh; ++j) {
+        for (uint16_t i = 0; i < t.map.lw; ++i) {
+            rfs_q16_t x, y;
+            double mean;
+            rfs_map_lattice_point(&t.map, i, j, &x, &y);
+            holes += !ref_radius(400, 25600.0, q8(x), q8(y), &mean);
+        }
+    }
+    assert_true(holes > points / 2u); /* every chunk of the lattice's upper rows is empty */
+    double lo_max, hi_max;
+    rfs_q16_t rx = 0, ry = 0, ax = 0, ay = 0, bx = 0, by = 0;
+    assert_true(ref_grid_max(&t, &c, 400, false, &lo_max, &hi_max, &rx, &ry));
+
+    bool a = rfs_seek_grid_max(&t.seek, &ax, &ay);
+    bool b = rfs_seek_grid_max_scan(&t.seek, &bx, &by);
+
+    assert_true(a);
+    assert_true(b);
+    assert_int_equal(ax, rx);
+    assert_int_equal(ay, ry);
+    assert_int_equal(bx, rx);
+    assert_int_equal(by, ry);
+    world_free(&t);
+}
+
+/* Without a model both searches fail (also through predict_row: the unfitted ridge); with
+ * holes at every reachable point too; one point with a prediction is the answer. */
 static void pruned_search_fails_without_model(void **state)
 {
     (void)state;
     world_t t;
     world_make(&t, 6.0, 4.0, 0.0, 0.0);
     seek_make(&t, rfs_seek_cfg_default(), 5);
-    rfs_knn_cfg_t c = rfs_knn_cfg_default();
-    assert_int_equal(rfs_knn_init(&g_knn, &c), 0);
-    t.seek.model = rfs_knn_model(&g_knn);
     rfs_rng_t r;
     rfs_rng_seed(&r, 1);
     set_reach(&t, 0, &r);
     rfs_q16_t x, y;
+    assert_true(t.seek.model.ops->predict_row != 0);
+    assert_false(rfs_seek_grid_max_scan(&t.seek, &x, &y));
+    rfs_knn_cfg_t c = rfs_knn_cfg_default();
+    assert_int_equal(rfs_knn_init(&g_knn, &c), 0);
+    t.seek.model = rfs_knn_model(&g_knn);
 
     bool a = rfs_seek_grid_max(&t.seek, &x, &y);
 
     assert_false(a);
     assert_false(rfs_seek_grid_max_scan(&t.seek, &x, &y));
+
+    make_samples(50, 0, 6.0, 4.0, 0, &r);
+    fit(&c, 50);
+    make_holes(&t, 100, &r);
+    t.seek.model = (rfs_model_t){.ops = &holey_ops, .self = &g_holey};
+    assert_false(rfs_seek_grid_max(&t.seek, &x, &y));
+    assert_false(rfs_seek_grid_max_scan(&t.seek, &x, &y));
+    g_holes[0] &= (uint8_t)~1u; /* lattice point (0, 0) has a prediction again */
+    assert_true(rfs_seek_grid_max(&t.seek, &x, &y));
+    assert_int_equal(x, g_holey.x0);
+    assert_int_equal(y, g_holey.y0);
+    assert_true(rfs_seek_grid_max_scan(&t.seek, &x, &y));
+    assert_int_equal(x, g_holey.x0);
+    assert_int_equal(y, g_holey.y0);
     world_free(&t);
 }
 
@@ -505,6 +698,7 @@ int main(void)
         cmocka_unit_test(bound_refused_without_model),
         cmocka_unit_test(kneighbors_ties_as_ring_scan),
         cmocka_unit_test(pruned_search_equals_full_scan),
+        cmocka_unit_test(radius_with_holes_still_has_maximum),
         cmocka_unit_test(pruned_search_fails_without_model),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -399,12 +399,170 @@ static bool mlp_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *v
     return true;
 }
 
+/* --- Upper bound over a box (the grid search's branch and bound, issue 8) ----------- */
+
+/* The bound follows mlp_predict() step by step. Every step before the output sum is
+ * monotone (standardise, the pre-activation's rounding and saturation, the sigmoid: its
+ * monotonicity is tested exhaustively), and so is every step after it (rshr, rfs_sat32,
+ * rfs_q16_mul by out_std > 0, rfs_q16_add), so a true upper bound of forward()'s int64
+ * output sum `acc` (Q40) gives one of the prediction, bit for bit. Two bounds of acc, the
+ * smaller is used:
+ * - interval: each pre-activation p_j is linear in the standardised inputs, so its range
+ *   [l_j, u_j] over the box is exact from the corners; h_j = S(p_j) is in [S(l_j), S(u_j)]
+ *   and acc <= c + sum_j v_j S(u_j or l_j), exact. Loose on large boxes: every unit takes
+ *   its best end at once (tens of dB over a 3.75 m tile).
+ * - linear relaxation (a first-order Taylor bound, as neural-network verifiers use): for
+ *   a unit whose range is inside +-16, with m_j the middle of [l_j, u_j] and
+ *   R_j = max |p - m_j|, the exact logistic sigma gives (Lagrange remainder)
+ *     v S(p) <= v S(m) + v sigma'(m) (p - m) + |v| (2 E + C R^2 / 2)
+ *   (in LSB of Q16), E the table's error against sigma (<= 1.27 LSB, tested; 2 charged),
+ *   C a bound of sigma'' of the sign that hurts over [l, u] (v > 0: the convex side p < 0
+ *   only; v < 0: the concave side p > 0 only). The slope used, G = v k with
+ *   k = S(m) (1 - S(m)) rounded (k within 3 LSB of 2^16 sigma'(m)), is within
+ *   3 |v| / 2^16 + 1/2 (Q24) of v sigma'(m), charged times R.
+ *   Then p = A / 2^24 + delta (|delta| <= 1/2, charged |G| / 2) and A is linear in the
+ *   inputs, so sum_j G_j (p_j - m_j) is linear in (xs, ys) and is largest at a corner: the
+ *   units' slopes cancel where the network's own gradient is small, which the interval
+ *   bound cannot see. A unit takes the relaxation only when its charge is below its
+ *   interval charge v (S(end) - S(m)). Every product is rounded up (mul_ceil24).
+ * The remainder C R^2 / 2 dominates what is left (about 6 dB over a 3.75 m tile of a
+ * paper-configuration fit, 0.3 dB over 1 m; docs/MODELS.md). Cost: two sigmoids and about
+ * ten 64-bit products per unit, about 5 predictions' work. */
+
+/* |S(p) - 2^16 sigmoid(p / 2^16)| in LSB, all p (tested max 1.27). */
+#define MLP_TAB_ERR_LSB 2
+/* max |sigmoid''| = sqrt(3) / 18 = 0.0962250, Q16 rounded up. */
+#define MLP_CURV_MAX_Q16 6307
+/* |sigmoid''(t)| rises on [0, 1.3169579] (86308.15 in Q16) and falls beyond it. */
+#define MLP_CURV_PEAK_LO_Q16 86300
+#define MLP_CURV_PEAK_HI_Q16 86320
+/* Pre-activation ranges inside (-16, 16) (Q16) may take the linear relaxation. */
+#define MLP_RELAX_LIMIT_Q16 ((int32_t)1 << 20)
+/* The box is split into 2^s x 2^s parts, each bounded, the largest taken. 0: a 2 x 2 split
+ * quarters the remainder but costs four bounds; on the Cortex-M4 bench the grid search
+ * then takes 17.7 M instructions instead of 15.1 M and the deciding period misses 200 ms
+ * (docs/PERFORMANCE.md, "Models"). */
+#define MLP_BOUND_SPLIT_LOG2 0u
+
+/* Upper bound of |sigmoid''(t)| from s = S(t) (either half), Q16.
+ * Scaling and overflow: s (2^16 - s) <= 2^30 times |2 s - 2^16| <= 2^16 is < 2^46 in
+ * int64; >> 32 is f(s) = s (1 - s) |1 - 2 s| in Q16, floored (+1). |f'| <= 1 on each half
+ * and S stays on sigma's half, so the table's error moves f by at most MLP_TAB_ERR_LSB. */
+static int64_t curv_from_s(int64_t s)
+{
+    int64_t d = 2 * s - 65536;
+    return ((s * (65536 - s) * (d < 0 ? -d : d)) >> 32) + 1 + MLP_TAB_ERR_LSB;
+}
+
+/* ceil(g e / 2^24), exact. Scaling and overflow: |g| < 2^31, |e| < 2^55; e = eh 2^24 + el
+ * with 0 <= el < 2^24, so g eh < 2^62 and g el < 2^55 fit int64 (no 128-bit product). */
+static int64_t mul_ceil24(int64_t g, int64_t e)
+{
+    int64_t eh = e >> 24;
+    int64_t el = e - eh * ((int64_t)1 << 24);
+    return g * eh + ((g * el + (((int64_t)1 << 24) - 1)) >> 24);
+}
+
+/* Upper bound of forward()'s acc (Q40) over standardised inputs [xa, xb] x [ya, yb].
+ * Scaling and overflow: |xs|, |ys| <= 2^24 (Q16), weights < 2^31 (Q24): pre-activations
+ * |A| < 3 x 2^55 (Q40) as in forward(); v S < 2^47, the interval sum < 2^54. A relaxed unit
+ * has u - l < 2^21, so R <= 2^20, A's range < 2^46 and |A - m 2^24| < 2^46; C < 2^13,
+ * C R^2 < 2^53 >> 25 is the remainder in Q8 of an LSB (< 2^29), times |v| < 2^60; the slope
+ * charge (3 |v| + 2^15) R < 2^54; k <= 2^14 (Q16), G = v k >> 16 < 2^29 (Q24). Each of the
+ * six terms of a relaxed unit is below 2^53 in Q40, so 100 units' sums stay below 2^63. */
+static int64_t box_acc(const rfs_mlp_t *m, int64_t xa, int64_t xb, int64_t ya, int64_t yb)
+{
+    int64_t xc = xa + ((xb - xa) >> 1), yc = ya + ((yb - ya) >> 1);
+    int64_t iv = (int64_t)m->c_q24 * 65536;     /* interval bound, Q40 */
+    int64_t rb = iv;                            /* relaxed bound, Q40 */
+    int64_t lxa = 0, lxb = 0, lya = 0, lyb = 0; /* its linear part at either end, Q40 */
+    for (uint16_t j = 0u; j < m->cfg.hidden; ++j) {
+        int64_t w0 = m->w_q24[j][0], w1 = m->w_q24[j][1], b = (int64_t)m->b_q24[j] * 65536;
+        int64_t alo = (w0 >= 0 ? w0 * xa : w0 * xb) + (w1 >= 0 ? w1 * ya : w1 * yb) + b;
+        int64_t ahi = (w0 >= 0 ? w0 * xb : w0 * xa) + (w1 >= 0 ? w1 * yb : w1 * ya) + b;
+        int32_t l = rfs_sat32(rshr(alo, 24)), u = rfs_sat32(rshr(ahi, 24));
+        int64_t v = m->v_q24[j];
+        int64_t hub = rfs_mlp_sigmoid(v >= 0 ? u : l);
+        iv += v * hub;
+        if (l <= -MLP_RELAX_LIMIT_Q16 || u >= MLP_RELAX_LIMIT_Q16) {
+            rb += v * hub;
+            continue;
+        }
+        int32_t mid = l + ((u - l) >> 1);
+        int64_t r = (u - mid) > (mid - l) ? (u - mid) : (mid - l);
+        int64_t sm = rfs_mlp_sigmoid(mid);
+        /* |t| range [a, e] of the side that hurts; |sigma''(t)| <= |t| / 8 (sigma' <= 1/4,
+         * |1 - 2 sigma| = tanh(|t| / 2) <= |t| / 2), rises to its peak, then falls. */
+        int64_t curv = 0, a = 0, e = -1;
+        if (v >= 0 && l < 0) {
+            a = u < 0 ? -u : 0;
+            e = -l;
+        } else if (v < 0 && u > 0) {
+            a = l > 0 ? l : 0;
+            e = u;
+        }
+        if (e >= 0) {
+            curv = e <= MLP_CURV_PEAK_LO_Q16 ? (e >> 3) + 1
+                   : (a >= MLP_CURV_PEAK_HI_Q16 ? curv_from_s(hub) : MLP_CURV_MAX_Q16);
+            curv = curv < MLP_CURV_MAX_Q16 ? curv : MLP_CURV_MAX_Q16;
+        }
+        int64_t k = (sm * (65536 - sm) + 32768) >> 16;
+        int64_t g = rshr(v * k, 16);
+        int64_t av = v < 0 ? -v : v, ag = g < 0 ? -g : g;
+        int64_t e8 = ((curv * r * r + (((int64_t)1 << 25) - 1)) >> 25) +
+                     2 * MLP_TAB_ERR_LSB * 256;
+        int64_t charge = ((av * e8 + 255) >> 8) + (((3 * av + 32768) * r + 65535) >> 16) +
+                         ((ag + 1) >> 1);
+        if (charge >= v * (hub - sm)) {
+            rb += v * hub;
+            continue;
+        }
+        rb += v * sm + charge + mul_ceil24(g, w0 * xc + w1 * yc + b - (int64_t)mid * (1 << 24));
+        lxa += mul_ceil24(g, w0 * (xa - xc));
+        lxb += mul_ceil24(g, w0 * (xb - xc));
+        lya += mul_ceil24(g, w1 * (ya - yc));
+        lyb += mul_ceil24(g, w1 * (yb - yc));
+    }
+    rb += (lxa > lxb ? lxa : lxb) + (lya > lyb ? lya : lyb);
+    return rb < iv ? rb : iv;
+}
+
+/* The bound op (rfs_model.h): the largest box_acc() of the box's parts, through the
+ * output steps of mlp_predict(). A single point gets its prediction exactly. */
+static bool mlp_bound(const void *self, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,
+                      rfs_q16_t y1, rfs_q16_t *ub)
+{
+    const rfs_mlp_t *m = self;
+    RFS_ASSERT(m != NULL && ub != NULL && x0 <= x1 && y0 <= y1);
+    if (!m->valid) {
+        return false;
+    }
+    int64_t xa = standardise((int64_t)x0 * 100, m->mean_x_q16, m->inv_sx_q24);
+    int64_t xb = standardise((int64_t)x1 * 100, m->mean_x_q16, m->inv_sx_q24);
+    int64_t ya = standardise((int64_t)y0 * 100, m->mean_y_q16, m->inv_sy_q24);
+    int64_t yb = standardise((int64_t)y1 * 100, m->mean_y_q16, m->inv_sy_q24);
+    int64_t acc = INT64_MIN;
+    unsigned sx = xb > xa ? MLP_BOUND_SPLIT_LOG2 : 0u, sy = yb > ya ? MLP_BOUND_SPLIT_LOG2 : 0u;
+    for (int64_t i = 0; i < ((int64_t)1 << sx); ++i) {
+        for (int64_t k = 0; k < ((int64_t)1 << sy); ++k) {
+            int64_t a = box_acc(m, xa + (((xb - xa) * i) >> sx),
+                                xa + (((xb - xa) * (i + 1)) >> sx),
+                                ya + (((yb - ya) * k) >> sy), ya + (((yb - ya) * (k + 1)) >> sy));
+            acc = a > acc ? a : acc;
+        }
+    }
+    int32_t o = rfs_sat32(rshr(acc, 24));
+    *ub = rfs_q16_add(m->out_mean, rfs_q16_mul(o, m->out_std));
+    return true;
+}
+
 const rfs_model_ops_t rfs_mlp_ops = {
     .name = "mlp",
     .reset = mlp_reset,
     .fit = mlp_fit,
     .predict = mlp_predict,
     .argmax = NULL,
+    .bound = mlp_bound,
 };
 
 rfs_model_t rfs_mlp_model(rfs_mlp_t *m)

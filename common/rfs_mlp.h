@@ -34,6 +34,12 @@
  * and returns RFS_FIT_MORE until the last epoch is done. The standardisation pass is
  * done whole inside the call that starts the fit (about 20 instructions per sample,
  * under 1/500 of an epoch).
+ *
+ * Upper bound over a box (the `bound` op, issue 8): for the seeker's branch-and-bound grid
+ * search, a bound of predict() over an axis-aligned box that holds bit for bit: the
+ * smaller of interval arithmetic through the monotone steps of predict() and a linear
+ * relaxation of each hidden unit with its second-order remainder charged (rfs_mlp.c).
+ * A single point gets its prediction exactly; no model, no bound.
  */
 #ifndef RFS_MLP_H
 #define RFS_MLP_H

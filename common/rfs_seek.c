@@ -1453,6 +1453,7 @@ static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t 
          * nothing can be planned would otherwise relearn and search the whole lattice
          * (and plan every line-search point) 20 times a second while standing still. */
         s->retry_after_us = now_us + NO_GOAL_RETRY_US;
+        s->retry_no_goal = true;
         return;
     }
     s->state = RFS_SEEK_DRIVING;
@@ -1460,6 +1461,15 @@ static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t 
                                              &out->right_mm_s);
     if (st != RFS_DRIVE_RUNNING) {
         s->prev_status = st;
+    }
+    if (st == RFS_DRIVE_REACHED && (d->kind == RFS_SEEK_GREEDY || d->kind == RFS_SEEK_EPSILON)) {
+        /* A null move: the goal is where the robot stands (a greedy step or line search
+         * blocked at a wall). An iteration of the paper takes a step's time; deciding
+         * again at every 50 ms period instead repeats the relearn check, the grid search
+         * and the line search's planning 20 times a second (one 3ne run: 111 s of CPU
+         * for 900 simulated seconds). Decide again after one window, as after no goal. */
+        s->retry_after_us = now_us + NO_GOAL_RETRY_US;
+        s->retry_no_goal = false;
     }
 }
 
@@ -1634,7 +1644,7 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
         s->prev_status = st;
     }
     if (now_us < s->retry_after_us) {
-        out->faults |= RFS_SEEK_FAULT_NO_GOAL;
+        out->faults |= s->retry_no_goal ? RFS_SEEK_FAULT_NO_GOAL : 0u;
         stop_wheels(s, now_us, out);
         goto report;
     }

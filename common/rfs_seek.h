@@ -202,7 +202,8 @@ typedef struct rfs_seek {
     uint8_t heading;                          ///< chemotaxis: heading, sixteenths of a turn
     bool have_prev_mean;                      ///< chemotaxis: prev_mean is valid
     rfs_q16_t prev_mean;                      ///< chemotaxis: 1 s mean at the last decision
-    int64_t retry_after_us;                   ///< no goal was found: next decision not before, us
+    int64_t retry_after_us;                   ///< no goal, or a null move: next decision not before, us
+    bool retry_no_goal;                       ///< the wait is for no goal (RFS_SEEK_FAULT_NO_GOAL)
     /* Improvements (cfg.recheck_dist, cfg.eps_by_travel). */
     bool have_chk;                            ///< chk_x/chk_y are valid
     rfs_q16_t chk_x, chk_y;                   ///< position of the last check, metres Q16.16

@@ -569,6 +569,43 @@ static void test_meta_path_unreachable_maximum(void **state)
     world_free(&t);
 }
 
+
+/* A null move (the greedy goal is where the robot stands): the seeker decides again one
+ * averaging window later, not at every 50 ms period, and raises no NO_GOAL fault. */
+static void test_null_move_backs_off(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 10.0, 10.0, 0, 0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    cfg.eps_amp = 0;
+    cfg.eps_floor = 0; /* every decision after the first is greedy */
+    seek_make(&t, cfg, 4);
+    fixed_model_t fm = { false, 0, 0 };
+    rfs_model_t model = { &k_fixed_ops, &fm };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 5.0, .y = 5.0 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 0, 5000000, &out)); /* the initial move */
+    r.x = r.gx; /* arrive at once */
+    r.y = r.gy;
+    r.pending = false;
+    fm.mx = Q(r.x); /* the model's maximum: right here */
+    fm.my = Q(r.y);
+    int64_t prev = -1;
+    for (int k = 0; k < 4; ++k) {
+        assert_true(next_decision(&t, &r, &f, 0, 5000000, &out));
+        assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
+        assert_false(out.faults & RFS_SEEK_FAULT_NO_GOAL);
+        if (prev >= 0) {
+            assert_int_equal(r.t_us - prev, 1000000); /* one window, not one period */
+        }
+        prev = r.t_us;
+    }
+    world_free(&t);
+}
+
 /* Names round-trip and the unit vector against double precision. */
 static void test_names_and_unit(void **state)
 {
@@ -625,6 +662,7 @@ int main(void)
         cmocka_unit_test(test_eps_by_travel),
         cmocka_unit_test(test_recheck_abandons_leg),
         cmocka_unit_test(test_meta_path_unreachable_maximum),
+        cmocka_unit_test(test_null_move_backs_off),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -542,7 +542,10 @@ static bool mlp_bound(const void *self, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1
     int64_t ya = standardise((int64_t)y0 * 100, m->mean_y_q16, m->inv_sy_q24);
     int64_t yb = standardise((int64_t)y1 * 100, m->mean_y_q16, m->inv_sy_q24);
     int64_t acc = INT64_MIN;
-    unsigned sx = xb > xa ? MLP_BOUND_SPLIT_LOG2 : 0u, sy = yb > ya ? MLP_BOUND_SPLIT_LOG2 : 0u;
+    /* Split only a box of some extent (with MLP_BOUND_SPLIT_LOG2 > 0). */
+    const unsigned split = MLP_BOUND_SPLIT_LOG2;
+    unsigned sx = xb > xa ? split : 0u;
+    unsigned sy = yb > ya ? split : 0u;
     for (int64_t i = 0; i < ((int64_t)1 << sx); ++i) {
         for (int64_t k = 0; k < ((int64_t)1 << sy); ++k) {
             int64_t a = box_acc(m, xa + (((xb - xa) * i) >> sx),

@@ -771,7 +771,7 @@ static void bb_node(grid_bb_t *bb, const grid_node_t *nd, uint32_t rmask, bool o
     grid_node_t ch[4];
     rfs_q16_t ub[4];
     bool ok[4];
-    uint32_t order[4], n = 0;
+    uint32_t order[4] = {0u, 0u, 0u, 0u}, n = 0; /* filled in insertion order below */
     for (uint32_t q = 0; q < 4u; ++q) {
         grid_node_t c = *nd;
         c.i0 = (uint16_t)(nd->i0 + ((q & 1u) ? hw : 0u));

@@ -380,7 +380,9 @@ def fig_noise(figdir, sweep):
             ps = np.array([100 * s["p"] for _, s in pts])
             lo = np.array([100 * s["lo"] for _, s in pts])
             hi = np.array([100 * s["hi"] for _, s in pts])
-            ax.errorbar(xs, ps, yerr=[ps - lo, hi - ps], marker="o", capsize=3, label=st)
+            # Wilson bounds can sit a rounding error inside p at 0 % and 100 %.
+            ax.errorbar(xs, ps, yerr=[np.maximum(ps - lo, 0.0), np.maximum(hi - ps, 0.0)],
+                        marker="o", capsize=3, label=st)
         ax.set_xlabel(lab)
         ax.set_xticks([0, 2, 4, 8])
         ax.grid(alpha=0.3)

@@ -351,6 +351,24 @@ static void test_no_goal_backs_off(void **state)
 }
 
 
+/* rfs_seek_init's result for cfg on a 5 x 5 m world with the local ridge. */
+static int init_result(rfs_seek_cfg_t cfg)
+{
+    world_t t;
+    world_make(&t, 5.0, 5.0, 0, 0);
+    uint32_t lpts = (uint32_t)t.map.lw * t.map.lh;
+    uint8_t *bits = calloc(lpts, 1);
+    rfs_seek_mem_t mem = { .visited = bits, .visited_bytes = lpts, .reach = bits,
+                           .reach_bytes = lpts };
+    rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
+    rfs_ridge_init(&t.ridge, &rc);
+    int rc_init = rfs_seek_init(&t.seek, &cfg, &t.map, rfs_ridge_model(&t.ridge),
+                                &rfs_target_rssi, &mem);
+    free(bits);
+    world_free(&t);
+    return rc_init;
+}
+
 /* The meta-path preset: its improvements are on, every other strategy keeps the paper's
  * rule, and a negative recheck distance is refused. */
 static void test_meta_path_preset(void **state)
@@ -366,19 +384,8 @@ static void test_meta_path_preset(void **state)
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META);
     assert_int_equal(cfg.recheck_dist, 0);
     assert_false(cfg.eps_by_travel);
-    world_t t;
-    world_make(&t, 5.0, 5.0, 0, 0);
     cfg.recheck_dist = -1;
-    uint32_t lpts = (uint32_t)t.map.lw * t.map.lh;
-    uint8_t *bits = calloc(lpts, 1);
-    rfs_seek_mem_t mem = { .visited = bits, .visited_bytes = lpts, .reach = bits,
-                           .reach_bytes = lpts };
-    rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
-    rfs_ridge_init(&t.ridge, &rc);
-    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, rfs_ridge_model(&t.ridge),
-                                   &rfs_target_rssi, &mem), -1);
-    free(bits);
-    world_free(&t);
+    assert_int_equal(init_result(cfg), -1);
 }
 
 /* eps_by_travel: epsilon's n is the larger of the iteration and the whole steps of
@@ -633,19 +640,8 @@ static void test_names_and_unit(void **state)
     }
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     assert_int_equal(cfg.strategy, RFS_SEEK_META); /* the paper's is the default */
-    world_t t;
-    world_make(&t, 5.0, 5.0, 0, 0);
     cfg.strategy = RFS_SEEK_STRATEGY_COUNT;
-    uint32_t lpts = (uint32_t)t.map.lw * t.map.lh;
-    uint8_t *bits = calloc(lpts, 1);
-    rfs_seek_mem_t mem = { .visited = bits, .visited_bytes = lpts, .reach = bits,
-                           .reach_bytes = lpts };
-    rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
-    rfs_ridge_init(&t.ridge, &rc);
-    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, rfs_ridge_model(&t.ridge),
-                                   &rfs_target_rssi, &mem), -1);
-    free(bits);
-    world_free(&t);
+    assert_int_equal(init_result(cfg), -1);
 }
 
 int main(void)

@@ -173,6 +173,13 @@ void rfs_can_pack_rssi(const rfs_can_rssi_t *r, uint8_t counter, rfs_can_frame_t
     frame_seal(f);
 }
 
+void rfs_can_pack_receiver(const rfs_can_receiver_t *r, uint8_t counter, rfs_can_frame_t *f)
+{
+    frame_begin(f, RFS_CAN_ID_RX_STATUS, RFS_CAN_DLC_RX_STATUS, counter, 0);
+    put_u32(&f->data[1], r->t_us32);
+    frame_seal(f);
+}
+
 void rfs_can_pack_status(const rfs_can_status_t *s, uint8_t counter, rfs_can_frame_t *f)
 {
     frame_begin(f, RFS_CAN_ID_STATUS, RFS_CAN_DLC_STATUS, counter, (uint8_t)(s->state & 0x3u));
@@ -241,6 +248,20 @@ rfs_can_err_t rfs_can_unpack_rssi(const rfs_can_frame_t *f, rfs_can_rssi_t *r, u
     r->dbm = (int8_t)f->data[1];
     r->seq = f->data[2];
     r->t_us32 = get_u32(&f->data[3]);
+    *counter = f->data[0] & 0x0Fu;
+    return RFS_CAN_OK;
+}
+
+rfs_can_err_t rfs_can_unpack_receiver(const rfs_can_frame_t *f, rfs_can_receiver_t *r, uint8_t *counter)
+{
+    rfs_can_err_t e = frame_check(f, RFS_CAN_ID_RX_STATUS, RFS_CAN_DLC_RX_STATUS);
+    if (e != RFS_CAN_OK) {
+        return e;
+    }
+    if (f->data[0] >> 4) {
+        return RFS_CAN_E_RANGE;
+    }
+    r->t_us32 = get_u32(&f->data[1]);
     *counter = f->data[0] & 0x0Fu;
     return RFS_CAN_OK;
 }
@@ -357,6 +378,11 @@ void rfs_can_tx_pose(rfs_can_tx_t *tx, const rfs_can_pose_t *p, rfs_can_frame_t 
 void rfs_can_tx_rssi(rfs_can_tx_t *tx, const rfs_can_rssi_t *r, rfs_can_frame_t *f)
 {
     rfs_can_pack_rssi(r, tx_next(tx, RFS_CAN_IDX_RSSI), f);
+}
+
+void rfs_can_tx_receiver(rfs_can_tx_t *tx, const rfs_can_receiver_t *r, rfs_can_frame_t *f)
+{
+    rfs_can_pack_receiver(r, tx_next(tx, RFS_CAN_IDX_RX_STATUS), f);
 }
 
 void rfs_can_tx_status(rfs_can_tx_t *tx, const rfs_can_status_t *s, rfs_can_frame_t *f)
@@ -548,6 +574,30 @@ rfs_can_err_t rfs_can_rx_frame(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int64
         msg->rssi_dbm = r.dbm;
         msg->rssi_seq = r.seq;
         msg->rssi_t_us = t;
+        return RFS_CAN_OK;
+    }
+    case RFS_CAN_ID_RX_STATUS: {
+        /* The same time window as the packets (issue 10): the heartbeat comes from the
+         * same capture clock, so a stale, future or reordered one is dropped alike, in
+         * its own stream (a heartbeat may follow a packet stamped later). */
+        rfs_can_receiver_t r;
+        e = rfs_can_unpack_receiver(f, &r, &c);
+        if (e == RFS_CAN_OK) {
+            e = counter_check(rx, RFS_CAN_IDX_RX_STATUS, c);
+        }
+        int64_t t = 0;
+        if (e == RFS_CAN_OK) {
+            t = rfs_can_unwrap_time(now_us, r.t_us32);
+            e = time_check(rx, t, now_us, rx->have_receiver, rx->last_receiver_us);
+        }
+        if (e != RFS_CAN_OK) {
+            return drop(rx, e);
+        }
+        counter_accept(rx, RFS_CAN_IDX_RX_STATUS, c);
+        rx->last_receiver_us = t;
+        rx->have_receiver = true;
+        msg->kind = RFS_CAN_MSG_RECEIVER;
+        msg->receiver_t_us = t;
         return RFS_CAN_OK;
     }
     default:

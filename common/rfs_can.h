@@ -28,6 +28,8 @@
  *                    a pose is the POSE_XY + POSE_TH pair with the same counter,
  *                    XY sent first; it is complete when POSE_TH arrives
  *   0x120 RSSI       radio module -> controller, 8: source, dBm, sequence, time
+ *   0x121 RX_STATUS  radio module -> controller, 6: capture time: the receiver was
+ *                    listening up to then, packet or not (issue 10, docs/FAULTS.md)
  *   0x180 STATUS     controller -> anyone, 8: heartbeat with state, decision, faults
  * Lower ids win arbitration: wheel commands first, then inputs, then the heartbeat.
  */
@@ -52,12 +54,14 @@ typedef struct rfs_can_frame {
 #define RFS_CAN_ID_POSE_XY 0x110u   ///< pose, first half: position
 #define RFS_CAN_ID_POSE_TH 0x111u   ///< pose, second half: heading and time
 #define RFS_CAN_ID_RSSI 0x120u      ///< RSSI measurement from a radio module
+#define RFS_CAN_ID_RX_STATUS 0x121u ///< receiver heartbeat from the radio module (issue 10)
 #define RFS_CAN_ID_STATUS 0x180u    ///< controller status / heartbeat
 
 #define RFS_CAN_DLC_WHEEL_CMD 6u ///< exact DLC of WHEEL_CMD
 #define RFS_CAN_DLC_POSE_XY 8u   ///< exact DLC of POSE_XY
 #define RFS_CAN_DLC_POSE_TH 8u   ///< exact DLC of POSE_TH
 #define RFS_CAN_DLC_RSSI 8u      ///< exact DLC of RSSI
+#define RFS_CAN_DLC_RX_STATUS 6u ///< exact DLC of RX_STATUS
 #define RFS_CAN_DLC_STATUS 8u    ///< exact DLC of STATUS
 
 #define RFS_CAN_ID_MAX 0x7FFu        ///< largest 11-bit id
@@ -75,6 +79,7 @@ typedef enum rfs_can_msg_idx {
     RFS_CAN_IDX_POSE_TH,
     RFS_CAN_IDX_RSSI,
     RFS_CAN_IDX_STATUS,
+    RFS_CAN_IDX_RX_STATUS,
     RFS_CAN_NMSG ///< number of message ids
 } rfs_can_msg_idx_t;
 
@@ -116,6 +121,13 @@ typedef struct rfs_can_rssi {
     uint32_t t_us32;    ///< sender's time of reception, low 32 bits of microseconds
 } rfs_can_rssi_t;
 
+/// Receiver heartbeat (issue 10): sent by the radio module's capture loop every 50-100 ms
+/// and at least once per the controller's rssi_timeout_us, only while that loop runs.
+typedef struct rfs_can_receiver {
+    uint32_t t_us32;    ///< capture time the receiver was listening up to, low 32 bits of
+                        ///< microseconds (the clock of the RSSI frames' t_us32)
+} rfs_can_receiver_t;
+
 /// Controller heartbeat.
 typedef struct rfs_can_status {
     uint8_t state;       ///< rfs_seek_state_t, 0..3
@@ -149,6 +161,8 @@ void rfs_can_pack_pose_xy(const rfs_can_pose_t *p, uint8_t counter, rfs_can_fram
 void rfs_can_pack_pose_th(const rfs_can_pose_t *p, uint8_t counter, rfs_can_frame_t *f);
 /// Encode RSSI.
 void rfs_can_pack_rssi(const rfs_can_rssi_t *r, uint8_t counter, rfs_can_frame_t *f);
+/// Encode RX_STATUS.
+void rfs_can_pack_receiver(const rfs_can_receiver_t *r, uint8_t counter, rfs_can_frame_t *f);
 /// Encode STATUS.
 void rfs_can_pack_status(const rfs_can_status_t *s, uint8_t counter, rfs_can_frame_t *f);
 
@@ -161,6 +175,8 @@ rfs_can_err_t rfs_can_unpack_pose_xy(const rfs_can_frame_t *f, rfs_can_pose_t *p
 rfs_can_err_t rfs_can_unpack_pose_th(const rfs_can_frame_t *f, rfs_can_pose_t *p, uint8_t *counter);
 /// Decode RSSI.
 rfs_can_err_t rfs_can_unpack_rssi(const rfs_can_frame_t *f, rfs_can_rssi_t *r, uint8_t *counter);
+/// Decode RX_STATUS (data[0] bits 4..7 are reserved, zero).
+rfs_can_err_t rfs_can_unpack_receiver(const rfs_can_frame_t *f, rfs_can_receiver_t *r, uint8_t *counter);
 /// Decode STATUS.
 rfs_can_err_t rfs_can_unpack_status(const rfs_can_frame_t *f, rfs_can_status_t *s, uint8_t *counter);
 
@@ -210,6 +226,8 @@ void rfs_can_tx_wheel(rfs_can_tx_t *tx, const rfs_can_wheel_t *w, rfs_can_frame_
 void rfs_can_tx_pose(rfs_can_tx_t *tx, const rfs_can_pose_t *p, rfs_can_frame_t *xy, rfs_can_frame_t *th);
 /// Encode an RSSI measurement with the next counter.
 void rfs_can_tx_rssi(rfs_can_tx_t *tx, const rfs_can_rssi_t *r, rfs_can_frame_t *f);
+/// Encode a receiver heartbeat with the next counter.
+void rfs_can_tx_receiver(rfs_can_tx_t *tx, const rfs_can_receiver_t *r, rfs_can_frame_t *f);
 /// Encode a heartbeat with the next counter.
 void rfs_can_tx_status(rfs_can_tx_t *tx, const rfs_can_status_t *s, rfs_can_frame_t *f);
 
@@ -242,6 +260,8 @@ typedef struct rfs_can_rx {
     uint16_t have_rssi;                        ///< bit per source: last_rssi_us valid
     uint8_t last_seq[RFS_CAN_MAX_SOURCES];     ///< last RSSI sequence number per source
     uint32_t rssi_seq_gaps;                    ///< radio packets missing by sequence number
+    int64_t last_receiver_us;                  ///< newest accepted RX_STATUS time, microseconds
+    bool have_receiver;                        ///< last_receiver_us is valid
 } rfs_can_rx_t;
 
 /// What a received frame produced.
@@ -251,6 +271,7 @@ typedef enum rfs_can_msg_kind {
     RFS_CAN_MSG_POSE,     ///< a complete pose (in the core's units)
     RFS_CAN_MSG_RSSI,     ///< an RSSI measurement with an unwrapped time
     RFS_CAN_MSG_STATUS,   ///< a controller heartbeat
+    RFS_CAN_MSG_RECEIVER, ///< a receiver heartbeat with an unwrapped time
 } rfs_can_msg_kind_t;
 
 /// A decoded message, ready for the core.
@@ -263,6 +284,7 @@ typedef struct rfs_can_msg {
     int8_t rssi_dbm;         ///< RFS_CAN_MSG_RSSI: dBm
     uint8_t rssi_seq;        ///< RFS_CAN_MSG_RSSI: sequence number
     int64_t rssi_t_us;       ///< RFS_CAN_MSG_RSSI: unwrapped time, microseconds
+    int64_t receiver_t_us;   ///< RFS_CAN_MSG_RECEIVER: unwrapped capture time, microseconds
 } rfs_can_msg_t;
 
 /// Defaults: max_age 1 s, max_future 100 ms.

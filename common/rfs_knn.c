@@ -256,6 +256,48 @@ static void scan_cell_k(const rfs_knn_t *s, uint32_t cell, int32_t qx, int32_t q
     }
 }
 
+/* A walk over the rings of grid cells around a centre cell, nearest first: ring r is the
+ * square of cells r away in x or y (ring 0 the centre), visited row by row, left to right,
+ * cells outside the grid skipped. Rings run from 0 to max(gw, gh), by which every cell has
+ * been visited; the caller stops earlier once no farther cell can matter. */
+typedef struct knn_ring {
+    int32_t cx, cy; /* centre cell */
+    int32_t r;      /* current ring */
+    int32_t i, j;   /* next cell of the ring to consider (column, row) */
+} knn_ring_t;
+
+/* Start ring r; false once r is past the last ring. */
+static bool ring_start(const rfs_knn_t *s, knn_ring_t *it, int32_t r)
+{
+    it->r = r;
+    it->i = it->cx - r;
+    it->j = it->cy - r;
+    return r <= (s->gw > s->gh ? s->gw : s->gh);
+}
+
+/* The next cell of the current ring inside the grid: (*i, *j); false when the ring is done.
+ * Inner rows of a ring hold only their two end cells (step 2 r). */
+static bool ring_next(const rfs_knn_t *s, knn_ring_t *it, int32_t *i, int32_t *j)
+{
+    for (; it->j <= it->cy + it->r; ++it->j, it->i = it->cx - it->r) {
+        if (it->j < 0 || it->j >= s->gh) {
+            continue;
+        }
+        bool edge_row = (it->j == it->cy - it->r) || (it->j == it->cy + it->r);
+        int32_t step = edge_row || it->r == 0 ? 1 : 2 * it->r;
+        while (it->i <= it->cx + it->r) {
+            int32_t at = it->i;
+            it->i += step;
+            if (at >= 0 && at < s->gw) {
+                *i = at;
+                *j = it->j;
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
 /* Rings of cells around the query's cell, nearest first; after ring r every cell not
  * yet visited is at least r cells away in x or y, so the search stops once the k-th
  * distance is within r cell sides. */
@@ -265,21 +307,13 @@ static bool predict_k(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t *val
     b.m = 0u;
     b.k = s->cfg.k < s->n ? s->cfg.k : s->n;
     int32_t c8 = (int32_t)s->cell_cm * 256;
-    int32_t cx = axis_cell(qx - (int32_t)s->min_x_cm * 256, c8, s->gw);
-    int32_t cy = axis_cell(qy - (int32_t)s->min_y_cm * 256, c8, s->gh);
-    int32_t rmax = s->gw > s->gh ? s->gw : s->gh;
-    for (int32_t r = 0; r <= rmax; ++r) {
-        for (int32_t j = cy - r; j <= cy + r; ++j) {
-            if (j < 0 || j >= s->gh) {
-                continue;
-            }
-            bool edge_row = (j == cy - r) || (j == cy + r);
-            int32_t step = edge_row || r == 0 ? 1 : 2 * r;
-            for (int32_t i = cx - r; i <= cx + r; i += step) {
-                if (i >= 0 && i < s->gw) {
-                    scan_cell_k(s, (uint32_t)(j * s->gw + i), qx, qy, &b);
-                }
-            }
+    knn_ring_t ring;
+    ring.cx = axis_cell(qx - (int32_t)s->min_x_cm * 256, c8, s->gw);
+    ring.cy = axis_cell(qy - (int32_t)s->min_y_cm * 256, c8, s->gh);
+    for (int32_t r = 0; ring_start(s, &ring, r); ++r) {
+        int32_t i, j;
+        while (ring_next(s, &ring, &i, &j)) {
+            scan_cell_k(s, (uint32_t)(j * s->gw + i), qx, qy, &b);
         }
         int64_t reach = (int64_t)r * c8;
         // NOLINTNEXTLINE(clang-analyzer-core.UndefinedBinaryOperatorResult): valid needs n >= 1, so k >= 1
@@ -417,38 +451,29 @@ static int64_t kth_far2(const rfs_knn_t *s, const knn_box_t *b, uint32_t kk)
     int32_t c8 = (int32_t)s->cell_cm * 256;
     int32_t ox = (int32_t)s->min_x_cm * 256, oy = (int32_t)s->min_y_cm * 256;
     int64_t hx = ((int64_t)b->x1 - b->x0) / 2, hy = ((int64_t)b->y1 - b->y0) / 2;
-    int32_t cx = axis_cell((int32_t)(b->x0 + hx) - ox, c8, s->gw);
-    int32_t cy = axis_cell((int32_t)(b->y0 + hy) - oy, c8, s->gh);
-    int32_t rmax = s->gw > s->gh ? s->gw : s->gh;
-    for (int32_t r = 0; r <= rmax; ++r) {
-        for (int32_t j = cy - r; j <= cy + r; ++j) {
-            if (j < 0 || j >= s->gh) {
+    knn_ring_t ring;
+    ring.cx = axis_cell((int32_t)(b->x0 + hx) - ox, c8, s->gw);
+    ring.cy = axis_cell((int32_t)(b->y0 + hy) - oy, c8, s->gh);
+    for (int32_t r = 0; ring_start(s, &ring, r); ++r) {
+        int32_t i, j;
+        while (ring_next(s, &ring, &i, &j)) {
+            uint32_t cell = (uint32_t)(j * s->gw + i);
+            if (m == kk && s->start[cell] != s->start[cell + 1u] &&
+                cell_box_d2(s, i, j, b, true) >= far[kk - 1u]) {
                 continue;
             }
-            bool edge_row = (j == cy - r) || (j == cy + r);
-            int32_t step = edge_row || r == 0 ? 1 : 2 * r;
-            for (int32_t i = cx - r; i <= cx + r; i += step) {
-                if (i < 0 || i >= s->gw) {
+            for (uint32_t k = s->start[cell]; k < s->start[cell + 1u]; ++k) {
+                int64_t n2, f2;
+                box_d2(&s->pts[k], b, &n2, &f2);
+                if (m == kk && f2 >= far[kk - 1u]) {
                     continue;
                 }
-                uint32_t cell = (uint32_t)(j * s->gw + i);
-                if (m == kk && s->start[cell] != s->start[cell + 1u] &&
-                    cell_box_d2(s, i, j, b, true) >= far[kk - 1u]) {
-                    continue;
+                uint32_t at = m < kk ? m++ : m - 1u;
+                while (at > 0u && far[at - 1u] > f2) {
+                    far[at] = far[at - 1u];
+                    --at;
                 }
-                for (uint32_t k = s->start[cell]; k < s->start[cell + 1u]; ++k) {
-                    int64_t n2, f2;
-                    box_d2(&s->pts[k], b, &n2, &f2);
-                    if (m == kk && f2 >= far[kk - 1u]) {
-                        continue;
-                    }
-                    uint32_t at = m < kk ? m++ : m - 1u;
-                    while (at > 0u && far[at - 1u] > f2) {
-                        far[at] = far[at - 1u];
-                        --at;
-                    }
-                    far[at] = f2;
-                }
+                far[at] = f2;
             }
         }
         int64_t reach = r > 0 ? (int64_t)r * c8 - 1 : 0;
@@ -457,6 +482,18 @@ static int64_t kth_far2(const rfs_knn_t *s, const knn_box_t *b, uint32_t kk)
         }
     }
     return far[kk - 1u];
+}
+
+/* Insert target v into top[0, *m), kept descending; once *m == cap the smallest held
+ * makes room (the caller has checked that v is larger). */
+static void top_insert(int16_t *top, uint32_t *m, uint32_t cap, int16_t v)
+{
+    uint32_t at = *m < cap ? (*m)++ : *m - 1u;
+    while (at > 0u && top[at - 1u] < v) {
+        top[at] = top[at - 1u];
+        --at;
+    }
+    top[at] = v;
 }
 
 /* k-neighbours: a query q of the box has its kk nearest samples within kth(q) of it, and
@@ -485,6 +522,7 @@ static bool bound_k(const rfs_knn_t *s, const knn_box_t *b, rfs_q16_t *ub)
             }
             for (uint32_t k = s->start[cell]; k < s->start[cell + 1u]; ++k) {
                 int16_t v = s->pts[k].v_q6;
+                // NOLINTNEXTLINE(clang-analyzer-core.UndefinedBinaryOperatorResult): valid needs n >= 1, so kk >= 1
                 if (m == kk && v <= top[m - 1u]) {
                     continue;
                 }
@@ -493,12 +531,7 @@ static bool bound_k(const rfs_knn_t *s, const knn_box_t *b, rfs_q16_t *ub)
                 if (n2 > u2) {
                     continue;
                 }
-                uint32_t at = m < kk ? m++ : m - 1u;
-                while (at > 0u && top[at - 1u] < v) {
-                    top[at] = top[at - 1u];
-                    --at;
-                }
-                top[at] = v;
+                top_insert(top, &m, kk, v);
             }
         }
     }
@@ -559,12 +592,7 @@ static bool bound_radius(const rfs_knn_t *s, const knn_box_t *b, rfs_q16_t *ub)
                         continue;
                     }
                 }
-                uint32_t at = m < RFS_KNN_MAX_K ? m++ : m - 1u;
-                while (at > 0u && top[at - 1u] < v) {
-                    top[at] = top[at - 1u];
-                    --at;
-                }
-                top[at] = v;
+                top_insert(top, &m, RFS_KNN_MAX_K, v);
             }
         }
     }

@@ -154,6 +154,21 @@ bool rfs_app_on_rssi(rfs_app_t *a, uint8_t src, int64_t t_us, int8_t dbm, int64_
     return ok;
 }
 
+bool rfs_app_on_receiver(rfs_app_t *a, int64_t t_us, int64_t rx_us)
+{
+    /* The heartbeat comes from the radio module like its packets: in a dead zone it is
+     * the only proof that module is alive, so it feeds the same receive-time watchdog. */
+    a->rssi_rx_us = rx_us;
+    a->have_rssi_rx = true;
+    const bool ok = rfs_seek_on_receiver(&a->seek, t_us);
+    if (ok) {
+        a->stats.receiver++;
+    } else {
+        a->stats.rejected++;
+    }
+    return ok;
+}
+
 void rfs_app_set_bus_off(rfs_app_t *a, bool off)
 {
     a->bus_off = off;
@@ -222,6 +237,8 @@ rfs_can_err_t rfs_app_on_can(rfs_app_t *a, const rfs_can_frame_t *f, int64_t rx_
         (void)rfs_app_on_pose(a, &msg.pose, rx_us);
     } else if (msg.kind == RFS_CAN_MSG_RSSI) {
         (void)rfs_app_on_rssi(a, msg.rssi_src, msg.rssi_t_us, msg.rssi_dbm, rx_us);
+    } else if (msg.kind == RFS_CAN_MSG_RECEIVER) {
+        (void)rfs_app_on_receiver(a, msg.receiver_t_us, rx_us);
     }
     return e;
 }

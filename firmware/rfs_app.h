@@ -7,7 +7,8 @@
  *
  * A port feeds what arrives, in arrival order, and calls rfs_app_step() at the control
  * rate (RFS_APP_PERIOD_US):
- *   - decoded inputs: rfs_app_on_pose(), rfs_app_on_rssi() (the Linux/LCM port), or
+ *   - decoded inputs: rfs_app_on_pose(), rfs_app_on_rssi(), rfs_app_on_receiver() (the
+ *     receiver heartbeat, issue 10; the Linux/LCM port), or
  *   - raw CAN frames: rfs_app_on_can() (the STM32 and emulator ports; decoding by
  *     common/rfs_can.h),
  *   - transport state: rfs_app_set_bus_off() (bxCAN bus-off, SocketCAN error state).
@@ -15,8 +16,9 @@
  * as the CAN frames of docs/CAN.md.
  *
  * Safety (issue 6): besides the seeker's own staleness rule on input timestamps, the
- * application commands zero wheel speed whenever no pose or no RSSI frame has been
- * RECEIVED for input_timeout_us of local time (150 ms < the 200 ms requirement), and
+ * application commands zero wheel speed whenever no pose or no RSSI input (a measurement
+ * or a receiver heartbeat) has been RECEIVED for input_timeout_us of local time (150 ms <
+ * the 200 ms requirement), and
  * while the bus is off. Zero output comes at once, without the drive's acceleration ramp.
  * After a watchdog reset the port calls rfs_app_init() again: the first step outputs zero
  * with RFS_APP_FAULT_RESET set. Driving resumes by itself when inputs return.
@@ -67,7 +69,7 @@
 /// the seeker's RFS_SEEK_FAULT_* bits).
 enum {
     RFS_APP_FAULT_POSE_LOST = 1u << 8,  ///< no pose received for input_timeout_us
-    RFS_APP_FAULT_RSSI_LOST = 1u << 9,  ///< no RSSI received for input_timeout_us
+    RFS_APP_FAULT_RSSI_LOST = 1u << 9,  ///< no RSSI nor receiver heartbeat received for input_timeout_us
     RFS_APP_FAULT_BUS_OFF = 1u << 10,   ///< the CAN controller is bus-off
     RFS_APP_FAULT_RESET = 1u << 11,     ///< first step after a (watchdog) reset
     RFS_APP_FAULT_BAD_FRAME = 1u << 12, ///< a frame failed to decode since the last step
@@ -135,6 +137,7 @@ typedef struct rfs_app_out {
 typedef struct rfs_app_stats {
     uint32_t poses;             ///< poses accepted by the seeker
     uint32_t rssi;              ///< measurements accepted by the seeker
+    uint32_t receiver;          ///< receiver heartbeats accepted by the seeker (issue 10)
     uint32_t rejected;          ///< inputs the seeker rejected (order, bad source)
     uint32_t bad_frames;        ///< CAN frames that failed to decode (DLC, checksum)
     uint32_t unknown_frames;    ///< CAN frames with ids that are not ours
@@ -150,9 +153,9 @@ typedef struct rfs_app {
     rfs_map_t map;                                  ///< the map (grids owned by the port)
     rfs_rng_t rng;                                  ///< the random source
     int64_t pose_rx_us;                             ///< local time the last pose arrived
-    int64_t rssi_rx_us;                             ///< local time the last RSSI arrived
+    int64_t rssi_rx_us;                             ///< local time the last RSSI or heartbeat arrived
     bool have_pose_rx;                              ///< a pose has arrived since init
-    bool have_rssi_rx;                              ///< an RSSI has arrived since init
+    bool have_rssi_rx;                              ///< an RSSI or heartbeat has arrived since init
     bool bus_off;                                   ///< the transport reports bus-off
     bool after_reset;                               ///< no step has run since init
     bool bad_frame;                                 ///< a frame failed since the last step
@@ -204,14 +207,22 @@ bool rfs_app_on_pose(rfs_app_t *a, const rfs_pose_t *pose, int64_t rx_us);
 /// time rx_us. false when the seeker rejected it.
 bool rfs_app_on_rssi(rfs_app_t *a, uint8_t src, int64_t t_us, int8_t dbm, int64_t rx_us);
 
+/// A receiver heartbeat (issue 10; docs/FAULTS.md): the radio's capture loop was
+/// listening up to t_us (its own capture clock, the packets' clock), heard or not; it
+/// arrived at local time rx_us. Refreshes the RSSI input's receive-time watchdog like a
+/// packet and calls rfs_seek_on_receiver(), which judges the stamp as it judges a
+/// packet's: older than the newest heartbeat is rejected, one further ahead of now than
+/// rssi_timeout_us makes the stream stale (a clock jump). false when rejected.
+bool rfs_app_on_receiver(rfs_app_t *a, int64_t t_us, int64_t rx_us);
+
 /// The transport went bus-off (true) or recovered (false).
 void rfs_app_set_bus_off(rfs_app_t *a, bool off);
 
 /// One control period at local time now_us. Cannot fail.
 void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out);
 
-/// A raw CAN frame arrived at local time rx_us: decoded with rfs_can (pose pairs, RSSI;
-/// other ids counted as unknown) and fed to the seeker. Returns the decode result.
+/// A raw CAN frame arrived at local time rx_us: decoded with rfs_can (pose pairs, RSSI,
+/// receiver heartbeat; other ids counted as unknown) and fed to the seeker. Returns the decode result.
 rfs_can_err_t rfs_app_on_can(rfs_app_t *a, const rfs_can_frame_t *f, int64_t rx_us);
 
 /// Encode a step's output as its CAN frames, in sending order: frames[0] = WHEEL_CMD,

@@ -60,6 +60,7 @@ static int payload_len(uint8_t type)
     case RFS_REPLAY_POSE: return 28;
     case RFS_REPLAY_RSSI: return 18;
     case RFS_REPLAY_CAN: return 21;
+    case RFS_REPLAY_RECEIVER: return 16;
     case RFS_REPLAY_STEP: return 8;
     case RFS_REPLAY_BUS: return 9;
     case RFS_REPLAY_RESET: return 8;
@@ -192,6 +193,10 @@ rfs_replay_status_t rfs_replay_parse(const uint8_t *buf, uint32_t len, uint32_t 
         rec->u.rssi.src = p[16];
         rec->u.rssi.dbm = (int8_t)p[17];
         break;
+    case RFS_REPLAY_RECEIVER:
+        rec->t_us = rds64(p);
+        rec->u.receiver_t_us = rds64(p + 8);
+        break;
     case RFS_REPLAY_CAN:
     case RFS_REPLAY_CAN_TX:
         rec->t_us = rds64(p);
@@ -288,6 +293,10 @@ uint32_t rfs_replay_encode(const rfs_replay_rec_t *rec, uint8_t *buf, uint32_t c
         p = wr64(p, (uint64_t)rec->u.rssi.t_us);
         *p++ = rec->u.rssi.src;
         *p++ = (uint8_t)rec->u.rssi.dbm;
+        break;
+    case RFS_REPLAY_RECEIVER:
+        p = wr64(p, (uint64_t)rec->t_us);
+        p = wr64(p, (uint64_t)rec->u.receiver_t_us);
         break;
     case RFS_REPLAY_CAN:
     case RFS_REPLAY_CAN_TX:
@@ -473,6 +482,12 @@ bool rfs_replay_play(rfs_replay_player_t *p, const rfs_replay_rec_t *rec)
         }
         (void)rfs_app_on_rssi(p->app, rec->u.rssi.src, rec->u.rssi.t_us, rec->u.rssi.dbm,
                               rec->t_us);
+        return true;
+    case RFS_REPLAY_RECEIVER:
+        if (!start(p)) {
+            return false;
+        }
+        (void)rfs_app_on_receiver(p->app, rec->u.receiver_t_us, rec->t_us);
         return true;
     case RFS_REPLAY_CAN: {
         if (!start(p)) {

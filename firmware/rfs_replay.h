@@ -17,6 +17,8 @@
  *   POSE     rx i64, t i64, x q16, y q16, theta q16                    28
  *   RSSI     rx i64, t i64, src u8, dbm i8                             18
  *   CAN      rx i64, id u32, dlc u8, data[8]                           21
+ *   RECEIVER rx i64, t i64  (receiver heartbeat: listening up to t,     16
+ *                            issue 10; docs/FAULTS.md)
  *   STEP     now i64                          (run one control period)  8
  *   BUS      now i64, off u8                  (bus-off entered / left)  9
  *   RESET    now i64                          (watchdog reset: re-init) 8
@@ -27,6 +29,9 @@
  *            prediction, mean, epsilon, x, y, goal_x, goal_y, max_x, max_y,
  *            path_len (q16 each), samples u16                           57
  *   CAN_TX   t i64, id u32, dlc u8, data[8]                             21
+ *
+ * Version 1 streams written before RECEIVER existed hold no such record and load unchanged;
+ * a player fed none keeps the packets-only rule.
  *
  * The parser is portable C (no libc but memcpy/memset), works on a caller buffer that
  * may end anywhere, checks every length, enum and range, and never reads past `len`.
@@ -61,6 +66,7 @@ typedef enum rfs_replay_type {
     RFS_REPLAY_POSE = 0x10,
     RFS_REPLAY_RSSI = 0x11,
     RFS_REPLAY_CAN = 0x12,
+    RFS_REPLAY_RECEIVER = 0x13,
     RFS_REPLAY_STEP = 0x20,
     RFS_REPLAY_BUS = 0x21,
     RFS_REPLAY_RESET = 0x22,
@@ -115,6 +121,7 @@ typedef struct rfs_replay_rec {
             uint8_t src;      ///< source index
             int8_t dbm;       ///< dBm
         } rssi;               ///< RSSI
+        int64_t receiver_t_us; ///< RECEIVER: capture time listened up to, microseconds
         rfs_replay_can_t can; ///< CAN, CAN_TX
         uint8_t bus_off;      ///< BUS: 1 = entered bus-off, 0 = recovered
         rfs_app_out_t out;    ///< OUT (decision unused) and DECISION (decision only)

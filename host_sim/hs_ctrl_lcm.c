@@ -16,6 +16,7 @@ typedef struct ctrl_lcm {
     hs_can_t *can;               /* NULL: wheel frames come over RFS_CAN_FALLBACK */
     rfs_can_rx_t rx;             /* the motor controller node's CAN receiver */
     uint32_t seq[RFS_CAN_MAX_SOURCES]; /* packet sequence numbers per source */
+    uint32_t rx_seq;             /* receiver heartbeats published */
     rfs_can_wheel_t wheel;       /* newest wheel command */
     uint32_t wheels_rx;          /* wheel frames accepted */
     rfs_seek_out_t status;       /* newest status */
@@ -78,6 +79,15 @@ static void cb_rssi(void *self, uint8_t src, int64_t t_us, int8_t dbm)
     ctrl_lcm_t *s = self;
     uint32_t q = src < RFS_CAN_MAX_SOURCES ? s->seq[src]++ : 0;
     (void)hs_lcm_pub_rssi(s->lcm, src, t_us, dbm, q);
+}
+
+/* The simulated receiver's heartbeat (issue 10), as the sniffer's capture loop sends it:
+ * published before the clock tick of the step it precedes, so the controller has it
+ * when it steps. */
+static void cb_receiver(void *self, int64_t t_us)
+{
+    ctrl_lcm_t *s = self;
+    (void)hs_lcm_pub_receiver(s->lcm, t_us, s->rx_seq++);
 }
 
 static void cb_step(void *self, int64_t now_us, hs_ctrl_out_t *out)
@@ -184,6 +194,7 @@ int hs_ctrl_lcm_open(hs_ctrl_t *c, const hs_ctrl_lcm_cfg_t *cfg, char *err, size
     c->period_us = cfg->period_us;
     c->on_pose = cb_pose;
     c->on_rssi = cb_rssi;
+    c->on_receiver = cb_receiver;
     c->step = cb_step;
     c->predict = NULL;
     c->close = cb_close;

@@ -4,6 +4,8 @@
  * lcm-gen types of lcm/<type>.lcm; nothing of LCM crosses this header. Channels:
  *   RFS_POSE            rfseek.pose_t           localisation -> controller
  *   RFS_RSSI            rfseek.rssi_t           radio module -> controller
+ *   RFS_RSSI_STATUS     rfseek.rssi_status_t    radio module -> controller: receiver
+ *                                               heartbeat (issue 10, docs/FAULTS.md)
  *   RFS_CLOCK           rfseek.clock_t          lock-step simulator -> controller
  *   RFS_WHEEL_CMD       rfseek.wheel_cmd_t      controller -> logs (copy of the CAN frame)
  *   RFS_SEEKER_STATUS   rfseek.seeker_status_t  controller -> anyone
@@ -24,6 +26,7 @@
 
 #define HS_LCM_CH_POSE "RFS_POSE"                 ///< pose channel
 #define HS_LCM_CH_RSSI "RFS_RSSI"                 ///< RSSI channel
+#define HS_LCM_CH_RSSI_STATUS "RFS_RSSI_STATUS"   ///< receiver heartbeat channel
 #define HS_LCM_CH_CLOCK "RFS_CLOCK"               ///< lock-step clock channel
 #define HS_LCM_CH_WHEEL "RFS_WHEEL_CMD"           ///< wheel command copy
 #define HS_LCM_CH_STATUS "RFS_SEEKER_STATUS"      ///< seeker status
@@ -40,6 +43,9 @@ typedef struct hs_lcm_handlers {
     void (*on_can)(void *ctx, int64_t t_us, const rfs_can_frame_t *f);          ///< RFS_CAN_FALLBACK
     /// A message was dropped; `why` is the one-line "CHANNEL: reason". May be NULL.
     void (*on_bad)(void *ctx, const char *why);
+    /// RFS_RSSI_STATUS: the receiver was listening up to capture time t_us (a heartbeat;
+    /// seq is the sender's heartbeat count).
+    void (*on_receiver)(void *ctx, int64_t t_us, uint32_t seq);
 } hs_lcm_handlers_t;
 
 /// Receive counters.
@@ -68,6 +74,9 @@ void hs_lcm_record(hs_lcm_t *l, hs_lcm_log_t *log);
 int hs_lcm_pub_pose(hs_lcm_t *l, const rfs_pose_t *pose);
 /// Publish an RSSI measurement.
 int hs_lcm_pub_rssi(hs_lcm_t *l, uint8_t src, int64_t t_us, int8_t dbm, uint32_t seq);
+/// Publish a receiver heartbeat: the capture loop was listening up to t_us (the
+/// packets' clock); seq counts the sender's heartbeats.
+int hs_lcm_pub_receiver(hs_lcm_t *l, int64_t t_us, uint32_t seq);
 /// Publish a lock-step clock tick.
 int hs_lcm_pub_clock(hs_lcm_t *l, int64_t t_us);
 /// Publish the wheel command copy.

@@ -13,6 +13,7 @@
 #include "rfseek_can_frame_t.h"
 #include "rfseek_clock_t.h"
 #include "rfseek_pose_t.h"
+#include "rfseek_rssi_status_t.h"
 #include "rfseek_rssi_t.h"
 #include "rfseek_seeker_status_t.h"
 #include "rfseek_wheel_cmd_t.h"
@@ -141,6 +142,15 @@ static void dispatch(const hs_lcm_handlers_t *h, hs_lcm_stats_t *s, const char *
         }
         good(s);
         h->on_rssi(h->ctx, (uint8_t)m.source, m.utime, (int8_t)m.dbm, (uint32_t)m.seq);
+    } else if (strcmp(ch, HS_LCM_CH_RSSI_STATUS) == 0 && h->on_receiver) {
+        rfseek_rssi_status_t m;
+        int n = rfseek_rssi_status_t_decode(data, 0, len, &m);
+        if (n < 0 || n != len) {
+            bad(s, h, ch, "truncated, oversized or not an rfseek.rssi_status_t (%.0f bytes)", (double)len);
+            return;
+        }
+        good(s);
+        h->on_receiver(h->ctx, m.utime, (uint32_t)m.seq);
     } else if (strcmp(ch, HS_LCM_CH_CLOCK) == 0 && h->on_clock) {
         rfseek_clock_t m;
         int n = rfseek_clock_t_decode(data, 0, len, &m);
@@ -281,6 +291,7 @@ hs_lcm_t *hs_lcm_open(const char *url, const hs_lcm_handlers_t *h, char *err, si
         {HS_LCM_CH_POSE, l->h.on_pose != NULL},   {HS_LCM_CH_RSSI, l->h.on_rssi != NULL},
         {HS_LCM_CH_CLOCK, l->h.on_clock != NULL}, {HS_LCM_CH_WHEEL, l->h.on_wheel != NULL},
         {HS_LCM_CH_STATUS, l->h.on_status != NULL}, {HS_LCM_CH_CAN_FALLBACK, l->h.on_can != NULL},
+        {HS_LCM_CH_RSSI_STATUS, l->h.on_receiver != NULL},
     };
     for (size_t i = 0; i < sizeof subs / sizeof subs[0]; i++) {
         if (subs[i].on && lcm_subscribe(l->lcm, subs[i].ch, on_msg, l) == NULL) {
@@ -320,6 +331,12 @@ int hs_lcm_pub_rssi(hs_lcm_t *l, uint8_t src, int64_t t_us, int8_t dbm, uint32_t
 {
     rfseek_rssi_t m = {t_us, src, dbm, (int32_t)seq};
     HS_LCM_PUBLISH(l, HS_LCM_CH_RSSI, rfseek_rssi_t, &m, t_us);
+}
+
+int hs_lcm_pub_receiver(hs_lcm_t *l, int64_t t_us, uint32_t seq)
+{
+    rfseek_rssi_status_t m = {t_us, (int32_t)seq};
+    HS_LCM_PUBLISH(l, HS_LCM_CH_RSSI_STATUS, rfseek_rssi_status_t, &m, t_us);
 }
 
 int hs_lcm_pub_clock(hs_lcm_t *l, int64_t t_us)

@@ -30,7 +30,7 @@ FW_MAP ?= --box 40 20 --res 0.125
 FW_STM32_SRCS := firmware/port/stm32f4/startup.c firmware/port/stm32f4/board.c \
 	firmware/port/stm32f4/rfs_bxcan.c firmware/port/stm32f4/main.c firmware/rfs_app.c
 FW_QEMU_SRCS := firmware/port/stm32f4/startup.c firmware/port/qemu/semihost.c \
-	firmware/port/qemu/main.c firmware/rfs_app.c firmware/rfs_replay.c
+	firmware/port/qemu/bench_clock.c firmware/port/qemu/main.c firmware/rfs_app.c firmware/rfs_replay.c
 FW_BENCH_SRCS := firmware/port/stm32f4/startup.c firmware/port/qemu/semihost.c \
 	firmware/port/qemu/bench_clock.c firmware/port/qemu/bench.c firmware/rfs_app.c
 FW_ALL_HDRS := $(CORE_HDRS) $(FW_HDRS) $(wildcard firmware/port/*/*.h)

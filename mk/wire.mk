@@ -36,6 +36,12 @@ $(WIRE_LCM_TOOL): tests/wire/lcm_tool.c $(HOST_LIB_DEPS) $(CORE_LIB) $(HOST_HDRS
 TEST_DEPS += $(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm
 TEST_SCRIPTS += 'tests/wire/rfseekd_test.sh $(BUILD)'
 $(eval $(call cmocka_test,test_lcm,tests/wire/test_lcm.c,))
+# The receiver heartbeat (issue 10) through rfseek-record/-replay and the qemu image.
+TEST_DEPS += firmware $(BUILD)/bin/rfseek-record $(BUILD)/bin/rfseek-replay
+TEST_SCRIPTS += 'tests/wire/heartbeat_replay.sh $(BUILD)'
+# ... and through the pcap feeder's replay (every captured frame proves the receiver alive).
+TEST_DEPS += $(BUILD)/feed/asan/rfseek-feed
+TEST_SCRIPTS += '$(PYTHON) tests/wire/feed_heartbeat.py $(BUILD)/feed/asan/rfseek-feed'
 
 # --- bench: codec instructions (callgrind), two-process overhead ----------------------
 $(BUILD)/tests/wire/bench_can: tests/wire/bench_can.c $(CORE_LIB) $(CORE_HDRS)

@@ -35,13 +35,14 @@ def main(argv):
     except Exception as e:  # canmatrix raises many kinds
         print("FAIL dbc-load %s: %s" % (dbc_path, e))
         return 1
-    if len(db.frames) != 5:
-        print("FAIL dbc-load %s: expected 5 frames, found %d" % (dbc_path, len(db.frames)))
+    if len(db.frames) != 6:
+        print("FAIL dbc-load %s: expected 6 frames, found %d" % (dbc_path, len(db.frames)))
         return 1
     print("PASS dbc-load %s (%d frames)" % (dbc_path, len(db.frames)))
     assert crc8_j1850(b"123456789") == 0x4B  # the catalogue check value
     failures = 0
     count = 0
+    seen = set()
     with open(vec_path) as fh:
         for lineno, line in enumerate(fh, 1):
             parts = line.split()
@@ -70,12 +71,17 @@ def main(argv):
             if int(dec["Checksum"].raw_value) != crc or data[-1] != crc:
                 errs.append("checksum %02X != independent CRC %02X" % (data[-1], crc))
             count += 1
+            seen.add(cid)
             if errs:
                 failures += 1
                 print("FAIL dbc-decode %s %s: %s" % (where, fr.name, "; ".join(errs)))
     if count == 0:
         print("FAIL dbc-decode %s: no vectors" % vec_path)
         return 1
+    missing = sorted(fr.arbitration_id.id for fr in db.frames if fr.arbitration_id.id not in seen)
+    if missing:
+        print("FAIL dbc-coverage: no vectors for %s" % ", ".join("%03X" % i for i in missing))
+        failures += 1
     if failures == 0:
         print("PASS dbc-decode %d frames match field by field" % count)
     return 1 if failures else 0

@@ -157,10 +157,15 @@ static void print_stats(const char *name, const feed_stats_t *st)
 /* Called for each frame from one of the MACs (index m) that carries a signal. */
 typedef int (*feed_fn)(void *ctx, int m, const hs_pcap_pkt_t *pkt, const hs_rt_frame_t *f);
 
-/* Read every packet, count why packets give nothing, call fn for the matching ones.
- * Returns 0, or 1 after a read error (message on stderr) or when fn failed. */
+/* Called for every record read, from any transmitter, parsable or not: the capture loop
+ * was alive at its time (the receiver heartbeat, issue 10). */
+typedef int (*alive_fn)(void *ctx, int64_t t_us);
+
+/* Read every packet, count why packets give nothing, call fn for the matching ones and
+ * alive (when not NULL) for every one. Returns 0, or 1 after a read error (message on
+ * stderr) or when fn or alive failed. */
 static int scan_capture(hs_pcap_reader_t *r, const uint8_t (*macs)[6], int n_macs, feed_stats_t *st,
-                        feed_fn fn, void *ctx)
+                        feed_fn fn, void *ctx, alive_fn alive, void *alive_ctx)
 {
     char err[512];
     for (;;) {
@@ -173,6 +178,7 @@ static int scan_capture(hs_pcap_reader_t *r, const uint8_t (*macs)[6], int n_mac
             return 1;
         }
         st->packets++;
+        if (alive != NULL && alive(alive_ctx, pkt.t_us) != 0) { return 1; }
         if (pkt.caplen < pkt.origlen) { st->caplen_short++; }
         hs_rt_frame_t f;
         const int prc = hs_rt_frame_parse(pkt.data, pkt.caplen, &f);
@@ -229,7 +235,7 @@ static int run_tsv(hs_pcap_reader_t *r, const char *output, bool live, const uin
     static char obuf[1 << 16];
     setvbuf(out, obuf, _IOFBF, sizeof(obuf));
     tsv_ctx_t c = {out, live};
-    int rc = scan_capture(r, macs, n_macs, st, tsv_line, &c);
+    int rc = scan_capture(r, macs, n_macs, st, tsv_line, &c, NULL, NULL);
     if (fflush(out) != 0 || ferror(out)) {
         fprintf(stderr, "rfseek-feed: %s: write error: %s\n", output != NULL ? tmp : "stdout", strerror(errno));
         rc = 1;
@@ -277,6 +283,33 @@ static int rp_collect(void *ctx, int m, const hs_pcap_pkt_t *pkt, const hs_rt_fr
     }
     vec->v[vec->n++] = (rp_pkt_t){pkt->t_us, (uint8_t)m, f->rt.dbm_signal,
                                   (uint16_t)(f->wlan.seq << 4 | f->wlan.frag)};
+    return 0;
+}
+
+/* Receiver heartbeat times (issue 10; docs/FAULTS.md): every record the capture loop
+ * reads proves it alive at that record's time, whoever sent it; one heartbeat per
+ * RP_ALIVE_US of capture time at most, as a live sniffer would send them. */
+#define RP_ALIVE_US 50000
+
+typedef struct rp_times {
+    int64_t *v;
+    size_t n, cap;
+} rp_times_t;
+
+static int rp_alive(void *ctx, int64_t t_us)
+{
+    rp_times_t *hb = ctx;
+    if (hb->n > 0 && t_us < hb->v[hb->n - 1] + RP_ALIVE_US) {
+        return 0;
+    }
+    if (hb->n == hb->cap) {
+        const size_t cap = hb->cap ? hb->cap * 2 : 1024;
+        int64_t *nv = realloc(hb->v, cap * sizeof(*nv));
+        if (nv == NULL) { fprintf(stderr, "rfseek-feed: out of memory\n"); return 1; }
+        hb->v = nv;
+        hb->cap = cap;
+    }
+    hb->v[hb->n++] = t_us;
     return 0;
 }
 
@@ -414,8 +447,13 @@ typedef struct rp_opts {
     uint64_t seed;
 } rp_opts_t;
 
-/* Replay: packets, poses and control periods in time order (equal times: packets, then
- * poses, then control, as the simulator), time counted from the first pose. The robot's
+/* Replay: packets, poses, receiver heartbeats and control periods in time order (equal
+ * times: packets, then poses, then heartbeats, then control, as the simulator), time
+ * counted from the first pose. With the scenario's radio.receiver.heartbeat (the
+ * default) every record of the capture, from any transmitter, proves the capture loop
+ * alive at its time: the controller is told so at most once per 50 ms of capture time
+ * (rfs_seek_on_receiver, issue 10), so a stretch where the source is not heard but the
+ * channel is is a dead zone, not a dead sensor. The robot's
  * position at any instant is the recorded pose interpolated linearly (theta along the
  * shorter arc); the controller's wheel commands go nowhere. Ends at the last pose, or
  * when the robot comes within the stop radius of the goal. */
@@ -453,9 +491,12 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
         return 1;
     }
     rp_vec_t pk = {NULL, 0, 0};
-    if (scan_capture(r, (const uint8_t(*)[6])macs, n_macs, st, rp_collect, &pk) != 0) {
+    rp_times_t hb = {NULL, 0, 0};
+    if (scan_capture(r, (const uint8_t(*)[6])macs, n_macs, st, rp_collect, &pk,
+                     sc.rx_heartbeat ? rp_alive : NULL, &hb) != 0) {
         free(poses);
         free(pk.v);
+        free(hb.v);
         return 1;
     }
     hs_sim_env_t env;
@@ -463,6 +504,7 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
         fprintf(stderr, "rfseek-feed: %s\n", err);
         free(poses);
         free(pk.v);
+        free(hb.v);
         return 1;
     }
     hs_ctrl_inproc_cfg_t cc = hs_ctrl_inproc_cfg_default();
@@ -477,6 +519,7 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
         hs_sim_env_close(&env);
         free(poses);
         free(pk.v);
+        free(hb.v);
         return 1;
     }
     char tmp[4096];
@@ -513,7 +556,7 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
         rfs_pdr_t pdr[FEED_MAX_MACS];
         const rfs_pdr_cfg_t pdr_cfg = rfs_pdr_cfg_default();
         for (int k = 0; k < n_macs; k++) { (void)rfs_pdr_init(&pdr[k], &pdr_cfg); }
-        size_t pi = 0, qi = 0; /* next packet, next pose */
+        size_t pi = 0, qi = 0, hi = 0; /* next packet, next pose, next heartbeat */
         size_t seg = 0;        /* poses[seg], poses[seg + 1] bracket the current time */
         double travelled_at_seg = 0.0;
         uint64_t ctrl_k = 1;
@@ -521,11 +564,13 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
         double fx = poses[0].x, fy = poses[0].y;
         int64_t t_last = 0;
         while (pi < pk.n && pk.v[pi].t_us < t0) { pi++; before++; }
+        while (hi < hb.n && hb.v[hi] < t0) { hi++; }
         for (;;) {
             int64_t te = INT64_MAX;
             int kind = -1;
             if (pi < pk.n) { te = pk.v[pi].t_us - t0; kind = 0; }
             if (qi < n_poses && poses[qi].t_us - t0 < te) { te = poses[qi].t_us - t0; kind = 1; }
+            if (hi < hb.n && hb.v[hi] - t0 < te) { te = hb.v[hi] - t0; kind = 3; }
             const int64_t tc = (int64_t)ctrl_k * ctrl.period_us;
             if (tc < te) { te = tc; kind = 2; }
             if (te > t_end || kind < 0) { break; }
@@ -560,6 +605,11 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
                     ctrl.on_rssi(ctrl.self, p->src, te, meas);
                     fprintf(fsam, "%.6f\t%u\t%.3f\t%.3f\t%.3f\t%d\n", te * 1e-6, (unsigned)p->src, ex, ey,
                             etr, (int)meas);
+                }
+            } else if (kind == 3) {
+                hi++;
+                if (ctrl.on_receiver != NULL) {
+                    ctrl.on_receiver(ctrl.self, te);
                 }
             } else if (kind == 1) {
                 const rp_pose_t *q = &poses[qi++];
@@ -636,6 +686,7 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
     hs_sim_env_close(&env);
     free(poses);
     free(pk.v);
+    free(hb.v);
     return rc;
 }
 

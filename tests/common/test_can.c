@@ -559,6 +559,108 @@ static void seek_output_maps_to_status_and_wheels(void **state)
     assert_int_equal(w.flags, RFS_CAN_WHEEL_STOP);
 }
 
+/* RX_STATUS (0x121, issue 10): bytes from the Python reference (struct '<BI' + CRC-8 over
+ * 21 01 and the payload), every time value round trips, a wrong DLC, any flipped bit and
+ * the reserved nibble are rejected. */
+static void receiver_frame_bytes_round_trip_and_rejects(void **state)
+{
+    (void)state;
+    const uint8_t want[] = {0x03, 0x00, 0xFF, 0xFF, 0xFF, 0x4B};
+    const uint8_t want2[] = {0x0A, 0x15, 0xCD, 0x5B, 0x07, 0x8D};
+    rfs_can_receiver_t r = {0xFFFFFF00u}, out = {0};
+    rfs_can_frame_t f, g;
+    uint8_t c = 99;
+
+    rfs_can_pack_receiver(&r, 3, &f);
+    r.t_us32 = 123456789u;
+    rfs_can_pack_receiver(&r, 0x1A, &g); /* only the counter's low 4 bits are used */
+
+    assert_int_equal(f.id, 0x121);
+    assert_int_equal(f.dlc, 6);
+    assert_memory_equal(f.data, want, 6);
+    assert_int_equal(f.data[6], 0);
+    assert_int_equal(f.data[7], 0);
+    assert_memory_equal(g.data, want2, 6);
+    assert_int_equal(rfs_can_unpack_receiver(&f, &out, &c), RFS_CAN_OK);
+    assert_int_equal(out.t_us32, 0xFFFFFF00u);
+    assert_int_equal(c, 3);
+    const uint32_t ts[] = {0u, 1u, 0x7FFFFFFFu, 0x80000000u, 0xFFFFFFFFu};
+    for (unsigned i = 0; i < 5u; i++) {
+        rfs_can_receiver_t a = {ts[i]}, b = {0};
+        rfs_can_pack_receiver(&a, (uint8_t)i, &g);
+        assert_int_equal(rfs_can_unpack_receiver(&g, &b, &c), RFS_CAN_OK);
+        assert_int_equal(b.t_us32, ts[i]);
+        assert_int_equal(c, i);
+    }
+    for (uint8_t dlc = 0; dlc <= 8; dlc++) {
+        g = f;
+        g.dlc = dlc;
+        out.t_us32 = 0;
+        assert_int_equal(rfs_can_unpack_receiver(&g, &out, &c),
+                         dlc == 6 ? RFS_CAN_OK : RFS_CAN_E_DLC);
+        assert_int_equal(out.t_us32, dlc == 6 ? 0xFFFFFF00u : 0u);
+    }
+    for (unsigned bit = 0; bit < 48u; bit++) {
+        g = f;
+        g.data[bit / 8u] ^= (uint8_t)(1u << (bit % 8u));
+        assert_int_equal(rfs_can_unpack_receiver(&g, &out, &c), RFS_CAN_E_CHECKSUM);
+    }
+    g = f;
+    g.id = RFS_CAN_ID_RSSI; /* a copy under another id fails its checksum there */
+    assert_int_equal(rfs_can_unpack_receiver(&g, &out, &c), RFS_CAN_E_ID);
+    g.dlc = 8;
+    assert_int_equal(rfs_can_unpack_rssi(&g, &(rfs_can_rssi_t){0}, &c), RFS_CAN_E_CHECKSUM);
+    g = f;
+    g.data[0] |= 0x10u; /* reserved nibble set: re-seal so only the range check fails */
+    g.data[5] = rfs_can_checksum(g.id, g.dlc, g.data);
+    assert_int_equal(rfs_can_unpack_receiver(&g, &out, &c), RFS_CAN_E_RANGE);
+}
+
+static void rx_receiver_unwraps_and_applies_the_packet_time_window(void **state)
+{
+    (void)state;
+    rfs_can_rx_t rx = rx_fixture();
+    rfs_can_msg_t m;
+    rfs_can_frame_t f;
+    rfs_can_tx_t tx;
+    rfs_can_tx_init(&tx);
+    /* now is just past a 2^32 us wrap of the low 32 bits. */
+    const int64_t now = ((int64_t)1 << 32) + 1000;
+    rfs_can_receiver_t r = {0xFFFFFFF0u}; /* 1,016 us before now, across the wrap */
+    rfs_can_tx_receiver(&tx, &r, &f);
+
+    assert_int_equal(rfs_can_rx_frame(&rx, &f, now, &m), RFS_CAN_OK);
+    assert_int_equal(m.kind, RFS_CAN_MSG_RECEIVER);
+    assert_true(m.receiver_t_us == ((int64_t)1 << 32) - 16);
+
+    r.t_us32 = rfs_can_wrap_time(now - 2000); /* older than the newest heartbeat */
+    rfs_can_tx_receiver(&tx, &r, &f);
+    assert_int_equal(rfs_can_rx_frame(&rx, &f, now, &m), RFS_CAN_E_ORDER);
+    assert_int_equal(m.kind, RFS_CAN_MSG_NONE);
+    r.t_us32 = rfs_can_wrap_time(now - 1000001);
+    rfs_can_tx_receiver(&tx, &r, &f);
+    assert_int_equal(rfs_can_rx_frame(&rx, &f, now, &m), RFS_CAN_E_STALE);
+    r.t_us32 = rfs_can_wrap_time(now + 100001);
+    rfs_can_tx_receiver(&tx, &r, &f);
+    assert_int_equal(rfs_can_rx_frame(&rx, &f, now, &m), RFS_CAN_E_FUTURE);
+    /* A packet stamped later does not order the heartbeat stream (its own stream). */
+    rfs_can_rssi_t p = {0, -60, 0, rfs_can_wrap_time(now + 50000)};
+    rfs_can_tx_rssi(&tx, &p, &f);
+    assert_int_equal(rfs_can_rx_frame(&rx, &f, now, &m), RFS_CAN_OK);
+    r.t_us32 = rfs_can_wrap_time(now);
+    rfs_can_tx_receiver(&tx, &r, &f);
+    assert_int_equal(rfs_can_rx_frame(&rx, &f, now, &m), RFS_CAN_OK);
+    assert_true(m.receiver_t_us == now);
+    rfs_can_frame_t dup = f; /* the same counter again: a duplicate */
+    assert_int_equal(rfs_can_rx_frame(&rx, &dup, now, &m), RFS_CAN_E_REPEAT);
+    assert_int_equal(rx.msg[RFS_CAN_IDX_RX_STATUS].accepted, 2);
+    assert_int_equal(rx.msg[RFS_CAN_IDX_RX_STATUS].lost, 3); /* counters 1..3 were dropped */
+    assert_int_equal(rx.dropped[RFS_CAN_E_ORDER], 1);
+    assert_int_equal(rx.dropped[RFS_CAN_E_STALE], 1);
+    assert_int_equal(rx.dropped[RFS_CAN_E_FUTURE], 1);
+    assert_int_equal(rx.dropped[RFS_CAN_E_REPEAT], 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -583,6 +685,8 @@ int main(void)
         cmocka_unit_test(random_frames_are_all_accounted_for),
         cmocka_unit_test(rx_init_validates_config),
         cmocka_unit_test(seek_output_maps_to_status_and_wheels),
+        cmocka_unit_test(receiver_frame_bytes_round_trip_and_rejects),
+        cmocka_unit_test(rx_receiver_unwraps_and_applies_the_packet_time_window),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

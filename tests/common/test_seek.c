@@ -47,6 +47,31 @@ static void feed(world_t *t, int64_t t_us, double x, double y, double th, int8_t
     rfs_seek_step(&t->seek, t_us, &t->rng, out);
 }
 
+/* One period in a radio dead zone (issue 10): a pose at (x, y) and a receiver report, both
+ * stamped t and accepted (the stamps only grow), then a step; no packet. */
+static void feed_report(world_t *t, int64_t t_us, double x, double y, rfs_seek_out_t *out)
+{
+    rfs_pose_t p = pose_at(t_us, x, y, 0);
+    assert_true(rfs_seek_on_pose(&t->seek, &p, &t->rng));
+    assert_true(rfs_seek_on_receiver(&t->seek, t_us));
+    rfs_seek_step(&t->seek, t_us, &t->rng, out);
+}
+
+/* The heartbeat tests' start: a 10 x 10 m room, the default seeker (seed 11), and 1 s at
+ * 20 Hz of packets and receiver reports at (5, 5). Returns the time reached. */
+static int64_t heartbeat_start(world_t *t, rfs_seek_out_t *out)
+{
+    world_make(t, 10, 10, 0, 0);
+    seek_make(t, rfs_seek_cfg_default(), 11);
+    int64_t now = 0;
+    for (int k = 0; k < 20; ++k) {
+        now += 50000;
+        assert_true(rfs_seek_on_receiver(&t->seek, now));
+        feed(t, now, 5.0, 5.0, 0, -40, out);
+    }
+    return now;
+}
+
 /* With epsilon forced to 1, every goal after the initial move is novel: at least the
  * novelty radius from every position the robot reported. */
 static void test_epsilon_goals_are_novel(void **state)
@@ -272,19 +297,9 @@ static void test_heartbeat_keeps_goal_without_packets(void **state)
 {
     (void)state;
     world_t a, b;
-    world_make(&a, 10, 10, 0, 0);
-    world_make(&b, 10, 10, 0, 0);
-    seek_make(&a, rfs_seek_cfg_default(), 11);
-    seek_make(&b, rfs_seek_cfg_default(), 11);
     rfs_seek_out_t oa, ob;
-    int64_t now = 0;
-    for (int k = 0; k < 20; ++k) { /* 1 s at 20 Hz with packets and reports */
-        now += 50000;
-        assert_true(rfs_seek_on_receiver(&a.seek, now));
-        assert_true(rfs_seek_on_receiver(&b.seek, now));
-        feed(&a, now, 5.0, 5.0, 0, -40, &oa);
-        feed(&b, now, 5.0, 5.0, 0, -40, &ob);
-    }
+    (void)heartbeat_start(&a, &oa); /* the twins share nothing: one after the other */
+    int64_t now = heartbeat_start(&b, &ob);
     /* The robot stands still, so the initial goal (>= 0.5 m away) is still being driven. */
     assert_int_equal(ob.state, RFS_SEEK_DRIVING);
     assert_int_equal(ob.decision.kind, RFS_SEEK_INITIAL);
@@ -293,10 +308,7 @@ static void test_heartbeat_keeps_goal_without_packets(void **state)
     int moving = 0;
     for (int k = 0; k < 60; ++k) { /* 3 s: B hears nothing, its receiver is up */
         now += 50000;
-        rfs_pose_t p = pose_at(now, 5.0, 5.0, 0);
-        assert_true(rfs_seek_on_pose(&b.seek, &p, &b.rng));
-        assert_true(rfs_seek_on_receiver(&b.seek, now));
-        rfs_seek_step(&b.seek, now, &b.rng, &ob);
+        feed_report(&b, now, 5.0, 5.0, &ob);
         feed(&a, now, 5.0, 5.0, 0, -40, &oa);
         assert_int_equal(ob.faults & RFS_SEEK_FAULT_RSSI_STALE, 0);
         assert_int_equal(ob.state, RFS_SEEK_DRIVING);
@@ -312,10 +324,7 @@ static void test_heartbeat_keeps_goal_without_packets(void **state)
      * stored samples, as without a mean) and gives a new goal. */
     for (int k = 0; k < 20 && !ob.decided; ++k) { /* the wheels ramp down, then it ends */
         now += 50000;
-        rfs_pose_t p = pose_at(now, gx, gy, 0);
-        rfs_seek_on_pose(&b.seek, &p, &b.rng);
-        assert_true(rfs_seek_on_receiver(&b.seek, now));
-        rfs_seek_step(&b.seek, now, &b.rng, &ob);
+        feed_report(&b, now, gx, gy, &ob);
         assert_int_equal(ob.faults & RFS_SEEK_FAULT_RSSI_STALE, 0);
     }
     assert_true(ob.decided);
@@ -335,15 +344,8 @@ static void test_no_packet_no_heartbeat_stops_wheels(void **state)
 {
     (void)state;
     world_t t;
-    world_make(&t, 10, 10, 0, 0);
-    seek_make(&t, rfs_seek_cfg_default(), 11);
     rfs_seek_out_t out;
-    int64_t now = 0;
-    for (int k = 0; k < 20; ++k) {
-        now += 50000;
-        rfs_seek_on_receiver(&t.seek, now);
-        feed(&t, now, 5.0, 5.0, 0, -40, &out);
-    }
+    int64_t now = heartbeat_start(&t, &out);
     assert_true(out.left_mm_s != 0 || out.right_mm_s != 0);
     for (int phase = 0; phase < 2; ++phase) {
         /* phase 0: both stop at once; phase 1: 1 s of reports only, then they stop. */
@@ -351,10 +353,7 @@ static void test_no_packet_no_heartbeat_stops_wheels(void **state)
         if (phase == 1) {
             for (int k = 0; k < 20; ++k) {
                 now += 50000;
-                rfs_pose_t p = pose_at(now, 5.0, 5.0, 0);
-                rfs_seek_on_pose(&t.seek, &p, &t.rng);
-                rfs_seek_on_receiver(&t.seek, now);
-                rfs_seek_step(&t.seek, now, &t.rng, &out);
+                feed_report(&t, now, 5.0, 5.0, &out);
                 assert_int_equal(out.faults & RFS_SEEK_FAULT_RSSI_STALE, 0);
                 assert_true(out.left_mm_s != 0 || out.right_mm_s != 0);
             }
@@ -406,10 +405,7 @@ static void test_heartbeat_never_makes_a_mean(void **state)
     double x = 5.0, y = 5.0, gx = 5.0, gy = 5.0;
     for (int k = 0; k < 400; ++k) { /* 20 s; the robot jumps to a goal once it moves */
         now += 50000;
-        rfs_pose_t p = pose_at(now, x, y, 0);
-        rfs_seek_on_pose(&t.seek, &p, &t.rng);
-        assert_true(rfs_seek_on_receiver(&t.seek, now));
-        rfs_seek_step(&t.seek, now, &t.rng, &out);
+        feed_report(&t, now, x, y, &out);
         assert_int_equal(out.faults & RFS_SEEK_FAULT_RSSI_STALE, 0);
         if (out.left_mm_s != 0 || out.right_mm_s != 0) {
             moving++;
@@ -441,15 +437,8 @@ static void test_heartbeat_stamps(void **state)
 {
     (void)state;
     world_t t;
-    world_make(&t, 10, 10, 0, 0);
-    seek_make(&t, rfs_seek_cfg_default(), 11);
     rfs_seek_out_t out;
-    int64_t now = 0;
-    for (int k = 0; k < 20; ++k) {
-        now += 50000;
-        assert_true(rfs_seek_on_receiver(&t.seek, now));
-        feed(&t, now, 5.0, 5.0, 0, -40, &out);
-    }
+    int64_t now = heartbeat_start(&t, &out);
     assert_true(rfs_seek_on_receiver(&t.seek, now));          /* equal: accepted */
     assert_false(rfs_seek_on_receiver(&t.seek, now - 1));     /* older: rejected */
     assert_int_equal(t.seek.rx_rejected, 1);

@@ -1,7 +1,9 @@
 /* test_app.c - the application loop (firmware/rfs_app.h) on the host: configuration and
  * map checks, the safety stops (input lost, bus-off, reset) against the requirement of
  * issue 6 (zero wheels within 200 ms), CAN in and out through common/rfs_can.h's own
- * decoders. */
+ * decoders, and the receiver heartbeat (issue 10): a radio dead zone is driven through
+ * with it, stops within 200 ms without it, and a heartbeat from the future stops the
+ * wheels as a packet from the future does. */
 #include "rfs_test.h"
 
 #include <string.h>
@@ -9,23 +11,7 @@
 #include "rfs_app.h"
 #include "rfs_can.h"
 
-#define W 200u /* 20 x 10 m at 0.1 m */
-#define H 100u
-static uint8_t s_free[(W + 7u) / 8u * H];
-static rfs_app_t s_app;
-
-static rfs_app_map_t room(void)
-{
-    memset(s_free, 0, sizeof s_free);
-    for (uint16_t y = 1; y < H - 1u; y++) {
-        for (uint16_t x = 1; x < W - 1u; x++) {
-            rfs_map_bit_set(s_free, (W + 7u) / 8u, x, y, true);
-        }
-    }
-    const rfs_app_map_t m = {.w = W, .h = H, .res = RFS_Q16_FRAC(1, 10), .origin_x = 0,
-                             .origin_y = 0, .free = s_free, .wall = NULL};
-    return m;
-}
+#include "app_fixture.h"
 
 /* Feed 10 Hz poses at (5, 5) and 200/s packets up to t_end, stepping at 20 Hz; returns the
  * number of steps with non-zero wheels. The robot is held in place: it turns or drives
@@ -47,6 +33,97 @@ static int run(int64_t t0, int64_t t_end, bool poses, bool rssi, rfs_app_out_t *
         }
     }
     return moving;
+}
+
+/* A dead zone (issue 10): 10 Hz poses at (5, 5), no packets, and, when `heartbeat`, a
+ * receiver heartbeat stamped `hb_lead` after its arrival once per control period just
+ * before the step (as the sniffer's capture loop sends it). Returns the moving steps. */
+static int run_dead_zone(int64_t t0, int64_t t_end, bool heartbeat, int64_t hb_lead,
+                         rfs_app_out_t *last)
+{
+    int moving = 0;
+    for (int64_t t = t0; t < t_end; t += 5000) {
+        if (t % 100000 == 0) {
+            const rfs_pose_t p = {.t_us = t, .x = RFS_Q16_INT(5), .y = RFS_Q16_INT(5), .theta = 0};
+            rfs_app_on_pose(&s_app, &p, t);
+        }
+        if (t % RFS_APP_PERIOD_US == 0) {
+            if (heartbeat) {
+                rfs_app_on_receiver(&s_app, t + hb_lead, t);
+            }
+            rfs_app_step(&s_app, t, last);
+            moving += (last->left_mm_s != 0 || last->right_mm_s != 0);
+        }
+    }
+    return moving;
+}
+
+/* Drive for 2 s with packets, then enter a dead zone (no packets) with or without
+ * heartbeats; *moving_late counts the moving steps from 200 ms after the last packet. */
+static void drive_then_dead_zone(bool heartbeat, int *moving_late, rfs_app_out_t *o)
+{
+    const rfs_app_cfg_t c = rfs_app_cfg_default();
+    const rfs_app_map_t m = room();
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    run(0, 2000000, true, true, o);
+    assert_true(o->left_mm_s != 0 || o->right_mm_s != 0); /* driving when the packets stop */
+    /* The last packet is stamped 1.995 s; 200 ms later is 2.195 s. */
+    run_dead_zone(2000000, 2200000, heartbeat, 0, o);
+    *moving_late = run_dead_zone(2200000, 4000000, heartbeat, 0, o);
+}
+
+static void test_dead_zone_heartbeat_keeps_driving(void **state)
+{
+    (void)state;
+    rfs_app_out_t o;
+    int moving = 0;
+
+    drive_then_dead_zone(true, &moving, &o);
+
+    /* 36 steps in [2.2, 4.0) s: the robot is held in place, so it never reaches its goal
+     * and drives on every step once the inputs are fresh. */
+    assert_int_equal(moving, 36);
+    assert_false(o.faults & (RFS_APP_FAULT_RSSI_LOST | RFS_SEEK_FAULT_RSSI_STALE));
+    assert_int_equal(s_app.stats.receiver, 40u); /* one per period from 2.0 s to 3.95 s */
+    assert_int_equal(s_app.stats.rejected, 0u);
+}
+
+static void test_dead_zone_without_heartbeat_stops_within_200_ms(void **state)
+{
+    (void)state;
+    rfs_app_out_t o;
+    int moving = -1;
+
+    drive_then_dead_zone(false, &moving, &o);
+
+    assert_int_equal(moving, 0);
+    assert_true(o.faults & RFS_APP_FAULT_RSSI_LOST);
+    assert_true(o.faults & RFS_SEEK_FAULT_RSSI_STALE);
+    assert_int_equal(s_app.stats.receiver, 0u);
+}
+
+static void test_heartbeat_from_the_future_stops_like_a_packet(void **state)
+{
+    (void)state;
+    /* A packet stamped 5 s ahead (a clock jump, issue 9) makes the stream stale: the
+     * wheels stop. A heartbeat stamped 5 s ahead must do the same. */
+    rfs_app_out_t o_hb, o_pkt;
+    int moving = 0;
+    drive_then_dead_zone(true, &moving, &o_hb);
+    assert_true(moving > 0);
+
+    assert_int_equal(run_dead_zone(4000000, 4500000, true, 5000000, &o_hb), 0);
+    assert_true(o_hb.faults & RFS_SEEK_FAULT_RSSI_STALE);
+    /* Back on the right clock the heartbeats are older than the future one: rejected
+     * (out of order) and the stream stays stale, as for packets. */
+    const uint32_t rej = s_app.stats.rejected;
+    assert_int_equal(run_dead_zone(4500000, 5000000, true, 0, &o_hb), 0);
+    assert_int_equal(s_app.stats.rejected - rej, 10u);
+
+    drive_then_dead_zone(true, &moving, &o_pkt);
+    rfs_app_on_rssi(&s_app, 0, 4000000 + 5000000, -60, 4000000);
+    assert_int_equal(run_dead_zone(4000000, 4500000, false, 0, &o_pkt), 0);
+    assert_true(o_pkt.faults & RFS_SEEK_FAULT_RSSI_STALE);
 }
 
 static void test_init_checks_configuration_and_map(void **state)
@@ -199,6 +276,42 @@ static void test_can_inputs_are_decoded_or_counted(void **state)
     assert_false(o.faults & RFS_APP_FAULT_BAD_FRAME);
 }
 
+static void test_can_receiver_frames_keep_a_dead_zone_driving(void **state)
+{
+    (void)state;
+    rfs_app_out_t o;
+    int moving = 0;
+    drive_then_dead_zone(false, &moving, &o); /* packets until 2 s, then nothing to 4 s */
+    assert_int_equal(moving, 0);
+    rfs_can_tx_t tx;
+    rfs_can_tx_init(&tx);
+    rfs_can_frame_t f;
+    int moving_can = 0;
+
+    /* The radio module's heartbeat frames (0x121) once per period, 4.0 .. 6.0 s. */
+    for (int64_t t = 4000000; t < 6000000; t += RFS_APP_PERIOD_US) {
+        if (t % 100000 == 0) {
+            const rfs_pose_t p = {.t_us = t, .x = RFS_Q16_INT(5), .y = RFS_Q16_INT(5), .theta = 0};
+            rfs_app_on_pose(&s_app, &p, t);
+        }
+        const rfs_can_receiver_t r = {rfs_can_wrap_time(t)};
+        rfs_can_tx_receiver(&tx, &r, &f);
+        assert_int_equal(rfs_app_on_can(&s_app, &f, t), RFS_CAN_OK);
+        rfs_app_step(&s_app, t, &o);
+        moving_can += (o.left_mm_s != 0 || o.right_mm_s != 0);
+    }
+
+    /* Every step but the first one out of the stale state drives: 39 of 40. */
+    assert_int_equal(moving_can, 39);
+    assert_int_equal(s_app.stats.receiver, 40u);
+    /* Stamped beyond the CAN receiver's 100 ms future window: rejected as a packet is. */
+    const rfs_can_receiver_t late = {rfs_can_wrap_time(6000000 + 100001)};
+    rfs_can_tx_receiver(&tx, &late, &f);
+    assert_int_equal(rfs_app_on_can(&s_app, &f, 6000000), RFS_CAN_E_FUTURE);
+    assert_int_equal(s_app.stats.receiver, 40u);
+    assert_int_equal(s_app.stats.bad_frames, 1u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -208,6 +321,10 @@ int main(void)
         cmocka_unit_test(test_bus_off_stops_at_once_and_recovers),
         cmocka_unit_test(test_frames_decode_with_the_protocol_decoders),
         cmocka_unit_test(test_can_inputs_are_decoded_or_counted),
+        cmocka_unit_test(test_dead_zone_heartbeat_keeps_driving),
+        cmocka_unit_test(test_dead_zone_without_heartbeat_stops_within_200_ms),
+        cmocka_unit_test(test_heartbeat_from_the_future_stops_like_a_packet),
+        cmocka_unit_test(test_can_receiver_frames_keep_a_dead_zone_driving),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -8,29 +8,13 @@
 
 #include <string.h>
 
+#include "app_fixture.h"
 #include "rfs_app.h"
 #include "rfs_knn.h"
 #include "rfs_mlp.h"
 #include "rfs_replay.h"
 
-#define W 200u /* 20 x 10 m at 0.1 m */
-#define H 100u
-static uint8_t s_free[(W + 7u) / 8u * H];
-static rfs_app_t s_app;
 static uint64_t s_state[(sizeof(rfs_mlp_t) + 7u) / 8u]; /* an image holding ridge and mlp */
-
-static rfs_app_map_t room(void)
-{
-    memset(s_free, 0, sizeof s_free);
-    for (uint16_t y = 1; y < H - 1u; y++) {
-        for (uint16_t x = 1; x < W - 1u; x++) {
-            rfs_map_bit_set(s_free, (W + 7u) / 8u, x, y, true);
-        }
-    }
-    const rfs_app_map_t m = {.w = W, .h = H, .res = RFS_Q16_FRAC(1, 10), .origin_x = 0,
-                             .origin_y = 0, .free = s_free, .wall = NULL};
-    return m;
-}
 
 static void test_built_in_state_holds_the_ridge_only(void **state)
 {

@@ -352,6 +352,140 @@ static void test_player_errors(void **state)
     assert_int_equal(p.error, RFS_REPLAY_E_ORDER);
 }
 
+/* RECEIVER (issue 10): type 0x13, length 16, rx then the capture time, both i64 LE. */
+static void test_receiver_record_exact_bytes_and_lengths(void **state)
+{
+    (void)state;
+    rfs_replay_rec_t r;
+    memset(&r, 0, sizeof r);
+    r.type = RFS_REPLAY_RECEIVER;
+    r.t_us = 0x0102030405060708LL;
+    r.u.receiver_t_us = -2;
+    const uint8_t want[18] = {0x13, 16,
+                              0x08, 0x07, 0x06, 0x05, 0x04, 0x03, 0x02, 0x01,
+                              0xFE, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
+    uint8_t buf[RFS_REPLAY_MAX_RECORD];
+
+    assert_int_equal(rfs_replay_encode(&r, buf, sizeof buf), 18);
+
+    assert_memory_equal(buf, want, 18);
+    rfs_replay_rec_t back;
+    uint32_t used = 0;
+    assert_int_equal(rfs_replay_parse(want, 18, &used, &back), RFS_REPLAY_OK);
+    assert_int_equal(used, 18);
+    assert_int_equal(back.type, RFS_REPLAY_RECEIVER);
+    assert_true(back.t_us == 0x0102030405060708LL);
+    assert_true(back.u.receiver_t_us == -2);
+    roundtrip(&r);
+    uint8_t shorter[17], longer[19];
+    memcpy(shorter, want, 17);
+    shorter[1] = 15;
+    memcpy(longer, want, 18);
+    longer[1] = 17;
+    longer[18] = 0;
+    assert_int_equal(rfs_replay_parse(shorter, 17, &used, &back), RFS_REPLAY_BAD);
+    assert_string_equal(back.error, "wrong record length for its type");
+    assert_int_equal(rfs_replay_parse(longer, 19, &used, &back), RFS_REPLAY_BAD);
+    assert_string_equal(back.error, "wrong record length for its type");
+}
+
+/* Play a dead zone: a 20 x 10 m room, 10 Hz poses at (5, 5) throughout, packets for the
+ * first 2 s, then none; with `heartbeat` a RECEIVER record before every STEP. Returns the
+ * STEPs from 2.2 s to 4 s whose output drives. */
+static int play_dead_zone(bool heartbeat, rfs_replay_player_t *p, rfs_app_t *app, buf_sink_t *out)
+{
+    const rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    rfs_replay_rec_t r;
+    rfs_replay_player_init(p, app, &cfg, sink, out);
+    memset(&r, 0, sizeof r);
+    r.type = RFS_REPLAY_MAP;
+    r.u.map.w = 200;
+    r.u.map.h = 100;
+    r.u.map.res = 6554; /* 0.1 m */
+    assert_true(rfs_replay_play(p, &r));
+    for (uint32_t off = 0; off < 25u * 100u; off += RFS_REPLAY_CHUNK) {
+        memset(&r, 0, sizeof r);
+        r.type = RFS_REPLAY_MAP_FREE;
+        r.u.chunk.offset = off;
+        r.u.chunk.n = (uint8_t)(2500u - off < RFS_REPLAY_CHUNK ? 2500u - off : RFS_REPLAY_CHUNK);
+        for (uint32_t i = 0; i < r.u.chunk.n; i++) {
+            const uint32_t row = (off + i) / 25u, col = (off + i) % 25u;
+            /* Free inside a one-cell border. */
+            uint8_t v = 0xFF;
+            if (row == 0u || row == 99u) {
+                v = 0;
+            } else if (col == 0u) {
+                v = 0xFE;
+            } else if (col == 24u) {
+                v = 0x7F;
+            }
+            r.u.chunk.bytes[i] = v;
+        }
+        assert_true(rfs_replay_play(p, &r));
+    }
+    int moving = 0;
+    for (int64_t t = 0; t < 4000000; t += 5000) {
+        memset(&r, 0, sizeof r);
+        if (t % 100000 == 0) {
+            r.type = RFS_REPLAY_POSE;
+            r.t_us = t;
+            r.u.pose.t_us = t;
+            r.u.pose.x = 5 * 65536;
+            r.u.pose.y = 5 * 65536;
+            assert_true(rfs_replay_play(p, &r));
+        }
+        if (t < 2000000) {
+            r.type = RFS_REPLAY_RSSI;
+            r.t_us = t;
+            r.u.rssi.t_us = t;
+            r.u.rssi.dbm = (int8_t)(-60 - (t / 5000) % 3);
+            assert_true(rfs_replay_play(p, &r));
+        }
+        if (t % RFS_APP_PERIOD_US == 0) {
+            if (heartbeat) {
+                r.type = RFS_REPLAY_RECEIVER;
+                r.t_us = t;
+                r.u.receiver_t_us = t;
+                assert_true(rfs_replay_play(p, &r));
+            }
+            r.type = RFS_REPLAY_STEP;
+            r.t_us = t;
+            out->n = 0;
+            assert_true(rfs_replay_play(p, &r));
+            if (t >= 2200000 && (app->last.left_mm_s != 0 || app->last.right_mm_s != 0)) {
+                moving++;
+            }
+        }
+    }
+    return moving;
+}
+
+static void test_receiver_records_drive_through_a_dead_zone(void **state)
+{
+    (void)state;
+    static rfs_app_t app;
+    static rfs_replay_player_t p;
+    static buf_sink_t out;
+
+    const int with = play_dead_zone(true, &p, &app, &out);
+    const uint32_t heard = app.stats.receiver;
+    const int without = play_dead_zone(false, &p, &app, &out);
+
+    /* 36 steps in [2.2, 4.0) s; the robot is held in place and never reaches its goal. */
+    assert_int_equal(with, 36);
+    assert_int_equal(heard, 80u);
+    assert_int_equal(without, 0);
+    assert_int_equal(app.stats.receiver, 0u);
+    /* A RECEIVER record before the map is an input before the map. */
+    const rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    rfs_replay_player_init(&p, &app, &cfg, sink, &out);
+    rfs_replay_rec_t r;
+    memset(&r, 0, sizeof r);
+    r.type = RFS_REPLAY_RECEIVER;
+    assert_false(rfs_replay_play(&p, &r));
+    assert_int_equal(p.error, RFS_REPLAY_E_NO_MAP);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -362,6 +496,8 @@ int main(void)
         cmocka_unit_test(test_malformed_records_are_rejected),
         cmocka_unit_test(test_random_bytes_never_overrun),
         cmocka_unit_test(test_player_errors),
+        cmocka_unit_test(test_receiver_record_exact_bytes_and_lengths),
+        cmocka_unit_test(test_receiver_records_drive_through_a_dead_zone),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

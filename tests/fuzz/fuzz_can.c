@@ -4,17 +4,18 @@
  * Input: a sequence of 12-byte records, each one received frame:
  *   ctrl u8   bit 0: overwrite data[dlc-1] with the correct checksum (so the fuzzer gets
  *             past the CRC and reaches the range, counter, pairing and time checks);
- *             bits 1..3: id = one of our five ids (0..4) or the raw 11-bit id below (5..7)
+ *             bits 1..3: id = one of our six ids (0..5: wheel, pose xy, pose th, RSSI,
+ *             status, receiver status) or the raw 11-bit id below (6..7)
  *   dt   u16  receiver time advance, units of 1 ms (0 .. 65.5 s), little-endian
  *   dlc  u8   taken mod 16 (values > 8 are invalid frames the decoder must reject)
- *   data 8 bytes (data[0..1] also give the raw id for ctrl ids 5..7)
+ *   data 8 bytes (data[0..1] also give the raw id for ctrl ids 6..7)
  *
  * Beyond ASan/UBSan it checks what rfs_can.h promises:
  *   - a frame the stateless decoder accepts re-encodes to exactly the same bytes
  *     (the layout has no unused bits: anything else would be a lossy or lax decoder);
  *   - every frame is either accepted or counted in one drop reason (an accepted POSE_XY
  *     may also count the earlier unpaired one as a PAIR drop);
- *   - an accepted RSSI lies inside [now - max_age, now + max_future];
+ *   - an accepted RSSI or receiver heartbeat lies inside [now - max_age, now + max_future];
  *   - a complete pose lies inside the int24 millimetre range and (-pi, pi].
  */
 #include <stddef.h>
@@ -26,8 +27,8 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-static const uint32_t k_ids[5] = {RFS_CAN_ID_WHEEL_CMD, RFS_CAN_ID_POSE_XY, RFS_CAN_ID_POSE_TH,
-                                  RFS_CAN_ID_RSSI, RFS_CAN_ID_STATUS};
+static const uint32_t k_ids[6] = {RFS_CAN_ID_WHEEL_CMD, RFS_CAN_ID_POSE_XY, RFS_CAN_ID_POSE_TH,
+                                  RFS_CAN_ID_RSSI, RFS_CAN_ID_STATUS, RFS_CAN_ID_RX_STATUS};
 
 /* Decode f with the stateless decoder of its id; on success re-encode with the same
  * counter and require identical bytes 0..dlc-1. */
@@ -68,6 +69,12 @@ static void check_roundtrip(const rfs_can_frame_t *f)
         rfs_can_pack_status(&s, c, &g);
         break;
     }
+    case RFS_CAN_ID_RX_STATUS: {
+        rfs_can_receiver_t r;
+        if (rfs_can_unpack_receiver(f, &r, &c) != RFS_CAN_OK) { return; }
+        rfs_can_pack_receiver(&r, c, &g);
+        break;
+    }
     default:
         return;
     }
@@ -91,7 +98,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         const unsigned sel = (r[0] >> 1) & 7u;
         f.dlc = (uint8_t)(r[3] & 0x0Fu);
         memcpy(f.data, r + 4, 8);
-        f.id = sel < 5u ? k_ids[sel] : ((uint32_t)r[4] | ((uint32_t)r[5] << 8)) & 0xFFFFu;
+        f.id = sel < 6u ? k_ids[sel] : ((uint32_t)r[4] | ((uint32_t)r[5] << 8)) & 0xFFFFu;
         if ((r[0] & 1u) && f.dlc >= 1u && f.dlc <= 8u) {
             f.data[f.dlc - 1u] = rfs_can_checksum(f.id, f.dlc, f.data);
             /* Both checksum implementations must agree on every input. */
@@ -113,6 +120,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 msg.rssi_src >= RFS_CAN_MAX_SOURCES) {
                 abort();
             }
+        }
+        if (msg.kind == RFS_CAN_MSG_RECEIVER &&
+            (msg.receiver_t_us < now - cfg.max_age_us || msg.receiver_t_us > now + cfg.max_future_us)) {
+            abort();
         }
         if (msg.kind == RFS_CAN_MSG_POSE) {
             /* int24 mm is +-8388.6 m; theta within (-pi, pi] plus one Q2.13 step. */

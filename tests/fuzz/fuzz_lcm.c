@@ -3,7 +3,7 @@
  * anyone on the network can publish any bytes on our channels, and logs are files.
  *
  * Input: byte 0 selects the path, the rest is the payload.
- *   byte 0 < 0x80: a message on channel (byte 0 mod 6), published on an in-process
+ *   byte 0 < 0x80: a message on channel (byte 0 mod 7), published on an in-process
  *                  memq:// connection and received through hs_lcm_handle() - the same
  *                  code path as a UDP message;
  *   byte 0 >= 0x80: the payload is an LCM log file, read with hs_lcm_log_next() (channel
@@ -71,19 +71,28 @@ static void on_can(void *ctx, int64_t t_us, const rfs_can_frame_t *f)
     if (f->id > RFS_CAN_ID_MAX || f->dlc > 8u) { abort(); }
 }
 
+static void on_receiver(void *ctx, int64_t t_us, uint32_t seq)
+{
+    (void)ctx;
+    (void)t_us;
+    (void)seq;
+}
+
 static void on_bad(void *ctx, const char *why)
 {
     (void)ctx;
     fuzz_check_err_line(why);
 }
 
-static const hs_lcm_handlers_t k_h = {NULL, on_pose, on_rssi, on_clock, on_wheel, on_status, on_can, on_bad};
+static const hs_lcm_handlers_t k_h = {NULL,     on_pose, on_rssi, on_clock,   on_wheel,
+                                      on_status, on_can, on_bad, on_receiver};
 static hs_lcm_t *g_lcm;
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static const char *const ch[6] = {HS_LCM_CH_POSE,  HS_LCM_CH_RSSI,   HS_LCM_CH_CLOCK,
-                                      HS_LCM_CH_WHEEL, HS_LCM_CH_STATUS, HS_LCM_CH_CAN_FALLBACK};
+    static const char *const ch[7] = {HS_LCM_CH_POSE,   HS_LCM_CH_RSSI,         HS_LCM_CH_CLOCK,
+                                      HS_LCM_CH_WHEEL,  HS_LCM_CH_STATUS,       HS_LCM_CH_CAN_FALLBACK,
+                                      HS_LCM_CH_RSSI_STATUS};
     if (size < 1u) { return 0; }
     char err[256] = "";
     if (data[0] < 0x80u) {
@@ -96,7 +105,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
         hs_lcm_stats_t before, after;
         hs_lcm_get_stats(g_lcm, &before);
-        if (hs_lcm_pub_raw(g_lcm, 0, ch[data[0] % 6u], data + 1, size - 1u) != 0) { return 0; }
+        if (hs_lcm_pub_raw(g_lcm, 0, ch[data[0] % 7u], data + 1, size - 1u) != 0) { return 0; }
         int handled = 0;
         while (hs_lcm_handle(g_lcm, 0) == 1) { handled++; }
         hs_lcm_get_stats(g_lcm, &after);

@@ -5,10 +5,11 @@
 
 Seeds are built here from the documented formats (docs/CAN.md, the ROS map_server
 convention, docs/SIMULATOR.md, the LCM wire format), not by the code under test:
-  can/       12-byte frame records (see fuzz_can.c): pose pairs, RSSI, wheel, status
+  can/       12-byte frame records (see fuzz_can.c): pose pairs, RSSI, wheel, status,
+             receiver heartbeats
   map/       YAML + "#PGM\\n" + PGM: tests/data/maps_bad fixtures and small P2/P5 images
   scenario/  the scenarios/*.yaml files and a few hand-written edge cases
-  lcm/       one message per channel (LCM encoding: 8-byte fingerprint, big-endian fields;
+  lcm/       one message per channel, the receiver heartbeat included (LCM encoding: 8-byte fingerprint, big-endian fields;
              fingerprints computed with lcm-gen's hash) and small LCM logs
 """
 import os
@@ -27,7 +28,8 @@ def put(sub, name, data):
 
 
 # --- CAN: records ctrl, dt (ms, LE u16), dlc, data[8] -----------------------------------
-# ctrl bit 0 = fix the checksum; bits 1..3 = id index (0 wheel, 1 xy, 2 th, 3 rssi, 4 status).
+# ctrl bit 0 = fix the checksum; bits 1..3 = id index (0 wheel, 1 xy, 2 th, 3 rssi, 4 status,
+# 5 receiver status; 6, 7 a raw id from data[0..1]).
 T0 = 5_000_000_000  # the harness's start time, microseconds
 
 
@@ -67,7 +69,24 @@ put("can", "pose_wrap", pose(0, -8388608, 8388607, 25736, T0 + 2**32 + 100_000) 
 put("can", "repeat_unpaired", pose(3, 1, 2, 3, T0 + 100_000) + pose(3, 1, 2, 3, T0 + 200_000) +
     rec(2, 0, 8, [0x05, 0, 0]) + rec(1, 1, 8, [0x06]) + rec(1, 1, 8, [0x07]))
 put("can", "bad_dlc_crc", rec(3, 1, 7, [0], fix=True) + rec(3, 1, 8, [0] * 8, fix=False) +
-    rec(5, 1, 8, [0xff, 0x07, 0, 0, 0, 0, 0, 0]) + rec(7, 1, 15, [0x11, 0x01]))
+    rec(6, 1, 8, [0xff, 0x07, 0, 0, 0, 0, 0, 0]) + rec(7, 1, 15, [0x11, 0x01]))
+
+
+def receiver(counter, t_us, dt_ms=50):
+    return rec(5, dt_ms, 6, bytes([counter & 15]) + struct.pack("<I", t_us & 0xFFFFFFFF))
+
+
+# A dead zone: heartbeats every 50 ms with no packet, one repeated, one from the future,
+# one stale, one across the 32-bit wrap, then a damaged DLC and a reserved nibble.
+hb = b""
+now = T0
+for i in range(8):
+    now += 50_000
+    hb += receiver(i, now - 2_000)
+hb += receiver(7, now, dt_ms=1) + receiver(8, now + 50_000 + 200_000) + receiver(9, now - 2_000_000)
+hb += receiver(10, T0 + 2**32 + 400_000, dt_ms=0) + rec(5, 1, 8, [0x0b, 0, 0, 0, 0, 0, 0])
+hb += rec(5, 1, 6, [0x1c, 0, 0, 0, 0])
+put("can", "receiver_dead_zone", hb)
 
 # --- map: YAML "#PGM\n" PGM -------------------------------------------------------------
 MAP_YAML = ("image: m.pgm\nresolution: 0.05\norigin: [-1.0, 2.5, 0.0]\nnegate: 0\n"
@@ -139,23 +158,27 @@ CLOCK = [("utime", "int64_t", 0)]
 WHEEL = [("utime", "int64_t", 0), ("left_mm_s", "int16_t", 0), ("right_mm_s", "int16_t", 0),
          ("stop", "boolean", 0)]
 CAN = [("utime", "int64_t", 0), ("id", "int32_t", 0), ("dlc", "int8_t", 0), ("data", "byte", 1)]
+RSSI_STATUS = [("utime", "int64_t", 0), ("seq", "int32_t", 0)]
 msgs = {
     0: struct.pack(">Q", lcm_hash(POSE)) + struct.pack(">qddd", 1_000_000, 8.0, 6.0, 7.0),
     1: struct.pack(">Q", lcm_hash(RSSI)) + struct.pack(">qhhi", 1_000_000, 0, -60, 7),
     2: struct.pack(">Q", lcm_hash(CLOCK)) + struct.pack(">q", 2_000_000),
     3: struct.pack(">Q", lcm_hash(WHEEL)) + struct.pack(">qhhb", 1_000_000, 300, -300, 0),
     5: struct.pack(">Q", lcm_hash(CAN)) + struct.pack(">qib", 1_000_000, 0x120, 8) + bytes(range(8)),
+    6: struct.pack(">Q", lcm_hash(RSSI_STATUS)) + struct.pack(">qi", 1_050_000, 21),
 }
 for sel, m in msgs.items():
     put("lcm", "msg_%d" % sel, bytes([sel]) + m)
 put("lcm", "msg_4_garbage", bytes([4]) + b"\x00" * 40)
+put("lcm", "msg_6_clock", bytes([6]) + msgs[2])  # a clock_t on the heartbeat channel
 
 
 def log_event(num, t, ch, data):
     return struct.pack(">IqqII", 0xEDA1DA01, num, t, len(ch), len(data)) + ch.encode() + data
 
 
-names = ["RFS_POSE", "RFS_RSSI", "RFS_CLOCK", "RFS_WHEEL_CMD", "RFS_SEEKER_STATUS", "RFS_CAN_FALLBACK"]
+names = ["RFS_POSE", "RFS_RSSI", "RFS_CLOCK", "RFS_WHEEL_CMD", "RFS_SEEKER_STATUS", "RFS_CAN_FALLBACK",
+         "RFS_RSSI_STATUS"]
 log = b"".join(log_event(i, 1_000_000 + i, names[sel], m) for i, (sel, m) in enumerate(msgs.items()))
 put("lcm", "log_all", b"\x80" + log)
 put("lcm", "log_unknown_channel", b"\x80" + log_event(0, 5, "OTHER", b"abc") + log_event(1, 6, "RFS_POSE", b"x"))

@@ -22,14 +22,22 @@
 #include "hs_scenario.h"
 #include "hs_sim.h"
 
+/* Append fault k (its defaults) over [start_s, start_s + duration_s) to c; returns it for
+ * the fields a test sets besides. */
+static hs_fault_t *add(hs_faults_cfg_t *c, hs_fault_kind_t k, double start_s, double duration_s)
+{
+    hs_fault_t *f = &c->f[c->n++];
+    *f = hs_faults_default(k);
+    f->start_s = start_s;
+    f->duration_s = duration_s;
+    return f;
+}
+
 static hs_faults_cfg_t one(hs_fault_kind_t k, double start_s, double duration_s)
 {
     hs_faults_cfg_t c;
     memset(&c, 0, sizeof c);
-    c.n = 1;
-    c.f[0] = hs_faults_default(k);
-    c.f[0].start_s = start_s;
-    c.f[0].duration_s = duration_s;
+    (void)add(&c, k, start_s, duration_s);
     return c;
 }
 
@@ -187,18 +195,13 @@ static void test_can_drop_rate_matches_probability(void **state)
 static void test_one_shot_events_fire_once_when_due(void **state)
 {
     (void)state;
-    hs_faults_cfg_t c;
-    memset(&c, 0, sizeof c);
-    c.n = 2;
-    c.f[0] = hs_faults_default(HS_FAULT_KIDNAP);
-    c.f[0].start_s = 5.0;
+    hs_faults_cfg_t c = one(HS_FAULT_KIDNAP, 5.0, 0.0); /* one-shot: no duration */
     c.f[0].x = 3.0;
     c.f[0].y = 4.0;
     c.f[0].theta = 1.0;
-    c.f[1] = hs_faults_default(HS_FAULT_SOURCE_MOVE);
-    c.f[1].start_s = 2.0;
-    c.f[1].x = 7.0;
-    c.f[1].y = 8.0;
+    hs_fault_t *move = add(&c, HS_FAULT_SOURCE_MOVE, 2.0, 0.0);
+    move->x = 7.0;
+    move->y = 8.0;
     hs_faults_run_t r;
     hs_faults_start(&r, &c, 7, NULL);
     hs_faults_event_t ev;
@@ -339,7 +342,7 @@ static void measure(FILE *log, double bus_off_start_s, measured_t *m)
 }
 
 /// Run scenarios/faults/open-NAME.yaml with `seed`, logging into a temporary file.
-static void run_fault_io(const char *name, uint64_t seed, hs_sim_result_t *res, FILE **log,
+static void run_fault(const char *name, uint64_t seed, hs_sim_result_t *res, FILE **log,
                          hs_scenario_t *sc_out, FILE *decisions)
 {
     char path[256], err[1024];
@@ -367,12 +370,6 @@ static void run_fault_io(const char *name, uint64_t seed, hs_sim_result_t *res, 
     *sc_out = sc;
 }
 
-static void run_fault(const char *name, uint64_t seed, hs_sim_result_t *res, FILE **log,
-                      hs_scenario_t *sc_out)
-{
-    run_fault_io(name, seed, res, log, sc_out, NULL);
-}
-
 /// The checks every fault shares: the run reached the source, no command moved the
 /// wheels while the newest input was more than 200 ms old, and the log is not empty.
 static void common_checks(const char *name, const hs_sim_result_t *res, const measured_t *m)
@@ -386,6 +383,18 @@ static void common_checks(const char *name, const hs_sim_result_t *res, const me
         fail_msg("%s: %u wheel commands non-zero with an input stamp over 200 ms from now", name,
                  m->stale_moving);
     }
+}
+
+/// Run open-NAME.yaml with seed 1, measure its log (around the window when the fault is a
+/// bus-off) and make the common checks.
+static void run_checked(const char *name, hs_sim_result_t *res, hs_scenario_t *sc, measured_t *m)
+{
+    FILE *log;
+    run_fault(name, 1, res, &log, sc, NULL);
+    const hs_fault_t *f = &sc->faults.f[0];
+    measure(log, f->kind == HS_FAULT_BUS_OFF ? f->start_s : INFINITY, m);
+    fclose(log);
+    common_checks(name, res, m);
 }
 
 static void test_stale_input_faults_stop_the_wheels_and_recover(void **state)
@@ -408,13 +417,9 @@ static void test_stale_input_faults_stop_the_wheels_and_recover(void **state)
     };
     for (unsigned i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         hs_sim_result_t res;
-        FILE *log;
         hs_scenario_t sc;
-        run_fault(cases[i].name, 1, &res, &log, &sc);
         measured_t m;
-        measure(log, INFINITY, &m);
-        fclose(log);
-        common_checks(cases[i].name, &res, &m);
+        run_checked(cases[i].name, &res, &sc, &m);
         if (m.stale_cmds < cases[i].min_stale) {
             fail_msg("%s: only %u commands with stale inputs (want >= %u)", cases[i].name,
                      m.stale_cmds, cases[i].min_stale);
@@ -433,14 +438,10 @@ static void test_bus_off_stops_the_wheels_within_200_ms(void **state)
 {
     (void)state;
     hs_sim_result_t res;
-    FILE *log;
     hs_scenario_t sc;
-    run_fault("bus_off", 1, &res, &log, &sc);
-    const hs_fault_t *f = &sc.faults.f[0];
     measured_t m;
-    measure(log, f->start_s, &m);
-    fclose(log);
-    common_checks("bus_off", &res, &m);
+    run_checked("bus_off", &res, &sc, &m);
+    const hs_fault_t *f = &sc.faults.f[0];
     // The last command that got through came in the control period before the window.
     assert_true(m.last_delivered_before_s >= f->start_s - 0.05 - 1e-6);
     // The motor controller's 200 ms timeout set the wheels' target to zero from the first
@@ -457,13 +458,9 @@ static void test_can_send_failures_are_survived(void **state)
 {
     (void)state;
     hs_sim_result_t res;
-    FILE *log;
     hs_scenario_t sc;
-    run_fault("can_drop", 1, &res, &log, &sc);
     measured_t m;
-    measure(log, INFINITY, &m);
-    fclose(log);
-    common_checks("can_drop", &res, &m);
+    run_checked("can_drop", &res, &sc, &m);
     assert_true(m.moving_after > 0);
 }
 
@@ -471,13 +468,9 @@ static void test_kidnapped_robot_still_reaches_the_source(void **state)
 {
     (void)state;
     hs_sim_result_t res;
-    FILE *log;
     hs_scenario_t sc;
-    run_fault("kidnap", 1, &res, &log, &sc);
     measured_t m;
-    measure(log, INFINITY, &m);
-    fclose(log);
-    common_checks("kidnap", &res, &m);
+    run_checked("kidnap", &res, &sc, &m);
     const hs_fault_t *f = &sc.faults.f[0];
     assert_true(fabs(m.kidnap_s - f->start_s) <= 0.02 + 1e-6);
     // The next localisation pose is where the robot was put down (pose noise 5 cm, and at
@@ -489,13 +482,9 @@ static void test_moved_source_is_found_at_its_new_place(void **state)
 {
     (void)state;
     hs_sim_result_t res;
-    FILE *log;
     hs_scenario_t sc;
-    run_fault("source_move", 1, &res, &log, &sc);
     measured_t m;
-    measure(log, INFINITY, &m);
-    fclose(log);
-    common_checks("source_move", &res, &m);
+    run_checked("source_move", &res, &sc, &m);
     const hs_fault_t *f = &sc.faults.f[0];
     assert_true(res.sim_time_s > f->start_s); // the move happened during the run
     assert_true(hypot(res.final_x - f->x, res.final_y - f->y) <= sc.stop_radius_m + 1e-9);
@@ -513,7 +502,7 @@ static void test_goal_resumes_after_silence(void **state)
     hs_sim_result_t res;
     FILE *log;
     hs_scenario_t sc;
-    run_fault_io("rssi_silence", 1, &res, &log, &sc, dec);
+    run_fault("rssi_silence", 1, &res, &log, &sc, dec);
     fclose(log);
     const double t0 = sc.faults.f[0].start_s, t1 = t0 + sc.faults.f[0].duration_s;
     rewind(dec);

@@ -399,26 +399,23 @@ static void dead_moving(FILE *log, unsigned *moving_deaf, double *first_pkt_s)
 static void test_receiver_heartbeat_through_faults(void **state)
 {
     (void)state;
+    static const struct {
+        hs_fault_kind_t kind;
+        double start_s, duration_s, lag_s; /* lag_s 0: the default's */
+    } w[] = {
+        {HS_FAULT_RSSI_SILENCE, 1.0, 1.0, 0.0}, {HS_FAULT_RSSI_PAST, 3.0, 1.0, 0.5},
+        {HS_FAULT_RSSI_FUTURE, 5.0, 1.0, 2.0},  {HS_FAULT_RSSI_REORDER, 7.0, 1.0, 0.0},
+        {HS_FAULT_POSE_PAST, 0.0, 10.0, 0.0},
+    };
     hs_faults_cfg_t c;
     memset(&c, 0, sizeof c);
-    c.n = 5;
-    c.f[0] = hs_faults_default(HS_FAULT_RSSI_SILENCE);
-    c.f[0].start_s = 1.0;
-    c.f[0].duration_s = 1.0;
-    c.f[1] = hs_faults_default(HS_FAULT_RSSI_PAST);
-    c.f[1].start_s = 3.0;
-    c.f[1].duration_s = 1.0;
-    c.f[1].lag_s = 0.5;
-    c.f[2] = hs_faults_default(HS_FAULT_RSSI_FUTURE);
-    c.f[2].start_s = 5.0;
-    c.f[2].duration_s = 1.0;
-    c.f[2].lag_s = 2.0;
-    c.f[3] = hs_faults_default(HS_FAULT_RSSI_REORDER);
-    c.f[3].start_s = 7.0;
-    c.f[3].duration_s = 1.0;
-    c.f[4] = hs_faults_default(HS_FAULT_POSE_PAST);
-    c.f[4].start_s = 0.0;
-    c.f[4].duration_s = 10.0;
+    for (c.n = 0; c.n < sizeof w / sizeof w[0]; c.n++) {
+        hs_fault_t *f = &c.f[c.n];
+        *f = hs_faults_default(w[c.n].kind);
+        f->start_s = w[c.n].start_s;
+        f->duration_s = w[c.n].duration_s;
+        f->lag_s = w[c.n].lag_s > 0.0 ? w[c.n].lag_s : f->lag_s;
+    }
     hs_faults_run_t r;
     hs_faults_start(&r, &c, 1, NULL);
     unsigned delivered = 0;

@@ -21,7 +21,8 @@
 #include "rfs_can.h"
 
 static const uint32_t our_ids[] = {RFS_CAN_ID_WHEEL_CMD, RFS_CAN_ID_POSE_XY, RFS_CAN_ID_POSE_TH, RFS_CAN_ID_RSSI,
-                                   RFS_CAN_ID_STATUS};
+                                   RFS_CAN_ID_STATUS, RFS_CAN_ID_RX_STATUS};
+#define N_OUR_IDS (sizeof our_ids / sizeof our_ids[0])
 
 static void usage(FILE *o)
 {
@@ -38,7 +39,7 @@ static void nap_ms(int ms)
 static int do_send(const char *ifname, const char *expect)
 {
     char err[256];
-    hs_can_t *c = hs_can_open(ifname, our_ids, 5, err, sizeof err);
+    hs_can_t *c = hs_can_open(ifname, our_ids, N_OUR_IDS, err, sizeof err);
     if (!c) {
         fprintf(stderr, "%s\n", err);
         return 1;
@@ -67,6 +68,10 @@ static int do_send(const char *ifname, const char *expect)
         rfs_can_status_t s = {(uint8_t)(3 - i), (uint8_t)(2 + i), (uint8_t)(2 + 2 * i), i == 0, i == 1,
                               (uint8_t)(i ? 0x0F : 0), i ? 0xFFFFFFFFu : 7u};
         rfs_can_tx_status(&tx, &s, &fr[n++]);
+    }
+    for (int i = 0; i < 2; i++) { /* receiver heartbeats (issue 10), across the wrap */
+        rfs_can_receiver_t r = {rfs_can_wrap_time(t0 + 100000 * i)};
+        rfs_can_tx_receiver(&tx, &r, &fr[n++]);
     }
     char tmp[512];
     snprintf(tmp, sizeof tmp, "%s.tmp", expect);
@@ -138,6 +143,9 @@ static int do_recv(const char *ifname, int64_t now_us)
         case RFS_CAN_MSG_WHEEL:
             printf("WHEEL left=%d right=%d flags=%u\n", m.wheel.left_mm_s, m.wheel.right_mm_s, m.wheel.flags);
             break;
+        case RFS_CAN_MSG_RECEIVER:
+            printf("RECEIVER t=%" PRId64 "\n", m.receiver_t_us);
+            break;
         case RFS_CAN_MSG_STATUS:
             printf("STATUS state=%u kind=%u prev=%u relearned=%u line=%u faults=%u iter=%" PRIu32 "\n", m.status.state,
                    m.status.kind, m.status.prev, m.status.relearned, m.status.line_search, m.status.faults,
@@ -165,9 +173,9 @@ static int do_faults(const char *ifname)
 {
     int fails = 0;
     char err[256], cmd[256], d[256];
-    hs_can_t *gone = hs_can_open("rfsnope0", our_ids, 5, err, sizeof err);
+    hs_can_t *gone = hs_can_open("rfsnope0", our_ids, N_OUR_IDS, err, sizeof err);
     fails += check(gone == NULL && strstr(err, "rfsnope0: no such interface") != NULL, "can-missing-iface", err);
-    hs_can_t *c = hs_can_open(ifname, our_ids, 5, err, sizeof err);
+    hs_can_t *c = hs_can_open(ifname, our_ids, N_OUR_IDS, err, sizeof err);
     if (!c) {
         return check(0, "can-open", err);
     }

@@ -76,7 +76,13 @@ def main(argv):
     want.append("DROP stale")
     # 12. a remote frame: filtered by the kernel like 7
     send.append("120#R")
-    want.append("STATS delivered=10 foreign=0 dropped=4 checksum=1 rssi_jumps=1 seq_gaps=1")
+    # 13. a receiver heartbeat (issue 10), counter 0, 5 ms ago
+    send.append(frame(0x121, struct.pack("<BI", 0x00, t32(NOW - 5000))))
+    want.append("RECEIVER t=%d" % (NOW - 5000))
+    # 14. a receiver heartbeat 300 ms ahead: beyond the 100 ms future window
+    send.append(frame(0x121, struct.pack("<BI", 0x01, t32(NOW + 300000))))
+    want.append("DROP future")
+    want.append("STATS delivered=12 foreign=0 dropped=5 checksum=1 rssi_jumps=1 seq_gaps=1")
     with open(os.path.join(out, "cansend.txt"), "w") as f:
         f.write("\n".join(send) + "\n")
     with open(os.path.join(out, "expect_recv.txt"), "w") as f:

@@ -54,6 +54,13 @@ int main(int argc, char **argv)
         print_frame(&f);
         printf(" Counter=%u Source=%u Rssi=%d Seq=%u Time=%" PRIu32 "\n", c, r.src, r.dbm, r.seq, r.t_us32);
     }
+    for (unsigned i = 0; i < sizeof ts / sizeof ts[0]; i++) {
+        rfs_can_receiver_t r = {ts[i]};
+        uint8_t c = (uint8_t)(i * 7u % 16u);
+        rfs_can_pack_receiver(&r, c, &f);
+        print_frame(&f);
+        printf(" Counter=%u Time=%" PRIu32 "\n", c, r.t_us32);
+    }
     const uint32_t iters[] = {0, 0xFFFFFFFFu, 1, 0x12345678u, 5, 65536};
     for (unsigned i = 0; i < sizeof iters / sizeof iters[0]; i++) {
         rfs_can_status_t s = {(uint8_t)(i % 4u), (uint8_t)((i + 1u) % 4u), (uint8_t)(i % 5u), (i & 1u) != 0,

@@ -6,11 +6,18 @@
  *                               pose with a NaN x, an RSSI from source 99, a clock message
  *                               on the pose channel, 5 bytes of garbage on RFS_RSSI and a
  *                               pose older than the newest; at 2 s a clock going backwards
+ *   lcm_tool mkdeadzone OUT.lcmlog on|off
+ *                               a radio dead zone (issue 10): 4 s of poses (10 Hz) at the
+ *                               office map's start, RSSI (100 Hz) only for the first 1 s,
+ *                               RFS_CLOCK at 20 Hz; with "on" a receiver heartbeat
+ *                               (RFS_RSSI_STATUS) just before every clock tick (81) and
+ *                               5 bytes of garbage on RFS_RSSI_STATUS at 2 s
  *   lcm_tool dump LOG           print each status in a log as
  *                               "STATUS t state left right faults decided"
  */
 #include <inttypes.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -97,6 +104,45 @@ static int mklog(const char *out)
     return 0;
 }
 
+static int mkdeadzone(const char *out, bool heartbeat)
+{
+    char err[256];
+    hs_lcm_t *l = hs_lcm_open("memq://", NULL, err, sizeof err);
+    hs_lcm_log_t *ol = l ? hs_lcm_log_open(out, "w", err, sizeof err) : NULL;
+    if (!ol) {
+        fprintf(stderr, "lcm_tool: %s\n", err);
+        hs_lcm_close(l);
+        return 1;
+    }
+    hs_lcm_record(l, ol);
+    for (int64_t t_us = 0; t_us <= 4000000; t_us += 5000) {
+        if (t_us < 1000000 && t_us % 10000 == 0) {
+            int8_t dbm = (int8_t)(-60 - (int)((t_us / 10000) % 7));
+            hs_lcm_pub_rssi(l, 0, t_us, dbm, (uint32_t)(t_us / 10000));
+        }
+        if (t_us % 100000 == 0) {
+            rfs_pose_t p = {t_us, 8 * 65536, 6 * 65536, 0};
+            hs_lcm_pub_pose(l, &p);
+        }
+        if (heartbeat && t_us == 2000000) {
+            const uint8_t junk[5] = {1, 2, 3, 4, 5};
+            hs_lcm_pub_raw(l, t_us, HS_LCM_CH_RSSI_STATUS, junk, sizeof junk);
+        }
+        if (t_us % 50000 == 0) {
+            if (heartbeat) {
+                hs_lcm_pub_receiver(l, t_us, (uint32_t)(t_us / 50000));
+            }
+            hs_lcm_pub_clock(l, t_us);
+        }
+    }
+    hs_lcm_close(l);
+    if (hs_lcm_log_close(ol) != 0) {
+        fprintf(stderr, "lcm_tool: %s: cannot finish the log\n", out);
+        return 1;
+    }
+    return 0;
+}
+
 static void on_status(void *ctx, int64_t t_us, const rfs_seek_out_t *o)
 {
     (void)ctx;
@@ -133,10 +179,14 @@ int main(int argc, char **argv)
     if (argc == 3 && strcmp(argv[1], "mklog") == 0) {
         return mklog(argv[2]);
     }
+    if (argc == 4 && strcmp(argv[1], "mkdeadzone") == 0 &&
+        (strcmp(argv[3], "on") == 0 || strcmp(argv[3], "off") == 0)) {
+        return mkdeadzone(argv[2], strcmp(argv[3], "on") == 0);
+    }
     if (argc == 3 && strcmp(argv[1], "dump") == 0) {
         return dump(argv[2]);
     }
     fprintf(argc == 2 && strcmp(argv[1], "--help") == 0 ? stdout : stderr,
-            "usage: lcm_tool mklog OUT.lcmlog | lcm_tool dump LOG\n");
+            "usage: lcm_tool mklog OUT.lcmlog | lcm_tool mkdeadzone OUT.lcmlog on|off | lcm_tool dump LOG\n");
     return argc == 2 && strcmp(argv[1], "--help") == 0 ? 0 : 2;
 }

@@ -49,7 +49,7 @@ for pat in "RFS_POSE: truncated, oversized or not an rfseek.pose_t (37 bytes)" \
 done
 # 81 clock ticks (0..4 s at 20 Hz; the backwards one is dropped), the 5 malformed
 # messages, and the one out-of-order pose rejected by the seeker.
-grep -qE "^rfseekd: 81 steps, [0-9]+ decisions, 5 bad messages, 0 CAN send failures, seeker rejected 1 inputs" "$w/err1.txt" \
+grep -qE "^rfseekd: 81 steps, [0-9]+ decisions, 5 bad messages, 0 CAN send failures, 0 receiver heartbeats, seeker rejected 1 inputs" "$w/err1.txt" \
     && pass rfseekd-bad-input-counted || fail "rfseekd-bad-input-counted ($(tail -1 "$w/err1.txt"))"
 # STATUS t state left right faults decided
 awk '$2 < 3000000 && ($4 != 0 || $5 != 0) {moving++}
@@ -73,6 +73,32 @@ if [ -x "$build/asan/bin/rfseekd" ]; then
         fail "rfseekd-bad-input-under-asan-ubsan (rc $rc: $(grep -m3 -E 'Sanitizer|runtime error' "$w/err-asan.txt"))"
     fi
 fi
+# A radio dead zone (issue 10): packets stop at 1 s, poses go on. Without the receiver
+# heartbeat (RFS_RSSI_STATUS) the wheels stop within 200 ms and stay stopped; with it
+# every one of the 81 heartbeats reaches the application (counted by rfseekd) and the
+# robot drives on to 4 s; the garbage heartbeat is dropped with one line.
+for hb in off on; do
+    "$tool" mkdeadzone "$w/dz-$hb.lcmlog" $hb || fail "lcm-mkdeadzone-$hb"
+    "$d" --map $map --replay "$w/dz-$hb.lcmlog" --clock-lcm --lcm memq:// --log "$w/dz-out-$hb.lcmlog" \
+        > /dev/null 2> "$w/dz-err-$hb.txt" || fail "rfseekd-dead-zone-run-$hb"
+    "$tool" dump "$w/dz-out-$hb.lcmlog" > "$w/dz-status-$hb.txt" || fail "lcm-dump-dead-zone-$hb"
+done
+# moving steps before 1 s, from 1.2 s to 4 s
+dz() { awk '($4 != 0 || $5 != 0) && $2 < 1000000 {a++} ($4 != 0 || $5 != 0) && $2 >= 1200000 {b++}
+            END {printf "%d %d\n", a, b}' "$1"; }
+read -r off_before off_after <<<"$(dz "$w/dz-status-off.txt")"
+read -r on_before on_after <<<"$(dz "$w/dz-status-on.txt")"
+[ "$off_before" -gt 5 ] && [ "$off_after" -eq 0 ] \
+    && pass "rfseekd-dead-zone-without-heartbeat-stops ($off_before moving steps before 1 s, none from 1.2 s)" \
+    || fail "rfseekd-dead-zone-without-heartbeat-stops ($off_before before, $off_after after)"
+[ "$on_before" -eq "$off_before" ] && [ "$on_after" -ge 50 ] \
+    && pass "rfseekd-dead-zone-heartbeat-drives-on ($on_after of 57 steps from 1.2 s move)" \
+    || fail "rfseekd-dead-zone-heartbeat-drives-on ($on_before before, $on_after after)"
+grep -qE "^rfseekd: 81 steps, [0-9]+ decisions, 1 bad messages, 0 CAN send failures, 81 receiver heartbeats, seeker rejected 0 inputs" \
+    "$w/dz-err-on.txt" && grep -qF "RFS_RSSI_STATUS: truncated, oversized or not an rfseek.rssi_status_t (5 bytes)" "$w/dz-err-on.txt" \
+    && pass "rfseekd-heartbeats-reach-the-app (81 of 81, the garbage one dropped)" \
+    || fail "rfseekd-heartbeats-reach-the-app ($(cat "$w/dz-err-on.txt" | tr '\n' ';'))"
+
 timeout 60 lcm-logplayer -l memq:// -s 1000 "$w/out1.lcmlog" > /dev/null 2>&1 \
     && pass rfseekd-log-plays-in-lcm-logplayer || fail rfseekd-log-plays-in-lcm-logplayer
 

@@ -28,6 +28,9 @@ typedef struct rx {
     int frames;
     char bad[200];
     int bads;
+    int64_t rx_t;
+    uint32_t rx_seq;
+    int rxs;
 } rx_t;
 
 static void on_pose(void *c, const rfs_pose_t *p) { rx_t *r = c; r->pose = *p; r->poses++; }
@@ -47,9 +50,11 @@ static void on_bad(void *c, const char *why)
     r->bads++;
 }
 
+static void on_receiver(void *c, int64_t t, uint32_t q) { rx_t *r = c; r->rx_t = t; r->rx_seq = q; r->rxs++; }
+
 static hs_lcm_handlers_t handlers(rx_t *r)
 {
-    hs_lcm_handlers_t h = {r, on_pose, on_rssi, on_clock, on_wheel, on_status, on_can, on_bad};
+    hs_lcm_handlers_t h = {r, on_pose, on_rssi, on_clock, on_wheel, on_status, on_can, on_bad, on_receiver};
     return h;
 }
 
@@ -249,6 +254,50 @@ static void bad_url_and_unreadable_log_give_one_line(void **state)
     assert_string_equal(err, "/nonexistent/dir/x.lcmlog: cannot open for reading");
 }
 
+/* RFS_RSSI_STATUS (issue 10). Reference bytes from the LCM wire format computed in Python
+ * (tests/fuzz/make_corpus.py's lcm_hash of {int64_t utime, int32_t seq} = 0xc77a89abfd4c5ba6,
+ * then utime and seq big-endian): utime -5,000,000,123, seq -7. */
+static void receiver_status_matches_reference_bytes_and_rejects_others(void **state)
+{
+    (void)state;
+    const uint8_t ref[20] = {0xc7, 0x7a, 0x89, 0xab, 0xfd, 0x4c, 0x5b, 0xa6, 0xff, 0xff,
+                             0xff, 0xfe, 0xd5, 0xfa, 0x0d, 0x85, 0xff, 0xff, 0xff, 0xf9};
+    rx_t r;
+    hs_lcm_t *l = open_memq(&r);
+
+    assert_int_equal(hs_lcm_pub_raw(l, 0, HS_LCM_CH_RSSI_STATUS, ref, sizeof ref), 0);
+    drain(l);
+    assert_int_equal(r.rxs, 1);
+    assert_true(r.rx_t == -5000000123LL);
+    assert_int_equal(r.rx_seq, 0xFFFFFFF9u);
+    assert_int_equal(hs_lcm_pub_receiver(l, 1700000000123456LL, 41u), 0);
+    drain(l);
+    assert_int_equal(r.rxs, 2);
+    assert_true(r.rx_t == 1700000000123456LL);
+    assert_int_equal(r.rx_seq, 41u);
+
+    /* A clock_t (fingerprint 0x4d0d41c1f105b12f, one int64) on the heartbeat channel, a
+     * truncated and an over-long heartbeat: dropped with one line each, nothing delivered. */
+    const uint8_t clk[16] = {0x4d, 0x0d, 0x41, 0xc1, 0xf1, 0x05, 0xb1, 0x2f, 0, 0, 0, 0, 0, 0, 0, 1};
+    uint8_t longer[21];
+    memcpy(longer, ref, sizeof ref);
+    longer[20] = 0;
+    assert_int_equal(hs_lcm_pub_raw(l, 0, HS_LCM_CH_RSSI_STATUS, clk, sizeof clk), 0);
+    drain(l);
+    assert_string_equal(r.bad, "RFS_RSSI_STATUS: truncated, oversized or not an rfseek.rssi_status_t (16 bytes)");
+    assert_int_equal(hs_lcm_pub_raw(l, 0, HS_LCM_CH_RSSI_STATUS, ref, 19), 0);
+    assert_int_equal(hs_lcm_pub_raw(l, 0, HS_LCM_CH_RSSI_STATUS, longer, sizeof longer), 0);
+    drain(l);
+    assert_string_equal(r.bad, "RFS_RSSI_STATUS: truncated, oversized or not an rfseek.rssi_status_t (21 bytes)");
+    assert_int_equal(r.bads, 3);
+    assert_int_equal(r.rxs, 2);
+    hs_lcm_stats_t st;
+    hs_lcm_get_stats(l, &st);
+    assert_int_equal(st.received, 2);
+    assert_int_equal(st.bad, 3);
+    hs_lcm_close(l);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -257,6 +306,7 @@ int main(void)
         cmocka_unit_test(malformed_messages_are_dropped_and_described),
         cmocka_unit_test(log_is_written_atomically_and_reads_back),
         cmocka_unit_test(bad_url_and_unreadable_log_give_one_line),
+        cmocka_unit_test(receiver_status_matches_reference_bytes_and_rejects_others),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,5 +1,6 @@
 /* bench_clock.h - exact instruction counts on the emulator image (qemu-system-arm
- * -M netduinoplus2 -icount shift=7), shared by the bench images (bench.c, bench_models.c).
+ * -M netduinoplus2 -icount shift=7), shared by the bench images (bench.c, bench_models.c);
+ * the emulator port (main.c) uses its decimal printer and stack painting only.
  *
  * With -icount every instruction advances the virtual clock by exactly 2^7 ns and SysTick
  * (core clock, 168 MHz in qemu's model) counts that clock, so a SysTick difference is an

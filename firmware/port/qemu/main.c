@@ -12,6 +12,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "bench_clock.h"
 #include "rfs_app.h"
 #include "rfs_mlp.h"
 #include "rfs_replay.h"
@@ -25,28 +26,10 @@ static rfs_replay_player_t s_player;
 static uint64_t s_model[(sizeof(rfs_mlp_t) + 7u) / 8u];
 
 /* Stack high-water mark: the stack is painted at start and scanned at the end (the
- * figure that sizes the hardware image's stack, docs/FIRMWARE.md). */
-extern uint32_t _sstack, _estack;
-#define STACK_PAINT 0xA5A5A5A5u
-
-static void stack_paint(void)
-{
-    uintptr_t sp;
-    __asm__ volatile("mov %0, sp" : "=r"(sp));
-    for (uint32_t *p = &_sstack; (uintptr_t)p < sp - 64u; p++) {
-        *p = STACK_PAINT;
-    }
-}
-
-static uint32_t stack_used(void)
-{
-    const uint32_t *p = &_sstack;
-    // cppcheck-suppress comparePointers ; _sstack.._estack are one region (linker script)
-    while (p < &_estack && *p == STACK_PAINT) {
-        p++;
-    }
-    return (uint32_t)((uintptr_t)&_estack - (uintptr_t)p);
-}
+ * figure that sizes the hardware image's stack, docs/FIRMWARE.md), counted from the top
+ * of the stack: the depth below the painting's stack pointer plus the start-up's frames
+ * above it. */
+extern uint32_t _estack;
 
 /* A fault (a stack overflow runs off the bottom of SRAM) ends the run loudly. */
 void HardFault_Handler(void);
@@ -54,18 +37,6 @@ void HardFault_Handler(void)
 {
     rfs_sh_puts("rfseek-qemu: HardFault (stack overflow or bad access)\n");
     rfs_sh_exit(1);
-}
-
-static void put_u32(uint32_t v)
-{
-    char buf[12];
-    int i = 11;
-    buf[i] = '\0';
-    do {
-        buf[--i] = (char)('0' + (int)(v % 10u));
-        v /= 10u;
-    } while (v != 0u);
-    rfs_sh_puts(&buf[i]);
 }
 
 /* Output buffering: semihosting calls are slow in the emulator (a trap each). */
@@ -130,7 +101,7 @@ static int args(char *cmd, char **in, char **out)
 
 int main(void)
 {
-    stack_paint();
+    const uintptr_t sp = rfs_bc_stack_paint();
     static char cmd[256];
     char *in_name, *out_name;
     if (rfs_sh_cmdline(cmd, sizeof cmd) != 0 || args(cmd, &in_name, &out_name) != 0) {
@@ -195,7 +166,7 @@ int main(void)
         die("output: write error");
     }
     rfs_sh_puts("rfseek-qemu: stack used ");
-    put_u32(stack_used());
+    rfs_bc_put_u64(rfs_bc_stack_depth(sp) + ((uintptr_t)&_estack - sp));
     rfs_sh_puts(" bytes\n");
     rfs_sh_exit(0);
 }

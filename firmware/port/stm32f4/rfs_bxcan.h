@@ -140,7 +140,8 @@ typedef struct rfs_bxcan {
 } rfs_bxcan_t;
 
 /// Defaults: 42 MHz APB1, 500 kbit/s, 1 + 11 + 2 tq (sample point 85.7 %), SJW 1;
-/// POSE_XY and POSE_TH into FIFO 0 (their order matters), RSSI into FIFO 1.
+/// POSE_XY and POSE_TH into FIFO 0 (their order matters), RSSI and RX_STATUS (the
+/// receiver heartbeat) into FIFO 1.
 rfs_bxcan_cfg_t rfs_bxcan_cfg_default(void);
 
 /// The BTR value for a configuration: BRP = pclk / (bitrate * (1 + ts1 + ts2)) - 1.

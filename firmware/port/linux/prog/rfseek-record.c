@@ -7,6 +7,12 @@
  * rfs_replay_play() - the very code path of the emulator image - so the recorded stream,
  * replayed anywhere, must reproduce the live outputs byte for byte.
  *
+ * The simulated receiver's heartbeat (issue 10; the scenario's radio.receiver.heartbeat,
+ * once per control period) is recorded as the radio module's RX_STATUS frame (0x121,
+ * --heartbeat can, the default), as a RECEIVER record (--heartbeat record: the decoded
+ * path of the Linux port), or not at all (--heartbeat off: the packets-only rule). The
+ * drop windows below that stop the RSSI frames stop it too: a silent radio module.
+ *
  * Faults for the safety tests are injected live and recorded:
  *   --drop T0:T1    no pose or RSSI frame reaches the controller in [T0, T1) seconds
  *   --drop-pose T0:T1, --drop-rssi T0:T1   only the poses / only the RSSI frames stop
@@ -28,6 +34,8 @@
 #include "rfs_replay.h"
 
 #define MAX_WINDOWS 8
+
+typedef enum hb_mode { HB_CAN = 0, HB_RECORD, HB_OFF } hb_mode_t;
 
 typedef struct window {
     int64_t t0_us, t1_us;
@@ -54,6 +62,7 @@ typedef struct recorder {
     unsigned nreset;
     unsigned next_reset;
     bool bus_off;
+    hb_mode_t heartbeat;
     uint32_t records;
 } recorder_t;
 
@@ -136,6 +145,28 @@ static void on_rssi(void *self, uint8_t src, int64_t t_us, int8_t dbm)
     feed_can(r, t_us, &f);
 }
 
+static void on_receiver(void *self, int64_t t_us)
+{
+    recorder_t *r = self;
+    if (r->heartbeat == HB_OFF || in_window(r->drop, r->ndrop, t_us) ||
+        in_window(r->drop_rssi, r->ndrop_rssi, t_us)) {
+        return;
+    }
+    if (r->heartbeat == HB_CAN) {
+        const rfs_can_receiver_t m = {.t_us32 = rfs_can_wrap_time(t_us)};
+        rfs_can_frame_t f;
+        rfs_can_tx_receiver(&r->tx, &m, &f);
+        feed_can(r, t_us, &f);
+        return;
+    }
+    rfs_replay_rec_t rec;
+    memset(&rec, 0, sizeof rec);
+    rec.type = RFS_REPLAY_RECEIVER;
+    rec.t_us = t_us;
+    rec.u.receiver_t_us = t_us;
+    feed(r, &rec);
+}
+
 static void step(void *self, int64_t now_us, hs_ctrl_out_t *out)
 {
     recorder_t *r = self;
@@ -202,9 +233,13 @@ static void usage(FILE *f)
             "  --max-time S         stop after S simulated seconds (default: the scenario's)\n"
             "  --drop T0:T1         no pose/RSSI frames reach the controller in [T0, T1) s\n"
             "  --drop-pose T0:T1    only the pose frames stop in [T0, T1) s\n"
-            "  --drop-rssi T0:T1    only the RSSI frames stop in [T0, T1) s\n"
+            "  --drop-rssi T0:T1    only the RSSI frames (and receiver heartbeats) stop in\n"
+            "                       [T0, T1) s\n"
             "  --bus-off T0:T1      the controller's CAN is bus-off in [T0, T1) s\n"
             "  --reset T            watchdog reset at T s\n"
+            "  --heartbeat MODE     the receiver heartbeat (issue 10; when the scenario has it):\n"
+            "                       can (RX_STATUS frames, default), record (RECEIVER\n"
+            "                       records) or off (packets only)\n"
             "  --fit-budget N       samples learnt per control period (0: all; the MCU\n"
             "                       configuration uses 2500)\n"
             "  --model NAME         internal model, overriding the scenario's: ridge, mlp, knn,\n"
@@ -228,6 +263,7 @@ int main(int argc, char **argv)
         {"reset", required_argument, 0, 'r'},   {"help", no_argument, 0, 'h'},
         {"drop-pose", required_argument, 0, 'P'}, {"drop-rssi", required_argument, 0, 'R'},
         {"fit-budget", required_argument, 0, 'f'}, {"model", required_argument, 0, 'm'},
+        {"heartbeat", required_argument, 0, 'H'},
         {0, 0, 0, 0}};
     static recorder_t rec;
     const char *out_path = NULL, *live_path = NULL;
@@ -304,6 +340,17 @@ int main(int argc, char **argv)
                 return 2;
             }
             model_name = optarg;
+            break;
+        case 'H':
+            if (strcmp(optarg, "can") == 0) {
+                rec.heartbeat = HB_CAN;
+            } else if (strcmp(optarg, "record") == 0) {
+                rec.heartbeat = HB_RECORD;
+            } else if (strcmp(optarg, "off") == 0) {
+                rec.heartbeat = HB_OFF;
+            } else {
+                die_opt("--heartbeat (can, record or off)", optarg);
+            }
             break;
         case 'h': usage(stdout); return 0;
         default: usage(stderr); return 2;
@@ -429,6 +476,7 @@ int main(int argc, char **argv)
     ctrl.period_us = RFS_APP_PERIOD_US;
     ctrl.on_pose = on_pose;
     ctrl.on_rssi = on_rssi;
+    ctrl.on_receiver = on_receiver;
     ctrl.step = step;
     hs_sim_result_t res;
     const int rc = hs_sim_run(&env, run_seed, &ctrl, NULL, &res, err, sizeof err);

@@ -78,6 +78,7 @@ static const char *type_name(rfs_replay_type_t t)
     case RFS_REPLAY_POSE: return "POSE";
     case RFS_REPLAY_RSSI: return "RSSI";
     case RFS_REPLAY_CAN: return "CAN";
+    case RFS_REPLAY_RECEIVER: return "RECEIVER";
     case RFS_REPLAY_STEP: return "STEP";
     case RFS_REPLAY_BUS: return "BUS";
     case RFS_REPLAY_RESET: return "RESET";
@@ -116,6 +117,9 @@ static void print_rec(const rfs_replay_rec_t *r)
         break;
     case RFS_REPLAY_RSSI:
         printf("\tt=%" PRId64 "\tsrc=%u\tdbm=%d", r->u.rssi.t_us, r->u.rssi.src, r->u.rssi.dbm);
+        break;
+    case RFS_REPLAY_RECEIVER:
+        printf("\tt=%" PRId64, r->u.receiver_t_us);
         break;
     case RFS_REPLAY_CAN:
     case RFS_REPLAY_CAN_TX:

@@ -1,5 +1,6 @@
 /* rfseekd.c - the Linux port of the firmware (issue 4): the same application loop as the
- * microcontroller (firmware/rfs_app.h), with pose and RSSI from LCM, wheel commands to
+ * microcontroller (firmware/rfs_app.h), with pose, RSSI and the receiver heartbeat
+ * (RFS_RSSI_STATUS, issue 10) from LCM, wheel commands to
  * SocketCAN (or the LCM fallback channel RFS_CAN_FALLBACK carrying raw CAN frames), the
  * status to LCM, and runs recorded as LCM logs. See docs/CAN.md.
  *
@@ -26,7 +27,8 @@
 static const char usage_text[] =
     "usage: rfseekd --map MAP.yaml [--lcm URL] [--can IFACE | --can-over-lcm] [options]\n"
     "       rfseekd --map MAP.yaml --replay LOG [--clock-lcm] [options]\n"
-    "The rfseek controller as a Linux process: pose (RFS_POSE) and RSSI (RFS_RSSI) from LCM,\n"
+    "The rfseek controller as a Linux process: pose (RFS_POSE), RSSI (RFS_RSSI) and the\n"
+    "receiver heartbeat (RFS_RSSI_STATUS: listening, packet or not) from LCM,\n"
     "wheel commands to CAN, status to RFS_SEEKER_STATUS (and a copy on RFS_WHEEL_CMD).\n"
     "  --map FILE        ROS map_server YAML (required)\n"
     "  --res M           core map cell size, metres (default 0.1)\n"
@@ -209,6 +211,14 @@ static void on_rssi(void *ctx, uint8_t src, int64_t t_us, int8_t dbm, uint32_t s
     (void)seq;
     advance_to(d, t_us);
     (void)rfs_app_on_rssi(d->app, src, t_us, dbm, rx_time(d, t_us));
+}
+
+static void on_receiver(void *ctx, int64_t t_us, uint32_t seq)
+{
+    daemon_t *d = ctx;
+    (void)seq;
+    advance_to(d, t_us);
+    (void)rfs_app_on_receiver(d->app, t_us, rx_time(d, t_us));
 }
 
 static void on_clock(void *ctx, int64_t t_us)
@@ -404,6 +414,7 @@ int main(int argc, char **argv)
     h.ctx = &d;
     h.on_pose = on_pose;
     h.on_rssi = on_rssi;
+    h.on_receiver = on_receiver;
     h.on_clock = clock_lcm ? on_clock : NULL;
     h.on_bad = on_bad;
     if (log_path && !(d.rec = hs_lcm_log_open(log_path, "w", err, sizeof err))) {
@@ -496,8 +507,8 @@ int main(int argc, char **argv)
         }
     }
     fprintf(stderr, "rfseekd: %" PRIu32 " steps, %" PRIu32 " decisions, %" PRIu32 " bad messages, %" PRIu32
-                    " CAN send failures, seeker rejected %" PRIu32 " inputs\n",
-            d.steps, d.decided, d.bad_msgs, d.can_fail, d.app->stats.rejected);
+                    " CAN send failures, %" PRIu32 " receiver heartbeats, seeker rejected %" PRIu32 " inputs\n",
+            d.steps, d.decided, d.bad_msgs, d.can_fail, d.app->stats.receiver, d.app->stats.rejected);
 out:
     if (in) {
         hs_lcm_log_close(in);

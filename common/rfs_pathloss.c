@@ -44,10 +44,13 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
     c.bin_cap = 5u;
     /* Strong enough to hold n near physics when the robot has seen little: 3000 weight x
      * dB^2 is about 60 capped bins missing by a 3 dB RMS per unit of n. The loss per
-     * wall varies more between buildings (and SLAM maps mark clutter as walls), so its
-     * prior is ten times weaker (docs/PATHLOSS.md has the simulator runs behind both). */
+     * wall varies far more between buildings (drywall 3 dB, concrete 10 dB and more),
+     * and a SLAM map marks furniture and laser artefacts as walls, so a map's "wall" is
+     * worth less: its prior is a hundred times weaker, and the data sets W after a few
+     * metres (300 held W near 5 dB for 40 m on the Intel lab map, where a crossing
+     * costs 3 dB: docs/PATHLOSS.md has the simulator runs behind both weights). */
     c.prior_weight = RFS_Q16_INT(3000);
-    c.w_prior_weight = RFS_Q16_INT(300);
+    c.w_prior_weight = RFS_Q16_INT(30);
     c.huber = RFS_Q16_INT(6);    /* about 1.5 x the 4 dB shadowing of the paper's office */
     c.spread_k = RFS_Q16_INT(6); /* chi-square, 2 degrees of freedom, 95 %: 5.99 */
     c.margin = RFS_Q16_INT(20);

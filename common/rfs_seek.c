@@ -51,6 +51,7 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
      * of travel, not by the few long iterations. */
     cfg->recheck_dist = path ? cfg->step : 0;
     cfg->eps_by_travel = path;
+    cfg->eps_geodesic = path;
 }
 
 uint32_t rfs_seek_lattice_bits_bytes(const rfs_map_t *map)
@@ -397,6 +398,23 @@ static bool choose_initial(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     return false;
 }
 
+/* Rejection step of a geodesic epsilon draw: a candidate proposed with weight
+ * e^(-straight distance) is kept with probability e^(-(path length - straight distance)),
+ * so the kept goals have weight e^(-path length) (the last try is always kept).
+ * Scaling: the straight distance from the weight table's q (grid * sqrt(q), Q16) and
+ * the path length (Q16, <= 32 km) differ by less than 2^31; e^(-d) is Q16. */
+static bool accept_detour(const rfs_seek_t *s, rfs_rng_t *rng, uint32_t q)
+{
+    uint32_t root_q16 = rfs_isqrt64((uint64_t)q << 32);
+    int64_t straight = ((int64_t)s->map->cfg.grid * root_q16) >> 16;
+    int64_t detour = (int64_t)s->drive.path.length - straight;
+    if (detour <= 0) {
+        return true;
+    }
+    rfs_q16_t keep = rfs_q16_exp_neg(rfs_sat32(detour));
+    return rfs_rng_below(rng, RFS_Q16_ONE) < (uint32_t)keep;
+}
+
 /* Epsilon step (paper section 2): a random reachable point at least the novelty radius
  * from every past position, drawn with probability proportional to e^(-distance). */
 static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
@@ -437,7 +455,11 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
                         s->decision.goal_x = px;
                         s->decision.goal_y = py;
                         if (go_to(s, px, py, now_us)) {
-                            return true;
+                            if (!s->cfg.eps_geodesic || attempt == GOAL_TRIES - 1 ||
+                                accept_detour(s, rng, q)) {
+                                return true;
+                            }
+                            goto next_attempt;
                         }
                         bit_set(s->visited, idx); /* unreachable in practice: do not redraw it */
                         goto next_attempt;

@@ -70,6 +70,9 @@ typedef struct rfs_seek_cfg {
                                 ///< (0: only when a goal ends, the paper's)
     bool eps_by_travel;         ///< epsilon's n = max(iteration, metres travelled / step):
                                 ///< one long leg anneals as much as the 1 m steps it replaces
+    bool eps_geodesic;          ///< epsilon goals drawn with P proportional to e^(-path
+                                ///< length) instead of e^(-straight distance): a point
+                                ///< behind a wall is as far as the way round it
 } rfs_seek_cfg_t;
 
 /// Caller-owned memory for the seeker's large arrays.

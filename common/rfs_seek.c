@@ -38,6 +38,8 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.tumble_worse = RFS_Q16_ONE;           /* and tumbles when they do not */
     c.recheck_dist = 0;                     /* the paper checks when a step ends */
     c.eps_by_travel = false;                /* and counts epsilon's n in iterations */
+    c.recheck_adapt = false;                /* one fixed threshold */
+    c.eps_geodesic = false;                 /* epsilon weights by straight distance */
     return c;
 }
 
@@ -51,6 +53,7 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
      * of travel, not by the few long iterations. */
     cfg->recheck_dist = path ? cfg->step : 0;
     cfg->eps_by_travel = path;
+    cfg->recheck_adapt = path;
     cfg->eps_geodesic = path;
 }
 
@@ -1408,9 +1411,28 @@ static uint32_t epsilon_index(const rfs_seek_t *s)
     return n;
 }
 
+bool rfs_seek_recheck_miss(const rfs_seek_cfg_t *cfg, int64_t *miss_ms, rfs_q16_t miss)
+{
+    RFS_ASSERT(cfg != 0 && miss_ms != 0 && miss >= 0);
+    rfs_q16_t thr = cfg->error_threshold;
+    if (cfg->recheck_adapt) {
+        /* The running mean of the squared misses moves 1/8 of the way at each check (about
+         * the last eight metres); the check fails only beyond the larger of the threshold
+         * and its square root. Scaling: a miss clamped to 128 dB (Q16 < 2^24) squared is
+         * below 2^48 in Q32; >> 16 is dB^2 Q16 < 2^32; the mean stays in that range. */
+        int64_t m = miss > RFS_Q16_INT(128) ? RFS_Q16_INT(128) : miss;
+        int64_t sq = (m * m) >> 16;
+        *miss_ms += (sq - *miss_ms) / 8;
+        rfs_q16_t rms = rfs_q16_sqrt(rfs_sat32(*miss_ms));
+        thr = rms > thr ? rms : thr;
+    }
+    return miss > thr;
+}
+
 /* recheck_dist: while a greedy leg is driven, every recheck_dist of travel, the relearn
- * check of Algorithm 1 (|1 s mean - prediction| > threshold). true when it fails: the
- * leg is abandoned and the next iteration relearns. */
+ * check of Algorithm 1 (|1 s mean - prediction| > threshold; with recheck_adapt the
+ * threshold is at least the RMS of the recent misses). true when it fails: the leg is
+ * abandoned and the next iteration relearns. */
 static bool recheck_fails(rfs_seek_t *s, int64_t now_us)
 {
     if (s->cfg.recheck_dist <= 0 || s->decision.kind != RFS_SEEK_GREEDY || !s->have_chk ||
@@ -1424,7 +1446,7 @@ static bool recheck_fails(rfs_seek_t *s, int64_t now_us)
         !s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &pred)) {
         return false;
     }
-    return rfs_q16_abs(rfs_q16_sub(mean, pred)) > s->cfg.error_threshold;
+    return rfs_seek_recheck_miss(&s->cfg, &s->miss_ms, rfs_q16_abs(rfs_q16_sub(mean, pred)));
 }
 
 static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)

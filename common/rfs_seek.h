@@ -70,6 +70,10 @@ typedef struct rfs_seek_cfg {
                                 ///< (0: only when a goal ends, the paper's)
     bool eps_by_travel;         ///< epsilon's n = max(iteration, metres travelled / step):
                                 ///< one long leg anneals as much as the 1 m steps it replaces
+    bool recheck_adapt;         ///< an in-leg recheck fails only when the miss exceeds the
+                                ///< larger of error_threshold and the RMS of the recent
+                                ///< misses: a model that misses by 5 dB everywhere (SLAM
+                                ///< clutter, shadowing) is not relearnt at every metre
     bool eps_geodesic;          ///< epsilon goals drawn with P proportional to e^(-path
                                 ///< length) instead of e^(-straight distance): a point
                                 ///< behind a wall is as far as the way round it
@@ -212,6 +216,8 @@ typedef struct rfs_seek {
     rfs_q16_t chk_x, chk_y;                   ///< position of the last check, metres Q16.16
     int64_t travel;                           ///< straight distance summed over checks, metres Q16.16
     bool replan;                              ///< a recheck failed: relearn and go greedy again
+    int64_t miss_ms;                          ///< recheck_adapt: running mean of the squared
+                                              ///< recheck misses |mean - prediction|, dB^2 Q16.16
 } rfs_seek_t;
 
 /// The paper's parameters (section 2 and 5.2): the `meta` configuration.
@@ -255,6 +261,13 @@ bool rfs_seek_grid_max(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my);
 
 /// The same search by evaluating every point (the reference for the shortcut).
 bool rfs_seek_grid_max_scan(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my);
+
+/// The in-leg relearn check on one miss |1 s mean - prediction| (target units Q16.16, >= 0):
+/// true when it fails, i.e. the miss exceeds error_threshold, or with recheck_adapt the
+/// larger of error_threshold and the RMS of the recent misses; *miss_ms (dB^2 Q16.16,
+/// start at 0) is the running mean of the squared misses, moved 1/8 of the way (C
+/// integer division) towards this miss squared (clamped to 128 dB) at every call.
+bool rfs_seek_recheck_miss(const rfs_seek_cfg_t *cfg, int64_t *miss_ms, rfs_q16_t miss);
 
 /// epsilon(n) = eps_amp * e^(-eps_rate * n) + eps_floor, Q16.16.
 rfs_q16_t rfs_seek_epsilon(const rfs_seek_cfg_t *cfg, uint32_t n);

@@ -200,6 +200,8 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seed = 1;
     sc->seek_recheck_m = -1.0;
     sc->seek_eps_by_travel = -1;
+    sc->seek_eps_geodesic = -1;
+    sc->seek_recheck_adapt = -1;
     sc->seek_eps_rate = -1.0;
     snprintf(sc->model, sizeof sc->model, "ridge");
     snprintf(sc->target, sizeof sc->target, "rssi");
@@ -406,17 +408,28 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
         return -1;
     }
     if ((n = get(p, root, "seek"))) {
-        static const char *const k[] = {"recheck_m", "eps_by_travel", "eps_rate", NULL};
-        bool ebt = false;
+        static const char *const k[] = {"recheck_m", "eps_by_travel", "eps_rate",
+                                        "eps_geodesic", "recheck_adapt", NULL};
+        bool ebt = false, geo = false, adapt = false;
+        bool has_adapt = get(p, n, "recheck_adapt") != NULL;
         bool has_ebt = get(p, n, "eps_by_travel") != NULL;
+        bool has_geo = get(p, n, "eps_geodesic") != NULL;
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "eps_rate", 0, 100, &sc->seek_eps_rate) ||
-            boolean(p, n, "seek", "eps_by_travel", &ebt)) {
+            boolean(p, n, "seek", "eps_by_travel", &ebt) ||
+            boolean(p, n, "seek", "eps_geodesic", &geo) ||
+            boolean(p, n, "seek", "recheck_adapt", &adapt)) {
             return -1;
         }
         if (has_ebt) {
             sc->seek_eps_by_travel = ebt ? 1 : 0;
+        }
+        if (has_geo) {
+            sc->seek_eps_geodesic = geo ? 1 : 0;
+        }
+        if (has_adapt) {
+            sc->seek_recheck_adapt = adapt ? 1 : 0;
         }
     }
     if (!rfs_models_lookup(sc->model)) {

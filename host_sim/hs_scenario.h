@@ -7,7 +7,8 @@
  *                                  # pdr (one: packet delivery ratio, rfs_pdr.h)
  *   strategy: meta                 # meta (the paper), meta-global, fd-gradient,
  *                                  # plane-gradient, chemotaxis, meta-path
- *   seek: {recheck_m: 1.0, eps_by_travel: true, eps_rate: 0.162}
+ *   seek: {recheck_m: 1.0, eps_by_travel: true, eps_rate: 0.162, eps_geodesic: true,
+ *                                  #       recheck_adapt: true}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2
@@ -66,6 +67,8 @@ typedef struct hs_scenario {
     double seek_recheck_m;        ///< seek.recheck_m: relearn check every this many metres
                                   ///< of a greedy leg (-1 = the strategy's preset)
     int seek_eps_by_travel;       ///< seek.eps_by_travel: 0 / 1 (-1 = the strategy's preset)
+    int seek_eps_geodesic;        ///< seek.eps_geodesic: 0 / 1 (-1 = the strategy's preset)
+    int seek_recheck_adapt;       ///< seek.recheck_adapt: 0 / 1 (-1 = the strategy's preset)
     double seek_eps_rate;         ///< seek.eps_rate: epsilon's decay per iteration (-1 = the
                                   ///< paper's ln(9/4)/5, epsilon(5) = 0.5)
     unsigned nsources;            ///< sources

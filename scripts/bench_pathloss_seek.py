@@ -29,11 +29,13 @@ BREAKS = [
      [(r"position: \[27\.5, 10\.0\]", "position: [20.0, 6.0]")]),
 ]
 # (strategy, model, label, extra scenario text): meta-path's preset improvements
-# (recheck every step of a greedy leg, epsilon annealed by travel; docs/STRATEGIES.md) are
-# also run switched off, so each row shows what they bring.
+# (recheck every step of a greedy leg against an adaptive threshold, epsilon annealed by
+# travel, epsilon goals weighted by path length; docs/STRATEGIES.md) are also run switched off, so each row shows what
+# they bring.
 CONFIGS = [("meta", "ridge", "meta + ridge", ""),
            ("meta-path", "pathloss", "meta-path + pathloss, improvements off",
-            "seek: {recheck_m: 0, eps_by_travel: false}\n"),
+            "seek: {recheck_m: 0, eps_by_travel: false, eps_geodesic: false, "
+            "recheck_adapt: false}\n"),
            ("meta-path", "pathloss", "meta-path + pathloss", "")]
 
 
@@ -112,9 +114,11 @@ the source before 150 m of travel or 15 simulated minutes. Travel ratios are ove
 (a failed run counts its 150 m). `meta + ridge` is the paper's algorithm with its own
 parameters; `meta-path + pathloss` is the improvement (docs/PATHLOSS.md, docs/STRATEGIES.md):
 the pathloss model's estimated source is the greedy goal, reached through the planner, with
-meta-path's two preset improvements (the relearn check after every metre of a greedy leg,
-epsilon annealed by the metres travelled); "improvements off" is the same without them
-(`seek: {{recheck_m: 0, eps_by_travel: false}}` added to the scenario).
+meta-path's preset improvements (the relearn check after every metre of a greedy leg,
+failing only beyond the larger of 3 dB and the RMS of the recent misses; epsilon annealed
+by the metres travelled; epsilon goals drawn by path length); "improvements off" is the
+same without them (`seek: {{recheck_m: 0, eps_by_travel: false, eps_geodesic: false,
+recheck_adapt: false}}` added to the scenario).
 
 Command: `/usr/bin/python3 scripts/bench_pathloss_seek.py --seeds {a.seeds}` (wall time
 {wall:.0f} s on this 2-core machine, shared with other work while it ran).

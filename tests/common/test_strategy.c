@@ -377,13 +377,16 @@ static void test_meta_path_preset(void **state)
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     assert_int_equal(cfg.recheck_dist, 0);
     assert_false(cfg.eps_by_travel);
+    assert_false(cfg.eps_geodesic);
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
     assert_int_equal(cfg.strategy, RFS_SEEK_META_PATH);
     assert_int_equal(cfg.recheck_dist, cfg.step);
     assert_true(cfg.eps_by_travel);
+    assert_true(cfg.eps_geodesic);
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META);
     assert_int_equal(cfg.recheck_dist, 0);
     assert_false(cfg.eps_by_travel);
+    assert_false(cfg.eps_geodesic);
     cfg.recheck_dist = -1;
     assert_int_equal(init_result(cfg), -1);
 }
@@ -443,6 +446,7 @@ static void run_recheck(double recheck_m, int *jumps, int *jumps_abandoned, int 
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
     cfg.recheck_dist = Q(recheck_m);
+    cfg.recheck_adapt = false; /* the fixed 3 dB rule; the adaptive one: test_recheck_adapt */
     cfg.eps_by_travel = false;
     cfg.eps_amp = 0;
     cfg.eps_floor = RFS_Q16_HALF;
@@ -486,6 +490,53 @@ static void test_recheck_abandons_leg(void **state)
     assert_int_equal(ab, 0);     /* the paper's rule runs every leg to its end */
 }
 
+
+/* recheck_adapt's rule against double precision: a running mean of the squared misses
+ * moved 1/8 of the way at each check, and a check fails beyond max(3 dB, its root). Misses
+ * from a seeded generator: long quiet stretches (model good to 1-2 dB), bursts of 4-8 dB
+ * (a cluttered area), single 12 dB jumps. Off, the rule is the fixed 3 dB. */
+static void test_recheck_adapt(void **state)
+{
+    (void)state;
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    assert_false(cfg.recheck_adapt);
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    assert_true(cfg.recheck_adapt);
+    rfs_seek_cfg_t off = rfs_seek_cfg_default();
+    uint32_t r = 12345u;
+    int64_t ms = 0, ms_off = 0;
+    double ref = 0.0;
+    int fails = 0, fails_fixed = 0, checked = 0;
+    for (int k = 0; k < 4000; ++k) {
+        r = r * 1664525u + 1013904223u;
+        double u = (double)(r >> 8) / 16777216.0;
+        int phase = (k / 200) % 3; /* quiet, burst, quiet with jumps */
+        double miss = phase == 1 ? 4.0 + 4.0 * u : (k % 37 == 0 && phase == 2 ? 12.0 : 2.0 * u);
+        rfs_q16_t mq = (rfs_q16_t)lround(miss * 65536.0);
+        bool got = rfs_seek_recheck_miss(&cfg, &ms, mq);
+        bool got_off = rfs_seek_recheck_miss(&off, &ms_off, mq);
+        double mqd = mq / 65536.0;
+        ref += (mqd * mqd - ref) / 8.0;
+        double thr = fmax(3.0, sqrt(ref));
+        assert_int_equal(got_off, mqd > 3.0);
+        assert_int_equal(ms_off, 0); /* off: no state */
+        if (fabs(ms / 65536.0 - ref) > 1e-3 * (1.0 + ref)) {
+            fail_msg("check %d: mean square %.6f, reference %.6f", k, ms / 65536.0, ref);
+        }
+        if (fabs(mqd - thr) > 1e-3) {
+            assert_int_equal(got, mqd > thr);
+            checked++;
+        }
+        fails += got;
+        fails_fixed += got_off;
+    }
+    assert_true(checked > 3900);
+    /* The bursts fail the fixed rule at every check but the adaptive one only until the
+     * running RMS has caught up (then about half of them, those above the RMS); the 12 dB
+     * jumps in quiet stretches still fail both. */
+    assert_true(4 * fails < 3 * fails_fixed);
+    assert_true(fails >= 30);
+}
 
 /* A model that knows its maximum (like the path-loss model's estimated source): a
  * constant prediction and a fixed argmax. */
@@ -613,6 +664,241 @@ static void test_null_move_backs_off(void **state)
     world_free(&t);
 }
 
+/* The geodesic epsilon step (cfg.eps_geodesic, docs/STRATEGIES.md) against a double-
+ * precision reference. The map: 10 m x 8 m with a one-cell wall at x in [5.2, 5.3)
+ * from the floor to y = 5.0; the only way to its far side is the gap above it. The robot
+ * stands at the lattice point (4.625, 3.625), 0.575 m from the wall, 1.375 m below
+ * its end. Every legal lattice point is a candidate (the epsilon radius, 8 m, covers the
+ * map), except those within the 0.5 m novelty radius of the robot. */
+#define GEO_WALL_X 5.2
+#define GEO_WALL_TOP 5.0
+#define GEO_RX 4.625
+#define GEO_RY 3.625
+/* Epsilon tries per decision (rfs_seek.c GOAL_TRIES); the last one is always kept. */
+#define GEO_TRIES 6
+
+/* The fixture's free cells, restated: the border and the wall column. */
+static bool geo_free(int cx, int cy, int w, int h)
+{
+    if (cx <= 0 || cy <= 0 || cx >= w - 1 || cy >= h - 1) {
+        return false;
+    }
+    return !(cx == (int)lround(GEO_WALL_X / RES) && (cy + 0.5) * RES < GEO_WALL_TOP);
+}
+
+/* rfs_map.h's rule in cell units: a cell is legal when every cell whose closed square
+ * comes closer than the clearance (0.25 m = 2.5 cells) to its centre is on the map and
+ * free. Offsets are whole cells, so the squared gaps are exact in double. */
+static bool geo_legal_cell(int cx, int cy, int w, int h)
+{
+    for (int dy = -3; dy <= 3; ++dy) {
+        for (int dx = -3; dx <= 3; ++dx) {
+            double ex = abs(dx) > 0 ? abs(dx) - 0.5 : 0.0, ey = abs(dy) > 0 ? abs(dy) - 0.5 : 0.0;
+            if (ex * ex + ey * ey >= 6.25) {
+                continue;
+            }
+            int x = cx + dx, y = cy + dy;
+            if (x < 0 || y < 0 || x >= w || y >= h || !geo_free(x, y, w, h)) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+/* The segment p-q does not enter the obstacle's interior x0 < x < x1, y < y1 (Liang-
+ * Barsky clip; touching its boundary is allowed: the taut length is an infimum). */
+static bool geo_sees(double px, double py, double qx, double qy, double x0, double x1, double y1)
+{
+    double t0 = 0.0, t1 = 1.0, dx = qx - px, dy = qy - py;
+    double pp[3] = { -dx, dx, dy }, qq[3] = { px - x0, x1 - px, y1 - py };
+    for (int k = 0; k < 3; ++k) {
+        if (pp[k] == 0.0) {
+            if (qq[k] <= 0.0) {
+                return true;
+            }
+            continue;
+        }
+        double r = qq[k] / pp[k];
+        if (pp[k] < 0.0) {
+            t0 = r > t0 ? r : t0;
+        } else {
+            t1 = r < t1 ? r : t1;
+        }
+    }
+    return t0 >= t1; /* empty or a single touching point */
+}
+
+/* Shortest path length from the robot to (gx, gy) around the obstacle [x0, x1] x
+ * (-inf, y1]: straight when it is in sight, else through its top corners a = (x0, y1),
+ * b = (x1, y1) (the shortest path in a polygon bends only at reflex vertices). */
+static double geo_taut(double gx, double gy, double x0, double x1, double y1)
+{
+    const double px = GEO_RX, py = GEO_RY;
+    if (geo_sees(px, py, gx, gy, x0, x1, y1)) {
+        return hypot(gx - px, gy - py);
+    }
+    double best = INFINITY;
+    double cx[2] = { x0, x1 };
+    for (int u = 0; u < 2; ++u) {
+        for (int v = 0; v < 2; ++v) {
+            /* robot -> corner u [-> corner v] -> goal */
+            if (!geo_sees(px, py, cx[u], y1, x0, x1, y1) ||
+                !geo_sees(cx[v], y1, gx, gy, x0, x1, y1)) {
+                continue;
+            }
+            double l = hypot(cx[u] - px, y1 - py) + fabs(cx[v] - cx[u]) +
+                       hypot(gx - cx[v], gy - y1);
+            best = l < best ? l : best;
+        }
+    }
+    return best;
+}
+
+/* Lattice point (i, j) is an epsilon candidate: legal, within the epsilon radius of the
+ * robot's lattice point and beyond the 0.5 m novelty radius (q > 4: the robot only ever
+ * stood there). Every legal lattice point is reachable: the legal cells are the floor
+ * minus the inflated wall, a U of three rectangles, each at least two lattice steps
+ * wide. Gives the point, metres, and its straight distance, metres. */
+static bool geo_candidate(int i, int j, int w, int h, double *x, double *y, double *d)
+{
+    int ci = (int)lround((GEO_RX - 0.125) / 0.25), cj = (int)lround((GEO_RY - 0.125) / 0.25);
+    int q = (i - ci) * (i - ci) + (j - cj) * (j - cj);
+    *x = 0.125 + 0.25 * i;
+    *y = 0.125 + 0.25 * j;
+    *d = 0.25 * sqrt((double)q);
+    return q > 4 && q <= RFS_SEEK_EPS_RADIUS * RFS_SEEK_EPS_RADIUS &&
+           geo_legal_cell((int)floor(*x / RES), (int)floor(*y / RES), w, h);
+}
+
+static bool geo_far(double x, double y)
+{
+    return x > GEO_WALL_X + 0.1 && y < GEO_WALL_TOP;
+}
+
+/* The inflated wall: the illegal cells around the wall column, x in [5.0, 5.5), y below
+ * 5.2 (the wall's cells plus 2 cells of clearance mask); a legal segment touches none
+ * of their closed squares, so every legal path is at least the taut length around it. */
+#define GEO_OB_X0 5.0
+#define GEO_OB_X1 5.5
+#define GEO_OB_Y1 5.2
+/* The planner's excess over the taut length, metres: its path bends at lattice points
+ * (0.25 m apart) beside the two corners instead of on them, and string pulling of the
+ * octile path is greedy. Asserted below for every far candidate (measured at most 0.52 m
+ * when this test was written); 0.6 m leaves margin. */
+#define GEO_EXCESS 0.6
+
+/* Far-side probability of one decision in double: proposal p ~ e^(-d) over the
+ * candidates; with geodesic, kept with a = e^(-(L - d)), L the taut length plus
+ * `excess` where the path bends, and the 6th try always kept:
+ * P(x) = p a (1 - (1 - A)^5) / A + (1 - A)^5 p, A = sum p a. */
+static double geo_far_prob(bool geodesic, double excess, int *ncand)
+{
+    world_t t;
+    world_make(&t, 10.0, 8.0, GEO_WALL_X, GEO_WALL_TOP);
+    int w = t.w, h = t.h, lw = t.map.lw, lh = t.map.lh;
+    world_free(&t);
+    double wsum = 0.0, wfar = 0.0, asum = 0.0, afar = 0.0;
+    *ncand = 0;
+    for (int j = 0; j < lh; ++j) {
+        for (int i = 0; i < lw; ++i) {
+            double x, y, d;
+            if (!geo_candidate(i, j, w, h, &x, &y, &d)) {
+                continue;
+            }
+            (*ncand)++;
+            double wt = exp(-d), a = 1.0;
+            double l = geo_taut(x, y, GEO_OB_X0, GEO_OB_X1, GEO_OB_Y1);
+            if (geodesic && l > d + 1e-9) {
+                a = exp(-(l + excess - d));
+            }
+            wsum += wt;
+            asum += wt * a;
+            wfar += geo_far(x, y) ? wt : 0.0;
+            afar += geo_far(x, y) ? wt * a : 0.0;
+        }
+    }
+    if (!geodesic) {
+        return wfar / wsum;
+    }
+    double A = asum / wsum, miss = pow(1.0 - A, GEO_TRIES - 1);
+    return (afar / wsum) * (1.0 - miss) / A + miss * wfar / wsum;
+}
+
+/* n epsilon decisions, each from a freshly initialised seeker at the robot's point: the
+ * first decision (the initial move) finds no goal (initial_step_max below one lattice
+ * step), the second is the epsilon draw (epsilon = 1). Returns the far-side count. When
+ * check_plan, also plans to every far candidate and asserts taut <= L <= taut + excess. */
+static int geo_far_draws(bool geodesic, int n, bool check_plan)
+{
+    world_t t;
+    world_make(&t, 10.0, 8.0, GEO_WALL_X, GEO_WALL_TOP);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    cfg.eps_geodesic = geodesic;
+    cfg.initial_step_max = Q(0.1);
+    cfg.eps_amp = 0;
+    cfg.eps_floor = RFS_Q16_ONE;
+    seek_make(&t, cfg, 1);
+    fixed_model_t fm = { false, Q(1.0), Q(1.0) };
+    rfs_model_t model = { &k_fixed_ops, &fm };
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    int far = 0;
+    for (int k = 0; k < n; ++k) {
+        assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+        rfs_rng_seed(&t.rng, 1000u + (uint64_t)k);
+        run_t r = { .x = GEO_RX, .y = GEO_RY };
+        rfs_seek_out_t out;
+        assert_true(next_decision(&t, &r, &f, 0, 5000000, &out));
+        assert_int_equal(out.decision.kind, RFS_SEEK_INITIAL);
+        assert_true(next_decision(&t, &r, &f, 0, 5000000, &out));
+        assert_int_equal(out.decision.kind, RFS_SEEK_EPSILON);
+        assert_int_equal(out.faults & RFS_SEEK_FAULT_NO_GOAL, 0);
+        far += geo_far(D(out.decision.goal_x), D(out.decision.goal_y));
+    }
+    for (int j = 0; check_plan && j < t.map.lh; ++j) {
+        for (int i = 0; i < t.map.lw; ++i) {
+            double x, y, d;
+            if (!geo_candidate(i, j, t.w, t.h, &x, &y, &d) || !geo_far(x, y)) {
+                continue;
+            }
+            assert_true(rfs_map_lattice_legal(&t.map, (uint16_t)i, (uint16_t)j));
+            rfs_path_t p;
+            assert_true(rfs_plan_path(&t.seek.plan, Q(GEO_RX), Q(GEO_RY), Q(x), Q(y), &p));
+            double l = geo_taut(x, y, GEO_OB_X0, GEO_OB_X1, GEO_OB_Y1);
+            assert_true(D(p.length) > l - 1e-3 && D(p.length) < l + GEO_EXCESS);
+        }
+    }
+    world_free(&t);
+    return far;
+}
+
+/* The far side of the wall is about a quarter of the mass under e^(-straight distance)
+ * and under 5 % when a goal behind the wall counts its way round. n = 10000 draws each;
+ * tolerance 4 binomial sigma. eps_geodesic off: the paper's rule, exact in double (the
+ * Q0.16 weight table moves it by < 0.001). On: between the reference with the taut
+ * path lengths (a lower bound of any legal path) and with taut + GEO_EXCESS wherever a
+ * path bends (the planner's bound, asserted). */
+static void test_eps_geodesic_distribution(void **state)
+{
+    (void)state;
+    const int n = 10000;
+    int nc;
+    double p_off = geo_far_prob(false, 0.0, &nc);
+    assert_int_equal(nc, 1088); /* 40 x 32 lattice - 179 illegal - 13 visited */
+    double p_hi = geo_far_prob(true, 0.0, &nc), p_lo = geo_far_prob(true, GEO_EXCESS, &nc);
+    assert_true(p_off > 0.2 && p_hi < 0.06 && p_lo > 0.01); /* the map separates the rules */
+    double f_off = geo_far_draws(false, n, false) / (double)n;
+    double f_on = geo_far_draws(true, n, true) / (double)n;
+    double s_off = sqrt(p_off * (1.0 - p_off) / n);
+    double s_lo = sqrt(p_lo * (1.0 - p_lo) / n), s_hi = sqrt(p_hi * (1.0 - p_hi) / n);
+    if (fabs(f_off - p_off) > 4.0 * s_off || f_on < p_lo - 4.0 * s_lo || f_on > p_hi + 4.0 * s_hi) {
+        print_error("far side: off %.4f (want %.4f), on %.4f (want %.4f..%.4f)\n", f_off, p_off,
+                    f_on, p_lo, p_hi);
+        fail();
+    }
+}
+
+
 /* Names round-trip and the unit vector against double precision. */
 static void test_names_and_unit(void **state)
 {
@@ -657,8 +943,10 @@ int main(void)
         cmocka_unit_test(test_meta_path_preset),
         cmocka_unit_test(test_eps_by_travel),
         cmocka_unit_test(test_recheck_abandons_leg),
+        cmocka_unit_test(test_recheck_adapt),
         cmocka_unit_test(test_meta_path_unreachable_maximum),
         cmocka_unit_test(test_null_move_backs_off),
+        cmocka_unit_test(test_eps_geodesic_distribution),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

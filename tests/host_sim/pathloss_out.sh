@@ -27,8 +27,9 @@ for r in "pl default.yaml --model pathloss --strategy meta-path" \
     fi
 done
 
-# residual.tsv: minimum within 2 m of the final estimate (summary.json and the last log
-# row agree), est_error_m = |estimate - source 0| recomputed here, stable columns.
+# residual.tsv: the final estimate (summary.json and the last log row agree) within 2 m
+# of one of the surface's three lowest points (the fit refines around its best 3 coarse
+# candidates, 2 m apart, by less than a coarse step; docs/PATHLOSS.md), est_error_m = |estimate - source 0| recomputed here, stable columns.
 for name in pl pll; do
     if /usr/bin/python3 - "$T/$name" <<'EOF'
 import json, math, sys
@@ -49,9 +50,10 @@ last = rows[-1]
 lx, ly = float(last[head.index("est_src_x_m")]), float(last[head.index("est_src_y_m")])
 ex, ey = s["est_src_x_m"], s["est_src_y_m"]
 assert abs(lx - ex) <= 0.0015 and abs(ly - ey) <= 0.0015, ((lx, ly), (ex, ey))
-mx, my, mv = min(res, key=lambda r: r[2])
-dmin = math.hypot(mx - lx, my - ly)
-assert dmin <= 2.0, "surface minimum (%.3f, %.3f) is %.3f m from the estimate" % (mx, my, dmin)
+low = sorted(res, key=lambda r: r[2])[:3]
+dmin = min(math.hypot(r[0] - lx, r[1] - ly) for r in low)
+assert dmin <= 2.0, "the surface's three lowest points %s are %.3f m or more from the estimate" % (
+    [(r[0], r[1]) for r in low], dmin)
 sx, sy = s["sources"][0]
 err = math.hypot(ex - sx, ey - sy)
 # Both sides are printed to 1 mm: the recomputed distance may differ by rounding only.

@@ -72,6 +72,14 @@ static void bit_set(uint8_t *bits, uint32_t i)
     bits[i >> 3] = (uint8_t)(bits[i >> 3] | (1u << (i & 7u)));
 }
 
+/* Length of a lattice offset (di, dj) with q = di^2 + dj^2, metres Q16.16: grid * sqrt(q).
+ * Scaling: grid Q16 * isqrt(q << 32) Q16 -> Q32 >> 16 = Q16 metres, saturated. */
+static rfs_q16_t offset_dist(const rfs_map_t *m, uint32_t q)
+{
+    uint32_t root_q16 = rfs_isqrt64((uint64_t)q << 32);
+    return rfs_sat32(((int64_t)m->cfg.grid * root_q16) >> 16);
+}
+
 int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map,
                   rfs_model_t model, const rfs_target_ops_t *target, const rfs_seek_mem_t *mem)
 {
@@ -119,11 +127,9 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
     memset(s->reach, 0, lbytes);
     /* Epsilon weights e^(-d), d = grid * sqrt(q) for q = di^2 + dj^2 (section 2:
      * P(x) proportional to e^(-|x - x0|)), tabulated once so a draw costs a lookup per
-     * candidate. Scaling: grid Q16 * isqrt(q << 32) Q16 -> Q32 >> 16 = Q16 metres. */
+     * candidate (offset_dist). */
     for (uint32_t q = 0; q < RFS_SEEK_EPS_TABLE; ++q) {
-        uint32_t root_q16 = rfs_isqrt64((uint64_t)q << 32);
-        rfs_q16_t d = rfs_sat32(((int64_t)map->cfg.grid * root_q16) >> 16);
-        rfs_q16_t w = rfs_q16_exp_neg(d);
+        rfs_q16_t w = rfs_q16_exp_neg(offset_dist(map, q));
         s->eps_w[q] = (uint16_t)(w >= RFS_Q16_ONE ? 0xFFFFu : (uint32_t)w);
     }
     s->state = RFS_SEEK_WAITING;
@@ -332,8 +338,9 @@ static bool reachable_point(const rfs_seek_t *s, uint16_t i, uint16_t j)
     return bit_get(s->reach, (uint32_t)j * s->map->lw + i);
 }
 
-/* Plan from the robot to (gx, gy) and start driving. false when there is no path. */
-static bool go_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, int64_t now_us)
+/* Plan from the robot to (gx, gy) into the drive's path (not yet driven). false when
+ * there is no path. */
+static bool plan_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy)
 {
     rfs_q16_t sx = s->pose.x, sy = s->pose.y;
     if (!rfs_map_point_legal(s->map, sx, sy)) {
@@ -349,6 +356,15 @@ static bool go_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, int64_t now_us)
         return false;
     }
     s->decision.path_len = s->drive.path.length;
+    return true;
+}
+
+/* Plan to (gx, gy) and drive the path. */
+static bool go_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, int64_t now_us)
+{
+    if (!plan_to(s, gx, gy)) {
+        return false;
+    }
     rfs_drive_set_path(&s->drive, &s->drive.path, now_us);
     return true;
 }
@@ -408,9 +424,7 @@ static bool choose_initial(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
  * the path length (Q16, <= 32 km) differ by less than 2^31; e^(-d) is Q16. */
 static bool accept_detour(const rfs_seek_t *s, rfs_rng_t *rng, uint32_t q)
 {
-    uint32_t root_q16 = rfs_isqrt64((uint64_t)q << 32);
-    int64_t straight = ((int64_t)s->map->cfg.grid * root_q16) >> 16;
-    int64_t detour = (int64_t)s->drive.path.length - straight;
+    int64_t detour = (int64_t)s->drive.path.length - offset_dist(s->map, q);
     if (detour <= 0) {
         return true;
     }
@@ -457,9 +471,11 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
                         rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
                         s->decision.goal_x = px;
                         s->decision.goal_y = py;
-                        if (go_to(s, px, py, now_us)) {
+                        if (plan_to(s, px, py)) {
+                            /* A rejected draw never reaches the drive. */
                             if (!s->cfg.eps_geodesic || attempt == GOAL_TRIES - 1 ||
                                 accept_detour(s, rng, q)) {
+                                rfs_drive_set_path(&s->drive, &s->drive.path, now_us);
                                 return true;
                             }
                             goto next_attempt;

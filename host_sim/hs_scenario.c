@@ -127,6 +127,20 @@ static int boolean(pctx_t *p, yaml_node_t *m, const char *where, const char *key
     return 0;
 }
 
+/// seek.KEY as 0 / 1 when present; *out keeps -1 (the strategy's preset) when absent.
+static int preset_bool(pctx_t *p, yaml_node_t *m, const char *key, int *out)
+{
+    bool v = false;
+    if (get(p, m, key) == NULL) {
+        return 0;
+    }
+    if (boolean(p, m, "seek", key, &v) != 0) {
+        return -1;
+    }
+    *out = v ? 1 : 0;
+    return 0;
+}
+
 static int str(pctx_t *p, yaml_node_t *m, const char *where, const char *key, char *out,
                size_t cap)
 {
@@ -410,26 +424,13 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
     if ((n = get(p, root, "seek"))) {
         static const char *const k[] = {"recheck_m", "eps_by_travel", "eps_rate",
                                         "eps_geodesic", "recheck_adapt", NULL};
-        bool ebt = false, geo = false, adapt = false;
-        bool has_adapt = get(p, n, "recheck_adapt") != NULL;
-        bool has_ebt = get(p, n, "eps_by_travel") != NULL;
-        bool has_geo = get(p, n, "eps_geodesic") != NULL;
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "eps_rate", 0, 100, &sc->seek_eps_rate) ||
-            boolean(p, n, "seek", "eps_by_travel", &ebt) ||
-            boolean(p, n, "seek", "eps_geodesic", &geo) ||
-            boolean(p, n, "seek", "recheck_adapt", &adapt)) {
+            preset_bool(p, n, "eps_by_travel", &sc->seek_eps_by_travel) ||
+            preset_bool(p, n, "eps_geodesic", &sc->seek_eps_geodesic) ||
+            preset_bool(p, n, "recheck_adapt", &sc->seek_recheck_adapt)) {
             return -1;
-        }
-        if (has_ebt) {
-            sc->seek_eps_by_travel = ebt ? 1 : 0;
-        }
-        if (has_geo) {
-            sc->seek_eps_geodesic = geo ? 1 : 0;
-        }
-        if (has_adapt) {
-            sc->seek_recheck_adapt = adapt ? 1 : 0;
         }
     }
     if (!rfs_models_lookup(sc->model)) {

@@ -15,16 +15,17 @@ usage: replay_test.py FEED
 import json
 import math
 import os
-import struct
 import subprocess
 import sys
 import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import pcap_build  # noqa: E402
 
 FEED = sys.argv[1]
 SCEN = "scenarios/default.yaml"
 SRC_MAC = bytes.fromhex("020000000001")
 OTHER = bytes.fromhex("020000000099")
-BSSID = bytes.fromhex("0a1b2c3d4e5f")
 SOURCE_XY = (27.5, 10.0)
 T0 = 1700000000000000  # first pose, microseconds since the epoch
 fails = 0
@@ -34,13 +35,6 @@ def check(name, ok, detail=""):
     global fails
     print(("PASS " if ok else "FAIL ") + name + ("" if ok else ": " + detail))
     fails += 0 if ok else 1
-
-
-def record(t_us, mac, seq, dbm):
-    rt = struct.pack("<BBHI", 0, 0, 9, 0x20) + struct.pack("<b", dbm)
-    hdr = struct.pack("<BB", 0x08, 0x01) + b"\0\0" + BSSID + mac + BSSID + struct.pack("<H", (seq & 0xFFF) << 4)
-    data = rt + hdr
-    return struct.pack("<IIII", t_us // 1000000, t_us % 1000000, len(data), len(data)) + data
 
 
 def pose_at(poses, t):
@@ -78,12 +72,11 @@ def main():
             received_in += 1
         else:
             dbm = -70
-        recs.append(record(t, SRC_MAC, seq, dbm))
+        recs.append(pcap_build.record(t, SRC_MAC, seq, dbm))
         if k % 7 == 0:
-            recs.append(record(t + 1, OTHER, k, -30))
+            recs.append(pcap_build.record(t + 1, OTHER, k, -30))
     cap = os.path.join(tmp, "run.pcap")
-    with open(cap, "wb") as f:
-        f.write(struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 127) + b"".join(recs))
+    pcap_build.write(cap, recs)
 
     out = os.path.join(tmp, "out")
     p = subprocess.run([FEED, cap, "--pose", os.path.join(tmp, "poses.csv"), "--scenario", SCEN,

@@ -16,16 +16,17 @@ heartbeat keeps the stream fresh. Checks (counted from log.tsv, times from this 
   other without heartbeat: none; the three runs agree on every decision up to 10 s.
 """
 import os
-import struct
 import subprocess
 import sys
 import tempfile
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "feed"))
+import pcap_build  # noqa: E402
 
 FEED = sys.argv[1]
 SCEN = "scenarios/default.yaml"
 SRC = bytes.fromhex("020000000001")
 OTHER = bytes.fromhex("020000000099")
-BSSID = bytes.fromhex("0a1b2c3d4e5f")
 T0 = 1700000000000000
 fails = 0
 
@@ -36,23 +37,15 @@ def check(name, ok, detail=""):
     fails += 0 if ok else 1
 
 
-def record(t_us, mac, seq, dbm):
-    rt = struct.pack("<BBHI", 0, 0, 9, 0x20) + struct.pack("<b", dbm)
-    hdr = struct.pack("<BB", 0x08, 0x01) + b"\0\0" + BSSID + mac + BSSID + struct.pack("<H", (seq & 0xFFF) << 4)
-    data = rt + hdr
-    return struct.pack("<IIII", t_us // 1000000, t_us % 1000000, len(data), len(data)) + data
-
-
 def capture(path, other):
     recs = []
     for k in range(3000):
         t = T0 + k * 20000 + 7
         if t < T0 + 10_000_000:
-            recs.append(record(t, SRC, k, -60 - k % 5))
+            recs.append(pcap_build.record(t, SRC, k, -60 - k % 5))
         elif other:
-            recs.append(record(t, OTHER, k, -30))
-    with open(path, "wb") as f:
-        f.write(struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 127) + b"".join(recs))
+            recs.append(pcap_build.record(t, OTHER, k, -30))
+    pcap_build.write(path, recs)
 
 
 def decisions(out):

@@ -10,7 +10,8 @@
 #   - without the heartbeat the robot never moves; with it, it drives and decides;
 #   - the Cortex-M4 image under qemu gives the host's bytes for both encodings;
 #   - an old stream (no heartbeat at all) still plays: the "off" recording is one;
-#   - a RECEIVER record of the wrong length is one error line naming the file.
+#   - a RECEIVER record of the wrong length is one error line naming the file;
+#   - a bad --heartbeat value is one error line, exit status non-zero, no recording.
 set -uo pipefail
 B=${1:?usage: heartbeat_replay.sh BUILD}
 bin=$B/bin; elf=$B/firmware/qemu.elf
@@ -29,6 +30,13 @@ sed -e "s|^map: maps/office.yaml|map: $PWD/scenarios/maps/office.yaml|" \
     -e 's|sensitivity_dbm: -95, loss_width_db: 1.5|sensitivity_dbm: -45, loss_width_db: 0.01|' \
     scenarios/default.yaml > "$tmp/dead.yaml"
 grep -q 'sensitivity_dbm: -45' "$tmp/dead.yaml" || { fail "dead-zone scenario" "scenarios/default.yaml changed"; exit 1; }
+
+# A bad --heartbeat value: one error line naming the option, exit 1, no recording left.
+"$bin/rfseek-record" "$tmp/dead.yaml" -o "$tmp/bad.rfsr" --heartbeat sometimes > /dev/null 2> "$tmp/bad.err"
+rc=$?
+[ "$rc" -ne 0 ] && [ "$(wc -l < "$tmp/bad.err")" -eq 1 ] && grep -q -- '--heartbeat' "$tmp/bad.err" \
+    && [ ! -e "$tmp/bad.rfsr" ] && pass "record --heartbeat sometimes: one error line, nothing written" \
+    || fail "record --heartbeat sometimes" "exit $rc: $(head -c 200 "$tmp/bad.err")"
 
 moving() { "$bin/rfseek-replay" --print "$1" | awk '$1 == "OUT" && ($3 != "left=0" || $4 != "right=0")' | wc -l; }
 for m in can record off; do

@@ -17,7 +17,7 @@ echo "$out" | awk -F'\t' '
         printf "%-34s %14s %12s\n", "measurement", "instructions", "ms@168MHz"
         for (i = 1; i <= n; i++) {
             if (name[i] ~ /^calib/) continue
-            if (t[i] == 0) { printf "%-34s %14s\n", name[i], c[i]; continue }
+            if (t[i] == 0) { printf "%-34s %14s\n", name[i], c[i]; v[name[i]] = c[i]; continue }
             ins = (t[i] - e) / per; r = int(ins + 0.5)
             # Exact unless SysTick wrapped (every 2^24 ticks, 780,190 instructions): then
             # the count includes the few instructions of each wrap interrupt.
@@ -25,10 +25,23 @@ echo "$out" | awk -F'\t' '
             printf "%-34s %14d %12.3f\n", name[i], r, r / 168000
             if (name[i] == "worst_iteration") worst = r
             if (name[i] == "sliced_worst_period") sliced = r
+            if (name[i] == "worst_eps_geodesic") geo = r
+            if (name[i] == "worst_eps_straight") straight = r
+            if (name[i] == "worst_eps_paper") paper = r
         }
         printf "(counts over 780,190 instructions include ~10 instructions per SysTick wrap interrupt)\n"
         printf "worst-case control period, faithful configuration (fit in one period): %d instructions, target 500000: %s\n", worst, worst <= 500000 ? "met" : "MISSED"
         printf "worst-case control period, MCU configuration (fit_budget 2500): %d instructions, target 500000: %s\n", sliced, sliced <= 500000 ? "met" : "MISSED"
+        # The meta-path epsilon decision behind a wall (bench.c geo_decision): the budget
+        # of a period and the 200 ms safety deadline (33,600,000 instructions at 168 MHz).
+        printf "meta-path epsilon decision behind a wall, eps_geodesic (%d plans): %d instructions, target 500000: %s (%.1f x), 200 ms deadline 33600000: %s\n", v["worst_eps_geodesic_plans"], geo, geo <= 500000 ? "met" : "MISSED", geo / 500000, geo <= 33600000 ? "met" : "MISSED"
+        printf "the same decision, eps_geodesic off (%d plan): %d instructions, target 500000: %s (%.1f x), 200 ms deadline 33600000: %s\n", v["worst_eps_straight_plans"], straight, straight <= 500000 ? "met" : "MISSED", straight / 500000, straight <= 33600000 ? "met" : "MISSED"
+        printf "the same decision, faithful configuration (%d plan): %d instructions, target 500000: %s (%.1f x), 200 ms deadline 33600000: %s\n", v["worst_eps_paper_plans"], paper, paper <= 500000 ? "met" : "MISSED", paper / 500000, paper <= 33600000 ? "met" : "MISSED"
+        # The epsilon rows count only if the period decided an epsilon goal after a
+        # relearn and the replay of its draws kept the same goal (else the plan count
+        # would describe another decision, e.g. after a change to rfs_seek.c).
+        for (k in v) if (k ~ /^worst_eps_.*_(eps_relearn|replay_goal_ok)$/ && v[k] != 1) badgeo = badgeo " " k
+        if (badgeo != "") { printf "epsilon scenario checks failed:%s\n", badgeo; exit 1 }
         if (bad != "") { printf "non-integral instruction counts:%s\n", bad; exit 1 }
     }'
 scripts/fw_budget.sh "$B/firmware/firmware.elf"

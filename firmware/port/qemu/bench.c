@@ -8,7 +8,9 @@
  * points, all legal but a wall round the edge), 10,000 samples all inside the 5 m radius,
  * a relearn (the model is discarded), then a greedy step (epsilon set to 0 so the greedy
  * branch is certain): grid search over every reachable lattice point, step choice with
- * path planning, drive control. Then each phase alone on the same data.
+ * path planning, drive control. Then each phase alone on the same data. Last, an epsilon
+ * decision that must plan round a wall: meta-path's geodesic draw (up to six plans), the
+ * same without it, and the paper's, on the same map with one interior wall (geo_decision).
  */
 #include <stdint.h>
 #include <string.h>
@@ -31,23 +33,230 @@ static uint8_t s_free[MAP_STRIDE * MAP_H];
 static uint8_t s_wall[MAP_STRIDE * MAP_H];
 static rfs_rssi_t s_win;
 
-/* 10,000 samples inside 4.9 m of (20, 10); the field rises towards +x (-60 dBm at the
- * robot, +1 dB per metre, +-1 dB noise), so the maximum is at the east wall. */
-static void fill_store(rfs_store_t *st, uint64_t seed)
+/* 10,000 samples inside 4.9 m of (cx, cy) cm, keeping only those with x >= xmin and
+ * y <= ymax (cm: the side of a wall the robot was on); the field rises towards +x (-60 dBm
+ * at the centre, +1 dB per metre, +-1 dB noise). The limits reject before the noise draw,
+ * so limits that reject nothing give the same samples as no limits. */
+static void fill_store_at(rfs_store_t *st, uint64_t seed, int32_t cx, int32_t cy, int32_t xmin,
+                          int32_t ymax)
 {
     rfs_rng_t rng;
     rfs_rng_seed(&rng, seed);
     while (st->count < RFS_APP_MAX_SAMPLES) {
         const int32_t dx = (int32_t)rfs_rng_below(&rng, 981u) - 490; /* cm */
         const int32_t dy = (int32_t)rfs_rng_below(&rng, 981u) - 490;
-        if (dx * dx + dy * dy > 490 * 490) {
+        if (dx * dx + dy * dy > 490 * 490 || cx + dx < xmin || cy + dy > ymax) {
             continue;
         }
-        const rfs_sample_t smp = {.x_cm = (int16_t)(2000 + dx), .y_cm = (int16_t)(1000 + dy),
+        const rfs_sample_t smp = {.x_cm = (int16_t)(cx + dx), .y_cm = (int16_t)(cy + dy),
                                   .v_q6 = (int16_t)((-60 * 64) + (dx * 64) / 100 +
                                                     (int32_t)rfs_rng_below(&rng, 128u) - 64)};
         rfs_store_offer(st, smp, &rng);
     }
+}
+
+/* The worst case's store: around (20, 10), so the maximum is at the east wall. */
+static void fill_store(rfs_store_t *st, uint64_t seed)
+{
+    fill_store_at(st, seed, 2000, 1000, INT32_MIN, INT32_MAX);
+}
+
+/* The meta-path epsilon decision (RFS_SEEK_META_PATH's eps_geodesic; rfs_seek.c
+ * choose_epsilon and accept_detour): a goal is proposed with weight e^(-straight
+ * distance), planned, and kept with probability e^(-(path length - straight distance));
+ * up to GOAL_TRIES = 6 draws, the sixth kept whatever its detour, so one decision plans
+ * up to six paths. Its worst case on the bench's 40 x 20 m map: an interior wall along
+ * y = 10 m from the west wall to x = 36 m, the way round it a 4 m gap at the east end;
+ * the robot at (1.125, 8.625) m just south of it, its side explored within the 8 m
+ * epsilon radius (visited bits), so every candidate lies north of the wall, at most 8 m
+ * away in a straight line and at least 35 + 27 = 62 m away by the gap: every detour
+ * exceeds 13 m, where e^(-detour) is 0 in Q16 (rfs_q16_exp_neg), draws 1 to 5 are
+ * rejected and the sixth is kept. Each plan is a Dijkstra from the goal round the wall
+ * back to the start, over nearly the whole lattice. */
+#define GEO_WALL_ROW 79u   /* cells: the wall is rows 79 and 80, y 9.875 .. 10.125 m */
+#define GEO_WALL_END 288u  /* cells: it ends at x = 36 m */
+#define GEO_RI 4u          /* the robot's lattice point: x = 0.125 + 4 x 0.25 m */
+#define GEO_RJ 34u         /* y = 0.125 + 34 x 0.25 = 8.625 m */
+#define GEO_SOUTH_J 39u    /* last lattice row south of the wall (y 9.875 m) */
+#define GEO_TRIES 6        /* GOAL_TRIES of rfs_seek.c */
+
+static void geo_wall(void)
+{
+    for (uint16_t y = GEO_WALL_ROW; y <= GEO_WALL_ROW + 1u; y++) {
+        for (uint16_t x = 0; x < GEO_WALL_END; x++) {
+            rfs_map_bit_set(s_wall, MAP_STRIDE, x, y, true);
+            rfs_map_bit_set(s_free, MAP_STRIDE, x, y, false);
+        }
+    }
+}
+
+/* The robot's history: every lattice point south of the wall within the epsilon radius
+ * of it has been visited. */
+static void geo_history(rfs_seek_t *s)
+{
+    const uint32_t lw = s->map->lw;
+    for (uint32_t j = 0; j <= GEO_SOUTH_J; j++) {
+        if (j + RFS_SEEK_EPS_RADIUS < GEO_RJ) {
+            continue;
+        }
+        for (uint32_t i = 0; i <= GEO_RI + RFS_SEEK_EPS_RADIUS && i < lw; i++) {
+            const uint32_t idx = j * lw + i;
+            s->visited[idx >> 3] = (uint8_t)(s->visited[idx >> 3] | (1u << (idx & 7u)));
+        }
+    }
+}
+
+/* choose_epsilon's weighted scan: the candidates around (ci, cj) in its order (rows, then
+ * columns), neither visited nor unreachable, weight eps_w[di^2 + dj^2]. Returns the sum
+ * of the weights up to the first point where it exceeds pick (that point in *oi, *oj, *oq
+ * and *found), or the total when none does (pick UINT32_MAX: the total).
+ * Scaling: weights Q0.16 <= 65535, at most 65^2 candidates: the sum stays below 2^28. */
+static uint32_t geo_scan(const rfs_seek_t *s, uint16_t ci, uint16_t cj, uint32_t pick,
+                         uint16_t *oi, uint16_t *oj, uint32_t *oq, bool *found)
+{
+    const rfs_map_t *m = s->map;
+    const int32_t r = RFS_SEEK_EPS_RADIUS;
+    uint32_t acc = 0;
+    *found = false;
+    for (int32_t dj = -r; dj <= r; ++dj) {
+        const int32_t j = (int32_t)cj + dj;
+        if (j < 0 || j >= (int32_t)m->lh) {
+            continue;
+        }
+        for (int32_t di = -r; di <= r; ++di) {
+            const int32_t i = (int32_t)ci + di;
+            const uint32_t q = (uint32_t)(di * di + dj * dj);
+            if (i < 0 || i >= (int32_t)m->lw || q >= RFS_SEEK_EPS_TABLE) {
+                continue;
+            }
+            const uint32_t idx = (uint32_t)j * m->lw + (uint32_t)i;
+            if (((s->visited[idx >> 3] >> (idx & 7u)) & 1u) ||
+                !((s->reach[idx >> 3] >> (idx & 7u)) & 1u)) {
+                continue;
+            }
+            acc += s->eps_w[q];
+            if (acc > pick) {
+                *oi = (uint16_t)i;
+                *oj = (uint16_t)j;
+                *oq = q;
+                *found = true;
+                return acc;
+            }
+        }
+    }
+    return acc;
+}
+
+/* An independent count of the plans of that decision: its draws replayed from a copy of
+ * the random source taken just before the step, on the step's own visited, reach and
+ * weight tables (a draw changes them only when a plan fails, and then the replayed goal
+ * differs): the epsilon coin (finish_decision), then per try one weighted pick, one plan
+ * and, geodesic and not the last try, one detour test. Returns the plans; the kept goal
+ * in *gx, *gy; the smallest detour of a tested draw in *min_detour (metres Q16.16,
+ * INT64_MAX when none was tested). Scaling: the straight distance grid * sqrt(q) as
+ * rfs_seek.c's offset_dist (Q16 x Q16 >> 16); path lengths <= 32 km, so the detour fits
+ * int32 for rfs_q16_exp_neg. */
+static uint32_t geo_replay(rfs_seek_t *s, rfs_rng_t rng, bool geodesic, rfs_q16_t *gx,
+                           rfs_q16_t *gy, int64_t *min_detour)
+{
+    const rfs_map_t *m = s->map;
+    uint16_t ci, cj, gi = 0, gj = 0;
+    uint32_t q = 0, plans = 0;
+    bool found;
+    rfs_map_lattice_nearest(m, s->pose.x, s->pose.y, &ci, &cj);
+    *min_detour = INT64_MAX;
+    (void)rfs_rng_u32(&rng);
+    for (int attempt = 0; attempt < GEO_TRIES; ++attempt) {
+        const uint32_t total = geo_scan(s, ci, cj, UINT32_MAX, &gi, &gj, &q, &found);
+        if (total == 0u) {
+            return plans;
+        }
+        (void)geo_scan(s, ci, cj, rfs_rng_below(&rng, total), &gi, &gj, &q, &found);
+        rfs_map_lattice_point(m, gi, gj, gx, gy);
+        rfs_path_t path;
+        plans++;
+        if (!rfs_plan_path(&s->plan, s->pose.x, s->pose.y, *gx, *gy, &path) || !geodesic ||
+            attempt == GEO_TRIES - 1) {
+            return plans;
+        }
+        const int64_t straight = ((int64_t)m->cfg.grid * rfs_isqrt64((uint64_t)q << 32)) >> 16;
+        const int64_t detour = (int64_t)path.length - straight;
+        if (detour <= 0) {
+            return plans;
+        }
+        *min_detour = detour < *min_detour ? detour : *min_detour;
+        if (rfs_rng_below(&rng, RFS_Q16_ONE) < (uint32_t)rfs_q16_exp_neg(rfs_sat32(detour))) {
+            return plans;
+        }
+    }
+    return plans;
+}
+
+/* Row names of one geo_decision (bench.sh prints them in this order). */
+typedef struct geo_rows {
+    const char *period;      /* instructions of the measured period */
+    const char *stack;       /* its stack depth, bytes */
+    const char *eps_relearn; /* 1: it relearnt and decided an epsilon goal */
+    const char *plans;       /* paths planned (geo_replay) */
+    const char *goal_ok;     /* 1: the replay kept the decision's goal */
+    const char *path_cm;     /* kept path, cm */
+    const char *detour_cm;   /* smallest detour of a tested draw, cm (NULL: not printed) */
+    const char *ridge_n;     /* samples the relearn used (all 10,000 inside the 5 m radius) */
+} geo_rows_t;
+
+/* One epsilon decision in that worst case, of the meta-path preset (geodesic or not) or
+ * of the paper's configuration (meta_path false: RFS_SEEK_META, whose epsilon draw is the
+ * straight one): fresh init on the walled map, the store around the robot, a boot period (flood fill,
+ * fit, initial move; not measured), then the model discarded and the history set, and
+ * the next period measured: relearn on 10,000 samples + the epsilon decision. The kept
+ * goal in *gx, *gy (for the plan measured alone). */
+static void geo_decision(const rfs_app_map_t *map, bool meta_path, bool geodesic,
+                         const geo_rows_t *row, rfs_q16_t *gx, rfs_q16_t *gy)
+{
+    rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    if (meta_path) {
+        rfs_seek_cfg_use_strategy(&cfg.seek, RFS_SEEK_META_PATH);
+        cfg.seek.eps_geodesic = geodesic;
+    }
+    cfg.seek.eps_floor = RFS_Q16_ONE; /* epsilon = 1: the epsilon branch for certain */
+    cfg.seek.eps_amp = 0;
+    if (rfs_app_init(&s_app, &cfg, map) != 0) {
+        rfs_sh_puts("bench: rfs_app_init failed on the walled map\n");
+        rfs_sh_exit(1);
+    }
+    const rfs_q16_t rx = RFS_Q16_FRAC(9, 8), ry = RFS_Q16_FRAC(69, 8); /* (1.125, 8.625) m */
+    fill_store_at(&s_app.seek.store, 42u, 112, 862, 30, 970);
+    int64_t t = 1000000;
+    const rfs_pose_t p0 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
+    rfs_app_on_pose(&s_app, &p0, t);
+    rfs_app_on_rssi(&s_app, 0, t, -60, t);
+    rfs_app_out_t out;
+    rfs_app_step(&s_app, t, &out);
+    rfs_drive_stop(&s_app.seek.drive, t);
+    s_app.seek.model.ops->reset(s_app.seek.model.self);
+    geo_history(&s_app.seek);
+    t += RFS_APP_PERIOD_US;
+    const rfs_pose_t p1 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
+    rfs_app_on_pose(&s_app, &p1, t);
+    rfs_app_on_rssi(&s_app, 0, t, -60, t);
+    const rfs_rng_t rng0 = s_app.rng;
+    const uintptr_t sp0 = rfs_bc_stack_paint();
+    RFS_BC_MEASURE(row->period, 1, rfs_app_step(&s_app, t, &out));
+    rfs_bc_report(row->stack, 0, rfs_bc_stack_depth(sp0));
+    rfs_bc_report(row->eps_relearn, 0,
+                  (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_EPSILON &&
+                             out.decision.relearned));
+    int64_t min_detour;
+    const uint32_t plans = geo_replay(&s_app.seek, rng0, geodesic, gx, gy, &min_detour);
+    rfs_bc_report(row->plans, 0, plans);
+    rfs_bc_report(row->goal_ok, 0,
+                  (uint32_t)(*gx == out.decision.goal_x && *gy == out.decision.goal_y));
+    rfs_bc_report(row->path_cm, 0, (uint32_t)((out.decision.path_len * 100) >> 16));
+    if (row->detour_cm != 0) {
+        rfs_bc_report(row->detour_cm, 0,
+                      min_detour == INT64_MAX ? 0u : (uint32_t)((min_detour * 100) >> 16));
+    }
+    rfs_bc_report(row->ridge_n, 0, s_app.ridge.n_used);
 }
 
 int main(void)
@@ -309,5 +518,34 @@ int main(void)
                   (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_GREEDY &&
                              out.decision.relearned));
     rfs_bc_report("sliced_goal_x_cm", 0, (uint32_t)((out.decision.goal_x * 100) >> 16));
+
+    /* The meta-path epsilon decision behind a wall (geo_decision), geodesic and not, and
+     * the paper's configuration's, side by side; then one of its plans alone: from the robot to the geodesic decision's
+     * kept goal. */
+    geo_wall();
+    rfs_q16_t gx, gy, sx, sy; /* the kept goals; the plan alone goes to the geodesic one */
+    static const geo_rows_t geo_on = {
+        "worst_eps_geodesic", "stack_bytes_worst_eps_geodesic", "worst_eps_geodesic_eps_relearn",
+        "worst_eps_geodesic_plans", "worst_eps_geodesic_replay_goal_ok",
+        "worst_eps_geodesic_path_cm", "worst_eps_geodesic_min_detour_cm",
+        "worst_eps_geodesic_ridge_samples"};
+    static const geo_rows_t geo_off = {
+        "worst_eps_straight", "stack_bytes_worst_eps_straight", "worst_eps_straight_eps_relearn",
+        "worst_eps_straight_plans", "worst_eps_straight_replay_goal_ok",
+        "worst_eps_straight_path_cm", 0, "worst_eps_straight_ridge_samples"};
+    static const geo_rows_t geo_paper = {
+        "worst_eps_paper", "stack_bytes_worst_eps_paper", "worst_eps_paper_eps_relearn",
+        "worst_eps_paper_plans", "worst_eps_paper_replay_goal_ok", "worst_eps_paper_path_cm", 0,
+        "worst_eps_paper_ridge_samples"};
+    geo_decision(&map, true, true, &geo_on, &gx, &gy);
+    geo_decision(&map, true, false, &geo_off, &sx, &sy);
+    geo_decision(&map, false, false, &geo_paper, &sx, &sy);
+    bool geo_ok = false;
+    RFS_BC_MEASURE("phase_plan_behind_wall", 1,
+                   geo_ok = rfs_plan_path(&s_app.seek.plan, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(69, 8),
+                                          gx, gy, &path));
+    rfs_bc_report("plan_behind_wall_ok", 0, geo_ok ? 1u : 0u);
+    rfs_bc_report("plan_behind_wall_expanded", 0, s_app.seek.plan.expanded);
+    rfs_bc_report("plan_behind_wall_path_cm", 0, (uint32_t)((path.length * 100) >> 16));
     rfs_sh_exit(0);
 }

@@ -130,6 +130,8 @@ static void derive_legal(rfs_map_t *m)
     }
 }
 
+static void derive_steps(rfs_map_t *m);
+
 int rfs_map_init(rfs_map_t *m, const rfs_map_cfg_t *cfg, uint16_t w, uint16_t h,
                  rfs_q16_t res, rfs_q16_t origin_x, rfs_q16_t origin_y,
                  const uint8_t *free_bits, const uint8_t *wall_bits, uint8_t *legal_bits)
@@ -174,6 +176,7 @@ int rfs_map_init(rfs_map_t *m, const rfs_map_cfg_t *cfg, uint16_t w, uint16_t h,
     m->lw = (uint16_t)lw;
     m->lh = (uint16_t)lh;
     derive_legal(m);
+    derive_steps(m);
     return 0;
 }
 
@@ -202,10 +205,17 @@ bool rfs_map_point_legal(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y)
 
 /* --- exact supercover traversal ---------------------------------------------------- */
 
+typedef enum visit_mode {
+    VISIT_LEGAL,  /* check legality */
+    VISIT_WALLS,  /* count wall runs */
+    VISIT_RECORD  /* record the cells (step patterns) */
+} visit_mode_t;
+
 typedef struct visitor {
     const rfs_map_t *m;
-    bool walls;       /* count wall runs (else: check legality) */
-    bool legal;       /* legality so far */
+    uint16_t *rec;    /* VISIT_RECORD: 16 x 16 bit box of cells (0..15, 0..15) */
+    uint8_t mode;     /* visit_mode_t */
+    bool legal;       /* legality so far (VISIT_RECORD: every cell inside the box) */
     bool in_wall;     /* previous visited cell was a wall */
     uint16_t runs;    /* wall runs so far */
 } visitor_t;
@@ -215,11 +225,19 @@ static bool visit(visitor_t *v, int32_t i, int32_t j)
 {
     const rfs_map_t *m = v->m;
     bool on = i >= 0 && j >= 0 && i < (int32_t)m->w && j < (int32_t)m->h;
-    if (!v->walls) {
+    if (v->mode == VISIT_LEGAL) {
         if (!on || !rfs_map_bit(m->legal, m->stride, (uint16_t)i, (uint16_t)j)) {
             v->legal = false;
             return false;
         }
+        return true;
+    }
+    if (v->mode == VISIT_RECORD) {
+        if (i < 0 || i > 15 || j < 0 || j > 15) {
+            v->legal = false;
+            return false;
+        }
+        v->rec[j] = (uint16_t)(v->rec[j] | (1u << i));
         return true;
     }
     bool wall = on && rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)j);
@@ -323,10 +341,126 @@ bool rfs_map_segment_legal(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q
     if (!rfs_map_cell(m, x0, y0, &cx, &cy) || !rfs_map_cell(m, x1, y1, &cx, &cy)) {
         return false;
     }
-    visitor_t v = {m, false, true, false, 0};
+    visitor_t v = {m, 0, VISIT_LEGAL, true, false, 0};
     traverse(&v, (int64_t)x0 - m->origin_x, (int64_t)y0 - m->origin_y,
              (int64_t)x1 - m->origin_x, (int64_t)y1 - m->origin_y);
     return v.legal;
+}
+
+/* --- lattice step patterns ------------------------------------------------------------ */
+
+/* Directions of the four recorded patterns; the other four walk the same segments back. */
+static const int8_t STEP_DX[4] = {1, 1, 0, -1};
+static const int8_t STEP_DY[4] = {0, 1, 1, 1};
+
+/* Record each direction's pattern from the traversal itself. The traversal is invariant
+ * under shifts by whole cells (floors and cross-multiplications shift together), so when
+ * grid = n * res every lattice point (g/2 + i*g) lies at the same offset (g/2) mod res
+ * within its cell, its cell is i*n + (g/2)/res, and the cells of one step from any point
+ * at that offset, relative to its cell, are those of every step in that direction:
+ * corners and edges included, by construction. The reference step starts at that offset
+ * in cell (8, 8) of a 16 x 16 box (coordinates only: recording reads no grid, so the
+ * map's size does not matter). Other ratios (0.25 m over 0.1 m cells: the offset drifts
+ * from point to point) keep step_n 0 and rfs_map_lattice_step_legal runs the traversal.
+ * Scaling and overflow: n <= 6 and grid <= 2^24 (256 m), so the reference coordinates
+ * (below 8 res + 2 grid) are far inside the traversal's 2^30 limit. */
+static void derive_steps(rfs_map_t *m)
+{
+    m->step_n = 0;
+    if (m->cfg.grid > ((int32_t)1 << 24)) {
+        return;
+    }
+    /* 32-bit divisions: both positive and below 2^31 (no libgcc helper on the M4). */
+    const uint32_t r = (uint32_t)m->res;
+    const uint32_t g = (uint32_t)m->cfg.grid;
+    if (g % r != 0u || g / r > 6u) {
+        return;
+    }
+    const int64_t x0 = 8 * (int64_t)r + (int64_t)((g / 2u) % r);
+    for (uint32_t k = 0; k < 4u; k++) {
+        uint16_t box[16];
+        memset(box, 0, sizeof(box));
+        visitor_t v = {m, box, VISIT_RECORD, true, false, 0};
+        traverse(&v, x0, x0, x0 + STEP_DX[k] * (int64_t)g, x0 + STEP_DY[k] * (int64_t)g);
+        if (!v.legal) {
+            return;
+        }
+        int32_t c_lo = 16, c_hi = -1, k_lo = 16, k_hi = -1;
+        for (int32_t row = 0; row < 16; row++) {
+            for (int32_t c = 0; c < 16; c++) {
+                if ((box[row] >> c) & 1u) {
+                    c_lo = c < c_lo ? c : c_lo;
+                    c_hi = c > c_hi ? c : c_hi;
+                    k_lo = row < k_lo ? row : k_lo;
+                    k_hi = row > k_hi ? row : k_hi;
+                }
+            }
+        }
+        if (c_hi < 0 || c_hi - c_lo + 1 > (int32_t)RFS_MAP_STEP_BOX ||
+            k_hi - k_lo + 1 > (int32_t)RFS_MAP_STEP_BOX) {
+            return;
+        }
+        rfs_map_step_t *st = &m->step[k];
+        memset(st, 0, sizeof(*st));
+        st->cx = (int8_t)(c_lo - 8);
+        st->cy = (int8_t)(k_lo - 8);
+        st->cols = (uint8_t)(c_hi - c_lo + 1);
+        st->rows = (uint8_t)(k_hi - k_lo + 1);
+        for (int32_t row = k_lo; row <= k_hi; row++) {
+            st->mask[row - k_lo] = (uint8_t)(box[row] >> c_lo);
+        }
+    }
+    m->step_c0 = (uint8_t)((g / 2u) / r);
+    m->step_n = (uint8_t)(g / r);
+}
+
+bool rfs_map_lattice_step_legal(const rfs_map_t *m, uint16_t i, uint16_t j, int32_t di,
+                                int32_t dj)
+{
+    int32_t ti = (int32_t)i + di;
+    int32_t tj = (int32_t)j + dj;
+    if (i >= m->lw || j >= m->lh || ti < 0 || tj < 0 || ti >= (int32_t)m->lw ||
+        tj >= (int32_t)m->lh) {
+        return false;
+    }
+    /* Walk a step of the lower half of the directions backwards: same segment. */
+    int32_t si = (int32_t)i;
+    int32_t sj = (int32_t)j;
+    if (dj < 0 || (dj == 0 && di < 0)) {
+        si = ti;
+        sj = tj;
+        di = -di;
+        dj = -dj;
+    }
+    if (m->step_n != 0 && dj >= 0 && dj <= 1 && di >= -1 && di <= 1 && (di | dj) != 0) {
+        const rfs_map_step_t *st = &m->step[dj == 0 ? 0 : 2 - di];
+        /* Scaling and overflow: lattice index < 2^16 times n <= 6 fits in int32. */
+        int32_t cx = si * m->step_n + m->step_c0 + st->cx;
+        int32_t cy = sj * m->step_n + m->step_c0 + st->cy;
+        if (cx >= 0 && cy >= 0 && cx + st->cols <= (int32_t)m->w &&
+            cy + st->rows <= (int32_t)m->h) {
+            const uint8_t *row = m->legal + (uint32_t)cy * m->stride + ((uint32_t)cx >> 3);
+            const uint32_t sh = (uint32_t)cx & 7u;
+            const bool two = sh + st->cols > 8u; /* then cx + cols <= w keeps row[1] on the row */
+            for (uint32_t k = 0; k < st->rows; k++, row += m->stride) {
+                uint32_t bits = (uint32_t)row[0] >> sh;
+                if (two) {
+                    bits |= (uint32_t)row[1] << (8u - sh);
+                }
+                if ((bits & st->mask[k]) != st->mask[k]) {
+                    return false;
+                }
+            }
+            return true;
+        }
+    }
+    rfs_q16_t x0;
+    rfs_q16_t y0;
+    rfs_q16_t x1;
+    rfs_q16_t y1;
+    rfs_map_lattice_point(m, i, j, &x0, &y0);
+    rfs_map_lattice_point(m, (uint16_t)ti, (uint16_t)tj, &x1, &y1);
+    return rfs_map_segment_legal(m, x0, y0, x1, y1);
 }
 
 static int64_t clamp64(int64_t v, int64_t lo, int64_t hi)
@@ -344,7 +478,7 @@ uint16_t rfs_map_walls_crossed(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, r
      * the clamp moves them along the axes, an approximation documented in MAPS.md). */
     int64_t we = (int64_t)m->w * m->res;
     int64_t he = (int64_t)m->h * m->res;
-    visitor_t v = {m, true, true, false, 0};
+    visitor_t v = {m, 0, VISIT_WALLS, true, false, 0};
     traverse(&v, clamp64((int64_t)x0 - m->origin_x, 0, we),
              clamp64((int64_t)y0 - m->origin_y, 0, he),
              clamp64((int64_t)x1 - m->origin_x, 0, we),
@@ -390,6 +524,13 @@ bool rfs_map_lattice_legal(const rfs_map_t *m, uint16_t i, uint16_t j)
 {
     if (i >= m->lw || j >= m->lh) {
         return false;
+    }
+    if (m->step_n != 0) {
+        /* grid = n * res: point i is at g/2 + i*n*res from the origin, inside the extent,
+         * so its cell is i*n + (g/2)/res exactly (what rfs_map_cell computes). Scaling
+         * and overflow: i < 2^16, n <= 6, and the cell is below w (< 2^16). */
+        return rfs_map_bit(m->legal, m->stride, (uint16_t)(i * m->step_n + m->step_c0),
+                           (uint16_t)(j * m->step_n + m->step_c0));
     }
     rfs_q16_t x;
     rfs_q16_t y;

@@ -16,7 +16,10 @@
  *
  * The lattice: greedy grid search, epsilon candidates and path planning all use one
  * lattice of points `grid` apart (default 0.25 m): point (i, j) is at origin + grid/2 +
- * (i, j) * grid, and lw x lh points lie inside the map's extent.
+ * (i, j) * grid, and lw x lh points lie inside the map's extent. When grid is a whole
+ * multiple of res (0.25 m over 0.125 m cells), every lattice step of one direction
+ * visits the same cells relative to its start's cell: rfs_map_init records them once
+ * from the traversal, and rfs_map_lattice_step_legal tests those bits directly.
  */
 #ifndef RFS_MAP_H
 #define RFS_MAP_H
@@ -32,6 +35,21 @@ typedef struct rfs_map_cfg {
     rfs_q16_t grid;      ///< metres, Q16.16: lattice spacing for search and planning (0.25)
 } rfs_map_cfg_t;
 
+/// Most columns and rows of a lattice step's cell box (one byte per row).
+#define RFS_MAP_STEP_BOX 8u
+
+/// The cells the exact traversal visits for one lattice step, as a bit box relative to
+/// the cell of the step's start point. Recorded at init from the traversal itself on one
+/// reference step; valid for every step of its direction when every lattice point lies
+/// at the same place within its cell (grid a whole multiple of res).
+typedef struct rfs_map_step {
+    int8_t cx;                       ///< cells: the box's left column minus the start's
+    int8_t cy;                       ///< cells: the box's bottom row minus the start's
+    uint8_t cols;                    ///< columns in the box, 1..RFS_MAP_STEP_BOX
+    uint8_t rows;                    ///< rows in the box, 1..RFS_MAP_STEP_BOX
+    uint8_t mask[RFS_MAP_STEP_BOX];  ///< bit c of mask[k]: cell (cx + c, cy + k) is visited
+} rfs_map_step_t;
+
 /// The map; the bit arrays are caller-owned and must outlive it.
 typedef struct rfs_map {
     rfs_map_cfg_t cfg;     ///< configuration copied at init
@@ -46,6 +64,11 @@ typedef struct rfs_map {
     uint8_t *legal;        ///< 1 = legal (derived), h * stride bytes
     uint16_t lw;           ///< lattice points along x
     uint16_t lh;           ///< lattice points along y
+    /// Lattice step patterns for the directions (1, 0), (1, 1), (0, 1), (-1, 1); the
+    /// other four are the same segments walked backwards.
+    rfs_map_step_t step[4];
+    uint8_t step_n;        ///< cells per lattice step (grid / res); 0 = no patterns
+    uint8_t step_c0;       ///< cells: the cell of lattice point 0 along an axis, (grid/2) / res
 } rfs_map_t;
 
 /// Defaults: 0.25 m clearance, 0.25 m lattice.
@@ -83,6 +106,14 @@ bool rfs_map_point_legal(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y);
 /// Straight-move legality: every cell the segment passes through is legal.
 bool rfs_map_segment_legal(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,
                            rfs_q16_t y1);
+
+/// Legality of the lattice step from point (i, j) to (i + di, j + dj), di and dj in
+/// {-1, 0, 1}: exactly rfs_map_segment_legal between the two points (false when either
+/// is off the lattice). With step patterns (grid a multiple of res, at most 6 cells) and
+/// the step's cell box on the map it tests the recorded cells' legal bits directly, a
+/// few byte loads; otherwise it runs the traversal.
+bool rfs_map_lattice_step_legal(const rfs_map_t *m, uint16_t i, uint16_t j, int32_t di,
+                                int32_t dj);
 
 /// Walls crossed by the straight line: the number of runs of consecutive wall cells the
 /// segment touches, in order along it (0 when the map has no wall grid). Endpoints off

@@ -115,6 +115,9 @@ static bool search(rfs_plan_t *p, uint32_t s_idx, uint32_t g_idx)
     const uint32_t lw = m->lw;
     const uint32_t n = lw * m->lh;
     uint8_t *w = p->work;
+    /* Step patterns (grid a multiple of res): lattice legality and edges from the
+     * recorded cells; otherwise, or for the reference, positions and the traversal. */
+    const bool steps = m->step_n != 0 && !p->exact_edges;
     memset(w, 0, n);
     rings_t r;
     memset(&r, 0, sizeof(r));
@@ -148,9 +151,11 @@ static bool search(rfs_plan_t *p, uint32_t s_idx, uint32_t g_idx)
             }
             uint16_t ui = (uint16_t)(u % lw);
             uint16_t uj = (uint16_t)(u / lw);
-            rfs_q16_t ux;
-            rfs_q16_t uy;
-            rfs_map_lattice_point(m, ui, uj, &ux, &uy);
+            rfs_q16_t ux = 0;
+            rfs_q16_t uy = 0;
+            if (!steps) {
+                rfs_map_lattice_point(m, ui, uj, &ux, &uy);
+            }
             for (uint32_t k = 0; k < 8u; k++) {
                 int32_t vi = (int32_t)ui + DIR_X[k];
                 int32_t vj = (int32_t)uj + DIR_Y[k];
@@ -169,15 +174,25 @@ static bool search(rfs_plan_t *p, uint32_t s_idx, uint32_t g_idx)
                         continue;
                     }
                 }
-                rfs_q16_t vx;
-                rfs_q16_t vy;
-                rfs_map_lattice_point(m, (uint16_t)vi, (uint16_t)vj, &vx, &vy);
-                if (!(wv & W_OPEN) && !rfs_map_point_legal(m, vx, vy)) {
-                    w[v] = (uint8_t)(wv | W_ILLEGAL);
-                    continue;
-                }
-                if (!rfs_map_segment_legal(m, ux, uy, vx, vy)) {
-                    continue;
+                if (steps) {
+                    if (!(wv & W_OPEN) && !rfs_map_lattice_legal(m, (uint16_t)vi, (uint16_t)vj)) {
+                        w[v] = (uint8_t)(wv | W_ILLEGAL);
+                        continue;
+                    }
+                    if (!rfs_map_lattice_step_legal(m, ui, uj, DIR_X[k], DIR_Y[k])) {
+                        continue;
+                    }
+                } else {
+                    rfs_q16_t vx;
+                    rfs_q16_t vy;
+                    rfs_map_lattice_point(m, (uint16_t)vi, (uint16_t)vj, &vx, &vy);
+                    if (!(wv & W_OPEN) && !rfs_map_point_legal(m, vx, vy)) {
+                        w[v] = (uint8_t)(wv | W_ILLEGAL);
+                        continue;
+                    }
+                    if (!rfs_map_segment_legal(m, ux, uy, vx, vy)) {
+                        continue;
+                    }
                 }
                 /* Parent direction points from v back to u. */
                 w[v] = (uint8_t)(W_OPEN | ((nc & 3u) << W_TMOD_SHIFT) | ((k + 4u) & 7u));

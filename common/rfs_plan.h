@@ -5,13 +5,15 @@
  * segment between the two points is legal), from the goal's lattice point outward until
  * the start's is closed, with integer costs 2 for a straight and 3 for a diagonal step
  * (octile, diagonal 1.5 instead of 1.414) so the priority queue is Dial's: four ring
- * buffers, one per cost mod 4. The start and the goal join the lattice through the
- * closest legal lattice point of their 3 x 3 neighbourhood that a legal segment reaches
- * (a start inside the clearance zone: the closest legal one of its 5 x 5, unchecked, so
- * the robot can get out). The lattice path is then shortened by string pulling: from
- * each kept waypoint, the farthest later point of the path still reachable by a legal
- * straight segment. A goal in line of sight gives a one-waypoint path without search.
- * Work memory is caller-owned: one byte per lattice point and the queue (docs/MAPS.md).
+ * buffers, one per cost mod 4. Edges are tested by rfs_map_lattice_step_legal (the
+ * traversal's cells recorded once per direction; same answers, a few byte loads). The
+ * start and the goal join the lattice through the closest legal lattice point of their
+ * 3 x 3 neighbourhood that a legal segment reaches (a start inside the clearance zone:
+ * the closest legal one of its 5 x 5, unchecked, so the robot can get out). The lattice
+ * path is then shortened by string pulling: from each kept waypoint, the farthest later
+ * point of the path still reachable by a legal straight segment. A goal in line of
+ * sight gives a one-waypoint path without search. Work memory is caller-owned: one byte
+ * per lattice point and the queue (docs/MAPS.md).
  */
 #ifndef RFS_PLAN_H
 #define RFS_PLAN_H
@@ -33,6 +35,9 @@ typedef struct rfs_plan {
     uint32_t queue_cap;     ///< its capacity, split in four quarters (2 * (lw + lh) ample: docs/MAPS.md)
     uint32_t expanded;      ///< lattice points expanded by the last search (for benchmarks)
     uint32_t queue_peak;    ///< most entries one of the four queue quarters held in the last search
+    bool exact_edges;       ///< false (init): lattice points and edges from the map's
+                            ///< step patterns where it has them; true: positions and
+                            ///< rfs_map_segment_legal always (the tests' reference)
 } rfs_plan_t;
 
 /// A planned path: waypoints in order, the last one the goal itself.

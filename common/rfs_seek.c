@@ -269,7 +269,7 @@ static bool snap_legal(const rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y, bool need_
 }
 
 /* Flood-fill the lattice points reachable from the robot (8-connected, an edge where
- * the straight segment is legal), so that greedy maxima and epsilon goals never lie in
+ * the straight segment is legal: rfs_map_lattice_step_legal), so that greedy maxima and epsilon goals never lie in
  * a pocket of the map the robot cannot reach (SLAM maps have many). */
 static void compute_reach(rfs_seek_t *s)
 {
@@ -294,8 +294,6 @@ static void compute_reach(rfs_seek_t *s)
         head = (head + 1u) % s->queue_cap;
         count--;
         uint16_t i = (uint16_t)(idx % m->lw), j = (uint16_t)(idx / m->lw);
-        rfs_q16_t x0, y0;
-        rfs_map_lattice_point(m, i, j, &x0, &y0);
         for (int k = 0; k < 8; ++k) {
             int32_t ni = (int32_t)i + k_di[k], nj = (int32_t)j + k_dj[k];
             if (ni < 0 || nj < 0 || ni >= (int32_t)m->lw || nj >= (int32_t)m->lh) {
@@ -305,9 +303,9 @@ static void compute_reach(rfs_seek_t *s)
             if (bit_get(s->reach, nidx) || !rfs_map_lattice_legal(m, (uint16_t)ni, (uint16_t)nj)) {
                 continue;
             }
-            rfs_q16_t x1, y1;
-            rfs_map_lattice_point(m, (uint16_t)ni, (uint16_t)nj, &x1, &y1);
-            if (!rfs_map_segment_legal(m, x0, y0, x1, y1)) {
+            /* The recorded step cells when the map has them, else the traversal: the
+             * same answer as rfs_map_segment_legal between the two lattice points. */
+            if (!rfs_map_lattice_step_legal(m, i, j, k_di[k], k_dj[k])) {
                 continue;
             }
             bit_set(s->reach, nidx);

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "ref_geom.h"
 #include "rfs_plan.h"
 
 #define W 120
@@ -72,20 +73,7 @@ static void ref_legal_cells(void)
 /* Closed segment (Q16 units relative to the origin) vs closed cell square; exact. */
 static int touch(double x0, double y0, double x1, double y1, int i, int j)
 {
-    double r = RES;
-    double bx0 = i * r, bx1 = (i + 1) * r, by0 = j * r, by1 = (j + 1) * r;
-    if (fmax(x0, x1) < bx0 || fmin(x0, x1) > bx1 || fmax(y0, y1) < by0 || fmin(y0, y1) > by1) {
-        return 0;
-    }
-    double cx[4] = {bx0, bx1, bx0, bx1};
-    double cy[4] = {by0, by0, by1, by1};
-    int pos = 0, neg = 0;
-    for (int k = 0; k < 4; k++) {
-        double cr = (x1 - x0) * (cy[k] - y0) - (y1 - y0) * (cx[k] - x0);
-        pos += cr > 0;
-        neg += cr < 0;
-    }
-    return !(pos == 4 || neg == 4);
+    return ref_touch(x0, y0, x1, y1, RES, i, j);
 }
 
 /* Reference segment legality for points given in Q16 map coordinates (origin 0). */

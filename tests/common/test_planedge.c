@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "ref_geom.h"
 #include "rfs_plan.h"
 
 #define WMAX 240
@@ -103,25 +104,6 @@ static void build(const map_case_t *c, uint32_t seed)
                      0);
 }
 
-/* Closed segment vs closed square [i r, (i+1) r] x [j r, (j+1) r], coordinates in Q16
- * units; exact in double (integers below 2^21, products below 2^43). */
-static int touch(double x0, double y0, double x1, double y1, double r, int i, int j)
-{
-    double bx0 = i * r, bx1 = (i + 1) * r, by0 = j * r, by1 = (j + 1) * r;
-    if (fmax(x0, x1) < bx0 || fmin(x0, x1) > bx1 || fmax(y0, y1) < by0 || fmin(y0, y1) > by1) {
-        return 0;
-    }
-    double cx[4] = {bx0, bx1, bx0, bx1};
-    double cy[4] = {by0, by0, by1, by1};
-    int pos = 0, neg = 0;
-    for (int k = 0; k < 4; k++) {
-        double cr = (x1 - x0) * (cy[k] - y0) - (y1 - y0) * (cx[k] - x0);
-        pos += cr > 0;
-        neg += cr < 0;
-    }
-    return !(pos == 4 || neg == 4);
-}
-
 /* The recorded step cells are the cells a closed lattice step touches (double geometry
  * on the step from lattice point (5, 5)), and step_n / step_c0 are grid / res and
  * (grid / 2) / res where grid is a whole multiple of res, 0 elsewhere. */
@@ -145,7 +127,7 @@ static void test_step_patterns(void **state)
             int n_cells = 0;
             for (int dj = -10; dj <= 10; dj++) {
                 for (int di = -10; di <= 10; di++) {
-                    int want = touch(x0, x0, x0 + DX[k] * g, x0 + DY[k] * g, r, s + di, s + dj);
+                    int want = ref_touch(x0, x0, x0 + DX[k] * g, x0 + DY[k] * g, r, s + di, s + dj);
                     int bc = di - st->cx, bk = dj - st->cy;
                     int got = bc >= 0 && bk >= 0 && bc < st->cols && bk < st->rows &&
                               ((st->mask[bk] >> bc) & 1);

@@ -140,6 +140,25 @@ static void start(rfs_drive_t *d, sim_t *s, double x, double y, double th)
     s->th = th;
 }
 
+/* A fresh drive and robot at the origin heading th (radians), given the one goal (gx, gy)
+ * (metres) at t = 0; the path is returned for run(). */
+static rfs_path_t start_to(rfs_drive_t *d, sim_t *s, double th, double gx, double gy)
+{
+    start(d, s, 0.0, 0.0, th);
+    rfs_path_t p = one_goal(gx, gy);
+    rfs_drive_set_path(d, &p, 0);
+    return p;
+}
+
+/* The update one period after end_us (the run's last) reports IDLE; the wheel commands it
+ * gives are returned in *l, *r (mm/s). */
+static void expect_idle_after(rfs_drive_t *d, const sim_t *s, int64_t end_us, int16_t *l,
+                              int16_t *r)
+{
+    rfs_pose_t pp = pose_of(s);
+    assert_int_equal(rfs_drive_update(d, &pp, end_us + DT_US, l, r), RFS_DRIVE_IDLE);
+}
+
 /* Straight ahead, behind, and random goals from random headings: all reached. */
 static void test_reaches_goals(void **state)
 {
@@ -152,9 +171,7 @@ static void test_reaches_goals(void **state)
         double th = (k == 0) ? 0.0 : (k == 1 ? 0.0 : (rand() / (double)RAND_MAX) * 6.283 - 3.1416);
         double gx = (k == 0) ? 3.0 : (k == 1 ? -2.0 : (rand() / (double)RAND_MAX) * 8.0 - 4.0);
         double gy = (k <= 1) ? 0.0 : (rand() / (double)RAND_MAX) * 8.0 - 4.0;
-        start(&d, &s, 0.0, 0.0, th);
-        rfs_path_t p = one_goal(gx, gy);
-        rfs_drive_set_path(&d, &p, 0);
+        rfs_path_t p = start_to(&d, &s, th, gx, gy);
         rfs_drive_status_t st = run(&d, &s, &p, 60.0, false, &end);
         assert_int_equal(st, RFS_DRIVE_REACHED);
         assert_true(hypot(s.x - gx, s.y - gy) <= 0.1 + 1e-3);
@@ -167,18 +184,15 @@ static void test_reaches_goals(void **state)
         /* The time is physically plausible: at least distance / v_max. */
         assert_true(end / 1e6 >= (hypot(gx, gy) - 0.1) / 0.7);
         /* REACHED is reported once, then IDLE with wheels at 0. */
-        rfs_pose_t pp = pose_of(&s);
         int16_t l;
         int16_t r;
-        assert_int_equal(rfs_drive_update(&d, &pp, end + DT_US, &l, &r), RFS_DRIVE_IDLE);
+        expect_idle_after(&d, &s, end, &l, &r);
         assert_int_equal(l, 0);
         assert_int_equal(r, 0);
     }
     /* Straight 3 m: the top speed is reached and the run takes about the ideal time of a
      * trapezoid profile (accelerate at 1 m/s^2, cruise at 0.7 m/s, brake at 0.5 m/s^2). */
-    start(&d, &s, 0.0, 0.0, 0.0);
-    rfs_path_t p = one_goal(3.0, 0.0);
-    rfs_drive_set_path(&d, &p, 0);
+    rfs_path_t p = start_to(&d, &s, 0.0, 3.0, 0.0);
     assert_int_equal(run(&d, &s, &p, 60.0, false, &end), RFS_DRIVE_REACHED);
     double ideal = 0.7 / 1.0 + 0.7 / 0.5 + (3.0 - 0.7 * 0.7 / 2 - 0.7 * 0.7 / 1.0) / 0.7;
     assert_true(end / 1e6 > ideal - 0.5 && end / 1e6 < ideal + 1.0);
@@ -288,10 +302,9 @@ static void test_timeout(void **state)
     rfs_drive_set_path(&d, &p, 0);
     assert_int_equal(run(&d, &s, &p, 60.0, false, &end), RFS_DRIVE_TIMEOUT);
     assert_true(end > 2000000 && end <= 2000000 + DT_US);
-    rfs_pose_t pp = pose_of(&s);
     int16_t l;
     int16_t r;
-    assert_int_equal(rfs_drive_update(&d, &pp, end + DT_US, &l, &r), RFS_DRIVE_IDLE);
+    expect_idle_after(&d, &s, end, &l, &r);
     /* Abandoned: the wheels ramp down within the acceleration limit. */
     assert_true(l < s.l && l >= s.l - 21);
 }
@@ -303,14 +316,11 @@ static void test_blocked(void **state)
     rfs_drive_t d;
     sim_t s;
     int64_t end;
-    start(&d, &s, 0.0, 0.0, 0.0);
-    rfs_path_t p = one_goal(5.0, 0.0);
-    rfs_drive_set_path(&d, &p, 0);
+    rfs_path_t p = start_to(&d, &s, 0.0, 5.0, 0.0);
     assert_int_equal(run(&d, &s, &p, 60.0, true, &end), RFS_DRIVE_BLOCKED);
     assert_true(end >= d.cfg.stall_us && end <= d.cfg.stall_us + 2 * DT_US);
     /* Moving normally it is not blocked. */
-    start(&d, &s, 0.0, 0.0, 0.0);
-    rfs_drive_set_path(&d, &p, 0);
+    p = start_to(&d, &s, 0.0, 5.0, 0.0);
     assert_int_equal(run(&d, &s, &p, 60.0, false, &end), RFS_DRIVE_REACHED);
 }
 
@@ -321,16 +331,13 @@ static void test_stop(void **state)
     rfs_drive_t d;
     sim_t s;
     int64_t end;
-    start(&d, &s, 0.0, 0.0, 0.0);
-    rfs_path_t p = one_goal(5.0, 0.0);
-    rfs_drive_set_path(&d, &p, 0);
+    rfs_path_t p = start_to(&d, &s, 0.0, 5.0, 0.0);
     assert_int_equal(run(&d, &s, &p, 1.0, false, &end), RFS_DRIVE_RUNNING);
     assert_true(s.l > 500);
     rfs_drive_stop(&d, end);
-    rfs_pose_t pp = pose_of(&s);
     int16_t l;
     int16_t r;
-    assert_int_equal(rfs_drive_update(&d, &pp, end + DT_US, &l, &r), RFS_DRIVE_IDLE);
+    expect_idle_after(&d, &s, end, &l, &r);
     assert_int_equal(l, 0);
     assert_int_equal(r, 0);
 }

@@ -264,23 +264,37 @@ static void test_legal_grid_matches_reference(void **state)
     }
 }
 
+/* The bit grids of a hand-made W x H map: every cell free and no wall until a test says
+ * otherwise; init writes the legal bits. One set, reset by each call. */
+typedef struct bits {
+    uint8_t free[H * ((W + 7) / 8)];
+    uint8_t wall[H * ((W + 7) / 8)];
+    uint8_t legal[H * ((W + 7) / 8)];
+} bits_t;
+
+static bits_t *all_free(void)
+{
+    static bits_t b;
+    memset(&b, 0, sizeof(b));
+    memset(b.free, 0xFF, sizeof(b.free));
+    return &b;
+}
+
 /* Map edges: with everything free, the border cells within the clearance are illegal. */
 static void test_map_edges(void **state)
 {
     (void)state;
-    static uint8_t fb[H * ((W + 7) / 8)];
-    static uint8_t lb[H * ((W + 7) / 8)];
-    memset(fb, 0xFF, sizeof(fb));
+    bits_t *b = all_free();
     rfs_map_t m;
     rfs_map_cfg_t cfg = rfs_map_cfg_default();
     /* res 0.1 as the loader rounds it (Q16 6554 = 0.100006 m), clearance 0.25 m: cell 2's
      * centre is 0.250015 m from the edge, so cells 0 and 1 of each border are illegal and
      * cell 2 is legal. */
-    assert_int_equal(rfs_map_init(&m, &cfg, W, H, 6554, 0, 0, fb, NULL, lb), 0);
+    assert_int_equal(rfs_map_init(&m, &cfg, W, H, 6554, 0, 0, b->free, NULL, b->legal), 0);
     for (int x = 0; x < W; x++) {
         for (int y = 0; y < H; y++) {
             int inside = x >= 2 && y >= 2 && x < W - 2 && y < H - 2;
-            assert_int_equal(rfs_map_bit(lb, m.stride, (uint16_t)x, (uint16_t)y), inside);
+            assert_int_equal(rfs_map_bit(b->legal, m.stride, (uint16_t)x, (uint16_t)y), inside);
         }
     }
     /* Points: on the map and legal; just off the map: illegal. */
@@ -296,20 +310,19 @@ static void test_map_edges(void **state)
 static void test_unknown_cell(void **state)
 {
     (void)state;
-    static uint8_t fb[H * ((W + 7) / 8)];
-    static uint8_t lb[H * ((W + 7) / 8)];
-    memset(fb, 0xFF, sizeof(fb));
+    bits_t *b = all_free();
     uint16_t stride = (W + 7) / 8;
-    rfs_map_bit_set(fb, stride, 20, 20, false);
+    rfs_map_bit_set(b->free, stride, 20, 20, false);
     rfs_map_t m;
     rfs_map_cfg_t cfg = rfs_map_cfg_default();
     /* res 0.25 exactly, clearance 0.25: the cell's own 8 neighbours come within 0.177 m
      * or 0.125 m of the centre; the next ring is >= 0.375 m away. */
-    assert_int_equal(rfs_map_init(&m, &cfg, W, H, RFS_Q16_FRAC(1, 4), 0, 0, fb, NULL, lb), 0);
+    assert_int_equal(rfs_map_init(&m, &cfg, W, H, RFS_Q16_FRAC(1, 4), 0, 0, b->free, NULL, b->legal),
+                     0);
     for (int y = 15; y <= 25; y++) {
         for (int x = 15; x <= 25; x++) {
             int near = abs(x - 20) <= 1 && abs(y - 20) <= 1;
-            assert_int_equal(rfs_map_bit(lb, m.stride, (uint16_t)x, (uint16_t)y), !near);
+            assert_int_equal(rfs_map_bit(b->legal, m.stride, (uint16_t)x, (uint16_t)y), !near);
         }
     }
 }
@@ -379,16 +392,14 @@ static void test_segments_match_reference(void **state)
 static void test_segment_grazing_corner(void **state)
 {
     (void)state;
-    static uint8_t fb[H * ((W + 7) / 8)];
-    static uint8_t lb[H * ((W + 7) / 8)];
-    memset(fb, 0xFF, sizeof(fb));
+    bits_t *b = all_free();
     uint16_t stride = (W + 7) / 8;
     rfs_map_t m;
     rfs_map_cfg_t cfg = rfs_map_cfg_default();
     cfg.clearance = 0; /* legal = free: the geometry is the cells themselves */
     const rfs_q16_t r = RFS_Q16_FRAC(1, 4);
-    rfs_map_bit_set(fb, stride, 10, 10, false);
-    assert_int_equal(rfs_map_init(&m, &cfg, W, H, r, 0, 0, fb, NULL, lb), 0);
+    rfs_map_bit_set(b->free, stride, 10, 10, false);
+    assert_int_equal(rfs_map_init(&m, &cfg, W, H, r, 0, 0, b->free, NULL, b->legal), 0);
     /* The line x + y = 20r touches cell (10, 10) = [10r, 11r]^2 only at its corner. */
     assert_false(rfs_map_segment_legal(&m, 9 * r, 11 * r, 11 * r, 9 * r));
     /* One Q16 step lower-left, it misses the cell. */
@@ -397,10 +408,10 @@ static void test_segment_grazing_corner(void **state)
     assert_false(rfs_map_segment_legal(&m, 5 * r, 10 * r, 15 * r, 10 * r));
     assert_true(rfs_map_segment_legal(&m, 5 * r, 10 * r - 1, 15 * r, 10 * r - 1));
     /* Between two diagonal obstacles through their shared corner: blocked. */
-    rfs_map_bit_set(fb, stride, 10, 10, true);
-    rfs_map_bit_set(fb, stride, 21, 20, false);
-    rfs_map_bit_set(fb, stride, 20, 21, false);
-    assert_int_equal(rfs_map_init(&m, &cfg, W, H, r, 0, 0, fb, NULL, lb), 0);
+    rfs_map_bit_set(b->free, stride, 10, 10, true);
+    rfs_map_bit_set(b->free, stride, 21, 20, false);
+    rfs_map_bit_set(b->free, stride, 20, 21, false);
+    assert_int_equal(rfs_map_init(&m, &cfg, W, H, r, 0, 0, b->free, NULL, b->legal), 0);
     assert_false(rfs_map_segment_legal(&m, 20 * r + r / 2, 20 * r + r / 2, 21 * r + r / 2,
                                        21 * r + r / 2));
     /* The same move through a corner of four free cells: clear. */
@@ -431,22 +442,18 @@ static void test_walls_crossed(void **state)
     }
     assert_true(nonzero > 50);
 
-    static uint8_t fb[H * ((W + 7) / 8)];
-    static uint8_t wb[H * ((W + 7) / 8)];
-    static uint8_t lb[H * ((W + 7) / 8)];
-    memset(fb, 0xFF, sizeof(fb));
-    memset(wb, 0, sizeof(wb));
+    bits_t *b = all_free();
     uint16_t stride = (W + 7) / 8;
     for (int y = 0; y < H; y++) {
         /* Two walls: x = 10..11 (two cells thick, one run) and x = 30. */
-        rfs_map_bit_set(wb, stride, 10, (uint16_t)y, true);
-        rfs_map_bit_set(wb, stride, 11, (uint16_t)y, true);
-        rfs_map_bit_set(wb, stride, 30, (uint16_t)y, true);
+        rfs_map_bit_set(b->wall, stride, 10, (uint16_t)y, true);
+        rfs_map_bit_set(b->wall, stride, 11, (uint16_t)y, true);
+        rfs_map_bit_set(b->wall, stride, 30, (uint16_t)y, true);
     }
     rfs_map_t m;
     rfs_map_cfg_t cfg = rfs_map_cfg_default();
     const rfs_q16_t r = RFS_Q16_FRAC(1, 10);
-    assert_int_equal(rfs_map_init(&m, &cfg, W, H, r, 0, 0, fb, wb, lb), 0);
+    assert_int_equal(rfs_map_init(&m, &cfg, W, H, r, 0, 0, b->free, b->wall, b->legal), 0);
     assert_int_equal(rfs_map_walls_crossed(&m, 5 * r, 5 * r, 40 * r, 20 * r), 2);
     assert_int_equal(rfs_map_walls_crossed(&m, 40 * r, 20 * r, 5 * r, 5 * r), 2);
     assert_int_equal(rfs_map_walls_crossed(&m, 5 * r, 5 * r, 20 * r, 20 * r), 1);
@@ -455,19 +462,28 @@ static void test_walls_crossed(void **state)
     assert_int_equal(rfs_map_walls_crossed(&m, -RFS_Q16_INT(100), 5 * r, RFS_Q16_INT(100), 5 * r), 2);
 }
 
+/* Along one axis, lattice lines at o + g/2 + k g (k < n; o Q16.16, g metres): is line idx
+ * as near to p (Q16.16) as the nearest of all n, by brute force in double? */
+static int nearest_on_axis(rfs_q16_t p, rfs_q16_t o, double g, int n, int idx)
+{
+    double best = 1e30;
+    for (int k = 0; k < n; k++) {
+        best = fmin(best, fabs(((double)p - o) / 65536.0 - (g / 2 + k * g)));
+    }
+    return fabs(((double)p - o) / 65536.0 - (g / 2 + idx * g)) <= best + 1e-9;
+}
+
 /* Lattice: counts, positions and nearest points from the definitions in double. */
 static void test_lattice(void **state)
 {
     (void)state;
-    static uint8_t fb[H * ((W + 7) / 8)];
-    static uint8_t lb[H * ((W + 7) / 8)];
-    memset(fb, 0xFF, sizeof(fb));
+    bits_t *b = all_free();
     rfs_map_t m;
     rfs_map_cfg_t cfg = rfs_map_cfg_default();
     const rfs_q16_t r = RFS_Q16_FRAC(1, 10);
     const rfs_q16_t ox = -RFS_Q16_INT(3) - 12345;
     const rfs_q16_t oy = RFS_Q16_INT(7) + 999;
-    assert_int_equal(rfs_map_init(&m, &cfg, W, H, r, ox, oy, fb, NULL, lb), 0);
+    assert_int_equal(rfs_map_init(&m, &cfg, W, H, r, ox, oy, b->free, NULL, b->legal), 0);
     double g = cfg.grid / 65536.0;
     /* Points at g/2 + i*g strictly inside W*r and H*r metres. */
     int lw = 0;
@@ -494,20 +510,8 @@ static void test_lattice(void **state)
         rfs_map_lattice_nearest(&m, px, py, &i, &j);
         /* Reference: the nearest of all lattice points by brute force (ties are
          * measure-zero for random Q16 points; accept either side of a tie). */
-        double best = 1e30;
-        for (int a = 0; a < lw; a++) {
-            double d = fabs(((double)px - ox) / 65536.0 - (g / 2 + a * g));
-            best = fmin(best, d);
-        }
-        double got = fabs(((double)px - ox) / 65536.0 - (g / 2 + i * g));
-        assert_true(got <= best + 1e-9);
-        best = 1e30;
-        for (int b = 0; b < lh; b++) {
-            double d = fabs(((double)py - oy) / 65536.0 - (g / 2 + b * g));
-            best = fmin(best, d);
-        }
-        got = fabs(((double)py - oy) / 65536.0 - (g / 2 + j * g));
-        assert_true(got <= best + 1e-9);
+        assert_true(nearest_on_axis(px, ox, g, lw, i));
+        assert_true(nearest_on_axis(py, oy, g, lh, j));
     }
     /* Lattice legality = legality of the point; off the lattice is illegal. */
     rfs_map_lattice_point(&m, 0, 0, &x, &y);

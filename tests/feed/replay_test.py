@@ -20,7 +20,9 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
 import pcap_build  # noqa: E402
+from checks import check, exit_status  # noqa: E402
 
 FEED = sys.argv[1]
 SCEN = "scenarios/default.yaml"
@@ -28,13 +30,6 @@ SRC_MAC = bytes.fromhex("020000000001")
 OTHER = bytes.fromhex("020000000099")
 SOURCE_XY = (27.5, 10.0)
 T0 = 1700000000000000  # first pose, microseconds since the epoch
-fails = 0
-
-
-def check(name, ok, detail=""):
-    global fails
-    print(("PASS " if ok else "FAIL ") + name + ("" if ok else ": " + detail))
-    fails += 0 if ok else 1
 
 
 def pose_at(poses, t):
@@ -161,4 +156,4 @@ def main():
 
 
 main()
-sys.exit(1 if fails else 0)
+sys.exit(exit_status())

@@ -7,16 +7,7 @@
 # replay, the outputs are not trivial, and malformed streams fail cleanly on both sides.
 set -uo pipefail
 B=${1:-build}
-bin=$B/bin; elf=$B/firmware/qemu.elf
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-fails=0
-pass() { echo "PASS $1"; }
-fail() { echo "FAIL $1${2:+: $2}"; fails=$((fails + 1)); }
-qemu() { # qemu IN OUT -> exit status of the image
-    (cd "$tmp" && timeout 120 qemu-system-arm -M netduinoplus2 -nographic -monitor none \
-        -serial null -semihosting-config enable=on,target=native -kernel "$OLDPWD/$elf" \
-        -append "$1 $2")
-}
+. "$(dirname "$0")/../lib/fw_stream.sh"
 
 if ! "$bin/rfseek-record" scenarios/default.yaml -o "$tmp/in.rfsr" --live-out "$tmp/live.rfso" \
         --max-time 120 --drop 20:22 --bus-off 35:36 --reset 50 --fit-budget 2500 >"$tmp/record.txt"; then

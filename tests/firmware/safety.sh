@@ -7,16 +7,7 @@
 # both output streams are checked (and must be identical).
 set -uo pipefail
 B=${1:-build}
-bin=$B/bin; elf=$B/firmware/qemu.elf
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-fails=0
-pass() { echo "PASS $1"; }
-fail() { echo "FAIL $1${2:+: $2}"; fails=$((fails + 1)); }
-qemu() {
-    (cd "$tmp" && timeout 120 qemu-system-arm -M netduinoplus2 -nographic -monitor none \
-        -serial null -semihosting-config enable=on,target=native -kernel "$OLDPWD/$elf" \
-        -append "$1 $2")
-}
+. "$(dirname "$0")/../lib/fw_stream.sh"
 rec() { "$bin/rfseek-record" scenarios/default.yaml --max-time 100 -o "$tmp/$1.rfsr" "${@:2}" >/dev/null; }
 show() { "$bin/rfseek-replay" --print "$1"; }
 
@@ -29,10 +20,10 @@ pick() { # pick AFTER_US -> first t >= AFTER_US preceded by 6 moving steps
 }
 sec() { awk -v t="$1" -v d="${2:-0}" 'BEGIN { printf "%.6f", t / 1e6 + d }'; }
 
-# check NAME OUT_TXT KIND FAULT_US END_US STOP_US
+# check_stop NAME OUT_TXT KIND FAULT_US END_US STOP_US ALLOW_US FLAG
 #   every OUT in [STOP_US + allowed, END_US) has zero wheels, there is at least one, the
 #   robot moved in the 300 ms before FAULT_US, and moves again within 20 s after END_US.
-check() {
+check_stop() {
     local name=$1 txt=$2 kind=$3 t0=$4 t1=$5 stop=$6 allow=$7 flag=$8
     local r
     r=$(awk -v t0="$t0" -v t1="$t1" -v stop="$stop" -v allow="$allow" -v flag="$flag" '
@@ -82,7 +73,7 @@ run_case() {
     fi
     for side in host qemu; do
         show "$tmp/$name.$side" >"$tmp/$name.$side.txt"
-        check "$name ($side)" "$tmp/$name.$side.txt" "$kind" "$t0" "$t1" "$stop" "$allow" "$flag"
+        check_stop "$name ($side)" "$tmp/$name.$side.txt" "$kind" "$t0" "$t1" "$stop" "$allow" "$flag"
     done
 }
 

@@ -27,13 +27,36 @@ static void test_header_bytes_and_checks(void **state)
     assert_int_equal(rfs_replay_check_header(h, 8), -1);
 }
 
+/* A record of type TYPE at T_US (microseconds), every other field zero. */
+static rfs_replay_rec_t rec_at(rfs_replay_type_t type, int64_t t_us)
+{
+    rfs_replay_rec_t r;
+    memset(&r, 0, sizeof r);
+    r.type = type;
+    r.t_us = t_us;
+    return r;
+}
+
+/* R encodes to exactly the N bytes WANT (worked out by hand), and WANT parses back into
+ * *BACK as one whole record of R's type. */
+static void expect_exact_bytes(const rfs_replay_rec_t *r, const uint8_t *want, uint32_t n,
+                               rfs_replay_rec_t *back)
+{
+    uint8_t buf[RFS_REPLAY_MAX_RECORD];
+    uint32_t used = 0;
+
+    assert_int_equal(rfs_replay_encode(r, buf, sizeof buf), n);
+
+    assert_memory_equal(buf, want, n);
+    assert_int_equal(rfs_replay_parse(want, n, &used, back), RFS_REPLAY_OK);
+    assert_int_equal(used, n);
+    assert_int_equal(back->type, r->type);
+}
+
 static void test_pose_record_exact_bytes(void **state)
 {
     (void)state;
-    rfs_replay_rec_t r;
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_POSE;
-    r.t_us = 0x0102030405060708LL;
+    rfs_replay_rec_t r = rec_at(RFS_REPLAY_POSE, 0x0102030405060708LL);
     r.u.pose.t_us = -1;
     r.u.pose.x = 65536;    /* 1 m */
     r.u.pose.y = -65536;   /* -1 m */
@@ -44,16 +67,10 @@ static void test_pose_record_exact_bytes(void **state)
                               0x00, 0x00, 0x01, 0x00,
                               0x00, 0x00, 0xFF, 0xFF,
                               0x0F, 0xC9, 0x00, 0x00};
-    uint8_t buf[RFS_REPLAY_MAX_RECORD];
-
-    const uint32_t n = rfs_replay_encode(&r, buf, sizeof buf);
-
-    assert_int_equal(n, 30);
-    assert_memory_equal(buf, want, 30);
     rfs_replay_rec_t back;
-    uint32_t used = 0;
-    assert_int_equal(rfs_replay_parse(want, 30, &used, &back), RFS_REPLAY_OK);
-    assert_int_equal(used, 30);
+
+    expect_exact_bytes(&r, want, 30, &back);
+
     assert_int_equal(back.t_us, 0x0102030405060708LL);
     assert_int_equal(back.u.pose.t_us, -1);
     assert_int_equal(back.u.pose.x, 65536);
@@ -121,39 +138,32 @@ static void roundtrip(const rfs_replay_rec_t *r)
 static void test_every_type_round_trips(void **state)
 {
     (void)state;
-    rfs_replay_rec_t r;
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_CFG;
+    rfs_replay_rec_t r = rec_at(RFS_REPLAY_CFG, 0);
     r.u.cfg.seed = 0x1122334455667788ULL;
     r.u.cfg.target = 1;
     r.u.cfg.node = 9;
     r.u.cfg.fit_budget = 2500;
     roundtrip(&r);
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_MAP;
+    r = rec_at(RFS_REPLAY_MAP, 0);
     r.u.map.w = 350;
     r.u.map.h = 120;
     r.u.map.res = 6554;
     r.u.map.origin_x = -3 * 65536;
     r.u.map.has_wall = 1;
     roundtrip(&r);
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_MAP_WALL;
+    r = rec_at(RFS_REPLAY_MAP_WALL, 0);
     r.u.chunk.offset = 480;
     r.u.chunk.n = RFS_REPLAY_CHUNK;
     for (unsigned i = 0; i < RFS_REPLAY_CHUNK; i++) {
         r.u.chunk.bytes[i] = (uint8_t)(i * 7);
     }
     roundtrip(&r);
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_RSSI;
-    r.t_us = 123;
+    r = rec_at(RFS_REPLAY_RSSI, 123);
     r.u.rssi.t_us = 120;
     r.u.rssi.src = 1;
     r.u.rssi.dbm = -97;
     roundtrip(&r);
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_CAN;
+    r = rec_at(RFS_REPLAY_CAN, 0);
     r.u.can.id = 0x7FF;
     r.u.can.dlc = 8;
     r.u.can.data[7] = 0xAB;
@@ -170,8 +180,7 @@ static void test_every_type_round_trips(void **state)
     r.type = RFS_REPLAY_BUS;
     r.u.bus_off = 1;
     roundtrip(&r);
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_DECISION;
+    r = rec_at(RFS_REPLAY_DECISION, 0);
     r.u.out.decision.t_us = 99;
     r.u.out.decision.kind = RFS_SEEK_EPSILON;
     r.u.out.decision.prev = RFS_DRIVE_BLOCKED;
@@ -294,15 +303,13 @@ static void test_player_errors(void **state)
     rfs_replay_player_init(&p, &app, &cfg, sink, &out);
     assert_int_equal(out.n, 8);
     assert_memory_equal(out.b, "RFSR\x01\0\0\0", 8);
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_STEP;
+    r = rec_at(RFS_REPLAY_STEP, 0);
     assert_false(rfs_replay_play(&p, &r));
     assert_int_equal(p.error, RFS_REPLAY_E_NO_MAP);
     assert_false(rfs_replay_play(&p, &r)); /* stays stopped */
 
     rfs_replay_player_init(&p, &app, &cfg, sink, &out);
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_MAP;
+    r = rec_at(RFS_REPLAY_MAP, 0);
     r.u.map.w = 1000;
     r.u.map.h = 1000;
     r.u.map.res = 6554;
@@ -313,9 +320,7 @@ static void test_player_errors(void **state)
     r.u.map.w = 80; /* 10 bytes per row */
     r.u.map.h = 40; /* 400 bytes */
     assert_true(rfs_replay_play(&p, &r));
-    rfs_replay_rec_t c;
-    memset(&c, 0, sizeof c);
-    c.type = RFS_REPLAY_MAP_FREE;
+    rfs_replay_rec_t c = rec_at(RFS_REPLAY_MAP_FREE, 0);
     c.u.chunk.offset = 399;
     c.u.chunk.n = 2;
     assert_false(rfs_replay_play(&p, &c));
@@ -329,9 +334,7 @@ static void test_player_errors(void **state)
     assert_true(rfs_replay_play(&p, &c));
     c.u.chunk.offset = 200;
     assert_true(rfs_replay_play(&p, &c));
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_STEP;
-    r.t_us = 50000;
+    r = rec_at(RFS_REPLAY_STEP, 50000);
     out.n = 0;
     assert_true(rfs_replay_play(&p, &r));
     assert_true(p.started);
@@ -341,8 +344,7 @@ static void test_player_errors(void **state)
     assert_int_equal(out.b[18], 0x82);
     assert_int_equal(out.b[18 + 10], 0x00); /* id 0x100 LE */
     assert_int_equal(out.b[18 + 11], 0x01);
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_CFG;
+    r = rec_at(RFS_REPLAY_CFG, 0);
     assert_false(rfs_replay_play(&p, &r));
     assert_int_equal(p.error, RFS_REPLAY_E_ORDER);
 
@@ -356,23 +358,16 @@ static void test_player_errors(void **state)
 static void test_receiver_record_exact_bytes_and_lengths(void **state)
 {
     (void)state;
-    rfs_replay_rec_t r;
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_RECEIVER;
-    r.t_us = 0x0102030405060708LL;
+    rfs_replay_rec_t r = rec_at(RFS_REPLAY_RECEIVER, 0x0102030405060708LL);
     r.u.receiver_t_us = -2;
     const uint8_t want[18] = {0x13, 16,
                               0x08, 0x07, 0x06, 0x05, 0x04, 0x03, 0x02, 0x01,
                               0xFE, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
-    uint8_t buf[RFS_REPLAY_MAX_RECORD];
-
-    assert_int_equal(rfs_replay_encode(&r, buf, sizeof buf), 18);
-
-    assert_memory_equal(buf, want, 18);
     rfs_replay_rec_t back;
     uint32_t used = 0;
-    assert_int_equal(rfs_replay_parse(want, 18, &used, &back), RFS_REPLAY_OK);
-    assert_int_equal(used, 18);
+
+    expect_exact_bytes(&r, want, 18, &back);
+
     assert_int_equal(back.type, RFS_REPLAY_RECEIVER);
     assert_true(back.t_us == 0x0102030405060708LL);
     assert_true(back.u.receiver_t_us == -2);
@@ -397,15 +392,13 @@ static int play_dead_zone(bool heartbeat, rfs_replay_player_t *p, rfs_app_t *app
     const rfs_app_cfg_t cfg = rfs_app_cfg_default();
     rfs_replay_rec_t r;
     rfs_replay_player_init(p, app, &cfg, sink, out);
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_MAP;
+    r = rec_at(RFS_REPLAY_MAP, 0);
     r.u.map.w = 200;
     r.u.map.h = 100;
     r.u.map.res = 6554; /* 0.1 m */
     assert_true(rfs_replay_play(p, &r));
     for (uint32_t off = 0; off < 25u * 100u; off += RFS_REPLAY_CHUNK) {
-        memset(&r, 0, sizeof r);
-        r.type = RFS_REPLAY_MAP_FREE;
+        r = rec_at(RFS_REPLAY_MAP_FREE, 0);
         r.u.chunk.offset = off;
         r.u.chunk.n = (uint8_t)(2500u - off < RFS_REPLAY_CHUNK ? 2500u - off : RFS_REPLAY_CHUNK);
         for (uint32_t i = 0; i < r.u.chunk.n; i++) {
@@ -479,9 +472,7 @@ static void test_receiver_records_drive_through_a_dead_zone(void **state)
     /* A RECEIVER record before the map is an input before the map. */
     const rfs_app_cfg_t cfg = rfs_app_cfg_default();
     rfs_replay_player_init(&p, &app, &cfg, sink, &out);
-    rfs_replay_rec_t r;
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_RECEIVER;
+    rfs_replay_rec_t r = rec_at(RFS_REPLAY_RECEIVER, 0);
     assert_false(rfs_replay_play(&p, &r));
     assert_int_equal(p.error, RFS_REPLAY_E_NO_MAP);
 }

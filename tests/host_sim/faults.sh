@@ -10,9 +10,7 @@ SIM=${1:?usage: faults.sh path/to/rfseek-sim [seeds]}
 N=${2:-3}
 T=$(mktemp -d /tmp/rfs_faults.XXXXXX)
 trap 'rm -rf -- "$T"' EXIT
-fails=0
-pass() { echo "PASS $1"; }
-fail() { echo "FAIL $1${2:+: $2}"; fails=$((fails + 1)); }
+. "$(dirname "$0")/../lib/checks.sh"
 OPEN_MAP=$(realpath scenarios/maps/open.yaml)
 
 # --- every fault scenario, N seeds ------------------------------------------------------

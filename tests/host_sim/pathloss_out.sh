@@ -9,9 +9,7 @@ set -uo pipefail
 SIM=${1:?usage: pathloss_out.sh path/to/rfseek-sim}
 T=$(mktemp -d /tmp/rfs_plhost.XXXXXX)
 trap 'rm -rf -- "$T"' EXIT
-fails=0
-pass() { echo "PASS $1"; }
-fail() { echo "FAIL $1${2:+: $2}"; fails=$((fails + 1)); }
+. "$(dirname "$0")/../lib/checks.sh"
 
 # One pathloss run on the default office and one on the L-shaped floor, one ridge run.
 for r in "pl default.yaml --model pathloss --strategy meta-path" \

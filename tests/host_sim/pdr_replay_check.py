@@ -11,18 +11,15 @@ before the oldest frame in the window count by the share of that gap inside it.
 Retransmissions (same number) and fragments other than 0 give no value. Prints PASS/FAIL
 lines; exit 1 on a failure.
 """
+import os
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+from checks import check, exit_status  # noqa: E402
+
 cap, mac, samples, t0 = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
 W = 1_000_000
-fails = 0
-
-
-def check(name, ok, detail=""):
-    global fails
-    print(("PASS " if ok else "FAIL ") + name + ("" if ok else ": " + detail))
-    fails += 0 if ok else 1
 
 
 out = subprocess.run(["tshark", "-r", cap, "-Y", "wlan.sa == %s && radiotap.dbm_antsignal" % mac,
@@ -80,4 +77,4 @@ for (tg, vg), (tw, vw) in zip(got, want):
 check("values equal the recomputation from tshark", not bad and len(got) == len(want), "; ".join(bad[:4]))
 check("losses are seen (not 100 % throughout)", len({v for _, v in got}) >= 2 and min(v for _, v in got) < 100,
       str(got))
-sys.exit(1 if fails else 0)
+sys.exit(exit_status())

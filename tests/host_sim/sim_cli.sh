@@ -7,9 +7,7 @@ set -uo pipefail
 SIM=${1:?usage: sim_cli.sh path/to/rfseek-sim}
 T=$(mktemp -d /tmp/rfs_sim_cli.XXXXXX)
 trap 'rm -rf -- "$T"' EXIT
-fails=0
-pass() { echo "PASS $1"; }
-fail() { echo "FAIL $1${2:+: $2}"; fails=$((fails + 1)); }
+. "$(dirname "$0")/../lib/checks.sh"
 OPEN_MAP=$(realpath scenarios/maps/open.yaml)
 
 # bad NAME EXPECTED-TEXT ARGS...: exit 1, exactly one stderr line containing the text, and

@@ -11,9 +11,7 @@ map=scenarios/maps/office.yaml
 w=$(mktemp -d /tmp/rfs_status_est.XXXXXX)
 ns=rfsplh$$
 trap 'ip netns del "$ns" 2>/dev/null; rm -rf -- "$w"' EXIT
-fails=0
-pass() { echo "PASS $1"; }
-fail() { echo "FAIL $1"; fails=$((fails + 1)); }
+. "$(dirname "$0")/../lib/checks.sh"
 if ! ip netns add "$ns" 2>/dev/null; then
     echo "SKIP status_est: cannot create a network namespace (needs root)"
     exit 0

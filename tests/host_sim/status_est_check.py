@@ -12,8 +12,12 @@ decision with a relearn the model maximum (the goal the seeker chose) within 1.5
 estimated source (the model is flat within 1 m of it). With "none": no status carries an
 estimate and the fields are zero. Prints PASS/FAIL lines; exits 1 on failure.
 """
+import os
 import struct
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+from checks import check, exit_status  # noqa: E402
 
 
 def events(path):
@@ -69,19 +73,12 @@ def main(argv):
     except (OSError, ValueError, struct.error, UnicodeDecodeError) as e:
         print("FAIL status_decode: %s" % e)
         return 1
-    fails = 0
-
-    def check(name, ok, why=""):
-        nonlocal fails
-        print("%s %s%s" % ("PASS" if ok else "FAIL", name, "" if ok else ": " + why))
-        fails += 0 if ok else 1
-
     check("status_count", len(st) > 100, "%d statuses" % len(st))
     est_keys = ["est_x", "est_y", "est_n", "est_w", "est_p0", "est_rms", "est_area"]
     if not want:
         bad = [m for m in st if m["est_valid"] or any(m[k] != 0.0 for k in est_keys)]
         check("no_estimate", not bad, str(bad[:1]))
-        return 1 if fails else 0
+        return exit_status()
     first = next((i for i, m in enumerate(st) if m["decided"] and m["model_updated"]), None)
     check("a_relearn", first is not None)
     if first is None:
@@ -104,7 +101,7 @@ def main(argv):
     print("last estimate: (%.3f, %.3f) n %.3f W %.2f dB P0 %.2f rms %.2f dB area %.1f m^2"
           % (last["est_x"], last["est_y"], last["est_n"], last["est_w"], last["est_p0"],
              last["est_rms"], last["est_area"]))
-    return 1 if fails else 0
+    return exit_status()
 
 
 if __name__ == "__main__":

@@ -6,8 +6,7 @@ set -u
 sim=${1:?usage: strategy_cli.sh path/to/rfseek-sim}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fails=0
-check() { if eval "$2"; then echo "PASS $1"; else echo "FAIL $1"; fails=$((fails + 1)); fi; }
+. "$(dirname "$0")/../lib/checks.sh"
 
 "$sim" scenarios/default.yaml --seed 1 --strategy gradient >"$tmp/o" 2>"$tmp/e"
 rc=$?

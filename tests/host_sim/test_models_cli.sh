@@ -10,8 +10,8 @@ feed=$b/feed/asan/rfseek-feed
 [ -x "$feed" ] || feed=$b/bin/rfseek-feed
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fails=0
-check() { if eval "$2"; then echo "PASS $1"; else echo "FAIL $1"; fails=$((fails + 1)); fi; }
+. "$(dirname "$0")/../lib/checks.sh"
+. "$(dirname "$0")/../lib/qemu.sh"
 one_line() { [ "$(wc -l <"$1")" -eq 1 ] && grep -q "$2" "$1"; }
 field() { /usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])" "$1" "$2"; }
 
@@ -108,10 +108,7 @@ check feed-target-needs-pose '[ $? -eq 2 ] && one_line "$tmp/e" "only go with --
 check feed-target-pdr-two-sources '[ $? -eq 2 ] && one_line "$tmp/e" "^rfseek-feed: --target: pdr needs exactly 1 source" && [ ! -e "$tmp/no4" ]'
 
 # --- firmware: the model by configuration (CFG record), on the host and the Cortex-M4 -----
-qemu() { # qemu DIR IN OUT: the emulator image plays DIR/IN into DIR/OUT; console on stdout
-    (cd "$1" && timeout 300 qemu-system-arm -M netduinoplus2 -nographic -monitor none -serial null \
-        -semihosting-config enable=on,target=native -kernel "$OLDPWD/$b/firmware/qemu.elf" -append "$2 $3")
-}
+qemu() { qemu_play "$b/firmware/qemu.elf" "$@" 300; } # qemu DIR IN OUT; console on stdout
 rec=$b/bin/rfseek-record rpl=$b/bin/rfseek-replay
 "$rec" scenarios/default.yaml -o "$tmp/mlp.rfsr" --live-out "$tmp/mlp-live.rfso" --max-time 60 \
     --fit-budget 2500 --model mlp >/dev/null 2>"$tmp/e"

@@ -8,31 +8,30 @@ maps=${RFS_MAPS_DIR:-/work/shared/data/maps}
 bad=tests/data/maps_bad
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fails=0
-check() { if [ "$2" = 0 ]; then echo "PASS $1"; else echo "FAIL $1"; fails=$((fails + 1)); fi; }
+. "$(dirname "$0")/../lib/checks.sh"
 
-"$bin" --help | grep -q '^usage: rfseek-map'; check help $?
+"$bin" --help | grep -q '^usage: rfseek-map'; check_rc help $?
 
 out=$("$bin" "$maps/intel.yaml" --res 0.1 --pgm "$tmp/intel.pgm")
 rc=$?
-check intel-exit $rc
-echo "$out" | grep -q 'image cells  free 192948, occupied 29942, unknown 113509'; check intel-counts $?
-echo "$out" | grep -q 'core cells   free 192948, wall 29942,'; check intel-core-counts $?
-echo "$out" | grep -q "core bytes   $((581 * ((579 + 7) / 8))) per bit grid"; check intel-bytes $?
-head -c 100 "$tmp/intel.pgm" | grep -aq '^579 581$'; check intel-pgm-header $?
-[ ! -e "$tmp/intel.pgm.tmp" ]; check intel-pgm-no-temp $?
+check_rc intel-exit $rc
+echo "$out" | grep -q 'image cells  free 192948, occupied 29942, unknown 113509'; check_rc intel-counts $?
+echo "$out" | grep -q 'core cells   free 192948, wall 29942,'; check_rc intel-core-counts $?
+echo "$out" | grep -q "core bytes   $((581 * ((579 + 7) / 8))) per bit grid"; check_rc intel-bytes $?
+head -c 100 "$tmp/intel.pgm" | grep -aq '^579 581$'; check_rc intel-pgm-header $?
+[ ! -e "$tmp/intel.pgm.tmp" ]; check_rc intel-pgm-no-temp $?
 size=$(stat -c %s "$tmp/intel.pgm"); hdr=$(head -c 100 "$tmp/intel.pgm" | grep -ac '')
-[ $((size - 579 * 581)) -gt 0 ] && [ $((size - 579 * 581)) -lt 120 ]; check intel-pgm-size $?
+[ $((size - 579 * 581)) -gt 0 ] && [ $((size - 579 * 581)) -lt 120 ]; check_rc intel-pgm-size $?
 
 # Bad input: one line naming the file, exit 1; bad options exit 2.
 err=$("$bin" "$bad/res_zero.yaml" 2>&1 >/dev/null); rc=$?
-[ $rc = 1 ] && [ "$(echo "$err" | wc -l)" = 1 ] && echo "$err" | grep -q "res_zero.yaml: resolution: must be > 0"; check bad-res $?
+[ $rc = 1 ] && [ "$(echo "$err" | wc -l)" = 1 ] && echo "$err" | grep -q "res_zero.yaml: resolution: must be > 0"; check_rc bad-res $?
 err=$("$bin" "$bad/image_truncated.yaml" 2>&1 >/dev/null); rc=$?
-[ $rc = 1 ] && [ "$(echo "$err" | wc -l)" = 1 ] && echo "$err" | grep -q "truncated.pgm: truncated"; check bad-pgm $?
+[ $rc = 1 ] && [ "$(echo "$err" | wc -l)" = 1 ] && echo "$err" | grep -q "truncated.pgm: truncated"; check_rc bad-pgm $?
 err=$("$bin" "$bad/ok.yaml" --res abc 2>&1 >/dev/null); rc=$?
-[ $rc = 2 ] && echo "$err" | grep -q -- "--res: a non-negative number"; check bad-option $?
+[ $rc = 2 ] && echo "$err" | grep -q -- "--res: a non-negative number"; check_rc bad-option $?
 err=$("$bin" 2>&1 >/dev/null); rc=$?
-[ $rc = 2 ]; check no-map $?
+[ $rc = 2 ]; check_rc no-map $?
 "$bin" "$bad/thresh_order.yaml" --pgm "$tmp/no.pgm" >/dev/null 2>&1
-[ ! -e "$tmp/no.pgm" ] && [ ! -e "$tmp/no.pgm.tmp" ]; check bad-no-output $?
+[ ! -e "$tmp/no.pgm" ] && [ ! -e "$tmp/no.pgm.tmp" ]; check_rc bad-no-output $?
 [ $fails = 0 ]

@@ -16,25 +16,21 @@ heartbeat keeps the stream fresh. Checks (counted from log.tsv, times from this 
   other without heartbeat: none; the three runs agree on every decision up to 10 s.
 """
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "feed"))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
 import pcap_build  # noqa: E402
+from checks import check, exit_status  # noqa: E402
 
 FEED = sys.argv[1]
 SCEN = "scenarios/default.yaml"
 SRC = bytes.fromhex("020000000001")
 OTHER = bytes.fromhex("020000000099")
 T0 = 1700000000000000
-fails = 0
-
-
-def check(name, ok, detail=""):
-    global fails
-    print(("PASS " if ok else "FAIL ") + name + ("" if ok else ": " + detail))
-    fails += 0 if ok else 1
 
 
 def capture(path, other):
@@ -56,6 +52,13 @@ def decisions(out):
 
 def main():
     tmp = tempfile.mkdtemp(prefix="rfs_feed_hb_")
+    try:
+        return run(tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def run(tmp):
     with open(os.path.join(tmp, "poses.csv"), "w") as f:
         f.write("t_us,x_m,y_m,theta_rad\n")
         for k in range(601):
@@ -90,7 +93,7 @@ def main():
           str(late["other-off"]))
     check("the three runs agree up to 10 s (%d decisions)" % len(early["other"]),
           len(early["other"]) >= 1 and early["other"] == early["quiet"] == early["other-off"], str(early))
-    return 1 if fails else 0
+    return exit_status()
 
 
 if __name__ == "__main__":

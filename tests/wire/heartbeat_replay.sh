@@ -14,16 +14,7 @@
 #   - a bad --heartbeat value is one error line, exit status non-zero, no recording.
 set -uo pipefail
 B=${1:?usage: heartbeat_replay.sh BUILD}
-bin=$B/bin; elf=$B/firmware/qemu.elf
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-fails=0
-pass() { echo "PASS $1"; }
-fail() { echo "FAIL $1${2:+: $2}"; fails=$((fails + 1)); }
-qemu() {
-    (cd "$tmp" && timeout 120 qemu-system-arm -M netduinoplus2 -nographic -monitor none \
-        -serial null -semihosting-config enable=on,target=native -kernel "$OLDPWD/$elf" \
-        -append "$1 $2" 2> "$2.err")
-}
+. "$(dirname "$0")/../lib/fw_stream.sh"
 sed -e "s|^map: maps/office.yaml|map: $PWD/scenarios/maps/office.yaml|" \
     -e 's|^  shadowing:.*|  shadowing: {enabled: false}|' -e 's|^  fading:.*|  fading: {enabled: false}|' \
     -e 's|^  noise:.*|  noise: {enabled: false}|' \
@@ -63,7 +54,7 @@ d_off=$("$bin/rfseek-replay" --print "$tmp/off.live" | grep -c '^DECISION')
     && pass "dead zone: without the heartbeat 0 moving steps, with it $m_on of 2400 and $d_on decisions" \
     || fail "dead zone drives only with the heartbeat" "off: $m_off moving, $d_off decisions; on: $m_on, $d_on"
 for m in can record; do
-    if qemu $m.rfsr $m.qemu && cmp -s "$tmp/$m.host" "$tmp/$m.qemu"; then
+    if qemu $m.rfsr $m.qemu 2> "$tmp/$m.qemu.err" && cmp -s "$tmp/$m.host" "$tmp/$m.qemu"; then
         pass "heartbeat $m: Cortex-M4 (qemu) output equals the host's ($(stat -c %s "$tmp/$m.qemu") bytes)"
     else
         fail "heartbeat $m: Cortex-M4 (qemu) output equals the host's"

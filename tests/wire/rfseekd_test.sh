@@ -9,9 +9,7 @@ d=$build/bin/rfseekd tool=$build/tests/wire/lcm_tool
 map=scenarios/maps/office.yaml
 w=$build/tests/wire/rfseekd
 rm -rf "$w" && mkdir -p "$w"
-fails=0
-pass() { echo "PASS $1"; }
-fail() { echo "FAIL $1"; fails=$((fails + 1)); }
+. "$(dirname "$0")/../lib/checks.sh"
 # expect_err NAME WANT_RC PATTERN ARGS...: one error line matching PATTERN, that exit code
 expect_err() {
     local name=$1 want=$2 pat=$3; shift 3

@@ -11,6 +11,8 @@
  * path planning, drive control. Then each phase alone on the same data. Last, an epsilon
  * decision that must plan round a wall: meta-path's geodesic draw (up to six plans), the
  * same without it, and the paper's, on the same map with one interior wall (geo_decision).
+ * Then the paper's greedy decision next to that wall, whose line search plans every legal
+ * candidate until one plans (ls_decision), and the same beside a closed room.
  */
 #include <stdint.h>
 #include <string.h>
@@ -257,6 +259,256 @@ static void geo_decision(const rfs_app_map_t *map, bool meta_path, bool geodesic
                       min_detour == INT64_MAX ? 0u : (uint32_t)((min_detour * 100) >> 16));
     }
     rfs_bc_report(row->ridge_n, 0, s_app.ridge.n_used);
+}
+
+/* The paper's greedy decision behind a wall (RFS_SEEK_META; rfs_seek.c choose_greedy):
+ * the grid search's maximum, the point 1 m towards it, and when that point is illegal a
+ * line search at the map resolution along the line to the maximum, alternating at random
+ * between in front of the step point and beyond it, planning (go_to) every legal
+ * candidate until one plans; the maximum itself last. Only a plan that fails lets the
+ * search go on, so its cost is the failed plans plus the one that succeeds. */
+#define LS_ROOM_NORTH 119u /* cells: a room's north wall, rows 119 and 120 (y 14.875 .. 15.125 m) */
+#define LS_ROOM_EAST 286u  /* cells: its east wall, columns 286 and 287 (x 35.75 .. 36 m) */
+
+/* A closed room north of the interior wall (its door shut when the map was made): walls
+ * along y = 15 m from the west wall to x = 36 m and from there down to the interior
+ * wall's east end, so the room's 141 x 17 legal lattice points are unreachable and the
+ * north strip above it is reached only through the 4 m gap at the east end. */
+static void ls_room(void)
+{
+    for (uint16_t y = GEO_WALL_ROW + 2u; y <= LS_ROOM_NORTH + 1u; y++) {
+        for (uint16_t x = 0; x < GEO_WALL_END; x++) {
+            const bool wall = y >= LS_ROOM_NORTH || x >= LS_ROOM_EAST;
+            if (wall) {
+                rfs_map_bit_set(s_wall, MAP_STRIDE, x, y, true);
+                rfs_map_bit_set(s_free, MAP_STRIDE, x, y, false);
+            }
+        }
+    }
+}
+
+/* 10,000 samples inside 4.9 m of (cx, cy) cm with y <= ymax cm (the robot's side of the
+ * wall); the field rises northwards, +1 dB per metre, and westwards, +0.25 dB per metre
+ * (so the maximum over the reachable lattice is its north-west corner, (0.625, 19.375) m,
+ * nearly straight north of a robot near the west wall), +-1 dB noise. */
+static void fill_store_north(rfs_store_t *st, uint64_t seed, int32_t cx, int32_t cy, int32_t ymax)
+{
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, seed);
+    while (st->count < RFS_APP_MAX_SAMPLES) {
+        const int32_t dx = (int32_t)rfs_rng_below(&rng, 981u) - 490; /* cm */
+        const int32_t dy = (int32_t)rfs_rng_below(&rng, 981u) - 490;
+        if (dx * dx + dy * dy > 490 * 490 || cx + dx < 30 || cy + dy > ymax) {
+            continue;
+        }
+        const rfs_sample_t smp = {.x_cm = (int16_t)(cx + dx), .y_cm = (int16_t)(cy + dy),
+                                  .v_q6 = (int16_t)((-60 * 64) + (dy * 64) / 100 - (dx * 16) / 100 +
+                                                    (int32_t)rfs_rng_below(&rng, 128u) - 64)};
+        rfs_store_offer(st, smp, &rng);
+    }
+}
+
+/* What the replay of one greedy decision found. */
+typedef struct ls_replay_out {
+    uint32_t plans;        /* rfs_plan_path calls */
+    uint32_t failed;       /* of which returned false */
+    uint32_t expanded;     /* lattice points expanded by all of them */
+    uint32_t candidates;   /* line-search points looked at (legal or not) */
+    bool line_search;      /* the step point was illegal or did not plan */
+    bool ok;               /* a goal planned */
+    rfs_q16_t gx, gy;      /* the goal kept, metres Q16.16 */
+    rfs_q16_t path;        /* its path length, metres Q16.16 */
+} ls_replay_out_t;
+
+/* One plan of the replay, counted. */
+static bool ls_plan(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, ls_replay_out_t *o)
+{
+    rfs_path_t path;
+    o->plans++;
+    const bool ok = rfs_plan_path(&s->plan, s->pose.x, s->pose.y, gx, gy, &path);
+    o->expanded += s->plan.expanded;
+    if (!ok) {
+        o->failed++;
+        return false;
+    }
+    o->ok = true;
+    o->gx = gx;
+    o->gy = gy;
+    o->path = path.length;
+    return true;
+}
+
+/* An independent count of the plans of that decision: choose_greedy's step and line
+ * search replayed from a copy of the random source taken just before the step, from
+ * the robot's pose (legal here, so plan_to plans from it unsnapped) to the maximum the
+ * decision reports (its grid search is not random): the epsilon coin (finish_decision),
+ * then the step point and per line-search index k one coin for the side taken first.
+ * Scaling: as choose_greedy's: t (Q16 fraction of the way, 0 < t <= 1) times the offset
+ * to the maximum (a Q16 difference, |.| < 2^32) stays below 2^48 in int64; dt = res /
+ * distance (Q16), at least 1. */
+static void ls_replay(rfs_seek_t *s, rfs_rng_t rng, rfs_q16_t mx, rfs_q16_t my, ls_replay_out_t *o)
+{
+    const rfs_map_t *m = s->map;
+    const rfs_q16_t x0 = s->pose.x, y0 = s->pose.y;
+    memset(o, 0, sizeof *o);
+    (void)rfs_rng_u32(&rng);
+    const int64_t dx = (int64_t)mx - x0, dy = (int64_t)my - y0;
+    const rfs_q16_t dist = rfs_q16_dist(x0, y0, mx, my);
+    if (dist <= s->cfg.step) {
+        (void)ls_plan(s, mx, my, o);
+        return;
+    }
+    const rfs_q16_t t_step = rfs_q16_div(s->cfg.step, dist);
+    rfs_q16_t gx = rfs_sat32(x0 + ((dx * t_step) >> 16));
+    rfs_q16_t gy = rfs_sat32(y0 + ((dy * t_step) >> 16));
+    if (rfs_map_point_legal(m, gx, gy) && ls_plan(s, gx, gy, o)) {
+        return;
+    }
+    o->line_search = true;
+    rfs_q16_t dt = rfs_q16_div(m->res, dist);
+    dt = dt <= 0 ? 1 : dt;
+    for (int32_t k = 1; k < 65536; ++k) {
+        bool any = false;
+        const bool beyond_first = (rfs_rng_u32(&rng) & 1u) != 0u;
+        for (int side = 0; side < 2; ++side) {
+            const bool beyond = (side == 0) == beyond_first;
+            const int64_t t = (int64_t)t_step + (beyond ? (int64_t)k * dt : -(int64_t)k * dt);
+            if (t <= 0 || t > RFS_Q16_ONE) {
+                continue;
+            }
+            any = true;
+            o->candidates++;
+            gx = rfs_sat32(x0 + ((dx * t) >> 16));
+            gy = rfs_sat32(y0 + ((dy * t) >> 16));
+            if (rfs_map_point_legal(m, gx, gy) && ls_plan(s, gx, gy, o)) {
+                return;
+            }
+        }
+        if (!any) {
+            break;
+        }
+    }
+    (void)ls_plan(s, mx, my, o);
+}
+
+/* Row names of one ls_decision (bench.sh prints them in this order). */
+typedef struct ls_rows {
+    const char *period;      /* instructions of the measured period */
+    const char *stack;       /* its stack depth, bytes */
+    const char *greedy;      /* 1: it relearnt and decided a greedy goal by the line search */
+    const char *plans;       /* paths planned (ls_replay) */
+    const char *failed;      /* of which failed */
+    const char *expanded;    /* lattice points all of them expanded */
+    const char *candidates;  /* line-search points looked at */
+    const char *goal_ok;     /* 1: the replay kept the decision's goal (and planned, as it did) */
+    const char *path_cm;     /* kept path, cm */
+    const char *ridge_n;     /* samples the relearn used */
+} ls_rows_t;
+
+/* One greedy decision of the paper's configuration (epsilon forced to 0 so the greedy
+ * branch is certain, as for worst_iteration) with the robot at (rx, ry): fresh init on
+ * the map as it stands, the store on the robot's side of the wall, a boot period (not
+ * measured), the model discarded, and the next period measured: relearn on 10,000
+ * samples + the greedy decision. */
+static void ls_decision(const rfs_app_map_t *map, rfs_q16_t rx, rfs_q16_t ry, const ls_rows_t *row,
+                        rfs_q16_t *gx, rfs_q16_t *gy)
+{
+    rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.seek.eps_amp = 0;
+    cfg.seek.eps_floor = 0;
+    if (rfs_app_init(&s_app, &cfg, map) != 0) {
+        rfs_sh_puts("bench: rfs_app_init failed on the walled map\n");
+        rfs_sh_exit(1);
+    }
+    fill_store_north(&s_app.seek.store, 44u, (int32_t)((rx * 100) >> 16),
+                     (int32_t)((ry * 100) >> 16), 960);
+    int64_t t = 1000000;
+    const rfs_pose_t p0 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
+    rfs_app_on_pose(&s_app, &p0, t);
+    rfs_app_on_rssi(&s_app, 0, t, -60, t);
+    rfs_app_out_t out;
+    rfs_app_step(&s_app, t, &out);
+    rfs_drive_stop(&s_app.seek.drive, t);
+    s_app.seek.model.ops->reset(s_app.seek.model.self);
+    t += RFS_APP_PERIOD_US;
+    const rfs_pose_t p1 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
+    rfs_app_on_pose(&s_app, &p1, t);
+    rfs_app_on_rssi(&s_app, 0, t, -60, t);
+    const rfs_rng_t rng0 = s_app.rng;
+    const uintptr_t sp0 = rfs_bc_stack_paint();
+    RFS_BC_MEASURE(row->period, 1, rfs_app_step(&s_app, t, &out));
+    rfs_bc_report(row->stack, 0, rfs_bc_stack_depth(sp0));
+    rfs_bc_report(row->greedy, 0,
+                  (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_GREEDY &&
+                             out.decision.relearned && out.decision.line_search &&
+                             rfs_map_point_legal(&s_app.map, rx, ry)));
+    ls_replay_out_t o;
+    ls_replay(&s_app.seek, rng0, out.decision.max_x, out.decision.max_y, &o);
+    rfs_bc_report(row->plans, 0, o.plans);
+    rfs_bc_report(row->failed, 0, o.failed);
+    rfs_bc_report(row->expanded, 0, o.expanded);
+    rfs_bc_report(row->candidates, 0, o.candidates);
+    rfs_bc_report(row->goal_ok, 0,
+                  (uint32_t)(o.ok && o.line_search && (out.faults & RFS_SEEK_FAULT_NO_GOAL) == 0u &&
+                             o.gx == out.decision.goal_x && o.gy == out.decision.goal_y &&
+                             o.path == out.decision.path_len));
+    rfs_bc_report(row->path_cm, 0, (uint32_t)((out.decision.path_len * 100) >> 16));
+    rfs_bc_report(row->ridge_n, 0, s_app.ridge.n_used);
+    *gx = out.decision.goal_x;
+    *gy = out.decision.goal_y;
+}
+
+/* The line-search rows, after every other (a function of its own, so main's code and
+ * with it the rows measured inside main stay as they were). */
+static void __attribute__((noinline)) ls_measure(const rfs_app_map_t *map)
+{
+    rfs_q16_t gx, gy;
+    /* The paper's greedy decision next to that wall (ls_decision). The robot at
+     * (1.125, 9.25) m, 0.375 m short of the wall's clearance zone (y 9.625 .. 10.375 m);
+     * the maximum at the north-west corner, so the 1 m step point (y ~10.25 m) lies in
+     * the zone and the line search runs: its first legal candidate beyond the zone is
+     * two indices out, in front of the step point five, so it plans round the wall. */
+    static const ls_rows_t ls_wall = {
+        "worst_greedy_ls_wall", "stack_bytes_worst_greedy_ls_wall", "worst_greedy_ls_wall_greedy",
+        "worst_greedy_ls_wall_plans", "worst_greedy_ls_wall_failed",
+        "worst_greedy_ls_wall_expanded", "worst_greedy_ls_wall_candidates",
+        "worst_greedy_ls_wall_replay_goal_ok", "worst_greedy_ls_wall_path_cm",
+        "worst_greedy_ls_wall_ridge_samples"};
+    ls_decision(map, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(37, 4), &ls_wall, &gx, &gy);
+    /* The worst constructed: a closed room north of the wall (ls_room). From
+     * (1.125, 9.5) m, at the edge of the clearance zone, the step point (y ~10.5 m) is
+     * legal, in the room: it and the room's candidates plan and fail until the search
+     * in front of the step point reaches the robot's side, 0.12 m ahead. The next
+     * decision, from that goal (in the last 0.005 m before the zone), finds no legal
+     * candidate in front but the robot's own point (index 8, t = t_step - 8 dt = 1 by
+     * rounding): the room candidates beyond plan and fail until then, and the goal is a
+     * null move, decided again every second (rfs_seek.c end_decision). */
+    ls_room();
+    static const ls_rows_t ls_room_first = {
+        "worst_greedy_ls_room_first", "stack_bytes_worst_greedy_ls_room_first",
+        "worst_greedy_ls_room_first_greedy", "worst_greedy_ls_room_first_plans",
+        "worst_greedy_ls_room_first_failed", "worst_greedy_ls_room_first_expanded",
+        "worst_greedy_ls_room_first_candidates", "worst_greedy_ls_room_first_replay_goal_ok",
+        "worst_greedy_ls_room_first_path_cm", "worst_greedy_ls_room_first_ridge_samples"};
+    static const ls_rows_t ls_room_next = {
+        "worst_greedy_ls_room", "stack_bytes_worst_greedy_ls_room", "worst_greedy_ls_room_greedy",
+        "worst_greedy_ls_room_plans", "worst_greedy_ls_room_failed",
+        "worst_greedy_ls_room_expanded", "worst_greedy_ls_room_candidates",
+        "worst_greedy_ls_room_replay_goal_ok", "worst_greedy_ls_room_path_cm",
+        "worst_greedy_ls_room_ridge_samples"};
+    ls_decision(map, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(19, 2), &ls_room_first, &gx, &gy);
+    ls_decision(map, gx, gy, &ls_room_next, &gx, &gy);
+    /* The same from (1.125, 9.6) m, 2 cm short of that goal (the drive stops within
+     * 0.1 m of it): there index 8 in front gives t = 0 (skipped), so no candidate in
+     * front is legal, and every room candidate beyond plans and fails until the north
+     * strip's first one plans round both walls. */
+    static const ls_rows_t ls_room_worst = {
+        "worst_greedy_ls_room_worst", "stack_bytes_worst_greedy_ls_room_worst",
+        "worst_greedy_ls_room_worst_greedy", "worst_greedy_ls_room_worst_plans",
+        "worst_greedy_ls_room_worst_failed", "worst_greedy_ls_room_worst_expanded",
+        "worst_greedy_ls_room_worst_candidates", "worst_greedy_ls_room_worst_replay_goal_ok",
+        "worst_greedy_ls_room_worst_path_cm", "worst_greedy_ls_room_worst_ridge_samples"};
+    ls_decision(map, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(48, 5), &ls_room_worst, &gx, &gy);
 }
 
 int main(void)
@@ -547,5 +799,7 @@ int main(void)
     rfs_bc_report("plan_behind_wall_ok", 0, geo_ok ? 1u : 0u);
     rfs_bc_report("plan_behind_wall_expanded", 0, s_app.seek.plan.expanded);
     rfs_bc_report("plan_behind_wall_path_cm", 0, (uint32_t)((path.length * 100) >> 16));
+
+    ls_measure(&map);
     rfs_sh_exit(0);
 }

@@ -253,6 +253,16 @@ static void pull(puller_t *pl, rfs_q16_t x, rfs_q16_t y)
     pl->has_last = true;
 }
 
+void rfs_plan_set_component(rfs_plan_t *p, const uint8_t *bits)
+{
+    p->component = bits;
+}
+
+static bool component_bit(const uint8_t *bits, uint32_t idx)
+{
+    return ((bits[idx >> 3] >> (idx & 7u)) & 1u) != 0u;
+}
+
 bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1,
                    rfs_path_t *out)
 {
@@ -275,6 +285,10 @@ bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_
     uint32_t g_idx;
     if (!connect(m, x1, y1, false, &g_idx) || !connect(m, x0, y0, true, &s_idx)) {
         return false;
+    }
+    if (p->component != 0 && component_bit(p->component, s_idx) &&
+        !component_bit(p->component, g_idx)) {
+        return false; /* different components: the search cannot succeed */
     }
     if (!search(p, s_idx, g_idx)) {
         return false;

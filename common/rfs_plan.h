@@ -38,6 +38,10 @@ typedef struct rfs_plan {
     bool exact_edges;       ///< false (init): lattice points and edges from the map's
                             ///< step patterns where it has them; true: positions and
                             ///< rfs_map_segment_legal always (the tests' reference)
+    const uint8_t *component; ///< optional (NULL at init): one bit per lattice point
+                            ///< (index j * lw + i, bit i & 7 of byte i >> 3), a union of
+                            ///< whole connected components of the lattice graph
+                            ///< (rfs_plan_set_component)
 } rfs_plan_t;
 
 /// A planned path: waypoints in order, the last one the goal itself.
@@ -58,5 +62,15 @@ int rfs_plan_init(rfs_plan_t *p, const rfs_map_t *map, uint8_t *work, uint32_t w
 /// RFS_PLAN_MAX_WAYPOINTS waypoints (both counted as unreachable; out->n is then 0).
 bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1,
                    rfs_path_t *out);
+
+/// Tell the planner which lattice points are known to be connected: `bits` (NULL: none)
+/// holds one bit per lattice point and must be a union of whole components of the lattice
+/// graph (8 neighbours, an edge where the segment between the points is legal: the graph
+/// the search walks), e.g. a flood fill from the robot, or every legal point. A plan whose
+/// start joins the lattice at a marked point and whose goal joins it at an unmarked one
+/// then fails at once: the search would flood the goal's whole component and fail (a
+/// closed room can cost a million instructions on a Cortex-M4). Results are unchanged;
+/// the caller keeps the array valid while set.
+void rfs_plan_set_component(rfs_plan_t *p, const uint8_t *bits);
 
 #endif /* RFS_PLAN_H */

@@ -125,6 +125,10 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
     s->queue_cap = mem->plan_queue_cap;
     memset(s->visited, 0, lbytes);
     memset(s->reach, 0, lbytes);
+    /* The reach bits are the robot's component (or every legal point, or none): a plan to
+     * a goal outside it fails without flooding the goal's side (line searches and epsilon
+     * draws next to a closed room, docs/PERFORMANCE.md). */
+    rfs_plan_set_component(&s->plan, s->reach);
     /* Epsilon weights e^(-d), d = grid * sqrt(q) for q = di^2 + dj^2 (section 2:
      * P(x) proportional to e^(-|x - x0|)), tabulated once so a draw costs a lookup per
      * candidate (offset_dist). */

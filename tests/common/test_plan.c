@@ -281,6 +281,111 @@ static void test_unreachable(void **state)
     assert_true(len > 4.0 + 0.5 && len < 4.0 + 2 * 1.6 + 0.5);
 }
 
+/* Reference component: breadth-first flood over the lattice from (si, sj) with the
+ * reference legality (double precision), one bit per point as rfs_plan_set_component
+ * takes it. */
+static uint8_t comp_bits[LMAX / 8];
+static int comp_queue[LMAX];
+
+static void ref_component(int lw, int lh, int si, int sj)
+{
+    double g = (double)wd.m.cfg.grid;
+    memset(comp_bits, 0, sizeof comp_bits);
+    int head = 0, tail = 0;
+    comp_queue[tail++] = sj * lw + si;
+    comp_bits[(sj * lw + si) >> 3] |= (uint8_t)(1u << ((sj * lw + si) & 7));
+    while (head < tail) {
+        int u = comp_queue[head++], ui = u % lw, uj = u / lw;
+        for (int dj = -1; dj <= 1; dj++) {
+            for (int di = -1; di <= 1; di++) {
+                int vi = ui + di, vj = uj + dj, v = vj * lw + vi;
+                if ((di == 0 && dj == 0) || vi < 0 || vj < 0 || vi >= lw || vj >= lh ||
+                    (comp_bits[v >> 3] >> (v & 7) & 1) || !legal_lattice(vi, vj) ||
+                    !ref_seg(g / 2 + ui * g, g / 2 + uj * g, g / 2 + vi * g, g / 2 + vj * g)) {
+                    continue;
+                }
+                comp_bits[v >> 3] |= (uint8_t)(1u << (v & 7));
+                comp_queue[tail++] = v;
+            }
+        }
+    }
+}
+
+/* rfs_plan_set_component: with the start's component (from the reference flood) plans are
+ * bit-identical to plans without it, and a goal outside it fails at once (no point
+ * expanded) where the plain search floods the goal's side first. */
+static void test_component(void **state)
+{
+    (void)state;
+    int skipped = 0, same = 0, other = 0;
+    for (uint32_t s = 1; s <= 6; s++) {
+        build(s * 7919u, 14, 1); /* a closed room on every map: unreachable goals */
+        int lw = wd.m.lw, lh = wd.m.lh;
+        double g = (double)wd.m.cfg.grid;
+        rfs_plan_t a, b;
+        static uint8_t work_b[LMAX];
+        static uint32_t queue_b[1024];
+        assert_int_equal(rfs_plan_init(&a, &wd.m, work, sizeof(work), queue, 1024), 0);
+        assert_int_equal(rfs_plan_init(&b, &wd.m, work_b, sizeof(work_b), queue_b, 1024), 0);
+        assert_null(b.component);
+        uint32_t seed = s;
+        for (int k = 0; k < 40; k++) {
+            int si, sj, gi, gj;
+            do {
+                si = (int)(lcg(&seed) % (uint32_t)lw);
+                sj = (int)(lcg(&seed) % (uint32_t)lh);
+            } while (!legal_lattice(si, sj));
+            do {
+                gi = (int)(lcg(&seed) % (uint32_t)lw);
+                gj = (int)(lcg(&seed) % (uint32_t)lh);
+            } while (!legal_lattice(gi, gj));
+            ref_component(lw, lh, si, sj);
+            rfs_plan_set_component(&b, comp_bits);
+            rfs_q16_t x0 = (rfs_q16_t)(g / 2 + si * g), y0 = (rfs_q16_t)(g / 2 + sj * g);
+            rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi * g), y1 = (rfs_q16_t)(g / 2 + gj * g);
+            rfs_path_t pa, pb;
+            bool oka = rfs_plan_path(&a, x0, y0, x1, y1, &pa);
+            bool okb = rfs_plan_path(&b, x0, y0, x1, y1, &pb);
+            uint32_t exp_a = a.expanded, exp_b = b.expanded;
+            assert_int_equal(oka, okb);
+            assert_int_equal(pa.n, pb.n);
+            assert_int_equal(pa.length, pb.length);
+            assert_memory_equal(pa.x, pb.x, pa.n * sizeof(pa.x[0]));
+            assert_memory_equal(pa.y, pb.y, pa.n * sizeof(pa.y[0]));
+            /* Marks that are a union of components but not the start's (the closed
+             * room's): nothing may be refused, results the same. */
+            int ri = 34, rj = 10;
+            while (!legal_lattice(ri, rj) && ++ri <= 38) {
+            }
+            assert_true(ri <= 38); /* inside the room, 8..10 m x 2..4 m */
+            ref_component(lw, lh, ri, rj);
+            if (!(comp_bits[(sj * lw + si) >> 3] >> ((sj * lw + si) & 7) & 1)) {
+                rfs_path_t pc;
+                bool okc = rfs_plan_path(&b, x0, y0, x1, y1, &pc);
+                assert_int_equal(oka, okc);
+                assert_int_equal(pa.n, pc.n);
+                assert_int_equal(pa.length, pc.length);
+                other += oka;
+            }
+            ref_component(lw, lh, si, sj);
+            int gin = comp_bits[(gj * lw + gi) >> 3] >> ((gj * lw + gi) & 7) & 1;
+            if (!gin) {
+                assert_false(oka); /* outside the start's component: unreachable */
+                if (!ref_seg(x0, y0, x1, y1)) {
+                    assert_int_equal(exp_b, 0); /* refused without a search */
+                    assert_true(exp_a > 0);
+                    skipped++;
+                }
+            } else {
+                same++;
+            }
+        }
+    }
+    print_message("goals in the start's component %d, refused without a search %d, planned "
+                  "with another component marked %d\n", same, skipped, other);
+    assert_true(skipped >= 20 && same >= 100 && other >= 100);
+}
+
 /* A queue too small for the wavefront is reported (as unreachable), never overrun. */
 static void test_queue_overflow(void **state)
 {
@@ -338,6 +443,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_random_maps),
         cmocka_unit_test(test_unreachable),
+        cmocka_unit_test(test_component),
         cmocka_unit_test(test_queue_overflow),
         cmocka_unit_test(test_line_of_sight),
         cmocka_unit_test(test_init_rejects),

@@ -195,6 +195,15 @@ static int legal_lattice(int i, int j)
     return wd.legal_c[(int)floor(y / RES)][(int)floor(x / RES)];
 }
 
+/* A legal lattice point drawn uniformly (by rejection) from the seeded generator. */
+static void random_legal(uint32_t *seed, int lw, int lh, int *i, int *j)
+{
+    do {
+        *i = (int)(lcg(seed) % (uint32_t)lw);
+        *j = (int)(lcg(seed) % (uint32_t)lh);
+    } while (!legal_lattice(*i, *j));
+}
+
 static void run_random_pairs(uint32_t seed, int pairs, int *n_reach, int *n_unreach, double *worst)
 {
     rfs_plan_t p;
@@ -204,14 +213,8 @@ static void run_random_pairs(uint32_t seed, int pairs, int *n_reach, int *n_unre
     double g = (double)wd.m.cfg.grid;
     for (int k = 0; k < pairs; k++) {
         int si, sj, gi, gj;
-        do {
-            si = (int)(lcg(&seed) % (uint32_t)lw);
-            sj = (int)(lcg(&seed) % (uint32_t)lh);
-        } while (!legal_lattice(si, sj));
-        do {
-            gi = (int)(lcg(&seed) % (uint32_t)lw);
-            gj = (int)(lcg(&seed) % (uint32_t)lh);
-        } while (!legal_lattice(gi, gj));
+        random_legal(&seed, lw, lh, &si, &sj);
+        random_legal(&seed, lw, lh, &gi, &gj);
         double want = ref_dijkstra(lw, lh, si, sj, gi, gj);
         rfs_path_t path;
         rfs_q16_t x0 = (rfs_q16_t)(g / 2 + si * g), y0 = (rfs_q16_t)(g / 2 + sj * g);
@@ -331,14 +334,8 @@ static void test_component(void **state)
         uint32_t seed = s;
         for (int k = 0; k < 40; k++) {
             int si, sj, gi, gj;
-            do {
-                si = (int)(lcg(&seed) % (uint32_t)lw);
-                sj = (int)(lcg(&seed) % (uint32_t)lh);
-            } while (!legal_lattice(si, sj));
-            do {
-                gi = (int)(lcg(&seed) % (uint32_t)lw);
-                gj = (int)(lcg(&seed) % (uint32_t)lh);
-            } while (!legal_lattice(gi, gj));
+            random_legal(&seed, lw, lh, &si, &sj);
+            random_legal(&seed, lw, lh, &gi, &gj);
             ref_component(lw, lh, si, sj);
             rfs_plan_set_component(&b, comp_bits);
             rfs_q16_t x0 = (rfs_q16_t)(g / 2 + si * g), y0 = (rfs_q16_t)(g / 2 + sj * g);

@@ -12,12 +12,12 @@ mkdir -p "$OUT"
 rm -rf -- "$OUT/run"
 "$SIM" scenarios/default.yaml --seed "$SEED" --field --out "$OUT/run" >/dev/null
 /usr/bin/python3 scripts/plot_run.py "$OUT/run" --outdir "$OUT"
-echo "demo: $(grep -E '"(reached|distance_travelled_m|shortest_path_m|model_updates)"' "$OUT/run/summary.json" | tr -d ' \n')"
+echo "demo (the paper's meta + ridge, seed $SEED): $(grep -E '"(reached|distance_travelled_m|shortest_path_m|model_updates)"' "$OUT/run/summary.json" | tr -d ' \n')"
 echo "demo: figures in $OUT: trajectory.png rssi.png hexbin.png"
 mkdir -p "$OUT/pathloss"
 rm -rf -- "$OUT/pathloss/run"
 "$SIM" scenarios/default.yaml --seed "$SEED" --model pathloss --strategy meta-path \
     --out "$OUT/pathloss/run" >/dev/null
 /usr/bin/python3 scripts/plot_run.py "$OUT/pathloss/run" --outdir "$OUT/pathloss"
-echo "demo (pathloss): $(grep -E '"(reached|distance_travelled_m|shortest_path_m|est_error_m|est_area_m2)"' "$OUT/pathloss/run/summary.json" | tr -d ' \n')"
+echo "demo (meta-path + pathloss, seed $SEED): $(grep -E '"(reached|distance_travelled_m|shortest_path_m|est_error_m|est_area_m2)"' "$OUT/pathloss/run/summary.json" | tr -d ' \n')"
 echo "demo: figures in $OUT/pathloss: trajectory.png rssi.png residual.png"

@@ -17,6 +17,8 @@
 
 #include <string.h>
 
+#include "rfs_assert.h"
+
 /* The map extent is limited to 2^30 Q16 units (16384 m) per axis so that coordinates
  * relative to the origin fit in 31 bits and the traversal's products fit in int64. */
 #define MAP_EXTENT_MAX ((int64_t)1 << 30)
@@ -417,6 +419,7 @@ static void derive_steps(rfs_map_t *m)
 bool rfs_map_lattice_step_legal(const rfs_map_t *m, uint16_t i, uint16_t j, int32_t di,
                                 int32_t dj)
 {
+    RFS_ASSERT(di >= -1 && di <= 1 && dj >= -1 && dj <= 1);
     int32_t ti = (int32_t)i + di;
     int32_t tj = (int32_t)j + dj;
     if (i >= m->lw || j >= m->lh || ti < 0 || tj < 0 || ti >= (int32_t)m->lw ||

@@ -286,8 +286,8 @@ bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_
     if (!connect(m, x1, y1, false, &g_idx) || !connect(m, x0, y0, true, &s_idx)) {
         return false;
     }
-    if (p->component != 0 && component_bit(p->component, s_idx) &&
-        !component_bit(p->component, g_idx)) {
+    if (p->component != 0 &&
+        component_bit(p->component, s_idx) != component_bit(p->component, g_idx)) {
         return false; /* different components: the search cannot succeed */
     }
     if (!search(p, s_idx, g_idx)) {

@@ -39,8 +39,8 @@ typedef struct rfs_plan {
                             ///< step patterns where it has them; true: positions and
                             ///< rfs_map_segment_legal always (the tests' reference)
     const uint8_t *component; ///< optional (NULL at init): one bit per lattice point
-                            ///< (index j * lw + i, bit i & 7 of byte i >> 3), a union of
-                            ///< whole connected components of the lattice graph
+                            ///< (idx = j * lw + i: bit idx & 7 of byte idx >> 3), a union
+                            ///< of whole connected components of the lattice graph
                             ///< (rfs_plan_set_component)
 } rfs_plan_t;
 
@@ -67,10 +67,10 @@ bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_
 /// holds one bit per lattice point and must be a union of whole components of the lattice
 /// graph (8 neighbours, an edge where the segment between the points is legal: the graph
 /// the search walks), e.g. a flood fill from the robot, or every legal point. A plan whose
-/// start joins the lattice at a marked point and whose goal joins it at an unmarked one
-/// then fails at once: the search would flood the goal's whole component and fail (a
-/// closed room can cost a million instructions on a Cortex-M4). Results are unchanged;
-/// the caller keeps the array valid while set.
+/// start and goal join the lattice at points of which exactly one is marked then fails at
+/// once: they lie in different components, and the search would flood the goal's whole
+/// component and fail (a closed room can cost a million instructions on a Cortex-M4).
+/// Results are unchanged; the caller keeps the array valid while set.
 void rfs_plan_set_component(rfs_plan_t *p, const uint8_t *bits);
 
 #endif /* RFS_PLAN_H */

@@ -272,9 +272,10 @@ static bool snap_legal(const rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y, bool need_
     return false;
 }
 
-/* Flood-fill the lattice points reachable from the robot (8-connected, an edge where
- * the straight segment is legal: rfs_map_lattice_step_legal), so that greedy maxima and epsilon goals never lie in
- * a pocket of the map the robot cannot reach (SLAM maps have many). */
+/* Flood-fill the lattice points reachable from the robot (8-connected, an edge where the
+ * straight segment is legal: rfs_map_lattice_step_legal), so that greedy maxima and
+ * epsilon goals never lie in a pocket of the map the robot cannot reach (SLAM maps have
+ * many). */
 static void compute_reach(rfs_seek_t *s)
 {
     const rfs_map_t *m = s->map;

@@ -26,6 +26,13 @@ static int fail(char *err, size_t errlen, const char *file, const char *fmt, ...
         vsnprintf(msg, sizeof(msg), fmt, ap);
         va_end(ap);
         snprintf(err, errlen, "%s: %s", file, msg);
+        /* One line whatever the input: a file name or value from the YAML can hold line
+         * breaks (a folded flow scalar); control characters are shown as '?'. */
+        for (char *c = err; *c != '\0'; ++c) {
+            if ((unsigned char)*c < 0x20u || *c == 0x7f) {
+                *c = '?';
+            }
+        }
     }
     return -1;
 }

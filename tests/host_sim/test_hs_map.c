@@ -156,6 +156,8 @@ static void test_bad_input(void **state)
         {BAD "yaw.yaml", BAD "yaw.yaml", "yaw 0.5 unsupported"},
         {BAD "origin_short.yaml", BAD "origin_short.yaml", "origin: a list of three numbers"},
         {BAD "missing_free.yaml", BAD "missing_free.yaml", "missing key 'free_thresh'"},
+        /* line breaks in the image name (found by fuzz_map): still one line, shown as '?' */
+        {BAD "image_newline.yaml", BAD "nothere??folded.pgm", "cannot open"},
     };
     for (size_t k = 0; k < sizeof(t) / sizeof(t[0]); k++) {
         hs_map_t m;

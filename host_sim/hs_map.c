@@ -14,6 +14,8 @@
 
 #include <yaml.h>
 
+#include "hs_err.h"
+
 /* Largest image accepted: 2^28 pixels (16384 x 16384). */
 #define HS_MAP_MAX_PIXELS (1u << 28)
 
@@ -26,13 +28,7 @@ static int fail(char *err, size_t errlen, const char *file, const char *fmt, ...
         vsnprintf(msg, sizeof(msg), fmt, ap);
         va_end(ap);
         snprintf(err, errlen, "%s: %s", file, msg);
-        /* One line whatever the input: a file name or value from the YAML can hold line
-         * breaks (a folded flow scalar); control characters are shown as '?'. */
-        for (char *c = err; *c != '\0'; ++c) {
-            if ((unsigned char)*c < 0x20u || *c == 0x7f) {
-                *c = '?';
-            }
-        }
+        hs_err_one_line(err); /* a file name from the YAML can hold line breaks */
     }
     return -1;
 }

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <yaml.h>
 
+#include "hs_err.h"
 #include "rfs_models.h"
 
 typedef struct pctx {
@@ -31,6 +32,7 @@ static int fail(pctx_t *p, const yaml_node_t *n, const char *fmt, ...)
     } else {
         snprintf(p->err, p->errlen, "%s: %s", p->file, msg);
     }
+    hs_err_one_line(p->err); /* a key or value from the YAML can hold line breaks */
     return -1;
 }
 

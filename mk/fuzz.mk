@@ -20,11 +20,13 @@ $(FUZZ_DIR)/fuzz_can: tests/fuzz/fuzz_can.c $(CORE_SRCS) $(FUZZ_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(CORE_SRCS) -o $@
 
-$(FUZZ_DIR)/fuzz_map: tests/fuzz/fuzz_map.c host_sim/hs_map.c $(CORE_SRCS) $(FUZZ_HDRS)
+FUZZ_MAP_SRCS := host_sim/hs_map.c host_sim/hs_err.c
+$(FUZZ_DIR)/fuzz_map: tests/fuzz/fuzz_map.c $(FUZZ_MAP_SRCS) $(CORE_SRCS) $(FUZZ_HDRS)
 	@mkdir -p $(@D)
-	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< host_sim/hs_map.c $(CORE_SRCS) -o $@ $(FUZZ_YAML_LIBS) -lm
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_MAP_SRCS) $(CORE_SRCS) -o $@ $(FUZZ_YAML_LIBS) -lm
 
-FUZZ_SCN_SRCS := host_sim/hs_scenario.c host_sim/hs_radio.c host_sim/hs_motor.c $(wildcard host_sim/hs_faults.c)
+FUZZ_SCN_SRCS := host_sim/hs_scenario.c host_sim/hs_err.c host_sim/hs_radio.c host_sim/hs_motor.c \
+    $(wildcard host_sim/hs_faults.c)
 $(FUZZ_DIR)/fuzz_scenario: tests/fuzz/fuzz_scenario.c $(FUZZ_SCN_SRCS) $(CORE_SRCS) $(FUZZ_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_SCN_SRCS) $(CORE_SRCS) -o $@ $(FUZZ_YAML_LIBS) -lm

@@ -149,6 +149,8 @@ static void test_scenario_bad(void **state)
                "radio:\n  fading: {enabled: true, doppler: 3}\n",
                ":6: radio.fading: unknown key 'doppler'");
     expect_bad("dup.yaml", "map: @MAP@\nseed: 1\nseed: 2\n", "duplicate key 'seed'");
+    /* A quoted key with a line break (found beside fuzz_map's image name): still one line. */
+    expect_bad("newline_key.yaml", "map: @MAP@\n\"bad\\nkey\": 1\n", "unknown key 'bad?key'");
     expect_bad("nomap.yaml", "seed: 1\n", "map: missing");
     expect_bad("badnum.yaml",
                "map: @MAP@\nsources:\n  - position: [15, ten]\nstart: {position: [5, 10]}\n",

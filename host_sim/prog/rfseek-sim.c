@@ -18,6 +18,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "hs_err.h"
 #include "hs_pcap.h"
 #include "hs_sim.h"
 
@@ -59,9 +60,10 @@ static void usage(FILE *f)
 
 static int die(const char *fmt, const char *a, const char *b)
 {
-    fprintf(stderr, "%s: ", prog);
-    fprintf(stderr, fmt, a, b);
-    fputc('\n', stderr);
+    char msg[1024];
+    snprintf(msg, sizeof msg, fmt, a, b);
+    hs_err_one_line(msg); /* an option's value can hold a line break */
+    fprintf(stderr, "%s: %s\n", prog, msg);
     return 1;
 }
 

@@ -46,6 +46,9 @@ bad malformed_scenario "syntax.yaml:2: YAML syntax error" "$T/syntax.yaml" --out
 scn unknown.yaml "${BASE}colour: red
 "
 bad unknown_key "unknown.yaml:5: scenario: unknown key 'colour'" "$T/unknown.yaml" --out "$T/out"
+# An option value with a line break still gives one line (shown as '?').
+scn good.yaml "$BASE"
+bad strategy_newline "--strategy: unknown 'a?b'" "$T/good.yaml" --strategy $'a\nb' --out "$T/out"
 printf '%s' "$BASE" | sed "s|@MAP@|$T/nomap/map.yaml|" >"$T/nomap.yaml"
 bad missing_map "nomap.yaml: map: $T/nomap/map.yaml" "$T/nomap.yaml" --out "$T/out"
 mkdir -p "$T/badmap"

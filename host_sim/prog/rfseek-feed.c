@@ -23,6 +23,7 @@
 #include <unistd.h>
 
 #include "hs_ctrl.h"
+#include "hs_err.h"
 #include "hs_pcap.h"
 #include "hs_radiotap.h"
 #include "hs_scenario.h"
@@ -690,6 +691,16 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
     return rc;
 }
 
+/* An option error with the offending value: one line on stderr even when the value holds
+ * a line break (shown as '?'). fmt has one %s. */
+static void opt_err(const char *fmt, const char *v)
+{
+    char msg[512];
+    snprintf(msg, sizeof msg, fmt, v);
+    hs_err_one_line(msg);
+    fprintf(stderr, "rfseek-feed: %s\n", msg);
+}
+
 int main(int argc, char **argv)
 {
     const char *output = NULL;
@@ -722,13 +733,13 @@ int main(int argc, char **argv)
                     return 2;
                 }
                 if (parse_mac(v, macs[n_macs]) != 0) {
-                    fprintf(stderr, "rfseek-feed: --mac: '%s' is not a MAC address (aa:bb:cc:dd:ee:ff)\n", v);
+                    opt_err("--mac: '%s' is not a MAC address (aa:bb:cc:dd:ee:ff)", v);
                     return 2;
                 }
                 n_macs++;
             } else if (strcmp(a, "--format") == 0) {
                 if (strcmp(v, "tsv") != 0) {
-                    fprintf(stderr, "rfseek-feed: --format: '%s' is not supported (tsv)\n", v);
+                    opt_err("--format: '%s' is not supported (tsv)", v);
                     return 2;
                 }
             } else if (strcmp(a, "--output") == 0) {
@@ -741,13 +752,13 @@ int main(int argc, char **argv)
                 ro.out = v;
             } else if (strcmp(a, "--model") == 0) {
                 if (rfs_models_lookup(v) == NULL) {
-                    fprintf(stderr, "rfseek-feed: --model: unknown '%s' (ridge, mlp, knn, radius, pathloss)\n", v);
+                    opt_err("--model: unknown '%s' (ridge, mlp, knn, radius, pathloss)", v);
                     return 2;
                 }
                 ro.model = v;
             } else if (strcmp(a, "--target") == 0) {
                 if (strcmp(v, "rssi") != 0 && strcmp(v, "pdr") != 0) {
-                    fprintf(stderr, "rfseek-feed: --target: unknown '%s' (rssi, pdr)\n", v);
+                    opt_err("--target: unknown '%s' (rssi, pdr)", v);
                     return 2;
                 }
                 ro.target = v;
@@ -756,7 +767,7 @@ int main(int argc, char **argv)
                 errno = 0;
                 ro.seed = strtoull(v, &e, 10);
                 if (e == v || *e != '\0' || errno != 0 || v[0] == '-') {
-                    fprintf(stderr, "rfseek-feed: --seed: '%s' is not a non-negative integer\n", v);
+                    opt_err("--seed: '%s' is not a non-negative integer", v);
                     return 2;
                 }
                 ro.has_seed = true;
@@ -766,7 +777,7 @@ int main(int argc, char **argv)
         } else if (strcmp(a, "--live") == 0) {
             live = true;
         } else if (a[0] == '-' && a[1] != '\0') {
-            fprintf(stderr, "rfseek-feed: unknown option '%s' (see --help)\n", a);
+            opt_err("unknown option '%s' (see --help)", a);
             return 2;
         } else if (ro.capture == NULL) {
             ro.capture = a;

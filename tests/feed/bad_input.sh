@@ -16,6 +16,8 @@ expect() {
     local lines; lines=$(grep -c . "$tmp/err")
     if grep -qE 'Sanitizer|runtime error' "$tmp/err"; then
         echo "FAIL $name: sanitizer report"; head -5 "$tmp/err"; fail=1
+    elif [ "$rc" -ne 0 ] && [ "$lines" -ne 1 ]; then
+        echo "FAIL $name: $lines stderr lines, want one"; head -3 "$tmp/err"; fail=1
     elif [ "$rc" -ne "$want_rc" ]; then
         echo "FAIL $name: exit $rc, want $want_rc"; head -3 "$tmp/err"; fail=1
     elif ! grep -qE -- "$re" "$tmp/err"; then
@@ -49,6 +51,7 @@ expect bad_mac_hex 2 "--mac: '02:aa:bb:cc:00:0g' is not a MAC address" -- "$gen/
 expect bad_format 2 "--format: 'csv' is not supported" -- "$gen/ds.pcap" --mac $mac --format csv
 expect unknown_option 2 "unknown option '--frobnicate'" -- "$gen/ds.pcap" --mac $mac --frobnicate
 expect mac_missing_value 2 "--mac needs a value" -- "$gen/ds.pcap" --mac
+expect seed_newline 2 "--seed: '1\\?2' is not a non-negative integer" -- "$gen/ds.pcap" --mac $mac --pose x --seed $'1\n2'
 "$feed" --help | grep -q '^usage: rfseek-feed CAPTURE --mac MAC' && echo "PASS help" || { echo "FAIL help"; fail=1; }
 # --output: written through a temporary file, nothing left behind on failure
 "$feed" "$gen/ds.pcap" --mac $mac --output "$tmp/ok.tsv" && [ "$(wc -l < "$tmp/ok.tsv")" -eq 80 ] && [ ! -e "$tmp/ok.tsv.tmp" ] \

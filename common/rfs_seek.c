@@ -497,11 +497,6 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     return false;
 }
 
-static bool reach_bit(const uint8_t *bits, uint32_t idx)
-{
-    return (bits[idx >> 3] >> (idx & 7u)) & 1u;
-}
-
 /* Full scan: row by row, in chunks, so that a model with predict_row costs one call per
  * chunk and the lattice coordinates advance by addition. The paper's greedy step takes
  * the argmax of the model over the reachable points (section 2); a point where the model
@@ -526,7 +521,7 @@ static bool grid_max_scan(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
             rfs_q16_t cx0 = x0 + (rfs_q16_t)i0 * m->cfg.grid;
             bool any = false;
             for (uint16_t k = 0; k < n && !any; ++k) {
-                any = reach_bit(s->reach, base + i0 + k);
+                any = bit_get(s->reach, base + i0 + k);
             }
             if (!any) {
                 continue;
@@ -538,7 +533,7 @@ static bool grid_max_scan(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my)
             }
             for (uint16_t k = 0; k < n; ++k) {
                 rfs_q16_t v;
-                if (!reach_bit(s->reach, base + i0 + k)) {
+                if (!bit_get(s->reach, base + i0 + k)) {
                     continue;
                 }
                 if (have_row) {
@@ -564,7 +559,7 @@ static int32_t first_set(const uint8_t *b, uint32_t from, uint32_t to)
 {
     uint32_t i = from;
     for (; i < to && (i & 7u) != 0u; ++i) {
-        if (reach_bit(b, i)) {
+        if (bit_get(b, i)) {
             return (int32_t)i;
         }
     }
@@ -575,7 +570,7 @@ static int32_t first_set(const uint8_t *b, uint32_t from, uint32_t to)
         }
     }
     for (; i < to; ++i) {
-        if (reach_bit(b, i)) {
+        if (bit_get(b, i)) {
             return (int32_t)i;
         }
     }
@@ -588,7 +583,7 @@ static int32_t last_set(const uint8_t *b, uint32_t from, uint32_t to)
     uint32_t i = to;
     while (i > from && (i & 7u) != 0u) {
         --i;
-        if (reach_bit(b, i)) {
+        if (bit_get(b, i)) {
             return (int32_t)i;
         }
     }
@@ -601,7 +596,7 @@ static int32_t last_set(const uint8_t *b, uint32_t from, uint32_t to)
     }
     while (i > from) {
         --i;
-        if (reach_bit(b, i)) {
+        if (bit_get(b, i)) {
             return (int32_t)i;
         }
     }
@@ -636,7 +631,7 @@ static bool grid_max_rows(const rfs_seek_t *s, int dir, rfs_q16_t *mx, rfs_q16_t
         if (dir > 0) {
             for (int32_t i = pick - 1; i >= first; --i) {
                 rfs_q16_t w;
-                if (!reach_bit(s->reach, base + (uint32_t)i)) {
+                if (!bit_get(s->reach, base + (uint32_t)i)) {
                     continue;
                 }
                 if (!ops->predict(s->model.self, x0 + (rfs_q16_t)i * m->cfg.grid, py, &w) ||
@@ -783,7 +778,7 @@ static void bb_leaf(grid_bb_t *bb, const grid_node_t *nd, uint32_t rmask)
         }
         for (uint16_t i = nd->i0; i < nd->i0 + nd->w; ++i) {
             rfs_q16_t v;
-            if (!reach_bit(s->reach, base + i)) {
+            if (!bit_get(s->reach, base + i)) {
                 continue;
             }
             if (ops->predict_row != 0) {

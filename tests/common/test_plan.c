@@ -284,34 +284,21 @@ static void test_unreachable(void **state)
     assert_true(len > 4.0 + 0.5 && len < 4.0 + 2 * 1.6 + 0.5);
 }
 
-/* Reference component: breadth-first flood over the lattice from (si, sj) with the
- * reference legality (double precision), one bit per point as rfs_plan_set_component
+/* Reference component (double precision), one bit per point as rfs_plan_set_component
  * takes it. */
 static uint8_t comp_bits[LMAX / 8];
-static int comp_queue[LMAX];
+
+static int ref_step(void *ctx, int ui, int uj, int vi, int vj)
+{
+    (void)ctx;
+    double g = (double)wd.m.cfg.grid;
+    return legal_lattice(vi, vj) &&
+           ref_seg(g / 2 + ui * g, g / 2 + uj * g, g / 2 + vi * g, g / 2 + vj * g);
+}
 
 static void ref_component(int lw, int lh, int si, int sj)
 {
-    double g = (double)wd.m.cfg.grid;
-    memset(comp_bits, 0, sizeof comp_bits);
-    int head = 0, tail = 0;
-    comp_queue[tail++] = sj * lw + si;
-    comp_bits[(sj * lw + si) >> 3] |= (uint8_t)(1u << ((sj * lw + si) & 7));
-    while (head < tail) {
-        int u = comp_queue[head++], ui = u % lw, uj = u / lw;
-        for (int dj = -1; dj <= 1; dj++) {
-            for (int di = -1; di <= 1; di++) {
-                int vi = ui + di, vj = uj + dj, v = vj * lw + vi;
-                if ((di == 0 && dj == 0) || vi < 0 || vj < 0 || vi >= lw || vj >= lh ||
-                    (comp_bits[v >> 3] >> (v & 7) & 1) || !legal_lattice(vi, vj) ||
-                    !ref_seg(g / 2 + ui * g, g / 2 + uj * g, g / 2 + vi * g, g / 2 + vj * g)) {
-                    continue;
-                }
-                comp_bits[v >> 3] |= (uint8_t)(1u << (v & 7));
-                comp_queue[tail++] = v;
-            }
-        }
-    }
+    ref_flood(lw, lh, si, sj, ref_step, NULL, comp_bits);
 }
 
 /* rfs_plan_set_component: with the start's component (from the reference flood) plans are

@@ -551,30 +551,10 @@ static int bit_of(const uint8_t *bits, int v)
     return (bits[v >> 3] >> (v & 7)) & 1;
 }
 
-/* Breadth-first flood from (si, sj) with the reference legality. */
-static void ref_flood(const rfs_map_t *m, int si, int sj, uint8_t *bits)
+static int ref_map_step(void *ctx, int ui, int uj, int vi, int vj)
 {
-    int lw = m->lw, lh = m->lh, n = lw * lh, h = 0, t = 0;
-    int *q = malloc(sizeof(int) * (size_t)n);
-    memset(bits, 0, (size_t)(n + 7) / 8);
-    q[t++] = sj * lw + si;
-    bits[(sj * lw + si) >> 3] |= (uint8_t)(1u << ((sj * lw + si) & 7));
-    while (h < t) {
-        int u = q[h++], ui = u % lw, uj = u / lw;
-        for (int dj = -1; dj <= 1; dj++) {
-            for (int di = -1; di <= 1; di++) {
-                int vi = ui + di, vj = uj + dj, v = vj * lw + vi;
-                if ((di == 0 && dj == 0) || vi < 0 || vj < 0 || vi >= lw || vj >= lh ||
-                    bit_of(bits, v) || !ref_lat_legal(m, vi, vj) ||
-                    !ref_step_legal(m, ui, uj, vi, vj)) {
-                    continue;
-                }
-                bits[v >> 3] |= (uint8_t)(1u << (v & 7));
-                q[t++] = v;
-            }
-        }
-    }
-    free(q);
+    const rfs_map_t *m = ctx;
+    return ref_lat_legal(m, vi, vj) && ref_step_legal(m, ui, uj, vi, vj);
 }
 
 /* A speckled 8 x 6 m map (2.5 % of the cells occupied, no clearance: many small pockets)
@@ -626,7 +606,7 @@ static void reach_case(uint32_t seed, double res, bool small_queue, int *in_comp
     rfs_seek_on_rssi(&t.seek, 0, 100000, -50, &t.rng);
     rfs_seek_step(&t.seek, 100000, &t.rng, &out);
     uint8_t *ref = calloc(t.mem.reach_bytes, 1);
-    ref_flood(&t.map, si, sj, ref);
+    ref_flood(t.map.lw, t.map.lh, si, sj, ref_map_step, &t.map, ref);
     for (int j = 0; j < t.map.lh; j++) {
         for (int i = 0; i < t.map.lw; i++) {
             int v = j * t.map.lw + i;

@@ -206,18 +206,20 @@ typedef struct geo_rows {
     const char *ridge_n;     /* samples the relearn used (all 10,000 inside the 5 m radius) */
 } geo_rows_t;
 
-/* Bring s_app (store already filled) to a measured decision at (rx, ry): one period at
- * the pose, its goal dropped and its model discarded (so the next period relearns), then
- * `history` (may be NULL) and the same pose and a measurement one period later. Returns
- * the time of the period to measure. */
-static int64_t prime_decision(rfs_q16_t rx, rfs_q16_t ry, void (*history)(rfs_seek_t *))
+/* Bring s_app (store already filled) to a decision at (rx, ry) and measure it: one period
+ * at the pose, its goal dropped and its model discarded (so the measured period relearns),
+ * then `history` (may be NULL), the same pose and a measurement one period later, and
+ * that period measured as `period` with its stack depth as `stack`. *rng0 is the random
+ * source just before it (for the replays). */
+static void measure_decision(rfs_q16_t rx, rfs_q16_t ry, void (*history)(rfs_seek_t *),
+                             const char *period, const char *stack, rfs_app_out_t *out,
+                             rfs_rng_t *rng0)
 {
     int64_t t = 1000000;
     const rfs_pose_t p0 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
     rfs_app_on_pose(&s_app, &p0, t);
     rfs_app_on_rssi(&s_app, 0, t, -60, t);
-    rfs_app_out_t out;
-    rfs_app_step(&s_app, t, &out);
+    rfs_app_step(&s_app, t, out);
     rfs_drive_stop(&s_app.seek.drive, t);
     s_app.seek.model.ops->reset(s_app.seek.model.self);
     if (history != 0) {
@@ -227,7 +229,10 @@ static int64_t prime_decision(rfs_q16_t rx, rfs_q16_t ry, void (*history)(rfs_se
     const rfs_pose_t p1 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
     rfs_app_on_pose(&s_app, &p1, t);
     rfs_app_on_rssi(&s_app, 0, t, -60, t);
-    return t;
+    *rng0 = s_app.rng;
+    const uintptr_t sp0 = rfs_bc_stack_paint();
+    RFS_BC_MEASURE(period, 1, rfs_app_step(&s_app, t, out));
+    rfs_bc_report(stack, 0, rfs_bc_stack_depth(sp0));
 }
 
 /* One epsilon decision in that worst case, of the meta-path preset (geodesic or not) or
@@ -253,11 +258,8 @@ static void geo_decision(const rfs_app_map_t *map, bool meta_path, bool geodesic
     const rfs_q16_t rx = RFS_Q16_FRAC(9, 8), ry = RFS_Q16_FRAC(69, 8); /* (1.125, 8.625) m */
     fill_store_at(&s_app.seek.store, 42u, 112, 862, 30, 970);
     rfs_app_out_t out;
-    const int64_t t = prime_decision(rx, ry, geo_history);
-    const rfs_rng_t rng0 = s_app.rng;
-    const uintptr_t sp0 = rfs_bc_stack_paint();
-    RFS_BC_MEASURE(row->period, 1, rfs_app_step(&s_app, t, &out));
-    rfs_bc_report(row->stack, 0, rfs_bc_stack_depth(sp0));
+    rfs_rng_t rng0;
+    measure_decision(rx, ry, geo_history, row->period, row->stack, &out, &rng0);
     rfs_bc_report(row->eps_relearn, 0,
                   (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_EPSILON &&
                              out.decision.relearned));
@@ -436,11 +438,8 @@ static void ls_decision(const rfs_app_map_t *map, rfs_q16_t rx, rfs_q16_t ry, co
     fill_store_north(&s_app.seek.store, 44u, (int32_t)((rx * 100) >> 16),
                      (int32_t)((ry * 100) >> 16), 960);
     rfs_app_out_t out;
-    const int64_t t = prime_decision(rx, ry, 0);
-    const rfs_rng_t rng0 = s_app.rng;
-    const uintptr_t sp0 = rfs_bc_stack_paint();
-    RFS_BC_MEASURE(row->period, 1, rfs_app_step(&s_app, t, &out));
-    rfs_bc_report(row->stack, 0, rfs_bc_stack_depth(sp0));
+    rfs_rng_t rng0;
+    measure_decision(rx, ry, 0, row->period, row->stack, &out, &rng0);
     rfs_bc_report(row->greedy, 0,
                   (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_GREEDY &&
                              out.decision.relearned && out.decision.line_search &&

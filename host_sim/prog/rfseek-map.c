@@ -8,12 +8,14 @@
  */
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "hs_err.h"
 #include "hs_map.h"
 #include "rfs_plan.h"
 
@@ -32,14 +34,28 @@ static const char k_usage[] =
     "  --help         this text\n"
     "Exit 0 on success, 1 on a bad map or I/O error, 2 on bad options.\n";
 
+/* One error line on stderr, "rfseek-map: " first: option values and file names can hold
+ * line breaks (shown as '?'; the project's error rule). */
+static void err_line(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static void err_line(const char *fmt, ...)
+{
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    hs_err_one_line(msg);
+    fprintf(stderr, "rfseek-map: %s\n", msg);
+}
+
 static int parse_pos(const char *opt, const char *s, double *out)
 {
     char *end = NULL;
     errno = 0;
     double v = s != NULL ? strtod(s, &end) : 0.0;
     if (s == NULL || end == s || *end != '\0' || errno != 0 || !isfinite(v) || v < 0) {
-        fprintf(stderr, "rfseek-map: %s: a non-negative number of metres expected, got '%s'\n",
-                opt, s != NULL ? s : "(nothing)");
+        err_line("%s: a non-negative number of metres expected, got '%s'", opt,
+                 s != NULL ? s : "(nothing)");
         return -1;
     }
     *out = v;
@@ -52,7 +68,7 @@ static int write_pgm(const char *path, const hs_core_map_t *c)
     snprintf(tmp, sizeof(tmp), "%s.tmp", path);
     FILE *f = fopen(tmp, "wb");
     if (f == NULL) {
-        fprintf(stderr, "rfseek-map: %s: cannot create: %s\n", tmp, strerror(errno));
+        err_line("%s: cannot create: %s", tmp, strerror(errno));
         return -1;
     }
     const rfs_map_t *m = &c->map;
@@ -72,12 +88,12 @@ static int write_pgm(const char *path, const hs_core_map_t *c)
         }
     }
     if (fflush(f) != 0 || ferror(f) || fclose(f) != 0) {
-        fprintf(stderr, "rfseek-map: %s: write error\n", tmp);
+        err_line("%s: write error", tmp);
         remove(tmp);
         return -1;
     }
     if (rename(tmp, path) != 0) {
-        fprintf(stderr, "rfseek-map: %s: cannot rename to %s: %s\n", tmp, path, strerror(errno));
+        err_line("%s: cannot rename to %s: %s", tmp, path, strerror(errno));
         remove(tmp);
         return -1;
     }
@@ -227,7 +243,7 @@ int main(int argc, char **argv)
             const char *v = i + 1 < argc ? argv[++i] : NULL;
             if (strcmp(a, "--pgm") == 0) {
                 if (v == NULL || *v == '\0') {
-                    fprintf(stderr, "rfseek-map: --pgm: an output file name expected\n");
+                    err_line("--pgm: an output file name expected");
                     return 2;
                 }
                 pgm = v;
@@ -240,32 +256,31 @@ int main(int argc, char **argv)
             char *end = NULL;
             bench = v != NULL ? strtol(v, &end, 10) : -1;
             if (v == NULL || *end != '\0' || bench < 1 || bench > 1000000) {
-                fprintf(stderr, "rfseek-map: --bench: a count 1..1000000 expected, got '%s'\n",
-                        v != NULL ? v : "(nothing)");
+                err_line("--bench: a count 1..1000000 expected, got '%s'", v != NULL ? v : "(nothing)");
                 return 2;
             }
         } else if (a[0] == '-' && a[1] != '\0') {
-            fprintf(stderr, "rfseek-map: %s: unknown option (see --help)\n", a);
+            err_line("%s: unknown option (see --help)", a);
             return 2;
         } else if (yaml == NULL) {
             yaml = a;
         } else {
-            fprintf(stderr, "rfseek-map: %s: only one map expected (see --help)\n", a);
+            err_line("%s: only one map expected (see --help)", a);
             return 2;
         }
     }
     if (yaml == NULL) {
-        fprintf(stderr, "rfseek-map: no map given (see --help)\n");
+        err_line("no map given (see --help)");
         return 2;
     }
     if (!(res > 0) || !(grid > 0)) {
-        fprintf(stderr, "rfseek-map: --res and --grid must be > 0\n");
+        err_line("--res and --grid must be > 0");
         return 2;
     }
     char err[1024];
     hs_map_t m;
     if (hs_map_load(yaml, &m, err, sizeof(err)) != 0) {
-        fprintf(stderr, "rfseek-map: %s\n", err);
+        err_line("%s", err);
         return 1;
     }
     rfs_map_cfg_t cfg = rfs_map_cfg_default();
@@ -273,7 +288,7 @@ int main(int argc, char **argv)
     cfg.grid = (rfs_q16_t)lround(grid * 65536.0);
     hs_core_map_t c;
     if (hs_map_to_core(&m, res, &cfg, &c, err, sizeof(err)) != 0) {
-        fprintf(stderr, "rfseek-map: %s: %s\n", yaml, err);
+        err_line("%s: %s", yaml, err);
         hs_map_free(&m);
         return 1;
     }

@@ -8,11 +8,14 @@
  * else the LCM fallback channel RFS_CAN_FALLBACK). Prints summary.json to stdout.
  */
 #include <errno.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "hs_ctrl_lcm.h"
+#include "hs_err.h"
 #include "hs_scenario.h"
 #include "hs_sim.h"
 
@@ -25,6 +28,60 @@ static const char usage_text[] =
     "  --timeout-ms N   wait this long for the controller's answer to a step (default 5000)\n"
     "  --max-time S     stop after S simulated seconds (overrides the scenario's stop time)\n"
     "  --help           this text\n";
+
+/* One error line on stderr, "rfseek-sim-lcm: " first: option values, file names, the LCM
+ * URL and liblcm's words can hold line breaks (shown as '?'; the project's error rule). */
+static void err_line(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static void err_line(const char *fmt, ...)
+{
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    hs_err_one_line(msg);
+    fprintf(stderr, "rfseek-sim-lcm: %s\n", msg);
+}
+
+/* liblcm reports a bad provider URL on stderr itself, the raw URL included (several lines
+ * for a multicast problem). While the controller link opens, stderr goes to a temporary
+ * file; its text then joins our one error line, or is passed on as one line. */
+typedef struct stderr_capture {
+    FILE *f;   /* the captured text, or NULL */
+    int saved; /* the original stderr while capturing, else -1 */
+} stderr_capture_t;
+
+static void capture_start(stderr_capture_t *c)
+{
+    fflush(stderr);
+    c->saved = -1;
+    c->f = tmpfile();
+    if (c->f != NULL && (c->saved = dup(STDERR_FILENO)) >= 0 &&
+        dup2(fileno(c->f), STDERR_FILENO) < 0) {
+        close(c->saved);
+        c->saved = -1;
+    }
+}
+
+/* Restore stderr; the captured text (at most n - 1 bytes, "" when none) into buf. */
+static void capture_stop(stderr_capture_t *c, char *buf, size_t n)
+{
+    buf[0] = '\0';
+    if (c->saved >= 0) {
+        fflush(stderr);
+        (void)dup2(c->saved, STDERR_FILENO);
+        close(c->saved);
+        rewind(c->f);
+        size_t k = fread(buf, 1, n - 1, c->f);
+        while (k > 0 && (buf[k - 1] == '\n' || buf[k - 1] == ' ')) {
+            k--;
+        }
+        buf[k] = '\0';
+    }
+    if (c->f != NULL) {
+        fclose(c->f);
+    }
+}
 
 int main(int argc, char **argv)
 {
@@ -42,7 +99,7 @@ int main(int argc, char **argv)
         } else if (a[0] != '-' && !scn) {
             scn = a;
         } else if (!v) {
-            fprintf(stderr, "rfseek-sim-lcm: missing value for %s (see --help)\n", a);
+            err_line("missing value for %s (see --help)", a);
             return 2;
         } else if (strcmp(a, "--lcm") == 0) {
             cfg.lcm_url = v, i++;
@@ -52,38 +109,38 @@ int main(int argc, char **argv)
             errno = 0;
             seed = strtoll(v, &end, 10);
             if (errno || *end || seed < 0) {
-                fprintf(stderr, "rfseek-sim-lcm: --seed: '%s' is not a non-negative integer\n", v);
+                err_line("--seed: '%s' is not a non-negative integer", v);
                 return 2;
             }
             i++;
         } else if (strcmp(a, "--max-time") == 0) {
             max_time = strtod(v, &end);
             if (*end || !(max_time > 0 && max_time <= 86400)) {
-                fprintf(stderr, "rfseek-sim-lcm: --max-time: '%s' is not seconds in (0, 86400]\n", v);
+                err_line("--max-time: '%s' is not seconds in (0, 86400]", v);
                 return 2;
             }
             i++;
         } else if (strcmp(a, "--timeout-ms") == 0) {
             long t = strtol(v, &end, 10);
             if (*end || t < 1 || t > 600000) {
-                fprintf(stderr, "rfseek-sim-lcm: --timeout-ms: '%s' is not in 1..600000\n", v);
+                err_line("--timeout-ms: '%s' is not in 1..600000", v);
                 return 2;
             }
             cfg.reply_timeout_ms = (int)t;
             i++;
         } else {
-            fprintf(stderr, "rfseek-sim-lcm: unknown option '%s' (see --help)\n", a);
+            err_line("unknown option '%s' (see --help)", a);
             return 2;
         }
     }
     if (!scn) {
-        fprintf(stderr, "rfseek-sim-lcm: a SCENARIO file is required (see --help)\n");
+        err_line("a SCENARIO file is required (see --help)");
         return 2;
     }
     char err[512];
     hs_scenario_t sc;
     if (hs_scenario_load(scn, &sc, err, sizeof err) != 0) {
-        fprintf(stderr, "rfseek-sim-lcm: %s\n", err);
+        err_line("%s", err);
         return 1;
     }
     if (max_time > 0) {
@@ -92,14 +149,22 @@ int main(int argc, char **argv)
     hs_sim_env_t env;
     memset(&env, 0, sizeof env);
     if (hs_sim_env_open(&env, &sc, err, sizeof err) != 0) {
-        fprintf(stderr, "rfseek-sim-lcm: %s\n", err);
+        err_line("%s", err);
         return 1;
     }
     hs_ctrl_t ctrl;
-    if (hs_ctrl_lcm_open(&ctrl, &cfg, err, sizeof err) != 0) {
-        fprintf(stderr, "rfseek-sim-lcm: %s\n", err);
+    stderr_capture_t cap;
+    char said[256];
+    capture_start(&cap);
+    const int open_rc = hs_ctrl_lcm_open(&ctrl, &cfg, err, sizeof err);
+    capture_stop(&cap, said, sizeof said);
+    if (open_rc != 0) {
+        err_line("%s%s%s%s", err, said[0] ? " (liblcm: " : "", said, said[0] ? ")" : "");
         hs_sim_env_close(&env);
         return 1;
+    }
+    if (said[0]) {
+        err_line("liblcm: %s", said);
     }
     hs_sim_result_t res;
     hs_sim_io_t io;
@@ -108,7 +173,7 @@ int main(int argc, char **argv)
     uint32_t timeouts = hs_ctrl_lcm_timeouts(&ctrl);
     hs_ctrl_close(&ctrl);
     if (rc != 0) {
-        fprintf(stderr, "rfseek-sim-lcm: %s\n", err);
+        err_line("%s", err);
         hs_sim_env_close(&env);
         return 1;
     }

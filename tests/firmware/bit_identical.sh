@@ -59,4 +59,38 @@ for f in trunc badtype badmagic; do
         pass "qemu image rejects $f stream: $(cat "$tmp/$f.qerr")"
     fi
 done
+
+# A line break in an option, its value or a file name: one error line (shown as '?'),
+# exit 2 for options / 1 for files, and no output or temporary file left (tmp/nl*).
+# one_err NAME PROG RC TEXT ARGS...
+one_err() {
+    local name=$1 prog=$2 want=$3 text=$4
+    shift 4
+    "$bin/$prog" "$@" >/dev/null 2>"$tmp/nl_err.txt"
+    local rc=$? lines
+    lines=$(wc -l <"$tmp/nl_err.txt")
+    mv "$tmp/nl_err.txt" "$tmp/err.txt"
+    if [ $rc -ne "$want" ]; then fail "$name" "exit $rc"
+    elif [ "$lines" -ne 1 ]; then fail "$name" "$lines stderr lines: $(head -c 200 "$tmp/err.txt")"
+    elif ! grep -qF -- "$text" "$tmp/err.txt"; then fail "$name" "stderr '$(cat "$tmp/err.txt")' lacks '$text'"
+    elif compgen -G "$tmp/nl*" >/dev/null; then fail "$name" "left $(ls -d "$tmp"/nl*)"
+    else pass "$name"; fi
+    rm -rf "$tmp"/nl*
+}
+nl=$'\n' scn=scenarios/default.yaml
+one_err record-newline-option rfseek-record 2 "unknown option '--x?y'" $scn -o "$tmp/nl.rfsr" "--x${nl}y"
+one_err record-newline-missing-value rfseek-record 2 "missing value for '--drop'" $scn -o "$tmp/nl.rfsr" --drop
+one_err record-newline-max-time rfseek-record 2 "--max-time: bad value '1?2'" $scn -o "$tmp/nl.rfsr" --max-time "1${nl}2"
+one_err record-newline-drop rfseek-record 2 "--drop: bad value '1:2?'" $scn -o "$tmp/nl.rfsr" --drop "1:2${nl}"
+one_err record-newline-model rfseek-record 2 "--model: unknown 'a?b'" $scn -o "$tmp/nl.rfsr" --model "a${nl}b"
+one_err record-newline-scenario rfseek-record 1 "nl?s.yaml" "$tmp/nl${nl}s.yaml" -o "$tmp/nl.rfsr"
+one_err record-newline-out rfseek-record 1 "nl/a?b.rfsr" $scn -o "$tmp/nl/a${nl}b.rfsr" --max-time 1
+one_err record-newline-live-out rfseek-record 1 "nl/a?b.rfso" $scn -o "$tmp/nl.rfsr" \
+    --live-out "$tmp/nl/a${nl}b.rfso" --max-time 1
+one_err record-no-out rfseek-record 2 "rfseek-record: " $scn
+one_err replay-newline-option rfseek-replay 2 "--x?y: unknown option" "$tmp/in.rfsr" -o "$tmp/nl.rfso" "--x${nl}y"
+one_err replay-newline-in rfseek-replay 1 "nl?none.rfsr: No such file" "$tmp/nl${nl}none.rfsr" -o "$tmp/nl.rfso"
+one_err replay-newline-out rfseek-replay 1 "nl/a?b.rfso" "$tmp/in.rfsr" -o "$tmp/nl/a${nl}b.rfso"
+one_err replay-newline-second-input rfseek-replay 2 "a?b" "$tmp/in.rfsr" "a${nl}b" -o "$tmp/nl.rfso"
+one_err replay-missing-value rfseek-replay 2 "-o: missing value" "$tmp/in.rfsr" -o
 exit $((fails > 0))

@@ -34,4 +34,28 @@ err=$("$bin" 2>&1 >/dev/null); rc=$?
 [ $rc = 2 ]; check_rc no-map $?
 "$bin" "$bad/thresh_order.yaml" --pgm "$tmp/no.pgm" >/dev/null 2>&1
 [ ! -e "$tmp/no.pgm" ] && [ ! -e "$tmp/no.pgm.tmp" ]; check_rc bad-no-output $?
+
+# A line break in an option, an option name or a file name still gives one error line
+# (shown as '?'), and no output is written.
+# one_err NAME RC TEXT ARGS...: exit RC, exactly one stderr line holding TEXT, no tmp/nl*.
+one_err() {
+    local name=$1 want=$2 text=$3
+    shift 3
+    "$bin" "$@" >/dev/null 2>"$tmp/err"
+    local rc=$?
+    if [ $rc != "$want" ]; then fail "$name" "exit $rc"
+    elif [ "$(wc -l <"$tmp/err")" != 1 ]; then fail "$name" "$(wc -l <"$tmp/err") stderr lines: $(head -c 200 "$tmp/err")"
+    elif ! grep -qF -- "$text" "$tmp/err"; then fail "$name" "stderr '$(cat "$tmp/err")' lacks '$text'"
+    elif compgen -G "$tmp/nl*" >/dev/null; then fail "$name" "left $(ls "$tmp"/nl*)"
+    else pass "$name"; fi
+    rm -rf "$tmp"/nl*
+}
+one_err newline-res 2 "--res: a non-negative number of metres expected, got '1?2'" \
+    "$bad/ok.yaml" --res $'1\n2' --pgm "$tmp/nl.pgm"
+one_err newline-bench 2 "--bench: a count 1..1000000 expected, got '5?6'" \
+    "$bad/ok.yaml" --bench $'5\n6' --pgm "$tmp/nl.pgm"
+one_err newline-option 2 "--x?y: unknown option" "$bad/ok.yaml" $'--x\ny' --pgm "$tmp/nl.pgm"
+one_err newline-second-map 2 "a?b: only one map expected" "$bad/ok.yaml" $'a\nb' --pgm "$tmp/nl.pgm"
+one_err newline-map-name 1 "nl?map.yaml" "$tmp/"$'nl\nmap.yaml' --pgm "$tmp/nl.pgm"
+one_err newline-pgm 1 "nl/a?b.pgm.tmp: cannot create" "$bad/ok.yaml" --pgm "$tmp/nl/a"$'\n'"b.pgm"
 [ $fails = 0 ]

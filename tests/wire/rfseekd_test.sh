@@ -11,12 +11,14 @@ w=$build/tests/wire/rfseekd
 rm -rf "$w" && mkdir -p "$w"
 . "$(dirname "$0")/../lib/checks.sh"
 # expect_err NAME WANT_RC PATTERN ARGS...: one error line matching PATTERN, that exit code
-expect_err() {
-    local name=$1 want=$2 pat=$3; shift 3
-    "$d" "$@" > "$w/out" 2> "$w/err"; local rc=$?
+# (rfseekd; expect_err_of BIN NAME ... for another program)
+expect_err_of() {
+    local bin=$1 name=$2 want=$3 pat=$4; shift 4
+    "$bin" "$@" > "$w/out" 2> "$w/err"; local rc=$?
     if [ $rc -eq "$want" ] && [ "$(wc -l < "$w/err")" -eq 1 ] && grep -q -- "$pat" "$w/err"; then pass "$name"
     else fail "$name (rc $rc, stderr: $(head -3 "$w/err"))"; fi
 }
+expect_err() { expect_err_of "$d" "$@"; }
 
 "$d" --help > "$w/help" && grep -q -- '--can-over-lcm' "$w/help" && pass rfseekd-help || fail rfseekd-help
 expect_err rfseekd-unknown-option 2 "unknown option (see --help): --bogus" --bogus
@@ -29,6 +31,36 @@ expect_err rfseekd-missing-log 1 "$w/none.lcmlog" --map $map --replay "$w/none.l
 "$d" --map $map --lcm memq:// --log "$w/sub/x.lcmlog" > /dev/null 2> "$w/err"
 [ $? -eq 1 ] && grep -q "x.lcmlog.tmp: cannot open for writing" "$w/err" && [ ! -e "$w/sub/x.lcmlog" ] \
     && pass rfseekd-unwritable-log || fail "rfseekd-unwritable-log ($(cat "$w/err"))"
+# A line break in an option, its value or a file name: still one line (shown as '?'),
+# liblcm's own complaint about a bad URL folded into it, and nothing written (tmp/nl*).
+nl=$'\n'
+expect_err rfseekd-newline-option 2 "unknown option (see --help): --x?y" "--x${nl}y"
+expect_err rfseekd-newline-target 2 "--target: expected rssi or bridge, got a?b" --map $map --target "a${nl}b"
+expect_err rfseekd-newline-res 2 "--res: expected metres in \[0.01, 1\], got 1?2" --map $map --res "1${nl}2"
+expect_err rfseekd-newline-seed 2 "--seed: expected a non-negative integer, got 1?2" --map $map --seed "1${nl}2"
+expect_err rfseekd-newline-map 1 "nl?map.yaml" --map "$w/nl${nl}map.yaml" --lcm memq://
+expect_err rfseekd-newline-lcm-url 1 "lcm: udpm://?q: cannot open this provider.*liblcm: .*?q" \
+    --map $map --lcm "udpm://${nl}q" --decisions "$w/nl-dec.txt"
+expect_err rfseekd-bad-provider 1 "lcm: foo://: cannot open this provider.*liblcm: .*foo" \
+    --map $map --lcm foo:// --decisions "$w/nl-dec.txt"
+expect_err rfseekd-newline-can 1 "can: rfsno?q" --map $map --lcm memq:// --can "rfsno${nl}q"
+expect_err rfseekd-newline-decisions 1 "nl/a?b: cannot write" --map $map --lcm memq:// --decisions "$w/nl/a${nl}b"
+expect_err rfseekd-newline-log 1 "nl/a?b.tmp: cannot open for writing" --map $map --lcm memq:// --log "$w/nl/a${nl}b"
+expect_err rfseekd-newline-replay 1 "nl?none.lcmlog" --map $map --replay "$w/nl${nl}none.lcmlog"
+compgen -G "$w/nl*" > /dev/null && fail "rfseekd-newline-nothing-written ($(ls -d "$w"/nl*))" \
+    || pass rfseekd-newline-nothing-written
+# rfseek-sim-lcm: the same rule (it writes only summary.json, to stdout: none on error).
+sl=$build/bin/rfseek-sim-lcm scn=scenarios/default.yaml
+expect_err_of "$sl" sim-lcm-newline-option 2 "unknown option '--x?y'" $scn "--x${nl}y" 1
+expect_err_of "$sl" sim-lcm-newline-missing-value 2 "missing value for --x?y" $scn "--x${nl}y"
+expect_err_of "$sl" sim-lcm-newline-seed 2 "--seed: '1?2' is not" $scn --seed "1${nl}2"
+expect_err_of "$sl" sim-lcm-newline-max-time 2 "--max-time: '1?2' is not" $scn --max-time "1${nl}2"
+expect_err_of "$sl" sim-lcm-newline-timeout 2 "--timeout-ms: '1?2' is not" $scn --timeout-ms "1${nl}2"
+expect_err_of "$sl" sim-lcm-newline-scenario 1 "nl?s.yaml" "$w/nl${nl}s.yaml" --lcm memq://
+expect_err_of "$sl" sim-lcm-newline-lcm-url 1 "lcm: udpm://?q: cannot open this provider.*liblcm: .*?q" \
+    $scn --lcm "udpm://${nl}q" --max-time 1
+expect_err_of "$sl" sim-lcm-newline-can 1 "can: rfsno?q" $scn --lcm memq:// --can "rfsno${nl}q" --max-time 1
+[ ! -s "$w/out" ] && pass sim-lcm-newline-no-summary || fail sim-lcm-newline-no-summary
 
 # A crafted input log: malformed messages are dropped with one line each, the controller
 # keeps running, and the wheels stop within 200 ms of the inputs stopping at 3 s.

@@ -22,11 +22,13 @@
 #include <errno.h>
 #include <getopt.h>
 #include <inttypes.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "hs_err.h"
 #include "hs_scenario.h"
 #include "hs_sim.h"
 #include "rfs_app.h"
@@ -66,6 +68,20 @@ typedef struct recorder {
     uint32_t records;
 } recorder_t;
 
+/* One error line on stderr, "rfseek-record: " first: option values, option names and file
+ * names can hold line breaks (shown as '?'; the project's error rule). */
+static void err_line(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static void err_line(const char *fmt, ...)
+{
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    hs_err_one_line(msg);
+    fprintf(stderr, "rfseek-record: %s\n", msg);
+}
+
 static void put(recorder_t *r, const rfs_replay_rec_t *rec)
 {
     uint8_t buf[RFS_REPLAY_MAX_RECORD];
@@ -81,8 +97,7 @@ static void feed(recorder_t *r, const rfs_replay_rec_t *rec)
 {
     put(r, rec);
     if (!rfs_replay_play(r->player, rec)) {
-        fprintf(stderr, "rfseek-record: %s: %s\n", r->in_path,
-                rfs_replay_err_str(r->player->error));
+        err_line("%s: %s", r->in_path, rfs_replay_err_str(r->player->error));
         exit(1);
     }
 }
@@ -250,7 +265,7 @@ static void usage(FILE *f)
 
 static void die_opt(const char *opt, const char *val)
 {
-    fprintf(stderr, "rfseek-record: %s: bad value '%s'\n", opt, val);
+    err_line("%s: bad value '%s'", opt, val);
     exit(2);
 }
 
@@ -272,8 +287,13 @@ int main(int argc, char **argv)
     double max_time = -1;
     uint32_t fit_budget = 0;
     const char *model_name = NULL;
+    /* getopt's own messages would echo a bad option raw (and the usage follows on stderr):
+     * it stays quiet and the one line is ours. A leading ':' tells a missing value (':')
+     * from an unknown option ('?'). */
+    static const char shortopts[] = ":o:h";
+    opterr = 0;
     int c;
-    while ((c = getopt_long(argc, argv, "o:h", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, shortopts, opts, NULL)) != -1) {
         char *end;
         switch (c) {
         case 'o': out_path = optarg; break;
@@ -335,8 +355,7 @@ int main(int argc, char **argv)
         case 'm':
             if (rfs_models_lookup(optarg) == NULL ||
                 strlen(optarg) > RFS_REPLAY_MODEL_NAME_MAX) {
-                fprintf(stderr, "rfseek-record: --model: unknown '%s' (ridge, mlp, knn, radius, "
-                                "pathloss)\n", optarg);
+                err_line("--model: unknown '%s' (ridge, mlp, knn, radius, pathloss)", optarg);
                 return 2;
             }
             model_name = optarg;
@@ -353,26 +372,40 @@ int main(int argc, char **argv)
             }
             break;
         case 'h': usage(stdout); return 0;
-        default: usage(stderr); return 2;
+        case ':': err_line("missing value for '%s' (see --help)", argv[optind - 1]); return 2;
+        default:
+            /* An unknown short option is optopt (its word may hold more options); an
+             * unknown or ambiguous long one (optopt 0), or --help given a value (optopt
+             * 'h'), is the word just passed. */
+            if (optopt != 0 && optopt != 'h') {
+                err_line("unknown option '-%c' (see --help)", optopt);
+            } else {
+                err_line("unknown option '%s' (see --help)", argv[optind - 1]);
+            }
+            return 2;
         }
     }
-    if (optind + 1 != argc || out_path == NULL) {
-        usage(stderr);
+    if (optind >= argc || out_path == NULL) {
+        err_line("%s (see --help)", out_path == NULL ? "-o IN.rfsr is required" : "a SCENARIO is required");
+        return 2;
+    }
+    if (optind + 1 != argc) {
+        err_line("'%s': only one SCENARIO expected (see --help)", argv[optind + 1]);
         return 2;
     }
     const char *scn_path = argv[optind];
     char err[512];
     static hs_scenario_t sc;
     if (hs_scenario_load(scn_path, &sc, err, sizeof err) != 0) {
-        fprintf(stderr, "rfseek-record: %s\n", err);
+        err_line("%s", err);
         return 1;
     }
     if (max_time > 0) {
         sc.stop_time_s = max_time;
     }
     if (strcmp(sc.target, "pdr") == 0) {
-        fprintf(stderr, "rfseek-record: %s: target: pdr is not available on the firmware (the CAN "
-                        "RSSI frame carries no sequence number; docs/MODELS.md)\n", scn_path);
+        err_line("%s: target: pdr is not available on the firmware (the CAN RSSI frame carries no "
+                 "sequence number; docs/MODELS.md)", scn_path);
         return 1;
     }
     if (model_name == NULL) {
@@ -380,14 +413,13 @@ int main(int argc, char **argv)
     }
     static hs_sim_env_t env;
     if (hs_sim_env_open(&env, &sc, err, sizeof err) != 0) {
-        fprintf(stderr, "rfseek-record: %s\n", err);
+        err_line("%s", err);
         return 1;
     }
     const rfs_map_t *m = &env.core.map;
     if (rfs_map_bytes(m->w, m->h) > RFS_APP_MAX_MAP_BYTES) {
-        fprintf(stderr, "rfseek-record: %s: map of %u x %u cells is larger than the image "
-                        "holds (%u bytes per grid)\n", scn_path, m->w, m->h,
-                RFS_APP_MAX_MAP_BYTES);
+        err_line("%s: map of %u x %u cells is larger than the image holds (%u bytes per grid)",
+                 scn_path, m->w, m->h, RFS_APP_MAX_MAP_BYTES);
         return 1;
     }
 
@@ -397,11 +429,11 @@ int main(int argc, char **argv)
     snprintf(tmp_out, sizeof tmp_out, "%s.tmp.%ld", live_path ? live_path : "", (long)getpid());
     rec.in = fopen(tmp_in, "wb");
     if (rec.in == NULL) {
-        fprintf(stderr, "rfseek-record: %s: %s\n", out_path, strerror(errno));
+        err_line("%s: %s", out_path, strerror(errno));
         return 1;
     }
     if (live_path != NULL && (rec.out = fopen(tmp_out, "wb")) == NULL) {
-        fprintf(stderr, "rfseek-record: %s: %s\n", live_path, strerror(errno));
+        err_line("%s: %s", live_path, strerror(errno));
         fclose(rec.in);
         remove(tmp_in);
         return 1;
@@ -486,8 +518,7 @@ int main(int argc, char **argv)
     const int close_in = fclose(rec.in);
     const int close_out = rec.out != NULL ? fclose(rec.out) : 0;
     if (rc != 0 || rec.write_failed || close_in != 0 || close_out != 0) {
-        fprintf(stderr, "rfseek-record: %s: %s\n", rc != 0 ? scn_path : out_path,
-                rc != 0 ? err : "write failed");
+        err_line("%s: %s", rc != 0 ? scn_path : out_path, rc != 0 ? err : "write failed");
         remove(tmp_in);
         if (live_path != NULL) {
             remove(tmp_out);
@@ -495,7 +526,7 @@ int main(int argc, char **argv)
         return 1;
     }
     if (rename(tmp_in, out_path) != 0 || (live_path != NULL && rename(tmp_out, live_path) != 0)) {
-        fprintf(stderr, "rfseek-record: %s: %s\n", out_path, strerror(errno));
+        err_line("%s: %s", out_path, strerror(errno));
         return 1;
     }
     printf("recorded %" PRIu32 " records, %" PRIu32 " steps, %.1f s simulated, %s, "

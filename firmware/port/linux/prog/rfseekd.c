@@ -14,12 +14,15 @@
 #include <errno.h>
 #include <inttypes.h>
 #include <signal.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "hs_can.h"
+#include "hs_err.h"
 #include "hs_lcm.h"
 #include "hs_map.h"
 #include "rfs_app.h"
@@ -78,6 +81,60 @@ static void on_signal(int sig)
 {
     (void)sig;
     g_stop = 1;
+}
+
+/* One line on stderr, "rfseekd: " first: option values, file names, the LCM URL and
+ * liblcm's words can hold line breaks (shown as '?'; the project's error rule). */
+static void err_line(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static void err_line(const char *fmt, ...)
+{
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    hs_err_one_line(msg);
+    fprintf(stderr, "rfseekd: %s\n", msg);
+}
+
+/* liblcm reports a bad provider URL on stderr itself, the raw URL included (several lines
+ * for a multicast problem). While the provider opens, stderr goes to a temporary file; its
+ * text then joins our one error line, or is passed on as one line. */
+typedef struct stderr_capture {
+    FILE *f;   /* the captured text, or NULL */
+    int saved; /* the original stderr while capturing, else -1 */
+} stderr_capture_t;
+
+static void capture_start(stderr_capture_t *c)
+{
+    fflush(stderr);
+    c->saved = -1;
+    c->f = tmpfile();
+    if (c->f != NULL && (c->saved = dup(STDERR_FILENO)) >= 0 &&
+        dup2(fileno(c->f), STDERR_FILENO) < 0) {
+        close(c->saved);
+        c->saved = -1;
+    }
+}
+
+/* Restore stderr; the captured text (at most n - 1 bytes, "" when none) into buf. */
+static void capture_stop(stderr_capture_t *c, char *buf, size_t n)
+{
+    buf[0] = '\0';
+    if (c->saved >= 0) {
+        fflush(stderr);
+        (void)dup2(c->saved, STDERR_FILENO);
+        close(c->saved);
+        rewind(c->f);
+        size_t k = fread(buf, 1, n - 1, c->f);
+        while (k > 0 && (buf[k - 1] == '\n' || buf[k - 1] == ' ')) {
+            k--;
+        }
+        buf[k] = '\0';
+    }
+    if (c->f != NULL) {
+        fclose(c->f);
+    }
 }
 
 static int64_t realtime_us(void)
@@ -239,12 +296,12 @@ static void on_bad(void *ctx, const char *why)
 {
     daemon_t *d = ctx;
     d->bad_msgs++;
-    fprintf(stderr, "rfseekd: dropped LCM message: %s\n", why);
+    err_line("dropped LCM message: %s", why);
 }
 
 static int die(const char *msg, const char *arg)
 {
-    fprintf(stderr, "rfseekd: %s%s\n", msg, arg ? arg : "");
+    err_line("%s%s", msg, arg ? arg : "");
     return 2;
 }
 
@@ -363,7 +420,7 @@ int main(int argc, char **argv)
     cfg.target = strcmp(target, "bridge") == 0 ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
     if (hs_map_load(map_path, &m, err, sizeof err) != 0 || hs_map_to_core(&m, res, &cfg.map, &core, err, sizeof err) != 0) {
         hs_map_free(&m);
-        fprintf(stderr, "rfseekd: %s\n", err);
+        err_line("%s", err);
         return 1;
     }
     // The Linux port holds any model: its state in a heap buffer of the model's size.
@@ -388,9 +445,9 @@ int main(int argc, char **argv)
     memset(&d, 0, sizeof d);
     d.app = malloc(sizeof *d.app);
     if (!d.app || rfs_app_init(d.app, &cfg, &am) != 0) {
-        fprintf(stderr, "rfseekd: %s: the map (%u x %u cells at %.2f m) exceeds the controller's limits "
-                        "(%u bytes per grid, %u lattice points)\n",
-                map_path, core.map.w, core.map.h, res, RFS_APP_MAX_MAP_BYTES, RFS_APP_MAX_LATTICE);
+        err_line("%s: the map (%u x %u cells at %.2f m) exceeds the controller's limits (%u bytes per "
+                 "grid, %u lattice points)",
+                 map_path, core.map.w, core.map.h, res, RFS_APP_MAX_MAP_BYTES, RFS_APP_MAX_LATTICE);
         free(d.app);
         free(model_state);
         hs_core_map_free(&core);
@@ -404,8 +461,11 @@ int main(int argc, char **argv)
     d.decisions = replay ? stdout : NULL;
     int rc = 0;
     hs_lcm_log_t *in = NULL;
-    if (dec_path && !(d.decisions = fopen(dec_path, "w"))) {
-        fprintf(stderr, "rfseekd: %s: cannot write\n", dec_path);
+    /* The decisions go to a temporary file renamed at a clean end: nothing half-written. */
+    char dec_tmp[4096];
+    snprintf(dec_tmp, sizeof dec_tmp, "%s.tmp.%ld", dec_path ? dec_path : "", (long)getpid());
+    if (dec_path && !(d.decisions = fopen(dec_tmp, "w"))) {
+        err_line("%s: cannot write: %s", dec_path, strerror(errno));
         rc = 1;
         goto out;
     }
@@ -418,7 +478,7 @@ int main(int argc, char **argv)
     h.on_clock = clock_lcm ? on_clock : NULL;
     h.on_bad = on_bad;
     if (log_path && !(d.rec = hs_lcm_log_open(log_path, "w", err, sizeof err))) {
-        fprintf(stderr, "rfseekd: %s\n", err);
+        err_line("%s", err);
         rc = 1;
         goto out;
     }
@@ -426,11 +486,18 @@ int main(int argc, char **argv)
         /* In replay, LCM (when given) only carries the outputs. */
         hs_lcm_handlers_t none;
         memset(&none, 0, sizeof none);
+        stderr_capture_t cap;
+        char said[256];
+        capture_start(&cap);
         d.lcm = hs_lcm_open(url, replay ? &none : &h, err, sizeof err);
+        capture_stop(&cap, said, sizeof said);
         if (!d.lcm) {
-            fprintf(stderr, "rfseekd: %s\n", err);
+            err_line("%s%s%s%s", err, said[0] ? " (liblcm: " : "", said, said[0] ? ")" : "");
             rc = 1;
             goto out;
+        }
+        if (said[0]) {
+            err_line("liblcm: %s", said);
         }
         hs_lcm_record(d.lcm, d.rec);
     }
@@ -438,7 +505,7 @@ int main(int argc, char **argv)
         const uint32_t ids[] = {RFS_CAN_ID_WHEEL_CMD, RFS_CAN_ID_STATUS};
         d.can = hs_can_open(can_if, ids, 2, err, sizeof err);
         if (!d.can) {
-            fprintf(stderr, "rfseekd: %s\n", err);
+            err_line("%s", err);
             rc = 1;
             goto out;
         }
@@ -448,7 +515,7 @@ int main(int argc, char **argv)
     if (replay) {
         in = hs_lcm_log_open(replay, "r", err, sizeof err);
         if (!in) {
-            fprintf(stderr, "rfseekd: %s\n", err);
+            err_line("%s", err);
             rc = 1;
             goto out;
         }
@@ -466,7 +533,7 @@ int main(int argc, char **argv)
                 if (url && strncmp(url, "file://", 7) == 0) {
                     break;
                 }
-                fprintf(stderr, "rfseekd: %s: LCM receive failed\n", url ? url : "(default URL)");
+                err_line("%s: LCM receive failed", url ? url : "(default URL)");
                 rc = 1;
                 break;
             }
@@ -495,7 +562,7 @@ int main(int argc, char **argv)
                 if (url && strncmp(url, "file://", 7) == 0) {
                     break;
                 }
-                fprintf(stderr, "rfseekd: %s: LCM receive failed\n", url ? url : "(default URL)");
+                err_line("%s: LCM receive failed", url ? url : "(default URL)");
                 rc = 1;
                 break;
             }
@@ -514,11 +581,21 @@ out:
         hs_lcm_log_close(in);
     }
     if (d.rec && hs_lcm_log_close(d.rec) != 0) {
-        fprintf(stderr, "rfseekd: %s: could not finish the log\n", log_path);
+        err_line("%s: could not finish the log", log_path);
         rc = 1;
     }
     if (d.decisions && d.decisions != stdout) {
-        fclose(d.decisions);
+        if (fclose(d.decisions) != 0 && rc == 0) {
+            err_line("%s: write failed", dec_path);
+            rc = 1;
+        }
+        if (rc == 0 && rename(dec_tmp, dec_path) != 0) {
+            err_line("%s: %s", dec_path, strerror(errno));
+            rc = 1;
+        }
+        if (rc != 0) {
+            remove(dec_tmp);
+        }
     }
     hs_can_close(d.can);
     hs_lcm_close(d.lcm);

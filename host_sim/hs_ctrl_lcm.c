@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "hs_can.h"
+#include "hs_err.h"
 #include "hs_lcm.h"
 #include "rfs_can.h"
 
@@ -27,7 +28,7 @@ typedef struct ctrl_lcm {
 
 hs_ctrl_lcm_cfg_t hs_ctrl_lcm_cfg_default(void)
 {
-    hs_ctrl_lcm_cfg_t c = {NULL, NULL, 50000, 5000};
+    hs_ctrl_lcm_cfg_t c = {NULL, NULL, 50000, 5000, NULL};
     return c;
 }
 
@@ -62,10 +63,20 @@ static void on_status(void *ctx, int64_t t_us, const rfs_seek_out_t *out)
     s->have_status = true;
 }
 
+/* One stderr line, "PROG: " first when the program gave its name (hs_ctrl_lcm_cfg_t). */
+static void say(const ctrl_lcm_t *s, const char *msg)
+{
+    char line[256];
+    snprintf(line, sizeof line, "%s", msg);
+    hs_err_one_line(line);
+    fprintf(stderr, "%s%s%s\n", s->cfg.prog ? s->cfg.prog : "", s->cfg.prog ? ": " : "", line);
+}
+
 static void on_bad(void *ctx, const char *why)
 {
-    (void)ctx;
-    fprintf(stderr, "rfseek-sim: dropped LCM message: %s\n", why);
+    char msg[256];
+    snprintf(msg, sizeof msg, "dropped LCM message: %s", why);
+    say(ctx, msg);
 }
 
 static void cb_pose(void *self, const rfs_pose_t *pose)
@@ -127,8 +138,10 @@ static void cb_step(void *self, int64_t now_us, hs_ctrl_out_t *out)
     }
     if (!answered) {
         if (s->timeouts++ == 0) {
-            fprintf(stderr, "rfseek-sim: no answer from the controller for step t=%lld us within %d ms; wheels stopped\n",
-                    (long long)now_us, s->cfg.reply_timeout_ms);
+            char msg[160];
+            snprintf(msg, sizeof msg, "no answer from the controller for step t=%lld us within %d ms; wheels stopped",
+                     (long long)now_us, s->cfg.reply_timeout_ms);
+            say(s, msg);
         }
         memset(out, 0, sizeof *out);
         out->state = RFS_SEEK_STALE;

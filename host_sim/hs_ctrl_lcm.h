@@ -24,12 +24,18 @@ typedef struct hs_ctrl_lcm_cfg {
     const char *can_iface;   ///< SocketCAN interface for wheel commands; NULL: RFS_CAN_FALLBACK
     int64_t period_us;       ///< control period, microseconds (50,000)
     int reply_timeout_ms;    ///< wait for the controller's answer to one step (5,000)
+    /// Program name that starts this controller's stderr lines (a dropped message, the
+    /// first unanswered step), as "PROG: ..."; NULL: the lines start with the text. Kept,
+    /// not copied: it must outlive the controller (a string literal).
+    const char *prog;
 } hs_ctrl_lcm_cfg_t;
 
-/// Defaults: LCM's default URL, the LCM fallback for CAN, 20 Hz, 5 s reply timeout.
+/// Defaults: LCM's default URL, the LCM fallback for CAN, 20 Hz, 5 s reply timeout, no
+/// program name.
 hs_ctrl_lcm_cfg_t hs_ctrl_lcm_cfg_default(void);
 
-/// Open. Returns 0, or -1 with err = "lcm: ..." / "can: ..." (one line).
+/// Open. Returns -1 with err = "lcm: ..." / "can: ..." (one line), or 0 with err = "" or
+/// liblcm's warning "lcm: URL: liblcm: ..." (one line, to print; see hs_lcm_open()).
 int hs_ctrl_lcm_open(hs_ctrl_t *c, const hs_ctrl_lcm_cfg_t *cfg, char *err, size_t errlen);
 
 /// Steps that got no answer in time (the wheels were commanded to zero).

@@ -62,8 +62,12 @@ typedef struct hs_lcm hs_lcm_t;
 typedef struct hs_lcm_log hs_lcm_log_t;
 
 /// Open an LCM provider URL (memq://, file://..., udpm://...; NULL = LCM's default) and
-/// subscribe to the channels whose handler is set. Returns NULL with err = "lcm: URL:
-/// reason" on failure.
+/// subscribe to the channels whose handler is set. What liblcm itself prints on stderr
+/// meanwhile (a bad provider or option, multicast set-up) is captured, not shown: err
+/// always ends as one line (control characters of the URL or of liblcm's text as '?').
+/// Failure: NULL, err = "lcm: URL: reason" plus " (liblcm: TEXT)" when liblcm said why.
+/// Success: the connection, err = "" - or, when liblcm warned (e.g. "Warning: Invalid
+/// value for ttl"), err = "lcm: URL: liblcm: TEXT", a warning for the caller to print.
 hs_lcm_t *hs_lcm_open(const char *url, const hs_lcm_handlers_t *h, char *err, size_t errlen);
 
 /// Also write every message published or delivered to this log (NULL stops recording).

@@ -6,10 +6,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <lcm/eventlog.h>
 #include <lcm/lcm.h>
 
+#include "hs_err.h"
 #include "rfseek_can_frame_t.h"
 #include "rfseek_clock_t.h"
 #include "rfseek_pose_t.h"
@@ -267,7 +269,63 @@ static void on_msg(const lcm_recv_buf_t *rbuf, const char *ch, void *user)
     dispatch(&l->h, &l->stats, ch, rbuf->data, (int)rbuf->data_size);
 }
 
-hs_lcm_t *hs_lcm_open(const char *url, const hs_lcm_handlers_t *h, char *err, size_t errlen)
+/* liblcm reports a bad provider URL or option on stderr itself, in one or more lines with
+ * the raw URL ("Error: LCM provider \"foo\" not found", "Warning: Invalid value for ttl",
+ * glib's indented receive-buffer warning at the first udpm subscription). While the
+ * provider opens and subscribes, stderr goes to a temporary file, so that text joins
+ * our one-line error instead (the project's error rule). */
+typedef struct stderr_capture {
+    FILE *f;   /* the captured text, or NULL */
+    int saved; /* the original stderr while capturing, else -1 */
+} stderr_capture_t;
+
+static void capture_start(stderr_capture_t *c)
+{
+    fflush(stderr);
+    c->saved = -1;
+    c->f = tmpfile();
+    if (c->f != NULL && (c->saved = dup(STDERR_FILENO)) >= 0 && dup2(fileno(c->f), STDERR_FILENO) < 0) {
+        close(c->saved);
+        c->saved = -1;
+    }
+}
+
+/* Restore stderr; the captured text into buf (at most n - 1 bytes, "" when none) as one
+ * line: blanks at both ends dropped, control characters shown as '?', runs of spaces
+ * (glib's indentation) made one. */
+static void capture_stop(stderr_capture_t *c, char *buf, size_t n)
+{
+    buf[0] = '\0';
+    if (c->saved >= 0) {
+        fflush(stderr);
+        (void)dup2(c->saved, STDERR_FILENO);
+        close(c->saved);
+        rewind(c->f);
+        size_t k = fread(buf, 1, n - 1, c->f);
+        while (k > 0 && (buf[k - 1] == '\n' || buf[k - 1] == ' ')) {
+            k--;
+        }
+        buf[k] = '\0';
+        size_t a = 0;
+        while (buf[a] == '\n' || buf[a] == ' ') {
+            a++;
+        }
+        hs_err_one_line(buf + a);
+        size_t o = 0;
+        for (size_t r = a; buf[r] != '\0'; r++) {
+            if (buf[r] != ' ' || o == 0 || buf[o - 1] != ' ') {
+                buf[o++] = buf[r];
+            }
+        }
+        buf[o] = '\0';
+    }
+    if (c->f != NULL) {
+        fclose(c->f);
+    }
+}
+
+/* The provider and its subscriptions; NULL with err = "lcm: URL: reason". */
+static hs_lcm_t *open_provider(const char *url, const hs_lcm_handlers_t *h, char *err, size_t errlen)
 {
     hs_lcm_t *l = calloc(1, sizeof *l);
     if (!l) {
@@ -301,6 +359,28 @@ hs_lcm_t *hs_lcm_open(const char *url, const hs_lcm_handlers_t *h, char *err, si
             return NULL;
         }
     }
+    return l;
+}
+
+hs_lcm_t *hs_lcm_open(const char *url, const hs_lcm_handlers_t *h, char *err, size_t errlen)
+{
+    stderr_capture_t cap;
+    char said[256];
+    capture_start(&cap);
+    hs_lcm_t *l = open_provider(url, h, err, errlen);
+    capture_stop(&cap, said, sizeof said);
+    if (errlen == 0) {
+        return l;
+    }
+    if (!l && said[0]) {
+        size_t k = strlen(err);
+        snprintf(err + k, errlen - k, " (liblcm: %s)", said);
+    } else if (l && said[0]) {
+        snprintf(err, errlen, "lcm: %s: liblcm: %s", url ? url : "(default)", said);
+    } else if (l) {
+        err[0] = '\0';
+    }
+    hs_err_one_line(err); /* the URL can hold line breaks */
     return l;
 }
 

@@ -560,7 +560,7 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
     return 0;
 }
 
-int hs_scenario_load(const char *path, hs_scenario_t *sc, char *err, size_t errlen)
+static int load(const char *path, hs_scenario_t *sc, char *err, size_t errlen)
 {
     hs_scenario_defaults(sc);
     if (strlen(path) >= sizeof sc->path) {
@@ -599,5 +599,14 @@ int hs_scenario_load(const char *path, hs_scenario_t *sc, char *err, size_t errl
     yaml_document_delete(&p.doc);
     yaml_parser_delete(&parser);
     fclose(f);
+    return rc;
+}
+
+int hs_scenario_load(const char *path, hs_scenario_t *sc, char *err, size_t errlen)
+{
+    const int rc = load(path, sc, err, errlen);
+    if (rc != 0 && errlen > 0) {
+        hs_err_one_line(err); /* the file name can hold line breaks (an unopenable path too) */
+    }
     return rc;
 }

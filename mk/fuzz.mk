@@ -39,9 +39,9 @@ FUZZ_LCM_GEN_HDRS := $(FUZZ_LCM_NAMES:%=$(BUILD)/gen/%.h)
 $(FUZZ_DIR)/gen/%.o: $(BUILD)/gen/%.c $(FUZZ_LCM_GEN_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(CSTD) -g -O1 -I$(BUILD)/gen $(FUZZ_SAN) -fsanitize=fuzzer-no-link -c $< -o $@
-$(FUZZ_DIR)/fuzz_lcm: tests/fuzz/fuzz_lcm.c host_sim/hs_lcm_adapt.c $(FUZZ_LCM_GEN_OBJS) $(CORE_SRCS) $(FUZZ_HDRS) $(FUZZ_LCM_GEN_HDRS)
+$(FUZZ_DIR)/fuzz_lcm: tests/fuzz/fuzz_lcm.c host_sim/hs_lcm_adapt.c host_sim/hs_err.c $(FUZZ_LCM_GEN_OBJS) $(CORE_SRCS) $(FUZZ_HDRS) $(FUZZ_LCM_GEN_HDRS)
 	@mkdir -p $(@D)
-	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< host_sim/hs_lcm_adapt.c $(FUZZ_LCM_GEN_OBJS) $(CORE_SRCS) -o $@ $(FUZZ_LCM_LIBS) -lm
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< host_sim/hs_lcm_adapt.c host_sim/hs_err.c $(FUZZ_LCM_GEN_OBJS) $(CORE_SRCS) -o $@ $(FUZZ_LCM_LIBS) -lm
 
 # make test: each target over its committed corpus plus a short burst of new inputs.
 FUZZ_TEST_RUNS ?= 5000

@@ -12,7 +12,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "hs_ctrl_lcm.h"
 #include "hs_err.h"
@@ -43,50 +42,11 @@ static void err_line(const char *fmt, ...)
     fprintf(stderr, "rfseek-sim-lcm: %s\n", msg);
 }
 
-/* liblcm reports a bad provider URL on stderr itself, the raw URL included (several lines
- * for a multicast problem). While the controller link opens, stderr goes to a temporary
- * file; its text then joins our one error line, or is passed on as one line. */
-typedef struct stderr_capture {
-    FILE *f;   /* the captured text, or NULL */
-    int saved; /* the original stderr while capturing, else -1 */
-} stderr_capture_t;
-
-static void capture_start(stderr_capture_t *c)
-{
-    fflush(stderr);
-    c->saved = -1;
-    c->f = tmpfile();
-    if (c->f != NULL && (c->saved = dup(STDERR_FILENO)) >= 0 &&
-        dup2(fileno(c->f), STDERR_FILENO) < 0) {
-        close(c->saved);
-        c->saved = -1;
-    }
-}
-
-/* Restore stderr; the captured text (at most n - 1 bytes, "" when none) into buf. */
-static void capture_stop(stderr_capture_t *c, char *buf, size_t n)
-{
-    buf[0] = '\0';
-    if (c->saved >= 0) {
-        fflush(stderr);
-        (void)dup2(c->saved, STDERR_FILENO);
-        close(c->saved);
-        rewind(c->f);
-        size_t k = fread(buf, 1, n - 1, c->f);
-        while (k > 0 && (buf[k - 1] == '\n' || buf[k - 1] == ' ')) {
-            k--;
-        }
-        buf[k] = '\0';
-    }
-    if (c->f != NULL) {
-        fclose(c->f);
-    }
-}
-
 int main(int argc, char **argv)
 {
     const char *scn = NULL;
     hs_ctrl_lcm_cfg_t cfg = hs_ctrl_lcm_cfg_default();
+    cfg.prog = "rfseek-sim-lcm";
     long long seed = -1;
     double max_time = 0;
     for (int i = 1; i < argc; i++) {
@@ -153,18 +113,13 @@ int main(int argc, char **argv)
         return 1;
     }
     hs_ctrl_t ctrl;
-    stderr_capture_t cap;
-    char said[256];
-    capture_start(&cap);
-    const int open_rc = hs_ctrl_lcm_open(&ctrl, &cfg, err, sizeof err);
-    capture_stop(&cap, said, sizeof said);
-    if (open_rc != 0) {
-        err_line("%s%s%s%s", err, said[0] ? " (liblcm: " : "", said, said[0] ? ")" : "");
+    if (hs_ctrl_lcm_open(&ctrl, &cfg, err, sizeof err) != 0) {
+        err_line("%s", err);
         hs_sim_env_close(&env);
         return 1;
     }
-    if (said[0]) {
-        err_line("liblcm: %s", said);
+    if (err[0]) { /* liblcm's warning, as one line (hs_ctrl_lcm.h) */
+        err_line("%s", err);
     }
     hs_sim_result_t res;
     hs_sim_io_t io;

@@ -41,6 +41,8 @@ if "$SIM" --help | grep -q -- '--seeds A..B'; then pass help; else fail help; fi
 
 # --- bad input ---------------------------------------------------------------------------
 bad missing_scenario "$T/none.yaml: No such file or directory" "$T/none.yaml" --out "$T/out"
+# A scenario file name with a line break that cannot be opened: one line, the break as '?'.
+bad missing_scenario_newline "$T/nl?none.yaml: No such file or directory" "$T/nl"$'\n'"none.yaml" --out "$T/out"
 printf 'map: [1, 2\n' >"$T/syntax.yaml"
 bad malformed_scenario "syntax.yaml:2: YAML syntax error" "$T/syntax.yaml" --out "$T/out"
 scn unknown.yaml "${BASE}colour: red

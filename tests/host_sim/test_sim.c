@@ -231,6 +231,10 @@ static void test_scenario_missing_file(void **state)
     char err[512];
     assert_int_equal(hs_scenario_load("/nonexistent/s.yaml", &sc, err, sizeof err), -1);
     assert_string_equal(err, "/nonexistent/s.yaml: No such file or directory");
+    // A file name with line breaks it cannot open: still one line, the breaks shown as '?'
+    // (strerror(ENOENT) is glibc's text, as above).
+    assert_int_equal(hs_scenario_load("/nonexistent/a\nb\r\tc.yaml", &sc, err, sizeof err), -1);
+    assert_string_equal(err, "/nonexistent/a?b??c.yaml: No such file or directory");
 }
 
 /// Motor model: acceleration limit, saturation, and the 200 ms command timeout.

@@ -61,6 +61,30 @@ expect_err_of "$sl" sim-lcm-newline-lcm-url 1 "lcm: udpm://?q: cannot open this 
     $scn --lcm "udpm://${nl}q" --max-time 1
 expect_err_of "$sl" sim-lcm-newline-can 1 "can: rfsno?q" $scn --lcm memq:// --can "rfsno${nl}q" --max-time 1
 [ ! -s "$w/out" ] && pass sim-lcm-newline-no-summary || fail sim-lcm-newline-no-summary
+# liblcm's own stderr is folded by hs_lcm_open (host_sim/hs_lcm_adapt.c): its two lines
+# for a bad option of a missing log (lcm_logprov.c) become part of one error line, and a
+# warning on a provider that does open is one line before the end-of-run summary.
+expect_err rfseekd-liblcm-two-lines 1 "cannot open this provider.*(liblcm: Warning: Invalid value for speed?Error: Failed to open $PWD/$w/none.lcmlog: No such file or directory)\$" \
+    --map $map --lcm "file://$PWD/$w/none.lcmlog?speed=abc"
+"$d" --map $map --lcm "file://$PWD/$w/warn.lcmlog?mode=w&foo=1" --duration 1 > "$w/out" 2> "$w/err"; rc=$?
+[ $rc -eq 0 ] && [ "$(wc -l < "$w/err")" -eq 2 ] \
+    && [ "$(head -1 "$w/err")" = "rfseekd: lcm: file://$PWD/$w/warn.lcmlog?mode=w&foo=1: liblcm: Warning: unrecognized option: [foo]" ] \
+    && grep -q "^rfseekd: [0-9]* steps, " "$w/err" && pass rfseekd-liblcm-warning-one-line \
+    || fail "rfseekd-liblcm-warning-one-line (rc $rc: $(tr '\n' '|' < "$w/err"))"
+expect_err_of "$sl" sim-lcm-liblcm-two-lines 1 "^rfseek-sim-lcm: lcm: file://.*(liblcm: Warning: Invalid value for speed?Error: Failed to open" \
+    $scn --lcm "file://$PWD/$w/none.lcmlog?speed=abc" --max-time 1
+# hs_ctrl_lcm's own lines carry the name of the program using it: a malformed
+# RFS_SEEKER_STATUS (5 bytes; the log written here with LCM's documented event layout:
+# magic, event number, time, channel length, data length, channel, data) is dropped with
+# one line, then the first unanswered step and their count are reported (exit 1).
+printf '\xed\xa1\xda\x01\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\x11\0\0\0\x05RFS_SEEKER_STATUS\x01\x02\x03\x04\x05' \
+    > "$w/bad-status.lcmlog"
+"$sl" $scn --lcm "file://$PWD/$w/bad-status.lcmlog?speed=0" --timeout-ms 50 --max-time 0.5 > "$w/out" 2> "$w/err"; rc=$?
+[ $rc -eq 1 ] && [ "$(wc -l < "$w/err")" -eq 3 ] && ! grep -qv "^rfseek-sim-lcm: " "$w/err" \
+    && grep -qxF "rfseek-sim-lcm: dropped LCM message: RFS_SEEKER_STATUS: truncated, oversized or not an rfseek.seeker_status_t (5 bytes)" "$w/err" \
+    && grep -q "^rfseek-sim-lcm: no answer from the controller for step t=[0-9]* us within 50 ms; wheels stopped\$" "$w/err" \
+    && pass sim-lcm-ctrl-lines-name-the-program \
+    || fail "sim-lcm-ctrl-lines-name-the-program (rc $rc: $(tr '\n' '|' < "$w/err"))"
 
 # A crafted input log: malformed messages are dropped with one line each, the controller
 # keeps running, and the wheels stop within 200 ms of the inputs stopping at 3 s.

@@ -248,7 +248,8 @@ static void bad_url_and_unreadable_log_give_one_line(void **state)
     char err[200];
     hs_lcm_t *l = hs_lcm_open("nosuch://x", NULL, err, sizeof err);
     assert_null(l);
-    assert_string_equal(err, "lcm: nosuch://x: cannot open this provider (bad URL, no multicast route, or no file)");
+    assert_string_equal(err, "lcm: nosuch://x: cannot open this provider (bad URL, no multicast route, or no file)"
+                             " (liblcm: Error: LCM provider \"nosuch\" not found)");
     hs_lcm_log_t *g = hs_lcm_log_open("/nonexistent/dir/x.lcmlog", "r", err, sizeof err);
     assert_null(g);
     assert_string_equal(err, "/nonexistent/dir/x.lcmlog: cannot open for reading");

@@ -97,46 +97,6 @@ static void err_line(const char *fmt, ...)
     fprintf(stderr, "rfseekd: %s\n", msg);
 }
 
-/* liblcm reports a bad provider URL on stderr itself, the raw URL included (several lines
- * for a multicast problem). While the provider opens, stderr goes to a temporary file; its
- * text then joins our one error line, or is passed on as one line. */
-typedef struct stderr_capture {
-    FILE *f;   /* the captured text, or NULL */
-    int saved; /* the original stderr while capturing, else -1 */
-} stderr_capture_t;
-
-static void capture_start(stderr_capture_t *c)
-{
-    fflush(stderr);
-    c->saved = -1;
-    c->f = tmpfile();
-    if (c->f != NULL && (c->saved = dup(STDERR_FILENO)) >= 0 &&
-        dup2(fileno(c->f), STDERR_FILENO) < 0) {
-        close(c->saved);
-        c->saved = -1;
-    }
-}
-
-/* Restore stderr; the captured text (at most n - 1 bytes, "" when none) into buf. */
-static void capture_stop(stderr_capture_t *c, char *buf, size_t n)
-{
-    buf[0] = '\0';
-    if (c->saved >= 0) {
-        fflush(stderr);
-        (void)dup2(c->saved, STDERR_FILENO);
-        close(c->saved);
-        rewind(c->f);
-        size_t k = fread(buf, 1, n - 1, c->f);
-        while (k > 0 && (buf[k - 1] == '\n' || buf[k - 1] == ' ')) {
-            k--;
-        }
-        buf[k] = '\0';
-    }
-    if (c->f != NULL) {
-        fclose(c->f);
-    }
-}
-
 static int64_t realtime_us(void)
 {
     struct timespec ts;
@@ -410,7 +370,7 @@ int main(int argc, char **argv)
         return die("--replay sends no CAN frames: drop --can / --can-over-lcm", NULL);
     }
 
-    char err[256];
+    char err[512];
     hs_map_t m;
     memset(&m, 0, sizeof m);
     hs_core_map_t core;
@@ -486,18 +446,14 @@ int main(int argc, char **argv)
         /* In replay, LCM (when given) only carries the outputs. */
         hs_lcm_handlers_t none;
         memset(&none, 0, sizeof none);
-        stderr_capture_t cap;
-        char said[256];
-        capture_start(&cap);
         d.lcm = hs_lcm_open(url, replay ? &none : &h, err, sizeof err);
-        capture_stop(&cap, said, sizeof said);
         if (!d.lcm) {
-            err_line("%s%s%s%s", err, said[0] ? " (liblcm: " : "", said, said[0] ? ")" : "");
+            err_line("%s", err);
             rc = 1;
             goto out;
         }
-        if (said[0]) {
-            err_line("liblcm: %s", said);
+        if (err[0]) { /* liblcm's warning, as one line (hs_lcm.h) */
+            err_line("%s", err);
         }
         hs_lcm_record(d.lcm, d.rec);
     }

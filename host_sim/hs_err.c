@@ -1,6 +1,9 @@
 /* hs_err.c - see hs_err.h. */
 #include "hs_err.h"
 
+#include <stdarg.h>
+#include <stdio.h>
+
 void hs_err_one_line(char *s)
 {
     for (char *c = s; *c != '\0'; ++c) {
@@ -8,4 +11,15 @@ void hs_err_one_line(char *s)
             *c = '?';
         }
     }
+}
+
+void hs_err_print(const char *prog, const char *fmt, ...)
+{
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    hs_err_one_line(msg);
+    fprintf(stderr, "%s: %s\n", prog, msg);
 }

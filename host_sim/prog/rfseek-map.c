@@ -8,7 +8,6 @@
  */
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,19 +33,7 @@ static const char k_usage[] =
     "  --help         this text\n"
     "Exit 0 on success, 1 on a bad map or I/O error, 2 on bad options.\n";
 
-/* One error line on stderr, "rfseek-map: " first: option values and file names can hold
- * line breaks (shown as '?'; the project's error rule). */
-static void err_line(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static void err_line(const char *fmt, ...)
-{
-    char msg[1024];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    hs_err_one_line(msg);
-    fprintf(stderr, "rfseek-map: %s\n", msg);
-}
+static const char PROG[] = "rfseek-map"; /* the prefix of its error lines (hs_err_print) */
 
 static int parse_pos(const char *opt, const char *s, double *out)
 {
@@ -54,7 +41,7 @@ static int parse_pos(const char *opt, const char *s, double *out)
     errno = 0;
     double v = s != NULL ? strtod(s, &end) : 0.0;
     if (s == NULL || end == s || *end != '\0' || errno != 0 || !isfinite(v) || v < 0) {
-        err_line("%s: a non-negative number of metres expected, got '%s'", opt,
+        hs_err_print(PROG, "%s: a non-negative number of metres expected, got '%s'", opt,
                  s != NULL ? s : "(nothing)");
         return -1;
     }
@@ -68,7 +55,7 @@ static int write_pgm(const char *path, const hs_core_map_t *c)
     snprintf(tmp, sizeof(tmp), "%s.tmp", path);
     FILE *f = fopen(tmp, "wb");
     if (f == NULL) {
-        err_line("%s: cannot create: %s", tmp, strerror(errno));
+        hs_err_print(PROG, "%s: cannot create: %s", tmp, strerror(errno));
         return -1;
     }
     const rfs_map_t *m = &c->map;
@@ -88,12 +75,12 @@ static int write_pgm(const char *path, const hs_core_map_t *c)
         }
     }
     if (fflush(f) != 0 || ferror(f) || fclose(f) != 0) {
-        err_line("%s: write error", tmp);
+        hs_err_print(PROG, "%s: write error", tmp);
         remove(tmp);
         return -1;
     }
     if (rename(tmp, path) != 0) {
-        err_line("%s: cannot rename to %s: %s", tmp, path, strerror(errno));
+        hs_err_print(PROG, "%s: cannot rename to %s: %s", tmp, path, strerror(errno));
         remove(tmp);
         return -1;
     }
@@ -243,7 +230,7 @@ int main(int argc, char **argv)
             const char *v = i + 1 < argc ? argv[++i] : NULL;
             if (strcmp(a, "--pgm") == 0) {
                 if (v == NULL || *v == '\0') {
-                    err_line("--pgm: an output file name expected");
+                    hs_err_print(PROG, "--pgm: an output file name expected");
                     return 2;
                 }
                 pgm = v;
@@ -256,31 +243,31 @@ int main(int argc, char **argv)
             char *end = NULL;
             bench = v != NULL ? strtol(v, &end, 10) : -1;
             if (v == NULL || *end != '\0' || bench < 1 || bench > 1000000) {
-                err_line("--bench: a count 1..1000000 expected, got '%s'", v != NULL ? v : "(nothing)");
+                hs_err_print(PROG, "--bench: a count 1..1000000 expected, got '%s'", v != NULL ? v : "(nothing)");
                 return 2;
             }
         } else if (a[0] == '-' && a[1] != '\0') {
-            err_line("%s: unknown option (see --help)", a);
+            hs_err_print(PROG, "%s: unknown option (see --help)", a);
             return 2;
         } else if (yaml == NULL) {
             yaml = a;
         } else {
-            err_line("%s: only one map expected (see --help)", a);
+            hs_err_print(PROG, "%s: only one map expected (see --help)", a);
             return 2;
         }
     }
     if (yaml == NULL) {
-        err_line("no map given (see --help)");
+        hs_err_print(PROG, "no map given (see --help)");
         return 2;
     }
     if (!(res > 0) || !(grid > 0)) {
-        err_line("--res and --grid must be > 0");
+        hs_err_print(PROG, "--res and --grid must be > 0");
         return 2;
     }
     char err[1024];
     hs_map_t m;
     if (hs_map_load(yaml, &m, err, sizeof(err)) != 0) {
-        err_line("%s", err);
+        hs_err_print(PROG, "%s", err);
         return 1;
     }
     rfs_map_cfg_t cfg = rfs_map_cfg_default();
@@ -288,7 +275,7 @@ int main(int argc, char **argv)
     cfg.grid = (rfs_q16_t)lround(grid * 65536.0);
     hs_core_map_t c;
     if (hs_map_to_core(&m, res, &cfg, &c, err, sizeof(err)) != 0) {
-        err_line("%s: %s", yaml, err);
+        hs_err_print(PROG, "%s: %s", yaml, err);
         hs_map_free(&m);
         return 1;
     }

@@ -8,7 +8,6 @@
  * else the LCM fallback channel RFS_CAN_FALLBACK). Prints summary.json to stdout.
  */
 #include <errno.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,19 +27,7 @@ static const char usage_text[] =
     "  --max-time S     stop after S simulated seconds (overrides the scenario's stop time)\n"
     "  --help           this text\n";
 
-/* One error line on stderr, "rfseek-sim-lcm: " first: option values, file names, the LCM
- * URL and liblcm's words can hold line breaks (shown as '?'; the project's error rule). */
-static void err_line(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static void err_line(const char *fmt, ...)
-{
-    char msg[1024];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    hs_err_one_line(msg);
-    fprintf(stderr, "rfseek-sim-lcm: %s\n", msg);
-}
+static const char PROG[] = "rfseek-sim-lcm"; /* the prefix of its error lines (hs_err_print) */
 
 int main(int argc, char **argv)
 {
@@ -59,7 +46,7 @@ int main(int argc, char **argv)
         } else if (a[0] != '-' && !scn) {
             scn = a;
         } else if (!v) {
-            err_line("missing value for %s (see --help)", a);
+            hs_err_print(PROG, "missing value for %s (see --help)", a);
             return 2;
         } else if (strcmp(a, "--lcm") == 0) {
             cfg.lcm_url = v, i++;
@@ -69,38 +56,38 @@ int main(int argc, char **argv)
             errno = 0;
             seed = strtoll(v, &end, 10);
             if (errno || *end || seed < 0) {
-                err_line("--seed: '%s' is not a non-negative integer", v);
+                hs_err_print(PROG, "--seed: '%s' is not a non-negative integer", v);
                 return 2;
             }
             i++;
         } else if (strcmp(a, "--max-time") == 0) {
             max_time = strtod(v, &end);
             if (*end || !(max_time > 0 && max_time <= 86400)) {
-                err_line("--max-time: '%s' is not seconds in (0, 86400]", v);
+                hs_err_print(PROG, "--max-time: '%s' is not seconds in (0, 86400]", v);
                 return 2;
             }
             i++;
         } else if (strcmp(a, "--timeout-ms") == 0) {
             long t = strtol(v, &end, 10);
             if (*end || t < 1 || t > 600000) {
-                err_line("--timeout-ms: '%s' is not in 1..600000", v);
+                hs_err_print(PROG, "--timeout-ms: '%s' is not in 1..600000", v);
                 return 2;
             }
             cfg.reply_timeout_ms = (int)t;
             i++;
         } else {
-            err_line("unknown option '%s' (see --help)", a);
+            hs_err_print(PROG, "unknown option '%s' (see --help)", a);
             return 2;
         }
     }
     if (!scn) {
-        err_line("a SCENARIO file is required (see --help)");
+        hs_err_print(PROG, "a SCENARIO file is required (see --help)");
         return 2;
     }
     char err[512];
     hs_scenario_t sc;
     if (hs_scenario_load(scn, &sc, err, sizeof err) != 0) {
-        err_line("%s", err);
+        hs_err_print(PROG, "%s", err);
         return 1;
     }
     if (max_time > 0) {
@@ -109,17 +96,17 @@ int main(int argc, char **argv)
     hs_sim_env_t env;
     memset(&env, 0, sizeof env);
     if (hs_sim_env_open(&env, &sc, err, sizeof err) != 0) {
-        err_line("%s", err);
+        hs_err_print(PROG, "%s", err);
         return 1;
     }
     hs_ctrl_t ctrl;
     if (hs_ctrl_lcm_open(&ctrl, &cfg, err, sizeof err) != 0) {
-        err_line("%s", err);
+        hs_err_print(PROG, "%s", err);
         hs_sim_env_close(&env);
         return 1;
     }
     if (err[0]) { /* liblcm's warning, as one line (hs_ctrl_lcm.h) */
-        err_line("%s", err);
+        hs_err_print(PROG, "%s", err);
     }
     hs_sim_result_t res;
     hs_sim_io_t io;
@@ -128,7 +115,7 @@ int main(int argc, char **argv)
     uint32_t timeouts = hs_ctrl_lcm_timeouts(&ctrl);
     hs_ctrl_close(&ctrl);
     if (rc != 0) {
-        err_line("%s", err);
+        hs_err_print(PROG, "%s", err);
         hs_sim_env_close(&env);
         return 1;
     }

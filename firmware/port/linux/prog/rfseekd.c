@@ -14,7 +14,6 @@
 #include <errno.h>
 #include <inttypes.h>
 #include <signal.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -83,19 +82,7 @@ static void on_signal(int sig)
     g_stop = 1;
 }
 
-/* One line on stderr, "rfseekd: " first: option values, file names, the LCM URL and
- * liblcm's words can hold line breaks (shown as '?'; the project's error rule). */
-static void err_line(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static void err_line(const char *fmt, ...)
-{
-    char msg[1024];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    hs_err_one_line(msg);
-    fprintf(stderr, "rfseekd: %s\n", msg);
-}
+static const char PROG[] = "rfseekd"; /* the prefix of its error lines (hs_err_print) */
 
 static int64_t realtime_us(void)
 {
@@ -256,12 +243,12 @@ static void on_bad(void *ctx, const char *why)
 {
     daemon_t *d = ctx;
     d->bad_msgs++;
-    err_line("dropped LCM message: %s", why);
+    hs_err_print(PROG, "dropped LCM message: %s", why);
 }
 
 static int die(const char *msg, const char *arg)
 {
-    err_line("%s%s", msg, arg ? arg : "");
+    hs_err_print(PROG, "%s%s", msg, arg ? arg : "");
     return 2;
 }
 
@@ -380,7 +367,7 @@ int main(int argc, char **argv)
     cfg.target = strcmp(target, "bridge") == 0 ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
     if (hs_map_load(map_path, &m, err, sizeof err) != 0 || hs_map_to_core(&m, res, &cfg.map, &core, err, sizeof err) != 0) {
         hs_map_free(&m);
-        err_line("%s", err);
+        hs_err_print(PROG, "%s", err);
         return 1;
     }
     // The Linux port holds any model: its state in a heap buffer of the model's size.
@@ -405,7 +392,7 @@ int main(int argc, char **argv)
     memset(&d, 0, sizeof d);
     d.app = malloc(sizeof *d.app);
     if (!d.app || rfs_app_init(d.app, &cfg, &am) != 0) {
-        err_line("%s: the map (%u x %u cells at %.2f m) exceeds the controller's limits (%u bytes per "
+        hs_err_print(PROG, "%s: the map (%u x %u cells at %.2f m) exceeds the controller's limits (%u bytes per "
                  "grid, %u lattice points)",
                  map_path, core.map.w, core.map.h, res, RFS_APP_MAX_MAP_BYTES, RFS_APP_MAX_LATTICE);
         free(d.app);
@@ -425,7 +412,7 @@ int main(int argc, char **argv)
     char dec_tmp[4096];
     snprintf(dec_tmp, sizeof dec_tmp, "%s.tmp.%ld", dec_path ? dec_path : "", (long)getpid());
     if (dec_path && !(d.decisions = fopen(dec_tmp, "w"))) {
-        err_line("%s: cannot write: %s", dec_path, strerror(errno));
+        hs_err_print(PROG, "%s: cannot write: %s", dec_path, strerror(errno));
         rc = 1;
         goto out;
     }
@@ -438,7 +425,7 @@ int main(int argc, char **argv)
     h.on_clock = clock_lcm ? on_clock : NULL;
     h.on_bad = on_bad;
     if (log_path && !(d.rec = hs_lcm_log_open(log_path, "w", err, sizeof err))) {
-        err_line("%s", err);
+        hs_err_print(PROG, "%s", err);
         rc = 1;
         goto out;
     }
@@ -448,12 +435,12 @@ int main(int argc, char **argv)
         memset(&none, 0, sizeof none);
         d.lcm = hs_lcm_open(url, replay ? &none : &h, err, sizeof err);
         if (!d.lcm) {
-            err_line("%s", err);
+            hs_err_print(PROG, "%s", err);
             rc = 1;
             goto out;
         }
         if (err[0]) { /* liblcm's warning, as one line (hs_lcm.h) */
-            err_line("%s", err);
+            hs_err_print(PROG, "%s", err);
         }
         hs_lcm_record(d.lcm, d.rec);
     }
@@ -461,7 +448,7 @@ int main(int argc, char **argv)
         const uint32_t ids[] = {RFS_CAN_ID_WHEEL_CMD, RFS_CAN_ID_STATUS};
         d.can = hs_can_open(can_if, ids, 2, err, sizeof err);
         if (!d.can) {
-            err_line("%s", err);
+            hs_err_print(PROG, "%s", err);
             rc = 1;
             goto out;
         }
@@ -471,7 +458,7 @@ int main(int argc, char **argv)
     if (replay) {
         in = hs_lcm_log_open(replay, "r", err, sizeof err);
         if (!in) {
-            err_line("%s", err);
+            hs_err_print(PROG, "%s", err);
             rc = 1;
             goto out;
         }
@@ -489,7 +476,7 @@ int main(int argc, char **argv)
                 if (url && strncmp(url, "file://", 7) == 0) {
                     break;
                 }
-                err_line("%s: LCM receive failed", url ? url : "(default URL)");
+                hs_err_print(PROG, "%s: LCM receive failed", url ? url : "(default URL)");
                 rc = 1;
                 break;
             }
@@ -518,7 +505,7 @@ int main(int argc, char **argv)
                 if (url && strncmp(url, "file://", 7) == 0) {
                     break;
                 }
-                err_line("%s: LCM receive failed", url ? url : "(default URL)");
+                hs_err_print(PROG, "%s: LCM receive failed", url ? url : "(default URL)");
                 rc = 1;
                 break;
             }
@@ -537,16 +524,16 @@ out:
         hs_lcm_log_close(in);
     }
     if (d.rec && hs_lcm_log_close(d.rec) != 0) {
-        err_line("%s: could not finish the log", log_path);
+        hs_err_print(PROG, "%s: could not finish the log", log_path);
         rc = 1;
     }
     if (d.decisions && d.decisions != stdout) {
         if (fclose(d.decisions) != 0 && rc == 0) {
-            err_line("%s: write failed", dec_path);
+            hs_err_print(PROG, "%s: write failed", dec_path);
             rc = 1;
         }
         if (rc == 0 && rename(dec_tmp, dec_path) != 0) {
-            err_line("%s: %s", dec_path, strerror(errno));
+            hs_err_print(PROG, "%s: %s", dec_path, strerror(errno));
             rc = 1;
         }
         if (rc != 0) {

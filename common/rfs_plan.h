@@ -27,14 +27,27 @@
 /// Most waypoints a plan returns.
 #define RFS_PLAN_MAX_WAYPOINTS 64u
 
+/// The bucket queue of one Dijkstra (rfs_plan_path's, or a search tree's between calls).
+typedef struct rfs_plan_dial {
+    uint32_t head[4];   ///< oldest entry of each ring (index within its quarter of the queue)
+    uint32_t count[4];  ///< entries in each ring (stale ones included)
+    uint32_t cost;      ///< cost of the bucket being drained: half lattice steps
+                        ///< (straight 2, diagonal 3; below 3 * lw * lh)
+    uint32_t pending;   ///< a closed point whose neighbours are not yet relaxed (the
+                        ///< point the last call stopped at), or UINT32_MAX
+    uint32_t peak;      ///< most entries one ring has held
+    bool overflow;      ///< a push found its ring full: the search is void
+} rfs_plan_dial_t;
+
 /// Planner state: caller-owned work arrays sized for the map's lattice.
 typedef struct rfs_plan {
     const rfs_map_t *map;   ///< the map planned on
     uint8_t *work;          ///< lw * lh bytes: visit marks and back-pointers
     uint32_t *queue;        ///< wavefront queue of lattice indices
     uint32_t queue_cap;     ///< its capacity, split in four quarters (2 * (lw + lh) ample: docs/MAPS.md)
-    uint32_t expanded;      ///< lattice points expanded by the last search (for benchmarks)
-    uint32_t queue_peak;    ///< most entries one of the four queue quarters held in the last search
+    uint32_t expanded;      ///< lattice points expanded by the last call (for benchmarks)
+    uint32_t queue_peak;    ///< most entries one of the four queue quarters held in the
+                            ///< last search (a tree: since it was seeded)
     bool exact_edges;       ///< false (init): lattice points and edges from the map's
                             ///< step patterns where it has them; true: positions and
                             ///< rfs_map_segment_legal always (the tests' reference)
@@ -42,6 +55,14 @@ typedef struct rfs_plan {
                             ///< (idx = j * lw + i: bit idx & 7 of byte idx >> 3), a union
                             ///< of whole connected components of the lattice graph
                             ///< (rfs_plan_set_component)
+    rfs_plan_dial_t dial;   ///< the search's queue state
+    rfs_q16_t tree_x;       ///< search tree's root (rfs_plan_tree_begin), metres Q16.16
+    rfs_q16_t tree_y;       ///< metres Q16.16
+    uint32_t tree_root;     ///< its lattice point (idx = j * lw + i) once seeded
+    uint32_t tree_last;     ///< goal point of the path marked in the work bytes, or UINT32_MAX
+    uint8_t tree;           ///< tree state: 0 none (init, rfs_plan_path), 1 begun,
+                            ///< 2 seeded (work holds it), 3 root joins no lattice point
+    bool tree_marks;        ///< the tree keeps its last path marked (legal root)
 } rfs_plan_t;
 
 /// A planned path: waypoints in order, the last one the goal itself.
@@ -62,6 +83,21 @@ int rfs_plan_init(rfs_plan_t *p, const rfs_map_t *map, uint8_t *work, uint32_t w
 /// RFS_PLAN_MAX_WAYPOINTS waypoints (both counted as unreachable; out->n is then 0).
 bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1,
                    rfs_path_t *out);
+
+/// Begin a search tree rooted at (x0, y0), usually the robot, for several goals planned
+/// from the same start (one geodesic epsilon decision). O(1): the root joins the lattice
+/// (as rfs_plan_path joins its start) and the Dijkstra is seeded at the first goal that
+/// needs a search. Any rfs_plan_path call ends the tree (it reuses the work memory).
+void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0);
+
+/// Plan from the tree's root to the legal point (x1, y1): rfs_plan_path's contract and
+/// result cases, but the tree's Dijkstra (from the root) is continued only until the
+/// goal's lattice point is closed, and a goal closed by an earlier call needs no search.
+/// The lattice path may differ from rfs_plan_path's among equal-cost ones (ties); the
+/// waypoints are string pulled from the root forwards, as rfs_plan_path does. A path
+/// depends only on the root and the goal, not on the goals asked before. false, out->n
+/// 0, also when no tree was begun or an rfs_plan_path call ended it.
+bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out);
 
 /// Tell the planner which lattice points are known to be connected: `bits` (NULL: none)
 /// holds one bit per lattice point and must be a union of whole components of the lattice

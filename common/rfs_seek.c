@@ -341,25 +341,44 @@ static bool reachable_point(const rfs_seek_t *s, uint16_t i, uint16_t j)
     return bit_get(s->reach, (uint32_t)j * s->map->lw + i);
 }
 
-/* Plan from the robot to (gx, gy) into the drive's path (not yet driven). false when
- * there is no path. */
-static bool plan_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy)
+/* Where plans start: the robot, or the closest legal lattice point when it stands in the
+ * clearance zone. false when there is none. */
+static bool plan_start(const rfs_seek_t *s, rfs_q16_t *sx, rfs_q16_t *sy)
 {
-    rfs_q16_t sx = s->pose.x, sy = s->pose.y;
-    if (!rfs_map_point_legal(s->map, sx, sy)) {
+    *sx = s->pose.x;
+    *sy = s->pose.y;
+    if (!rfs_map_point_legal(s->map, *sx, *sy)) {
         uint16_t i, j;
-        if (!snap_legal(s, sx, sy, false, &i, &j)) {
+        if (!snap_legal(s, *sx, *sy, false, &i, &j)) {
             return false;
         }
-        rfs_map_lattice_point(s->map, i, j, &sx, &sy);
+        rfs_map_lattice_point(s->map, i, j, sx, sy);
+    }
+    return true;
+}
+
+/* Plan from the robot to (gx, gy) into the drive's path (not yet driven). false when
+ * there is no path. With `tree`, from the search tree choose_epsilon began at
+ * plan_start (rfs_plan_tree_path: same contract). */
+static bool plan_to_from(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, bool tree)
+{
+    rfs_q16_t sx, sy;
+    if (!tree && !plan_start(s, &sx, &sy)) {
+        return false;
     }
     /* Plan straight into the drive's own path: a 520-byte rfs_path_t on the stack would
      * overflow the microcontroller's 2.5 KB stack during a decision. */
-    if (!rfs_plan_path(&s->plan, sx, sy, gx, gy, &s->drive.path)) {
+    if (tree ? !rfs_plan_tree_path(&s->plan, gx, gy, &s->drive.path)
+             : !rfs_plan_path(&s->plan, sx, sy, gx, gy, &s->drive.path)) {
         return false;
     }
     s->decision.path_len = s->drive.path.length;
     return true;
+}
+
+static bool plan_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy)
+{
+    return plan_to_from(s, gx, gy, false);
 }
 
 /* Plan to (gx, gy) and drive the path. */
@@ -443,6 +462,15 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     uint16_t ci, cj;
     rfs_map_lattice_nearest(m, s->pose.x, s->pose.y, &ci, &cj);
     const int32_t r = RFS_SEEK_EPS_RADIUS;
+    /* Geodesic: every try plans from the robot, so one search tree rooted there serves
+     * them all (resumed out to each goal; a goal it already reached costs no search).
+     * No tree when the robot has no legal start: every plan then fails, as plan_to's. */
+    const bool tree = s->cfg.eps_geodesic;
+    rfs_q16_t sx, sy;
+    const bool tree_ok = tree && plan_start(s, &sx, &sy);
+    if (tree_ok) {
+        rfs_plan_tree_begin(&s->plan, sx, sy);
+    }
     for (int attempt = 0; attempt < GOAL_TRIES; ++attempt) {
         /* Scaling: weights Q0.16 <= 65535, at most 65^2 candidates: sum < 2^28. */
         uint32_t total = 0;
@@ -474,7 +502,8 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
                         rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
                         s->decision.goal_x = px;
                         s->decision.goal_y = py;
-                        if (plan_to(s, px, py)) {
+                        if (tree ? tree_ok && plan_to_from(s, px, py, true)
+                                 : plan_to(s, px, py)) {
                             /* A rejected draw never reaches the drive. */
                             if (!s->cfg.eps_geodesic || attempt == GOAL_TRIES - 1 ||
                                 accept_detour(s, rng, q)) {

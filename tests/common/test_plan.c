@@ -97,6 +97,8 @@ static int ref_seg(double x0, double y0, double x1, double y1)
     return 1;
 }
 
+static void build_finish(void);
+
 static void build(uint32_t seed, int nrect, int enclose)
 {
     memset(&wd, 0, sizeof(wd));
@@ -127,6 +129,11 @@ static void build(uint32_t seed, int nrect, int enclose)
             wd.free_c[a - 60][80] = wd.free_c[a - 60][100] = 0;
         }
     }
+    build_finish();
+}
+
+static void build_finish(void)
+{
     for (int y = 0; y < H; y++) {
         for (int x = 0; x < W; x++) {
             rfs_map_bit_set(wd.free_bits, STRIDE, (uint16_t)x, (uint16_t)y, wd.free_c[y][x]);
@@ -137,7 +144,8 @@ static void build(uint32_t seed, int nrect, int enclose)
     ref_legal_cells();
 }
 
-/* Reference Dijkstra over the lattice in double; returns the distance or INFINITY. */
+/* Reference Dijkstra over the lattice in double; returns the distance or INFINITY. With
+ * gi < 0 it runs to the end: dist_ref then holds every point's distance (Q16 units). */
 #define LMAX 4096
 static double dist_ref[LMAX];
 static int done_ref[LMAX];
@@ -160,7 +168,7 @@ static double ref_dijkstra(int lw, int lh, int si, int sj, int gi, int gj)
         if (u < 0 || isinf(dist_ref[u])) {
             return INFINITY;
         }
-        if (u == gj * lw + gi) {
+        if (gi >= 0 && u == gj * lw + gi) {
             return dist_ref[u] / 65536.0;
         }
         done_ref[u] = 1;
@@ -422,6 +430,384 @@ static void test_init_rejects(void **state)
     assert_int_equal(rfs_plan_init(&p, &wd.m, work, need, queue, 8), 0);
 }
 
+/* Maps for the search-tree tests: 0 random walls (14 strips), 1 the same with the closed
+ * room, 2 speckled (about 0.4 % of the cells single obstacles), 3 rooms (walls at x = 4 m
+ * and 8 m and y = 4 m, each stretch with a 1 m door at random), 4 the wall map (one wall
+ * along y = 4 m from the west edge, the way round a 1.5 m gap at the east end). */
+static void build_kind(int kind, uint32_t seed)
+{
+    if (kind <= 1) {
+        build(seed * 7919u, 14, kind);
+        return;
+    }
+    memset(&wd, 0, sizeof(wd));
+    for (int y = 0; y < H; y++) {
+        for (int x = 0; x < W; x++) {
+            wd.free_c[y][x] = kind != 2 || lcg(&seed) % 1000u >= 4u;
+        }
+    }
+    if (kind == 3) {
+        for (int a = 0; a < H; a++) {
+            wd.free_c[a][40] = wd.free_c[a][80] = 0;
+        }
+        for (int a = 0; a < W; a++) {
+            wd.free_c[40][a] = 0;
+        }
+        /* Doors: two per vertical wall (below and above y = 4 m), three in the other. */
+        for (int k = 0; k < 2; k++) {
+            for (int h = 0; h < 2; h++) {
+                int y0 = h * 40 + 2 + (int)(lcg(&seed) % 26u);
+                for (int t = 0; t < 10; t++) {
+                    wd.free_c[y0 + t][40 + 40 * k] = 1;
+                }
+            }
+        }
+        for (int k = 0; k < 3; k++) {
+            int x0 = k * 40 + 2 + (int)(lcg(&seed) % 26u);
+            for (int t = 0; t < 10; t++) {
+                wd.free_c[40][x0 + t] = 1;
+            }
+        }
+    } else if (kind == 4) {
+        for (int a = 0; a < W - 15; a++) {
+            wd.free_c[40][a] = wd.free_c[41][a] = 0;
+        }
+    }
+    build_finish();
+}
+
+/* Independent reference of the planner's own lattice costs: Dijkstra in integers with
+ * straight steps 2 and diagonal steps 3 over the reference's edges (ref_step). */
+static int oct_ref[LMAX];
+
+static void ref_octile(int lw, int lh, int si, int sj)
+{
+    static int done[LMAX];
+    for (int k = 0; k < lw * lh; k++) {
+        oct_ref[k] = INT32_MAX;
+        done[k] = 0;
+    }
+    oct_ref[sj * lw + si] = 0;
+    for (;;) {
+        int u = -1;
+        for (int k = 0; k < lw * lh; k++) {
+            if (!done[k] && oct_ref[k] < INT32_MAX && (u < 0 || oct_ref[k] < oct_ref[u])) {
+                u = k;
+            }
+        }
+        if (u < 0) {
+            return;
+        }
+        done[u] = 1;
+        int ui = u % lw, uj = u / lw;
+        for (int dj = -1; dj <= 1; dj++) {
+            for (int di = -1; di <= 1; di++) {
+                int vi = ui + di, vj = uj + dj;
+                if ((di == 0 && dj == 0) || vi < 0 || vj < 0 || vi >= lw || vj >= lh) {
+                    continue;
+                }
+                int v = vj * lw + vi, c = oct_ref[u] + (di != 0 && dj != 0 ? 3 : 2);
+                if (!done[v] && c < oct_ref[v] && ref_step(NULL, ui, uj, vi, vj)) {
+                    oct_ref[v] = c;
+                }
+            }
+        }
+    }
+}
+
+/* Reference points of octile cost below / at most c (c INT32_MAX: every reachable one). */
+static void oct_count(int n, int c, int *below, int *upto)
+{
+    *below = *upto = 0;
+    for (int k = 0; k < n; k++) {
+        *below += oct_ref[k] < c || (c == INT32_MAX && oct_ref[k] < INT32_MAX);
+        *upto += oct_ref[k] <= c && oct_ref[k] < INT32_MAX;
+    }
+}
+
+static void assert_same_path(const rfs_path_t *a, const rfs_path_t *b)
+{
+    assert_int_equal(a->n, b->n);
+    assert_int_equal(a->length, b->length);
+    assert_memory_equal(a->x, b->x, a->n * sizeof(a->x[0]));
+    assert_memory_equal(a->y, b->y, a->n * sizeof(a->y[0]));
+}
+
+typedef struct tree_stats {
+    int goals, searched, reached, unreached, los, free_hits, illegal_roots;
+    double worst_ratio;    /* tree path length / reference lattice optimum */
+    double worst_diff_m;   /* |tree path - rfs_plan_path path|, metres */
+    double worst_diff_rel; /* the same over the rfs_plan_path length */
+    double sum_signed;     /* sum of tree path - rfs_plan_path path, metres */
+    int longer, shorter;   /* tree paths longer / shorter than rfs_plan_path's */
+} tree_stats_t;
+
+#define TREE_GOALS 8
+
+/* Trees from several robot positions on one map, a sequence of goals each: every result
+ * against the double-precision references (reachability: ref_flood; legality: ref_seg;
+ * length: ref_dijkstra; expanded points: the integer octile Dijkstra), against
+ * rfs_plan_path for the same start and goal, and against a fresh tree per goal and the
+ * goals asked again in reverse order (same paths, bit for bit). Every third tree starts
+ * off the lattice (a robot between lattice points) and every third inside the clearance
+ * zone (a robot pushed there: its first hop is taken as it is, as rfs_plan_path takes
+ * it); there the lattice references do not apply and rfs_plan_path is the comparison. */
+static void check_trees(int kind, uint32_t seed, int trees, tree_stats_t *st)
+{
+    build_kind(kind, seed);
+    const int lw = wd.m.lw, lh = wd.m.lh, n = lw * lh;
+    const double g = (double)wd.m.cfg.grid;
+    assert_true(n <= LMAX);
+    static uint8_t work_f[LMAX], work_p[LMAX];
+    static uint32_t queue_f[1024], queue_p[1024];
+    rfs_plan_t t, f, pp;
+    assert_int_equal(rfs_plan_init(&t, &wd.m, work, sizeof(work), queue, 1024), 0);
+    assert_int_equal(rfs_plan_init(&f, &wd.m, work_f, sizeof(work_f), queue_f, 1024), 0);
+    assert_int_equal(rfs_plan_init(&pp, &wd.m, work_p, sizeof(work_p), queue_p, 1024), 0);
+    uint32_t rs = seed * 31u + (uint32_t)kind;
+    for (int tr = 0; tr < trees; tr++) {
+        const bool on_lattice = tr % 3 == 0, illegal = tr % 3 == 2;
+        int si, sj;
+        random_legal(&rs, lw, lh, &si, &sj);
+        rfs_q16_t x0 = (rfs_q16_t)(g / 2 + si * g), y0 = (rfs_q16_t)(g / 2 + sj * g);
+        if (illegal) {
+            /* A point of the clearance zone: from lattice points next to it, 0.1 m steps
+             * in a random direction until one is illegal (inside the map). */
+            rfs_q16_t ox, oy;
+            const rfs_q16_t dm = RFS_Q16_FRAC(1, 10);
+            do {
+                random_legal(&rs, lw, lh, &si, &sj);
+                const int dx = (int)(lcg(&rs) % 3u) - 1, dy = (int)(lcg(&rs) % 3u) - 1;
+                ox = (rfs_q16_t)(g / 2 + si * g);
+                oy = (rfs_q16_t)(g / 2 + sj * g);
+                for (int a = 0; a < 5 && rfs_map_point_legal(&wd.m, ox, oy); a++) {
+                    ox += dx * dm;
+                    oy += dy * dm;
+                }
+            } while (ox <= 0 || oy <= 0 || ox >= W * RES || oy >= H * RES ||
+                     rfs_map_point_legal(&wd.m, ox, oy));
+            x0 = ox;
+            y0 = oy;
+            st->illegal_roots++;
+        } else if (!on_lattice) {
+            rfs_q16_t ox, oy;
+            do {
+                ox = x0 + (rfs_q16_t)(lcg(&rs) % (uint32_t)g) - (rfs_q16_t)(g / 2);
+                oy = y0 + (rfs_q16_t)(lcg(&rs) % (uint32_t)g) - (rfs_q16_t)(g / 2);
+            } while (!rfs_map_point_legal(&wd.m, ox, oy));
+            x0 = ox;
+            y0 = oy;
+        } else {
+            (void)ref_dijkstra(lw, lh, si, sj, -1, -1);
+            ref_octile(lw, lh, si, sj);
+            ref_component(lw, lh, si, sj);
+        }
+        int gi[TREE_GOALS], gj[TREE_GOALS];
+        rfs_path_t pt[TREE_GOALS];
+        bool okt[TREE_GOALS];
+        int c_max = -1;      /* largest octile cost of a goal searched for so far */
+        uint32_t total = 0;  /* points the tree has expanded */
+        rfs_plan_tree_begin(&t, x0, y0);
+        for (int k = 0; k < TREE_GOALS; k++) {
+            random_legal(&rs, lw, lh, &gi[k], &gj[k]);
+            const int gv = gj[k] * lw + gi[k];
+            const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi[k] * g), y1 = (rfs_q16_t)(g / 2 + gj[k] * g);
+            okt[k] = rfs_plan_tree_path(&t, x1, y1, &pt[k]);
+            const uint32_t e = t.expanded;
+            total += e;
+            const bool los = ref_seg(x0, y0, x1, y1);
+            st->goals++;
+            /* rfs_plan_path from the same start: the same reachability. */
+            rfs_path_t pb;
+            const bool okp = rfs_plan_path(&pp, x0, y0, x1, y1, &pb);
+            assert_int_equal(okt[k], okp);
+            if (los) {
+                st->los++;
+                assert_true(okt[k]);
+                assert_int_equal(pt[k].n, 1);
+                assert_int_equal(e, 0);
+            }
+            if (on_lattice && !los) {
+                const bool in = (comp_bits[gv >> 3] >> (gv & 7)) & 1;
+                assert_int_equal(okt[k], in); /* the reference flood */
+                assert_int_equal(in, oct_ref[gv] < INT32_MAX);
+                assert_int_equal(in, !isinf(dist_ref[gv]));
+                const int c = in ? oct_ref[gv] : INT32_MAX;
+                if (c < c_max) {
+                    /* Closed on the way to an earlier goal: no search. */
+                    assert_int_equal(e, 0);
+                    st->free_hits++;
+                }
+                c_max = c > c_max ? c : c_max;
+                /* Every point cheaper than the farthest goal yet is closed, none dearer. */
+                int below, upto;
+                oct_count(n, c_max, &below, &upto);
+                assert_true((int)total >= below && (int)total <= upto);
+                st->searched++;
+            }
+            if (!okt[k]) {
+                st->unreached++;
+                assert_int_equal(pt[k].n, 0);
+                continue;
+            }
+            st->reached++;
+            assert_true(pt[k].n >= 1);
+            assert_int_equal(pt[k].x[pt[k].n - 1], x1);
+            assert_int_equal(pt[k].y[pt[k].n - 1], y1);
+            double len = 0, px = x0, py = y0;
+            for (int w = 0; w < pt[k].n; w++) {
+                if (illegal && w == 0) {
+                    /* The hop out of the clearance zone: to a legal point 2 lattice
+                     * steps away at most (rfs_plan_path's escape join). */
+                    assert_true(rfs_map_point_legal(&wd.m, pt[k].x[0], pt[k].y[0]));
+                    assert_true(hypot(pt[k].x[0] - px, pt[k].y[0] - py) <= 2 * sqrt(2.0) * g + 2 * g);
+                } else {
+                    assert_true(ref_seg(px, py, pt[k].x[w], pt[k].y[w]));
+                    assert_true(rfs_map_segment_legal(&wd.m, (rfs_q16_t)px, (rfs_q16_t)py,
+                                                      pt[k].x[w], pt[k].y[w]));
+                }
+                len += hypot(pt[k].x[w] - px, pt[k].y[w] - py) / 65536.0;
+                px = pt[k].x[w];
+                py = pt[k].y[w];
+            }
+            assert_true(fabs(pt[k].length / 65536.0 - len) < 1e-3 * (1 + pt[k].n));
+            assert_true(len >= hypot(x1 - x0, y1 - y0) / 65536.0 - 1e-4);
+            if (on_lattice) {
+                const double want = dist_ref[gv] / 65536.0;
+                assert_true(len <= want * 1.06 + 1e-3);
+                if (want > 0 && len / want > st->worst_ratio) {
+                    st->worst_ratio = len / want;
+                }
+            }
+            const double diff = fabs((double)pt[k].length - pb.length) / 65536.0;
+            /* Ties among equal-cost lattice paths pull differently (either way). */
+            assert_true(diff < 0.75);
+            st->worst_diff_m = diff > st->worst_diff_m ? diff : st->worst_diff_m;
+            st->sum_signed += ((double)pt[k].length - pb.length) / 65536.0;
+            st->longer += pt[k].length > pb.length;
+            st->shorter += pt[k].length < pb.length;
+            if (pb.length > 0 && diff * 65536.0 / pb.length > st->worst_diff_rel) {
+                st->worst_diff_rel = diff * 65536.0 / pb.length;
+            }
+            /* A fresh tree for this goal alone: the same path. */
+            rfs_path_t pf;
+            rfs_plan_tree_begin(&f, x0, y0);
+            assert_true(rfs_plan_tree_path(&f, x1, y1, &pf));
+            assert_same_path(&pt[k], &pf);
+        }
+        /* The same goals again, reversed, on a new tree: the same paths and results. */
+        rfs_plan_tree_begin(&t, x0, y0);
+        for (int k = TREE_GOALS - 1; k >= 0; k--) {
+            const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi[k] * g), y1 = (rfs_q16_t)(g / 2 + gj[k] * g);
+            rfs_path_t pr;
+            assert_int_equal(rfs_plan_tree_path(&t, x1, y1, &pr), okt[k]);
+            if (okt[k]) {
+                assert_same_path(&pt[k], &pr);
+            }
+        }
+    }
+}
+
+/* rfs_plan_tree_begin / rfs_plan_tree_path on five kinds of map. */
+static void test_tree_paths(void **state)
+{
+    (void)state;
+    tree_stats_t st;
+    memset(&st, 0, sizeof(st));
+    for (int kind = 0; kind <= 4; kind++) {
+        for (uint32_t s = 1; s <= (kind <= 1 ? 3u : 2u); s++) {
+            check_trees(kind, s, 12, &st);
+        }
+    }
+    print_message("trees %d (%d rooted in the clearance zone), goals %d (line of sight %d, "
+                  "searched from a lattice root %d, of them already closed %d), reached %d, "
+                  "unreached %d; worst length / reference %.4f; largest |tree - "
+                  "rfs_plan_path| %.4f m (%.2f %%)\n", 12 * 12, st.illegal_roots,
+                  st.goals, st.los, st.searched, st.free_hits, st.reached, st.unreached,
+                  st.worst_ratio, st.worst_diff_m, 100 * st.worst_diff_rel);
+    print_message("tree paths longer than rfs_plan_path's %d, shorter %d, mean difference "
+                  "%+.4f m\n", st.longer, st.shorter, st.sum_signed / st.reached);
+    assert_true(st.searched >= 200 && st.free_hits >= 40 && st.unreached >= 10);
+    assert_true(st.reached >= 300 && st.los >= 20 && st.illegal_roots >= 40);
+    /* No bias: either direction's ties are as likely to be longer as shorter. */
+    assert_true(fabs(st.sum_signed / st.reached) < 0.02);
+}
+
+/* The tree's edges: no tree, a tree ended by rfs_plan_path, a root that joins no lattice
+ * point, a goal outside the root's component (refused without a search), an illegal goal,
+ * and a queue too small (refused, never overrun, the tree void afterwards). */
+static void test_tree_misuse_and_limits(void **state)
+{
+    (void)state;
+    build_kind(4, 1); /* the wall map: (2, 2) m to (2, 6) m goes round the wall's end */
+    rfs_plan_t p;
+    assert_int_equal(rfs_plan_init(&p, &wd.m, work, sizeof(work), queue, 1024), 0);
+    const rfs_q16_t m1 = RFS_Q16_INT(1);
+    rfs_path_t path;
+    path.n = 7;
+    assert_false(rfs_plan_tree_path(&p, 2 * m1, 6 * m1, &path)); /* never begun */
+    assert_int_equal(path.n, 0);
+    rfs_plan_tree_begin(&p, 2 * m1, 2 * m1);
+    assert_true(rfs_plan_tree_path(&p, 2 * m1, 6 * m1, &path));
+    /* Round the wall's end: the cells within 0.25 m of it reach x = 10.7 m, so the path
+     * crosses y 4.0 .. 4.2 m east of that: at least hypot(8.7, 2) + 0.2 + hypot(8.7, 1.8)
+     * m; its waypoints are lattice points (0.25 m apart) there, so at most 0.7 m more. */
+    const double taut = hypot(8.7, 2.0) + 0.2 + hypot(8.7, 1.8);
+    const double round = path.length / 65536.0;
+    print_message("round the wall's end: %.4f m (at least %.4f m)\n", round, taut);
+    assert_true(round >= taut && round < taut + 0.7);
+    assert_true(p.expanded > 0);
+    rfs_path_t again;
+    assert_true(rfs_plan_tree_path(&p, 2 * m1, 6 * m1, &again));
+    assert_int_equal(p.expanded, 0);
+    assert_same_path(&path, &again);
+    assert_false(rfs_plan_tree_path(&p, 2 * m1, 4 * m1, &again)); /* on the wall: illegal */
+    assert_true(rfs_plan_path(&p, 2 * m1, 2 * m1, 3 * m1, 2 * m1, &again));
+    again.n = 7;
+    assert_false(rfs_plan_tree_path(&p, 2 * m1, 6 * m1, &again)); /* ended by rfs_plan_path */
+    assert_int_equal(again.n, 0);
+
+    /* A root inside the wall (illegal, no legal point within its 5 x 5): no path. */
+    build(5, 0, 0);
+    for (int y = 20; y < 60; y++) {
+        for (int x = 20; x < 60; x++) {
+            wd.free_c[y][x] = 0;
+        }
+    }
+    build_finish();
+    assert_int_equal(rfs_plan_init(&p, &wd.m, work, sizeof(work), queue, 1024), 0);
+    rfs_plan_tree_begin(&p, 4 * m1, 4 * m1);
+    assert_false(rfs_plan_tree_path(&p, 7 * m1, 7 * m1, &path));
+    assert_false(rfs_plan_tree_path(&p, 8 * m1, 7 * m1, &path));
+    assert_int_equal(p.expanded, 0);
+
+    /* The closed room and its component marks: refused without a search from outside. */
+    build(5, 0, 1);
+    assert_int_equal(rfs_plan_init(&p, &wd.m, work, sizeof(work), queue, 1024), 0);
+    const int lw = wd.m.lw, lh = wd.m.lh;
+    ref_component(lw, lh, 8, 8); /* (2.125, 2.125) m, outside the room */
+    rfs_plan_set_component(&p, comp_bits);
+    rfs_plan_tree_begin(&p, 2 * m1, 2 * m1);
+    assert_false(rfs_plan_tree_path(&p, 9 * m1, 3 * m1, &path));
+    assert_int_equal(p.expanded, 0);
+    rfs_plan_set_component(&p, NULL);
+    assert_false(rfs_plan_tree_path(&p, 9 * m1, 3 * m1, &path)); /* floods the outside */
+    assert_true(p.expanded > 1000);
+    assert_true(rfs_plan_tree_path(&p, 7 * m1, 3 * m1, &path)); /* all closed by then */
+    assert_int_equal(p.expanded, 0);
+
+    /* A queue too small: refused, the guard words intact, later goals refused too. */
+    build_kind(4, 1);
+    static uint32_t small[8 + 4];
+    small[8] = small[9] = small[10] = small[11] = 0xA5A5A5A5u;
+    assert_int_equal(rfs_plan_init(&p, &wd.m, work, sizeof(work), small, 8), 0);
+    rfs_plan_tree_begin(&p, 2 * m1, 2 * m1);
+    assert_false(rfs_plan_tree_path(&p, 2 * m1, 6 * m1, &path));
+    assert_false(rfs_plan_tree_path(&p, 3 * m1, 6 * m1, &path));
+    assert_int_equal(small[8], 0xA5A5A5A5u);
+    assert_int_equal(small[11], 0xA5A5A5A5u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -431,6 +817,8 @@ int main(void)
         cmocka_unit_test(test_queue_overflow),
         cmocka_unit_test(test_line_of_sight),
         cmocka_unit_test(test_init_rejects),
+        cmocka_unit_test(test_tree_paths),
+        cmocka_unit_test(test_tree_misuse_and_limits),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

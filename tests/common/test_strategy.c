@@ -828,7 +828,8 @@ static double geo_far_prob(bool geodesic, double excess, int *ncand)
 /* n epsilon decisions, each from a freshly initialised seeker at the robot's point: the
  * first decision (the initial move) finds no goal (initial_step_max below one lattice
  * step), the second is the epsilon draw (epsilon = 1). Returns the far-side count. When
- * check_plan, also plans to every far candidate and asserts taut <= L <= taut + excess. */
+ * check_plan, also plans to every far candidate and asserts taut <= L <= taut + excess,
+ * with rfs_plan_path and with the search tree the geodesic decision plans with. */
 static int geo_far_draws(bool geodesic, int n, bool check_plan)
 {
     world_t t;
@@ -855,18 +856,33 @@ static int geo_far_draws(bool geodesic, int n, bool check_plan)
         assert_int_equal(out.faults & RFS_SEEK_FAULT_NO_GOAL, 0);
         far += geo_far(D(out.decision.goal_x), D(out.decision.goal_y));
     }
-    for (int j = 0; check_plan && j < t.map.lh; ++j) {
-        for (int i = 0; i < t.map.lw; ++i) {
-            double x, y, d;
-            if (!geo_candidate(i, j, t.w, t.h, &x, &y, &d) || !geo_far(x, y)) {
-                continue;
-            }
-            assert_true(rfs_map_lattice_legal(&t.map, (uint16_t)i, (uint16_t)j));
-            rfs_path_t p;
-            assert_true(rfs_plan_path(&t.seek.plan, Q(GEO_RX), Q(GEO_RY), Q(x), Q(y), &p));
-            double l = geo_taut(x, y, GEO_OB_X0, GEO_OB_X1, GEO_OB_Y1);
-            assert_true(D(p.length) > l - 1e-3 && D(p.length) < l + GEO_EXCESS);
+    /* Both planners the seeker uses: rfs_plan_path (pass 0) and, as the geodesic
+     * decision plans, one search tree from the robot for every goal (pass 1). */
+    double worst[2] = { 0.0, 0.0 };
+    for (int pass = 0; check_plan && pass < 2; ++pass) {
+        if (pass == 1) {
+            rfs_plan_tree_begin(&t.seek.plan, Q(GEO_RX), Q(GEO_RY));
         }
+        for (int j = 0; j < t.map.lh; ++j) {
+            for (int i = 0; i < t.map.lw; ++i) {
+                double x, y, d;
+                if (!geo_candidate(i, j, t.w, t.h, &x, &y, &d) || !geo_far(x, y)) {
+                    continue;
+                }
+                assert_true(rfs_map_lattice_legal(&t.map, (uint16_t)i, (uint16_t)j));
+                rfs_path_t p;
+                assert_true(pass == 0 ? rfs_plan_path(&t.seek.plan, Q(GEO_RX), Q(GEO_RY), Q(x),
+                                                      Q(y), &p)
+                                      : rfs_plan_tree_path(&t.seek.plan, Q(x), Q(y), &p));
+                double l = geo_taut(x, y, GEO_OB_X0, GEO_OB_X1, GEO_OB_Y1);
+                assert_true(D(p.length) > l - 1e-3 && D(p.length) < l + GEO_EXCESS);
+                worst[pass] = D(p.length) - l > worst[pass] ? D(p.length) - l : worst[pass];
+            }
+        }
+    }
+    if (check_plan) {
+        print_message("largest excess over the taut length: rfs_plan_path %.3f m, tree %.3f m\n",
+                      worst[0], worst[1]);
     }
     world_free(&t);
     return far;

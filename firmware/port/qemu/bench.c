@@ -73,8 +73,10 @@ static void fill_store(rfs_store_t *st, uint64_t seed)
  * epsilon radius (visited bits), so every candidate lies north of the wall, at most 8 m
  * away in a straight line and at least 35 + 27 = 62 m away by the gap: every detour
  * exceeds 13 m, where e^(-detour) is 0 in Q16 (rfs_q16_exp_neg), draws 1 to 5 are
- * rejected and the sixth is kept. Each plan is a Dijkstra from the goal round the wall
- * back to the start, over nearly the whole lattice. */
+ * rejected and the sixth is kept. The six plans share one search tree rooted at the
+ * robot (rfs_plan_tree_path): its Dijkstra round the wall over nearly the whole lattice
+ * is resumed for each goal, and each path is pulled only from where it leaves the
+ * previous one. */
 #define GEO_WALL_ROW 79u   /* cells: the wall is rows 79 and 80, y 9.875 .. 10.125 m */
 #define GEO_WALL_END 288u  /* cells: it ends at x = 36 m */
 #define GEO_RI 4u          /* the robot's lattice point: x = 0.125 + 4 x 0.25 m */
@@ -153,7 +155,9 @@ static uint32_t geo_scan(const rfs_seek_t *s, uint16_t ci, uint16_t cj, uint32_t
  * the random source taken just before the step, on the step's own visited, reach and
  * weight tables (a draw changes them only when a plan fails, and then the replayed goal
  * differs): the epsilon coin (finish_decision), then per try one weighted pick, one plan
- * and, geodesic and not the last try, one detour test. Returns the plans; the kept goal
+ * and, geodesic and not the last try, one detour test (its plans by rfs_plan_path, not
+ * the decision's search tree: lengths may differ by a tie of the lattice path, detours
+ * here all exceed 13 m either way). Returns the plans; the kept goal
  * in *gx, *gy; the smallest detour of a tested draw in *min_detour (metres Q16.16,
  * INT64_MAX when none was tested). Scaling: the straight distance grid * sqrt(q) as
  * rfs_seek.c's offset_dist (Q16 x Q16 >> 16); path lengths <= 32 km, so the detour fits
@@ -774,8 +778,8 @@ int main(void)
     rfs_bc_report("sliced_goal_x_cm", 0, (uint32_t)((out.decision.goal_x * 100) >> 16));
 
     /* The meta-path epsilon decision behind a wall (geo_decision), geodesic and not, and
-     * the paper's configuration's, side by side; then one of its plans alone: from the robot to the geodesic decision's
-     * kept goal. */
+     * the paper's configuration's, side by side; then one of its plans alone: from the
+     * robot to the geodesic decision's kept goal, by rfs_plan_path and by a search tree. */
     geo_wall();
     rfs_q16_t gx, gy, sx, sy; /* the kept goals; the plan alone goes to the geodesic one */
     static const geo_rows_t geo_on = {
@@ -801,6 +805,21 @@ int main(void)
     rfs_bc_report("plan_behind_wall_ok", 0, geo_ok ? 1u : 0u);
     rfs_bc_report("plan_behind_wall_expanded", 0, s_app.seek.plan.expanded);
     rfs_bc_report("plan_behind_wall_path_cm", 0, (uint32_t)((path.length * 100) >> 16));
+    /* The same goal by a fresh search tree from the robot (the geodesic decision's first
+     * try), then a second goal on that tree (the straight decision's kept goal, also
+     * north of the wall: the search resumed, the path pulled from where it parts). */
+    RFS_BC_MEASURE("phase_tree_behind_wall", 1, {
+        rfs_plan_tree_begin(&s_app.seek.plan, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(69, 8));
+        geo_ok = rfs_plan_tree_path(&s_app.seek.plan, gx, gy, &path);
+    });
+    rfs_bc_report("tree_behind_wall_ok", 0, geo_ok ? 1u : 0u);
+    rfs_bc_report("tree_behind_wall_expanded", 0, s_app.seek.plan.expanded);
+    rfs_bc_report("tree_behind_wall_path_cm", 0, (uint32_t)((path.length * 100) >> 16));
+    RFS_BC_MEASURE("phase_tree_second_goal", 1,
+                   geo_ok = rfs_plan_tree_path(&s_app.seek.plan, sx, sy, &path));
+    rfs_bc_report("tree_second_goal_ok", 0, geo_ok ? 1u : 0u);
+    rfs_bc_report("tree_second_goal_expanded", 0, s_app.seek.plan.expanded);
+    rfs_bc_report("tree_second_goal_path_cm", 0, (uint32_t)((path.length * 100) >> 16));
 
     ls_measure(&map);
     rfs_sh_exit(0);

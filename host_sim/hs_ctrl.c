@@ -8,6 +8,7 @@
 #include <math.h>
 
 #include "rfs_models.h"
+#include "rfs_pathloss.h"
 #include "rfs_pdr.h"
 #include "rfs_ridge.h"
 
@@ -26,6 +27,7 @@ hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void)
     c.target = "rssi";
     c.seed = 1;
     c.period_us = 50000;
+    c.p0_min_dbm = NAN;
     return c;
 }
 
@@ -158,6 +160,16 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
         if (rfs_ridge_init(p->model_state, &rc) != 0) {
             ip_close(p);
             snprintf(err, errlen, "model: ridge: map-wide radius rejected");
+            return -1;
+        }
+    }
+    if (me->ops == &rfs_pathloss_ops && !isnan(cfg->p0_min_dbm)) {
+        // The node's transmit power, when known, bounds P0 (docs/PATHLOSS.md "The P0 floor").
+        rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
+        pc.p0_min = (rfs_q16_t)lround(fmax(-200.0, fmin(100.0, cfg->p0_min_dbm)) * 65536.0);
+        if (rfs_pathloss_init(p->model_state, &pc) != 0) {
+            ip_close(p);
+            snprintf(err, errlen, "model: pathloss: p0_min_dbm %g rejected", cfg->p0_min_dbm);
             return -1;
         }
     }

@@ -60,6 +60,8 @@ typedef struct hs_ctrl_inproc_cfg {
                             ///< "pdr" (one; measurements are rfs_pdr_value() percentages)
     uint64_t seed;          ///< seed of the controller's own randomness (epsilon moves)
     int64_t period_us;      ///< control period, microseconds (50,000)
+    double p0_min_dbm;      ///< pathloss model only: floor on the signal at 1 m, dBm, in
+                            ///< [-200, 100] (NAN: the model's default, -45)
 } hs_ctrl_inproc_cfg_t;
 
 /// Defaults: the paper's seeker, local ridge, RSSI of one source, 20 Hz.

@@ -8,7 +8,7 @@
  *   strategy: meta                 # meta (the paper), meta-global, fd-gradient,
  *                                  # plane-gradient, chemotaxis, meta-path
  *   seek: {recheck_m: 1.0, eps_by_travel: true, eps_rate: 0.162, eps_geodesic: true,
- *                                  #       recheck_adapt: true}
+ *                                  #       recheck_adapt: true, p0_min_dbm: -32}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2
@@ -71,6 +71,9 @@ typedef struct hs_scenario {
     int seek_recheck_adapt;       ///< seek.recheck_adapt: 0 / 1 (-1 = the strategy's preset)
     double seek_eps_rate;         ///< seek.eps_rate: epsilon's decay per iteration (-1 = the
                                   ///< paper's ln(9/4)/5, epsilon(5) = 0.5)
+    double seek_p0_min_dbm;       ///< seek.p0_min_dbm: the pathloss model's floor on the
+                                  ///< signal at 1 m, dBm (NAN = its default, -45; other
+                                  ///< models ignore it; docs/PATHLOSS.md "The P0 floor")
     unsigned nsources;            ///< sources
     hs_scn_source_t src[HS_SCN_MAX_SOURCES]; ///< the sources
     double start_x, start_y;      ///< robot start, metres

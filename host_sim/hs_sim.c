@@ -826,6 +826,7 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     if (e->sc.seek_recheck_adapt >= 0) {
         cc.seek.recheck_adapt = e->sc.seek_recheck_adapt != 0;
     }
+    cc.p0_min_dbm = e->sc.seek_p0_min_dbm;
     cc.seed = seed ^ 0x5A17C0FFEE000003ull;
     hs_ctrl_t ctrl;
     char cerr[256];

@@ -27,6 +27,11 @@ BREAKS = [
      [(r"sigma_db: 4\.0, dcorr_m", "sigma_db: 8.0, dcorr_m")]),
     ("default, source in the corridor (20, 6)", "scenarios/default.yaml",
      [(r"position: \[27\.5, 10\.0\]", "position: [20.0, 6.0]")]),
+    # The known-power row's belief (20 dBm, p0_min_dbm -32) wrong: weaker nodes.
+    ("3ne, the node at 8 dBm (not 20)", "scenarios/3ne.yaml",
+     [(r'(mac: "02:00:00:00:00:01")', '\\1\n    tx_dbm: 8')]),
+    ("3ne, the node at 0 dBm (not 20)", "scenarios/3ne.yaml",
+     [(r'(mac: "02:00:00:00:00:01")', '\\1\n    tx_dbm: 0')]),
 ]
 # (strategy, model, label, extra scenario text): meta-path's preset improvements
 # (recheck every step of a greedy leg against an adaptive threshold, epsilon annealed by
@@ -36,7 +41,11 @@ CONFIGS = [("meta", "ridge", "meta + ridge", ""),
            ("meta-path", "pathloss", "meta-path + pathloss, improvements off",
             "seek: {recheck_m: 0, eps_by_travel: false, eps_geodesic: false, "
             "recheck_adapt: false}\n"),
-           ("meta-path", "pathloss", "meta-path + pathloss", "")]
+           ("meta-path", "pathloss", "meta-path + pathloss", ""),
+           # The node's transmit power known (20 dBm EIRP): the P0 floor 12 dB below the
+           # free-space 1 m signal (docs/PATHLOSS.md, "The P0 floor").
+           ("meta-path", "pathloss", "meta-path + pathloss, transmit power known",
+            "seek: {p0_min_dbm: -32}\n")]
 
 
 def wilson(k, n, z=1.96):
@@ -118,15 +127,25 @@ meta-path's preset improvements (the relearn check after every metre of a greedy
 failing only beyond the larger of 3 dB and the RMS of the recent misses; epsilon annealed
 by the metres travelled; epsilon goals drawn by path length); "improvements off" is the
 same without them (`seek: {{recheck_m: 0, eps_by_travel: false, eps_geodesic: false,
-recheck_adapt: false}}` added to the scenario).
+recheck_adapt: false}}` added to the scenario). "transmit power known" is the same as
+`meta-path + pathloss` with the seeker told the node's power: `seek: {{p0_min_dbm: -32}}`
+(20 dBm EIRP - 40 dB in the first metre - a 12 dB margin; docs/PATHLOSS.md "The P0
+floor"); the last two rows of "Where it breaks" are nodes weaker than that belief.
 
 Command: `/usr/bin/python3 scripts/bench_pathloss_seek.py --seeds {a.seeds}` (wall time
 {wall:.0f} s on this 2-core machine, shared with other work while it ran).
 Target (issue 10): >= 95% success and median travel <= 2x the shortest path on each.
 """
+    # The hand-written "## Reading" section (and anything after it) is kept.
+    reading = ""
+    if os.path.exists(a.out):
+        old = open(a.out).read()
+        at = old.find("\n## Reading")
+        if at >= 0:
+            reading = "\n" + old[at:].rstrip("\n") + "\n"
     tmp = a.out + ".tmp"
     with open(tmp, "w") as f:
-        f.write(head + "\n".join(lines) + "\n")
+        f.write(head + "\n".join(lines) + "\n" + reading)
     os.replace(tmp, a.out)
     print(f"wrote {a.out} ({wall:.0f} s)")
 

@@ -127,6 +127,10 @@ put("scenario", "mac_signed", b"-1:00:00:00:00:00")  # once accepted as ff:00:..
 put("scenario", "mac_upper", b"02:00:00:00:00:0A")
 put("scenario", "anchors", b"base: &b {position: [1, 2]}\nmap: m.yaml\nsources: [*b, *b, *b]\n"
     b"start: {position: [0, 0]}\n")
+put("scenario", "seek_all", b"map: m.yaml\nmodel: pathloss\nstrategy: meta-path\n"
+    b"seek: {recheck_m: 1, eps_by_travel: true, eps_rate: 0.2, eps_geodesic: false, "
+    b"recheck_adapt: true, p0_min_dbm: -32}\nsources:\n  - {position: [1, 2], tx_dbm: 20}\n"
+    b"start: {position: [0, 0]}\n")
 
 # --- LCM: fingerprint + big-endian fields ----------------------------------------------------
 def lcm_hash(fields):

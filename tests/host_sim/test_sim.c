@@ -95,6 +95,7 @@ static void test_scenario_good(void **state)
     assert_true(sc.seek_recheck_m == -1.0 && sc.seek_eps_by_travel == -1 && sc.seek_eps_rate == -1.0);
     assert_int_equal(sc.seek_eps_geodesic, -1);
     assert_int_equal(sc.seek_recheck_adapt, -1);
+    assert_true(isnan(sc.seek_p0_min_dbm)); // the pathloss model's own default
     assert_true(sc.rx_heartbeat); // issue 10: on unless the scenario turns it off
     // seek: overrides of the strategy's preset.
     char text[2048];
@@ -110,6 +111,10 @@ static void test_scenario_good(void **state)
     assert_int_equal(sc.seek_eps_geodesic, 1);
     assert_int_equal(sc.seek_eps_by_travel, -1); // the others keep the strategy's preset
     assert_int_equal(sc.seek_recheck_adapt, -1);
+    snprintf(text, sizeof text, "%sseek: {p0_min_dbm: -32.5}\n", GOOD);
+    assert_int_equal(hs_scenario_load(scn("seek_p0.yaml", text), &sc, err, sizeof err), 0);
+    assert_true(sc.seek_p0_min_dbm == -32.5);
+    assert_true(isnan(sc.seek_p0_min_dbm) == false && sc.seek_recheck_m == -1.0);
 }
 
 /// Each bad scenario: -1 and one line naming the file, the line and the field.
@@ -187,6 +192,14 @@ static void test_scenario_bad(void **state)
                "map: @MAP@\nseek: {recheck_adapt: yes please}\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",
                "seek_adapt_bool.yaml:2: seek.recheck_adapt: expected true or false");
+    expect_bad("seek_p0_range.yaml",
+               "map: @MAP@\nseek: {p0_min_dbm: -300}\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "seek_p0_range.yaml:2: seek.p0_min_dbm: -300 is out of range");
+    expect_bad("seek_p0_num.yaml",
+               "map: @MAP@\nseek: {p0_min_dbm: loud}\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "seek_p0_num.yaml:2: seek.p0_min_dbm:");
     expect_bad("nostart.yaml", "map: @MAP@\nsources:\n  - position: [15, 10]\n", "start: missing");
     expect_bad("never.yaml",
                "map: @MAP@\nsources:\n  - position: [15, 10]\nstart: {position: [5, 10]}\n"
@@ -312,6 +325,37 @@ static void test_open_all_seeds_reach(void **state)
         assert_true(llabs((long long)r.packets_sent - (long long)(r.sim_time_s * 200.0)) <= 2);
     }
     hs_sim_env_close(&env);
+}
+
+/// seek.p0_min_dbm reaches the pathloss model. The open hall's node transmits 20 dBm, so
+/// P0 (the signal at 1 m) is 20 - 39.6 = -19.6 dBm in the simulator: the default fit finds
+/// it and the robot drives about the 10 m straight in. A floor of 0 dBm (a belief 20 dB
+/// above the truth) penalises every candidate near the robot's samples and misleads the
+/// robot: the same seed travels far longer (docs/PATHLOSS.md, "The P0 floor").
+static void test_p0_floor_reaches_the_model(void **state)
+{
+    (void)state;
+    hs_sim_result_t r[2];
+    for (int k = 0; k < 2; k++) {
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "map: @MAP@\nmodel: pathloss\nstrategy: meta-path\n%s"
+                 "sources:\n  - position: [15.0, 10.0]\n    tx_dbm: 20\n"
+                 "start: {position: [5.0, 10.0], theta: 0.0}\n"
+                 "radio:\n  shadowing: {sigma_db: 3.0, dcorr_m: 3.0}\n",
+                 k == 0 ? "" : "seek: {p0_min_dbm: 0}\n");
+        hs_sim_env_t env;
+        assert_int_equal(load_env(scn("p0_floor.yaml", text), &env), 0);
+        char err[512];
+        assert_int_equal(hs_sim_run_inproc(&env, 1, NULL, &r[k], err, sizeof err), 0);
+        hs_sim_env_close(&env);
+    }
+    print_message("default floor: %.1f m, P0 %.1f dBm; floor 0 dBm: %.1f m, P0 %.1f dBm\n",
+                  r[0].distance_travelled_m, r[0].est_p0, r[1].distance_travelled_m,
+                  r[1].est_p0);
+    assert_true(r[0].reached && fabs(r[0].est_p0 - -19.6) < 6.0);
+    assert_true(r[0].distance_travelled_m < 2.0 * 10.0);
+    assert_true(r[1].distance_travelled_m > 2.0 * r[0].distance_travelled_m);
 }
 
 /// Everything a run writes, in memory.
@@ -514,6 +558,7 @@ int main(void)
         cmocka_unit_test(test_scenario_missing_file),
         cmocka_unit_test(test_motor),
         cmocka_unit_test(test_open_all_seeds_reach),
+        cmocka_unit_test(test_p0_floor_reaches_the_model),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_shipped_scenarios),
         cmocka_unit_test(test_receiver_heartbeat_through_faults),

@@ -36,4 +36,14 @@ ip netns del "$ns"
 "$d" --map $map --model ridge --replay "$w/run.lcmlog" --clock-lcm --lcm memq:// --log "$w/ridge.lcmlog" \
     > /dev/null 2> "$w/r.err" && pass status_est_ridge_replay || fail "status_est_ridge_replay ($(head -2 "$w/r.err"))"
 /usr/bin/python3 tests/host_sim/status_est_check.py "$w/ridge.lcmlog" none || fails=$((fails + 1))
+# --p0-min reaches the pathloss model: the recorded inputs replayed with the default floor
+# written out (-45) decide exactly as without it, with a floor of 0 dBm (20 dB above what
+# the simulated 20 dBm node gives at 1 m) differently.
+for v in none -45 0; do
+    a=(); [ "$v" = none ] || a=(--p0-min "$v")
+    "$d" --map $map --model pathloss "${a[@]}" --replay "$w/run.lcmlog" --clock-lcm \
+        > "$w/p0$v.txt" 2> "$w/p0$v.err" || fail "status_est_p0_min_replay $v ($(head -2 "$w/p0$v.err"))"
+done
+[ -s "$w/p0none.txt" ] && cmp -s "$w/p0none.txt" "$w/p0-45.txt" && ! cmp -s "$w/p0none.txt" "$w/p00.txt" \
+    && pass status_est_p0_min_replay || fail "status_est_p0_min_replay: decisions $(wc -l < "$w/p0none.txt") / $(wc -l < "$w/p0-45.txt") / $(wc -l < "$w/p00.txt")"
 exit $((fails > 0))

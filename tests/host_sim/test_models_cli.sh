@@ -137,6 +137,14 @@ d=$b/bin/rfseekd tool=$b/tests/wire/lcm_tool
 check rfseekd-model-unknown '[ $? -eq 2 ] && one_line "$tmp/e" "^rfseekd: --model: expected ridge, mlp, knn, radius or pathloss, got svm"'
 "$d" --help | grep -q -- "--model NAME"
 check rfseekd-help-model '[ $? -eq 0 ]'
+"$d" --map scenarios/maps/office.yaml --model pathloss --p0-min loud >"$tmp/o" 2>"$tmp/e"
+check rfseekd-p0-min-number '[ $? -eq 2 ] && one_line "$tmp/e" "^rfseekd: --p0-min: expected dBm in \[-200, 100\], got loud"'
+"$d" --map scenarios/maps/office.yaml --model pathloss --p0-min -300 >"$tmp/o" 2>"$tmp/e"
+check rfseekd-p0-min-range '[ $? -eq 2 ] && one_line "$tmp/e" "^rfseekd: --p0-min: expected dBm in \[-200, 100\], got -300"'
+"$d" --map scenarios/maps/office.yaml --model ridge --p0-min -32 >"$tmp/o" 2>"$tmp/e"
+check rfseekd-p0-min-not-pathloss '[ $? -eq 2 ] && one_line "$tmp/e" "^rfseekd: --p0-min: only with --model pathloss"'
+"$d" --help | grep -q -- "--p0-min DBM"
+check rfseekd-help-p0-min '[ $? -eq 0 ]'
 if [ -x "$tool" ] && "$tool" mklog "$tmp/in.lcmlog"; then
     for m in ridge mlp knn; do
         "$d" --map scenarios/maps/office.yaml --replay "$tmp/in.lcmlog" --clock-lcm --model "$m" \

@@ -13,6 +13,7 @@
  */
 #include <errno.h>
 #include <inttypes.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,6 +26,7 @@
 #include "hs_lcm.h"
 #include "hs_map.h"
 #include "rfs_app.h"
+#include "rfs_pathloss.h"
 
 static const char usage_text[] =
     "usage: rfseekd --map MAP.yaml [--lcm URL] [--can IFACE | --can-over-lcm] [options]\n"
@@ -44,6 +46,8 @@ static const char usage_text[] =
     "  --target NAME     rssi (default) or bridge\n"
     "  --model NAME      internal model: ridge (default, the paper's), mlp, knn, radius,\n"
     "                    pathloss (docs/MODELS.md; the STM32 image holds the ridge only)\n"
+    "  --p0-min DBM      pathloss only: floor on the fitted signal at 1 m (default -45); the\n"
+    "                    node's EIRP - 52 when its power is known (docs/PATHLOSS.md)\n"
     "  --seed N          seed of the controller's random source (default 1)\n"
     "  --duration S      stop after S seconds of controller time (default: run until signalled)\n"
     "  --idle-exit MS    stop when no LCM message arrived for MS milliseconds\n"
@@ -268,7 +272,7 @@ static bool is_value_option(const char *a)
 {
     static const char *const opts[] = {"--map", "--lcm", "--can", "--replay", "--log", "--decisions",
                                        "--target", "--res", "--seed", "--duration", "--idle-exit",
-                                       "--model"};
+                                       "--model", "--p0-min"};
     for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++) {
         if (strcmp(a, opts[i]) == 0) {
             return true;
@@ -282,6 +286,7 @@ int main(int argc, char **argv)
     const char *map_path = NULL, *url = NULL, *can_if = NULL, *replay = NULL, *log_path = NULL, *dec_path = NULL;
     const char *target = "rssi";
     const rfs_models_entry_t *model = NULL; // NULL: the application's built-in ridge
+    double p0_min = NAN;                    // --p0-min: NAN keeps the model's default
     double res = 0.1;
     int64_t seed = 1, duration_s = 0, idle_ms = 0;
     bool can_over_lcm = false, clock_lcm = false;
@@ -321,6 +326,13 @@ int main(int argc, char **argv)
             if (model == NULL) {
                 return die("--model: expected ridge, mlp, knn, radius or pathloss, got ", v);
             }
+        } else if (strcmp(a, "--p0-min") == 0) {
+            char *end;
+            p0_min = strtod(v, &end);
+            if (*v == '\0' || *end != '\0' || !(p0_min >= -200.0 && p0_min <= 100.0)) {
+                return die("--p0-min: expected dBm in [-200, 100], got ", v);
+            }
+            i++;
         } else if (strcmp(a, "--res") == 0) {
             char *end;
             res = strtod(v, &end);
@@ -349,6 +361,9 @@ int main(int argc, char **argv)
     }
     if (!map_path) {
         return die("--map MAP.yaml is required (see --help)", NULL);
+    }
+    if (!isnan(p0_min) && (model == NULL || model->ops != &rfs_pathloss_ops)) {
+        return die("--p0-min: only with --model pathloss", NULL);
     }
     if (can_if && can_over_lcm) {
         return die("--can and --can-over-lcm exclude each other", NULL);
@@ -400,6 +415,20 @@ int main(int argc, char **argv)
         hs_core_map_free(&core);
         hs_map_free(&m);
         return 1;
+    }
+    if (!isnan(p0_min)) {
+        /* The node's power known: a floor on the fitted signal at 1 m (docs/PATHLOSS.md
+         * "The P0 floor"). The state is re-initialised before any fit. */
+        rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
+        pc.p0_min = (rfs_q16_t)lround(p0_min * 65536.0);
+        if (rfs_pathloss_init((rfs_pathloss_t *)model_state, &pc) != 0) {
+            hs_err_print(PROG, "--p0-min %g: rejected by the pathloss model", p0_min);
+            free(d.app);
+            free(model_state);
+            hs_core_map_free(&core);
+            hs_map_free(&m);
+            return 1;
+        }
     }
     d.can_over_lcm = can_over_lcm;
     d.clock_lcm = clock_lcm;

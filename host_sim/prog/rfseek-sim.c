@@ -9,6 +9,7 @@
  */
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -49,6 +50,9 @@ static void usage(FILE *f)
             "                  (docs/STRATEGIES.md, docs/RESULTS.md)\n"
             "  --model NAME    internal model, overriding the scenario's: ridge, mlp, knn,\n"
             "                  radius, pathloss\n"
+            "  --p0-min DBM    pathloss only: floor on the fitted signal at 1 m, overriding\n"
+            "                  the scenario's seek.p0_min_dbm (default -45; the node's EIRP\n"
+            "                  - 52 when its power is known: docs/PATHLOSS.md)\n"
             "  --no-faults     ignore the scenario's fault schedule (docs/FAULTS.md)\n"
             "  --quiet         no progress bar\n"
             "  --bench         with --seeds: run them one after another in this process without\n"
@@ -411,6 +415,7 @@ int main(int argc, char **argv)
     uint64_t seed = 0;
     bool has_seed = false, samples = false, field = false, emit = false, quiet = false;
     bool bench = false, no_faults = false;
+    double p0_min = NAN; // --p0-min: NAN keeps the scenario's (or the model's default)
     long jobs = sysconf(_SC_NPROCESSORS_ONLN);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -455,6 +460,14 @@ int main(int argc, char **argv)
                 return die("%s: expected a name%s", a, "");
             }
             *(a[2] == 's' ? &strategy : &model) = argv[++i];
+        } else if (strcmp(a, "--p0-min") == 0) {
+            char *end = NULL;
+            p0_min = more ? strtod(argv[i + 1], &end) : NAN;
+            if (!more || !*argv[i + 1] || *end != '\0' || !(p0_min >= -200.0 && p0_min <= 100.0)) {
+                return die("--p0-min: expected dBm in [-200, 100], got '%s'%s",
+                           more ? argv[i + 1] : "", "");
+            }
+            i++;
         } else if (strcmp(a, "--no-faults") == 0) {
             no_faults = true;
         } else if (strcmp(a, "--quiet") == 0) {
@@ -523,6 +536,12 @@ int main(int argc, char **argv)
     if (no_faults) {
         sc.faults.n = 0;
     }
+    if (!isnan(p0_min)) {
+        if (strcmp(sc.model, "pathloss") != 0) {
+            return die("--p0-min: only with model pathloss (this run's is %s)%s", sc.model, "");
+        }
+        sc.seek_p0_min_dbm = p0_min;
+    }
     if (emit) {
         // The same runs, one command per seed; scripts/merge_runs.py DIR merges them.
         char self[PATH_MAX], scn[PATH_MAX];
@@ -532,9 +551,13 @@ int main(int argc, char **argv)
         }
         self[n] = '\0';
         for (uint64_t s = sa; s <= sb; s++) {
-            printf("%s %s --seed %llu --out %s/seed-%llu --strategy %s --model %s%s\n", self,
+            char p0[48] = "";
+            if (!isnan(p0_min)) {
+                snprintf(p0, sizeof p0, " --p0-min %.17g", p0_min);
+            }
+            printf("%s %s --seed %llu --out %s/seed-%llu --strategy %s --model %s%s%s\n", self,
                    scn, (unsigned long long)s, out, (unsigned long long)s, sc.strategy, sc.model,
-                   no_faults ? " --no-faults" : "");
+                   no_faults ? " --no-faults" : "", p0);
         }
         return 0;
     }

@@ -45,6 +45,26 @@ bad missing_scenario "$T/none.yaml: No such file or directory" "$T/none.yaml" --
 bad missing_scenario_newline "$T/nl?none.yaml: No such file or directory" "$T/nl"$'\n'"none.yaml" --out "$T/out"
 printf 'map: [1, 2\n' >"$T/syntax.yaml"
 bad malformed_scenario "syntax.yaml:2: YAML syntax error" "$T/syntax.yaml" --out "$T/out"
+scn p0.yaml "$BASE"
+bad p0_min_number "--p0-min: expected dBm in [-200, 100], got 'loud'" "$T/p0.yaml" --model pathloss --p0-min loud --out "$T/out"
+bad p0_min_range "--p0-min: expected dBm in [-200, 100], got '-300'" "$T/p0.yaml" --model pathloss --p0-min -300 --out "$T/out"
+bad p0_min_model "--p0-min: only with model pathloss (this run's is ridge)" "$T/p0.yaml" --p0-min -32 --out "$T/out"
+# --p0-min and the scenario's seek.p0_min_dbm are the same setting: same run, byte for byte.
+scn p0key.yaml "${BASE}model: pathloss
+strategy: meta-path
+seek: {p0_min_dbm: -30}
+"
+"$SIM" "$T/p0.yaml" --model pathloss --strategy meta-path --p0-min -30 --seed 3 >"$T/p0cli.json" 2>/dev/null
+"$SIM" "$T/p0key.yaml" --seed 3 >"$T/p0key.json" 2>/dev/null
+"$SIM" "$T/p0.yaml" --model pathloss --strategy meta-path --p0-min 0 --seed 3 >"$T/p0zero.json" 2>/dev/null
+same() { grep -vE '"(scenario|wall_time_s|cpu_time_s)"' "$1"; }
+if [ -s "$T/p0cli.json" ] && cmp -s <(same "$T/p0cli.json") <(same "$T/p0key.json") \
+    && ! cmp -s <(grep distance_travelled_m "$T/p0cli.json") \
+                <(grep distance_travelled_m "$T/p0zero.json"); then
+    pass p0_min_cli_equals_key
+else
+    fail p0_min_cli_equals_key "$(head -c 300 "$T/p0cli.json") / $(head -c 300 "$T/p0key.json")"
+fi
 scn unknown.yaml "${BASE}colour: red
 "
 bad unknown_key "unknown.yaml:5: scenario: unknown key 'colour'" "$T/unknown.yaml" --out "$T/out"

@@ -49,10 +49,9 @@ static int pathloss_init_default(void *state)
  *   500,000 per period.
  * - mlp: 700 sample-updates, 16.3 M (about 23,000 per update; the first slice also
  *   standardises the samples); 800 would be 18.6 M.
- * - pathloss: 500 wall counts, 11.3 M. A call evaluates at least one whole candidate
- *   (bins + 1 <= RFS_PATHLOSS_MAX_BINS + 1 = 513 wall counts), so every budget up to 512
- *   costs at most one candidate per call; above it calls take several smaller
- *   candidates: 800 reached 18.0 M with 1,000 samples. */
+ * - pathloss: 600 wall counts, 16.4 M (about 25,000 per count; the first slice also bins
+ *   the samples); 700 would be 18.6 M. A call stops before a bin whose footprint (up to
+ *   four counts) could overrun the budget, resuming the candidate at the next call. */
 static const rfs_models_entry_t k_models[] = {
     {"ridge", &rfs_ridge_ops, (uint32_t)sizeof(rfs_ridge_t), ridge_init_default,
      "local ridge regression, 5 m radius, alpha 1 (paper 5.2.1)", 2500u},
@@ -63,7 +62,7 @@ static const rfs_models_entry_t k_models[] = {
     {"radius", &rfs_radius_ops, (uint32_t)sizeof(rfs_knn_t), radius_init_default,
      "radius-neighbours regression, r = 1 m (paper 5.2)", 2500u},
     {"pathloss", &rfs_pathloss_ops, (uint32_t)sizeof(rfs_pathloss_t), pathloss_init_default,
-     "map-aware log-distance + walls fit, source search (issue 10, beyond the paper)", 500u},
+     "map-aware log-distance + walls fit, source search (issue 10, beyond the paper)", 600u},
 };
 
 #define N_MODELS (sizeof(k_models) / sizeof(k_models[0]))

@@ -24,8 +24,13 @@
 #define DB_PER_LOG2_SQ_Q30 1616142483LL
 /// Lattice spacing without a map, metres Q16.16 (the map default).
 #define NOMAP_GRID RFS_Q16_FRAC(1, 4)
-/// Wall counts saturate here (4 bits in the cache; 15 walls are 75 dB at 5 dB each).
+/// Wall counts saturate here (15 walls are 75 dB at 5 dB each; four of them, in quarter
+/// walls, fit a byte of the cache).
 #define WALLS_MAX 15u
+/// Wall counts per bin footprint.
+#define FOOTPRINT_RAYS 4u
+/// What an evaluated candidate is for (rfs_pathloss_ev_t.kind).
+enum { EV_COARSE = 0, EV_REFINE = 1, EV_HOLD = 2 };
 /// Cached wall counts per work unit.
 #define CACHED_PER_UNIT 32u
 
@@ -61,6 +66,9 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
      * in all but 1 of 3,479 fits, estimates farther away had it below in 1,176 of 5,553. */
     c.p0_min = RFS_Q16_INT(-45);
     c.hold_k = RFS_Q16_INT(6);
+    /* A quarter of the 1 m bin: the four points sit at the centres of the bin's quarters
+     * when its centroid is central (docs/PATHLOSS.md, "A bin's walls"). */
+    c.footprint = RFS_Q16_FRAC(1, 4);
     return c;
 }
 
@@ -81,7 +89,7 @@ int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg)
               c->w_prior_weight > 0 && c->w_prior_weight <= RFS_Q16_INT(10000) && c->huber > 0 &&
               c->huber <= RFS_Q16_INT(100) && c->spread_k >= 0 &&
               c->spread_k <= RFS_Q16_INT(1000) && c->margin >= 0 && c->hold_k >= 0 &&
-              c->hold_k <= RFS_Q16_INT(64) &&
+              c->hold_k <= RFS_Q16_INT(64) && c->footprint >= 0 && c->footprint <= c->bin / 2 &&
               c->margin <= RFS_Q16_INT(100);
     if (!ok) {
         return -1;
@@ -408,55 +416,97 @@ static void solve_nw(const rfs_pathloss_cfg_t *c, const int64_t M[3], const int6
     *w_out = ew[best];
 }
 
-/* Fit (P0, n, W) for the source at lattice point (li, lj) and its Huber loss.
- * Scaling and overflow (|L| < 64 dB, so L Q16 < 2^22; counts sum to <= 65,535 = 2^16;
- * |dz| < 2^10 dB, Q16 < 2^26): centred values in Q8 are below 2^15 (l), 2^16 (k) and
- * c dz < 2^34 (e); the sums c l^2, c l k, c k^2 stay below 2^16 x 2^32 = 2^48 and
- * l e, k e below 2^16 x 2^34 = 2^50, all in int64. */
-static void eval(rfs_pathloss_t *p, uint16_t li, uint16_t lj, int32_t col,
-                 rfs_pathloss_cand_t *out)
+/* One line's walls to the candidate, saturated. */
+static uint32_t walls_to(rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx, rfs_q16_t sy)
 {
-    const rfs_pathloss_cfg_t *c = &p->cfg;
-    rfs_q16_t sx, sy;
-    lattice_xy(&p->lat, li, lj, &sx, &sy);
-    int64_t sl = 0, sk = 0;
-    for (uint32_t b = 0u; b < p->nbins; ++b) {
-        const rfs_pathloss_bin_t *bb = &p->bins[b];
-        int64_t dx = (int64_t)bb->x - sx, dy = (int64_t)bb->y - sy;
-        int32_t L = rfs_pathloss_db_dist(sq_sum(dx, dy));
-        uint32_t k = 0u;
-        if (p->map != 0) {
-            rfs_pathloss_row_t *r = bb->row != RFS_PATHLOSS_NO_ROW ? &p->rows[bb->row] : 0;
-            bool cacheable = r != 0 && col >= 0 && col < (int32_t)RFS_PATHLOSS_CACHE_COLS;
-            uint8_t *cell = cacheable ? &p->walls[bb->row][col / 2] : 0;
-            const unsigned shift = (unsigned)(col & 1) * 4u;
-            if (cacheable && col < (int32_t)r->filled) {
-                k = (*cell >> shift) & 0xFu;
-                p->walls_cached++;
-            } else {
-                k = rfs_map_walls_crossed(p->map, bb->wx, bb->wy, sx, sy);
-                k = k > WALLS_MAX ? WALLS_MAX : k;
-                p->walls_counted++;
-                if (cacheable && col == (int32_t)r->filled) {
-                    *cell = (uint8_t)((*cell & ~(0xFu << shift)) | (k << shift));
-                    r->filled++;
-                }
+    uint32_t k = rfs_map_walls_crossed(p->map, x, y, sx, sy);
+    p->walls_counted++;
+    return k > WALLS_MAX ? WALLS_MAX : k;
+}
+
+/* A bin's walls to the candidate (sx, sy) in quarter walls (0..4 x WALLS_MAX): the sum of
+ * the counts from its footprint's four points (wx +- f, wy +- f), a point that is not
+ * legal counting as the centre (wx, wy); with footprint 0, four times the centre's.
+ * At most four counts: the centre is counted only in place of an illegal point. */
+static uint32_t footprint_walls(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb, rfs_q16_t sx,
+                                rfs_q16_t sy)
+{
+    const rfs_q16_t f = p->cfg.footprint;
+    if (f == 0) {
+        return FOOTPRINT_RAYS * walls_to(p, bb->wx, bb->wy, sx, sy);
+    }
+    uint32_t sum = 0u, centre = UINT32_MAX;
+    for (uint32_t q = 0u; q < FOOTPRINT_RAYS; ++q) {
+        rfs_q16_t x = rfs_sat32((int64_t)bb->wx + ((q & 1u) != 0u ? f : -f));
+        rfs_q16_t y = rfs_sat32((int64_t)bb->wy + ((q & 2u) != 0u ? f : -f));
+        if (rfs_map_point_legal(p->map, x, y)) {
+            sum += walls_to(p, x, y, sx, sy);
+        } else {
+            if (centre == UINT32_MAX) {
+                centre = walls_to(p, bb->wx, bb->wy, sx, sy);
+            }
+            sum += centre;
+        }
+    }
+    return sum;
+}
+
+/* One bin's distance term and walls for the candidate in p->ev (its 10 log10(d) in
+ * l_q16[b], its walls in k[b]). Returns the wall counts (lines) computed: 0 when cached. */
+static uint32_t gather_bin(rfs_pathloss_t *p, uint32_t b)
+{
+    const rfs_pathloss_bin_t *bb = &p->bins[b];
+    const rfs_q16_t sx = p->ev.sx, sy = p->ev.sy;
+    const int32_t col = p->ev.col;
+    int64_t dx = (int64_t)bb->x - sx, dy = (int64_t)bb->y - sy;
+    p->l_q16[b] = rfs_pathloss_db_dist(sq_sum(dx, dy));
+    uint32_t k = 0u, lines = 0u;
+    if (p->map != 0) {
+        rfs_pathloss_row_t *r = bb->row != RFS_PATHLOSS_NO_ROW ? &p->rows[bb->row] : 0;
+        bool cacheable = r != 0 && col >= 0 && col < (int32_t)RFS_PATHLOSS_CACHE_COLS;
+        uint8_t *cell = cacheable ? &p->walls[bb->row][col] : 0;
+        if (cacheable && col < (int32_t)r->filled) {
+            k = *cell;
+            p->walls_cached++;
+        } else {
+            uint32_t before = p->walls_counted;
+            k = footprint_walls(p, bb, sx, sy);
+            lines = p->walls_counted - before;
+            p->footprints++;
+            if (cacheable && col == (int32_t)r->filled) {
+                *cell = (uint8_t)k;
+                r->filled++;
             }
         }
-        p->l_q16[b] = L;
-        p->k[b] = (uint8_t)k;
-        sl += (int64_t)bb->count * L;
-        sk += (int64_t)bb->count * (int64_t)k;
+    }
+    p->k[b] = (uint8_t)k;
+    return lines;
+}
+
+/* Fit (P0, n, W) for the candidate in p->ev, whose bins gather_bin() has done, and its
+ * Huber loss.
+ * Scaling and overflow (|L| < 64 dB, so L Q16 < 2^22; counts sum to <= 65,535 = 2^16;
+ * walls in quarters <= 60, Q16 / 4 < 2^20; |dz| < 2^10 dB, Q16 < 2^26): centred values in
+ * Q8 are below 2^15 (l), 2^16 (k) and c dz < 2^34 (e); the sums c l^2, c l k, c k^2 stay
+ * below 2^16 x 2^32 = 2^48 and l e, k e below 2^16 x 2^34 = 2^50, all in int64. */
+static void solve(rfs_pathloss_t *p, rfs_pathloss_cand_t *out)
+{
+    const rfs_pathloss_cfg_t *c = &p->cfg;
+    const rfs_q16_t sx = p->ev.sx, sy = p->ev.sy;
+    int64_t sl = 0, sk = 0;
+    for (uint32_t b = 0u; b < p->nbins; ++b) {
+        sl += (int64_t)p->bins[b].count * p->l_q16[b];
+        sk += (int64_t)p->bins[b].count * (int64_t)p->k[b]; /* quarter walls */
     }
     const int64_t tot = (int64_t)p->total;
     const int32_t ml = (int32_t)rfs_sdiv64_round(sl, tot);
-    const int32_t mk = (int32_t)rfs_sdiv64_round(sk * 65536, tot);
+    const int32_t mk = (int32_t)rfs_sdiv64_round(sk * 16384, tot); /* walls Q16 */
     int64_t all = 0, alk = 0, akk = 0, bl = 0, bk = 0;
     for (uint32_t b = 0u; b < p->nbins; ++b) {
         const rfs_pathloss_bin_t *bb = &p->bins[b];
         int64_t cnt = bb->count;
         int64_t l8 = ((int64_t)p->l_q16[b] - ml + 128) >> 8;
-        int64_t k8 = ((int64_t)p->k[b] * 65536 - mk + 128) >> 8;
+        int64_t k8 = ((int64_t)p->k[b] * 16384 - mk + 128) >> 8;
         int64_t e8 = (cnt * bb->dz_q16 + 128) >> 8;
         all += cnt * l8 * l8;
         alk += cnt * l8 * k8;
@@ -480,7 +530,7 @@ static void eval(rfs_pathloss_t *p, uint16_t li, uint16_t lj, int32_t col,
         const rfs_pathloss_bin_t *bb = &p->bins[b];
         int64_t r = (int64_t)bb->dz_q16 +
                     (((int64_t)n * ((int64_t)p->l_q16[b] - ml) +
-                      (int64_t)w * ((int64_t)p->k[b] * 65536 - mk) + 32768) >> 16);
+                      (int64_t)w * ((int64_t)p->k[b] * 16384 - mk) + 32768) >> 16);
         int64_t a = (r < 0 ? -r : r);
         a = (a + 128) >> 8;
         a = a > ((int64_t)1 << 24) ? ((int64_t)1 << 24) : a;
@@ -499,21 +549,28 @@ static void eval(rfs_pathloss_t *p, uint16_t li, uint16_t lj, int32_t col,
     out->loss = loss;
     out->sx = sx;
     out->sy = sy;
-    out->li = li;
-    out->lj = lj;
+    out->li = p->ev.li;
+    out->lj = p->ev.lj;
     out->n = n;
     out->w = w;
     out->p0 = rfs_sat32(p0);
     p->candidates++;
 }
 
-/* eval() and the work units it used: wall counts computed, plus cached ones / 32, plus 1. */
-static uint32_t eval_units(rfs_pathloss_t *p, uint16_t li, uint16_t lj, int32_t col,
-                           rfs_pathloss_cand_t *out)
+/* Start evaluating candidate (li, lj), cache column col (-1: none), for phase step
+ * `kind` (surface index c for a coarse candidate). */
+static void ev_start(rfs_pathloss_t *p, uint16_t li, uint16_t lj, int32_t col, uint8_t kind,
+                     uint32_t c)
 {
-    uint32_t counted = p->walls_counted, cached = p->walls_cached;
-    eval(p, li, lj, col, out);
-    return (p->walls_counted - counted) + (p->walls_cached - cached) / CACHED_PER_UNIT + 1u;
+    p->ev.on = true;
+    p->ev.kind = kind;
+    p->ev.li = li;
+    p->ev.lj = lj;
+    lattice_xy(&p->lat, li, lj, &p->ev.sx, &p->ev.sy);
+    p->ev.col = col;
+    p->ev.c = c;
+    p->ev.b = 0u;
+    p->ev.cached = p->walls_cached;
 }
 
 /* Mean Huber loss per unit weight, dB^2 Q16, saturated below NO_LOSS. */
@@ -615,6 +672,7 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
         cache_assign(p);
         p->col = 0u;
         p->walls_counted = 0u;
+        p->footprints = 0u;
         p->walls_cached = 0u;
         p->phase = RFS_PATHLOSS_COARSE;
         p->pos = 0u;
@@ -622,14 +680,47 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
         p->nvis = 0u;
         p->candidates = 0u;
         p->cur.loss = INT64_MAX;
+        p->ev.on = false;
     }
     const rfs_pathloss_lat_t *l = &p->lat;
     uint32_t used = 0u;
     for (;;) {
-        /* Stop before a candidate that could overrun the budget (at most one wall count
-         * per bin), but evaluate at least one per call. */
-        if (budget != 0u && used != 0u && used + p->nbins + 1u > budget) {
-            return RFS_FIT_MORE;
+        if (p->ev.on) {
+            /* Gather the candidate's bins; stop before a bin that could overrun the budget
+             * (at most four wall counts), but gather at least one per call. */
+            while (p->ev.b < p->nbins) {
+                if (budget != 0u && used != 0u && used + FOOTPRINT_RAYS > budget) {
+                    return RFS_FIT_MORE;
+                }
+                used += gather_bin(p, p->ev.b++);
+            }
+            rfs_pathloss_cand_t cd;
+            solve(p, &cd);
+            used += (p->walls_cached - p->ev.cached) / CACHED_PER_UNIT + 1u;
+            p->ev.on = false;
+            if (p->ev.kind == EV_COARSE) {
+                p->surface[p->ev.c] = mean_loss(p, cd.loss);
+                keep_top(p, &cd);
+            } else if (p->ev.kind == EV_HOLD) {
+                /* The previous source (p->best until finish()) against the new best: keep
+                 * it while its loss is within the likelihood-ratio margin. Scaling: the
+                 * loss is below 2^53 (weights <= 2^16 times Huber values < 2^36, plus the
+                 * P0 term); (loss / bins) * hold_k (Q16 <= 2^22) saturates rather than
+                 * wrap. */
+                uint64_t per = rfs_udiv64((uint64_t)p->cur.loss, p->nbins);
+                uint64_t thr = per >= ((uint64_t)1 << 41)
+                                   ? UINT64_MAX
+                                   : (uint64_t)p->cur.loss + ((per * (uint64_t)p->cfg.hold_k) >> 16);
+                if ((uint64_t)cd.loss <= thr) {
+                    p->cur = cd;
+                }
+                finish(p);
+                return RFS_FIT_DONE;
+            }
+            if (p->ev.kind != EV_HOLD) {
+                consider(p, &cd);
+            }
+            continue;
         }
         int32_t i, j;
         if (p->phase == RFS_PATHLOSS_COARSE) {
@@ -651,11 +742,7 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
             if (!cand_legal(p, i, j)) {
                 continue;
             }
-            rfs_pathloss_cand_t cd;
-            used += eval_units(p, (uint16_t)i, (uint16_t)j, (int32_t)p->col++, &cd);
-            p->surface[c] = mean_loss(p, cd.loss);
-            consider(p, &cd);
-            keep_top(p, &cd);
+            ev_start(p, (uint16_t)i, (uint16_t)j, (int32_t)p->col++, EV_COARSE, c);
             continue;
         }
         /* Refinement: the 3 x 3 neighbourhood at p->step around each top candidate
@@ -665,21 +752,8 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
             p->pos = 9u;
         }
         if (p->phase == RFS_PATHLOSS_HOLD) {
-            /* The previous source (p->best until finish()) against the new best: keep it
-             * while its loss is within the likelihood-ratio margin. Scaling: the loss is
-             * below 2^53 (weights <= 2^16 times Huber values < 2^36, plus the P0 term);
-             * (loss / bins) * hold_k (Q16 <= 2^22) saturates rather than wrap. */
-            rfs_pathloss_cand_t cd;
-            (void)eval_units(p, p->best.li, p->best.lj, -1, &cd); /* the fit ends here */
-            uint64_t per = rfs_udiv64((uint64_t)p->cur.loss, p->nbins);
-            uint64_t thr = per >= ((uint64_t)1 << 41)
-                               ? UINT64_MAX
-                               : (uint64_t)p->cur.loss + ((per * (uint64_t)p->cfg.hold_k) >> 16);
-            if ((uint64_t)cd.loss <= thr) {
-                p->cur = cd;
-            }
-            finish(p);
-            return RFS_FIT_DONE;
+            ev_start(p, p->best.li, p->best.lj, -1, EV_HOLD, 0u); /* the fit ends with it */
+            continue;
         }
         if (p->phase == RFS_PATHLOSS_FINE && p->pos >= 9u) {
             if (p->step <= 1u) {
@@ -706,9 +780,7 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
         if (rem == 4u || !cand_legal(p, i, j) || seen_before(p, i, j)) {
             continue;
         }
-        rfs_pathloss_cand_t cd;
-        used += eval_units(p, (uint16_t)i, (uint16_t)j, -1, &cd);
-        consider(p, &cd);
+        ev_start(p, (uint16_t)i, (uint16_t)j, -1, EV_REFINE, 0u);
     }
 }
 
@@ -779,6 +851,7 @@ bool rfs_pathloss_estimate(const rfs_pathloss_t *p, rfs_pathloss_est_t *est)
     est->bin = cm_to_q16(p->used_bin_cm);
     est->candidates = p->candidates;
     est->walls_counted = p->walls_counted;
+    est->footprints = p->footprints;
     est->walls_cached = p->walls_cached;
     return true;
 }

@@ -32,17 +32,22 @@
  * of coarse candidates whose loss is within spread_k / bins of the best's (relative):
  * a likelihood-ratio region that counts each bin as one independent observation.
  *
- * Wall counts start at the centre of the core cell that holds the bin's centroid. Those
- * of the coarse candidates are cached across fits (RFS_PATHLOSS_CACHE_ROWS origins x
- * the first RFS_PATHLOSS_CACHE_COLS legal coarse candidates, 4 bits each, so counts
- * saturate at 15 walls): bins are fixed cells, so a relearn counts walls only for bins
- * that are new or whose centroid moved to another core cell, and for the refinement.
- * The cache is cleared when the map or the coarse lattice changes, or when it is full.
+ * A bin's walls are its footprint's: the mean of the counts from the four points
+ * `footprint` (0.25 m) either side of the centre of the core cell that holds the bin's
+ * centroid, along x and y (a point that is not legal counts as the centre), in quarter
+ * walls. A bin's mean is an average over where its samples were taken, and on a
+ * cluttered map one line's count jumps by several walls within centimetres of where it
+ * starts (footprint 0: the centre's count alone). The counts of the coarse candidates
+ * are cached across fits (RFS_PATHLOSS_CACHE_ROWS origins x the first
+ * RFS_PATHLOSS_CACHE_COLS legal coarse candidates, a byte each; a count saturates at 15
+ * walls): bins are fixed cells, so a relearn counts walls only for bins that are new or
+ * whose centroid moved to another core cell, and for the refinement. The cache is
+ * cleared when the map or the coarse lattice changes, or when it is full.
  *
- * Work: one unit is one computed wall count (a cached one is 1/32 unit). fit() with
- * budget 0 does everything; with budget > 0 it stops before a candidate that could
- * overrun the budget (a candidate costs at most bins + 1 units; at least one candidate
- * per call) and returns RFS_FIT_MORE until the search is done. The first call also bins
+ * Work: one unit is one computed wall count (a cached footprint is 1/32 unit). fit()
+ * with budget 0 does everything; with budget > 0 it stops before a candidate that could
+ * overrun the budget (a candidate costs at most 4 x bins + 1 units; at least one
+ * candidate per call) and returns RFS_FIT_MORE until the search is done. The first call also bins
  * the samples (about 100 instructions per sample). The
  * model is invalid while a fit is in progress; a sliced fit keeps the bins of its first
  * call, so samples added meanwhile are used by the next relearn.
@@ -69,7 +74,7 @@
 #define RFS_PATHLOSS_MAX_VISITED 128u
 /// Wall-count origins cached (rows) and legal coarse candidates per origin (columns).
 #define RFS_PATHLOSS_CACHE_ROWS 512u
-#define RFS_PATHLOSS_CACHE_COLS 128u
+#define RFS_PATHLOSS_CACHE_COLS 64u
 /// Slots of the cache's hash table (a power of two, twice the rows).
 #define RFS_PATHLOSS_CACHE_HASH (2u * RFS_PATHLOSS_CACHE_ROWS)
 /// No cache row.
@@ -98,6 +103,9 @@ typedef struct rfs_pathloss_cfg {
     rfs_q16_t p0_min;       ///< target units Q16.16: weakest plausible signal at 1 m (-45 dBm;
                             ///< INT32_MIN: no floor). A candidate whose fit needs a weaker
                             ///< P0 adds total weight x Huber(p0_min - P0) to its loss
+    rfs_q16_t footprint;    ///< metres Q16.16: a bin's wall counts start this far either
+                            ///< side of its cell's centre, along x and y (0.25 m; 0: from
+                            ///< the centre alone), 0..bin / 2
     rfs_q16_t hold_k;       ///< a relearn keeps the previous fit's source when its loss is
                             ///< within best (1 + hold_k / bins) (2.0; 0: off, always the
                             ///< least loss): no jumping between sources the data cannot
@@ -162,6 +170,21 @@ typedef enum rfs_pathloss_phase {
     RFS_PATHLOSS_HOLD,     ///< the previous fit's source, kept when still as good (hold_k)
 } rfs_pathloss_phase_t;
 
+/// A candidate being evaluated: its bins' wall counts are gathered across calls of a
+/// sliced fit, then its (P0, n, W) solved.
+typedef struct rfs_pathloss_ev {
+    bool on;         ///< a candidate is being evaluated
+    uint8_t kind;    ///< what its result is for (the phase that chose it)
+    uint16_t li;     ///< its lattice index along x
+    uint16_t lj;     ///< along y
+    rfs_q16_t sx;    ///< its position, metres Q16.16
+    rfs_q16_t sy;
+    int32_t col;     ///< its wall-count cache column, -1 when none
+    uint32_t c;      ///< its coarse surface index (coarse candidates)
+    uint32_t b;      ///< next bin to gather
+    uint32_t cached; ///< walls_cached when it started (work accounting)
+} rfs_pathloss_ev_t;
+
 /// What the model believes (rfs_pathloss_estimate()).
 typedef struct rfs_pathloss_est {
     rfs_q16_t sx;         ///< estimated source x, metres Q16.16
@@ -175,11 +198,12 @@ typedef struct rfs_pathloss_est {
     uint16_t bins;        ///< bins used
     rfs_q16_t bin;        ///< bin side used, metres Q16.16
     uint32_t candidates;  ///< candidates evaluated
-    uint32_t walls_counted; ///< wall counts computed by the last fit
-    uint32_t walls_cached;  ///< wall counts the last fit read from the cache
+    uint32_t walls_counted; ///< wall counts (lines) computed by the last fit
+    uint32_t footprints;    ///< bin footprints it counted (up to four lines each)
+    uint32_t walls_cached;  ///< bin footprints it read from the cache
 } rfs_pathloss_est_t;
 
-/// State, caller-owned (about 66 KB, 37 KB of it the wall-count cache).
+/// State, caller-owned (about 67 KB, 37 KB of it the wall-count cache).
 typedef struct rfs_pathloss {
     rfs_pathloss_cfg_t cfg;                       ///< configuration copied at init
     bool valid;                                   ///< a model exists
@@ -202,6 +226,7 @@ typedef struct rfs_pathloss {
     uint8_t ntop;                                 ///< coarse candidates kept in top[]
     rfs_pathloss_cand_t top[RFS_PATHLOSS_MAX_TOP]; ///< best coarse candidates, best first
     rfs_pathloss_cand_t cur;                      ///< best so far
+    rfs_pathloss_ev_t ev;                         ///< the candidate being evaluated
     uint16_t fc_i;                                ///< centre of the fine level, lattice x
     uint16_t fc_j;                                ///< lattice y
     uint16_t step;                                ///< spacing of the fine level, lattice steps
@@ -211,17 +236,18 @@ typedef struct rfs_pathloss {
     rfs_pathloss_bin_t bins[RFS_PATHLOSS_MAX_BINS]; ///< sample bins
     uint16_t hash[RFS_PATHLOSS_HASH];             ///< bin index + 1 by hashed cell, 0 = empty
     int32_t l_q16[RFS_PATHLOSS_MAX_BINS];         ///< scratch: 10 log10(d) per bin, dB Q16.16
-    uint8_t k[RFS_PATHLOSS_MAX_BINS];             ///< scratch: walls per bin
+    uint8_t k[RFS_PATHLOSS_MAX_BINS];             ///< scratch: walls per bin, quarter walls
     uint32_t col;                                 ///< legal coarse candidates so far (cache column)
-    uint32_t walls_counted;                       ///< wall counts computed by this fit
-    uint32_t walls_cached;                        ///< wall counts read from the cache by this fit
+    uint32_t walls_counted;                       ///< wall counts (lines) computed by this fit
+    uint32_t footprints;                          ///< bin footprints counted by this fit
+    uint32_t walls_cached;                        ///< bin footprints read from the cache by this fit
     const rfs_map_t *cache_map;                   ///< map the cache belongs to (NULL: empty)
     rfs_pathloss_lat_t cache_lat;                 ///< coarse lattice the cache belongs to
     uint16_t nrows;                               ///< cache rows in use
     uint16_t row_hash[RFS_PATHLOSS_CACHE_HASH];   ///< row + 1 by hashed core cell, 0 = empty
     rfs_pathloss_row_t rows[RFS_PATHLOSS_CACHE_ROWS]; ///< cached origins
-    uint8_t walls[RFS_PATHLOSS_CACHE_ROWS][RFS_PATHLOSS_CACHE_COLS / 2u]; ///< 4-bit counts,
-                                                  ///< column c in the low nibble when even
+    uint8_t walls[RFS_PATHLOSS_CACHE_ROWS][RFS_PATHLOSS_CACHE_COLS]; ///< footprint wall
+                                                  ///< counts, quarter walls
     uint32_t surface[RFS_PATHLOSS_MAX_COARSE];    ///< mean Huber loss per unit weight of
                                                   ///< each coarse point, dB^2 Q16.16;
                                                   ///< NO_LOSS = no candidate

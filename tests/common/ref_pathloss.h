@@ -7,8 +7,10 @@
  * of squared residuals over the interior solution, the four edges and the four corners
  * of the (n, W) box, the Huber loss in double, and a bitmap of evaluated points. Only
  * the wall counts come from the core (rfs_map_walls_crossed and rfs_map_cell, tested in
- * test_map.c), because they are the model's definition of a wall: counted from the
- * centre of the core cell holding the bin's centroid, saturated at 15. No cache.
+ * test_map.c), because they are the model's definition of a wall: a bin's walls are the
+ * mean of the counts (each saturated at 15) from the four points `footprint` either side
+ * of the centre of the core cell holding its centroid, along x and y, a point that is not
+ * legal (rfs_map_point_legal) counting from the centre. No cache.
  */
 #ifndef REF_PATHLOSS_H
 #define REF_PATHLOSS_H
@@ -31,6 +33,7 @@ typedef struct ref_pl_cfg {
     long bin_cap;
     double w_prior_weight;
     double p0_min; /* weakest plausible P0; a fit below adds total x Huber(p0_min - P0) */
+    double footprint; /* m: offsets of a bin's wall-count points from its cell's centre */
 } ref_pl_cfg_t;
 
 typedef struct ref_pl_bin {
@@ -59,12 +62,13 @@ typedef struct ref_pl {
     int candidates;
     unsigned char *seen; /* lattice points evaluated */
     double L[REF_PL_MAX_BINS];
-    int K[REF_PL_MAX_BINS];
+    double K[REF_PL_MAX_BINS];
 } ref_pl_t;
 
 static inline ref_pl_cfg_t ref_pl_cfg_default(void)
 {
-    ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5, 30.0, -45.0};
+    ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5, 30.0, -45.0,
+                      0.25};
     return c;
 }
 
@@ -192,7 +196,7 @@ static inline double ref_pl_eval(ref_pl_t *r, int i, int j, double *pn, double *
     for (int b = 0; b < r->nbins; ++b) {
         double d = hypot(r->bins[b].x - sx, r->bins[b].y - sy);
         r->L[b] = 10.0 * log10(d < 1.0 ? 1.0 : d);
-        int k = 0;
+        double k = 0.0;
         if (r->map != NULL) {
             rfs_q16_t bx = (rfs_q16_t)lround(r->bins[b].x * 65536.0);
             rfs_q16_t by = (rfs_q16_t)lround(r->bins[b].y * 65536.0);
@@ -202,9 +206,20 @@ static inline double ref_pl_eval(ref_pl_t *r, int i, int j, double *pn, double *
                 bx = (rfs_q16_t)lround((r->map->origin_x / 65536.0 + (cx + 0.5) * res) * 65536.0);
                 by = (rfs_q16_t)lround((r->map->origin_y / 65536.0 + (cy + 0.5) * res) * 65536.0);
             }
-            k = rfs_map_walls_crossed(r->map, bx, by, qx, qy);
+            int c0 = rfs_map_walls_crossed(r->map, bx, by, qx, qy);
+            c0 = c0 > 15 ? 15 : c0;
+            rfs_q16_t f = (rfs_q16_t)lround(r->cfg.footprint * 65536.0);
+            for (int q = 0; q < 4; ++q) {
+                rfs_q16_t px = bx + ((q & 1) ? f : -f), py = by + ((q & 2) ? f : -f);
+                int c = c0;
+                if (f != 0 && rfs_map_point_legal(r->map, px, py)) {
+                    c = rfs_map_walls_crossed(r->map, px, py, qx, qy);
+                    c = c > 15 ? 15 : c;
+                }
+                k += c / 4.0;
+            }
         }
-        r->K[b] = k > 15 ? 15 : k;
+        r->K[b] = k;
     }
     /* Normal equations of the centred problem with the prior, solved directly. */
     double sc = 0, ml = 0, mk = 0, mz = 0;

@@ -165,8 +165,8 @@ static void init_rejects_bad_configurations(void **state)
 {
     fixture_t *f = *state;
     rfs_pathloss_cfg_t good = rfs_pathloss_cfg_default();
-    rfs_pathloss_cfg_t bad[14];
-    for (int i = 0; i < 14; ++i) {
+    rfs_pathloss_cfg_t bad[16];
+    for (int i = 0; i < 16; ++i) {
         bad[i] = good;
     }
     bad[0].bin = RFS_Q16_FRAC(1, 20);
@@ -183,9 +183,11 @@ static void init_rejects_bad_configurations(void **state)
     bad[11].margin = RFS_Q16_INT(101);
     bad[12].bin_cap = 0;
     bad[13].w_prior_weight = 0;
+    bad[14].footprint = -1;
+    bad[15].footprint = good.bin / 2 + 1;      /* beyond the bin */
 
     assert_int_equal(rfs_pathloss_init(&f->pl, &good), 0);
-    for (int i = 0; i < 14; ++i) {
+    for (int i = 0; i < 16; ++i) {
         if (rfs_pathloss_init(&f->pl, &bad[i]) != -1) {
             fail_msg("bad configuration %d accepted", i);
         }
@@ -397,6 +399,26 @@ static void p0_floor_off_same_as_reference(void **state)
     expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
 }
 
+/* footprint 0 (each bin's walls counted from its cell's centre alone, the model before
+ * the footprint) equals the double reference too, and differs from the default: the
+ * test's office has bins whose footprint straddles a wall's end. */
+static void footprint_off_same_as_reference(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+    c.footprint = 0;
+    rc.footprint = 0.0;
+    expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
+    rfs_pathloss_est_t off;
+    assert_true(rfs_pathloss_estimate(&f->pl, &off));
+    assert_int_equal(off.walls_counted, off.footprints); /* one line per footprint */
+    rfs_pathloss_est_t on = fit_default(f, NS, &f->map, 0, NULL);
+    assert_true(on.walls_counted > 3u * on.footprints);
+    assert_true(on.rms != off.rms);
+}
+
 /* The default configuration on the same data: the prior (3, 5 dB) pulls n and W from
  * the truth (2.6, 6.5 dB) towards itself, the source stays within one lattice cell. */
 static void default_prior_shrinks_towards_physics(void **state)
@@ -500,14 +522,26 @@ static void sliced_fit_equals_whole_fit(void **state)
     assert_memory_equal(&f->pl.best, &best, sizeof(best));
     assert_int_equal(sliced.spread_m2, whole.spread_m2);
     assert_int_equal(sliced.candidates, whole.candidates);
-    /* a fresh state: no cached wall counts, one unit per (bin, candidate) pair plus one
-     * per candidate; each call evaluates candidates until 2000 units are used */
+    /* a fresh state: no cached wall counts, one footprint per (bin, candidate) pair of
+     * one to four lines, one unit a line plus one per candidate; each call evaluates
+     * candidates until 2000 units are used */
     assert_int_equal(sliced.walls_cached, 0);
-    assert_int_equal(sliced.walls_counted, sliced.candidates * sliced.bins);
+    assert_int_equal(sliced.footprints, sliced.candidates * sliced.bins);
+    assert_true(sliced.walls_counted >= sliced.footprints);
+    assert_true(sliced.walls_counted <= 4u * sliced.footprints);
+    assert_int_equal(sliced.walls_counted, whole.walls_counted);
     uint32_t units = sliced.walls_counted + sliced.candidates;
-    /* each call stops before a candidate that could overrun 2000 units */
-    assert_true((uint32_t)calls >= units / 2000u);
-    assert_true((uint32_t)calls <= units / (2000u - sliced.bins - 1u) + 1u);
+    /* each call stops before a bin that could overrun 2000 units (four lines), and adds at
+     * most one unit for the candidate it then solves */
+    assert_true((uint32_t)calls >= units / 2001u);
+    assert_true((uint32_t)calls <= units / (2000u - 4u) + 1u);
+
+    /* A budget of one bin a call: candidates are resumed within their bins. */
+    rfs_pathloss_est_t fine = fit_default(f, NS, &f->map, 4, &calls);
+    assert_memory_equal(&f->pl.best, &best, sizeof(best));
+    assert_int_equal(fine.spread_m2, whole.spread_m2);
+    assert_int_equal(fine.walls_counted, whole.walls_counted);
+    assert_true((uint32_t)calls >= fine.footprints);
 }
 
 static int by_x(const void *a, const void *b)
@@ -541,9 +575,9 @@ static void cached_relearn_equals_fresh(void **state)
     assert_memory_equal(&warm->best, &f->pl.best, sizeof(f->pl.best));
     assert_memory_equal(warm->surface, f->pl.surface, sizeof(f->pl.surface));
     assert_int_equal(ew.candidates, ef.candidates);
-    assert_int_equal(ew.walls_counted + ew.walls_cached, ef.walls_counted + ef.walls_cached);
+    assert_int_equal(ew.footprints + ew.walls_cached, ef.footprints + ef.walls_cached);
     /* the coarse counts of the west half's bins came from the cache */
-    assert_true(ew.walls_cached > ef.walls_counted / 4u);
+    assert_true(ew.walls_cached > ef.footprints / 4u);
     free(warm);
 }
 
@@ -763,6 +797,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(residual_surface_and_spread, setup, teardown),
         cmocka_unit_test_setup_teardown(closed_loop_finds_the_room, setup, teardown),
         cmocka_unit_test_setup_teardown(relearn_holds_previous_source, setup, teardown),
+        cmocka_unit_test_setup_teardown(footprint_off_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_floor_off_same_as_reference, setup, teardown),
         cmocka_unit_test(registered_as_pathloss),
     };

@@ -113,10 +113,10 @@ bench)
         for (k = 1; k <= nm; k++) {
             m = model[k]
             g = ("argmax_" m in v) ? "argmax_" m : "grid_" m
-            printf "%-9s %7d %14d %9s %14d %10s %12s %8d\n", m, val["state_bytes_" m], ins("relearn_" m), ms(ins("relearn_" m)),
+            printf "%-9s %7d %14.0f %9s %14.0f %10s %12s %8d\n", m, val["state_bytes_" m], ins("relearn_" m), ms(ins("relearn_" m)),
                 ins(g), ms(ins(g)), (g ~ /^argmax/ ? "(argmax)" : "(" val["points_" m] ")"), ins("predict_" m)
             if (g ~ /^argmax/ && ("grid_" m in v))
-                printf "%-9s %7s %14s %9s %14d %10s %12s   rfs_seek_grid_max, for reference\n", "", "", "", "", ins("grid_" m), ms(ins("grid_" m)), "(" val["points_" m] ")"
+                printf "%-9s %7s %14s %9s %14.0f %10s %12s   rfs_seek_grid_max, for reference\n", "", "", "", "", ins("grid_" m), ms(ins("grid_" m)), "(" val["points_" m] ")"
         }
         printf "\nsliced relearn: heaviest slice (exact), slices, all slices (to ~calls/20); registry = mcu_fit_budget\n"
         printf "%-9s %7s %14s %9s %7s %14s %8s %6s %6s\n", "model", "budget", "heaviest slice", "ms", "slices", "all slices", "200 ms", "50 %", "500 k"
@@ -124,7 +124,7 @@ bench)
             s = sl[k]; m = s; sub(/_[0-9]+$/, "", m); b = s; sub(/.*_/, "", b)
             w = ins("slice_worst_" s)
             t = int((v["slice_total_" s] - c["slice_total_" s] * e) / per + 0.5)
-            printf "%-9s %7d %14d %9s %7d %14d %8s %6s %6s%s\n", m, b, w, ms(w), val["slices_" s], t, fits(w, 33600000), fits(w, 16800000), fits(w, 500000),
+            printf "%-9s %7d %14.0f %9s %7d %14.0f %8s %6s %6s%s\n", m, b, w, ms(w), val["slices_" s], t, fits(w, 33600000), fits(w, 16800000), fits(w, 500000),
                 (b == val["mcu_budget_" m] ? "  registry" : "")
         }
         printf "\nat the registry budgets (the firmware'"'"'s MCU configuration), 200 ms = 33,600,000 instructions;\n"
@@ -133,17 +133,17 @@ bench)
             m = model[k]; s = m "_" val["mcu_budget_" m]
             if (!(("slice_worst_" s) in v)) { printf "  %-9s no registry budget measured\n", m; continue }
             w = ins("slice_worst_" s)
-            printf "  %-9s budget %5d: heaviest slice %10d instructions = %6s ms, %4.1f %% of the deadline: %s\n", m, val["mcu_budget_" m], w, ms(w), w / 336000,
+            printf "  %-9s budget %5d: heaviest slice %10.0f instructions = %6s ms, %4.1f %% of the deadline: %s\n", m, val["mcu_budget_" m], w, ms(w), w / 336000,
                 w < 33600000 ? "meets 200 ms" : "MISSES 200 ms"
             g = ("argmax_" m in v) ? "argmax_" m : "grid_" m
             d = ins("slice_last_" s) + ins(g)
-            printf "  %-9s %12s last slice + %-6s %10d instructions = %6s ms, %4.1f %% of the deadline: %s\n", "", "", (g ~ /^argmax/ ? "argmax" : "grid"), d, ms(d), d / 336000,
+            printf "  %-9s %12s last slice + %-6s %10.0f instructions = %6s ms, %4.1f %% of the deadline: %s\n", "", "", (g ~ /^argmax/ ? "argmax" : "grid"), d, ms(d), d / 336000,
                 d < 33600000 ? "meets 200 ms" : "MISSES 200 ms"
         }
         printf "\n160 x 80 predictions, bench/bench_models.c loop (instructions per point):\n"
         for (k = 1; k <= nm; k++) {
             n = "predict12800_" model[k]
-            if (n in v) printf "  %-9s %14d %8.0f\n", model[k], ins(n), ins(n) / 12800
+            if (n in v) printf "  %-9s %14.0f %8.0f\n", model[k], ins(n), ins(n) / 12800
         }
         printf "stack (painted): "
         for (k = 1; k <= nm; k++) printf "%s relearn %d B grid %d B; ", model[k], val["stack_relearn_" model[k]], val["stack_grid_" model[k]]

@@ -44,10 +44,11 @@
  * whose centroid moved to another core cell, and for the refinement. The cache is
  * cleared when the map or the coarse lattice changes, or when it is full.
  *
- * Work: one unit is one computed wall count (a cached footprint is 1/32 unit). fit()
- * with budget 0 does everything; with budget > 0 it stops before a candidate that could
- * overrun the budget (a candidate costs at most 4 x bins + 1 units; at least one
- * candidate per call) and returns RFS_FIT_MORE until the search is done. The first call also bins
+ * Work: one unit is one computed wall count (a cached footprint is 1/32 unit, solving a
+ * candidate one unit). fit() with budget 0 does everything; with budget > 0 it stops
+ * before a bin whose footprint could overrun the budget (four units; at least one bin
+ * per call), resumes that candidate at its next bin on the next call, and returns
+ * RFS_FIT_MORE until the search is done. The first call also bins
  * the samples (about 100 instructions per sample). The
  * model is invalid while a fit is in progress; a sliced fit keeps the bins of its first
  * call, so samples added meanwhile are used by the next relearn.

@@ -195,7 +195,7 @@ int main(int argc, char **argv)
     printf("bins %u\n", e.bins);
     printf("candidates %u\n", e.candidates);
     printf("walls_counted %u\n", e.walls_counted);
-    printf("walls_cached %u\n", e.walls_cached);
+    printf("footprints_cached %u\n", e.footprints_cached);
     printf("coarse %u x %u\n", ncx, ncy);
     printf("state_bytes %zu\n", sizeof(rfs_pathloss_t));
     printf("estimate %.3f %.3f n %.3f W %.3f P0 %.3f rms %.3f spread %.1f m2 predict %.3f\n",

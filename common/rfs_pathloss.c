@@ -416,12 +416,19 @@ static void solve_nw(const rfs_pathloss_cfg_t *c, const int64_t M[3], const int6
     *w_out = ew[best];
 }
 
-/* One line's walls to the candidate, saturated. */
+/* One line's walls from (x, y) to (sx, sy), saturated at WALLS_MAX. */
+static uint32_t walls_sat(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,
+                          rfs_q16_t sy)
+{
+    uint32_t k = rfs_map_walls_crossed(m, x, y, sx, sy);
+    return k > WALLS_MAX ? WALLS_MAX : k;
+}
+
+/* walls_sat(), counted as a fit's work. */
 static uint32_t walls_to(rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx, rfs_q16_t sy)
 {
-    uint32_t k = rfs_map_walls_crossed(p->map, x, y, sx, sy);
     p->walls_counted++;
-    return k > WALLS_MAX ? WALLS_MAX : k;
+    return walls_sat(p->map, x, y, sx, sy);
 }
 
 /* A bin's walls to the candidate (sx, sy) in quarter walls (0..4 x WALLS_MAX): the sum of
@@ -467,7 +474,7 @@ static uint32_t gather_bin(rfs_pathloss_t *p, uint32_t b)
         uint8_t *cell = cacheable ? &p->walls[bb->row][col] : 0;
         if (cacheable && col < (int32_t)r->filled) {
             k = *cell;
-            p->walls_cached++;
+            p->footprints_cached++;
         } else {
             uint32_t before = p->walls_counted;
             k = footprint_walls(p, bb, sx, sy);
@@ -570,7 +577,7 @@ static void ev_start(rfs_pathloss_t *p, uint16_t li, uint16_t lj, int32_t col, u
     p->ev.col = col;
     p->ev.c = c;
     p->ev.b = 0u;
-    p->ev.cached = p->walls_cached;
+    p->ev.cached = p->footprints_cached;
 }
 
 /* Mean Huber loss per unit weight, dB^2 Q16, saturated below NO_LOSS. */
@@ -673,7 +680,7 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
         p->col = 0u;
         p->walls_counted = 0u;
         p->footprints = 0u;
-        p->walls_cached = 0u;
+        p->footprints_cached = 0u;
         p->phase = RFS_PATHLOSS_COARSE;
         p->pos = 0u;
         p->ntop = 0u;
@@ -696,7 +703,7 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
             }
             rfs_pathloss_cand_t cd;
             solve(p, &cd);
-            used += (p->walls_cached - p->ev.cached) / CACHED_PER_UNIT + 1u;
+            used += (p->footprints_cached - p->ev.cached) / CACHED_PER_UNIT + 1u;
             p->ev.on = false;
             if (p->ev.kind == EV_COARSE) {
                 p->surface[p->ev.c] = mean_loss(p, cd.loss);
@@ -710,16 +717,15 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
                 uint64_t per = rfs_udiv64((uint64_t)p->cur.loss, p->nbins);
                 uint64_t thr = per >= ((uint64_t)1 << 41)
                                    ? UINT64_MAX
-                                   : (uint64_t)p->cur.loss + ((per * (uint64_t)p->cfg.hold_k) >> 16);
+                                   : (uint64_t)p->cur.loss +
+                                         ((per * (uint64_t)p->cfg.hold_k) >> 16);
                 if ((uint64_t)cd.loss <= thr) {
                     p->cur = cd;
                 }
                 finish(p);
                 return RFS_FIT_DONE;
             }
-            if (p->ev.kind != EV_HOLD) {
-                consider(p, &cd);
-            }
+            consider(p, &cd);
             continue;
         }
         int32_t i, j;
@@ -797,8 +803,7 @@ static bool pathloss_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16
     int64_t L = rfs_pathloss_db_dist(sq_sum(dx, dy));
     int64_t k = 0;
     if (p->map != 0) {
-        k = rfs_map_walls_crossed(p->map, x, y, p->best.sx, p->best.sy);
-        k = k > (int64_t)WALLS_MAX ? (int64_t)WALLS_MAX : k;
+        k = walls_sat(p->map, x, y, p->best.sx, p->best.sy);
     }
     int64_t v = (int64_t)p->best.p0 - (((int64_t)p->best.n * L + 32768) >> 16) - p->best.w * k;
     *value = rfs_sat32(v);
@@ -852,7 +857,7 @@ bool rfs_pathloss_estimate(const rfs_pathloss_t *p, rfs_pathloss_est_t *est)
     est->candidates = p->candidates;
     est->walls_counted = p->walls_counted;
     est->footprints = p->footprints;
-    est->walls_cached = p->walls_cached;
+    est->footprints_cached = p->footprints_cached;
     return true;
 }
 

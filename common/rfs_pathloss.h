@@ -183,7 +183,7 @@ typedef struct rfs_pathloss_ev {
     int32_t col;     ///< its wall-count cache column, -1 when none
     uint32_t c;      ///< its coarse surface index (coarse candidates)
     uint32_t b;      ///< next bin to gather
-    uint32_t cached; ///< walls_cached when it started (work accounting)
+    uint32_t cached; ///< footprints_cached when it started (work accounting)
 } rfs_pathloss_ev_t;
 
 /// What the model believes (rfs_pathloss_estimate()).
@@ -199,9 +199,9 @@ typedef struct rfs_pathloss_est {
     uint16_t bins;        ///< bins used
     rfs_q16_t bin;        ///< bin side used, metres Q16.16
     uint32_t candidates;  ///< candidates evaluated
-    uint32_t walls_counted; ///< wall counts (lines) computed by the last fit
-    uint32_t footprints;    ///< bin footprints it counted (up to four lines each)
-    uint32_t walls_cached;  ///< bin footprints it read from the cache
+    uint32_t walls_counted;     ///< wall counts (lines) computed by the last fit
+    uint32_t footprints;        ///< bin footprints it counted (up to four lines each)
+    uint32_t footprints_cached; ///< bin footprints it read from the cache
 } rfs_pathloss_est_t;
 
 /// State, caller-owned (about 67 KB, 37 KB of it the wall-count cache).
@@ -241,7 +241,7 @@ typedef struct rfs_pathloss {
     uint32_t col;                                 ///< legal coarse candidates so far (cache column)
     uint32_t walls_counted;                       ///< wall counts (lines) computed by this fit
     uint32_t footprints;                          ///< bin footprints counted by this fit
-    uint32_t walls_cached;                        ///< bin footprints read from the cache by this fit
+    uint32_t footprints_cached;                   ///< bin footprints read from the cache
     const rfs_map_t *cache_map;                   ///< map the cache belongs to (NULL: empty)
     rfs_pathloss_lat_t cache_lat;                 ///< coarse lattice the cache belongs to
     uint16_t nrows;                               ///< cache rows in use

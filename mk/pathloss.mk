@@ -24,7 +24,7 @@ define pathloss_row
 ir=$$($(call pathloss_ir,$(1),$(2))); o=$$tmp/$(1).out; \
 v() { awk -v k=$$1 '$$1 == k {print $$2}' $$o; }; \
 printf "  %-34s %5s %5s %8s %8s %13s %9s\n" "$(3)" $$(v bins) $$(v candidates) $$(v walls_counted) \
-    $$(v walls_cached) $$ir $$(awk -v a=$$ir -v u=$$(v walls_counted) 'BEGIN{printf "%.0f", a/(u>0?u:1)}')
+    $$(v footprints_cached) $$ir $$(awk -v a=$$ir -v u=$$(v walls_counted) 'BEGIN{printf "%.0f", a/(u>0?u:1)}')
 endef
 
 .PHONY: bench-pathloss

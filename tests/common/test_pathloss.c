@@ -525,7 +525,7 @@ static void sliced_fit_equals_whole_fit(void **state)
     /* a fresh state: no cached wall counts, one footprint per (bin, candidate) pair of
      * one to four lines, one unit a line plus one per candidate; each call evaluates
      * candidates until 2000 units are used */
-    assert_int_equal(sliced.walls_cached, 0);
+    assert_int_equal(sliced.footprints_cached, 0);
     assert_int_equal(sliced.footprints, sliced.candidates * sliced.bins);
     assert_true(sliced.walls_counted >= sliced.footprints);
     assert_true(sliced.walls_counted <= 4u * sliced.footprints);
@@ -575,9 +575,9 @@ static void cached_relearn_equals_fresh(void **state)
     assert_memory_equal(&warm->best, &f->pl.best, sizeof(f->pl.best));
     assert_memory_equal(warm->surface, f->pl.surface, sizeof(f->pl.surface));
     assert_int_equal(ew.candidates, ef.candidates);
-    assert_int_equal(ew.footprints + ew.walls_cached, ef.footprints + ef.walls_cached);
+    assert_int_equal(ew.footprints + ew.footprints_cached, ef.footprints + ef.footprints_cached);
     /* the coarse counts of the west half's bins came from the cache */
-    assert_true(ew.walls_cached > ef.footprints / 4u);
+    assert_true(ew.footprints_cached > ef.footprints / 4u);
     free(warm);
 }
 

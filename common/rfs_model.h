@@ -63,6 +63,11 @@ typedef struct rfs_model_ops {
     /// exactly the full scan's maximum (branch and bound, issue 8).
     bool (*bound)(const void *self, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1,
                   rfs_q16_t *ub);
+    /// Optional (may be NULL): draw where the maximum may be from the model's belief (the
+    /// path-loss model: a candidate source with probability falling with its misfit);
+    /// false when there is no model. Epsilon steps go there (rfs_seek_cfg_t.eps_sample):
+    /// exploration towards plausible sources rather than at random.
+    bool (*sample)(const void *self, rfs_rng_t *rng, rfs_q16_t *x, rfs_q16_t *y);
 } rfs_model_ops_t;
 
 /// A model: its operations and its caller-owned state.

@@ -66,6 +66,10 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
      * in all but 1 of 3,479 fits, estimates farther away had it below in 1,176 of 5,553. */
     c.p0_min = RFS_Q16_INT(-45);
     c.hold_k = RFS_Q16_INT(6);
+    /* The spread region's and hold_k's likelihood-ratio reading of the surface, untempered
+     * (docs/PATHLOSS.md, "Epsilon steps that draw the source"). */
+    c.sample_t = RFS_Q16_ONE;
+    c.hold_search = true;
     /* A quarter of the 1 m bin: the four points sit at the centres of the bin's quarters
      * when its centroid is central (docs/PATHLOSS.md, "A bin's walls"). */
     c.footprint = RFS_Q16_FRAC(1, 4);
@@ -90,7 +94,8 @@ int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg)
               c->huber <= RFS_Q16_INT(100) && c->spread_k >= 0 &&
               c->spread_k <= RFS_Q16_INT(1000) && c->margin >= 0 && c->hold_k >= 0 &&
               c->hold_k <= RFS_Q16_INT(64) && c->footprint >= 0 && c->footprint <= c->bin / 2 &&
-              c->margin <= RFS_Q16_INT(100);
+              c->margin <= RFS_Q16_INT(100) && c->sample_t >= RFS_Q16_FRAC(1, 16) &&
+              c->sample_t <= RFS_Q16_INT(64);
     if (!ok) {
         return -1;
     }
@@ -662,6 +667,48 @@ static void finish(rfs_pathloss_t *p)
     p->prev_map = p->map;
 }
 
+/* The hold phase: the previous source (p->best until finish()) and, with hold_search, a
+ * 3 x 3 hill-climb round it at halving spacings; then its best point against the new
+ * best. true: a candidate was started (evaluate it and call again); false: the phase is
+ * over and p->cur is the fit's answer. Keeps the held point while its loss is within the
+ * likelihood-ratio margin cur (1 + hold_k / bins). Scaling: the loss is below 2^53
+ * (weights <= 2^16 times Huber values < 2^36, plus the P0 term); (loss / bins) * hold_k
+ * (Q16 <= 2^22) saturates rather than wrap. */
+static bool hold_next(rfs_pathloss_t *p)
+{
+    if (p->hold_pos == UINT8_MAX) {
+        p->hold_pos = 0u;
+        ev_start(p, p->hold_i, p->hold_j, -1, EV_HOLD, 0u);
+        return true;
+    }
+    for (;;) {
+        while (p->hold_pos < 9u) {
+            uint32_t rem = p->hold_pos++;
+            int32_t i = (int32_t)p->hold_i + ((int32_t)(rem % 3u) - 1) * p->hold_step;
+            int32_t j = (int32_t)p->hold_j + ((int32_t)(rem / 3u) - 1) * p->hold_step;
+            if (rem != 4u && cand_legal(p, i, j)) {
+                ev_start(p, (uint16_t)i, (uint16_t)j, -1, EV_HOLD, 0u);
+                return true;
+            }
+        }
+        if (p->hold_step <= 1u) {
+            break;
+        }
+        p->hold_step = (uint16_t)(p->hold_step / 2u);
+        p->hold_i = p->hold_best.li;
+        p->hold_j = p->hold_best.lj;
+        p->hold_pos = 0u;
+    }
+    uint64_t per = rfs_udiv64((uint64_t)p->cur.loss, p->nbins);
+    uint64_t thr = per >= ((uint64_t)1 << 41)
+                       ? UINT64_MAX
+                       : (uint64_t)p->cur.loss + ((per * (uint64_t)p->cfg.hold_k) >> 16);
+    if ((uint64_t)p->hold_best.loss <= thr) {
+        p->cur = p->hold_best;
+    }
+    return false;
+}
+
 static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, uint32_t budget,
                                      rfs_rng_t *rng)
 {
@@ -709,21 +756,15 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
                 p->surface[p->ev.c] = mean_loss(p, cd.loss);
                 keep_top(p, &cd);
             } else if (p->ev.kind == EV_HOLD) {
-                /* The previous source (p->best until finish()) against the new best: keep
-                 * it while its loss is within the likelihood-ratio margin. Scaling: the
-                 * loss is below 2^53 (weights <= 2^16 times Huber values < 2^36, plus the
-                 * P0 term); (loss / bins) * hold_k (Q16 <= 2^22) saturates rather than
-                 * wrap. */
-                uint64_t per = rfs_udiv64((uint64_t)p->cur.loss, p->nbins);
-                uint64_t thr = per >= ((uint64_t)1 << 41)
-                                   ? UINT64_MAX
-                                   : (uint64_t)p->cur.loss +
-                                         ((per * (uint64_t)p->cfg.hold_k) >> 16);
-                if ((uint64_t)cd.loss <= thr) {
-                    p->cur = cd;
+                if (!p->hold_have || cd.loss < p->hold_best.loss) {
+                    p->hold_best = cd;
+                    p->hold_have = true;
                 }
-                finish(p);
-                return RFS_FIT_DONE;
+                if (!p->cfg.hold_search) {
+                    p->hold_pos = 9u;
+                    p->hold_step = 1u;
+                }
+                continue;
             }
             consider(p, &cd);
             continue;
@@ -758,8 +799,11 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
             p->pos = 9u;
         }
         if (p->phase == RFS_PATHLOSS_HOLD) {
-            ev_start(p, p->best.li, p->best.lj, -1, EV_HOLD, 0u); /* the fit ends with it */
-            continue;
+            if (hold_next(p)) {
+                continue;
+            }
+            finish(p);
+            return RFS_FIT_DONE;
         }
         if (p->phase == RFS_PATHLOSS_FINE && p->pos >= 9u) {
             if (p->step <= 1u) {
@@ -767,6 +811,11 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
                     (p->best.li != p->cur.li || p->best.lj != p->cur.lj) &&
                     cand_legal(p, p->best.li, p->best.lj)) {
                     p->phase = RFS_PATHLOSS_HOLD;
+                    p->hold_i = p->best.li;
+                    p->hold_j = p->best.lj;
+                    p->hold_step = (uint16_t)(l->cs / 2u < 1u ? 1u : l->cs / 2u);
+                    p->hold_pos = UINT8_MAX; /* the previous source itself first */
+                    p->hold_have = false;
                     continue;
                 }
                 finish(p);
@@ -821,6 +870,67 @@ static bool pathloss_argmax(const void *self, rfs_q16_t *x, rfs_q16_t *y)
     return true;
 }
 
+/* Weight of coarse surface point c (rfs_pathloss_draw_weight), for a valid model. */
+static uint32_t draw_weight(const rfs_pathloss_t *p, uint32_t c)
+{
+    uint32_t m = p->surface[c];
+    if (m == RFS_PATHLOSS_NO_LOSS) {
+        return 0u;
+    }
+    /* x = (m - m0) bins / (2 T bm): chi2 / 2T against the chosen source (bm), less the
+     * same for the best coarse point (m0 <= m), which so weighs 1; the draw's
+     * probabilities are those of e^(-chi2 / 2T). */
+    uint64_t bm = mean_loss(p, p->best.loss);
+    bm = bm > 0u ? bm : 1u;
+    uint64_t m0 = mean_loss(p, p->top[0].loss);
+    uint64_t num = m > m0 ? ((uint64_t)m - m0) * p->used_bins : 0u;
+    uint64_t den = (bm * 2u * (uint64_t)p->cfg.sample_t) >> 16;
+    den = den > 0u ? den : 1u;
+    if (num >= 16u * den) {
+        return 0u;
+    }
+    return (uint32_t)rfs_q16_exp_neg((rfs_q16_t)rfs_udiv64(num << 16, den));
+}
+
+uint32_t rfs_pathloss_draw_weight(const rfs_pathloss_t *p, uint16_t ci, uint16_t cj)
+{
+    RFS_ASSERT(p != 0);
+    if (!p->valid || ci >= p->lat.ncx || cj >= p->lat.ncy) {
+        return 0u;
+    }
+    return draw_weight(p, (uint32_t)cj * p->lat.ncx + ci);
+}
+
+/* A plausible source: a coarse candidate of the last fit drawn with its weight (the
+ * tempered likelihood ratio against the chosen source). Two passes over the surface,
+ * no table. Scaling: at most RFS_PATHLOSS_MAX_COARSE weights <= 2^16 sum below 2^26. */
+static bool pathloss_sample(const void *self, rfs_rng_t *rng, rfs_q16_t *x, rfs_q16_t *y)
+{
+    const rfs_pathloss_t *p = (const rfs_pathloss_t *)self;
+    RFS_ASSERT(p != 0 && rng != 0 && x != 0 && y != 0);
+    if (!p->valid) {
+        return false;
+    }
+    const rfs_pathloss_lat_t *l = &p->lat;
+    const uint32_t nc = (uint32_t)l->ncx * l->ncy;
+    uint32_t total = 0u;
+    for (uint32_t c = 0u; c < nc; ++c) {
+        total += draw_weight(p, c);
+    }
+    RFS_ASSERT(total > 0u); /* the best coarse point weighs 1 */
+    uint32_t pick = rfs_rng_below(rng, total), acc = 0u;
+    for (uint32_t c = 0u; c < nc; ++c) {
+        acc += draw_weight(p, c);
+        if (acc > pick) {
+            lattice_xy(l, (uint16_t)(l->c0i + (c % l->ncx) * l->cs),
+                       (uint16_t)(l->c0j + (c / l->ncx) * l->cs), x, y);
+            return true;
+        }
+    }
+    RFS_ASSERT(false); /* acc reaches total > pick */
+    return false;
+}
+
 const rfs_model_ops_t rfs_pathloss_ops = {
     .name = "pathloss",
     .reset = pathloss_reset,
@@ -828,6 +938,7 @@ const rfs_model_ops_t rfs_pathloss_ops = {
     .predict = pathloss_predict,
     .argmax = pathloss_argmax,
     .predict_row = 0,
+    .sample = pathloss_sample,
 };
 
 rfs_model_t rfs_pathloss_model(rfs_pathloss_t *p)

@@ -97,7 +97,7 @@ typedef struct rfs_pathloss_cfg {
     uint16_t bin_cap;       ///< a bin weighs min(samples, bin_cap) (5): shadowing makes a
                             ///< place one observation however long the robot stays
     rfs_q16_t prior_weight; ///< weight of the n prior, weight x dB^2, Q16.16 (3000), > 0
-    rfs_q16_t w_prior_weight; ///< weight of the W prior, weight x dB^2, Q16.16 (300), > 0
+    rfs_q16_t w_prior_weight; ///< weight of the W prior, weight x dB^2, Q16.16 (30), > 0
     rfs_q16_t huber;        ///< Huber threshold on a bin's mean residual, dB Q16.16 (6 dB)
     rfs_q16_t spread_k;     ///< spread region: loss <= best (1 + spread_k / bins) (6.0)
     rfs_q16_t margin;       ///< metres Q16.16: candidates beyond the samples without a map (20 m)
@@ -108,9 +108,16 @@ typedef struct rfs_pathloss_cfg {
                             ///< side of its cell's centre, along x and y (0.25 m; 0: from
                             ///< the centre alone), 0..bin / 2
     rfs_q16_t hold_k;       ///< a relearn keeps the previous fit's source when its loss is
-                            ///< within best (1 + hold_k / bins) (2.0; 0: off, always the
+                            ///< within best (1 + hold_k / bins) (6.0; 0: off, always the
                             ///< least loss): no jumping between sources the data cannot
                             ///< tell apart. Needs the same map as the previous fit
+    bool hold_search;       ///< the source held against the new best is the best point of
+                            ///< a local search round the previous one (3 x 3 steps of
+                            ///< coarse / 2, halved to the lattice's: its optimum under the
+                            ///< new data), not that point alone (true)
+    rfs_q16_t sample_t;     ///< temperature of the model's draws (rfs_pathloss_ops.sample):
+                            ///< coarse candidate c is drawn with weight e^(-chi2_c / 2T),
+                            ///< chi2_c = (loss_c / best loss - 1) x bins (1.0), 1/16..64
 } rfs_pathloss_cfg_t;
 
 /// One sample bin. Scaling: sums of up to 65,535 samples of int16 fit int32.
@@ -168,7 +175,8 @@ typedef enum rfs_pathloss_phase {
     RFS_PATHLOSS_COARSE,   ///< coarse candidates
     RFS_PATHLOSS_REFINE,   ///< around the best coarse candidates at half the coarse spacing
     RFS_PATHLOSS_FINE,     ///< around the best so far, halving the spacing to the lattice's
-    RFS_PATHLOSS_HOLD,     ///< the previous fit's source, kept when still as good (hold_k)
+    RFS_PATHLOSS_HOLD,     ///< the previous fit's source (or the best point round it,
+                           ///< hold_search), kept when still as good (hold_k)
 } rfs_pathloss_phase_t;
 
 /// A candidate being evaluated: its bins' wall counts are gathered across calls of a
@@ -231,6 +239,12 @@ typedef struct rfs_pathloss {
     uint16_t fc_i;                                ///< centre of the fine level, lattice x
     uint16_t fc_j;                                ///< lattice y
     uint16_t step;                                ///< spacing of the fine level, lattice steps
+    uint16_t hold_i;                              ///< hold_search: centre, lattice x
+    uint16_t hold_j;                              ///< lattice y
+    uint16_t hold_step;                           ///< its spacing, lattice steps
+    uint8_t hold_pos;                             ///< next of its 3 x 3 points (9: done)
+    bool hold_have;                               ///< hold_best is set
+    rfs_pathloss_cand_t hold_best;                ///< best point of the hold search so far
     uint16_t nvis;                                ///< refinement points remembered
     uint16_t vis_i[RFS_PATHLOSS_MAX_VISITED];     ///< their lattice x
     uint16_t vis_j[RFS_PATHLOSS_MAX_VISITED];     ///< their lattice y
@@ -281,6 +295,17 @@ void rfs_pathloss_surface_size(const rfs_pathloss_t *p, uint16_t *ncx, uint16_t 
 /// the point was not a candidate (not legal); the position is set whenever in range.
 bool rfs_pathloss_residual_at(const rfs_pathloss_t *p, uint16_t ci, uint16_t cj, rfs_q16_t *x,
                               rfs_q16_t *y, rfs_q16_t *rms);
+
+/// Weight, Q0.16 (65536 = 1), with which the model's draw (rfs_pathloss_ops.sample) picks
+/// coarse point (ci, cj) of the last fit: e^(-(m - m0) x bins / (2 T m_best)), m its mean
+/// loss per unit weight (the surface), m0 the best coarse point's (which weighs 1), m_best
+/// the chosen source's, T cfg.sample_t: proportional to e^(-chi2 / 2T) with chi2 =
+/// (m / m_best - 1) x bins, the spread region's and hold_k's reading of the surface. 0
+/// when there is no model, (ci, cj) is off the surface or not a candidate, or the
+/// exponent is 16 or more (a weight below 2^-23).
+/// Scaling: (m - m0) x bins < 2^32 x 2^9 and m_best x 2T < 2^32 x 2^23 in uint64; the
+/// exponent in Q16 < 16 x 2^16 (rfs_q16_exp_neg).
+uint32_t rfs_pathloss_draw_weight(const rfs_pathloss_t *p, uint16_t ci, uint16_t cj);
 
 /// 10 log10(max(d, 1 m)) for a squared distance d2 in m^2 Q32.32 (the square of a Q16.16
 /// difference), dB Q16.16, error < 1e-4 dB.

@@ -40,6 +40,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.eps_by_travel = false;                /* and counts epsilon's n in iterations */
     c.recheck_adapt = false;                /* one fixed threshold */
     c.eps_geodesic = false;                 /* epsilon weights by straight distance */
+    c.eps_sample = false;                   /* and epsilon goals at random, not drawn */
     return c;
 }
 
@@ -55,6 +56,7 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
     cfg->eps_by_travel = path;
     cfg->recheck_adapt = path;
     cfg->eps_geodesic = path;
+    cfg->eps_sample = path;
 }
 
 uint32_t rfs_seek_lattice_bits_bytes(const rfs_map_t *map)
@@ -456,8 +458,35 @@ static bool accept_detour(const rfs_seek_t *s, rfs_rng_t *rng, uint32_t q)
 
 /* Epsilon step (paper section 2): a random reachable point at least the novelty radius
  * from every past position, drawn with probability proportional to e^(-distance). */
+static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool whole,
+                              int64_t now_us);
+
+/* eps_sample: the epsilon goal is a draw from the model's belief (a plausible source),
+ * driven the whole planned way and rechecked like a greedy leg. false (the novelty draw
+ * follows) when the model draws nothing or a point within 1.5 steps of the robot: at its
+ * own estimate only a random move brings new data. */
+static bool choose_epsilon_sample(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
+{
+    rfs_q16_t x, y;
+    if (!s->cfg.eps_sample || s->model.ops->sample == 0 ||
+        !s->model.ops->sample(s->model.self, rng, &x, &y)) {
+        return false;
+    }
+    rfs_q16_t near = rfs_q16_add(s->cfg.step, s->cfg.step / 2);
+    if (rfs_q16_dist(s->pose.x, s->pose.y, x, y) < near) {
+        return false;
+    }
+    s->decision.max_x = x;
+    s->decision.max_y = y;
+    s->decision.sampled = greedy_along_path(s, x, y, true, now_us);
+    return s->decision.sampled;
+}
+
 static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
 {
+    if (choose_epsilon_sample(s, rng, now_us)) {
+        return true;
+    }
     const rfs_map_t *m = s->map;
     uint16_t ci, cj;
     rfs_map_lattice_nearest(m, s->pose.x, s->pose.y, &ci, &cj);
@@ -1478,7 +1507,8 @@ bool rfs_seek_recheck_miss(const rfs_seek_cfg_t *cfg, int64_t *miss_ms, rfs_q16_
  * abandoned and the next iteration relearns. */
 static bool recheck_fails(rfs_seek_t *s, int64_t now_us)
 {
-    if (s->cfg.recheck_dist <= 0 || s->decision.kind != RFS_SEEK_GREEDY || !s->have_chk ||
+    if (s->cfg.recheck_dist <= 0 ||
+        (s->decision.kind != RFS_SEEK_GREEDY && !s->decision.sampled) || !s->have_chk ||
         rfs_q16_dist(s->chk_x, s->chk_y, s->pose.x, s->pose.y) < s->cfg.recheck_dist) {
         return false;
     }

@@ -77,6 +77,11 @@ typedef struct rfs_seek_cfg {
     bool eps_geodesic;          ///< epsilon goals drawn with P proportional to e^(-path
                                 ///< length) instead of e^(-straight distance): a point
                                 ///< behind a wall is as far as the way round it
+    bool eps_sample;            ///< an epsilon goal is a draw from the model's belief
+                                ///< (rfs_model_ops_t.sample, when the model has one): a
+                                ///< plausible source, driven to and rechecked like a
+                                ///< greedy leg; a draw within 1.5 steps of the robot falls
+                                ///< back to the novelty draw
 } rfs_seek_cfg_t;
 
 /// Caller-owned memory for the seeker's large arrays.
@@ -141,7 +146,9 @@ typedef struct rfs_seek_decision {
     rfs_q16_t epsilon;         ///< epsilon for this iteration, Q16.16
     rfs_q16_t x, y;            ///< position at decision time, metres Q16.16
     rfs_q16_t goal_x, goal_y;  ///< chosen goal, metres Q16.16
-    rfs_q16_t max_x, max_y;    ///< model maximum found by the grid search (greedy only)
+    rfs_q16_t max_x, max_y;    ///< model maximum found by the grid search (greedy), or the
+                               ///< model's draw (a sampled epsilon step)
+    bool sampled;              ///< epsilon: the goal is the model's draw (cfg.eps_sample)
     rfs_q16_t path_len;        ///< planned path length, metres Q16.16
     uint16_t samples;          ///< samples in the store
 } rfs_seek_decision_t;
@@ -224,7 +231,8 @@ typedef struct rfs_seek {
 rfs_seek_cfg_t rfs_seek_cfg_default(void);
 
 /// Choose a strategy with its named preset: sets cfg->strategy and the improvement
-/// fields, on for RFS_SEEK_META_PATH (recheck_dist = cfg->step, eps_by_travel), the
+/// fields, on for RFS_SEEK_META_PATH (recheck_dist = cfg->step, eps_by_travel,
+/// recheck_adapt, eps_geodesic, eps_sample), the
 /// paper's (0, false) for every other strategy.
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 

@@ -218,6 +218,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_eps_by_travel = -1;
     sc->seek_eps_geodesic = -1;
     sc->seek_recheck_adapt = -1;
+    sc->seek_eps_sample = -1;
     sc->seek_p0_min_dbm = NAN;
     sc->seek_eps_rate = -1.0;
     snprintf(sc->model, sizeof sc->model, "ridge");
@@ -427,14 +428,15 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
     if ((n = get(p, root, "seek"))) {
         static const char *const k[] = {"recheck_m", "eps_by_travel", "eps_rate",
                                         "eps_geodesic", "recheck_adapt", "p0_min_dbm",
-                                        NULL};
+                                        "eps_sample", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "eps_rate", 0, 100, &sc->seek_eps_rate) ||
             num(p, n, "seek", "p0_min_dbm", -200, 100, &sc->seek_p0_min_dbm) ||
             preset_bool(p, n, "eps_by_travel", &sc->seek_eps_by_travel) ||
             preset_bool(p, n, "eps_geodesic", &sc->seek_eps_geodesic) ||
-            preset_bool(p, n, "recheck_adapt", &sc->seek_recheck_adapt)) {
+            preset_bool(p, n, "recheck_adapt", &sc->seek_recheck_adapt) ||
+            preset_bool(p, n, "eps_sample", &sc->seek_eps_sample)) {
             return -1;
         }
     }

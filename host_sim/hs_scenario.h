@@ -8,7 +8,8 @@
  *   strategy: meta                 # meta (the paper), meta-global, fd-gradient,
  *                                  # plane-gradient, chemotaxis, meta-path
  *   seek: {recheck_m: 1.0, eps_by_travel: true, eps_rate: 0.162, eps_geodesic: true,
- *                                  #       recheck_adapt: true, p0_min_dbm: -32}
+ *                                  #       recheck_adapt: true, eps_sample: true,
+ *                                  #       p0_min_dbm: -32}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2
@@ -69,6 +70,7 @@ typedef struct hs_scenario {
     int seek_eps_by_travel;       ///< seek.eps_by_travel: 0 / 1 (-1 = the strategy's preset)
     int seek_eps_geodesic;        ///< seek.eps_geodesic: 0 / 1 (-1 = the strategy's preset)
     int seek_recheck_adapt;       ///< seek.recheck_adapt: 0 / 1 (-1 = the strategy's preset)
+    int seek_eps_sample;          ///< seek.eps_sample: 0 / 1 (-1 = the strategy's preset)
     double seek_eps_rate;         ///< seek.eps_rate: epsilon's decay per iteration (-1 = the
                                   ///< paper's ln(9/4)/5, epsilon(5) = 0.5)
     double seek_p0_min_dbm;       ///< seek.p0_min_dbm: the pathloss model's floor on the

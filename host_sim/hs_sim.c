@@ -701,8 +701,9 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
                     res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
                     if (io && io->log) {
                         char reason[96];
-                        snprintf(reason, sizeof reason, "prev=%s%s%s%s", prev_name(d->prev),
+                        snprintf(reason, sizeof reason, "prev=%s%s%s%s%s", prev_name(d->prev),
                                  d->line_search ? ",line_search" : "",
+                                 d->sampled ? ",sampled" : "",
                                  d->model_valid ? "" : ",no_model",
                                  d->mean_valid ? "" : ",no_mean");
                         double pred = d->model_valid ? q16d(d->prediction) : NAN;
@@ -825,6 +826,9 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     }
     if (e->sc.seek_recheck_adapt >= 0) {
         cc.seek.recheck_adapt = e->sc.seek_recheck_adapt != 0;
+    }
+    if (e->sc.seek_eps_sample >= 0) {
+        cc.seek.eps_sample = e->sc.seek_eps_sample != 0;
     }
     cc.p0_min_dbm = e->sc.seek_p0_min_dbm;
     cc.seed = seed ^ 0x5A17C0FFEE000003ull;

@@ -35,12 +35,12 @@ BREAKS = [
 ]
 # (strategy, model, label, extra scenario text): meta-path's preset improvements
 # (recheck every step of a greedy leg against an adaptive threshold, epsilon annealed by
-# travel, epsilon goals weighted by path length; docs/STRATEGIES.md) are also run switched off, so each row shows what
-# they bring.
+# travel, epsilon goals weighted by path length, epsilon goals drawn from the model's
+# belief; docs/STRATEGIES.md) are also run switched off, so each row shows what they bring.
 CONFIGS = [("meta", "ridge", "meta + ridge", ""),
            ("meta-path", "pathloss", "meta-path + pathloss, improvements off",
             "seek: {recheck_m: 0, eps_by_travel: false, eps_geodesic: false, "
-            "recheck_adapt: false}\n"),
+            "recheck_adapt: false, eps_sample: false}\n"),
            ("meta-path", "pathloss", "meta-path + pathloss", ""),
            # The node's transmit power known (20 dBm EIRP): the P0 floor 12 dB below the
            # free-space 1 m signal (docs/PATHLOSS.md, "The P0 floor").
@@ -125,9 +125,10 @@ parameters; `meta-path + pathloss` is the improvement (docs/PATHLOSS.md, docs/ST
 the pathloss model's estimated source is the greedy goal, reached through the planner, with
 meta-path's preset improvements (the relearn check after every metre of a greedy leg,
 failing only beyond the larger of 3 dB and the RMS of the recent misses; epsilon annealed
-by the metres travelled; epsilon goals drawn by path length); "improvements off" is the
-same without them (`seek: {{recheck_m: 0, eps_by_travel: false, eps_geodesic: false,
-recheck_adapt: false}}` added to the scenario). "transmit power known" is the same as
+by the metres travelled; epsilon goals drawn by path length; an epsilon goal drawn from
+the model's belief, a plausible source, when one lies beyond 1.5 m); "improvements off" is
+the same without them (`seek: {{recheck_m: 0, eps_by_travel: false, eps_geodesic: false,
+recheck_adapt: false, eps_sample: false}}` added to the scenario). "transmit power known" is the same as
 `meta-path + pathloss` with the seeker told the node's power: `seek: {{p0_min_dbm: -32}}`
 (20 dBm EIRP - 40 dB in the first metre - a 12 dB margin; docs/PATHLOSS.md "The P0
 floor"); the last two rows of "Where it breaks" are nodes weaker than that belief.

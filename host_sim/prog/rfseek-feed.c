@@ -630,8 +630,9 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
                     res.greedy += d->kind == RFS_SEEK_GREEDY ? 1u : 0u;
                     res.epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
                     char reason[96];
-                    snprintf(reason, sizeof(reason), "prev=%s%s%s%s", rp_prev(d->prev),
-                             d->line_search ? ",line_search" : "", d->model_valid ? "" : ",no_model",
+                    snprintf(reason, sizeof(reason), "prev=%s%s%s%s%s", rp_prev(d->prev),
+                             d->line_search ? ",line_search" : "", d->sampled ? ",sampled" : "",
+                             d->model_valid ? "" : ",no_model",
                              d->mean_valid ? "" : ",no_mean");
                     fprintf(flog,
                             "%u\t%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%s\t%s\t%d\t%.3f\t%.3f\t"

@@ -382,4 +382,38 @@ static inline bool ref_pl_fit(ref_pl_t *r, const rfs_sample_t *s, int n, const r
     return true;
 }
 
+/* The hold search after ref_pl_fit: from lattice point (i, j), a 3 x 3 hill-climb at
+ * half the coarse spacing, halved down to one step (the centre first, then row by row;
+ * ties keep the earlier). Returns the least loss found and its point; with local false,
+ * the loss of (i, j) alone. */
+static inline double ref_pl_hold(ref_pl_t *r, int i, int j, bool local, int *bi, int *bj)
+{
+    r->seen = calloc((size_t)r->lw * r->lh, 1);
+    double n, w, p0;
+    double best = ref_pl_eval(r, i, j, &n, &w, &p0);
+    *bi = i;
+    *bj = j;
+    for (int h = r->cs / 2 < 1 ? 1 : r->cs / 2; local; h /= 2) {
+        int ci = *bi, cj = *bj;
+        for (int b = -1; b <= 1; ++b) {
+            for (int a = -1; a <= 1; ++a) {
+                if ((a != 0 || b != 0) && ref_pl_legal(r, ci + a * h, cj + b * h)) {
+                    double l = ref_pl_eval(r, ci + a * h, cj + b * h, &n, &w, &p0);
+                    if (l < best) {
+                        best = l;
+                        *bi = ci + a * h;
+                        *bj = cj + b * h;
+                    }
+                }
+            }
+        }
+        if (h <= 1) {
+            break;
+        }
+    }
+    free(r->seen);
+    r->seen = NULL;
+    return best;
+}
+
 #endif /* REF_PATHLOSS_H */

@@ -165,8 +165,8 @@ static void init_rejects_bad_configurations(void **state)
 {
     fixture_t *f = *state;
     rfs_pathloss_cfg_t good = rfs_pathloss_cfg_default();
-    rfs_pathloss_cfg_t bad[16];
-    for (int i = 0; i < 16; ++i) {
+    rfs_pathloss_cfg_t bad[18];
+    for (int i = 0; i < 18; ++i) {
         bad[i] = good;
     }
     bad[0].bin = RFS_Q16_FRAC(1, 20);
@@ -185,9 +185,11 @@ static void init_rejects_bad_configurations(void **state)
     bad[13].w_prior_weight = 0;
     bad[14].footprint = -1;
     bad[15].footprint = good.bin / 2 + 1;      /* beyond the bin */
+    bad[16].sample_t = RFS_Q16_FRAC(1, 16) - 1;
+    bad[17].sample_t = RFS_Q16_INT(64) + 1;
 
     assert_int_equal(rfs_pathloss_init(&f->pl, &good), 0);
-    for (int i = 0; i < 16; ++i) {
+    for (int i = 0; i < 18; ++i) {
         if (rfs_pathloss_init(&f->pl, &bad[i]) != -1) {
             fail_msg("bad configuration %d accepted", i);
         }
@@ -326,22 +328,25 @@ static void same_cell_as_double_reference_office(void **state)
 }
 
 
-/* hold_k: a relearn keeps the previous fit's source while its loss is within
- * best x (1 + hold_k / bins), best being the new search's least loss. Expected decisions
- * from the double-precision reference: its search on the new data gives the best, its
- * evaluation of the previous source that source's loss. Pairs of noisy data sets from
- * sources 0-2.7 m apart give both outcomes. */
-static void relearn_holds_previous_source(void **state)
+/* hold_k: a relearn keeps the previous fit's source (with hold_search, the best point of
+ * a local search round it) while its loss is within best x (1 + hold_k / bins), best
+ * being the new search's least loss. Expected decisions from the double-precision
+ * reference: its search on the new data gives the best, its hold search from the
+ * previous source (or that source alone) the held point and its loss. Pairs of noisy
+ * data sets from sources 0-2.7 m apart (0-10 m with the search) give both outcomes. */
+static void check_hold(fixture_t *f, bool local)
 {
-    fixture_t *f = *state;
     rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    c.hold_search = local;
     ref_pl_cfg_t rc = ref_pl_cfg_default();
-    int kept = 0, replaced = 0;
+    int kept = 0, replaced = 0, moved_hold = 0;
     for (int trial = 0; trial < 40; ++trial) {
         truth_t a = k_office, b = k_office;
         a.noise = b.noise = 6.0;
-        b.sx += 0.25 * (double)(trial % 10);
-        b.sy += 0.5 * (double)(trial / 10);
+        /* The search climbs up to 1.75 m: sources up to 9 m apart for it. */
+        double step = local ? 1.0 : 0.25;
+        b.sx += step * (double)(trial % 10);
+        b.sy += 2.0 * step * (double)(trial / 10);
         const int n = 80;
         make_samples(f->s, n, &f->map, &a, 100 + (uint64_t)trial);
         rfs_pathloss_est_t ea = fit_with(f, &c, n, &f->map, 0, NULL);
@@ -358,13 +363,9 @@ static void relearn_holds_previous_source(void **state)
         ref_pl_t *r = &f->ref;
         int ai = (int)lround((ea.sx / 65536.0 - r->ox) / r->grid);
         int aj = (int)lround((ea.sy / 65536.0 - r->oy) / r->grid);
-        double nn, ww, pp;
         double best = r->loss, rsx = r->sx, rsy = r->sy;
-        r->seen = calloc((size_t)r->lw * r->lh, 1); /* ref_pl_fit freed its own */
-        assert_non_null(r->seen);
-        double la = ref_pl_eval(r, ai, aj, &nn, &ww, &pp);
-        free(r->seen);
-        r->seen = NULL;
+        int hi, hj;
+        double la = ref_pl_hold(r, ai, aj, local, &hi, &hj);
         bool moved = fabs(rsx - ea.sx / 65536.0) > 1e-3 || fabs(rsy - ea.sy / 65536.0) > 1e-3;
         if (!moved) {
             continue; /* the new search found the old source itself: nothing to hold */
@@ -374,7 +375,9 @@ static void relearn_holds_previous_source(void **state)
             continue; /* too close to the threshold to call in fixed point */
         }
         bool keep = la <= best + margin;
-        double wx = keep ? ea.sx / 65536.0 : rsx, wy = keep ? ea.sy / 65536.0 : rsy;
+        double hx = r->ox + hi * r->grid, hy = r->oy + hj * r->grid;
+        double wx = keep ? hx : rsx, wy = keep ? hy : rsy;
+        moved_hold += keep && (hi != ai || hj != aj);
         if (fabs(eb.sx / 65536.0 - wx) > 1e-3 || fabs(eb.sy / 65536.0 - wy) > 1e-3) {
             fail_msg("trial %d: (%.3f, %.3f), expected (%.3f, %.3f) (%s)", trial,
                      eb.sx / 65536.0, eb.sy / 65536.0, wx, wy, keep ? "kept" : "replaced");
@@ -382,9 +385,23 @@ static void relearn_holds_previous_source(void **state)
         kept += keep;
         replaced += !keep;
     }
-    print_message("hold: %d kept, %d replaced\n", kept, replaced);
+    print_message("hold (%s): %d kept (%d moved by the search), %d replaced\n",
+                  local ? "search" : "point", kept, moved_hold, replaced);
     assert_true(kept >= 2);
     assert_true(replaced >= 2);
+    if (local) {
+        assert_true(moved_hold >= 1); /* the search is exercised, not just the point */
+    }
+}
+
+static void relearn_holds_previous_source(void **state)
+{
+    check_hold(*state, false);
+}
+
+static void relearn_holds_best_point_round_previous_source(void **state)
+{
+    check_hold(*state, true);
 }
 
 /* p0_min: the fixed-point search equals the double reference with the floor off too. */
@@ -675,6 +692,89 @@ static void residual_surface_and_spread(void **state)
     assert_true(e.spread_m2 >= RFS_Q16_INT(4) && e.spread_m2 <= RFS_Q16_INT(8));
 }
 
+/* The model's draw (rfs_pathloss_ops.sample, eps_sample): coarse point c is drawn with
+ * probability proportional to e^(-chi2_c / 2T), chi2_c = (m_c / m_best - 1) x bins, m
+ * the mean loss per unit weight (rms^2 / 2 of the reported surface). Weights recomputed
+ * in double from the reported surface and estimate; draw frequencies within 4.5
+ * binomial sigma of them over 40,000 draws. Few, noisy samples: a broad belief. */
+static void draws_follow_the_residual_surface(void **state)
+{
+    fixture_t *f = *state;
+    truth_t t = k_office;
+    t.noise = 6.0;
+    const int n = 60;
+    const int ndraw = 40000;
+    make_samples(f->s, n, &f->map, &t, 21);
+    static const double temps[2] = {1.0, 4.0};
+    for (int k = 0; k < 2; ++k) {
+        rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+        c.sample_t = (rfs_q16_t)lround(temps[k] * 65536.0);
+        rfs_pathloss_est_t e = fit_with(f, &c, n, &f->map, 0, NULL);
+        uint16_t ncx, ncy;
+        rfs_pathloss_surface_size(&f->pl, &ncx, &ncy);
+        int nc = ncx * ncy;
+        double *m = calloc((size_t)nc, sizeof *m), *want = calloc((size_t)nc, sizeof *want);
+        int *count = calloc((size_t)nc, sizeof *count);
+        assert_true(m != NULL && want != NULL && count != NULL);
+        double m0 = INFINITY, bm = pow(e.rms / 65536.0, 2) / 2.0, sum = 0;
+        for (int ci = 0; ci < nc; ++ci) {
+            rfs_q16_t x, y, rms;
+            m[ci] = rfs_pathloss_residual_at(&f->pl, (uint16_t)(ci % ncx), (uint16_t)(ci / ncx),
+                                             &x, &y, &rms)
+                        ? pow(rms / 65536.0, 2) / 2.0
+                        : NAN;
+            m0 = isnan(m[ci]) ? m0 : fmin(m0, m[ci]);
+        }
+        for (int ci = 0; ci < nc; ++ci) {
+            double ex = isnan(m[ci]) ? INFINITY : (m[ci] - m0) * e.bins / (2.0 * temps[k] * bm);
+            want[ci] = ex >= 16.0 ? 0.0 : exp(-ex);
+            double got = rfs_pathloss_draw_weight(&f->pl, (uint16_t)(ci % ncx),
+                                                  (uint16_t)(ci / ncx)) / 65536.0;
+            if (fabs(ex - 16.0) > 0.01 && fabs(got - want[ci]) > 2e-3) {
+                fail_msg("T %.0f, point %d: weight %.5f, double %.5f", temps[k], ci, got,
+                         want[ci]);
+            }
+            sum += want[ci];
+        }
+        rfs_rng_t rng;
+        rfs_rng_seed(&rng, 5 + (uint64_t)k);
+        for (int d = 0; d < ndraw; ++d) {
+            rfs_q16_t x, y;
+            assert_true(rfs_pathloss_ops.sample(&f->pl, &rng, &x, &y));
+            int ci = -1;
+            for (int q = 0; q < nc && ci < 0; ++q) {
+                rfs_q16_t px, py, rms;
+                if (rfs_pathloss_residual_at(&f->pl, (uint16_t)(q % ncx), (uint16_t)(q / ncx),
+                                             &px, &py, &rms) &&
+                    px == x && py == y) {
+                    ci = q;
+                }
+            }
+            assert_true(ci >= 0 && want[ci] > 0.0); /* a candidate, of weight */
+            count[ci]++;
+        }
+        int wide = 0;
+        for (int ci = 0; ci < nc; ++ci) {
+            double p = want[ci] / sum, got = (double)count[ci] / ndraw;
+            if (fabs(got - p) > 4.5 * sqrt(p * (1.0 - p) / ndraw) + 1e-9) {
+                fail_msg("T %.0f, point %d: drawn %.4f, expected %.4f", temps[k], ci, got, p);
+            }
+            wide += p >= 0.01;
+        }
+        print_message("draws at T %.0f: %d points of probability >= 1 %%\n", temps[k], wide);
+        assert_true(wide >= 3);
+        free(m);
+        free(want);
+        free(count);
+    }
+    rfs_q16_t x, y;
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 1);
+    rfs_pathloss_ops.reset(&f->pl);
+    assert_false(rfs_pathloss_ops.sample(&f->pl, &rng, &x, &y));
+    assert_int_equal(rfs_pathloss_draw_weight(&f->pl, 0, 0), 0u);
+}
+
 /* Closed loop with the paper's meta-algorithm (rfs_seek, paper defaults) and this model:
  * the office of this file, the source in a room, the robot starting in the corridor
  * 17 m away; a double-precision world (unicycle kinematics) with -40 - 30 log10(d)
@@ -796,7 +896,10 @@ int main(void)
         cmocka_unit_test_setup_teardown(predict_is_the_fitted_formula, setup, teardown),
         cmocka_unit_test_setup_teardown(residual_surface_and_spread, setup, teardown),
         cmocka_unit_test_setup_teardown(closed_loop_finds_the_room, setup, teardown),
+        cmocka_unit_test_setup_teardown(draws_follow_the_residual_surface, setup, teardown),
         cmocka_unit_test_setup_teardown(relearn_holds_previous_source, setup, teardown),
+        cmocka_unit_test_setup_teardown(relearn_holds_best_point_round_previous_source, setup,
+                                        teardown),
         cmocka_unit_test_setup_teardown(footprint_off_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_floor_off_same_as_reference, setup, teardown),
         cmocka_unit_test(registered_as_pathloss),

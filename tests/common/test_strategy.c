@@ -378,15 +378,18 @@ static void test_meta_path_preset(void **state)
     assert_int_equal(cfg.recheck_dist, 0);
     assert_false(cfg.eps_by_travel);
     assert_false(cfg.eps_geodesic);
+    assert_false(cfg.eps_sample);
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
     assert_int_equal(cfg.strategy, RFS_SEEK_META_PATH);
     assert_int_equal(cfg.recheck_dist, cfg.step);
     assert_true(cfg.eps_by_travel);
     assert_true(cfg.eps_geodesic);
+    assert_true(cfg.eps_sample);
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META);
     assert_int_equal(cfg.recheck_dist, 0);
     assert_false(cfg.eps_by_travel);
     assert_false(cfg.eps_geodesic);
+    assert_false(cfg.eps_sample);
     cfg.recheck_dist = -1;
     assert_int_equal(init_result(cfg), -1);
 }
@@ -627,6 +630,82 @@ static void test_meta_path_unreachable_maximum(void **state)
     world_free(&t);
 }
 
+
+/* A model that also draws (rfs_model_ops_t.sample): always the point (sx, sy). */
+typedef struct sampling_model {
+    fixed_model_t base; /* first: the fixed_* operations read it */
+    rfs_q16_t sx, sy;
+    int draws;
+} sampling_model_t;
+
+static bool fixed_sample(const void *self, rfs_rng_t *rng, rfs_q16_t *x, rfs_q16_t *y)
+{
+    (void)rng;
+    sampling_model_t *m = (sampling_model_t *)(uintptr_t)self;
+    m->draws++;
+    *x = m->sx;
+    *y = m->sy;
+    return m->base.valid;
+}
+
+static const rfs_model_ops_t k_sampling_ops = {
+    .name = "sampling", .reset = fixed_reset, .fit = fixed_fit, .predict = fixed_predict,
+    .argmax = fixed_argmax, .sample = fixed_sample,
+};
+
+/* eps_sample (docs/STRATEGIES.md): an epsilon decision goes the whole way to the model's
+ * draw, 10.5 m away here (the planned path of an open room is the straight line, its
+ * length the distance in double); a draw within 1.5 steps of the robot, the option off
+ * or a model that draws nothing give the novelty move (within the 8 m epsilon radius). */
+static void eps_sample_case(bool on, const rfs_model_ops_t *ops, double dx, bool expect)
+{
+    world_t t;
+    world_make(&t, 20.0, 10.0, 0, 0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    assert_true(cfg.eps_sample); /* the preset's */
+    cfg.eps_sample = on;
+    cfg.eps_amp = 0;
+    cfg.eps_floor = RFS_Q16_ONE; /* every decision after the first is epsilon */
+    seek_make(&t, cfg, 5);
+    sampling_model_t sm = { { false, Q(15.0), Q(5.0) }, 0, 0, 0 };
+    rfs_model_t model = { ops, &sm };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.125, .y = 5.125 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 0, 5000000, &out));
+    assert_int_equal(out.decision.kind, RFS_SEEK_INITIAL);
+    r.x = r.gx; /* arrive at once */
+    r.y = r.gy;
+    r.pending = false;
+    sm.sx = Q(r.x + dx);
+    sm.sy = Q(r.y);
+    assert_true(next_decision(&t, &r, &f, 0, 5000000, &out));
+    const rfs_seek_decision_t *d = &out.decision;
+    assert_int_equal(d->kind, RFS_SEEK_EPSILON);
+    assert_int_equal(d->sampled, expect);
+    double len = hypot(D(d->goal_x) - D(d->x), D(d->goal_y) - D(d->y));
+    if (expect) {
+        assert_true(fabs(D(d->goal_x) - D(sm.sx)) < 1e-4 && fabs(D(d->goal_y) - D(sm.sy)) < 1e-4);
+        assert_true(fabs(D(d->path_len) - dx) < 0.01);
+        assert_true(fabs(D(d->max_x) - D(sm.sx)) < 1e-4);
+    } else {
+        assert_true(len <= 8.0 * sqrt(2.0) + 1e-3); /* the novelty draw's radius */
+        assert_true(fabs(D(d->goal_x) - D(sm.sx)) > 1e-4 || fabs(D(d->goal_y) - D(sm.sy)) > 1e-4);
+    }
+    assert_int_equal(sm.draws > 0, on && ops->sample != NULL);
+    world_free(&t);
+}
+
+static void test_eps_sample_goes_to_the_draw(void **state)
+{
+    (void)state;
+    eps_sample_case(true, &k_sampling_ops, 10.5, true);
+    eps_sample_case(true, &k_sampling_ops, 1.25, false); /* within 1.5 steps */
+    eps_sample_case(false, &k_sampling_ops, 10.5, false);
+    eps_sample_case(true, &k_fixed_ops, 10.5, false);    /* the model does not draw */
+}
 
 /* A null move (the greedy goal is where the robot stands): the seeker decides again one
  * averaging window later, not at every 50 ms period, and raises no NO_GOAL fault. */
@@ -961,6 +1040,7 @@ int main(void)
         cmocka_unit_test(test_recheck_abandons_leg),
         cmocka_unit_test(test_recheck_adapt),
         cmocka_unit_test(test_meta_path_unreachable_maximum),
+        cmocka_unit_test(test_eps_sample_goes_to_the_draw),
         cmocka_unit_test(test_null_move_backs_off),
         cmocka_unit_test(test_eps_geodesic_distribution),
     };

@@ -95,17 +95,19 @@ static void test_scenario_good(void **state)
     assert_true(sc.seek_recheck_m == -1.0 && sc.seek_eps_by_travel == -1 && sc.seek_eps_rate == -1.0);
     assert_int_equal(sc.seek_eps_geodesic, -1);
     assert_int_equal(sc.seek_recheck_adapt, -1);
+    assert_int_equal(sc.seek_eps_sample, -1);
     assert_true(isnan(sc.seek_p0_min_dbm)); // the pathloss model's own default
     assert_true(sc.rx_heartbeat); // issue 10: on unless the scenario turns it off
     // seek: overrides of the strategy's preset.
     char text[2048];
     snprintf(text, sizeof text, "%sstrategy: meta-path\nseek: {recheck_m: 0.5, eps_by_travel: false, "
-             "eps_rate: 0.3, eps_geodesic: false, recheck_adapt: false}\n", GOOD);
+             "eps_rate: 0.3, eps_geodesic: false, recheck_adapt: false, eps_sample: false}\n", GOOD);
     assert_int_equal(hs_scenario_load(scn("seek.yaml", text), &sc, err, sizeof err), 0);
     assert_string_equal(sc.strategy, "meta-path");
     assert_true(sc.seek_recheck_m == 0.5 && sc.seek_eps_by_travel == 0 && sc.seek_eps_rate == 0.3);
     assert_int_equal(sc.seek_eps_geodesic, 0);
     assert_int_equal(sc.seek_recheck_adapt, 0);
+    assert_int_equal(sc.seek_eps_sample, 0);
     snprintf(text, sizeof text, "%sseek: {eps_geodesic: true}\n", GOOD);
     assert_int_equal(hs_scenario_load(scn("seek_geo.yaml", text), &sc, err, sizeof err), 0);
     assert_int_equal(sc.seek_eps_geodesic, 1);
@@ -188,6 +190,10 @@ static void test_scenario_bad(void **state)
                "map: @MAP@\nseek: {eps_geodesic: 1.5}\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",
                "seek_geo_bool.yaml:2: seek.eps_geodesic: expected true or false");
+    expect_bad("seek_sample_bool.yaml",
+               "map: @MAP@\nseek: {eps_sample: 2}\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "seek_sample_bool.yaml:2: seek.eps_sample: expected true or false");
     expect_bad("seek_adapt_bool.yaml",
                "map: @MAP@\nseek: {recheck_adapt: yes please}\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",

@@ -145,11 +145,22 @@ check rfseekd-p0-min-range '[ $? -eq 2 ] && one_line "$tmp/e" "^rfseekd: --p0-mi
 check rfseekd-p0-min-not-pathloss '[ $? -eq 2 ] && one_line "$tmp/e" "^rfseekd: --p0-min: only with --model pathloss"'
 "$d" --help | grep -q -- "--p0-min DBM"
 check rfseekd-help-p0-min '[ $? -eq 0 ]'
+"$d" --map scenarios/maps/office.yaml --strategy meta-global >"$tmp/o" 2>"$tmp/e"
+check rfseekd-strategy-global '[ $? -eq 2 ] && one_line "$tmp/e" "^rfseekd: --strategy: expected meta, meta-path, fd-gradient, plane-gradient or chemotaxis, got meta-global"'
+"$d" --map scenarios/maps/office.yaml --strategy Meta >"$tmp/o" 2>"$tmp/e"
+check rfseekd-strategy-unknown '[ $? -eq 2 ] && one_line "$tmp/e" "^rfseekd: --strategy: expected .*, got Meta"'
+"$d" --help | grep -q -- "--strategy NAME"
+check rfseekd-help-strategy '[ $? -eq 0 ]'
 if [ -x "$tool" ] && "$tool" mklog "$tmp/in.lcmlog"; then
     for m in ridge mlp knn; do
         "$d" --map scenarios/maps/office.yaml --replay "$tmp/in.lcmlog" --clock-lcm --model "$m" \
             >"$tmp/d-$m.txt" 2>"$tmp/d-$m.err"
-        check "rfseekd-model-$m" '[ $? -eq 0 ] && grep -q "^rfseekd: 81 steps" "$tmp/d-$m.err" && [ -s "$tmp/d-$m.txt" ]'
+        check "rfseekd-model-$m" '[ $? -eq 0 ] && grep -q "^rfseekd: 81 steps.*(strategy meta, model $m)\$" "$tmp/d-$m.err" && [ -s "$tmp/d-$m.txt" ]'
+    done
+    for st in meta-path chemotaxis; do
+        "$d" --map scenarios/maps/office.yaml --replay "$tmp/in.lcmlog" --clock-lcm --model pathloss \
+            --strategy "$st" >"$tmp/s-$st.txt" 2>"$tmp/s-$st.err"
+        check "rfseekd-strategy-$st" '[ $? -eq 0 ] && grep -q "^rfseekd: 81 steps.*(strategy $st, model pathloss)\$" "$tmp/s-$st.err"'
     done
 else
     echo "FAIL rfseekd-model-replay: $tool mklog unavailable"; fails=$((fails + 1))

@@ -193,4 +193,27 @@ fi
     --idle-exit 2000 2>/dev/null
 cmp -s "$w/live.txt" "$w/replay3.txt" && pass "two-process-replay-through-lcm-file-provider" \
     || fail two-process-replay-through-lcm-file-provider
+
+# The improvement of issue 10 on the Linux port: meta-path with the pathloss model, the
+# same two processes in a fresh namespace.
+ns=rfswirep$$
+ip netns add "$ns" && trap 'ip netns del "$ns" 2>/dev/null' EXIT
+ip netns exec "$ns" ip link set lo up && ip netns exec "$ns" ip route add 224.0.0.0/4 dev lo \
+    || { fail "netns setup (meta-path)"; exit 1; }
+ip netns exec "$ns" timeout 300 "$d" --map $map --lcm "$url" --can-over-lcm --clock-lcm \
+    --model pathloss --strategy meta-path --idle-exit 3000 2> "$w/dp.err" > /dev/null &
+dpid=$!
+sleep 0.5
+ip netns exec "$ns" timeout 300 "$build/bin/rfseek-sim-lcm" scenarios/default.yaml --lcm "$url" \
+    > "$w/summary-path.json" 2> "$w/sim-path.err"
+src=$?
+wait $dpid
+drc=$?
+ip netns del "$ns"; trap - EXIT
+if [ $src -eq 0 ] && [ $drc -eq 0 ] && grep -q '"reached": true' "$w/summary-path.json" \
+    && grep -q "(strategy meta-path, model pathloss)\$" "$w/dp.err"; then
+    pass "two-process-meta-path-pathloss-reaches-source ($(grep -E '"(distance_travelled_m|iterations)"' "$w/summary-path.json" | tr -d ' \n'))"
+else
+    fail "two-process-meta-path-pathloss-reaches-source (sim rc $src, rfseekd rc $drc: $(cat "$w/sim-path.err" "$w/dp.err" | tail -3))"
+fi
 exit $((fails > 0))

@@ -46,6 +46,10 @@ static const char usage_text[] =
     "  --target NAME     rssi (default) or bridge\n"
     "  --model NAME      internal model: ridge (default, the paper's), mlp, knn, radius,\n"
     "                    pathloss (docs/MODELS.md; the STM32 image holds the ridge only)\n"
+    "  --strategy NAME   meta (default, the paper's Algorithm 1) or meta-path (greedy legs\n"
+    "                    along the planned path, with its preset improvements; with\n"
+    "                    --model pathloss: docs/STRATEGIES.md); also fd-gradient,\n"
+    "                    plane-gradient, chemotaxis (the simulator's baselines)\n"
     "  --p0-min DBM      pathloss only: floor on the fitted signal at 1 m (default -45); the\n"
     "                    node's EIRP - 52 when its power is known (docs/PATHLOSS.md)\n"
     "  --seed N          seed of the controller's random source (default 1)\n"
@@ -272,7 +276,7 @@ static bool is_value_option(const char *a)
 {
     static const char *const opts[] = {"--map", "--lcm", "--can", "--replay", "--log", "--decisions",
                                        "--target", "--res", "--seed", "--duration", "--idle-exit",
-                                       "--model", "--p0-min"};
+                                       "--model", "--p0-min", "--strategy"};
     for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++) {
         if (strcmp(a, opts[i]) == 0) {
             return true;
@@ -287,6 +291,7 @@ int main(int argc, char **argv)
     const char *target = "rssi";
     const rfs_models_entry_t *model = NULL; // NULL: the application's built-in ridge
     double p0_min = NAN;                    // --p0-min: NAN keeps the model's default
+    rfs_seek_strategy_t strategy = RFS_SEEK_META; // --strategy: the paper's
     double res = 0.1;
     int64_t seed = 1, duration_s = 0, idle_ms = 0;
     bool can_over_lcm = false, clock_lcm = false;
@@ -326,6 +331,14 @@ int main(int argc, char **argv)
             if (model == NULL) {
                 return die("--model: expected ridge, mlp, knn, radius or pathloss, got ", v);
             }
+        } else if (strcmp(a, "--strategy") == 0) {
+            // meta-global needs the ridge's radius widened to the map (rfseek-sim does it):
+            // not offered here rather than run as plain meta under its name.
+            if (!rfs_seek_strategy_parse(v, &strategy) || strategy == RFS_SEEK_META_GLOBAL) {
+                return die("--strategy: expected meta, meta-path, fd-gradient, plane-gradient or "
+                           "chemotaxis, got ", v);
+            }
+            i++;
         } else if (strcmp(a, "--p0-min") == 0) {
             char *end;
             p0_min = strtod(v, &end);
@@ -378,6 +391,7 @@ int main(int argc, char **argv)
     hs_core_map_t core;
     memset(&core, 0, sizeof core);
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg.seek, strategy);
     cfg.seed = (uint64_t)seed;
     cfg.target = strcmp(target, "bridge") == 0 ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
     if (hs_map_load(map_path, &m, err, sizeof err) != 0 || hs_map_to_core(&m, res, &cfg.map, &core, err, sizeof err) != 0) {
@@ -546,8 +560,10 @@ int main(int argc, char **argv)
         }
     }
     fprintf(stderr, "rfseekd: %" PRIu32 " steps, %" PRIu32 " decisions, %" PRIu32 " bad messages, %" PRIu32
-                    " CAN send failures, %" PRIu32 " receiver heartbeats, seeker rejected %" PRIu32 " inputs\n",
-            d.steps, d.decided, d.bad_msgs, d.can_fail, d.app->stats.receiver, d.app->stats.rejected);
+                    " CAN send failures, %" PRIu32 " receiver heartbeats, seeker rejected %" PRIu32
+                    " inputs (strategy %s, model %s)\n",
+            d.steps, d.decided, d.bad_msgs, d.can_fail, d.app->stats.receiver, d.app->stats.rejected,
+            rfs_seek_strategy_name(d.app->seek.cfg.strategy), d.app->seek.model.ops->name);
 out:
     if (in) {
         hs_lcm_log_close(in);

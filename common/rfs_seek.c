@@ -456,8 +456,6 @@ static bool accept_detour(const rfs_seek_t *s, rfs_rng_t *rng, uint32_t q)
     return rfs_rng_below(rng, RFS_Q16_ONE) < (uint32_t)keep;
 }
 
-/* Epsilon step (paper section 2): a random reachable point at least the novelty radius
- * from every past position, drawn with probability proportional to e^(-distance). */
 static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool whole,
                               int64_t now_us);
 
@@ -476,12 +474,18 @@ static bool choose_epsilon_sample(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     if (rfs_q16_dist(s->pose.x, s->pose.y, x, y) < near) {
         return false;
     }
+    if (!greedy_along_path(s, x, y, true, now_us)) {
+        return false;
+    }
+    s->decision.sampled = true;
     s->decision.max_x = x;
     s->decision.max_y = y;
-    s->decision.sampled = greedy_along_path(s, x, y, true, now_us);
-    return s->decision.sampled;
+    return true;
 }
 
+/* Epsilon step (paper section 2): a random reachable point at least the novelty radius
+ * from every past position, drawn with probability proportional to e^(-distance); with
+ * eps_sample, the model's draw first (above). */
 static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
 {
     if (choose_epsilon_sample(s, rng, now_us)) {

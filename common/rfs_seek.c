@@ -461,8 +461,12 @@ static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool wh
 
 /* eps_sample: the epsilon goal is a draw from the model's belief (a plausible source),
  * driven the whole planned way and rechecked like a greedy leg. false (the novelty draw
- * follows) when the model draws nothing or a point within 1.5 steps of the robot: at its
- * own estimate only a random move brings new data. */
+ * follows) when the model draws nothing, a point within 1.5 steps of the robot, or one
+ * the robot has been to (within the novelty radius of a past position), and whenever the
+ * robot stands within 1.5 steps of the model's own maximum: at a wrong estimate the
+ * draws lie in the rooms round it, a leg there fails its recheck within a metre and the
+ * relearnt fit holds the estimate (hold_k), so the robot shuttles; only the novelty
+ * move's new places shift the fit. */
 static bool choose_epsilon_sample(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
 {
     rfs_q16_t x, y;
@@ -472,6 +476,16 @@ static bool choose_epsilon_sample(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     }
     rfs_q16_t near = rfs_q16_add(s->cfg.step, s->cfg.step / 2);
     if (rfs_q16_dist(s->pose.x, s->pose.y, x, y) < near) {
+        return false;
+    }
+    rfs_q16_t mx, my;
+    if (s->model.ops->argmax != 0 && s->model.ops->argmax(s->model.self, &mx, &my) &&
+        rfs_q16_dist(s->pose.x, s->pose.y, mx, my) < near) {
+        return false;
+    }
+    uint16_t li, lj;
+    rfs_map_lattice_nearest(s->map, x, y, &li, &lj);
+    if (bit_get(s->visited, (uint32_t)lj * s->map->lw + li)) {
         return false;
     }
     if (!greedy_along_path(s, x, y, true, now_us)) {

@@ -80,8 +80,9 @@ typedef struct rfs_seek_cfg {
     bool eps_sample;            ///< an epsilon goal is a draw from the model's belief
                                 ///< (rfs_model_ops_t.sample, when the model has one): a
                                 ///< plausible source, driven to and rechecked like a
-                                ///< greedy leg; a draw within 1.5 steps of the robot falls
-                                ///< back to the novelty draw
+                                ///< greedy leg; the novelty draw instead when the draw is
+                                ///< within 1.5 steps of the robot or where it has been, or
+                                ///< the robot stands within 1.5 steps of the model's argmax
 } rfs_seek_cfg_t;
 
 /// Caller-owned memory for the seeker's large arrays.

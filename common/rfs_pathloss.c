@@ -667,6 +667,14 @@ static void finish(rfs_pathloss_t *p)
     p->prev_map = p->map;
 }
 
+/* Point rem (0..8, row by row; 4 is the centre) of the 3 x 3 neighbourhood of lattice
+ * point (ci, cj) at spacing step. */
+static void neighbour(int32_t ci, int32_t cj, uint32_t rem, int32_t step, int32_t *i, int32_t *j)
+{
+    *i = ci + ((int32_t)(rem % 3u) - 1) * step;
+    *j = cj + ((int32_t)(rem / 3u) - 1) * step;
+}
+
 /* The hold phase: the previous source (p->best until finish()) and, with hold_search, a
  * 3 x 3 hill-climb round it at halving spacings; then its best point against the new
  * best. true: a candidate was started (evaluate it and call again); false: the phase is
@@ -681,11 +689,11 @@ static bool hold_next(rfs_pathloss_t *p)
         ev_start(p, p->hold_i, p->hold_j, -1, EV_HOLD, 0u);
         return true;
     }
-    for (;;) {
+    while (p->cfg.hold_search) {
         while (p->hold_pos < 9u) {
             uint32_t rem = p->hold_pos++;
-            int32_t i = (int32_t)p->hold_i + ((int32_t)(rem % 3u) - 1) * p->hold_step;
-            int32_t j = (int32_t)p->hold_j + ((int32_t)(rem / 3u) - 1) * p->hold_step;
+            int32_t i, j;
+            neighbour(p->hold_i, p->hold_j, rem, p->hold_step, &i, &j);
             if (rem != 4u && cand_legal(p, i, j)) {
                 ev_start(p, (uint16_t)i, (uint16_t)j, -1, EV_HOLD, 0u);
                 return true;
@@ -756,13 +764,8 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
                 p->surface[p->ev.c] = mean_loss(p, cd.loss);
                 keep_top(p, &cd);
             } else if (p->ev.kind == EV_HOLD) {
-                if (!p->hold_have || cd.loss < p->hold_best.loss) {
+                if (cd.loss < p->hold_best.loss) {
                     p->hold_best = cd;
-                    p->hold_have = true;
-                }
-                if (!p->cfg.hold_search) {
-                    p->hold_pos = 9u;
-                    p->hold_step = 1u;
                 }
                 continue;
             }
@@ -815,7 +818,7 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
                     p->hold_j = p->best.lj;
                     p->hold_step = (uint16_t)(l->cs / 2u < 1u ? 1u : l->cs / 2u);
                     p->hold_pos = UINT8_MAX; /* the previous source itself first */
-                    p->hold_have = false;
+                    p->hold_best.loss = INT64_MAX;
                     continue;
                 }
                 finish(p);
@@ -830,8 +833,7 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
         p->pos++;
         int32_t ci = p->phase == RFS_PATHLOSS_REFINE ? p->top[k].li : p->fc_i;
         int32_t cj = p->phase == RFS_PATHLOSS_REFINE ? p->top[k].lj : p->fc_j;
-        i = ci + ((int32_t)(rem % 3u) - 1) * p->step;
-        j = cj + ((int32_t)(rem / 3u) - 1) * p->step;
+        neighbour(ci, cj, rem, p->step, &i, &j);
         if (rem == 4u || !cand_legal(p, i, j) || seen_before(p, i, j)) {
             continue;
         }
@@ -870,26 +872,35 @@ static bool pathloss_argmax(const void *self, rfs_q16_t *x, rfs_q16_t *y)
     return true;
 }
 
+/* The per-fit constants of the draw's weights. x = (m - m0) bins / (2 T bm): chi2 / 2T
+ * against the chosen source (bm), less the same for the best coarse point (m0 <= m),
+ * which so weighs 1; the draw's probabilities are those of e^(-chi2 / 2T). */
+typedef struct draw_k {
+    uint64_t m0;  /* best coarse point's mean loss, dB^2 Q16 */
+    uint64_t den; /* 2 T bm, dB^2 Q16, >= 1 */
+} draw_k_t;
+
+static draw_k_t draw_consts(const rfs_pathloss_t *p)
+{
+    uint64_t bm = mean_loss(p, p->best.loss);
+    bm = bm > 0u ? bm : 1u;
+    uint64_t den = (bm * 2u * (uint64_t)p->cfg.sample_t) >> 16;
+    draw_k_t k = {mean_loss(p, p->top[0].loss), den > 0u ? den : 1u};
+    return k;
+}
+
 /* Weight of coarse surface point c (rfs_pathloss_draw_weight), for a valid model. */
-static uint32_t draw_weight(const rfs_pathloss_t *p, uint32_t c)
+static uint32_t draw_weight(const rfs_pathloss_t *p, const draw_k_t *k, uint32_t c)
 {
     uint32_t m = p->surface[c];
     if (m == RFS_PATHLOSS_NO_LOSS) {
         return 0u;
     }
-    /* x = (m - m0) bins / (2 T bm): chi2 / 2T against the chosen source (bm), less the
-     * same for the best coarse point (m0 <= m), which so weighs 1; the draw's
-     * probabilities are those of e^(-chi2 / 2T). */
-    uint64_t bm = mean_loss(p, p->best.loss);
-    bm = bm > 0u ? bm : 1u;
-    uint64_t m0 = mean_loss(p, p->top[0].loss);
-    uint64_t num = m > m0 ? ((uint64_t)m - m0) * p->used_bins : 0u;
-    uint64_t den = (bm * 2u * (uint64_t)p->cfg.sample_t) >> 16;
-    den = den > 0u ? den : 1u;
-    if (num >= 16u * den) {
+    uint64_t num = m > k->m0 ? ((uint64_t)m - k->m0) * p->used_bins : 0u;
+    if (num >= 16u * k->den) {
         return 0u;
     }
-    return (uint32_t)rfs_q16_exp_neg((rfs_q16_t)rfs_udiv64(num << 16, den));
+    return (uint32_t)rfs_q16_exp_neg((rfs_q16_t)rfs_udiv64(num << 16, k->den));
 }
 
 uint32_t rfs_pathloss_draw_weight(const rfs_pathloss_t *p, uint16_t ci, uint16_t cj)
@@ -898,7 +909,8 @@ uint32_t rfs_pathloss_draw_weight(const rfs_pathloss_t *p, uint16_t ci, uint16_t
     if (!p->valid || ci >= p->lat.ncx || cj >= p->lat.ncy) {
         return 0u;
     }
-    return draw_weight(p, (uint32_t)cj * p->lat.ncx + ci);
+    draw_k_t k = draw_consts(p);
+    return draw_weight(p, &k, (uint32_t)cj * p->lat.ncx + ci);
 }
 
 /* A plausible source: a coarse candidate of the last fit drawn with its weight (the
@@ -913,14 +925,15 @@ static bool pathloss_sample(const void *self, rfs_rng_t *rng, rfs_q16_t *x, rfs_
     }
     const rfs_pathloss_lat_t *l = &p->lat;
     const uint32_t nc = (uint32_t)l->ncx * l->ncy;
+    const draw_k_t k = draw_consts(p);
     uint32_t total = 0u;
     for (uint32_t c = 0u; c < nc; ++c) {
-        total += draw_weight(p, c);
+        total += draw_weight(p, &k, c);
     }
     RFS_ASSERT(total > 0u); /* the best coarse point weighs 1 */
     uint32_t pick = rfs_rng_below(rng, total), acc = 0u;
     for (uint32_t c = 0u; c < nc; ++c) {
-        acc += draw_weight(p, c);
+        acc += draw_weight(p, &k, c);
         if (acc > pick) {
             lattice_xy(l, (uint16_t)(l->c0i + (c % l->ncx) * l->cs),
                        (uint16_t)(l->c0j + (c / l->ncx) * l->cs), x, y);

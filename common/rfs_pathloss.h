@@ -242,9 +242,10 @@ typedef struct rfs_pathloss {
     uint16_t hold_i;                              ///< hold_search: centre, lattice x
     uint16_t hold_j;                              ///< lattice y
     uint16_t hold_step;                           ///< its spacing, lattice steps
-    uint8_t hold_pos;                             ///< next of its 3 x 3 points (9: done)
-    bool hold_have;                               ///< hold_best is set
+    uint8_t hold_pos;                             ///< next of its 3 x 3 points (9: done;
+                                                  ///< UINT8_MAX: the centre first)
     rfs_pathloss_cand_t hold_best;                ///< best point of the hold search so far
+                                                  ///< (loss INT64_MAX before the first)
     uint16_t nvis;                                ///< refinement points remembered
     uint16_t vis_i[RFS_PATHLOSS_MAX_VISITED];     ///< their lattice x
     uint16_t vis_j[RFS_PATHLOSS_MAX_VISITED];     ///< their lattice y

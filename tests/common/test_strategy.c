@@ -657,9 +657,9 @@ static const rfs_model_ops_t k_sampling_ops = {
  * draw, 10.5 m away here (the planned path of an open room is the straight line, its
  * length the distance in double); a draw within 1.5 steps of the robot, a draw where the
  * robot has been (the start, 2 m behind it: within the novelty radius of a past
- * position), a robot standing at the model's maximum, the option off or a model that
+ * position), a draw 1.25 m away (within 1.5 steps), a robot standing at the model's maximum, the option off or a model that
  * draws nothing give the novelty move (within the 8 m epsilon radius). */
-enum { DRAW_AHEAD = 0, DRAW_AT_START = 1, MAX_AT_ROBOT = 2 };
+enum { DRAW_AHEAD = 0, DRAW_AT_START = 1, MAX_AT_ROBOT = 2, DRAW_NEAR = 3 };
 
 static void eps_sample_case(bool on, const rfs_model_ops_t *ops, double dx, bool expect,
                             int where)
@@ -686,7 +686,8 @@ static void eps_sample_case(bool on, const rfs_model_ops_t *ops, double dx, bool
     r.pending = false;
     sm.sx = where == DRAW_AT_START ? Q(4.125) : Q(r.x + dx);
     sm.sy = where == DRAW_AT_START ? Q(5.125) : Q(r.y);
-    assert_true(hypot(D(sm.sx) - r.x, D(sm.sy) - r.y) >= 1.5); /* beyond the near rule */
+    /* Beyond the near rule, except where the case tests it. */
+    assert_true((hypot(D(sm.sx) - r.x, D(sm.sy) - r.y) >= 1.5) == (where != DRAW_NEAR));
     if (where == MAX_AT_ROBOT) {
         sm.base.mx = Q(r.x);
         sm.base.my = Q(r.y);
@@ -712,40 +713,11 @@ static void test_eps_sample_goes_to_the_draw(void **state)
 {
     (void)state;
     eps_sample_case(true, &k_sampling_ops, 10.5, true, DRAW_AHEAD);
+    eps_sample_case(true, &k_sampling_ops, 1.25, false, DRAW_NEAR);
     eps_sample_case(true, &k_sampling_ops, 10.5, false, DRAW_AT_START);
     eps_sample_case(true, &k_sampling_ops, 10.5, false, MAX_AT_ROBOT);
     eps_sample_case(false, &k_sampling_ops, 10.5, false, DRAW_AHEAD);
     eps_sample_case(true, &k_fixed_ops, 10.5, false, DRAW_AHEAD); /* the model does not draw */
-}
-
-/* The near rule on its own: a draw 1.25 m from the robot. */
-static void test_eps_sample_near_draw_falls_back(void **state)
-{
-    (void)state;
-    world_t t;
-    world_make(&t, 20.0, 10.0, 0, 0);
-    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
-    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
-    cfg.eps_amp = 0;
-    cfg.eps_floor = RFS_Q16_ONE;
-    seek_make(&t, cfg, 5);
-    sampling_model_t sm = { { false, Q(15.0), Q(5.0) }, 0, 0, 0 };
-    rfs_model_t model = { &k_sampling_ops, &sm };
-    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
-    field_t f = { .kind = 2, .scripted = -60.0 };
-    run_t r = { .x = 4.125, .y = 5.125 };
-    rfs_seek_out_t out;
-    assert_true(next_decision(&t, &r, &f, 0, 5000000, &out));
-    r.x = r.gx;
-    r.y = r.gy;
-    r.pending = false;
-    sm.sx = Q(r.x + 1.25);
-    sm.sy = Q(r.y);
-    assert_true(next_decision(&t, &r, &f, 0, 5000000, &out));
-    assert_int_equal(out.decision.kind, RFS_SEEK_EPSILON);
-    assert_false(out.decision.sampled);
-    assert_true(sm.draws > 0);
-    world_free(&t);
 }
 
 /* A null move (the greedy goal is where the robot stands): the seeker decides again one
@@ -1082,7 +1054,6 @@ int main(void)
         cmocka_unit_test(test_recheck_adapt),
         cmocka_unit_test(test_meta_path_unreachable_maximum),
         cmocka_unit_test(test_eps_sample_goes_to_the_draw),
-        cmocka_unit_test(test_eps_sample_near_draw_falls_back),
         cmocka_unit_test(test_null_move_backs_off),
         cmocka_unit_test(test_eps_geodesic_distribution),
     };

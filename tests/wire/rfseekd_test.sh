@@ -157,30 +157,41 @@ timeout 60 lcm-logplayer -l memq:// -s 1000 "$w/out1.lcmlog" > /dev/null 2>&1 \
     && pass rfseekd-log-plays-in-lcm-logplayer || fail rfseekd-log-plays-in-lcm-logplayer
 
 # Two processes over udpm://, only inside a network namespace we create and delete.
-ns=rfswire$$
-if ! ip netns add "$ns" 2>/dev/null; then
+# two_process TAG RFSEEKD-ARGS...: rfseekd (with the args) and rfseek-sim-lcm on the default
+# office in a fresh namespace; rfseekd's stderr in $w/d-TAG.err, the simulator's summary in
+# $w/summary-TAG.json and stderr in $w/sim-TAG.err; sets src and drc. Returns 2 when no
+# namespace can be made.
+url='udpm://239.255.76.67:7667?ttl=0'
+two_process() {
+    local tag=$1
+    shift
+    ns=rfswire$tag$$
+    ip netns add "$ns" 2>/dev/null || return 2
+    trap 'ip netns del "$ns" 2>/dev/null' EXIT
+    ip netns exec "$ns" ip link set lo up && ip netns exec "$ns" ip route add 224.0.0.0/4 dev lo \
+        || { fail "netns setup ($tag)"; exit 1; }
+    ip netns exec "$ns" timeout 300 "$d" --map $map --lcm "$url" --can-over-lcm --clock-lcm \
+        --idle-exit 3000 "$@" 2> "$w/d-$tag.err" > /dev/null &
+    local dpid=$!
+    sleep 0.5
+    ip netns exec "$ns" timeout 300 "$build/bin/rfseek-sim-lcm" scenarios/default.yaml --lcm "$url" \
+        > "$w/summary-$tag.json" 2> "$w/sim-$tag.err"
+    src=$?
+    wait $dpid
+    drc=$?
+    ip netns del "$ns"; trap - EXIT
+    ip netns list | grep -q "^$ns" && fail "netns $ns left behind"
+    return 0
+}
+two_process paper --log "$w/run.lcmlog" --decisions "$w/live.txt"
+if [ $? -eq 2 ]; then
     echo "SKIP two-process run: cannot create a network namespace (needs root)"
     exit $((fails > 0))
 fi
-trap 'ip netns del "$ns" 2>/dev/null' EXIT
-ip netns exec "$ns" ip link set lo up && ip netns exec "$ns" ip route add 224.0.0.0/4 dev lo \
-    || { fail "netns setup"; exit 1; }
-url='udpm://239.255.76.67:7667?ttl=0'
-ip netns exec "$ns" timeout 300 "$d" --map $map --lcm "$url" --can-over-lcm --clock-lcm --log "$w/run.lcmlog" \
-    --decisions "$w/live.txt" --idle-exit 3000 2> "$w/d.err" &
-dpid=$!
-sleep 0.5
-ip netns exec "$ns" timeout 300 "$build/bin/rfseek-sim-lcm" scenarios/default.yaml --lcm "$url" \
-    > "$w/summary.json" 2> "$w/sim.err"
-src=$?
-wait $dpid
-drc=$?
-ip netns del "$ns"; trap - EXIT
-ip netns list | grep -q "^$ns" && fail "netns $ns left behind"
-if [ $src -eq 0 ] && [ $drc -eq 0 ] && grep -q '"reached": true' "$w/summary.json"; then
-    pass "two-process-run-reaches-source ($(grep -E '"(sim_time_s|iterations)"' "$w/summary.json" | tr -d ' \n'))"
+if [ $src -eq 0 ] && [ $drc -eq 0 ] && grep -q '"reached": true' "$w/summary-paper.json"; then
+    pass "two-process-run-reaches-source ($(grep -E '"(sim_time_s|iterations)"' "$w/summary-paper.json" | tr -d ' \n'))"
 else
-    fail "two-process-run-reaches-source (sim rc $src, rfseekd rc $drc: $(cat "$w/sim.err" "$w/d.err" | head -5))"
+    fail "two-process-run-reaches-source (sim rc $src, rfseekd rc $drc: $(cat "$w/sim-paper.err" "$w/d-paper.err" | head -5))"
 fi
 "$d" --map $map --replay "$w/run.lcmlog" --clock-lcm > "$w/replay1.txt" 2>/dev/null
 "$d" --map $map --replay "$w/run.lcmlog" --clock-lcm > "$w/replay2.txt" 2>/dev/null
@@ -194,26 +205,12 @@ fi
 cmp -s "$w/live.txt" "$w/replay3.txt" && pass "two-process-replay-through-lcm-file-provider" \
     || fail two-process-replay-through-lcm-file-provider
 
-# The improvement of issue 10 on the Linux port: meta-path with the pathloss model, the
-# same two processes in a fresh namespace.
-ns=rfswirep$$
-ip netns add "$ns" && trap 'ip netns del "$ns" 2>/dev/null' EXIT
-ip netns exec "$ns" ip link set lo up && ip netns exec "$ns" ip route add 224.0.0.0/4 dev lo \
-    || { fail "netns setup (meta-path)"; exit 1; }
-ip netns exec "$ns" timeout 300 "$d" --map $map --lcm "$url" --can-over-lcm --clock-lcm \
-    --model pathloss --strategy meta-path --idle-exit 3000 2> "$w/dp.err" > /dev/null &
-dpid=$!
-sleep 0.5
-ip netns exec "$ns" timeout 300 "$build/bin/rfseek-sim-lcm" scenarios/default.yaml --lcm "$url" \
-    > "$w/summary-path.json" 2> "$w/sim-path.err"
-src=$?
-wait $dpid
-drc=$?
-ip netns del "$ns"; trap - EXIT
+# The improvement of issue 10 on the Linux port: meta-path with the pathloss model.
+two_process path --model pathloss --strategy meta-path
 if [ $src -eq 0 ] && [ $drc -eq 0 ] && grep -q '"reached": true' "$w/summary-path.json" \
-    && grep -q "(strategy meta-path, model pathloss)\$" "$w/dp.err"; then
+    && grep -q "(strategy meta-path, model pathloss)\$" "$w/d-path.err"; then
     pass "two-process-meta-path-pathloss-reaches-source ($(grep -E '"(distance_travelled_m|iterations)"' "$w/summary-path.json" | tr -d ' \n'))"
 else
-    fail "two-process-meta-path-pathloss-reaches-source (sim rc $src, rfseekd rc $drc: $(cat "$w/sim-path.err" "$w/dp.err" | tail -3))"
+    fail "two-process-meta-path-pathloss-reaches-source (sim rc $src, rfseekd rc $drc: $(cat "$w/sim-path.err" "$w/d-path.err" | tail -3))"
 fi
 exit $((fails > 0))

@@ -53,7 +53,7 @@ static void bench_setup(bench_t *b)
     b->mem.plan_work = calloc(lpts, 1);
     b->mem.plan_queue_cap = lpts;
     b->mem.plan_queue = calloc(lpts, sizeof(uint32_t));
-    b->mem.visited_bytes = b->mem.reach_bytes = rfs_seek_lattice_bits_bytes(&b->map);
+    b->mem.visited_bytes = b->mem.reach_bytes = rfs_reach_bytes(&b->map);
     b->mem.visited = calloc(b->mem.visited_bytes, 1);
     b->mem.reach = calloc(b->mem.reach_bytes, 1);
     rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();

@@ -67,7 +67,7 @@ static inline void seek_make(world_t *t, rfs_seek_cfg_t cfg, uint64_t seed)
     t->mem.plan_work_bytes = lpts;
     t->mem.plan_queue_cap = lpts;
     t->mem.plan_queue = calloc(lpts, sizeof(uint32_t));
-    t->mem.visited_bytes = rfs_seek_lattice_bits_bytes(&t->map);
+    t->mem.visited_bytes = rfs_reach_bytes(&t->map);
     t->mem.visited = calloc(t->mem.visited_bytes, 1);
     t->mem.reach_bytes = t->mem.visited_bytes;
     t->mem.reach = calloc(t->mem.reach_bytes, 1);

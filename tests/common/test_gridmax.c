@@ -1,10 +1,10 @@
 /* test_gridmax.c - the kNN / radius upper bound over a box (common/rfs_knn.c, bound op)
- * and the seeker's branch-and-bound grid search (common/rfs_seek.c, rfs_seek_grid_max).
+ * and the branch-and-bound grid search (common/rfs_gridmax.c, rfs_gridmax_find).
  *
  * The bound is checked against a brute-force nearest-neighbour computation in double
  * precision here (every sample, exact squared distances, the most favourable choice at a
  * tie), at many queries inside each box, and against predict() bit for bit. The pruned
- * search is checked against the full scan (rfs_seek_grid_max_scan: same success, same
+ * search is checked against the full scan (rfs_gridmax_scan: same success, same
  * point, ties included) over many random sample sets, reachability patterns, both modes
  * and random holes (points without a prediction, which both searches skip), and both
  * against a brute force that skips such points: radius exactly, k-neighbours within the
@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rfs_gridmax.h"
 #include "rfs_knn.h"
 #include "seek_world.h"
 
@@ -572,8 +573,8 @@ static void pruned_search_equals_full_scan(void **state)
             rfs_q16_t ax = 0, ay = 0, bx = 0, by = 0, rx = 0, ry = 0;
             bool want = check && ref_grid_max(&t, &c, n, pct > 0u, &lo_max, &hi_max, &rx, &ry);
 
-            bool a = rfs_seek_grid_max(&t.seek, &ax, &ay);
-            bool b = rfs_seek_grid_max_scan(&t.seek, &bx, &by);
+            bool a = rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &ax, &ay);
+            bool b = rfs_gridmax_scan(t.seek.map, &t.seek.model, t.seek.reach, &bx, &by);
 
             assert_int_equal(a, b);
             if (check) {
@@ -639,8 +640,8 @@ static void radius_with_holes_still_has_maximum(void **state)
     rfs_q16_t rx = 0, ry = 0, ax = 0, ay = 0, bx = 0, by = 0;
     assert_true(ref_grid_max(&t, &c, 400, false, &lo_max, &hi_max, &rx, &ry));
 
-    bool a = rfs_seek_grid_max(&t.seek, &ax, &ay);
-    bool b = rfs_seek_grid_max_scan(&t.seek, &bx, &by);
+    bool a = rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &ax, &ay);
+    bool b = rfs_gridmax_scan(t.seek.map, &t.seek.model, t.seek.reach, &bx, &by);
 
     assert_true(a);
     assert_true(b);
@@ -664,27 +665,27 @@ static void pruned_search_fails_without_model(void **state)
     set_reach(&t, 0, &r);
     rfs_q16_t x, y;
     assert_true(t.seek.model.ops->predict_row != 0);
-    assert_false(rfs_seek_grid_max_scan(&t.seek, &x, &y));
+    assert_false(rfs_gridmax_scan(t.seek.map, &t.seek.model, t.seek.reach, &x, &y));
     rfs_knn_cfg_t c = rfs_knn_cfg_default();
     assert_int_equal(rfs_knn_init(&g_knn, &c), 0);
     t.seek.model = rfs_knn_model(&g_knn);
 
-    bool a = rfs_seek_grid_max(&t.seek, &x, &y);
+    bool a = rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &x, &y);
 
     assert_false(a);
-    assert_false(rfs_seek_grid_max_scan(&t.seek, &x, &y));
+    assert_false(rfs_gridmax_scan(t.seek.map, &t.seek.model, t.seek.reach, &x, &y));
 
     make_samples(50, 0, 6.0, 4.0, 0, &r);
     fit(&c, 50);
     make_holes(&t, 100, &r);
     t.seek.model = (rfs_model_t){.ops = &holey_ops, .self = &g_holey};
-    assert_false(rfs_seek_grid_max(&t.seek, &x, &y));
-    assert_false(rfs_seek_grid_max_scan(&t.seek, &x, &y));
+    assert_false(rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &x, &y));
+    assert_false(rfs_gridmax_scan(t.seek.map, &t.seek.model, t.seek.reach, &x, &y));
     g_holes[0] &= (uint8_t)~1u; /* lattice point (0, 0) has a prediction again */
-    assert_true(rfs_seek_grid_max(&t.seek, &x, &y));
+    assert_true(rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &x, &y));
     assert_int_equal(x, g_holey.x0);
     assert_int_equal(y, g_holey.y0);
-    assert_true(rfs_seek_grid_max_scan(&t.seek, &x, &y));
+    assert_true(rfs_gridmax_scan(t.seek.map, &t.seek.model, t.seek.reach, &x, &y));
     assert_int_equal(x, g_holey.x0);
     assert_int_equal(y, g_holey.y0);
     world_free(&t);

@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rfs_gridmax.h"
 #include "rfs_mlp.h"
 #include "seek_world.h"
 
@@ -833,7 +834,7 @@ static void mlp_set_reach(world_t *t, uint32_t kind, rfs_rng_t *r)
     }
 }
 
-/* rfs_seek_grid_max with the MLP (branch and bound on its bound) finds exactly the point
+/* rfs_gridmax_find with the MLP (branch and bound on its bound) finds exactly the point
  * a brute-force scan of every reachable lattice point with predict() finds (the first
  * strict maximum in row-major order), on fits and random networks and four reachability
  * patterns; with every point reachable it predicts at fewer than 60 % of them. */
@@ -883,7 +884,7 @@ static void grid_search_equals_brute_force(void **state)
         g_counted.predicts = 0;
         t.seek.model = (rfs_model_t){.ops = &counted_ops, .self = &g_counted};
 
-        bool got = rfs_seek_grid_max(&t.seek, &ax, &ay);
+        bool got = rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &ax, &ay);
 
         assert_int_equal(got, want);
         if (ax != bx || ay != by) {

@@ -8,6 +8,7 @@
 
 
 #include "ref_geom.h"
+#include "rfs_gridmax.h"
 #include "seek_world.h"
 
 static void test_epsilon_schedule(void **state)
@@ -232,9 +233,9 @@ static void test_grid_max_row_shortcut(void **state)
         t.seek.model.self = &pm;
         rfs_q16_t ax, ay, bx, by;
         t.seek.model.ops = &pm_ops;
-        assert_true(rfs_seek_grid_max(&t.seek, &ax, &ay));
+        assert_true(rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &ax, &ay));
         t.seek.model.ops = &pm_scan_ops;
-        assert_true(rfs_seek_grid_max(&t.seek, &bx, &by));
+        assert_true(rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &bx, &by));
         assert_int_equal(ax, bx);
         assert_int_equal(ay, by);
         /* Brute force in double over reachable lattice points: the value at the found

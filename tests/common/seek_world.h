@@ -97,4 +97,14 @@ static inline rfs_pose_t pose_at(int64_t t_us, double x, double y, double th)
     return p;
 }
 
+/* Feed pose + one measurement at time t (both fresh), then step. */
+static inline void feed(world_t *t, int64_t t_us, double x, double y, double th, int8_t dbm,
+                        rfs_seek_out_t *out)
+{
+    rfs_pose_t p = pose_at(t_us, x, y, th);
+    rfs_seek_on_pose(&t->seek, &p, &t->rng);
+    rfs_seek_on_rssi(&t->seek, 0, t_us, dbm, &t->rng);
+    rfs_seek_step(&t->seek, t_us, &t->rng, out);
+}
+
 #endif /* SEEK_WORLD_H */

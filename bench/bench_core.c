@@ -1,7 +1,8 @@
 /* bench_core.c - the worst-case control iteration of the core, for `make bench`.
  *
- * Worst case (issue 2): 10,000 samples all within the ridge radius, a relearn, and a grid
- * search over a 40 x 20 m map at the 0.25 m lattice (12,800 points). Modes:
+ * Worst case (docs/PERFORMANCE.md, "Core: the worst-case iteration"): 10,000 samples all
+ * within the ridge radius, a relearn, and a grid search over a 40 x 20 m map at the
+ * 0.25 m lattice (12,800 points). Modes:
  *   bench_core iter          run the iteration once (for callgrind: Ir of rfs_seek_step)
  *   bench_core time N        run it N times, print the median wall time in microseconds
  *   bench_core dump FILE     write the samples and the query point for the sklearn twin

@@ -25,7 +25,7 @@ static void test_defaults_are_the_papers(void **state)
     assert_int_equal(r.alpha, 65536);
 }
 
-/* One period in a radio dead zone (issue 10): a pose at (x, y) and a receiver report, both
+/* One period in a radio dead zone (docs/FAULTS.md): a pose at (x, y) and a receiver report, both
  * stamped t and accepted (the stamps only grow), then a step; no packet. */
 static void feed_report(world_t *t, int64_t t_us, double x, double y, rfs_seek_out_t *out)
 {
@@ -85,10 +85,11 @@ static void test_stale_inputs_stop_wheels(void **state)
     world_free(&t);
 }
 
-/* Dead zones (issue 10): the receiver reports itself up every period, with no packet.
- * Twin seekers, same seed and the same poses: A keeps getting packets, B only receiver
- * reports after the first second. Until A decides anew, B must drive exactly as A (the
- * goal and the drive law do not depend on the packets), with no stale flag. */
+/* Dead zones (docs/STRATEGIES.md, "Dead zones"): the receiver reports itself up every
+ * period, with no packet. Twin seekers, same seed and the same poses: A keeps getting
+ * packets, B only receiver reports after the first second. Until A decides anew, B must
+ * drive exactly as A (the goal and the drive law do not depend on the packets), with no
+ * stale flag. */
 static void test_heartbeat_keeps_goal_without_packets(void **state)
 {
     (void)state;
@@ -134,8 +135,8 @@ static void test_heartbeat_keeps_goal_without_packets(void **state)
 }
 
 /* Neither packets nor receiver reports: the wheels are at zero within 200 ms of the last
- * input, with the RSSI fault flag (issue 6), while poses keep coming; and again when the
- * reports stop after a stretch of reports without packets. */
+ * input, with the RSSI fault flag (docs/FIRMWARE.md, "Safety"), while poses keep coming;
+ * and again when the reports stop after a stretch of reports without packets. */
 static void test_no_packet_no_heartbeat_stops_wheels(void **state)
 {
     (void)state;
@@ -226,7 +227,7 @@ static void test_heartbeat_never_makes_a_mean(void **state)
     world_free(&t);
 }
 
-/* Report stamps follow the measurements' rules (issue 9): older than the newest is
+/* Report stamps follow the measurements' rules (docs/FAULTS.md): older than the newest is
  * rejected, equal accepted; a newest report further ahead than the timeout (a clock jump)
  * is stale even while packets are fresh, until the clock reaches it. */
 static void test_heartbeat_stamps(void **state)

@@ -322,7 +322,7 @@ static void test_eps_sample_goes_to_the_draw(void **state)
 #define GEO_WALL_TOP 5.0
 #define GEO_RX 4.625
 #define GEO_RY 3.625
-/* Epsilon tries per decision (rfs_seek.c GOAL_TRIES); the last one is always kept. */
+/* Epsilon tries per decision (rfs_seek_meta.c GOAL_TRIES); the last one is always kept. */
 #define GEO_TRIES 6
 
 /* The fixture's free cells, restated: the border and the wall column. */

@@ -23,6 +23,8 @@
 /// The model's maximum over the lattice points set in `reach` (one bit per lattice
 /// point, rfs_reach.h), by the fastest search the model allows; (mx, my) metres Q16.16.
 /// false when no such point has a prediction (no model, no reachable point).
+/// Scaling and overflow: lattice coordinates x0 + i * grid, Q16.16, stay below 2^31 on
+/// any map rfs_map_init accepts; predictions are only compared, never combined.
 bool rfs_gridmax_find(const rfs_map_t *map, const rfs_model_t *model, const uint8_t *reach,
                       rfs_q16_t *mx, rfs_q16_t *my);
 

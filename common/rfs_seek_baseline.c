@@ -132,10 +132,10 @@ static int8_t fd_probe(rfs_seek_t *s, int axis, int64_t now_us)
     return 0;
 }
 
-/* fd-gradient: the 1 s mean at p, at p + step x and at p + step y (each
- * after standing still for one averaging window, rfs_seek_step), then one step from p
- * along the estimated gradient ((m_x - m_0) / step, (m_y - m_0) / step). An axis whose
- * probe point is illegal in both directions contributes no component. */
+/* fd-gradient: the 1 s mean at p, at p + step x and at p + step y (each after standing
+ * still for one averaging window: the table's `dwell`), then one step from p along the
+ * estimated gradient ((m_x - m_0) / step, (m_y - m_0) / step). An axis whose probe point
+ * is illegal in both directions contributes no component. */
 bool rfs_seek_baseline_fd(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t now_us)
 {
     (void)model_ok;
@@ -219,10 +219,10 @@ bool rfs_seek_baseline_plane(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64
     return go_random_heading(s, false, rng, now_us);
 }
 
-/* chemotaxis: run-and-tumble on the change of the 1 s mean since the last
- * decision. After a rise it runs on in its heading (tumbling with tumble_better), after
- * a fall it tumbles with tumble_worse. Its decisions use no position; the position only
- * checks that a step is legal and plans it. */
+/* chemotaxis: run-and-tumble on the change of the 1 s mean since the last decision.
+ * After a rise it runs on in its heading (tumbling with tumble_better), after a fall it
+ * tumbles with tumble_worse. Its decisions use no position; the position only checks
+ * that a step is legal and plans it. */
 bool rfs_seek_baseline_chemo(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t now_us)
 {
     (void)model_ok;

@@ -1,7 +1,8 @@
 /* bench_core.c - the worst-case control iteration of the core, for `make bench`.
  *
- * Worst case (issue 2): 10,000 samples all within the ridge radius, a relearn, and a grid
- * search over a 40 x 20 m map at the 0.25 m lattice (12,800 points). Modes:
+ * Worst case (docs/PERFORMANCE.md, "Core: the worst-case iteration"): 10,000 samples all
+ * within the ridge radius, a relearn, and a grid search over a 40 x 20 m map at the
+ * 0.25 m lattice (12,800 points). Modes:
  *   bench_core iter          run the iteration once (for callgrind: Ir of rfs_seek_step)
  *   bench_core time N        run it N times, print the median wall time in microseconds
  *   bench_core dump FILE     write the samples and the query point for the sklearn twin
@@ -53,7 +54,7 @@ static void bench_setup(bench_t *b)
     b->mem.plan_work = calloc(lpts, 1);
     b->mem.plan_queue_cap = lpts;
     b->mem.plan_queue = calloc(lpts, sizeof(uint32_t));
-    b->mem.visited_bytes = b->mem.reach_bytes = rfs_seek_lattice_bits_bytes(&b->map);
+    b->mem.visited_bytes = b->mem.reach_bytes = rfs_reach_bytes(&b->map);
     b->mem.visited = calloc(b->mem.visited_bytes, 1);
     b->mem.reach = calloc(b->mem.reach_bytes, 1);
     rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();

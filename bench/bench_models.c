@@ -8,10 +8,10 @@
  *   bench_models relearn MODEL        one full fit (budget 0)
  *   bench_models grid MODEL           a full fit (not counted), then a prediction at
  *                                     every lattice point (the cost of the full scan)
- *   bench_models scan MODEL           a full fit (not counted), then the seeker's full
- *                                     scan, rfs_seek_grid_max_scan()
- *   bench_models search MODEL         a full fit (not counted), then the seeker's grid
- *                                     search, rfs_seek_grid_max() (its shortcuts: rows for
+ *   bench_models scan MODEL           a full fit (not counted), then the grid search's
+ *                                     full scan, rfs_gridmax_scan()
+ *   bench_models search MODEL         a full fit (not counted), then the grid search,
+ *                                     rfs_gridmax_find() (its shortcuts: rows for
  *                                     ridge, branch and bound for knn and radius); every
  *                                     lattice point of the open 40 x 20 m map reachable
  *   bench_models slice MODEL BUDGET   only the first fit call with that budget (the
@@ -30,8 +30,9 @@
 
 #include <valgrind/callgrind.h>
 
+#include "rfs_gridmax.h"
 #include "rfs_models.h"
-#include "rfs_seek.h"
+#include "rfs_reach.h"
 
 #define N 10000u
 #define GRID_W 160
@@ -93,10 +94,10 @@ static void make_samples(rfs_sample_t *s)
     }
 }
 
-/* The seeker's grid search over an open 40 x 20 m map (0.1 m cells, no walls) whose
- * 0.25 m lattice is the 160 x 80 points above, every point marked reachable; only the
- * search itself is counted. */
-static bool seek_search(const rfs_models_entry_t *e, void *state, bool pruned, rfs_q16_t *mx,
+/* The grid search (rfs_gridmax.h) over an open 40 x 20 m map (0.1 m cells, no walls)
+ * whose 0.25 m lattice is the 160 x 80 points above, every point marked reachable; only
+ * the search itself is counted. */
+static bool grid_search(const rfs_models_entry_t *e, void *state, bool pruned, rfs_q16_t *mx,
                         rfs_q16_t *my)
 {
     enum { W = 400, H = 200 };
@@ -108,36 +109,18 @@ static bool seek_search(const rfs_models_entry_t *e, void *state, bool pruned, r
                      legal_bits) != 0) {
         return false;
     }
-    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
-    uint32_t lpts = (uint32_t)map.lw * map.lh, bits = rfs_seek_lattice_bits_bytes(&map);
-    rfs_seek_mem_t mem = {
-        .samples = calloc(cfg.store.capacity, sizeof(rfs_sample_t)),
-        .pending = calloc(256, sizeof(rfs_pending_t)),
-        .pending_cap = 256,
-        .plan_work = calloc(lpts, 1),
-        .plan_work_bytes = lpts,
-        .plan_queue = calloc(lpts, sizeof(uint32_t)),
-        .plan_queue_cap = lpts,
-        .visited = calloc(bits, 1),
-        .visited_bytes = bits,
-        .reach = calloc(bits, 1),
-        .reach_bytes = bits,
-    };
-    static rfs_seek_t seek;
-    rfs_model_t model = {.ops = e->ops, .self = state};
-    bool ok = rfs_seek_init(&seek, &cfg, &map, model, &rfs_target_rssi, &mem) == 0;
-    if (ok) {
-        memset(mem.reach, 0xFF, bits); /* caller-owned: every point reachable */
-        CALLGRIND_START_INSTRUMENTATION;
-        ok = pruned ? rfs_seek_grid_max(&seek, mx, my) : rfs_seek_grid_max_scan(&seek, mx, my);
-        CALLGRIND_STOP_INSTRUMENTATION;
+    uint32_t bits = rfs_reach_bytes(&map);
+    uint8_t *reach = malloc(bits);
+    if (reach == NULL) {
+        return false;
     }
-    free(mem.samples);
-    free(mem.pending);
-    free(mem.plan_work);
-    free(mem.plan_queue);
-    free(mem.visited);
-    free(mem.reach);
+    memset(reach, 0xFF, bits); /* every point reachable */
+    rfs_model_t model = {.ops = e->ops, .self = state};
+    CALLGRIND_START_INSTRUMENTATION;
+    bool ok = pruned ? rfs_gridmax_find(&map, &model, reach, mx, my)
+                     : rfs_gridmax_scan(&map, &model, reach, mx, my);
+    CALLGRIND_STOP_INSTRUMENTATION;
+    free(reach);
     return ok;
 }
 
@@ -205,7 +188,7 @@ int main(int argc, char **argv)
     } else if (strcmp(argv[1], "scan") == 0 || strcmp(argv[1], "search") == 0) {
         e->ops->fit(state, &in, 0u, &rng);
         rfs_q16_t mx = 0, my = 0;
-        bool ok = seek_search(e, state, strcmp(argv[1], "search") == 0, &mx, &my);
+        bool ok = grid_search(e, state, strcmp(argv[1], "search") == 0, &mx, &my);
         printf("max %d %d\n", mx, my);
         check = ok;
     } else {

@@ -461,147 +461,176 @@ static rfs_can_err_t time_check(const rfs_can_rx_t *rx, int64_t t, int64_t now_u
     return RFS_CAN_OK;
 }
 
+/* WHEEL_CMD: a counter check. */
+static rfs_can_err_t rx_wheel(rfs_can_rx_t *rx, const rfs_can_frame_t *f, rfs_can_msg_t *msg)
+{
+    uint8_t c = 0;
+    rfs_can_wheel_t w;
+    rfs_can_err_t e = rfs_can_unpack_wheel(f, &w, &c);
+    if (e == RFS_CAN_OK) {
+        e = counter_check(rx, RFS_CAN_IDX_WHEEL_CMD, c);
+    }
+    if (e != RFS_CAN_OK) {
+        return drop(rx, e);
+    }
+    counter_accept(rx, RFS_CAN_IDX_WHEEL_CMD, c);
+    msg->kind = RFS_CAN_MSG_WHEEL;
+    msg->wheel = w;
+    return RFS_CAN_OK;
+}
+
+/* STATUS: a counter check. */
+static rfs_can_err_t rx_status(rfs_can_rx_t *rx, const rfs_can_frame_t *f, rfs_can_msg_t *msg)
+{
+    uint8_t c = 0;
+    rfs_can_status_t s;
+    rfs_can_err_t e = rfs_can_unpack_status(f, &s, &c);
+    if (e == RFS_CAN_OK) {
+        e = counter_check(rx, RFS_CAN_IDX_STATUS, c);
+    }
+    if (e != RFS_CAN_OK) {
+        return drop(rx, e);
+    }
+    counter_accept(rx, RFS_CAN_IDX_STATUS, c);
+    msg->kind = RFS_CAN_MSG_STATUS;
+    msg->status = s;
+    return RFS_CAN_OK;
+}
+
+/* POSE_XY: the first half of a pose, held until its POSE_TH. */
+static rfs_can_err_t rx_pose_xy(rfs_can_rx_t *rx, const rfs_can_frame_t *f)
+{
+    uint8_t c = 0;
+    rfs_can_pose_t p;
+    rfs_can_err_t e = rfs_can_unpack_pose_xy(f, &p, &c);
+    if (e == RFS_CAN_OK) {
+        e = counter_check(rx, RFS_CAN_IDX_POSE_XY, c);
+    }
+    if (e != RFS_CAN_OK) {
+        return drop(rx, e);
+    }
+    if (rx->have_pending) {
+        /* The previous XY never got its TH: that pose is lost. */
+        (void)drop(rx, RFS_CAN_E_PAIR);
+    }
+    counter_accept(rx, RFS_CAN_IDX_POSE_XY, c);
+    rx->pending.x_mm = p.x_mm;
+    rx->pending.y_mm = p.y_mm;
+    rx->pending_counter = c;
+    rx->have_pending = true;
+    return RFS_CAN_OK;
+}
+
+/* POSE_TH: completes the pose begun by the POSE_XY of the same counter. */
+static rfs_can_err_t rx_pose_th(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int64_t now_us,
+                                rfs_can_msg_t *msg)
+{
+    uint8_t c = 0;
+    rfs_can_pose_t p;
+    rfs_can_err_t e = rfs_can_unpack_pose_th(f, &p, &c);
+    if (e == RFS_CAN_OK) {
+        e = counter_check(rx, RFS_CAN_IDX_POSE_TH, c);
+    }
+    if (e == RFS_CAN_OK && (!rx->have_pending || rx->pending_counter != c)) {
+        e = RFS_CAN_E_PAIR;
+    }
+    int64_t t = 0;
+    if (e == RFS_CAN_OK) {
+        t = rfs_can_unwrap_time(now_us, p.t_us32);
+        e = time_check(rx, t, now_us, rx->have_pose, rx->last_pose_us);
+    }
+    if (e != RFS_CAN_OK) {
+        if (e != RFS_CAN_E_PAIR && e != RFS_CAN_E_REPEAT) {
+            rx->have_pending = false;
+        }
+        return drop(rx, e);
+    }
+    counter_accept(rx, RFS_CAN_IDX_POSE_TH, c);
+    rx->have_pending = false;
+    p.x_mm = rx->pending.x_mm;
+    p.y_mm = rx->pending.y_mm;
+    rx->last_pose_us = t;
+    rx->have_pose = true;
+    msg->kind = RFS_CAN_MSG_POSE;
+    msg->pose = rfs_can_pose_to_core(&p, t);
+    return RFS_CAN_OK;
+}
+
+/* RSSI: a measurement, in its source's own stream (time window, sequence gaps). */
+static rfs_can_err_t rx_rssi(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int64_t now_us,
+                             rfs_can_msg_t *msg)
+{
+    uint8_t c = 0;
+    rfs_can_rssi_t r;
+    rfs_can_err_t e = rfs_can_unpack_rssi(f, &r, &c);
+    if (e == RFS_CAN_OK) {
+        e = counter_check(rx, RFS_CAN_IDX_RSSI, c);
+    }
+    int64_t t = 0;
+    if (e == RFS_CAN_OK) {
+        t = rfs_can_unwrap_time(now_us, r.t_us32);
+        e = time_check(rx, t, now_us, (rx->have_rssi >> r.src) & 1u, rx->last_rssi_us[r.src]);
+    }
+    if (e != RFS_CAN_OK) {
+        return drop(rx, e);
+    }
+    counter_accept(rx, RFS_CAN_IDX_RSSI, c);
+    if (((rx->have_rssi >> r.src) & 1u) && r.seq != rx->last_seq[r.src]) {
+        bump(&rx->rssi_seq_gaps, (uint8_t)(r.seq - rx->last_seq[r.src] - 1u));
+    }
+    rx->have_rssi = (uint16_t)(rx->have_rssi | (1u << r.src));
+    rx->last_rssi_us[r.src] = t;
+    rx->last_seq[r.src] = r.seq;
+    msg->kind = RFS_CAN_MSG_RSSI;
+    msg->rssi_src = r.src;
+    msg->rssi_dbm = r.dbm;
+    msg->rssi_seq = r.seq;
+    msg->rssi_t_us = t;
+    return RFS_CAN_OK;
+}
+
+/* RX_STATUS: the same time window as the packets (docs/CAN.md, "0x121 RX_STATUS"): the
+ * heartbeat comes from the same capture clock, so a stale, future or reordered one is
+ * dropped alike, in its own stream (a heartbeat may follow a packet stamped later). */
+static rfs_can_err_t rx_receiver(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int64_t now_us,
+                                 rfs_can_msg_t *msg)
+{
+    uint8_t c = 0;
+    rfs_can_receiver_t r;
+    rfs_can_err_t e = rfs_can_unpack_receiver(f, &r, &c);
+    if (e == RFS_CAN_OK) {
+        e = counter_check(rx, RFS_CAN_IDX_RX_STATUS, c);
+    }
+    int64_t t = 0;
+    if (e == RFS_CAN_OK) {
+        t = rfs_can_unwrap_time(now_us, r.t_us32);
+        e = time_check(rx, t, now_us, rx->have_receiver, rx->last_receiver_us);
+    }
+    if (e != RFS_CAN_OK) {
+        return drop(rx, e);
+    }
+    counter_accept(rx, RFS_CAN_IDX_RX_STATUS, c);
+    rx->last_receiver_us = t;
+    rx->have_receiver = true;
+    msg->kind = RFS_CAN_MSG_RECEIVER;
+    msg->receiver_t_us = t;
+    return RFS_CAN_OK;
+}
+
 rfs_can_err_t rfs_can_rx_frame(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int64_t now_us, rfs_can_msg_t *msg)
 {
-    rfs_can_err_t e;
-    uint8_t c = 0;
     msg->kind = RFS_CAN_MSG_NONE;
     /* Keep the window arithmetic far from the int64 limits. */
     const int64_t lim = (int64_t)1 << 60;
     now_us = now_us > lim ? lim : (now_us < -lim ? -lim : now_us);
     switch (f->id) {
-    case RFS_CAN_ID_WHEEL_CMD: {
-        rfs_can_wheel_t w;
-        e = rfs_can_unpack_wheel(f, &w, &c);
-        if (e == RFS_CAN_OK) {
-            e = counter_check(rx, RFS_CAN_IDX_WHEEL_CMD, c);
-        }
-        if (e != RFS_CAN_OK) {
-            return drop(rx, e);
-        }
-        counter_accept(rx, RFS_CAN_IDX_WHEEL_CMD, c);
-        msg->kind = RFS_CAN_MSG_WHEEL;
-        msg->wheel = w;
-        return RFS_CAN_OK;
-    }
-    case RFS_CAN_ID_STATUS: {
-        rfs_can_status_t s;
-        e = rfs_can_unpack_status(f, &s, &c);
-        if (e == RFS_CAN_OK) {
-            e = counter_check(rx, RFS_CAN_IDX_STATUS, c);
-        }
-        if (e != RFS_CAN_OK) {
-            return drop(rx, e);
-        }
-        counter_accept(rx, RFS_CAN_IDX_STATUS, c);
-        msg->kind = RFS_CAN_MSG_STATUS;
-        msg->status = s;
-        return RFS_CAN_OK;
-    }
-    case RFS_CAN_ID_POSE_XY: {
-        rfs_can_pose_t p;
-        e = rfs_can_unpack_pose_xy(f, &p, &c);
-        if (e == RFS_CAN_OK) {
-            e = counter_check(rx, RFS_CAN_IDX_POSE_XY, c);
-        }
-        if (e != RFS_CAN_OK) {
-            return drop(rx, e);
-        }
-        if (rx->have_pending) {
-            /* The previous XY never got its TH: that pose is lost. */
-            (void)drop(rx, RFS_CAN_E_PAIR);
-        }
-        counter_accept(rx, RFS_CAN_IDX_POSE_XY, c);
-        rx->pending.x_mm = p.x_mm;
-        rx->pending.y_mm = p.y_mm;
-        rx->pending_counter = c;
-        rx->have_pending = true;
-        return RFS_CAN_OK;
-    }
-    case RFS_CAN_ID_POSE_TH: {
-        rfs_can_pose_t p;
-        e = rfs_can_unpack_pose_th(f, &p, &c);
-        if (e == RFS_CAN_OK) {
-            e = counter_check(rx, RFS_CAN_IDX_POSE_TH, c);
-        }
-        if (e == RFS_CAN_OK && (!rx->have_pending || rx->pending_counter != c)) {
-            e = RFS_CAN_E_PAIR;
-        }
-        int64_t t = 0;
-        if (e == RFS_CAN_OK) {
-            t = rfs_can_unwrap_time(now_us, p.t_us32);
-            e = time_check(rx, t, now_us, rx->have_pose, rx->last_pose_us);
-        }
-        if (e != RFS_CAN_OK) {
-            if (e != RFS_CAN_E_PAIR && e != RFS_CAN_E_REPEAT) {
-                rx->have_pending = false;
-            }
-            return drop(rx, e);
-        }
-        counter_accept(rx, RFS_CAN_IDX_POSE_TH, c);
-        rx->have_pending = false;
-        p.x_mm = rx->pending.x_mm;
-        p.y_mm = rx->pending.y_mm;
-        rx->last_pose_us = t;
-        rx->have_pose = true;
-        msg->kind = RFS_CAN_MSG_POSE;
-        msg->pose = rfs_can_pose_to_core(&p, t);
-        return RFS_CAN_OK;
-    }
-    case RFS_CAN_ID_RSSI: {
-        rfs_can_rssi_t r;
-        e = rfs_can_unpack_rssi(f, &r, &c);
-        if (e == RFS_CAN_OK) {
-            e = counter_check(rx, RFS_CAN_IDX_RSSI, c);
-        }
-        int64_t t = 0;
-        if (e == RFS_CAN_OK) {
-            t = rfs_can_unwrap_time(now_us, r.t_us32);
-            e = time_check(rx, t, now_us, (rx->have_rssi >> r.src) & 1u, rx->last_rssi_us[r.src]);
-        }
-        if (e != RFS_CAN_OK) {
-            return drop(rx, e);
-        }
-        counter_accept(rx, RFS_CAN_IDX_RSSI, c);
-        if (((rx->have_rssi >> r.src) & 1u) && r.seq != rx->last_seq[r.src]) {
-            bump(&rx->rssi_seq_gaps, (uint8_t)(r.seq - rx->last_seq[r.src] - 1u));
-        }
-        rx->have_rssi = (uint16_t)(rx->have_rssi | (1u << r.src));
-        rx->last_rssi_us[r.src] = t;
-        rx->last_seq[r.src] = r.seq;
-        msg->kind = RFS_CAN_MSG_RSSI;
-        msg->rssi_src = r.src;
-        msg->rssi_dbm = r.dbm;
-        msg->rssi_seq = r.seq;
-        msg->rssi_t_us = t;
-        return RFS_CAN_OK;
-    }
-    case RFS_CAN_ID_RX_STATUS: {
-        /* The same time window as the packets (issue 10): the heartbeat comes from the
-         * same capture clock, so a stale, future or reordered one is dropped alike, in
-         * its own stream (a heartbeat may follow a packet stamped later). */
-        rfs_can_receiver_t r;
-        e = rfs_can_unpack_receiver(f, &r, &c);
-        if (e == RFS_CAN_OK) {
-            e = counter_check(rx, RFS_CAN_IDX_RX_STATUS, c);
-        }
-        int64_t t = 0;
-        if (e == RFS_CAN_OK) {
-            t = rfs_can_unwrap_time(now_us, r.t_us32);
-            e = time_check(rx, t, now_us, rx->have_receiver, rx->last_receiver_us);
-        }
-        if (e != RFS_CAN_OK) {
-            return drop(rx, e);
-        }
-        counter_accept(rx, RFS_CAN_IDX_RX_STATUS, c);
-        rx->last_receiver_us = t;
-        rx->have_receiver = true;
-        msg->kind = RFS_CAN_MSG_RECEIVER;
-        msg->receiver_t_us = t;
-        return RFS_CAN_OK;
-    }
-    default:
-        return drop(rx, RFS_CAN_E_ID);
+    case RFS_CAN_ID_WHEEL_CMD: return rx_wheel(rx, f, msg);
+    case RFS_CAN_ID_STATUS: return rx_status(rx, f, msg);
+    case RFS_CAN_ID_POSE_XY: return rx_pose_xy(rx, f);
+    case RFS_CAN_ID_POSE_TH: return rx_pose_th(rx, f, now_us, msg);
+    case RFS_CAN_ID_RSSI: return rx_rssi(rx, f, now_us, msg);
+    case RFS_CAN_ID_RX_STATUS: return rx_receiver(rx, f, now_us, msg);
+    default: return drop(rx, RFS_CAN_E_ID);
     }
 }
 

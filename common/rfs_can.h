@@ -29,7 +29,7 @@
  *                    XY sent first; it is complete when POSE_TH arrives
  *   0x120 RSSI       radio module -> controller, 8: source, dBm, sequence, time
  *   0x121 RX_STATUS  radio module -> controller, 6: capture time: the receiver was
- *                    listening up to then, packet or not (issue 10, docs/FAULTS.md)
+ *                    listening up to then, packet or not (docs/FAULTS.md)
  *   0x180 STATUS     controller -> anyone, 8: heartbeat with state, decision, faults
  * Lower ids win arbitration: wheel commands first, then inputs, then the heartbeat.
  */
@@ -54,7 +54,7 @@ typedef struct rfs_can_frame {
 #define RFS_CAN_ID_POSE_XY 0x110u   ///< pose, first half: position
 #define RFS_CAN_ID_POSE_TH 0x111u   ///< pose, second half: heading and time
 #define RFS_CAN_ID_RSSI 0x120u      ///< RSSI measurement from a radio module
-#define RFS_CAN_ID_RX_STATUS 0x121u ///< receiver heartbeat from the radio module (issue 10)
+#define RFS_CAN_ID_RX_STATUS 0x121u ///< receiver heartbeat from the radio module
 #define RFS_CAN_ID_STATUS 0x180u    ///< controller status / heartbeat
 
 #define RFS_CAN_DLC_WHEEL_CMD 6u ///< exact DLC of WHEEL_CMD
@@ -121,8 +121,9 @@ typedef struct rfs_can_rssi {
     uint32_t t_us32;    ///< sender's time of reception, low 32 bits of microseconds
 } rfs_can_rssi_t;
 
-/// Receiver heartbeat (issue 10): sent by the radio module's capture loop every 50-100 ms
-/// and at least once per the controller's rssi_timeout_us, only while that loop runs.
+/// Receiver heartbeat (docs/CAN.md, "0x121 RX_STATUS"): sent by the radio module's capture
+/// loop every 50-100 ms and at least once per the controller's rssi_timeout_us, only while
+/// that loop runs.
 typedef struct rfs_can_receiver {
     uint32_t t_us32;    ///< capture time the receiver was listening up to, low 32 bits of
                         ///< microseconds (the clock of the RSSI frames' t_us32)

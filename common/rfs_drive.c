@@ -188,6 +188,121 @@ static int32_t brake_speed(int32_t accel, int64_t d_mm, int32_t v_end)
     return v > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)v;
 }
 
+/* The waypoint driven to: those passed (within SWITCH_DIST) are skipped, each one
+ * restarting the stall reference. Returns the distance to it, metres Q16.16. */
+static rfs_q16_t next_waypoint(rfs_drive_t *d, const rfs_pose_t *pose, int64_t now_us)
+{
+    uint16_t last = (uint16_t)(d->path.n - 1u);
+    rfs_q16_t dn = rfs_q16_dist(pose->x, pose->y, d->path.x[d->next], d->path.y[d->next]);
+    while (d->next < last && dn < SWITCH_DIST) {
+        d->next++;
+        dn = rfs_q16_dist(pose->x, pose->y, d->path.x[d->next], d->path.y[d->next]);
+        d->stall_ref_us = now_us;
+        d->stall_ref_dist = dn;
+    }
+    return dn;
+}
+
+/* Stall check at distance dn (metres Q16.16) from the waypoint: true when the robot came
+ * less than progress_min closer over the last stall_us. */
+static bool stalled(rfs_drive_t *d, rfs_q16_t dn, int64_t now_us)
+{
+    const rfs_drive_cfg_t *c = &d->cfg;
+    bool blocked = false;
+    if (d->stall_ref_dist == RFS_Q16_MAX) {
+        d->stall_ref_dist = dn;
+        d->stall_ref_us = now_us;
+    } else if (now_us >= d->stall_ref_us &&
+               (uint64_t)now_us - (uint64_t)d->stall_ref_us >= (uint64_t)c->stall_us) {
+        blocked = (int64_t)d->stall_ref_dist - dn < c->progress_min;
+        d->stall_ref_us = now_us;
+        d->stall_ref_dist = dn;
+    }
+    return blocked;
+}
+
+/* Turning on the spot towards heading error e (radians Q16.16): omega * wheel_base / 2,
+ * mm/s, capped at v_max / 2 and at a wheel speed that can stop within the remaining arc
+ * |e| * b / 2 at half the acceleration limit (no overshoot). */
+static int32_t turn_speed(const rfs_drive_cfg_t *c, rfs_q16_t e)
+{
+    int32_t half_base = c->wheel_base_mm / 2;
+    int32_t w_mm = (int32_t)(((int64_t)rfs_q16_mul(K_TURN, e) * half_base) >> 16);
+    int32_t cap = c->v_max_mm_s / 2;
+    int32_t arc_mm = (int32_t)(((int64_t)rfs_q16_abs(e) * half_base) >> 16);
+    int32_t vb = brake_speed(c->accel_mm_s2, arc_mm, 0);
+    cap = vb < cap ? vb : cap;
+    return w_mm > cap ? cap : (w_mm < -cap ? -cap : w_mm);
+}
+
+/* Corner speed at the next waypoint, mm/s, for the approach (ex, ey) (metres Q16.16):
+ * v_max (1 - theta / turn_in_place)^2 for a turn of theta between the approach and the
+ * next leg; 0 from turn_in_place on, where the robot will turn on the spot, and at the
+ * goal. */
+static int32_t corner_speed(const rfs_drive_t *d, int64_t ex, int64_t ey)
+{
+    const rfs_drive_cfg_t *c = &d->cfg;
+    if (d->next >= (uint16_t)(d->path.n - 1u)) {
+        return 0;
+    }
+    int64_t ux = q16_to_mm(ex);
+    int64_t uy = q16_to_mm(ey);
+    int64_t wx = q16_to_mm((int64_t)d->path.x[d->next + 1] - d->path.x[d->next]);
+    int64_t wy = q16_to_mm((int64_t)d->path.y[d->next + 1] - d->path.y[d->next]);
+    rfs_q16_t theta = rfs_q16_abs(atan2_q16(ux * wy - uy * wx, ux * wx + uy * wy));
+    if (theta >= c->turn_in_place) {
+        return 0;
+    }
+    rfs_q16_t f = rfs_q16_div(c->turn_in_place - theta, c->turn_in_place);
+    return (int32_t)(((int64_t)rfs_q16_mul(f, f) * c->v_max_mm_s) >> 16);
+}
+
+/* Wheel speed targets (mm/s) towards the waypoint at distance dn (metres Q16.16). */
+static void steer(rfs_drive_t *d, const rfs_pose_t *pose, rfs_q16_t dn, int32_t *tl,
+                  int32_t *tr)
+{
+    const rfs_drive_cfg_t *c = &d->cfg;
+    int64_t ex = (int64_t)d->path.x[d->next] - pose->x;
+    int64_t ey = (int64_t)d->path.y[d->next] - pose->y;
+    rfs_q16_t e = wrap_pi((int64_t)atan2_q16(ey, ex) - pose->theta);
+    int32_t v = 0;
+    int32_t w_mm = 0; /* omega * wheel_base / 2, mm/s */
+    /* Hysteresis: once turning on the spot, keep turning until the error is below
+     * turn_in_place / 16, so the robot never drives off while rotating. */
+    if (rfs_q16_abs(e) > c->turn_in_place) {
+        d->turning = true;
+    } else if (rfs_q16_abs(e) < c->turn_in_place / 16) {
+        d->turning = false;
+    }
+    if (d->turning) {
+        w_mm = turn_speed(c, e);
+    } else {
+        int32_t v_end = corner_speed(d, ex, ey);
+        /* Brake to v_end where the waypoint counts as passed (or at half the goal
+         * tolerance), not at the waypoint itself: no overshoot at corners. */
+        bool corner = d->next < (uint16_t)(d->path.n - 1u);
+        rfs_q16_t stop_at = corner ? SWITCH_DIST : c->goal_tol / 2;
+        v = brake_speed(c->accel_mm_s2, q16_to_mm((int64_t)dn - stop_at), v_end);
+        v = v < V_CREEP ? V_CREEP : v;
+        v = v > c->v_max_mm_s ? c->v_max_mm_s : v;
+        /* Fade the forward speed in as the heading error closes, so the switch from
+         * turning on the spot is smooth. */
+        rfs_q16_t fade = rfs_q16_div(c->turn_in_place - rfs_q16_abs(e), c->turn_in_place);
+        v = (int32_t)(((int64_t)rfs_q16_mul(fade, fade) * v) >> 16);
+        w_mm = (int32_t)(((int64_t)rfs_q16_mul(K_HEADING, e) * (c->wheel_base_mm / 2)) >> 16);
+    }
+    *tl = v - w_mm;
+    *tr = v + w_mm;
+    int32_t m = *tl < 0 ? -*tl : *tl;
+    int32_t mr = *tr < 0 ? -*tr : *tr;
+    m = mr > m ? mr : m;
+    if (m > c->v_max_mm_s) {
+        /* Scale both wheels: the curvature is kept, the speed drops. */
+        *tl = (int32_t)rfs_sdiv64_round((int64_t)*tl * c->v_max_mm_s, m);
+        *tr = (int32_t)rfs_sdiv64_round((int64_t)*tr * c->v_max_mm_s, m);
+    }
+}
+
 rfs_drive_status_t rfs_drive_update(rfs_drive_t *d, const rfs_pose_t *pose, int64_t now_us,
                                     int16_t *left_mm_s, int16_t *right_mm_s)
 {
@@ -205,15 +320,8 @@ rfs_drive_status_t rfs_drive_update(rfs_drive_t *d, const rfs_pose_t *pose, int6
     rfs_drive_status_t result = d->status;
 
     if (d->status == RFS_DRIVE_RUNNING) {
-        uint16_t last = (uint16_t)(d->path.n - 1u);
-        rfs_q16_t dn = rfs_q16_dist(pose->x, pose->y, d->path.x[d->next], d->path.y[d->next]);
-        while (d->next < last && dn < SWITCH_DIST) {
-            d->next++;
-            dn = rfs_q16_dist(pose->x, pose->y, d->path.x[d->next], d->path.y[d->next]);
-            d->stall_ref_us = now_us;
-            d->stall_ref_dist = dn;
-        }
-        bool at_goal = d->next == last && dn <= c->goal_tol;
+        rfs_q16_t dn = next_waypoint(d, pose, now_us);
+        bool at_goal = d->next == (uint16_t)(d->path.n - 1u) && dn <= c->goal_tol;
         if (now_us > d->start_us && (uint64_t)now_us - (uint64_t)d->start_us > (uint64_t)c->timeout_us) {
             result = RFS_DRIVE_TIMEOUT;
         } else if (at_goal) {
@@ -221,77 +329,10 @@ rfs_drive_status_t rfs_drive_update(rfs_drive_t *d, const rfs_pose_t *pose, int6
                 result = RFS_DRIVE_REACHED;
             }
         } else {
-            if (d->stall_ref_dist == RFS_Q16_MAX) {
-                d->stall_ref_dist = dn;
-                d->stall_ref_us = now_us;
-            } else if (now_us >= d->stall_ref_us &&
-                       (uint64_t)now_us - (uint64_t)d->stall_ref_us >= (uint64_t)c->stall_us) {
-                if ((int64_t)d->stall_ref_dist - dn < c->progress_min) {
-                    result = RFS_DRIVE_BLOCKED;
-                }
-                d->stall_ref_us = now_us;
-                d->stall_ref_dist = dn;
+            if (stalled(d, dn, now_us)) {
+                result = RFS_DRIVE_BLOCKED;
             }
-            int64_t ex = (int64_t)d->path.x[d->next] - pose->x;
-            int64_t ey = (int64_t)d->path.y[d->next] - pose->y;
-            rfs_q16_t e = wrap_pi((int64_t)atan2_q16(ey, ex) - pose->theta);
-            int32_t half_base = c->wheel_base_mm / 2;
-            int32_t v = 0;
-            int32_t w_mm = 0; /* omega * wheel_base / 2, mm/s */
-            /* Hysteresis: once turning on the spot, keep turning until the error is
-             * below turn_in_place / 16, so the robot never drives off while rotating. */
-            if (rfs_q16_abs(e) > c->turn_in_place) {
-                d->turning = true;
-            } else if (rfs_q16_abs(e) < c->turn_in_place / 16) {
-                d->turning = false;
-            }
-            if (d->turning) {
-                w_mm = (int32_t)(((int64_t)rfs_q16_mul(K_TURN, e) * half_base) >> 16);
-                /* Cap: v_max / 2, and a wheel speed that can stop within the remaining
-                 * arc |e| * b / 2 at half the acceleration limit (no overshoot). */
-                int32_t cap = c->v_max_mm_s / 2;
-                int32_t arc_mm = (int32_t)(((int64_t)rfs_q16_abs(e) * half_base) >> 16);
-                int32_t vb = brake_speed(c->accel_mm_s2, arc_mm, 0);
-                cap = vb < cap ? vb : cap;
-                w_mm = w_mm > cap ? cap : (w_mm < -cap ? -cap : w_mm);
-            } else {
-                int32_t v_end = 0;
-                if (d->next < last) {
-                    /* Corner speed: v_max (1 - theta / turn_in_place)^2 for a turn of
-                     * theta between the approach and the next leg; 0 from turn_in_place
-                     * on, where the robot will turn on the spot. */
-                    int64_t ux = q16_to_mm(ex);
-                    int64_t uy = q16_to_mm(ey);
-                    int64_t wx = q16_to_mm((int64_t)d->path.x[d->next + 1] - d->path.x[d->next]);
-                    int64_t wy = q16_to_mm((int64_t)d->path.y[d->next + 1] - d->path.y[d->next]);
-                    rfs_q16_t theta = rfs_q16_abs(atan2_q16(ux * wy - uy * wx, ux * wx + uy * wy));
-                    if (theta < c->turn_in_place) {
-                        rfs_q16_t f = rfs_q16_div(c->turn_in_place - theta, c->turn_in_place);
-                        v_end = (int32_t)(((int64_t)rfs_q16_mul(f, f) * c->v_max_mm_s) >> 16);
-                    }
-                }
-                /* Brake to v_end where the waypoint counts as passed (or at half the
-                 * goal tolerance), not at the waypoint itself: no overshoot at corners. */
-                rfs_q16_t stop_at = d->next < last ? SWITCH_DIST : c->goal_tol / 2;
-                v = brake_speed(c->accel_mm_s2, q16_to_mm((int64_t)dn - stop_at), v_end);
-                v = v < V_CREEP ? V_CREEP : v;
-                v = v > c->v_max_mm_s ? c->v_max_mm_s : v;
-                /* Fade the forward speed in as the heading error closes, so the switch
-                 * from turning on the spot is smooth. */
-                rfs_q16_t fade = rfs_q16_div(c->turn_in_place - rfs_q16_abs(e), c->turn_in_place);
-                v = (int32_t)(((int64_t)rfs_q16_mul(fade, fade) * v) >> 16);
-                w_mm = (int32_t)(((int64_t)rfs_q16_mul(K_HEADING, e) * half_base) >> 16);
-            }
-            tl = v - w_mm;
-            tr = v + w_mm;
-            int32_t m = tl < 0 ? -tl : tl;
-            int32_t mr = tr < 0 ? -tr : tr;
-            m = mr > m ? mr : m;
-            if (m > c->v_max_mm_s) {
-                /* Scale both wheels: the curvature is kept, the speed drops. */
-                tl = (int32_t)rfs_sdiv64_round((int64_t)tl * c->v_max_mm_s, m);
-                tr = (int32_t)rfs_sdiv64_round((int64_t)tr * c->v_max_mm_s, m);
-            }
+            steer(d, pose, dn, &tl, &tr);
         }
     }
     if (result != RFS_DRIVE_RUNNING) {

@@ -374,7 +374,7 @@ static bool knn_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *v
                                          : predict_k(s, qx, qy, value);
 }
 
-/* --- Upper bound over a box (the grid search's branch and bound, issue 8) ---------- */
+/* --- Upper bound over a box (the grid search's branch and bound, rfs_gridmax.h) --- */
 
 /* A query box in cm Q24.8: query_q8() is non-decreasing, so every query in the metre box
  * maps into the box of the rounded corners. */

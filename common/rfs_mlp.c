@@ -399,7 +399,7 @@ static bool mlp_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *v
     return true;
 }
 
-/* --- Upper bound over a box (the grid search's branch and bound, issue 8) ----------- */
+/* --- Upper bound over a box (the grid search's branch and bound, rfs_gridmax.h) ---- */
 
 /* The bound follows mlp_predict() step by step. Every step before the output sum is
  * monotone (standardise, the pre-activation's rounding and saturation, the sigmoid: its

@@ -35,7 +35,7 @@
  * done whole inside the call that starts the fit (about 20 instructions per sample,
  * under 1/500 of an epoch).
  *
- * Upper bound over a box (the `bound` op, issue 8): for the seeker's branch-and-bound grid
+ * Upper bound over a box (the `bound` op, docs/MODELS.md): for the branch-and-bound grid
  * search, a bound of predict() over an axis-aligned box that holds bit for bit: the
  * smaller of interval arithmetic through the monotone steps of predict() and a linear
  * relaxation of each hidden unit with its second-order remainder charged (rfs_mlp.c).

@@ -60,7 +60,7 @@ typedef struct rfs_model_ops {
     /// that predict() (and predict_row()) succeeds at every point of the box and returns
     /// at most *ub there; false = no such promise (no model, or a point may have no
     /// prediction). Lets the grid search skip whole blocks of the lattice and still find
-    /// exactly the full scan's maximum (branch and bound, issue 8).
+    /// exactly the full scan's maximum (branch and bound, rfs_gridmax.h).
     bool (*bound)(const void *self, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1,
                   rfs_q16_t *ub);
     /// Optional (may be NULL): draw where the maximum may be from the model's belief (the

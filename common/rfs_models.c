@@ -45,8 +45,8 @@ static int pathloss_init_default(void *state)
  * docs/PERFORMANCE.md, "Models on the Cortex-M4"): the largest round budget whose
  * heaviest slice stays under 16,800,000 Cortex-M4 instructions, half the 200 ms deadline
  * at 168 MHz, the other half left for the rest of the period and cycles > instructions.
- * - ridge, knn, radius: 2,500 samples, 74 k / 147 k instructions: also inside issue 6's
- *   500,000 per period.
+ * - ridge, knn, radius: 2,500 samples, 74 k / 147 k instructions: also inside the
+ *   firmware's 500,000 per period (docs/FIRMWARE.md).
  * - mlp: 700 sample-updates, 16.3 M (about 23,000 per update; the first slice also
  *   standardises the samples); 800 would be 18.6 M.
  * - pathloss: 600 wall counts, 16.4 M (about 25,000 per count; the first slice also bins
@@ -62,7 +62,7 @@ static const rfs_models_entry_t k_models[] = {
     {"radius", &rfs_radius_ops, (uint32_t)sizeof(rfs_knn_t), radius_init_default,
      "radius-neighbours regression, r = 1 m (paper 5.2)", 2500u},
     {"pathloss", &rfs_pathloss_ops, (uint32_t)sizeof(rfs_pathloss_t), pathloss_init_default,
-     "map-aware log-distance + walls fit, source search (issue 10, beyond the paper)", 600u},
+     "map-aware log-distance + walls fit, source search (beyond the paper)", 600u},
 };
 
 #define N_MODELS (sizeof(k_models) / sizeof(k_models[0]))

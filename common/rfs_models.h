@@ -28,10 +28,11 @@ typedef struct rfs_models_entry {
     const char *summary;         ///< one line for --help
     /// Work units per control period (rfs_seek_cfg_t.fit_budget) for the microcontroller
     /// (rfs_app_cfg_mcu()): the largest round budget whose heaviest fit slice stays under
-    /// half the 200 ms safety deadline (issues 8, 10) on a 168 MHz Cortex-M4, measured with
-    /// make bench-models-m4 (docs/PERFORMANCE.md, "Models on the Cortex-M4"). A work unit
-    /// is the model's own (ridge and knn: a sample, mlp: a sample-update, pathloss: a wall
-    /// count), so each model has its number. Never 0 (0 would be the whole fit at once).
+    /// half the 200 ms safety deadline (docs/FIRMWARE.md, "Safety") on a 168 MHz
+    /// Cortex-M4, measured with make bench-models-m4 (docs/PERFORMANCE.md, "Models on the
+    /// Cortex-M4"). A work unit is the model's own (ridge and knn: a sample, mlp: a
+    /// sample-update, pathloss: a wall count), so each model has its number. Never 0 (0
+    /// would be the whole fit at once).
     uint32_t mcu_fit_budget;
 } rfs_models_entry_t;
 

@@ -1,4 +1,5 @@
-/* rfs_pathloss.c - the map-aware path-loss model (issue 10; see rfs_pathloss.h).
+/* rfs_pathloss.c - the map-aware path-loss model (see rfs_pathloss.h): binning, the
+ * candidate search and the fit; the wall counts are in rfs_pathloss_walls.c.
  *
  * For a candidate source s every bin b has a distance term L_b = 10 log10(max(d, 1 m))
  * and a wall count k_b. With count weights c_b and bin means z_b, the least-squares fit
@@ -19,16 +20,12 @@
 #include <string.h>
 
 #include "rfs_assert.h"
+#include "rfs_pathloss_internal.h"
 
 /// 10 log10(2) / 2 in Q2.30 (1.50514998...): 10 log10(d) per log2(d^2).
 #define DB_PER_LOG2_SQ_Q30 1616142483LL
 /// Lattice spacing without a map, metres Q16.16 (the map default).
 #define NOMAP_GRID RFS_Q16_FRAC(1, 4)
-/// Wall counts saturate here (15 walls are 75 dB at 5 dB each; four of them, in quarter
-/// walls, fit a byte of the cache).
-#define WALLS_MAX 15u
-/// Wall counts per bin footprint.
-#define FOOTPRINT_RAYS 4u
 /// What an evaluated candidate is for (rfs_pathloss_ev_t.kind).
 enum { EV_COARSE = 0, EV_REFINE = 1, EV_HOLD = 2 };
 /// Cached wall counts per work unit.
@@ -227,73 +224,6 @@ static void bin_samples(rfs_pathloss_t *p, const rfs_sample_t *smp, uint16_t n)
     }
 }
 
-static uint32_t cell_hash(uint16_t cx, uint16_t cy)
-{
-    return ((uint32_t)cx * 0x9E3779B1u + (uint32_t)cy * 0x85EBCA77u) >> 22; /* 10 bits */
-}
-
-/* Field by field: the core may call no memcmp (only memcpy/memset/memmove). */
-static bool same_lattice(const rfs_pathloss_lat_t *a, const rfs_pathloss_lat_t *b)
-{
-    return a->ox == b->ox && a->oy == b->oy && a->grid == b->grid && a->lw == b->lw &&
-           a->lh == b->lh && a->cs == b->cs && a->c0i == b->c0i && a->c0j == b->c0j &&
-           a->ncx == b->ncx && a->ncy == b->ncy;
-}
-
-static void cache_clear(rfs_pathloss_t *p)
-{
-    p->nrows = 0u;
-    memset(p->row_hash, 0, sizeof(p->row_hash));
-}
-
-/* Give every bin on the map its wall-count cache row (found by its origin's core cell, or
- * new), after clearing the cache when it belongs to another map or lattice. */
-static void cache_assign(rfs_pathloss_t *p)
-{
-    _Static_assert(RFS_PATHLOSS_CACHE_HASH == 1024u, "cell_hash yields 10 bits");
-    _Static_assert(RFS_PATHLOSS_CACHE_ROWS >= RFS_PATHLOSS_MAX_BINS, "a row for every bin");
-    if (p->map == 0) {
-        return;
-    }
-    if (p->cache_map != p->map || !same_lattice(&p->cache_lat, &p->lat)) {
-        cache_clear(p);
-        p->cache_map = p->map;
-        p->cache_lat = p->lat;
-    }
-    for (uint32_t b = 0u; b < p->nbins; ++b) {
-        rfs_pathloss_bin_t *bb = &p->bins[b];
-        uint16_t cx, cy;
-        if (!rfs_map_cell(p->map, bb->x, bb->y, &cx, &cy)) {
-            continue;
-        }
-        uint32_t h = cell_hash(cx, cy);
-        while (p->row_hash[h] != 0u) {
-            const rfs_pathloss_row_t *r = &p->rows[p->row_hash[h] - 1u];
-            if (r->cx == cx && r->cy == cy) {
-                break;
-            }
-            h = (h + 1u) & (RFS_PATHLOSS_CACHE_HASH - 1u);
-        }
-        if (p->row_hash[h] == 0u) {
-            if (p->nrows == RFS_PATHLOSS_CACHE_ROWS) {
-                /* Full of origins no bin uses any more: start again (rows >= bins). */
-                cache_clear(p);
-                for (uint32_t c = 0u; c < b; ++c) {
-                    p->bins[c].row = RFS_PATHLOSS_NO_ROW;
-                }
-                b = UINT32_MAX; /* the loop's ++ restarts it at 0 */
-                continue;
-            }
-            rfs_pathloss_row_t *r = &p->rows[p->nrows];
-            r->cx = cx;
-            r->cy = cy;
-            r->filled = 0u;
-            p->row_hash[h] = (uint16_t)(++p->nrows);
-        }
-        bb->row = (uint16_t)(p->row_hash[h] - 1u);
-    }
-}
-
 /* The candidate lattice: the map's legal lattice, or the bins' extent plus the margin. */
 static void setup_lattice(rfs_pathloss_t *p, const rfs_map_t *m)
 {
@@ -421,77 +351,15 @@ static void solve_nw(const rfs_pathloss_cfg_t *c, const int64_t M[3], const int6
     *w_out = ew[best];
 }
 
-/* One line's walls from (x, y) to (sx, sy), saturated at WALLS_MAX. */
-static uint32_t walls_sat(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,
-                          rfs_q16_t sy)
-{
-    uint32_t k = rfs_map_walls_crossed(m, x, y, sx, sy);
-    return k > WALLS_MAX ? WALLS_MAX : k;
-}
-
-/* walls_sat(), counted as a fit's work. */
-static uint32_t walls_to(rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx, rfs_q16_t sy)
-{
-    p->walls_counted++;
-    return walls_sat(p->map, x, y, sx, sy);
-}
-
-/* A bin's walls to the candidate (sx, sy) in quarter walls (0..4 x WALLS_MAX): the sum of
- * the counts from its footprint's four points (wx +- f, wy +- f), a point that is not
- * legal counting as the centre (wx, wy); with footprint 0, four times the centre's.
- * At most four counts: the centre is counted only in place of an illegal point. */
-static uint32_t footprint_walls(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb, rfs_q16_t sx,
-                                rfs_q16_t sy)
-{
-    const rfs_q16_t f = p->cfg.footprint;
-    if (f == 0) {
-        return FOOTPRINT_RAYS * walls_to(p, bb->wx, bb->wy, sx, sy);
-    }
-    uint32_t sum = 0u, centre = UINT32_MAX;
-    for (uint32_t q = 0u; q < FOOTPRINT_RAYS; ++q) {
-        rfs_q16_t x = rfs_sat32((int64_t)bb->wx + ((q & 1u) != 0u ? f : -f));
-        rfs_q16_t y = rfs_sat32((int64_t)bb->wy + ((q & 2u) != 0u ? f : -f));
-        if (rfs_map_point_legal(p->map, x, y)) {
-            sum += walls_to(p, x, y, sx, sy);
-        } else {
-            if (centre == UINT32_MAX) {
-                centre = walls_to(p, bb->wx, bb->wy, sx, sy);
-            }
-            sum += centre;
-        }
-    }
-    return sum;
-}
-
 /* One bin's distance term and walls for the candidate in p->ev (its 10 log10(d) in
  * l_q16[b], its walls in k[b]). Returns the wall counts (lines) computed: 0 when cached. */
 static uint32_t gather_bin(rfs_pathloss_t *p, uint32_t b)
 {
     const rfs_pathloss_bin_t *bb = &p->bins[b];
-    const rfs_q16_t sx = p->ev.sx, sy = p->ev.sy;
-    const int32_t col = p->ev.col;
-    int64_t dx = (int64_t)bb->x - sx, dy = (int64_t)bb->y - sy;
+    int64_t dx = (int64_t)bb->x - p->ev.sx, dy = (int64_t)bb->y - p->ev.sy;
     p->l_q16[b] = rfs_pathloss_db_dist(sq_sum(dx, dy));
-    uint32_t k = 0u, lines = 0u;
-    if (p->map != 0) {
-        rfs_pathloss_row_t *r = bb->row != RFS_PATHLOSS_NO_ROW ? &p->rows[bb->row] : 0;
-        bool cacheable = r != 0 && col >= 0 && col < (int32_t)RFS_PATHLOSS_CACHE_COLS;
-        uint8_t *cell = cacheable ? &p->walls[bb->row][col] : 0;
-        if (cacheable && col < (int32_t)r->filled) {
-            k = *cell;
-            p->footprints_cached++;
-        } else {
-            uint32_t before = p->walls_counted;
-            k = footprint_walls(p, bb, sx, sy);
-            lines = p->walls_counted - before;
-            p->footprints++;
-            if (cacheable && col == (int32_t)r->filled) {
-                *cell = (uint8_t)k;
-                r->filled++;
-            }
-        }
-    }
-    p->k[b] = (uint8_t)k;
+    uint32_t lines = 0u;
+    p->k[b] = p->map != 0 ? (uint8_t)rfs_pathloss_walls_bin(p, bb, &lines) : 0u;
     return lines;
 }
 
@@ -717,127 +585,172 @@ static bool hold_next(rfs_pathloss_t *p)
     return false;
 }
 
+/* A fit begins: bin the samples, lay the candidate lattice, assign the cache. false when
+ * there is nothing to fit. */
+static bool fit_begin(rfs_pathloss_t *p, const rfs_model_fit_in_t *in)
+{
+    p->valid = false;
+    if (in->n == 0u) {
+        return false;
+    }
+    p->map = in->map;
+    bin_samples(p, in->samples, in->n);
+    setup_lattice(p, in->map);
+    rfs_pathloss_walls_assign(p);
+    p->col = 0u;
+    p->walls_counted = 0u;
+    p->footprints = 0u;
+    p->footprints_cached = 0u;
+    p->phase = RFS_PATHLOSS_COARSE;
+    p->pos = 0u;
+    p->ntop = 0u;
+    p->nvis = 0u;
+    p->candidates = 0u;
+    p->cur.loss = INT64_MAX;
+    p->ev.on = false;
+    return true;
+}
+
+/* Evaluate the started candidate: gather its bins, stopping before a bin that could
+ * overrun the budget (at most four wall counts) but gathering at least one per call
+ * (false: call again), then solve it and record the result for its phase. *used counts
+ * the work units of this call. */
+static bool ev_run(rfs_pathloss_t *p, uint32_t budget, uint32_t *used)
+{
+    while (p->ev.b < p->nbins) {
+        if (budget != 0u && *used != 0u && *used + RFS_PATHLOSS_FOOTPRINT_RAYS > budget) {
+            return false;
+        }
+        *used += gather_bin(p, p->ev.b++);
+    }
+    rfs_pathloss_cand_t cd;
+    solve(p, &cd);
+    *used += (p->footprints_cached - p->ev.cached) / CACHED_PER_UNIT + 1u;
+    p->ev.on = false;
+    if (p->ev.kind == EV_HOLD) {
+        if (cd.loss < p->hold_best.loss) {
+            p->hold_best = cd;
+        }
+        return true;
+    }
+    if (p->ev.kind == EV_COARSE) {
+        p->surface[p->ev.c] = mean_loss(p, cd.loss);
+        keep_top(p, &cd);
+    }
+    consider(p, &cd);
+    return true;
+}
+
+/* The coarse phase's next point: start it when legal; at the end, on to the refinement.
+ * true when the fit is over (no legal candidate on the map: *res FAILED). */
+static bool coarse_next(rfs_pathloss_t *p, rfs_fit_result_t *res)
+{
+    const rfs_pathloss_lat_t *l = &p->lat;
+    uint32_t nc = (uint32_t)l->ncx * l->ncy;
+    if (p->pos >= nc) {
+        if (p->ntop == 0u) {
+            p->phase = RFS_PATHLOSS_IDLE;
+            *res = RFS_FIT_FAILED;
+            return true;
+        }
+        p->phase = RFS_PATHLOSS_REFINE;
+        p->step = (uint16_t)(l->cs / 2u < 1u ? 1u : l->cs / 2u);
+        p->pos = 0u;
+        return false;
+    }
+    uint32_t c = p->pos++;
+    int32_t i = l->c0i + (int32_t)(c % l->ncx) * l->cs;
+    int32_t j = l->c0j + (int32_t)(c / l->ncx) * l->cs;
+    p->surface[c] = RFS_PATHLOSS_NO_LOSS;
+    if (cand_legal(p, i, j)) {
+        ev_start(p, (uint16_t)i, (uint16_t)j, (int32_t)p->col++, EV_COARSE, c);
+    }
+    return false;
+}
+
+/* After the finest refinement: hold the previous source (docs/PATHLOSS.md, "Sampled
+ * epsilon goals and the hold search") when the fit moved away from it on the same map
+ * and it is still a legal candidate. true when the hold phase began. */
+static bool hold_begin(rfs_pathloss_t *p)
+{
+    if (p->cfg.hold_k <= 0 || !p->have_prev || p->map == 0 || p->prev_map != p->map ||
+        (p->best.li == p->cur.li && p->best.lj == p->cur.lj) ||
+        !cand_legal(p, p->best.li, p->best.lj)) {
+        return false;
+    }
+    const rfs_pathloss_lat_t *l = &p->lat;
+    p->phase = RFS_PATHLOSS_HOLD;
+    p->hold_i = p->best.li;
+    p->hold_j = p->best.lj;
+    p->hold_step = (uint16_t)(l->cs / 2u < 1u ? 1u : l->cs / 2u);
+    p->hold_pos = UINT8_MAX; /* the previous source itself first */
+    p->hold_best.loss = INT64_MAX;
+    return true;
+}
+
+/* The refinement's next point: the 3 x 3 neighbourhood at p->step around each top
+ * candidate (REFINE) or around the best so far (FINE), row by row, at halving steps;
+ * then the hold phase. true when the fit is over (*res DONE). */
+static bool refine_next(rfs_pathloss_t *p, rfs_fit_result_t *res)
+{
+    if (p->phase == RFS_PATHLOSS_REFINE && p->pos >= 9u * p->ntop) {
+        p->phase = RFS_PATHLOSS_FINE;
+        p->pos = 9u;
+    }
+    if (p->phase == RFS_PATHLOSS_HOLD) {
+        if (hold_next(p)) {
+            return false;
+        }
+        finish(p);
+        *res = RFS_FIT_DONE;
+        return true;
+    }
+    if (p->phase == RFS_PATHLOSS_FINE && p->pos >= 9u) {
+        if (p->step <= 1u) {
+            if (hold_begin(p)) {
+                return false;
+            }
+            finish(p);
+            *res = RFS_FIT_DONE;
+            return true;
+        }
+        p->step = (uint16_t)(p->step / 2u);
+        p->fc_i = p->cur.li;
+        p->fc_j = p->cur.lj;
+        p->pos = 0u;
+    }
+    uint32_t k = p->pos / 9u, rem = p->pos % 9u;
+    p->pos++;
+    int32_t ci = p->phase == RFS_PATHLOSS_REFINE ? p->top[k].li : p->fc_i;
+    int32_t cj = p->phase == RFS_PATHLOSS_REFINE ? p->top[k].lj : p->fc_j;
+    int32_t i, j;
+    neighbour(ci, cj, rem, p->step, &i, &j);
+    if (rem != 4u && cand_legal(p, i, j) && !seen_before(p, i, j)) {
+        ev_start(p, (uint16_t)i, (uint16_t)j, -1, EV_REFINE, 0u);
+    }
+    return false;
+}
+
 static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, uint32_t budget,
                                      rfs_rng_t *rng)
 {
     rfs_pathloss_t *p = (rfs_pathloss_t *)self;
     (void)rng;
     RFS_ASSERT(p != 0 && in != 0 && (in->samples != 0 || in->n == 0u));
-    if (p->phase == RFS_PATHLOSS_IDLE) {
-        p->valid = false;
-        if (in->n == 0u) {
-            return RFS_FIT_FAILED;
-        }
-        p->map = in->map;
-        bin_samples(p, in->samples, in->n);
-        setup_lattice(p, in->map);
-        cache_assign(p);
-        p->col = 0u;
-        p->walls_counted = 0u;
-        p->footprints = 0u;
-        p->footprints_cached = 0u;
-        p->phase = RFS_PATHLOSS_COARSE;
-        p->pos = 0u;
-        p->ntop = 0u;
-        p->nvis = 0u;
-        p->candidates = 0u;
-        p->cur.loss = INT64_MAX;
-        p->ev.on = false;
+    if (p->phase == RFS_PATHLOSS_IDLE && !fit_begin(p, in)) {
+        return RFS_FIT_FAILED;
     }
-    const rfs_pathloss_lat_t *l = &p->lat;
     uint32_t used = 0u;
+    rfs_fit_result_t res = RFS_FIT_DONE;
     for (;;) {
         if (p->ev.on) {
-            /* Gather the candidate's bins; stop before a bin that could overrun the budget
-             * (at most four wall counts), but gather at least one per call. */
-            while (p->ev.b < p->nbins) {
-                if (budget != 0u && used != 0u && used + FOOTPRINT_RAYS > budget) {
-                    return RFS_FIT_MORE;
-                }
-                used += gather_bin(p, p->ev.b++);
+            if (!ev_run(p, budget, &used)) {
+                return RFS_FIT_MORE;
             }
-            rfs_pathloss_cand_t cd;
-            solve(p, &cd);
-            used += (p->footprints_cached - p->ev.cached) / CACHED_PER_UNIT + 1u;
-            p->ev.on = false;
-            if (p->ev.kind == EV_COARSE) {
-                p->surface[p->ev.c] = mean_loss(p, cd.loss);
-                keep_top(p, &cd);
-            } else if (p->ev.kind == EV_HOLD) {
-                if (cd.loss < p->hold_best.loss) {
-                    p->hold_best = cd;
-                }
-                continue;
-            }
-            consider(p, &cd);
-            continue;
+        } else if (p->phase == RFS_PATHLOSS_COARSE ? coarse_next(p, &res)
+                                                   : refine_next(p, &res)) {
+            return res;
         }
-        int32_t i, j;
-        if (p->phase == RFS_PATHLOSS_COARSE) {
-            uint32_t nc = (uint32_t)l->ncx * l->ncy;
-            if (p->pos >= nc) {
-                if (p->ntop == 0u) {
-                    p->phase = RFS_PATHLOSS_IDLE;
-                    return RFS_FIT_FAILED; /* no legal candidate on the map */
-                }
-                p->phase = RFS_PATHLOSS_REFINE;
-                p->step = (uint16_t)(l->cs / 2u < 1u ? 1u : l->cs / 2u);
-                p->pos = 0u;
-                continue;
-            }
-            uint32_t c = p->pos++;
-            i = l->c0i + (int32_t)(c % l->ncx) * l->cs;
-            j = l->c0j + (int32_t)(c / l->ncx) * l->cs;
-            p->surface[c] = RFS_PATHLOSS_NO_LOSS;
-            if (!cand_legal(p, i, j)) {
-                continue;
-            }
-            ev_start(p, (uint16_t)i, (uint16_t)j, (int32_t)p->col++, EV_COARSE, c);
-            continue;
-        }
-        /* Refinement: the 3 x 3 neighbourhood at p->step around each top candidate
-         * (REFINE) or around the best so far (FINE), row by row. */
-        if (p->phase == RFS_PATHLOSS_REFINE && p->pos >= 9u * p->ntop) {
-            p->phase = RFS_PATHLOSS_FINE;
-            p->pos = 9u;
-        }
-        if (p->phase == RFS_PATHLOSS_HOLD) {
-            if (hold_next(p)) {
-                continue;
-            }
-            finish(p);
-            return RFS_FIT_DONE;
-        }
-        if (p->phase == RFS_PATHLOSS_FINE && p->pos >= 9u) {
-            if (p->step <= 1u) {
-                if (p->cfg.hold_k > 0 && p->have_prev && p->map != 0 && p->prev_map == p->map &&
-                    (p->best.li != p->cur.li || p->best.lj != p->cur.lj) &&
-                    cand_legal(p, p->best.li, p->best.lj)) {
-                    p->phase = RFS_PATHLOSS_HOLD;
-                    p->hold_i = p->best.li;
-                    p->hold_j = p->best.lj;
-                    p->hold_step = (uint16_t)(l->cs / 2u < 1u ? 1u : l->cs / 2u);
-                    p->hold_pos = UINT8_MAX; /* the previous source itself first */
-                    p->hold_best.loss = INT64_MAX;
-                    continue;
-                }
-                finish(p);
-                return RFS_FIT_DONE;
-            }
-            p->step = (uint16_t)(p->step / 2u);
-            p->fc_i = p->cur.li;
-            p->fc_j = p->cur.lj;
-            p->pos = 0u;
-        }
-        uint32_t k = p->pos / 9u, rem = p->pos % 9u;
-        p->pos++;
-        int32_t ci = p->phase == RFS_PATHLOSS_REFINE ? p->top[k].li : p->fc_i;
-        int32_t cj = p->phase == RFS_PATHLOSS_REFINE ? p->top[k].lj : p->fc_j;
-        neighbour(ci, cj, rem, p->step, &i, &j);
-        if (rem == 4u || !cand_legal(p, i, j) || seen_before(p, i, j)) {
-            continue;
-        }
-        ev_start(p, (uint16_t)i, (uint16_t)j, -1, EV_REFINE, 0u);
     }
 }
 
@@ -854,7 +767,7 @@ static bool pathloss_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16
     int64_t L = rfs_pathloss_db_dist(sq_sum(dx, dy));
     int64_t k = 0;
     if (p->map != 0) {
-        k = walls_sat(p->map, x, y, p->best.sx, p->best.sy);
+        k = rfs_pathloss_walls_line(p->map, x, y, p->best.sx, p->best.sy);
     }
     int64_t v = (int64_t)p->best.p0 - (((int64_t)p->best.n * L + 32768) >> 16) - p->best.w * k;
     *value = rfs_sat32(v);

@@ -1,4 +1,4 @@
-/* rfs_pathloss.h - a map-aware, physics-informed internal model (issue 10; paper section 3:
+/* rfs_pathloss.h - a map-aware, physics-informed internal model (docs/PATHLOSS.md; paper section 3:
  * "representations of varying complexity ... depending on the available resources and
  * prior knowledge").
  *

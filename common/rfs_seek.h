@@ -28,11 +28,12 @@
 #include "rfs_map.h"
 #include "rfs_model.h"
 #include "rfs_plan.h"
+#include "rfs_reach.h"
 #include "rfs_rssi.h"
 #include "rfs_store.h"
 #include "rfs_target.h"
 
-/// How the seeker chooses its goals (issue 7). Every strategy uses the same sensors,
+/// How the seeker chooses its goals (docs/STRATEGIES.md). Every strategy uses the same sensors,
 /// step width, map legality and path planner; only the decision rule differs.
 typedef enum rfs_seek_strategy {
     RFS_SEEK_META = 0,       ///< the meta-algorithm, paper section 2 (default)
@@ -95,13 +96,10 @@ typedef struct rfs_seek_mem {
     uint32_t *plan_queue;      ///< planner queue
     uint32_t plan_queue_cap;   ///< its capacity
     uint8_t *visited;          ///< one bit per lattice point: within the novelty radius of a past position
-    uint32_t visited_bytes;    ///< its size, (lw * lh + 7) / 8
+    uint32_t visited_bytes;    ///< its size, rfs_reach_bytes(map) = (lw * lh + 7) / 8
     uint8_t *reach;            ///< one bit per lattice point: reachable from the robot's position
-    uint32_t reach_bytes;      ///< its size, (lw * lh + 7) / 8
+    uint32_t reach_bytes;      ///< its size, rfs_reach_bytes(map)
 } rfs_seek_mem_t;
-
-/// Bytes of one lattice bit array (visited, reach) for a map.
-uint32_t rfs_seek_lattice_bits_bytes(const rfs_map_t *map);
 
 /// Why an iteration chose its goal.
 typedef enum rfs_seek_kind {
@@ -207,7 +205,7 @@ typedef struct rfs_seek {
     int64_t resume_start_us;                  ///< how long the interrupted goal had been driven, microseconds
     uint16_t last_li, last_lj;                ///< lattice point of the last novelty update
     bool have_last_l;                         ///< last_li/last_lj are valid
-    /* Baseline strategies (issue 7). */
+    /* Baseline strategies (rfs_seek_baseline.c). */
     bool dwell_done;                          ///< fd: the robot has stood one window here
     int64_t dwell_until_us;                   ///< fd: wheels stay stopped until then, microseconds
     uint8_t fd_phase;                         ///< fd: 0 at p, 1 at the x probe, 2 at the y probe
@@ -262,15 +260,6 @@ bool rfs_seek_on_receiver(rfs_seek_t *s, int64_t t_us);
 /// report. Cannot fail.
 void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out);
 
-/// The model's maximum over the reachable legal lattice (the greedy grid search, paper
-/// section 2): first strict maximum in row-major order. Uses the model's row_monotone
-/// shortcut when it has one. Points without a prediction are skipped; false when no
-/// reachable point has one (no model, no reachable point).
-bool rfs_seek_grid_max(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my);
-
-/// The same search by evaluating every point (the reference for the shortcut).
-bool rfs_seek_grid_max_scan(const rfs_seek_t *s, rfs_q16_t *mx, rfs_q16_t *my);
-
 /// The in-leg relearn check on one miss |1 s mean - prediction| (target units Q16.16, >= 0):
 /// true when it fails, i.e. the miss exceeds error_threshold, or with recheck_adapt the
 /// larger of error_threshold and the RMS of the recent misses; *miss_ms (dB^2 Q16.16,
@@ -282,7 +271,7 @@ bool rfs_seek_recheck_miss(const rfs_seek_cfg_t *cfg, int64_t *miss_ms, rfs_q16_
 rfs_q16_t rfs_seek_epsilon(const rfs_seek_cfg_t *cfg, uint32_t n);
 
 /// Name of a strategy as on the command line ("meta", "meta-global", "fd-gradient",
-/// "plane-gradient", "chemotaxis"); "?" for a value out of range.
+/// "plane-gradient", "chemotaxis", "meta-path"); "?" for a value out of range.
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st);
 
 /// The strategy named `name` (NUL-terminated, exact). false when there is none.

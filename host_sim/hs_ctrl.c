@@ -133,9 +133,9 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
     p->mem.plan_work = calloc(lat, 1);
     p->mem.plan_queue_cap = lat; // never overflows: each lattice point is queued once
     p->mem.plan_queue = calloc(lat, sizeof(uint32_t));
-    p->mem.visited_bytes = rfs_seek_lattice_bits_bytes(map);
+    p->mem.visited_bytes = rfs_reach_bytes(map);
     p->mem.visited = calloc(p->mem.visited_bytes, 1);
-    p->mem.reach_bytes = rfs_seek_lattice_bits_bytes(map);
+    p->mem.reach_bytes = rfs_reach_bytes(map);
     p->mem.reach = calloc(p->mem.reach_bytes, 1);
     if (!p->mem.samples || !p->mem.pending || !p->mem.plan_work || !p->mem.plan_queue ||
         !p->mem.visited || !p->mem.reach) {

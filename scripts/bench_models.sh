@@ -14,8 +14,8 @@ ir() { # ir OUTNAME ARGS...: instructions inside the instrumented region
 }
 echo "models: 10,000 samples over 40 x 20 m; grid search = 12,800 lattice points (0.25 m)"
 echo "  host x86-64 instructions (callgrind, exact)"
-echo "  predict all: a prediction at every point; full scan: rfs_seek_grid_max_scan();"
-echo "  search: rfs_seek_grid_max() (row shortcut for ridge, branch and bound for mlp/knn/radius)"
+echo "  predict all: a prediction at every point; full scan: rfs_gridmax_scan();"
+echo "  search: rfs_gridmax_find() (row shortcut for ridge, branch and bound for mlp/knn/radius)"
 printf "  %-7s %13s %13s %9s %13s %13s %7s\n" model "full relearn" "predict all" "/point" \
     "full scan" "search" "ratio"
 for m in ridge mlp knn radius; do

@@ -67,7 +67,7 @@ static inline void seek_make(world_t *t, rfs_seek_cfg_t cfg, uint64_t seed)
     t->mem.plan_work_bytes = lpts;
     t->mem.plan_queue_cap = lpts;
     t->mem.plan_queue = calloc(lpts, sizeof(uint32_t));
-    t->mem.visited_bytes = rfs_seek_lattice_bits_bytes(&t->map);
+    t->mem.visited_bytes = rfs_reach_bytes(&t->map);
     t->mem.visited = calloc(t->mem.visited_bytes, 1);
     t->mem.reach_bytes = t->mem.visited_bytes;
     t->mem.reach = calloc(t->mem.reach_bytes, 1);
@@ -95,6 +95,16 @@ static inline rfs_pose_t pose_at(int64_t t_us, double x, double y, double th)
 {
     rfs_pose_t p = { t_us, Q(x), Q(y), Q(th) };
     return p;
+}
+
+/* Feed pose + one measurement at time t (both fresh), then step. */
+static inline void feed(world_t *t, int64_t t_us, double x, double y, double th, int8_t dbm,
+                        rfs_seek_out_t *out)
+{
+    rfs_pose_t p = pose_at(t_us, x, y, th);
+    rfs_seek_on_pose(&t->seek, &p, &t->rng);
+    rfs_seek_on_rssi(&t->seek, 0, t_us, dbm, &t->rng);
+    rfs_seek_step(&t->seek, t_us, &t->rng, out);
 }
 
 #endif /* SEEK_WORLD_H */

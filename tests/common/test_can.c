@@ -559,7 +559,7 @@ static void seek_output_maps_to_status_and_wheels(void **state)
     assert_int_equal(w.flags, RFS_CAN_WHEEL_STOP);
 }
 
-/* RX_STATUS (0x121, issue 10): bytes from the Python reference (struct '<BI' + CRC-8 over
+/* RX_STATUS (0x121, docs/CAN.md): bytes from the Python reference (struct '<BI' + CRC-8 over
  * 21 01 and the payload), every time value round trips, a wrong DLC, any flipped bit and
  * the reserved nibble are rejected. */
 static void receiver_frame_bytes_round_trip_and_rejects(void **state)

@@ -1,10 +1,10 @@
 /* test_gridmax.c - the kNN / radius upper bound over a box (common/rfs_knn.c, bound op)
- * and the seeker's branch-and-bound grid search (common/rfs_seek.c, rfs_seek_grid_max).
+ * and the grid search (common/rfs_gridmax.c): the branch and bound and the row shortcut.
  *
  * The bound is checked against a brute-force nearest-neighbour computation in double
  * precision here (every sample, exact squared distances, the most favourable choice at a
  * tie), at many queries inside each box, and against predict() bit for bit. The pruned
- * search is checked against the full scan (rfs_seek_grid_max_scan: same success, same
+ * search is checked against the full scan (rfs_gridmax_scan: same success, same
  * point, ties included) over many random sample sets, reachability patterns, both modes
  * and random holes (points without a prediction, which both searches skip), and both
  * against a brute force that skips such points: radius exactly, k-neighbours within the
@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rfs_gridmax.h"
 #include "rfs_knn.h"
 #include "seek_world.h"
 
@@ -572,8 +573,8 @@ static void pruned_search_equals_full_scan(void **state)
             rfs_q16_t ax = 0, ay = 0, bx = 0, by = 0, rx = 0, ry = 0;
             bool want = check && ref_grid_max(&t, &c, n, pct > 0u, &lo_max, &hi_max, &rx, &ry);
 
-            bool a = rfs_seek_grid_max(&t.seek, &ax, &ay);
-            bool b = rfs_seek_grid_max_scan(&t.seek, &bx, &by);
+            bool a = rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &ax, &ay);
+            bool b = rfs_gridmax_scan(t.seek.map, &t.seek.model, t.seek.reach, &bx, &by);
 
             assert_int_equal(a, b);
             if (check) {
@@ -639,8 +640,8 @@ static void radius_with_holes_still_has_maximum(void **state)
     rfs_q16_t rx = 0, ry = 0, ax = 0, ay = 0, bx = 0, by = 0;
     assert_true(ref_grid_max(&t, &c, 400, false, &lo_max, &hi_max, &rx, &ry));
 
-    bool a = rfs_seek_grid_max(&t.seek, &ax, &ay);
-    bool b = rfs_seek_grid_max_scan(&t.seek, &bx, &by);
+    bool a = rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &ax, &ay);
+    bool b = rfs_gridmax_scan(t.seek.map, &t.seek.model, t.seek.reach, &bx, &by);
 
     assert_true(a);
     assert_true(b);
@@ -664,29 +665,103 @@ static void pruned_search_fails_without_model(void **state)
     set_reach(&t, 0, &r);
     rfs_q16_t x, y;
     assert_true(t.seek.model.ops->predict_row != 0);
-    assert_false(rfs_seek_grid_max_scan(&t.seek, &x, &y));
+    assert_false(rfs_gridmax_scan(t.seek.map, &t.seek.model, t.seek.reach, &x, &y));
     rfs_knn_cfg_t c = rfs_knn_cfg_default();
     assert_int_equal(rfs_knn_init(&g_knn, &c), 0);
     t.seek.model = rfs_knn_model(&g_knn);
 
-    bool a = rfs_seek_grid_max(&t.seek, &x, &y);
+    bool a = rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &x, &y);
 
     assert_false(a);
-    assert_false(rfs_seek_grid_max_scan(&t.seek, &x, &y));
+    assert_false(rfs_gridmax_scan(t.seek.map, &t.seek.model, t.seek.reach, &x, &y));
 
     make_samples(50, 0, 6.0, 4.0, 0, &r);
     fit(&c, 50);
     make_holes(&t, 100, &r);
     t.seek.model = (rfs_model_t){.ops = &holey_ops, .self = &g_holey};
-    assert_false(rfs_seek_grid_max(&t.seek, &x, &y));
-    assert_false(rfs_seek_grid_max_scan(&t.seek, &x, &y));
+    assert_false(rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &x, &y));
+    assert_false(rfs_gridmax_scan(t.seek.map, &t.seek.model, t.seek.reach, &x, &y));
     g_holes[0] &= (uint8_t)~1u; /* lattice point (0, 0) has a prediction again */
-    assert_true(rfs_seek_grid_max(&t.seek, &x, &y));
+    assert_true(rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &x, &y));
     assert_int_equal(x, g_holey.x0);
     assert_int_equal(y, g_holey.y0);
-    assert_true(rfs_seek_grid_max_scan(&t.seek, &x, &y));
+    assert_true(rfs_gridmax_scan(t.seek.map, &t.seek.model, t.seek.reach, &x, &y));
     assert_int_equal(x, g_holey.x0);
     assert_int_equal(y, g_holey.y0);
+    world_free(&t);
+}
+
+/* A plane c + gx x + gy y rounded to Q16 (monotone along rows), for the row shortcut. */
+typedef struct plane_model {
+    double c, gx, gy;
+} plane_model_t;
+
+static bool pm_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *v)
+{
+    const plane_model_t *m = self;
+    *v = Q(m->c + m->gx * D(x) + m->gy * D(y));
+    return true;
+}
+
+static int pm_monotone(const void *self)
+{
+    const plane_model_t *m = self;
+    return m->gx > 0 ? 1 : (m->gx < 0 ? -1 : 0);
+}
+
+static const rfs_model_ops_t pm_ops = {
+    .name = "plane", .predict = pm_predict, .row_monotone = pm_monotone,
+};
+
+static const rfs_model_ops_t pm_scan_ops = {
+    .name = "plane-scan", .predict = pm_predict,
+};
+
+/* The row shortcut finds exactly the maximum the full scan finds, ties included (slopes
+ * so small that whole rows round to one value), on a map with a wall; and the scan's
+ * answer is the brute-force maximum computed in double here. */
+static void test_grid_max_row_shortcut(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 12, 8, 6.0, 6.0);
+    seek_make(&t, rfs_seek_cfg_default(), 5);
+    rfs_seek_out_t out;
+    feed(&t, 100000, 3.0, 3.0, 0, -50, &out); /* first step computes reachability */
+    rfs_rng_t r;
+    rfs_rng_seed(&r, 99);
+    for (int k = 0; k < 300; ++k) {
+        plane_model_t pm;
+        double scale = k % 3 == 0 ? 1e-7 : (k % 3 == 1 ? 1e-3 : 3.0);
+        pm.c = -60;
+        pm.gx = ((double)rfs_rng_u32(&r) / 4294967296.0 - 0.5) * scale;
+        pm.gy = ((double)rfs_rng_u32(&r) / 4294967296.0 - 0.5) * scale;
+        if (k % 10 == 0) {
+            pm.gx = 0;
+        }
+        t.seek.model.self = &pm;
+        rfs_q16_t ax, ay, bx, by;
+        t.seek.model.ops = &pm_ops;
+        assert_true(rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &ax, &ay));
+        t.seek.model.ops = &pm_scan_ops;
+        assert_true(rfs_gridmax_find(t.seek.map, &t.seek.model, t.seek.reach, &bx, &by));
+        assert_int_equal(ax, bx);
+        assert_int_equal(ay, by);
+        /* Brute force in double over reachable lattice points: the value at the found
+         * point is the maximum (up to the Q16 rounding of the model). */
+        double best = -1e300;
+        for (uint16_t j = 0; j < t.map.lh; ++j) {
+            for (uint16_t i = 0; i < t.map.lw; ++i) {
+                uint32_t idx = (uint32_t)j * t.map.lw + i;
+                if (!((t.mem.reach[idx >> 3] >> (idx & 7)) & 1)) {
+                    continue;
+                }
+                double x = (i + 0.5) * 0.25, y = (j + 0.5) * 0.25;
+                best = fmax(best, pm.c + pm.gx * x + pm.gy * y);
+            }
+        }
+        assert_true(pm.c + pm.gx * D(ax) + pm.gy * D(ay) >= best - 2.0 / 65536);
+    }
     world_free(&t);
 }
 
@@ -700,6 +775,7 @@ int main(void)
         cmocka_unit_test(pruned_search_equals_full_scan),
         cmocka_unit_test(radius_with_holes_still_has_maximum),
         cmocka_unit_test(pruned_search_fails_without_model),
+        cmocka_unit_test(test_grid_max_row_shortcut),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,6 +1,6 @@
 /* test_models.c - the model registry (common/rfs_models).
  *
- * The expected names are the ones issue 8 fixes for the command line
+ * The expected names are the command line's (docs/MODELS.md, "Choosing a model")
  * (`--model ridge|mlp|knn|radius`); each of them must come up with its default
  * configuration and learn a plane z = 0.5 x - 40 dB closely enough to predict it
  * (checked against the plane, computed here). Rows added later are checked for

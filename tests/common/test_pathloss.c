@@ -794,7 +794,7 @@ static double closed_loop_run(fixture_t *f, uint64_t seed, double *travel)
     mem.plan_work_bytes = lpts;
     mem.plan_queue_cap = lpts;
     mem.plan_queue = calloc(lpts, sizeof(uint32_t));
-    mem.visited_bytes = rfs_seek_lattice_bits_bytes(&f->map);
+    mem.visited_bytes = rfs_reach_bytes(&f->map);
     mem.visited = calloc(mem.visited_bytes, 1);
     mem.reach_bytes = mem.visited_bytes;
     mem.reach = calloc(mem.reach_bytes, 1);

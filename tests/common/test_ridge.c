@@ -14,7 +14,7 @@
 
 #include "rfs_ridge.h"
 
-/// Agreement required by issue 2 over the whole map, dB.
+/// Agreement required over the whole map, dB (docs/FIXED_POINT.md, "Local ridge model").
 #define TOL_DB 0.05
 /// What the arithmetic allows: slopes rounded to Q24 (3e-8 dB/m) over up to 900 m, the
 /// centre rounded to Q16 (7.6e-6 m) times the slope, intercept and output roundings.
@@ -52,7 +52,7 @@ static int32_t rand_range(rfs_rng_t *g, int32_t lo, int32_t hi)
     return lo + (int32_t)rfs_rng_below(g, (uint32_t)(hi - lo + 1));
 }
 
-/* One data set of the given kind; kinds cover the cases issue 2 names. */
+/* One data set of the given kind; kinds cover the required cases. */
 static void make_set(dataset_t *d, int kind, rfs_rng_t *g)
 {
     d->radius_cm = 500;

@@ -53,7 +53,7 @@ static rfs_pose_t pose(int64_t t, double x, double y)
 static void test_defaults_and_init(void **state)
 {
     (void)state;
-    assert_int_equal(sizeof(rfs_sample_t), 6); /* issue 2: at most 6 bytes a sample */
+    assert_int_equal(sizeof(rfs_sample_t), 6); /* at most 6 bytes a sample (docs/FIXED_POINT.md) */
     rfs_store_cfg_t c = rfs_store_cfg_default();
     assert_int_equal(c.capacity, 10000);
     assert_int_equal(c.max_gap_us, 500000);

@@ -116,7 +116,7 @@ bench)
             printf "%-9s %7d %14.0f %9s %14.0f %10s %12s %8d\n", m, val["state_bytes_" m], ins("relearn_" m), ms(ins("relearn_" m)),
                 ins(g), ms(ins(g)), (g ~ /^argmax/ ? "(argmax)" : "(" val["points_" m] ")"), ins("predict_" m)
             if (g ~ /^argmax/ && ("grid_" m in v))
-                printf "%-9s %7s %14s %9s %14.0f %10s %12s   rfs_seek_grid_max, for reference\n", "", "", "", "", ins("grid_" m), ms(ins("grid_" m)), "(" val["points_" m] ")"
+                printf "%-9s %7s %14s %9s %14.0f %10s %12s   rfs_gridmax_find, for reference\n", "", "", "", "", ins("grid_" m), ms(ins("grid_" m)), "(" val["points_" m] ")"
         }
         printf "\nsliced relearn: heaviest slice (exact), slices, all slices (to ~calls/20); registry = mcu_fit_budget\n"
         printf "%-9s %7s %14s %9s %7s %14s %8s %6s %6s\n", "model", "budget", "heaviest slice", "ms", "slices", "all slices", "200 ms", "50 %", "500 k"

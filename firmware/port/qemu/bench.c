@@ -63,7 +63,7 @@ static void fill_store(rfs_store_t *st, uint64_t seed)
     fill_store_at(st, seed, 2000, 1000, INT32_MIN, INT32_MAX);
 }
 
-/* The meta-path epsilon decision (RFS_SEEK_META_PATH's eps_geodesic; rfs_seek.c
+/* The meta-path epsilon decision (RFS_SEEK_META_PATH's eps_geodesic; rfs_seek_meta.c
  * choose_epsilon and accept_detour): a goal is proposed with weight e^(-straight
  * distance), planned, and kept with probability e^(-(path length - straight distance));
  * up to GOAL_TRIES = 6 draws, the sixth kept whatever its detour, so one decision plans
@@ -82,7 +82,7 @@ static void fill_store(rfs_store_t *st, uint64_t seed)
 #define GEO_RI 4u          /* the robot's lattice point: x = 0.125 + 4 x 0.25 m */
 #define GEO_RJ 34u         /* y = 0.125 + 34 x 0.25 = 8.625 m */
 #define GEO_SOUTH_J 39u    /* last lattice row south of the wall (y 9.875 m) */
-#define GEO_TRIES 6        /* GOAL_TRIES of rfs_seek.c */
+#define GEO_TRIES 6        /* GOAL_TRIES of rfs_seek_meta.c */
 
 static void geo_wall(void)
 {
@@ -160,7 +160,7 @@ static uint32_t geo_scan(const rfs_seek_t *s, uint16_t ci, uint16_t cj, uint32_t
  * here all exceed 13 m either way). Returns the plans; the kept goal
  * in *gx, *gy; the smallest detour of a tested draw in *min_detour (metres Q16.16,
  * INT64_MAX when none was tested). Scaling: the straight distance grid * sqrt(q) as
- * rfs_seek.c's offset_dist (Q16 x Q16 >> 16); path lengths <= 32 km, so the detour fits
+ * rfs_seek_meta.c's offset_dist (Q16 x Q16 >> 16); path lengths <= 32 km, so the detour fits
  * int32 for rfs_q16_exp_neg. */
 static uint32_t geo_replay(rfs_seek_t *s, rfs_rng_t rng, bool geodesic, rfs_q16_t *gx,
                            rfs_q16_t *gy, int64_t *min_detour)
@@ -280,7 +280,7 @@ static void geo_decision(const rfs_app_map_t *map, bool meta_path, bool geodesic
     rfs_bc_report(row->ridge_n, 0, s_app.ridge.n_used);
 }
 
-/* The paper's greedy decision behind a wall (RFS_SEEK_META; rfs_seek.c choose_greedy):
+/* The paper's greedy decision behind a wall (RFS_SEEK_META; rfs_seek_meta.c, rfs_seek_meta_step):
  * the grid search's maximum, the point 1 m towards it, and when that point is illegal a
  * line search at the map resolution along the line to the maximum, alternating at random
  * between in front of the step point and beyond it, planning (go_to) every legal
@@ -626,7 +626,7 @@ int main(void)
     rfs_bc_report("ridge_samples_used", 0, ridge->n_used);
 
     /* Grid search: the model at every reachable lattice point, as choose_greedy does it
-     * (rfs_seek.c: rows in chunks of 64, one predict_row call per chunk when the model
+     * (rfs_gridmax.c: rows in chunks, one predict_row call per chunk when the model
      * has it, else one predict per point). */
     const rfs_map_t *m = &s_app.map;
     rfs_q16_t best = RFS_Q16_MIN, bx = 0, by = 0;

@@ -8,6 +8,7 @@
 
 #include "bench_clock.h"
 #include "rfs_app.h"
+#include "rfs_gridmax.h"
 #include "rfs_models.h"
 #include "rfs_target.h"
 
@@ -156,7 +157,7 @@ static int map_init(rfs_mw_mem_t *mem, const rfs_app_map_t *am)
     return 0;
 }
 
-/* The seeker around the model, for rfs_seek_grid_max(): the paper's configuration; every
+/* The seeker around the model, for rfs_gridmax_find(): the paper's configuration; every
  * legal lattice point reachable. Returns the number of reachable points, 0 on failure. */
 static uint32_t seek_init(rfs_mw_mem_t *mem, rfs_model_t model)
 {
@@ -324,7 +325,8 @@ static int run_model(rfs_mw_mem_t *mem, const rfs_models_entry_t *e, uint32_t n,
     if (!floor || (flags & RFS_MW_QUICK) == 0u) {
         const uintptr_t sp2 = rfs_bc_stack_paint();
         RFS_BC_MEASURE(name2(nb, sizeof nb, "grid", e->name), 1,
-                       found = rfs_seek_grid_max(&mem->seek, &gx, &gy));
+                       found = rfs_gridmax_find(&mem->map, &mem->seek.model, mem->reach,
+                                                 &gx, &gy));
         rfs_bc_report(name2(nb, sizeof nb, "stack_grid", e->name), 0, rfs_bc_stack_depth(sp2));
         rfs_bc_report(name2(nb, sizeof nb, "sum_grid", e->name), 0,
                       fnv_u32(fnv_u32(fnv_u32(FNV_OFFSET, found), (uint32_t)gx), (uint32_t)gy));

@@ -13,7 +13,7 @@
  * - "floor" (bench/bench_pathloss.c, "whole floor"): the office map at 0.1 m, n samples at
  *   random legal points, -40 - 30 log10(d) - 5 dB per wall from (27.5, 10) m plus 4 dB
  *   noise, one rng (seed 7) for the samples and the fit. The pathloss model only.
- * Reachability for rfs_seek_grid_max: every legal lattice point (both maps are one
+ * Reachability for rfs_gridmax_find: every legal lattice point (both maps are one
  * connected floor; the seeker's flood fill is internal to rfs_seek).
  *
  * Sliced relearns: at each model's registry budget (rfs_models_entry_t.mcu_fit_budget,
@@ -75,7 +75,7 @@ typedef struct rfs_mw_mem {
     rfs_sample_t samples[RFS_MW_MAX_SAMPLES];  ///< the workload's samples
     uint8_t legal[RFS_MW_MAX_MAP_BYTES];       ///< the map's derived legal grid
     rfs_map_t map;                             ///< the workload's map
-    rfs_seek_t seek;                           ///< seeker, for rfs_seek_grid_max only
+    rfs_seek_t seek;                           ///< seeker, for rfs_gridmax_find only
     rfs_pending_t pending[RFS_MW_PENDING];     ///< its pending ring
     uint8_t plan_work[RFS_MW_MAX_LATTICE];     ///< its planner's work array
     uint32_t plan_queue[8];                    ///< its planner's queue (the minimum)

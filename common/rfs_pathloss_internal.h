@@ -1,0 +1,32 @@
+/* rfs_pathloss_internal.h - private to rfs_pathloss.c and rfs_pathloss_walls.c: the wall
+ * counts the fit and the prediction share. Not part of the core's API.
+ */
+#ifndef RFS_PATHLOSS_INTERNAL_H
+#define RFS_PATHLOSS_INTERNAL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rfs_pathloss.h"
+
+/* Wall counts saturate here (15 walls are 75 dB at 5 dB each; four of them, in quarter
+ * walls, fit a byte of the cache). */
+#define RFS_PATHLOSS_WALLS_MAX 15u
+/* Wall counts per bin footprint. */
+#define RFS_PATHLOSS_FOOTPRINT_RAYS 4u
+
+/* Give every bin on the map its wall-count cache row (found by its origin's core cell, or
+ * new), after clearing the cache when it belongs to another map or lattice. */
+void rfs_pathloss_walls_assign(rfs_pathloss_t *p);
+
+/* One line's walls from (x, y) to (sx, sy) (metres Q16.16), saturated at
+ * RFS_PATHLOSS_WALLS_MAX. */
+uint32_t rfs_pathloss_walls_line(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,
+                                 rfs_q16_t sy);
+
+/* Bin bb's walls to the candidate in p->ev, in quarter walls (0..4 x WALLS_MAX): from
+ * the cache when its column is filled, else counted (and cached when it is the next
+ * column). *lines: the wall counts computed (left alone when cached). */
+uint32_t rfs_pathloss_walls_bin(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb, uint32_t *lines);
+
+#endif /* RFS_PATHLOSS_INTERNAL_H */

@@ -1,0 +1,133 @@
+/* rfs_pathloss_walls.c - the path-loss model's wall counts (docs/PATHLOSS.md, "A bin's
+ * walls: the footprint" and "Work, the wall-count cache and slicing"): a bin's footprint
+ * counts and the cache that keeps the coarse candidates' counts across fits. */
+#include "rfs_pathloss_internal.h"
+
+#include <string.h>
+
+static uint32_t cell_hash(uint16_t cx, uint16_t cy)
+{
+    return ((uint32_t)cx * 0x9E3779B1u + (uint32_t)cy * 0x85EBCA77u) >> 22; /* 10 bits */
+}
+
+/* Field by field: the core may call no memcmp (only memcpy/memset/memmove). */
+static bool same_lattice(const rfs_pathloss_lat_t *a, const rfs_pathloss_lat_t *b)
+{
+    return a->ox == b->ox && a->oy == b->oy && a->grid == b->grid && a->lw == b->lw &&
+           a->lh == b->lh && a->cs == b->cs && a->c0i == b->c0i && a->c0j == b->c0j &&
+           a->ncx == b->ncx && a->ncy == b->ncy;
+}
+
+static void cache_clear(rfs_pathloss_t *p)
+{
+    p->nrows = 0u;
+    memset(p->row_hash, 0, sizeof(p->row_hash));
+}
+
+void rfs_pathloss_walls_assign(rfs_pathloss_t *p)
+{
+    _Static_assert(RFS_PATHLOSS_CACHE_HASH == 1024u, "cell_hash yields 10 bits");
+    _Static_assert(RFS_PATHLOSS_CACHE_ROWS >= RFS_PATHLOSS_MAX_BINS, "a row for every bin");
+    if (p->map == 0) {
+        return;
+    }
+    if (p->cache_map != p->map || !same_lattice(&p->cache_lat, &p->lat)) {
+        cache_clear(p);
+        p->cache_map = p->map;
+        p->cache_lat = p->lat;
+    }
+    for (uint32_t b = 0u; b < p->nbins; ++b) {
+        rfs_pathloss_bin_t *bb = &p->bins[b];
+        uint16_t cx, cy;
+        if (!rfs_map_cell(p->map, bb->x, bb->y, &cx, &cy)) {
+            continue;
+        }
+        uint32_t h = cell_hash(cx, cy);
+        while (p->row_hash[h] != 0u) {
+            const rfs_pathloss_row_t *r = &p->rows[p->row_hash[h] - 1u];
+            if (r->cx == cx && r->cy == cy) {
+                break;
+            }
+            h = (h + 1u) & (RFS_PATHLOSS_CACHE_HASH - 1u);
+        }
+        if (p->row_hash[h] == 0u) {
+            if (p->nrows == RFS_PATHLOSS_CACHE_ROWS) {
+                /* Full of origins no bin uses any more: start again (rows >= bins). */
+                cache_clear(p);
+                for (uint32_t c = 0u; c < b; ++c) {
+                    p->bins[c].row = RFS_PATHLOSS_NO_ROW;
+                }
+                b = UINT32_MAX; /* the loop's ++ restarts it at 0 */
+                continue;
+            }
+            rfs_pathloss_row_t *r = &p->rows[p->nrows];
+            r->cx = cx;
+            r->cy = cy;
+            r->filled = 0u;
+            p->row_hash[h] = (uint16_t)(++p->nrows);
+        }
+        bb->row = (uint16_t)(p->row_hash[h] - 1u);
+    }
+}
+
+uint32_t rfs_pathloss_walls_line(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,
+                          rfs_q16_t sy)
+{
+    uint32_t k = rfs_map_walls_crossed(m, x, y, sx, sy);
+    return k > RFS_PATHLOSS_WALLS_MAX ? RFS_PATHLOSS_WALLS_MAX : k;
+}
+
+/* rfs_pathloss_walls_line(), counted as a fit's work. */
+static uint32_t walls_to(rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx, rfs_q16_t sy)
+{
+    p->walls_counted++;
+    return rfs_pathloss_walls_line(p->map, x, y, sx, sy);
+}
+
+/* A bin's walls to the candidate (sx, sy) in quarter walls (0..4 x RFS_PATHLOSS_WALLS_MAX): the sum of
+ * the counts from its footprint's four points (wx +- f, wy +- f), a point that is not
+ * legal counting as the centre (wx, wy); with footprint 0, four times the centre's.
+ * At most four counts: the centre is counted only in place of an illegal point. */
+static uint32_t footprint_walls(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb, rfs_q16_t sx,
+                                rfs_q16_t sy)
+{
+    const rfs_q16_t f = p->cfg.footprint;
+    if (f == 0) {
+        return RFS_PATHLOSS_FOOTPRINT_RAYS * walls_to(p, bb->wx, bb->wy, sx, sy);
+    }
+    uint32_t sum = 0u, centre = UINT32_MAX;
+    for (uint32_t q = 0u; q < RFS_PATHLOSS_FOOTPRINT_RAYS; ++q) {
+        rfs_q16_t x = rfs_sat32((int64_t)bb->wx + ((q & 1u) != 0u ? f : -f));
+        rfs_q16_t y = rfs_sat32((int64_t)bb->wy + ((q & 2u) != 0u ? f : -f));
+        if (rfs_map_point_legal(p->map, x, y)) {
+            sum += walls_to(p, x, y, sx, sy);
+        } else {
+            if (centre == UINT32_MAX) {
+                centre = walls_to(p, bb->wx, bb->wy, sx, sy);
+            }
+            sum += centre;
+        }
+    }
+    return sum;
+}
+
+uint32_t rfs_pathloss_walls_bin(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb, uint32_t *lines)
+{
+    const int32_t col = p->ev.col;
+    rfs_pathloss_row_t *r = bb->row != RFS_PATHLOSS_NO_ROW ? &p->rows[bb->row] : 0;
+    bool cacheable = r != 0 && col >= 0 && col < (int32_t)RFS_PATHLOSS_CACHE_COLS;
+    uint8_t *cell = cacheable ? &p->walls[bb->row][col] : 0;
+    if (cacheable && col < (int32_t)r->filled) {
+        p->footprints_cached++;
+        return *cell;
+    }
+    uint32_t before = p->walls_counted;
+    uint32_t k = footprint_walls(p, bb, p->ev.sx, p->ev.sy);
+    *lines = p->walls_counted - before;
+    p->footprints++;
+    if (cacheable && col == (int32_t)r->filled) {
+        *cell = (uint8_t)k;
+        r->filled++;
+    }
+    return k;
+}

@@ -1,0 +1,90 @@
+/* rfs_seek_internal.h - private to the rfs_seek*.c files: the strategy table's entry and
+ * the functions the loop (rfs_seek.c), the paper's choices (rfs_seek_meta.c) and the
+ * baselines (rfs_seek_baseline.c) share. Not part of the core's API.
+ */
+#ifndef RFS_SEEK_INTERNAL_H
+#define RFS_SEEK_INTERNAL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rfs_seek.h"
+
+/* One strategy's decision rule (docs/STRATEGIES.md, "Choosing a strategy"): the loop in
+ * rfs_seek.c calls these and nothing else that depends on the strategy. A choose or
+ * to_max function sets decision.kind and the goal, plans and starts the drive, and
+ * returns false when it found no goal. */
+typedef struct rfs_seek_strategy_ops {
+    const char *name; /* as on the command line */
+    /* The iteration's goal; after the relearn check, the fit and the initial move when
+     * `learns`. model_ok: the model predicts at the robot (false unless `learns`). */
+    bool (*choose)(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t now_us);
+    /* The greedy step towards the model's maximum (mx, my), metres Q16.16; known: it is
+     * the model's own argmax, not a grid search's. NULL without a greedy step. */
+    bool (*to_max)(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool known, rfs_rng_t *rng,
+                   int64_t now_us);
+    bool learns;       /* an iteration checks the model, relearns it and begins with the
+                        * initial move (false: the rule needs only the 1 s means) */
+    bool refit;        /* the model is relearnt at every iteration, not only on a miss */
+    bool dwell;        /* stand still one averaging window before every decision */
+    bool improvements; /* rfs_seek_cfg_use_strategy turns the improvements beside the
+                        * paper on (rfs_seek_cfg_t, docs/STRATEGIES.md) */
+} rfs_seek_strategy_ops_t;
+
+/* The configured strategy's entry of the table. */
+const rfs_seek_strategy_ops_t *rfs_seek_ops(const rfs_seek_t *s);
+
+/* ---- rfs_seek.c: planning for every strategy --------------------------------------- */
+
+/* Where plans start: the robot, or the closest legal lattice point when it stands in the
+ * clearance zone. false when there is none. */
+bool rfs_seek_plan_start(const rfs_seek_t *s, rfs_q16_t *sx, rfs_q16_t *sy);
+
+/* Plan from the robot to (gx, gy) into the drive's path (not yet driven) and set
+ * decision.path_len. false when there is no path. With `tree`, from the search tree
+ * begun at rfs_seek_plan_start (rfs_plan_tree_path: same contract). */
+bool rfs_seek_plan_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, bool tree);
+
+/* Plan to (gx, gy) and drive the path. */
+bool rfs_seek_go_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, int64_t now_us);
+
+/* ---- rfs_seek_meta.c: the paper's choices (section 2) and their variants ----------- */
+
+/* Tabulate the epsilon weights e^(-d) by squared lattice offset (s->eps_w). */
+void rfs_seek_meta_init(rfs_seek_t *s);
+
+/* The initial random move: a uniformly chosen reachable lattice point within
+ * initial_step_max of the robot. */
+bool rfs_seek_meta_initial(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us);
+
+/* Mark the lattice points within the novelty radius of (x, y) as visited. */
+void rfs_seek_meta_visit(rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y);
+
+/* choose of the meta strategies: "if random() > epsilon: greedy, else epsilon"; greedy is
+ * the model's maximum (its argmax, else the grid search) and the strategy's to_max step,
+ * epsilon a novel reachable point drawn with P proportional to e^(-distance) (with
+ * eps_sample the model's draw first). */
+bool rfs_seek_meta_choose(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t now_us);
+
+/* to_max of meta and meta-global: min(distance, step) straight towards the maximum,
+ * with the line search when that point is illegal. */
+bool rfs_seek_meta_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool known,
+                        rfs_rng_t *rng, int64_t now_us);
+
+/* to_max of meta-path: `step` along the planned path (the whole path to a known
+ * maximum). */
+bool rfs_seek_meta_path_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool known,
+                             rfs_rng_t *rng, int64_t now_us);
+
+/* ---- rfs_seek_baseline.c: the baselines' choose functions -------------------------- */
+
+/* fd-gradient: probes at p + step x and p + step y, then a step along the difference. */
+bool rfs_seek_baseline_fd(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t now_us);
+
+/* plane-gradient: a step along the refit model's gradient. */
+bool rfs_seek_baseline_plane(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t now_us);
+
+/* chemotaxis: run on or tumble by the change of the 1 s mean. */
+bool rfs_seek_baseline_chemo(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t now_us);
+
+#endif /* RFS_SEEK_INTERNAL_H */

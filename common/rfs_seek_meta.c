@@ -1,0 +1,422 @@
+/* rfs_seek_meta.c - the paper's choices of an iteration's goal (section 2): the initial
+ * random move, the greedy step towards the model's maximum and the novelty-driven epsilon
+ * step, with their meta-path variants (docs/STRATEGIES.md, "meta-path's preset
+ * improvements"). rfs_seek.c decides which one an iteration takes. */
+#include "rfs_seek_internal.h"
+
+#include "rfs_gridmax.h"
+#include "rfs_reach.h"
+
+/* Line-search candidates and epsilon redraws tried before giving up on an iteration. */
+#define GOAL_TRIES 6
+
+/* Length of a lattice offset (di, dj) with q = di^2 + dj^2, metres Q16.16: grid * sqrt(q).
+ * Scaling: grid Q16 * isqrt(q << 32) Q16 -> Q32 >> 16 = Q16 metres, saturated. */
+static rfs_q16_t offset_dist(const rfs_map_t *m, uint32_t q)
+{
+    uint32_t root_q16 = rfs_isqrt64((uint64_t)q << 32);
+    return rfs_sat32(((int64_t)m->cfg.grid * root_q16) >> 16);
+}
+
+void rfs_seek_meta_init(rfs_seek_t *s)
+{
+    /* Epsilon weights e^(-d), d = grid * sqrt(q) for q = di^2 + dj^2 (section 2:
+     * P(x) proportional to e^(-|x - x0|)), tabulated once so a draw costs a lookup per
+     * candidate (offset_dist). */
+    for (uint32_t q = 0; q < RFS_SEEK_EPS_TABLE; ++q) {
+        rfs_q16_t w = rfs_q16_exp_neg(offset_dist(s->map, q));
+        s->eps_w[q] = (uint16_t)(w >= RFS_Q16_ONE ? 0xFFFFu : (uint32_t)w);
+    }
+}
+
+rfs_q16_t rfs_seek_epsilon(const rfs_seek_cfg_t *cfg, uint32_t n)
+{
+    /* Scaling: rate (Q16) * n saturates at Q16 max, where e^-x is 0 anyway. */
+    int64_t x = (int64_t)cfg->eps_rate * (int64_t)(n > 65535u ? 65535u : n);
+    rfs_q16_t e = rfs_q16_exp_neg(rfs_sat32(x));
+    return rfs_q16_add(rfs_q16_mul(cfg->eps_amp, e), cfg->eps_floor);
+}
+
+/* Epsilon's n: the iteration (paper), or with eps_by_travel the larger of it and the
+ * whole steps travelled. Scaling: travel (Q16, >= 0) / step (Q16, > 0) is whole steps,
+ * floor, by rfs_udiv64 (no libgcc division on 32-bit targets). */
+static uint32_t epsilon_index(const rfs_seek_t *s)
+{
+    uint32_t n = s->decision.iteration;
+    if (s->cfg.eps_by_travel) {
+        int64_t steps = (int64_t)rfs_udiv64((uint64_t)s->travel, (uint64_t)s->cfg.step);
+        uint32_t t = steps > (int64_t)UINT32_MAX ? UINT32_MAX : (uint32_t)steps;
+        n = t > n ? t : n;
+    }
+    return n;
+}
+
+/* Novelty (paper section 2): the lattice points within the novelty radius of a position
+ * the robot reported, which epsilon goals avoid. Scaling: offsets Q16 squared in int64
+ * (Q32) against the radius squared. */
+void rfs_seek_meta_visit(rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y)
+{
+    const rfs_map_t *m = s->map;
+    uint16_t ci, cj;
+    rfs_map_lattice_nearest(m, x, y, &ci, &cj);
+    if (s->have_last_l && s->last_li == ci && s->last_lj == cj) {
+        return;
+    }
+    s->have_last_l = true;
+    s->last_li = ci;
+    s->last_lj = cj;
+    int32_t r = s->cfg.novelty_radius / m->cfg.grid + 1;
+    int64_t r2 = (int64_t)s->cfg.novelty_radius * s->cfg.novelty_radius;
+    for (int32_t dj = -r; dj <= r; ++dj) {
+        int32_t j = (int32_t)cj + dj;
+        if (j < 0 || j >= (int32_t)m->lh) {
+            continue;
+        }
+        for (int32_t di = -r; di <= r; ++di) {
+            int32_t i = (int32_t)ci + di;
+            if (i < 0 || i >= (int32_t)m->lw) {
+                continue;
+            }
+            rfs_q16_t px, py;
+            rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
+            int64_t dx = (int64_t)px - x, dy = (int64_t)py - y;
+            /* Q16 squared = Q32; compare with the radius squared (Q32). */
+            if (dx * dx + dy * dy <= r2) {
+                rfs_reach_bit_set(s->visited, (uint32_t)j * m->lw + (uint32_t)i);
+            }
+        }
+    }
+}
+
+/* Initial random move: a uniformly chosen reachable lattice point within
+ * initial_step_max of the robot (paper: "restricted to twice the regular step width"). */
+bool rfs_seek_meta_initial(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
+{
+    const rfs_map_t *m = s->map;
+    uint16_t ci, cj;
+    rfs_map_lattice_nearest(m, s->pose.x, s->pose.y, &ci, &cj);
+    int32_t r = s->cfg.initial_step_max / m->cfg.grid;
+    int64_t r2 = (int64_t)s->cfg.initial_step_max * s->cfg.initial_step_max;
+    for (int attempt = 0; attempt < GOAL_TRIES; ++attempt) {
+        /* Count candidates, then pick the k-th: uniform without a candidate list. */
+        uint32_t n = 0;
+        for (int pass = 0; pass < 2; ++pass) {
+            uint32_t pick = pass ? rfs_rng_below(rng, n) : 0u, seen = 0;
+            for (int32_t dj = -r; dj <= r; ++dj) {
+                for (int32_t di = -r; di <= r; ++di) {
+                    int32_t i = (int32_t)ci + di, j = (int32_t)cj + dj;
+                    if ((di == 0 && dj == 0) || i < 0 || j < 0 || i >= (int32_t)m->lw ||
+                        j >= (int32_t)m->lh || !rfs_reach_at(m, s->reach, (uint16_t)i, (uint16_t)j)) {
+                        continue;
+                    }
+                    rfs_q16_t px, py;
+                    rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
+                    int64_t dx = (int64_t)px - s->pose.x, dy = (int64_t)py - s->pose.y;
+                    if (dx * dx + dy * dy > r2) {
+                        continue;
+                    }
+                    if (pass == 0) {
+                        n++;
+                    } else if (seen++ == pick) {
+                        s->decision.goal_x = px;
+                        s->decision.goal_y = py;
+                        if (rfs_seek_go_to(s, px, py, now_us)) {
+                            return true;
+                        }
+                        goto next_attempt;
+                    }
+                }
+            }
+            if (n == 0) {
+                return false;
+            }
+        }
+    next_attempt:;
+    }
+    return false;
+}
+
+/* Rejection step of a geodesic epsilon draw: a candidate proposed with weight
+ * e^(-straight distance) is kept with probability e^(-(path length - straight distance)),
+ * so the kept goals have weight e^(-path length) (the last try is always kept).
+ * Scaling: the straight distance from the weight table's q (grid * sqrt(q), Q16) and
+ * the path length (Q16, <= 32 km) differ by less than 2^31; e^(-d) is Q16. */
+static bool accept_detour(const rfs_seek_t *s, rfs_rng_t *rng, uint32_t q)
+{
+    int64_t detour = (int64_t)s->drive.path.length - offset_dist(s->map, q);
+    if (detour <= 0) {
+        return true;
+    }
+    rfs_q16_t keep = rfs_q16_exp_neg(rfs_sat32(detour));
+    return rfs_rng_below(rng, RFS_Q16_ONE) < (uint32_t)keep;
+}
+
+/* meta-path (an improvement beside the paper): plan to the maximum and keep the first
+ * `step` metres of the path, so a greedy step goes round walls the way the planner does
+ * instead of straight at the maximum with a line search; with a model that knows where
+ * its maximum is (argmax: the pathloss model's estimated source) the goal is that point
+ * itself, reached through the planner. The cut point lies on a legal segment
+ * of the path. Scaling: waypoint offsets (Q16, < 2^32) times the remaining length
+ * (Q16, < 2^16 m) < 2^63; segment lengths by rfs_q16_dist(). */
+static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool whole,
+                              int64_t now_us)
+{
+    if (!rfs_seek_go_to(s, mx, my, now_us)) {
+        /* The maximum is where the robot cannot go (a room whose door the clearance does
+         * not pass, a spot off the free space): head for the reachable point nearest to
+         * it rather than giving the iteration to a random epsilon move. */
+        rfs_q16_t nx, ny;
+        if (!rfs_reach_nearest(s->map, s->reach, mx, my, &nx, &ny) ||
+            !rfs_seek_go_to(s, nx, ny, now_us)) {
+            return false;
+        }
+    }
+    rfs_path_t *p = &s->drive.path;
+    int64_t px = s->pose.x, py = s->pose.y;
+    int64_t left = whole ? INT32_MAX : s->cfg.step;
+    for (uint16_t k = 0; k < p->n; ++k) {
+        int64_t dx = (int64_t)p->x[k] - px, dy = (int64_t)p->y[k] - py;
+        int64_t len = rfs_q16_dist((rfs_q16_t)px, (rfs_q16_t)py, p->x[k], p->y[k]);
+        if (len >= left) {
+            if (len > 0) {
+                p->x[k] = rfs_sat32(px + rfs_sdiv64_round(dx * left, len));
+                p->y[k] = rfs_sat32(py + rfs_sdiv64_round(dy * left, len));
+            }
+            p->n = (uint16_t)(k + 1u);
+            p->length = s->cfg.step;
+            break;
+        }
+        left -= len;
+        px = p->x[k];
+        py = p->y[k];
+    }
+    s->decision.goal_x = p->x[p->n - 1u];
+    s->decision.goal_y = p->y[p->n - 1u];
+    s->decision.path_len = p->length;
+    rfs_drive_set_path(&s->drive, p, now_us);
+    return true;
+}
+
+/* eps_sample: the epsilon goal is a draw from the model's belief (a plausible source),
+ * driven the whole planned way and rechecked like a greedy leg. false (the novelty draw
+ * follows) when the model draws nothing, a point within 1.5 steps of the robot, or one
+ * the robot has been to (within the novelty radius of a past position), and whenever the
+ * robot stands within 1.5 steps of the model's own maximum: at a wrong estimate the
+ * draws lie in the rooms round it, a leg there fails its recheck within a metre and the
+ * relearnt fit holds the estimate (hold_k), so the robot shuttles; only the novelty
+ * move's new places shift the fit. */
+static bool epsilon_sample(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
+{
+    rfs_q16_t x, y;
+    if (!s->cfg.eps_sample || s->model.ops->sample == 0 ||
+        !s->model.ops->sample(s->model.self, rng, &x, &y)) {
+        return false;
+    }
+    rfs_q16_t near = rfs_q16_add(s->cfg.step, s->cfg.step / 2);
+    if (rfs_q16_dist(s->pose.x, s->pose.y, x, y) < near) {
+        return false;
+    }
+    rfs_q16_t mx, my;
+    if (s->model.ops->argmax != 0 && s->model.ops->argmax(s->model.self, &mx, &my) &&
+        rfs_q16_dist(s->pose.x, s->pose.y, mx, my) < near) {
+        return false;
+    }
+    uint16_t li, lj;
+    rfs_map_lattice_nearest(s->map, x, y, &li, &lj);
+    if (rfs_reach_bit(s->visited, (uint32_t)lj * s->map->lw + li)) {
+        return false;
+    }
+    if (!greedy_along_path(s, x, y, true, now_us)) {
+        return false;
+    }
+    s->decision.sampled = true;
+    s->decision.max_x = x;
+    s->decision.max_y = y;
+    return true;
+}
+
+/* Epsilon step (paper section 2): a random reachable point at least the novelty radius
+ * from every past position, drawn with probability proportional to e^(-distance); with
+ * eps_sample, the model's draw first (above). */
+static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
+{
+    if (epsilon_sample(s, rng, now_us)) {
+        return true;
+    }
+    const rfs_map_t *m = s->map;
+    uint16_t ci, cj;
+    rfs_map_lattice_nearest(m, s->pose.x, s->pose.y, &ci, &cj);
+    const int32_t r = RFS_SEEK_EPS_RADIUS;
+    /* Geodesic: every try plans from the robot, so one search tree rooted there serves
+     * them all (resumed out to each goal; a goal it already reached costs no search).
+     * No tree when the robot has no legal start: every plan then fails, as a
+     * plan from the robot does. */
+    const bool tree = s->cfg.eps_geodesic;
+    rfs_q16_t sx, sy;
+    const bool tree_ok = tree && rfs_seek_plan_start(s, &sx, &sy);
+    if (tree_ok) {
+        rfs_plan_tree_begin(&s->plan, sx, sy);
+    }
+    for (int attempt = 0; attempt < GOAL_TRIES; ++attempt) {
+        /* Scaling: weights Q0.16 <= 65535, at most 65^2 candidates: sum < 2^28. */
+        uint32_t total = 0;
+        for (int pass = 0; pass < 2; ++pass) {
+            uint32_t pick = pass ? rfs_rng_below(rng, total) : 0u, acc = 0;
+            for (int32_t dj = -r; dj <= r; ++dj) {
+                int32_t j = (int32_t)cj + dj;
+                if (j < 0 || j >= (int32_t)m->lh) {
+                    continue;
+                }
+                for (int32_t di = -r; di <= r; ++di) {
+                    int32_t i = (int32_t)ci + di;
+                    uint32_t q = (uint32_t)(di * di + dj * dj);
+                    if (i < 0 || i >= (int32_t)m->lw || q >= RFS_SEEK_EPS_TABLE) {
+                        continue;
+                    }
+                    uint32_t idx = (uint32_t)j * m->lw + (uint32_t)i;
+                    if (rfs_reach_bit(s->visited, idx) || !rfs_reach_bit(s->reach, idx)) {
+                        continue;
+                    }
+                    uint32_t w = s->eps_w[q];
+                    if (pass == 0) {
+                        total += w;
+                        continue;
+                    }
+                    acc += w;
+                    if (acc > pick) {
+                        rfs_q16_t px, py;
+                        rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
+                        s->decision.goal_x = px;
+                        s->decision.goal_y = py;
+                        if ((!tree || tree_ok) && rfs_seek_plan_to(s, px, py, tree)) {
+                            /* A rejected draw never reaches the drive. */
+                            if (!s->cfg.eps_geodesic || attempt == GOAL_TRIES - 1 ||
+                                accept_detour(s, rng, q)) {
+                                rfs_drive_set_path(&s->drive, &s->drive.path, now_us);
+                                return true;
+                            }
+                            goto next_attempt;
+                        }
+                        rfs_reach_bit_set(s->visited, idx); /* unreachable in practice: do not redraw it */
+                        goto next_attempt;
+                    }
+                }
+            }
+            if (total == 0) {
+                return false;
+            }
+        }
+    next_attempt:;
+    }
+    return false;
+}
+
+/* Greedy step (paper section 2): the model's maximum, from the model itself when it
+ * knows where it is (argmax: the pathloss model's estimated source, docs/PATHLOSS.md,
+ * "In the loop"), else by the grid search over every reachable legal lattice point; then
+ * the strategy's step towards it. */
+static bool choose_greedy(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
+{
+    rfs_q16_t mx = 0, my = 0;
+    bool found = false;
+    bool known = false;
+    if (s->model.ops->argmax != 0 && s->model.ops->argmax(s->model.self, &mx, &my)) {
+        found = true;
+        known = true;
+    } else {
+        found = rfs_gridmax_find(s->map, &s->model, s->reach, &mx, &my);
+    }
+    if (!found) {
+        return false;
+    }
+    s->decision.max_x = mx;
+    s->decision.max_y = my;
+    return rfs_seek_ops(s)->to_max(s, mx, my, known, rng, now_us);
+}
+
+bool rfs_seek_meta_path_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool known,
+                             rfs_rng_t *rng, int64_t now_us)
+{
+    (void)rng;
+    return greedy_along_path(s, mx, my, known, now_us);
+}
+
+/* The paper's greedy step: move min(distance, step) towards the maximum; when that point
+ * is not legal, search the line to the maximum for the first legal point, before or after
+ * the obstacle. */
+bool rfs_seek_meta_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool known,
+                        rfs_rng_t *rng, int64_t now_us)
+{
+    (void)known;
+    const rfs_map_t *m = s->map;
+    int64_t dx = (int64_t)mx - s->pose.x, dy = (int64_t)my - s->pose.y;
+    rfs_q16_t dist = rfs_q16_dist(s->pose.x, s->pose.y, mx, my);
+    if (dist <= s->cfg.step) {
+        s->decision.goal_x = mx;
+        s->decision.goal_y = my;
+        return rfs_seek_go_to(s, mx, my, now_us);
+    }
+    /* Point at fraction t (Q16) of the way to the maximum. */
+    rfs_q16_t t_step = rfs_q16_div(s->cfg.step, dist);
+    rfs_q16_t gx = rfs_sat32(s->pose.x + ((dx * t_step) >> 16));
+    rfs_q16_t gy = rfs_sat32(s->pose.y + ((dy * t_step) >> 16));
+    if (rfs_map_point_legal(m, gx, gy) && rfs_seek_go_to(s, gx, gy, now_us)) {
+        s->decision.goal_x = gx;
+        s->decision.goal_y = gy;
+        return true;
+    }
+    /* Line search at the map resolution, alternating at random between in front of the
+     * step point (towards the robot) and beyond it (towards the maximum). */
+    s->decision.line_search = true;
+    rfs_q16_t dt = rfs_q16_div(m->res, dist);
+    if (dt <= 0) {
+        dt = 1;
+    }
+    for (int32_t k = 1; k < 65536; ++k) {
+        bool any = false;
+        bool beyond_first = (rfs_rng_u32(rng) & 1u) != 0u;
+        for (int side = 0; side < 2; ++side) {
+            bool beyond = (side == 0) == beyond_first;
+            int64_t t = (int64_t)t_step + (beyond ? (int64_t)k * dt : -(int64_t)k * dt);
+            if (t <= 0 || t > RFS_Q16_ONE) {
+                continue;
+            }
+            any = true;
+            gx = rfs_sat32(s->pose.x + ((dx * t) >> 16));
+            gy = rfs_sat32(s->pose.y + ((dy * t) >> 16));
+            if (rfs_map_point_legal(m, gx, gy) && rfs_seek_go_to(s, gx, gy, now_us)) {
+                s->decision.goal_x = gx;
+                s->decision.goal_y = gy;
+                return true;
+            }
+        }
+        if (!any) {
+            break;
+        }
+    }
+    s->decision.goal_x = mx;
+    s->decision.goal_y = my;
+    return rfs_seek_go_to(s, mx, my, now_us);
+}
+
+/* "if random() > epsilon: greedy, else epsilon" (Algorithm 1), for every meta strategy.
+ * A leg abandoned by a failed recheck continues greedily on the relearnt model: the draw
+ * was made when the leg began. When the chosen move finds no goal the other is tried. */
+bool rfs_seek_meta_choose(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t now_us)
+{
+    rfs_seek_decision_t *d = &s->decision;
+    d->epsilon = rfs_seek_epsilon(&s->cfg, epsilon_index(s));
+    bool greedy = model_ok && (s->replan || rfs_rng_q16(rng) >= d->epsilon);
+    s->replan = false;
+    d->kind = greedy ? RFS_SEEK_GREEDY : RFS_SEEK_EPSILON;
+    bool ok = greedy ? choose_greedy(s, rng, now_us) : choose_epsilon(s, rng, now_us);
+    if (!ok && greedy) {
+        d->kind = RFS_SEEK_EPSILON; /* no reachable maximum: explore instead */
+        ok = choose_epsilon(s, rng, now_us);
+    }
+    if (!ok && !greedy && model_ok) {
+        d->kind = RFS_SEEK_GREEDY; /* nothing novel left within reach */
+        ok = choose_greedy(s, rng, now_us);
+    }
+    return ok;
+}

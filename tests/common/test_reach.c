@@ -1,0 +1,140 @@
+/* test_reach.c - reachability (common/rfs_reach.c): the seeker's reach bits after its
+ * first period are exactly the robot's component of the lattice graph, compared with a
+ * double-precision flood fill (ref_geom.h).
+ */
+#include "rfs_test.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ref_geom.h"
+#include "seek_world.h"
+
+/* Reference lattice legality: the legal bit of the point's cell (double geometry). */
+static int ref_lat_legal(const rfs_map_t *m, int i, int j)
+{
+    double g = m->cfg.grid, r = m->res;
+    double x = floor(g / 2) + i * g, y = floor(g / 2) + j * g;
+    return rfs_map_bit(m->legal, m->stride, (uint16_t)floor(x / r), (uint16_t)floor(y / r));
+}
+
+/* Reference edge legality: every cell the closed segment touches is legal and on the map. */
+static int ref_step_legal(const rfs_map_t *m, int i0, int j0, int i1, int j1)
+{
+    double g = m->cfg.grid, r = m->res;
+    double x0 = floor(g / 2) + i0 * g, y0 = floor(g / 2) + j0 * g;
+    double x1 = floor(g / 2) + i1 * g, y1 = floor(g / 2) + j1 * g;
+    int clo = (int)floor(fmin(x0, x1) / r) - 1, chi = (int)floor(fmax(x0, x1) / r) + 1;
+    int rlo = (int)floor(fmin(y0, y1) / r) - 1, rhi = (int)floor(fmax(y0, y1) / r) + 1;
+    for (int cj = rlo; cj <= rhi; cj++) {
+        for (int ci = clo; ci <= chi; ci++) {
+            if (ref_touch(x0, y0, x1, y1, r, ci, cj) &&
+                (ci < 0 || cj < 0 || ci >= m->w || cj >= m->h ||
+                 !rfs_map_bit(m->legal, m->stride, (uint16_t)ci, (uint16_t)cj))) {
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
+
+static int bit_of(const uint8_t *bits, int v)
+{
+    return (bits[v >> 3] >> (v & 7)) & 1;
+}
+
+static int ref_map_step(void *ctx, int ui, int uj, int vi, int vj)
+{
+    const rfs_map_t *m = ctx;
+    return ref_lat_legal(m, vi, vj) && ref_step_legal(m, ui, uj, vi, vj);
+}
+
+/* A speckled 8 x 6 m map (2.5 % of the cells occupied, no clearance: many small pockets)
+ * at cell size res, and the seeker's reach bits after its first period at a random legal
+ * lattice point. They decide which plans the planner refuses without a search
+ * (rfs_plan_set_component), so they must be exactly the robot's component: compared with
+ * a double-precision flood. With an 8-entry queue the fill overflows and marks every legal
+ * point instead (still a union of whole components). */
+static void reach_case(uint32_t seed, double res, bool small_queue, int *in_component, int *legal)
+{
+    world_t t;
+    memset(&t, 0, sizeof t);
+    t.w = (uint16_t)lround(8.0 / res);
+    t.h = (uint16_t)lround(6.0 / res);
+    uint32_t bytes = rfs_map_bytes(t.w, t.h);
+    uint16_t stride = (uint16_t)((t.w + 7) / 8);
+    t.free_bits = calloc(bytes, 1);
+    t.wall_bits = calloc(bytes, 1);
+    t.legal_bits = calloc(bytes, 1);
+    uint32_t s = seed * 2654435761u;
+    for (uint16_t y = 0; y < t.h; ++y) {
+        for (uint16_t x = 0; x < t.w; ++x) {
+            s = s * 1664525u + 1013904223u;
+            rfs_map_bit_set(t.free_bits, stride, x, y, (s >> 8) % 1000u >= 25u);
+        }
+    }
+    rfs_map_cfg_t mc = rfs_map_cfg_default();
+    mc.clearance = 0;
+    assert_int_equal(rfs_map_init(&t.map, &mc, t.w, t.h, Q(res), 0, 0, t.free_bits,
+                                  t.wall_bits, t.legal_bits), 0);
+    int si, sj;
+    do {
+        s = s * 1664525u + 1013904223u;
+        si = (int)((s >> 8) % t.map.lw);
+        s = s * 1664525u + 1013904223u;
+        sj = (int)((s >> 8) % t.map.lh);
+    } while (!ref_lat_legal(&t.map, si, sj));
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    seek_make(&t, cfg, seed);
+    if (small_queue) {
+        t.mem.plan_queue_cap = 8;
+        assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, rfs_ridge_model(&t.ridge),
+                                       &rfs_target_rssi, &t.mem), 0);
+    }
+    double g = D(t.map.cfg.grid);
+    rfs_pose_t p = pose_at(100000, g / 2 + si * g, g / 2 + sj * g, 0);
+    rfs_seek_out_t out;
+    rfs_seek_on_pose(&t.seek, &p, &t.rng);
+    rfs_seek_on_rssi(&t.seek, 0, 100000, -50, &t.rng);
+    rfs_seek_step(&t.seek, 100000, &t.rng, &out);
+    uint8_t *ref = calloc(t.mem.reach_bytes, 1);
+    ref_flood(t.map.lw, t.map.lh, si, sj, ref_map_step, &t.map, ref);
+    for (int j = 0; j < t.map.lh; j++) {
+        for (int i = 0; i < t.map.lw; i++) {
+            int v = j * t.map.lw + i;
+            int want = small_queue ? ref_lat_legal(&t.map, i, j) : bit_of(ref, v);
+            if (bit_of(t.mem.reach, v) != want) {
+                fail_msg("seed %u, %.3f m cells%s: point (%d, %d) reach %d, reference %d", seed,
+                         res, small_queue ? ", 8-entry queue" : "", i, j, !want, want);
+            }
+            *in_component += bit_of(ref, v);
+            *legal += ref_lat_legal(&t.map, i, j);
+        }
+    }
+    free(ref);
+    world_free(&t);
+}
+
+static void test_reach_is_the_component(void **state)
+{
+    (void)state;
+    int comp = 0, legal = 0;
+    for (uint32_t seed = 1; seed <= 12; seed++) {
+        reach_case(seed, 0.125, false, &comp, &legal); /* step patterns */
+        reach_case(seed, 0.1, false, &comp, &legal);   /* the exact traversal */
+    }
+    print_message("robot's components %d of %d legal lattice points\n", comp, legal);
+    assert_true(comp > legal / 10 && comp < legal); /* pockets exist, the fill is not trivial */
+    int c2 = 0, l2 = 0;
+    reach_case(3, 0.125, true, &c2, &l2);
+    reach_case(4, 0.1, true, &c2, &l2);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_reach_is_the_component),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

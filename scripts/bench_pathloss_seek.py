@@ -1,9 +1,12 @@
 #!/usr/bin/env python3
-"""Issue 10's table: the paper's local ridge (strategy meta) beside the map-aware pathloss
-model (strategy meta-path) on the shipped office scenarios, and where pathloss breaks
-(8 dB shadowing, a source in the corridor). Writes docs/RESULTS_PATHLOSS.md.
+"""The path-loss model's named configurations: the paper's local ridge (strategy meta)
+beside the map-aware pathloss model (strategy meta-path) with its preset improvements off,
+on (the default) and with the node's transmit power known, on the shipped floors and
+where it breaks (8 dB shadowing, a source in the corridor, nodes weaker than believed).
+Writes its section of docs/RESULTS.md, between the markers below, and nothing else.
 
     /usr/bin/python3 scripts/bench_pathloss_seek.py [--seeds N] [--sim build/bin/rfseek-sim]
+                                                    [--results docs/RESULTS.md]
 """
 import argparse
 import math
@@ -33,18 +36,18 @@ BREAKS = [
     ("3ne, the node at 0 dBm (not 20)", "scenarios/3ne.yaml",
      [(r'(mac: "02:00:00:00:00:01")', '\\1\n    tx_dbm: 0')]),
 ]
-# (strategy, model, label, extra scenario text): meta-path's preset improvements
+# (strategy, model, column, extra scenario text): meta-path's preset improvements
 # (recheck every step of a greedy leg against an adaptive threshold, epsilon annealed by
 # travel, epsilon goals weighted by path length, epsilon goals drawn from the model's
 # belief; docs/STRATEGIES.md) are also run switched off, so each row shows what they bring.
 CONFIGS = [("meta", "ridge", "meta + ridge", ""),
-           ("meta-path", "pathloss", "meta-path + pathloss, improvements off",
+           ("meta-path", "pathloss", "improvements off",
             "seek: {recheck_m: 0, eps_by_travel: false, eps_geodesic: false, "
             "recheck_adapt: false, eps_sample: false}\n"),
            ("meta-path", "pathloss", "meta-path + pathloss", ""),
            # The node's transmit power known (20 dBm EIRP): the P0 floor 12 dB below the
            # free-space 1 m signal (docs/PATHLOSS.md, "The P0 floor").
-           ("meta-path", "pathloss", "meta-path + pathloss, transmit power known",
+           ("meta-path", "pathloss", "transmit power known",
             "seek: {p0_min_dbm: -32}\n")]
 
 
@@ -91,64 +94,95 @@ def scenario_file(path, edits, tmpdir, extra=""):
     return tmp
 
 
+BEGIN = "<!-- bench_pathloss_seek: begin -->"
+END = "<!-- bench_pathloss_seek: end -->"
+
+
+def commit():
+    """The checked-out commit, "-dirty" when the tracked files differ from it."""
+    def git(*a):
+        r = subprocess.run(["git"] + list(a), capture_output=True, text=True)
+        return r.stdout.strip() if r.returncode == 0 else ""
+    h = git("rev-parse", "--short=7", "HEAD") or "unknown"
+    return h + ("-dirty" if git("status", "--porcelain", "--untracked-files=no") else "")
+
+
+def cell(r):
+    return (f"{100 * r['k'] / r['n']:.0f} % ({100 * r['lo']:.0f}-{100 * r['hi']:.0f}), "
+            f"{r['ratio']:.2f}")
+
+
+def section(seeds, wall, at, table):
+    """The section as it goes into RESULTS.md; table: [(title, [(label, [cell])])]."""
+    L = [BEGIN, "## The path-loss model's configurations", "",
+         f"Written by `/usr/bin/python3 scripts/bench_pathloss_seek.py --seeds {seeds}` at "
+         f"commit {at} ({wall:.0f} s on two cores). Each cell: success (95 % Wilson "
+         "interval), then the median over **all** runs of travel / shortest path (a failed "
+         "run counts its 150 m; the tables above take the median over the successful runs). "
+         f"Seeds 1..{seeds}, the scenario's radio settings unless the row says otherwise. "
+         "Columns: `meta + ridge` is the paper; the others are `meta-path + pathloss` "
+         "(docs/STRATEGIES.md, docs/PATHLOSS.md) with its preset improvements off (`seek: "
+         "{recheck_m: 0, eps_by_travel: false, eps_geodesic: false, recheck_adapt: false, "
+         "eps_sample: false}`), as shipped, and with the node's transmit power known (`seek: "
+         "{p0_min_dbm: -32}`: 20 dBm EIRP - 52 dB, docs/PATHLOSS.md \"The P0 floor\"). The "
+         "last two rows are nodes weaker than that belief. Target: >= 95 % success and "
+         "<= 2x the shortest path on every floor.", ""]
+    for title, rows in table:
+        L.append(f"| {title} | " + " | ".join(c[2] for c in CONFIGS) + " |")
+        L.append("|---" * (len(CONFIGS) + 1) + "|")
+        for label, cells in rows:
+            L.append(f"| {label} | " + " | ".join(cells) + " |")
+        L.append("")
+    L.append(END)
+    return "\n".join(L) + "\n"
+
+
+def splice(path, text):
+    """RESULTS.md with its bench_pathloss_seek section replaced by text (appended when the
+    file has none); written to a temporary file and renamed."""
+    old = open(path).read() if os.path.exists(path) else ""
+    b, e = old.find(BEGIN), old.find(END)
+    if b >= 0 and e > b:
+        rest = old[e + len(END):].lstrip("\n")
+        new = old[:b] + text + ("\n" + rest if rest else "")
+    elif b >= 0 or e >= 0:
+        sys.exit(f"bench_pathloss_seek: {path}: one section marker without the other")
+    else:
+        new = old.rstrip("\n") + ("\n\n" if old else "") + text
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(new)
+    os.replace(tmp, path)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seeds", type=int, default=200)
     ap.add_argument("--sim", default="build/bin/rfseek-sim")
-    ap.add_argument("--out", default="docs/RESULTS_PATHLOSS.md")
+    ap.add_argument("--results", default="docs/RESULTS.md",
+                    help="the markdown file whose section is replaced")
     a = ap.parse_args()
+    if a.seeds < 1:
+        sys.exit("bench_pathloss_seek: --seeds must be at least 1")
     tmps = []
     t0 = time.time()
-    lines = []
+    table = []
     try:
-        for title, rows in (("Target scenarios", ROWS), ("Where it breaks", BREAKS)):
-            lines.append(f"\n## {title}\n")
-            lines.append("| scenario | strategy + model | success (95% CI) | median travel / shortest path | p90 | median model updates |")
-            lines.append("|---|---|---|---|---|---|")
+        for title, rows in (("floor", ROWS), ("where it breaks", BREAKS)):
+            out = []
             for label, path, edits in rows:
+                cells = []
                 for strategy, model, name, extra in CONFIGS:
                     scen = scenario_file(path, edits, tmps, extra)
-                    r = run(a.sim, scen, strategy, model, a.seeds)
-                    lines.append(f"| {label} | {name} | {r['k']}/{r['n']} = {100*r['k']/r['n']:.0f}% ({100*r['lo']:.0f}-{100*r['hi']:.0f}%) | {r['ratio']:.2f} | {r['p90']:.2f} | {r['updates']:.0f} |")
-                    print(lines[-1], flush=True)
+                    cells.append(cell(run(a.sim, scen, strategy, model, a.seeds)))
+                    print(f"{label} | {name} | {cells[-1]}", flush=True)
+                out.append((label, cells))
+            table.append((title, out))
     finally:
         for t in tmps:
             os.unlink(t)
-    wall = time.time() - t0
-    head = f"""# Results: the map-aware pathloss model beside the paper's local ridge (issue 10)
-
-Every row: {a.seeds} seeds (1..{a.seeds}) of the scenario at its shipped radio settings (4 dB
-shadowing, 4 dB measurement noise unless the row says otherwise), success = within 1.5 m of
-the source before 150 m of travel or 15 simulated minutes. Travel ratios are over all runs
-(a failed run counts its 150 m). `meta + ridge` is the paper's algorithm with its own
-parameters; `meta-path + pathloss` is the improvement (docs/PATHLOSS.md, docs/STRATEGIES.md):
-the pathloss model's estimated source is the greedy goal, reached through the planner, with
-meta-path's preset improvements (the relearn check after every metre of a greedy leg,
-failing only beyond the larger of 3 dB and the RMS of the recent misses; epsilon annealed
-by the metres travelled; epsilon goals drawn by path length; an epsilon goal drawn from
-the model's belief, a plausible source, when one lies beyond 1.5 m); "improvements off" is
-the same without them (`seek: {{recheck_m: 0, eps_by_travel: false, eps_geodesic: false,
-recheck_adapt: false, eps_sample: false}}` added to the scenario). "transmit power known" is the same as
-`meta-path + pathloss` with the seeker told the node's power: `seek: {{p0_min_dbm: -32}}`
-(20 dBm EIRP - 40 dB in the first metre - a 12 dB margin; docs/PATHLOSS.md "The P0
-floor"); the last two rows of "Where it breaks" are nodes weaker than that belief.
-
-Command: `/usr/bin/python3 scripts/bench_pathloss_seek.py --seeds {a.seeds}` (wall time
-{wall:.0f} s on this 2-core machine, shared with other work while it ran).
-Target (issue 10): >= 95% success and median travel <= 2x the shortest path on each.
-"""
-    # The hand-written "## Reading" section (and anything after it) is kept.
-    reading = ""
-    if os.path.exists(a.out):
-        old = open(a.out).read()
-        at = old.find("\n## Reading")
-        if at >= 0:
-            reading = "\n" + old[at:].rstrip("\n") + "\n"
-    tmp = a.out + ".tmp"
-    with open(tmp, "w") as f:
-        f.write(head + "\n".join(lines) + "\n" + reading)
-    os.replace(tmp, a.out)
-    print(f"wrote {a.out} ({wall:.0f} s)")
+    splice(a.results, section(a.seeds, time.time() - t0, commit(), table))
+    print(f"wrote {a.results} ({time.time() - t0:.0f} s)")
 
 
 if __name__ == "__main__":

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""bench_seek.py - the seeking-efficacy benchmark (issue 7): docs/RESULTS.md + figures.
+"""bench_seek.py - the seeking-efficacy benchmark: docs/RESULTS.md + figures.
 
 Runs every strategy on every shipped scenario with the simulator's batch mode
 (rfseek-sim --seeds A..B --jobs N), the default scenario at other shadowing and noise
@@ -21,7 +21,9 @@ Definitions (also written into RESULTS.md):
                position at the decision to the goal), over the sum of planned path
                lengths: the part of the planned travel spent going around walls.
 Everything goes to a temporary directory first; RESULTS.md is written to a temporary
-file and renamed.
+file and renamed. Two parts of the old RESULTS.md are kept as they are: the hand-written
+Summary (between the HAND markers) and the section scripts/bench_pathloss_seek.py writes
+(between its own markers).
 """
 import argparse
 import glob
@@ -37,8 +39,8 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 STRATEGIES = ["meta", "meta-global", "fd-gradient", "plane-gradient", "chemotaxis", "meta-path"]
-# The strategies' internal model: the local ridge (the paper's), except meta-path, the
-# improvement of issue 10, which runs with the map-aware path-loss model.
+# The strategies' internal model: the local ridge (the paper's), except meta-path, which
+# runs with the map-aware path-loss model (docs/PATHLOSS.md).
 STRAT_MODEL = {"meta-path": "pathloss"}
 BASELINES = ["meta-global", "fd-gradient", "plane-gradient", "chemotaxis"]
 
@@ -578,53 +580,85 @@ def main():
     return 0
 
 
+HAND = ("<!-- hand-written: begin -->", "<!-- hand-written: end -->")
+PATHLOSS = ("<!-- bench_pathloss_seek: begin -->", "<!-- bench_pathloss_seek: end -->")
+
+
+def kept(old, marks):
+    """The text of old from marks[0] through marks[1], or ""."""
+    b, e = old.find(marks[0]), old.find(marks[1])
+    return old[b:e + len(marks[1])] if 0 <= b < e else ""
+
+
+def commit():
+    """The checked-out commit, "-dirty" when the tracked files differ from it."""
+    def git(*a):
+        r = subprocess.run(["git"] + list(a), capture_output=True, text=True)
+        return r.stdout.strip() if r.returncode == 0 else ""
+    h = git("rev-parse", "--short=7", "HEAD") or "unknown"
+    return h + ("-dirty" if git("status", "--porcelain", "--untracked-files=no") else "")
+
+
+def short(s):
+    """One compact cell: success % (Wilson interval), median ratio over the successful."""
+    return "**%.1f** (%.1f-%.1f), %s" % (100 * s["p"], 100 * s["lo"], 100 * s["hi"],
+                                         fmt(s["ratio"], 2))
+
+
+def sweep_tables(sweep):
+    """The shadowing and noise sweep, one row per strategy, one column per level."""
+    L = []
+    for key, lab in (("shadow", "shadowing (noise 4 dB)"), ("noise", "noise (shadowing 4 dB)")):
+        levels = sorted(next(iter(sweep[key].values())).keys())
+        L.append("| strategy, %s | " % lab + " | ".join("%g dB" % x for x in levels) + " |")
+        L.append("|---" * (len(levels) + 1) + "|")
+        for st, byx in sweep[key].items():
+            L.append("| %s | " % st + " | ".join(short(byx[x]) for x in levels) + " |")
+        L.append("")
+    return L
+
+
+def model_table(mtab, scenarios, counts):
+    """Internal models under meta: one row per model, one column per scenario."""
+    L = ["| model (seeds) | " + " | ".join(scenarios) + " |",
+         "|---" * (len(scenarios) + 1) + "|"]
+    for m in MODELS:
+        if all(mtab[(sc, m)] is None for sc in scenarios):
+            continue
+        L.append("| %s (%d) | " % (m, counts[m]) + " | ".join(
+            short(mtab[(sc, m)]) if mtab[(sc, m)] else "not run" for sc in scenarios) + " |")
+    L.append("")
+    return L
+
+
 def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, times, ns, ms, bs):
+    old = open(path).read() if os.path.exists(path) else ""
     L = []
     A = L.append
-    A("# Seeking efficacy (issue 7)\n")
-    A("Produced by `make bench-seek` (`%s scripts/bench_seek.py --seeds %d --jobs %d "
-      "--slow-model-seeds %d%s%s%s`), simulator `rfseek-sim` in-process core, fixed point. "
-      "Seeds 1..N of every scenario; the same seeds for every strategy, so differences "
-      "between rows are paired." % (sys.executable, args.seeds, args.jobs,
-                                    args.slow_model_seeds,
-                                    " --noise-seeds %d" % ns if ns != args.seeds else "",
-                                    " --model-seeds %d" % ms if ms != args.seeds else "",
-                                    " --bridge-seeds %d" % bs if bs != args.seeds else ""))
+    A("# Results\n")
+    A("Written by `make bench-seek` (`%s scripts/bench_seek.py --seeds %d --jobs %d "
+      "--slow-model-seeds %d%s%s%s`) at commit %s: `rfseek-sim`, in-process fixed-point "
+      "core. Seeds 1..N of every scenario, the same seeds for every strategy, so rows are "
+      "paired. Do not edit the tables by hand: re-run the benchmark."
+      % (sys.executable, args.seeds, args.jobs, args.slow_model_seeds,
+         " --noise-seeds %d" % ns if ns != args.seeds else "",
+         " --model-seeds %d" % ms if ms != args.seeds else "",
+         " --bridge-seeds %d" % bs if bs != args.seeds else "", commit()))
     A("")
     A("**Definitions.** *Success*: within 1.5 m of the source before 150 m of travel (and "
       "900 s). *Travel*: path length of the true robot position. *Ratio*: travel / "
-      "shortest path from the start around walls (with 0.25 m clearance), median over the "
-      "successful runs. *Model updates*: decisions at which the model was relearnt "
-      "(plane-gradient relearns at every step by definition; fd-gradient and chemotaxis "
-      "have no model). *Epsilon travel %*: travel during iterations that were epsilon "
-      "steps, over all travel (only meta and meta-global take epsilon steps). *Detour %*: "
-      "sum over iterations of (planned path length - straight line from the decision "
-      "position to the goal) over the sum of planned path lengths, i.e. the part of the "
-      "planned travel spent going around walls and obstacles.\n")
-    A("**Strategies** (common/rfs_seek.c; same sensors, 1 m step, map legality and path "
-      "planner): `meta` the paper's meta-algorithm with the paper's defaults (local ridge "
-      "5 m, alpha 1, 3 dB threshold, epsilon(5) = 0.5); `meta-global` the same with the "
-      "ridge radius covering the map; `fd-gradient` 1 s means standing at p, p + 1 m x and "
-      "p + 1 m y (or - 1 m where + is illegal), then a 1 m step from p along the estimated "
-      "gradient; `plane-gradient` the local ridge refit at every step and a 1 m step along "
-      "its gradient, no epsilon and no check (section 4.1's view); `chemotaxis` "
-      "run-and-tumble on the change of the 1 s mean between decisions (tumble with "
-      "p = 0.2 after a rise, always after a fall; 16 headings), position used only for "
-      "legality and planning. A gradient step whose end point is illegal goes to the "
-      "nearest reachable legal lattice point around it. `meta-path` (the improvement of "
-      "issue 10, docs/STRATEGIES.md, docs/PATHLOSS.md) runs with the map-aware path-loss "
-      "model instead of the ridge: the estimated source is the greedy goal, walked along "
-      "the planned path with the relearn check after every metre and epsilon annealed by "
-      "the metres travelled; it is not a baseline but the improvement, measured beside "
-      "the paper's `meta`.\n")
-    # The hand-written part (from the issue 10 pointer through "## Summary") is kept from
-    # the previous file: its numbers are checked by hand against the new tables.
-    if os.path.exists(path):
-        old = open(path).read()
-        start = old.find("**The map-aware model (issue 10)**")
-        end = old.find("## Every strategy on every shipped scenario")
-        if 0 <= start < end:
-            A(old[start:end].rstrip("\n") + "\n")
+      "shortest path from the start around walls (0.25 m clearance), median over the "
+      "successful runs. *Model updates*: decisions that relearnt the model. *Epsilon "
+      "travel %*: travel during epsilon steps over all travel. *Detour %*: planned path "
+      "length beyond the straight line to the goal, over all planned path length. Cells "
+      "of the compact tables: success % (95 % Wilson interval), ratio.\n")
+    A("**Strategies** (docs/STRATEGIES.md): `meta` is the paper's algorithm with its own "
+      "parameters and local ridge; `meta-global`, `fd-gradient`, `plane-gradient` and "
+      "`chemotaxis` are baselines behind the same sensors, step, map legality and planner; "
+      "`meta-path` runs with the map-aware path-loss model (docs/PATHLOSS.md) and is the "
+      "improvement, not a baseline.\n")
+    hand = kept(old, HAND)
+    A(hand + "\n" if hand else "%s\n## Summary\n\n(to be written)\n\n%s\n" % HAND)
     A("## Every strategy on every shipped scenario (shadowing and noise as the scenario "
       "file says; default: 4 dB / 4 dB)\n")
     for sc in scenarios:
@@ -649,15 +683,9 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
       "(meta-global, fd-gradient, plane-gradient, chemotaxis) in every scenario.")
     A("")
     A("## Default scenario at other shadowing and noise levels\n")
-    A("Generated scenario variants of scenarios/default.yaml (shadowing correlation 5 m; "
-      "shadowing 0 dB = shadowing disabled). %d seeds each.\n" % ns)
-    for key, lab in (("shadow", "shadowing dB (noise 4 dB)"),
-                     ("noise", "noise dB (shadowing 4 dB)")):
-        A(HEAD % ("strategy, " + lab))
-        for st in STRATEGIES:
-            for x, s in sorted(sweep[key][st].items()):
-                A(row("%s, %g" % (st, x), s))
-        A("")
+    A("Generated variants of scenarios/default.yaml (shadowing correlation 5 m; 0 dB = "
+      "shadowing off), %d seeds each, every strategy with its model as above.\n" % ns)
+    L.extend(sweep_tables(sweep))
     A("![success vs shadowing and noise](figures/seek_success_vs_noise.png)\n")
     A("## Failure analysis\n")
     A("Where failed runs ended and how close they came (final straight-line distance to "
@@ -712,27 +740,22 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
         A("")
     A("![bridging](figures/seek_bridge.png)\n")
     A("## Internal models (strategy meta)\n")
-    A("Models from the registry common/rfs_models.h (`--model NAME`). %d seeds each, "
-      "except mlp and knn: %d seeds (a run costs 1-4 s of CPU: the MLP's training of 3 "
-      "epochs over up to 10,000 samples at every relearn, the kNN's grid search over "
-      "every lattice point), so their CIs are wider. The ridge rows are the meta runs "
-      "above (seeds 1..N of the same runs). `meta-path` with the path-loss model is in "
-      "the strategy tables above.\n"
-      % (ms, args.slow_model_seeds))
-    for sc in scenarios:
-        A("### %s\n" % sc)
-        A(HEAD % "model")
-        for m in MODELS:
-            A(row(m, mtab[(sc, m)]) if mtab[(sc, m)] else "| %s | 0 | not run |" % m)
-        A("")
+    A("Models from the registry common/rfs_models.h (`--model NAME`) under the paper's "
+      "`meta`; mlp and knn on fewer seeds (a run costs 1-4 s of CPU), so their intervals "
+      "are wider. The ridge row is the meta runs above.\n")
+    counts = {m: (args.slow_model_seeds if m in SLOW_MODELS else ms) for m in MODELS}
+    counts["ridge"] = args.seeds if ms == args.seeds else ms
+    L.extend(model_table(mtab, scenarios, counts))
+    pl = kept(old, PATHLOSS)
+    if pl:
+        A(pl + "\n")
     A("## Figures\n")
+    A("Seeds 1-5 of each strategy on the default office (red circles: model updates; "
+      "orange crosses: epsilon or tumble steps), then the RSSI of seed 1 of each against "
+      "distance travelled (every packet grey, 1 m moving average blue).\n")
     for st in STRATEGIES:
-        A("Five runs of `%s` on the default office (seeds 1-5; red circles: model updates; "
-          "orange crosses: epsilon or tumble steps):\n\n![%s](figures/seek_traj_%s.png)\n"
-          % (st, st, st))
-    A("RSSI against distance travelled (every received packet, grey; 1 m moving average, "
-      "blue), seed 1 of each strategy on the default office:\n\n"
-      "![rssi](figures/seek_rssi_vs_distance.png)\n")
+        A("![%s](figures/seek_traj_%s.png)" % (st, st))
+    A("![rssi](figures/seek_rssi_vs_distance.png)\n")
     A("## Wall time of the benchmark\n")
     A("On this machine (2 cores, shared with other builds while it ran), `--jobs %d`: "
       "strategy sweep (%d scenarios x %d strategies x %d seeds) %.0f s; noise sweep %.0f s; "

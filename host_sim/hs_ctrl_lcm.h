@@ -35,7 +35,7 @@ typedef struct hs_ctrl_lcm_cfg {
 hs_ctrl_lcm_cfg_t hs_ctrl_lcm_cfg_default(void);
 
 /// Open. Returns -1 with err = "lcm: ..." / "can: ..." (one line), or 0 with err = "" or
-/// liblcm's warning "lcm: URL: liblcm: ..." (one line, to print; see hs_lcm_open()).
+/// liblcm's warning "lcm: URL: liblcm: ..." (one line, to print; see lx_lcm_open()).
 int hs_ctrl_lcm_open(hs_ctrl_t *c, const hs_ctrl_lcm_cfg_t *cfg, char *err, size_t errlen);
 
 /// Steps that got no answer in time (the wheels were commanded to zero).

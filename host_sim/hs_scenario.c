@@ -9,7 +9,7 @@
 #include <string.h>
 #include <yaml.h>
 
-#include "hs_err.h"
+#include "lx_err.h"
 #include "rfs_models.h"
 
 typedef struct pctx {
@@ -32,7 +32,7 @@ static int fail(pctx_t *p, const yaml_node_t *n, const char *fmt, ...)
     } else {
         snprintf(p->err, p->errlen, "%s: %s", p->file, msg);
     }
-    hs_err_one_line(p->err); /* a key or value from the YAML can hold line breaks */
+    lx_err_one_line(p->err); /* a key or value from the YAML can hold line breaks */
     return -1;
 }
 
@@ -611,7 +611,7 @@ int hs_scenario_load(const char *path, hs_scenario_t *sc, char *err, size_t errl
 {
     const int rc = load(path, sc, err, errlen);
     if (rc != 0 && errlen > 0) {
-        hs_err_one_line(err); /* the file name can hold line breaks (an unopenable path too) */
+        lx_err_one_line(err); /* the file name can hold line breaks (an unopenable path too) */
     }
     return rc;
 }

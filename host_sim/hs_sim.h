@@ -21,15 +21,15 @@
 #include <stdio.h>
 
 #include "hs_ctrl.h"
-#include "hs_map.h"
+#include "lx_map.h"
 #include "hs_scenario.h"
 
 /// What stays the same for every seed of a scenario: the map, its core grids, and the
 /// shortest path from the start to the goal.
 typedef struct hs_sim_env {
     hs_scenario_t sc;          ///< the scenario
-    hs_map_t map;              ///< the map at its own resolution
-    hs_core_map_t core;        ///< the core's grids (core_res_m, clearance_m)
+    lx_map_t map;              ///< the map at its own resolution
+    lx_core_map_t core;        ///< the core's grids (core_res_m, clearance_m)
     double shortest_path_m;    ///< start to the legal point nearest the goal, around walls (NaN: no goal)
     double shortest_to_stop_m; ///< start to the first legal point within stop_radius_m (NaN: no goal)
     double x0, y0, x1, y1;     ///< the map's extent, metres

@@ -4,8 +4,8 @@ PCAP_LIBS := $(shell pkg-config --libs libpcap 2>/dev/null || echo -lpcap)
 HOST_LDLIBS += $(PCAP_LIBS)
 
 FEED := $(BUILD)/feed
-FEED_SRCS := host_sim/hs_pcap.c host_sim/hs_radiotap.c
-FEED_HDRS := host_sim/hs_pcap.h host_sim/hs_radiotap.h
+FEED_SRCS := firmware/port/linux/lx_pcap.c firmware/port/linux/lx_radiotap.c
+FEED_HDRS := firmware/port/linux/lx_pcap.h firmware/port/linux/lx_radiotap.h
 
 # rfseek-feed under ASan+UBSan (the host and core libraries' ASan builds: --pose runs the
 # simulator's controller), for the bad-input and replay tests.
@@ -15,7 +15,7 @@ $(FEED)/asan/rfseek-feed: host_sim/prog/rfseek-feed.c $(HOST_ASAN_LIB) $(CORE_AS
 	$(CC) $(HOST_CFLAGS) -O1 $(SAN_FLAGS) -c $< -o $(FEED)/asan/rfseek-feed.o
 	$(HOST_LINK) $(SAN_FLAGS) -o $@ $(FEED)/asan/rfseek-feed.o $(HOST_ASAN_LIB) $(CORE_ASAN_LIB) $(HOST_LDLIBS)
 
-# Writes radiotap captures through hs_pcap_writer (bench input, writer cross-check).
+# Writes radiotap captures through lx_pcap_writer (bench input, writer cross-check).
 $(FEED)/feed_writegen: tests/feed/feed_writegen.c $(FEED_SRCS) $(FEED_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) $< $(FEED_SRCS) -o $@ $(PCAP_LIBS)
@@ -30,10 +30,10 @@ $(FEED)/gen/.stamp: scripts/gen_captures.py $(FEED)/feed_writegen
 
 # libFuzzer target over the radiotap + 802.11 parser (clang only).
 FUZZ_CC ?= clang
-$(FEED)/fuzz_radiotap: tests/fuzz/fuzz_radiotap.c host_sim/hs_radiotap.c host_sim/hs_radiotap.h
+$(FEED)/fuzz_radiotap: tests/fuzz/fuzz_radiotap.c firmware/port/linux/lx_radiotap.c firmware/port/linux/lx_radiotap.h
 	@mkdir -p $(@D)
 	$(FUZZ_CC) -std=c11 -g -O1 -Ihost_sim -fsanitize=fuzzer,address,undefined \
-		-fno-sanitize-recover=all $< host_sim/hs_radiotap.c -o $@
+		-fno-sanitize-recover=all $< firmware/port/linux/lx_radiotap.c -o $@
 
 TEST_DEPS += $(BUILD)/bin/rfseek-feed $(FEED)/asan/rfseek-feed $(FEED)/gen/.stamp $(FEED)/fuzz_radiotap
 TEST_SCRIPTS += "tests/feed/cross_check.sh $(BUILD)/bin/rfseek-feed tests/data/captures/*.pcap $(FEED)/gen/*.pcap $(FEED)/gen/*.pcapng"
@@ -52,8 +52,8 @@ $(BUILD)/asan/tests/$(1): tests/host_sim/$(1).c $(FEED_SRCS) $(FEED_HDRS) tests/
 	$$(CC) $$(HOST_CFLAGS) -O1 $$(SAN_FLAGS) -Itests $$< $(FEED_SRCS) -o $$@ -lcmocka $(PCAP_LIBS)
 TEST_BINS += $(BUILD)/tests/$(1) $(BUILD)/asan/tests/$(1)
 endef
-$(eval $(call feed_cmocka,test_radiotap))
-$(eval $(call feed_cmocka,test_pcap_writer))
+$(eval $(call feed_cmocka,test_lx_radiotap))
+$(eval $(call feed_cmocka,test_lx_pcap))
 
 # Frames/s extracting one MAC's RSSI from a 1,000,000-frame capture, side by side with
 # tshark on the same file (median of 3).

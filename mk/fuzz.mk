@@ -20,12 +20,12 @@ $(FUZZ_DIR)/fuzz_can: tests/fuzz/fuzz_can.c $(CORE_SRCS) $(FUZZ_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(CORE_SRCS) -o $@
 
-FUZZ_MAP_SRCS := host_sim/hs_map.c host_sim/hs_err.c
+FUZZ_MAP_SRCS := firmware/port/linux/lx_map.c firmware/port/linux/lx_err.c
 $(FUZZ_DIR)/fuzz_map: tests/fuzz/fuzz_map.c $(FUZZ_MAP_SRCS) $(CORE_SRCS) $(FUZZ_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_MAP_SRCS) $(CORE_SRCS) -o $@ $(FUZZ_YAML_LIBS) -lm
 
-FUZZ_SCN_SRCS := host_sim/hs_scenario.c host_sim/hs_err.c host_sim/hs_radio.c host_sim/hs_motor.c \
+FUZZ_SCN_SRCS := host_sim/hs_scenario.c firmware/port/linux/lx_err.c host_sim/hs_radio.c host_sim/hs_motor.c \
     $(wildcard host_sim/hs_faults.c)
 $(FUZZ_DIR)/fuzz_scenario: tests/fuzz/fuzz_scenario.c $(FUZZ_SCN_SRCS) $(CORE_SRCS) $(FUZZ_HDRS)
 	@mkdir -p $(@D)
@@ -39,9 +39,9 @@ FUZZ_LCM_GEN_HDRS := $(FUZZ_LCM_NAMES:%=$(BUILD)/gen/%.h)
 $(FUZZ_DIR)/gen/%.o: $(BUILD)/gen/%.c $(FUZZ_LCM_GEN_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(CSTD) -g -O1 -I$(BUILD)/gen $(FUZZ_SAN) -fsanitize=fuzzer-no-link -c $< -o $@
-$(FUZZ_DIR)/fuzz_lcm: tests/fuzz/fuzz_lcm.c host_sim/hs_lcm_adapt.c host_sim/hs_err.c $(FUZZ_LCM_GEN_OBJS) $(CORE_SRCS) $(FUZZ_HDRS) $(FUZZ_LCM_GEN_HDRS)
+$(FUZZ_DIR)/fuzz_lcm: tests/fuzz/fuzz_lcm.c firmware/port/linux/lx_lcm.c firmware/port/linux/lx_err.c $(FUZZ_LCM_GEN_OBJS) $(CORE_SRCS) $(FUZZ_HDRS) $(FUZZ_LCM_GEN_HDRS)
 	@mkdir -p $(@D)
-	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< host_sim/hs_lcm_adapt.c host_sim/hs_err.c $(FUZZ_LCM_GEN_OBJS) $(CORE_SRCS) -o $@ $(FUZZ_LCM_LIBS) -lm
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< firmware/port/linux/lx_lcm.c firmware/port/linux/lx_err.c $(FUZZ_LCM_GEN_OBJS) $(CORE_SRCS) -o $@ $(FUZZ_LCM_LIBS) -lm
 
 # make test: each target over its committed corpus plus a short burst of new inputs.
 FUZZ_TEST_RUNS ?= 5000

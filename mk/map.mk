@@ -1,11 +1,11 @@
-# mk/map.mk - the map loader (host_sim/hs_map.c: libyaml), its tests and rfseek-map.
+# mk/map.mk - the map loader (firmware/port/linux/lx_map.c: libyaml), its tests and rfseek-map.
 HOST_CFLAGS += $(shell pkg-config --cflags yaml-0.1)
 HOST_LDLIBS += $(shell pkg-config --libs yaml-0.1)
 
 # CMocka tests of the host map loader (real maps in /work/shared/data/maps,
 # bad-input fixtures in tests/data/maps_bad/).
-ifneq ($(wildcard tests/host_sim/test_hs_map.c),)
-$(eval $(call cmocka_test,test_hs_map,tests/host_sim/test_hs_map.c,))
+ifneq ($(wildcard tests/linux/test_lx_map.c),)
+$(eval $(call cmocka_test,test_lx_map,tests/linux/test_lx_map.c,))
 endif
 
 # rfseek-map on a real map and on bad input: one error line, non-zero exit.

@@ -3,7 +3,7 @@
 HOST_LDLIBS += -lbox2d $(shell pkg-config --libs yaml-0.1)
 
 # CMocka tests of the simulator's parts (tests/host_sim/test_{radio,world,sim}.c).
-SIM_CMOCKA := $(patsubst tests/host_sim/%.c,%,$(wildcard tests/host_sim/test_radio.c tests/host_sim/test_world.c tests/host_sim/test_sim.c))
+SIM_CMOCKA := $(patsubst tests/host_sim/%.c,%,$(wildcard tests/host_sim/test_radio.c tests/host_sim/test_box2d.c tests/host_sim/test_sim.c))
 $(foreach t,$(SIM_CMOCKA),$(eval $(call cmocka_test,$(t),tests/host_sim/$(t).c,)))
 
 # The command-line program on good and bad scenarios (PASS/FAIL lines).

@@ -10,9 +10,9 @@ TEST_SCRIPTS += 'tests/wire/dbc_test.sh $(BUILD)'
 
 # --- SocketCAN: the static test binary and the VM (or native vcan) test --------------
 WIRE_VM_BIN := $(BUILD)/tests/vm/can_vm_test
-$(WIRE_VM_BIN): tests/vm/can_vm_test.c host_sim/hs_can_adapt.c host_sim/hs_can.h $(CORE_LIB) $(CORE_HDRS)
+$(WIRE_VM_BIN): tests/vm/can_vm_test.c firmware/port/linux/lx_can.c firmware/port/linux/lx_can.h $(CORE_LIB) $(CORE_HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(CSTD) $(WARN) $(OPT) -D_DEFAULT_SOURCE -Icommon -Ihost_sim -static tests/vm/can_vm_test.c host_sim/hs_can_adapt.c $(CORE_LIB) -o $@
+	$(CC) $(CSTD) $(WARN) $(OPT) -D_DEFAULT_SOURCE -Icommon -Ihost_sim -static tests/vm/can_vm_test.c firmware/port/linux/lx_can.c $(CORE_LIB) -o $@
 TEST_DEPS += $(WIRE_VM_BIN)
 TEST_SCRIPTS += 'tests/vm/run_vm_test.sh $(BUILD)'
 

@@ -19,8 +19,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "hs_err.h"
-#include "hs_pcap.h"
+#include "lx_err.h"
+#include "lx_pcap.h"
 #include "hs_sim.h"
 
 static const char *prog = "rfseek-sim";
@@ -66,7 +66,7 @@ static int die(const char *fmt, const char *a, const char *b)
 {
     char msg[1024];
     snprintf(msg, sizeof msg, fmt, a, b);
-    hs_err_one_line(msg); /* an option's value can hold a line break */
+    lx_err_one_line(msg); /* an option's value can hold a line break */
     fprintf(stderr, "%s: %s\n", prog, msg);
     return 1;
 }
@@ -129,7 +129,7 @@ static FILE *open_in(const char *dir, const char *name)
 }
 
 typedef struct pcap_ctx {
-    hs_pcap_writer_t *w;
+    lx_pcap_writer_t *w;
     const hs_scenario_t *sc;
     int failed;
 } pcap_ctx_t;
@@ -140,7 +140,7 @@ static void on_packet(void *ctx, unsigned src, int64_t t_us, uint16_t seq, bool 
     pcap_ctx_t *p = ctx;
     static const uint8_t bssid[6] = {0x02, 0x00, 0x00, 0x00, 0xbb, 0x01};
     if (received && p->w &&
-        hs_pcap_writer_frame(p->w, t_us, p->sc->src[src].mac, bssid, seq, (int8_t)dbm, 2437) != 0) {
+        lx_pcap_writer_frame(p->w, t_us, p->sc->src[src].mac, bssid, seq, (int8_t)dbm, 2437) != 0) {
         p->failed = 1;
     }
 }
@@ -173,7 +173,7 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         }
     }
     if (rc == 0 && pcap) {
-        pc.w = hs_pcap_writer_open(pcap, err, sizeof err);
+        pc.w = lx_pcap_writer_open(pcap, err, sizeof err);
         if (!pc.w) {
             fprintf(stderr, "%s: %s\n", prog, err);
             rc = 1;
@@ -216,7 +216,7 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         }
     }
     if (pc.w) {
-        if (hs_pcap_writer_close(pc.w) != 0 || pc.failed) {
+        if (lx_pcap_writer_close(pc.w) != 0 || pc.failed) {
             fprintf(stderr, "%s: %s: write failed\n", prog, pcap);
             rc = 1;
         }

@@ -61,7 +61,7 @@ expect_err_of "$sl" sim-lcm-newline-lcm-url 1 "lcm: udpm://?q: cannot open this 
     $scn --lcm "udpm://${nl}q" --max-time 1
 expect_err_of "$sl" sim-lcm-newline-can 1 "can: rfsno?q" $scn --lcm memq:// --can "rfsno${nl}q" --max-time 1
 [ ! -s "$w/out" ] && pass sim-lcm-newline-no-summary || fail sim-lcm-newline-no-summary
-# liblcm's own stderr is folded by hs_lcm_open (host_sim/hs_lcm_adapt.c): its two lines
+# liblcm's own stderr is folded by lx_lcm_open (firmware/port/linux/lx_lcm.c): its two lines
 # for a bad option of a missing log (lcm_logprov.c) become part of one error line, and a
 # warning on a provider that does open is one line before the end-of-run summary.
 expect_err rfseekd-liblcm-two-lines 1 "cannot open this provider.*(liblcm: Warning: Invalid value for speed?Error: Failed to open $PWD/$w/none.lcmlog: No such file or directory)\$" \

@@ -1,6 +1,6 @@
 /* lx_map.c - ROS map_server YAML + PGM loader and conversion to the core's bit grids.
- * The convention is documented in lx_map.h and docs/MAPS.md. libyaml is used only here
- * for map files.
+ * The convention is documented in lx_map.h and docs/MAPS.md. The YAML is read through
+ * lx_yaml.h.
  */
 #include "lx_map.h"
 
@@ -12,9 +12,8 @@
 #include <string.h>
 #include <strings.h>
 
-#include <yaml.h>
-
 #include "lx_err.h"
+#include "lx_yaml.h"
 
 /* Largest image accepted: 2^28 pixels (16384 x 16384). */
 #define LX_MAP_MAX_PIXELS (1u << 28)
@@ -197,12 +196,6 @@ typedef struct yaml_fields {
     int negate;
 } yaml_fields_t;
 
-static const char *scalar(yaml_document_t *d, yaml_node_t *n)
-{
-    (void)d;
-    return n != NULL && n->type == YAML_SCALAR_NODE ? (const char *)n->data.scalar.value : NULL;
-}
-
 static bool parse_double(const char *s, double *out)
 {
     if (s == NULL || *s == '\0') {
@@ -221,28 +214,29 @@ static bool parse_double(const char *s, double *out)
 static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fields_t *f,
                       char *err, size_t errlen)
 {
-    yaml_parser_t parser;
-    yaml_document_t doc;
-    if (!yaml_parser_initialize(&parser)) {
-        return fail(err, errlen, path, "cannot initialise the YAML parser");
-    }
-    yaml_parser_set_input_string(&parser, buf, len);
-    if (!yaml_parser_load(&parser, &doc)) {
-        int rc = fail(err, errlen, path, "malformed YAML at line %zu: %s",
-                      parser.problem_mark.line + 1, parser.problem ? parser.problem : "parse error");
-        yaml_parser_delete(&parser);
+    lx_yaml_doc_t doc;
+    lx_yaml_error_t ye;
+    lx_yaml_rc_t yrc = lx_yaml_load_string(buf, len, &doc, &ye);
+    if (yrc != LX_YAML_OK) {
+        int rc = yrc == LX_YAML_SYNTAX
+                   ? fail(err, errlen, path, "malformed YAML at line %lu: %s", ye.line,
+                          ye.problem ? ye.problem : "parse error")
+               : yrc == LX_YAML_TOO_BIG
+                   ? fail(err, errlen, path, "more than %u YAML nodes", LX_YAML_MAX_NODES)
+                   : fail(err, errlen, path, "cannot initialise the YAML parser");
+        lx_yaml_free(&doc);
         return rc;
     }
     int rc = 0;
-    yaml_node_t *root = yaml_document_get_root_node(&doc);
-    if (root == NULL || root->type != YAML_MAPPING_NODE) {
+    const lx_yaml_node_t *root = doc.root;
+    if (root == NULL || root->kind != LX_YAML_MAPPING) {
         rc = fail(err, errlen, path, "not a map_server YAML (a mapping of keys expected)");
         goto out;
     }
-    for (yaml_node_pair_t *pr = root->data.mapping.pairs.start; pr < root->data.mapping.pairs.top; pr++) {
-        const char *key = scalar(&doc, yaml_document_get_node(&doc, pr->key));
-        yaml_node_t *vn = yaml_document_get_node(&doc, pr->value);
-        const char *val = scalar(&doc, vn);
+    for (size_t i = 0; i < root->n; i++) {
+        const char *key = lx_yaml_scalar(root->child[2 * i]);
+        const lx_yaml_node_t *vn = root->child[2 * i + 1];
+        const char *val = lx_yaml_scalar(vn);
         if (key == NULL) {
             rc = fail(err, errlen, path, "non-scalar key");
             goto out;
@@ -263,12 +257,12 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
         } else if (strcmp(key, "origin") == 0) {
             double v[3];
             int k = 0;
-            if (vn == NULL || vn->type != YAML_SEQUENCE_NODE) {
+            if (vn == NULL || vn->kind != LX_YAML_SEQUENCE) {
                 rc = fail(err, errlen, path, "origin: a list [x, y, yaw] expected");
                 goto out;
             }
-            for (yaml_node_item_t *it = vn->data.sequence.items.start; it < vn->data.sequence.items.top; it++) {
-                if (k == 3 || !parse_double(scalar(&doc, yaml_document_get_node(&doc, *it)), &v[k])) {
+            for (size_t it = 0; it < vn->n; it++) {
+                if (k == 3 || !parse_double(lx_yaml_scalar(vn->child[it]), &v[k])) {
                     rc = fail(err, errlen, path, "origin: a list of three numbers [x, y, yaw] expected");
                     goto out;
                 }
@@ -330,8 +324,7 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
                   f->free_th, f->occ);
     }
 out:
-    yaml_document_delete(&doc);
-    yaml_parser_delete(&parser);
+    lx_yaml_free(&doc);
     return rc;
 }
 

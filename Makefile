@@ -141,13 +141,13 @@ test: deps
 	@$(MAKE) --no-print-directory test-only
 
 # The job list scripts/run_tests.sh reads: NAME, kind (bin or script), serial or not,
-# command; one per line.
+# command; one per line ("-" for an empty field).
 TAB := $(shell printf '\t')
 define NEWLINE
 
 
 endef
-TEST_JOBS_TEXT = $(foreach n,$(TEST_BIN_NAMES),$(n)$(TAB)bin$(TAB)$(TAB)$(BUILD)/tests/$(n)$(NEWLINE)asan/$(n)$(TAB)bin$(TAB)$(TAB)$(BUILD)/asan/tests/$(n)$(NEWLINE))$(foreach s,$(TEST_SCRIPT_NAMES),$(s)$(TAB)script$(TAB)$(TEST_SERIAL_$(s))$(TAB)$(TEST_CMD_$(s))$(NEWLINE))
+TEST_JOBS_TEXT = $(foreach n,$(TEST_BIN_NAMES),$(n)$(TAB)bin$(TAB)-$(TAB)$(BUILD)/tests/$(n)$(NEWLINE)asan/$(n)$(TAB)bin$(TAB)-$(TAB)$(BUILD)/asan/tests/$(n)$(NEWLINE))$(foreach s,$(TEST_SCRIPT_NAMES),$(s)$(TAB)script$(TAB)$(or $(TEST_SERIAL_$(s)),-)$(TAB)$(TEST_CMD_$(s))$(NEWLINE))
 TEST_BINS = $(TEST_BIN_NAMES:%=$(BUILD)/tests/%) $(TEST_BIN_NAMES:%=$(BUILD)/asan/tests/%)
 
 test-only: all $(TEST_BINS) $(TEST_DEPS)

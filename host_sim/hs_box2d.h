@@ -1,4 +1,4 @@
-/* hs_box2d.h - the physical world of the simulator: walls and the robot (issue 3).
+/* hs_box2d.h - the physical world of the simulator: walls and the robot.
  *
  * Behind this header sits Box2D 2.4 (hs_box2d.cpp is the only file that includes it).
  * Everything here is in our own types: metres, radians, seconds, doubles.

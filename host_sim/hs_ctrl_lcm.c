@@ -92,7 +92,7 @@ static void cb_rssi(void *self, uint8_t src, int64_t t_us, int8_t dbm)
     (void)lx_lcm_pub_rssi(s->lcm, src, t_us, dbm, q);
 }
 
-/* The simulated receiver's heartbeat (issue 10), as the sniffer's capture loop sends it:
+/* The simulated receiver's heartbeat, as the sniffer's capture loop sends it:
  * published before the clock tick of the step it precedes, so the controller has it
  * when it steps. */
 static void cb_receiver(void *self, int64_t t_us)

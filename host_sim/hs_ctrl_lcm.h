@@ -1,8 +1,8 @@
-/* hs_ctrl_lcm.h - the controller in a separate process (issue 4): an hs_ctrl_t that
+/* hs_ctrl_lcm.h - the controller in a separate process: an hs_ctrl_t that
  * publishes the simulated sensors on LCM and takes the wheel commands from CAN.
  *
  * on_pose / on_rssi / on_receiver publish RFS_POSE / RFS_RSSI / RFS_RSSI_STATUS (the
- * receiver heartbeat, issue 10). step(now) publishes RFS_CLOCK(now) and
+ * receiver heartbeat). step(now) publishes RFS_CLOCK(now) and
  * waits for the controller process (rfseekd --clock-lcm) to answer that step: the
  * WHEEL_CMD frame arrives as the simulated motor controller node would see it - from
  * SocketCAN when an interface is given, else from the clearly named LCM fallback channel

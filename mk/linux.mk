@@ -60,12 +60,12 @@ $(WIRE_LCM_TOOL): tests/wire/lcm_tool.c $(LIBS_linux) | $(LCM_GEN_HDRS)
 $(eval $(call test_script,rfseekd,tests/wire/rfseekd_test.sh $(BUILD),$(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/asan/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
 
 # SocketCAN against the kernel's CAN stack: a static test binary, run natively in a network
-# namespace with vcan or in a qemu VM (which boots with both cores: run alone).
+# namespace with vcan or in a one-CPU qemu VM (its own namespace and build/vm: parallel-safe).
 WIRE_VM_BIN := $(BUILD)/tests/vm/can_vm_test
 $(WIRE_VM_BIN): tests/vm/can_vm_test.c $(BUILD)/obj/firmware/port/linux/lx_can.o $(CORE_LIB)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) $(INC_linux) $(DEPFLAGS) -MF $@.d -MT $@ -static $< $(BUILD)/obj/firmware/port/linux/lx_can.o $(CORE_LIB) -o $@
-$(eval $(call test_script,can_vm,tests/vm/run_vm_test.sh $(BUILD),$(WIRE_VM_BIN) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm,serial))
+$(eval $(call test_script,can_vm,tests/vm/run_vm_test.sh $(BUILD),$(WIRE_VM_BIN) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
 
 # The daemon and the player link neither Box2D nor the C++ runtime.
 $(eval $(call test_script,link,scripts/check_link.sh $(LINUX_PROGS),$(LINUX_PROGS)))

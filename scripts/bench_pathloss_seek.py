@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Issue 10's table: the paper's local ridge (strategy meta) beside the map-aware pathloss
+"""The path-loss table: the paper's local ridge (strategy meta) beside the map-aware pathloss
 model (strategy meta-path) on the shipped office scenarios, and where pathloss breaks
 (8 dB shadowing, a source in the corridor). Writes docs/RESULTS_PATHLOSS.md.
 
@@ -115,7 +115,7 @@ def main():
         for t in tmps:
             os.unlink(t)
     wall = time.time() - t0
-    head = f"""# Results: the map-aware pathloss model beside the paper's local ridge (issue 10)
+    head = f"""# Results: the map-aware pathloss model beside the paper's local ridge
 
 Every row: {a.seeds} seeds (1..{a.seeds}) of the scenario at its shipped radio settings (4 dB
 shadowing, 4 dB measurement noise unless the row says otherwise), success = within 1.5 m of
@@ -135,7 +135,7 @@ floor"); the last two rows of "Where it breaks" are nodes weaker than that belie
 
 Command: `/usr/bin/python3 scripts/bench_pathloss_seek.py --seeds {a.seeds}` (wall time
 {wall:.0f} s on this 2-core machine, shared with other work while it ran).
-Target (issue 10): >= 95% success and median travel <= 2x the shortest path on each.
+Target: >= 95% success and median travel <= 2x the shortest path on each.
 """
     # The hand-written "## Reading" section (and anything after it) is kept.
     reading = ""

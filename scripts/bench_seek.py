@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""bench_seek.py - the seeking-efficacy benchmark (issue 7): docs/RESULTS.md + figures.
+"""bench_seek.py - the seeking-efficacy benchmark: docs/RESULTS.md + figures.
 
 Runs every strategy on every shipped scenario with the simulator's batch mode
 (rfseek-sim --seeds A..B --jobs N), the default scenario at other shadowing and noise
@@ -38,7 +38,7 @@ import numpy as np
 
 STRATEGIES = ["meta", "meta-global", "fd-gradient", "plane-gradient", "chemotaxis", "meta-path"]
 # The strategies' internal model: the local ridge (the paper's), except meta-path, the
-# improvement of issue 10, which runs with the map-aware path-loss model.
+# improvement (docs/STRATEGIES.md), which runs with the map-aware path-loss model.
 STRAT_MODEL = {"meta-path": "pathloss"}
 BASELINES = ["meta-global", "fd-gradient", "plane-gradient", "chemotaxis"]
 
@@ -581,7 +581,7 @@ def main():
 def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, times, ns, ms, bs):
     L = []
     A = L.append
-    A("# Seeking efficacy (issue 7)\n")
+    A("# Seeking efficacy\n")
     A("Produced by `make bench-seek` (`%s scripts/bench_seek.py --seeds %d --jobs %d "
       "--slow-model-seeds %d%s%s%s`), simulator `rfseek-sim` in-process core, fixed point. "
       "Seeds 1..N of every scenario; the same seeds for every strategy, so differences "
@@ -611,17 +611,17 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
       "run-and-tumble on the change of the 1 s mean between decisions (tumble with "
       "p = 0.2 after a rise, always after a fall; 16 headings), position used only for "
       "legality and planning. A gradient step whose end point is illegal goes to the "
-      "nearest reachable legal lattice point around it. `meta-path` (the improvement of "
-      "issue 10, docs/STRATEGIES.md, docs/PATHLOSS.md) runs with the map-aware path-loss "
+      "nearest reachable legal lattice point around it. `meta-path` (the improvement, "
+      "docs/STRATEGIES.md, docs/PATHLOSS.md) runs with the map-aware path-loss "
       "model instead of the ridge: the estimated source is the greedy goal, walked along "
       "the planned path with the relearn check after every metre and epsilon annealed by "
       "the metres travelled; it is not a baseline but the improvement, measured beside "
       "the paper's `meta`.\n")
-    # The hand-written part (from the issue 10 pointer through "## Summary") is kept from
+    # The hand-written part (from the map-aware model pointer through "## Summary") is kept from
     # the previous file: its numbers are checked by hand against the new tables.
     if os.path.exists(path):
         old = open(path).read()
-        start = old.find("**The map-aware model (issue 10)**")
+        start = old.find("**The map-aware model")
         end = old.find("## Every strategy on every shipped scenario")
         if 0 <= start < end:
             A(old[start:end].rstrip("\n") + "\n")

@@ -1,4 +1,4 @@
-/* rfseek-feed - RSSI of chosen transmitters from an 802.11 radiotap capture (issue 5).
+/* rfseek-feed - RSSI of chosen transmitters from an 802.11 radiotap capture.
  *
  * Prints one line per frame whose source address (Wireshark's wlan.sa) is one of the
  * --mac addresses and whose radiotap header carries a dBm antenna signal:
@@ -159,7 +159,7 @@ static void print_stats(const char *name, const feed_stats_t *st)
 typedef int (*feed_fn)(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_frame_t *f);
 
 /* Called for every record read, from any transmitter, parsable or not: the capture loop
- * was alive at its time (the receiver heartbeat, issue 10). */
+ * was alive at its time (the receiver heartbeat). */
 typedef int (*alive_fn)(void *ctx, int64_t t_us);
 
 /* Read every packet, count why packets give nothing, call fn for the matching ones and
@@ -287,7 +287,7 @@ static int rp_collect(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_fr
     return 0;
 }
 
-/* Receiver heartbeat times (issue 10; docs/FAULTS.md): every record the capture loop
+/* Receiver heartbeat times (docs/FAULTS.md): every record the capture loop
  * reads proves it alive at that record's time, whoever sent it; one heartbeat per
  * RP_ALIVE_US of capture time at most, as a live sniffer would send them. */
 #define RP_ALIVE_US 50000
@@ -453,7 +453,7 @@ typedef struct rp_opts {
  * counted from the first pose. With the scenario's radio.receiver.heartbeat (the
  * default) every record of the capture, from any transmitter, proves the capture loop
  * alive at its time: the controller is told so at most once per 50 ms of capture time
- * (rfs_seek_on_receiver, issue 10), so a stretch where the source is not heard but the
+ * (rfs_seek_on_receiver), so a stretch where the source is not heard but the
  * channel is is a dead zone, not a dead sensor. The robot's
  * position at any instant is the recorded pose interpolated linearly (theta along the
  * shorter arc); the controller's wheel commands go nowhere. Ends at the last pose, or
@@ -642,7 +642,7 @@ static int run_replay(const rp_opts_t *o, lx_pcap_reader_t *r, uint8_t (*macs)[6
                             d->mean_valid ? rp_d(d->mean) : NAN, rp_d(d->epsilon), rp_d(d->goal_x),
                             rp_d(d->goal_y), rp_d(d->max_x), rp_d(d->max_y), rp_d(d->path_len), d->samples,
                             etr);
-                    hs_sim_log_estimate(flog, &ctrl); /* issue 10: path-loss estimate or nan */
+                    hs_sim_log_estimate(flog, &ctrl); /* path-loss estimate or nan */
                 }
             }
             if (has_goal && sc.stop_radius_m > 0.0 && hypot(ex - sc.goal_x, ey - sc.goal_y) <= sc.stop_radius_m) {
@@ -662,7 +662,7 @@ static int run_replay(const rp_opts_t *o, lx_pcap_reader_t *r, uint8_t (*macs)[6
         res.final_y = fy;
         res.final_distance_m = has_goal ? hypot(fx - sc.goal_x, fy - sc.goal_y) : NAN;
         res.packets_sent = res.packets_received + lost; /* from the sequence-number gaps */
-        hs_sim_result_estimate(&res, &ctrl, sc.src[0].x, sc.src[0].y); /* issue 10 */
+        hs_sim_result_estimate(&res, &ctrl, sc.src[0].x, sc.src[0].y);
         FILE *fsum = rp_open(tmp, "summary.json");
         if (fsum == NULL) {
             fprintf(stderr, "rfseek-feed: %s/summary.json: %s\n", tmp, strerror(errno));

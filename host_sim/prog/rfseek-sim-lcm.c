@@ -1,4 +1,4 @@
-/* rfseek-sim-lcm.c - the simulator with the controller in a separate process (issue 4).
+/* rfseek-sim-lcm.c - the simulator with the controller in a separate process.
  *
  *   rfseek-sim-lcm SCENARIO [--lcm URL] [--can IFACE] [--seed N] [--timeout-ms N] [--max-time S]
  *

@@ -1,4 +1,4 @@
-/* rfseek-sim - run the seeker in the simulated world (issue 3, docs/SIMULATOR.md).
+/* rfseek-sim - run the seeker in the simulated world (docs/SIMULATOR.md).
  *
  *   rfseek-sim SCENARIO [--seed N] [--out DIR] [--samples] [--field] [--pcap FILE]
  *   rfseek-sim SCENARIO --seeds A..B [--jobs N] [--out DIR]
@@ -163,7 +163,7 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         if (faults) {
             io.faults = open_in(dir, "faults.tsv");
         }
-        if (strcmp(env->sc.model, "pathloss") == 0) { // issue 10: the last fit's surface
+        if (strcmp(env->sc.model, "pathloss") == 0) { // the last fit's surface
             io.residual = open_in(dir, "residual.tsv");
         }
         if (!io.log || !io.track || (samples && !io.samples) || (faults && !io.faults) ||
@@ -185,7 +185,7 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         fprintf(stderr, "%s: %s\n", prog, err);
         rc = 1;
     }
-    // field.tsv for source 0 and field1.tsv for a second source (bridging, issue 7).
+    // field.tsv for source 0 and field1.tsv for a second source (bridging).
     for (unsigned src = 0; rc == 0 && field && dir && src < env->sc.nsources; src++) {
         FILE *f = open_in(dir, src == 0 ? "field.tsv" : "field1.tsv");
         if (!f || hs_sim_field(env, seed, src, 0.1, f, err, sizeof err) != 0) {

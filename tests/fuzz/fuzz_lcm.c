@@ -1,5 +1,5 @@
 /* fuzz_lcm - libFuzzer target for LCM message decoding (the lcm-gen decoders of the lcm/ types
- * and our checks in firmware/port/linux/lx_lcm.c, issue 9). LCM on a robot is UDP multicast:
+ * and our checks in firmware/port/linux/lx_lcm.c). LCM on a robot is UDP multicast:
  * anyone on the network can publish any bytes on our channels, and logs are files.
  *
  * Input: byte 0 selects the path, the rest is the payload.

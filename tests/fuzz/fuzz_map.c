@@ -1,4 +1,4 @@
-/* fuzz_map - libFuzzer target for the ROS map_server loader (firmware/port/linux/lx_map.h, issue 9).
+/* fuzz_map - libFuzzer target for the ROS map_server loader (firmware/port/linux/lx_map.h).
  *
  * Input: the YAML text, then the 5 bytes "#PGM\n", then the image file's bytes (no
  * separator: everything is YAML and the image is empty). They are written to m.yaml and

@@ -1,4 +1,4 @@
-/* fuzz_radiotap - libFuzzer target for the radiotap + 802.11 parser (issue 5).
+/* fuzz_radiotap - libFuzzer target for the radiotap + 802.11 parser.
  * Input: one captured record (radiotap header, then the 802.11 frame). Beyond "no
  * out-of-bounds read" (ASan) it checks what the parser promises: a usable header lies
  * inside the input, an address is only reported when the frame holds it.

@@ -1,4 +1,4 @@
-/* test_status_est.c - the path-loss estimate in the LCM seeker status (issue 10):
+/* test_status_est.c - the path-loss estimate in the LCM seeker status:
  * lx_lcm_pub_status_est() puts it in the last fields of rfseek.seeker_status_t, read back
  * here from the recorded bytes by hand (big-endian, the .lcm field order) rather than by the
  * generated decoder; lx_lcm_pub_status() leaves them zero; the receiver drops a status whose

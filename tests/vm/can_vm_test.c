@@ -1,4 +1,4 @@
-/* can_vm_test.c - our side of the SocketCAN test (issue 4), run on vcan0 inside a qemu
+/* can_vm_test.c - our side of the SocketCAN test, run on vcan0 inside a qemu
  * VM with Debian's kernel (or natively where the host has vcan). Statically linked.
  *
  *   can_vm_test send IFACE EXPECT   encode and send a fixed scenario; write the frames as
@@ -69,7 +69,7 @@ static int do_send(const char *ifname, const char *expect)
                               (uint8_t)(i ? 0x0F : 0), i ? 0xFFFFFFFFu : 7u};
         rfs_can_tx_status(&tx, &s, &fr[n++]);
     }
-    for (int i = 0; i < 2; i++) { /* receiver heartbeats (issue 10), across the wrap */
+    for (int i = 0; i < 2; i++) { /* receiver heartbeats, across the wrap */
         rfs_can_receiver_t r = {rfs_can_wrap_time(t0 + 100000 * i)};
         rfs_can_tx_receiver(&tx, &r, &fr[n++]);
     }

@@ -1,4 +1,4 @@
-/* lcm_tool.c - test helper for rfseekd and the LCM adapter (issue 4).
+/* lcm_tool.c - test helper for rfseekd and the LCM adapter.
  *
  *   lcm_tool mklog OUT.lcmlog   write a crafted input log: 3 s of poses (10 Hz) and RSSI
  *                               (100 Hz) at the office map's start, RFS_CLOCK at 20 Hz for
@@ -7,7 +7,7 @@
  *                               on the pose channel, 5 bytes of garbage on RFS_RSSI and a
  *                               pose older than the newest; at 2 s a clock going backwards
  *   lcm_tool mkdeadzone OUT.lcmlog on|off
- *                               a radio dead zone (issue 10): 4 s of poses (10 Hz) at the
+ *                               a radio dead zone: 4 s of poses (10 Hz) at the
  *                               office map's start, RSSI (100 Hz) only for the first 1 s,
  *                               RFS_CLOCK at 20 Hz; with "on" a receiver heartbeat
  *                               (RFS_RSSI_STATUS) just before every clock tick (81) and

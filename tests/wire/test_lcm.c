@@ -255,7 +255,7 @@ static void bad_url_and_unreadable_log_give_one_line(void **state)
     assert_string_equal(err, "/nonexistent/dir/x.lcmlog: cannot open for reading");
 }
 
-/* RFS_RSSI_STATUS (issue 10). Reference bytes from the LCM wire format computed in Python
+/* RFS_RSSI_STATUS. Reference bytes from the LCM wire format computed in Python
  * (tests/fuzz/make_corpus.py's lcm_hash of {int64_t utime, int32_t seq} = 0xc77a89abfd4c5ba6,
  * then utime and seq big-endian): utime -5,000,000,123, seq -7. */
 static void receiver_status_matches_reference_bytes_and_rejects_others(void **state)

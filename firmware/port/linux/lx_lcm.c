@@ -81,7 +81,7 @@ static double dbl_of(rfs_q16_t q)
     return (double)q / 65536.0;
 }
 
-/* The path-loss estimate of a status (issue 10): every field a Q16.16 value, the area not
+/* The path-loss estimate of a status: every field a Q16.16 value, the area not
  * negative; all zero when est_valid is false. */
 static bool est_ok(const rfseek_seeker_status_t *m)
 {
@@ -480,7 +480,7 @@ int lx_lcm_pub_status_est(lx_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out,
     m.max_y = dbl_of(d->max_y);
     m.path_len = dbl_of(d->path_len);
     m.samples = d->samples;
-    if (est) { // issue 10: the path-loss model's estimate (memset left them 0 otherwise)
+    if (est) { // the path-loss model's estimate (memset left them 0 otherwise)
         m.est_valid = true;
         m.est_x = dbl_of(est->sx);
         m.est_y = dbl_of(est->sy);

@@ -5,7 +5,7 @@
  *   RFS_POSE            rfseek.pose_t           localisation -> controller
  *   RFS_RSSI            rfseek.rssi_t           radio module -> controller
  *   RFS_RSSI_STATUS     rfseek.rssi_status_t    radio module -> controller: receiver
- *                                               heartbeat (issue 10, docs/FAULTS.md)
+ *                                               heartbeat (docs/FAULTS.md)
  *   RFS_CLOCK           rfseek.clock_t          lock-step simulator -> controller
  *   RFS_WHEEL_CMD       rfseek.wheel_cmd_t      controller -> logs (copy of the CAN frame)
  *   RFS_SEEKER_STATUS   rfseek.seeker_status_t  controller -> anyone
@@ -87,7 +87,7 @@ int lx_lcm_pub_clock(lx_lcm_t *l, int64_t t_us);
 int lx_lcm_pub_wheel(lx_lcm_t *l, int64_t t_us, const rfs_can_wheel_t *w);
 /// Publish a status (decision record and command of one control step).
 int lx_lcm_pub_status(lx_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out);
-/// Publish a status with the path-loss model's estimate (issue 10); est NULL publishes
+/// Publish a status with the path-loss model's estimate; est NULL publishes
 /// est_valid false and zero estimate fields, like lx_lcm_pub_status().
 int lx_lcm_pub_status_est(lx_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out,
                           const rfs_pathloss_est_t *est);

@@ -1,4 +1,4 @@
-/* lx_pcap.h - 802.11 radiotap captures in and out, behind our own types (issue 5).
+/* lx_pcap.h - 802.11 radiotap captures in and out, behind our own types.
  *
  * The only header in front of libpcap: lx_pcap.c is the one file that includes pcap.h.
  * The reader hands out raw captured packets (radiotap header + 802.11 frame) with their

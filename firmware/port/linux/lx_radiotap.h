@@ -1,4 +1,4 @@
-/* lx_radiotap.h - radiotap and 802.11 MAC header parsing over a byte buffer (issue 5).
+/* lx_radiotap.h - radiotap and 802.11 MAC header parsing over a byte buffer.
  *
  * Pure C, no libpcap, every read bounds-checked against the captured length, so it can
  * run on anything a capture or the air hands us (the fuzz target drives it directly).

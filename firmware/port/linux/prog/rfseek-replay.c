@@ -1,5 +1,5 @@
 /* rfseek-replay - the host build of the firmware application loop on a recorded stream
- * (firmware/rfs_replay.h), and a printer for streams (issue 6).
+ * (firmware/rfs_replay.h), and a printer for streams.
  *
  *   rfseek-replay IN.rfsr -o OUT.rfso   play an input stream, write the output stream
  *   rfseek-replay --print FILE          print any stream, one record per line (TSV)

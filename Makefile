@@ -177,4 +177,5 @@ clean:
 	rm -rf $(BUILD) $(CLEAN_EXTRA)
 
 # Header dependencies written by $(DEPFLAGS) (none before the first build).
--include $(shell find $(BUILD) -name '*.d' -not -path '*/fuzz*' -not -path '*/vm/*' 2>/dev/null)
+-include $(shell find $(BUILD) \( -path '$(BUILD)/fuzz' -o -path '$(BUILD)/vm' -o -name 'fuzz-corpus' \
+	-o -path '$(BUILD)/test-logs' \) -prune -o -name '*.d' -print 2>/dev/null)

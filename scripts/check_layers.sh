@@ -46,7 +46,7 @@ while read -r f; do
             from=${home[$(basename "$inc")]:-}
             [ -z "$from" ] && continue  # not a project header
             if [[ $ok != *" $from "* ]]; then
-                echo "FAIL layers: $f includes $inc from $from/ (allowed from $dir/:$(allowed "$dir" | sed 's/[^ ]*/ &\//g'))"
+                echo "FAIL layers: $f includes $inc from $from/ (from $dir/ only $(allowed "$dir" | sed 's/[^ ]*/&\//g'))"
                 bad=$((bad + 1))
             fi
         elif [[ $line =~ ^[[:space:]]*#[[:space:]]*include[[:space:]]*\<([^\>]+)\> ]]; then

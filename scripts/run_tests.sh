@@ -39,6 +39,10 @@ run_job() {
         rc=$?
         ok=$(grep -c '^\[       OK \]' "$log")
         bad=$(grep -E '^\[  (FAILED|ERROR)   \] [A-Za-z_]' "$log" | grep -v 'test(s)' | sort -u | wc -l)
+        # A case filter (RFS_TEST_CASE, make check CASE=) that matches nothing is a mistake.
+        if [ -n "${RFS_TEST_CASE:-}" ] && [ "$ok" -eq 0 ] && [ "$bad" -eq 0 ]; then
+            echo "FAIL no case of ${names[$i]} matches RFS_TEST_CASE='$RFS_TEST_CASE'" >>"$log"; bad=1
+        fi
     else
         bash -c "${cmds[$i]}" >"$log" 2>&1
         rc=$?

@@ -151,8 +151,7 @@ TEST_JOBS_TEXT = $(foreach n,$(TEST_BIN_NAMES),$(n)$(TAB)bin$(TAB)-$(TAB)$(BUILD
 TEST_BINS = $(TEST_BIN_NAMES:%=$(BUILD)/tests/%) $(TEST_BIN_NAMES:%=$(BUILD)/asan/tests/%)
 
 test-only: all $(TEST_BINS) $(TEST_DEPS)
-	@mkdir -p $(BUILD)
-	$(file >$(BUILD)/test-jobs.tsv,$(TEST_JOBS_TEXT))
+	$(shell mkdir -p $(BUILD))$(file >$(BUILD)/test-jobs.tsv,$(TEST_JOBS_TEXT))
 	@BUILD=$(BUILD) scripts/run_tests.sh $(BUILD)/test-jobs.tsv
 
 # make check T=NAME: only what that test needs is built.
@@ -162,8 +161,7 @@ check: $(if $(T),$(CHECK_PREREQS))
 	@if [ -z "$(T)" ]; then echo "make check T=NAME [CASE=GLOB] [ASAN=1]; names: make check-list" >&2; exit 2; fi
 	@if [ -z "$(filter $(T),$(TEST_BIN_NAMES) $(TEST_SCRIPT_NAMES))" ]; then \
 	    echo "make check: no test named '$(T)' (make check-list)" >&2; exit 2; fi
-	@mkdir -p $(BUILD)
-	$(file >$(BUILD)/test-jobs.tsv,$(TEST_JOBS_TEXT))
+	$(shell mkdir -p $(BUILD))$(file >$(BUILD)/test-jobs.tsv,$(TEST_JOBS_TEXT))
 	@BUILD=$(BUILD) RFS_TEST_CASE='$(CASE)' scripts/run_tests.sh $(BUILD)/test-jobs.tsv --only '$(CHECK_NAME)'
 
 .PHONY: check-list

@@ -28,7 +28,7 @@ static lx_yaml_rc_t copy_doc(yaml_document_t *y, lx_yaml_doc_t *doc, lx_yaml_err
         }
     }
     doc->nodes = calloc(count, sizeof(*doc->nodes));
-    doc->links = calloc(nlinks > 0 ? nlinks : 1, sizeof(*doc->links));
+    doc->links = calloc(nlinks > 0 ? nlinks : 1, sizeof(const lx_yaml_node_t *));
     doc->text = malloc(ntext > 0 ? ntext : 1);
     if (doc->nodes == NULL || doc->links == NULL || doc->text == NULL) {
         return LX_YAML_NOMEM;

@@ -34,25 +34,24 @@ typedef struct lx_yaml_node {
 
 /// A loaded document: root is NULL for an empty stream.
 typedef struct lx_yaml_doc {
-    const lx_yaml_node_t *root; ///< the document's root node, or NULL when empty
-    lx_yaml_node_t *nodes;      ///< every node, one allocation
+    const lx_yaml_node_t *root;   ///< the document's root node, or NULL when empty
+    lx_yaml_node_t *nodes;        ///< every node, one allocation
     const lx_yaml_node_t **links; ///< every child pointer, one allocation
-    char *text;                 ///< every scalar's text, one allocation
+    char *text;                   ///< every scalar's text, one allocation
 } lx_yaml_doc_t;
 
 /// Result of a load.
 typedef enum lx_yaml_rc {
-    LX_YAML_OK = 0,      ///< loaded
-    LX_YAML_NOMEM,       ///< the parser could not start or a copy failed
-    LX_YAML_SYNTAX,      ///< malformed YAML: line and problem set
-    LX_YAML_TOO_BIG,     ///< more than LX_YAML_MAX_NODES nodes
+    LX_YAML_OK = 0,  ///< loaded
+    LX_YAML_NOMEM,   ///< the parser could not start or a copy failed
+    LX_YAML_SYNTAX,  ///< malformed YAML: line and problem set
+    LX_YAML_TOO_BIG, ///< more than LX_YAML_MAX_NODES nodes
 } lx_yaml_rc_t;
 
-/// Where and why a load failed (LX_YAML_SYNTAX: line of the problem, 1-based, and
-/// libyaml's text for it, never NULL).
+/// Where and why a load failed (set for LX_YAML_SYNTAX).
 typedef struct lx_yaml_error {
-    unsigned long line; ///< 1-based line of the problem
-    const char *problem; ///< static text naming the problem, or NULL when libyaml gave none
+    unsigned long line;  ///< 1-based line of the problem
+    const char *problem; ///< libyaml's static text naming the problem, or NULL when it gave none
 } lx_yaml_error_t;
 
 /// Load the first document of `len` bytes at `buf` into `doc` (freed with lx_yaml_free,

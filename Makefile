@@ -1,7 +1,9 @@
 # rfseek top-level build. `make` builds everything for the host, `make test` runs every
-# test, `make firmware` cross-compiles the Cortex-M4 image, `make bench` prints figures,
-# `make demo` runs the default simulated mission. Each part of the tree adds its own
-# rules in mk/<part>.mk through the variables below.
+# test, `make check T=NAME` one of them, `make firmware` cross-compiles the Cortex-M4
+# image, `make bench` prints figures, `make demo` runs the default simulated mission.
+# Each part of the tree has its fragment mk/<part>.mk (core, firmware, linux, sim, fuzz,
+# bench, lint). Every name two fragments share is defined here, before the includes, so
+# no fragment depends on the order they are read in.
 .DEFAULT_GOAL := all
 SHELL := /bin/bash
 
@@ -20,154 +22,117 @@ PYTHON ?= /usr/bin/python3
 WARN := -Wall -Wextra -Werror
 CSTD := -std=c11
 OPT ?= -O2 -g
-# The core: freestanding C11, no float, no libc beyond memcpy/memset/memmove.
-CORE_FLAGS := $(CSTD) $(WARN) -ffreestanding -fno-builtin -fno-common -Icommon
-HOST_CFLAGS := $(CSTD) $(WARN) $(OPT) -D_DEFAULT_SOURCE -Icommon -Ihost_sim -I$(BUILD)/gen
-HOST_CXXFLAGS := -std=c++17 $(WARN) $(OPT) -Icommon -Ihost_sim -I$(BUILD)/gen
-HOST_LDLIBS := -lm
+# Every object writes its header dependencies beside it (read back at the end of this
+# file): touching a header recompiles only the objects that include it.
+DEPFLAGS := -MMD -MP
 SAN_FLAGS := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+HOST_CFLAGS := $(CSTD) $(WARN) $(OPT) -D_DEFAULT_SOURCE
+HOST_CXXFLAGS := -std=c++17 $(WARN) $(OPT)
+
+# --- the layers: host_sim -> firmware/port/linux -> firmware -> common ------------------
+# One library per layer (and its ASan+UBSan twin); a layer's include path holds itself and
+# the layers below, never above.
+CORE_SRCS := $(sort $(wildcard common/*.c))
+CORE_LIB := $(BUILD)/lib/librfs_core.a
+CORE_ASAN_LIB := $(BUILD)/asan/lib/librfs_core.a
+FW_LIB := $(BUILD)/lib/librfs_fw.a
+FW_ASAN_LIB := $(BUILD)/asan/lib/librfs_fw.a
+LINUX_LIB := $(BUILD)/lib/librfs_linux.a
+LINUX_ASAN_LIB := $(BUILD)/asan/lib/librfs_linux.a
+SIM_LIB := $(BUILD)/lib/librfs_sim.a
+SIM_ASAN_LIB := $(BUILD)/asan/lib/librfs_sim.a
+FW := $(BUILD)/firmware
+FEED := $(BUILD)/feed
+FUZZ_DIR := $(BUILD)/fuzz
+
+INC_core := -Icommon
+INC_fw := $(INC_core) -Ifirmware
+INC_linux := $(INC_fw) -Ifirmware/port/linux -I$(BUILD)/gen
+INC_sim := $(INC_linux) -Ihost_sim
+
+# Outside libraries: pkg-config, or the plain -l when a .pc file is missing (lcm.pc needs
+# glib's). Only the Linux port and the simulator use them; only the simulator uses Box2D.
+YAML_CFLAGS := $(shell pkg-config --cflags yaml-0.1 2>/dev/null)
+YAML_LIBS := $(shell pkg-config --libs yaml-0.1 2>/dev/null || echo -lyaml)
+LCM_LIBS := $(shell pkg-config --libs lcm 2>/dev/null || echo -llcm)
+PCAP_LIBS := $(shell pkg-config --libs libpcap 2>/dev/null || echo -lpcap)
+
+LIBS_core := $(CORE_LIB)
+LIBS_fw := $(FW_LIB) $(CORE_LIB)
+LIBS_linux := $(LINUX_LIB) $(LIBS_fw)
+LIBS_sim := $(SIM_LIB) $(LIBS_linux)
+ASAN_LIBS_core := $(CORE_ASAN_LIB)
+ASAN_LIBS_fw := $(FW_ASAN_LIB) $(CORE_ASAN_LIB)
+ASAN_LIBS_linux := $(LINUX_ASAN_LIB) $(ASAN_LIBS_fw)
+ASAN_LIBS_sim := $(SIM_ASAN_LIB) $(ASAN_LIBS_linux)
+LDLIBS_core := -lm
+LDLIBS_fw := -lm
+LDLIBS_linux := -Wl,--as-needed $(LCM_LIBS) $(YAML_LIBS) $(PCAP_LIBS) -lm
+LDLIBS_sim := -lbox2d $(LCM_LIBS) $(YAML_LIBS) $(PCAP_LIBS) -lm
+# The C linker for everything but the simulator, whose Box2D adapter is C++.
+LD_core := $(CC)
+LD_fw := $(CC)
+LD_linux := $(CC)
+LD_sim := $(CXX)
+
+# lcm-gen types (lcm/<type>.lcm -> $(BUILD)/gen/rfseek_<type>.{c,h}, mk/linux.mk).
+LCM_GEN_NAMES := $(patsubst lcm/%.lcm,rfseek_%,$(sort $(wildcard lcm/*.lcm)))
+LCM_GEN_SRCS := $(LCM_GEN_NAMES:%=$(BUILD)/gen/%.c)
+LCM_GEN_HDRS := $(LCM_GEN_NAMES:%=$(BUILD)/gen/%.h)
 
 # Lists the fragments extend.
 ALL_TARGETS :=       # built by `make`
-TEST_BINS :=         # CMocka binaries run by `make test` (ASan+UBSan variants included)
-TEST_SCRIPTS :=      # other test commands run by `make test`, each prints PASS/FAIL lines
+TEST_BIN_NAMES :=    # CMocka programs: build/tests/NAME and build/asan/tests/NAME
+TEST_SCRIPT_NAMES := # other test commands (each prints PASS/FAIL lines)
+TEST_DEPS :=         # what the test commands need built
 BENCH_TARGETS :=     # phony targets run by `make bench`
 CLEAN_EXTRA :=
 
-# --- the portable core ---------------------------------------------------------------
-CORE_SRCS := $(sort $(wildcard common/*.c))
-CORE_HDRS := $(wildcard common/*.h)
-CORE_OBJS := $(CORE_SRCS:%.c=$(BUILD)/obj/%.o)
-CORE_LIB := $(BUILD)/lib/librfs_core.a
-CORE_ASAN_LIB := $(BUILD)/asan/lib/librfs_core.a
-
-$(BUILD)/obj/common/%.o: common/%.c $(CORE_HDRS)
-	@mkdir -p $(@D)
-	$(CC) $(CORE_FLAGS) $(OPT) -c $< -o $@
-
-$(BUILD)/asan/obj/common/%.o: common/%.c $(CORE_HDRS)
-	@mkdir -p $(@D)
-	$(CC) $(CORE_FLAGS) -O1 -g $(SAN_FLAGS) -c $< -o $@
-
-$(CORE_LIB): $(CORE_OBJS)
-	@mkdir -p $(@D)
-	rm -f $@ && ar rcs $@ $^
-
-$(CORE_ASAN_LIB): $(CORE_SRCS:%.c=$(BUILD)/asan/obj/%.o)
-	@mkdir -p $(@D)
-	rm -f $@ && ar rcs $@ $^
-
-# The core must also build for -m32 and for the Cortex-M4, and reference nothing
-# outside itself but memcpy/memset/memmove.
-$(BUILD)/m32/obj/common/%.o: common/%.c $(CORE_HDRS)
-	@mkdir -p $(@D)
-	$(CC) -m32 $(CORE_FLAGS) -O2 -c $< -o $@
-
-$(BUILD)/arm/obj/common/%.o: common/%.c $(CORE_HDRS)
-	@mkdir -p $(@D)
-	$(ARM_CC) -mcpu=cortex-m4 -mthumb -mfloat-abi=soft $(CORE_FLAGS) -Os -ffunction-sections -fdata-sections -c $< -o $@
-
-$(BUILD)/m32/lib/librfs_core.a: $(CORE_SRCS:%.c=$(BUILD)/m32/obj/%.o)
-	@mkdir -p $(@D)
-	rm -f $@ && ar rcs $@ $^
-
-$(BUILD)/arm/lib/librfs_core.a: $(CORE_SRCS:%.c=$(BUILD)/arm/obj/%.o)
-	@mkdir -p $(@D)
-	rm -f $@ && arm-none-eabi-ar rcs $@ $^
-
-.PHONY: check-core
-check-core: $(CORE_LIB) $(BUILD)/m32/lib/librfs_core.a $(BUILD)/arm/lib/librfs_core.a
-	@scripts/check_core_symbols.sh nm $(CORE_LIB)
-	@scripts/check_core_symbols.sh nm $(BUILD)/m32/lib/librfs_core.a
-	@scripts/check_core_symbols.sh arm-none-eabi-nm $(BUILD)/arm/lib/librfs_core.a
-
-ALL_TARGETS += $(CORE_LIB)
-
-# --- CMocka tests of the core: tests/common/test_<module>.c ------------------------
-# Tests include their fixtures and double-precision references (tests/*/*.h).
-TEST_HDRS := $(wildcard tests/*/*.h)
-# $(call cmocka_test,NAME,SOURCES,EXTRA_LIBS) defines build/tests/NAME and its ASan twin.
+# $(call cmocka_test,NAME,SOURCE,LAYER): build/tests/NAME and its ASan+UBSan twin
+# build/asan/tests/NAME, SOURCE linked with the libraries of LAYER (core, fw, linux, sim).
 define cmocka_test
-$(BUILD)/tests/$(1): $(2) $$(CORE_LIB) $$(HOST_LIB_DEPS) tests/rfs_test.h $$(TEST_HDRS)
+$(BUILD)/tests/$(1): $(2) $$(LIBS_$(3)) | $$(LCM_GEN_HDRS)
 	@mkdir -p $$(@D)
-	$$(HOST_LINK) $$(HOST_CFLAGS) -x c -Itests $(2) -x none -o $$@ $$(HOST_LIB_DEPS) $$(CORE_LIB) -lcmocka $(3) $$(HOST_LDLIBS)
-$(BUILD)/asan/tests/$(1): $(2) $$(CORE_ASAN_LIB) $$(HOST_ASAN_LIB_DEPS) tests/rfs_test.h $$(TEST_HDRS)
+	$$(LD_$(3)) $$(HOST_CFLAGS) $$(DEPFLAGS) -MF $$@.d -MT $$@ $$(INC_$(3)) -Itests -x c $(2) -x none -o $$@ $$(LIBS_$(3)) -lcmocka $$(LDLIBS_$(3))
+$(BUILD)/asan/tests/$(1): $(2) $$(ASAN_LIBS_$(3)) | $$(LCM_GEN_HDRS)
 	@mkdir -p $$(@D)
-	$$(HOST_LINK) $$(HOST_CFLAGS) -O1 $$(SAN_FLAGS) -x c -Itests $(2) -x none -o $$@ $$(HOST_ASAN_LIB_DEPS) $$(CORE_ASAN_LIB) -lcmocka $(3) $$(HOST_LDLIBS)
-TEST_BINS += $(BUILD)/tests/$(1) $(BUILD)/asan/tests/$(1)
+	$$(LD_$(3)) $$(HOST_CFLAGS) -O1 $$(SAN_FLAGS) $$(DEPFLAGS) -MF $$@.d -MT $$@ $$(INC_$(3)) -Itests -x c $(2) -x none -o $$@ $$(ASAN_LIBS_$(3)) -lcmocka $$(LDLIBS_$(3))
+TEST_BIN_NAMES += $(1)
 endef
 
-# --- host-side library and programs ---------------------------------------------------
-# Every host_sim/*.c and *.cpp is in librfs_host.a; host_sim/prog/<name>.c and
-# firmware/port/linux/prog/<name>.c become build/bin/<name>. Fragments add flags and
-# libraries (pkg-config) to HOST_CFLAGS / HOST_LDLIBS and generated sources to HOST_GEN.
-HOST_SRCS := $(sort $(wildcard host_sim/*.c))
-HOST_CXX_SRCS := $(sort $(wildcard host_sim/*.cpp))
-HOST_HDRS = $(wildcard host_sim/*.h) $(CORE_HDRS) $(HOST_GEN_HDRS)
-HOST_GEN_HDRS :=
-HOST_GEN_SRCS :=
-HOST_LIB := $(BUILD)/lib/librfs_host.a
-HOST_ASAN_LIB := $(BUILD)/asan/lib/librfs_host.a
-HOST_LIB_DEPS = $(if $(HOST_SRCS)$(HOST_CXX_SRCS),$(HOST_LIB))
-HOST_ASAN_LIB_DEPS = $(if $(HOST_SRCS)$(HOST_CXX_SRCS),$(HOST_ASAN_LIB))
-HOST_PROGS := $(patsubst %.c,$(BUILD)/bin/%,$(notdir $(wildcard host_sim/prog/*.c firmware/port/linux/prog/*.c)))
+# $(call test_script,NAME,COMMAND,PREREQUISITES[,serial]): a test command run from the
+# repository root by `make test` (in parallel with the others unless `serial`) and by
+# `make check T=NAME`.
+define test_script
+TEST_SCRIPT_NAMES += $(1)
+TEST_CMD_$(1) = $(2)
+TEST_DEPS_$(1) = $(3)
+TEST_SERIAL_$(1) := $(4)
+TEST_DEPS += $(3)
+endef
 
-include $(sort $(wildcard mk/*.mk))
-
-HOST_OBJS = $(HOST_SRCS:%.c=$(BUILD)/obj/%.o) $(HOST_CXX_SRCS:%.cpp=$(BUILD)/obj/%.o) $(HOST_GEN_SRCS:%.c=%.o)
-HOST_ASAN_OBJS = $(HOST_SRCS:%.c=$(BUILD)/asan/obj/%.o) $(HOST_CXX_SRCS:%.cpp=$(BUILD)/asan/obj/%.o) $(HOST_GEN_SRCS:%.c=%.asan.o)
-
-$(BUILD)/obj/host_sim/%.o: host_sim/%.c $(HOST_HDRS)
-	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) -c $< -o $@
-$(BUILD)/obj/host_sim/%.o: host_sim/%.cpp $(HOST_HDRS)
-	@mkdir -p $(@D)
-	$(CXX) $(HOST_CXXFLAGS) -c $< -o $@
-$(BUILD)/asan/obj/host_sim/%.o: host_sim/%.c $(HOST_HDRS)
-	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) -O1 $(SAN_FLAGS) -c $< -o $@
-$(BUILD)/asan/obj/host_sim/%.o: host_sim/%.cpp $(HOST_HDRS)
-	@mkdir -p $(@D)
-	$(CXX) $(HOST_CXXFLAGS) -O1 $(SAN_FLAGS) -c $< -o $@
-$(BUILD)/gen/%.o: $(BUILD)/gen/%.c $(HOST_GEN_HDRS)
-	$(CC) $(CSTD) $(OPT) -D_DEFAULT_SOURCE -I$(BUILD)/gen -c $< -o $@
-$(BUILD)/gen/%.asan.o: $(BUILD)/gen/%.c $(HOST_GEN_HDRS)
-	$(CC) $(CSTD) -O1 -g $(SAN_FLAGS) -D_DEFAULT_SOURCE -I$(BUILD)/gen -c $< -o $@
-
-$(HOST_LIB): $(HOST_OBJS)
-	@mkdir -p $(@D)
-	rm -f $@ && ar rcs $@ $^
-$(HOST_ASAN_LIB): $(HOST_ASAN_OBJS)
-	@mkdir -p $(@D)
-	rm -f $@ && ar rcs $@ $^
-
-# Programs link with g++ when the host library holds C++ (the Box2D adapter).
-HOST_LINK = $(if $(HOST_CXX_SRCS),$(CXX),$(CC))
-$(BUILD)/bin/%: host_sim/prog/%.c $(HOST_LIB_DEPS) $(CORE_LIB) $(HOST_HDRS)
-	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) -c $< -o $(BUILD)/obj/$*.main.o
-	$(HOST_LINK) -o $@ $(BUILD)/obj/$*.main.o $(HOST_LIB_DEPS) $(CORE_LIB) $(HOST_LDLIBS)
-$(BUILD)/bin/%: firmware/port/linux/prog/%.c $(HOST_LIB_DEPS) $(CORE_LIB) $(HOST_HDRS)
-	@mkdir -p $(@D) $(BUILD)/obj
-	$(CC) $(HOST_CFLAGS) -Ifirmware -Ifirmware/port/linux -c $< -o $(BUILD)/obj/$*.main.o
-	$(HOST_LINK) -o $@ $(BUILD)/obj/$*.main.o $(HOST_LIB_DEPS) $(CORE_LIB) $(HOST_LDLIBS)
-
-ALL_TARGETS += $(HOST_PROGS)
-
-CORE_TESTS := $(patsubst tests/common/%.c,%,$(wildcard tests/common/test_*.c))
-$(foreach t,$(CORE_TESTS),$(eval $(call cmocka_test,$(t),tests/common/$(t).c,)))
+include mk/core.mk mk/firmware.mk mk/linux.mk mk/sim.mk mk/fuzz.mk mk/bench.mk mk/lint.mk
 
 # --- top-level goals -------------------------------------------------------------------
-.PHONY: all deps test test-only bench demo firmware clean help
+.PHONY: all deps test test-only check bench demo firmware clean help
 all: $(ALL_TARGETS)
 
 help:
 	@echo "make deps      install missing Debian packages (needs root)"
 	@echo "make           build everything for the host into $(BUILD)/"
-	@echo "make test      deps + build + every test (plain and ASan+UBSan), summary line last"
+	@echo "make test      deps + build + every test (plain and ASan+UBSan), in parallel"
+	@echo "               (TEST_JOBS=N, default nproc), logs in $(BUILD)/test-logs/, summary line last"
+	@echo "make check T=NAME [CASE=GLOB] [ASAN=1]"
+	@echo "               build and run one test: a CMocka program (test_seek; ASAN=1 its"
+	@echo "               ASan+UBSan twin; CASE runs only the cases matching the glob) or a"
+	@echo "               test script (sim_cli, rfseekd, bit_identical, ...)"
+	@echo "make check-list  the names make check accepts"
 	@echo "make firmware  cross-compile the Cortex-M4 image"
 	@echo "make bench     print the performance figures (docs/PERFORMANCE.md)"
 	@echo "make demo      deps + run the default simulated mission, figures in out/demo/"
+	@echo "make lint      cppcheck, clang-tidy and the layer check"
+	@echo "make fuzz      every libFuzzer target for FUZZ_SECONDS each"
+	@echo "make sweep     the simulator under ASan+UBSan over SWEEP_SEEDS seeds"
 
 deps:
 	@scripts/deps.sh
@@ -175,15 +140,40 @@ deps:
 test: deps
 	@$(MAKE) --no-print-directory test-only
 
-CORE_CHECK_LIBS := $(CORE_LIB) $(BUILD)/m32/lib/librfs_core.a $(BUILD)/arm/lib/librfs_core.a
-TEST_SCRIPTS += "scripts/check_core_symbols.sh nm $(CORE_LIB)"
-TEST_SCRIPTS += "scripts/check_core_symbols.sh nm $(BUILD)/m32/lib/librfs_core.a"
-TEST_SCRIPTS += "scripts/check_core_symbols.sh arm-none-eabi-nm $(BUILD)/arm/lib/librfs_core.a"
+# The job list scripts/run_tests.sh reads: NAME, kind (bin or script), serial or not,
+# command; one per line ("-" for an empty field).
+TAB := $(shell printf '\t')
+define NEWLINE
 
-test-only: all $(CORE_CHECK_LIBS) $(TEST_BINS) $(TEST_DEPS)
-	@BUILD=$(BUILD) scripts/run_tests.sh $(TEST_BINS) -- $(TEST_SCRIPTS)
+
+endef
+TEST_JOBS_TEXT = $(foreach n,$(TEST_BIN_NAMES),$(n)$(TAB)bin$(TAB)-$(TAB)$(BUILD)/tests/$(n)$(NEWLINE)asan/$(n)$(TAB)bin$(TAB)-$(TAB)$(BUILD)/asan/tests/$(n)$(NEWLINE))$(foreach s,$(TEST_SCRIPT_NAMES),$(s)$(TAB)script$(TAB)$(or $(TEST_SERIAL_$(s)),-)$(TAB)$(TEST_CMD_$(s))$(NEWLINE))
+TEST_BINS = $(TEST_BIN_NAMES:%=$(BUILD)/tests/%) $(TEST_BIN_NAMES:%=$(BUILD)/asan/tests/%)
+
+test-only: all $(TEST_BINS) $(TEST_DEPS)
+	$(shell mkdir -p $(BUILD))$(file >$(BUILD)/test-jobs.tsv,$(TEST_JOBS_TEXT))
+	@BUILD=$(BUILD) scripts/run_tests.sh $(BUILD)/test-jobs.tsv
+
+# make check T=NAME: only what that test needs is built.
+CHECK_NAME = $(if $(filter $(T),$(TEST_BIN_NAMES)),$(if $(ASAN),asan/)$(T),$(T))
+CHECK_PREREQS = $(if $(filter $(T),$(TEST_BIN_NAMES)),$(BUILD)/$(if $(ASAN),asan/)tests/$(T),$(TEST_DEPS_$(T)))
+check: $(if $(T),$(CHECK_PREREQS))
+	@if [ -z "$(T)" ]; then echo "make check T=NAME [CASE=GLOB] [ASAN=1]; names: make check-list" >&2; exit 2; fi
+	@if [ -z "$(filter $(T),$(TEST_BIN_NAMES) $(TEST_SCRIPT_NAMES))" ]; then \
+	    echo "make check: no test named '$(T)' (make check-list)" >&2; exit 2; fi
+	$(shell mkdir -p $(BUILD))$(file >$(BUILD)/test-jobs.tsv,$(TEST_JOBS_TEXT))
+	@BUILD=$(BUILD) RFS_TEST_CASE='$(CASE)' scripts/run_tests.sh $(BUILD)/test-jobs.tsv --only '$(CHECK_NAME)'
+
+.PHONY: check-list
+check-list:
+	@echo "CMocka programs: $(sort $(TEST_BIN_NAMES))"
+	@echo "test scripts:    $(sort $(TEST_SCRIPT_NAMES))"
 
 bench: all $(BENCH_TARGETS)
 
 clean:
 	rm -rf $(BUILD) $(CLEAN_EXTRA)
+
+# Header dependencies written by $(DEPFLAGS) (none before the first build).
+-include $(shell find $(BUILD) \( -path '$(BUILD)/fuzz' -o -path '$(BUILD)/vm' -o -name 'fuzz-corpus' \
+	-o -path '$(BUILD)/test-logs' \) -prune -o -name '*.d' -print 2>/dev/null)

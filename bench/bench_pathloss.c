@@ -24,7 +24,7 @@
 
 #include <valgrind/callgrind.h>
 
-#include "hs_map.h"
+#include "lx_map.h"
 #include "rfs_pathloss.h"
 
 #define SX 27.5
@@ -80,12 +80,12 @@ int main(int argc, char **argv)
         return usage(stderr, 2);
     }
     char err[256];
-    hs_map_t hm;
-    hs_core_map_t cm;
+    lx_map_t hm;
+    lx_core_map_t cm;
     memset(&hm, 0, sizeof(hm));
     memset(&cm, 0, sizeof(cm));
-    if (hs_map_load(argv[1], &hm, err, sizeof(err)) != 0 ||
-        hs_map_to_core(&hm, 0.1, NULL, &cm, err, sizeof(err)) != 0) {
+    if (lx_map_load(argv[1], &hm, err, sizeof(err)) != 0 ||
+        lx_map_to_core(&hm, 0.1, NULL, &cm, err, sizeof(err)) != 0) {
         fprintf(stderr, "bench_pathloss: %s\n", err);
         return 1;
     }
@@ -203,7 +203,7 @@ int main(int argc, char **argv)
            e.rms / 65536.0, e.spread_m2 / 65536.0, v / 65536.0);
     free(p);
     free(s);
-    hs_core_map_free(&cm);
-    hs_map_free(&hm);
+    lx_core_map_free(&cm);
+    lx_map_free(&hm);
     return 0;
 }

@@ -180,7 +180,7 @@ void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out)
     rfs_seek_step(&a->seek, now_us, &a->rng, &so);
 
     uint16_t faults = so.faults;
-    /* Received-time watchdogs on the inputs (issue 6 safety): independent of the sender
+    /* Received-time watchdogs on the inputs (docs/FIRMWARE.md, safety): independent of the sender
      * time stamps the seeker judges, so a sender whose clock runs on while its frames
      * stop arriving still stops the wheels. */
     /* Differences in uint64 only when now > rx (exact there): recorded times are outside

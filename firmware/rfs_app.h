@@ -1,4 +1,4 @@
-/* rfs_app.h - the application loop shared by every firmware port (issue 6).
+/* rfs_app.h - the application loop shared by every firmware port.
  *
  * One rfs_app_t holds everything the controller needs at run time: the seeker
  * (common/rfs_seek.h, paper section 2, Algorithm 1), the local ridge model (section
@@ -8,14 +8,14 @@
  * A port feeds what arrives, in arrival order, and calls rfs_app_step() at the control
  * rate (RFS_APP_PERIOD_US):
  *   - decoded inputs: rfs_app_on_pose(), rfs_app_on_rssi(), rfs_app_on_receiver() (the
- *     receiver heartbeat, issue 10; the Linux/LCM port), or
+ *     receiver heartbeat; the Linux/LCM port), or
  *   - raw CAN frames: rfs_app_on_can() (the STM32 and emulator ports; decoding by
  *     common/rfs_can.h),
  *   - transport state: rfs_app_set_bus_off() (bxCAN bus-off, SocketCAN error state).
  * rfs_app_step() returns the wheel command and the status; rfs_app_frames() encodes them
  * as the CAN frames of docs/CAN.md.
  *
- * Safety (issue 6): besides the seeker's own staleness rule on input timestamps, the
+ * Safety: besides the seeker's own staleness rule on input timestamps, the
  * application commands zero wheel speed whenever no pose or no RSSI input (a measurement
  * or a receiver heartbeat) has been RECEIVED for input_timeout_us of local time (150 ms <
  * the 200 ms requirement), and
@@ -137,7 +137,7 @@ typedef struct rfs_app_out {
 typedef struct rfs_app_stats {
     uint32_t poses;             ///< poses accepted by the seeker
     uint32_t rssi;              ///< measurements accepted by the seeker
-    uint32_t receiver;          ///< receiver heartbeats accepted by the seeker (issue 10)
+    uint32_t receiver;          ///< receiver heartbeats accepted by the seeker
     uint32_t rejected;          ///< inputs the seeker rejected (order, bad source)
     uint32_t bad_frames;        ///< CAN frames that failed to decode (DLC, checksum)
     uint32_t unknown_frames;    ///< CAN frames with ids that are not ours
@@ -177,8 +177,8 @@ typedef struct rfs_app {
 rfs_app_cfg_t rfs_app_cfg_default(void);
 
 /// The microcontroller configuration: the defaults with the fit sliced over control
-/// periods so that no period's slice of a relearn comes near the 200 ms safety deadline
-/// (issues 8, 10): fit_budget_by_model set, and seek.fit_budget = RFS_APP_MCU_FIT_BUDGET
+/// periods so that no period's slice of a relearn comes near the 200 ms safety deadline:
+/// fit_budget_by_model set, and seek.fit_budget = RFS_APP_MCU_FIT_BUDGET
 /// (the ridge's; rfs_app_init() takes another model's from the registry). Decisions are
 /// the same; a ridge relearn keeps the wheels stopped for three more periods (150 ms).
 rfs_app_cfg_t rfs_app_cfg_mcu(void);
@@ -207,7 +207,7 @@ bool rfs_app_on_pose(rfs_app_t *a, const rfs_pose_t *pose, int64_t rx_us);
 /// time rx_us. false when the seeker rejected it.
 bool rfs_app_on_rssi(rfs_app_t *a, uint8_t src, int64_t t_us, int8_t dbm, int64_t rx_us);
 
-/// A receiver heartbeat (issue 10; docs/FAULTS.md): the radio's capture loop was
+/// A receiver heartbeat (docs/FAULTS.md): the radio's capture loop was
 /// listening up to t_us (its own capture clock, the packets' clock), heard or not; it
 /// arrived at local time rx_us. Refreshes the RSSI input's receive-time watchdog like a
 /// packet and calls rfs_seek_on_receiver(), which judges the stamp as it judges a

@@ -1,4 +1,4 @@
-/* rfs_replay.h - the recorded stream format: timestamped inputs in, outputs out (issue 6).
+/* rfs_replay.h - the recorded stream format: timestamped inputs in, outputs out.
  *
  * One format serves both directions, so the host build and the ARM image under qemu can
  * be fed the same bytes and their outputs compared byte for byte:
@@ -18,7 +18,7 @@
  *   RSSI     rx i64, t i64, src u8, dbm i8                             18
  *   CAN      rx i64, id u32, dlc u8, data[8]                           21
  *   RECEIVER rx i64, t i64  (receiver heartbeat: listening up to t,     16
- *                            issue 10; docs/FAULTS.md)
+ *                            docs/FAULTS.md)
  *   STEP     now i64                          (run one control period)  8
  *   BUS      now i64, off u8                  (bus-off entered / left)  9
  *   RESET    now i64                          (watchdog reset: re-init) 8

@@ -1,8 +1,8 @@
-/* hs_box2d.cpp - the Box2D 2.4 adapter behind hs_world.h (the only file including Box2D).
+/* hs_box2d.cpp - the Box2D 2.4 adapter behind hs_box2d.h (the only file including Box2D).
  *
- * Geometry: the map frame, metres, as in hs_map_t. Walls are static fixtures on two
+ * Geometry: the map frame, metres, as in lx_map_t. Walls are static fixtures on two
  * static bodies (collision and radio); the robot is a dynamic circle whose velocity is
- * set before every step (unicycle from the wheel speeds, see hs_world.h).
+ * set before every step (unicycle from the wheel speeds, see hs_box2d.h).
  */
 #include <box2d/box2d.h>
 
@@ -16,7 +16,7 @@
 #include <vector>
 
 extern "C" {
-#include "hs_world.h"
+#include "hs_box2d.h"
 }
 
 namespace {
@@ -25,10 +25,10 @@ constexpr uint16 CAT_COLLIDE = 0x0001; // walls the robot collides with
 constexpr uint16 CAT_RADIO = 0x0002;   // walls the radio counts; never collide
 constexpr uint16 CAT_ROBOT = 0x0004;
 
-bool cell_in(const hs_map_t *m, uint32_t x, uint32_t y, hs_world_kind_t kind)
+bool cell_in(const lx_map_t *m, uint32_t x, uint32_t y, hs_box2d_kind_t kind)
 {
     uint8_t c = m->cell[(size_t)y * m->w + x];
-    return kind == HS_WORLD_RADIO ? c == HS_CELL_OCC : c != HS_CELL_FREE;
+    return kind == HS_BOX2D_RADIO ? c == LX_CELL_OCC : c != LX_CELL_FREE;
 }
 
 // Collects, per radio fixture, the fraction at which a ray enters it.
@@ -46,8 +46,8 @@ public:
 
 } // namespace
 
-struct hs_world {
-    hs_world_cfg_t cfg;
+struct hs_box2d {
+    hs_box2d_cfg_t cfg;
     b2World *world;
     b2Body *robot;
     long n_collide;
@@ -55,7 +55,7 @@ struct hs_world {
     uint32_t w, h;
     double res, ox, oy;
     std::vector<uint8_t> cell; // copy of the map cells (for disc_blocked)
-    // Free-space cache for the fast path of hs_world_step: per CLEAR_M cell, 1 when a
+    // Free-space cache for the fast path of hs_box2d_step: per CLEAR_M cell, 1 when a
     // disc of radius + CLEAR_MARGIN anywhere in it touches nothing, 0 when it may,
     // -1 not yet known.
     mutable std::vector<int8_t> clear;
@@ -67,9 +67,9 @@ constexpr double CLEAR_M = 0.1;       // cache cell, metres
 constexpr double CLEAR_MARGIN = 0.05; // > one step of travel (0.7 m/s x 20 ms) plus Box2D's skin
 }
 
-extern "C" hs_world_cfg_t hs_world_cfg_default(void)
+extern "C" hs_box2d_cfg_t hs_box2d_cfg_default(void)
 {
-    hs_world_cfg_t c;
+    hs_box2d_cfg_t c;
     c.robot_radius_m = 0.177; // TurtleBot 2 (Kobuki) footprint radius, turtlebot_navigation
     c.robot_mass_kg = 6.3;    // Kobuki base mass, vendor data sheet
     c.velocity_iters = 8;     // Box2D manual's recommendation
@@ -78,7 +78,7 @@ extern "C" hs_world_cfg_t hs_world_cfg_default(void)
     return c;
 }
 
-extern "C" long hs_world_merge_rects(const hs_map_t *m, hs_world_kind_t kind, hs_rect_t **out)
+extern "C" long hs_box2d_merge_rects(const lx_map_t *m, hs_box2d_kind_t kind, hs_rect_t **out)
 {
     *out = nullptr;
     std::vector<hs_rect_t> done;
@@ -134,10 +134,10 @@ extern "C" long hs_world_merge_rects(const hs_map_t *m, hs_world_kind_t kind, hs
     return (long)done.size();
 }
 
-static long add_walls(const hs_map_t *m, b2Body *body, hs_world_kind_t kind)
+static long add_walls(const lx_map_t *m, b2Body *body, hs_box2d_kind_t kind)
 {
     hs_rect_t *rects = nullptr;
-    long n = hs_world_merge_rects(m, kind, &rects);
+    long n = hs_box2d_merge_rects(m, kind, &rects);
     for (long i = 0; i < n; i++) {
         const hs_rect_t &r = rects[i];
         float hx = (float)(0.5 * r.w * m->res);
@@ -149,7 +149,7 @@ static long add_walls(const hs_map_t *m, b2Body *body, hs_world_kind_t kind)
         b2FixtureDef fd;
         fd.shape = &box;
         fd.friction = 0.0f;
-        if (kind == HS_WORLD_RADIO) {
+        if (kind == HS_BOX2D_RADIO) {
             fd.isSensor = true;
             fd.filter.categoryBits = CAT_RADIO;
             fd.filter.maskBits = 0; // answers ray casts only
@@ -163,10 +163,10 @@ static long add_walls(const hs_map_t *m, b2Body *body, hs_world_kind_t kind)
     return n;
 }
 
-extern "C" hs_world_t *hs_world_create(const hs_map_t *m, const hs_world_cfg_t *cfg, char *err,
+extern "C" hs_box2d_t *hs_box2d_create(const lx_map_t *m, const hs_box2d_cfg_t *cfg, char *err,
                                        size_t errlen)
 {
-    hs_world_cfg_t c = cfg ? *cfg : hs_world_cfg_default();
+    hs_box2d_cfg_t c = cfg ? *cfg : hs_box2d_cfg_default();
     if (!(c.robot_radius_m > 0.0) || !(c.robot_mass_kg > 0.0) || c.velocity_iters < 1 ||
         c.position_iters < 1 || !(c.wall_merge_gap_m >= 0.0)) {
         snprintf(err, errlen, "world: robot radius, mass and solver iterations must be positive");
@@ -176,7 +176,7 @@ extern "C" hs_world_t *hs_world_create(const hs_map_t *m, const hs_world_cfg_t *
         snprintf(err, errlen, "world: empty map");
         return nullptr;
     }
-    hs_world_t *w = new (std::nothrow) hs_world();
+    hs_box2d_t *w = new (std::nothrow) hs_box2d();
     if (!w) {
         snprintf(err, errlen, "world: out of memory");
         return nullptr;
@@ -200,8 +200,8 @@ extern "C" hs_world_t *hs_world_create(const hs_map_t *m, const hs_world_cfg_t *
         sd.type = b2_staticBody;
         b2Body *collide = w->world->CreateBody(&sd);
         b2Body *radio = w->world->CreateBody(&sd);
-        w->n_collide = add_walls(m, collide, HS_WORLD_COLLIDE);
-        w->n_radio = add_walls(m, radio, HS_WORLD_RADIO);
+        w->n_collide = add_walls(m, collide, HS_BOX2D_COLLIDE);
+        w->n_radio = add_walls(m, radio, HS_BOX2D_RADIO);
         if (w->n_collide < 0 || w->n_radio < 0) {
             throw std::bad_alloc();
         }
@@ -219,14 +219,14 @@ extern "C" hs_world_t *hs_world_create(const hs_map_t *m, const hs_world_cfg_t *
         fd.filter.maskBits = CAT_COLLIDE;
         w->robot->CreateFixture(&fd);
     } catch (const std::bad_alloc &) {
-        hs_world_destroy(w);
+        hs_box2d_destroy(w);
         snprintf(err, errlen, "world: out of memory");
         return nullptr;
     }
     return w;
 }
 
-extern "C" void hs_world_destroy(hs_world_t *w)
+extern "C" void hs_box2d_destroy(hs_box2d_t *w)
 {
     if (!w) {
         return;
@@ -235,12 +235,12 @@ extern "C" void hs_world_destroy(hs_world_t *w)
     delete w;
 }
 
-extern "C" long hs_world_rect_count(const hs_world_t *w, hs_world_kind_t kind)
+extern "C" long hs_box2d_rect_count(const hs_box2d_t *w, hs_box2d_kind_t kind)
 {
-    return kind == HS_WORLD_RADIO ? w->n_radio : w->n_collide;
+    return kind == HS_BOX2D_RADIO ? w->n_radio : w->n_collide;
 }
 
-extern "C" void hs_world_place_robot(hs_world_t *w, double x, double y, double theta)
+extern "C" void hs_box2d_place_robot(hs_box2d_t *w, double x, double y, double theta)
 {
     w->robot->SetTransform(b2Vec2((float)x, (float)y), (float)theta);
     w->robot->SetLinearVelocity(b2Vec2(0.0f, 0.0f));
@@ -248,10 +248,10 @@ extern "C" void hs_world_place_robot(hs_world_t *w, double x, double y, double t
     w->robot->SetAwake(true);
 }
 
-extern "C" void hs_world_robot_pose(const hs_world_t *w, double *x, double *y, double *theta)
+extern "C" void hs_box2d_robot_pose(const hs_box2d_t *w, double *x, double *y, double *theta)
 {
     b2Vec2 p = w->robot->GetPosition();
-    double a = w->robot->GetAngle(); // kept within +-100 rad by hs_world_step
+    double a = w->robot->GetAngle(); // kept within +-100 rad by hs_box2d_step
     while (a > M_PI) {
         a -= 2.0 * M_PI;
     }
@@ -264,9 +264,9 @@ extern "C" void hs_world_robot_pose(const hs_world_t *w, double *x, double *y, d
 }
 
 /// true when no wall can be within CLEAR_MARGIN of the robot anywhere in its cache cell.
-static bool disc_blocked_r(const hs_world_t *w, double x, double y, double r);
+static bool disc_blocked_r(const hs_box2d_t *w, double x, double y, double r);
 
-static bool robot_clear(const hs_world_t *w)
+static bool robot_clear(const hs_box2d_t *w)
 {
     b2Vec2 p = w->robot->GetPosition();
     double fx = (p.x - w->ox) / CLEAR_M, fy = (p.y - w->oy) / CLEAR_M;
@@ -283,7 +283,7 @@ static bool robot_clear(const hs_world_t *w)
     return w->clear[i] == 1;
 }
 
-extern "C" void hs_world_step(hs_world_t *w, double v_m_s, double omega_rad_s, double dt_s)
+extern "C" void hs_box2d_step(hs_box2d_t *w, double v_m_s, double omega_rad_s, double dt_s)
 {
     float a = w->robot->GetAngle();
     if (std::fabs(v_m_s) * dt_s < CLEAR_MARGIN && robot_clear(w)) {
@@ -315,7 +315,7 @@ extern "C" void hs_world_step(hs_world_t *w, double v_m_s, double omega_rad_s, d
     }
 }
 
-extern "C" bool hs_world_robot_touching(const hs_world_t *w)
+extern "C" bool hs_box2d_robot_touching(const hs_box2d_t *w)
 {
     if (robot_clear(w)) {
         return false; // contacts are not updated on the fast path; none can touch here
@@ -328,7 +328,7 @@ extern "C" bool hs_world_robot_touching(const hs_world_t *w)
     return false;
 }
 
-extern "C" unsigned hs_world_walls_crossed(const hs_world_t *w, double x0, double y0, double x1,
+extern "C" unsigned hs_box2d_walls_crossed(const hs_box2d_t *w, double x0, double y0, double x1,
                                            double y1)
 {
     double len = std::hypot(x1 - x0, y1 - y0);
@@ -384,12 +384,12 @@ extern "C" unsigned hs_world_walls_crossed(const hs_world_t *w, double x0, doubl
     return n;
 }
 
-extern "C" bool hs_world_disc_blocked(const hs_world_t *w, double x, double y)
+extern "C" bool hs_box2d_disc_blocked(const hs_box2d_t *w, double x, double y)
 {
     return disc_blocked_r(w, x, y, w->cfg.robot_radius_m);
 }
 
-static bool disc_blocked_r(const hs_world_t *w, double x, double y, double r)
+static bool disc_blocked_r(const hs_box2d_t *w, double x, double y, double r)
 {
     double fx0 = (x - r - w->ox) / w->res, fx1 = (x + r - w->ox) / w->res;
     double fy0 = (y - r - w->oy) / w->res, fy1 = (y + r - w->oy) / w->res;
@@ -398,7 +398,7 @@ static bool disc_blocked_r(const hs_world_t *w, double x, double y, double r)
     }
     for (long cy = (long)fy0; cy <= (long)fy1; cy++) {
         for (long cx = (long)fx0; cx <= (long)fx1; cx++) {
-            if (w->cell[(size_t)cy * w->w + (size_t)cx] == HS_CELL_FREE) {
+            if (w->cell[(size_t)cy * w->w + (size_t)cx] == LX_CELL_FREE) {
                 continue;
             }
             // Nearest point of the cell to the disc centre.

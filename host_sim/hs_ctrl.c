@@ -153,7 +153,7 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
         return -1;
     }
     if (cfg->seek.strategy == RFS_SEEK_META_GLOBAL && me->ops == &rfs_ridge_ops) {
-        // issue 7 e: the local ridge with a radius covering the whole map (ridge limit 300 m).
+        // the local ridge with a radius covering the whole map (ridge limit 300 m).
         double diag = hypot((double)map->w, (double)map->h) * map->res / 65536.0 + 1.0;
         rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
         rc.radius = (rfs_q16_t)lround(fmin(diag, 300.0) * 65536.0);

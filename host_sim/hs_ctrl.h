@@ -7,9 +7,9 @@
  *
  * Implementations:
  *   - in-process over the core's rfs_seek (hs_ctrl_inproc_open() below, hs_ctrl.c);
- *   - two-process (issue 4): an implementation that publishes on_pose/on_rssi on LCM and
+ *   - two-process: an implementation that publishes on_pose/on_rssi on LCM and
  *     returns the wheel command received over CAN (its own file, same interface);
- *   - baseline strategies (issue 7): other implementations of the same interface.
+ *   - baseline strategies: other implementations of the same interface.
  * Ordering contract: calls arrive with non-decreasing time: every on_pose/on_rssi with a
  * timestamp <= now_us is delivered before step(now_us). A controller that receives its
  * inputs late (over a wire) simply answers with the newest command it has.
@@ -38,7 +38,7 @@ typedef struct hs_ctrl {
     /// A received packet from source `src` (index in scenario order) at t_us with dbm.
     void (*on_rssi)(void *self, uint8_t src, int64_t t_us, int8_t dbm);
     /// Optional (may be NULL): the receiver is up and listening at t_us, packet or not
-    /// (issue 10: a heartbeat keeps a radio dead zone from reading as a failed sensor).
+    /// (a heartbeat keeps a radio dead zone from reading as a failed sensor).
     void (*on_receiver)(void *self, int64_t t_us);
     /// One control period at now_us: the wheel command and the latest decision.
     void (*step)(void *self, int64_t now_us, hs_ctrl_out_t *out);
@@ -48,7 +48,7 @@ typedef struct hs_ctrl {
     /// Release everything the controller holds (self included). May be NULL.
     void (*close)(void *self);
     /// Optional (may be NULL): the path-loss model's state when the controller's model is
-    /// "pathloss" (issue 10: estimate and residual surface for logs and plots), else NULL.
+    /// "pathloss" (estimate and residual surface for logs and plots), else NULL.
     const rfs_pathloss_t *(*pathloss)(void *self);
 } hs_ctrl_t;
 

@@ -6,15 +6,15 @@
 #include <string.h>
 #include <time.h>
 
-#include "hs_can.h"
-#include "hs_err.h"
-#include "hs_lcm.h"
+#include "lx_can.h"
+#include "lx_err.h"
+#include "lx_lcm.h"
 #include "rfs_can.h"
 
 typedef struct ctrl_lcm {
     hs_ctrl_lcm_cfg_t cfg;
-    hs_lcm_t *lcm;
-    hs_can_t *can;               /* NULL: wheel frames come over RFS_CAN_FALLBACK */
+    lx_lcm_t *lcm;
+    lx_can_t *can;               /* NULL: wheel frames come over RFS_CAN_FALLBACK */
     rfs_can_rx_t rx;             /* the motor controller node's CAN receiver */
     uint32_t seq[RFS_CAN_MAX_SOURCES]; /* packet sequence numbers per source */
     uint32_t rx_seq;             /* receiver heartbeats published */
@@ -68,7 +68,7 @@ static void say(const ctrl_lcm_t *s, const char *msg)
 {
     char line[256];
     snprintf(line, sizeof line, "%s", msg);
-    hs_err_one_line(line);
+    lx_err_one_line(line);
     fprintf(stderr, "%s%s%s\n", s->cfg.prog ? s->cfg.prog : "", s->cfg.prog ? ": " : "", line);
 }
 
@@ -82,30 +82,30 @@ static void on_bad(void *ctx, const char *why)
 static void cb_pose(void *self, const rfs_pose_t *pose)
 {
     ctrl_lcm_t *s = self;
-    (void)hs_lcm_pub_pose(s->lcm, pose);
+    (void)lx_lcm_pub_pose(s->lcm, pose);
 }
 
 static void cb_rssi(void *self, uint8_t src, int64_t t_us, int8_t dbm)
 {
     ctrl_lcm_t *s = self;
     uint32_t q = src < RFS_CAN_MAX_SOURCES ? s->seq[src]++ : 0;
-    (void)hs_lcm_pub_rssi(s->lcm, src, t_us, dbm, q);
+    (void)lx_lcm_pub_rssi(s->lcm, src, t_us, dbm, q);
 }
 
-/* The simulated receiver's heartbeat (issue 10), as the sniffer's capture loop sends it:
+/* The simulated receiver's heartbeat, as the sniffer's capture loop sends it:
  * published before the clock tick of the step it precedes, so the controller has it
  * when it steps. */
 static void cb_receiver(void *self, int64_t t_us)
 {
     ctrl_lcm_t *s = self;
-    (void)hs_lcm_pub_receiver(s->lcm, t_us, s->rx_seq++);
+    (void)lx_lcm_pub_receiver(s->lcm, t_us, s->rx_seq++);
 }
 
 static void cb_step(void *self, int64_t now_us, hs_ctrl_out_t *out)
 {
     ctrl_lcm_t *s = self;
     uint32_t wheels0 = s->wheels_rx;
-    (void)hs_lcm_pub_clock(s->lcm, now_us);
+    (void)lx_lcm_pub_clock(s->lcm, now_us);
     int64_t deadline = mono_ms() + s->cfg.reply_timeout_ms;
     bool answered = false;
     while (!answered) {
@@ -117,7 +117,7 @@ static void cb_step(void *self, int64_t now_us, hs_ctrl_out_t *out)
             /* Two sources: take what CAN holds, then wait briefly on LCM; the status
              * normally arrives just after the wheel frame. */
             rfs_can_frame_t f;
-            while (hs_can_recv(s->can, &f, 0) == 1) {
+            while (lx_can_recv(s->can, &f, 0) == 1) {
                 on_frame(s, &f);
             }
             answered = s->have_status && s->status_t_us == now_us && s->wheels_rx != wheels0;
@@ -125,14 +125,14 @@ static void cb_step(void *self, int64_t now_us, hs_ctrl_out_t *out)
                 break;
             }
             if (s->wheels_rx == wheels0) {
-                if (hs_can_recv(s->can, &f, 1) == 1) {
+                if (lx_can_recv(s->can, &f, 1) == 1) {
                     on_frame(s, &f);
                 }
             } else {
-                (void)hs_lcm_handle(s->lcm, 1);
+                (void)lx_lcm_handle(s->lcm, 1);
             }
         } else {
-            (void)hs_lcm_handle(s->lcm, (int)(left > 100 ? 100 : left));
+            (void)lx_lcm_handle(s->lcm, (int)(left > 100 ? 100 : left));
         }
         answered = s->have_status && s->status_t_us == now_us && s->wheels_rx != wheels0;
     }
@@ -162,8 +162,8 @@ static void cb_close(void *self)
     if (!s) {
         return;
     }
-    hs_can_close(s->can);
-    hs_lcm_close(s->lcm);
+    lx_can_close(s->can);
+    lx_lcm_close(s->lcm);
     free(s);
 }
 
@@ -181,22 +181,22 @@ int hs_ctrl_lcm_open(hs_ctrl_t *c, const hs_ctrl_lcm_cfg_t *cfg, char *err, size
     s->cfg = *cfg;
     rfs_can_rx_cfg_t rc = rfs_can_rx_cfg_default();
     (void)rfs_can_rx_init(&s->rx, &rc);
-    hs_lcm_handlers_t h;
+    lx_lcm_handlers_t h;
     memset(&h, 0, sizeof h);
     h.ctx = s;
     h.on_status = on_status;
     h.on_can = cfg->can_iface ? NULL : on_can;
     h.on_bad = on_bad;
-    s->lcm = hs_lcm_open(cfg->lcm_url, &h, err, errlen);
+    s->lcm = lx_lcm_open(cfg->lcm_url, &h, err, errlen);
     if (!s->lcm) {
         free(s);
         return -1;
     }
     if (cfg->can_iface) {
         const uint32_t ids[] = {RFS_CAN_ID_WHEEL_CMD};
-        s->can = hs_can_open(cfg->can_iface, ids, 1, err, errlen);
+        s->can = lx_can_open(cfg->can_iface, ids, 1, err, errlen);
         if (!s->can) {
-            hs_lcm_close(s->lcm);
+            lx_lcm_close(s->lcm);
             free(s);
             return -1;
         }

@@ -1,8 +1,8 @@
-/* hs_ctrl_lcm.h - the controller in a separate process (issue 4): an hs_ctrl_t that
+/* hs_ctrl_lcm.h - the controller in a separate process: an hs_ctrl_t that
  * publishes the simulated sensors on LCM and takes the wheel commands from CAN.
  *
  * on_pose / on_rssi / on_receiver publish RFS_POSE / RFS_RSSI / RFS_RSSI_STATUS (the
- * receiver heartbeat, issue 10). step(now) publishes RFS_CLOCK(now) and
+ * receiver heartbeat). step(now) publishes RFS_CLOCK(now) and
  * waits for the controller process (rfseekd --clock-lcm) to answer that step: the
  * WHEEL_CMD frame arrives as the simulated motor controller node would see it - from
  * SocketCAN when an interface is given, else from the clearly named LCM fallback channel
@@ -35,7 +35,7 @@ typedef struct hs_ctrl_lcm_cfg {
 hs_ctrl_lcm_cfg_t hs_ctrl_lcm_cfg_default(void);
 
 /// Open. Returns -1 with err = "lcm: ..." / "can: ..." (one line), or 0 with err = "" or
-/// liblcm's warning "lcm: URL: liblcm: ..." (one line, to print; see hs_lcm_open()).
+/// liblcm's warning "lcm: URL: liblcm: ..." (one line, to print; see lx_lcm_open()).
 int hs_ctrl_lcm_open(hs_ctrl_t *c, const hs_ctrl_lcm_cfg_t *cfg, char *err, size_t errlen);
 
 /// Steps that got no answer in time (the wheels were commanded to zero).

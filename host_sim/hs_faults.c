@@ -39,12 +39,12 @@ hs_fault_t hs_faults_default(hs_fault_kind_t k)
     memset(&f, 0, sizeof f);
     f.kind = k;
     f.start_s = 30.0;
-    f.lag_s = 1.0;          // issue 9: timestamps "from the past"; 1 s is 10 pose periods
+    f.lag_s = 1.0;          // timestamps "from the past"; 1 s is 10 pose periods
     f.probability = 0.5;
-    f.x = 3.0;              // issue 9: pose jumps of 3 m
+    f.x = 3.0;              // pose jumps of 3 m
     switch (k) {
-    case HS_FAULT_RSSI_SILENCE: f.duration_s = 30.0; break; // issue 9: silence for 30 s
-    case HS_FAULT_BUS_OFF: f.duration_s = 2.0; break;       // issue 9: a 2 s bus-off
+    case HS_FAULT_RSSI_SILENCE: f.duration_s = 30.0; break; // silence for 30 s
+    case HS_FAULT_BUS_OFF: f.duration_s = 2.0; break;       // a 2 s bus-off
     case HS_FAULT_SOURCE_MOVE:
     case HS_FAULT_KIDNAP: f.duration_s = 0.0; break;
     default: f.duration_s = 30.0; break;

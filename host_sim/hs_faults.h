@@ -1,4 +1,4 @@
-/* hs_faults.h - fault injection in the simulator (issue 9, docs/FAULTS.md).
+/* hs_faults.h - fault injection in the simulator (docs/FAULTS.md).
  *
  * A scenario may carry a schedule of faults (`faults:` in the scenario YAML, parsed by
  * hs_scenario.c). Each fault has a kind, a start time and (for the faults that last) a
@@ -126,7 +126,7 @@ void hs_faults_start(hs_faults_run_t *r, const hs_faults_cfg_t *cfg, uint64_t se
 unsigned hs_faults_rssi(hs_faults_run_t *r, int64_t t_us, uint8_t src, int8_t dbm,
                         hs_faults_msg_t out[2]);
 
-/// The simulated receiver reports itself up at t_us (issue 10, the controller's heartbeat).
+/// The simulated receiver reports itself up at t_us (the controller's heartbeat).
 /// true with *stamp_us = the timestamp the controller sees, as a packet's would be (lagged
 /// by rssi_past, led by rssi_future); false during rssi_silence: a dead receiver or feed
 /// sends no heartbeat either. Logged as a `receiver` row.

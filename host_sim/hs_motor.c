@@ -7,7 +7,7 @@ hs_motor_cfg_t hs_motor_cfg_default(void)
     c.wheel_base_m = 0.23;  // Kobuki wheel base (kobuki_description)
     c.v_max_m_s = 0.7;      // Kobuki maximum translational speed
     c.accel_m_s2 = 1.0;     // our choice, above the core's drive limit so it never binds first
-    c.timeout_us = 200000;  // issue 3: wheels stop 200 ms after the last command
+    c.timeout_us = 200000;  // wheels stop 200 ms after the last command
     return c;
 }
 

@@ -1,4 +1,4 @@
-/* hs_motor.h - the motor-controller model of the simulated base (issue 3).
+/* hs_motor.h - the motor-controller model of the simulated base.
  *
  * Receives wheel speed commands (mm/s, as the core's rfs_seek_out_t carries them), ramps
  * each wheel towards its command at a limited acceleration, and drops the command to

@@ -57,7 +57,7 @@ hs_radio_cfg_t hs_radio_cfg_default(void)
     c.walls = true;
     c.wall_db = 5.0;                           // ns-3 buildings model, internal wall loss
     c.shadowing = true;
-    c.shadow_sigma_db = 4.0;                   // issue 3 default (indoor 3-6 dB)
+    c.shadow_sigma_db = 4.0;                   // indoor 3-6 dB
     c.shadow_dcorr_m = 5.0;                    // Gudmundson 1991 form, indoor scale
     c.shadow_grid_m = 0.5;                     // d_c / 10: bilinear error small at lags >= 0.5 m
     c.shadow_waves = 256;

@@ -7,19 +7,18 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <yaml.h>
 
-#include "hs_err.h"
+#include "lx_err.h"
+#include "lx_yaml.h"
 #include "rfs_models.h"
 
 typedef struct pctx {
-    yaml_document_t doc;
     const char *file;
     char *err;
     size_t errlen;
 } pctx_t;
 
-static int fail(pctx_t *p, const yaml_node_t *n, const char *fmt, ...)
+static int fail(pctx_t *p, const lx_yaml_node_t *n, const char *fmt, ...)
 {
     char msg[512];
     va_list ap;
@@ -27,29 +26,24 @@ static int fail(pctx_t *p, const yaml_node_t *n, const char *fmt, ...)
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
     if (n) {
-        snprintf(p->err, p->errlen, "%s:%lu: %s", p->file, (unsigned long)n->start_mark.line + 1,
+        snprintf(p->err, p->errlen, "%s:%lu: %s", p->file, n->line,
                  msg);
     } else {
         snprintf(p->err, p->errlen, "%s: %s", p->file, msg);
     }
-    hs_err_one_line(p->err); /* a key or value from the YAML can hold line breaks */
+    lx_err_one_line(p->err); /* a key or value from the YAML can hold line breaks */
     return -1;
 }
 
-static const char *scalar(const yaml_node_t *n)
-{
-    return n && n->type == YAML_SCALAR_NODE ? (const char *)n->data.scalar.value : NULL;
-}
-
 /// The mapping must be a mapping whose keys are unique scalars from `allowed`.
-static int check_keys(pctx_t *p, yaml_node_t *m, const char *where, const char *const *allowed)
+static int check_keys(pctx_t *p, const lx_yaml_node_t *m, const char *where, const char *const *allowed)
 {
-    if (!m || m->type != YAML_MAPPING_NODE) {
+    if (!m || m->kind != LX_YAML_MAPPING) {
         return fail(p, m, "%s: expected a mapping", where);
     }
-    for (yaml_node_pair_t *a = m->data.mapping.pairs.start; a < m->data.mapping.pairs.top; a++) {
-        yaml_node_t *k = yaml_document_get_node(&p->doc, a->key);
-        const char *ks = scalar(k);
+    for (size_t a = 0; a < m->n; a++) {
+        const lx_yaml_node_t *k = m->child[2 * a];
+        const char *ks = lx_yaml_scalar(k);
         if (!ks) {
             return fail(p, k, "%s: keys must be plain words", where);
         }
@@ -60,8 +54,8 @@ static int check_keys(pctx_t *p, yaml_node_t *m, const char *where, const char *
         if (!ok) {
             return fail(p, k, "%s: unknown key '%s'", where, ks);
         }
-        for (yaml_node_pair_t *b = m->data.mapping.pairs.start; b < a; b++) {
-            if (strcmp(scalar(yaml_document_get_node(&p->doc, b->key)), ks) == 0) {
+        for (size_t b = 0; b < a; b++) {
+            if (strcmp(lx_yaml_scalar(m->child[2 * b]), ks) == 0) {
                 return fail(p, k, "%s: duplicate key '%s'", where, ks);
             }
         }
@@ -69,20 +63,9 @@ static int check_keys(pctx_t *p, yaml_node_t *m, const char *where, const char *
     return 0;
 }
 
-static yaml_node_t *get(pctx_t *p, yaml_node_t *m, const char *key)
+static int to_num(pctx_t *p, const lx_yaml_node_t *n, const char *where, double lo, double hi, double *out)
 {
-    for (yaml_node_pair_t *a = m->data.mapping.pairs.start; a < m->data.mapping.pairs.top; a++) {
-        const char *ks = scalar(yaml_document_get_node(&p->doc, a->key));
-        if (ks && strcmp(ks, key) == 0) {
-            return yaml_document_get_node(&p->doc, a->value);
-        }
-    }
-    return NULL;
-}
-
-static int to_num(pctx_t *p, yaml_node_t *n, const char *where, double lo, double hi, double *out)
-{
-    const char *s = scalar(n);
+    const char *s = lx_yaml_scalar(n);
     if (!s || !*s) {
         return fail(p, n, "%s: expected a number", where);
     }
@@ -100,10 +83,10 @@ static int to_num(pctx_t *p, yaml_node_t *n, const char *where, double lo, doubl
 }
 
 /// Optional number field `key` of mapping m.
-static int num(pctx_t *p, yaml_node_t *m, const char *where, const char *key, double lo,
+static int num(pctx_t *p, const lx_yaml_node_t *m, const char *where, const char *key, double lo,
                double hi, double *out)
 {
-    yaml_node_t *n = get(p, m, key);
+    const lx_yaml_node_t *n = lx_yaml_get(m, key);
     if (!n) {
         return 0;
     }
@@ -112,13 +95,13 @@ static int num(pctx_t *p, yaml_node_t *m, const char *where, const char *key, do
     return to_num(p, n, w, lo, hi, out);
 }
 
-static int boolean(pctx_t *p, yaml_node_t *m, const char *where, const char *key, bool *out)
+static int boolean(pctx_t *p, const lx_yaml_node_t *m, const char *where, const char *key, bool *out)
 {
-    yaml_node_t *n = get(p, m, key);
+    const lx_yaml_node_t *n = lx_yaml_get(m, key);
     if (!n) {
         return 0;
     }
-    const char *s = scalar(n);
+    const char *s = lx_yaml_scalar(n);
     if (s && (strcmp(s, "true") == 0 || strcmp(s, "yes") == 0 || strcmp(s, "on") == 0)) {
         *out = true;
     } else if (s && (strcmp(s, "false") == 0 || strcmp(s, "no") == 0 || strcmp(s, "off") == 0)) {
@@ -130,10 +113,10 @@ static int boolean(pctx_t *p, yaml_node_t *m, const char *where, const char *key
 }
 
 /// seek.KEY as 0 / 1 when present; *out keeps -1 (the strategy's preset) when absent.
-static int preset_bool(pctx_t *p, yaml_node_t *m, const char *key, int *out)
+static int preset_bool(pctx_t *p, const lx_yaml_node_t *m, const char *key, int *out)
 {
     bool v = false;
-    if (get(p, m, key) == NULL) {
+    if (lx_yaml_get(m, key) == NULL) {
         return 0;
     }
     if (boolean(p, m, "seek", key, &v) != 0) {
@@ -143,14 +126,14 @@ static int preset_bool(pctx_t *p, yaml_node_t *m, const char *key, int *out)
     return 0;
 }
 
-static int str(pctx_t *p, yaml_node_t *m, const char *where, const char *key, char *out,
+static int str(pctx_t *p, const lx_yaml_node_t *m, const char *where, const char *key, char *out,
                size_t cap)
 {
-    yaml_node_t *n = get(p, m, key);
+    const lx_yaml_node_t *n = lx_yaml_get(m, key);
     if (!n) {
         return 0;
     }
-    const char *s = scalar(n);
+    const char *s = lx_yaml_scalar(n);
     if (!s || !*s) {
         return fail(p, n, "%s.%s: expected a word", where, key);
     }
@@ -162,25 +145,24 @@ static int str(pctx_t *p, yaml_node_t *m, const char *where, const char *key, ch
 }
 
 /// A [x, y] pair (required when `need`).
-static int xy(pctx_t *p, yaml_node_t *m, const char *where, const char *key, bool need,
+static int xy(pctx_t *p, const lx_yaml_node_t *m, const char *where, const char *key, bool need,
               double *x, double *y, bool *present)
 {
-    yaml_node_t *n = get(p, m, key);
+    const lx_yaml_node_t *n = lx_yaml_get(m, key);
     if (present) {
         *present = n != NULL;
     }
     if (!n) {
         return need ? fail(p, m, "%s: missing '%s'", where, key) : 0;
     }
-    if (n->type != YAML_SEQUENCE_NODE ||
-        n->data.sequence.items.top - n->data.sequence.items.start != 2) {
+    if (n->kind != LX_YAML_SEQUENCE || n->n != 2) {
         return fail(p, n, "%s.%s: expected [x, y] in metres", where, key);
     }
     char w[128];
     snprintf(w, sizeof w, "%s.%s", where, key);
-    if (to_num(p, yaml_document_get_node(&p->doc, n->data.sequence.items.start[0]), w, -1e5, 1e5,
+    if (to_num(p, n->child[0], w, -1e5, 1e5,
                x) != 0 ||
-        to_num(p, yaml_document_get_node(&p->doc, n->data.sequence.items.start[1]), w, -1e5, 1e5,
+        to_num(p, n->child[1], w, -1e5, 1e5,
                y) != 0) {
         return -1;
     }
@@ -228,9 +210,9 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->pose_sigma_xy_m = 0.05;
     sc->pose_sigma_theta_rad = 0.02;
     sc->radio = hs_radio_cfg_default();
-    sc->rx_heartbeat = true;          // issue 10: a listening receiver reports itself up
+    sc->rx_heartbeat = true;          // a listening receiver reports itself up
     sc->motor = hs_motor_cfg_default();
-    sc->stop_radius_m = 1.5;          // issue 3 stop condition
+    sc->stop_radius_m = 1.5;          // the run ends within 1.5 m of the source
     sc->stop_distance_m = 150.0;
     sc->stop_time_s = 900.0;
     sc->physics_hz = 50.0;
@@ -239,16 +221,16 @@ void hs_scenario_defaults(hs_scenario_t *sc)
 }
 
 /// radio: the radio model, and radio.receiver.heartbeat (the controller's receiver
-/// reports, issue 10), which belongs to the run rather than to the radio model.
-static int parse_radio(pctx_t *p, yaml_node_t *r, hs_radio_cfg_t *c, bool *heartbeat)
+/// reports), which belongs to the run rather than to the radio model.
+static int parse_radio(pctx_t *p, const lx_yaml_node_t *r, hs_radio_cfg_t *c, bool *heartbeat)
 {
     static const char *const top[] = {"pathloss", "walls", "shadowing", "fading", "noise",
                                       "receiver", NULL};
     if (check_keys(p, r, "radio", top) != 0) {
         return -1;
     }
-    yaml_node_t *n;
-    if ((n = get(p, r, "pathloss"))) {
+    const lx_yaml_node_t *n;
+    if ((n = lx_yaml_get(r, "pathloss"))) {
         static const char *const k[] = {"enabled", "exponent", "ref_dist_m", "ref_loss_db", NULL};
         if (check_keys(p, n, "radio.pathloss", k) || boolean(p, n, "radio.pathloss", "enabled", &c->pathloss) ||
             num(p, n, "radio.pathloss", "exponent", 0, 10, &c->exponent) ||
@@ -257,7 +239,7 @@ static int parse_radio(pctx_t *p, yaml_node_t *r, hs_radio_cfg_t *c, bool *heart
             return -1;
         }
     }
-    if ((n = get(p, r, "walls"))) {
+    if ((n = lx_yaml_get(r, "walls"))) {
         static const char *const k[] = {"enabled", "db_per_wall", "cache_m", NULL};
         if (check_keys(p, n, "radio.walls", k) || boolean(p, n, "radio.walls", "enabled", &c->walls) ||
             num(p, n, "radio.walls", "db_per_wall", 0, 100, &c->wall_db) ||
@@ -265,7 +247,7 @@ static int parse_radio(pctx_t *p, yaml_node_t *r, hs_radio_cfg_t *c, bool *heart
             return -1;
         }
     }
-    if ((n = get(p, r, "shadowing"))) {
+    if ((n = lx_yaml_get(r, "shadowing"))) {
         static const char *const k[] = {"enabled", "sigma_db", "dcorr_m", "grid_m", "waves", NULL};
         double waves = c->shadow_waves;
         if (check_keys(p, n, "radio.shadowing", k) ||
@@ -278,7 +260,7 @@ static int parse_radio(pctx_t *p, yaml_node_t *r, hs_radio_cfg_t *c, bool *heart
         }
         c->shadow_waves = (uint32_t)waves;
     }
-    if ((n = get(p, r, "fading"))) {
+    if ((n = lx_yaml_get(r, "fading"))) {
         static const char *const k[] = {"enabled", "wavelength_m", "rician_k_db", "waves", NULL};
         double waves = c->fading_waves;
         if (check_keys(p, n, "radio.fading", k) || boolean(p, n, "radio.fading", "enabled", &c->fading) ||
@@ -289,14 +271,14 @@ static int parse_radio(pctx_t *p, yaml_node_t *r, hs_radio_cfg_t *c, bool *heart
         }
         c->fading_waves = (uint32_t)waves;
     }
-    if ((n = get(p, r, "noise"))) {
+    if ((n = lx_yaml_get(r, "noise"))) {
         static const char *const k[] = {"enabled", "sigma_db", NULL};
         if (check_keys(p, n, "radio.noise", k) || boolean(p, n, "radio.noise", "enabled", &c->noise) ||
             num(p, n, "radio.noise", "sigma_db", 0, 30, &c->noise_sigma_db)) {
             return -1;
         }
     }
-    if ((n = get(p, r, "receiver"))) {
+    if ((n = lx_yaml_get(r, "receiver"))) {
         static const char *const k[] = {"quantise", "clip", "min_dbm", "max_dbm", "loss",
                                         "sensitivity_dbm", "loss_width_db", "heartbeat", NULL};
         if (check_keys(p, n, "radio.receiver", k) ||
@@ -318,19 +300,19 @@ static int parse_radio(pctx_t *p, yaml_node_t *r, hs_radio_cfg_t *c, bool *heart
 }
 
 /// faults: a list of {kind, start_s, duration_s, ...} (hs_faults.h, docs/FAULTS.md).
-static int parse_faults(pctx_t *p, yaml_node_t *n, hs_scenario_t *sc)
+static int parse_faults(pctx_t *p, const lx_yaml_node_t *n, hs_scenario_t *sc)
 {
-    if (n->type != YAML_SEQUENCE_NODE) {
+    if (n->kind != LX_YAML_SEQUENCE) {
         return fail(p, n, "faults: expected a list of faults");
     }
-    long nf = n->data.sequence.items.top - n->data.sequence.items.start;
+    long nf = (long)n->n;
     if (nf > (long)HS_FAULTS_MAX) {
         return fail(p, n, "faults: %ld given, at most %u", nf, HS_FAULTS_MAX);
     }
     static const char *const k[] = {"kind", "start_s", "duration_s", "offset", "position",
                                     "theta", "lag_s", "lead_s", "probability", "source", NULL};
     for (long i = 0; i < nf; i++) {
-        yaml_node_t *f = yaml_document_get_node(&p->doc, n->data.sequence.items.start[i]);
+        const lx_yaml_node_t *f = n->child[i];
         char where[32], kind[32] = "";
         snprintf(where, sizeof where, "faults[%ld]", i);
         if (check_keys(p, f, where, k) || str(p, f, where, "kind", kind, sizeof kind)) {
@@ -338,7 +320,7 @@ static int parse_faults(pctx_t *p, yaml_node_t *n, hs_scenario_t *sc)
         }
         hs_fault_kind_t fk;
         if (!hs_faults_kind_parse(kind, &fk)) {
-            return fail(p, get(p, f, "kind") ? get(p, f, "kind") : f,
+            return fail(p, lx_yaml_get(f, "kind") ? lx_yaml_get(f, "kind") : f,
                         "%s.kind: '%s' is not a fault (rssi_silence, rssi_past, rssi_reorder, "
                         "rssi_future, pose_jump, pose_past, pose_reorder, pose_future, can_drop, "
                         "bus_off, source_move, kidnap)", where, kind);
@@ -357,8 +339,8 @@ static int parse_faults(pctx_t *p, yaml_node_t *n, hs_scenario_t *sc)
             {"theta", 1u << HS_FAULT_KIDNAP},
         };
         for (size_t u = 0; u < sizeof use / sizeof use[0]; u++) {
-            if (get(p, f, use[u].key) && !(use[u].kinds & (1u << fk))) {
-                return fail(p, get(p, f, use[u].key), "%s.%s: does not apply to %s", where,
+            if (lx_yaml_get(f, use[u].key) && !(use[u].kinds & (1u << fk))) {
+                return fail(p, lx_yaml_get(f, use[u].key), "%s.%s: does not apply to %s", where,
                             use[u].key, kind);
             }
         }
@@ -387,7 +369,7 @@ static int parse_faults(pctx_t *p, yaml_node_t *n, hs_scenario_t *sc)
     return 0;
 }
 
-static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
+static int parse_root(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
 {
     static const char *const top[] = {"map", "seed", "model", "target", "strategy", "sources",
                                       "start", "localisation", "radio", "motor", "stop", "sim",
@@ -395,8 +377,8 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
     if (check_keys(p, root, "scenario", top) != 0) {
         return -1;
     }
-    yaml_node_t *n = get(p, root, "map");
-    const char *mp = scalar(n);
+    const lx_yaml_node_t *n = lx_yaml_get(root, "map");
+    const char *mp = lx_yaml_scalar(n);
     if (!mp || !*mp) {
         return fail(p, n ? n : root, "map: missing (path of a map_server YAML)");
     }
@@ -410,8 +392,8 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
         }
         snprintf(sc->map_path, sizeof sc->map_path, "%.*s%s", dl, p->file, mp);
     }
-    if ((n = get(p, root, "seed"))) {
-        const char *s = scalar(n);
+    if ((n = lx_yaml_get(root, "seed"))) {
+        const char *s = lx_yaml_scalar(n);
         char *end;
         errno = 0;
         unsigned long long v = s && *s && *s != '-' ? strtoull(s, &end, 10) : 0;
@@ -425,7 +407,7 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
         str(p, root, "scenario", "strategy", sc->strategy, sizeof sc->strategy)) {
         return -1;
     }
-    if ((n = get(p, root, "seek"))) {
+    if ((n = lx_yaml_get(root, "seek"))) {
         static const char *const k[] = {"recheck_m", "eps_by_travel", "eps_rate",
                                         "eps_geodesic", "recheck_adapt", "p0_min_dbm",
                                         "eps_sample", NULL};
@@ -448,25 +430,25 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
                              rfs_models_at(i)->name);
             used += k > 0 ? (size_t)k : 0;
         }
-        return fail(p, get(p, root, "model"), "model: '%s' is not a known model (%s)", sc->model,
+        return fail(p, lx_yaml_get(root, "model"), "model: '%s' is not a known model (%s)", sc->model,
                     names);
     }
     if (strcmp(sc->target, "rssi") != 0 && strcmp(sc->target, "bridge") != 0 &&
         strcmp(sc->target, "pdr") != 0) {
-        return fail(p, get(p, root, "target"), "target: '%s' is not rssi, bridge or pdr",
+        return fail(p, lx_yaml_get(root, "target"), "target: '%s' is not rssi, bridge or pdr",
                     sc->target);
     }
-    n = get(p, root, "sources");
-    if (!n || n->type != YAML_SEQUENCE_NODE) {
+    n = lx_yaml_get(root, "sources");
+    if (!n || n->kind != LX_YAML_SEQUENCE) {
         return fail(p, n ? n : root, "sources: missing (a list of 1 or 2 sources)");
     }
-    long ns = n->data.sequence.items.top - n->data.sequence.items.start;
+    long ns = (long)n->n;
     if (ns < 1 || ns > (long)HS_SCN_MAX_SOURCES) {
         return fail(p, n, "sources: %ld given, need 1 or %u", ns, HS_SCN_MAX_SOURCES);
     }
     sc->nsources = (unsigned)ns;
     for (long i = 0; i < ns; i++) {
-        yaml_node_t *s = yaml_document_get_node(&p->doc, n->data.sequence.items.start[i]);
+        const lx_yaml_node_t *s = n->child[i];
         static const char *const k[] = {"name", "position", "mac", "rate_hz", "tx_dbm", NULL};
         char where[32];
         snprintf(where, sizeof where, "sources[%ld]", i);
@@ -482,18 +464,18 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
             num(p, s, where, "tx_dbm", -50, 50, &src->tx_dbm)) {
             return -1;
         }
-        yaml_node_t *m = get(p, s, "mac");
-        if (m && hs_scenario_parse_mac(scalar(m), src->mac) != 0) {
+        const lx_yaml_node_t *m = lx_yaml_get(s, "mac");
+        if (m && hs_scenario_parse_mac(lx_yaml_scalar(m), src->mac) != 0) {
             return fail(p, m, "%s.mac: expected aa:bb:cc:dd:ee:ff", where);
         }
     }
     if (strcmp(sc->target, "bridge") == 0 && sc->nsources != 2) {
-        return fail(p, get(p, root, "target"), "target: bridge needs exactly 2 sources");
+        return fail(p, lx_yaml_get(root, "target"), "target: bridge needs exactly 2 sources");
     }
     if (strcmp(sc->target, "bridge") != 0 && sc->nsources != 1) {
-        return fail(p, get(p, root, "target"), "target: %s needs exactly 1 source", sc->target);
+        return fail(p, lx_yaml_get(root, "target"), "target: %s needs exactly 1 source", sc->target);
     }
-    n = get(p, root, "start");
+    n = lx_yaml_get(root, "start");
     if (!n) {
         return fail(p, root, "start: missing ({position: [x, y], theta: radians})");
     }
@@ -505,7 +487,7 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
             return -1;
         }
     }
-    if ((n = get(p, root, "localisation"))) {
+    if ((n = lx_yaml_get(root, "localisation"))) {
         static const char *const k[] = {"rate_hz", "sigma_xy_m", "sigma_theta_rad", NULL};
         if (check_keys(p, n, "localisation", k) ||
             num(p, n, "localisation", "rate_hz", 1, 1000, &sc->pose_rate_hz) ||
@@ -514,10 +496,10 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
             return -1;
         }
     }
-    if ((n = get(p, root, "radio")) && parse_radio(p, n, &sc->radio, &sc->rx_heartbeat) != 0) {
+    if ((n = lx_yaml_get(root, "radio")) && parse_radio(p, n, &sc->radio, &sc->rx_heartbeat) != 0) {
         return -1;
     }
-    if ((n = get(p, root, "motor"))) {
+    if ((n = lx_yaml_get(root, "motor"))) {
         static const char *const k[] = {"accel_m_s2", "timeout_ms", "v_max_m_s", "wheel_base_m",
                                         NULL};
         double to_ms = sc->motor.timeout_us / 1000.0;
@@ -530,7 +512,7 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
         }
         sc->motor.timeout_us = (int64_t)llround(to_ms * 1000.0);
     }
-    if ((n = get(p, root, "stop"))) {
+    if ((n = lx_yaml_get(root, "stop"))) {
         static const char *const k[] = {"radius_m", "max_distance_m", "max_time_s", "goal", NULL};
         if (check_keys(p, n, "stop", k) || num(p, n, "stop", "radius_m", 0, 1e4, &sc->stop_radius_m) ||
             num(p, n, "stop", "max_distance_m", 0, 1e6, &sc->stop_distance_m) ||
@@ -547,7 +529,7 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
         sc->goal_x = sc->src[0].x;
         sc->goal_y = sc->src[0].y;
     }
-    if ((n = get(p, root, "sim"))) {
+    if ((n = lx_yaml_get(root, "sim"))) {
         static const char *const k[] = {"physics_hz", "core_res_m", "clearance_m", NULL};
         if (check_keys(p, n, "sim", k) || num(p, n, "sim", "physics_hz", 10, 1000, &sc->physics_hz) ||
             num(p, n, "sim", "core_res_m", 0.02, 1, &sc->core_res_m) ||
@@ -555,12 +537,12 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
             return -1;
         }
     }
-    if ((n = get(p, root, "faults")) && parse_faults(p, n, sc) != 0) {
+    if ((n = lx_yaml_get(root, "faults")) && parse_faults(p, n, sc) != 0) {
         return -1;
     }
     char rerr[256];
     if (hs_radio_cfg_check(&sc->radio, rerr, sizeof rerr) != 0) {
-        return fail(p, get(p, root, "radio"), "%s", rerr);
+        return fail(p, lx_yaml_get(root, "radio"), "%s", rerr);
     }
     return 0;
 }
@@ -579,30 +561,23 @@ static int load(const char *path, hs_scenario_t *sc, char *err, size_t errlen)
         return -1;
     }
     pctx_t p = {.file = path, .err = err, .errlen = errlen};
-    yaml_parser_t parser;
-    if (!yaml_parser_initialize(&parser)) {
-        fclose(f);
-        snprintf(err, errlen, "%s: out of memory", path);
-        return -1;
-    }
-    yaml_parser_set_input_file(&parser, f);
+    lx_yaml_doc_t doc;
+    lx_yaml_error_t ye;
+    const lx_yaml_rc_t yrc = lx_yaml_load_file(f, &doc, &ye);
     int rc = -1;
-    if (!yaml_parser_load(&parser, &p.doc)) {
-        snprintf(err, errlen, "%s:%lu: YAML syntax error: %s", path,
-                 (unsigned long)parser.problem_mark.line + 1,
-                 parser.problem ? parser.problem : "unknown");
-        yaml_parser_delete(&parser);
-        fclose(f);
-        return -1;
-    }
-    yaml_node_t *root = yaml_document_get_root_node(&p.doc);
-    if (!root) {
+    if (yrc == LX_YAML_NOMEM) {
+        snprintf(err, errlen, "%s: out of memory", path);
+    } else if (yrc == LX_YAML_TOO_BIG) {
+        snprintf(err, errlen, "%s: more than %u YAML nodes", path, LX_YAML_MAX_NODES);
+    } else if (yrc != LX_YAML_OK) {
+        snprintf(err, errlen, "%s:%lu: YAML syntax error: %s", path, ye.line,
+                 ye.problem ? ye.problem : "unknown");
+    } else if (!doc.root) {
         snprintf(err, errlen, "%s: empty file", path);
     } else {
-        rc = parse_root(&p, root, sc);
+        rc = parse_root(&p, doc.root, sc);
     }
-    yaml_document_delete(&p.doc);
-    yaml_parser_delete(&parser);
+    lx_yaml_free(&doc);
     fclose(f);
     return rc;
 }
@@ -611,7 +586,7 @@ int hs_scenario_load(const char *path, hs_scenario_t *sc, char *err, size_t errl
 {
     const int rc = load(path, sc, err, errlen);
     if (rc != 0 && errlen > 0) {
-        hs_err_one_line(err); /* the file name can hold line breaks (an unopenable path too) */
+        lx_err_one_line(err); /* the file name can hold line breaks (an unopenable path too) */
     }
     return rc;
 }

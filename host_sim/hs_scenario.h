@@ -85,7 +85,7 @@ typedef struct hs_scenario {
     double pose_sigma_theta_rad;  ///< heading noise, radians (0.02)
     hs_radio_cfg_t radio;         ///< radio model
     bool rx_heartbeat;            ///< radio.receiver.heartbeat: the controller is told the
-                                  ///< receiver is up every control period (true; issue 10)
+                                  ///< receiver is up every control period (true)
     hs_motor_cfg_t motor;         ///< motor-controller model
     double stop_radius_m;         ///< reached within this of the goal (1.5; 0 = off)
     double stop_distance_m;       ///< stop after this much travel (150; 0 = off)

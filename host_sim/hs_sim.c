@@ -8,7 +8,7 @@
 
 #include "hs_motor.h"
 #include "hs_radio.h"
-#include "hs_world.h"
+#include "hs_box2d.h"
 #include "rfs_pdr.h"
 #include "rfs_plan.h"
 
@@ -180,7 +180,7 @@ static int legal_dijkstra(const rfs_map_t *m, long sx, long sy, double *dist)
 
 // --- environment ------------------------------------------------------------------------
 
-static bool cell_of(const hs_map_t *m, double x, double y, uint32_t *cx, uint32_t *cy)
+static bool cell_of(const lx_map_t *m, double x, double y, uint32_t *cx, uint32_t *cy)
 {
     double fx = (x - m->origin_x) / m->res, fy = (y - m->origin_y) / m->res;
     if (!(fx >= 0.0 && fy >= 0.0 && fx < m->w && fy < m->h)) {
@@ -200,9 +200,9 @@ static int check_point(const hs_sim_env_t *e, const char *field, double x, doubl
         return -1;
     }
     uint8_t c = e->map.cell[(size_t)cy * e->map.w + cx];
-    if (c != HS_CELL_FREE) {
+    if (c != LX_CELL_FREE) {
         snprintf(err, errlen, "%s: %s: (%.2f, %.2f) is inside a wall (%s cell)", e->sc.path,
-                 field, x, y, c == HS_CELL_OCC ? "occupied" : "unknown");
+                 field, x, y, c == LX_CELL_OCC ? "occupied" : "unknown");
         return -1;
     }
     return 0;
@@ -213,7 +213,7 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
     memset(e, 0, sizeof *e);
     e->sc = *sc;
     char merr[512];
-    if (hs_map_load(sc->map_path, &e->map, merr, sizeof merr) != 0) {
+    if (lx_map_load(sc->map_path, &e->map, merr, sizeof merr) != 0) {
         snprintf(err, errlen, "%s: map: %s", sc->path, merr);
         return -1;
     }
@@ -223,7 +223,7 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
     e->y1 = e->map.origin_y + e->map.h * e->map.res;
     rfs_map_cfg_t mc = rfs_map_cfg_default();
     mc.clearance = (rfs_q16_t)lround(sc->clearance_m * 65536.0);
-    if (hs_map_to_core(&e->map, sc->core_res_m, &mc, &e->core, merr, sizeof merr) != 0) {
+    if (lx_map_to_core(&e->map, sc->core_res_m, &mc, &e->core, merr, sizeof merr) != 0) {
         snprintf(err, errlen, "%s: map: %s: %s", sc->path, sc->map_path, merr);
         hs_sim_env_close(e);
         return -1;
@@ -345,15 +345,15 @@ void hs_sim_env_close(hs_sim_env_t *e)
         free(e->wall_cache[s]);
         e->wall_cache[s] = NULL;
     }
-    hs_core_map_free(&e->core);
-    hs_map_free(&e->map);
+    lx_core_map_free(&e->core);
+    lx_map_free(&e->map);
 }
 
 // --- the run loop -------------------------------------------------------------------------
 
 static unsigned walls_cb(void *ctx, double x0, double y0, double x1, double y1)
 {
-    return hs_world_walls_crossed(ctx, x0, y0, x1, y1);
+    return hs_box2d_walls_crossed(ctx, x0, y0, x1, y1);
 }
 
 static const char *kind_name(rfs_seek_kind_t k)
@@ -480,17 +480,17 @@ static void write_residual(FILE *f, const hs_ctrl_t *ctrl)
  * (the run edits it when a fault moves a source). NULL with err set on failure. */
 static hs_radio_t *world_radio_open(const hs_sim_env_t *e, uint64_t seed, bool place_robot,
                                     hs_radio_src_t rs[HS_SCN_MAX_SOURCES],
-                                    hs_world_t **world_out, char *err, size_t errlen)
+                                    hs_box2d_t **world_out, char *err, size_t errlen)
 {
     const hs_scenario_t *sc = &e->sc;
     char werr[256];
-    hs_world_t *world = hs_world_create(&e->map, NULL, werr, sizeof werr);
+    hs_box2d_t *world = hs_box2d_create(&e->map, NULL, werr, sizeof werr);
     if (!world) {
         snprintf(err, errlen, "%s: %s", sc->path, werr);
         return NULL;
     }
     if (place_robot) {
-        hs_world_place_robot(world, sc->start_x, sc->start_y, sc->start_theta);
+        hs_box2d_place_robot(world, sc->start_x, sc->start_y, sc->start_theta);
     }
     for (unsigned s = 0; s < sc->nsources; s++) {
         rs[s] = (hs_radio_src_t){sc->src[s].x, sc->src[s].y, sc->src[s].tx_dbm};
@@ -498,7 +498,7 @@ static hs_radio_t *world_radio_open(const hs_sim_env_t *e, uint64_t seed, bool p
     hs_radio_t *radio = hs_radio_create(&sc->radio, rs, sc->nsources, e->x0, e->y0, e->x1, e->y1,
                                         seed, walls_cb, world, werr, sizeof werr);
     if (!radio) {
-        hs_world_destroy(world);
+        hs_box2d_destroy(world);
         snprintf(err, errlen, "%s: %s", sc->path, werr);
         return NULL;
     }
@@ -518,7 +518,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     res->seed = seed;
     char werr[256];
     hs_radio_src_t rs[HS_SCN_MAX_SOURCES];
-    hs_world_t *world;
+    hs_box2d_t *world;
     hs_radio_t *radio = world_radio_open(e, seed, true, rs, &world, err, errlen);
     if (!radio) {
         return -1;
@@ -526,7 +526,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     hs_motor_t motor;
     if (hs_motor_init(&motor, &sc->motor) != 0) {
         hs_radio_destroy(radio);
-        hs_world_destroy(world);
+        hs_box2d_destroy(world);
         snprintf(err, errlen, "%s: motor: parameters must be positive", sc->path);
         return -1;
     }
@@ -559,7 +559,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
         }
         if (!pdr) {
             hs_radio_destroy(radio);
-            hs_world_destroy(world);
+            hs_box2d_destroy(world);
             snprintf(err, errlen, "%s: out of memory", sc->path);
             return -1;
         }
@@ -594,7 +594,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     }
 
     double px, py, pth;
-    hs_world_robot_pose(world, &px, &py, &pth);
+    hs_box2d_robot_pose(world, &px, &py, &pth);
     int64_t t = 0;
     double travelled = 0.0;
     const char *end = "time";
@@ -602,9 +602,9 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
         double v, w;
         hs_motor_update(&motor, t + dt_us, dt_s, &v, &w);
         hs_faults_motor(&fr, t, motor.timed_out); // the target this tick, [t, t + dt]
-        hs_world_step(world, v, w, dt_s);
+        hs_box2d_step(world, v, w, dt_s);
         double nx, ny, nth;
-        hs_world_robot_pose(world, &nx, &ny, &nth);
+        hs_box2d_robot_pose(world, &nx, &ny, &nth);
         double seg = sqrt((nx - px) * (nx - px) + (ny - py) * (ny - py));
         const int64_t t1 = t + dt_us;
         const double dth = wrap_pi(nth - pth);
@@ -676,7 +676,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
                 }
                 if (io && io->track) {
                     fprintf(io->track, "%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%.4f\t%d\n", te * 1e-6,
-                            ex, ey, eth, mx, my, mth, hs_world_robot_touching(world) ? 1 : 0);
+                            ex, ey, eth, mx, my, mth, hs_box2d_robot_touching(world) ? 1 : 0);
                 }
             } else {
                 ctrl_k++;
@@ -730,8 +730,8 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
         while (hs_faults_next_event(&fr, t, &fev)) {
             if (fev.kind == HS_FAULT_KIDNAP) {
                 // Carried away between two ticks: no travel, the wheels keep their command.
-                hs_world_place_robot(world, fev.x, fev.y, fev.theta);
-                hs_world_robot_pose(world, &px, &py, &pth);
+                hs_box2d_place_robot(world, fev.x, fev.y, fev.theta);
+                hs_box2d_robot_pose(world, &px, &py, &pth);
                 continue;
             }
             rs[fev.source].x = fev.x;
@@ -742,7 +742,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
             if (!moved) {
                 free(pdr);
                 hs_radio_destroy(radio);
-                hs_world_destroy(world);
+                hs_box2d_destroy(world);
                 snprintf(err, errlen, "%s: %s", sc->path, werr);
                 return -1;
             }
@@ -790,7 +790,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     }
     free(pdr);
     hs_radio_destroy(radio);
-    hs_world_destroy(world);
+    hs_box2d_destroy(world);
     res->wall_time_s = now_s() - t_wall0;
     res->cpu_time_s = cpu_s() - t_cpu0;
     return 0;
@@ -852,7 +852,7 @@ int hs_sim_field(const hs_sim_env_t *e, uint64_t seed, unsigned src, double step
         return -1;
     }
     hs_radio_src_t rs[HS_SCN_MAX_SOURCES];
-    hs_world_t *world;
+    hs_box2d_t *world;
     hs_radio_t *radio = world_radio_open(e, seed, false, rs, &world, err, errlen);
     if (!radio) {
         return -1;
@@ -866,7 +866,7 @@ int hs_sim_field(const hs_sim_env_t *e, uint64_t seed, unsigned src, double step
             // NOLINTEND(cert-flp30-c,clang-analyzer-security.FloatLoopCounter)
             uint32_t cx, cy;
             if (!cell_of(&e->map, x, y, &cx, &cy) ||
-                e->map.cell[(size_t)cy * e->map.w + cx] != HS_CELL_FREE) {
+                e->map.cell[(size_t)cy * e->map.w + cx] != LX_CELL_FREE) {
                 continue;
             }
             int dbm;
@@ -881,7 +881,7 @@ int hs_sim_field(const hs_sim_env_t *e, uint64_t seed, unsigned src, double step
         }
     }
     hs_radio_destroy(radio);
-    hs_world_destroy(world);
+    hs_box2d_destroy(world);
     return 0;
 }
 

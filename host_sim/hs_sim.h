@@ -21,15 +21,15 @@
 #include <stdio.h>
 
 #include "hs_ctrl.h"
-#include "hs_map.h"
+#include "lx_map.h"
 #include "hs_scenario.h"
 
 /// What stays the same for every seed of a scenario: the map, its core grids, and the
 /// shortest path from the start to the goal.
 typedef struct hs_sim_env {
     hs_scenario_t sc;          ///< the scenario
-    hs_map_t map;              ///< the map at its own resolution
-    hs_core_map_t core;        ///< the core's grids (core_res_m, clearance_m)
+    lx_map_t map;              ///< the map at its own resolution
+    lx_core_map_t core;        ///< the core's grids (core_res_m, clearance_m)
     double shortest_path_m;    ///< start to the legal point nearest the goal, around walls (NaN: no goal)
     double shortest_to_stop_m; ///< start to the first legal point within stop_radius_m (NaN: no goal)
     double x0, y0, x1, y1;     ///< the map's extent, metres
@@ -70,7 +70,7 @@ typedef struct hs_sim_result {
     uint32_t motor_timeouts;     ///< times the motor model stopped on a missing command
     double wall_time_s;          ///< host time the run took (not part of determinism)
     double cpu_time_s;           ///< CPU time of this process during the run
-    /// The path-loss model's final estimate (issue 10); false for other models or no fit.
+    /// The path-loss model's final estimate; false for other models or no fit.
     bool est_valid;
     double est_x, est_y;         ///< estimated source, metres
     double est_n;                ///< path-loss exponent
@@ -104,7 +104,7 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
 int hs_sim_field(const hs_sim_env_t *e, uint64_t seed, unsigned src, double step_m, FILE *f,
                  char *err, size_t errlen);
 
-/// The last columns of log.tsv (issue 10): the path-loss model's estimate at a decision.
+/// The last columns of log.tsv: the path-loss model's estimate at a decision.
 #define HS_SIM_LOG_EST_COLUMNS "est_src_x_m\test_src_y_m\test_n\test_w_db\test_p0\test_area_m2"
 
 /// End a log.tsv decision row: a tab, the HS_SIM_LOG_EST_COLUMNS values (source m, n,

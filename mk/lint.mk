@@ -1,8 +1,13 @@
-# mk/lint.mk - static analysis (issue 9, docs/RELIABILITY.md): cppcheck and clang-tidy over
-# common/, firmware/ and host_sim/ with the documented check set; must end clean.
+# mk/lint.mk - static analysis (docs/RELIABILITY.md): cppcheck and clang-tidy over common/,
+# firmware/ and host_sim/ with the documented check set, and the layer check (includes go
+# host_sim -> firmware/port/linux -> firmware -> common, never back; each outside library
+# from its one adapter); must end clean.
 #   make lint [LINT_JOBS=2]
-# Needs the generated LCM headers ($(BUILD)/gen; the list is from mk/fuzz.mk, read first).
+# clang-tidy needs the generated LCM headers.
 LINT_JOBS ?= 2
 .PHONY: lint
-lint: $(FUZZ_LCM_GEN_HDRS)
+lint: $(LCM_GEN_HDRS)
+	@scripts/check_layers.sh
 	@LINT_JOBS=$(LINT_JOBS) scripts/lint/run_lint.sh $(BUILD) cppcheck clang-tidy
+
+$(eval $(call test_script,layers,scripts/check_layers.sh,))

@@ -1,28 +1,110 @@
-# mk/sim.mk - the host simulator (issue 3): Box2D world, radio model, scenarios,
-# rfseek-sim, its tests, `make demo` and `make bench-sim`.
-HOST_LDLIBS += -lbox2d $(shell pkg-config --libs yaml-0.1)
+# mk/sim.mk - the simulator (host_sim/): Box2D world, radio model, scenarios, faults,
+# controller, as librfs_sim.a (on top of the Linux port's librfs_linux.a); its programs
+# (host_sim/prog/: rfseek-sim, rfseek-sim-lcm, rfseek-feed, rfseek-map, rfseek-record),
+# their tests, the pcap feeder's tests, `make demo`, `make maps` and `make sweep`
+# (docs/SIMULATOR.md, docs/FEEDER.md, docs/FAULTS.md).
+SIM_SRCS := $(sort $(wildcard host_sim/*.c))
+SIM_CXX_SRCS := $(sort $(wildcard host_sim/*.cpp))
+SIM_CFLAGS := $(HOST_CFLAGS) $(INC_sim)
+SIM_CXXFLAGS := $(HOST_CXXFLAGS) $(INC_sim)
+SIM_PROGS := $(patsubst host_sim/prog/%.c,$(BUILD)/bin/%,$(sort $(wildcard host_sim/prog/*.c)))
 
-# CMocka tests of the simulator's parts (tests/host_sim/test_{radio,world,sim}.c).
-SIM_CMOCKA := $(patsubst tests/host_sim/%.c,%,$(wildcard tests/host_sim/test_radio.c tests/host_sim/test_world.c tests/host_sim/test_sim.c))
-$(foreach t,$(SIM_CMOCKA),$(eval $(call cmocka_test,$(t),tests/host_sim/$(t).c,)))
+$(BUILD)/obj/host_sim/%.o: host_sim/%.c | $(LCM_GEN_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(SIM_CFLAGS) $(DEPFLAGS) -c $< -o $@
+$(BUILD)/obj/host_sim/%.o: host_sim/%.cpp
+	@mkdir -p $(@D)
+	$(CXX) $(SIM_CXXFLAGS) $(DEPFLAGS) -c $< -o $@
+$(BUILD)/asan/obj/host_sim/%.o: host_sim/%.c | $(LCM_GEN_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(SIM_CFLAGS) -O1 $(SAN_FLAGS) $(DEPFLAGS) -c $< -o $@
+$(BUILD)/asan/obj/host_sim/%.o: host_sim/%.cpp
+	@mkdir -p $(@D)
+	$(CXX) $(SIM_CXXFLAGS) -O1 $(SAN_FLAGS) $(DEPFLAGS) -c $< -o $@
 
-# The command-line program on good and bad scenarios (PASS/FAIL lines).
-ifneq ($(wildcard tests/host_sim/sim_cli.sh),)
-TEST_SCRIPTS += 'tests/host_sim/sim_cli.sh $(BUILD)/bin/rfseek-sim'
-endif
+$(SIM_LIB): $(SIM_SRCS:%.c=$(BUILD)/obj/%.o) $(SIM_CXX_SRCS:%.cpp=$(BUILD)/obj/%.o)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
+$(SIM_ASAN_LIB): $(SIM_SRCS:%.c=$(BUILD)/asan/obj/%.o) $(SIM_CXX_SRCS:%.cpp=$(BUILD)/asan/obj/%.o)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
 
+# Programs link with g++: the Box2D adapter is C++.
+$(SIM_PROGS): $(BUILD)/bin/%: $(BUILD)/obj/host_sim/prog/%.o $(LIBS_sim)
+	@mkdir -p $(@D)
+	$(LD_sim) -o $@ $< $(LIBS_sim) $(LDLIBS_sim)
+# rfseek-sim and rfseek-feed under ASan+UBSan (the sweep; the feeder's bad-input and replay
+# tests, whose --pose runs the simulator's controller).
+SWEEP_SIM := $(BUILD)/asan/bin/rfseek-sim
+FEED_ASAN := $(FEED)/asan/rfseek-feed
+$(SWEEP_SIM): $(BUILD)/asan/obj/host_sim/prog/rfseek-sim.o $(ASAN_LIBS_sim)
+	@mkdir -p $(@D)
+	$(LD_sim) $(SAN_FLAGS) -o $@ $< $(ASAN_LIBS_sim) $(LDLIBS_sim)
+$(FEED_ASAN): $(BUILD)/asan/obj/host_sim/prog/rfseek-feed.o $(ASAN_LIBS_sim)
+	@mkdir -p $(@D)
+	$(LD_sim) $(SAN_FLAGS) -o $@ $< $(ASAN_LIBS_sim) $(LDLIBS_sim)
+
+ALL_TARGETS += $(SIM_LIB) $(SIM_PROGS)
+
+# --- tests of the simulator --------------------------------------------------------------
+$(eval $(call cmocka_test,test_radio,tests/host_sim/test_radio.c,sim))
+$(eval $(call cmocka_test,test_box2d,tests/host_sim/test_box2d.c,sim))
+$(eval $(call cmocka_test,test_sim,tests/host_sim/test_sim.c,sim))
+# The fault hooks alone and whole runs of the open-hall fault scenarios, log read back.
+$(eval $(call cmocka_test,test_faults,tests/host_sim/test_faults.c,sim))
+
+SIM := $(BUILD)/bin/rfseek-sim
+# rfseek-sim on good and bad scenarios; on every fault scenario for 3 seeds and bad
+# `faults:` sections; every strategy's options; the path-loss estimate in log.tsv,
+# summary.json and residual.tsv; rfseek-map on a real map and on bad input.
+$(eval $(call test_script,sim_cli,tests/host_sim/sim_cli.sh $(SIM),$(SIM)))
+$(eval $(call test_script,faults,tests/host_sim/faults.sh $(SIM) 3,$(SIM)))
+$(eval $(call test_script,strategy_cli,tests/host_sim/strategy_cli.sh $(SIM),$(SIM)))
+$(eval $(call test_script,pathloss_out,tests/host_sim/pathloss_out.sh $(SIM),$(SIM)))
+$(eval $(call test_script,rfseek_map,tests/host_sim/test_rfseek_map.sh $(BUILD)/bin/rfseek-map,$(BUILD)/bin/rfseek-map))
+# rfseekd --model pathloss fills the estimate in its status (two-process run in a netns).
+$(eval $(call test_script,status_est,tests/host_sim/status_est.sh $(BUILD),$(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
+# Every program's model and target options and scenario keys, good and bad values; PDR
+# seeking in the simulator and PDR replay of real captures against tshark; the MLP
+# bit-identical on the emulated Cortex-M4 (docs/MODELS.md, "Choosing a model").
+$(eval $(call test_script,models_cli,tests/host_sim/test_models_cli.sh $(BUILD),$(SIM) $(BUILD)/bin/rfseek-feed $(FEED_ASAN) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-record $(BUILD)/bin/rfseek-replay $(FW_IMAGES)))
+# The receiver heartbeat through rfseek-record/-replay and the emulator image, and through
+# the pcap feeder's replay (every captured frame proves the receiver alive).
+$(eval $(call test_script,heartbeat_replay,tests/wire/heartbeat_replay.sh $(BUILD),$(BUILD)/bin/rfseek-record $(BUILD)/bin/rfseek-replay $(FW_IMAGES)))
+$(eval $(call test_script,feed_heartbeat,$(PYTHON) tests/wire/feed_heartbeat.py $(FEED_ASAN),$(FEED_ASAN)))
+# The simulator under ASan+UBSan, 3 seeds of the default and three fault scenarios.
+$(eval $(call test_script,sweep,scripts/san_sweep.sh $(SWEEP_SIM) 3 scenarios/default.yaml scenarios/faults/office-kidnap.yaml scenarios/faults/office-rssi_silence.yaml scenarios/faults/office-bus_off.yaml,$(SWEEP_SIM)))
+
+# --- the pcap feeder (rfseek-feed) ---------------------------------------------------------
+# Captures in many radiotap / 802.11 layouts (python, independent of our code) and one
+# written by our writer (lx_pcap_writer).
+$(FEED)/feed_writegen: tests/feed/feed_writegen.c $(LIBS_linux)
+	@mkdir -p $(@D)
+	$(LD_linux) $(HOST_CFLAGS) $(INC_linux) $(DEPFLAGS) -MF $@.d -MT $@ $< -o $@ $(LIBS_linux) $(LDLIBS_linux)
+$(FEED)/gen/.stamp: scripts/gen_captures.py $(FEED)/feed_writegen
+	@rm -rf $(FEED)/gen && mkdir -p $(FEED)/gen
+	$(PYTHON) scripts/gen_captures.py $(FEED)/gen
+	$(FEED)/feed_writegen $(FEED)/gen/writer.pcap 2000 > $(FEED)/gen/writer.pcap.macs
+	@touch $@
+$(eval $(call test_script,feed_cross_check,tests/feed/cross_check.sh $(BUILD)/bin/rfseek-feed tests/data/captures/*.pcap $(FEED)/gen/*.pcap $(FEED)/gen/*.pcapng,$(BUILD)/bin/rfseek-feed $(FEED)/gen/.stamp))
+$(eval $(call test_script,feed_bad_input,tests/feed/bad_input.sh $(FEED_ASAN) $(FEED)/gen,$(FEED_ASAN) $(FEED)/gen/.stamp))
+$(eval $(call test_script,feed_replay,$(PYTHON) tests/feed/replay_test.py $(FEED_ASAN),$(FEED_ASAN)))
+
+# --- goals ---------------------------------------------------------------------------------
 # Scenario maps are generated by scripts/make_maps.py and committed; `make maps` redoes it.
-.PHONY: maps
+.PHONY: maps demo sweep
 maps:
 	$(PYTHON) scripts/make_maps.py scenarios/maps
 
 # The default scenario with the paper's figures (figures 2 to 4) in out/demo/.
 demo: deps
-	@$(MAKE) --no-print-directory BUILD=$(BUILD) $(BUILD)/bin/rfseek-sim
+	@$(MAKE) --no-print-directory BUILD=$(BUILD) $(SIM)
 	BUILD=$(BUILD) scripts/demo.sh out/demo
 
-# Real-time factor of one robot and one 200 pkt/s source on one core; a 200-seed batch.
-.PHONY: bench-sim
-bench-sim: $(BUILD)/bin/rfseek-sim
-	@scripts/bench_sim.sh $(BUILD)/bin/rfseek-sim
-BENCH_TARGETS += bench-sim
+# The simulator under ASan+UBSan over many seeds: zero sanitizer reports allowed
+# (docs/RELIABILITY.md). Faults enabled: the office with each fault of scenarios/faults/.
+#   make sweep [SWEEP_SEEDS=200] [SWEEP_SCENARIOS="scenarios/default.yaml ..."]
+SWEEP_SEEDS ?= 200
+SWEEP_SCENARIOS ?= scenarios/default.yaml $(sort $(wildcard scenarios/faults/office-*.yaml))
+sweep: $(SWEEP_SIM)
+	@scripts/san_sweep.sh $(SWEEP_SIM) $(SWEEP_SEEDS) $(SWEEP_SCENARIOS)

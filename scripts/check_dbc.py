@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Check can/rfseek.dbc against frames encoded by our C code (issue 4).
+"""Check can/rfseek.dbc against frames encoded by our C code.
 
 Loads the DBC with canmatrix (an independent implementation of the format), reads
 "ID#HEX Field=raw ..." lines produced by build/.../can_vectors, decodes each frame's

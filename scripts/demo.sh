@@ -2,7 +2,7 @@
 # demo.sh - run the default scenario and draw the paper's figures 2 to 4 (make demo).
 #   scripts/demo.sh [OUTDIR]      (default out/demo; uses $BUILD/bin/rfseek-sim)
 # The run goes to OUTDIR/run (replaced), the figures to OUTDIR/*.png.
-# A second run with the map-aware path-loss model (issue 10: --model pathloss --strategy
+# A second run with the map-aware path-loss model (--model pathloss --strategy
 # meta-path) goes to OUTDIR/pathloss/run, its figures (with residual.png) to OUTDIR/pathloss.
 set -euo pipefail
 OUT=${1:-out/demo}

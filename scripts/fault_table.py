@@ -24,8 +24,8 @@ import subprocess
 import sys
 import tempfile
 
-# Per faults.tsv: commands, commands with an input older than 200 ms (a receiver heartbeat,
-# issue 10, keeps the RSSI stream fresh like a packet), non-zero ones among them, and the
+# Per faults.tsv: commands, commands with an input older than 200 ms (a receiver heartbeat
+# keeps the RSSI stream fresh like a packet), non-zero ones among them, and the
 # longest wait from the last delivered command to a motor timeout (seconds).
 AWK = r'''
 BEGIN { FS = "\t"; pm = -1e18; rm = -1e18; ld = -1e18; worst = 0 }

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Generate radiotap captures in many field layouts for the feeder cross-check (issue 5).
+"""Generate radiotap captures in many field layouts for the feeder cross-check.
 
 Pure python, writing pcap / pcapng bytes directly (no code under test involved), so
 tshark is the independent reader the feeder's output is compared with. Deterministic:

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""map2c.py - bake a map into the firmware image as const bit grids (issue 6).
+"""map2c.py - bake a map into the firmware image as const bit grids.
 
     map2c.py MAP.yaml [--res 0.1] -o OUT.c      a ROS map_server map (yaml + PGM)
     map2c.py --box W H [--res 0.1] -o OUT.c     an empty W x H m room (walls round it)

@@ -11,7 +11,7 @@ and field.tsv when run with --field). Writes into DIR (default RUNDIR):
                   moving average over 1 m                               (paper figs. 3, 4 bottom)
   hexbin.png      hexagonal histogram of the simulated field: mean RSSI per hexagon of
                   about 0.6 m (larger than the wavelength, as the paper's) (paper fig. 2)
-  residual.png    with residual.tsv (--model pathloss, issue 10): the path-loss fit's RMS
+  residual.png    with residual.tsv (--model pathloss): the path-loss fit's RMS
                   residual over the coarse candidate source positions as a heat map on the
                   map, with the true source (red star), the final estimate (white cross),
                   its uncertainty area and the trajectory

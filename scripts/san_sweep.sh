@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # san_sweep.sh - run the ASan+UBSan build of rfseek-sim over seeds 1..N of each scenario and
-# require zero sanitizer reports (issue 9; make sweep, docs/RELIABILITY.md).
+# require zero sanitizer reports (make sweep, docs/RELIABILITY.md).
 #   scripts/san_sweep.sh ASAN_SIM N SCENARIO...
 # Every report (ASan, UBSan, LeakSanitizer) goes to its own file through log_path; a run
 # that aborts on a report also ends its worker, which rfseek-sim reports. One PASS/FAIL

@@ -1,4 +1,4 @@
-/* rfseek-feed - RSSI of chosen transmitters from an 802.11 radiotap capture (issue 5).
+/* rfseek-feed - RSSI of chosen transmitters from an 802.11 radiotap capture.
  *
  * Prints one line per frame whose source address (Wireshark's wlan.sa) is one of the
  * --mac addresses and whose radiotap header carries a dBm antenna signal:
@@ -23,9 +23,9 @@
 #include <unistd.h>
 
 #include "hs_ctrl.h"
-#include "hs_err.h"
-#include "hs_pcap.h"
-#include "hs_radiotap.h"
+#include "lx_err.h"
+#include "lx_pcap.h"
+#include "lx_radiotap.h"
 #include "hs_scenario.h"
 #include "hs_sim.h"
 #include "rfs_models.h"
@@ -67,7 +67,7 @@ static const char k_usage[] =
 /* Counts reported by --stats. */
 typedef struct feed_stats {
     uint64_t packets;                 /* records read */
-    uint64_t rt_bad[HS_RT_N_STATUS]; /* per radiotap status */
+    uint64_t rt_bad[LX_RT_N_STATUS]; /* per radiotap status */
     uint64_t no_wlan;                 /* nothing after the radiotap header */
     uint64_t no_sa;                   /* 802.11 header without a source address */
     uint64_t sa_match;                /* SA is one of the MACs */
@@ -135,10 +135,10 @@ static void print_stats(const char *name, const feed_stats_t *st)
 {
     fprintf(stderr, "%s: %llu packets, %llu lines", name, (unsigned long long)st->packets,
             (unsigned long long)st->lines);
-    for (int s = HS_RT_STOP_UNKNOWN; s < HS_RT_N_STATUS; s++) {
+    for (int s = LX_RT_STOP_UNKNOWN; s < LX_RT_N_STATUS; s++) {
         if (st->rt_bad[s] != 0) {
             fprintf(stderr, "; %llu %s %s", (unsigned long long)st->rt_bad[s],
-                    s >= HS_RT_ERR_SHORT ? "skipped:" : "note:", hs_radiotap_status_str((hs_rt_status_t)s));
+                    s >= LX_RT_ERR_SHORT ? "skipped:" : "note:", lx_radiotap_status_str((lx_rt_status_t)s));
         }
     }
     const struct { uint64_t n; const char *what; } rest[] = {
@@ -156,22 +156,22 @@ static void print_stats(const char *name, const feed_stats_t *st)
 }
 
 /* Called for each frame from one of the MACs (index m) that carries a signal. */
-typedef int (*feed_fn)(void *ctx, int m, const hs_pcap_pkt_t *pkt, const hs_rt_frame_t *f);
+typedef int (*feed_fn)(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_frame_t *f);
 
 /* Called for every record read, from any transmitter, parsable or not: the capture loop
- * was alive at its time (the receiver heartbeat, issue 10). */
+ * was alive at its time (the receiver heartbeat). */
 typedef int (*alive_fn)(void *ctx, int64_t t_us);
 
 /* Read every packet, count why packets give nothing, call fn for the matching ones and
  * alive (when not NULL) for every one. Returns 0, or 1 after a read error (message on
  * stderr) or when fn or alive failed. */
-static int scan_capture(hs_pcap_reader_t *r, const uint8_t (*macs)[6], int n_macs, feed_stats_t *st,
+static int scan_capture(lx_pcap_reader_t *r, const uint8_t (*macs)[6], int n_macs, feed_stats_t *st,
                         feed_fn fn, void *ctx, alive_fn alive, void *alive_ctx)
 {
     char err[512];
     for (;;) {
-        hs_pcap_pkt_t pkt;
-        const int got = hs_pcap_next(r, &pkt, err, sizeof(err));
+        lx_pcap_pkt_t pkt;
+        const int got = lx_pcap_next(r, &pkt, err, sizeof(err));
         if (got == 2) { continue; }
         if (got == 0) { return 0; }
         if (got < 0) {
@@ -181,8 +181,8 @@ static int scan_capture(hs_pcap_reader_t *r, const uint8_t (*macs)[6], int n_mac
         st->packets++;
         if (alive != NULL && alive(alive_ctx, pkt.t_us) != 0) { return 1; }
         if (pkt.caplen < pkt.origlen) { st->caplen_short++; }
-        hs_rt_frame_t f;
-        const int prc = hs_rt_frame_parse(pkt.data, pkt.caplen, &f);
+        lx_rt_frame_t f;
+        const int prc = lx_rt_frame_parse(pkt.data, pkt.caplen, &f);
         st->rt_bad[f.rt.status]++;
         if (prc != 0) { continue; }
         if (!f.wlan_ok) { st->no_wlan++; continue; }
@@ -204,7 +204,7 @@ typedef struct tsv_ctx {
     bool live; /* flush each line: a live reader wants it at once */
 } tsv_ctx_t;
 
-static int tsv_line(void *ctx, int m, const hs_pcap_pkt_t *pkt, const hs_rt_frame_t *f)
+static int tsv_line(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_frame_t *f)
 {
     tsv_ctx_t *c = ctx;
     (void)m;
@@ -215,7 +215,7 @@ static int tsv_line(void *ctx, int m, const hs_pcap_pkt_t *pkt, const hs_rt_fram
     return 0;
 }
 
-static int run_tsv(hs_pcap_reader_t *r, const char *output, bool live, const uint8_t (*macs)[6],
+static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, const uint8_t (*macs)[6],
                    int n_macs, feed_stats_t *st)
 {
     char *tmp = NULL;
@@ -272,7 +272,7 @@ typedef struct rp_vec {
     size_t n, cap;
 } rp_vec_t;
 
-static int rp_collect(void *ctx, int m, const hs_pcap_pkt_t *pkt, const hs_rt_frame_t *f)
+static int rp_collect(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_frame_t *f)
 {
     rp_vec_t *vec = ctx;
     if (vec->n == vec->cap) {
@@ -287,7 +287,7 @@ static int rp_collect(void *ctx, int m, const hs_pcap_pkt_t *pkt, const hs_rt_fr
     return 0;
 }
 
-/* Receiver heartbeat times (issue 10; docs/FAULTS.md): every record the capture loop
+/* Receiver heartbeat times (docs/FAULTS.md): every record the capture loop
  * reads proves it alive at that record's time, whoever sent it; one heartbeat per
  * RP_ALIVE_US of capture time at most, as a live sniffer would send them. */
 #define RP_ALIVE_US 50000
@@ -453,12 +453,12 @@ typedef struct rp_opts {
  * counted from the first pose. With the scenario's radio.receiver.heartbeat (the
  * default) every record of the capture, from any transmitter, proves the capture loop
  * alive at its time: the controller is told so at most once per 50 ms of capture time
- * (rfs_seek_on_receiver, issue 10), so a stretch where the source is not heard but the
+ * (rfs_seek_on_receiver), so a stretch where the source is not heard but the
  * channel is is a dead zone, not a dead sensor. The robot's
  * position at any instant is the recorded pose interpolated linearly (theta along the
  * shorter arc); the controller's wheel commands go nowhere. Ends at the last pose, or
  * when the robot comes within the stop radius of the goal. */
-static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6], int n_macs,
+static int run_replay(const rp_opts_t *o, lx_pcap_reader_t *r, uint8_t (*macs)[6], int n_macs,
                       feed_stats_t *st)
 {
     char err[1200];
@@ -642,7 +642,7 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
                             d->mean_valid ? rp_d(d->mean) : NAN, rp_d(d->epsilon), rp_d(d->goal_x),
                             rp_d(d->goal_y), rp_d(d->max_x), rp_d(d->max_y), rp_d(d->path_len), d->samples,
                             etr);
-                    hs_sim_log_estimate(flog, &ctrl); /* issue 10: path-loss estimate or nan */
+                    hs_sim_log_estimate(flog, &ctrl); /* path-loss estimate or nan */
                 }
             }
             if (has_goal && sc.stop_radius_m > 0.0 && hypot(ex - sc.goal_x, ey - sc.goal_y) <= sc.stop_radius_m) {
@@ -662,7 +662,7 @@ static int run_replay(const rp_opts_t *o, hs_pcap_reader_t *r, uint8_t (*macs)[6
         res.final_y = fy;
         res.final_distance_m = has_goal ? hypot(fx - sc.goal_x, fy - sc.goal_y) : NAN;
         res.packets_sent = res.packets_received + lost; /* from the sequence-number gaps */
-        hs_sim_result_estimate(&res, &ctrl, sc.src[0].x, sc.src[0].y); /* issue 10 */
+        hs_sim_result_estimate(&res, &ctrl, sc.src[0].x, sc.src[0].y);
         FILE *fsum = rp_open(tmp, "summary.json");
         if (fsum == NULL) {
             fprintf(stderr, "rfseek-feed: %s/summary.json: %s\n", tmp, strerror(errno));
@@ -698,7 +698,7 @@ static void opt_err(const char *fmt, const char *v)
 {
     char msg[512];
     snprintf(msg, sizeof msg, fmt, v);
-    hs_err_one_line(msg);
+    lx_err_one_line(msg);
     fprintf(stderr, "rfseek-feed: %s\n", msg);
 }
 
@@ -812,8 +812,8 @@ int main(int argc, char **argv)
     }
 
     char err[512];
-    hs_pcap_reader_t *r = live ? hs_pcap_open_live(ro.capture, err, sizeof(err))
-                               : hs_pcap_open_offline(ro.capture, err, sizeof(err));
+    lx_pcap_reader_t *r = live ? lx_pcap_open_live(ro.capture, err, sizeof(err))
+                               : lx_pcap_open_offline(ro.capture, err, sizeof(err));
     if (r == NULL) {
         fprintf(stderr, "rfseek-feed: %s\n", err);
         return 1;
@@ -822,7 +822,7 @@ int main(int argc, char **argv)
     memset(&st, 0, sizeof(st));
     const int rc = replay ? run_replay(&ro, r, macs, n_macs, &st)
                           : run_tsv(r, output, live, (const uint8_t(*)[6])macs, n_macs, &st);
-    hs_pcap_close(r);
+    lx_pcap_close(r);
     if (stats) { print_stats(ro.capture, &st); }
     return rc;
 }

@@ -14,8 +14,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "hs_err.h"
-#include "hs_map.h"
+#include "lx_err.h"
+#include "lx_map.h"
 #include "rfs_plan.h"
 
 static const char k_usage[] =
@@ -33,7 +33,7 @@ static const char k_usage[] =
     "  --help         this text\n"
     "Exit 0 on success, 1 on a bad map or I/O error, 2 on bad options.\n";
 
-static const char PROG[] = "rfseek-map"; /* the prefix of its error lines (hs_err_print) */
+static const char PROG[] = "rfseek-map"; /* the prefix of its error lines (lx_err_print) */
 
 static int parse_pos(const char *opt, const char *s, double *out)
 {
@@ -41,7 +41,7 @@ static int parse_pos(const char *opt, const char *s, double *out)
     errno = 0;
     double v = s != NULL ? strtod(s, &end) : 0.0;
     if (s == NULL || end == s || *end != '\0' || errno != 0 || !isfinite(v) || v < 0) {
-        hs_err_print(PROG, "%s: a non-negative number of metres expected, got '%s'", opt,
+        lx_err_print(PROG, "%s: a non-negative number of metres expected, got '%s'", opt,
                  s != NULL ? s : "(nothing)");
         return -1;
     }
@@ -49,13 +49,13 @@ static int parse_pos(const char *opt, const char *s, double *out)
     return 0;
 }
 
-static int write_pgm(const char *path, const hs_core_map_t *c)
+static int write_pgm(const char *path, const lx_core_map_t *c)
 {
     char tmp[4096];
     snprintf(tmp, sizeof(tmp), "%s.tmp", path);
     FILE *f = fopen(tmp, "wb");
     if (f == NULL) {
-        hs_err_print(PROG, "%s: cannot create: %s", tmp, strerror(errno));
+        lx_err_print(PROG, "%s: cannot create: %s", tmp, strerror(errno));
         return -1;
     }
     const rfs_map_t *m = &c->map;
@@ -75,12 +75,12 @@ static int write_pgm(const char *path, const hs_core_map_t *c)
         }
     }
     if (fflush(f) != 0 || ferror(f) || fclose(f) != 0) {
-        hs_err_print(PROG, "%s: write error", tmp);
+        lx_err_print(PROG, "%s: write error", tmp);
         remove(tmp);
         return -1;
     }
     if (rename(tmp, path) != 0) {
-        hs_err_print(PROG, "%s: cannot rename to %s: %s", tmp, path, strerror(errno));
+        lx_err_print(PROG, "%s: cannot rename to %s: %s", tmp, path, strerror(errno));
         remove(tmp);
         return -1;
     }
@@ -101,7 +101,7 @@ static int cmp_double(const void *a, const void *b)
 }
 
 /* Planner and legal-grid figures for docs/PERFORMANCE.md. */
-static void run_bench(const hs_core_map_t *c, long n)
+static void run_bench(const lx_core_map_t *c, long n)
 {
     const rfs_map_t *m = &c->map;
     uint32_t lat = (uint32_t)m->lw * m->lh;
@@ -230,7 +230,7 @@ int main(int argc, char **argv)
             const char *v = i + 1 < argc ? argv[++i] : NULL;
             if (strcmp(a, "--pgm") == 0) {
                 if (v == NULL || *v == '\0') {
-                    hs_err_print(PROG, "--pgm: an output file name expected");
+                    lx_err_print(PROG, "--pgm: an output file name expected");
                     return 2;
                 }
                 pgm = v;
@@ -243,46 +243,46 @@ int main(int argc, char **argv)
             char *end = NULL;
             bench = v != NULL ? strtol(v, &end, 10) : -1;
             if (v == NULL || *end != '\0' || bench < 1 || bench > 1000000) {
-                hs_err_print(PROG, "--bench: a count 1..1000000 expected, got '%s'", v != NULL ? v : "(nothing)");
+                lx_err_print(PROG, "--bench: a count 1..1000000 expected, got '%s'", v != NULL ? v : "(nothing)");
                 return 2;
             }
         } else if (a[0] == '-' && a[1] != '\0') {
-            hs_err_print(PROG, "%s: unknown option (see --help)", a);
+            lx_err_print(PROG, "%s: unknown option (see --help)", a);
             return 2;
         } else if (yaml == NULL) {
             yaml = a;
         } else {
-            hs_err_print(PROG, "%s: only one map expected (see --help)", a);
+            lx_err_print(PROG, "%s: only one map expected (see --help)", a);
             return 2;
         }
     }
     if (yaml == NULL) {
-        hs_err_print(PROG, "no map given (see --help)");
+        lx_err_print(PROG, "no map given (see --help)");
         return 2;
     }
     if (!(res > 0) || !(grid > 0)) {
-        hs_err_print(PROG, "--res and --grid must be > 0");
+        lx_err_print(PROG, "--res and --grid must be > 0");
         return 2;
     }
     char err[1024];
-    hs_map_t m;
-    if (hs_map_load(yaml, &m, err, sizeof(err)) != 0) {
-        hs_err_print(PROG, "%s", err);
+    lx_map_t m;
+    if (lx_map_load(yaml, &m, err, sizeof(err)) != 0) {
+        lx_err_print(PROG, "%s", err);
         return 1;
     }
     rfs_map_cfg_t cfg = rfs_map_cfg_default();
     cfg.clearance = (rfs_q16_t)lround(clearance * 65536.0);
     cfg.grid = (rfs_q16_t)lround(grid * 65536.0);
-    hs_core_map_t c;
-    if (hs_map_to_core(&m, res, &cfg, &c, err, sizeof(err)) != 0) {
-        hs_err_print(PROG, "%s: %s", yaml, err);
-        hs_map_free(&m);
+    lx_core_map_t c;
+    if (lx_map_to_core(&m, res, &cfg, &c, err, sizeof(err)) != 0) {
+        lx_err_print(PROG, "%s: %s", yaml, err);
+        lx_map_free(&m);
         return 1;
     }
     uint32_t nf;
     uint32_t no;
     uint32_t nu;
-    hs_map_count(&m, &nf, &no, &nu);
+    lx_map_count(&m, &nf, &no, &nu);
     const rfs_map_t *cm = &c.map;
     uint32_t cfree = 0;
     uint32_t cwall = 0;
@@ -324,7 +324,7 @@ int main(int argc, char **argv)
     if (pgm != NULL && write_pgm(pgm, &c) != 0) {
         rc = 1;
     }
-    hs_core_map_free(&c);
-    hs_map_free(&m);
+    lx_core_map_free(&c);
+    lx_map_free(&m);
     return rc;
 }

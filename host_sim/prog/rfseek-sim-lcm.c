@@ -1,4 +1,4 @@
-/* rfseek-sim-lcm.c - the simulator with the controller in a separate process (issue 4).
+/* rfseek-sim-lcm.c - the simulator with the controller in a separate process.
  *
  *   rfseek-sim-lcm SCENARIO [--lcm URL] [--can IFACE] [--seed N] [--timeout-ms N] [--max-time S]
  *
@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include "hs_ctrl_lcm.h"
-#include "hs_err.h"
+#include "lx_err.h"
 #include "hs_scenario.h"
 #include "hs_sim.h"
 
@@ -27,7 +27,7 @@ static const char usage_text[] =
     "  --max-time S     stop after S simulated seconds (overrides the scenario's stop time)\n"
     "  --help           this text\n";
 
-static const char PROG[] = "rfseek-sim-lcm"; /* the prefix of its error lines (hs_err_print) */
+static const char PROG[] = "rfseek-sim-lcm"; /* the prefix of its error lines (lx_err_print) */
 
 int main(int argc, char **argv)
 {
@@ -46,7 +46,7 @@ int main(int argc, char **argv)
         } else if (a[0] != '-' && !scn) {
             scn = a;
         } else if (!v) {
-            hs_err_print(PROG, "missing value for %s (see --help)", a);
+            lx_err_print(PROG, "missing value for %s (see --help)", a);
             return 2;
         } else if (strcmp(a, "--lcm") == 0) {
             cfg.lcm_url = v, i++;
@@ -56,38 +56,38 @@ int main(int argc, char **argv)
             errno = 0;
             seed = strtoll(v, &end, 10);
             if (errno || *end || seed < 0) {
-                hs_err_print(PROG, "--seed: '%s' is not a non-negative integer", v);
+                lx_err_print(PROG, "--seed: '%s' is not a non-negative integer", v);
                 return 2;
             }
             i++;
         } else if (strcmp(a, "--max-time") == 0) {
             max_time = strtod(v, &end);
             if (*end || !(max_time > 0 && max_time <= 86400)) {
-                hs_err_print(PROG, "--max-time: '%s' is not seconds in (0, 86400]", v);
+                lx_err_print(PROG, "--max-time: '%s' is not seconds in (0, 86400]", v);
                 return 2;
             }
             i++;
         } else if (strcmp(a, "--timeout-ms") == 0) {
             long t = strtol(v, &end, 10);
             if (*end || t < 1 || t > 600000) {
-                hs_err_print(PROG, "--timeout-ms: '%s' is not in 1..600000", v);
+                lx_err_print(PROG, "--timeout-ms: '%s' is not in 1..600000", v);
                 return 2;
             }
             cfg.reply_timeout_ms = (int)t;
             i++;
         } else {
-            hs_err_print(PROG, "unknown option '%s' (see --help)", a);
+            lx_err_print(PROG, "unknown option '%s' (see --help)", a);
             return 2;
         }
     }
     if (!scn) {
-        hs_err_print(PROG, "a SCENARIO file is required (see --help)");
+        lx_err_print(PROG, "a SCENARIO file is required (see --help)");
         return 2;
     }
     char err[512];
     hs_scenario_t sc;
     if (hs_scenario_load(scn, &sc, err, sizeof err) != 0) {
-        hs_err_print(PROG, "%s", err);
+        lx_err_print(PROG, "%s", err);
         return 1;
     }
     if (max_time > 0) {
@@ -96,17 +96,17 @@ int main(int argc, char **argv)
     hs_sim_env_t env;
     memset(&env, 0, sizeof env);
     if (hs_sim_env_open(&env, &sc, err, sizeof err) != 0) {
-        hs_err_print(PROG, "%s", err);
+        lx_err_print(PROG, "%s", err);
         return 1;
     }
     hs_ctrl_t ctrl;
     if (hs_ctrl_lcm_open(&ctrl, &cfg, err, sizeof err) != 0) {
-        hs_err_print(PROG, "%s", err);
+        lx_err_print(PROG, "%s", err);
         hs_sim_env_close(&env);
         return 1;
     }
     if (err[0]) { /* liblcm's warning, as one line (hs_ctrl_lcm.h) */
-        hs_err_print(PROG, "%s", err);
+        lx_err_print(PROG, "%s", err);
     }
     hs_sim_result_t res;
     hs_sim_io_t io;
@@ -115,7 +115,7 @@ int main(int argc, char **argv)
     uint32_t timeouts = hs_ctrl_lcm_timeouts(&ctrl);
     hs_ctrl_close(&ctrl);
     if (rc != 0) {
-        hs_err_print(PROG, "%s", err);
+        lx_err_print(PROG, "%s", err);
         hs_sim_env_close(&env);
         return 1;
     }

@@ -1,4 +1,4 @@
-/* rfseek-sim - run the seeker in the simulated world (issue 3, docs/SIMULATOR.md).
+/* rfseek-sim - run the seeker in the simulated world (docs/SIMULATOR.md).
  *
  *   rfseek-sim SCENARIO [--seed N] [--out DIR] [--samples] [--field] [--pcap FILE]
  *   rfseek-sim SCENARIO --seeds A..B [--jobs N] [--out DIR]
@@ -19,8 +19,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "hs_err.h"
-#include "hs_pcap.h"
+#include "lx_err.h"
+#include "lx_pcap.h"
 #include "hs_sim.h"
 
 static const char *prog = "rfseek-sim";
@@ -66,7 +66,7 @@ static int die(const char *fmt, const char *a, const char *b)
 {
     char msg[1024];
     snprintf(msg, sizeof msg, fmt, a, b);
-    hs_err_one_line(msg); /* an option's value can hold a line break */
+    lx_err_one_line(msg); /* an option's value can hold a line break */
     fprintf(stderr, "%s: %s\n", prog, msg);
     return 1;
 }
@@ -129,7 +129,7 @@ static FILE *open_in(const char *dir, const char *name)
 }
 
 typedef struct pcap_ctx {
-    hs_pcap_writer_t *w;
+    lx_pcap_writer_t *w;
     const hs_scenario_t *sc;
     int failed;
 } pcap_ctx_t;
@@ -140,7 +140,7 @@ static void on_packet(void *ctx, unsigned src, int64_t t_us, uint16_t seq, bool 
     pcap_ctx_t *p = ctx;
     static const uint8_t bssid[6] = {0x02, 0x00, 0x00, 0x00, 0xbb, 0x01};
     if (received && p->w &&
-        hs_pcap_writer_frame(p->w, t_us, p->sc->src[src].mac, bssid, seq, (int8_t)dbm, 2437) != 0) {
+        lx_pcap_writer_frame(p->w, t_us, p->sc->src[src].mac, bssid, seq, (int8_t)dbm, 2437) != 0) {
         p->failed = 1;
     }
 }
@@ -163,7 +163,7 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         if (faults) {
             io.faults = open_in(dir, "faults.tsv");
         }
-        if (strcmp(env->sc.model, "pathloss") == 0) { // issue 10: the last fit's surface
+        if (strcmp(env->sc.model, "pathloss") == 0) { // the last fit's surface
             io.residual = open_in(dir, "residual.tsv");
         }
         if (!io.log || !io.track || (samples && !io.samples) || (faults && !io.faults) ||
@@ -173,7 +173,7 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         }
     }
     if (rc == 0 && pcap) {
-        pc.w = hs_pcap_writer_open(pcap, err, sizeof err);
+        pc.w = lx_pcap_writer_open(pcap, err, sizeof err);
         if (!pc.w) {
             fprintf(stderr, "%s: %s\n", prog, err);
             rc = 1;
@@ -185,7 +185,7 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         fprintf(stderr, "%s: %s\n", prog, err);
         rc = 1;
     }
-    // field.tsv for source 0 and field1.tsv for a second source (bridging, issue 7).
+    // field.tsv for source 0 and field1.tsv for a second source (bridging).
     for (unsigned src = 0; rc == 0 && field && dir && src < env->sc.nsources; src++) {
         FILE *f = open_in(dir, src == 0 ? "field.tsv" : "field1.tsv");
         if (!f || hs_sim_field(env, seed, src, 0.1, f, err, sizeof err) != 0) {
@@ -216,7 +216,7 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         }
     }
     if (pc.w) {
-        if (hs_pcap_writer_close(pc.w) != 0 || pc.failed) {
+        if (lx_pcap_writer_close(pc.w) != 0 || pc.failed) {
             fprintf(stderr, "%s: %s: write failed\n", prog, pcap);
             rc = 1;
         }

@@ -23,11 +23,11 @@ TIDY_CHECKS='-*,clang-analyzer-*,-clang-analyzer-security.insecureAPI.Deprecated
 flags_of() {
     case $1 in
         common/*) echo "-std=c11 -ffreestanding -Icommon" ;;
-        firmware/port/linux/*) echo "-std=c11 -D_DEFAULT_SOURCE -Icommon -Ifirmware -Ifirmware/port/linux -Ihost_sim -I$build/gen" ;;
+        firmware/port/linux/*) echo "-std=c11 -D_DEFAULT_SOURCE -Icommon -Ifirmware -Ifirmware/port/linux -I$build/gen $(pkg-config --cflags yaml-0.1 2>/dev/null)" ;;
         firmware/port/*) echo "-std=c11 -ffreestanding --target=arm-none-eabi -mcpu=cortex-m4 -mthumb -mfloat-abi=soft -isystem /usr/lib/arm-none-eabi/include -Icommon -Ifirmware -Ifirmware/port/stm32f4 -Ifirmware/port/qemu" ;;
         firmware/*) echo "-std=c11 -Icommon -Ifirmware" ;;
-        *.cpp) echo "-std=c++17 -Icommon -Ihost_sim" ;;
-        *) echo "-std=c11 -D_DEFAULT_SOURCE -Icommon -Ihost_sim -Ifirmware -I$build/gen $(pkg-config --cflags yaml-0.1 2>/dev/null)" ;;
+        *.cpp) echo "-std=c++17 -Icommon -Ifirmware -Ifirmware/port/linux -Ihost_sim" ;;
+        *) echo "-std=c11 -D_DEFAULT_SOURCE -Icommon -Ifirmware -Ifirmware/port/linux -Ihost_sim -I$build/gen" ;;
     esac
 }
 
@@ -41,7 +41,7 @@ for tool in "${tools[@]}"; do
         cppcheck --enable=warning,portability,performance --std=c11 --inline-suppr -q \
             --suppress=missingIncludeSystem --error-exitcode=1 -j "$jobs" \
             -DRFS_ASSERT_H --include=scripts/lint/cppcheck_assert.h \
-            -Icommon -Ihost_sim -Ifirmware -I"$build/gen" \
+            -Icommon -Ifirmware -Ifirmware/port/linux -Ihost_sim -I"$build/gen" \
             --template='{file}:{line}: {severity} {id}: {message}' common firmware host_sim >"$out" 2>&1
         status=$?
         ;;

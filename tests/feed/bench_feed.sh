@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # bench-feed: frames/s extracting one MAC's RSSI from a 1,000,000-frame capture written by
-# our writer, rfseek-feed side by side with the tshark command of issue 5 on the same file.
+# our writer, rfseek-feed side by side with the tshark command of docs/FEEDER.md on the same file.
 # Median of 3 runs each, output to files on the same disk (also compared: must be equal).
 # usage: bench_feed.sh FEED WRITEGEN DIR [FRAMES]
 set -euo pipefail

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Cross-check rfseek-feed against tshark, line for line (issue 5).
+# Cross-check rfseek-feed against tshark, line for line.
 # usage: cross_check.sh FEED_BIN CAPTURE...
 # For each CAPTURE: the transmitters are CAPTURE.macs when it exists (generated files),
 # otherwise every wlan.sa tshark finds. Compared: one run with all of them (our repeated

@@ -1,4 +1,4 @@
-/* feed_writegen - write N radiotap frames through hs_pcap_writer (bench input and the
+/* feed_writegen - write N radiotap frames through lx_pcap_writer (bench input and the
  * writer's tshark cross-check). Four transmitters take turns in a fixed pseudo-random
  * order; per frame: time 1 ms apart plus jitter, the sender's next sequence number, a
  * signal in [-95, -20] dBm, 2437 MHz or 5180 MHz. Prints the transmitters, one per line.
@@ -8,7 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "hs_pcap.h"
+#include "lx_pcap.h"
 
 int main(int argc, char **argv)
 {
@@ -28,7 +28,7 @@ int main(int argc, char **argv)
     };
     static const uint8_t bssid[6] = {0x02, 0x00, 0x00, 0x00, 0x00, 0xaa};
     char err[256];
-    hs_pcap_writer_t *w = hs_pcap_writer_open(argv[1], err, sizeof(err));
+    lx_pcap_writer_t *w = lx_pcap_writer_open(argv[1], err, sizeof(err));
     if (w == NULL) {
         fprintf(stderr, "feed_writegen: %s\n", err);
         return 1;
@@ -42,11 +42,11 @@ int main(int argc, char **argv)
         t += 1000 + (int64_t)((x >> 8) & 255u);
         const int8_t dbm = (int8_t)(-95 + (int)((x >> 12) % 76u));
         seq[s] = (uint16_t)((seq[s] + 1u) & 0x0fffu);
-        if (hs_pcap_writer_frame(w, t, macs[s], bssid, seq[s], dbm, s & 1u ? 5180 : 2437) != 0) {
+        if (lx_pcap_writer_frame(w, t, macs[s], bssid, seq[s], dbm, s & 1u ? 5180 : 2437) != 0) {
             break;
         }
     }
-    if (hs_pcap_writer_close(w) != 0) {
+    if (lx_pcap_writer_close(w) != 0) {
         fprintf(stderr, "feed_writegen: %s: write failed\n", argv[1]);
         return 1;
     }

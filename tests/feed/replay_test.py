@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""rfseek-feed --pose: replay a recorded run through the seeker (issue 5).
+"""rfseek-feed --pose: replay a recorded run through the seeker.
 
 Builds a capture (pure python pcap bytes) and a pose CSV for scenarios/default.yaml: the
 robot drives east along the corridor from the start at 0.5 m/s for 30 s, poses at 10 Hz;

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# bench.sh BUILD - instruction counts of the Cortex-M4 image under qemu -icount (issue 6).
+# bench.sh BUILD - instruction counts of the Cortex-M4 image under qemu -icount.
 # With -icount shift=7 each instruction advances the virtual clock by 128 ns; SysTick
 # counts the 168 MHz core clock of qemu's STM32F405 model, so 21.504 ticks elapse per
 # instruction and a tick difference converts to an exact instruction count. The image

@@ -60,7 +60,7 @@ check)
                    END { if (n == 0) exit 1; for (m in s) if (s[m] != w[m]) exit 1 }' "$tmp/m4.sums"; then
         pass "sliced relearn equals the whole relearn on the Cortex-M4"; else
         bad "a sliced relearn differs from the whole one on the Cortex-M4"; fi
-    # The 200 ms safety deadline (issues 8, 10) at every model's registry budget, from the
+    # The 200 ms safety deadline at every model's registry budget, from the
     # exact instruction count of its heaviest slice; every model the host twin runs has one.
     if awk -F'\t' -v models="$models" '
         $1 == "calib_empty" { e = $2 } $1 == "calib_nop1000" { per = ($2 - e) / 1000 }

@@ -3,7 +3,7 @@
  * the host build of the core, with a bench_clock that only prints. Its "sum_*" lines are
  * the independent reference tests/firmware/bench_models.sh compares the image's with.
  * It also checks that the office map baked into the image (scripts/map2c.py) is the one
- * the host loader makes (host_sim/hs_map.c), the map of bench/bench_pathloss.c.
+ * the host loader makes (firmware/port/linux/lx_map.c), the map of bench/bench_pathloss.c.
  *
  *   bench_models_host N [quick] [--office MAP.yaml]
  */
@@ -12,7 +12,7 @@
 #include <string.h>
 
 #include "bench_clock.h"
-#include "hs_map.h"
+#include "lx_map.h"
 #include "models_work.h"
 #include "rfs_app.h"
 
@@ -62,14 +62,14 @@ static int usage(FILE *f, int rc)
 static int same_office(const char *yaml)
 {
     char err[256];
-    hs_map_t hm;
-    hs_core_map_t cm;
+    lx_map_t hm;
+    lx_core_map_t cm;
     memset(&hm, 0, sizeof hm);
     memset(&cm, 0, sizeof cm);
-    if (hs_map_load(yaml, &hm, err, sizeof err) != 0 ||
-        hs_map_to_core(&hm, 0.1, NULL, &cm, err, sizeof err) != 0) {
+    if (lx_map_load(yaml, &hm, err, sizeof err) != 0 ||
+        lx_map_to_core(&hm, 0.1, NULL, &cm, err, sizeof err) != 0) {
         fprintf(stderr, "bench_models_host: %s\n", err);
-        hs_map_free(&hm);
+        lx_map_free(&hm);
         return -1;
     }
     const rfs_app_map_t *b = &rfs_mw_office_map;
@@ -78,8 +78,8 @@ static int same_office(const char *yaml)
     int same = m->w == b->w && m->h == b->h && m->res == b->res && m->origin_x == b->origin_x &&
                m->origin_y == b->origin_y && m->wall != NULL &&
                memcmp(m->free, b->free, bytes) == 0 && memcmp(m->wall, b->wall, bytes) == 0;
-    hs_core_map_free(&cm);
-    hs_map_free(&hm);
+    lx_core_map_free(&cm);
+    lx_map_free(&hm);
     return same;
 }
 

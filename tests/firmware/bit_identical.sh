@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# bit_identical.sh BUILD - issue 6: the same recorded input stream fed to the host build
+# bit_identical.sh BUILD - the same recorded input stream fed to the host build
 # of the application loop and to the Cortex-M4 image under qemu gives identical output
 # streams, byte for byte. The stream is a simulated mission (scenarios/default.yaml, the
 # firmware loop as the controller, inputs as CAN frames) with injected faults: inputs

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # budget.sh BUILD - the hardware image's link fails when flash or static RAM exceeds its
-# budget (issue 6: 64 KB flash, 96 KB static RAM). The real image links (make firmware);
+# budget (64 KB flash, 96 KB static RAM). The real image links (make firmware);
 # here the same objects are linked again with budgets just below what they use, and the
 # link must fail with the linker script's message.
 set -uo pipefail

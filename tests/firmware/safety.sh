@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# safety.sh BUILD - issue 6 safety: the wheels are commanded to zero within 200 ms when
+# safety.sh BUILD - safety: the wheels are commanded to zero within 200 ms when
 # the pose or the RSSI input stops, at once when bxCAN goes bus-off, and after a
 # watchdog reset; driving resumes when the inputs return. Each fault is injected into a
 # simulated mission (scenarios/default.yaml) at a moment the robot is driving, and the

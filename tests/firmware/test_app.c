@@ -1,7 +1,7 @@
 /* test_app.c - the application loop (firmware/rfs_app.h) on the host: configuration and
  * map checks, the safety stops (input lost, bus-off, reset) against the requirement of
- * issue 6 (zero wheels within 200 ms), CAN in and out through common/rfs_can.h's own
- * decoders, and the receiver heartbeat (issue 10): a radio dead zone is driven through
+ * safety (zero wheels within 200 ms), CAN in and out through common/rfs_can.h's own
+ * decoders, and the receiver heartbeat: a radio dead zone is driven through
  * with it, stops within 200 ms without it, and a heartbeat from the future stops the
  * wheels as a packet from the future does. */
 #include "rfs_test.h"
@@ -35,7 +35,7 @@ static int run(int64_t t0, int64_t t_end, bool poses, bool rssi, rfs_app_out_t *
     return moving;
 }
 
-/* A dead zone (issue 10): 10 Hz poses at (5, 5), no packets, and, when `heartbeat`, a
+/* A dead zone: 10 Hz poses at (5, 5), no packets, and, when `heartbeat`, a
  * receiver heartbeat stamped `hb_lead` after its arrival once per control period just
  * before the step (as the sniffer's capture loop sends it). Returns the moving steps. */
 static int run_dead_zone(int64_t t0, int64_t t_end, bool heartbeat, int64_t hb_lead,
@@ -105,7 +105,7 @@ static void test_dead_zone_without_heartbeat_stops_within_200_ms(void **state)
 static void test_heartbeat_from_the_future_stops_like_a_packet(void **state)
 {
     (void)state;
-    /* A packet stamped 5 s ahead (a clock jump, issue 9) makes the stream stale: the
+    /* A packet stamped 5 s ahead (a clock jump) makes the stream stale: the
      * wheels stop. A heartbeat stamped 5 s ahead must do the same. */
     rfs_app_out_t o_hb, o_pkt;
     int moving = 0;

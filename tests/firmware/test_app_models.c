@@ -1,8 +1,8 @@
-/* test_app_models.c - the model chosen by configuration in the firmware (issue 8):
+/* test_app_models.c - the model chosen by configuration in the firmware:
  * rfs_app_cfg_t.model through the registry, the state-size check that keeps a model out
  * of an image that cannot hold it, the CFG record's optional model name (byte layout
  * written out by hand from the format in firmware/rfs_replay.h), and the MCU
- * configuration's per-model fit budget (issues 8, 10; its deadline is checked on the
+ * configuration's per-model fit budget (its deadline is checked on the
  * Cortex-M4 by tests/firmware/bench_models.sh). */
 #include "rfs_test.h"
 
@@ -148,7 +148,7 @@ static void test_player_applies_or_refuses_the_model(void **state)
 }
 
 /* The MCU configuration slices each model's relearn by that model's registry budget
- * (issues 8, 10: a work unit is a sample for the ridge, a sample-update for the MLP, a
+ * (a work unit is a sample for the ridge, a sample-update for the MLP, a
  * wall count for pathloss); the other configurations keep the budget they are given. */
 static void test_mcu_fit_budget_is_the_model_s(void **state)
 {

@@ -1,4 +1,4 @@
-/* test_bxcan.c - the bxCAN driver against a fake register block (issue 6).
+/* test_bxcan.c - the bxCAN driver against a fake register block.
  *
  * No emulator models bxCAN, so the test plays the hardware: a plain rfs_bxcan_regs_t in
  * memory, and a fake that acknowledges mode requests (INRQ -> INAK) and releases FIFO

@@ -354,7 +354,7 @@ static void test_player_errors(void **state)
     assert_int_equal(p.error, RFS_REPLAY_E_ORDER);
 }
 
-/* RECEIVER (issue 10): type 0x13, length 16, rx then the capture time, both i64 LE. */
+/* RECEIVER: type 0x13, length 16, rx then the capture time, both i64 LE. */
 static void test_receiver_record_exact_bytes_and_lengths(void **state)
 {
     (void)state;

@@ -1,5 +1,5 @@
-/* fuzz_can - libFuzzer target for the CAN frame decoders and the receiver (common/rfs_can.h,
- * issue 9). Frames arrive from a bus anyone can write to, so every byte is outside input.
+/* fuzz_can - libFuzzer target for the CAN frame decoders and the receiver (common/rfs_can.h).
+ * Frames arrive from a bus anyone can write to, so every byte is outside input.
  *
  * Input: a sequence of 12-byte records, each one received frame:
  *   ctrl u8   bit 0: overwrite data[dlc-1] with the correct checksum (so the fuzzer gets

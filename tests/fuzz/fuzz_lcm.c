@@ -1,15 +1,15 @@
 /* fuzz_lcm - libFuzzer target for LCM message decoding (the lcm-gen decoders of the lcm/ types
- * and our checks in host_sim/hs_lcm_adapt.c, issue 9). LCM on a robot is UDP multicast:
+ * and our checks in firmware/port/linux/lx_lcm.c). LCM on a robot is UDP multicast:
  * anyone on the network can publish any bytes on our channels, and logs are files.
  *
  * Input: byte 0 selects the path, the rest is the payload.
  *   byte 0 < 0x80: a message on channel (byte 0 mod 7), published on an in-process
- *                  memq:// connection and received through hs_lcm_handle() - the same
+ *                  memq:// connection and received through lx_lcm_handle() - the same
  *                  code path as a UDP message;
- *   byte 0 >= 0x80: the payload is an LCM log file, read with hs_lcm_log_next() (channel
+ *   byte 0 >= 0x80: the payload is an LCM log file, read with lx_lcm_log_next() (channel
  *                  names, lengths and times from the file).
  *
- * Beyond ASan/UBSan it checks what hs_lcm.h promises: every delivered message is in
+ * Beyond ASan/UBSan it checks what lx_lcm.h promises: every delivered message is in
  * range (pose heading in [-pi, pi], source 0..15, CAN id 11-bit and DLC 0..8, status
  * enums valid) and every drop is reported as one non-empty line.
  */
@@ -21,7 +21,7 @@
 #include <string.h>
 
 #include "fuzz_tmp.h"
-#include "hs_lcm.h"
+#include "lx_lcm.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -84,47 +84,47 @@ static void on_bad(void *ctx, const char *why)
     fuzz_check_err_line(why);
 }
 
-static const hs_lcm_handlers_t k_h = {NULL,     on_pose, on_rssi, on_clock,   on_wheel,
+static const lx_lcm_handlers_t k_h = {NULL,     on_pose, on_rssi, on_clock,   on_wheel,
                                       on_status, on_can, on_bad, on_receiver};
-static hs_lcm_t *g_lcm;
+static lx_lcm_t *g_lcm;
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static const char *const ch[7] = {HS_LCM_CH_POSE,   HS_LCM_CH_RSSI,         HS_LCM_CH_CLOCK,
-                                      HS_LCM_CH_WHEEL,  HS_LCM_CH_STATUS,       HS_LCM_CH_CAN_FALLBACK,
-                                      HS_LCM_CH_RSSI_STATUS};
+    static const char *const ch[7] = {LX_LCM_CH_POSE,   LX_LCM_CH_RSSI,         LX_LCM_CH_CLOCK,
+                                      LX_LCM_CH_WHEEL,  LX_LCM_CH_STATUS,       LX_LCM_CH_CAN_FALLBACK,
+                                      LX_LCM_CH_RSSI_STATUS};
     if (size < 1u) { return 0; }
     char err[256] = "";
     if (data[0] < 0x80u) {
         if (g_lcm == NULL) {
-            g_lcm = hs_lcm_open("memq://", &k_h, err, sizeof err);
+            g_lcm = lx_lcm_open("memq://", &k_h, err, sizeof err);
             if (g_lcm == NULL) {
                 fprintf(stderr, "%s\n", err);
                 abort();
             }
         }
-        hs_lcm_stats_t before, after;
-        hs_lcm_get_stats(g_lcm, &before);
-        if (hs_lcm_pub_raw(g_lcm, 0, ch[data[0] % 7u], data + 1, size - 1u) != 0) { return 0; }
+        lx_lcm_stats_t before, after;
+        lx_lcm_get_stats(g_lcm, &before);
+        if (lx_lcm_pub_raw(g_lcm, 0, ch[data[0] % 7u], data + 1, size - 1u) != 0) { return 0; }
         int handled = 0;
-        while (hs_lcm_handle(g_lcm, 0) == 1) { handled++; }
-        hs_lcm_get_stats(g_lcm, &after);
+        while (lx_lcm_handle(g_lcm, 0) == 1) { handled++; }
+        lx_lcm_get_stats(g_lcm, &after);
         /* One message in, exactly one verdict out: delivered or dropped. */
         if (handled != 1 || (after.received - before.received) + (after.bad - before.bad) != 1u) { abort(); }
         if (after.bad != before.bad) { fuzz_check_err_line(after.last_error); }
         return 0;
     }
     const char *path = fuzz_tmp_write(0, "in.lcmlog", data + 1, size - 1u);
-    hs_lcm_log_t *log = hs_lcm_log_open(path, "r", err, sizeof err);
+    lx_lcm_log_t *log = lx_lcm_log_open(path, "r", err, sizeof err);
     if (log == NULL) {
         fuzz_check_err_line(err);
         return 0;
     }
-    hs_lcm_stats_t st;
+    lx_lcm_stats_t st;
     memset(&st, 0, sizeof st);
     int64_t t = 0;
-    for (int i = 0; i < 64 && hs_lcm_log_next(log, &k_h, &st, &t) == 1; i++) {
+    for (int i = 0; i < 64 && lx_lcm_log_next(log, &k_h, &st, &t) == 1; i++) {
     }
-    (void)hs_lcm_log_close(log);
+    (void)lx_lcm_log_close(log);
     return 0;
 }

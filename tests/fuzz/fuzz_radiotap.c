@@ -1,4 +1,4 @@
-/* fuzz_radiotap - libFuzzer target for the radiotap + 802.11 parser (issue 5).
+/* fuzz_radiotap - libFuzzer target for the radiotap + 802.11 parser.
  * Input: one captured record (radiotap header, then the 802.11 frame). Beyond "no
  * out-of-bounds read" (ASan) it checks what the parser promises: a usable header lies
  * inside the input, an address is only reported when the frame holds it.
@@ -7,31 +7,31 @@
 #include <stdint.h>
 #include <stdlib.h>
 
-#include "hs_radiotap.h"
+#include "lx_radiotap.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    hs_rt_frame_t f;
-    if (hs_rt_frame_parse(data, size, &f) != 0) {
-        if (f.rt.status < HS_RT_ERR_SHORT) { abort(); }
+    lx_rt_frame_t f;
+    if (lx_rt_frame_parse(data, size, &f) != 0) {
+        if (f.rt.status < LX_RT_ERR_SHORT) { abort(); }
         return 0;
     }
-    if (f.rt.status >= HS_RT_ERR_SHORT || f.rt.it_len < 8 || f.rt.it_len > size) { abort(); }
+    if (f.rt.status >= LX_RT_ERR_SHORT || f.rt.it_len < 8 || f.rt.it_len > size) { abort(); }
     const size_t n = size - f.rt.it_len;
     if (f.frame_len > n) { abort(); }
     if (f.wlan_ok) {
-        if (f.wlan.has_sa && (n < 24 || f.wlan.type == HS_WLAN_CTRL)) { abort(); }
+        if (f.wlan.has_sa && (n < 24 || f.wlan.type == LX_WLAN_CTRL)) { abort(); }
         if (f.wlan.has_ta && n < 16) { abort(); }
         if (f.wlan.seq > 4095 || f.wlan.frag > 15 || f.wlan.ds > 3) { abort(); }
     } else if (n >= 2) {
         abort();
     }
     /* The parser alone, on every prefix length the record could have been cut at. */
-    hs_radiotap_t rt;
-    (void)hs_radiotap_parse(data, size / 2, &rt);
-    hs_wlan_t w;
-    (void)hs_wlan_parse(data, size, &w);
+    lx_radiotap_t rt;
+    (void)lx_radiotap_parse(data, size / 2, &rt);
+    lx_wlan_t w;
+    (void)lx_wlan_parse(data, size, &w);
     return 0;
 }

@@ -1,5 +1,5 @@
 /* fuzz_scenario - libFuzzer target for the simulator's scenario loader
- * (host_sim/hs_scenario.h, issue 9). The input is the scenario file, written to a private
+ * (host_sim/hs_scenario.h). The input is the scenario file, written to a private
  * tmpfs directory and loaded with hs_scenario_load() (which resolves but does not open
  * the map, so nothing outside that directory is read).
  *

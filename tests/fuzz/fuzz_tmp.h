@@ -1,4 +1,4 @@
-/* fuzz_tmp.h - a private scratch directory for the file-reading fuzz targets (issue 9).
+/* fuzz_tmp.h - a private scratch directory for the file-reading fuzz targets.
  * Loaders that take a path are fuzzed through files written into a per-process directory
  * on /dev/shm (tmpfs: no disk writes), removed at exit. Header-only, test code only. */
 #ifndef FUZZ_TMP_H

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""make_corpus.py - write the seed corpora of the fuzz targets (issue 9, docs/RELIABILITY.md).
+"""make_corpus.py - write the seed corpora of the fuzz targets (docs/RELIABILITY.md).
 
     /usr/bin/python3 tests/fuzz/make_corpus.py [tests/fuzz/corpus]
 

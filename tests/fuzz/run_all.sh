@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# run_all.sh - run libFuzzer targets over their committed corpora (issue 9).
+# run_all.sh - run libFuzzer targets over their committed corpora.
 #   tests/fuzz/run_all.sh BUILD --runs N    NAME...   corpus + N new inputs each (make test)
 #   tests/fuzz/run_all.sh BUILD --seconds S NAME...   S seconds each (make fuzz)
 # NAME is can, lcm, map, scenario (BUILD/fuzz/fuzz_NAME), radiotap (BUILD/feed/) or replay

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # pathloss_out.sh - the path-loss model's estimate and residual surface in the simulator's
-# outputs (issue 10, host side): log.tsv columns, summary.json, residual.tsv and
+# outputs (host side): log.tsv columns, summary.json, residual.tsv and
 # residual.png; other models leave the same columns "nan" / null.
 #   tests/host_sim/pathloss_out.sh build/bin/rfseek-sim        (from the repository root)
 # Expected values are recomputed in python from the files (positions -> distances), never

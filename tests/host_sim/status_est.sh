@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# status_est.sh - rfseekd puts the path-loss model's estimate in its LCM seeker status
-# (issue 10): a two-process run (rfseek-sim-lcm + rfseekd --model pathloss, udpm:// inside a
+# status_est.sh - rfseekd puts the path-loss model's estimate in its LCM seeker status:
+# a two-process run (rfseek-sim-lcm + rfseekd --model pathloss, udpm:// inside a
 # network namespace we create and delete) recorded as an LCM log, decoded by hand in
 # tests/host_sim/status_est_check.py; the same inputs replayed with the ridge carry none.
 #   tests/host_sim/status_est.sh BUILD        (from the repository root)

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Check the path-loss estimate in the seeker statuses of an LCM log (issue 10).
+"""Check the path-loss estimate in the seeker statuses of an LCM log.
 
     tests/host_sim/status_est_check.py LOG.lcmlog pathloss|none [MAP_W_M MAP_H_M]
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# strategy_cli.sh SIM - rfseek-sim's --strategy / --model options (issue 7) and the
+# strategy_cli.sh SIM - rfseek-sim's --strategy / --model options and the
 # benchmark script's own input check: bad names give one error line and exit 1; good
 # names run and are reported in summary.json.
 set -u

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # test_models_cli.sh BUILD - the model and the target chosen by configuration, the same way
-# in every program (issue 8): rfseek-sim --model / `model:` / `target: pdr`, rfseek-feed
+# in every program: rfseek-sim --model / `model:` / `target: pdr`, rfseek-feed
 # --model / --target (PDR from a real capture's sequence numbers, checked against tshark),
 # rfseekd --model. Bad values: one error line, non-zero exit. Prints PASS/FAIL lines.
 set -u

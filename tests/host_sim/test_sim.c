@@ -1,7 +1,7 @@
 /* test_sim.c - scenarios, the motor model and the run loop (hs_scenario.h, hs_motor.h,
  * hs_sim.h): bad input gives one clear error, the motor model's limits and timeout, every
  * seed of the open scenario reaches the source 10 m away, runs are deterministic, and the
- * receiver heartbeat (issue 10) carries the robot through a radio dead zone.
+ * receiver heartbeat carries the robot through a radio dead zone.
  * Run from the repository root (make test does).
  */
 #include "rfs_test.h"
@@ -97,7 +97,7 @@ static void test_scenario_good(void **state)
     assert_int_equal(sc.seek_recheck_adapt, -1);
     assert_int_equal(sc.seek_eps_sample, -1);
     assert_true(isnan(sc.seek_p0_min_dbm)); // the pathloss model's own default
-    assert_true(sc.rx_heartbeat); // issue 10: on unless the scenario turns it off
+    assert_true(sc.rx_heartbeat); // on unless the scenario turns it off
     // seek: overrides of the strategy's preset.
     char text[2048];
     snprintf(text, sizeof text, "%sstrategy: meta-path\nseek: {recheck_m: 0.5, eps_by_travel: false, "
@@ -425,7 +425,7 @@ static void test_shipped_scenarios(void **state)
     }
 }
 
-/* A radio dead zone (issue 10): with the receiver's sensitivity at -45 dBm (a hard edge,
+/* A radio dead zone: with the receiver's sensitivity at -45 dBm (a hard edge,
  * 0.01 dB wide) and no shadowing, fading or noise, packets from the source 10 m away
  * arrive only within 10^((20 - 39.6 + 45) / 30) = 7.0 m of it (docs/RADIO_MODEL.md path
  * loss), so the robot starts in a stretch where every packet is lost. */

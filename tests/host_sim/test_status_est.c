@@ -1,7 +1,7 @@
-/* test_status_est.c - the path-loss estimate in the LCM seeker status (issue 10):
- * hs_lcm_pub_status_est() puts it in the last fields of rfseek.seeker_status_t, read back
+/* test_status_est.c - the path-loss estimate in the LCM seeker status:
+ * lx_lcm_pub_status_est() puts it in the last fields of rfseek.seeker_status_t, read back
  * here from the recorded bytes by hand (big-endian, the .lcm field order) rather than by the
- * generated decoder; hs_lcm_pub_status() leaves them zero; the receiver drops a status whose
+ * generated decoder; lx_lcm_pub_status() leaves them zero; the receiver drops a status whose
  * estimate is not finite, negative where it cannot be, or set without est_valid. */
 #include "rfs_test.h"
 
@@ -11,7 +11,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "hs_lcm.h"
+#include "lx_lcm.h"
 #include "rfseek_seeker_status_t.h"
 
 /// Bytes of the estimate at the end of the message: est_valid + 7 doubles.
@@ -56,29 +56,29 @@ static size_t status_bytes(const rfs_pathloss_est_t *est, uint8_t *buf, size_t c
     assert_true(fd >= 0);
     close(fd);
     char err[200];
-    hs_lcm_log_t *w = hs_lcm_log_open(path, "w", err, sizeof err);
+    lx_lcm_log_t *w = lx_lcm_log_open(path, "w", err, sizeof err);
     assert_non_null(w);
-    hs_lcm_handlers_t h;
+    lx_lcm_handlers_t h;
     memset(&h, 0, sizeof h);
-    hs_lcm_t *l = hs_lcm_open("memq://", &h, err, sizeof err);
+    lx_lcm_t *l = lx_lcm_open("memq://", &h, err, sizeof err);
     assert_non_null(l);
-    hs_lcm_record(l, w);
+    lx_lcm_record(l, w);
     rfs_seek_out_t out;
     memset(&out, 0, sizeof out);
     out.decision.samples = 42;
-    assert_int_equal(hs_lcm_pub_status_est(l, 1000, &out, est), 0);
-    hs_lcm_record(l, NULL);
-    hs_lcm_close(l);
-    assert_int_equal(hs_lcm_log_close(w), 0);
-    hs_lcm_log_t *r = hs_lcm_log_open(path, "r", err, sizeof err);
+    assert_int_equal(lx_lcm_pub_status_est(l, 1000, &out, est), 0);
+    lx_lcm_record(l, NULL);
+    lx_lcm_close(l);
+    assert_int_equal(lx_lcm_log_close(w), 0);
+    lx_lcm_log_t *r = lx_lcm_log_open(path, "r", err, sizeof err);
     assert_non_null(r);
     int64_t t;
     char ch[64];
     size_t len = 0;
-    assert_int_equal(hs_lcm_log_next_raw(r, &t, ch, sizeof ch, buf, cap, &len), 1);
-    assert_string_equal(ch, HS_LCM_CH_STATUS);
+    assert_int_equal(lx_lcm_log_next_raw(r, &t, ch, sizeof ch, buf, cap, &len), 1);
+    assert_string_equal(ch, LX_LCM_CH_STATUS);
     assert_true(len <= cap && len > EST_BYTES);
-    assert_int_equal(hs_lcm_log_close(r), 0);
+    assert_int_equal(lx_lcm_log_close(r), 0);
     unlink(path);
     return len;
 }
@@ -129,22 +129,22 @@ static rx_t deliver(const rfseek_seeker_status_t *m)
 {
     rx_t r;
     memset(&r, 0, sizeof r);
-    hs_lcm_handlers_t h;
+    lx_lcm_handlers_t h;
     memset(&h, 0, sizeof h);
     h.ctx = &r;
     h.on_status = on_status;
     h.on_bad = on_bad;
     char err[200];
-    hs_lcm_t *l = hs_lcm_open("memq://", &h, err, sizeof err);
+    lx_lcm_t *l = lx_lcm_open("memq://", &h, err, sizeof err);
     assert_non_null(l);
     uint8_t buf[512];
     int n = rfseek_seeker_status_t_encoded_size(m);
     assert_true(n > 0 && n <= (int)sizeof buf);
     assert_int_equal(rfseek_seeker_status_t_encode(buf, 0, n, m), n);
-    assert_int_equal(hs_lcm_pub_raw(l, 0, HS_LCM_CH_STATUS, buf, (size_t)n), 0);
-    while (hs_lcm_handle(l, 0) == 1) {
+    assert_int_equal(lx_lcm_pub_raw(l, 0, LX_LCM_CH_STATUS, buf, (size_t)n), 0);
+    while (lx_lcm_handle(l, 0) == 1) {
     }
-    hs_lcm_close(l);
+    lx_lcm_close(l);
     return r;
 }
 

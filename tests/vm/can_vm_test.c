@@ -1,4 +1,4 @@
-/* can_vm_test.c - our side of the SocketCAN test (issue 4), run on vcan0 inside a qemu
+/* can_vm_test.c - our side of the SocketCAN test, run on vcan0 inside a qemu
  * VM with Debian's kernel (or natively where the host has vcan). Statically linked.
  *
  *   can_vm_test send IFACE EXPECT   encode and send a fixed scenario; write the frames as
@@ -17,7 +17,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "hs_can.h"
+#include "lx_can.h"
 #include "rfs_can.h"
 
 static const uint32_t our_ids[] = {RFS_CAN_ID_WHEEL_CMD, RFS_CAN_ID_POSE_XY, RFS_CAN_ID_POSE_TH, RFS_CAN_ID_RSSI,
@@ -39,7 +39,7 @@ static void nap_ms(int ms)
 static int do_send(const char *ifname, const char *expect)
 {
     char err[256];
-    hs_can_t *c = hs_can_open(ifname, our_ids, N_OUR_IDS, err, sizeof err);
+    lx_can_t *c = lx_can_open(ifname, our_ids, N_OUR_IDS, err, sizeof err);
     if (!c) {
         fprintf(stderr, "%s\n", err);
         return 1;
@@ -69,7 +69,7 @@ static int do_send(const char *ifname, const char *expect)
                               (uint8_t)(i ? 0x0F : 0), i ? 0xFFFFFFFFu : 7u};
         rfs_can_tx_status(&tx, &s, &fr[n++]);
     }
-    for (int i = 0; i < 2; i++) { /* receiver heartbeats (issue 10), across the wrap */
+    for (int i = 0; i < 2; i++) { /* receiver heartbeats, across the wrap */
         rfs_can_receiver_t r = {rfs_can_wrap_time(t0 + 100000 * i)};
         rfs_can_tx_receiver(&tx, &r, &fr[n++]);
     }
@@ -78,14 +78,14 @@ static int do_send(const char *ifname, const char *expect)
     FILE *o = fopen(tmp, "w");
     if (!o) {
         fprintf(stderr, "can_vm_test: %s: cannot write\n", tmp);
-        hs_can_close(c);
+        lx_can_close(c);
         return 1;
     }
     int bad = 0;
     for (unsigned i = 0; i < n; i++) {
-        if (hs_can_send(c, &fr[i]) != 0) {
-            hs_can_health_t h;
-            hs_can_health(c, &h);
+        if (lx_can_send(c, &fr[i]) != 0) {
+            lx_can_health_t h;
+            lx_can_health(c, &h);
             fprintf(stderr, "can_vm_test: send %u failed (errno %d)\n", i, h.last_errno);
             bad = 1;
         }
@@ -98,14 +98,14 @@ static int do_send(const char *ifname, const char *expect)
     }
     fclose(o);
     rename(tmp, expect);
-    hs_can_close(c);
+    lx_can_close(c);
     return bad;
 }
 
 static int do_recv(const char *ifname, int64_t now_us)
 {
     char err[256];
-    hs_can_t *c = hs_can_open(ifname, NULL, 0, err, sizeof err);
+    lx_can_t *c = lx_can_open(ifname, NULL, 0, err, sizeof err);
     if (!c) {
         fprintf(stderr, "%s\n", err);
         return 1;
@@ -117,7 +117,7 @@ static int do_recv(const char *ifname, int64_t now_us)
     unsigned delivered = 0;
     for (;;) {
         rfs_can_frame_t f;
-        int r = hs_can_recv(c, &f, timeout);
+        int r = lx_can_recv(c, &f, timeout);
         if (r <= 0) {
             break;
         }
@@ -153,13 +153,13 @@ static int do_recv(const char *ifname, int64_t now_us)
             break;
         }
     }
-    hs_can_health_t h;
-    hs_can_health(c, &h);
+    lx_can_health_t h;
+    lx_can_health(c, &h);
     printf("STATS delivered=%u foreign=%" PRIu32 " dropped=%" PRIu32 " checksum=%" PRIu32 " rssi_jumps=%" PRIu32
            " seq_gaps=%" PRIu32 "\n",
            delivered, h.rx_foreign, rfs_can_rx_dropped_total(&rx), rx.dropped[RFS_CAN_E_CHECKSUM],
            rx.msg[RFS_CAN_IDX_RSSI].counter_jumps, rx.rssi_seq_gaps);
-    hs_can_close(c);
+    lx_can_close(c);
     return 0;
 }
 
@@ -173,9 +173,9 @@ static int do_faults(const char *ifname)
 {
     int fails = 0;
     char err[256], cmd[256], d[256];
-    hs_can_t *gone = hs_can_open("rfsnope0", our_ids, N_OUR_IDS, err, sizeof err);
+    lx_can_t *gone = lx_can_open("rfsnope0", our_ids, N_OUR_IDS, err, sizeof err);
     fails += check(gone == NULL && strstr(err, "rfsnope0: no such interface") != NULL, "can-missing-iface", err);
-    hs_can_t *c = hs_can_open(ifname, our_ids, N_OUR_IDS, err, sizeof err);
+    lx_can_t *c = lx_can_open(ifname, our_ids, N_OUR_IDS, err, sizeof err);
     if (!c) {
         return check(0, "can-open", err);
     }
@@ -183,19 +183,19 @@ static int do_faults(const char *ifname)
     rfs_can_tx_init(&tx);
     rfs_can_wheel_t w = {100, 100, 0};
     rfs_can_frame_t f;
-    hs_can_health_t h;
+    lx_can_health_t h;
     rfs_can_tx_wheel(&tx, &w, &f);
-    fails += check(hs_can_send(c, &f) == 0, "can-send-up", "");
+    fails += check(lx_can_send(c, &f) == 0, "can-send-up", "");
 
     snprintf(cmd, sizeof cmd, "ip link set %s down", ifname);
     if (system(cmd) != 0) {
         fails += check(0, "can-down", "ip link set down failed");
     }
-    int r = hs_can_send(c, &f);
-    hs_can_health(c, &h);
+    int r = lx_can_send(c, &f);
+    lx_can_health(c, &h);
     snprintf(d, sizeof d, "send=%d link=%d errno=%d tx_failed=%" PRIu32, r, h.link, h.last_errno, h.tx_failed);
-    fails += check(r == -1 && h.link == HS_CAN_LINK_DOWN && h.tx_failed == 1, "can-send-down-refused", d);
-    r = hs_can_recv(c, &f, 50);
+    fails += check(r == -1 && h.link == LX_CAN_LINK_DOWN && h.tx_failed == 1, "can-send-down-refused", d);
+    r = lx_can_recv(c, &f, 50);
     fails += check(r == -1, "can-recv-down-reports", "");
 
     snprintf(cmd, sizeof cmd, "ip link set %s up", ifname);
@@ -204,29 +204,29 @@ static int do_faults(const char *ifname)
     }
     nap_ms(1100); /* longer than the largest backoff */
     rfs_can_tx_wheel(&tx, &w, &f);
-    r = hs_can_send(c, &f);
-    hs_can_health(c, &h);
+    r = lx_can_send(c, &f);
+    lx_can_health(c, &h);
     snprintf(d, sizeof d, "send=%d link=%d recoveries=%" PRIu32, r, h.link, h.recoveries);
-    fails += check(r == 0 && h.link == HS_CAN_LINK_OK && h.recoveries == 1, "can-recovers-after-up", d);
+    fails += check(r == 0 && h.link == LX_CAN_LINK_OK && h.recoveries == 1, "can-recovers-after-up", d);
 
     /* Bus-off as a controller reports it: an error frame with CAN_ERR_BUSOFF (0x40). */
     snprintf(cmd, sizeof cmd, "cansend %s 20000040#0000000000000000", ifname);
     if (system(cmd) != 0) {
         fails += check(0, "can-inject-busoff", "cansend failed");
     }
-    r = hs_can_recv(c, &f, 1); /* the error frame is already queued */
-    hs_can_health(c, &h);
+    r = lx_can_recv(c, &f, 1); /* the error frame is already queued */
+    lx_can_health(c, &h);
     snprintf(d, sizeof d, "recv=%d link=%d bus_off=%" PRIu32 " err_frames=%" PRIu32, r, h.link, h.bus_off, h.err_frames);
-    fails += check(r == 0 && h.link == HS_CAN_LINK_BUS_OFF && h.bus_off == 1, "can-busoff-reported", d);
+    fails += check(r == 0 && h.link == LX_CAN_LINK_BUS_OFF && h.bus_off == 1, "can-busoff-reported", d);
     rfs_can_tx_wheel(&tx, &w, &f);
-    r = hs_can_send(c, &f);
+    r = lx_can_send(c, &f);
     fails += check(r == -1, "can-busoff-send-backs-off", "");
     nap_ms(150);
-    r = hs_can_send(c, &f);
-    hs_can_health(c, &h);
+    r = lx_can_send(c, &f);
+    lx_can_health(c, &h);
     snprintf(d, sizeof d, "send=%d link=%d recoveries=%" PRIu32, r, h.link, h.recoveries);
-    fails += check(r == 0 && h.link == HS_CAN_LINK_OK && h.recoveries == 2, "can-busoff-recovers", d);
-    hs_can_close(c);
+    fails += check(r == 0 && h.link == LX_CAN_LINK_OK && h.recoveries == 2, "can-busoff-recovers", d);
+    lx_can_close(c);
     return fails ? 1 : 0;
 }
 

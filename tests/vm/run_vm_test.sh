@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# SocketCAN test against the real Linux CAN stack (issue 4). Where the host kernel has
+# SocketCAN test against the real Linux CAN stack. Where the host kernel has
 # vcan, runs tests/vm/can_inner.sh natively; otherwise boots Debian's current kernel
 # under qemu (TCG) with a busybox-static initramfs holding our static test binary,
 # candump/cansend (can-utils) and ip, and reads the verdict from the serial console.

@@ -76,7 +76,7 @@ def main(argv):
     want.append("DROP stale")
     # 12. a remote frame: filtered by the kernel like 7
     send.append("120#R")
-    # 13. a receiver heartbeat (issue 10), counter 0, 5 ms ago
+    # 13. a receiver heartbeat, counter 0, 5 ms ago
     send.append(frame(0x121, struct.pack("<BI", 0x00, t32(NOW - 5000))))
     want.append("RECEIVER t=%d" % (NOW - 5000))
     # 14. a receiver heartbeat 300 ms ahead: beyond the 100 ms future window

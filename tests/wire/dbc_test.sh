@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The DBC loads in canmatrix and decodes our encoded frames field by field (issue 4).
+# The DBC loads in canmatrix and decodes our encoded frames field by field.
 # usage: tests/wire/dbc_test.sh BUILD
 set -uo pipefail
 build=${1:?usage: dbc_test.sh BUILD}

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""feed_heartbeat.py FEED - the receiver heartbeat in rfseek-feed --pose (issue 10).
+"""feed_heartbeat.py FEED - the receiver heartbeat in rfseek-feed --pose.
 
 Builds a capture in pure Python (classic pcap, radiotap with a dBm signal, 802.11 data
 frames) and a pose CSV for scenarios/default.yaml: the robot creeps east along the

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# heartbeat_replay.sh BUILD - the receiver heartbeat (issue 10) through the firmware's
+# heartbeat_replay.sh BUILD - the receiver heartbeat through the firmware's
 # wire paths: a simulated mission that starts in a radio dead zone (the office, the
 # receiver's sensitivity at -45 dBm with a hard edge and no shadowing, fading or noise:
 # packets arrive only within about 7 m of the source, the robot starts 20 m away),

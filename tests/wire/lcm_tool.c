@@ -1,4 +1,4 @@
-/* lcm_tool.c - test helper for rfseekd and the LCM adapter (issue 4).
+/* lcm_tool.c - test helper for rfseekd and the LCM adapter.
  *
  *   lcm_tool mklog OUT.lcmlog   write a crafted input log: 3 s of poses (10 Hz) and RSSI
  *                               (100 Hz) at the office map's start, RFS_CLOCK at 20 Hz for
@@ -7,7 +7,7 @@
  *                               on the pose channel, 5 bytes of garbage on RFS_RSSI and a
  *                               pose older than the newest; at 2 s a clock going backwards
  *   lcm_tool mkdeadzone OUT.lcmlog on|off
- *                               a radio dead zone (issue 10): 4 s of poses (10 Hz) at the
+ *                               a radio dead zone: 4 s of poses (10 Hz) at the
  *                               office map's start, RSSI (100 Hz) only for the first 1 s,
  *                               RFS_CLOCK at 20 Hz; with "on" a receiver heartbeat
  *                               (RFS_RSSI_STATUS) just before every clock tick (81) and
@@ -21,7 +21,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "hs_lcm.h"
+#include "lx_lcm.h"
 
 static int mklog(const char *out)
 {
@@ -29,75 +29,75 @@ static int mklog(const char *out)
     char tmpl_path[600];
     snprintf(tmpl_path, sizeof tmpl_path, "%s.tmpl", out);
     /* 1. Valid encodings of each type, to corrupt below. */
-    hs_lcm_log_t *tl = hs_lcm_log_open(tmpl_path, "w", err, sizeof err);
-    hs_lcm_t *l = hs_lcm_open("memq://", NULL, err, sizeof err);
+    lx_lcm_log_t *tl = lx_lcm_log_open(tmpl_path, "w", err, sizeof err);
+    lx_lcm_t *l = lx_lcm_open("memq://", NULL, err, sizeof err);
     if (!tl || !l) {
         fprintf(stderr, "lcm_tool: %s\n", err);
         return 1;
     }
-    hs_lcm_record(l, tl);
+    lx_lcm_record(l, tl);
     rfs_pose_t p0 = {1000000, 8 * 65536, 6 * 65536, 0};
-    hs_lcm_pub_pose(l, &p0);
-    hs_lcm_pub_rssi(l, 0, 1000000, -60, 7);
-    hs_lcm_pub_clock(l, 1000000);
-    hs_lcm_record(l, NULL);
-    hs_lcm_log_close(tl);
+    lx_lcm_pub_pose(l, &p0);
+    lx_lcm_pub_rssi(l, 0, 1000000, -60, 7);
+    lx_lcm_pub_clock(l, 1000000);
+    lx_lcm_record(l, NULL);
+    lx_lcm_log_close(tl);
     uint8_t pose[256], rssi[256], clk[256];
     size_t npose, nrssi, nclk;
     char ch[64];
     int64_t t;
-    tl = hs_lcm_log_open(tmpl_path, "r", err, sizeof err);
-    if (!tl || hs_lcm_log_next_raw(tl, &t, ch, sizeof ch, pose, sizeof pose, &npose) != 1 ||
-        hs_lcm_log_next_raw(tl, &t, ch, sizeof ch, rssi, sizeof rssi, &nrssi) != 1 ||
-        hs_lcm_log_next_raw(tl, &t, ch, sizeof ch, clk, sizeof clk, &nclk) != 1) {
+    tl = lx_lcm_log_open(tmpl_path, "r", err, sizeof err);
+    if (!tl || lx_lcm_log_next_raw(tl, &t, ch, sizeof ch, pose, sizeof pose, &npose) != 1 ||
+        lx_lcm_log_next_raw(tl, &t, ch, sizeof ch, rssi, sizeof rssi, &nrssi) != 1 ||
+        lx_lcm_log_next_raw(tl, &t, ch, sizeof ch, clk, sizeof clk, &nclk) != 1) {
         fprintf(stderr, "lcm_tool: %s: cannot read the templates back\n", tmpl_path);
         return 1;
     }
-    hs_lcm_log_close(tl);
+    lx_lcm_log_close(tl);
     remove(tmpl_path);
 
     /* 2. The crafted run. LCM encodes big-endian: 8-byte fingerprint, then the fields. */
-    hs_lcm_log_t *ol = hs_lcm_log_open(out, "w", err, sizeof err);
+    lx_lcm_log_t *ol = lx_lcm_log_open(out, "w", err, sizeof err);
     if (!ol) {
         fprintf(stderr, "lcm_tool: %s\n", err);
         return 1;
     }
-    hs_lcm_record(l, ol);
+    lx_lcm_record(l, ol);
     for (int64_t t_us = 0; t_us <= 4000000; t_us += 5000) {
         if (t_us < 3000000 && t_us % 10000 == 0) {
             int8_t dbm = (int8_t)(-60 - (int)((t_us / 10000) % 7));
-            hs_lcm_pub_rssi(l, 0, t_us, dbm, (uint32_t)(t_us / 10000));
+            lx_lcm_pub_rssi(l, 0, t_us, dbm, (uint32_t)(t_us / 10000));
         }
         if (t_us < 3000000 && t_us % 100000 == 0) {
             rfs_pose_t p = {t_us, 8 * 65536, 6 * 65536, 0};
-            hs_lcm_pub_pose(l, &p);
+            lx_lcm_pub_pose(l, &p);
         }
         if (t_us == 1000000) {
             uint8_t b[256];
-            hs_lcm_pub_raw(l, t_us, HS_LCM_CH_POSE, pose, npose - 3); /* truncated */
+            lx_lcm_pub_raw(l, t_us, LX_LCM_CH_POSE, pose, npose - 3); /* truncated */
             memcpy(b, pose, npose);
             const uint8_t nan_be[8] = {0x7F, 0xF8, 0, 0, 0, 0, 0, 0};
             memcpy(b + 16, nan_be, 8); /* x after fingerprint and utime */
-            hs_lcm_pub_raw(l, t_us, HS_LCM_CH_POSE, b, npose);
+            lx_lcm_pub_raw(l, t_us, LX_LCM_CH_POSE, b, npose);
             memcpy(b, rssi, nrssi);
             b[16] = 0;
             b[17] = 99; /* source, int16 after fingerprint and utime */
-            hs_lcm_pub_raw(l, t_us, HS_LCM_CH_RSSI, b, nrssi);
-            hs_lcm_pub_raw(l, t_us, HS_LCM_CH_POSE, clk, nclk); /* wrong type */
+            lx_lcm_pub_raw(l, t_us, LX_LCM_CH_RSSI, b, nrssi);
+            lx_lcm_pub_raw(l, t_us, LX_LCM_CH_POSE, clk, nclk); /* wrong type */
             const uint8_t junk[5] = {1, 2, 3, 4, 5};
-            hs_lcm_pub_raw(l, t_us, HS_LCM_CH_RSSI, junk, sizeof junk);
+            lx_lcm_pub_raw(l, t_us, LX_LCM_CH_RSSI, junk, sizeof junk);
             rfs_pose_t old = {500000, 8 * 65536, 6 * 65536, 0}; /* out of order */
-            hs_lcm_pub_pose(l, &old);
+            lx_lcm_pub_pose(l, &old);
         }
         if (t_us % 50000 == 0) {
-            hs_lcm_pub_clock(l, t_us);
+            lx_lcm_pub_clock(l, t_us);
         }
         if (t_us == 2000000) {
-            hs_lcm_pub_clock(l, 1000000); /* backwards */
+            lx_lcm_pub_clock(l, 1000000); /* backwards */
         }
     }
-    hs_lcm_close(l);
-    if (hs_lcm_log_close(ol) != 0) {
+    lx_lcm_close(l);
+    if (lx_lcm_log_close(ol) != 0) {
         fprintf(stderr, "lcm_tool: %s: cannot finish the log\n", out);
         return 1;
     }
@@ -107,36 +107,36 @@ static int mklog(const char *out)
 static int mkdeadzone(const char *out, bool heartbeat)
 {
     char err[256];
-    hs_lcm_t *l = hs_lcm_open("memq://", NULL, err, sizeof err);
-    hs_lcm_log_t *ol = l ? hs_lcm_log_open(out, "w", err, sizeof err) : NULL;
+    lx_lcm_t *l = lx_lcm_open("memq://", NULL, err, sizeof err);
+    lx_lcm_log_t *ol = l ? lx_lcm_log_open(out, "w", err, sizeof err) : NULL;
     if (!ol) {
         fprintf(stderr, "lcm_tool: %s\n", err);
-        hs_lcm_close(l);
+        lx_lcm_close(l);
         return 1;
     }
-    hs_lcm_record(l, ol);
+    lx_lcm_record(l, ol);
     for (int64_t t_us = 0; t_us <= 4000000; t_us += 5000) {
         if (t_us < 1000000 && t_us % 10000 == 0) {
             int8_t dbm = (int8_t)(-60 - (int)((t_us / 10000) % 7));
-            hs_lcm_pub_rssi(l, 0, t_us, dbm, (uint32_t)(t_us / 10000));
+            lx_lcm_pub_rssi(l, 0, t_us, dbm, (uint32_t)(t_us / 10000));
         }
         if (t_us % 100000 == 0) {
             rfs_pose_t p = {t_us, 8 * 65536, 6 * 65536, 0};
-            hs_lcm_pub_pose(l, &p);
+            lx_lcm_pub_pose(l, &p);
         }
         if (heartbeat && t_us == 2000000) {
             const uint8_t junk[5] = {1, 2, 3, 4, 5};
-            hs_lcm_pub_raw(l, t_us, HS_LCM_CH_RSSI_STATUS, junk, sizeof junk);
+            lx_lcm_pub_raw(l, t_us, LX_LCM_CH_RSSI_STATUS, junk, sizeof junk);
         }
         if (t_us % 50000 == 0) {
             if (heartbeat) {
-                hs_lcm_pub_receiver(l, t_us, (uint32_t)(t_us / 50000));
+                lx_lcm_pub_receiver(l, t_us, (uint32_t)(t_us / 50000));
             }
-            hs_lcm_pub_clock(l, t_us);
+            lx_lcm_pub_clock(l, t_us);
         }
     }
-    hs_lcm_close(l);
-    if (hs_lcm_log_close(ol) != 0) {
+    lx_lcm_close(l);
+    if (lx_lcm_log_close(ol) != 0) {
         fprintf(stderr, "lcm_tool: %s: cannot finish the log\n", out);
         return 1;
     }
@@ -153,20 +153,20 @@ static void on_status(void *ctx, int64_t t_us, const rfs_seek_out_t *o)
 static int dump(const char *path)
 {
     char err[256];
-    hs_lcm_log_t *lg = hs_lcm_log_open(path, "r", err, sizeof err);
+    lx_lcm_log_t *lg = lx_lcm_log_open(path, "r", err, sizeof err);
     if (!lg) {
         fprintf(stderr, "lcm_tool: %s\n", err);
         return 1;
     }
-    hs_lcm_handlers_t h;
+    lx_lcm_handlers_t h;
     memset(&h, 0, sizeof h);
     h.on_status = on_status;
-    hs_lcm_stats_t st;
+    lx_lcm_stats_t st;
     memset(&st, 0, sizeof st);
     int64_t t;
-    while (hs_lcm_log_next(lg, &h, &st, &t) == 1) {
+    while (lx_lcm_log_next(lg, &h, &st, &t) == 1) {
     }
-    hs_lcm_log_close(lg);
+    lx_lcm_log_close(lg);
     if (st.bad) {
         fprintf(stderr, "lcm_tool: %s: %u bad status messages (%s)\n", path, st.bad, st.last_error);
         return 1;

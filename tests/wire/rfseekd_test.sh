@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# rfseekd (issue 4): command line errors, malformed LCM input, stale inputs stop the wheels,
+# rfseekd: command line errors, malformed LCM input, stale inputs stop the wheels,
 # deterministic replay, logs readable by lcm-logplayer; then the two-process run (udpm in
 # a private network namespace) when this user may create one.
 # usage: tests/wire/rfseekd_test.sh BUILD
@@ -61,7 +61,7 @@ expect_err_of "$sl" sim-lcm-newline-lcm-url 1 "lcm: udpm://?q: cannot open this 
     $scn --lcm "udpm://${nl}q" --max-time 1
 expect_err_of "$sl" sim-lcm-newline-can 1 "can: rfsno?q" $scn --lcm memq:// --can "rfsno${nl}q" --max-time 1
 [ ! -s "$w/out" ] && pass sim-lcm-newline-no-summary || fail sim-lcm-newline-no-summary
-# liblcm's own stderr is folded by hs_lcm_open (host_sim/hs_lcm_adapt.c): its two lines
+# liblcm's own stderr is folded by lx_lcm_open (firmware/port/linux/lx_lcm.c): its two lines
 # for a bad option of a missing log (lcm_logprov.c) become part of one error line, and a
 # warning on a provider that does open is one line before the end-of-run summary.
 expect_err rfseekd-liblcm-two-lines 1 "cannot open this provider.*(liblcm: Warning: Invalid value for speed?Error: Failed to open $PWD/$w/none.lcmlog: No such file or directory)\$" \
@@ -127,7 +127,7 @@ if [ -x "$build/asan/bin/rfseekd" ]; then
         fail "rfseekd-bad-input-under-asan-ubsan (rc $rc: $(grep -m3 -E 'Sanitizer|runtime error' "$w/err-asan.txt"))"
     fi
 fi
-# A radio dead zone (issue 10): packets stop at 1 s, poses go on. Without the receiver
+# A radio dead zone: packets stop at 1 s, poses go on. Without the receiver
 # heartbeat (RFS_RSSI_STATUS) the wheels stop within 200 ms and stay stopped; with it
 # every one of the 81 heartbeats reaches the application (counted by rfseekd) and the
 # robot drives on to 4 s; the garbage heartbeat is dropped with one line.
@@ -205,7 +205,7 @@ fi
 cmp -s "$w/live.txt" "$w/replay3.txt" && pass "two-process-replay-through-lcm-file-provider" \
     || fail two-process-replay-through-lcm-file-provider
 
-# The improvement of issue 10 on the Linux port: meta-path with the pathloss model.
+# The map-aware improvement on the Linux port: meta-path with the pathloss model.
 two_process path --model pathloss --strategy meta-path
 if [ $src -eq 0 ] && [ $drc -eq 0 ] && grep -q '"reached": true' "$w/summary-path.json" \
     && grep -q "(strategy meta-path, model pathloss)\$" "$w/d-path.err"; then

@@ -1,4 +1,4 @@
-/* test_lcm.c - the LCM adapter (host_sim/hs_lcm.h) over memq:// and log files. */
+/* test_lcm.c - the LCM adapter (firmware/port/linux/lx_lcm.h) over memq:// and log files. */
 #include "rfs_test.h"
 
 #include <math.h>
@@ -7,7 +7,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "hs_lcm.h"
+#include "lx_lcm.h"
 
 typedef struct rx {
     rfs_pose_t pose;
@@ -52,25 +52,25 @@ static void on_bad(void *c, const char *why)
 
 static void on_receiver(void *c, int64_t t, uint32_t q) { rx_t *r = c; r->rx_t = t; r->rx_seq = q; r->rxs++; }
 
-static hs_lcm_handlers_t handlers(rx_t *r)
+static lx_lcm_handlers_t handlers(rx_t *r)
 {
-    hs_lcm_handlers_t h = {r, on_pose, on_rssi, on_clock, on_wheel, on_status, on_can, on_bad, on_receiver};
+    lx_lcm_handlers_t h = {r, on_pose, on_rssi, on_clock, on_wheel, on_status, on_can, on_bad, on_receiver};
     return h;
 }
 
-static hs_lcm_t *open_memq(rx_t *r)
+static lx_lcm_t *open_memq(rx_t *r)
 {
     memset(r, 0, sizeof *r);
-    hs_lcm_handlers_t h = handlers(r);
+    lx_lcm_handlers_t h = handlers(r);
     char err[200];
-    hs_lcm_t *l = hs_lcm_open("memq://", &h, err, sizeof err);
+    lx_lcm_t *l = lx_lcm_open("memq://", &h, err, sizeof err);
     assert_non_null(l);
     return l;
 }
 
-static void drain(hs_lcm_t *l)
+static void drain(lx_lcm_t *l)
 {
-    while (hs_lcm_handle(l, 0) == 1) {
+    while (lx_lcm_handle(l, 0) == 1) {
     }
 }
 
@@ -78,10 +78,10 @@ static void pose_round_trips_exactly_and_heading_is_normalised(void **state)
 {
     (void)state;
     rx_t r;
-    hs_lcm_t *l = open_memq(&r);
+    lx_lcm_t *l = open_memq(&r);
     rfs_pose_t p = {-123456789012LL, -2147418112 /* -32767 m */, 98305, -205887};
 
-    assert_int_equal(hs_lcm_pub_pose(l, &p), 0);
+    assert_int_equal(lx_lcm_pub_pose(l, &p), 0);
     drain(l);
 
     assert_int_equal(r.poses, 1);
@@ -91,17 +91,17 @@ static void pose_round_trips_exactly_and_heading_is_normalised(void **state)
     assert_int_equal(r.pose.theta, -205887);
     /* 4 rad wraps to 4 - 2 pi (double-precision reference). */
     rfs_pose_t q = {1, 0, 0, 4 * 65536};
-    hs_lcm_pub_pose(l, &q);
+    lx_lcm_pub_pose(l, &q);
     drain(l);
     assert_int_equal(r.pose.theta, (int32_t)llround((4.0 - 2.0 * M_PI) * 65536.0));
-    hs_lcm_close(l);
+    lx_lcm_close(l);
 }
 
 static void every_type_round_trips(void **state)
 {
     (void)state;
     rx_t r;
-    hs_lcm_t *l = open_memq(&r);
+    lx_lcm_t *l = open_memq(&r);
     rfs_can_wheel_t w = {-32768, 32767, RFS_CAN_WHEEL_STOP};
     rfs_seek_out_t o;
     memset(&o, 0, sizeof o);
@@ -125,11 +125,11 @@ static void every_type_round_trips(void **state)
     o.decision.samples = 10000;
     rfs_can_frame_t f = {0x120, 8, {1, 2, 3, 4, 5, 6, 7, 8}};
 
-    hs_lcm_pub_rssi(l, 15, 42, -128, 0xFFFFFFFFu);
-    hs_lcm_pub_clock(l, 50000);
-    hs_lcm_pub_wheel(l, 60000, &w);
-    hs_lcm_pub_status(l, 70000, &o);
-    hs_lcm_pub_can(l, 80000, &f);
+    lx_lcm_pub_rssi(l, 15, 42, -128, 0xFFFFFFFFu);
+    lx_lcm_pub_clock(l, 50000);
+    lx_lcm_pub_wheel(l, 60000, &w);
+    lx_lcm_pub_status(l, 70000, &o);
+    lx_lcm_pub_can(l, 80000, &f);
     drain(l);
 
     assert_int_equal(r.src, 15);
@@ -168,33 +168,33 @@ static void every_type_round_trips(void **state)
     assert_int_equal(r.frame.id, 0x120);
     assert_int_equal(r.frame.dlc, 8);
     assert_memory_equal(r.frame.data, f.data, 8);
-    hs_lcm_stats_t st;
-    hs_lcm_get_stats(l, &st);
+    lx_lcm_stats_t st;
+    lx_lcm_get_stats(l, &st);
     assert_int_equal(st.received, 5);
     assert_int_equal(st.bad, 0);
-    hs_lcm_close(l);
+    lx_lcm_close(l);
 }
 
 static void malformed_messages_are_dropped_and_described(void **state)
 {
     (void)state;
     rx_t r;
-    hs_lcm_t *l = open_memq(&r);
+    lx_lcm_t *l = open_memq(&r);
     const uint8_t junk[7] = {0xDE, 0xAD, 0xBE, 0xEF, 0, 1, 2};
 
-    hs_lcm_pub_raw(l, 0, HS_LCM_CH_POSE, junk, sizeof junk);
-    hs_lcm_pub_raw(l, 0, HS_LCM_CH_STATUS, junk, 0);
+    lx_lcm_pub_raw(l, 0, LX_LCM_CH_POSE, junk, sizeof junk);
+    lx_lcm_pub_raw(l, 0, LX_LCM_CH_STATUS, junk, 0);
     drain(l);
 
     assert_int_equal(r.poses, 0);
     assert_int_equal(r.statuses, 0);
     assert_int_equal(r.bads, 2);
     assert_string_equal(r.bad, "RFS_SEEKER_STATUS: truncated, oversized or not an rfseek.seeker_status_t (0 bytes)");
-    hs_lcm_stats_t st;
-    hs_lcm_get_stats(l, &st);
+    lx_lcm_stats_t st;
+    lx_lcm_get_stats(l, &st);
     assert_int_equal(st.bad, 2);
     assert_string_equal(st.last_error, r.bad);
-    hs_lcm_close(l);
+    lx_lcm_close(l);
 }
 
 static void log_is_written_atomically_and_reads_back(void **state)
@@ -206,34 +206,34 @@ static void log_is_written_atomically_and_reads_back(void **state)
     close(fd);
     unlink(path);
     char err[200];
-    hs_lcm_log_t *log = hs_lcm_log_open(path, "w", err, sizeof err);
+    lx_lcm_log_t *log = lx_lcm_log_open(path, "w", err, sizeof err);
     assert_non_null(log);
     rx_t r;
-    hs_lcm_t *l = open_memq(&r);
-    hs_lcm_record(l, log);
+    lx_lcm_t *l = open_memq(&r);
+    lx_lcm_record(l, log);
     rfs_pose_t p = {1000, 65536, -65536, 0};
-    hs_lcm_pub_pose(l, &p);
-    hs_lcm_pub_clock(l, 2000);
+    lx_lcm_pub_pose(l, &p);
+    lx_lcm_pub_clock(l, 2000);
     drain(l); /* received messages are recorded too */
-    hs_lcm_record(l, NULL);
+    lx_lcm_record(l, NULL);
 
     assert_int_equal(access(path, F_OK), -1); /* nothing at PATH before close */
-    assert_int_equal(hs_lcm_log_close(log), 0);
+    assert_int_equal(lx_lcm_log_close(log), 0);
     assert_int_equal(access(path, F_OK), 0);
 
-    log = hs_lcm_log_open(path, "r", err, sizeof err);
+    log = lx_lcm_log_open(path, "r", err, sizeof err);
     assert_non_null(log);
     rx_t back;
     memset(&back, 0, sizeof back);
-    hs_lcm_handlers_t h = handlers(&back);
+    lx_lcm_handlers_t h = handlers(&back);
     int64_t t;
     int n = 0;
-    while (hs_lcm_log_next(log, &h, NULL, &t) == 1) {
+    while (lx_lcm_log_next(log, &h, NULL, &t) == 1) {
         n++;
     }
-    hs_lcm_log_close(log);
+    lx_lcm_log_close(log);
     unlink(path);
-    hs_lcm_close(l);
+    lx_lcm_close(l);
     assert_int_equal(n, 4); /* 2 published + 2 received */
     assert_int_equal(back.poses, 2);
     assert_int_equal(back.pose.x, 65536);
@@ -246,16 +246,16 @@ static void bad_url_and_unreadable_log_give_one_line(void **state)
 {
     (void)state;
     char err[200];
-    hs_lcm_t *l = hs_lcm_open("nosuch://x", NULL, err, sizeof err);
+    lx_lcm_t *l = lx_lcm_open("nosuch://x", NULL, err, sizeof err);
     assert_null(l);
     assert_string_equal(err, "lcm: nosuch://x: cannot open this provider (bad URL, no multicast route, or no file)"
                              " (liblcm: Error: LCM provider \"nosuch\" not found)");
-    hs_lcm_log_t *g = hs_lcm_log_open("/nonexistent/dir/x.lcmlog", "r", err, sizeof err);
+    lx_lcm_log_t *g = lx_lcm_log_open("/nonexistent/dir/x.lcmlog", "r", err, sizeof err);
     assert_null(g);
     assert_string_equal(err, "/nonexistent/dir/x.lcmlog: cannot open for reading");
 }
 
-/* RFS_RSSI_STATUS (issue 10). Reference bytes from the LCM wire format computed in Python
+/* RFS_RSSI_STATUS. Reference bytes from the LCM wire format computed in Python
  * (tests/fuzz/make_corpus.py's lcm_hash of {int64_t utime, int32_t seq} = 0xc77a89abfd4c5ba6,
  * then utime and seq big-endian): utime -5,000,000,123, seq -7. */
 static void receiver_status_matches_reference_bytes_and_rejects_others(void **state)
@@ -264,14 +264,14 @@ static void receiver_status_matches_reference_bytes_and_rejects_others(void **st
     const uint8_t ref[20] = {0xc7, 0x7a, 0x89, 0xab, 0xfd, 0x4c, 0x5b, 0xa6, 0xff, 0xff,
                              0xff, 0xfe, 0xd5, 0xfa, 0x0d, 0x85, 0xff, 0xff, 0xff, 0xf9};
     rx_t r;
-    hs_lcm_t *l = open_memq(&r);
+    lx_lcm_t *l = open_memq(&r);
 
-    assert_int_equal(hs_lcm_pub_raw(l, 0, HS_LCM_CH_RSSI_STATUS, ref, sizeof ref), 0);
+    assert_int_equal(lx_lcm_pub_raw(l, 0, LX_LCM_CH_RSSI_STATUS, ref, sizeof ref), 0);
     drain(l);
     assert_int_equal(r.rxs, 1);
     assert_true(r.rx_t == -5000000123LL);
     assert_int_equal(r.rx_seq, 0xFFFFFFF9u);
-    assert_int_equal(hs_lcm_pub_receiver(l, 1700000000123456LL, 41u), 0);
+    assert_int_equal(lx_lcm_pub_receiver(l, 1700000000123456LL, 41u), 0);
     drain(l);
     assert_int_equal(r.rxs, 2);
     assert_true(r.rx_t == 1700000000123456LL);
@@ -283,20 +283,20 @@ static void receiver_status_matches_reference_bytes_and_rejects_others(void **st
     uint8_t longer[21];
     memcpy(longer, ref, sizeof ref);
     longer[20] = 0;
-    assert_int_equal(hs_lcm_pub_raw(l, 0, HS_LCM_CH_RSSI_STATUS, clk, sizeof clk), 0);
+    assert_int_equal(lx_lcm_pub_raw(l, 0, LX_LCM_CH_RSSI_STATUS, clk, sizeof clk), 0);
     drain(l);
     assert_string_equal(r.bad, "RFS_RSSI_STATUS: truncated, oversized or not an rfseek.rssi_status_t (16 bytes)");
-    assert_int_equal(hs_lcm_pub_raw(l, 0, HS_LCM_CH_RSSI_STATUS, ref, 19), 0);
-    assert_int_equal(hs_lcm_pub_raw(l, 0, HS_LCM_CH_RSSI_STATUS, longer, sizeof longer), 0);
+    assert_int_equal(lx_lcm_pub_raw(l, 0, LX_LCM_CH_RSSI_STATUS, ref, 19), 0);
+    assert_int_equal(lx_lcm_pub_raw(l, 0, LX_LCM_CH_RSSI_STATUS, longer, sizeof longer), 0);
     drain(l);
     assert_string_equal(r.bad, "RFS_RSSI_STATUS: truncated, oversized or not an rfseek.rssi_status_t (21 bytes)");
     assert_int_equal(r.bads, 3);
     assert_int_equal(r.rxs, 2);
-    hs_lcm_stats_t st;
-    hs_lcm_get_stats(l, &st);
+    lx_lcm_stats_t st;
+    lx_lcm_get_stats(l, &st);
     assert_int_equal(st.received, 2);
     assert_int_equal(st.bad, 3);
-    hs_lcm_close(l);
+    lx_lcm_close(l);
 }
 
 int main(void)

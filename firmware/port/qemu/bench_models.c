@@ -1,5 +1,5 @@
-/* bench_models.c - instruction counts of every internal model on the Cortex-M4 image
- * (issues 8 and 10): a full relearn, the heaviest slice of a sliced relearn, one grid
+/* bench_models.c - instruction counts of every internal model on the Cortex-M4 image:
+ * a full relearn, the heaviest slice of a sliced relearn, one grid
  * search, one prediction, the state size; models_work.c holds the workload and the run.
  *
  *   qemu-system-arm -M netduinoplus2 -nographic -monitor none -serial null \

@@ -1,6 +1,6 @@
 /* main.c - the emulator port (qemu-system-arm -M netduinoplus2): the application loop
  * of firmware/rfs_app.c driven by a recorded input stream read through semihosting,
- * its output stream written through semihosting (issue 6).
+ * its output stream written through semihosting.
  *
  *   qemu-system-arm -M netduinoplus2 -nographic -semihosting-config enable=on,target=native \
  *       -kernel qemu.elf -append "IN.rfsr OUT.rfso"

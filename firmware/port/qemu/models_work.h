@@ -1,4 +1,4 @@
-/* models_work.h - the workload of the model bench (issues 8 and 10) and its run, shared
+/* models_work.h - the workload of the model bench and its run, shared
  * by the Cortex-M4 image (bench_models.c: timed by SysTick under qemu -icount) and its
  * host twin (tests/firmware/bench_models_host.c: the same calls on the host build of the
  * core, the cross-check of tests/firmware/bench_models.sh). Both link their own

@@ -1,5 +1,5 @@
 /* main.c - the STM32F405 image: CAN in -> rfs_app (rfs_seek) -> wheel command and
- * status out over CAN, at 20 Hz, on a polled main loop (issue 6).
+ * status out over CAN, at 20 Hz, on a polled main loop.
  *
  * Safety: the application zeroes the wheels when pose or RSSI frames stop for 150 ms
  * and while bxCAN is bus-off (the driver also aborts pending mailboxes then, so no stale

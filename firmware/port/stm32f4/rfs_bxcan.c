@@ -29,7 +29,7 @@ rfs_bxcan_cfg_t rfs_bxcan_cfg_default(void)
     c.fifo0_ids[1] = RFS_CAN_ID_POSE_TH;
     c.n_fifo0 = 2u;
     c.fifo1_ids[0] = RFS_CAN_ID_RSSI;
-    c.fifo1_ids[1] = RFS_CAN_ID_RX_STATUS; /* the radio module's heartbeat (issue 10) */
+    c.fifo1_ids[1] = RFS_CAN_ID_RX_STATUS; /* the radio module's heartbeat */
     c.n_fifo1 = 2u;
     c.max_polls = 100000u;
     return c;

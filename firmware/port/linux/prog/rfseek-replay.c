@@ -1,5 +1,5 @@
 /* rfseek-replay - the host build of the firmware application loop on a recorded stream
- * (firmware/rfs_replay.h), and a printer for streams (issue 6).
+ * (firmware/rfs_replay.h), and a printer for streams.
  *
  *   rfseek-replay IN.rfsr -o OUT.rfso   play an input stream, write the output stream
  *   rfseek-replay --print FILE          print any stream, one record per line (TSV)
@@ -15,7 +15,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "hs_err.h"
+#include "lx_err.h"
 #include "rfs_app.h"
 #include "rfs_replay.h"
 
@@ -32,20 +32,20 @@ static void sink(void *ctx, const uint8_t *p, uint32_t n)
     }
 }
 
-static const char PROG[] = "rfseek-replay"; /* the prefix of its error lines (hs_err_print) */
+static const char PROG[] = "rfseek-replay"; /* the prefix of its error lines (lx_err_print) */
 
 static uint8_t *slurp(const char *path, size_t *len)
 {
     FILE *f = fopen(path, "rb");
     if (f == NULL) {
-        hs_err_print(PROG, "%s: %s", path, strerror(errno));
+        lx_err_print(PROG, "%s: %s", path, strerror(errno));
         return NULL;
     }
     size_t cap = 1 << 16, n = 0;
     uint8_t *buf = malloc(cap);
     for (;;) {
         if (buf == NULL) {
-            hs_err_print(PROG, "%s: out of memory", path);
+            lx_err_print(PROG, "%s: out of memory", path);
             fclose(f);
             return NULL;
         }
@@ -63,7 +63,7 @@ static uint8_t *slurp(const char *path, size_t *len)
     const int bad = ferror(f);
     fclose(f);
     if (bad) {
-        hs_err_print(PROG, "%s: read error", path);
+        lx_err_print(PROG, "%s: read error", path);
         free(buf);
         return NULL;
     }
@@ -177,22 +177,22 @@ int main(int argc, char **argv)
             print = 1;
         } else if (strcmp(argv[i], "-o") == 0) {
             if (i + 1 == argc) {
-                hs_err_print(PROG, "-o: missing value (see --help)");
+                lx_err_print(PROG, "-o: missing value (see --help)");
                 return 2;
             }
             out_path = argv[++i];
         } else if (argv[i][0] == '-') {
-            hs_err_print(PROG, "%s: unknown option (see --help)", argv[i]);
+            lx_err_print(PROG, "%s: unknown option (see --help)", argv[i]);
             return 2;
         } else if (in_path == NULL) {
             in_path = argv[i];
         } else {
-            hs_err_print(PROG, "%s: only one input stream expected (see --help)", argv[i]);
+            lx_err_print(PROG, "%s: only one input stream expected (see --help)", argv[i]);
             return 2;
         }
     }
     if (in_path == NULL || (print == 0) == (out_path == NULL)) {
-        hs_err_print(PROG, "%s (see --help)", in_path == NULL ? "an input stream is required"
+        lx_err_print(PROG, "%s (see --help)", in_path == NULL ? "an input stream is required"
                                     : print ? "--print and -o exclude each other"
                                             : "-o OUT.rfso or --print is required");
         return 2;
@@ -203,7 +203,7 @@ int main(int argc, char **argv)
         return 1;
     }
     if (rfs_replay_check_header(buf, (uint32_t)(len < 8 ? len : 8)) != 0) {
-        hs_err_print(PROG, "%s: offset 0: not an rfseek stream (bad header)", in_path);
+        lx_err_print(PROG, "%s: offset 0: not an rfseek stream (bad header)", in_path);
         free(buf);
         return 1;
     }
@@ -215,7 +215,7 @@ int main(int argc, char **argv)
         snprintf(tmp, sizeof tmp, "%s.tmp.%ld", out_path, (long)getpid());
         sc.f = fopen(tmp, "wb");
         if (sc.f == NULL) {
-            hs_err_print(PROG, "%s: %s", out_path, strerror(errno));
+            lx_err_print(PROG, "%s: %s", out_path, strerror(errno));
             free(buf);
             return 1;
         }
@@ -244,7 +244,7 @@ int main(int argc, char **argv)
         const rfs_replay_status_t st =
             rfs_replay_parse(buf + pos, (uint32_t)(left > 65536 ? 65536 : left), &used, &rec);
         if (st != RFS_REPLAY_OK) {
-            hs_err_print(PROG, "%s: offset %zu: %s", in_path, pos,
+            lx_err_print(PROG, "%s: offset %zu: %s", in_path, pos,
                      st == RFS_REPLAY_NEED_MORE ? "truncated record" : rec.error);
             rc = 1;
             break;
@@ -252,7 +252,7 @@ int main(int argc, char **argv)
         if (print) {
             print_rec(&rec);
         } else if (!rfs_replay_play(&player, &rec)) {
-            hs_err_print(PROG, "%s: offset %zu: %s", in_path, pos, rfs_replay_err_str(player.error));
+            lx_err_print(PROG, "%s: offset %zu: %s", in_path, pos, rfs_replay_err_str(player.error));
             rc = 1;
             break;
         }
@@ -264,13 +264,13 @@ int main(int argc, char **argv)
     free(buf);
     if (!print) {
         if (fclose(sc.f) != 0 || sc.failed) {
-            hs_err_print(PROG, "%s: write failed", out_path);
+            lx_err_print(PROG, "%s: write failed", out_path);
             rc = 1;
         }
         if (rc != 0) {
             remove(tmp);
         } else if (rename(tmp, out_path) != 0) {
-            hs_err_print(PROG, "%s: %s", out_path, strerror(errno));
+            lx_err_print(PROG, "%s: %s", out_path, strerror(errno));
             remove(tmp);
             rc = 1;
         }

@@ -21,10 +21,10 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "hs_can.h"
-#include "hs_err.h"
-#include "hs_lcm.h"
-#include "hs_map.h"
+#include "lx_can.h"
+#include "lx_err.h"
+#include "lx_lcm.h"
+#include "lx_map.h"
 #include "rfs_app.h"
 #include "rfs_pathloss.h"
 
@@ -59,12 +59,12 @@ static const char usage_text[] =
 
 typedef struct daemon {
     rfs_app_t *app;
-    hs_lcm_t *lcm;
-    hs_can_t *can;
+    lx_lcm_t *lcm;
+    lx_can_t *can;
     bool can_over_lcm;
     bool clock_lcm;
     bool replay;
-    hs_lcm_log_t *rec;
+    lx_lcm_log_t *rec;
     FILE *decisions;
     int64_t next_step_us;   /* replay without clock: next 50 ms boundary */
     bool have_time;
@@ -79,7 +79,7 @@ typedef struct daemon {
     uint32_t clock_backwards;
     int64_t last_clock_us;
     int64_t last_now_us;    /* time of the latest step */
-    hs_can_link_t link;
+    lx_can_link_t link;
 } daemon_t;
 
 static volatile sig_atomic_t g_stop;
@@ -90,7 +90,7 @@ static void on_signal(int sig)
     g_stop = 1;
 }
 
-static const char PROG[] = "rfseekd"; /* the prefix of its error lines (hs_err_print) */
+static const char PROG[] = "rfseekd"; /* the prefix of its error lines (lx_err_print) */
 
 static int64_t realtime_us(void)
 {
@@ -123,15 +123,15 @@ static void step(daemon_t *d, int64_t now_us)
         return;
     }
     if (d->can) {
-        hs_can_link_t link = hs_can_health(d->can, NULL);
+        lx_can_link_t link = lx_can_health(d->can, NULL);
         if (link != d->link) {
             fprintf(stderr, "rfseekd: CAN link %s\n",
-                    link == HS_CAN_LINK_OK ? "ok" : link == HS_CAN_LINK_PASSIVE ? "error-passive"
-                                                  : link == HS_CAN_LINK_BUS_OFF ? "bus-off: wheels stopped"
+                    link == LX_CAN_LINK_OK ? "ok" : link == LX_CAN_LINK_PASSIVE ? "error-passive"
+                                                  : link == LX_CAN_LINK_BUS_OFF ? "bus-off: wheels stopped"
                                                                                 : "down: wheels stopped");
             d->link = link;
         }
-        rfs_app_set_bus_off(d->app, link == HS_CAN_LINK_BUS_OFF || link == HS_CAN_LINK_DOWN);
+        rfs_app_set_bus_off(d->app, link == LX_CAN_LINK_BUS_OFF || link == LX_CAN_LINK_DOWN);
     }
     rfs_app_out_t out;
     d->last_now_us = now_us;
@@ -142,9 +142,9 @@ static void step(daemon_t *d, int64_t now_us)
     for (uint8_t i = 0; i < n; i++) {
         int r = 0;
         if (d->can) {
-            r = hs_can_send(d->can, &fr[i]);
+            r = lx_can_send(d->can, &fr[i]);
         } else if (d->can_over_lcm && d->lcm) {
-            r = hs_lcm_pub_can(d->lcm, now_us, &fr[i]);
+            r = lx_lcm_pub_can(d->lcm, now_us, &fr[i]);
         }
         if (r != 0 && d->can_fail++ == 0) {
             fprintf(stderr, "rfseekd: a CAN frame could not be sent (counted; retrying with backoff)\n");
@@ -161,12 +161,12 @@ static void step(daemon_t *d, int64_t now_us)
     rfs_can_wheel_t w = {out.left_mm_s, out.right_mm_s,
                          (uint8_t)(out.state == RFS_SEEK_DRIVING ? 0u : RFS_CAN_WHEEL_STOP)};
     if (d->lcm) {
-        (void)hs_lcm_pub_wheel(d->lcm, now_us, &w);
+        (void)lx_lcm_pub_wheel(d->lcm, now_us, &w);
         // issue 10: the path-loss model's estimate and uncertainty when that is the model.
         const rfs_model_t *mdl = &d->app->seek.model;
         rfs_pathloss_est_t est;
         bool pl = mdl->ops == &rfs_pathloss_ops && rfs_pathloss_estimate(mdl->self, &est);
-        (void)hs_lcm_pub_status_est(d->lcm, now_us, &so, pl ? &est : NULL);
+        (void)lx_lcm_pub_status_est(d->lcm, now_us, &so, pl ? &est : NULL);
     }
     if (out.decided) {
         d->decided++;
@@ -251,12 +251,12 @@ static void on_bad(void *ctx, const char *why)
 {
     daemon_t *d = ctx;
     d->bad_msgs++;
-    hs_err_print(PROG, "dropped LCM message: %s", why);
+    lx_err_print(PROG, "dropped LCM message: %s", why);
 }
 
 static int die(const char *msg, const char *arg)
 {
-    hs_err_print(PROG, "%s%s", msg, arg ? arg : "");
+    lx_err_print(PROG, "%s%s", msg, arg ? arg : "");
     return 2;
 }
 
@@ -386,17 +386,17 @@ int main(int argc, char **argv)
     }
 
     char err[512];
-    hs_map_t m;
+    lx_map_t m;
     memset(&m, 0, sizeof m);
-    hs_core_map_t core;
+    lx_core_map_t core;
     memset(&core, 0, sizeof core);
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
     rfs_seek_cfg_use_strategy(&cfg.seek, strategy);
     cfg.seed = (uint64_t)seed;
     cfg.target = strcmp(target, "bridge") == 0 ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
-    if (hs_map_load(map_path, &m, err, sizeof err) != 0 || hs_map_to_core(&m, res, &cfg.map, &core, err, sizeof err) != 0) {
-        hs_map_free(&m);
-        hs_err_print(PROG, "%s", err);
+    if (lx_map_load(map_path, &m, err, sizeof err) != 0 || lx_map_to_core(&m, res, &cfg.map, &core, err, sizeof err) != 0) {
+        lx_map_free(&m);
+        lx_err_print(PROG, "%s", err);
         return 1;
     }
     // The Linux port holds any model: its state in a heap buffer of the model's size.
@@ -407,8 +407,8 @@ int main(int argc, char **argv)
         model_state = aligned_alloc(RFS_MODELS_STATE_ALIGN, mb);
         if (model_state == NULL) {
             fprintf(stderr, "rfseekd: --model %s: out of memory\n", model->name);
-            hs_core_map_free(&core);
-            hs_map_free(&m);
+            lx_core_map_free(&core);
+            lx_map_free(&m);
             return 1;
         }
         cfg.model = model;
@@ -421,13 +421,13 @@ int main(int argc, char **argv)
     memset(&d, 0, sizeof d);
     d.app = malloc(sizeof *d.app);
     if (!d.app || rfs_app_init(d.app, &cfg, &am) != 0) {
-        hs_err_print(PROG, "%s: the map (%u x %u cells at %.2f m) exceeds the controller's limits (%u bytes per "
+        lx_err_print(PROG, "%s: the map (%u x %u cells at %.2f m) exceeds the controller's limits (%u bytes per "
                  "grid, %u lattice points)",
                  map_path, core.map.w, core.map.h, res, RFS_APP_MAX_MAP_BYTES, RFS_APP_MAX_LATTICE);
         free(d.app);
         free(model_state);
-        hs_core_map_free(&core);
-        hs_map_free(&m);
+        lx_core_map_free(&core);
+        lx_map_free(&m);
         return 1;
     }
     if (!isnan(p0_min)) {
@@ -436,11 +436,11 @@ int main(int argc, char **argv)
         rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
         pc.p0_min = (rfs_q16_t)lround(p0_min * 65536.0);
         if (rfs_pathloss_init((rfs_pathloss_t *)model_state, &pc) != 0) {
-            hs_err_print(PROG, "--p0-min %g: rejected by the pathloss model", p0_min);
+            lx_err_print(PROG, "--p0-min %g: rejected by the pathloss model", p0_min);
             free(d.app);
             free(model_state);
-            hs_core_map_free(&core);
-            hs_map_free(&m);
+            lx_core_map_free(&core);
+            lx_map_free(&m);
             return 1;
         }
     }
@@ -450,16 +450,16 @@ int main(int argc, char **argv)
     d.duration_us = duration_s * 1000000;
     d.decisions = replay ? stdout : NULL;
     int rc = 0;
-    hs_lcm_log_t *in = NULL;
+    lx_lcm_log_t *in = NULL;
     /* The decisions go to a temporary file renamed at a clean end: nothing half-written. */
     char dec_tmp[4096];
     snprintf(dec_tmp, sizeof dec_tmp, "%s.tmp.%ld", dec_path ? dec_path : "", (long)getpid());
     if (dec_path && !(d.decisions = fopen(dec_tmp, "w"))) {
-        hs_err_print(PROG, "%s: cannot write: %s", dec_path, strerror(errno));
+        lx_err_print(PROG, "%s: cannot write: %s", dec_path, strerror(errno));
         rc = 1;
         goto out;
     }
-    hs_lcm_handlers_t h;
+    lx_lcm_handlers_t h;
     memset(&h, 0, sizeof h);
     h.ctx = &d;
     h.on_pose = on_pose;
@@ -467,31 +467,31 @@ int main(int argc, char **argv)
     h.on_receiver = on_receiver;
     h.on_clock = clock_lcm ? on_clock : NULL;
     h.on_bad = on_bad;
-    if (log_path && !(d.rec = hs_lcm_log_open(log_path, "w", err, sizeof err))) {
-        hs_err_print(PROG, "%s", err);
+    if (log_path && !(d.rec = lx_lcm_log_open(log_path, "w", err, sizeof err))) {
+        lx_err_print(PROG, "%s", err);
         rc = 1;
         goto out;
     }
     if (!replay || url) {
         /* In replay, LCM (when given) only carries the outputs. */
-        hs_lcm_handlers_t none;
+        lx_lcm_handlers_t none;
         memset(&none, 0, sizeof none);
-        d.lcm = hs_lcm_open(url, replay ? &none : &h, err, sizeof err);
+        d.lcm = lx_lcm_open(url, replay ? &none : &h, err, sizeof err);
         if (!d.lcm) {
-            hs_err_print(PROG, "%s", err);
+            lx_err_print(PROG, "%s", err);
             rc = 1;
             goto out;
         }
-        if (err[0]) { /* liblcm's warning, as one line (hs_lcm.h) */
-            hs_err_print(PROG, "%s", err);
+        if (err[0]) { /* liblcm's warning, as one line (lx_lcm.h) */
+            lx_err_print(PROG, "%s", err);
         }
-        hs_lcm_record(d.lcm, d.rec);
+        lx_lcm_record(d.lcm, d.rec);
     }
     if (can_if) {
         const uint32_t ids[] = {RFS_CAN_ID_WHEEL_CMD, RFS_CAN_ID_STATUS};
-        d.can = hs_can_open(can_if, ids, 2, err, sizeof err);
+        d.can = lx_can_open(can_if, ids, 2, err, sizeof err);
         if (!d.can) {
-            hs_err_print(PROG, "%s", err);
+            lx_err_print(PROG, "%s", err);
             rc = 1;
             goto out;
         }
@@ -499,27 +499,27 @@ int main(int argc, char **argv)
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
     if (replay) {
-        in = hs_lcm_log_open(replay, "r", err, sizeof err);
+        in = lx_lcm_log_open(replay, "r", err, sizeof err);
         if (!in) {
-            hs_err_print(PROG, "%s", err);
+            lx_err_print(PROG, "%s", err);
             rc = 1;
             goto out;
         }
-        hs_lcm_stats_t st;
+        lx_lcm_stats_t st;
         memset(&st, 0, sizeof st);
         int64_t t;
-        while (!g_stop && !d.done && hs_lcm_log_next(in, &h, &st, &t) == 1) {
+        while (!g_stop && !d.done && lx_lcm_log_next(in, &h, &st, &t) == 1) {
         }
     } else if (clock_lcm) {
         int64_t idle_since = realtime_us();
         while (!g_stop && !d.done) {
-            int r = hs_lcm_handle(d.lcm, 100);
+            int r = lx_lcm_handle(d.lcm, 100);
             if (r < 0) {
                 /* LCM's file:// provider reports the end of its log this way. */
                 if (url && strncmp(url, "file://", 7) == 0) {
                     break;
                 }
-                hs_err_print(PROG, "%s: LCM receive failed", url ? url : "(default URL)");
+                lx_err_print(PROG, "%s: LCM receive failed", url ? url : "(default URL)");
                 rc = 1;
                 break;
             }
@@ -543,12 +543,12 @@ int main(int argc, char **argv)
                 }
                 continue;
             }
-            int r = hs_lcm_handle(d.lcm, (int)((next - now + 999) / 1000));
+            int r = lx_lcm_handle(d.lcm, (int)((next - now + 999) / 1000));
             if (r < 0) {
                 if (url && strncmp(url, "file://", 7) == 0) {
                     break;
                 }
-                hs_err_print(PROG, "%s: LCM receive failed", url ? url : "(default URL)");
+                lx_err_print(PROG, "%s: LCM receive failed", url ? url : "(default URL)");
                 rc = 1;
                 break;
             }
@@ -566,30 +566,30 @@ int main(int argc, char **argv)
             rfs_seek_strategy_name(d.app->seek.cfg.strategy), d.app->seek.model.ops->name);
 out:
     if (in) {
-        hs_lcm_log_close(in);
+        lx_lcm_log_close(in);
     }
-    if (d.rec && hs_lcm_log_close(d.rec) != 0) {
-        hs_err_print(PROG, "%s: could not finish the log", log_path);
+    if (d.rec && lx_lcm_log_close(d.rec) != 0) {
+        lx_err_print(PROG, "%s: could not finish the log", log_path);
         rc = 1;
     }
     if (d.decisions && d.decisions != stdout) {
         if (fclose(d.decisions) != 0 && rc == 0) {
-            hs_err_print(PROG, "%s: write failed", dec_path);
+            lx_err_print(PROG, "%s: write failed", dec_path);
             rc = 1;
         }
         if (rc == 0 && rename(dec_tmp, dec_path) != 0) {
-            hs_err_print(PROG, "%s: %s", dec_path, strerror(errno));
+            lx_err_print(PROG, "%s: %s", dec_path, strerror(errno));
             rc = 1;
         }
         if (rc != 0) {
             remove(dec_tmp);
         }
     }
-    hs_can_close(d.can);
-    hs_lcm_close(d.lcm);
+    lx_can_close(d.can);
+    lx_lcm_close(d.lcm);
     free(d.app);
     free(model_state);
-    hs_core_map_free(&core);
-    hs_map_free(&m);
+    lx_core_map_free(&core);
+    lx_map_free(&m);
     return rc;
 }

@@ -1,6 +1,6 @@
-/* hs_lcm_adapt.c - LCM behind host_sim/hs_lcm.h; the only file with LCM headers and the
+/* lx_lcm.c - LCM behind firmware/port/linux/lx_lcm.h; the only file with LCM headers and the
  * lcm-gen types (generated from lcm/<type>.lcm into $(BUILD)/gen at build time). */
-#include "hs_lcm.h"
+#include "lx_lcm.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -11,7 +11,7 @@
 #include <lcm/eventlog.h>
 #include <lcm/lcm.h>
 
-#include "hs_err.h"
+#include "lx_err.h"
 #include "rfseek_can_frame_t.h"
 #include "rfseek_clock_t.h"
 #include "rfseek_pose_t.h"
@@ -20,14 +20,14 @@
 #include "rfseek_seeker_status_t.h"
 #include "rfseek_wheel_cmd_t.h"
 
-struct hs_lcm {
+struct lx_lcm {
     lcm_t *lcm;             /* the connection */
-    hs_lcm_handlers_t h;    /* callbacks */
-    hs_lcm_stats_t stats;   /* counters */
-    hs_lcm_log_t *rec;      /* recording target, or NULL */
+    lx_lcm_handlers_t h;    /* callbacks */
+    lx_lcm_stats_t stats;   /* counters */
+    lx_lcm_log_t *rec;      /* recording target, or NULL */
 };
 
-struct hs_lcm_log {
+struct lx_lcm_log {
     lcm_eventlog_t *ev;     /* the file */
     char *path;             /* final path (writing) */
     char *tmp;              /* temporary path while writing, or NULL when reading */
@@ -35,9 +35,9 @@ struct hs_lcm_log {
 };
 
 /* Largest encoded message we accept (a status with a short reason string). */
-#define HS_LCM_MAX_MSG 4096
+#define LX_LCM_MAX_MSG 4096
 
-static void bad(hs_lcm_stats_t *s, const hs_lcm_handlers_t *h, const char *ch, const char *fmt, double v)
+static void bad(lx_lcm_stats_t *s, const lx_lcm_handlers_t *h, const char *ch, const char *fmt, double v)
 {
     char why[120];
     snprintf(why, sizeof why, fmt, v);
@@ -54,7 +54,7 @@ static void bad(hs_lcm_stats_t *s, const hs_lcm_handlers_t *h, const char *ch, c
     }
 }
 
-static void good(hs_lcm_stats_t *s)
+static void good(lx_lcm_stats_t *s)
 {
     if (s && s->received < UINT32_MAX) {
         s->received++;
@@ -81,7 +81,7 @@ static double dbl_of(rfs_q16_t q)
     return (double)q / 65536.0;
 }
 
-/* The path-loss estimate of a status (issue 10): every field a Q16.16 value, the area not
+/* The path-loss estimate of a status: every field a Q16.16 value, the area not
  * negative; all zero when est_valid is false. */
 static bool est_ok(const rfseek_seeker_status_t *m)
 {
@@ -99,13 +99,13 @@ static bool est_ok(const rfseek_seeker_status_t *m)
 /* Decode one message of a known channel and deliver it; bad ones are counted. The
  * decoder's byte count must equal the message length (no truncation, no trailing junk;
  * the type fingerprint is checked by the generated decoder). */
-static void dispatch(const hs_lcm_handlers_t *h, hs_lcm_stats_t *s, const char *ch, const void *data, int len)
+static void dispatch(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const char *ch, const void *data, int len)
 {
-    if (len < 0 || len > HS_LCM_MAX_MSG) {
+    if (len < 0 || len > LX_LCM_MAX_MSG) {
         bad(s, h, ch, "message of %.0f bytes is too long", (double)len);
         return;
     }
-    if (strcmp(ch, HS_LCM_CH_POSE) == 0 && h->on_pose) {
+    if (strcmp(ch, LX_LCM_CH_POSE) == 0 && h->on_pose) {
         rfseek_pose_t m;
         int n = rfseek_pose_t_decode(data, 0, len, &m);
         if (n < 0 || n != len) {
@@ -127,7 +127,7 @@ static void dispatch(const hs_lcm_handlers_t *h, hs_lcm_stats_t *s, const char *
         p.theta = (rfs_q16_t)llround(th * 65536.0);
         good(s);
         h->on_pose(h->ctx, &p);
-    } else if (strcmp(ch, HS_LCM_CH_RSSI) == 0 && h->on_rssi) {
+    } else if (strcmp(ch, LX_LCM_CH_RSSI) == 0 && h->on_rssi) {
         rfseek_rssi_t m;
         int n = rfseek_rssi_t_decode(data, 0, len, &m);
         if (n < 0 || n != len) {
@@ -144,7 +144,7 @@ static void dispatch(const hs_lcm_handlers_t *h, hs_lcm_stats_t *s, const char *
         }
         good(s);
         h->on_rssi(h->ctx, (uint8_t)m.source, m.utime, (int8_t)m.dbm, (uint32_t)m.seq);
-    } else if (strcmp(ch, HS_LCM_CH_RSSI_STATUS) == 0 && h->on_receiver) {
+    } else if (strcmp(ch, LX_LCM_CH_RSSI_STATUS) == 0 && h->on_receiver) {
         rfseek_rssi_status_t m;
         int n = rfseek_rssi_status_t_decode(data, 0, len, &m);
         if (n < 0 || n != len) {
@@ -153,7 +153,7 @@ static void dispatch(const hs_lcm_handlers_t *h, hs_lcm_stats_t *s, const char *
         }
         good(s);
         h->on_receiver(h->ctx, m.utime, (uint32_t)m.seq);
-    } else if (strcmp(ch, HS_LCM_CH_CLOCK) == 0 && h->on_clock) {
+    } else if (strcmp(ch, LX_LCM_CH_CLOCK) == 0 && h->on_clock) {
         rfseek_clock_t m;
         int n = rfseek_clock_t_decode(data, 0, len, &m);
         if (n < 0 || n != len) {
@@ -162,7 +162,7 @@ static void dispatch(const hs_lcm_handlers_t *h, hs_lcm_stats_t *s, const char *
         }
         good(s);
         h->on_clock(h->ctx, m.utime);
-    } else if (strcmp(ch, HS_LCM_CH_WHEEL) == 0 && h->on_wheel) {
+    } else if (strcmp(ch, LX_LCM_CH_WHEEL) == 0 && h->on_wheel) {
         rfseek_wheel_cmd_t m;
         int n = rfseek_wheel_cmd_t_decode(data, 0, len, &m);
         if (n < 0 || n != len) {
@@ -172,7 +172,7 @@ static void dispatch(const hs_lcm_handlers_t *h, hs_lcm_stats_t *s, const char *
         rfs_can_wheel_t w = {m.left_mm_s, m.right_mm_s, (uint8_t)(m.stop ? RFS_CAN_WHEEL_STOP : 0)};
         good(s);
         h->on_wheel(h->ctx, m.utime, &w);
-    } else if (strcmp(ch, HS_LCM_CH_STATUS) == 0 && h->on_status) {
+    } else if (strcmp(ch, LX_LCM_CH_STATUS) == 0 && h->on_status) {
         rfseek_seeker_status_t m;
         int n = rfseek_seeker_status_t_decode(data, 0, len, &m);
         if (n < 0 || n != len) {
@@ -215,7 +215,7 @@ static void dispatch(const hs_lcm_handlers_t *h, hs_lcm_stats_t *s, const char *
         rfseek_seeker_status_t_decode_cleanup(&m);
         good(s);
         h->on_status(h->ctx, t, &o);
-    } else if (strcmp(ch, HS_LCM_CH_CAN_FALLBACK) == 0 && h->on_can) {
+    } else if (strcmp(ch, LX_LCM_CH_CAN_FALLBACK) == 0 && h->on_can) {
         rfseek_can_frame_t m;
         int n = rfseek_can_frame_t_decode(data, 0, len, &m);
         if (n < 0 || n != len) {
@@ -236,7 +236,7 @@ static void dispatch(const hs_lcm_handlers_t *h, hs_lcm_stats_t *s, const char *
     }
 }
 
-static void log_event(hs_lcm_log_t *log, int64_t t_us, const char *ch, const void *data, int len)
+static void log_event(lx_lcm_log_t *log, int64_t t_us, const char *ch, const void *data, int len)
 {
     if (log == NULL || log->tmp == NULL) {
         return;
@@ -254,7 +254,7 @@ static void log_event(hs_lcm_log_t *log, int64_t t_us, const char *ch, const voi
 
 static void on_msg(const lcm_recv_buf_t *rbuf, const char *ch, void *user)
 {
-    hs_lcm_t *l = user;
+    lx_lcm_t *l = user;
     /* Record with the message's own utime when it decodes far enough, else the receive time. */
     int64_t t = rbuf->recv_utime;
     if (rbuf->data_size >= 16) {
@@ -310,7 +310,7 @@ static void capture_stop(stderr_capture_t *c, char *buf, size_t n)
         while (buf[a] == '\n' || buf[a] == ' ') {
             a++;
         }
-        hs_err_one_line(buf + a);
+        lx_err_one_line(buf + a);
         size_t o = 0;
         for (size_t r = a; buf[r] != '\0'; r++) {
             if (buf[r] != ' ' || o == 0 || buf[o - 1] != ' ') {
@@ -325,9 +325,9 @@ static void capture_stop(stderr_capture_t *c, char *buf, size_t n)
 }
 
 /* The provider and its subscriptions; NULL with err = "lcm: URL: reason". */
-static hs_lcm_t *open_provider(const char *url, const hs_lcm_handlers_t *h, char *err, size_t errlen)
+static lx_lcm_t *open_provider(const char *url, const lx_lcm_handlers_t *h, char *err, size_t errlen)
 {
-    hs_lcm_t *l = calloc(1, sizeof *l);
+    lx_lcm_t *l = calloc(1, sizeof *l);
     if (!l) {
         snprintf(err, errlen, "lcm: %s: out of memory", url ? url : "(default)");
         return NULL;
@@ -346,10 +346,10 @@ static hs_lcm_t *open_provider(const char *url, const hs_lcm_handlers_t *h, char
         const char *ch;
         bool on;
     } subs[] = {
-        {HS_LCM_CH_POSE, l->h.on_pose != NULL},   {HS_LCM_CH_RSSI, l->h.on_rssi != NULL},
-        {HS_LCM_CH_CLOCK, l->h.on_clock != NULL}, {HS_LCM_CH_WHEEL, l->h.on_wheel != NULL},
-        {HS_LCM_CH_STATUS, l->h.on_status != NULL}, {HS_LCM_CH_CAN_FALLBACK, l->h.on_can != NULL},
-        {HS_LCM_CH_RSSI_STATUS, l->h.on_receiver != NULL},
+        {LX_LCM_CH_POSE, l->h.on_pose != NULL},   {LX_LCM_CH_RSSI, l->h.on_rssi != NULL},
+        {LX_LCM_CH_CLOCK, l->h.on_clock != NULL}, {LX_LCM_CH_WHEEL, l->h.on_wheel != NULL},
+        {LX_LCM_CH_STATUS, l->h.on_status != NULL}, {LX_LCM_CH_CAN_FALLBACK, l->h.on_can != NULL},
+        {LX_LCM_CH_RSSI_STATUS, l->h.on_receiver != NULL},
     };
     for (size_t i = 0; i < sizeof subs / sizeof subs[0]; i++) {
         if (subs[i].on && lcm_subscribe(l->lcm, subs[i].ch, on_msg, l) == NULL) {
@@ -362,12 +362,12 @@ static hs_lcm_t *open_provider(const char *url, const hs_lcm_handlers_t *h, char
     return l;
 }
 
-hs_lcm_t *hs_lcm_open(const char *url, const hs_lcm_handlers_t *h, char *err, size_t errlen)
+lx_lcm_t *lx_lcm_open(const char *url, const lx_lcm_handlers_t *h, char *err, size_t errlen)
 {
     stderr_capture_t cap;
     char said[256];
     capture_start(&cap);
-    hs_lcm_t *l = open_provider(url, h, err, errlen);
+    lx_lcm_t *l = open_provider(url, h, err, errlen);
     capture_stop(&cap, said, sizeof said);
     if (errlen == 0) {
         return l;
@@ -380,19 +380,19 @@ hs_lcm_t *hs_lcm_open(const char *url, const hs_lcm_handlers_t *h, char *err, si
     } else if (l) {
         err[0] = '\0';
     }
-    hs_err_one_line(err); /* the URL can hold line breaks */
+    lx_err_one_line(err); /* the URL can hold line breaks */
     return l;
 }
 
-void hs_lcm_record(hs_lcm_t *l, hs_lcm_log_t *log)
+void lx_lcm_record(lx_lcm_t *l, lx_lcm_log_t *log)
 {
     l->rec = log;
 }
 
 /* Encode with the generated encoder into a stack buffer, record, publish. */
-#define HS_LCM_PUBLISH(l, ch, type, msgp, t_us)                                            \
+#define LX_LCM_PUBLISH(l, ch, type, msgp, t_us)                                            \
     do {                                                                                   \
-        uint8_t buf_[HS_LCM_MAX_MSG];                                                      \
+        uint8_t buf_[LX_LCM_MAX_MSG];                                                      \
         int n_ = type##_encoded_size(msgp);                                                \
         if (n_ <= 0 || n_ > (int)sizeof buf_ || type##_encode(buf_, 0, n_, msgp) != n_) { \
             return -1;                                                                     \
@@ -401,34 +401,34 @@ void hs_lcm_record(hs_lcm_t *l, hs_lcm_log_t *log)
         return lcm_publish((l)->lcm, (ch), buf_, (unsigned)n_) == 0 ? 0 : -1;              \
     } while (0)
 
-int hs_lcm_pub_pose(hs_lcm_t *l, const rfs_pose_t *pose)
+int lx_lcm_pub_pose(lx_lcm_t *l, const rfs_pose_t *pose)
 {
     rfseek_pose_t m = {pose->t_us, dbl_of(pose->x), dbl_of(pose->y), dbl_of(pose->theta)};
-    HS_LCM_PUBLISH(l, HS_LCM_CH_POSE, rfseek_pose_t, &m, pose->t_us);
+    LX_LCM_PUBLISH(l, LX_LCM_CH_POSE, rfseek_pose_t, &m, pose->t_us);
 }
 
-int hs_lcm_pub_rssi(hs_lcm_t *l, uint8_t src, int64_t t_us, int8_t dbm, uint32_t seq)
+int lx_lcm_pub_rssi(lx_lcm_t *l, uint8_t src, int64_t t_us, int8_t dbm, uint32_t seq)
 {
     rfseek_rssi_t m = {t_us, src, dbm, (int32_t)seq};
-    HS_LCM_PUBLISH(l, HS_LCM_CH_RSSI, rfseek_rssi_t, &m, t_us);
+    LX_LCM_PUBLISH(l, LX_LCM_CH_RSSI, rfseek_rssi_t, &m, t_us);
 }
 
-int hs_lcm_pub_receiver(hs_lcm_t *l, int64_t t_us, uint32_t seq)
+int lx_lcm_pub_receiver(lx_lcm_t *l, int64_t t_us, uint32_t seq)
 {
     rfseek_rssi_status_t m = {t_us, (int32_t)seq};
-    HS_LCM_PUBLISH(l, HS_LCM_CH_RSSI_STATUS, rfseek_rssi_status_t, &m, t_us);
+    LX_LCM_PUBLISH(l, LX_LCM_CH_RSSI_STATUS, rfseek_rssi_status_t, &m, t_us);
 }
 
-int hs_lcm_pub_clock(hs_lcm_t *l, int64_t t_us)
+int lx_lcm_pub_clock(lx_lcm_t *l, int64_t t_us)
 {
     rfseek_clock_t m = {t_us};
-    HS_LCM_PUBLISH(l, HS_LCM_CH_CLOCK, rfseek_clock_t, &m, t_us);
+    LX_LCM_PUBLISH(l, LX_LCM_CH_CLOCK, rfseek_clock_t, &m, t_us);
 }
 
-int hs_lcm_pub_wheel(hs_lcm_t *l, int64_t t_us, const rfs_can_wheel_t *w)
+int lx_lcm_pub_wheel(lx_lcm_t *l, int64_t t_us, const rfs_can_wheel_t *w)
 {
     rfseek_wheel_cmd_t m = {t_us, w->left_mm_s, w->right_mm_s, (w->flags & RFS_CAN_WHEEL_STOP) != 0};
-    HS_LCM_PUBLISH(l, HS_LCM_CH_WHEEL, rfseek_wheel_cmd_t, &m, t_us);
+    LX_LCM_PUBLISH(l, LX_LCM_CH_WHEEL, rfseek_wheel_cmd_t, &m, t_us);
 }
 
 static const char *reason_of(const rfs_seek_decision_t *d)
@@ -443,12 +443,12 @@ static const char *reason_of(const rfs_seek_decision_t *d)
     return names[k][d->relearned ? 1 : 0][d->line_search ? 1 : 0];
 }
 
-int hs_lcm_pub_status(hs_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out)
+int lx_lcm_pub_status(lx_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out)
 {
-    return hs_lcm_pub_status_est(l, t_us, out, NULL);
+    return lx_lcm_pub_status_est(l, t_us, out, NULL);
 }
 
-int hs_lcm_pub_status_est(hs_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out,
+int lx_lcm_pub_status_est(lx_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out,
                           const rfs_pathloss_est_t *est)
 {
     const rfs_seek_decision_t *d = &out->decision;
@@ -480,7 +480,7 @@ int hs_lcm_pub_status_est(hs_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out,
     m.max_y = dbl_of(d->max_y);
     m.path_len = dbl_of(d->path_len);
     m.samples = d->samples;
-    if (est) { // issue 10: the path-loss model's estimate (memset left them 0 otherwise)
+    if (est) { // the path-loss model's estimate (memset left them 0 otherwise)
         m.est_valid = true;
         m.est_x = dbl_of(est->sx);
         m.est_y = dbl_of(est->sy);
@@ -490,10 +490,10 @@ int hs_lcm_pub_status_est(hs_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out,
         m.est_rms = dbl_of(est->rms);
         m.est_area = dbl_of(est->spread_m2);
     }
-    HS_LCM_PUBLISH(l, HS_LCM_CH_STATUS, rfseek_seeker_status_t, &m, t_us);
+    LX_LCM_PUBLISH(l, LX_LCM_CH_STATUS, rfseek_seeker_status_t, &m, t_us);
 }
 
-int hs_lcm_pub_can(hs_lcm_t *l, int64_t t_us, const rfs_can_frame_t *f)
+int lx_lcm_pub_can(lx_lcm_t *l, int64_t t_us, const rfs_can_frame_t *f)
 {
     rfseek_can_frame_t m;
     memset(&m, 0, sizeof m);
@@ -501,30 +501,30 @@ int hs_lcm_pub_can(hs_lcm_t *l, int64_t t_us, const rfs_can_frame_t *f)
     m.id = (int32_t)f->id;
     m.dlc = (int8_t)(f->dlc > 8 ? 8 : f->dlc);
     memcpy(m.data, f->data, 8);
-    HS_LCM_PUBLISH(l, HS_LCM_CH_CAN_FALLBACK, rfseek_can_frame_t, &m, t_us);
+    LX_LCM_PUBLISH(l, LX_LCM_CH_CAN_FALLBACK, rfseek_can_frame_t, &m, t_us);
 }
 
-int hs_lcm_pub_raw(hs_lcm_t *l, int64_t t_us, const char *channel, const void *data, size_t len)
+int lx_lcm_pub_raw(lx_lcm_t *l, int64_t t_us, const char *channel, const void *data, size_t len)
 {
-    if (len > (size_t)HS_LCM_MAX_MSG * 16) {
+    if (len > (size_t)LX_LCM_MAX_MSG * 16) {
         return -1;
     }
     log_event(l->rec, t_us, channel, data, (int)len);
     return lcm_publish(l->lcm, channel, data, (unsigned)len) == 0 ? 0 : -1;
 }
 
-int hs_lcm_handle(hs_lcm_t *l, int timeout_ms)
+int lx_lcm_handle(lx_lcm_t *l, int timeout_ms)
 {
     int r = lcm_handle_timeout(l->lcm, timeout_ms < 0 ? 0 : timeout_ms);
     return r > 0 ? 1 : (r == 0 ? 0 : -1);
 }
 
-void hs_lcm_get_stats(const hs_lcm_t *l, hs_lcm_stats_t *s)
+void lx_lcm_get_stats(const lx_lcm_t *l, lx_lcm_stats_t *s)
 {
     *s = l->stats;
 }
 
-void hs_lcm_close(hs_lcm_t *l)
+void lx_lcm_close(lx_lcm_t *l)
 {
     if (!l) {
         return;
@@ -533,14 +533,14 @@ void hs_lcm_close(hs_lcm_t *l)
     free(l);
 }
 
-hs_lcm_log_t *hs_lcm_log_open(const char *path, const char *mode, char *err, size_t errlen)
+lx_lcm_log_t *lx_lcm_log_open(const char *path, const char *mode, char *err, size_t errlen)
 {
     bool w = strcmp(mode, "w") == 0;
     if (!w && strcmp(mode, "r") != 0) {
         snprintf(err, errlen, "%s: mode must be r or w", path);
         return NULL;
     }
-    hs_lcm_log_t *log = calloc(1, sizeof *log);
+    lx_lcm_log_t *log = calloc(1, sizeof *log);
     if (!log) {
         snprintf(err, errlen, "%s: out of memory", path);
         return NULL;
@@ -576,7 +576,7 @@ hs_lcm_log_t *hs_lcm_log_open(const char *path, const char *mode, char *err, siz
  * fails (found by tests/fuzz/fuzz_lcm.c). Peek at the next header the way LCM finds it
  * (scan for the magic) and report the end when its lengths run past the end of the file -
  * LCM would return no event for it either. */
-static bool event_fits(hs_lcm_log_t *log)
+static bool event_fits(lx_lcm_log_t *log)
 {
     FILE *f = log->ev->f;
     off_t pos = ftello(f);
@@ -604,7 +604,7 @@ static bool event_fits(hs_lcm_log_t *log)
     return ok;
 }
 
-int hs_lcm_log_next(hs_lcm_log_t *log, const hs_lcm_handlers_t *h, hs_lcm_stats_t *stats, int64_t *t_us)
+int lx_lcm_log_next(lx_lcm_log_t *log, const lx_lcm_handlers_t *h, lx_lcm_stats_t *stats, int64_t *t_us)
 {
     lcm_eventlog_event_t *ev = event_fits(log) ? lcm_eventlog_read_next_event(log->ev) : NULL;
     if (!ev) {
@@ -622,7 +622,7 @@ int hs_lcm_log_next(hs_lcm_log_t *log, const hs_lcm_handlers_t *h, hs_lcm_stats_
     return 1;
 }
 
-int hs_lcm_log_next_raw(hs_lcm_log_t *log, int64_t *t_us, char *channel, size_t chcap, void *data, size_t cap,
+int lx_lcm_log_next_raw(lx_lcm_log_t *log, int64_t *t_us, char *channel, size_t chcap, void *data, size_t cap,
                         size_t *len)
 {
     lcm_eventlog_event_t *ev = event_fits(log) ? lcm_eventlog_read_next_event(log->ev) : NULL;
@@ -643,7 +643,7 @@ int hs_lcm_log_next_raw(hs_lcm_log_t *log, int64_t *t_us, char *channel, size_t 
     return 1;
 }
 
-int hs_lcm_log_close(hs_lcm_log_t *log)
+int lx_lcm_log_close(lx_lcm_log_t *log)
 {
     if (!log) {
         return 0;

@@ -1,5 +1,5 @@
-/* hs_radiotap.c - radiotap and 802.11 header parsing (see hs_radiotap.h). */
-#include "hs_radiotap.h"
+/* lx_radiotap.c - radiotap and 802.11 header parsing (see lx_radiotap.h). */
+#include "lx_radiotap.h"
 
 #include <string.h>
 
@@ -68,24 +68,24 @@ static uint32_t rd32(const uint8_t *p)
 
 static uint64_t rd64(const uint8_t *p) { return (uint64_t)rd32(p) | ((uint64_t)rd32(p + 4) << 32); }
 
-const char *hs_radiotap_status_str(hs_rt_status_t st)
+const char *lx_radiotap_status_str(lx_rt_status_t st)
 {
     switch (st) {
-    case HS_RT_OK: return "ok";
-    case HS_RT_STOP_UNKNOWN: return "stopped at an unknown field";
-    case HS_RT_FIELD_OVERRUN: return "a field runs past it_len";
-    case HS_RT_ERR_SHORT: return "fewer than 8 bytes for the radiotap header";
-    case HS_RT_ERR_VERSION: return "radiotap version byte is not 0";
-    case HS_RT_ERR_LEN: return "radiotap it_len is below 8 or beyond the captured bytes";
-    case HS_RT_ERR_BITMAP: return "radiotap present bitmaps run past it_len";
-    case HS_RT_ERR_NS_BOTH: return "radiotap present word selects both namespaces (bits 29 and 30)";
+    case LX_RT_OK: return "ok";
+    case LX_RT_STOP_UNKNOWN: return "stopped at an unknown field";
+    case LX_RT_FIELD_OVERRUN: return "a field runs past it_len";
+    case LX_RT_ERR_SHORT: return "fewer than 8 bytes for the radiotap header";
+    case LX_RT_ERR_VERSION: return "radiotap version byte is not 0";
+    case LX_RT_ERR_LEN: return "radiotap it_len is below 8 or beyond the captured bytes";
+    case LX_RT_ERR_BITMAP: return "radiotap present bitmaps run past it_len";
+    case LX_RT_ERR_NS_BOTH: return "radiotap present word selects both namespaces (bits 29 and 30)";
     }
     return "unknown status";
 }
 
 /* Store a default-namespace field we use; `p` points at its `size` bytes. Repeated
  * fields (per-chain signal, noise, antenna) keep the first value: the combined one. */
-static void rt_store(hs_radiotap_t *rt, unsigned bit, const uint8_t *p)
+static void rt_store(lx_radiotap_t *rt, unsigned bit, const uint8_t *p)
 {
     switch (bit) {
     case RT_TSFT:
@@ -118,24 +118,24 @@ static void rt_store(hs_radiotap_t *rt, unsigned bit, const uint8_t *p)
     }
 }
 
-int hs_radiotap_parse(const uint8_t *buf, size_t len, hs_radiotap_t *rt)
+int lx_radiotap_parse(const uint8_t *buf, size_t len, lx_radiotap_t *rt)
 {
     memset(rt, 0, sizeof(*rt));
-    if (len < RT_HDR) { rt->status = HS_RT_ERR_SHORT; return -1; }
-    if (buf[0] != 0) { rt->status = HS_RT_ERR_VERSION; return -1; }
+    if (len < RT_HDR) { rt->status = LX_RT_ERR_SHORT; return -1; }
+    if (buf[0] != 0) { rt->status = LX_RT_ERR_VERSION; return -1; }
     const size_t it_len = rd16(buf + 2);
     rt->it_len = (uint16_t)it_len;
-    if (it_len < RT_HDR || it_len > len) { rt->status = HS_RT_ERR_LEN; return -1; }
+    if (it_len < RT_HDR || it_len > len) { rt->status = LX_RT_ERR_LEN; return -1; }
 
     /* The present words: all inside it_len, the last one without bit 31. */
     size_t words_end = 4;
     for (;;) {
-        if (words_end + 4 > it_len) { rt->status = HS_RT_ERR_BITMAP; return -1; }
+        if (words_end + 4 > it_len) { rt->status = LX_RT_ERR_BITMAP; return -1; }
         const uint32_t w = rd32(buf + words_end);
         words_end += 4;
         /* Which namespace the next word is in would be ambiguous: the header is invalid
          * (radiotap.org, "Extended presence masks"; Wireshark rejects it too). */
-        if ((w & (3u << RT_NS_RADIOTAP)) == (3u << RT_NS_RADIOTAP)) { rt->status = HS_RT_ERR_NS_BOTH; return -1; }
+        if ((w & (3u << RT_NS_RADIOTAP)) == (3u << RT_NS_RADIOTAP)) { rt->status = LX_RT_ERR_NS_BOTH; return -1; }
         if (rt->n_present < UINT8_MAX) { rt->n_present++; }
         if (!(w & (1u << RT_EXT))) { break; }
     }
@@ -160,9 +160,9 @@ int hs_radiotap_parse(const uint8_t *buf, size_t len, hs_radiotap_t *rt)
                 /* OUI (3), sub-namespace (1), skip_length (LE16), aligned to 2; we know
                  * no vendor namespace, so its data is skipped whole. */
                 off = (off + 1u) & ~(size_t)1u;
-                if (off + 6 > it_len) { rt->status = HS_RT_FIELD_OVERRUN; return 0; }
+                if (off + 6 > it_len) { rt->status = LX_RT_FIELD_OVERRUN; return 0; }
                 off += 6u + rd16(buf + off + 4);
-                if (off > it_len) { rt->status = HS_RT_FIELD_OVERRUN; return 0; }
+                if (off > it_len) { rt->status = LX_RT_FIELD_OVERRUN; return 0; }
                 vendor = true;
                 reset_on_ext = true;
                 if (rt->n_vendor < UINT8_MAX) { rt->n_vendor++; }
@@ -172,12 +172,12 @@ int hs_radiotap_parse(const uint8_t *buf, size_t len, hs_radiotap_t *rt)
             const unsigned idx = base + b;
             if (idx >= sizeof(k_fields) / sizeof(k_fields[0]) || k_fields[idx].align == 0) {
                 /* Size and alignment unknown: nothing after it can be located. */
-                rt->status = HS_RT_STOP_UNKNOWN;
+                rt->status = LX_RT_STOP_UNKNOWN;
                 return 0;
             }
             const size_t a = k_fields[idx].align;
             off = (off + a - 1u) & ~(a - 1u);
-            if (off + k_fields[idx].size > it_len) { rt->status = HS_RT_FIELD_OVERRUN; return 0; }
+            if (off + k_fields[idx].size > it_len) { rt->status = LX_RT_FIELD_OVERRUN; return 0; }
             rt_store(rt, idx, buf + off);
             off += k_fields[idx].size;
         }
@@ -186,11 +186,11 @@ int hs_radiotap_parse(const uint8_t *buf, size_t len, hs_radiotap_t *rt)
         base = reset_on_ext ? 0u : base + 32u;
         reset_on_ext = false;
     }
-    rt->status = HS_RT_OK;
+    rt->status = LX_RT_OK;
     return 0;
 }
 
-int hs_wlan_parse(const uint8_t *frame, size_t len, hs_wlan_t *w)
+int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w)
 {
     memset(w, 0, sizeof(*w));
     if (len < 2) { return -1; }
@@ -201,7 +201,7 @@ int hs_wlan_parse(const uint8_t *frame, size_t len, hs_wlan_t *w)
     const bool order = (w->fc & 0x8000u) != 0;
     w->hdr_len = 2;
     /* Address offsets: addr1 4, addr2 10, addr3 16, seq 22, addr4 24. */
-    if (w->type == HS_WLAN_CTRL) {
+    if (w->type == LX_WLAN_CTRL) {
         /* RTS, PS-Poll, CF-End(+Ack), BlockAckReq, BlockAck carry RA then TA; ACK and
          * CTS carry only RA. None of them has a source address (Wireshark: no wlan.sa). */
         const uint16_t with_ta = (1u << 8) | (1u << 9) | (1u << 10) | (1u << 11) | (1u << 14) | (1u << 15);
@@ -212,24 +212,24 @@ int hs_wlan_parse(const uint8_t *frame, size_t len, hs_wlan_t *w)
         }
         return 0;
     }
-    if (w->type != HS_WLAN_MGMT && w->type != HS_WLAN_DATA) { return 0; }
+    if (w->type != LX_WLAN_MGMT && w->type != LX_WLAN_DATA) { return 0; }
     /* The MAC header through its QoS control must be there before any address counts
      * (Wireshark adds wlan.sa only then): 24 bytes, + 6 for addr4 (data, ToDS and
      * FromDS), + 2 QoS control (QoS data subtypes). A +HTC field (order bit) is not
      * required: Wireshark reports the addresses of a frame cut inside it. */
     size_t need = 24;
-    const bool qos = w->type == HS_WLAN_DATA && (w->subtype & 8u) != 0;
-    if (w->type == HS_WLAN_DATA && w->ds == 3) { need += 6; }
+    const bool qos = w->type == LX_WLAN_DATA && (w->subtype & 8u) != 0;
+    if (w->type == LX_WLAN_DATA && w->ds == 3) { need += 6; }
     if (qos) { need += 2; }
     if (len < need) { return 0; }
-    if (order && (w->type == HS_WLAN_MGMT || qos)) { need += 4; }
+    if (order && (w->type == LX_WLAN_MGMT || qos)) { need += 4; }
     w->hdr_len = (uint16_t)need;
     memcpy(w->ta, frame + 10, 6);
     w->has_ta = true;
     /* IEEE 802.11-2020 Table 9-30: which address is the SA for each ToDS/FromDS; a
      * management frame's SA is addr2 whatever the DS bits. */
     static const uint8_t sa_at[4] = {10, 10, 16, 24};
-    memcpy(w->sa, frame + (w->type == HS_WLAN_MGMT ? 10 : sa_at[w->ds]), 6);
+    memcpy(w->sa, frame + (w->type == LX_WLAN_MGMT ? 10 : sa_at[w->ds]), 6);
     w->has_sa = true;
     const uint16_t sc = rd16(frame + 22);
     w->has_seq = true;
@@ -238,16 +238,16 @@ int hs_wlan_parse(const uint8_t *frame, size_t len, hs_wlan_t *w)
     return 0;
 }
 
-int hs_rt_frame_parse(const uint8_t *buf, size_t len, hs_rt_frame_t *f)
+int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f)
 {
     memset(f, 0, sizeof(*f));
-    if (hs_radiotap_parse(buf, len, &f->rt) != 0) { return -1; }
+    if (lx_radiotap_parse(buf, len, &f->rt) != 0) { return -1; }
     const size_t n = len - f->rt.it_len;
     /* The FCS is the last 4 bytes of the frame. Like Wireshark we still read the MAC
      * header from every captured byte: a frame shorter than header + FCS is damaged
      * either way, and this keeps our SA equal to tshark's wlan.sa. */
-    const bool fcs = f->rt.has_flags && (f->rt.flags & HS_RT_FLAG_FCS) != 0;
+    const bool fcs = f->rt.has_flags && (f->rt.flags & LX_RT_FLAG_FCS) != 0;
     f->frame_len = (uint32_t)(fcs ? (n >= 4 ? n - 4 : 0) : n);
-    f->wlan_ok = hs_wlan_parse(buf + f->rt.it_len, n, &f->wlan) == 0;
+    f->wlan_ok = lx_wlan_parse(buf + f->rt.it_len, n, &f->wlan) == 0;
     return 0;
 }

@@ -1,5 +1,5 @@
-/* hs_can_adapt.c - SocketCAN behind host_sim/hs_can.h; the only file with <linux/can.h>. */
-#include "hs_can.h"
+/* lx_can.c - SocketCAN behind firmware/port/linux/lx_can.h; the only file with <linux/can.h>. */
+#include "lx_can.h"
 
 #include <errno.h>
 #include <net/if.h>
@@ -17,19 +17,19 @@
 #include <linux/can/raw.h>
 #include <linux/if_arp.h>
 
-#define HS_CAN_MAX_FILTERS 32
-#define HS_CAN_BACKOFF_MIN_US 10000   /* first retry after 10 ms */
-#define HS_CAN_BACKOFF_MAX_US 1000000 /* retries at most every 1 s */
+#define LX_CAN_MAX_FILTERS 32
+#define LX_CAN_BACKOFF_MIN_US 10000   /* first retry after 10 ms */
+#define LX_CAN_BACKOFF_MAX_US 1000000 /* retries at most every 1 s */
 /* After bus-off the controller needs 128 x 11 recessive bits and the driver's restart-ms
  * (commonly 100 ms) before it sends again: probing earlier only fails. */
-#define HS_CAN_BUSOFF_FIRST_US 100000
+#define LX_CAN_BUSOFF_FIRST_US 100000
 
-struct hs_can {
+struct lx_can {
     int fd;                                   /* CAN_RAW socket, -1 while down */
     char ifname[IFNAMSIZ];                    /* interface name */
-    struct can_filter filt[HS_CAN_MAX_FILTERS]; /* receive filters */
+    struct can_filter filt[LX_CAN_MAX_FILTERS]; /* receive filters */
     size_t nfilt;                             /* how many (0 = all standard data frames) */
-    hs_can_health_t h;                        /* health and counters */
+    lx_can_health_t h;                        /* health and counters */
     int64_t next_retry_us;                    /* monotonic time of the next recovery attempt */
 };
 
@@ -48,7 +48,7 @@ static void bump(uint32_t *v)
 }
 
 /* Socket bound to the interface with our filters; -1 and errno on failure. */
-static int open_socket(hs_can_t *c, int *ifindex_out)
+static int open_socket(lx_can_t *c, int *ifindex_out)
 {
     unsigned idx = if_nametoindex(c->ifname);
     if (idx == 0) {
@@ -109,52 +109,52 @@ static int iface_up(const char *name)
     return (ifr.ifr_flags & IFF_UP) ? 1 : 0;
 }
 
-static void enter_down(hs_can_t *c, hs_can_link_t why, int err)
+static void enter_down(lx_can_t *c, lx_can_link_t why, int err)
 {
     int64_t now = mono_us();
     c->h.last_errno = err;
-    if (c->h.link == HS_CAN_LINK_OK || c->h.link == HS_CAN_LINK_PASSIVE) {
-        c->h.backoff_us = why == HS_CAN_LINK_BUS_OFF ? HS_CAN_BUSOFF_FIRST_US : HS_CAN_BACKOFF_MIN_US;
+    if (c->h.link == LX_CAN_LINK_OK || c->h.link == LX_CAN_LINK_PASSIVE) {
+        c->h.backoff_us = why == LX_CAN_LINK_BUS_OFF ? LX_CAN_BUSOFF_FIRST_US : LX_CAN_BACKOFF_MIN_US;
     } else {
-        c->h.backoff_us = c->h.backoff_us * 2 > HS_CAN_BACKOFF_MAX_US ? HS_CAN_BACKOFF_MAX_US : c->h.backoff_us * 2;
+        c->h.backoff_us = c->h.backoff_us * 2 > LX_CAN_BACKOFF_MAX_US ? LX_CAN_BACKOFF_MAX_US : c->h.backoff_us * 2;
     }
     c->h.link = why;
     c->next_retry_us = now + c->h.backoff_us;
 }
 
-static void mark_recovered(hs_can_t *c)
+static void mark_recovered(lx_can_t *c)
 {
-    if (c->h.link == HS_CAN_LINK_DOWN || c->h.link == HS_CAN_LINK_BUS_OFF) {
+    if (c->h.link == LX_CAN_LINK_DOWN || c->h.link == LX_CAN_LINK_BUS_OFF) {
         bump(&c->h.recoveries);
     }
-    c->h.link = HS_CAN_LINK_OK;
+    c->h.link = LX_CAN_LINK_OK;
     c->h.backoff_us = 0;
 }
 
 /* When a recovery attempt is due: for DOWN, wait for the interface to exist and be up,
  * then re-open and re-bind (an unregistered interface unbinds the old socket). For
  * BUS_OFF, the controller restarts itself (restart-ms); the next send is the probe. */
-static void try_recover(hs_can_t *c)
+static void try_recover(lx_can_t *c)
 {
-    if (c->h.link != HS_CAN_LINK_DOWN && c->h.link != HS_CAN_LINK_BUS_OFF) {
+    if (c->h.link != LX_CAN_LINK_DOWN && c->h.link != LX_CAN_LINK_BUS_OFF) {
         return;
     }
     if (mono_us() < c->next_retry_us) {
         return;
     }
-    if (c->h.link == HS_CAN_LINK_BUS_OFF) {
+    if (c->h.link == LX_CAN_LINK_BUS_OFF) {
         /* Allow one probe now; a failure doubles the backoff. */
         c->next_retry_us = mono_us();
         return;
     }
     int up = iface_up(c->ifname);
     if (up != 1) {
-        enter_down(c, HS_CAN_LINK_DOWN, up < 0 ? ENODEV : ENETDOWN);
+        enter_down(c, LX_CAN_LINK_DOWN, up < 0 ? ENODEV : ENETDOWN);
         return;
     }
     int fd = open_socket(c, NULL);
     if (fd < 0) {
-        enter_down(c, HS_CAN_LINK_DOWN, errno);
+        enter_down(c, LX_CAN_LINK_DOWN, errno);
         return;
     }
     if (c->fd >= 0) {
@@ -164,15 +164,15 @@ static void try_recover(hs_can_t *c)
     mark_recovered(c);
 }
 
-hs_can_t *hs_can_open(const char *ifname, const uint32_t *ids, size_t nids, char *err, size_t errlen)
+lx_can_t *lx_can_open(const char *ifname, const uint32_t *ids, size_t nids, char *err, size_t errlen)
 {
     if (ifname == NULL || ifname[0] == '\0' || strlen(ifname) >= IFNAMSIZ) {
         snprintf(err, errlen, "can: '%s': interface name empty or longer than %d characters",
                  ifname ? ifname : "", IFNAMSIZ - 1);
         return NULL;
     }
-    if (nids > HS_CAN_MAX_FILTERS) {
-        snprintf(err, errlen, "can: %s: %zu receive filters, at most %d", ifname, nids, HS_CAN_MAX_FILTERS);
+    if (nids > LX_CAN_MAX_FILTERS) {
+        snprintf(err, errlen, "can: %s: %zu receive filters, at most %d", ifname, nids, LX_CAN_MAX_FILTERS);
         return NULL;
     }
     for (size_t i = 0; i < nids; i++) {
@@ -181,7 +181,7 @@ hs_can_t *hs_can_open(const char *ifname, const uint32_t *ids, size_t nids, char
             return NULL;
         }
     }
-    hs_can_t *c = calloc(1, sizeof *c);
+    lx_can_t *c = calloc(1, sizeof *c);
     if (c == NULL) {
         snprintf(err, errlen, "can: %s: out of memory", ifname);
         return NULL;
@@ -203,11 +203,11 @@ hs_can_t *hs_can_open(const char *ifname, const uint32_t *ids, size_t nids, char
         free(c);
         return NULL;
     }
-    c->h.link = HS_CAN_LINK_OK;
+    c->h.link = LX_CAN_LINK_OK;
     return c;
 }
 
-int hs_can_send(hs_can_t *c, const rfs_can_frame_t *f)
+int lx_can_send(lx_can_t *c, const rfs_can_frame_t *f)
 {
     if (f->id > RFS_CAN_ID_MAX || f->dlc > 8) {
         /* Programmer error at the call site; refuse and count rather than send garbage. */
@@ -216,7 +216,7 @@ int hs_can_send(hs_can_t *c, const rfs_can_frame_t *f)
         return -1;
     }
     try_recover(c);
-    if ((c->h.link == HS_CAN_LINK_DOWN || c->h.link == HS_CAN_LINK_BUS_OFF) && mono_us() < c->next_retry_us) {
+    if ((c->h.link == LX_CAN_LINK_DOWN || c->h.link == LX_CAN_LINK_BUS_OFF) && mono_us() < c->next_retry_us) {
         bump(&c->h.tx_failed);
         return -1;
     }
@@ -238,9 +238,9 @@ int hs_can_send(hs_can_t *c, const rfs_can_frame_t *f)
     int e = n < 0 ? errno : EIO;
     bump(&c->h.tx_failed);
     if (e == ENETDOWN || e == ENODEV || e == ENXIO) {
-        enter_down(c, HS_CAN_LINK_DOWN, e);
-    } else if (c->h.link == HS_CAN_LINK_BUS_OFF) {
-        enter_down(c, HS_CAN_LINK_BUS_OFF, e);
+        enter_down(c, LX_CAN_LINK_DOWN, e);
+    } else if (c->h.link == LX_CAN_LINK_BUS_OFF) {
+        enter_down(c, LX_CAN_LINK_BUS_OFF, e);
     } else {
         /* ENOBUFS/EAGAIN: the queue is full (no ACK on the bus); not a link change. */
         c->h.last_errno = e;
@@ -248,13 +248,13 @@ int hs_can_send(hs_can_t *c, const rfs_can_frame_t *f)
     return -1;
 }
 
-static void on_error_frame(hs_can_t *c, const struct can_frame *cf)
+static void on_error_frame(lx_can_t *c, const struct can_frame *cf)
 {
     bump(&c->h.err_frames);
     canid_t cls = cf->can_id & CAN_ERR_MASK;
     if (cls & CAN_ERR_BUSOFF) {
         bump(&c->h.bus_off);
-        enter_down(c, HS_CAN_LINK_BUS_OFF, 0);
+        enter_down(c, LX_CAN_LINK_BUS_OFF, 0);
         return;
     }
     if (cls & CAN_ERR_RESTARTED) {
@@ -265,23 +265,23 @@ static void on_error_frame(hs_can_t *c, const struct can_frame *cf)
         uint8_t d1 = cf->len > 1 ? cf->data[1] : 0;
         if (d1 & (CAN_ERR_CRTL_RX_PASSIVE | CAN_ERR_CRTL_TX_PASSIVE | CAN_ERR_CRTL_RX_WARNING |
                   CAN_ERR_CRTL_TX_WARNING)) {
-            if (c->h.link == HS_CAN_LINK_OK) {
-                c->h.link = HS_CAN_LINK_PASSIVE;
+            if (c->h.link == LX_CAN_LINK_OK) {
+                c->h.link = LX_CAN_LINK_PASSIVE;
             }
-        } else if ((d1 & CAN_ERR_CRTL_ACTIVE) && c->h.link == HS_CAN_LINK_PASSIVE) {
-            c->h.link = HS_CAN_LINK_OK;
+        } else if ((d1 & CAN_ERR_CRTL_ACTIVE) && c->h.link == LX_CAN_LINK_PASSIVE) {
+            c->h.link = LX_CAN_LINK_OK;
         }
     }
 }
 
-int hs_can_recv(hs_can_t *c, rfs_can_frame_t *f, int timeout_ms)
+int lx_can_recv(lx_can_t *c, rfs_can_frame_t *f, int timeout_ms)
 {
     int64_t deadline = mono_us() + (int64_t)(timeout_ms < 0 ? 0 : timeout_ms) * 1000;
     for (;;) {
         try_recover(c);
         int64_t now = mono_us();
         int64_t left_us = deadline - now;
-        if (c->h.link == HS_CAN_LINK_DOWN || c->fd < 0) {
+        if (c->h.link == LX_CAN_LINK_DOWN || c->fd < 0) {
             if (left_us <= 0) {
                 return -1;
             }
@@ -293,7 +293,7 @@ int hs_can_recv(hs_can_t *c, rfs_can_frame_t *f, int timeout_ms)
         }
         struct pollfd p = {c->fd, POLLIN, 0};
         int wait_ms = left_us <= 0 ? 0 : (int)((left_us + 999) / 1000);
-        if (c->h.link == HS_CAN_LINK_BUS_OFF && c->next_retry_us - now < (int64_t)wait_ms * 1000) {
+        if (c->h.link == LX_CAN_LINK_BUS_OFF && c->next_retry_us - now < (int64_t)wait_ms * 1000) {
             wait_ms = (int)((c->next_retry_us - now + 999) / 1000);
             wait_ms = wait_ms < 0 ? 0 : wait_ms;
         }
@@ -311,7 +311,7 @@ int hs_can_recv(hs_can_t *c, rfs_can_frame_t *f, int timeout_ms)
                     continue;
                 }
                 /* ENETDOWN when the interface went down, ENODEV when it vanished. */
-                enter_down(c, HS_CAN_LINK_DOWN, e);
+                enter_down(c, LX_CAN_LINK_DOWN, e);
                 continue;
             }
             if (n != (ssize_t)sizeof cf) {
@@ -339,7 +339,7 @@ int hs_can_recv(hs_can_t *c, rfs_can_frame_t *f, int timeout_ms)
     }
 }
 
-hs_can_link_t hs_can_health(hs_can_t *c, hs_can_health_t *h)
+lx_can_link_t lx_can_health(lx_can_t *c, lx_can_health_t *h)
 {
     try_recover(c);
     if (h) {
@@ -348,7 +348,7 @@ hs_can_link_t hs_can_health(hs_can_t *c, hs_can_health_t *h)
     return c->h.link;
 }
 
-void hs_can_close(hs_can_t *c)
+void lx_can_close(lx_can_t *c)
 {
     if (c == NULL) {
         return;

@@ -1,4 +1,4 @@
-/* test_world.c - the Box2D world (hs_world.h): rectangle merging, walls stopping the
+/* test_box2d.c - the Box2D world (hs_box2d.h): rectangle merging, walls stopping the
  * robot, wall counting by ray casts, and one wall costing its attenuation in the radio
  * model. References are computed here from the map cells and plain geometry.
  */
@@ -9,12 +9,12 @@
 #include <string.h>
 
 #include "hs_radio.h"
-#include "hs_world.h"
+#include "hs_box2d.h"
 
 /// A w x h map at res with free interior and occupied cells from a callback.
-static hs_map_t make_map(uint32_t w, uint32_t h, double res, int (*cell)(uint32_t, uint32_t))
+static lx_map_t make_map(uint32_t w, uint32_t h, double res, int (*cell)(uint32_t, uint32_t))
 {
-    hs_map_t m;
+    lx_map_t m;
     memset(&m, 0, sizeof m);
     m.w = w;
     m.h = h;
@@ -38,24 +38,24 @@ static hs_map_t make_map(uint32_t w, uint32_t h, double res, int (*cell)(uint32_
 static int one_wall(uint32_t x, uint32_t y)
 {
     if (x < 2 || y < 2 || x >= 198 || y >= 198) {
-        return HS_CELL_OCC;
+        return LX_CELL_OCC;
     }
     if (x >= 100 && x < 102 && y < 160) {
-        return HS_CELL_OCC;
+        return LX_CELL_OCC;
     }
-    return HS_CELL_FREE;
+    return LX_CELL_FREE;
 }
 
 /// Three parallel walls at x = 3, 5, 7 m across the whole height, unknown border.
 static int three_walls(uint32_t x, uint32_t y)
 {
     if (x == 0 || y == 0 || x == 199 || y == 199) {
-        return HS_CELL_UNKNOWN;
+        return LX_CELL_UNKNOWN;
     }
     if ((x >= 60 && x < 62) || (x >= 100 && x < 102) || (x >= 140 && x < 142)) {
-        return HS_CELL_OCC;
+        return LX_CELL_OCC;
     }
-    return HS_CELL_FREE;
+    return LX_CELL_FREE;
 }
 
 static uint32_t lcg;
@@ -65,7 +65,7 @@ static int random_cells(uint32_t x, uint32_t y)
     (void)y;
     lcg = lcg * 1664525u + 1013904223u;
     uint32_t r = (lcg >> 24) % 10u;
-    return r < 3 ? HS_CELL_OCC : (r < 4 ? HS_CELL_UNKNOWN : HS_CELL_FREE);
+    return r < 3 ? LX_CELL_OCC : (r < 4 ? LX_CELL_UNKNOWN : LX_CELL_FREE);
 }
 
 /// Every covered cell lies in exactly one rectangle, and nothing else does.
@@ -73,10 +73,10 @@ static void test_merge_rects_cover_exactly(void **state)
 {
     (void)state;
     lcg = 12345;
-    hs_map_t m = make_map(97, 61, 0.05, random_cells);
+    lx_map_t m = make_map(97, 61, 0.05, random_cells);
     for (int kind = 0; kind < 2; kind++) {
         hs_rect_t *r = NULL;
-        long n = hs_world_merge_rects(&m, (hs_world_kind_t)kind, &r);
+        long n = hs_box2d_merge_rects(&m, (hs_box2d_kind_t)kind, &r);
         assert_true(n > 0);
         uint8_t *cover = calloc((size_t)m.w * m.h, 1);
         for (long i = 0; i < n; i++) {
@@ -87,7 +87,7 @@ static void test_merge_rects_cover_exactly(void **state)
             }
         }
         for (size_t i = 0; i < (size_t)m.w * m.h; i++) {
-            int want = kind == HS_WORLD_RADIO ? m.cell[i] == HS_CELL_OCC : m.cell[i] != HS_CELL_FREE;
+            int want = kind == HS_BOX2D_RADIO ? m.cell[i] == LX_CELL_OCC : m.cell[i] != LX_CELL_FREE;
             assert_int_equal(cover[i], want);
         }
         free(cover);
@@ -99,15 +99,15 @@ static void test_merge_rects_cover_exactly(void **state)
 /// An office-like 50 x 50 m map at 5 cm stays at a few rectangles per wall.
 static int grid_walls(uint32_t x, uint32_t y)
 {
-    return (x % 100 < 2 || y % 100 < 2) ? HS_CELL_OCC : HS_CELL_FREE;
+    return (x % 100 < 2 || y % 100 < 2) ? LX_CELL_OCC : LX_CELL_FREE;
 }
 
 static void test_merge_rects_cheap(void **state)
 {
     (void)state;
-    hs_map_t m = make_map(1000, 1000, 0.05, grid_walls);
+    lx_map_t m = make_map(1000, 1000, 0.05, grid_walls);
     hs_rect_t *r = NULL;
-    long n = hs_world_merge_rects(&m, HS_WORLD_COLLIDE, &r);
+    long n = hs_box2d_merge_rects(&m, HS_BOX2D_COLLIDE, &r);
     // 10 horizontal 2-row bands (1 rectangle each) and vertical pieces between them:
     // 10 columns x 10 gaps = 100; every other cell pattern would give 10^5+.
     assert_int_equal(n, 110);
@@ -119,77 +119,77 @@ static void test_merge_rects_cheap(void **state)
 static void test_walls_stop_the_robot(void **state)
 {
     (void)state;
-    hs_map_t m = make_map(200, 200, 0.05, one_wall);
+    lx_map_t m = make_map(200, 200, 0.05, one_wall);
     char err[256];
-    hs_world_t *w = hs_world_create(&m, NULL, err, sizeof err);
+    hs_box2d_t *w = hs_box2d_create(&m, NULL, err, sizeof err);
     assert_non_null(w);
-    assert_int_equal(hs_world_rect_count(w, HS_WORLD_RADIO), 5);
-    hs_world_place_robot(w, 3.0, 4.0, 0.0);
+    assert_int_equal(hs_box2d_rect_count(w, HS_BOX2D_RADIO), 5);
+    hs_box2d_place_robot(w, 3.0, 4.0, 0.0);
     for (int i = 0; i < 500; i++) { // 10 s at 0.5 m/s: 5 m of wheel travel towards x = 5
-        hs_world_step(w, 0.5, 0.0, 0.02);
+        hs_box2d_step(w, 0.5, 0.0, 0.02);
     }
     double x, y, th;
-    hs_world_robot_pose(w, &x, &y, &th);
+    hs_box2d_robot_pose(w, &x, &y, &th);
     // The wall face is at x = 5.0; the robot's centre stops 0.177 m before it (Box2D
     // keeps a skin of a few mm).
     assert_true(x < 5.0 - 0.177 + 0.02);
     assert_true(x > 5.0 - 0.177 - 0.03);
     assert_true(fabs(y - 4.0) < 0.05);
-    assert_true(hs_world_robot_touching(w));
+    assert_true(hs_box2d_robot_touching(w));
     // Free driving: 1 s at 0.5 m/s north from (3, 4) moves 0.5 m.
-    hs_world_place_robot(w, 3.0, 4.0, M_PI / 2);
+    hs_box2d_place_robot(w, 3.0, 4.0, M_PI / 2);
     for (int i = 0; i < 50; i++) {
-        hs_world_step(w, 0.5, 0.0, 0.02);
+        hs_box2d_step(w, 0.5, 0.0, 0.02);
     }
-    hs_world_robot_pose(w, &x, &y, &th);
+    hs_box2d_robot_pose(w, &x, &y, &th);
     assert_true(fabs(y - 4.5) < 0.01 && fabs(x - 3.0) < 0.01);
-    assert_false(hs_world_robot_touching(w));
+    assert_false(hs_box2d_robot_touching(w));
     // Turning on the spot: 1 rad/s for 1 s.
     for (int i = 0; i < 50; i++) {
-        hs_world_step(w, 0.0, 1.0, 0.02);
+        hs_box2d_step(w, 0.0, 1.0, 0.02);
     }
-    hs_world_robot_pose(w, &x, &y, &th);
+    hs_box2d_robot_pose(w, &x, &y, &th);
     assert_true(fabs(th - (M_PI / 2 + 1.0)) < 0.01);
-    hs_world_destroy(w);
+    hs_box2d_destroy(w);
     free(m.cell);
 }
 
 static void test_walls_crossed(void **state)
 {
     (void)state;
-    hs_map_t m = make_map(200, 200, 0.05, three_walls);
+    lx_map_t m = make_map(200, 200, 0.05, three_walls);
     char err[256];
-    hs_world_t *w = hs_world_create(&m, NULL, err, sizeof err);
+    hs_box2d_t *w = hs_box2d_create(&m, NULL, err, sizeof err);
     assert_non_null(w);
-    assert_int_equal(hs_world_walls_crossed(w, 1.0, 5.0, 9.0, 5.0), 3);
-    assert_int_equal(hs_world_walls_crossed(w, 9.0, 2.0, 1.0, 8.0), 3);   // either direction, slanted
-    assert_int_equal(hs_world_walls_crossed(w, 1.0, 5.0, 4.0, 6.0), 1);
-    assert_int_equal(hs_world_walls_crossed(w, 1.0, 1.0, 2.5, 9.0), 0);   // between walls
-    assert_int_equal(hs_world_walls_crossed(w, 3.05, 5.0, 4.0, 5.0), 1);  // starts inside a wall
-    assert_int_equal(hs_world_walls_crossed(w, 1.0, 5.0, 5.05, 5.0), 2);  // ends inside a wall
-    assert_int_equal(hs_world_walls_crossed(w, 1.0, 5.0, 1.0, 5.0), 0);   // zero length
+    assert_int_equal(hs_box2d_walls_crossed(w, 1.0, 5.0, 9.0, 5.0), 3);
+    assert_int_equal(hs_box2d_walls_crossed(w, 9.0, 2.0, 1.0, 8.0), 3);   // either direction, slanted
+    assert_int_equal(hs_box2d_walls_crossed(w, 1.0, 5.0, 4.0, 6.0), 1);
+    assert_int_equal(hs_box2d_walls_crossed(w, 1.0, 1.0, 2.5, 9.0), 0);   // between walls
+    assert_int_equal(hs_box2d_walls_crossed(w, 3.05, 5.0, 4.0, 5.0), 1);  // starts inside a wall
+    assert_int_equal(hs_box2d_walls_crossed(w, 1.0, 5.0, 5.05, 5.0), 2);  // ends inside a wall
+    assert_int_equal(hs_box2d_walls_crossed(w, 1.0, 5.0, 1.0, 5.0), 0);   // zero length
     // The unknown border is no radio wall.
-    assert_int_equal(hs_world_walls_crossed(w, 1.0, 0.02, 1.0, 5.0), 0);
+    assert_int_equal(hs_box2d_walls_crossed(w, 1.0, 0.02, 1.0, 5.0), 0);
     // Collisions: unknown cells stop the robot (it cannot leave the known map).
-    assert_true(hs_world_disc_blocked(w, 0.1, 5.0));
-    assert_true(hs_world_disc_blocked(w, 3.0, 5.0));
-    assert_false(hs_world_disc_blocked(w, 2.0, 5.0));
-    hs_world_destroy(w);
+    assert_true(hs_box2d_disc_blocked(w, 0.1, 5.0));
+    assert_true(hs_box2d_disc_blocked(w, 3.0, 5.0));
+    assert_false(hs_box2d_disc_blocked(w, 2.0, 5.0));
+    hs_box2d_destroy(w);
     free(m.cell);
 }
 
 static unsigned walls_cb(void *ctx, double x0, double y0, double x1, double y1)
 {
-    return hs_world_walls_crossed(ctx, x0, y0, x1, y1);
+    return hs_box2d_walls_crossed(ctx, x0, y0, x1, y1);
 }
 
 /// One wall between receiver and source costs exactly its attenuation.
 static void test_one_wall_costs_its_attenuation(void **state)
 {
     (void)state;
-    hs_map_t m = make_map(200, 200, 0.05, one_wall);
+    lx_map_t m = make_map(200, 200, 0.05, one_wall);
     char err[256];
-    hs_world_t *w = hs_world_create(&m, NULL, err, sizeof err);
+    hs_box2d_t *w = hs_box2d_create(&m, NULL, err, sizeof err);
     assert_non_null(w);
     hs_radio_cfg_t c = hs_radio_cfg_default();
     c.shadowing = c.fading = c.noise = c.quantise = c.clip = c.loss = false;
@@ -209,7 +209,7 @@ static void test_one_wall_costs_its_attenuation(void **state)
     // On the source's side of the wall the line is clear.
     assert_int_equal(hs_radio_walls(r, 0, 9.0, 9.0), 0);
     hs_radio_destroy(r);
-    hs_world_destroy(w);
+    hs_box2d_destroy(w);
     free(m.cell);
 }
 

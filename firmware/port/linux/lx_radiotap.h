@@ -1,4 +1,4 @@
-/* hs_radiotap.h - radiotap and 802.11 MAC header parsing over a byte buffer (issue 5).
+/* lx_radiotap.h - radiotap and 802.11 MAC header parsing over a byte buffer.
  *
  * Pure C, no libpcap, every read bounds-checked against the captured length, so it can
  * run on anything a capture or the air hands us (the fuzz target drives it directly).
@@ -17,41 +17,41 @@
  * values (Linux mac80211 layout: a namespace restart per chain) the first value is the
  * combined one and is the one reported.
  */
-#ifndef HS_RADIOTAP_H
-#define HS_RADIOTAP_H
+#ifndef LX_RADIOTAP_H
+#define LX_RADIOTAP_H
 
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
-/// Number of hs_rt_status_t values.
-#define HS_RT_N_STATUS 8
+/// Number of lx_rt_status_t values.
+#define LX_RT_N_STATUS 8
 
 /// Radiotap flags field bits used here.
-#define HS_RT_FLAG_FCS 0x10u     ///< frame includes the 4-byte FCS at its end
-#define HS_RT_FLAG_BADFCS 0x40u  ///< frame failed the FCS check
+#define LX_RT_FLAG_FCS 0x10u     ///< frame includes the 4-byte FCS at its end
+#define LX_RT_FLAG_BADFCS 0x40u  ///< frame failed the FCS check
 
-/// Why a radiotap header was rejected or stopped early (hs_radiotap_t.status).
-typedef enum hs_rt_status {
-    HS_RT_OK = 0,          ///< every present field parsed
-    HS_RT_STOP_UNKNOWN,    ///< stopped at a field we do not know; fields before it kept
-    HS_RT_FIELD_OVERRUN,   ///< a field ran past it_len; fields before it kept
-    HS_RT_ERR_SHORT,       ///< fewer than 8 bytes captured
-    HS_RT_ERR_VERSION,     ///< version byte is not 0
-    HS_RT_ERR_LEN,         ///< it_len < 8 or larger than the captured bytes
-    HS_RT_ERR_BITMAP,      ///< present words run past it_len (bit 31 chain never ends)
-    HS_RT_ERR_NS_BOTH,     ///< a present word sets both namespace bits 29 and 30
-} hs_rt_status_t;
+/// Why a radiotap header was rejected or stopped early (lx_radiotap_t.status).
+typedef enum lx_rt_status {
+    LX_RT_OK = 0,          ///< every present field parsed
+    LX_RT_STOP_UNKNOWN,    ///< stopped at a field we do not know; fields before it kept
+    LX_RT_FIELD_OVERRUN,   ///< a field ran past it_len; fields before it kept
+    LX_RT_ERR_SHORT,       ///< fewer than 8 bytes captured
+    LX_RT_ERR_VERSION,     ///< version byte is not 0
+    LX_RT_ERR_LEN,         ///< it_len < 8 or larger than the captured bytes
+    LX_RT_ERR_BITMAP,      ///< present words run past it_len (bit 31 chain never ends)
+    LX_RT_ERR_NS_BOTH,     ///< a present word sets both namespace bits 29 and 30
+} lx_rt_status_t;
 
 /// What a radiotap header says; `has_*` tells which fields were present and read.
-typedef struct hs_radiotap {
-    hs_rt_status_t status;   ///< see hs_rt_status_t; >= HS_RT_ERR_SHORT means unusable
+typedef struct lx_radiotap {
+    lx_rt_status_t status;   ///< see lx_rt_status_t; >= LX_RT_ERR_SHORT means unusable
     uint16_t it_len;         ///< radiotap header length, bytes (the 802.11 frame follows)
     uint8_t n_present;       ///< number of it_present words
     bool has_tsft;           ///< TSFT present
     uint64_t tsft_us;        ///< MAC timer at the first bit of the MPDU, microseconds
     bool has_flags;          ///< flags present
-    uint8_t flags;           ///< HS_RT_FLAG_* bits
+    uint8_t flags;           ///< LX_RT_FLAG_* bits
     bool has_rate;           ///< legacy rate present
     uint8_t rate_500k;       ///< TX/RX rate, units of 500 kbit/s
     bool has_channel;        ///< channel present
@@ -69,30 +69,30 @@ typedef struct hs_radiotap {
     uint8_t mcs_flags;       ///< MCS flags (bandwidth, GI, format, FEC, STBC)
     uint8_t mcs_index;       ///< MCS rate index
     uint8_t n_vendor;        ///< vendor namespaces skipped
-} hs_radiotap_t;
+} lx_radiotap_t;
 
 /// Parse the radiotap header at the start of `buf` (`len` captured bytes). Fills *rt
-/// and returns 0 when the header is usable (status HS_RT_OK, HS_RT_STOP_UNKNOWN or
-/// HS_RT_FIELD_OVERRUN; the 802.11 frame starts at it_len), -1 otherwise (status says
+/// and returns 0 when the header is usable (status LX_RT_OK, LX_RT_STOP_UNKNOWN or
+/// LX_RT_FIELD_OVERRUN; the 802.11 frame starts at it_len), -1 otherwise (status says
 /// why). Never reads outside buf[0, len).
-int hs_radiotap_parse(const uint8_t *buf, size_t len, hs_radiotap_t *rt);
+int lx_radiotap_parse(const uint8_t *buf, size_t len, lx_radiotap_t *rt);
 
 /// One line describing a status ("version byte is not 0", ...).
-const char *hs_radiotap_status_str(hs_rt_status_t st);
+const char *lx_radiotap_status_str(lx_rt_status_t st);
 
 /// 802.11 frame types (frame control bits 2-3).
 enum {
-    HS_WLAN_MGMT = 0, ///< management
-    HS_WLAN_CTRL = 1, ///< control
-    HS_WLAN_DATA = 2, ///< data
-    HS_WLAN_EXT = 3,  ///< extension
+    LX_WLAN_MGMT = 0, ///< management
+    LX_WLAN_CTRL = 1, ///< control
+    LX_WLAN_DATA = 2, ///< data
+    LX_WLAN_EXT = 3,  ///< extension
 };
 
 /// What the 802.11 MAC header says. Addresses follow IEEE 802.11-2020 Table 9-30 and
 /// Wireshark's wlan.ta / wlan.sa fields.
-typedef struct hs_wlan {
+typedef struct lx_wlan {
     uint16_t fc;          ///< frame control, host order
-    uint8_t type;         ///< HS_WLAN_*
+    uint8_t type;         ///< LX_WLAN_*
     uint8_t subtype;      ///< subtype, 0..15
     uint8_t ds;           ///< ToDS | FromDS << 1 (0..3)
     bool has_ta;          ///< a transmitter address is in the frame
@@ -103,25 +103,25 @@ typedef struct hs_wlan {
     uint16_t seq;         ///< sequence number, 0..4095 (for the packet delivery ratio)
     uint8_t frag;         ///< fragment number, 0..15
     uint16_t hdr_len;     ///< MAC header length incl. +HTC, bytes (2 when incomplete)
-} hs_wlan_t;
+} lx_wlan_t;
 
 /// Parse the 802.11 MAC header of `frame` (`len` bytes, FCS already removed). Returns 0
 /// when at least the frame control was readable, -1 when len < 2. Addresses and the
 /// sequence number count only when the whole MAC header is there (as Wireshark adds
 /// wlan.sa): an ACK, a CTS or a frame cut inside its header has no SA.
-int hs_wlan_parse(const uint8_t *frame, size_t len, hs_wlan_t *w);
+int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w);
 
 /// One parsed capture record: radiotap + 802.11, as the feeder needs it.
-typedef struct hs_rt_frame {
-    hs_radiotap_t rt;     ///< the radiotap header
-    hs_wlan_t wlan;       ///< the 802.11 header (valid when wlan_ok)
+typedef struct lx_rt_frame {
+    lx_radiotap_t rt;     ///< the radiotap header
+    lx_wlan_t wlan;       ///< the 802.11 header (valid when wlan_ok)
     bool wlan_ok;         ///< an 802.11 header followed the radiotap header
     uint32_t frame_len;   ///< 802.11 bytes after radiotap, FCS removed when flagged
                           ///< (the MAC header is parsed from all captured bytes)
-} hs_rt_frame_t;
+} lx_rt_frame_t;
 
 /// Parse a whole captured record. Returns 0 when the radiotap header was usable (the
 /// 802.11 part may still be absent: see wlan_ok), -1 otherwise.
-int hs_rt_frame_parse(const uint8_t *buf, size_t len, hs_rt_frame_t *f);
+int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f);
 
-#endif /* HS_RADIOTAP_H */
+#endif /* LX_RADIOTAP_H */

@@ -1,4 +1,4 @@
-/* test_radiotap.c - the radiotap and 802.11 header parser.
+/* test_lx_radiotap.c - the radiotap and 802.11 header parser.
  *
  * Expected values come from the bytes each test lays down by hand (offsets worked out
  * from the radiotap alignment rules in the comments) and, for the two real captures,
@@ -9,7 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "hs_radiotap.h"
+#include "lx_radiotap.h"
 
 /* Little-endian writers for building headers. */
 static void put16(uint8_t *p, uint16_t v) { p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); }
@@ -25,11 +25,11 @@ static void test_minimal_header_has_no_fields(void **state)
 {
     (void)state;
     uint8_t b[8] = {0, 0, 8, 0, 0, 0, 0, 0};
-    hs_radiotap_t rt;
+    lx_radiotap_t rt;
 
-    assert_int_equal(hs_radiotap_parse(b, sizeof(b), &rt), 0);
+    assert_int_equal(lx_radiotap_parse(b, sizeof(b), &rt), 0);
 
-    assert_int_equal(rt.status, HS_RT_OK);
+    assert_int_equal(rt.status, LX_RT_OK);
     assert_int_equal(rt.it_len, 8);
     assert_int_equal(rt.n_present, 1);
     assert_false(rt.has_tsft);
@@ -49,7 +49,7 @@ static size_t build_aligned(uint8_t *b)
                      (1u << 11) | (1u << 19));
     put32(b + 8, 0);
     put64(b + 16, 0x0123456789abcdefull);
-    b[24] = HS_RT_FLAG_FCS;
+    b[24] = LX_RT_FLAG_FCS;
     b[25] = 108;
     put16(b + 26, 5180);
     put16(b + 28, 0x0140);
@@ -67,15 +67,15 @@ static void test_fields_aligned_to_header_start(void **state)
     (void)state;
     uint8_t b[64];
     const size_t n = build_aligned(b);
-    hs_radiotap_t rt;
+    lx_radiotap_t rt;
 
-    assert_int_equal(hs_radiotap_parse(b, n, &rt), 0);
+    assert_int_equal(lx_radiotap_parse(b, n, &rt), 0);
 
-    assert_int_equal(rt.status, HS_RT_OK);
+    assert_int_equal(rt.status, LX_RT_OK);
     assert_int_equal(rt.n_present, 2);
     assert_true(rt.has_tsft);
     assert_true(rt.tsft_us == 0x0123456789abcdefull);
-    assert_int_equal(rt.flags, HS_RT_FLAG_FCS);
+    assert_int_equal(rt.flags, LX_RT_FLAG_FCS);
     assert_int_equal(rt.rate_500k, 108);
     assert_int_equal(rt.freq_mhz, 5180);
     assert_int_equal(rt.chan_flags, 0x0140);
@@ -98,9 +98,9 @@ static void test_alignment_independent_of_buffer_address(void **state)
     uint8_t b[80];
     const size_t n = build_aligned(tmp);
     memcpy(b + 1, tmp, n);
-    hs_radiotap_t rt;
+    lx_radiotap_t rt;
 
-    assert_int_equal(hs_radiotap_parse(b + 1, n, &rt), 0);
+    assert_int_equal(lx_radiotap_parse(b + 1, n, &rt), 0);
 
     assert_true(rt.tsft_us == 0x0123456789abcdefull);
     assert_int_equal(rt.freq_mhz, 5180);
@@ -124,11 +124,11 @@ static void test_per_chain_reports_combined_signal(void **state)
     b[19] = 0;
     b[20] = (uint8_t)-38;
     b[21] = 1;
-    hs_radiotap_t rt;
+    lx_radiotap_t rt;
 
-    assert_int_equal(hs_radiotap_parse(b, sizeof(b), &rt), 0);
+    assert_int_equal(lx_radiotap_parse(b, sizeof(b), &rt), 0);
 
-    assert_int_equal(rt.status, HS_RT_OK);
+    assert_int_equal(rt.status, LX_RT_OK);
     assert_int_equal(rt.dbm_signal, -40);
     assert_int_equal(rt.n_dbm_signal, 3);
     assert_int_equal(rt.antenna, 0);
@@ -158,11 +158,11 @@ static void test_vendor_namespace_skipped_by_length(void **state)
     put16(b + 36, 2462);
     put16(b + 38, 0x00c0);
     b[40] = (uint8_t)-61;
-    hs_radiotap_t rt;
+    lx_radiotap_t rt;
 
-    assert_int_equal(hs_radiotap_parse(b, sizeof(b), &rt), 0);
+    assert_int_equal(lx_radiotap_parse(b, sizeof(b), &rt), 0);
 
-    assert_int_equal(rt.status, HS_RT_OK);
+    assert_int_equal(rt.status, LX_RT_OK);
     assert_int_equal(rt.n_vendor, 1);
     assert_true(rt.tsft_us == 1000);
     assert_int_equal(rt.freq_mhz, 2462);
@@ -180,11 +180,11 @@ static void test_unknown_ext_bit_keeps_earlier_fields(void **state)
     put32(b + 8, 1u);
     b[12] = 0x10;
     b[13] = (uint8_t)-70;
-    hs_radiotap_t rt;
+    lx_radiotap_t rt;
 
-    assert_int_equal(hs_radiotap_parse(b, sizeof(b), &rt), 0);
+    assert_int_equal(lx_radiotap_parse(b, sizeof(b), &rt), 0);
 
-    assert_int_equal(rt.status, HS_RT_STOP_UNKNOWN);
+    assert_int_equal(rt.status, LX_RT_STOP_UNKNOWN);
     assert_int_equal(rt.flags, 0x10);
     assert_int_equal(rt.dbm_signal, -70);
 }
@@ -197,11 +197,11 @@ static void test_unknown_field_stops_before_later_fields(void **state)
     put16(b + 2, 24);
     put32(b + 4, (1u << 5) | (1u << 18) | (1u << 19));
     b[8] = (uint8_t)-33;
-    hs_radiotap_t rt;
+    lx_radiotap_t rt;
 
-    assert_int_equal(hs_radiotap_parse(b, sizeof(b), &rt), 0);
+    assert_int_equal(lx_radiotap_parse(b, sizeof(b), &rt), 0);
 
-    assert_int_equal(rt.status, HS_RT_STOP_UNKNOWN);
+    assert_int_equal(rt.status, LX_RT_STOP_UNKNOWN);
     assert_int_equal(rt.dbm_signal, -33);
     assert_false(rt.has_mcs);
 }
@@ -209,36 +209,36 @@ static void test_unknown_field_stops_before_later_fields(void **state)
 static void test_bad_headers_rejected(void **state)
 {
     (void)state;
-    hs_radiotap_t rt;
+    lx_radiotap_t rt;
     uint8_t b[16] = {0};
     put16(b + 2, 8);
 
-    assert_int_equal(hs_radiotap_parse(b, 7, &rt), -1);
-    assert_int_equal(rt.status, HS_RT_ERR_SHORT);
+    assert_int_equal(lx_radiotap_parse(b, 7, &rt), -1);
+    assert_int_equal(rt.status, LX_RT_ERR_SHORT);
 
     b[0] = 1;
-    assert_int_equal(hs_radiotap_parse(b, 16, &rt), -1);
-    assert_int_equal(rt.status, HS_RT_ERR_VERSION);
+    assert_int_equal(lx_radiotap_parse(b, 16, &rt), -1);
+    assert_int_equal(rt.status, LX_RT_ERR_VERSION);
     b[0] = 0;
 
     put16(b + 2, 17);
-    assert_int_equal(hs_radiotap_parse(b, 16, &rt), -1);
-    assert_int_equal(rt.status, HS_RT_ERR_LEN);
+    assert_int_equal(lx_radiotap_parse(b, 16, &rt), -1);
+    assert_int_equal(rt.status, LX_RT_ERR_LEN);
     put16(b + 2, 7);
-    assert_int_equal(hs_radiotap_parse(b, 16, &rt), -1);
-    assert_int_equal(rt.status, HS_RT_ERR_LEN);
+    assert_int_equal(lx_radiotap_parse(b, 16, &rt), -1);
+    assert_int_equal(rt.status, LX_RT_ERR_LEN);
 
     /* every word says another follows: runs into it_len */
     put16(b + 2, 16);
     put32(b + 4, 1u << 31);
     put32(b + 8, 1u << 31);
     put32(b + 12, 1u << 31);
-    assert_int_equal(hs_radiotap_parse(b, 16, &rt), -1);
-    assert_int_equal(rt.status, HS_RT_ERR_BITMAP);
+    assert_int_equal(lx_radiotap_parse(b, 16, &rt), -1);
+    assert_int_equal(rt.status, LX_RT_ERR_BITMAP);
 
     put32(b + 4, (1u << 29) | (1u << 30));
-    assert_int_equal(hs_radiotap_parse(b, 16, &rt), -1);
-    assert_int_equal(rt.status, HS_RT_ERR_NS_BOTH);
+    assert_int_equal(lx_radiotap_parse(b, 16, &rt), -1);
+    assert_int_equal(rt.status, LX_RT_ERR_NS_BOTH);
 }
 
 /* A field that runs past it_len ends the parse; the fields before it stay. */
@@ -249,10 +249,10 @@ static void test_field_overrun_keeps_earlier_fields(void **state)
     put16(b + 2, 12);
     put32(b + 4, (1u << 5) | (1u << 22)); /* signal at 8, timestamp would need 16..27 */
     b[8] = (uint8_t)-50;
-    hs_radiotap_t rt;
+    lx_radiotap_t rt;
 
-    assert_int_equal(hs_radiotap_parse(b, sizeof(b), &rt), 0);
-    assert_int_equal(rt.status, HS_RT_FIELD_OVERRUN);
+    assert_int_equal(lx_radiotap_parse(b, sizeof(b), &rt), 0);
+    assert_int_equal(rt.status, LX_RT_FIELD_OVERRUN);
     assert_int_equal(rt.dbm_signal, -50);
 
     /* vendor skip_length beyond it_len */
@@ -260,8 +260,8 @@ static void test_field_overrun_keeps_earlier_fields(void **state)
     put16(v + 2, 16);
     put32(v + 4, 1u << 30);
     put16(v + 12, 200);
-    assert_int_equal(hs_radiotap_parse(v, sizeof(v), &rt), 0);
-    assert_int_equal(rt.status, HS_RT_FIELD_OVERRUN);
+    assert_int_equal(lx_radiotap_parse(v, sizeof(v), &rt), 0);
+    assert_int_equal(rt.status, LX_RT_FIELD_OVERRUN);
 }
 
 /* A data frame header: fc, duration, addr1..3, seq ctl, [addr4], [QoS]. */
@@ -289,11 +289,11 @@ static void test_source_address_by_ds_bits(void **state)
     for (int ds = 0; ds < 4; ds++) {
         uint8_t f[40];
         const size_t n = build_data(f, ds, ds == 2, k_a, k_b, k_c, k_d);
-        hs_wlan_t w;
+        lx_wlan_t w;
 
-        assert_int_equal(hs_wlan_parse(f, n, &w), 0);
+        assert_int_equal(lx_wlan_parse(f, n, &w), 0);
 
-        assert_int_equal(w.type, HS_WLAN_DATA);
+        assert_int_equal(w.type, LX_WLAN_DATA);
         assert_int_equal(w.ds, ds);
         assert_true(w.has_sa);
         assert_memory_equal(w.sa, want_sa[ds], 6);
@@ -308,24 +308,24 @@ static void test_short_frames_have_no_source(void **state)
 {
     (void)state;
     uint8_t f[40];
-    hs_wlan_t w;
+    lx_wlan_t w;
     size_t n = build_data(f, 3, true, k_a, k_b, k_c, k_d); /* 32 bytes needed */
 
-    assert_int_equal(hs_wlan_parse(f, n - 1, &w), 0);
+    assert_int_equal(lx_wlan_parse(f, n - 1, &w), 0);
     assert_false(w.has_sa);
-    assert_int_equal(hs_wlan_parse(f, n, &w), 0);
+    assert_int_equal(lx_wlan_parse(f, n, &w), 0);
     assert_true(w.has_sa);
 
     n = build_data(f, 0, false, k_a, k_b, k_c, k_d);
-    assert_int_equal(hs_wlan_parse(f, 23, &w), 0);
+    assert_int_equal(lx_wlan_parse(f, 23, &w), 0);
     assert_false(w.has_sa);
     assert_false(w.has_seq);
-    assert_int_equal(hs_wlan_parse(f, 1, &w), -1);
+    assert_int_equal(lx_wlan_parse(f, 1, &w), -1);
 
     /* ACK: fc d4 00, duration, RA only */
     const uint8_t ack[10] = {0xd4, 0, 0, 0, 2, 0, 0, 0, 0, 0x0a};
-    assert_int_equal(hs_wlan_parse(ack, sizeof(ack), &w), 0);
-    assert_int_equal(w.type, HS_WLAN_CTRL);
+    assert_int_equal(lx_wlan_parse(ack, sizeof(ack), &w), 0);
+    assert_int_equal(w.type, LX_WLAN_CTRL);
     assert_false(w.has_sa);
     assert_false(w.has_ta);
 
@@ -333,7 +333,7 @@ static void test_short_frames_have_no_source(void **state)
     uint8_t rts[16] = {0xb4, 0};
     memcpy(rts + 4, k_a, 6);
     memcpy(rts + 10, k_b, 6);
-    assert_int_equal(hs_wlan_parse(rts, sizeof(rts), &w), 0);
+    assert_int_equal(lx_wlan_parse(rts, sizeof(rts), &w), 0);
     assert_true(w.has_ta);
     assert_memory_equal(w.ta, k_b, 6);
     assert_false(w.has_sa);
@@ -346,11 +346,11 @@ static void test_management_source_is_addr2(void **state)
     memcpy(f + 4, k_a, 6);
     memcpy(f + 10, k_b, 6);
     memcpy(f + 16, k_c, 6);
-    hs_wlan_t w;
+    lx_wlan_t w;
 
-    assert_int_equal(hs_wlan_parse(f, sizeof(f), &w), 0);
+    assert_int_equal(lx_wlan_parse(f, sizeof(f), &w), 0);
 
-    assert_int_equal(w.type, HS_WLAN_MGMT);
+    assert_int_equal(w.type, LX_WLAN_MGMT);
     assert_int_equal(w.subtype, 8);
     assert_true(w.has_sa);
     assert_memory_equal(w.sa, k_b, 6);
@@ -364,18 +364,18 @@ static void test_fcs_flag_strips_four_bytes(void **state)
     const size_t n = 9 + 32 + 4;
     put16(b + 2, 9);
     put32(b + 4, 1u << 1);
-    b[8] = HS_RT_FLAG_FCS;
+    b[8] = LX_RT_FLAG_FCS;
     build_data(b + 9, 1, false, k_a, k_b, k_c, k_d);
-    hs_rt_frame_t f;
+    lx_rt_frame_t f;
 
-    assert_int_equal(hs_rt_frame_parse(b, n, &f), 0);
+    assert_int_equal(lx_rt_frame_parse(b, n, &f), 0);
 
     assert_int_equal(f.frame_len, 32);
     assert_true(f.wlan_ok);
     assert_memory_equal(f.wlan.sa, k_b, 6);
 
     b[8] = 0;
-    assert_int_equal(hs_rt_frame_parse(b, n, &f), 0);
+    assert_int_equal(lx_rt_frame_parse(b, n, &f), 0);
     assert_int_equal(f.frame_len, 36);
 }
 
@@ -403,21 +403,21 @@ static void test_real_meshid_capture(void **state)
     uint8_t buf[2048];
     const size_t n = first_record("tests/data/captures/ieee802.11_meshid.pcap", buf, sizeof(buf));
     const uint8_t sa[6] = {0x18, 0x31, 0xbf, 0x57, 0xda, 0x1c};
-    hs_rt_frame_t f;
+    lx_rt_frame_t f;
 
-    assert_int_equal(hs_rt_frame_parse(buf, n, &f), 0);
+    assert_int_equal(lx_rt_frame_parse(buf, n, &f), 0);
 
     assert_int_equal(n, 239);
     assert_int_equal(f.rt.it_len, 56);
     assert_int_equal(f.rt.dbm_signal, -34);
     assert_int_equal(f.rt.n_dbm_signal, 3);
     assert_int_equal(f.rt.freq_mhz, 5745);
-    assert_true(f.rt.flags & HS_RT_FLAG_FCS);
+    assert_true(f.rt.flags & LX_RT_FLAG_FCS);
     assert_int_equal(f.rt.antenna, 0);
     assert_int_equal(f.rt.rate_500k, 12);
     assert_true(f.rt.tsft_us == 9526800862ull);
     assert_int_equal(f.frame_len, 239 - 56 - 4);
-    assert_int_equal(f.wlan.type, HS_WLAN_MGMT);
+    assert_int_equal(f.wlan.type, LX_WLAN_MGMT);
     assert_int_equal(f.wlan.subtype, 8);
     assert_memory_equal(f.wlan.sa, sa, 6);
     assert_int_equal(f.wlan.seq, 268);
@@ -432,11 +432,11 @@ static void test_real_exthdr_capture(void **state)
     uint8_t buf[2048];
     const size_t n = first_record("tests/data/captures/ieee802.11_exthdr.pcap", buf, sizeof(buf));
     const uint8_t sa[6] = {0x90, 0xa4, 0xde, 0xc0, 0x46, 0x11};
-    hs_rt_frame_t f;
+    lx_rt_frame_t f;
 
-    assert_int_equal(hs_rt_frame_parse(buf, n, &f), 0);
+    assert_int_equal(lx_rt_frame_parse(buf, n, &f), 0);
 
-    assert_int_equal(f.rt.status, HS_RT_STOP_UNKNOWN);
+    assert_int_equal(f.rt.status, LX_RT_STOP_UNKNOWN);
     assert_int_equal(f.rt.it_len, 89);
     assert_int_equal(f.rt.n_present, 2);
     assert_int_equal(f.rt.dbm_signal, -22);

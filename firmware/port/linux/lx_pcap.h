@@ -1,54 +1,54 @@
-/* hs_pcap.h - 802.11 radiotap captures in and out, behind our own types (issue 5).
+/* lx_pcap.h - 802.11 radiotap captures in and out, behind our own types.
  *
- * The only header in front of libpcap: hs_pcap.c is the one file that includes pcap.h.
+ * The only header in front of libpcap: lx_pcap.c is the one file that includes pcap.h.
  * The reader hands out raw captured packets (radiotap header + 802.11 frame) with their
- * timestamps; parsing them is hs_radiotap's job. The writer produces a classic
+ * timestamps; parsing them is lx_radiotap's job. The writer produces a classic
  * little-endian pcap, link type 127 (LINKTYPE_IEEE802_11_RADIOTAP), microsecond
  * timestamps, that Wireshark and tshark open: what the simulator writes for every packet
  * it simulates (paper section 5.1: RSSI read from a monitor-mode adapter through libpcap).
  */
-#ifndef HS_PCAP_H
-#define HS_PCAP_H
+#ifndef LX_PCAP_H
+#define LX_PCAP_H
 
 #include <stddef.h>
 #include <stdint.h>
 
 /// Link type every reader requires: LINKTYPE_IEEE802_11_RADIOTAP.
-#define HS_PCAP_LINKTYPE_RADIOTAP 127
+#define LX_PCAP_LINKTYPE_RADIOTAP 127
 
 /// An open capture (offline file or live interface).
-typedef struct hs_pcap_reader hs_pcap_reader_t;
+typedef struct lx_pcap_reader lx_pcap_reader_t;
 
-/// One captured packet; `data` stays valid until the next hs_pcap_next() or close.
-typedef struct hs_pcap_pkt {
+/// One captured packet; `data` stays valid until the next lx_pcap_next() or close.
+typedef struct lx_pcap_pkt {
     int64_t t_us;         ///< capture time, microseconds since the Unix epoch
     int64_t t_ns;         ///< the same, nanoseconds (full resolution of a pcapng/ns file)
     uint32_t caplen;      ///< bytes captured (length of `data`)
     uint32_t origlen;     ///< bytes on the air as the capture header states them
     const uint8_t *data;  ///< captured bytes: radiotap header then the 802.11 frame
-} hs_pcap_pkt_t;
+} lx_pcap_pkt_t;
 
 /// Open a .pcap or .pcapng file. Requires link type 127; any other link type, an empty or
 /// damaged file gets NULL and one line in `err` naming the file and the reason.
-hs_pcap_reader_t *hs_pcap_open_offline(const char *path, char *err, size_t errlen);
+lx_pcap_reader_t *lx_pcap_open_offline(const char *path, char *err, size_t errlen);
 
 /// Open a monitor-mode interface live (promiscuous, snaplen 65535, 100 ms read timeout).
 /// Same link-type rule as the offline reader. NULL and `err` on failure.
-hs_pcap_reader_t *hs_pcap_open_live(const char *ifname, char *err, size_t errlen);
+lx_pcap_reader_t *lx_pcap_open_live(const char *ifname, char *err, size_t errlen);
 
 /// Read the next packet: 1 = a packet in *pkt, 0 = end of file, 2 = live timeout (no
 /// packet yet), -1 = read error (a truncated record, message in `err`).
-int hs_pcap_next(hs_pcap_reader_t *r, hs_pcap_pkt_t *pkt, char *err, size_t errlen);
+int lx_pcap_next(lx_pcap_reader_t *r, lx_pcap_pkt_t *pkt, char *err, size_t errlen);
 
 /// Close the reader (NULL is fine).
-void hs_pcap_close(hs_pcap_reader_t *r);
+void lx_pcap_close(lx_pcap_reader_t *r);
 
 /// A radiotap pcap being written.
-typedef struct hs_pcap_writer hs_pcap_writer_t;
+typedef struct lx_pcap_writer lx_pcap_writer_t;
 
-/// Create `path`: the packets go to `path`.tmp, which hs_pcap_writer_close() renames to
+/// Create `path`: the packets go to `path`.tmp, which lx_pcap_writer_close() renames to
 /// `path`, so a reader never sees a half-written file. NULL and `err` on failure.
-hs_pcap_writer_t *hs_pcap_writer_open(const char *path, char *err, size_t errlen);
+lx_pcap_writer_t *lx_pcap_writer_open(const char *path, char *err, size_t errlen);
 
 /// Append one received 802.11 data frame: radiotap with TSFT (= t_us), flags (no FCS),
 /// channel (freq_mhz, 2.4 or 5 GHz OFDM) and dBm antenna signal; then a data frame with
@@ -57,14 +57,14 @@ hs_pcap_writer_t *hs_pcap_writer_open(const char *path, char *err, size_t errlen
 /// local experimental) with 4 bytes of payload. Timestamp: t_us (must be >= 0).
 /// Returns 0, or -1 on a write error or a negative t_us (the file is then discarded at
 /// close).
-int hs_pcap_writer_frame(hs_pcap_writer_t *w, int64_t t_us, const uint8_t src_mac[6],
+int lx_pcap_writer_frame(lx_pcap_writer_t *w, int64_t t_us, const uint8_t src_mac[6],
                          const uint8_t bssid[6], uint16_t seq, int8_t dbm, uint16_t freq_mhz);
 
 /// Flush, close and rename `path`.tmp to `path`. Returns 0; -1 when any write failed (the
 /// temporary file is removed and `path` is left untouched). Frees `w` either way.
-int hs_pcap_writer_close(hs_pcap_writer_t *w);
+int lx_pcap_writer_close(lx_pcap_writer_t *w);
 
 /// Frames written so far.
-uint64_t hs_pcap_writer_count(const hs_pcap_writer_t *w);
+uint64_t lx_pcap_writer_count(const lx_pcap_writer_t *w);
 
-#endif /* HS_PCAP_H */
+#endif /* LX_PCAP_H */

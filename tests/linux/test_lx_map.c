@@ -1,4 +1,4 @@
-/* test_hs_map.c - the ROS map_server loader and the conversion to the core's grids.
+/* test_lx_map.c - the ROS map_server loader and the conversion to the core's grids.
  *
  * Independent references: the cell counts of the three real maps are the table in
  * /work/shared/data/README.md (counted there with a separate PGM reader); orientation
@@ -13,7 +13,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "hs_map.h"
+#include "lx_map.h"
 
 #define BAD "tests/data/maps_bad/"
 
@@ -23,12 +23,12 @@ static const char *maps_dir(void)
     return d != NULL ? d : "/work/shared/data/maps";
 }
 
-static void load_real(const char *name, hs_map_t *m)
+static void load_real(const char *name, lx_map_t *m)
 {
     char path[512];
     char err[512] = "";
     snprintf(path, sizeof(path), "%s/%s", maps_dir(), name);
-    int rc = hs_map_load(path, m, err, sizeof(err));
+    int rc = lx_map_load(path, m, err, sizeof(err));
     if (rc != 0) {
         print_error("%s\n", err);
     }
@@ -50,7 +50,7 @@ static void test_real_maps_counts(void **state)
         {"intel.yaml", 579, 581, 0.1, 0.0, 0.0, 29942, 192948, 113509},
     };
     for (int k = 0; k < 3; k++) {
-        hs_map_t m;
+        lx_map_t m;
         load_real(t[k].yaml, &m);
         assert_int_equal(m.w, t[k].w);
         assert_int_equal(m.h, t[k].h);
@@ -59,11 +59,11 @@ static void test_real_maps_counts(void **state)
         uint32_t f;
         uint32_t o;
         uint32_t u;
-        hs_map_count(&m, &f, &o, &u);
+        lx_map_count(&m, &f, &o, &u);
         assert_int_equal(o, t[k].occ);
         assert_int_equal(f, t[k].fre);
         assert_int_equal(u, t[k].unk);
-        hs_map_free(&m);
+        lx_map_free(&m);
     }
 }
 
@@ -74,23 +74,23 @@ static void test_orientation_thresholds_negate(void **state)
     /* ok.pgm, rows top to bottom: [254 254 0 205] [254 254 254 254] [0 0 205 254].
      * p = (255 - v) / 255: 254 -> 0.004 free, 0 -> 1.0 occupied, 205 -> 0.196 (not
      * < 0.196, not > 0.65): unknown. */
-    hs_map_t m;
+    lx_map_t m;
     char err[512] = "";
-    assert_int_equal(hs_map_load(BAD "ok.yaml", &m, err, sizeof(err)), 0);
+    assert_int_equal(lx_map_load(BAD "ok.yaml", &m, err, sizeof(err)), 0);
     assert_int_equal(m.w, 4);
     assert_int_equal(m.h, 3);
     const uint8_t want[3][4] = {
         /* bottom row (PGM row 2) first */
-        {HS_CELL_OCC, HS_CELL_OCC, HS_CELL_UNKNOWN, HS_CELL_FREE},
-        {HS_CELL_FREE, HS_CELL_FREE, HS_CELL_FREE, HS_CELL_FREE},
-        {HS_CELL_FREE, HS_CELL_FREE, HS_CELL_OCC, HS_CELL_UNKNOWN},
+        {LX_CELL_OCC, LX_CELL_OCC, LX_CELL_UNKNOWN, LX_CELL_FREE},
+        {LX_CELL_FREE, LX_CELL_FREE, LX_CELL_FREE, LX_CELL_FREE},
+        {LX_CELL_FREE, LX_CELL_FREE, LX_CELL_OCC, LX_CELL_UNKNOWN},
     };
     for (int y = 0; y < 3; y++) {
         for (int x = 0; x < 4; x++) {
             assert_int_equal(m.cell[y * 4 + x], want[y][x]);
         }
     }
-    hs_map_free(&m);
+    lx_map_free(&m);
 
     /* The same image as P2 with negate 1 in a temporary directory: p = v / 255, so
      * 254 -> occupied, 0 -> free, 205 (0.804) -> occupied. */
@@ -109,19 +109,19 @@ static void test_orientation_thresholds_negate(void **state)
     fputs("image: n.pgm\nresolution: 0.5\norigin: [1.5, -2, 0]\nnegate: 1\n"
           "occupied_thresh: 0.65\nfree_thresh: 0.196\nmode: trinary\n", f);
     fclose(f);
-    assert_int_equal(hs_map_load(yp, &m, err, sizeof(err)), 0);
+    assert_int_equal(lx_map_load(yp, &m, err, sizeof(err)), 0);
     assert_true(m.origin_x == 1.5 && m.origin_y == -2.0 && m.res == 0.5 && m.negate == 1);
     for (int y = 0; y < 3; y++) {
         for (int x = 0; x < 4; x++) {
             uint8_t w = want[y][x];
-            uint8_t neg = w == HS_CELL_FREE ? HS_CELL_OCC : HS_CELL_FREE;
-            if (w == HS_CELL_UNKNOWN) {
-                neg = HS_CELL_OCC;
+            uint8_t neg = w == LX_CELL_FREE ? LX_CELL_OCC : LX_CELL_FREE;
+            if (w == LX_CELL_UNKNOWN) {
+                neg = LX_CELL_OCC;
             }
             assert_int_equal(m.cell[y * 4 + x], neg);
         }
     }
-    hs_map_free(&m);
+    lx_map_free(&m);
     remove(yp);
     remove(ip);
     rmdir(dir);
@@ -160,9 +160,9 @@ static void test_bad_input(void **state)
         {BAD "image_newline.yaml", BAD "nothere??folded.pgm", "cannot open"},
     };
     for (size_t k = 0; k < sizeof(t) / sizeof(t[0]); k++) {
-        hs_map_t m;
+        lx_map_t m;
         char err[512] = "";
-        int rc = hs_map_load(t[k].yaml, &m, err, sizeof(err));
+        int rc = lx_map_load(t[k].yaml, &m, err, sizeof(err));
         print_message("%s -> %s\n", t[k].yaml, err);
         assert_int_equal(rc, -1);
         assert_null(m.cell);
@@ -179,11 +179,11 @@ static void test_bad_input(void **state)
 static void test_core_same_resolution(void **state)
 {
     (void)state;
-    hs_map_t m;
+    lx_map_t m;
     load_real("intel.yaml", &m);
-    hs_core_map_t c;
+    lx_core_map_t c;
     char err[512] = "";
-    assert_int_equal(hs_map_to_core(&m, 0.1, NULL, &c, err, sizeof(err)), 0);
+    assert_int_equal(lx_map_to_core(&m, 0.1, NULL, &c, err, sizeof(err)), 0);
     assert_int_equal(c.map.w, 579);
     assert_int_equal(c.map.h, 581);
     uint32_t nf = 0;
@@ -196,8 +196,8 @@ static void test_core_same_resolution(void **state)
     }
     assert_int_equal(nf, 192948);
     assert_int_equal(nw, 29942);
-    hs_core_map_free(&c);
-    hs_map_free(&m);
+    lx_core_map_free(&c);
+    lx_map_free(&m);
 }
 
 /* Willow at 0.05 m to 0.1 m: each core cell is a 2 x 2 block (the last column half off
@@ -205,11 +205,11 @@ static void test_core_same_resolution(void **state)
 static void test_core_conservative(void **state)
 {
     (void)state;
-    hs_map_t m;
+    lx_map_t m;
     load_real("willow-full-0.05.yaml", &m);
-    hs_core_map_t c;
+    lx_core_map_t c;
     char err[512] = "";
-    assert_int_equal(hs_map_to_core(&m, 0.1, NULL, &c, err, sizeof(err)), 0);
+    assert_int_equal(lx_map_to_core(&m, 0.1, NULL, &c, err, sizeof(err)), 0);
     assert_int_equal(c.map.w, (1165 + 1) / 2);
     assert_int_equal(c.map.h, (945 + 1) / 2);
     uint32_t mism = 0;
@@ -227,8 +227,8 @@ static void test_core_conservative(void **state)
                         continue;
                     }
                     uint8_t s = m.cell[fy * m.w + fx];
-                    all_free &= s == HS_CELL_FREE;
-                    any_occ |= s == HS_CELL_OCC;
+                    all_free &= s == LX_CELL_FREE;
+                    any_occ |= s == LX_CELL_OCC;
                 }
             }
             nfree += (uint32_t)all_free;
@@ -241,24 +241,24 @@ static void test_core_conservative(void **state)
     /* The core map's origin and resolution are the Q16 roundings of the yaml's. */
     assert_int_equal(c.map.res, 6554);
     assert_int_equal(c.map.origin_x, 0);
-    hs_core_map_free(&c);
-    hs_map_free(&m);
+    lx_core_map_free(&c);
+    lx_map_free(&m);
 }
 
 /* Bad core conversions: resolution <= 0; a grid above 65535 cells. */
 static void test_core_rejects(void **state)
 {
     (void)state;
-    hs_map_t m;
+    lx_map_t m;
     load_real("intel.yaml", &m);
-    hs_core_map_t c;
+    lx_core_map_t c;
     char err[512] = "";
-    assert_int_equal(hs_map_to_core(&m, 0.0, NULL, &c, err, sizeof(err)), -1);
+    assert_int_equal(lx_map_to_core(&m, 0.0, NULL, &c, err, sizeof(err)), -1);
     assert_non_null(strstr(err, "map: core resolution"));
-    assert_int_equal(hs_map_to_core(&m, 0.0005, NULL, &c, err, sizeof(err)), -1);
+    assert_int_equal(lx_map_to_core(&m, 0.0005, NULL, &c, err, sizeof(err)), -1);
     assert_non_null(strstr(err, "does not fit"));
     assert_null(c.free_bits);
-    hs_map_free(&m);
+    lx_map_free(&m);
 }
 
 int main(void)

@@ -27,7 +27,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "hs_err.h"
+#include "lx_err.h"
 #include "hs_scenario.h"
 #include "hs_sim.h"
 #include "rfs_app.h"
@@ -67,7 +67,7 @@ typedef struct recorder {
     uint32_t records;
 } recorder_t;
 
-static const char PROG[] = "rfseek-record"; /* the prefix of its error lines (hs_err_print) */
+static const char PROG[] = "rfseek-record"; /* the prefix of its error lines (lx_err_print) */
 
 static void put(recorder_t *r, const rfs_replay_rec_t *rec)
 {
@@ -84,7 +84,7 @@ static void feed(recorder_t *r, const rfs_replay_rec_t *rec)
 {
     put(r, rec);
     if (!rfs_replay_play(r->player, rec)) {
-        hs_err_print(PROG, "%s: %s", r->in_path, rfs_replay_err_str(r->player->error));
+        lx_err_print(PROG, "%s: %s", r->in_path, rfs_replay_err_str(r->player->error));
         exit(1);
     }
 }
@@ -252,7 +252,7 @@ static void usage(FILE *f)
 
 static void die_opt(const char *opt, const char *val)
 {
-    hs_err_print(PROG, "%s: bad value '%s'", opt, val);
+    lx_err_print(PROG, "%s: bad value '%s'", opt, val);
     exit(2);
 }
 
@@ -342,7 +342,7 @@ int main(int argc, char **argv)
         case 'm':
             if (rfs_models_lookup(optarg) == NULL ||
                 strlen(optarg) > RFS_REPLAY_MODEL_NAME_MAX) {
-                hs_err_print(PROG, "--model: unknown '%s' (ridge, mlp, knn, radius, pathloss)", optarg);
+                lx_err_print(PROG, "--model: unknown '%s' (ridge, mlp, knn, radius, pathloss)", optarg);
                 return 2;
             }
             model_name = optarg;
@@ -359,39 +359,39 @@ int main(int argc, char **argv)
             }
             break;
         case 'h': usage(stdout); return 0;
-        case ':': hs_err_print(PROG, "missing value for '%s' (see --help)", argv[optind - 1]); return 2;
+        case ':': lx_err_print(PROG, "missing value for '%s' (see --help)", argv[optind - 1]); return 2;
         default:
             /* An unknown short option is optopt (its word may hold more options); an
              * unknown or ambiguous long one (optopt 0), or --help given a value (optopt
              * 'h'), is the word just passed. */
             if (optopt != 0 && optopt != 'h') {
-                hs_err_print(PROG, "unknown option '-%c' (see --help)", optopt);
+                lx_err_print(PROG, "unknown option '-%c' (see --help)", optopt);
             } else {
-                hs_err_print(PROG, "unknown option '%s' (see --help)", argv[optind - 1]);
+                lx_err_print(PROG, "unknown option '%s' (see --help)", argv[optind - 1]);
             }
             return 2;
         }
     }
     if (optind >= argc || out_path == NULL) {
-        hs_err_print(PROG, "%s (see --help)", out_path == NULL ? "-o IN.rfsr is required" : "a SCENARIO is required");
+        lx_err_print(PROG, "%s (see --help)", out_path == NULL ? "-o IN.rfsr is required" : "a SCENARIO is required");
         return 2;
     }
     if (optind + 1 != argc) {
-        hs_err_print(PROG, "'%s': only one SCENARIO expected (see --help)", argv[optind + 1]);
+        lx_err_print(PROG, "'%s': only one SCENARIO expected (see --help)", argv[optind + 1]);
         return 2;
     }
     const char *scn_path = argv[optind];
     char err[512];
     static hs_scenario_t sc;
     if (hs_scenario_load(scn_path, &sc, err, sizeof err) != 0) {
-        hs_err_print(PROG, "%s", err);
+        lx_err_print(PROG, "%s", err);
         return 1;
     }
     if (max_time > 0) {
         sc.stop_time_s = max_time;
     }
     if (strcmp(sc.target, "pdr") == 0) {
-        hs_err_print(PROG, "%s: target: pdr is not available on the firmware (the CAN RSSI frame carries no "
+        lx_err_print(PROG, "%s: target: pdr is not available on the firmware (the CAN RSSI frame carries no "
                  "sequence number; docs/MODELS.md)", scn_path);
         return 1;
     }
@@ -400,12 +400,12 @@ int main(int argc, char **argv)
     }
     static hs_sim_env_t env;
     if (hs_sim_env_open(&env, &sc, err, sizeof err) != 0) {
-        hs_err_print(PROG, "%s", err);
+        lx_err_print(PROG, "%s", err);
         return 1;
     }
     const rfs_map_t *m = &env.core.map;
     if (rfs_map_bytes(m->w, m->h) > RFS_APP_MAX_MAP_BYTES) {
-        hs_err_print(PROG, "%s: map of %u x %u cells is larger than the image holds (%u bytes per grid)",
+        lx_err_print(PROG, "%s: map of %u x %u cells is larger than the image holds (%u bytes per grid)",
                  scn_path, m->w, m->h, RFS_APP_MAX_MAP_BYTES);
         return 1;
     }
@@ -416,11 +416,11 @@ int main(int argc, char **argv)
     snprintf(tmp_out, sizeof tmp_out, "%s.tmp.%ld", live_path ? live_path : "", (long)getpid());
     rec.in = fopen(tmp_in, "wb");
     if (rec.in == NULL) {
-        hs_err_print(PROG, "%s: %s", out_path, strerror(errno));
+        lx_err_print(PROG, "%s: %s", out_path, strerror(errno));
         return 1;
     }
     if (live_path != NULL && (rec.out = fopen(tmp_out, "wb")) == NULL) {
-        hs_err_print(PROG, "%s: %s", live_path, strerror(errno));
+        lx_err_print(PROG, "%s: %s", live_path, strerror(errno));
         fclose(rec.in);
         remove(tmp_in);
         return 1;
@@ -505,7 +505,7 @@ int main(int argc, char **argv)
     const int close_in = fclose(rec.in);
     const int close_out = rec.out != NULL ? fclose(rec.out) : 0;
     if (rc != 0 || rec.write_failed || close_in != 0 || close_out != 0) {
-        hs_err_print(PROG, "%s: %s", rc != 0 ? scn_path : out_path, rc != 0 ? err : "write failed");
+        lx_err_print(PROG, "%s: %s", rc != 0 ? scn_path : out_path, rc != 0 ? err : "write failed");
         remove(tmp_in);
         if (live_path != NULL) {
             remove(tmp_out);
@@ -513,7 +513,7 @@ int main(int argc, char **argv)
         return 1;
     }
     if (rename(tmp_in, out_path) != 0 || (live_path != NULL && rename(tmp_out, live_path) != 0)) {
-        hs_err_print(PROG, "%s: %s", out_path, strerror(errno));
+        lx_err_print(PROG, "%s: %s", out_path, strerror(errno));
         return 1;
     }
     printf("recorded %" PRIu32 " records, %" PRIu32 " steps, %.1f s simulated, %s, "

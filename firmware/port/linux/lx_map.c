@@ -1,8 +1,8 @@
-/* hs_map.c - ROS map_server YAML + PGM loader and conversion to the core's bit grids.
- * The convention is documented in hs_map.h and docs/MAPS.md. libyaml is used only here
- * for map files.
+/* lx_map.c - ROS map_server YAML + PGM loader and conversion to the core's bit grids.
+ * The convention is documented in lx_map.h and docs/MAPS.md. The YAML is read through
+ * lx_yaml.h.
  */
-#include "hs_map.h"
+#include "lx_map.h"
 
 #include <errno.h>
 #include <math.h>
@@ -12,12 +12,11 @@
 #include <string.h>
 #include <strings.h>
 
-#include <yaml.h>
-
-#include "hs_err.h"
+#include "lx_err.h"
+#include "lx_yaml.h"
 
 /* Largest image accepted: 2^28 pixels (16384 x 16384). */
-#define HS_MAP_MAX_PIXELS (1u << 28)
+#define LX_MAP_MAX_PIXELS (1u << 28)
 
 static int fail(char *err, size_t errlen, const char *file, const char *fmt, ...)
 {
@@ -28,7 +27,7 @@ static int fail(char *err, size_t errlen, const char *file, const char *fmt, ...
         vsnprintf(msg, sizeof(msg), fmt, ap);
         va_end(ap);
         snprintf(err, errlen, "%s: %s", file, msg);
-        hs_err_one_line(err); /* a file name from the YAML can hold line breaks */
+        lx_err_one_line(err); /* a file name from the YAML can hold line breaks */
     }
     return -1;
 }
@@ -123,7 +122,7 @@ static int pgm_decode(const char *path, const uint8_t *b, size_t n, uint32_t *w,
     if (lw < 0 || lh < 0 || lm < 0) {
         return fail(err, errlen, path, "malformed or truncated PGM header (width height maxval)");
     }
-    if (lw == 0 || lh == 0 || (uint64_t)lw * (uint64_t)lh > HS_MAP_MAX_PIXELS) {
+    if (lw == 0 || lh == 0 || (uint64_t)lw * (uint64_t)lh > LX_MAP_MAX_PIXELS) {
         return fail(err, errlen, path, "image size %ld x %ld out of range (1..2^28 pixels)", lw, lh);
     }
     if (lm == 0) {
@@ -197,12 +196,6 @@ typedef struct yaml_fields {
     int negate;
 } yaml_fields_t;
 
-static const char *scalar(yaml_document_t *d, yaml_node_t *n)
-{
-    (void)d;
-    return n != NULL && n->type == YAML_SCALAR_NODE ? (const char *)n->data.scalar.value : NULL;
-}
-
 static bool parse_double(const char *s, double *out)
 {
     if (s == NULL || *s == '\0') {
@@ -221,28 +214,29 @@ static bool parse_double(const char *s, double *out)
 static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fields_t *f,
                       char *err, size_t errlen)
 {
-    yaml_parser_t parser;
-    yaml_document_t doc;
-    if (!yaml_parser_initialize(&parser)) {
-        return fail(err, errlen, path, "cannot initialise the YAML parser");
-    }
-    yaml_parser_set_input_string(&parser, buf, len);
-    if (!yaml_parser_load(&parser, &doc)) {
-        int rc = fail(err, errlen, path, "malformed YAML at line %zu: %s",
-                      parser.problem_mark.line + 1, parser.problem ? parser.problem : "parse error");
-        yaml_parser_delete(&parser);
+    lx_yaml_doc_t doc;
+    lx_yaml_error_t ye;
+    lx_yaml_rc_t yrc = lx_yaml_load_string(buf, len, &doc, &ye);
+    if (yrc != LX_YAML_OK) {
+        int rc = yrc == LX_YAML_SYNTAX
+                   ? fail(err, errlen, path, "malformed YAML at line %lu: %s", ye.line,
+                          ye.problem ? ye.problem : "parse error")
+               : yrc == LX_YAML_TOO_BIG
+                   ? fail(err, errlen, path, "more than %u YAML nodes", LX_YAML_MAX_NODES)
+                   : fail(err, errlen, path, "cannot initialise the YAML parser");
+        lx_yaml_free(&doc);
         return rc;
     }
     int rc = 0;
-    yaml_node_t *root = yaml_document_get_root_node(&doc);
-    if (root == NULL || root->type != YAML_MAPPING_NODE) {
+    const lx_yaml_node_t *root = doc.root;
+    if (root == NULL || root->kind != LX_YAML_MAPPING) {
         rc = fail(err, errlen, path, "not a map_server YAML (a mapping of keys expected)");
         goto out;
     }
-    for (yaml_node_pair_t *pr = root->data.mapping.pairs.start; pr < root->data.mapping.pairs.top; pr++) {
-        const char *key = scalar(&doc, yaml_document_get_node(&doc, pr->key));
-        yaml_node_t *vn = yaml_document_get_node(&doc, pr->value);
-        const char *val = scalar(&doc, vn);
+    for (size_t i = 0; i < root->n; i++) {
+        const char *key = lx_yaml_scalar(root->child[2 * i]);
+        const lx_yaml_node_t *vn = root->child[2 * i + 1];
+        const char *val = lx_yaml_scalar(vn);
         if (key == NULL) {
             rc = fail(err, errlen, path, "non-scalar key");
             goto out;
@@ -263,12 +257,12 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
         } else if (strcmp(key, "origin") == 0) {
             double v[3];
             int k = 0;
-            if (vn == NULL || vn->type != YAML_SEQUENCE_NODE) {
+            if (vn == NULL || vn->kind != LX_YAML_SEQUENCE) {
                 rc = fail(err, errlen, path, "origin: a list [x, y, yaw] expected");
                 goto out;
             }
-            for (yaml_node_item_t *it = vn->data.sequence.items.start; it < vn->data.sequence.items.top; it++) {
-                if (k == 3 || !parse_double(scalar(&doc, yaml_document_get_node(&doc, *it)), &v[k])) {
+            for (size_t it = 0; it < vn->n; it++) {
+                if (k == 3 || !parse_double(lx_yaml_scalar(vn->child[it]), &v[k])) {
                     rc = fail(err, errlen, path, "origin: a list of three numbers [x, y, yaw] expected");
                     goto out;
                 }
@@ -330,12 +324,11 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
                   f->free_th, f->occ);
     }
 out:
-    yaml_document_delete(&doc);
-    yaml_parser_delete(&parser);
+    lx_yaml_free(&doc);
     return rc;
 }
 
-int hs_map_load(const char *yaml_path, hs_map_t *m, char *err, size_t errlen)
+int lx_map_load(const char *yaml_path, lx_map_t *m, char *err, size_t errlen)
 {
     memset(m, 0, sizeof(*m));
     uint8_t *ybuf = NULL;
@@ -384,7 +377,7 @@ int hs_map_load(const char *yaml_path, hs_map_t *m, char *err, size_t errlen)
         for (uint32_t x = 0; x < w; x++) {
             double v = src[x];
             double p = f.negate ? v / maxval : (maxval - v) / maxval;
-            dst[x] = p > f.occ ? HS_CELL_OCC : (p < f.free_th ? HS_CELL_FREE : HS_CELL_UNKNOWN);
+            dst[x] = p > f.occ ? LX_CELL_OCC : (p < f.free_th ? LX_CELL_FREE : LX_CELL_UNKNOWN);
         }
     }
     free(pix);
@@ -400,7 +393,7 @@ int hs_map_load(const char *yaml_path, hs_map_t *m, char *err, size_t errlen)
     return 0;
 }
 
-void hs_map_free(hs_map_t *m)
+void lx_map_free(lx_map_t *m)
 {
     if (m != NULL) {
         free(m->cell);
@@ -408,20 +401,20 @@ void hs_map_free(hs_map_t *m)
     }
 }
 
-void hs_map_count(const hs_map_t *m, uint32_t *n_free, uint32_t *n_occ, uint32_t *n_unknown)
+void lx_map_count(const lx_map_t *m, uint32_t *n_free, uint32_t *n_occ, uint32_t *n_unknown)
 {
     uint32_t c[3] = {0, 0, 0};
     for (size_t i = 0; i < (size_t)m->w * m->h; i++) {
-        c[m->cell[i] < 3 ? m->cell[i] : HS_CELL_UNKNOWN]++;
+        c[m->cell[i] < 3 ? m->cell[i] : LX_CELL_UNKNOWN]++;
     }
     if (n_free != NULL) {
-        *n_free = c[HS_CELL_FREE];
+        *n_free = c[LX_CELL_FREE];
     }
     if (n_occ != NULL) {
-        *n_occ = c[HS_CELL_OCC];
+        *n_occ = c[LX_CELL_OCC];
     }
     if (n_unknown != NULL) {
-        *n_unknown = c[HS_CELL_UNKNOWN];
+        *n_unknown = c[LX_CELL_UNKNOWN];
     }
 }
 
@@ -432,10 +425,10 @@ void hs_map_count(const hs_map_t *m, uint32_t *n_free, uint32_t *n_occ, uint32_t
  * the image's (3.5 mm after 580 cells); without the tolerance every coarse cell would
  * pick up a sliver of its neighbours and the conversion would erode free space and
  * thicken walls by a whole cell. */
-#define HS_SLIVER 0.1
+#define LX_MAP_SLIVER 0.1
 
-int hs_map_to_core(const hs_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
-                   hs_core_map_t *out, char *err, size_t errlen)
+int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
+                   lx_core_map_t *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof(*out));
     if (!(core_res > 0) || !isfinite(core_res) || core_res > 1000.0) {
@@ -457,8 +450,8 @@ int hs_map_to_core(const hs_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
     double wm = m->w * m->res;
     double hm = m->h * m->res;
     /* Cover the whole image from the (quantised) origin. */
-    double cwd = ceil((m->origin_x + wm - ox - HS_SLIVER * m->res) / cr);
-    double chd = ceil((m->origin_y + hm - oy - HS_SLIVER * m->res) / cr);
+    double cwd = ceil((m->origin_x + wm - ox - LX_MAP_SLIVER * m->res) / cr);
+    double chd = ceil((m->origin_y + hm - oy - LX_MAP_SLIVER * m->res) / cr);
     if (cwd < 1 || chd < 1 || cwd > 65535 || chd > 65535) {
         return fail(err, errlen, "map", "core grid %.0f x %.0f cells at %g m does not fit 1..65535",
                     cwd, chd, core_res);
@@ -476,7 +469,7 @@ int hs_map_to_core(const hs_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
     out->wall_bits = calloc(bytes, 1);
     out->legal_bits = calloc(bytes, 1);
     if (out->free_bits == NULL || out->wall_bits == NULL || out->legal_bits == NULL) {
-        hs_core_map_free(out);
+        lx_core_map_free(out);
         return fail(err, errlen, "map", "out of memory");
     }
     uint16_t stride = (uint16_t)((cw + 7u) / 8u);
@@ -484,16 +477,16 @@ int hs_map_to_core(const hs_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
         /* Fine rows overlapping [oy + cy*cr, oy + (cy+1)*cr] by more than a sliver. */
         double y0 = (oy + cy * cr - m->origin_y) / m->res;
         double y1 = (oy + (cy + 1) * cr - m->origin_y) / m->res;
-        long fy0 = (long)floor(y0 + HS_SLIVER);
-        long fy1 = (long)ceil(y1 - HS_SLIVER) - 1;
+        long fy0 = (long)floor(y0 + LX_MAP_SLIVER);
+        long fy1 = (long)ceil(y1 - LX_MAP_SLIVER) - 1;
         if (fy1 < fy0) {
             fy1 = fy0; /* a core cell inside one fine cell (core finer than the image) */
         }
         for (uint16_t cx = 0; cx < cw; cx++) {
             double x0 = (ox + cx * cr - m->origin_x) / m->res;
             double x1 = (ox + (cx + 1) * cr - m->origin_x) / m->res;
-            long fx0 = (long)floor(x0 + HS_SLIVER);
-            long fx1 = (long)ceil(x1 - HS_SLIVER) - 1;
+            long fx0 = (long)floor(x0 + LX_MAP_SLIVER);
+            long fx1 = (long)ceil(x1 - LX_MAP_SLIVER) - 1;
             if (fx1 < fx0) {
                 fx1 = fx0;
             }
@@ -506,8 +499,8 @@ int hs_map_to_core(const hs_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
                         continue;
                     }
                     uint8_t s = m->cell[(size_t)fy * m->w + (size_t)fx];
-                    all_free = all_free && s == HS_CELL_FREE;
-                    any_occ = any_occ || s == HS_CELL_OCC;
+                    all_free = all_free && s == LX_CELL_FREE;
+                    any_occ = any_occ || s == LX_CELL_OCC;
                 }
             }
             rfs_map_bit_set(out->free_bits, stride, cx, cy, all_free);
@@ -516,7 +509,7 @@ int hs_map_to_core(const hs_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
     }
     if (rfs_map_init(&out->map, &c, cw, ch, (rfs_q16_t)res_q, (rfs_q16_t)ox_q, (rfs_q16_t)oy_q,
                      out->free_bits, out->wall_bits, out->legal_bits) != 0) {
-        hs_core_map_free(out);
+        lx_core_map_free(out);
         return fail(err, errlen, "map", "the core rejects the map (%u x %u cells at %g m, clearance %g m, "
                     "grid %g m: extent above 16384 m, clearance above 64 m or 255 cells, or lattice above 65535)",
                     cw, ch, core_res, c.clearance / 65536.0, c.grid / 65536.0);
@@ -524,7 +517,7 @@ int hs_map_to_core(const hs_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
     return 0;
 }
 
-void hs_core_map_free(hs_core_map_t *c)
+void lx_core_map_free(lx_core_map_t *c)
 {
     if (c != NULL) {
         free(c->free_bits);

@@ -1,5 +1,5 @@
-/* hs_pcap.c - the one libpcap adapter: capture reader (offline/live) and writer. */
-#include "hs_pcap.h"
+/* lx_pcap.c - the one libpcap adapter: capture reader (offline/live) and writer. */
+#include "lx_pcap.h"
 
 #include <errno.h>
 #include <stdbool.h>
@@ -9,13 +9,13 @@
 
 #include <pcap/pcap.h>
 
-struct hs_pcap_reader {
+struct lx_pcap_reader {
     pcap_t *p;        /* libpcap handle */
     bool live;        /* a live interface (timeouts are not the end) */
     char name[256];   /* file or interface, for messages */
 };
 
-struct hs_pcap_writer {
+struct lx_pcap_writer {
     pcap_t *dead;       /* libpcap handle that only describes the format */
     pcap_dumper_t *d;   /* the open temporary file */
     char *path;         /* final name */
@@ -40,7 +40,7 @@ static void copy_name(char *dst, size_t n, const char *src)
     snprintf(dst, n, "%s", src);
 }
 
-hs_pcap_reader_t *hs_pcap_open_offline(const char *path, char *err, size_t errlen)
+lx_pcap_reader_t *lx_pcap_open_offline(const char *path, char *err, size_t errlen)
 {
     char ebuf[PCAP_ERRBUF_SIZE] = "";
     /* Nanosecond precision keeps a pcapng/ns file's full timestamp; a microsecond file
@@ -54,7 +54,7 @@ hs_pcap_reader_t *hs_pcap_open_offline(const char *path, char *err, size_t errle
         pcap_close(p);
         return NULL;
     }
-    hs_pcap_reader_t *r = calloc(1, sizeof(*r));
+    lx_pcap_reader_t *r = calloc(1, sizeof(*r));
     if (r == NULL) {
         pcap_close(p);
         snprintf(err, errlen, "%s: out of memory", path);
@@ -65,7 +65,7 @@ hs_pcap_reader_t *hs_pcap_open_offline(const char *path, char *err, size_t errle
     return r;
 }
 
-hs_pcap_reader_t *hs_pcap_open_live(const char *ifname, char *err, size_t errlen)
+lx_pcap_reader_t *lx_pcap_open_live(const char *ifname, char *err, size_t errlen)
 {
     char ebuf[PCAP_ERRBUF_SIZE] = "";
     pcap_t *p = pcap_create(ifname, ebuf);
@@ -89,7 +89,7 @@ hs_pcap_reader_t *hs_pcap_open_live(const char *ifname, char *err, size_t errlen
         pcap_close(p);
         return NULL;
     }
-    hs_pcap_reader_t *r = calloc(1, sizeof(*r));
+    lx_pcap_reader_t *r = calloc(1, sizeof(*r));
     if (r == NULL) {
         pcap_close(p);
         snprintf(err, errlen, "%s: out of memory", ifname);
@@ -101,7 +101,7 @@ hs_pcap_reader_t *hs_pcap_open_live(const char *ifname, char *err, size_t errlen
     return r;
 }
 
-int hs_pcap_next(hs_pcap_reader_t *r, hs_pcap_pkt_t *pkt, char *err, size_t errlen)
+int lx_pcap_next(lx_pcap_reader_t *r, lx_pcap_pkt_t *pkt, char *err, size_t errlen)
 {
     struct pcap_pkthdr *h = NULL;
     const u_char *data = NULL;
@@ -123,14 +123,14 @@ int hs_pcap_next(hs_pcap_reader_t *r, hs_pcap_pkt_t *pkt, char *err, size_t errl
     return -1;
 }
 
-void hs_pcap_close(hs_pcap_reader_t *r)
+void lx_pcap_close(lx_pcap_reader_t *r)
 {
     if (r == NULL) { return; }
     pcap_close(r->p);
     free(r);
 }
 
-static void writer_free(hs_pcap_writer_t *w)
+static void writer_free(lx_pcap_writer_t *w)
 {
     if (w->d != NULL) { pcap_dump_close(w->d); }
     if (w->dead != NULL) { pcap_close(w->dead); }
@@ -139,9 +139,9 @@ static void writer_free(hs_pcap_writer_t *w)
     free(w);
 }
 
-hs_pcap_writer_t *hs_pcap_writer_open(const char *path, char *err, size_t errlen)
+lx_pcap_writer_t *lx_pcap_writer_open(const char *path, char *err, size_t errlen)
 {
-    hs_pcap_writer_t *w = calloc(1, sizeof(*w));
+    lx_pcap_writer_t *w = calloc(1, sizeof(*w));
     const size_t n = strlen(path);
     if (w == NULL || (w->path = malloc(n + 1)) == NULL || (w->tmp = malloc(n + 5)) == NULL) {
         snprintf(err, errlen, "%s: out of memory", path);
@@ -169,7 +169,7 @@ hs_pcap_writer_t *hs_pcap_writer_open(const char *path, char *err, size_t errlen
 /* Bytes of one written record: radiotap 23, 802.11 data header 24, LLC/SNAP 8, payload 4. */
 enum { WR_RT_LEN = 23, WR_LEN = WR_RT_LEN + 24 + 8 + 4 };
 
-int hs_pcap_writer_frame(hs_pcap_writer_t *w, int64_t t_us, const uint8_t src_mac[6],
+int lx_pcap_writer_frame(lx_pcap_writer_t *w, int64_t t_us, const uint8_t src_mac[6],
                          const uint8_t bssid[6], uint16_t seq, int8_t dbm, uint16_t freq_mhz)
 {
     if (w->failed) { return -1; }
@@ -216,7 +216,7 @@ int hs_pcap_writer_frame(hs_pcap_writer_t *w, int64_t t_us, const uint8_t src_ma
     return 0;
 }
 
-int hs_pcap_writer_close(hs_pcap_writer_t *w)
+int lx_pcap_writer_close(lx_pcap_writer_t *w)
 {
     if (w == NULL) { return -1; }
     int rc = w->failed ? -1 : 0;
@@ -229,7 +229,7 @@ int hs_pcap_writer_close(hs_pcap_writer_t *w)
     return rc;
 }
 
-uint64_t hs_pcap_writer_count(const hs_pcap_writer_t *w)
+uint64_t lx_pcap_writer_count(const lx_pcap_writer_t *w)
 {
     return w->count;
 }

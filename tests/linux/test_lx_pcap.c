@@ -1,7 +1,7 @@
-/* test_pcap_writer.c - hs_pcap_writer: what it writes, as tshark reads it back.
+/* test_lx_pcap.c - lx_pcap_writer: what it writes, as tshark reads it back.
  *
  * The reference reader is tshark (an independent 802.11/radiotap dissector): every value
- * passed to hs_pcap_writer_frame() must come back in its fields.
+ * passed to lx_pcap_writer_frame() must come back in its fields.
  */
 #include "rfs_test.h"
 
@@ -10,7 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "hs_pcap.h"
+#include "lx_pcap.h"
 
 typedef struct wr_case {
     int64_t t_us;
@@ -63,17 +63,17 @@ static void test_tshark_reads_back_every_value(void **state)
 {
     fixture_t *fx = *state;
     char err[256] = "";
-    hs_pcap_writer_t *w = hs_pcap_writer_open(fx->path, err, sizeof(err));
+    lx_pcap_writer_t *w = lx_pcap_writer_open(fx->path, err, sizeof(err));
     assert_non_null(w);
     for (size_t i = 0; i < N_CASES; i++) {
         const wr_case_t *c = &k_cases[i];
-        assert_int_equal(hs_pcap_writer_frame(w, c->t_us, c->src, k_bssid, c->seq, c->dbm, c->freq), 0);
+        assert_int_equal(lx_pcap_writer_frame(w, c->t_us, c->src, k_bssid, c->seq, c->dbm, c->freq), 0);
     }
     assert_int_equal(access(fx->path, F_OK), -1); /* only the temporary exists so far */
     assert_int_equal(access(fx->tmp, F_OK), 0);
-    assert_true(hs_pcap_writer_count(w) == N_CASES);
+    assert_true(lx_pcap_writer_count(w) == N_CASES);
 
-    assert_int_equal(hs_pcap_writer_close(w), 0);
+    assert_int_equal(lx_pcap_writer_close(w), 0);
 
     assert_int_equal(access(fx->path, F_OK), 0);
     assert_int_equal(access(fx->tmp, F_OK), -1);
@@ -112,7 +112,7 @@ static void test_open_in_missing_directory_fails_with_message(void **state)
     snprintf(path, sizeof(path), "%s/no/such/dir/out.pcap", fx->dir);
     char err[256] = "";
 
-    hs_pcap_writer_t *w = hs_pcap_writer_open(path, err, sizeof(err));
+    lx_pcap_writer_t *w = lx_pcap_writer_open(path, err, sizeof(err));
 
     assert_null(w);
     assert_non_null(strstr(err, "no/such/dir/out.pcap.tmp: cannot create"));
@@ -122,13 +122,13 @@ static void test_negative_time_discards_file(void **state)
 {
     fixture_t *fx = *state;
     char err[256] = "";
-    hs_pcap_writer_t *w = hs_pcap_writer_open(fx->path, err, sizeof(err));
+    lx_pcap_writer_t *w = lx_pcap_writer_open(fx->path, err, sizeof(err));
     assert_non_null(w);
     const wr_case_t *c = &k_cases[0];
 
-    assert_int_equal(hs_pcap_writer_frame(w, c->t_us, c->src, k_bssid, c->seq, c->dbm, c->freq), 0);
-    assert_int_equal(hs_pcap_writer_frame(w, -1, c->src, k_bssid, c->seq, c->dbm, c->freq), -1);
-    assert_int_equal(hs_pcap_writer_close(w), -1);
+    assert_int_equal(lx_pcap_writer_frame(w, c->t_us, c->src, k_bssid, c->seq, c->dbm, c->freq), 0);
+    assert_int_equal(lx_pcap_writer_frame(w, -1, c->src, k_bssid, c->seq, c->dbm, c->freq), -1);
+    assert_int_equal(lx_pcap_writer_close(w), -1);
 
     assert_int_equal(access(fx->path, F_OK), -1);
     assert_int_equal(access(fx->tmp, F_OK), -1);

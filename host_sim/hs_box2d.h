@@ -1,15 +1,15 @@
-/* hs_world.h - the physical world of the simulator: walls and the robot (issue 3).
+/* hs_box2d.h - the physical world of the simulator: walls and the robot.
  *
  * Behind this header sits Box2D 2.4 (hs_box2d.cpp is the only file that includes it).
  * Everything here is in our own types: metres, radians, seconds, doubles.
  *
- * Two kinds of static geometry are built from an hs_map_t:
+ * Two kinds of static geometry are built from an lx_map_t:
  *   - collision walls: every cell that is not free (occupied OR unknown: the robot can
  *     never leave the known map), merged into rectangles;
  *   - radio walls: occupied cells only, merged the same way; they never collide and only
- *     answer ray casts (hs_world_walls_crossed), so a large unknown area does not count
+ *     answer ray casts (hs_box2d_walls_crossed), so a large unknown area does not count
  *     as many walls for the radio model.
- * Merging (hs_world_merge_rects): greedy runs along each row, then runs with the same
+ * Merging (hs_box2d_merge_rects): greedy runs along each row, then runs with the same
  * x extent on consecutive rows are merged vertically, so a 50 x 50 m map at 5 cm stays
  * at a few thousand bodies' worth of fixtures.
  *
@@ -17,14 +17,14 @@
  * set every physics step from the wheel speeds (unicycle), so walls stop it while the
  * wheels keep turning (as on a real base pushing against a wall).
  */
-#ifndef HS_WORLD_H
-#define HS_WORLD_H
+#ifndef HS_BOX2D_H
+#define HS_BOX2D_H
 
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
-#include "hs_map.h"
+#include "lx_map.h"
 
 /// A merged axis-aligned rectangle of map cells [x0, x0 + w) x [y0, y0 + h), in cells.
 typedef struct hs_rect {
@@ -35,62 +35,62 @@ typedef struct hs_rect {
 } hs_rect_t;
 
 /// Which cells a rectangle set covers.
-typedef enum hs_world_kind {
-    HS_WORLD_COLLIDE = 0, ///< occupied or unknown cells
-    HS_WORLD_RADIO = 1,   ///< occupied cells only
-} hs_world_kind_t;
+typedef enum hs_box2d_kind {
+    HS_BOX2D_COLLIDE = 0, ///< occupied or unknown cells
+    HS_BOX2D_RADIO = 1,   ///< occupied cells only
+} hs_box2d_kind_t;
 
 /// World configuration.
-typedef struct hs_world_cfg {
+typedef struct hs_box2d_cfg {
     double robot_radius_m;  ///< robot footprint radius, metres (TurtleBot 2: 0.177)
     double robot_mass_kg;   ///< robot mass, kg (TurtleBot 2 base: 6.3)
     int velocity_iters;     ///< Box2D velocity iterations (8)
     int position_iters;     ///< Box2D position iterations (3)
     double wall_merge_gap_m; ///< ray cast hits closer than this count as one wall (0.1 m)
-} hs_world_cfg_t;
+} hs_box2d_cfg_t;
 
 /// Opaque world (owns the Box2D world).
-typedef struct hs_world hs_world_t;
+typedef struct hs_box2d hs_box2d_t;
 
 /// Defaults: TurtleBot 2 footprint and mass, Box2D's recommended iterations.
-hs_world_cfg_t hs_world_cfg_default(void);
+hs_box2d_cfg_t hs_box2d_cfg_default(void);
 
 /// Merge the cells of `kind` into rectangles. Returns the count and a malloc'd array in
 /// *out (NULL when none), or -1 when out of memory. Every covered cell is in exactly one
 /// rectangle.
-long hs_world_merge_rects(const hs_map_t *m, hs_world_kind_t kind, hs_rect_t **out);
+long hs_box2d_merge_rects(const lx_map_t *m, hs_box2d_kind_t kind, hs_rect_t **out);
 
 /// Build the world from a map. Returns NULL with err = "reason" on failure.
-hs_world_t *hs_world_create(const hs_map_t *m, const hs_world_cfg_t *cfg, char *err,
+hs_box2d_t *hs_box2d_create(const lx_map_t *m, const hs_box2d_cfg_t *cfg, char *err,
                             size_t errlen);
 
 /// Destroy the world (NULL is fine).
-void hs_world_destroy(hs_world_t *w);
+void hs_box2d_destroy(hs_box2d_t *w);
 
 /// Number of rectangles of each kind in the world.
-long hs_world_rect_count(const hs_world_t *w, hs_world_kind_t kind);
+long hs_box2d_rect_count(const hs_box2d_t *w, hs_box2d_kind_t kind);
 
 /// Place the robot at (x, y) metres with heading theta radians, at rest.
-void hs_world_place_robot(hs_world_t *w, double x, double y, double theta);
+void hs_box2d_place_robot(hs_box2d_t *w, double x, double y, double theta);
 
 /// Robot pose: x, y metres, theta radians in (-pi, pi].
-void hs_world_robot_pose(const hs_world_t *w, double *x, double *y, double *theta);
+void hs_box2d_robot_pose(const hs_box2d_t *w, double *x, double *y, double *theta);
 
 /// Advance by dt seconds with the robot driven at forward speed v (m/s) and turn rate
 /// omega (rad/s, counter-clockwise). Walls stop it.
-void hs_world_step(hs_world_t *w, double v_m_s, double omega_rad_s, double dt_s);
+void hs_box2d_step(hs_box2d_t *w, double v_m_s, double omega_rad_s, double dt_s);
 
 /// true when the robot touches a wall after the last step.
-bool hs_world_robot_touching(const hs_world_t *w);
+bool hs_box2d_robot_touching(const hs_box2d_t *w);
 
 /// Radio walls crossed by the straight segment (x0, y0)-(x1, y1), metres: the number of
 /// separate runs of wall along it (ray casts in both directions; hits closer than
 /// wall_merge_gap_m merged). Ends inside a wall count that wall.
-unsigned hs_world_walls_crossed(const hs_world_t *w, double x0, double y0, double x1,
+unsigned hs_box2d_walls_crossed(const hs_box2d_t *w, double x0, double y0, double x1,
                                 double y1);
 
 /// true when a disc of the robot's radius at (x, y) overlaps a collision wall or lies
 /// (partly) off the map.
-bool hs_world_disc_blocked(const hs_world_t *w, double x, double y);
+bool hs_box2d_disc_blocked(const hs_box2d_t *w, double x, double y);
 
-#endif /* HS_WORLD_H */
+#endif /* HS_BOX2D_H */

@@ -1,0 +1,145 @@
+/* lx_yaml.c - libyaml behind lx_yaml.h; the only file that includes <yaml.h>. */
+#include "lx_yaml.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include <yaml.h>
+
+/* Copy libyaml's composed document into our nodes; node ids are 1-based indices. */
+static lx_yaml_rc_t copy_doc(yaml_document_t *y, lx_yaml_doc_t *doc, lx_yaml_error_t *e)
+{
+    size_t count = (size_t)(y->nodes.top - y->nodes.start);
+    if (count == 0) {
+        return LX_YAML_OK; /* empty stream: no root */
+    }
+    if (count > LX_YAML_MAX_NODES) {
+        return LX_YAML_TOO_BIG;
+    }
+    size_t nlinks = 0;
+    size_t ntext = 0;
+    for (const yaml_node_t *n = y->nodes.start; n < y->nodes.top; n++) {
+        if (n->type == YAML_SCALAR_NODE) {
+            ntext += n->data.scalar.length + 1;
+        } else if (n->type == YAML_SEQUENCE_NODE) {
+            nlinks += (size_t)(n->data.sequence.items.top - n->data.sequence.items.start);
+        } else if (n->type == YAML_MAPPING_NODE) {
+            nlinks += 2 * (size_t)(n->data.mapping.pairs.top - n->data.mapping.pairs.start);
+        }
+    }
+    doc->nodes = calloc(count, sizeof(*doc->nodes));
+    doc->links = calloc(nlinks > 0 ? nlinks : 1, sizeof(const lx_yaml_node_t *));
+    doc->text = malloc(ntext > 0 ? ntext : 1);
+    if (doc->nodes == NULL || doc->links == NULL || doc->text == NULL) {
+        return LX_YAML_NOMEM;
+    }
+    const lx_yaml_node_t **link = doc->links;
+    char *text = doc->text;
+    for (size_t i = 0; i < count; i++) {
+        const yaml_node_t *n = &y->nodes.start[i];
+        lx_yaml_node_t *o = &doc->nodes[i];
+        o->line = (unsigned long)n->start_mark.line + 1;
+        o->child = link;
+        if (n->type == YAML_SCALAR_NODE) {
+            o->kind = LX_YAML_SCALAR;
+            memcpy(text, n->data.scalar.value, n->data.scalar.length);
+            text[n->data.scalar.length] = '\0';
+            o->value = text;
+            text += n->data.scalar.length + 1;
+            continue;
+        }
+        const yaml_node_item_t *ids = NULL;
+        size_t nid = 0;
+        if (n->type == YAML_SEQUENCE_NODE) {
+            o->kind = LX_YAML_SEQUENCE;
+            ids = n->data.sequence.items.start;
+            nid = (size_t)(n->data.sequence.items.top - ids);
+            o->n = nid;
+        } else {
+            o->kind = LX_YAML_MAPPING;
+            o->n = (size_t)(n->data.mapping.pairs.top - n->data.mapping.pairs.start);
+        }
+        for (size_t k = 0; k < (ids != NULL ? nid : 2 * o->n); k++) {
+            int id = ids != NULL ? ids[k]
+                   : (k % 2 == 0 ? n->data.mapping.pairs.start[k / 2].key
+                                 : n->data.mapping.pairs.start[k / 2].value);
+            if (id < 1 || (size_t)id > count) {
+                e->line = o->line;
+                e->problem = "bad node reference";
+                return LX_YAML_SYNTAX;
+            }
+            *link++ = &doc->nodes[id - 1];
+        }
+    }
+    doc->root = &doc->nodes[0]; /* libyaml composes the root first */
+    return LX_YAML_OK;
+}
+
+static lx_yaml_rc_t load(yaml_parser_t *parser, lx_yaml_doc_t *doc, lx_yaml_error_t *e)
+{
+    yaml_document_t y;
+    if (!yaml_parser_load(parser, &y)) {
+        e->line = (unsigned long)parser->problem_mark.line + 1;
+        e->problem = parser->problem;
+        yaml_parser_delete(parser);
+        return LX_YAML_SYNTAX;
+    }
+    lx_yaml_rc_t rc = copy_doc(&y, doc, e);
+    yaml_document_delete(&y);
+    yaml_parser_delete(parser);
+    return rc;
+}
+
+lx_yaml_rc_t lx_yaml_load_string(const uint8_t *buf, size_t len, lx_yaml_doc_t *doc,
+                                 lx_yaml_error_t *e)
+{
+    memset(doc, 0, sizeof(*doc));
+    memset(e, 0, sizeof(*e));
+    yaml_parser_t parser;
+    if (!yaml_parser_initialize(&parser)) {
+        return LX_YAML_NOMEM;
+    }
+    yaml_parser_set_input_string(&parser, buf, len);
+    return load(&parser, doc, e);
+}
+
+lx_yaml_rc_t lx_yaml_load_file(FILE *f, lx_yaml_doc_t *doc, lx_yaml_error_t *e)
+{
+    memset(doc, 0, sizeof(*doc));
+    memset(e, 0, sizeof(*e));
+    yaml_parser_t parser;
+    if (!yaml_parser_initialize(&parser)) {
+        return LX_YAML_NOMEM;
+    }
+    yaml_parser_set_input_file(&parser, f);
+    return load(&parser, doc, e);
+}
+
+void lx_yaml_free(lx_yaml_doc_t *doc)
+{
+    if (doc != NULL) {
+        free(doc->nodes);
+        free((void *)doc->links);
+        free(doc->text);
+        memset(doc, 0, sizeof(*doc));
+    }
+}
+
+const char *lx_yaml_scalar(const lx_yaml_node_t *n)
+{
+    return n != NULL && n->kind == LX_YAML_SCALAR ? n->value : NULL;
+}
+
+const lx_yaml_node_t *lx_yaml_get(const lx_yaml_node_t *m, const char *key)
+{
+    if (m == NULL || m->kind != LX_YAML_MAPPING) {
+        return NULL;
+    }
+    for (size_t i = 0; i < m->n; i++) {
+        const char *ks = lx_yaml_scalar(m->child[2 * i]);
+        if (ks != NULL && strcmp(ks, key) == 0) {
+            return m->child[2 * i + 1];
+        }
+    }
+    return NULL;
+}

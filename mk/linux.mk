@@ -1,0 +1,71 @@
+# mk/linux.mk - the Linux port (firmware/port/linux/): its I/O adapters (SocketCAN, LCM,
+# map files, YAML, pcap, radiotap, one-line errors) and the lcm-gen types as librfs_linux.a,
+# C only; rfseekd and rfseek-replay linked with the C linker against it, the application
+# and the core only; their tests, the SocketCAN VM test and the link check.
+LINUX_SRCS := $(sort $(wildcard firmware/port/linux/*.c))
+LINUX_CFLAGS := $(HOST_CFLAGS) $(INC_linux) $(YAML_CFLAGS)
+LINUX_PROGS := $(patsubst firmware/port/linux/prog/%.c,$(BUILD)/bin/%,$(sort $(wildcard firmware/port/linux/prog/*.c)))
+
+# lcm-gen C has unused parameters: compiled without -Werror.
+$(BUILD)/gen/rfseek_%.c $(BUILD)/gen/rfseek_%.h: lcm/%.lcm
+	@mkdir -p $(BUILD)/gen
+	lcm-gen -c --c-cpath $(BUILD)/gen --c-hpath $(BUILD)/gen $<
+$(BUILD)/gen/%.o: $(BUILD)/gen/%.c
+	$(CC) $(CSTD) $(OPT) -D_DEFAULT_SOURCE -I$(BUILD)/gen $(DEPFLAGS) -c $< -o $@
+$(BUILD)/gen/%.asan.o: $(BUILD)/gen/%.c
+	$(CC) $(CSTD) -O1 -g $(SAN_FLAGS) -D_DEFAULT_SOURCE -I$(BUILD)/gen $(DEPFLAGS) -c $< -o $@
+
+# The adapters and the programs' mains (prog/); every object waits for the generated
+# headers, which lx_lcm.c and some tests include.
+$(BUILD)/obj/firmware/port/linux/%.o: firmware/port/linux/%.c | $(LCM_GEN_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(LINUX_CFLAGS) $(DEPFLAGS) -c $< -o $@
+$(BUILD)/asan/obj/firmware/port/linux/%.o: firmware/port/linux/%.c | $(LCM_GEN_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(LINUX_CFLAGS) -O1 $(SAN_FLAGS) $(DEPFLAGS) -c $< -o $@
+
+$(LINUX_LIB): $(LINUX_SRCS:%.c=$(BUILD)/obj/%.o) $(LCM_GEN_SRCS:%.c=%.o)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
+$(LINUX_ASAN_LIB): $(LINUX_SRCS:%.c=$(BUILD)/asan/obj/%.o) $(LCM_GEN_SRCS:%.c=%.asan.o)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
+
+$(LINUX_PROGS): $(BUILD)/bin/%: $(BUILD)/obj/firmware/port/linux/prog/%.o $(LIBS_linux)
+	@mkdir -p $(@D)
+	$(LD_linux) -o $@ $< $(LIBS_linux) $(LDLIBS_linux)
+# rfseekd under ASan+UBSan, for the malformed-input replay in tests/wire/rfseekd_test.sh.
+$(BUILD)/asan/bin/rfseekd: $(BUILD)/asan/obj/firmware/port/linux/prog/rfseekd.o $(ASAN_LIBS_linux)
+	@mkdir -p $(@D)
+	$(LD_linux) $(SAN_FLAGS) -o $@ $< $(ASAN_LIBS_linux) $(LDLIBS_linux)
+
+ALL_TARGETS += $(LINUX_LIB) $(LINUX_PROGS)
+
+# --- tests -------------------------------------------------------------------------------
+# The map loader on real maps (/work/shared/data/maps) and bad input (tests/data/maps_bad/);
+# the radiotap parser and the pcap writer against tshark; the LCM adapter and the path-loss
+# estimate in the seeker status (hand-decoded bytes).
+$(eval $(call cmocka_test,test_lx_map,tests/linux/test_lx_map.c,linux))
+$(eval $(call cmocka_test,test_lx_radiotap,tests/linux/test_lx_radiotap.c,linux))
+$(eval $(call cmocka_test,test_lx_pcap,tests/linux/test_lx_pcap.c,linux))
+$(eval $(call cmocka_test,test_lcm,tests/wire/test_lcm.c,linux))
+$(eval $(call cmocka_test,test_status_est,tests/host_sim/test_status_est.c,linux))
+
+# rfseekd: options, bad input, deterministic replay (also under ASan+UBSan), logs readable
+# by lcm-logplayer, the two-process run with the simulator (udpm in a network namespace).
+WIRE_LCM_TOOL := $(BUILD)/tests/wire/lcm_tool
+$(WIRE_LCM_TOOL): tests/wire/lcm_tool.c $(LIBS_linux) | $(LCM_GEN_HDRS)
+	@mkdir -p $(@D)
+	$(LD_linux) $(LINUX_CFLAGS) $(DEPFLAGS) -MF $@.d -MT $@ $< -o $@ $(LIBS_linux) $(LDLIBS_linux)
+$(eval $(call test_script,rfseekd,tests/wire/rfseekd_test.sh $(BUILD),$(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/asan/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
+
+# SocketCAN against the kernel's CAN stack: a static test binary, run natively in a network
+# namespace with vcan or in a one-CPU qemu VM (its own namespace and build/vm: parallel-safe).
+WIRE_VM_BIN := $(BUILD)/tests/vm/can_vm_test
+$(WIRE_VM_BIN): tests/vm/can_vm_test.c $(BUILD)/obj/firmware/port/linux/lx_can.o $(CORE_LIB)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) $(INC_linux) $(DEPFLAGS) -MF $@.d -MT $@ -static $< $(BUILD)/obj/firmware/port/linux/lx_can.o $(CORE_LIB) -o $@
+$(eval $(call test_script,can_vm,tests/vm/run_vm_test.sh $(BUILD),$(WIRE_VM_BIN) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
+
+# The daemon and the player link neither Box2D nor the C++ runtime.
+$(eval $(call test_script,link,scripts/check_link.sh $(LINUX_PROGS),$(LINUX_PROGS)))

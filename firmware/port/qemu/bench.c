@@ -621,8 +621,8 @@ static void __attribute__((noinline)) measure_inputs(rfs_q16_t rx, rfs_q16_t ry,
 }
 
 /* Grid search: the model at every reachable lattice point, as choose_greedy does it
- * (rfs_seek.c: rows in chunks of 64, one predict_row call per chunk when the model has
- * it, else one predict per point). Returns the maximum. */
+ * (rfs_gridmax.c: rows in chunks, one predict_row call per chunk when the model has it,
+ * else one predict per point). Returns the maximum. */
 static rfs_q16_t __attribute__((noinline)) measure_grid_search(void)
 {
     const rfs_map_t *m = &s_app.map;

@@ -228,9 +228,9 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->pose_sigma_xy_m = 0.05;
     sc->pose_sigma_theta_rad = 0.02;
     sc->radio = hs_radio_cfg_default();
-    sc->rx_heartbeat = true;          // issue 10: a listening receiver reports itself up
+    sc->rx_heartbeat = true;          // a listening receiver reports itself up
     sc->motor = hs_motor_cfg_default();
-    sc->stop_radius_m = 1.5;          // issue 3 stop condition
+    sc->stop_radius_m = 1.5;          // the run ends within 1.5 m of the source
     sc->stop_distance_m = 150.0;
     sc->stop_time_s = 900.0;
     sc->physics_hz = 50.0;
@@ -239,7 +239,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
 }
 
 /// radio: the radio model, and radio.receiver.heartbeat (the controller's receiver
-/// reports, issue 10), which belongs to the run rather than to the radio model.
+/// reports), which belongs to the run rather than to the radio model.
 static int parse_radio(pctx_t *p, yaml_node_t *r, hs_radio_cfg_t *c, bool *heartbeat)
 {
     static const char *const top[] = {"pathloss", "walls", "shadowing", "fading", "noise",
@@ -387,14 +387,9 @@ static int parse_faults(pctx_t *p, yaml_node_t *n, hs_scenario_t *sc)
     return 0;
 }
 
-static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
+/* map: the map_server YAML's path, relative to the scenario's folder unless absolute. */
+static int parse_map_path(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
 {
-    static const char *const top[] = {"map", "seed", "model", "target", "strategy", "sources",
-                                      "start", "localisation", "radio", "motor", "stop", "sim",
-                                      "faults", "seek", NULL};
-    if (check_keys(p, root, "scenario", top) != 0) {
-        return -1;
-    }
     yaml_node_t *n = get(p, root, "map");
     const char *mp = scalar(n);
     if (!mp || !*mp) {
@@ -410,7 +405,14 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
         }
         snprintf(sc->map_path, sizeof sc->map_path, "%.*s%s", dl, p->file, mp);
     }
-    if ((n = get(p, root, "seed"))) {
+    return 0;
+}
+
+/* seed (optional): a non-negative integer. */
+static int parse_seed(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
+{
+    yaml_node_t *n = get(p, root, "seed");
+    if (n) {
         const char *s = scalar(n);
         char *end;
         errno = 0;
@@ -420,12 +422,14 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
         }
         sc->seed = v;
     }
-    if (str(p, root, "scenario", "model", sc->model, sizeof sc->model) ||
-        str(p, root, "scenario", "target", sc->target, sizeof sc->target) ||
-        str(p, root, "scenario", "strategy", sc->strategy, sizeof sc->strategy)) {
-        return -1;
-    }
-    if ((n = get(p, root, "seek"))) {
+    return 0;
+}
+
+/* seek (optional): the strategy's settings. */
+static int parse_seek(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
+{
+    yaml_node_t *n = get(p, root, "seek");
+    if (n) {
         static const char *const k[] = {"recheck_m", "eps_by_travel", "eps_rate",
                                         "eps_geodesic", "recheck_adapt", "p0_min_dbm",
                                         "eps_sample", NULL};
@@ -440,6 +444,12 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
             return -1;
         }
     }
+    return 0;
+}
+
+/* The model a known one, the target rssi, bridge or pdr. */
+static int check_model_target(pctx_t *p, yaml_node_t *root, const hs_scenario_t *sc)
+{
     if (!rfs_models_lookup(sc->model)) {
         char names[256] = "";
         size_t used = 0;
@@ -456,7 +466,37 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
         return fail(p, get(p, root, "target"), "target: '%s' is not rssi, bridge or pdr",
                     sc->target);
     }
-    n = get(p, root, "sources");
+    return 0;
+}
+
+/* sources[i]: its defaults, then its keys. */
+static int parse_source(pctx_t *p, yaml_node_t *s, long i, hs_scn_source_t *src)
+{
+    static const char *const k[] = {"name", "position", "mac", "rate_hz", "tx_dbm", NULL};
+    char where[32];
+    snprintf(where, sizeof where, "sources[%ld]", i);
+    snprintf(src->name, sizeof src->name, "src%ld", i);
+    src->rate_hz = 200.0; // paper section 5: about 200 packets/s
+    src->tx_dbm = 20.0;   // a typical 2.4 GHz access point (100 mW)
+    src->mac[0] = 0x02;   // locally administered, unique per index
+    src->mac[5] = (uint8_t)(i + 1);
+    if (check_keys(p, s, where, k) || str(p, s, where, "name", src->name, sizeof src->name) ||
+        xy(p, s, where, "position", true, &src->x, &src->y, NULL) ||
+        num(p, s, where, "rate_hz", 0.1, 10000, &src->rate_hz) ||
+        num(p, s, where, "tx_dbm", -50, 50, &src->tx_dbm)) {
+        return -1;
+    }
+    yaml_node_t *m = get(p, s, "mac");
+    if (m && hs_scenario_parse_mac(scalar(m), src->mac) != 0) {
+        return fail(p, m, "%s.mac: expected aa:bb:cc:dd:ee:ff", where);
+    }
+    return 0;
+}
+
+/* sources: 1 or 2, as many as the target needs. */
+static int parse_sources(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
+{
+    yaml_node_t *n = get(p, root, "sources");
     if (!n || n->type != YAML_SEQUENCE_NODE) {
         return fail(p, n ? n : root, "sources: missing (a list of 1 or 2 sources)");
     }
@@ -467,24 +507,8 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
     sc->nsources = (unsigned)ns;
     for (long i = 0; i < ns; i++) {
         yaml_node_t *s = yaml_document_get_node(&p->doc, n->data.sequence.items.start[i]);
-        static const char *const k[] = {"name", "position", "mac", "rate_hz", "tx_dbm", NULL};
-        char where[32];
-        snprintf(where, sizeof where, "sources[%ld]", i);
-        hs_scn_source_t *src = &sc->src[i];
-        snprintf(src->name, sizeof src->name, "src%ld", i);
-        src->rate_hz = 200.0; // paper section 5: about 200 packets/s
-        src->tx_dbm = 20.0;   // a typical 2.4 GHz access point (100 mW)
-        src->mac[0] = 0x02;   // locally administered, unique per index
-        src->mac[5] = (uint8_t)(i + 1);
-        if (check_keys(p, s, where, k) || str(p, s, where, "name", src->name, sizeof src->name) ||
-            xy(p, s, where, "position", true, &src->x, &src->y, NULL) ||
-            num(p, s, where, "rate_hz", 0.1, 10000, &src->rate_hz) ||
-            num(p, s, where, "tx_dbm", -50, 50, &src->tx_dbm)) {
+        if (parse_source(p, s, i, &sc->src[i]) != 0) {
             return -1;
-        }
-        yaml_node_t *m = get(p, s, "mac");
-        if (m && hs_scenario_parse_mac(scalar(m), src->mac) != 0) {
-            return fail(p, m, "%s.mac: expected aa:bb:cc:dd:ee:ff", where);
         }
     }
     if (strcmp(sc->target, "bridge") == 0 && sc->nsources != 2) {
@@ -493,7 +517,13 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
     if (strcmp(sc->target, "bridge") != 0 && sc->nsources != 1) {
         return fail(p, get(p, root, "target"), "target: %s needs exactly 1 source", sc->target);
     }
-    n = get(p, root, "start");
+    return 0;
+}
+
+/* start (required) and localisation (optional). */
+static int parse_start(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
+{
+    yaml_node_t *n = get(p, root, "start");
     if (!n) {
         return fail(p, root, "start: missing ({position: [x, y], theta: radians})");
     }
@@ -514,10 +544,14 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
             return -1;
         }
     }
-    if ((n = get(p, root, "radio")) && parse_radio(p, n, &sc->radio, &sc->rx_heartbeat) != 0) {
-        return -1;
-    }
-    if ((n = get(p, root, "motor"))) {
+    return 0;
+}
+
+/* motor (optional). */
+static int parse_motor(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
+{
+    yaml_node_t *n = get(p, root, "motor");
+    if (n) {
         static const char *const k[] = {"accel_m_s2", "timeout_ms", "v_max_m_s", "wheel_base_m",
                                         NULL};
         double to_ms = sc->motor.timeout_us / 1000.0;
@@ -530,7 +564,14 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
         }
         sc->motor.timeout_us = (int64_t)llround(to_ms * 1000.0);
     }
-    if ((n = get(p, root, "stop"))) {
+    return 0;
+}
+
+/* stop (optional; a run must end), and the goal: the source's unless given. */
+static int parse_stop(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
+{
+    yaml_node_t *n = get(p, root, "stop");
+    if (n) {
         static const char *const k[] = {"radius_m", "max_distance_m", "max_time_s", "goal", NULL};
         if (check_keys(p, n, "stop", k) || num(p, n, "stop", "radius_m", 0, 1e4, &sc->stop_radius_m) ||
             num(p, n, "stop", "max_distance_m", 0, 1e6, &sc->stop_distance_m) ||
@@ -547,13 +588,48 @@ static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
         sc->goal_x = sc->src[0].x;
         sc->goal_y = sc->src[0].y;
     }
-    if ((n = get(p, root, "sim"))) {
+    return 0;
+}
+
+/* sim (optional). */
+static int parse_sim(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
+{
+    yaml_node_t *n = get(p, root, "sim");
+    if (n) {
         static const char *const k[] = {"physics_hz", "core_res_m", "clearance_m", NULL};
         if (check_keys(p, n, "sim", k) || num(p, n, "sim", "physics_hz", 10, 1000, &sc->physics_hz) ||
             num(p, n, "sim", "core_res_m", 0.02, 1, &sc->core_res_m) ||
             num(p, n, "sim", "clearance_m", 0, 5, &sc->clearance_m)) {
             return -1;
         }
+    }
+    return 0;
+}
+
+static int parse_root(pctx_t *p, yaml_node_t *root, hs_scenario_t *sc)
+{
+    static const char *const top[] = {"map", "seed", "model", "target", "strategy", "sources",
+                                      "start", "localisation", "radio", "motor", "stop", "sim",
+                                      "faults", "seek", NULL};
+    if (check_keys(p, root, "scenario", top) != 0 || parse_map_path(p, root, sc) != 0 ||
+        parse_seed(p, root, sc) != 0) {
+        return -1;
+    }
+    if (str(p, root, "scenario", "model", sc->model, sizeof sc->model) ||
+        str(p, root, "scenario", "target", sc->target, sizeof sc->target) ||
+        str(p, root, "scenario", "strategy", sc->strategy, sizeof sc->strategy)) {
+        return -1;
+    }
+    if (parse_seek(p, root, sc) != 0 || check_model_target(p, root, sc) != 0 ||
+        parse_sources(p, root, sc) != 0 || parse_start(p, root, sc) != 0) {
+        return -1;
+    }
+    yaml_node_t *n;
+    if ((n = get(p, root, "radio")) && parse_radio(p, n, &sc->radio, &sc->rx_heartbeat) != 0) {
+        return -1;
+    }
+    if (parse_motor(p, root, sc) != 0 || parse_stop(p, root, sc) != 0 || parse_sim(p, root, sc) != 0) {
+        return -1;
     }
     if ((n = get(p, root, "faults")) && parse_faults(p, n, sc) != 0) {
         return -1;

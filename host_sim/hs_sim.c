@@ -281,7 +281,7 @@ static int shortest_paths(hs_sim_env_t *e, char *err, size_t errlen)
 {
     const hs_scenario_t *sc = &e->sc;
     const rfs_map_t *cm = &e->core.map;
-    double *dist = malloc(sizeof(double) * cm->w * cm->h);
+    double *dist = calloc((size_t)cm->w * cm->h, sizeof(double)); // all set by legal_dijkstra
     if (!dist) {
         snprintf(err, errlen, "%s: out of memory", sc->path);
         return -1;

@@ -176,6 +176,8 @@ static uint32_t geo_replay(rfs_seek_t *s, rfs_rng_t rng, bool geodesic, rfs_q16_
     bool found;
     rfs_map_lattice_nearest(m, s->pose.x, s->pose.y, &ci, &cj);
     *min_detour = INT64_MAX;
+    *gx = 0; /* no goal when no candidate is left */
+    *gy = 0;
     (void)rfs_rng_u32(&rng);
     for (int attempt = 0; attempt < GEO_TRIES; ++attempt) {
         const uint32_t total = geo_scan(s, ci, cj, UINT32_MAX, &gi, &gj, &q, &found);

@@ -59,6 +59,114 @@ static long parse(const char *s, const char *name, long lo, long hi)
     return v;
 }
 
+/* The next sample position of a walk: i-th of 40 along the current 1 m step from
+ * (*px, *py) to (*tx, *ty), a new step (a random legal direction) every 40 samples. */
+static void walk_point(const rfs_map_t *m, long i, rfs_rng_t *r, double *px, double *py,
+                       double *tx, double *ty, double *x, double *y)
+{
+    if (i % 40 == 0) {
+        /* next 1 m step: a random legal direction */
+        for (int tries = 0; tries < 1000; ++tries) {
+            double a = 6.283185307179586 * (rfs_rng_u32(r) / 4294967296.0);
+            *tx = *px + cos(a);
+            *ty = *py + sin(a);
+            if (rfs_map_segment_legal(m, (rfs_q16_t)lround(*px * 65536.0),
+                                      (rfs_q16_t)lround(*py * 65536.0),
+                                      (rfs_q16_t)lround(*tx * 65536.0),
+                                      (rfs_q16_t)lround(*ty * 65536.0))) {
+                break;
+            }
+            *tx = *px;
+            *ty = *py;
+        }
+    }
+    double t = (i % 40 + 1) / 40.0;
+    *x = *px + (*tx - *px) * t;
+    *y = *py + (*ty - *py) * t;
+    if (i % 40 == 39) {
+        *px = *tx;
+        *py = *ty;
+    }
+}
+
+/* n samples into s: along a walk from (8, 6) m, or at random legal points of the map;
+ * valued by the model with the source at (SX, SY) plus noise (the header comment). */
+static void make_samples(const rfs_map_t *m, bool walk, long n, rfs_rng_t *r, rfs_sample_t *s)
+{
+    double w_m = m->w * (m->res / 65536.0), h_m = m->h * (m->res / 65536.0);
+    rfs_q16_t qsx = (rfs_q16_t)lround(SX * 65536.0), qsy = (rfs_q16_t)lround(SY * 65536.0);
+    double px = 8.0, py = 6.0, tx = px, ty = py;
+    for (long i = 0; i < n;) {
+        double x, y;
+        if (walk) {
+            walk_point(m, i, r, &px, &py, &tx, &ty, &x, &y);
+        } else {
+            x = m->origin_x / 65536.0 + w_m * (rfs_rng_u32(r) / 4294967296.0);
+            y = m->origin_y / 65536.0 + h_m * (rfs_rng_u32(r) / 4294967296.0);
+        }
+        rfs_q16_t qx = (rfs_q16_t)lround(x * 65536.0), qy = (rfs_q16_t)lround(y * 65536.0);
+        if (!walk && !rfs_map_point_legal(m, qx, qy)) {
+            continue;
+        }
+        double d = hypot(x - SX, y - SY);
+        int k = rfs_map_walls_crossed(m, qx, qy, qsx, qsy);
+        double v = -40.0 - 30.0 * log10(d < 1.0 ? 1.0 : d) - 5.0 * k + 4.0 * gauss(r);
+        s[i].x_cm = (int16_t)lround(x * 100.0);
+        s[i].y_cm = (int16_t)lround(y * 100.0);
+        s[i].v_q6 = (int16_t)lround(v * 64.0);
+        ++i;
+    }
+}
+
+/* The fit of the mode, collection on around the measured calls: its result; the fit
+ * calls in *calls. */
+static rfs_fit_result_t fit_mode(const char *mode, rfs_pathloss_t *p, const rfs_model_fit_in_t *in,
+                                 long n, long budget, rfs_rng_t *r, long *calls)
+{
+    rfs_fit_result_t res;
+    *calls = 1;
+    if (strcmp(mode, "slice") == 0) {
+        CALLGRIND_TOGGLE_COLLECT;
+        res = rfs_pathloss_ops.fit(p, in, (uint32_t)budget, r);
+        CALLGRIND_TOGGLE_COLLECT;
+        while (res == RFS_FIT_MORE) {
+            res = rfs_pathloss_ops.fit(p, in, (uint32_t)budget, r);
+            ++*calls;
+        }
+    } else if (strcmp(mode, "pathwarm") == 0) {
+        rfs_model_fit_in_t early = *in;
+        early.n = (uint16_t)(n > 200 ? n - 200 : 1);
+        res = rfs_pathloss_ops.fit(p, &early, 0, r);
+        CALLGRIND_TOGGLE_COLLECT;
+        res = rfs_pathloss_ops.fit(p, in, 0, r);
+        CALLGRIND_TOGGLE_COLLECT;
+    } else if (strcmp(mode, "relearn") == 0 || strcmp(mode, "path") == 0) {
+        CALLGRIND_TOGGLE_COLLECT;
+        res = rfs_pathloss_ops.fit(p, in, 0, r);
+        CALLGRIND_TOGGLE_COLLECT;
+    } else {
+        res = rfs_pathloss_ops.fit(p, in, 0, r);
+    }
+    return res;
+}
+
+/* The fit's figures and estimate on stdout (predict: the prediction at (8, 6) m). */
+static void print_fit(const rfs_pathloss_t *p, const rfs_pathloss_est_t *e, long calls, rfs_q16_t v)
+{
+    uint16_t ncx, ncy;
+    rfs_pathloss_surface_size(p, &ncx, &ncy);
+    printf("calls %ld\n", calls);
+    printf("bins %u\n", e->bins);
+    printf("candidates %u\n", e->candidates);
+    printf("walls_counted %u\n", e->walls_counted);
+    printf("footprints_cached %u\n", e->footprints_cached);
+    printf("coarse %u x %u\n", ncx, ncy);
+    printf("state_bytes %zu\n", sizeof(rfs_pathloss_t));
+    printf("estimate %.3f %.3f n %.3f W %.3f P0 %.3f rms %.3f spread %.1f m2 predict %.3f\n",
+           e->sx / 65536.0, e->sy / 65536.0, e->n / 65536.0, e->w / 65536.0, e->p0 / 65536.0,
+           e->rms / 65536.0, e->spread_m2 / 65536.0, v / 65536.0);
+}
+
 int main(int argc, char **argv)
 {
     if (argc >= 2 && strcmp(argv[1], "--help") == 0) {
@@ -103,81 +211,15 @@ int main(int argc, char **argv)
     }
     rfs_rng_t r;
     rfs_rng_seed(&r, 7);
-    double w_m = m->w * (m->res / 65536.0), h_m = m->h * (m->res / 65536.0);
-    rfs_q16_t qsx = (rfs_q16_t)lround(SX * 65536.0), qsy = (rfs_q16_t)lround(SY * 65536.0);
-    double px = 8.0, py = 6.0, tx = px, ty = py;
-    for (long i = 0; i < n;) {
-        double x, y;
-        if (walk) {
-            if (i % 40 == 0) {
-                /* next 1 m step: a random legal direction */
-                for (int tries = 0; tries < 1000; ++tries) {
-                    double a = 6.283185307179586 * (rfs_rng_u32(&r) / 4294967296.0);
-                    tx = px + cos(a);
-                    ty = py + sin(a);
-                    if (rfs_map_segment_legal(m, (rfs_q16_t)lround(px * 65536.0),
-                                              (rfs_q16_t)lround(py * 65536.0),
-                                              (rfs_q16_t)lround(tx * 65536.0),
-                                              (rfs_q16_t)lround(ty * 65536.0))) {
-                        break;
-                    }
-                    tx = px;
-                    ty = py;
-                }
-            }
-            double t = (i % 40 + 1) / 40.0;
-            x = px + (tx - px) * t;
-            y = py + (ty - py) * t;
-            if (i % 40 == 39) {
-                px = tx;
-                py = ty;
-            }
-        } else {
-            x = m->origin_x / 65536.0 + w_m * (rfs_rng_u32(&r) / 4294967296.0);
-            y = m->origin_y / 65536.0 + h_m * (rfs_rng_u32(&r) / 4294967296.0);
-        }
-        rfs_q16_t qx = (rfs_q16_t)lround(x * 65536.0), qy = (rfs_q16_t)lround(y * 65536.0);
-        if (!walk && !rfs_map_point_legal(m, qx, qy)) {
-            continue;
-        }
-        double d = hypot(x - SX, y - SY);
-        int k = rfs_map_walls_crossed(m, qx, qy, qsx, qsy);
-        double v = -40.0 - 30.0 * log10(d < 1.0 ? 1.0 : d) - 5.0 * k + 4.0 * gauss(&r);
-        s[i].x_cm = (int16_t)lround(x * 100.0);
-        s[i].y_cm = (int16_t)lround(y * 100.0);
-        s[i].v_q6 = (int16_t)lround(v * 64.0);
-        ++i;
-    }
+    make_samples(m, walk, n, &r, s);
     rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
     if (rfs_pathloss_init(p, &c) != 0) {
         fprintf(stderr, "bench_pathloss: default configuration rejected\n");
         return 1;
     }
     rfs_model_fit_in_t in = {s, (uint16_t)n, 0, 0, m};
-    rfs_fit_result_t res;
-    long calls = 1;
-    if (strcmp(mode, "slice") == 0) {
-        CALLGRIND_TOGGLE_COLLECT;
-        res = rfs_pathloss_ops.fit(p, &in, (uint32_t)budget, &r);
-        CALLGRIND_TOGGLE_COLLECT;
-        while (res == RFS_FIT_MORE) {
-            res = rfs_pathloss_ops.fit(p, &in, (uint32_t)budget, &r);
-            ++calls;
-        }
-    } else if (strcmp(mode, "pathwarm") == 0) {
-        rfs_model_fit_in_t early = in;
-        early.n = (uint16_t)(n > 200 ? n - 200 : 1);
-        res = rfs_pathloss_ops.fit(p, &early, 0, &r);
-        CALLGRIND_TOGGLE_COLLECT;
-        res = rfs_pathloss_ops.fit(p, &in, 0, &r);
-        CALLGRIND_TOGGLE_COLLECT;
-    } else if (strcmp(mode, "relearn") == 0 || strcmp(mode, "path") == 0) {
-        CALLGRIND_TOGGLE_COLLECT;
-        res = rfs_pathloss_ops.fit(p, &in, 0, &r);
-        CALLGRIND_TOGGLE_COLLECT;
-    } else {
-        res = rfs_pathloss_ops.fit(p, &in, 0, &r);
-    }
+    long calls;
+    rfs_fit_result_t res = fit_mode(mode, p, &in, n, budget, &r, &calls);
     rfs_q16_t v = 0;
     if (strcmp(mode, "predict") == 0) {
         CALLGRIND_TOGGLE_COLLECT;
@@ -189,18 +231,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_pathloss: fit failed\n");
         return 1;
     }
-    uint16_t ncx, ncy;
-    rfs_pathloss_surface_size(p, &ncx, &ncy);
-    printf("calls %ld\n", calls);
-    printf("bins %u\n", e.bins);
-    printf("candidates %u\n", e.candidates);
-    printf("walls_counted %u\n", e.walls_counted);
-    printf("footprints_cached %u\n", e.footprints_cached);
-    printf("coarse %u x %u\n", ncx, ncy);
-    printf("state_bytes %zu\n", sizeof(rfs_pathloss_t));
-    printf("estimate %.3f %.3f n %.3f W %.3f P0 %.3f rms %.3f spread %.1f m2 predict %.3f\n",
-           e.sx / 65536.0, e.sy / 65536.0, e.n / 65536.0, e.w / 65536.0, e.p0 / 65536.0,
-           e.rms / 65536.0, e.spread_m2 / 65536.0, v / 65536.0);
+    print_fit(p, &e, calls, v);
     free(p);
     free(s);
     lx_core_map_free(&cm);

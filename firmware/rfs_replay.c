@@ -114,6 +114,157 @@ static uint8_t *put_decision(uint8_t *p, const rfs_seek_decision_t *d)
     return wr16(p, d->samples);
 }
 
+/* The record header's length n checked against the type's: NULL, or why it is wrong. */
+static const char *check_length(uint8_t type, uint8_t n)
+{
+    const int want = payload_len(type);
+    if (want == -2) {
+        return "unknown record type";
+    }
+    if (want >= 0 && n != (uint8_t)want) {
+        return "wrong record length for its type";
+    }
+    if (want == -3 && (n < 14u || n > 14u + RFS_REPLAY_MODEL_NAME_MAX)) {
+        return "CFG length out of range";
+    }
+    if (want == -1 && (n < 5u || n > 4u + RFS_REPLAY_CHUNK)) {
+        return "map chunk length out of range";
+    }
+    return NULL;
+}
+
+/* A CFG payload p of n bytes into rec: NULL, or why it is malformed. */
+static const char *get_cfg(const uint8_t *p, uint8_t n, rfs_replay_rec_t *rec)
+{
+    rec->u.cfg.seed = rd64(p);
+    rec->u.cfg.target = p[8];
+    rec->u.cfg.node = p[9];
+    rec->u.cfg.fit_budget = rd32(p + 10);
+    if (rec->u.cfg.target > (uint8_t)RFS_APP_TARGET_BRIDGE) {
+        return "CFG target out of range";
+    }
+    for (uint8_t i = 14u; i < n; i++) {
+        if (p[i] <= 0x20u || p[i] >= 0x7Fu) {
+            return "CFG model name not printable";
+        }
+        rec->u.cfg.model[i - 14u] = (char)p[i];
+    }
+    return NULL;
+}
+
+/* A MAP payload into rec: NULL, or why it is malformed. */
+static const char *get_map(const uint8_t *p, rfs_replay_rec_t *rec)
+{
+    rec->u.map.w = rd16(p);
+    rec->u.map.h = rd16(p + 2);
+    rec->u.map.res = rds32(p + 4);
+    rec->u.map.origin_x = rds32(p + 8);
+    rec->u.map.origin_y = rds32(p + 12);
+    rec->u.map.has_wall = p[16];
+    if (rec->u.map.w == 0u || rec->u.map.h == 0u) {
+        return "MAP size is zero";
+    }
+    if (rec->u.map.res <= 0) {
+        return "MAP resolution not positive";
+    }
+    if (rec->u.map.has_wall > 1u) {
+        return "MAP has_wall not 0 or 1";
+    }
+    return NULL;
+}
+
+/* A CAN or CAN_TX payload into rec: NULL, or why it is malformed. */
+static const char *get_can(const uint8_t *p, rfs_replay_rec_t *rec)
+{
+    rec->t_us = rds64(p);
+    rec->u.can.id = rd32(p + 8);
+    rec->u.can.dlc = p[12];
+    memcpy(rec->u.can.data, p + 13, 8);
+    if (rec->u.can.dlc > 8u) {
+        return "CAN dlc over 8";
+    }
+    if (rec->u.can.id > 0x7FFu) {
+        return "CAN id not 11-bit";
+    }
+    return NULL;
+}
+
+/* An OUT payload into rec: NULL, or why it is malformed. */
+static const char *get_out(const uint8_t *p, rfs_replay_rec_t *rec)
+{
+    rec->t_us = rds64(p);
+    rec->u.out.t_us = rec->t_us;
+    rec->u.out.left_mm_s = (int16_t)rd16(p + 8);
+    rec->u.out.right_mm_s = (int16_t)rd16(p + 10);
+    rec->u.out.state = (rfs_seek_state_t)p[12];
+    rec->u.out.faults = rd16(p + 13);
+    rec->u.out.decided = p[15] != 0u;
+    if (p[12] > (uint8_t)RFS_SEEK_DRIVING || p[15] > 1u) {
+        return "OUT state or decided out of range";
+    }
+    return NULL;
+}
+
+/* The payload p (n bytes, its length checked) of a record of this type into rec: NULL,
+ * or why it is malformed. */
+static const char *get_payload(uint8_t type, const uint8_t *p, uint8_t n, rfs_replay_rec_t *rec)
+{
+    switch (type) {
+    case RFS_REPLAY_CFG:
+        return get_cfg(p, n, rec);
+    case RFS_REPLAY_MAP:
+        return get_map(p, rec);
+    case RFS_REPLAY_MAP_FREE:
+    case RFS_REPLAY_MAP_WALL:
+        rec->u.chunk.offset = rd32(p);
+        rec->u.chunk.n = (uint8_t)(n - 4u);
+        memcpy(rec->u.chunk.bytes, p + 4, rec->u.chunk.n);
+        return NULL;
+    case RFS_REPLAY_POSE:
+        rec->t_us = rds64(p);
+        rec->u.pose.t_us = rds64(p + 8);
+        rec->u.pose.x = rds32(p + 16);
+        rec->u.pose.y = rds32(p + 20);
+        rec->u.pose.theta = rds32(p + 24);
+        return NULL;
+    case RFS_REPLAY_RSSI:
+        rec->t_us = rds64(p);
+        rec->u.rssi.t_us = rds64(p + 8);
+        rec->u.rssi.src = p[16];
+        rec->u.rssi.dbm = (int8_t)p[17];
+        return NULL;
+    case RFS_REPLAY_RECEIVER:
+        rec->t_us = rds64(p);
+        rec->u.receiver_t_us = rds64(p + 8);
+        return NULL;
+    case RFS_REPLAY_CAN:
+    case RFS_REPLAY_CAN_TX:
+        return get_can(p, rec);
+    case RFS_REPLAY_STEP:
+    case RFS_REPLAY_RESET:
+        rec->t_us = rds64(p);
+        return NULL;
+    case RFS_REPLAY_BUS:
+        rec->t_us = rds64(p);
+        rec->u.bus_off = p[8];
+        return p[8] > 1u ? "BUS state not 0 or 1" : NULL;
+    case RFS_REPLAY_END:
+        return NULL;
+    case RFS_REPLAY_OUT:
+        return get_out(p, rec);
+    case RFS_REPLAY_DECISION:
+        get_decision(p, &rec->u.out.decision);
+        rec->t_us = rec->u.out.decision.t_us;
+        if (p[12] > (uint8_t)RFS_SEEK_EPSILON || p[13] > 15u ||
+            p[14] > (uint8_t)RFS_DRIVE_BLOCKED) {
+            return "DECISION kind, flags or previous status out of range";
+        }
+        return NULL;
+    default:
+        return "unknown record type";
+    }
+}
+
 rfs_replay_status_t rfs_replay_parse(const uint8_t *buf, uint32_t len, uint32_t *used,
                                      rfs_replay_rec_t *rec)
 {
@@ -123,128 +274,17 @@ rfs_replay_status_t rfs_replay_parse(const uint8_t *buf, uint32_t len, uint32_t 
     }
     const uint8_t type = buf[0];
     const uint8_t n = buf[1];
-    const int want = payload_len(type);
-    if (want == -2) {
-        return bad(rec, "unknown record type");
-    }
-    if (want >= 0 && n != (uint8_t)want) {
-        return bad(rec, "wrong record length for its type");
-    }
-    if (want == -3 && (n < 14u || n > 14u + RFS_REPLAY_MODEL_NAME_MAX)) {
-        return bad(rec, "CFG length out of range");
-    }
-    if (want == -1 && (n < 5u || n > 4u + RFS_REPLAY_CHUNK)) {
-        return bad(rec, "map chunk length out of range");
+    const char *why = check_length(type, n);
+    if (why != NULL) {
+        return bad(rec, why);
     }
     if (len < 2u + (uint32_t)n) {
         return RFS_REPLAY_NEED_MORE;
     }
-    const uint8_t *p = buf + 2;
     rec->type = (rfs_replay_type_t)type;
-    switch (type) {
-    case RFS_REPLAY_CFG:
-        rec->u.cfg.seed = rd64(p);
-        rec->u.cfg.target = p[8];
-        rec->u.cfg.node = p[9];
-        rec->u.cfg.fit_budget = rd32(p + 10);
-        if (rec->u.cfg.target > (uint8_t)RFS_APP_TARGET_BRIDGE) {
-            return bad(rec, "CFG target out of range");
-        }
-        for (uint8_t i = 14u; i < n; i++) {
-            if (p[i] <= 0x20u || p[i] >= 0x7Fu) {
-                return bad(rec, "CFG model name not printable");
-            }
-            rec->u.cfg.model[i - 14u] = (char)p[i];
-        }
-        break;
-    case RFS_REPLAY_MAP:
-        rec->u.map.w = rd16(p);
-        rec->u.map.h = rd16(p + 2);
-        rec->u.map.res = rds32(p + 4);
-        rec->u.map.origin_x = rds32(p + 8);
-        rec->u.map.origin_y = rds32(p + 12);
-        rec->u.map.has_wall = p[16];
-        if (rec->u.map.w == 0u || rec->u.map.h == 0u) {
-            return bad(rec, "MAP size is zero");
-        }
-        if (rec->u.map.res <= 0) {
-            return bad(rec, "MAP resolution not positive");
-        }
-        if (rec->u.map.has_wall > 1u) {
-            return bad(rec, "MAP has_wall not 0 or 1");
-        }
-        break;
-    case RFS_REPLAY_MAP_FREE:
-    case RFS_REPLAY_MAP_WALL:
-        rec->u.chunk.offset = rd32(p);
-        rec->u.chunk.n = (uint8_t)(n - 4u);
-        memcpy(rec->u.chunk.bytes, p + 4, rec->u.chunk.n);
-        break;
-    case RFS_REPLAY_POSE:
-        rec->t_us = rds64(p);
-        rec->u.pose.t_us = rds64(p + 8);
-        rec->u.pose.x = rds32(p + 16);
-        rec->u.pose.y = rds32(p + 20);
-        rec->u.pose.theta = rds32(p + 24);
-        break;
-    case RFS_REPLAY_RSSI:
-        rec->t_us = rds64(p);
-        rec->u.rssi.t_us = rds64(p + 8);
-        rec->u.rssi.src = p[16];
-        rec->u.rssi.dbm = (int8_t)p[17];
-        break;
-    case RFS_REPLAY_RECEIVER:
-        rec->t_us = rds64(p);
-        rec->u.receiver_t_us = rds64(p + 8);
-        break;
-    case RFS_REPLAY_CAN:
-    case RFS_REPLAY_CAN_TX:
-        rec->t_us = rds64(p);
-        rec->u.can.id = rd32(p + 8);
-        rec->u.can.dlc = p[12];
-        memcpy(rec->u.can.data, p + 13, 8);
-        if (rec->u.can.dlc > 8u) {
-            return bad(rec, "CAN dlc over 8");
-        }
-        if (rec->u.can.id > 0x7FFu) {
-            return bad(rec, "CAN id not 11-bit");
-        }
-        break;
-    case RFS_REPLAY_STEP:
-    case RFS_REPLAY_RESET:
-        rec->t_us = rds64(p);
-        break;
-    case RFS_REPLAY_BUS:
-        rec->t_us = rds64(p);
-        rec->u.bus_off = p[8];
-        if (p[8] > 1u) {
-            return bad(rec, "BUS state not 0 or 1");
-        }
-        break;
-    case RFS_REPLAY_END:
-        break;
-    case RFS_REPLAY_OUT:
-        rec->t_us = rds64(p);
-        rec->u.out.t_us = rec->t_us;
-        rec->u.out.left_mm_s = (int16_t)rd16(p + 8);
-        rec->u.out.right_mm_s = (int16_t)rd16(p + 10);
-        rec->u.out.state = (rfs_seek_state_t)p[12];
-        rec->u.out.faults = rd16(p + 13);
-        rec->u.out.decided = p[15] != 0u;
-        if (p[12] > (uint8_t)RFS_SEEK_DRIVING || p[15] > 1u) {
-            return bad(rec, "OUT state or decided out of range");
-        }
-        break;
-    case RFS_REPLAY_DECISION:
-        get_decision(p, &rec->u.out.decision);
-        rec->t_us = rec->u.out.decision.t_us;
-        if (p[12] > (uint8_t)RFS_SEEK_EPSILON || p[13] > 15u ||
-            p[14] > (uint8_t)RFS_DRIVE_BLOCKED) {
-            return bad(rec, "DECISION kind, flags or previous status out of range");
-        }
-        break;
-    default:
-        return bad(rec, "unknown record type");
+    why = get_payload(type, buf + 2, n, rec);
+    if (why != NULL) {
+        return bad(rec, why);
     }
     *used = 2u + n;
     return RFS_REPLAY_OK;

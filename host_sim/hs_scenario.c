@@ -369,14 +369,9 @@ static int parse_faults(pctx_t *p, const lx_yaml_node_t *n, hs_scenario_t *sc)
     return 0;
 }
 
-static int parse_root(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
+/* map: the map_server YAML's path, relative to the scenario's folder unless absolute. */
+static int parse_map_path(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
 {
-    static const char *const top[] = {"map", "seed", "model", "target", "strategy", "sources",
-                                      "start", "localisation", "radio", "motor", "stop", "sim",
-                                      "faults", "seek", NULL};
-    if (check_keys(p, root, "scenario", top) != 0) {
-        return -1;
-    }
     const lx_yaml_node_t *n = lx_yaml_get(root, "map");
     const char *mp = lx_yaml_scalar(n);
     if (!mp || !*mp) {
@@ -392,7 +387,14 @@ static int parse_root(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
         }
         snprintf(sc->map_path, sizeof sc->map_path, "%.*s%s", dl, p->file, mp);
     }
-    if ((n = lx_yaml_get(root, "seed"))) {
+    return 0;
+}
+
+/* seed (optional): a non-negative integer. */
+static int parse_seed(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
+{
+    const lx_yaml_node_t *n = lx_yaml_get(root, "seed");
+    if (n) {
         const char *s = lx_yaml_scalar(n);
         char *end;
         errno = 0;
@@ -402,12 +404,14 @@ static int parse_root(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
         }
         sc->seed = v;
     }
-    if (str(p, root, "scenario", "model", sc->model, sizeof sc->model) ||
-        str(p, root, "scenario", "target", sc->target, sizeof sc->target) ||
-        str(p, root, "scenario", "strategy", sc->strategy, sizeof sc->strategy)) {
-        return -1;
-    }
-    if ((n = lx_yaml_get(root, "seek"))) {
+    return 0;
+}
+
+/* seek (optional): the strategy's settings. */
+static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
+{
+    const lx_yaml_node_t *n = lx_yaml_get(root, "seek");
+    if (n) {
         static const char *const k[] = {"recheck_m", "eps_by_travel", "eps_rate",
                                         "eps_geodesic", "recheck_adapt", "p0_min_dbm",
                                         "eps_sample", NULL};
@@ -422,6 +426,12 @@ static int parse_root(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             return -1;
         }
     }
+    return 0;
+}
+
+/* The model a known one, the target rssi, bridge or pdr. */
+static int check_model_target(pctx_t *p, const lx_yaml_node_t *root, const hs_scenario_t *sc)
+{
     if (!rfs_models_lookup(sc->model)) {
         char names[256] = "";
         size_t used = 0;
@@ -438,7 +448,37 @@ static int parse_root(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
         return fail(p, lx_yaml_get(root, "target"), "target: '%s' is not rssi, bridge or pdr",
                     sc->target);
     }
-    n = lx_yaml_get(root, "sources");
+    return 0;
+}
+
+/* sources[i]: its defaults, then its keys. */
+static int parse_source(pctx_t *p, const lx_yaml_node_t *s, long i, hs_scn_source_t *src)
+{
+    static const char *const k[] = {"name", "position", "mac", "rate_hz", "tx_dbm", NULL};
+    char where[32];
+    snprintf(where, sizeof where, "sources[%ld]", i);
+    snprintf(src->name, sizeof src->name, "src%ld", i);
+    src->rate_hz = 200.0; // paper section 5: about 200 packets/s
+    src->tx_dbm = 20.0;   // a typical 2.4 GHz access point (100 mW)
+    src->mac[0] = 0x02;   // locally administered, unique per index
+    src->mac[5] = (uint8_t)(i + 1);
+    if (check_keys(p, s, where, k) || str(p, s, where, "name", src->name, sizeof src->name) ||
+        xy(p, s, where, "position", true, &src->x, &src->y, NULL) ||
+        num(p, s, where, "rate_hz", 0.1, 10000, &src->rate_hz) ||
+        num(p, s, where, "tx_dbm", -50, 50, &src->tx_dbm)) {
+        return -1;
+    }
+    const lx_yaml_node_t *m = lx_yaml_get(s, "mac");
+    if (m && hs_scenario_parse_mac(lx_yaml_scalar(m), src->mac) != 0) {
+        return fail(p, m, "%s.mac: expected aa:bb:cc:dd:ee:ff", where);
+    }
+    return 0;
+}
+
+/* sources: 1 or 2, as many as the target needs. */
+static int parse_sources(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
+{
+    const lx_yaml_node_t *n = lx_yaml_get(root, "sources");
     if (!n || n->kind != LX_YAML_SEQUENCE) {
         return fail(p, n ? n : root, "sources: missing (a list of 1 or 2 sources)");
     }
@@ -449,24 +489,8 @@ static int parse_root(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
     sc->nsources = (unsigned)ns;
     for (long i = 0; i < ns; i++) {
         const lx_yaml_node_t *s = n->child[i];
-        static const char *const k[] = {"name", "position", "mac", "rate_hz", "tx_dbm", NULL};
-        char where[32];
-        snprintf(where, sizeof where, "sources[%ld]", i);
-        hs_scn_source_t *src = &sc->src[i];
-        snprintf(src->name, sizeof src->name, "src%ld", i);
-        src->rate_hz = 200.0; // paper section 5: about 200 packets/s
-        src->tx_dbm = 20.0;   // a typical 2.4 GHz access point (100 mW)
-        src->mac[0] = 0x02;   // locally administered, unique per index
-        src->mac[5] = (uint8_t)(i + 1);
-        if (check_keys(p, s, where, k) || str(p, s, where, "name", src->name, sizeof src->name) ||
-            xy(p, s, where, "position", true, &src->x, &src->y, NULL) ||
-            num(p, s, where, "rate_hz", 0.1, 10000, &src->rate_hz) ||
-            num(p, s, where, "tx_dbm", -50, 50, &src->tx_dbm)) {
+        if (parse_source(p, s, i, &sc->src[i]) != 0) {
             return -1;
-        }
-        const lx_yaml_node_t *m = lx_yaml_get(s, "mac");
-        if (m && hs_scenario_parse_mac(lx_yaml_scalar(m), src->mac) != 0) {
-            return fail(p, m, "%s.mac: expected aa:bb:cc:dd:ee:ff", where);
         }
     }
     if (strcmp(sc->target, "bridge") == 0 && sc->nsources != 2) {
@@ -475,7 +499,13 @@ static int parse_root(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
     if (strcmp(sc->target, "bridge") != 0 && sc->nsources != 1) {
         return fail(p, lx_yaml_get(root, "target"), "target: %s needs exactly 1 source", sc->target);
     }
-    n = lx_yaml_get(root, "start");
+    return 0;
+}
+
+/* start (required) and localisation (optional). */
+static int parse_start(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
+{
+    const lx_yaml_node_t *n = lx_yaml_get(root, "start");
     if (!n) {
         return fail(p, root, "start: missing ({position: [x, y], theta: radians})");
     }
@@ -496,10 +526,14 @@ static int parse_root(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             return -1;
         }
     }
-    if ((n = lx_yaml_get(root, "radio")) && parse_radio(p, n, &sc->radio, &sc->rx_heartbeat) != 0) {
-        return -1;
-    }
-    if ((n = lx_yaml_get(root, "motor"))) {
+    return 0;
+}
+
+/* motor (optional). */
+static int parse_motor(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
+{
+    const lx_yaml_node_t *n = lx_yaml_get(root, "motor");
+    if (n) {
         static const char *const k[] = {"accel_m_s2", "timeout_ms", "v_max_m_s", "wheel_base_m",
                                         NULL};
         double to_ms = sc->motor.timeout_us / 1000.0;
@@ -512,7 +546,14 @@ static int parse_root(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
         }
         sc->motor.timeout_us = (int64_t)llround(to_ms * 1000.0);
     }
-    if ((n = lx_yaml_get(root, "stop"))) {
+    return 0;
+}
+
+/* stop (optional; a run must end), and the goal: the source's unless given. */
+static int parse_stop(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
+{
+    const lx_yaml_node_t *n = lx_yaml_get(root, "stop");
+    if (n) {
         static const char *const k[] = {"radius_m", "max_distance_m", "max_time_s", "goal", NULL};
         if (check_keys(p, n, "stop", k) || num(p, n, "stop", "radius_m", 0, 1e4, &sc->stop_radius_m) ||
             num(p, n, "stop", "max_distance_m", 0, 1e6, &sc->stop_distance_m) ||
@@ -529,13 +570,48 @@ static int parse_root(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
         sc->goal_x = sc->src[0].x;
         sc->goal_y = sc->src[0].y;
     }
-    if ((n = lx_yaml_get(root, "sim"))) {
+    return 0;
+}
+
+/* sim (optional). */
+static int parse_sim(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
+{
+    const lx_yaml_node_t *n = lx_yaml_get(root, "sim");
+    if (n) {
         static const char *const k[] = {"physics_hz", "core_res_m", "clearance_m", NULL};
         if (check_keys(p, n, "sim", k) || num(p, n, "sim", "physics_hz", 10, 1000, &sc->physics_hz) ||
             num(p, n, "sim", "core_res_m", 0.02, 1, &sc->core_res_m) ||
             num(p, n, "sim", "clearance_m", 0, 5, &sc->clearance_m)) {
             return -1;
         }
+    }
+    return 0;
+}
+
+static int parse_root(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
+{
+    static const char *const top[] = {"map", "seed", "model", "target", "strategy", "sources",
+                                      "start", "localisation", "radio", "motor", "stop", "sim",
+                                      "faults", "seek", NULL};
+    if (check_keys(p, root, "scenario", top) != 0 || parse_map_path(p, root, sc) != 0 ||
+        parse_seed(p, root, sc) != 0) {
+        return -1;
+    }
+    if (str(p, root, "scenario", "model", sc->model, sizeof sc->model) ||
+        str(p, root, "scenario", "target", sc->target, sizeof sc->target) ||
+        str(p, root, "scenario", "strategy", sc->strategy, sizeof sc->strategy)) {
+        return -1;
+    }
+    if (parse_seek(p, root, sc) != 0 || check_model_target(p, root, sc) != 0 ||
+        parse_sources(p, root, sc) != 0 || parse_start(p, root, sc) != 0) {
+        return -1;
+    }
+    const lx_yaml_node_t *n;
+    if ((n = lx_yaml_get(root, "radio")) && parse_radio(p, n, &sc->radio, &sc->rx_heartbeat) != 0) {
+        return -1;
+    }
+    if (parse_motor(p, root, sc) != 0 || parse_stop(p, root, sc) != 0 || parse_sim(p, root, sc) != 0) {
+        return -1;
     }
     if ((n = lx_yaml_get(root, "faults")) && parse_faults(p, n, sc) != 0) {
         return -1;

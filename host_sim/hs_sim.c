@@ -208,6 +208,148 @@ static int check_point(const hs_sim_env_t *e, const char *field, double x, doubl
     return 0;
 }
 
+/* The scenario's positions: sources, start and one-shot faults on free cells, the start
+ * legal for the core (clearance). 0, or -1 with err set. */
+static int check_positions(const hs_sim_env_t *e, char *err, size_t errlen)
+{
+    const hs_scenario_t *sc = &e->sc;
+    for (unsigned s = 0; s < sc->nsources; s++) {
+        char f[48];
+        snprintf(f, sizeof f, "sources[%u].position", s);
+        if (check_point(e, f, sc->src[s].x, sc->src[s].y, err, errlen) != 0) {
+            return -1;
+        }
+    }
+    if (check_point(e, "start.position", sc->start_x, sc->start_y, err, errlen) != 0) {
+        return -1;
+    }
+    for (unsigned i = 0; i < sc->faults.n; i++) {
+        char f[48];
+        snprintf(f, sizeof f, "faults[%u].position", i);
+        if (hs_faults_one_shot(sc->faults.f[i].kind) &&
+            check_point(e, f, sc->faults.f[i].x, sc->faults.f[i].y, err, errlen) != 0) {
+            return -1;
+        }
+    }
+    rfs_q16_t qx = (rfs_q16_t)lround(sc->start_x * 65536.0);
+    rfs_q16_t qy = (rfs_q16_t)lround(sc->start_y * 65536.0);
+    if (!rfs_map_point_legal(&e->core.map, qx, qy)) {
+        snprintf(err, errlen,
+                 "%s: start.position: (%.2f, %.2f) is closer than the clearance (%.2f m) to a "
+                 "wall or unknown cell",
+                 sc->path, sc->start_x, sc->start_y, sc->clearance_m);
+        return -1;
+    }
+    return 0;
+}
+
+/* Over the legal cells' distances from the start (dist, metres): the distance to the goal
+ * of the nearest reachable cell (*best_gd) and the path to it (*best_path), and the
+ * shortest path into the stop radius (*stop_path; INFINITY: none). */
+static void goal_paths(const hs_sim_env_t *e, const double *dist, double *best_gd,
+                       double *best_path, double *stop_path)
+{
+    const hs_scenario_t *sc = &e->sc;
+    const rfs_map_t *cm = &e->core.map;
+    double res = cm->res / 65536.0;
+    *best_gd = INFINITY;
+    *best_path = INFINITY;
+    *stop_path = INFINITY;
+    for (long y = 0; y < cm->h; y++) {
+        for (long x = 0; x < cm->w; x++) {
+            double d = dist[(size_t)y * cm->w + x];
+            if (!isfinite(d)) {
+                continue;
+            }
+            double gx = e->x0 + (x + 0.5) * res - sc->goal_x;
+            double gy = e->y0 + (y + 0.5) * res - sc->goal_y;
+            double gd = sqrt(gx * gx + gy * gy);
+            if (gd < *best_gd - 1e-9 || (fabs(gd - *best_gd) <= 1e-9 && d < *best_path)) {
+                *best_gd = gd;
+                *best_path = d;
+            }
+            if (gd <= sc->stop_radius_m && d < *stop_path) {
+                *stop_path = d;
+            }
+        }
+    }
+}
+
+/* The shortest paths from the start to the goal and into the stop radius, checked to
+ * exist for the cells and for the controller's lattice. 0, or -1 with err set. */
+static int shortest_paths(hs_sim_env_t *e, char *err, size_t errlen)
+{
+    const hs_scenario_t *sc = &e->sc;
+    const rfs_map_t *cm = &e->core.map;
+    double *dist = calloc((size_t)cm->w * cm->h, sizeof(double)); // all set by legal_dijkstra
+    if (!dist) {
+        snprintf(err, errlen, "%s: out of memory", sc->path);
+        return -1;
+    }
+    double res = cm->res / 65536.0;
+    long sx = (long)((sc->start_x - e->x0) / res), sy = (long)((sc->start_y - e->y0) / res);
+    if (legal_dijkstra(cm, sx, sy, dist) != 0) {
+        free(dist);
+        snprintf(err, errlen, "%s: out of memory", sc->path);
+        return -1;
+    }
+    // Nearest reachable cell to the goal, and the shortest path into the stop radius.
+    double best_gd, best_path, stop_path;
+    goal_paths(e, dist, &best_gd, &best_path, &stop_path);
+    free(dist);
+    if (!isfinite(stop_path)) {
+        snprintf(err, errlen,
+                 "%s: stop.radius_m: the robot can never get within %.2f m of the goal "
+                 "(%.2f, %.2f): the nearest point it can reach is %.2f m away",
+                 sc->path, sc->stop_radius_m, sc->goal_x, sc->goal_y, best_gd);
+        return -1;
+    }
+    int lr = lattice_reaches(cm, sc->start_x, sc->start_y, sc->goal_x, sc->goal_y,
+                             sc->stop_radius_m);
+    if (lr <= 0) {
+        if (lr < 0) {
+            snprintf(err, errlen, "%s: out of memory", sc->path);
+        } else {
+            snprintf(err, errlen,
+                     "%s: stop.radius_m: the controller's planner (0.25 m lattice) cannot get "
+                     "within %.2f m of the goal (%.2f, %.2f): a door on the way is too narrow "
+                     "for the clearance on the core grid",
+                     sc->path, sc->stop_radius_m, sc->goal_x, sc->goal_y);
+        }
+        return -1;
+    }
+    e->shortest_path_m = best_path;
+    e->shortest_to_stop_m = stop_path;
+    return 0;
+}
+
+/* Everything after the map: positions, wall-count caches, shortest paths. 0, or -1 with
+ * err set. */
+static int env_prepare(hs_sim_env_t *e, char *err, size_t errlen)
+{
+    const hs_scenario_t *sc = &e->sc;
+    if (check_positions(e, err, errlen) != 0) {
+        return -1;
+    }
+    // Wall counts depend on the geometry only, not on the seed: one cache for all runs.
+    size_t wcb = hs_radio_wall_cache_bytes(&sc->radio, e->x0, e->y0, e->x1, e->y1);
+    for (unsigned s = 0; s < sc->nsources; s++) {
+        e->wall_cache[s] = malloc(wcb);
+        if (!e->wall_cache[s]) {
+            snprintf(err, errlen, "%s: out of memory", sc->path);
+            return -1;
+        }
+        memset(e->wall_cache[s], -1, wcb);
+    }
+    e->shortest_path_m = NAN;
+    e->shortest_to_stop_m = NAN;
+    bool has_goal = sc->has_goal || sc->nsources == 1;
+    if (has_goal && sc->stop_radius_m > 0.0) {
+        return shortest_paths(e, err, errlen);
+    }
+    return 0;
+}
+
 int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t errlen)
 {
     memset(e, 0, sizeof *e);
@@ -228,113 +370,9 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
         hs_sim_env_close(e);
         return -1;
     }
-    for (unsigned s = 0; s < sc->nsources; s++) {
-        char f[48];
-        snprintf(f, sizeof f, "sources[%u].position", s);
-        if (check_point(e, f, sc->src[s].x, sc->src[s].y, err, errlen) != 0) {
-            hs_sim_env_close(e);
-            return -1;
-        }
-    }
-    if (check_point(e, "start.position", sc->start_x, sc->start_y, err, errlen) != 0) {
+    if (env_prepare(e, err, errlen) != 0) {
         hs_sim_env_close(e);
         return -1;
-    }
-    for (unsigned i = 0; i < sc->faults.n; i++) {
-        char f[48];
-        snprintf(f, sizeof f, "faults[%u].position", i);
-        if (hs_faults_one_shot(sc->faults.f[i].kind) &&
-            check_point(e, f, sc->faults.f[i].x, sc->faults.f[i].y, err, errlen) != 0) {
-            hs_sim_env_close(e);
-            return -1;
-        }
-    }
-    const rfs_map_t *cm = &e->core.map;
-    rfs_q16_t qx = (rfs_q16_t)lround(sc->start_x * 65536.0);
-    rfs_q16_t qy = (rfs_q16_t)lround(sc->start_y * 65536.0);
-    if (!rfs_map_point_legal(cm, qx, qy)) {
-        snprintf(err, errlen,
-                 "%s: start.position: (%.2f, %.2f) is closer than the clearance (%.2f m) to a "
-                 "wall or unknown cell",
-                 sc->path, sc->start_x, sc->start_y, sc->clearance_m);
-        hs_sim_env_close(e);
-        return -1;
-    }
-    // Wall counts depend on the geometry only, not on the seed: one cache for all runs.
-    size_t wcb = hs_radio_wall_cache_bytes(&sc->radio, e->x0, e->y0, e->x1, e->y1);
-    for (unsigned s = 0; s < sc->nsources; s++) {
-        e->wall_cache[s] = malloc(wcb);
-        if (!e->wall_cache[s]) {
-            snprintf(err, errlen, "%s: out of memory", sc->path);
-            hs_sim_env_close(e);
-            return -1;
-        }
-        memset(e->wall_cache[s], -1, wcb);
-    }
-    e->shortest_path_m = NAN;
-    e->shortest_to_stop_m = NAN;
-    bool has_goal = sc->has_goal || sc->nsources == 1;
-    if (has_goal && sc->stop_radius_m > 0.0) {
-        double *dist = malloc(sizeof(double) * cm->w * cm->h);
-        if (!dist) {
-            snprintf(err, errlen, "%s: out of memory", sc->path);
-            hs_sim_env_close(e);
-            return -1;
-        }
-        double res = cm->res / 65536.0;
-        long sx = (long)((sc->start_x - e->x0) / res), sy = (long)((sc->start_y - e->y0) / res);
-        if (legal_dijkstra(cm, sx, sy, dist) != 0) {
-            free(dist);
-            snprintf(err, errlen, "%s: out of memory", sc->path);
-            hs_sim_env_close(e);
-            return -1;
-        }
-        // Nearest reachable cell to the goal, and the shortest path into the stop radius.
-        double best_gd = INFINITY, best_path = INFINITY, stop_path = INFINITY;
-        for (long y = 0; y < cm->h; y++) {
-            for (long x = 0; x < cm->w; x++) {
-                double d = dist[(size_t)y * cm->w + x];
-                if (!isfinite(d)) {
-                    continue;
-                }
-                double gx = e->x0 + (x + 0.5) * res - sc->goal_x;
-                double gy = e->y0 + (y + 0.5) * res - sc->goal_y;
-                double gd = sqrt(gx * gx + gy * gy);
-                if (gd < best_gd - 1e-9 || (fabs(gd - best_gd) <= 1e-9 && d < best_path)) {
-                    best_gd = gd;
-                    best_path = d;
-                }
-                if (gd <= sc->stop_radius_m && d < stop_path) {
-                    stop_path = d;
-                }
-            }
-        }
-        free(dist);
-        if (!isfinite(stop_path)) {
-            snprintf(err, errlen,
-                     "%s: stop.radius_m: the robot can never get within %.2f m of the goal "
-                     "(%.2f, %.2f): the nearest point it can reach is %.2f m away",
-                     sc->path, sc->stop_radius_m, sc->goal_x, sc->goal_y, best_gd);
-            hs_sim_env_close(e);
-            return -1;
-        }
-        int lr = lattice_reaches(cm, sc->start_x, sc->start_y, sc->goal_x, sc->goal_y,
-                                 sc->stop_radius_m);
-        if (lr <= 0) {
-            if (lr < 0) {
-                snprintf(err, errlen, "%s: out of memory", sc->path);
-            } else {
-                snprintf(err, errlen,
-                         "%s: stop.radius_m: the controller's planner (0.25 m lattice) cannot get "
-                         "within %.2f m of the goal (%.2f, %.2f): a door on the way is too narrow "
-                         "for the clearance on the core grid",
-                         sc->path, sc->stop_radius_m, sc->goal_x, sc->goal_y);
-            }
-            hs_sim_env_close(e);
-            return -1;
-        }
-        e->shortest_path_m = best_path;
-        e->shortest_to_stop_m = stop_path;
     }
     return 0;
 }
@@ -362,7 +400,7 @@ static const char *kind_name(rfs_seek_kind_t k)
     case RFS_SEEK_INITIAL: return "initial";
     case RFS_SEEK_GREEDY: return "greedy";
     case RFS_SEEK_EPSILON: return "epsilon";
-    default: return rfs_seek_kind_name(k); // baseline strategies (issue 7)
+    default: return rfs_seek_kind_name(k); // baseline strategies (docs/STRATEGIES.md)
     }
 }
 
@@ -414,10 +452,8 @@ static double cpu_s(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
-enum { EV_PACKET = 0, EV_POSE = 1, EV_CTRL = 2 };
-
-/// The path-loss model's estimate (issue 10), when the controller's model is "pathloss"
-/// and has one.
+/// The path-loss model's estimate (docs/PATHLOSS.md, "Uncertainty"), when the controller's
+/// model is "pathloss" and has one.
 static bool pathloss_estimate(const hs_ctrl_t *ctrl, rfs_pathloss_est_t *est)
 {
     const rfs_pathloss_t *pl = ctrl->pathloss ? ctrl->pathloss(ctrl->self) : NULL;
@@ -509,77 +545,123 @@ static hs_radio_t *world_radio_open(const hs_sim_env_t *e, uint64_t seed, bool p
     return radio;
 }
 
-int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_sim_io_t *io,
-               hs_sim_result_t *res, char *err, size_t errlen)
-{
-    const hs_scenario_t *sc = &e->sc;
-    double t_wall0 = now_s(), t_cpu0 = cpu_s();
-    memset(res, 0, sizeof *res);
-    res->seed = seed;
-    char werr[256];
-    hs_radio_src_t rs[HS_SCN_MAX_SOURCES];
+/* One run of hs_sim_run: the world, its radio, the motor and the fault injection, the
+ * event clocks, and where the robot is. */
+typedef struct sim_run {
+    const hs_sim_env_t *e;
+    const hs_scenario_t *sc;
+    uint64_t seed;
+    hs_ctrl_t *ctrl;
+    const hs_sim_io_t *io;
+    hs_sim_result_t *res;
+    hs_radio_src_t rs[HS_SCN_MAX_SOURCES]; /* the radio's sources (a fault may move one) */
     hs_box2d_t *world;
-    hs_radio_t *radio = world_radio_open(e, seed, true, rs, &world, err, errlen);
-    if (!radio) {
+    hs_radio_t *radio;
+    hs_motor_t motor;
+    rfs_rng_t rng_pkt, rng_pose; /* independent streams: packets (loss and noise), localisation noise */
+    hs_faults_run_t fr;
+    hs_faults_msg_t fm[2];
+    double goal_x, goal_y;       /* a moved source takes its goal along */
+    rfs_pdr_t *pdr;              /* target "pdr": one counter per source, else NULL */
+    int64_t dt_us;               /* physics tick */
+    double dt_s;
+    double pose_period_us;
+    double pkt_period_us[HS_SCN_MAX_SOURCES];
+    uint64_t pkt_k[HS_SCN_MAX_SOURCES];
+    double pkt_off_us[HS_SCN_MAX_SOURCES];
+    uint16_t seq[HS_SCN_MAX_SOURCES];
+    uint64_t pose_k, ctrl_k;
+    // Next event times, microseconds: k-th event of a stream at round(offset + k * period)
+    // (no drift), recomputed only when the event is consumed.
+    int64_t next_pkt[HS_SCN_MAX_SOURCES];
+    int64_t next_pose, next_ctrl;
+    int64_t stop_t_us;
+    bool has_goal;
+    double px, py, pth;          /* the robot at t: metres, radians */
+    int64_t t;                   /* microseconds */
+    double travelled;            /* metres */
+} sim_run_t;
+
+/* The robot's motion over one physics tick (t, t1], interpolated for the events in it. */
+typedef struct tick {
+    int64_t t1;
+    double nx, ny, nth; /* the pose at t1 */
+    double seg;         /* distance travelled in the tick */
+    double dth;         /* heading change, wrapped */
+} tick_t;
+
+/* An event at te, a fraction a into the tick: the robot's true position and distance. */
+typedef struct event {
+    int64_t te;
+    double a;
+    double ex, ey, etr;
+} event_t;
+
+enum { EV_PACKET = 0, EV_POSE = 1, EV_CTRL = 2 };
+
+/* Free what run_open made (the radio: the latest, when a source moved). */
+static void run_close(sim_run_t *r)
+{
+    free(r->pdr);
+    hs_radio_destroy(r->radio);
+    hs_box2d_destroy(r->world);
+}
+
+/* Set up a run: 0, or -1 with err set (nothing left open). */
+static int run_open(sim_run_t *r, char *err, size_t errlen)
+{
+    const hs_scenario_t *sc = r->sc;
+    r->radio = world_radio_open(r->e, r->seed, true, r->rs, &r->world, err, errlen);
+    if (!r->radio) {
         return -1;
     }
-    hs_motor_t motor;
-    if (hs_motor_init(&motor, &sc->motor) != 0) {
-        hs_radio_destroy(radio);
-        hs_box2d_destroy(world);
+    if (hs_motor_init(&r->motor, &sc->motor) != 0) {
+        run_close(r);
         snprintf(err, errlen, "%s: motor: parameters must be positive", sc->path);
         return -1;
     }
-    // Independent streams: packets (loss and noise) and localisation noise.
-    rfs_rng_t rng_pkt, rng_pose;
-    rfs_rng_seed(&rng_pkt, seed ^ 0x5A17C0FFEE000001ull);
-    rfs_rng_seed(&rng_pose, seed ^ 0x5A17C0FFEE000002ull);
+    rfs_rng_seed(&r->rng_pkt, r->seed ^ 0x5A17C0FFEE000001ull);
+    rfs_rng_seed(&r->rng_pose, r->seed ^ 0x5A17C0FFEE000002ull);
     // Fault injection (hs_faults.h): inputs, commands and world events pass its hooks.
-    hs_faults_run_t fr;
-    hs_faults_start(&fr, &sc->faults, seed, io ? io->faults : NULL);
-    hs_faults_msg_t fm[2];
-    double goal_x = sc->goal_x, goal_y = sc->goal_y; // a moved source takes its goal along
-
-    const int64_t dt_us = (int64_t)llround(1e6 / sc->physics_hz);
-    const double dt_s = dt_us * 1e-6;
-    const double pose_period_us = 1e6 / sc->pose_rate_hz;
-    double pkt_period_us[HS_SCN_MAX_SOURCES];
-    uint64_t pkt_k[HS_SCN_MAX_SOURCES] = {0};
-    double pkt_off_us[HS_SCN_MAX_SOURCES];
-    uint16_t seq[HS_SCN_MAX_SOURCES] = {0};
+    hs_faults_start(&r->fr, &sc->faults, r->seed, r->io ? r->io->faults : NULL);
+    r->goal_x = sc->goal_x;
+    r->goal_y = sc->goal_y;
+    r->dt_us = (int64_t)llround(1e6 / sc->physics_hz);
+    r->dt_s = r->dt_us * 1e-6;
+    r->pose_period_us = 1e6 / sc->pose_rate_hz;
     // Target "pdr" (rfs_pdr.h): the receiver counts the sequence numbers that arrive and
     // hands the controller rfs_pdr_value() percentages instead of dBm.
-    const bool pdr_target = strcmp(sc->target, "pdr") == 0;
-    rfs_pdr_t *pdr = NULL;
-    if (pdr_target) {
+    if (strcmp(sc->target, "pdr") == 0) {
         rfs_pdr_cfg_t pc = rfs_pdr_cfg_default();
-        pdr = calloc(sc->nsources, sizeof *pdr); // NOLINT(clang-analyzer-optin.portability.UnixAPI): nsources >= 1 (hs_scenario_load)
-        for (unsigned s = 0; pdr && s < sc->nsources; s++) {
-            (void)rfs_pdr_init(&pdr[s], &pc); // the default window is valid
+        r->pdr = calloc(sc->nsources, sizeof *r->pdr); // NOLINT(clang-analyzer-optin.portability.UnixAPI): nsources >= 1 (hs_scenario_load)
+        for (unsigned s = 0; r->pdr && s < sc->nsources; s++) {
+            (void)rfs_pdr_init(&r->pdr[s], &pc); // the default window is valid
         }
-        if (!pdr) {
-            hs_radio_destroy(radio);
-            hs_box2d_destroy(world);
+        if (!r->pdr) {
+            run_close(r);
             snprintf(err, errlen, "%s: out of memory", sc->path);
             return -1;
         }
     }
     for (unsigned s = 0; s < sc->nsources; s++) {
-        pkt_period_us[s] = 1e6 / sc->src[s].rate_hz;
-        pkt_off_us[s] = pkt_period_us[s] * (s + 0.5) / sc->nsources; // sources interleave
+        r->pkt_period_us[s] = 1e6 / sc->src[s].rate_hz;
+        r->pkt_off_us[s] = r->pkt_period_us[s] * (s + 0.5) / sc->nsources; // sources interleave
     }
-    uint64_t pose_k = 1, ctrl_k = 1;
-    // Next event times, microseconds: k-th event of a stream at round(offset + k * period)
-    // (no drift), recomputed only when the event is consumed.
-    int64_t next_pkt[HS_SCN_MAX_SOURCES];
+    r->pose_k = 1;
+    r->ctrl_k = 1;
     for (unsigned s = 0; s < sc->nsources; s++) {
-        next_pkt[s] = (int64_t)llround(pkt_off_us[s]);
+        r->next_pkt[s] = (int64_t)llround(r->pkt_off_us[s]);
     }
-    int64_t next_pose = (int64_t)llround(pose_period_us);
-    int64_t next_ctrl = ctrl->period_us;
-    const int64_t stop_t_us = sc->stop_time_s > 0.0 ? (int64_t)llround(sc->stop_time_s * 1e6) : INT64_MAX;
-    const bool has_goal = sc->has_goal || sc->nsources == 1;
+    r->next_pose = (int64_t)llround(r->pose_period_us);
+    r->next_ctrl = r->ctrl->period_us;
+    r->stop_t_us = sc->stop_time_s > 0.0 ? (int64_t)llround(sc->stop_time_s * 1e6) : INT64_MAX;
+    r->has_goal = sc->has_goal || sc->nsources == 1;
+    return 0;
+}
 
+/* The header lines of the per-run tables that are written. */
+static void write_headers(const hs_sim_io_t *io)
+{
     if (io && io->log) {
         fprintf(io->log, "iteration\tt_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\tkind\treason\t"
                          "relearned\tprediction_db\tmean_db\tepsilon\tgoal_x_m\tgoal_y_m\t"
@@ -592,205 +674,294 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     if (io && io->track) {
         fprintf(io->track, "t_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\test_theta_rad\ttouching\n");
     }
+}
 
-    double px, py, pth;
-    hs_box2d_robot_pose(world, &px, &py, &pth);
-    int64_t t = 0;
-    double travelled = 0.0;
-    const char *end = "time";
+/* The motor and the world advanced by one tick from r->t. */
+static void tick_motion(sim_run_t *r, tick_t *k)
+{
+    double v, w;
+    hs_motor_update(&r->motor, r->t + r->dt_us, r->dt_s, &v, &w);
+    hs_faults_motor(&r->fr, r->t, r->motor.timed_out); // the target this tick, [t, t + dt]
+    hs_box2d_step(r->world, v, w, r->dt_s);
+    hs_box2d_robot_pose(r->world, &k->nx, &k->ny, &k->nth);
+    k->seg = sqrt((k->nx - r->px) * (k->nx - r->px) + (k->ny - r->py) * (k->ny - r->py));
+    k->t1 = r->t + r->dt_us;
+    k->dth = wrap_pi(k->nth - r->pth);
+}
+
+/* The next event: its kind (EV_*) and time in *te, the source of a packet in *which. */
+static int next_event(const sim_run_t *r, int64_t *te, unsigned *which)
+{
+    // Packets, then poses, then control at equal times.
+    int kind = -1;
+    *te = INT64_MAX;
+    *which = 0;
+    for (unsigned s = 0; s < r->sc->nsources; s++) {
+        if (r->next_pkt[s] < *te) { // NOLINT(clang-analyzer-core.UndefinedBinaryOperatorResult): set for s < nsources in run_open
+            *te = r->next_pkt[s];
+            kind = EV_PACKET;
+            *which = s;
+        }
+    }
+    if (r->next_pose < *te) {
+        *te = r->next_pose;
+        kind = EV_POSE;
+    }
+    if (r->next_ctrl < *te) {
+        *te = r->next_ctrl;
+        kind = EV_CTRL;
+    }
+    return kind;
+}
+
+/* A packet of source s: received or lost, through the faults to the controller. */
+static void packet_event(sim_run_t *r, const event_t *ev, unsigned s)
+{
+    const hs_sim_io_t *io = r->io;
+    r->pkt_k[s]++;
+    r->next_pkt[s] = (int64_t)llround(r->pkt_off_us[s] + r->pkt_k[s] * r->pkt_period_us[s]);
+    int dbm = 0;
+    bool got = hs_radio_packet(r->radio, s, ev->ex, ev->ey, &r->rng_pkt, &dbm);
+    r->res->packets_sent++;
+    if (io && io->on_packet) {
+        io->on_packet(io->packet_ctx, s, ev->te, r->seq[s], got, dbm);
+    }
+    r->seq[s] = (uint16_t)((r->seq[s] + 1u) & 0x0FFFu); // 802.11 sequence numbers: 12 bits
+    int8_t meas = (int8_t)dbm;
+    if (got && r->pdr) {
+        // The packet's own number: seq[] already points at the next one.
+        (void)rfs_pdr_push(&r->pdr[s], ev->te, (uint16_t)((r->seq[s] - 1u) & 0x0FFFu));
+        got = rfs_pdr_value(&r->pdr[s], ev->te, &meas); // always true after a push
+    }
+    if (got) {
+        r->res->packets_received++;
+        unsigned nm = hs_faults_rssi(&r->fr, ev->te, (uint8_t)s, meas, r->fm);
+        for (unsigned k = 0; k < nm; k++) {
+            r->ctrl->on_rssi(r->ctrl->self, r->fm[k].src, r->fm[k].t_us, r->fm[k].dbm);
+        }
+        if (io && io->samples) {
+            fprintf(io->samples, "%.6f\t%u\t%.3f\t%.3f\t%.3f\t%d\n", ev->te * 1e-6, s, ev->ex,
+                    ev->ey, ev->etr, dbm);
+        }
+    }
+}
+
+/* A localisation pose: the true pose plus noise, through the faults to the controller. */
+static void pose_event(sim_run_t *r, const event_t *ev, const tick_t *k)
+{
+    const hs_scenario_t *sc = r->sc;
+    r->pose_k++;
+    r->next_pose = (int64_t)llround(r->pose_k * r->pose_period_us);
+    double eth = wrap_pi(r->pth + ev->a * k->dth);
+    double mx = ev->ex + sc->pose_sigma_xy_m * hs_radio_gauss(&r->rng_pose);
+    double my = ev->ey + sc->pose_sigma_xy_m * hs_radio_gauss(&r->rng_pose);
+    double mth = wrap_pi(eth + sc->pose_sigma_theta_rad * hs_radio_gauss(&r->rng_pose));
+    rfs_pose_t pose = {ev->te, dq16(mx), dq16(my), dq16(mth)};
+    unsigned nm = hs_faults_pose(&r->fr, &pose, r->fm);
+    for (unsigned i = 0; i < nm; i++) {
+        r->ctrl->on_pose(r->ctrl->self, &r->fm[i].pose);
+    }
+    if (r->io && r->io->track) {
+        fprintf(r->io->track, "%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%.4f\t%d\n", ev->te * 1e-6,
+                ev->ex, ev->ey, eth, mx, my, mth, hs_box2d_robot_touching(r->world) ? 1 : 0);
+    }
+}
+
+/* One log.tsv row: decision d at event ev with the robot's heading theta. */
+static void log_decision(FILE *f, const hs_ctrl_t *ctrl, const rfs_seek_decision_t *d,
+                         const event_t *ev, double theta)
+{
+    char reason[96];
+    snprintf(reason, sizeof reason, "prev=%s%s%s%s%s", prev_name(d->prev),
+             d->line_search ? ",line_search" : "",
+             d->sampled ? ",sampled" : "",
+             d->model_valid ? "" : ",no_model",
+             d->mean_valid ? "" : ",no_mean");
+    double pred = d->model_valid ? q16d(d->prediction) : NAN;
+    double mean = d->mean_valid ? q16d(d->mean) : NAN;
+    fprintf(f,
+            "%u\t%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%s\t%s\t%d\t%.3f\t%.3f\t"
+            "%.4f\t%.3f\t%.3f\t%.3f\t%.3f\t%.3f\t%u\t%.3f",
+            d->iteration, ev->te * 1e-6, ev->ex, ev->ey, theta,
+            q16d(d->x), q16d(d->y), kind_name(d->kind), reason,
+            d->relearned ? 1 : 0, pred, mean, q16d(d->epsilon),
+            q16d(d->goal_x), q16d(d->goal_y), q16d(d->max_x), q16d(d->max_y),
+            q16d(d->path_len), d->samples, ev->etr);
+    hs_sim_log_estimate(f, ctrl);
+}
+
+/* A control period: the receiver heartbeat, the controller's step, its command through
+ * the faults to the motor, and its decision counted and logged. */
+static void ctrl_event(sim_run_t *r, const event_t *ev, const tick_t *k)
+{
+    hs_ctrl_t *ctrl = r->ctrl;
+    r->ctrl_k++;
+    r->next_ctrl = (int64_t)r->ctrl_k * ctrl->period_us;
+    // The receiver is up unless a fault silenced it (docs/FAULTS.md, "The receiver
+    // heartbeat"): in a dead zone the controller hears "listening, nothing heard", not a
+    // failed sensor.
+    int64_t rx_us;
+    if (r->sc->rx_heartbeat && ctrl->on_receiver && hs_faults_receiver(&r->fr, ev->te, &rx_us)) {
+        ctrl->on_receiver(ctrl->self, rx_us);
+    }
+    hs_ctrl_out_t out;
+    memset(&out, 0, sizeof out);
+    ctrl->step(ctrl->self, ev->te, &out);
+    if (hs_faults_cmd(&r->fr, ev->te, &out)) {
+        hs_motor_command(&r->motor, ev->te, out.left_mm_s, out.right_mm_s);
+    }
+    if (out.decided) {
+        const rfs_seek_decision_t *d = &out.decision;
+        hs_sim_result_t *res = r->res;
+        res->iterations++;
+        res->model_updates += d->relearned ? 1u : 0u;
+        res->greedy += d->kind == RFS_SEEK_GREEDY ? 1u : 0u;
+        res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
+        if (r->io && r->io->log) {
+            log_decision(r->io->log, ctrl, d, ev, wrap_pi(r->pth + ev->a * k->dth));
+        }
+    }
+}
+
+/* Every event in (t, t1], in time order. */
+static void tick_events(sim_run_t *r, const tick_t *k)
+{
     for (;;) {
-        double v, w;
-        hs_motor_update(&motor, t + dt_us, dt_s, &v, &w);
-        hs_faults_motor(&fr, t, motor.timed_out); // the target this tick, [t, t + dt]
-        hs_box2d_step(world, v, w, dt_s);
-        double nx, ny, nth;
-        hs_box2d_robot_pose(world, &nx, &ny, &nth);
-        double seg = sqrt((nx - px) * (nx - px) + (ny - py) * (ny - py));
-        const int64_t t1 = t + dt_us;
-        const double dth = wrap_pi(nth - pth);
-        for (;;) {
-            // Next event in (t, t1]: packets, then poses, then control at equal times.
-            int64_t te = INT64_MAX;
-            int kind = -1;
-            unsigned which = 0;
-            for (unsigned s = 0; s < sc->nsources; s++) {
-                if (next_pkt[s] < te) { // NOLINT(clang-analyzer-core.UndefinedBinaryOperatorResult): set for s < nsources above
-                    te = next_pkt[s];
-                    kind = EV_PACKET;
-                    which = s;
-                }
-            }
-            if (next_pose < te) {
-                te = next_pose;
-                kind = EV_POSE;
-            }
-            if (next_ctrl < te) {
-                te = next_ctrl;
-                kind = EV_CTRL;
-            }
-            if (te > t1) {
-                break;
-            }
-            double a = (double)(te - t) / (double)dt_us;
-            double ex = px + a * (nx - px), ey = py + a * (ny - py);
-            double etr = travelled + a * seg;
-            if (kind == EV_PACKET) {
-                unsigned s = which;
-                pkt_k[s]++;
-                next_pkt[s] = (int64_t)llround(pkt_off_us[s] + pkt_k[s] * pkt_period_us[s]);
-                int dbm = 0;
-                bool got = hs_radio_packet(radio, s, ex, ey, &rng_pkt, &dbm);
-                res->packets_sent++;
-                if (io && io->on_packet) {
-                    io->on_packet(io->packet_ctx, s, te, seq[s], got, dbm);
-                }
-                seq[s] = (uint16_t)((seq[s] + 1u) & 0x0FFFu); // 802.11 sequence numbers: 12 bits
-                int8_t meas = (int8_t)dbm;
-                if (got && pdr) {
-                    // The packet's own number: seq[] already points at the next one.
-                    (void)rfs_pdr_push(&pdr[s], te, (uint16_t)((seq[s] - 1u) & 0x0FFFu));
-                    got = rfs_pdr_value(&pdr[s], te, &meas); // always true after a push
-                }
-                if (got) {
-                    res->packets_received++;
-                    unsigned nm = hs_faults_rssi(&fr, te, (uint8_t)s, meas, fm);
-                    for (unsigned k = 0; k < nm; k++) {
-                        ctrl->on_rssi(ctrl->self, fm[k].src, fm[k].t_us, fm[k].dbm);
-                    }
-                    if (io && io->samples) {
-                        fprintf(io->samples, "%.6f\t%u\t%.3f\t%.3f\t%.3f\t%d\n", te * 1e-6, s, ex,
-                                ey, etr, dbm);
-                    }
-                }
-            } else if (kind == EV_POSE) {
-                pose_k++;
-                next_pose = (int64_t)llround(pose_k * pose_period_us);
-                double eth = wrap_pi(pth + a * dth);
-                double mx = ex + sc->pose_sigma_xy_m * hs_radio_gauss(&rng_pose);
-                double my = ey + sc->pose_sigma_xy_m * hs_radio_gauss(&rng_pose);
-                double mth = wrap_pi(eth + sc->pose_sigma_theta_rad * hs_radio_gauss(&rng_pose));
-                rfs_pose_t pose = {te, dq16(mx), dq16(my), dq16(mth)};
-                unsigned nm = hs_faults_pose(&fr, &pose, fm);
-                for (unsigned k = 0; k < nm; k++) {
-                    ctrl->on_pose(ctrl->self, &fm[k].pose);
-                }
-                if (io && io->track) {
-                    fprintf(io->track, "%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%.4f\t%d\n", te * 1e-6,
-                            ex, ey, eth, mx, my, mth, hs_box2d_robot_touching(world) ? 1 : 0);
-                }
-            } else {
-                ctrl_k++;
-                next_ctrl = (int64_t)ctrl_k * ctrl->period_us;
-                // The receiver is up unless a fault silenced it (issue 10): in a dead zone
-                // the controller hears "listening, nothing heard", not a failed sensor.
-                int64_t rx_us;
-                if (sc->rx_heartbeat && ctrl->on_receiver && hs_faults_receiver(&fr, te, &rx_us)) {
-                    ctrl->on_receiver(ctrl->self, rx_us);
-                }
-                hs_ctrl_out_t out;
-                memset(&out, 0, sizeof out);
-                ctrl->step(ctrl->self, te, &out);
-                if (hs_faults_cmd(&fr, te, &out)) {
-                    hs_motor_command(&motor, te, out.left_mm_s, out.right_mm_s);
-                }
-                if (out.decided) {
-                    const rfs_seek_decision_t *d = &out.decision;
-                    res->iterations++;
-                    res->model_updates += d->relearned ? 1u : 0u;
-                    res->greedy += d->kind == RFS_SEEK_GREEDY ? 1u : 0u;
-                    res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
-                    if (io && io->log) {
-                        char reason[96];
-                        snprintf(reason, sizeof reason, "prev=%s%s%s%s%s", prev_name(d->prev),
-                                 d->line_search ? ",line_search" : "",
-                                 d->sampled ? ",sampled" : "",
-                                 d->model_valid ? "" : ",no_model",
-                                 d->mean_valid ? "" : ",no_mean");
-                        double pred = d->model_valid ? q16d(d->prediction) : NAN;
-                        double mean = d->mean_valid ? q16d(d->mean) : NAN;
-                        fprintf(io->log,
-                                "%u\t%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%s\t%s\t%d\t%.3f\t%.3f\t"
-                                "%.4f\t%.3f\t%.3f\t%.3f\t%.3f\t%.3f\t%u\t%.3f",
-                                d->iteration, te * 1e-6, ex, ey, wrap_pi(pth + a * dth),
-                                q16d(d->x), q16d(d->y), kind_name(d->kind), reason,
-                                d->relearned ? 1 : 0, pred, mean, q16d(d->epsilon),
-                                q16d(d->goal_x), q16d(d->goal_y), q16d(d->max_x), q16d(d->max_y),
-                                q16d(d->path_len), d->samples, etr);
-                        hs_sim_log_estimate(io->log, ctrl);
-                    }
-                }
-            }
-        }
-        travelled += seg;
-        px = nx;
-        py = ny;
-        pth = nth;
-        t = t1;
-        hs_faults_event_t fev;
-        while (hs_faults_next_event(&fr, t, &fev)) {
-            if (fev.kind == HS_FAULT_KIDNAP) {
-                // Carried away between two ticks: no travel, the wheels keep their command.
-                hs_box2d_place_robot(world, fev.x, fev.y, fev.theta);
-                hs_box2d_robot_pose(world, &px, &py, &pth);
-                continue;
-            }
-            rs[fev.source].x = fev.x;
-            rs[fev.source].y = fev.y;
-            hs_radio_t *moved = hs_radio_create(&sc->radio, rs, sc->nsources, e->x0, e->y0,
-                                                e->x1, e->y1, seed, walls_cb, world, werr,
-                                                sizeof werr);
-            if (!moved) {
-                free(pdr);
-                hs_radio_destroy(radio);
-                hs_box2d_destroy(world);
-                snprintf(err, errlen, "%s: %s", sc->path, werr);
-                return -1;
-            }
-            // Same seed, same fields; the shared wall caches hold only unmoved sources.
-            for (unsigned k = 0; k < sc->nsources; k++) {
-                if (sc->src[k].x == rs[k].x && sc->src[k].y == rs[k].y) {
-                    hs_radio_use_wall_cache(moved, k, e->wall_cache[k]);
-                }
-            }
-            hs_radio_destroy(radio);
-            radio = moved;
-            if (fev.source == 0 && !sc->has_goal) {
-                goal_x = fev.x;
-                goal_y = fev.y;
-            }
-        }
-        if (has_goal && sc->stop_radius_m > 0.0 &&
-            hypot(px - goal_x, py - goal_y) <= sc->stop_radius_m) {
-            end = "reached";
-            res->reached = true;
+        event_t ev;
+        unsigned which;
+        const int kind = next_event(r, &ev.te, &which);
+        if (ev.te > k->t1) {
             break;
         }
-        if (sc->stop_distance_m > 0.0 && travelled >= sc->stop_distance_m) {
-            end = "distance";
-            break;
-        }
-        if (t >= stop_t_us) {
-            end = "time";
-            break;
+        ev.a = (double)(ev.te - r->t) / (double)r->dt_us;
+        ev.ex = r->px + ev.a * (k->nx - r->px);
+        ev.ey = r->py + ev.a * (k->ny - r->py);
+        ev.etr = r->travelled + ev.a * k->seg;
+        if (kind == EV_PACKET) {
+            packet_event(r, &ev, which);
+        } else if (kind == EV_POSE) {
+            pose_event(r, &ev, k);
+        } else {
+            ctrl_event(r, &ev, k);
         }
     }
+}
+
+/* The fault schedule's world events due at r->t: a kidnap or a moved source. 0, or -1
+ * with err set (the moved radio could not be made). */
+static int world_events(sim_run_t *r, char *err, size_t errlen)
+{
+    const hs_scenario_t *sc = r->sc;
+    const hs_sim_env_t *e = r->e;
+    char werr[256];
+    hs_faults_event_t fev;
+    while (hs_faults_next_event(&r->fr, r->t, &fev)) {
+        if (fev.kind == HS_FAULT_KIDNAP) {
+            // Carried away between two ticks: no travel, the wheels keep their command.
+            hs_box2d_place_robot(r->world, fev.x, fev.y, fev.theta);
+            hs_box2d_robot_pose(r->world, &r->px, &r->py, &r->pth);
+            continue;
+        }
+        r->rs[fev.source].x = fev.x;
+        r->rs[fev.source].y = fev.y;
+        hs_radio_t *moved = hs_radio_create(&sc->radio, r->rs, sc->nsources, e->x0, e->y0,
+                                            e->x1, e->y1, r->seed, walls_cb, r->world, werr,
+                                            sizeof werr);
+        if (!moved) {
+            snprintf(err, errlen, "%s: %s", sc->path, werr);
+            return -1;
+        }
+        // Same seed, same fields; the shared wall caches hold only unmoved sources.
+        for (unsigned k = 0; k < sc->nsources; k++) {
+            if (sc->src[k].x == r->rs[k].x && sc->src[k].y == r->rs[k].y) {
+                hs_radio_use_wall_cache(moved, k, e->wall_cache[k]);
+            }
+        }
+        hs_radio_destroy(r->radio);
+        r->radio = moved;
+        if (fev.source == 0 && !sc->has_goal) {
+            r->goal_x = fev.x;
+            r->goal_y = fev.y;
+        }
+    }
+    return 0;
+}
+
+/* Why the run ends after this tick ("reached", "distance", "time"), or NULL. */
+static const char *run_end(sim_run_t *r)
+{
+    const hs_scenario_t *sc = r->sc;
+    if (r->has_goal && sc->stop_radius_m > 0.0 &&
+        hypot(r->px - r->goal_x, r->py - r->goal_y) <= sc->stop_radius_m) {
+        r->res->reached = true;
+        return "reached";
+    }
+    if (sc->stop_distance_m > 0.0 && r->travelled >= sc->stop_distance_m) {
+        return "distance";
+    }
+    if (r->t >= r->stop_t_us) {
+        return "time";
+    }
+    return NULL;
+}
+
+/* The result of a run that ended for reason end. */
+static void run_result(sim_run_t *r, const char *end)
+{
+    hs_sim_result_t *res = r->res;
     res->end = end;
-    res->sim_time_s = t * 1e-6;
-    res->distance_travelled_m = travelled;
-    res->shortest_path_m = e->shortest_path_m;
-    res->shortest_to_stop_m = e->shortest_to_stop_m;
-    res->final_x = px;
-    res->final_y = py;
-    res->final_distance_m = has_goal ? hypot(px - goal_x, py - goal_y) : NAN;
-    res->motor_timeouts = motor.timeouts;
+    res->sim_time_s = r->t * 1e-6;
+    res->distance_travelled_m = r->travelled;
+    res->shortest_path_m = r->e->shortest_path_m;
+    res->shortest_to_stop_m = r->e->shortest_to_stop_m;
+    res->final_x = r->px;
+    res->final_y = r->py;
+    res->final_distance_m = r->has_goal ? hypot(r->px - r->goal_x, r->py - r->goal_y) : NAN;
+    res->motor_timeouts = r->motor.timeouts;
     // Against source 0 where it is now (a moved source takes its error along).
-    hs_sim_result_estimate(res, ctrl, rs[0].x, rs[0].y);
-    if (io && io->residual) {
-        write_residual(io->residual, ctrl);
+    hs_sim_result_estimate(res, r->ctrl, r->rs[0].x, r->rs[0].y);
+    if (r->io && r->io->residual) {
+        write_residual(r->io->residual, r->ctrl);
     }
-    free(pdr);
-    hs_radio_destroy(radio);
-    hs_box2d_destroy(world);
+}
+
+int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_sim_io_t *io,
+               hs_sim_result_t *res, char *err, size_t errlen)
+{
+    double t_wall0 = now_s(), t_cpu0 = cpu_s();
+    memset(res, 0, sizeof *res);
+    res->seed = seed;
+    sim_run_t r;
+    memset(&r, 0, sizeof r);
+    r.e = e;
+    r.sc = &e->sc;
+    r.seed = seed;
+    r.ctrl = ctrl;
+    r.io = io;
+    r.res = res;
+    if (run_open(&r, err, errlen) != 0) {
+        return -1;
+    }
+    write_headers(io);
+    hs_box2d_robot_pose(r.world, &r.px, &r.py, &r.pth);
+    const char *end;
+    do {
+        tick_t k;
+        tick_motion(&r, &k);
+        tick_events(&r, &k);
+        r.travelled += k.seg;
+        r.px = k.nx;
+        r.py = k.ny;
+        r.pth = k.nth;
+        r.t = k.t1;
+        if (world_events(&r, err, errlen) != 0) {
+            run_close(&r);
+            return -1;
+        }
+        end = run_end(&r);
+    } while (end == NULL);
+    run_result(&r, end);
+    run_close(&r);
     res->wall_time_s = now_s() - t_wall0;
     res->cpu_time_s = cpu_s() - t_cpu0;
     return 0;
@@ -925,7 +1096,7 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
     fprintf(f, "  \"packets_sent\": %llu,\n", (unsigned long long)r->packets_sent);
     fprintf(f, "  \"packets_received\": %llu,\n", (unsigned long long)r->packets_received);
     fprintf(f, "  \"motor_timeouts\": %u,\n", r->motor_timeouts);
-    // issue 10: the path-loss model's final estimate (null for other models).
+    // The path-loss model's final estimate (null for other models).
     json_num(f, "est_src_x_m", r->est_valid ? r->est_x : NAN, false);
     json_num(f, "est_src_y_m", r->est_valid ? r->est_y : NAN, false);
     json_num(f, "est_n", r->est_valid ? r->est_n : NAN, false);

@@ -1,4 +1,4 @@
-/* rfseek-feed - RSSI of chosen transmitters from an 802.11 radiotap capture.
+/* rfseek-feed - RSSI of chosen transmitters from an 802.11 radiotap capture (docs/FEEDER.md).
  *
  * Prints one line per frame whose source address (Wireshark's wlan.sa) is one of the
  * --mac addresses and whose radiotap header carries a dBm antenna signal:
@@ -287,9 +287,9 @@ static int rp_collect(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_fr
     return 0;
 }
 
-/* Receiver heartbeat times (docs/FAULTS.md): every record the capture loop
- * reads proves it alive at that record's time, whoever sent it; one heartbeat per
- * RP_ALIVE_US of capture time at most, as a live sniffer would send them. */
+/* Receiver heartbeat times (docs/FAULTS.md, "The receiver heartbeat"): every record the
+ * capture loop reads proves it alive at that record's time, whoever sent it; one heartbeat
+ * per RP_ALIVE_US of capture time at most, as a live sniffer would send them. */
 #define RP_ALIVE_US 50000
 
 typedef struct rp_times {
@@ -448,248 +448,339 @@ typedef struct rp_opts {
     uint64_t seed;
 } rp_opts_t;
 
+/* One replay: the scenario, the recorded inputs, the controller and the outputs. */
+typedef struct replay {
+    const rp_opts_t *o;
+    hs_scenario_t sc;
+    hs_sim_env_t env;
+    bool env_open;
+    hs_ctrl_t ctrl;
+    bool ctrl_open;
+    bool pdr_target;
+    int n_macs;
+    rp_pose_t *poses;
+    size_t n_poses;
+    rp_vec_t pk;                    /* the matching frames */
+    rp_times_t hb;                  /* the receiver heartbeats */
+    char tmp[4096];                 /* the output directory until renamed */
+    FILE *flog, *fsam, *ftrk;
+    hs_sim_result_t res;
+    uint64_t before, after;         /* frames not fed: before the first pose, after the end */
+    /* Per-source sequence tracking: frames lost = gaps in the 12-bit numbers. */
+    bool seen[FEED_MAX_MACS];
+    uint16_t last_seq[FEED_MAX_MACS];
+    uint64_t lost;
+    /* Target "pdr": one delivery window (1 s) per source, fed from Sequence Control. */
+    rfs_pdr_t pdr[FEED_MAX_MACS];
+} replay_t;
+
+/* The robot at an event: its recorded pose interpolated, and the distance travelled. */
+typedef struct rp_at {
+    int64_t te;            /* microseconds from the first pose */
+    double ex, ey, eth;    /* metres, radians */
+    double etr;            /* metres */
+} rp_at_t;
+
+/* The scenario with the options' overrides, and the MACs of its sources (unless given):
+ * 0, or the exit status after a message. */
+static int rp_scenario(replay_t *rp, uint8_t (*macs)[6], int n_macs)
+{
+    const rp_opts_t *o = rp->o;
+    hs_scenario_t *sc = &rp->sc;
+    char err[1200];
+    if (hs_scenario_load(o->scenario, sc, err, sizeof(err)) != 0) {
+        fprintf(stderr, "rfseek-feed: %s\n", err);
+        return 1;
+    }
+    if (o->model != NULL) { snprintf(sc->model, sizeof(sc->model), "%s", o->model); }
+    if (o->target != NULL) {
+        if (sc->nsources != 1) {
+            fprintf(stderr, "rfseek-feed: --target: %s needs exactly 1 source, scenario %s has %u\n",
+                    o->target, o->scenario, sc->nsources);
+            return 2;
+        }
+        snprintf(sc->target, sizeof(sc->target), "%s", o->target);
+    }
+    rp->pdr_target = strcmp(sc->target, "pdr") == 0;
+    if (n_macs == 0) {
+        for (unsigned i = 0; i < sc->nsources; i++) { memcpy(macs[i], sc->src[i].mac, 6); }
+        n_macs = (int)sc->nsources;
+    } else if ((unsigned)n_macs != sc->nsources) {
+        fprintf(stderr, "rfseek-feed: --mac: %d addresses given, scenario %s has %u sources\n", n_macs,
+                o->scenario, sc->nsources);
+        return 2;
+    }
+    rp->n_macs = n_macs;
+    return 0;
+}
+
+/* The poses, the capture's frames and heartbeats, the environment and the controller:
+ * 0, or 1 after a message. */
+static int rp_open_inputs(replay_t *rp, lx_pcap_reader_t *r, uint8_t (*macs)[6], feed_stats_t *st)
+{
+    const rp_opts_t *o = rp->o;
+    char err[1200];
+    if (read_poses(o->poses, &rp->poses, &rp->n_poses, err, sizeof(err)) != 0) {
+        fprintf(stderr, "rfseek-feed: %s\n", err);
+        return 1;
+    }
+    if (scan_capture(r, (const uint8_t(*)[6])macs, rp->n_macs, st, rp_collect, &rp->pk,
+                     rp->sc.rx_heartbeat ? rp_alive : NULL, &rp->hb) != 0) {
+        return 1;
+    }
+    if (hs_sim_env_open(&rp->env, &rp->sc, err, sizeof(err)) != 0) {
+        fprintf(stderr, "rfseek-feed: %s\n", err);
+        return 1;
+    }
+    rp->env_open = true;
+    hs_ctrl_inproc_cfg_t cc = hs_ctrl_inproc_cfg_default();
+    cc.model = rp->sc.model;
+    cc.target = rp->sc.target;
+    cc.seed = o->has_seed ? o->seed : rp->sc.seed;
+    char cerr[256];
+    if (hs_ctrl_inproc_open(&rp->ctrl, &cc, &rp->env.core.map, cerr, sizeof(cerr)) != 0) {
+        fprintf(stderr, "rfseek-feed: %s: %s\n", o->scenario, cerr);
+        return 1;
+    }
+    rp->ctrl_open = true;
+    memset(&rp->res, 0, sizeof(rp->res));
+    rp->res.seed = cc.seed;
+    return 0;
+}
+
+/* The output directory (a temporary one) and its three logs: 0, or 1 after a message. */
+static int rp_open_outputs(replay_t *rp)
+{
+    snprintf(rp->tmp, sizeof(rp->tmp), "%s.tmp-%ld", rp->o->out, (long)getpid());
+    if (mkdir(rp->tmp, 0777) != 0) {
+        fprintf(stderr, "rfseek-feed: %s: cannot create: %s\n", rp->tmp, strerror(errno));
+        return 1;
+    }
+    rp->flog = rp_open(rp->tmp, "log.tsv");
+    rp->fsam = rp_open(rp->tmp, "samples.tsv");
+    rp->ftrk = rp_open(rp->tmp, "track.tsv");
+    if (rp->flog == NULL || rp->fsam == NULL || rp->ftrk == NULL) {
+        fprintf(stderr, "rfseek-feed: %s: cannot create the logs: %s\n", rp->tmp, strerror(errno));
+        return 1;
+    }
+    return 0;
+}
+
+/* A matching frame: counted (sequence gaps), and fed to the controller (as its PDR with
+ * target pdr) and to samples.tsv. */
+static void rp_packet(replay_t *rp, const rp_pkt_t *p, const rp_at_t *at)
+{
+    const uint16_t seq = (uint16_t)(p->seq_ctrl >> 4);
+    if (rp->seen[p->src]) {
+        const unsigned d = (unsigned)(seq - rp->last_seq[p->src]) & 0x0fffu;
+        if (d >= 2u && d <= 2048u) { rp->lost += d - 1u; }
+    }
+    rp->seen[p->src] = true;
+    rp->last_seq[p->src] = seq;
+    rp->res.packets_received++;
+    int8_t meas = p->dbm;
+    /* A retransmission or later fragment is not a new frame: no new ratio. */
+    const bool fed = !rp->pdr_target || (rfs_pdr_push_seq_ctrl(&rp->pdr[p->src], at->te, p->seq_ctrl) &&
+                                         rfs_pdr_value(&rp->pdr[p->src], at->te, &meas));
+    if (fed) {
+        rp->ctrl.on_rssi(rp->ctrl.self, p->src, at->te, meas);
+        fprintf(rp->fsam, "%.6f\t%u\t%.3f\t%.3f\t%.3f\t%d\n", at->te * 1e-6, (unsigned)p->src, at->ex,
+                at->ey, at->etr, (int)meas);
+    }
+}
+
+/* A recorded pose: to the controller and to track.tsv. */
+static void rp_pose(replay_t *rp, const rp_pose_t *q, int64_t te)
+{
+    rfs_pose_t pose = {te, rp_q16(q->x), rp_q16(q->y), rp_q16(rp_wrap(q->theta))};
+    rp->ctrl.on_pose(rp->ctrl.self, &pose);
+    fprintf(rp->ftrk, "%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%.4f\t0\n", te * 1e-6, q->x, q->y,
+            rp_wrap(q->theta), q->x, q->y, rp_wrap(q->theta));
+}
+
+/* A control period: the controller's step, its decision counted and logged (the wheel
+ * commands go nowhere). */
+static void rp_step(replay_t *rp, const rp_at_t *at)
+{
+    hs_ctrl_out_t out;
+    memset(&out, 0, sizeof(out));
+    rp->ctrl.step(rp->ctrl.self, at->te, &out);
+    if (!out.decided) {
+        return;
+    }
+    const rfs_seek_decision_t *d = &out.decision;
+    hs_sim_result_t *res = &rp->res;
+    res->iterations++;
+    res->model_updates += d->relearned ? 1u : 0u;
+    res->greedy += d->kind == RFS_SEEK_GREEDY ? 1u : 0u;
+    res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
+    char reason[96];
+    snprintf(reason, sizeof(reason), "prev=%s%s%s%s%s", rp_prev(d->prev),
+             d->line_search ? ",line_search" : "", d->sampled ? ",sampled" : "",
+             d->model_valid ? "" : ",no_model",
+             d->mean_valid ? "" : ",no_mean");
+    fprintf(rp->flog,
+            "%u\t%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%s\t%s\t%d\t%.3f\t%.3f\t"
+            "%.4f\t%.3f\t%.3f\t%.3f\t%.3f\t%.3f\t%u\t%.3f",
+            d->iteration, at->te * 1e-6, at->ex, at->ey, at->eth, rp_d(d->x), rp_d(d->y), rp_kind(d->kind),
+            reason, d->relearned ? 1 : 0, d->model_valid ? rp_d(d->prediction) : NAN,
+            d->mean_valid ? rp_d(d->mean) : NAN, rp_d(d->epsilon), rp_d(d->goal_x),
+            rp_d(d->goal_y), rp_d(d->max_x), rp_d(d->max_y), rp_d(d->path_len), d->samples,
+            at->etr);
+    hs_sim_log_estimate(rp->flog, &rp->ctrl); /* the path-loss estimate, or nan */
+}
+
 /* Replay: packets, poses, receiver heartbeats and control periods in time order (equal
  * times: packets, then poses, then heartbeats, then control, as the simulator), time
  * counted from the first pose. With the scenario's radio.receiver.heartbeat (the
  * default) every record of the capture, from any transmitter, proves the capture loop
  * alive at its time: the controller is told so at most once per 50 ms of capture time
- * (rfs_seek_on_receiver), so a stretch where the source is not heard but the
- * channel is is a dead zone, not a dead sensor. The robot's
- * position at any instant is the recorded pose interpolated linearly (theta along the
- * shorter arc); the controller's wheel commands go nowhere. Ends at the last pose, or
- * when the robot comes within the stop radius of the goal. */
-static int run_replay(const rp_opts_t *o, lx_pcap_reader_t *r, uint8_t (*macs)[6], int n_macs,
-                      feed_stats_t *st)
+ * (rfs_seek_on_receiver; docs/FAULTS.md, "The receiver heartbeat"), so a stretch where
+ * the source is not heard but the channel is is a dead zone, not a dead sensor. The
+ * robot's position at any instant is the recorded pose interpolated linearly (theta
+ * along the shorter arc); the controller's wheel commands go nowhere. Ends at the last
+ * pose, or when the robot comes within the stop radius of the goal. */
+static void rp_run(replay_t *rp)
 {
-    char err[1200];
-    hs_scenario_t sc;
-    if (hs_scenario_load(o->scenario, &sc, err, sizeof(err)) != 0) {
-        fprintf(stderr, "rfseek-feed: %s\n", err);
-        return 1;
-    }
-    if (o->model != NULL) { snprintf(sc.model, sizeof(sc.model), "%s", o->model); }
-    if (o->target != NULL) {
-        if (sc.nsources != 1) {
-            fprintf(stderr, "rfseek-feed: --target: %s needs exactly 1 source, scenario %s has %u\n",
-                    o->target, o->scenario, sc.nsources);
-            return 2;
-        }
-        snprintf(sc.target, sizeof(sc.target), "%s", o->target);
-    }
-    const bool pdr_target = strcmp(sc.target, "pdr") == 0;
-    if (n_macs == 0) {
-        for (unsigned i = 0; i < sc.nsources; i++) { memcpy(macs[i], sc.src[i].mac, 6); }
-        n_macs = (int)sc.nsources;
-    } else if ((unsigned)n_macs != sc.nsources) {
-        fprintf(stderr, "rfseek-feed: --mac: %d addresses given, scenario %s has %u sources\n", n_macs,
-                o->scenario, sc.nsources);
-        return 2;
-    }
-    rp_pose_t *poses = NULL;
-    size_t n_poses = 0;
-    if (read_poses(o->poses, &poses, &n_poses, err, sizeof(err)) != 0) {
-        fprintf(stderr, "rfseek-feed: %s\n", err);
-        return 1;
-    }
-    rp_vec_t pk = {NULL, 0, 0};
-    rp_times_t hb = {NULL, 0, 0};
-    if (scan_capture(r, (const uint8_t(*)[6])macs, n_macs, st, rp_collect, &pk,
-                     sc.rx_heartbeat ? rp_alive : NULL, &hb) != 0) {
-        free(poses);
-        free(pk.v);
-        free(hb.v);
-        return 1;
-    }
-    hs_sim_env_t env;
-    if (hs_sim_env_open(&env, &sc, err, sizeof(err)) != 0) {
-        fprintf(stderr, "rfseek-feed: %s\n", err);
-        free(poses);
-        free(pk.v);
-        free(hb.v);
-        return 1;
-    }
-    hs_ctrl_inproc_cfg_t cc = hs_ctrl_inproc_cfg_default();
-    cc.model = sc.model;
-    cc.target = sc.target;
-    cc.seed = o->has_seed ? o->seed : sc.seed;
-    hs_ctrl_t ctrl;
-    char cerr[256];
-    int rc = 0;
-    if (hs_ctrl_inproc_open(&ctrl, &cc, &env.core.map, cerr, sizeof(cerr)) != 0) {
-        fprintf(stderr, "rfseek-feed: %s: %s\n", o->scenario, cerr);
-        hs_sim_env_close(&env);
-        free(poses);
-        free(pk.v);
-        free(hb.v);
-        return 1;
-    }
-    char tmp[4096];
-    snprintf(tmp, sizeof(tmp), "%s.tmp-%ld", o->out, (long)getpid());
-    if (mkdir(tmp, 0777) != 0) {
-        fprintf(stderr, "rfseek-feed: %s: cannot create: %s\n", tmp, strerror(errno));
-        rc = 1;
-    }
-    FILE *flog = rc == 0 ? rp_open(tmp, "log.tsv") : NULL;
-    FILE *fsam = rc == 0 ? rp_open(tmp, "samples.tsv") : NULL;
-    FILE *ftrk = rc == 0 ? rp_open(tmp, "track.tsv") : NULL;
-    if (rc == 0 && (flog == NULL || fsam == NULL || ftrk == NULL)) {
-        fprintf(stderr, "rfseek-feed: %s: cannot create the logs: %s\n", tmp, strerror(errno));
-        rc = 1;
-    }
-    hs_sim_result_t res;
-    memset(&res, 0, sizeof(res));
-    res.seed = cc.seed;
-    uint64_t before = 0, after = 0;
-    if (rc == 0) {
-        fprintf(flog, "iteration\tt_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\tkind\treason\t"
+    const hs_scenario_t *sc = &rp->sc;
+    const rp_pose_t *poses = rp->poses;
+    const size_t n_poses = rp->n_poses;
+    const rp_vec_t *pk = &rp->pk;
+    const rp_times_t *hb = &rp->hb;
+    hs_sim_result_t *res = &rp->res;
+    const int64_t t0 = poses[0].t_us;
+    const int64_t t_end = poses[n_poses - 1].t_us - t0;
+    const bool has_goal = sc->has_goal || sc->nsources == 1;
+    fprintf(rp->flog, "iteration\tt_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\tkind\treason\t"
                       "relearned\tprediction_db\tmean_db\tepsilon\tgoal_x_m\tgoal_y_m\t"
                       "max_x_m\tmax_y_m\tpath_m\tsamples\ttravelled_m\t" HS_SIM_LOG_EST_COLUMNS "\n");
-        fprintf(fsam, "t_s\tsrc\tx_m\ty_m\ttravelled_m\t%s\n", pdr_target ? "pdr_pct" : "dbm");
-        fprintf(ftrk, "t_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\test_theta_rad\ttouching\n");
-        const int64_t t0 = poses[0].t_us;
-        const int64_t t_end = poses[n_poses - 1].t_us - t0;
-        const bool has_goal = sc.has_goal || sc.nsources == 1;
-        /* Per-source sequence tracking: frames lost = gaps in the 12-bit numbers. */
-        bool seen[FEED_MAX_MACS] = {false};
-        uint16_t last_seq[FEED_MAX_MACS] = {0};
-        uint64_t lost = 0;
-        /* Target "pdr": one delivery window (1 s) per source, fed from Sequence Control. */
-        rfs_pdr_t pdr[FEED_MAX_MACS];
-        const rfs_pdr_cfg_t pdr_cfg = rfs_pdr_cfg_default();
-        for (int k = 0; k < n_macs; k++) { (void)rfs_pdr_init(&pdr[k], &pdr_cfg); }
-        size_t pi = 0, qi = 0, hi = 0; /* next packet, next pose, next heartbeat */
-        size_t seg = 0;        /* poses[seg], poses[seg + 1] bracket the current time */
-        double travelled_at_seg = 0.0;
-        uint64_t ctrl_k = 1;
-        const char *end = "time";
-        double fx = poses[0].x, fy = poses[0].y;
-        int64_t t_last = 0;
-        while (pi < pk.n && pk.v[pi].t_us < t0) { pi++; before++; }
-        while (hi < hb.n && hb.v[hi] < t0) { hi++; }
-        for (;;) {
-            int64_t te = INT64_MAX;
-            int kind = -1;
-            if (pi < pk.n) { te = pk.v[pi].t_us - t0; kind = 0; }
-            if (qi < n_poses && poses[qi].t_us - t0 < te) { te = poses[qi].t_us - t0; kind = 1; }
-            if (hi < hb.n && hb.v[hi] - t0 < te) { te = hb.v[hi] - t0; kind = 3; }
-            const int64_t tc = (int64_t)ctrl_k * ctrl.period_us;
-            if (tc < te) { te = tc; kind = 2; }
-            if (te > t_end || kind < 0) { break; }
-            t_last = te;
-            /* The recorded robot position at te. */
-            while (seg + 2 < n_poses && poses[seg + 1].t_us - t0 <= te) {
-                travelled_at_seg += hypot(poses[seg + 1].x - poses[seg].x, poses[seg + 1].y - poses[seg].y);
-                seg++;
-            }
-            const rp_pose_t *pa = &poses[seg], *pb = &poses[seg + 1];
-            const double a = (double)(te - (pa->t_us - t0)) / (double)(pb->t_us - pa->t_us);
-            const double ex = pa->x + a * (pb->x - pa->x), ey = pa->y + a * (pb->y - pa->y);
-            const double eth = rp_wrap(pa->theta + a * rp_wrap(pb->theta - pa->theta));
-            const double etr = travelled_at_seg + a * hypot(pb->x - pa->x, pb->y - pa->y);
-            fx = ex;
-            fy = ey;
-            if (kind == 0) {
-                const rp_pkt_t *p = &pk.v[pi++];
-                const uint16_t seq = (uint16_t)(p->seq_ctrl >> 4);
-                if (seen[p->src]) {
-                    const unsigned d = (unsigned)(seq - last_seq[p->src]) & 0x0fffu;
-                    if (d >= 2u && d <= 2048u) { lost += d - 1u; }
-                }
-                seen[p->src] = true;
-                last_seq[p->src] = seq;
-                res.packets_received++;
-                int8_t meas = p->dbm;
-                /* A retransmission or later fragment is not a new frame: no new ratio. */
-                const bool fed = !pdr_target || (rfs_pdr_push_seq_ctrl(&pdr[p->src], te, p->seq_ctrl) &&
-                                                 rfs_pdr_value(&pdr[p->src], te, &meas));
-                if (fed) {
-                    ctrl.on_rssi(ctrl.self, p->src, te, meas);
-                    fprintf(fsam, "%.6f\t%u\t%.3f\t%.3f\t%.3f\t%d\n", te * 1e-6, (unsigned)p->src, ex, ey,
-                            etr, (int)meas);
-                }
-            } else if (kind == 3) {
-                hi++;
-                if (ctrl.on_receiver != NULL) {
-                    ctrl.on_receiver(ctrl.self, te);
-                }
-            } else if (kind == 1) {
-                const rp_pose_t *q = &poses[qi++];
-                rfs_pose_t pose = {te, rp_q16(q->x), rp_q16(q->y), rp_q16(rp_wrap(q->theta))};
-                ctrl.on_pose(ctrl.self, &pose);
-                fprintf(ftrk, "%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%.4f\t0\n", te * 1e-6, q->x, q->y,
-                        rp_wrap(q->theta), q->x, q->y, rp_wrap(q->theta));
-            } else {
-                ctrl_k++;
-                hs_ctrl_out_t out;
-                memset(&out, 0, sizeof(out));
-                ctrl.step(ctrl.self, te, &out);
-                if (out.decided) {
-                    const rfs_seek_decision_t *d = &out.decision;
-                    res.iterations++;
-                    res.model_updates += d->relearned ? 1u : 0u;
-                    res.greedy += d->kind == RFS_SEEK_GREEDY ? 1u : 0u;
-                    res.epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
-                    char reason[96];
-                    snprintf(reason, sizeof(reason), "prev=%s%s%s%s%s", rp_prev(d->prev),
-                             d->line_search ? ",line_search" : "", d->sampled ? ",sampled" : "",
-                             d->model_valid ? "" : ",no_model",
-                             d->mean_valid ? "" : ",no_mean");
-                    fprintf(flog,
-                            "%u\t%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%s\t%s\t%d\t%.3f\t%.3f\t"
-                            "%.4f\t%.3f\t%.3f\t%.3f\t%.3f\t%.3f\t%u\t%.3f",
-                            d->iteration, te * 1e-6, ex, ey, eth, rp_d(d->x), rp_d(d->y), rp_kind(d->kind),
-                            reason, d->relearned ? 1 : 0, d->model_valid ? rp_d(d->prediction) : NAN,
-                            d->mean_valid ? rp_d(d->mean) : NAN, rp_d(d->epsilon), rp_d(d->goal_x),
-                            rp_d(d->goal_y), rp_d(d->max_x), rp_d(d->max_y), rp_d(d->path_len), d->samples,
-                            etr);
-                    hs_sim_log_estimate(flog, &ctrl); /* path-loss estimate or nan */
-                }
-            }
-            if (has_goal && sc.stop_radius_m > 0.0 && hypot(ex - sc.goal_x, ey - sc.goal_y) <= sc.stop_radius_m) {
-                end = "reached";
-                res.reached = true;
-                res.distance_travelled_m = etr;
-                break;
-            }
-            res.distance_travelled_m = etr;
+    fprintf(rp->fsam, "t_s\tsrc\tx_m\ty_m\ttravelled_m\t%s\n", rp->pdr_target ? "pdr_pct" : "dbm");
+    fprintf(rp->ftrk, "t_s\tx_m\ty_m\ttheta_rad\test_x_m\test_y_m\test_theta_rad\ttouching\n");
+    const rfs_pdr_cfg_t pdr_cfg = rfs_pdr_cfg_default();
+    for (int k = 0; k < rp->n_macs; k++) { (void)rfs_pdr_init(&rp->pdr[k], &pdr_cfg); }
+    size_t pi = 0, qi = 0, hi = 0; /* next packet, next pose, next heartbeat */
+    size_t seg = 0;        /* poses[seg], poses[seg + 1] bracket the current time */
+    double travelled_at_seg = 0.0;
+    uint64_t ctrl_k = 1;
+    const char *end = "time";
+    double fx = poses[0].x, fy = poses[0].y;
+    int64_t t_last = 0;
+    while (pi < pk->n && pk->v[pi].t_us < t0) { pi++; rp->before++; }
+    while (hi < hb->n && hb->v[hi] < t0) { hi++; }
+    for (;;) {
+        int64_t te = INT64_MAX;
+        int kind = -1;
+        if (pi < pk->n) { te = pk->v[pi].t_us - t0; kind = 0; }
+        if (qi < n_poses && poses[qi].t_us - t0 < te) { te = poses[qi].t_us - t0; kind = 1; }
+        if (hi < hb->n && hb->v[hi] - t0 < te) { te = hb->v[hi] - t0; kind = 3; }
+        const int64_t tc = (int64_t)ctrl_k * rp->ctrl.period_us;
+        if (tc < te) { te = tc; kind = 2; }
+        if (te > t_end || kind < 0) { break; }
+        t_last = te;
+        /* The recorded robot position at te. */
+        while (seg + 2 < n_poses && poses[seg + 1].t_us - t0 <= te) {
+            travelled_at_seg += hypot(poses[seg + 1].x - poses[seg].x, poses[seg + 1].y - poses[seg].y);
+            seg++;
         }
-        after = pk.n - pi;
-        res.end = end;
-        res.sim_time_s = t_last * 1e-6;
-        res.shortest_path_m = env.shortest_path_m;
-        res.shortest_to_stop_m = env.shortest_to_stop_m;
-        res.final_x = fx;
-        res.final_y = fy;
-        res.final_distance_m = has_goal ? hypot(fx - sc.goal_x, fy - sc.goal_y) : NAN;
-        res.packets_sent = res.packets_received + lost; /* from the sequence-number gaps */
-        hs_sim_result_estimate(&res, &ctrl, sc.src[0].x, sc.src[0].y);
-        FILE *fsum = rp_open(tmp, "summary.json");
+        const rp_pose_t *pa = &poses[seg], *pb = &poses[seg + 1];
+        const double a = (double)(te - (pa->t_us - t0)) / (double)(pb->t_us - pa->t_us);
+        rp_at_t at;
+        at.te = te;
+        at.ex = pa->x + a * (pb->x - pa->x);
+        at.ey = pa->y + a * (pb->y - pa->y);
+        at.eth = rp_wrap(pa->theta + a * rp_wrap(pb->theta - pa->theta));
+        at.etr = travelled_at_seg + a * hypot(pb->x - pa->x, pb->y - pa->y);
+        fx = at.ex;
+        fy = at.ey;
+        if (kind == 0) {
+            rp_packet(rp, &pk->v[pi++], &at);
+        } else if (kind == 3) {
+            hi++;
+            if (rp->ctrl.on_receiver != NULL) {
+                rp->ctrl.on_receiver(rp->ctrl.self, te);
+            }
+        } else if (kind == 1) {
+            rp_pose(rp, &poses[qi++], te);
+        } else {
+            ctrl_k++;
+            rp_step(rp, &at);
+        }
+        if (has_goal && sc->stop_radius_m > 0.0 &&
+            hypot(at.ex - sc->goal_x, at.ey - sc->goal_y) <= sc->stop_radius_m) {
+            end = "reached";
+            res->reached = true;
+            res->distance_travelled_m = at.etr;
+            break;
+        }
+        res->distance_travelled_m = at.etr;
+    }
+    rp->after = pk->n - pi;
+    res->end = end;
+    res->sim_time_s = t_last * 1e-6;
+    res->shortest_path_m = rp->env.shortest_path_m;
+    res->shortest_to_stop_m = rp->env.shortest_to_stop_m;
+    res->final_x = fx;
+    res->final_y = fy;
+    res->final_distance_m = has_goal ? hypot(fx - sc->goal_x, fy - sc->goal_y) : NAN;
+    res->packets_sent = res->packets_received + rp->lost; /* from the sequence-number gaps */
+    hs_sim_result_estimate(res, &rp->ctrl, sc->src[0].x, sc->src[0].y); /* the path-loss estimate */
+}
+
+/* summary.json, the logs closed, the directory renamed into place (removed on failure),
+ * and everything freed: the exit status (rc: so far). */
+static int rp_finish(replay_t *rp, feed_stats_t *st, int rc, bool ran)
+{
+    if (ran) {
+        FILE *fsum = rp_open(rp->tmp, "summary.json");
         if (fsum == NULL) {
-            fprintf(stderr, "rfseek-feed: %s/summary.json: %s\n", tmp, strerror(errno));
+            fprintf(stderr, "rfseek-feed: %s/summary.json: %s\n", rp->tmp, strerror(errno));
             rc = 1;
         } else {
-            hs_sim_write_summary(fsum, &env, &res);
+            hs_sim_write_summary(fsum, &rp->env, &rp->res);
             if (fclose(fsum) != 0) { rc = 1; }
         }
     }
-    if (flog != NULL && (ferror(flog) || fclose(flog) != 0)) { rc = 1; }
-    if (fsam != NULL && (ferror(fsam) || fclose(fsam) != 0)) { rc = 1; }
-    if (ftrk != NULL && (ferror(ftrk) || fclose(ftrk) != 0)) { rc = 1; }
-    if (rc == 0 && rename(tmp, o->out) != 0) {
-        fprintf(stderr, "rfseek-feed: %s: cannot rename to %s: %s\n", tmp, o->out, strerror(errno));
-        rc = 1;
+    if (rp->flog != NULL && (ferror(rp->flog) || fclose(rp->flog) != 0)) { rc = 1; }
+    if (rp->fsam != NULL && (ferror(rp->fsam) || fclose(rp->fsam) != 0)) { rc = 1; }
+    if (rp->ftrk != NULL && (ferror(rp->ftrk) || fclose(rp->ftrk) != 0)) { rc = 1; }
+    if (rp->tmp[0] != '\0') {
+        if (rc == 0 && rename(rp->tmp, rp->o->out) != 0) {
+            fprintf(stderr, "rfseek-feed: %s: cannot rename to %s: %s\n", rp->tmp, rp->o->out, strerror(errno));
+            rc = 1;
+        }
+        if (rc != 0) { rp_rmdir(rp->tmp); }
+        if (rc == 0 && st != NULL) {
+            st->replay_before = rp->before;
+            st->replay_after = rp->after;
+        }
     }
-    if (rc != 0) { rp_rmdir(tmp); }
-    if (rc == 0 && st != NULL) {
-        st->replay_before = before;
-        st->replay_after = after;
-    }
-    hs_ctrl_close(&ctrl);
-    hs_sim_env_close(&env);
-    free(poses);
-    free(pk.v);
-    free(hb.v);
+    if (rp->ctrl_open) { hs_ctrl_close(&rp->ctrl); }
+    if (rp->env_open) { hs_sim_env_close(&rp->env); }
+    free(rp->poses);
+    free(rp->pk.v);
+    free(rp->hb.v);
     return rc;
+}
+
+/* Replay the capture and the poses through the controller into o->out (rp_run). */
+static int run_replay(const rp_opts_t *o, lx_pcap_reader_t *r, uint8_t (*macs)[6], int n_macs,
+                      feed_stats_t *st)
+{
+    static replay_t rp;
+    memset(&rp, 0, sizeof(rp));
+    rp.o = o;
+    int rc = rp_scenario(&rp, macs, n_macs);
+    if (rc != 0) {
+        return rc;
+    }
+    if (rp_open_inputs(&rp, r, macs, st) != 0) {
+        return rp_finish(&rp, st, 1, false);
+    }
+    rc = rp_open_outputs(&rp);
+    if (rc == 0) {
+        rp_run(&rp);
+    }
+    return rp_finish(&rp, st, rc, rc == 0);
 }
 
 /* An option error with the offending value: one line on stderr even when the value holds
@@ -702,17 +793,106 @@ static void opt_err(const char *fmt, const char *v)
     fprintf(stderr, "rfseek-feed: %s\n", msg);
 }
 
-int main(int argc, char **argv)
-{
-    const char *output = NULL;
-    rp_opts_t ro;
-    memset(&ro, 0, sizeof(ro));
+/* The command line. */
+typedef struct feed_opts {
+    rp_opts_t ro;                    /* the capture, and the replay's options */
+    const char *output;              /* --output, or NULL: stdout */
     uint8_t macs[FEED_MAX_MACS][6];
-    int n_macs = 0;
-    bool stats = false;
-    bool live = false;
+    int n_macs;
+    bool stats;
+    bool live;
+} feed_opts_t;
+
+enum { RUN = -1 }; /* parse_options: go on (else the exit status) */
+
+/* One option a that takes a value v: RUN, or the exit status after a message. */
+static int parse_value(feed_opts_t *fo, const char *a, const char *v)
+{
+    rp_opts_t *ro = &fo->ro;
+    if (strcmp(a, "--mac") == 0) {
+        if (fo->n_macs == FEED_MAX_MACS) {
+            fprintf(stderr, "rfseek-feed: --mac: at most %d addresses\n", FEED_MAX_MACS);
+            return 2;
+        }
+        if (parse_mac(v, fo->macs[fo->n_macs]) != 0) {
+            opt_err("--mac: '%s' is not a MAC address (aa:bb:cc:dd:ee:ff)", v);
+            return 2;
+        }
+        fo->n_macs++;
+    } else if (strcmp(a, "--format") == 0) {
+        if (strcmp(v, "tsv") != 0) {
+            opt_err("--format: '%s' is not supported (tsv)", v);
+            return 2;
+        }
+    } else if (strcmp(a, "--output") == 0) {
+        fo->output = v;
+    } else if (strcmp(a, "--pose") == 0) {
+        ro->poses = v;
+    } else if (strcmp(a, "--scenario") == 0) {
+        ro->scenario = v;
+    } else if (strcmp(a, "--out") == 0) {
+        ro->out = v;
+    } else if (strcmp(a, "--model") == 0) {
+        if (rfs_models_lookup(v) == NULL) {
+            opt_err("--model: unknown '%s' (ridge, mlp, knn, radius, pathloss)", v);
+            return 2;
+        }
+        ro->model = v;
+    } else if (strcmp(a, "--target") == 0) {
+        if (strcmp(v, "rssi") != 0 && strcmp(v, "pdr") != 0) {
+            opt_err("--target: unknown '%s' (rssi, pdr)", v);
+            return 2;
+        }
+        ro->target = v;
+    } else {
+        char *e = NULL;
+        errno = 0;
+        ro->seed = strtoull(v, &e, 10);
+        if (e == v || *e != '\0' || errno != 0 || v[0] == '-') {
+            opt_err("--seed: '%s' is not a non-negative integer", v);
+            return 2;
+        }
+        ro->has_seed = true;
+    }
+    return RUN;
+}
+
+/* The options that go together, checked: RUN, or the exit status after a message. */
+static int check_options(const feed_opts_t *fo)
+{
+    const rp_opts_t *ro = &fo->ro;
+    const bool replay = ro->poses != NULL;
+    if (ro->capture == NULL) {
+        fprintf(stderr, "rfseek-feed: no CAPTURE given (see --help)\n");
+        return 2;
+    }
+    if (replay && (ro->scenario == NULL || ro->out == NULL)) {
+        fprintf(stderr, "rfseek-feed: --pose needs --scenario and --out (see --help)\n");
+        return 2;
+    }
+    if (!replay && (ro->scenario != NULL || ro->out != NULL || ro->has_seed || ro->model != NULL ||
+                    ro->target != NULL)) {
+        fprintf(stderr, "rfseek-feed: --scenario, --out, --seed, --model and --target only go with --pose "
+                        "(see --help)\n");
+        return 2;
+    }
+    if (replay && (fo->output != NULL || fo->live)) {
+        fprintf(stderr, "rfseek-feed: --output and --live do not go with --pose (see --help)\n");
+        return 2;
+    }
+    if (!replay && fo->n_macs == 0) {
+        fprintf(stderr, "rfseek-feed: no --mac given (see --help)\n");
+        return 2;
+    }
+    return RUN;
+}
+
+/* The command line into *fo: RUN, or the exit status (--help, a bad option). */
+static int parse_options(int argc, char **argv, feed_opts_t *fo)
+{
     static const char *const k_valued[] = {"--mac",  "--format", "--output", "--pose", "--scenario",
                                            "--out",  "--seed",   "--model",  "--target"};
+    memset(fo, 0, sizeof(*fo));
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         bool valued = false;
@@ -727,102 +907,46 @@ int main(int argc, char **argv)
                 fprintf(stderr, "rfseek-feed: %s needs a value (see --help)\n", a);
                 return 2;
             }
-            const char *v = argv[++i];
-            if (strcmp(a, "--mac") == 0) {
-                if (n_macs == FEED_MAX_MACS) {
-                    fprintf(stderr, "rfseek-feed: --mac: at most %d addresses\n", FEED_MAX_MACS);
-                    return 2;
-                }
-                if (parse_mac(v, macs[n_macs]) != 0) {
-                    opt_err("--mac: '%s' is not a MAC address (aa:bb:cc:dd:ee:ff)", v);
-                    return 2;
-                }
-                n_macs++;
-            } else if (strcmp(a, "--format") == 0) {
-                if (strcmp(v, "tsv") != 0) {
-                    opt_err("--format: '%s' is not supported (tsv)", v);
-                    return 2;
-                }
-            } else if (strcmp(a, "--output") == 0) {
-                output = v;
-            } else if (strcmp(a, "--pose") == 0) {
-                ro.poses = v;
-            } else if (strcmp(a, "--scenario") == 0) {
-                ro.scenario = v;
-            } else if (strcmp(a, "--out") == 0) {
-                ro.out = v;
-            } else if (strcmp(a, "--model") == 0) {
-                if (rfs_models_lookup(v) == NULL) {
-                    opt_err("--model: unknown '%s' (ridge, mlp, knn, radius, pathloss)", v);
-                    return 2;
-                }
-                ro.model = v;
-            } else if (strcmp(a, "--target") == 0) {
-                if (strcmp(v, "rssi") != 0 && strcmp(v, "pdr") != 0) {
-                    opt_err("--target: unknown '%s' (rssi, pdr)", v);
-                    return 2;
-                }
-                ro.target = v;
-            } else {
-                char *e = NULL;
-                errno = 0;
-                ro.seed = strtoull(v, &e, 10);
-                if (e == v || *e != '\0' || errno != 0 || v[0] == '-') {
-                    opt_err("--seed: '%s' is not a non-negative integer", v);
-                    return 2;
-                }
-                ro.has_seed = true;
+            const int rc = parse_value(fo, a, argv[++i]);
+            if (rc != RUN) {
+                return rc;
             }
         } else if (strcmp(a, "--stats") == 0) {
-            stats = true;
+            fo->stats = true;
         } else if (strcmp(a, "--live") == 0) {
-            live = true;
+            fo->live = true;
         } else if (a[0] == '-' && a[1] != '\0') {
             opt_err("unknown option '%s' (see --help)", a);
             return 2;
-        } else if (ro.capture == NULL) {
-            ro.capture = a;
+        } else if (fo->ro.capture == NULL) {
+            fo->ro.capture = a;
         } else {
-            fprintf(stderr, "rfseek-feed: more than one capture given ('%s' and '%s')\n", ro.capture, a);
+            fprintf(stderr, "rfseek-feed: more than one capture given ('%s' and '%s')\n", fo->ro.capture, a);
             return 2;
         }
     }
-    const bool replay = ro.poses != NULL;
-    if (ro.capture == NULL) {
-        fprintf(stderr, "rfseek-feed: no CAPTURE given (see --help)\n");
-        return 2;
-    }
-    if (replay && (ro.scenario == NULL || ro.out == NULL)) {
-        fprintf(stderr, "rfseek-feed: --pose needs --scenario and --out (see --help)\n");
-        return 2;
-    }
-    if (!replay && (ro.scenario != NULL || ro.out != NULL || ro.has_seed || ro.model != NULL ||
-                    ro.target != NULL)) {
-        fprintf(stderr, "rfseek-feed: --scenario, --out, --seed, --model and --target only go with --pose "
-                        "(see --help)\n");
-        return 2;
-    }
-    if (replay && (output != NULL || live)) {
-        fprintf(stderr, "rfseek-feed: --output and --live do not go with --pose (see --help)\n");
-        return 2;
-    }
-    if (!replay && n_macs == 0) {
-        fprintf(stderr, "rfseek-feed: no --mac given (see --help)\n");
-        return 2;
-    }
+    return check_options(fo);
+}
 
+int main(int argc, char **argv)
+{
+    static feed_opts_t fo;
+    int rc = parse_options(argc, argv, &fo);
+    if (rc != RUN) {
+        return rc;
+    }
     char err[512];
-    lx_pcap_reader_t *r = live ? lx_pcap_open_live(ro.capture, err, sizeof(err))
-                               : lx_pcap_open_offline(ro.capture, err, sizeof(err));
+    lx_pcap_reader_t *r = fo.live ? lx_pcap_open_live(fo.ro.capture, err, sizeof(err))
+                                  : lx_pcap_open_offline(fo.ro.capture, err, sizeof(err));
     if (r == NULL) {
         fprintf(stderr, "rfseek-feed: %s\n", err);
         return 1;
     }
     feed_stats_t st;
     memset(&st, 0, sizeof(st));
-    const int rc = replay ? run_replay(&ro, r, macs, n_macs, &st)
-                          : run_tsv(r, output, live, (const uint8_t(*)[6])macs, n_macs, &st);
+    rc = fo.ro.poses != NULL ? run_replay(&fo.ro, r, fo.macs, fo.n_macs, &st)
+                             : run_tsv(r, fo.output, fo.live, (const uint8_t(*)[6])fo.macs, fo.n_macs, &st);
     lx_pcap_close(r);
-    if (stats) { print_stats(ro.capture, &st); }
+    if (fo.stats) { print_stats(fo.ro.capture, &st); }
     return rc;
 }

@@ -1,17 +1,18 @@
 /* rfseek-record - run a simulated mission with the firmware application loop as the
  * controller and record its input stream (and its live output) in the replay format of
- * firmware/rfs_replay.h (issue 6).
+ * firmware/rfs_replay.h (docs/FIRMWARE.md, "The emulator port and the bit-identical test").
  *
  * The controller is the firmware's: every pose and RSSI measurement of the simulator is
  * encoded as the CAN frames of docs/CAN.md, recorded, and played into rfs_app through
  * rfs_replay_play() - the very code path of the emulator image - so the recorded stream,
  * replayed anywhere, must reproduce the live outputs byte for byte.
  *
- * The simulated receiver's heartbeat (issue 10; the scenario's radio.receiver.heartbeat,
- * once per control period) is recorded as the radio module's RX_STATUS frame (0x121,
- * --heartbeat can, the default), as a RECEIVER record (--heartbeat record: the decoded
- * path of the Linux port), or not at all (--heartbeat off: the packets-only rule). The
- * drop windows below that stop the RSSI frames stop it too: a silent radio module.
+ * The simulated receiver's heartbeat (docs/FAULTS.md, "The receiver heartbeat"; the
+ * scenario's radio.receiver.heartbeat, once per control period) is recorded as the radio
+ * module's RX_STATUS frame (0x121, --heartbeat can, the default), as a RECEIVER record
+ * (--heartbeat record: the decoded path of the Linux port), or not at all (--heartbeat
+ * off: the packets-only rule). The drop windows below that stop the RSSI frames stop it
+ * too: a silent radio module.
  *
  * Faults for the safety tests are injected live and recorded:
  *   --drop T0:T1    no pose or RSSI frame reaches the controller in [T0, T1) seconds
@@ -239,7 +240,7 @@ static void usage(FILE *f)
             "                       [T0, T1) s\n"
             "  --bus-off T0:T1      the controller's CAN is bus-off in [T0, T1) s\n"
             "  --reset T            watchdog reset at T s\n"
-            "  --heartbeat MODE     the receiver heartbeat (issue 10; when the scenario has it):\n"
+            "  --heartbeat MODE     the receiver heartbeat (when the scenario has it):\n"
             "                       can (RX_STATUS frames, default), record (RECEIVER\n"
             "                       records) or off (packets only)\n"
             "  --fit-budget N       samples learnt per control period (0: all; the MCU\n"
@@ -256,7 +257,118 @@ static void die_opt(const char *opt, const char *val)
     exit(2);
 }
 
-int main(int argc, char **argv)
+/* The command line (the fault windows and the heartbeat mode go to the recorder). */
+typedef struct options {
+    const char *out_path, *live_path;
+    const char *scn_path;
+    bool have_seed;
+    unsigned long long seed;
+    double max_time;       /* seconds; <= 0: the scenario's */
+    uint32_t fit_budget;
+    const char *model_name; /* NULL: the scenario's */
+} options_t;
+
+/* One recording: the recorder, the simulator and the application it plays into (static
+ * in main: the scenario, the environment and the application are large). */
+typedef struct recording {
+    recorder_t rec;
+    hs_scenario_t sc;
+    hs_sim_env_t env;
+    rfs_app_t app;
+    rfs_replay_player_t player;
+    uint64_t *model_state;
+    char tmp_in[4096], tmp_out[4096]; /* the outputs until renamed */
+} recording_t;
+
+enum { RUN = -1 }; /* parse_options: go on (else the exit status) */
+
+/* A fault window [T0, T1) of option opt into w[*n]; exits on a bad value. */
+static void add_window(window_t *w, unsigned *n, const char *opt, const char *val)
+{
+    if (*n == MAX_WINDOWS || parse_window(val, &w[(*n)++]) != 0) {
+        die_opt(opt, val);
+    }
+}
+
+/* One option c of getopt_long with its optarg: RUN, or the exit status. */
+static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
+{
+    char *end;
+    switch (c) {
+    case 'o': o->out_path = optarg; break;
+    case 'l': o->live_path = optarg; break;
+    case 's':
+        errno = 0;
+        o->seed = strtoull(optarg, &end, 0);
+        if (errno != 0 || end == optarg || *end != '\0') {
+            die_opt("--seed", optarg);
+        }
+        o->have_seed = true;
+        break;
+    case 't':
+        o->max_time = strtod(optarg, &end);
+        if (end == optarg || *end != '\0' || !(o->max_time > 0) || o->max_time > 1e5) {
+            die_opt("--max-time", optarg);
+        }
+        break;
+    case 'd': add_window(rec->drop, &rec->ndrop, "--drop", optarg); break;
+    case 'P': add_window(rec->drop_pose, &rec->ndrop_pose, "--drop-pose", optarg); break;
+    case 'R': add_window(rec->drop_rssi, &rec->ndrop_rssi, "--drop-rssi", optarg); break;
+    case 'b': add_window(rec->busoff, &rec->nbusoff, "--bus-off", optarg); break;
+    case 'f': {
+        errno = 0;
+        const unsigned long v = strtoul(optarg, &end, 0);
+        if (errno != 0 || end == optarg || *end != '\0' || v > 100000ul) {
+            die_opt("--fit-budget", optarg);
+        }
+        o->fit_budget = (uint32_t)v;
+        break;
+    }
+    case 'r': {
+        const double t = strtod(optarg, &end);
+        if (rec->nreset == MAX_WINDOWS || end == optarg || *end != '\0' || t < 0 || t > 1e6) {
+            die_opt("--reset", optarg);
+        }
+        rec->reset_us[rec->nreset++] = (int64_t)(t * 1e6 + 0.5);
+        break;
+    }
+    case 'm':
+        if (rfs_models_lookup(optarg) == NULL ||
+            strlen(optarg) > RFS_REPLAY_MODEL_NAME_MAX) {
+            lx_err_print(PROG, "--model: unknown '%s' (ridge, mlp, knn, radius, pathloss)", optarg);
+            return 2;
+        }
+        o->model_name = optarg;
+        break;
+    case 'H':
+        if (strcmp(optarg, "can") == 0) {
+            rec->heartbeat = HB_CAN;
+        } else if (strcmp(optarg, "record") == 0) {
+            rec->heartbeat = HB_RECORD;
+        } else if (strcmp(optarg, "off") == 0) {
+            rec->heartbeat = HB_OFF;
+        } else {
+            die_opt("--heartbeat (can, record or off)", optarg);
+        }
+        break;
+    case 'h': usage(stdout); return 0;
+    case ':': lx_err_print(PROG, "missing value for '%s' (see --help)", argv[optind - 1]); return 2;
+    default:
+        /* An unknown short option is optopt (its word may hold more options); an
+         * unknown or ambiguous long one (optopt 0), or --help given a value (optopt
+         * 'h'), is the word just passed. */
+        if (optopt != 0 && optopt != 'h') {
+            lx_err_print(PROG, "unknown option '-%c' (see --help)", optopt);
+        } else {
+            lx_err_print(PROG, "unknown option '%s' (see --help)", argv[optind - 1]);
+        }
+        return 2;
+    }
+    return RUN;
+}
+
+/* The command line into *o and *rec: RUN, or the exit status. */
+static int parse_options(int argc, char **argv, options_t *o, recorder_t *rec)
 {
     static const struct option opts[] = {
         {"out", required_argument, 0, 'o'},     {"live-out", required_argument, 0, 'l'},
@@ -267,13 +379,8 @@ int main(int argc, char **argv)
         {"fit-budget", required_argument, 0, 'f'}, {"model", required_argument, 0, 'm'},
         {"heartbeat", required_argument, 0, 'H'},
         {0, 0, 0, 0}};
-    static recorder_t rec;
-    const char *out_path = NULL, *live_path = NULL;
-    bool have_seed = false;
-    unsigned long long seed = 0;
-    double max_time = -1;
-    uint32_t fit_budget = 0;
-    const char *model_name = NULL;
+    memset(o, 0, sizeof *o);
+    o->max_time = -1;
     /* getopt's own messages would echo a bad option raw (and the usage follows on stderr):
      * it stays quiet and the one line is ours. A leading ':' tells a missing value (':')
      * from an unknown option ('?'). */
@@ -281,188 +388,121 @@ int main(int argc, char **argv)
     opterr = 0;
     int c;
     while ((c = getopt_long(argc, argv, shortopts, opts, NULL)) != -1) {
-        char *end;
-        switch (c) {
-        case 'o': out_path = optarg; break;
-        case 'l': live_path = optarg; break;
-        case 's':
-            errno = 0;
-            seed = strtoull(optarg, &end, 0);
-            if (errno != 0 || end == optarg || *end != '\0') {
-                die_opt("--seed", optarg);
-            }
-            have_seed = true;
-            break;
-        case 't':
-            max_time = strtod(optarg, &end);
-            if (end == optarg || *end != '\0' || !(max_time > 0) || max_time > 1e5) {
-                die_opt("--max-time", optarg);
-            }
-            break;
-        case 'd':
-            if (rec.ndrop == MAX_WINDOWS || parse_window(optarg, &rec.drop[rec.ndrop++]) != 0) {
-                die_opt("--drop", optarg);
-            }
-            break;
-        case 'P':
-            if (rec.ndrop_pose == MAX_WINDOWS ||
-                parse_window(optarg, &rec.drop_pose[rec.ndrop_pose++]) != 0) {
-                die_opt("--drop-pose", optarg);
-            }
-            break;
-        case 'R':
-            if (rec.ndrop_rssi == MAX_WINDOWS ||
-                parse_window(optarg, &rec.drop_rssi[rec.ndrop_rssi++]) != 0) {
-                die_opt("--drop-rssi", optarg);
-            }
-            break;
-        case 'b':
-            if (rec.nbusoff == MAX_WINDOWS ||
-                parse_window(optarg, &rec.busoff[rec.nbusoff++]) != 0) {
-                die_opt("--bus-off", optarg);
-            }
-            break;
-        case 'f': {
-            errno = 0;
-            const unsigned long v = strtoul(optarg, &end, 0);
-            if (errno != 0 || end == optarg || *end != '\0' || v > 100000ul) {
-                die_opt("--fit-budget", optarg);
-            }
-            fit_budget = (uint32_t)v;
-            break;
-        }
-        case 'r': {
-            const double t = strtod(optarg, &end);
-            if (rec.nreset == MAX_WINDOWS || end == optarg || *end != '\0' || t < 0 || t > 1e6) {
-                die_opt("--reset", optarg);
-            }
-            rec.reset_us[rec.nreset++] = (int64_t)(t * 1e6 + 0.5);
-            break;
-        }
-        case 'm':
-            if (rfs_models_lookup(optarg) == NULL ||
-                strlen(optarg) > RFS_REPLAY_MODEL_NAME_MAX) {
-                lx_err_print(PROG, "--model: unknown '%s' (ridge, mlp, knn, radius, pathloss)", optarg);
-                return 2;
-            }
-            model_name = optarg;
-            break;
-        case 'H':
-            if (strcmp(optarg, "can") == 0) {
-                rec.heartbeat = HB_CAN;
-            } else if (strcmp(optarg, "record") == 0) {
-                rec.heartbeat = HB_RECORD;
-            } else if (strcmp(optarg, "off") == 0) {
-                rec.heartbeat = HB_OFF;
-            } else {
-                die_opt("--heartbeat (can, record or off)", optarg);
-            }
-            break;
-        case 'h': usage(stdout); return 0;
-        case ':': lx_err_print(PROG, "missing value for '%s' (see --help)", argv[optind - 1]); return 2;
-        default:
-            /* An unknown short option is optopt (its word may hold more options); an
-             * unknown or ambiguous long one (optopt 0), or --help given a value (optopt
-             * 'h'), is the word just passed. */
-            if (optopt != 0 && optopt != 'h') {
-                lx_err_print(PROG, "unknown option '-%c' (see --help)", optopt);
-            } else {
-                lx_err_print(PROG, "unknown option '%s' (see --help)", argv[optind - 1]);
-            }
-            return 2;
+        const int rc = parse_option(c, argv, o, rec);
+        if (rc != RUN) {
+            return rc;
         }
     }
-    if (optind >= argc || out_path == NULL) {
-        lx_err_print(PROG, "%s (see --help)", out_path == NULL ? "-o IN.rfsr is required" : "a SCENARIO is required");
+    if (optind >= argc || o->out_path == NULL) {
+        lx_err_print(PROG, "%s (see --help)", o->out_path == NULL ? "-o IN.rfsr is required" : "a SCENARIO is required");
         return 2;
     }
     if (optind + 1 != argc) {
         lx_err_print(PROG, "'%s': only one SCENARIO expected (see --help)", argv[optind + 1]);
         return 2;
     }
-    const char *scn_path = argv[optind];
+    o->scn_path = argv[optind];
+    return RUN;
+}
+
+/* The scenario and its environment, checked against what the image holds: 0, or 1 after
+ * an error line. */
+static int open_scenario(recording_t *s, options_t *o)
+{
     char err[512];
-    static hs_scenario_t sc;
-    if (hs_scenario_load(scn_path, &sc, err, sizeof err) != 0) {
+    if (hs_scenario_load(o->scn_path, &s->sc, err, sizeof err) != 0) {
         lx_err_print(PROG, "%s", err);
         return 1;
     }
-    if (max_time > 0) {
-        sc.stop_time_s = max_time;
+    if (o->max_time > 0) {
+        s->sc.stop_time_s = o->max_time;
     }
-    if (strcmp(sc.target, "pdr") == 0) {
+    if (strcmp(s->sc.target, "pdr") == 0) {
         lx_err_print(PROG, "%s: target: pdr is not available on the firmware (the CAN RSSI frame carries no "
-                 "sequence number; docs/MODELS.md)", scn_path);
+                 "sequence number; docs/MODELS.md)", o->scn_path);
         return 1;
     }
-    if (model_name == NULL) {
-        model_name = sc.model; // checked against the registry by the scenario loader
+    if (o->model_name == NULL) {
+        o->model_name = s->sc.model; // checked against the registry by the scenario loader
     }
-    static hs_sim_env_t env;
-    if (hs_sim_env_open(&env, &sc, err, sizeof err) != 0) {
+    if (hs_sim_env_open(&s->env, &s->sc, err, sizeof err) != 0) {
         lx_err_print(PROG, "%s", err);
         return 1;
     }
-    const rfs_map_t *m = &env.core.map;
+    const rfs_map_t *m = &s->env.core.map;
     if (rfs_map_bytes(m->w, m->h) > RFS_APP_MAX_MAP_BYTES) {
         lx_err_print(PROG, "%s: map of %u x %u cells is larger than the image holds (%u bytes per grid)",
-                 scn_path, m->w, m->h, RFS_APP_MAX_MAP_BYTES);
+                 o->scn_path, m->w, m->h, RFS_APP_MAX_MAP_BYTES);
         return 1;
     }
+    return 0;
+}
 
-    /* Outputs go to temporary files renamed at the end: nothing half-written. */
-    char tmp_in[4096], tmp_out[4096];
-    snprintf(tmp_in, sizeof tmp_in, "%s.tmp.%ld", out_path, (long)getpid());
-    snprintf(tmp_out, sizeof tmp_out, "%s.tmp.%ld", live_path ? live_path : "", (long)getpid());
-    rec.in = fopen(tmp_in, "wb");
-    if (rec.in == NULL) {
-        lx_err_print(PROG, "%s: %s", out_path, strerror(errno));
+/* The output streams, as temporary files renamed at the end (nothing half-written): 0,
+ * or 1 after an error line. */
+static int open_outputs(recording_t *s, const options_t *o)
+{
+    recorder_t *rec = &s->rec;
+    snprintf(s->tmp_in, sizeof s->tmp_in, "%s.tmp.%ld", o->out_path, (long)getpid());
+    snprintf(s->tmp_out, sizeof s->tmp_out, "%s.tmp.%ld", o->live_path ? o->live_path : "", (long)getpid());
+    rec->in = fopen(s->tmp_in, "wb");
+    if (rec->in == NULL) {
+        lx_err_print(PROG, "%s: %s", o->out_path, strerror(errno));
         return 1;
     }
-    if (live_path != NULL && (rec.out = fopen(tmp_out, "wb")) == NULL) {
-        lx_err_print(PROG, "%s: %s", live_path, strerror(errno));
-        fclose(rec.in);
-        remove(tmp_in);
+    if (o->live_path != NULL && (rec->out = fopen(s->tmp_out, "wb")) == NULL) {
+        lx_err_print(PROG, "%s: %s", o->live_path, strerror(errno));
+        fclose(rec->in);
+        remove(s->tmp_in);
         return 1;
     }
-    rec.in_path = out_path;
-    static rfs_app_t app;
-    static rfs_replay_player_t player;
-    rec.app = &app;
-    rec.player = &player;
-    rfs_can_tx_init(&rec.tx);
-    const uint64_t run_seed = have_seed ? seed : sc.seed;
+    rec->in_path = o->out_path;
+    return 0;
+}
 
+/* The stream's header and the player over the application: 0, or 1 after an error line. */
+static int start_player(recording_t *s)
+{
+    recorder_t *rec = &s->rec;
+    rec->app = &s->app;
+    rec->player = &s->player;
+    rfs_can_tx_init(&rec->tx);
     uint8_t hdr[RFS_REPLAY_HEADER_LEN];
     rfs_replay_header(hdr);
-    if (fwrite(hdr, 1, sizeof hdr, rec.in) != sizeof hdr) {
-        rec.write_failed = 1;
+    if (fwrite(hdr, 1, sizeof hdr, rec->in) != sizeof hdr) {
+        rec->write_failed = 1;
     }
     // The host holds every model (the CFG record names it; the emulator may refuse it).
     const uint32_t model_bytes = (rfs_models_max_state_bytes() + 7u) & ~7u;
-    static uint64_t *model_state;
-    model_state = aligned_alloc(RFS_MODELS_STATE_ALIGN, model_bytes);
-    if (model_state == NULL) {
+    s->model_state = aligned_alloc(RFS_MODELS_STATE_ALIGN, model_bytes);
+    if (s->model_state == NULL) {
         fprintf(stderr, "rfseek-record: out of memory\n");
         return 1;
     }
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
-    cfg.model_state = model_state;
+    cfg.model_state = s->model_state;
     cfg.model_state_bytes = model_bytes;
-    rfs_replay_player_init(&player, &app, &cfg, sink, &rec);
+    rfs_replay_player_init(&s->player, &s->app, &cfg, sink, rec);
+    return 0;
+}
 
+/* The configuration records: CFG, MAP and the map's grids in chunks. */
+static void record_config(recording_t *s, const options_t *o, uint64_t run_seed)
+{
+    recorder_t *rec = &s->rec;
+    const rfs_map_t *m = &s->env.core.map;
     rfs_replay_rec_t r;
     memset(&r, 0, sizeof r);
     r.type = RFS_REPLAY_CFG;
     r.u.cfg.seed = run_seed;
-    r.u.cfg.target = sc.nsources == 2u ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
+    r.u.cfg.target = s->sc.nsources == 2u ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
     r.u.cfg.node = 1u;
-    r.u.cfg.fit_budget = fit_budget;
-    if (strcmp(model_name, "ridge") != 0) { // the ridge is every player's base: a v1 CFG
-        const size_t n = strlen(model_name); // registry names are <= 15 bytes (checked above)
-        memcpy(r.u.cfg.model, model_name, n < RFS_REPLAY_MODEL_NAME_MAX ? n : RFS_REPLAY_MODEL_NAME_MAX);
+    r.u.cfg.fit_budget = o->fit_budget;
+    if (strcmp(o->model_name, "ridge") != 0) { // the ridge is every player's base: a v1 CFG
+        const size_t n = strlen(o->model_name); // registry names are <= 15 bytes (checked above)
+        memcpy(r.u.cfg.model, o->model_name, n < RFS_REPLAY_MODEL_NAME_MAX ? n : RFS_REPLAY_MODEL_NAME_MAX);
     }
-    feed(&rec, &r);
+    feed(rec, &r);
     memset(&r, 0, sizeof r);
     r.type = RFS_REPLAY_MAP;
     r.u.map.w = m->w;
@@ -470,11 +510,11 @@ int main(int argc, char **argv)
     r.u.map.res = m->res;
     r.u.map.origin_x = m->origin_x;
     r.u.map.origin_y = m->origin_y;
-    r.u.map.has_wall = env.core.wall_bits != NULL ? 1u : 0u;
-    feed(&rec, &r);
+    r.u.map.has_wall = s->env.core.wall_bits != NULL ? 1u : 0u;
+    feed(rec, &r);
     const uint32_t bytes = rfs_map_bytes(m->w, m->h);
     for (int g = 0; g < 2; g++) {
-        const uint8_t *bits = g == 0 ? env.core.free_bits : env.core.wall_bits;
+        const uint8_t *bits = g == 0 ? s->env.core.free_bits : s->env.core.wall_bits;
         if (bits == NULL) {
             continue;
         }
@@ -484,42 +524,66 @@ int main(int argc, char **argv)
             r.u.chunk.offset = off;
             r.u.chunk.n = (uint8_t)(bytes - off < RFS_REPLAY_CHUNK ? bytes - off : RFS_REPLAY_CHUNK);
             memcpy(r.u.chunk.bytes, bits + off, r.u.chunk.n);
-            feed(&rec, &r);
+            feed(rec, &r);
         }
     }
+}
 
+/* The mission with the recorder as the controller, the END record, and the outputs
+ * renamed into place: the exit status. */
+static int run_mission(recording_t *s, const options_t *o, uint64_t run_seed)
+{
+    recorder_t *rec = &s->rec;
+    char err[512];
     hs_ctrl_t ctrl;
     memset(&ctrl, 0, sizeof ctrl);
     ctrl.name = "firmware";
-    ctrl.self = &rec;
+    ctrl.self = rec;
     ctrl.period_us = RFS_APP_PERIOD_US;
     ctrl.on_pose = on_pose;
     ctrl.on_rssi = on_rssi;
     ctrl.on_receiver = on_receiver;
     ctrl.step = step;
     hs_sim_result_t res;
-    const int rc = hs_sim_run(&env, run_seed, &ctrl, NULL, &res, err, sizeof err);
+    const int rc = hs_sim_run(&s->env, run_seed, &ctrl, NULL, &res, err, sizeof err);
+    rfs_replay_rec_t r;
     memset(&r, 0, sizeof r);
     r.type = RFS_REPLAY_END;
-    put(&rec, &r);
-    const int close_in = fclose(rec.in);
-    const int close_out = rec.out != NULL ? fclose(rec.out) : 0;
-    if (rc != 0 || rec.write_failed || close_in != 0 || close_out != 0) {
-        lx_err_print(PROG, "%s: %s", rc != 0 ? scn_path : out_path, rc != 0 ? err : "write failed");
-        remove(tmp_in);
-        if (live_path != NULL) {
-            remove(tmp_out);
+    put(rec, &r);
+    const int close_in = fclose(rec->in);
+    const int close_out = rec->out != NULL ? fclose(rec->out) : 0;
+    if (rc != 0 || rec->write_failed || close_in != 0 || close_out != 0) {
+        lx_err_print(PROG, "%s: %s", rc != 0 ? o->scn_path : o->out_path, rc != 0 ? err : "write failed");
+        remove(s->tmp_in);
+        if (o->live_path != NULL) {
+            remove(s->tmp_out);
         }
         return 1;
     }
-    if (rename(tmp_in, out_path) != 0 || (live_path != NULL && rename(tmp_out, live_path) != 0)) {
-        lx_err_print(PROG, "%s: %s", out_path, strerror(errno));
+    if (rename(s->tmp_in, o->out_path) != 0 || (o->live_path != NULL && rename(s->tmp_out, o->live_path) != 0)) {
+        lx_err_print(PROG, "%s: %s", o->out_path, strerror(errno));
         return 1;
     }
     printf("recorded %" PRIu32 " records, %" PRIu32 " steps, %.1f s simulated, %s, "
            "%u decisions, final distance %.2f m\n",
-           rec.records, player.steps, res.sim_time_s, res.end, res.iterations,
+           rec->records, s->player.steps, res.sim_time_s, res.end, res.iterations,
            res.final_distance_m);
-    hs_sim_env_close(&env);
+    hs_sim_env_close(&s->env);
     return 0;
+}
+
+int main(int argc, char **argv)
+{
+    static recording_t s;
+    options_t o;
+    int rc = parse_options(argc, argv, &o, &s.rec);
+    if (rc != RUN) {
+        return rc;
+    }
+    if (open_scenario(&s, &o) != 0 || open_outputs(&s, &o) != 0 || start_player(&s) != 0) {
+        return 1;
+    }
+    const uint64_t run_seed = o.have_seed ? o.seed : s.sc.seed;
+    record_config(&s, &o, run_seed);
+    return run_mission(&s, &o, run_seed);
 }

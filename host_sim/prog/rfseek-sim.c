@@ -163,7 +163,7 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         if (faults) {
             io.faults = open_in(dir, "faults.tsv");
         }
-        if (strcmp(env->sc.model, "pathloss") == 0) { // the last fit's surface
+        if (strcmp(env->sc.model, "pathloss") == 0) { // the last fit's surface (docs/PATHLOSS.md, "Uncertainty")
             io.residual = open_in(dir, "residual.tsv");
         }
         if (!io.log || !io.track || (samples && !io.samples) || (faults && !io.faults) ||
@@ -185,7 +185,7 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         fprintf(stderr, "%s: %s\n", prog, err);
         rc = 1;
     }
-    // field.tsv for source 0 and field1.tsv for a second source (bridging).
+    // field.tsv for source 0 and field1.tsv for a second source (bridging: the "bridge" target).
     for (unsigned src = 0; rc == 0 && field && dir && src < env->sc.nsources; src++) {
         FILE *f = open_in(dir, src == 0 ? "field.tsv" : "field1.tsv");
         if (!f || hs_sim_field(env, seed, src, 0.1, f, err, sizeof err) != 0) {
@@ -241,129 +241,179 @@ static void progress(uint64_t done, uint64_t total, uint64_t reached)
     fflush(stderr);
 }
 
-static int run_batch(const hs_sim_env_t *env, uint64_t a, uint64_t b, int jobs, const char *dir,
-                     bool samples, bool quiet)
+/* One --seeds batch: the seeds a..b shared among jobs worker processes, each result
+ * sent to the parent through a pipe. */
+typedef struct batch {
+    const hs_sim_env_t *env;
+    uint64_t a, b, total;
+    int jobs;
+    const char *dir;      /* per-seed directories and runs.tsv in it, or NULL: stdout */
+    bool samples, quiet;
+    hs_sim_result_t *all; /* by seed - a */
+    bool *have;
+    pid_t *pids;
+    int fds[2];           /* the workers' pipe */
+    uint64_t done, reached;
+} batch_t;
+
+/* Worker j: its seeds (a + j, a + j + jobs, ...), each run and its result written to the
+ * pipe; exits 1 after the first failure. */
+static _Noreturn void batch_worker(const batch_t *bt, int j)
 {
-    uint64_t total = b - a + 1;
-    if ((uint64_t)jobs > total) {
-        jobs = (int)total;
+    close(bt->fds[0]);
+    for (uint64_t s = bt->a + (uint64_t)j; s <= bt->b; s += (uint64_t)bt->jobs) {
+        wire_res_t w;
+        memset(&w, 0, sizeof w);
+        char sub[PATH_MAX + 64];
+        const char *sd = NULL;
+        if (bt->dir) {
+            if (snprintf(sub, sizeof sub, "%s/seed-%llu", bt->dir, (unsigned long long)s) >=
+                    (int)sizeof sub ||
+                mkdir(sub, 0777) != 0) {
+                fprintf(stderr, "%s: %s: %s\n", prog, sub, strerror(errno));
+                w.end = -1;
+            }
+            sd = sub;
+        }
+        if (w.end == 0) {
+            FILE *devnull = NULL;
+            if (!sd) {
+                devnull = freopen("/dev/null", "w", stdout); // no per-seed JSON on stdout
+                (void)devnull;
+            }
+            if (run_one(bt->env, s, sd, bt->samples, false, NULL, &w.r) != 0) {
+                w.end = -1;
+            } else {
+                w.end = w.r.reached ? 0 : (strcmp(w.r.end, "distance") == 0 ? 1 : 2);
+            }
+        }
+        w.r.seed = s;
+        w.r.end = NULL;
+        if (write(bt->fds[1], &w, sizeof w) != (ssize_t)sizeof w || w.end < 0) {
+            _exit(1);
+        }
     }
-    hs_sim_result_t *all = calloc(total, sizeof *all);
-    bool *have = calloc(total, sizeof *have);
-    pid_t *pids = calloc((size_t)jobs, sizeof *pids);
-    int fds[2];
-    if (!all || !have || !pids || pipe(fds) != 0) {
-        free(all); free(have); free(pids);
-        fprintf(stderr, "%s: out of memory\n", prog);
-        return 1;
-    }
+    _exit(0);
+}
+
+/* The workers forked: 0, or 1 after a message (the ones started are terminated). */
+static int batch_fork(batch_t *bt)
+{
     fflush(stdout);
     fflush(stderr);
-    for (int j = 0; j < jobs; j++) {
+    for (int j = 0; j < bt->jobs; j++) {
         pid_t pid = fork();
         if (pid < 0) {
             fprintf(stderr, "%s: fork: %s\n", prog, strerror(errno));
             for (int k = 0; k < j; k++) {
-                kill(pids[k], SIGTERM);
+                kill(bt->pids[k], SIGTERM);
             }
-            free(all); free(have); free(pids);
             return 1;
         }
         if (pid == 0) {
-            close(fds[0]);
-            for (uint64_t s = a + (uint64_t)j; s <= b; s += (uint64_t)jobs) {
-                wire_res_t w;
-                memset(&w, 0, sizeof w);
-                char sub[PATH_MAX + 64];
-                const char *sd = NULL;
-                if (dir) {
-                    if (snprintf(sub, sizeof sub, "%s/seed-%llu", dir, (unsigned long long)s) >=
-                            (int)sizeof sub ||
-                        mkdir(sub, 0777) != 0) {
-                        fprintf(stderr, "%s: %s: %s\n", prog, sub, strerror(errno));
-                        w.end = -1;
-                    }
-                    sd = sub;
-                }
-                if (w.end == 0) {
-                    FILE *devnull = NULL;
-                    if (!sd) {
-                        devnull = freopen("/dev/null", "w", stdout); // no per-seed JSON on stdout
-                        (void)devnull;
-                    }
-                    if (run_one(env, s, sd, samples, false, NULL, &w.r) != 0) {
-                        w.end = -1;
-                    } else {
-                        w.end = w.r.reached ? 0 : (strcmp(w.r.end, "distance") == 0 ? 1 : 2);
-                    }
-                }
-                w.r.seed = s;
-                w.r.end = NULL;
-                if (write(fds[1], &w, sizeof w) != (ssize_t)sizeof w || w.end < 0) {
-                    _exit(1);
-                }
-            }
-            _exit(0);
+            batch_worker(bt, j);
         }
-        pids[j] = pid;
+        bt->pids[j] = pid;
     }
-    close(fds[1]);
-    uint64_t done = 0, reached = 0;
+    close(bt->fds[1]);
+    return 0;
+}
+
+/* The workers' results read until the pipe closes or one failed, then the workers
+ * reaped: 0, or 1 when a run or a worker failed. */
+static int batch_collect(batch_t *bt)
+{
     int rc = 0;
     wire_res_t w;
-    if (!quiet) {
-        progress(0, total, 0);
+    if (!bt->quiet) {
+        progress(0, bt->total, 0);
     }
-    while (read(fds[0], &w, sizeof w) == (ssize_t)sizeof w) {
+    while (read(bt->fds[0], &w, sizeof w) == (ssize_t)sizeof w) {
         if (w.end < 0) {
             rc = 1;
             break;
         }
-        uint64_t i = w.r.seed - a;
-        all[i] = w.r;
-        all[i].end = end_names[w.end];
-        have[i] = true;
-        done++;
-        reached += w.r.reached ? 1u : 0u;
-        if (!quiet) {
-            progress(done, total, reached);
+        uint64_t i = w.r.seed - bt->a;
+        bt->all[i] = w.r;
+        bt->all[i].end = end_names[w.end];
+        bt->have[i] = true;
+        bt->done++;
+        bt->reached += w.r.reached ? 1u : 0u;
+        if (!bt->quiet) {
+            progress(bt->done, bt->total, bt->reached);
         }
     }
-    if (!quiet) {
+    if (!bt->quiet) {
         fputc('\n', stderr);
     }
-    close(fds[0]);
-    for (int j = 0; j < jobs; j++) {
+    close(bt->fds[0]);
+    for (int j = 0; j < bt->jobs; j++) {
         int st;
         if (rc != 0) {
-            kill(pids[j], SIGTERM);
+            kill(bt->pids[j], SIGTERM);
         }
-        waitpid(pids[j], &st, 0);
+        waitpid(bt->pids[j], &st, 0);
         if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
             rc = 1;
         }
     }
-    if (rc == 0 && done != total) {
+    if (rc == 0 && bt->done != bt->total) {
         fprintf(stderr, "%s: a worker ended early (%llu of %llu seeds)\n", prog,
-                (unsigned long long)done, (unsigned long long)total);
+                (unsigned long long)bt->done, (unsigned long long)bt->total);
         rc = 1;
     }
-    if (rc == 0) {
-        FILE *t = dir ? open_in(dir, "runs.tsv") : stdout;
-        if (!t) {
-            fprintf(stderr, "%s: %s/runs.tsv: %s\n", prog, dir, strerror(errno));
-            rc = 1;
-        } else {
-            hs_sim_table_header(t);
-            for (uint64_t i = 0; i < total; i++) {
-                hs_sim_table_row(t, &all[i]);
-            }
-            if (dir && fclose(t) != 0) {
-                rc = 1;
-            }
+    return rc;
+}
+
+/* runs.tsv (stdout without a directory): 0, or 1 after a failure. */
+static int batch_table(const batch_t *bt)
+{
+    FILE *t = bt->dir ? open_in(bt->dir, "runs.tsv") : stdout;
+    if (!t) {
+        fprintf(stderr, "%s: %s/runs.tsv: %s\n", prog, bt->dir, strerror(errno));
+        return 1;
+    }
+    hs_sim_table_header(t);
+    for (uint64_t i = 0; i < bt->total; i++) {
+        hs_sim_table_row(t, &bt->all[i]);
+    }
+    if (bt->dir && fclose(t) != 0) {
+        return 1;
+    }
+    return 0;
+}
+
+static int run_batch(const hs_sim_env_t *env, uint64_t a, uint64_t b, int jobs, const char *dir,
+                     bool samples, bool quiet)
+{
+    batch_t bt;
+    memset(&bt, 0, sizeof bt);
+    bt.env = env;
+    bt.a = a;
+    bt.b = b;
+    bt.total = b - a + 1;
+    bt.jobs = (uint64_t)jobs > bt.total ? (int)bt.total : jobs;
+    bt.dir = dir;
+    bt.samples = samples;
+    bt.quiet = quiet;
+    // NOLINTNEXTLINE(clang-analyzer-optin.portability.UnixAPI): total 0 only for --seeds 0..2^64-1 (wraps)
+    bt.all = calloc(bt.total, sizeof *bt.all);
+    bt.have = calloc(bt.total, sizeof *bt.have);
+    bt.pids = calloc((size_t)bt.jobs, sizeof *bt.pids);
+    int rc;
+    if (!bt.all || !bt.have || !bt.pids || pipe(bt.fds) != 0) {
+        fprintf(stderr, "%s: out of memory\n", prog);
+        rc = 1;
+    } else {
+        rc = batch_fork(&bt);
+        if (rc == 0) {
+            rc = batch_collect(&bt);
+        }
+        if (rc == 0) {
+            rc = batch_table(&bt);
         }
     }
-    free(all); free(have); free(pids);
+    free(bt.all); free(bt.have); free(bt.pids);
     return rc;
 }
 
@@ -408,15 +458,25 @@ static int run_bench(const hs_sim_env_t *env, uint64_t a, uint64_t b)
     return 0;
 }
 
-int main(int argc, char **argv)
+/* The command line. */
+typedef struct sim_opts {
+    const char *scenario, *out, *pcap, *seeds;
+    const char *strategy, *model; /* overrides of the scenario's, or NULL */
+    uint64_t seed;
+    bool has_seed, samples, field, emit, quiet, bench, no_faults;
+    double p0_min;                /* --p0-min: NAN keeps the scenario's (or the model's default) */
+    long jobs;
+    uint64_t sa, sb;              /* --seeds A..B */
+} sim_opts_t;
+
+enum { RUN = -1 }; /* parse_options: go on (else the exit status) */
+
+/* The command line into *o: RUN, or the exit status (--help, a bad option). */
+static int parse_options(int argc, char **argv, sim_opts_t *o)
 {
-    const char *scenario = NULL, *out = NULL, *pcap = NULL, *seeds = NULL;
-    const char *strategy = NULL, *model = NULL;
-    uint64_t seed = 0;
-    bool has_seed = false, samples = false, field = false, emit = false, quiet = false;
-    bool bench = false, no_faults = false;
-    double p0_min = NAN; // --p0-min: NAN keeps the scenario's (or the model's default)
-    long jobs = sysconf(_SC_NPROCESSORS_ONLN);
+    memset(o, 0, sizeof *o);
+    o->p0_min = NAN;
+    o->jobs = sysconf(_SC_NPROCESSORS_ONLN);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         bool more = i + 1 < argc;
@@ -424,156 +484,176 @@ int main(int argc, char **argv)
             usage(stdout);
             return 0;
         } else if (strcmp(a, "--seed") == 0) {
-            if (!more || parse_u64(argv[++i], &seed) != 0) {
+            if (!more || parse_u64(argv[++i], &o->seed) != 0) {
                 return die("--seed: expected a non-negative integer%s%s", "", "");
             }
-            has_seed = true;
+            o->has_seed = true;
         } else if (strcmp(a, "--out") == 0) {
             if (!more || !*argv[i + 1]) {
                 return die("--out: expected a directory%s%s", "", "");
             }
-            out = argv[++i];
+            o->out = argv[++i];
         } else if (strcmp(a, "--pcap") == 0) {
             if (!more || !*argv[i + 1]) {
                 return die("--pcap: expected a file name%s%s", "", "");
             }
-            pcap = argv[++i];
+            o->pcap = argv[++i];
         } else if (strcmp(a, "--seeds") == 0) {
             if (!more) {
                 return die("--seeds: expected A..B%s%s", "", "");
             }
-            seeds = argv[++i];
+            o->seeds = argv[++i];
         } else if (strcmp(a, "--jobs") == 0) {
             uint64_t j;
             if (!more || parse_u64(argv[++i], &j) != 0 || j < 1 || j > 1024) {
                 return die("--jobs: expected a number from 1 to 1024%s%s", "", "");
             }
-            jobs = (long)j;
+            o->jobs = (long)j;
         } else if (strcmp(a, "--samples") == 0) {
-            samples = true;
+            o->samples = true;
         } else if (strcmp(a, "--field") == 0) {
-            field = true;
+            o->field = true;
         } else if (strcmp(a, "--emit-jobs") == 0) {
-            emit = true;
+            o->emit = true;
         } else if (strcmp(a, "--strategy") == 0 || strcmp(a, "--model") == 0) {
             if (!more || !*argv[i + 1]) {
                 return die("%s: expected a name%s", a, "");
             }
-            *(a[2] == 's' ? &strategy : &model) = argv[++i];
+            *(a[2] == 's' ? &o->strategy : &o->model) = argv[++i];
         } else if (strcmp(a, "--p0-min") == 0) {
             char *end = NULL;
-            p0_min = more ? strtod(argv[i + 1], &end) : NAN;
-            if (!more || !*argv[i + 1] || *end != '\0' || !(p0_min >= -200.0 && p0_min <= 100.0)) {
+            o->p0_min = more ? strtod(argv[i + 1], &end) : NAN;
+            if (!more || !*argv[i + 1] || *end != '\0' || !(o->p0_min >= -200.0 && o->p0_min <= 100.0)) {
                 return die("--p0-min: expected dBm in [-200, 100], got '%s'%s",
                            more ? argv[i + 1] : "", "");
             }
             i++;
         } else if (strcmp(a, "--no-faults") == 0) {
-            no_faults = true;
+            o->no_faults = true;
         } else if (strcmp(a, "--quiet") == 0) {
-            quiet = true;
+            o->quiet = true;
         } else if (strcmp(a, "--bench") == 0) {
-            bench = true;
+            o->bench = true;
         } else if (a[0] == '-' && a[1] != '\0') {
             return die("unknown option '%s' (see --help)%s", a, "");
-        } else if (!scenario) {
-            scenario = a;
+        } else if (!o->scenario) {
+            o->scenario = a;
         } else {
             return die("unexpected argument '%s' (one scenario only)%s", a, "");
         }
     }
-    if (!scenario) {
+    return RUN;
+}
+
+/* The options that go together, checked: RUN, or the exit status after a message. */
+static int check_options(sim_opts_t *o)
+{
+    if (!o->scenario) {
         usage(stderr);
         return 1;
     }
-    uint64_t sa = 0, sb = 0;
-    if (seeds && parse_range(seeds, &sa, &sb) != 0) {
-        return die("--seeds: '%s' is not A..B with A <= B%s", seeds, "");
+    if (o->seeds && parse_range(o->seeds, &o->sa, &o->sb) != 0) {
+        return die("--seeds: '%s' is not A..B with A <= B%s", o->seeds, "");
     }
-    if (seeds && has_seed) {
+    if (o->seeds && o->has_seed) {
         return die("--seed and --seeds exclude each other%s%s", "", "");
     }
-    if (emit && (!seeds || !out)) {
+    if (o->emit && (!o->seeds || !o->out)) {
         return die("--emit-jobs needs --seeds A..B and --out DIR%s%s", "", "");
     }
-    if (bench && (!seeds || out || emit)) {
+    if (o->bench && (!o->seeds || o->out || o->emit)) {
         return die("--bench needs --seeds A..B and no --out or --emit-jobs%s%s", "", "");
     }
-    if (pcap && seeds) {
+    if (o->pcap && o->seeds) {
         return die("--pcap is for a single run, not --seeds%s%s", "", "");
     }
-    if (jobs < 1) {
-        jobs = 1;
+    if (o->jobs < 1) {
+        o->jobs = 1;
     }
-    if (out) {
+    if (o->out) {
         struct stat st;
-        if (stat(out, &st) == 0) {
-            return die("%s: already exists (choose a new --out directory)%s", out, "");
+        if (stat(o->out, &st) == 0) {
+            return die("%s: already exists (choose a new --out directory)%s", o->out, "");
         }
     }
+    return RUN;
+}
 
+/* The scenario with the options' overrides: RUN, or the exit status after a message. */
+static int load_scenario(const sim_opts_t *o, hs_scenario_t *sc)
+{
     char err[1024];
-    hs_scenario_t sc;
-    if (hs_scenario_load(scenario, &sc, err, sizeof err) != 0) {
+    if (hs_scenario_load(o->scenario, sc, err, sizeof err) != 0) {
         fprintf(stderr, "%s: %s\n", prog, err);
         return 1;
     }
     rfs_seek_strategy_t st_check;
-    if (strategy && (strlen(strategy) >= sizeof sc.strategy ||
-                     !rfs_seek_strategy_parse(strategy, &st_check))) {
+    if (o->strategy && (strlen(o->strategy) >= sizeof sc->strategy ||
+                        !rfs_seek_strategy_parse(o->strategy, &st_check))) {
         return die("--strategy: unknown '%s' (meta, meta-global, fd-gradient, plane-gradient, "
-                   "chemotaxis, meta-path)%s", strategy, "");
+                   "chemotaxis, meta-path)%s", o->strategy, "");
     }
-    if (model && (strlen(model) >= sizeof sc.model || !hs_ctrl_model_known(model))) {
-        return die("--model: unknown '%s' (ridge, mlp, knn, radius, pathloss)%s", model, "");
+    if (o->model && (strlen(o->model) >= sizeof sc->model || !hs_ctrl_model_known(o->model))) {
+        return die("--model: unknown '%s' (ridge, mlp, knn, radius, pathloss)%s", o->model, "");
     }
-    if (strategy) {
-        snprintf(sc.strategy, sizeof sc.strategy, "%s", strategy);
+    if (o->strategy) {
+        snprintf(sc->strategy, sizeof sc->strategy, "%s", o->strategy);
     }
-    if (model) {
-        snprintf(sc.model, sizeof sc.model, "%s", model);
+    if (o->model) {
+        snprintf(sc->model, sizeof sc->model, "%s", o->model);
     }
-    if (no_faults) {
-        sc.faults.n = 0;
+    if (o->no_faults) {
+        sc->faults.n = 0;
     }
-    if (!isnan(p0_min)) {
-        if (strcmp(sc.model, "pathloss") != 0) {
-            return die("--p0-min: only with model pathloss (this run's is %s)%s", sc.model, "");
+    if (!isnan(o->p0_min)) {
+        if (strcmp(sc->model, "pathloss") != 0) {
+            return die("--p0-min: only with model pathloss (this run's is %s)%s", sc->model, "");
         }
-        sc.seek_p0_min_dbm = p0_min;
+        sc->seek_p0_min_dbm = o->p0_min;
     }
-    if (emit) {
-        // The same runs, one command per seed; scripts/merge_runs.py DIR merges them.
-        char self[PATH_MAX], scn[PATH_MAX];
-        ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
-        if (n <= 0 || !realpath(scenario, scn)) {
-            return die("cannot resolve the program or scenario path%s%s", "", "");
-        }
-        self[n] = '\0';
-        for (uint64_t s = sa; s <= sb; s++) {
-            char p0[48] = "";
-            if (!isnan(p0_min)) {
-                snprintf(p0, sizeof p0, " --p0-min %.17g", p0_min);
-            }
-            printf("%s %s --seed %llu --out %s/seed-%llu --strategy %s --model %s%s%s\n", self,
-                   scn, (unsigned long long)s, out, (unsigned long long)s, sc.strategy, sc.model,
-                   no_faults ? " --no-faults" : "", p0);
-        }
-        return 0;
+    return RUN;
+}
+
+/* --emit-jobs: the same runs, one command per seed; scripts/merge_runs.py DIR merges
+ * them. The exit status. */
+static int emit_jobs(const sim_opts_t *o, const hs_scenario_t *sc)
+{
+    char self[PATH_MAX], scn[PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n <= 0 || !realpath(o->scenario, scn)) {
+        return die("cannot resolve the program or scenario path%s%s", "", "");
     }
+    self[n] = '\0';
+    for (uint64_t s = o->sa; s <= o->sb; s++) {
+        char p0[48] = "";
+        if (!isnan(o->p0_min)) {
+            snprintf(p0, sizeof p0, " --p0-min %.17g", o->p0_min);
+        }
+        printf("%s %s --seed %llu --out %s/seed-%llu --strategy %s --model %s%s%s\n", self,
+               scn, (unsigned long long)s, o->out, (unsigned long long)s, sc->strategy, sc->model,
+               o->no_faults ? " --no-faults" : "", p0);
+    }
+    return 0;
+}
+
+/* The runs (one, a batch, or the bench) into a temporary --out directory renamed into
+ * place when complete: the exit status. */
+static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
+{
+    char err[1024];
     hs_sim_env_t env;
-    if (hs_sim_env_open(&env, &sc, err, sizeof err) != 0) {
+    if (hs_sim_env_open(&env, sc, err, sizeof err) != 0) {
         fprintf(stderr, "%s: %s\n", prog, err);
         return 1;
     }
-    if (bench) {
-        int brc = run_bench(&env, sa, sb);
+    if (o->bench) {
+        int brc = run_bench(&env, o->sa, o->sb);
         hs_sim_env_close(&env);
         return brc;
     }
     char tmp[PATH_MAX + 64];
-    if (out) {
-        if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", out, (long)getpid()) >= (int)sizeof tmp ||
+    if (o->out) {
+        if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", o->out, (long)getpid()) >= (int)sizeof tmp ||
             mkdir(tmp, 0777) != 0) {
             fprintf(stderr, "%s: %s: %s\n", prog, tmp, strerror(errno));
             hs_sim_env_close(&env);
@@ -581,17 +661,17 @@ int main(int argc, char **argv)
         }
     }
     int rc;
-    if (seeds) {
-        rc = run_batch(&env, sa, sb, (int)jobs, out ? tmp : NULL, samples, quiet);
+    if (o->seeds) {
+        rc = run_batch(&env, o->sa, o->sb, (int)o->jobs, o->out ? tmp : NULL, o->samples, o->quiet);
     } else {
         hs_sim_result_t res;
-        rc = run_one(&env, has_seed ? seed : sc.seed, out ? tmp : NULL, out != NULL, field, pcap,
-                     &res);
+        rc = run_one(&env, o->has_seed ? o->seed : sc->seed, o->out ? tmp : NULL, o->out != NULL,
+                     o->field, o->pcap, &res);
     }
     hs_sim_env_close(&env);
-    if (out) {
-        if (rc == 0 && rename(tmp, out) != 0) {
-            fprintf(stderr, "%s: %s: %s\n", prog, out, strerror(errno));
+    if (o->out) {
+        if (rc == 0 && rename(tmp, o->out) != 0) {
+            fprintf(stderr, "%s: %s: %s\n", prog, o->out, strerror(errno));
             rc = 1;
         }
         if (rc != 0) {
@@ -599,4 +679,22 @@ int main(int argc, char **argv)
         }
     }
     return rc;
+}
+
+int main(int argc, char **argv)
+{
+    sim_opts_t o;
+    int rc = parse_options(argc, argv, &o);
+    if (rc == RUN) {
+        rc = check_options(&o);
+    }
+    if (rc != RUN) {
+        return rc;
+    }
+    static hs_scenario_t sc;
+    rc = load_scenario(&o, &sc);
+    if (rc != RUN) {
+        return rc;
+    }
+    return o.emit ? emit_jobs(&o, &sc) : run_scenario(&o, &sc);
 }

@@ -544,6 +544,179 @@ typedef struct tree_stats {
 
 #define TREE_GOALS 8
 
+/* One tree of check_trees: its root, what kind of root it is, and its planners. */
+typedef struct tree_run {
+    rfs_plan_t *t, *f, *pp;  /* the tree, a fresh tree per goal, rfs_plan_path */
+    int lw, lh, n;
+    double g;                /* lattice spacing, Q16 */
+    bool on_lattice, illegal;
+    rfs_q16_t x0, y0;        /* the root */
+    int c_max;               /* largest octile cost of a goal searched for so far */
+    uint32_t total;          /* points the tree has expanded */
+    tree_stats_t *st;
+} tree_run_t;
+
+/* The root of tree tr: a lattice point (every third; the references computed from it),
+ * a point of the clearance zone (every third) or a legal point between lattice points. */
+static void tree_root(tree_run_t *tr, int k, uint32_t *rs)
+{
+    const int lw = tr->lw, lh = tr->lh;
+    const double g = tr->g;
+    tr->on_lattice = k % 3 == 0;
+    tr->illegal = k % 3 == 2;
+    int si, sj;
+    random_legal(rs, lw, lh, &si, &sj);
+    tr->x0 = (rfs_q16_t)(g / 2 + si * g);
+    tr->y0 = (rfs_q16_t)(g / 2 + sj * g);
+    if (tr->illegal) {
+        /* A point of the clearance zone: from lattice points next to it, 0.1 m steps
+         * in a random direction until one is illegal (inside the map). */
+        rfs_q16_t ox, oy;
+        const rfs_q16_t dm = RFS_Q16_FRAC(1, 10);
+        do {
+            random_legal(rs, lw, lh, &si, &sj);
+            const int dx = (int)(lcg(rs) % 3u) - 1, dy = (int)(lcg(rs) % 3u) - 1;
+            ox = (rfs_q16_t)(g / 2 + si * g);
+            oy = (rfs_q16_t)(g / 2 + sj * g);
+            for (int a = 0; a < 5 && rfs_map_point_legal(&wd.m, ox, oy); a++) {
+                ox += dx * dm;
+                oy += dy * dm;
+            }
+        } while (ox <= 0 || oy <= 0 || ox >= W * RES || oy >= H * RES ||
+                 rfs_map_point_legal(&wd.m, ox, oy));
+        tr->x0 = ox;
+        tr->y0 = oy;
+        tr->st->illegal_roots++;
+    } else if (!tr->on_lattice) {
+        rfs_q16_t ox, oy;
+        do {
+            ox = tr->x0 + (rfs_q16_t)(lcg(rs) % (uint32_t)g) - (rfs_q16_t)(g / 2);
+            oy = tr->y0 + (rfs_q16_t)(lcg(rs) % (uint32_t)g) - (rfs_q16_t)(g / 2);
+        } while (!rfs_map_point_legal(&wd.m, ox, oy));
+        tr->x0 = ox;
+        tr->y0 = oy;
+    } else {
+        (void)ref_dijkstra(lw, lh, si, sj, -1, -1);
+        ref_octile(lw, lh, si, sj);
+        ref_component(lw, lh, si, sj);
+    }
+}
+
+/* A lattice root, a goal gv out of line of sight: reached as the reference flood says;
+ * no search when it was closed on the way to an earlier goal (e points expanded); the
+ * tree holds every point cheaper than the farthest goal yet and none dearer. */
+static void check_tree_search(tree_run_t *tr, int gv, bool ok, uint32_t e)
+{
+    const bool in = (comp_bits[gv >> 3] >> (gv & 7)) & 1;
+    assert_int_equal(ok, in); /* the reference flood */
+    assert_int_equal(in, oct_ref[gv] < INT32_MAX);
+    assert_int_equal(in, !isinf(dist_ref[gv]));
+    const int c = in ? oct_ref[gv] : INT32_MAX;
+    if (c < tr->c_max) {
+        /* Closed on the way to an earlier goal: no search. */
+        assert_int_equal(e, 0);
+        tr->st->free_hits++;
+    }
+    tr->c_max = c > tr->c_max ? c : tr->c_max;
+    /* Every point cheaper than the farthest goal yet is closed, none dearer. */
+    int below, upto;
+    oct_count(tr->n, tr->c_max, &below, &upto);
+    assert_true((int)tr->total >= below && (int)tr->total <= upto);
+    tr->st->searched++;
+}
+
+/* The tree's path pt to (x1, y1), goal gv, found: its hops legal (the first one out of
+ * the clearance zone from an illegal root), its length theirs, no shorter than the
+ * straight line and within 6 % of the lattice optimum from a lattice root. */
+static void check_tree_hops(tree_run_t *tr, const rfs_path_t *pt, rfs_q16_t x1, rfs_q16_t y1, int gv)
+{
+    const double g = tr->g;
+    assert_true(pt->n >= 1);
+    assert_int_equal(pt->x[pt->n - 1], x1);
+    assert_int_equal(pt->y[pt->n - 1], y1);
+    double len = 0, px = tr->x0, py = tr->y0;
+    for (int w = 0; w < pt->n; w++) {
+        if (tr->illegal && w == 0) {
+            /* The hop out of the clearance zone: to a legal point 2 lattice
+             * steps away at most (rfs_plan_path's escape join). */
+            assert_true(rfs_map_point_legal(&wd.m, pt->x[0], pt->y[0]));
+            assert_true(hypot(pt->x[0] - px, pt->y[0] - py) <= 2 * sqrt(2.0) * g + 2 * g);
+        } else {
+            assert_true(ref_seg(px, py, pt->x[w], pt->y[w]));
+            assert_true(rfs_map_segment_legal(&wd.m, (rfs_q16_t)px, (rfs_q16_t)py,
+                                              pt->x[w], pt->y[w]));
+        }
+        len += hypot(pt->x[w] - px, pt->y[w] - py) / 65536.0;
+        px = pt->x[w];
+        py = pt->y[w];
+    }
+    assert_true(fabs(pt->length / 65536.0 - len) < 1e-3 * (1 + pt->n));
+    assert_true(len >= hypot(x1 - tr->x0, y1 - tr->y0) / 65536.0 - 1e-4);
+    if (tr->on_lattice) {
+        const double want = dist_ref[gv] / 65536.0;
+        assert_true(len <= want * 1.06 + 1e-3);
+        if (want > 0 && len / want > tr->st->worst_ratio) {
+            tr->st->worst_ratio = len / want;
+        }
+    }
+}
+
+/* The tree's path pt against rfs_plan_path's pb from the same root (ties among
+ * equal-cost lattice paths pull differently, either way), and against a fresh tree for
+ * this goal alone (the same path). */
+static void check_tree_against(tree_run_t *tr, const rfs_path_t *pt, const rfs_path_t *pb,
+                               rfs_q16_t x1, rfs_q16_t y1)
+{
+    tree_stats_t *st = tr->st;
+    const double diff = fabs((double)pt->length - pb->length) / 65536.0;
+    assert_true(diff < 0.75);
+    st->worst_diff_m = diff > st->worst_diff_m ? diff : st->worst_diff_m;
+    st->sum_signed += ((double)pt->length - pb->length) / 65536.0;
+    st->longer += pt->length > pb->length;
+    st->shorter += pt->length < pb->length;
+    if (pb->length > 0 && diff * 65536.0 / pb->length > st->worst_diff_rel) {
+        st->worst_diff_rel = diff * 65536.0 / pb->length;
+    }
+    rfs_path_t pf;
+    rfs_plan_tree_begin(tr->f, tr->x0, tr->y0);
+    assert_true(rfs_plan_tree_path(tr->f, x1, y1, &pf));
+    assert_same_path(pt, &pf);
+}
+
+/* Goal (gi, gj) on the tree: its result *ok and path *pt, checked. */
+static void check_tree_goal(tree_run_t *tr, int gi, int gj, bool *ok, rfs_path_t *pt)
+{
+    const double g = tr->g;
+    const int gv = gj * tr->lw + gi;
+    const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi * g), y1 = (rfs_q16_t)(g / 2 + gj * g);
+    *ok = rfs_plan_tree_path(tr->t, x1, y1, pt);
+    const uint32_t e = tr->t->expanded;
+    tr->total += e;
+    const bool los = ref_seg(tr->x0, tr->y0, x1, y1);
+    tr->st->goals++;
+    /* rfs_plan_path from the same start: the same reachability. */
+    rfs_path_t pb;
+    const bool okp = rfs_plan_path(tr->pp, tr->x0, tr->y0, x1, y1, &pb);
+    assert_int_equal(*ok, okp);
+    if (los) {
+        tr->st->los++;
+        assert_true(*ok);
+        assert_int_equal(pt->n, 1);
+        assert_int_equal(e, 0);
+    }
+    if (tr->on_lattice && !los) {
+        check_tree_search(tr, gv, *ok, e);
+    }
+    if (!*ok) {
+        tr->st->unreached++;
+        assert_int_equal(pt->n, 0);
+        return;
+    }
+    tr->st->reached++;
+    check_tree_hops(tr, pt, x1, y1, gv);
+    check_tree_against(tr, pt, &pb, x1, y1);
+}
+
 /* Trees from several robot positions on one map, a sequence of goals each: every result
  * against the double-precision references (reachability: ref_flood; legality: ref_seg;
  * length: ref_dijkstra; expanded points: the integer octile Dijkstra), against
@@ -555,154 +728,45 @@ typedef struct tree_stats {
 static void check_trees(int kind, uint32_t seed, int trees, tree_stats_t *st)
 {
     build_kind(kind, seed);
-    const int lw = wd.m.lw, lh = wd.m.lh, n = lw * lh;
-    const double g = (double)wd.m.cfg.grid;
-    assert_true(n <= LMAX);
+    tree_run_t tr;
+    memset(&tr, 0, sizeof(tr));
+    tr.lw = wd.m.lw;
+    tr.lh = wd.m.lh;
+    tr.n = tr.lw * tr.lh;
+    tr.g = (double)wd.m.cfg.grid;
+    tr.st = st;
+    assert_true(tr.n <= LMAX);
     static uint8_t work_f[LMAX], work_p[LMAX];
     static uint32_t queue_f[1024], queue_p[1024];
     rfs_plan_t t, f, pp;
     assert_int_equal(rfs_plan_init(&t, &wd.m, work, sizeof(work), queue, 1024), 0);
     assert_int_equal(rfs_plan_init(&f, &wd.m, work_f, sizeof(work_f), queue_f, 1024), 0);
     assert_int_equal(rfs_plan_init(&pp, &wd.m, work_p, sizeof(work_p), queue_p, 1024), 0);
+    tr.t = &t;
+    tr.f = &f;
+    tr.pp = &pp;
     uint32_t rs = seed * 31u + (uint32_t)kind;
-    for (int tr = 0; tr < trees; tr++) {
-        const bool on_lattice = tr % 3 == 0, illegal = tr % 3 == 2;
-        int si, sj;
-        random_legal(&rs, lw, lh, &si, &sj);
-        rfs_q16_t x0 = (rfs_q16_t)(g / 2 + si * g), y0 = (rfs_q16_t)(g / 2 + sj * g);
-        if (illegal) {
-            /* A point of the clearance zone: from lattice points next to it, 0.1 m steps
-             * in a random direction until one is illegal (inside the map). */
-            rfs_q16_t ox, oy;
-            const rfs_q16_t dm = RFS_Q16_FRAC(1, 10);
-            do {
-                random_legal(&rs, lw, lh, &si, &sj);
-                const int dx = (int)(lcg(&rs) % 3u) - 1, dy = (int)(lcg(&rs) % 3u) - 1;
-                ox = (rfs_q16_t)(g / 2 + si * g);
-                oy = (rfs_q16_t)(g / 2 + sj * g);
-                for (int a = 0; a < 5 && rfs_map_point_legal(&wd.m, ox, oy); a++) {
-                    ox += dx * dm;
-                    oy += dy * dm;
-                }
-            } while (ox <= 0 || oy <= 0 || ox >= W * RES || oy >= H * RES ||
-                     rfs_map_point_legal(&wd.m, ox, oy));
-            x0 = ox;
-            y0 = oy;
-            st->illegal_roots++;
-        } else if (!on_lattice) {
-            rfs_q16_t ox, oy;
-            do {
-                ox = x0 + (rfs_q16_t)(lcg(&rs) % (uint32_t)g) - (rfs_q16_t)(g / 2);
-                oy = y0 + (rfs_q16_t)(lcg(&rs) % (uint32_t)g) - (rfs_q16_t)(g / 2);
-            } while (!rfs_map_point_legal(&wd.m, ox, oy));
-            x0 = ox;
-            y0 = oy;
-        } else {
-            (void)ref_dijkstra(lw, lh, si, sj, -1, -1);
-            ref_octile(lw, lh, si, sj);
-            ref_component(lw, lh, si, sj);
-        }
+    for (int k = 0; k < trees; k++) {
+        tree_root(&tr, k, &rs);
         int gi[TREE_GOALS], gj[TREE_GOALS];
         rfs_path_t pt[TREE_GOALS];
         bool okt[TREE_GOALS];
-        int c_max = -1;      /* largest octile cost of a goal searched for so far */
-        uint32_t total = 0;  /* points the tree has expanded */
-        rfs_plan_tree_begin(&t, x0, y0);
-        for (int k = 0; k < TREE_GOALS; k++) {
-            random_legal(&rs, lw, lh, &gi[k], &gj[k]);
-            const int gv = gj[k] * lw + gi[k];
-            const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi[k] * g), y1 = (rfs_q16_t)(g / 2 + gj[k] * g);
-            okt[k] = rfs_plan_tree_path(&t, x1, y1, &pt[k]);
-            const uint32_t e = t.expanded;
-            total += e;
-            const bool los = ref_seg(x0, y0, x1, y1);
-            st->goals++;
-            /* rfs_plan_path from the same start: the same reachability. */
-            rfs_path_t pb;
-            const bool okp = rfs_plan_path(&pp, x0, y0, x1, y1, &pb);
-            assert_int_equal(okt[k], okp);
-            if (los) {
-                st->los++;
-                assert_true(okt[k]);
-                assert_int_equal(pt[k].n, 1);
-                assert_int_equal(e, 0);
-            }
-            if (on_lattice && !los) {
-                const bool in = (comp_bits[gv >> 3] >> (gv & 7)) & 1;
-                assert_int_equal(okt[k], in); /* the reference flood */
-                assert_int_equal(in, oct_ref[gv] < INT32_MAX);
-                assert_int_equal(in, !isinf(dist_ref[gv]));
-                const int c = in ? oct_ref[gv] : INT32_MAX;
-                if (c < c_max) {
-                    /* Closed on the way to an earlier goal: no search. */
-                    assert_int_equal(e, 0);
-                    st->free_hits++;
-                }
-                c_max = c > c_max ? c : c_max;
-                /* Every point cheaper than the farthest goal yet is closed, none dearer. */
-                int below, upto;
-                oct_count(n, c_max, &below, &upto);
-                assert_true((int)total >= below && (int)total <= upto);
-                st->searched++;
-            }
-            if (!okt[k]) {
-                st->unreached++;
-                assert_int_equal(pt[k].n, 0);
-                continue;
-            }
-            st->reached++;
-            assert_true(pt[k].n >= 1);
-            assert_int_equal(pt[k].x[pt[k].n - 1], x1);
-            assert_int_equal(pt[k].y[pt[k].n - 1], y1);
-            double len = 0, px = x0, py = y0;
-            for (int w = 0; w < pt[k].n; w++) {
-                if (illegal && w == 0) {
-                    /* The hop out of the clearance zone: to a legal point 2 lattice
-                     * steps away at most (rfs_plan_path's escape join). */
-                    assert_true(rfs_map_point_legal(&wd.m, pt[k].x[0], pt[k].y[0]));
-                    assert_true(hypot(pt[k].x[0] - px, pt[k].y[0] - py) <= 2 * sqrt(2.0) * g + 2 * g);
-                } else {
-                    assert_true(ref_seg(px, py, pt[k].x[w], pt[k].y[w]));
-                    assert_true(rfs_map_segment_legal(&wd.m, (rfs_q16_t)px, (rfs_q16_t)py,
-                                                      pt[k].x[w], pt[k].y[w]));
-                }
-                len += hypot(pt[k].x[w] - px, pt[k].y[w] - py) / 65536.0;
-                px = pt[k].x[w];
-                py = pt[k].y[w];
-            }
-            assert_true(fabs(pt[k].length / 65536.0 - len) < 1e-3 * (1 + pt[k].n));
-            assert_true(len >= hypot(x1 - x0, y1 - y0) / 65536.0 - 1e-4);
-            if (on_lattice) {
-                const double want = dist_ref[gv] / 65536.0;
-                assert_true(len <= want * 1.06 + 1e-3);
-                if (want > 0 && len / want > st->worst_ratio) {
-                    st->worst_ratio = len / want;
-                }
-            }
-            const double diff = fabs((double)pt[k].length - pb.length) / 65536.0;
-            /* Ties among equal-cost lattice paths pull differently (either way). */
-            assert_true(diff < 0.75);
-            st->worst_diff_m = diff > st->worst_diff_m ? diff : st->worst_diff_m;
-            st->sum_signed += ((double)pt[k].length - pb.length) / 65536.0;
-            st->longer += pt[k].length > pb.length;
-            st->shorter += pt[k].length < pb.length;
-            if (pb.length > 0 && diff * 65536.0 / pb.length > st->worst_diff_rel) {
-                st->worst_diff_rel = diff * 65536.0 / pb.length;
-            }
-            /* A fresh tree for this goal alone: the same path. */
-            rfs_path_t pf;
-            rfs_plan_tree_begin(&f, x0, y0);
-            assert_true(rfs_plan_tree_path(&f, x1, y1, &pf));
-            assert_same_path(&pt[k], &pf);
+        tr.c_max = -1;
+        tr.total = 0;
+        rfs_plan_tree_begin(&t, tr.x0, tr.y0);
+        for (int q = 0; q < TREE_GOALS; q++) {
+            random_legal(&rs, tr.lw, tr.lh, &gi[q], &gj[q]);
+            check_tree_goal(&tr, gi[q], gj[q], &okt[q], &pt[q]);
         }
         /* The same goals again, reversed, on a new tree: the same paths and results. */
-        rfs_plan_tree_begin(&t, x0, y0);
-        for (int k = TREE_GOALS - 1; k >= 0; k--) {
-            const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi[k] * g), y1 = (rfs_q16_t)(g / 2 + gj[k] * g);
+        rfs_plan_tree_begin(&t, tr.x0, tr.y0);
+        for (int q = TREE_GOALS - 1; q >= 0; q--) {
+            const rfs_q16_t x1 = (rfs_q16_t)(tr.g / 2 + gi[q] * tr.g);
+            const rfs_q16_t y1 = (rfs_q16_t)(tr.g / 2 + gj[q] * tr.g);
             rfs_path_t pr;
-            assert_int_equal(rfs_plan_tree_path(&t, x1, y1, &pr), okt[k]);
-            if (okt[k]) {
-                assert_same_path(&pt[k], &pr);
+            assert_int_equal(rfs_plan_tree_path(&t, x1, y1, &pr), okt[q]);
+            if (okt[q]) {
+                assert_same_path(&pt[q], &pr);
             }
         }
     }

@@ -96,9 +96,172 @@ static bool est_ok(const rfseek_seeker_status_t *m)
     return m->est_area >= 0.0 && m->est_rms >= 0.0;
 }
 
-/* Decode one message of a known channel and deliver it; bad ones are counted. The
- * decoder's byte count must equal the message length (no truncation, no trailing junk;
- * the type fingerprint is checked by the generated decoder). */
+/* The decoders of dispatch(), one per channel: decode a message of `len` bytes, check its
+ * fields, and deliver it, or count it bad with one line. The decoder's byte count must
+ * equal the message length (no truncation, no trailing junk; the type fingerprint is
+ * checked by the generated decoder). */
+
+static void on_pose_msg(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const char *ch, const void *data, int len)
+{
+    rfseek_pose_t m;
+    int n = rfseek_pose_t_decode(data, 0, len, &m);
+    if (n < 0 || n != len) {
+        bad(s, h, ch, "truncated, oversized or not an rfseek.pose_t (%.0f bytes)", (double)len);
+        return;
+    }
+    rfs_pose_t p;
+    p.t_us = m.utime;
+    if (!q16_of(m.x, &p.x) || !q16_of(m.y, &p.y)) {
+        bad(s, h, ch, "x or y is not a finite position within +-32768 m (x = %g)", m.x);
+        return;
+    }
+    if (!isfinite(m.theta) || fabs(m.theta) > 1e6) {
+        bad(s, h, ch, "theta is not finite (%g)", m.theta);
+        return;
+    }
+    /* Normalise to [-pi, pi]: localisers publish unwrapped headings. */
+    double th = remainder(m.theta, 2.0 * M_PI);
+    p.theta = (rfs_q16_t)llround(th * 65536.0);
+    good(s);
+    h->on_pose(h->ctx, &p);
+}
+
+static void on_rssi_msg(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const char *ch, const void *data, int len)
+{
+    rfseek_rssi_t m;
+    int n = rfseek_rssi_t_decode(data, 0, len, &m);
+    if (n < 0 || n != len) {
+        bad(s, h, ch, "truncated, oversized or not an rfseek.rssi_t (%.0f bytes)", (double)len);
+        return;
+    }
+    if (m.source < 0 || m.source >= (int)RFS_CAN_MAX_SOURCES) {
+        bad(s, h, ch, "source %.0f out of range 0..15", m.source);
+        return;
+    }
+    if (m.dbm < -128 || m.dbm > 127) {
+        bad(s, h, ch, "dbm %.0f out of range -128..127", m.dbm);
+        return;
+    }
+    good(s);
+    h->on_rssi(h->ctx, (uint8_t)m.source, m.utime, (int8_t)m.dbm, (uint32_t)m.seq);
+}
+
+static void on_receiver_msg(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const char *ch, const void *data,
+                            int len)
+{
+    rfseek_rssi_status_t m;
+    int n = rfseek_rssi_status_t_decode(data, 0, len, &m);
+    if (n < 0 || n != len) {
+        bad(s, h, ch, "truncated, oversized or not an rfseek.rssi_status_t (%.0f bytes)", (double)len);
+        return;
+    }
+    good(s);
+    h->on_receiver(h->ctx, m.utime, (uint32_t)m.seq);
+}
+
+static void on_clock_msg(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const char *ch, const void *data, int len)
+{
+    rfseek_clock_t m;
+    int n = rfseek_clock_t_decode(data, 0, len, &m);
+    if (n < 0 || n != len) {
+        bad(s, h, ch, "truncated, oversized or not an rfseek.clock_t (%.0f bytes)", (double)len);
+        return;
+    }
+    good(s);
+    h->on_clock(h->ctx, m.utime);
+}
+
+static void on_wheel_msg(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const char *ch, const void *data, int len)
+{
+    rfseek_wheel_cmd_t m;
+    int n = rfseek_wheel_cmd_t_decode(data, 0, len, &m);
+    if (n < 0 || n != len) {
+        bad(s, h, ch, "truncated, oversized or not an rfseek.wheel_cmd_t (%.0f bytes)", (double)len);
+        return;
+    }
+    rfs_can_wheel_t w = {m.left_mm_s, m.right_mm_s, (uint8_t)(m.stop ? RFS_CAN_WHEEL_STOP : 0)};
+    good(s);
+    h->on_wheel(h->ctx, m.utime, &w);
+}
+
+/* A decoded status's fields into *o: false when one is out of range or not finite. */
+static bool status_of(const rfseek_seeker_status_t *m, rfs_seek_out_t *o)
+{
+    memset(o, 0, sizeof *o);
+    rfs_seek_decision_t *d = &o->decision;
+    bool ok = m->state >= 0 && m->state <= RFS_SEEK_DRIVING && m->kind >= 0 && m->kind <= RFS_SEEK_EPSILON &&
+              m->prev >= 0 && m->prev <= RFS_DRIVE_BLOCKED && m->faults >= 0 && m->faults <= 0xFFFF &&
+              q16_of(m->prediction, &d->prediction) && q16_of(m->mean, &d->mean) &&
+              q16_of(m->epsilon, &d->epsilon) && q16_of(m->x, &d->x) && q16_of(m->y, &d->y) &&
+              q16_of(m->goal_x, &d->goal_x) && q16_of(m->goal_y, &d->goal_y) && q16_of(m->max_x, &d->max_x) &&
+              q16_of(m->max_y, &d->max_y) && q16_of(m->path_len, &d->path_len) && m->samples >= 0 &&
+              m->samples <= 0xFFFF && est_ok(m);
+    if (!ok) {
+        return false;
+    }
+    o->left_mm_s = m->left_mm_s;
+    o->right_mm_s = m->right_mm_s;
+    o->state = (rfs_seek_state_t)m->state;
+    o->faults = (uint16_t)m->faults;
+    o->decided = m->decided;
+    d->iteration = (uint32_t)m->iteration;
+    d->t_us = m->decision_utime;
+    d->kind = (rfs_seek_kind_t)m->kind;
+    d->relearned = m->model_updated;
+    d->line_search = m->line_search;
+    d->model_valid = m->model_valid;
+    d->mean_valid = m->mean_valid;
+    d->prev = (rfs_drive_status_t)m->prev;
+    d->samples = (uint16_t)m->samples;
+    return true;
+}
+
+static void on_status_msg(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const char *ch, const void *data, int len)
+{
+    rfseek_seeker_status_t m;
+    int n = rfseek_seeker_status_t_decode(data, 0, len, &m);
+    if (n < 0 || n != len) {
+        if (n >= 0) {
+            rfseek_seeker_status_t_decode_cleanup(&m);
+        }
+        bad(s, h, ch, "truncated, oversized or not an rfseek.seeker_status_t (%.0f bytes)", (double)len);
+        return;
+    }
+    rfs_seek_out_t o;
+    if (!status_of(&m, &o)) {
+        rfseek_seeker_status_t_decode_cleanup(&m);
+        bad(s, h, ch, "a field is out of range or not finite (state %.0f)", m.state);
+        return;
+    }
+    int64_t t = m.utime;
+    rfseek_seeker_status_t_decode_cleanup(&m);
+    good(s);
+    h->on_status(h->ctx, t, &o);
+}
+
+static void on_can_msg(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const char *ch, const void *data, int len)
+{
+    rfseek_can_frame_t m;
+    int n = rfseek_can_frame_t_decode(data, 0, len, &m);
+    if (n < 0 || n != len) {
+        bad(s, h, ch, "truncated, oversized or not an rfseek.can_frame_t (%.0f bytes)", (double)len);
+        return;
+    }
+    if (m.id < 0 || m.id > (int32_t)RFS_CAN_ID_MAX || m.dlc < 0 || m.dlc > 8) {
+        bad(s, h, ch, "id or dlc out of range (id %.0f)", m.id);
+        return;
+    }
+    rfs_can_frame_t f;
+    memset(&f, 0, sizeof f);
+    f.id = (uint32_t)m.id;
+    f.dlc = (uint8_t)m.dlc;
+    memcpy(f.data, m.data, (size_t)m.dlc);
+    good(s);
+    h->on_can(h->ctx, m.utime, &f);
+}
+
+/* Decode one message of a known channel and deliver it to its handler; bad ones are
+ * counted. */
 static void dispatch(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const char *ch, const void *data, int len)
 {
     if (len < 0 || len > LX_LCM_MAX_MSG) {
@@ -106,133 +269,19 @@ static void dispatch(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const char *
         return;
     }
     if (strcmp(ch, LX_LCM_CH_POSE) == 0 && h->on_pose) {
-        rfseek_pose_t m;
-        int n = rfseek_pose_t_decode(data, 0, len, &m);
-        if (n < 0 || n != len) {
-            bad(s, h, ch, "truncated, oversized or not an rfseek.pose_t (%.0f bytes)", (double)len);
-            return;
-        }
-        rfs_pose_t p;
-        p.t_us = m.utime;
-        if (!q16_of(m.x, &p.x) || !q16_of(m.y, &p.y)) {
-            bad(s, h, ch, "x or y is not a finite position within +-32768 m (x = %g)", m.x);
-            return;
-        }
-        if (!isfinite(m.theta) || fabs(m.theta) > 1e6) {
-            bad(s, h, ch, "theta is not finite (%g)", m.theta);
-            return;
-        }
-        /* Normalise to [-pi, pi]: localisers publish unwrapped headings. */
-        double th = remainder(m.theta, 2.0 * M_PI);
-        p.theta = (rfs_q16_t)llround(th * 65536.0);
-        good(s);
-        h->on_pose(h->ctx, &p);
+        on_pose_msg(h, s, ch, data, len);
     } else if (strcmp(ch, LX_LCM_CH_RSSI) == 0 && h->on_rssi) {
-        rfseek_rssi_t m;
-        int n = rfseek_rssi_t_decode(data, 0, len, &m);
-        if (n < 0 || n != len) {
-            bad(s, h, ch, "truncated, oversized or not an rfseek.rssi_t (%.0f bytes)", (double)len);
-            return;
-        }
-        if (m.source < 0 || m.source >= (int)RFS_CAN_MAX_SOURCES) {
-            bad(s, h, ch, "source %.0f out of range 0..15", m.source);
-            return;
-        }
-        if (m.dbm < -128 || m.dbm > 127) {
-            bad(s, h, ch, "dbm %.0f out of range -128..127", m.dbm);
-            return;
-        }
-        good(s);
-        h->on_rssi(h->ctx, (uint8_t)m.source, m.utime, (int8_t)m.dbm, (uint32_t)m.seq);
+        on_rssi_msg(h, s, ch, data, len);
     } else if (strcmp(ch, LX_LCM_CH_RSSI_STATUS) == 0 && h->on_receiver) {
-        rfseek_rssi_status_t m;
-        int n = rfseek_rssi_status_t_decode(data, 0, len, &m);
-        if (n < 0 || n != len) {
-            bad(s, h, ch, "truncated, oversized or not an rfseek.rssi_status_t (%.0f bytes)", (double)len);
-            return;
-        }
-        good(s);
-        h->on_receiver(h->ctx, m.utime, (uint32_t)m.seq);
+        on_receiver_msg(h, s, ch, data, len);
     } else if (strcmp(ch, LX_LCM_CH_CLOCK) == 0 && h->on_clock) {
-        rfseek_clock_t m;
-        int n = rfseek_clock_t_decode(data, 0, len, &m);
-        if (n < 0 || n != len) {
-            bad(s, h, ch, "truncated, oversized or not an rfseek.clock_t (%.0f bytes)", (double)len);
-            return;
-        }
-        good(s);
-        h->on_clock(h->ctx, m.utime);
+        on_clock_msg(h, s, ch, data, len);
     } else if (strcmp(ch, LX_LCM_CH_WHEEL) == 0 && h->on_wheel) {
-        rfseek_wheel_cmd_t m;
-        int n = rfseek_wheel_cmd_t_decode(data, 0, len, &m);
-        if (n < 0 || n != len) {
-            bad(s, h, ch, "truncated, oversized or not an rfseek.wheel_cmd_t (%.0f bytes)", (double)len);
-            return;
-        }
-        rfs_can_wheel_t w = {m.left_mm_s, m.right_mm_s, (uint8_t)(m.stop ? RFS_CAN_WHEEL_STOP : 0)};
-        good(s);
-        h->on_wheel(h->ctx, m.utime, &w);
+        on_wheel_msg(h, s, ch, data, len);
     } else if (strcmp(ch, LX_LCM_CH_STATUS) == 0 && h->on_status) {
-        rfseek_seeker_status_t m;
-        int n = rfseek_seeker_status_t_decode(data, 0, len, &m);
-        if (n < 0 || n != len) {
-            if (n >= 0) {
-                rfseek_seeker_status_t_decode_cleanup(&m);
-            }
-            bad(s, h, ch, "truncated, oversized or not an rfseek.seeker_status_t (%.0f bytes)", (double)len);
-            return;
-        }
-        rfs_seek_out_t o;
-        memset(&o, 0, sizeof o);
-        rfs_seek_decision_t *d = &o.decision;
-        bool ok = m.state >= 0 && m.state <= RFS_SEEK_DRIVING && m.kind >= 0 && m.kind <= RFS_SEEK_EPSILON &&
-                  m.prev >= 0 && m.prev <= RFS_DRIVE_BLOCKED && m.faults >= 0 && m.faults <= 0xFFFF &&
-                  q16_of(m.prediction, &d->prediction) && q16_of(m.mean, &d->mean) &&
-                  q16_of(m.epsilon, &d->epsilon) && q16_of(m.x, &d->x) && q16_of(m.y, &d->y) &&
-                  q16_of(m.goal_x, &d->goal_x) && q16_of(m.goal_y, &d->goal_y) && q16_of(m.max_x, &d->max_x) &&
-                  q16_of(m.max_y, &d->max_y) && q16_of(m.path_len, &d->path_len) && m.samples >= 0 &&
-                  m.samples <= 0xFFFF && est_ok(&m);
-        if (!ok) {
-            rfseek_seeker_status_t_decode_cleanup(&m);
-            bad(s, h, ch, "a field is out of range or not finite (state %.0f)", m.state);
-            return;
-        }
-        o.left_mm_s = m.left_mm_s;
-        o.right_mm_s = m.right_mm_s;
-        o.state = (rfs_seek_state_t)m.state;
-        o.faults = (uint16_t)m.faults;
-        o.decided = m.decided;
-        d->iteration = (uint32_t)m.iteration;
-        d->t_us = m.decision_utime;
-        d->kind = (rfs_seek_kind_t)m.kind;
-        d->relearned = m.model_updated;
-        d->line_search = m.line_search;
-        d->model_valid = m.model_valid;
-        d->mean_valid = m.mean_valid;
-        d->prev = (rfs_drive_status_t)m.prev;
-        d->samples = (uint16_t)m.samples;
-        int64_t t = m.utime;
-        rfseek_seeker_status_t_decode_cleanup(&m);
-        good(s);
-        h->on_status(h->ctx, t, &o);
+        on_status_msg(h, s, ch, data, len);
     } else if (strcmp(ch, LX_LCM_CH_CAN_FALLBACK) == 0 && h->on_can) {
-        rfseek_can_frame_t m;
-        int n = rfseek_can_frame_t_decode(data, 0, len, &m);
-        if (n < 0 || n != len) {
-            bad(s, h, ch, "truncated, oversized or not an rfseek.can_frame_t (%.0f bytes)", (double)len);
-            return;
-        }
-        if (m.id < 0 || m.id > (int32_t)RFS_CAN_ID_MAX || m.dlc < 0 || m.dlc > 8) {
-            bad(s, h, ch, "id or dlc out of range (id %.0f)", m.id);
-            return;
-        }
-        rfs_can_frame_t f;
-        memset(&f, 0, sizeof f);
-        f.id = (uint32_t)m.id;
-        f.dlc = (uint8_t)m.dlc;
-        memcpy(f.data, m.data, (size_t)m.dlc);
-        good(s);
-        h->on_can(h->ctx, m.utime, &f);
+        on_can_msg(h, s, ch, data, len);
     }
 }
 

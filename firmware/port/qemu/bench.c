@@ -1,10 +1,11 @@
-/* bench.c - instruction counts of the control loop on the Cortex-M4 image (issue 6).
+/* bench.c - instruction counts of the control loop on the Cortex-M4 image (docs/FIRMWARE.md,
+ * "Bench").
  *
  * Run under qemu-system-arm -M netduinoplus2 -icount shift=7 (tests/firmware/bench.sh):
  * SysTick counts instructions exactly (bench_clock.h: the method, the 1,000-NOP
  * calibration); the image prints raw tick counts, bench.sh converts.
  *
- * The worst case of issue 6: a 40 x 20 m map (0.125 m cells, 0.25 m lattice: 160 x 80
+ * The worst case: a 40 x 20 m map (0.125 m cells, 0.25 m lattice: 160 x 80
  * points, all legal but a wall round the edge), 10,000 samples all inside the 5 m radius,
  * a relearn (the model is discarded), then a greedy step (epsilon set to 0 so the greedy
  * branch is certain): grid search over every reachable lattice point, step choice with
@@ -13,6 +14,10 @@
  * same without it, and the paper's, on the same map with one interior wall (geo_decision).
  * Then the paper's greedy decision next to that wall, whose line search plans every legal
  * candidate until one plans (ls_decision), and the same beside a closed room.
+ *
+ * Each step of main is a function of its own, kept out of line: a count includes the few
+ * instructions the compiler schedules around the measured call, so the code of one step
+ * does not move the counts of another.
  */
 #include <stdint.h>
 #include <string.h>
@@ -171,6 +176,8 @@ static uint32_t geo_replay(rfs_seek_t *s, rfs_rng_t rng, bool geodesic, rfs_q16_
     bool found;
     rfs_map_lattice_nearest(m, s->pose.x, s->pose.y, &ci, &cj);
     *min_detour = INT64_MAX;
+    *gx = 0; /* no goal when no candidate is left */
+    *gy = 0;
     (void)rfs_rng_u32(&rng);
     for (int attempt = 0; attempt < GEO_TRIES; ++attempt) {
         const uint32_t total = geo_scan(s, ci, cj, UINT32_MAX, &gi, &gj, &q, &found);
@@ -280,7 +287,7 @@ static void geo_decision(const rfs_app_map_t *map, bool meta_path, bool geodesic
     rfs_bc_report(row->ridge_n, 0, s_app.ridge.n_used);
 }
 
-/* The paper's greedy decision behind a wall (RFS_SEEK_META; rfs_seek_meta.c, rfs_seek_meta_step):
+/* The paper's greedy decision behind a wall (RFS_SEEK_META; rfs_seek_meta.c choose_greedy):
  * the grid search's maximum, the point 1 m towards it, and when that point is illegal a
  * line search at the map resolution along the line to the maximum, alternating at random
  * between in front of the step point and beyond it, planning (go_to) every legal
@@ -464,8 +471,7 @@ static void ls_decision(const rfs_app_map_t *map, rfs_q16_t rx, rfs_q16_t ry, co
     *gy = out.decision.goal_y;
 }
 
-/* The line-search rows, after every other (a function of its own, so main's code and
- * with it the rows measured inside main stay as they were). */
+/* The line-search rows, after every other. */
 static void __attribute__((noinline)) ls_measure(const rfs_app_map_t *map)
 {
     rfs_q16_t gx, gy;
@@ -517,25 +523,24 @@ static void __attribute__((noinline)) ls_measure(const rfs_app_map_t *map)
     ls_decision(map, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(48, 5), &ls_room_worst, &gx, &gy);
 }
 
-int main(void)
+/* The bench's map: free inside, a one-cell wall round the edge. */
+static void __attribute__((noinline)) edge_map(void)
 {
-    rfs_bc_start(); /* SysTick, and the calibration lines */
-
-    /* The map: free inside, a one-cell wall round the edge. */
     for (uint16_t y = 0; y < MAP_H; y++) {
         for (uint16_t x = 0; x < MAP_W; x++) {
             const bool edge = x == 0u || y == 0u || x == MAP_W - 1u || y == MAP_H - 1u;
             rfs_map_bit_set(edge ? s_wall : s_free, MAP_STRIDE, x, y, true);
         }
     }
-    const rfs_app_map_t map = {.w = MAP_W, .h = MAP_H, .res = RFS_Q16_FRAC(1, 8),
-                               .origin_x = 0, .origin_y = 0, .free = s_free, .wall = s_wall};
-    rfs_app_cfg_t cfg = rfs_app_cfg_default();
-    cfg.seek.eps_amp = 0; /* epsilon = 0: the greedy branch, the expensive one, for certain */
-    cfg.seek.eps_floor = 0;
+}
+
+/* rfs_app_init on the whole map, then a boot with an empty store: the reachability flood
+ * fill and the initial move only; s_app initialised again afterwards. */
+static void __attribute__((noinline)) measure_init(const rfs_app_map_t *map, const rfs_app_cfg_t *cfg)
+{
     int rc = -1;
     uintptr_t sp0 = rfs_bc_stack_paint();
-    RFS_BC_MEASURE("app_init", 1, rc = rfs_app_init(&s_app, &cfg, &map));
+    RFS_BC_MEASURE("app_init", 1, rc = rfs_app_init(&s_app, cfg, map));
     rfs_bc_report("stack_bytes_app_init", 0, rfs_bc_stack_depth(sp0));
     if (rc != 0) {
         rfs_sh_puts("bench: rfs_app_init failed\n");
@@ -543,34 +548,29 @@ int main(void)
     }
     rfs_bc_report("lattice_points", 0, (uint32_t)s_app.map.lw * s_app.map.lh);
 
-    /* Boot with an empty store: the reachability flood fill and the initial move only. */
-    {
-        int64_t tb = 500000;
-        const rfs_pose_t pb = {.t_us = tb, .x = RFS_Q16_INT(20), .y = RFS_Q16_INT(10), .theta = 0};
-        rfs_app_on_pose(&s_app, &pb, tb);
-        rfs_app_on_rssi(&s_app, 0, tb, -60, tb);
-        rfs_app_out_t ob;
-        RFS_BC_MEASURE("boot_iteration_no_samples", 1, rfs_app_step(&s_app, tb, &ob));
-        if (rfs_app_init(&s_app, &cfg, &map) != 0) {
-            rfs_sh_exit(1);
-        }
+    int64_t tb = 500000;
+    const rfs_pose_t pb = {.t_us = tb, .x = RFS_Q16_INT(20), .y = RFS_Q16_INT(10), .theta = 0};
+    rfs_app_on_pose(&s_app, &pb, tb);
+    rfs_app_on_rssi(&s_app, 0, tb, -60, tb);
+    rfs_app_out_t ob;
+    RFS_BC_MEASURE("boot_iteration_no_samples", 1, rfs_app_step(&s_app, tb, &ob));
+    if (rfs_app_init(&s_app, cfg, map) != 0) {
+        rfs_sh_exit(1);
     }
+}
 
-    const rfs_q16_t rx = RFS_Q16_INT(20), ry = RFS_Q16_INT(10);
-    rfs_rng_t rng;
-    rfs_rng_seed(&rng, 43u);
-    fill_store(&s_app.seek.store, 42u);
-    rfs_bc_report("samples", 0, s_app.seek.store.count);
-
+/* The periods on the full store with the robot at (rx, ry): the boot, the worst case and
+ * an ordinary period while driving. Returns the time of the last; its output in *out. */
+static int64_t __attribute__((noinline)) measure_periods(rfs_q16_t rx, rfs_q16_t ry, rfs_app_out_t *out)
+{
     /* Boot: the first period with a pose and a measurement: reachability flood fill,
      * first fit, the initial move. */
     int64_t t = 1000000;
     const rfs_pose_t pose0 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
     rfs_app_on_pose(&s_app, &pose0, t);
     rfs_app_on_rssi(&s_app, 0, t, -60, t);
-    rfs_app_out_t out;
-    sp0 = rfs_bc_stack_paint();
-    RFS_BC_MEASURE("first_iteration", 1, rfs_app_step(&s_app, t, &out));
+    uintptr_t sp0 = rfs_bc_stack_paint();
+    RFS_BC_MEASURE("first_iteration", 1, rfs_app_step(&s_app, t, out));
     rfs_bc_report("stack_bytes_first_iteration", 0, rfs_bc_stack_depth(sp0));
 
     /* The worst case: the goal ended, the model no longer fits (discarded), iteration 1. */
@@ -581,23 +581,28 @@ int main(void)
     rfs_app_on_pose(&s_app, &pose1, t);
     rfs_app_on_rssi(&s_app, 0, t, -60, t);
     sp0 = rfs_bc_stack_paint();
-    RFS_BC_MEASURE("worst_iteration", 1, rfs_app_step(&s_app, t, &out));
+    RFS_BC_MEASURE("worst_iteration", 1, rfs_app_step(&s_app, t, out));
     rfs_bc_report("stack_bytes_worst_iteration", 0, rfs_bc_stack_depth(sp0));
     rfs_bc_report("worst_decided_greedy_relearned", 0,
-                  (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_GREEDY &&
-                             out.decision.relearned));
-    rfs_bc_report("worst_goal_x_cm", 0, (uint32_t)((out.decision.goal_x * 100) >> 16));
-    rfs_bc_report("worst_samples", 0, out.decision.samples);
+                  (uint32_t)(out->decided && out->decision.kind == RFS_SEEK_GREEDY &&
+                             out->decision.relearned));
+    rfs_bc_report("worst_goal_x_cm", 0, (uint32_t)((out->decision.goal_x * 100) >> 16));
+    rfs_bc_report("worst_samples", 0, out->decision.samples);
 
     /* An ordinary period while driving the goal just chosen. */
     t += RFS_APP_PERIOD_US;
     const rfs_pose_t pose2 = {.t_us = t, .x = rx + 1000, .y = ry, .theta = 0};
     rfs_app_on_pose(&s_app, &pose2, t);
     rfs_app_on_rssi(&s_app, 0, t, -60, t);
-    RFS_BC_MEASURE("driving_iteration", 1, rfs_app_step(&s_app, t, &out));
+    RFS_BC_MEASURE("driving_iteration", 1, rfs_app_step(&s_app, t, out));
+    return t;
+}
 
-    /* Phases alone. Averaging: one packet into a full 1 s window (200 packets/s), then
-     * the 1 s mean. */
+/* The input phases alone, at time t. Averaging: one packet into a full 1 s window (200
+ * packets/s), then the 1 s mean. Sample store: 20 measurements (0.1 s at 200 packets/s)
+ * wait for the next pose, which turns them into samples of the full reservoir. */
+static void __attribute__((noinline)) measure_inputs(rfs_q16_t rx, rfs_q16_t ry, int64_t t, rfs_rng_t *rng)
+{
     const rfs_rssi_cfg_t wcfg = rfs_rssi_cfg_default();
     (void)rfs_rssi_init(&s_win, &wcfg);
     for (int i = 0; i < 200; i++) {
@@ -607,28 +612,23 @@ int main(void)
     RFS_BC_MEASURE("phase_averaging_push", 1, (void)rfs_rssi_push(&s_win, 1000000, -61));
     RFS_BC_MEASURE("phase_averaging_mean", 1, (void)rfs_rssi_mean(&s_win, 1000000, &mean));
 
-    /* Sample store: 20 measurements (0.1 s at 200 packets/s) wait for the next pose, which
-     * turns them into samples of the full reservoir. */
     rfs_store_t *st = &s_app.seek.store;
     int64_t ts = t + 5000;
-    RFS_BC_MEASURE("phase_store_value", 1, rfs_store_add_value(st, ts, RFS_Q16_INT(-60), &rng));
+    RFS_BC_MEASURE("phase_store_value", 1, rfs_store_add_value(st, ts, RFS_Q16_INT(-60), rng));
     for (int i = 1; i < 20; i++) {
-        rfs_store_add_value(st, ts + 5000 * i, RFS_Q16_INT(-60), &rng);
+        rfs_store_add_value(st, ts + 5000 * i, RFS_Q16_INT(-60), rng);
     }
     const rfs_pose_t pose3 = {.t_us = t + 100000, .x = rx, .y = ry, .theta = 0};
-    RFS_BC_MEASURE("phase_store_pose_20", 20, (void)rfs_store_add_pose(st, &pose3, &rng));
+    RFS_BC_MEASURE("phase_store_pose_20", 20, (void)rfs_store_add_pose(st, &pose3, rng));
+}
 
-    /* Relearn: the local ridge on 10,000 samples, all inside the radius. */
-    rfs_ridge_t *ridge = &s_app.ridge;
-    const rfs_model_fit_in_t fin = {st->samples, st->count, rx, ry, &s_app.map};
-    rfs_ridge_ops.reset(ridge);
-    RFS_BC_MEASURE("phase_relearn", 1, (void)rfs_ridge_ops.fit(ridge, &fin, 0, &rng));
-    rfs_bc_report("ridge_samples_used", 0, ridge->n_used);
-
-    /* Grid search: the model at every reachable lattice point, as choose_greedy does it
-     * (rfs_gridmax.c: rows in chunks, one predict_row call per chunk when the model
-     * has it, else one predict per point). */
+/* Grid search: the model at every reachable lattice point, as choose_greedy does it
+ * (rfs_gridmax.c: rows in chunks, one predict_row call per chunk when the model has it,
+ * else one predict per point). Returns the maximum. */
+static rfs_q16_t __attribute__((noinline)) measure_grid_search(void)
+{
     const rfs_map_t *m = &s_app.map;
+    rfs_ridge_t *ridge = &s_app.ridge;
     rfs_q16_t best = RFS_Q16_MIN, bx = 0, by = 0;
     uint32_t points = 0;
     static rfs_q16_t row[64];
@@ -663,12 +663,18 @@ int main(void)
     rfs_bc_report("grid_points_searched", 0, points);
     rfs_bc_report("grid_max_x_cm", 0, (uint32_t)((bx * 100) >> 16));
     (void)by;
+    return best;
+}
 
-    /* A proposal, measured beside the faithful search: for a model that is affine in
-     * (x, y) - the local ridge is a plane - the prediction along one lattice row is
-     * monotone, so the row's maximum over reachable points is at its leftmost or
-     * rightmost reachable point: 2 predictions per row instead of one per point, the
-     * same maximum value exactly. */
+/* A proposal, measured beside the faithful search: for a model that is affine in
+ * (x, y) - the local ridge is a plane - the prediction along one lattice row is
+ * monotone, so the row's maximum over reachable points is at its leftmost or
+ * rightmost reachable point: 2 predictions per row instead of one per point, the
+ * same maximum value exactly (best: the faithful search's). */
+static void __attribute__((noinline)) measure_row_ends(rfs_q16_t best)
+{
+    const rfs_map_t *m = &s_app.map;
+    rfs_ridge_t *ridge = &s_app.ridge;
     rfs_q16_t best2 = RFS_Q16_MIN;
     RFS_BC_MEASURE("proposal_grid_search_row_ends", 1, {
         for (uint16_t j = 0; j < m->lh; ++j) {
@@ -702,6 +708,27 @@ int main(void)
         }
     });
     rfs_bc_report("proposal_same_max_value", 0, best2 == best ? 1u : 0u);
+}
+
+/* The decision's phases alone with the robot at (rx, ry): relearn (the local ridge on
+ * 10,000 samples, all inside the radius), grid search, the sliced fit, the step choice
+ * (its path in *path), drive control and the CAN side of a period (out: the period's
+ * output). */
+static void __attribute__((noinline)) measure_decision_phases(rfs_q16_t rx, rfs_q16_t ry, int64_t t,
+                                                              rfs_rng_t *rng,
+                                                              const rfs_app_out_t *out,
+                                                              rfs_path_t *path)
+{
+    rfs_store_t *st = &s_app.seek.store;
+    rfs_ridge_t *ridge = &s_app.ridge;
+    const rfs_model_fit_in_t fin = {st->samples, st->count, rx, ry, &s_app.map};
+    rfs_ridge_ops.reset(ridge);
+    RFS_BC_MEASURE("phase_relearn", 1, (void)rfs_ridge_ops.fit(ridge, &fin, 0, rng));
+    rfs_bc_report("ridge_samples_used", 0, ridge->n_used);
+
+    const rfs_q16_t best = measure_grid_search();
+    measure_row_ends(best);
+    const rfs_map_t *m = &s_app.map;
 
     /* A proposal: the fit sliced over control periods (cfg.seek.fit_budget samples per
      * period, here 2,500: four periods). */
@@ -709,44 +736,48 @@ int main(void)
     rfs_fit_result_t fres = RFS_FIT_MORE;
     uint32_t slices = 0;
     while (fres == RFS_FIT_MORE && slices < 100u) {
-        RFS_BC_MEASURE("proposal_relearn_slice_2500", 1, fres = rfs_ridge_ops.fit(ridge, &fin, 2500u, &rng));
+        RFS_BC_MEASURE("proposal_relearn_slice_2500", 1, fres = rfs_ridge_ops.fit(ridge, &fin, 2500u, rng));
         slices++;
     }
 
     /* Step choice: the point 1 m towards the maximum, its legality, the path to it. */
-    rfs_path_t path;
     bool ok = false;
     RFS_BC_MEASURE("phase_step_choice", 1, {
         const rfs_q16_t gx = rx + RFS_Q16_ONE;
-        ok = rfs_map_point_legal(m, gx, ry) && rfs_plan_path(&s_app.seek.plan, rx, ry, gx, ry, &path);
+        ok = rfs_map_point_legal(m, gx, ry) && rfs_plan_path(&s_app.seek.plan, rx, ry, gx, ry, path);
     });
     rfs_bc_report("step_path_ok", 0, ok ? 1u : 0u);
 
     /* Drive control: one update following that path. */
     rfs_drive_t *dr = &s_app.seek.drive;
-    rfs_drive_set_path(dr, &path, t);
+    rfs_drive_set_path(dr, path, t);
     const rfs_pose_t pose4 = {.t_us = t + 50000, .x = rx, .y = ry, .theta = 0};
     int16_t l, r;
     RFS_BC_MEASURE("phase_drive_control", 1, (void)rfs_drive_update(dr, &pose4, t + 50000, &l, &r));
 
     /* The CAN side of a period: decode one RSSI frame, encode the two output frames. */
     rfs_can_frame_t fr[2];
-    RFS_BC_MEASURE("phase_can_out_frames", 1, (void)rfs_app_frames(&s_app, &out, fr));
+    RFS_BC_MEASURE("phase_can_out_frames", 1, (void)rfs_app_frames(&s_app, out, fr));
+}
 
-    /* Beside the faithful configuration: the same worst case with the fit sliced over
-     * control periods (cfg.seek.fit_budget = 2,500 samples per period; the wheels stay
-     * stopped while learning). Every period until the decision is measured; the largest
-     * is the worst-case period of this configuration. */
-    cfg.seek.fit_budget = 2500u;
-    if (rfs_app_init(&s_app, &cfg, &map) != 0) {
+/* Beside the faithful configuration: the same worst case with the fit sliced over
+ * control periods (cfg.seek.fit_budget = 2,500 samples per period; the wheels stay
+ * stopped while learning). Every period until the decision is measured; the largest
+ * is the worst-case period of this configuration. out: the last period's output. */
+static void __attribute__((noinline)) measure_sliced(const rfs_app_map_t *map, rfs_app_cfg_t *cfg,
+                                                     rfs_q16_t rx, rfs_q16_t ry, rfs_app_out_t *out)
+{
+    cfg->seek.fit_budget = 2500u;
+    if (rfs_app_init(&s_app, cfg, map) != 0) {
         rfs_sh_exit(1);
     }
     fill_store(&s_app.seek.store, 42u);
-    t = 1000000;
+    int64_t t = 1000000;
+    const rfs_pose_t pose0 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
     rfs_app_on_pose(&s_app, &pose0, t);
     rfs_app_on_rssi(&s_app, 0, t, -60, t);
-    for (int k = 0; k < 20 && !(k > 0 && out.decided); k++) {
-        rfs_app_step(&s_app, t, &out); /* boot: flood fill, first (sliced) fit, initial move */
+    for (int k = 0; k < 20 && !(k > 0 && out->decided); k++) {
+        rfs_app_step(&s_app, t, out); /* boot: flood fill, first (sliced) fit, initial move */
         t += RFS_APP_PERIOD_US;
         const rfs_pose_t pk = {.t_us = t, .x = rx, .y = ry, .theta = 0};
         rfs_app_on_pose(&s_app, &pk, t);
@@ -756,14 +787,14 @@ int main(void)
     s_app.seek.model.ops->reset(s_app.seek.model.self);
     uint64_t worst_slice = 0;
     uint32_t periods = 0;
-    out.decided = false;
-    while (!out.decided && periods < 20u) {
+    out->decided = false;
+    while (!out->decided && periods < 20u) {
         t += RFS_APP_PERIOD_US;
         const rfs_pose_t pk = {.t_us = t, .x = rx, .y = ry, .theta = 0};
         rfs_app_on_pose(&s_app, &pk, t);
         rfs_app_on_rssi(&s_app, 0, t, -60, t);
         const uint64_t a = rfs_bc_ticks();
-        rfs_app_step(&s_app, t, &out);
+        rfs_app_step(&s_app, t, out);
         const uint64_t b = rfs_bc_ticks();
         rfs_bc_report("sliced_fit_period", b - a, 1);
         if (b - a > worst_slice) {
@@ -773,13 +804,16 @@ int main(void)
     }
     rfs_bc_report("sliced_worst_period", worst_slice, 1);
     rfs_bc_report("sliced_decided_greedy_relearned", 0,
-                  (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_GREEDY &&
-                             out.decision.relearned));
-    rfs_bc_report("sliced_goal_x_cm", 0, (uint32_t)((out.decision.goal_x * 100) >> 16));
+                  (uint32_t)(out->decided && out->decision.kind == RFS_SEEK_GREEDY &&
+                             out->decision.relearned));
+    rfs_bc_report("sliced_goal_x_cm", 0, (uint32_t)((out->decision.goal_x * 100) >> 16));
+}
 
-    /* The meta-path epsilon decision behind a wall (geo_decision), geodesic and not, and
-     * the paper's configuration's, side by side; then one of its plans alone: from the
-     * robot to the geodesic decision's kept goal, by rfs_plan_path and by a search tree. */
+/* The meta-path epsilon decision behind a wall (geo_decision), geodesic and not, and
+ * the paper's configuration's, side by side; then one of its plans alone: from the
+ * robot to the geodesic decision's kept goal, by rfs_plan_path and by a search tree. */
+static void __attribute__((noinline)) measure_behind_wall(const rfs_app_map_t *map, rfs_path_t *path)
+{
     geo_wall();
     rfs_q16_t gx, gy, sx, sy; /* the kept goals; the plan alone goes to the geodesic one */
     static const geo_rows_t geo_on = {
@@ -795,32 +829,56 @@ int main(void)
         "worst_eps_paper", "stack_bytes_worst_eps_paper", "worst_eps_paper_eps_relearn",
         "worst_eps_paper_plans", "worst_eps_paper_replay_goal_ok", "worst_eps_paper_path_cm", 0,
         "worst_eps_paper_ridge_samples"};
-    geo_decision(&map, true, true, &geo_on, &gx, &gy);
-    geo_decision(&map, true, false, &geo_off, &sx, &sy);
-    geo_decision(&map, false, false, &geo_paper, &sx, &sy);
+    geo_decision(map, true, true, &geo_on, &gx, &gy);
+    geo_decision(map, true, false, &geo_off, &sx, &sy);
+    geo_decision(map, false, false, &geo_paper, &sx, &sy);
     bool geo_ok = false;
     RFS_BC_MEASURE("phase_plan_behind_wall", 1,
                    geo_ok = rfs_plan_path(&s_app.seek.plan, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(69, 8),
-                                          gx, gy, &path));
+                                          gx, gy, path));
     rfs_bc_report("plan_behind_wall_ok", 0, geo_ok ? 1u : 0u);
     rfs_bc_report("plan_behind_wall_expanded", 0, s_app.seek.plan.expanded);
-    rfs_bc_report("plan_behind_wall_path_cm", 0, (uint32_t)((path.length * 100) >> 16));
+    rfs_bc_report("plan_behind_wall_path_cm", 0, (uint32_t)((path->length * 100) >> 16));
     /* The same goal by a fresh search tree from the robot (the geodesic decision's first
      * try), then a second goal on that tree (the straight decision's kept goal, also
      * north of the wall: the search resumed, the path pulled from where it parts). */
     RFS_BC_MEASURE("phase_tree_behind_wall", 1, {
         rfs_plan_tree_begin(&s_app.seek.plan, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(69, 8));
-        geo_ok = rfs_plan_tree_path(&s_app.seek.plan, gx, gy, &path);
+        geo_ok = rfs_plan_tree_path(&s_app.seek.plan, gx, gy, path);
     });
     rfs_bc_report("tree_behind_wall_ok", 0, geo_ok ? 1u : 0u);
     rfs_bc_report("tree_behind_wall_expanded", 0, s_app.seek.plan.expanded);
-    rfs_bc_report("tree_behind_wall_path_cm", 0, (uint32_t)((path.length * 100) >> 16));
+    rfs_bc_report("tree_behind_wall_path_cm", 0, (uint32_t)((path->length * 100) >> 16));
     RFS_BC_MEASURE("phase_tree_second_goal", 1,
-                   geo_ok = rfs_plan_tree_path(&s_app.seek.plan, sx, sy, &path));
+                   geo_ok = rfs_plan_tree_path(&s_app.seek.plan, sx, sy, path));
     rfs_bc_report("tree_second_goal_ok", 0, geo_ok ? 1u : 0u);
     rfs_bc_report("tree_second_goal_expanded", 0, s_app.seek.plan.expanded);
-    rfs_bc_report("tree_second_goal_path_cm", 0, (uint32_t)((path.length * 100) >> 16));
+    rfs_bc_report("tree_second_goal_path_cm", 0, (uint32_t)((path->length * 100) >> 16));
+}
 
+int main(void)
+{
+    rfs_bc_start(); /* SysTick, and the calibration lines */
+    edge_map();
+    const rfs_app_map_t map = {.w = MAP_W, .h = MAP_H, .res = RFS_Q16_FRAC(1, 8),
+                               .origin_x = 0, .origin_y = 0, .free = s_free, .wall = s_wall};
+    rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.seek.eps_amp = 0; /* epsilon = 0: the greedy branch, the expensive one, for certain */
+    cfg.seek.eps_floor = 0;
+    measure_init(&map, &cfg);
+
+    const rfs_q16_t rx = RFS_Q16_INT(20), ry = RFS_Q16_INT(10);
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 43u);
+    fill_store(&s_app.seek.store, 42u);
+    rfs_bc_report("samples", 0, s_app.seek.store.count);
+    rfs_app_out_t out;
+    const int64_t t = measure_periods(rx, ry, &out);
+    measure_inputs(rx, ry, t, &rng);
+    rfs_path_t path;
+    measure_decision_phases(rx, ry, t, &rng, &out, &path);
+    measure_sliced(&map, &cfg, rx, ry, &out);
+    measure_behind_wall(&map, &path);
     ls_measure(&map);
     rfs_sh_exit(0);
 }

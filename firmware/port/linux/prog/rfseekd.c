@@ -1,6 +1,6 @@
-/* rfseekd.c - the Linux port of the firmware (issue 4): the same application loop as the
+/* rfseekd.c - the Linux port of the firmware: the same application loop as the
  * microcontroller (firmware/rfs_app.h), with pose, RSSI and the receiver heartbeat
- * (RFS_RSSI_STATUS, issue 10) from LCM, wheel commands to
+ * (RFS_RSSI_STATUS; docs/FAULTS.md, "The receiver heartbeat") from LCM, wheel commands to
  * SocketCAN (or the LCM fallback channel RFS_CAN_FALLBACK carrying raw CAN frames), the
  * status to LCM, and runs recorded as LCM logs. See docs/CAN.md.
  *
@@ -80,6 +80,12 @@ typedef struct daemon {
     int64_t last_clock_us;
     int64_t last_now_us;    /* time of the latest step */
     lx_can_link_t link;
+    lx_lcm_handlers_t handlers; /* the inputs' callbacks (ctx: this daemon) */
+    lx_lcm_log_t *in;       /* --replay: the input log */
+    char dec_tmp[4096];     /* --decisions: written here, renamed at a clean end */
+    lx_map_t map;           /* --map, and the core's grids made from it */
+    lx_core_map_t core;
+    void *model_state;      /* --model: its state (heap, the model's size) */
 } daemon_t;
 
 static volatile sig_atomic_t g_stop;
@@ -162,7 +168,8 @@ static void step(daemon_t *d, int64_t now_us)
                          (uint8_t)(out.state == RFS_SEEK_DRIVING ? 0u : RFS_CAN_WHEEL_STOP)};
     if (d->lcm) {
         (void)lx_lcm_pub_wheel(d->lcm, now_us, &w);
-        // issue 10: the path-loss model's estimate and uncertainty when that is the model.
+        // The path-loss model's estimate and uncertainty when that is the model
+        // (docs/PATHLOSS.md, "Uncertainty").
         const rfs_model_t *mdl = &d->app->seek.model;
         rfs_pathloss_est_t est;
         bool pl = mdl->ops == &rfs_pathloss_ops && rfs_pathloss_estimate(mdl->self, &est);
@@ -285,16 +292,91 @@ static bool is_value_option(const char *a)
     return false;
 }
 
-int main(int argc, char **argv)
+/* The command line. */
+typedef struct options {
+    const char *map_path, *url, *can_if, *replay, *log_path, *dec_path;
+    const char *target;
+    const rfs_models_entry_t *model; /* NULL: the application's built-in ridge */
+    double p0_min;                   /* --p0-min: NAN keeps the model's default */
+    rfs_seek_strategy_t strategy;    /* --strategy: the paper's by default */
+    double res;
+    int64_t seed, duration_s, idle_ms;
+    bool can_over_lcm, clock_lcm;
+} options_t;
+
+enum { RUN = -1 }; /* parse_options: go on (else the exit status) */
+
+/* One option that takes a value v: RUN, or the exit status of a bad value. */
+static int parse_value(options_t *o, const char *a, const char *v)
 {
-    const char *map_path = NULL, *url = NULL, *can_if = NULL, *replay = NULL, *log_path = NULL, *dec_path = NULL;
-    const char *target = "rssi";
-    const rfs_models_entry_t *model = NULL; // NULL: the application's built-in ridge
-    double p0_min = NAN;                    // --p0-min: NAN keeps the model's default
-    rfs_seek_strategy_t strategy = RFS_SEEK_META; // --strategy: the paper's
-    double res = 0.1;
-    int64_t seed = 1, duration_s = 0, idle_ms = 0;
-    bool can_over_lcm = false, clock_lcm = false;
+    if (strcmp(a, "--map") == 0) {
+        o->map_path = v;
+    } else if (strcmp(a, "--lcm") == 0) {
+        o->url = v;
+    } else if (strcmp(a, "--can") == 0) {
+        o->can_if = v;
+    } else if (strcmp(a, "--replay") == 0) {
+        o->replay = v;
+    } else if (strcmp(a, "--log") == 0) {
+        o->log_path = v;
+    } else if (strcmp(a, "--decisions") == 0) {
+        o->dec_path = v;
+    } else if (strcmp(a, "--target") == 0) {
+        o->target = v;
+        if (strcmp(o->target, "rssi") != 0 && strcmp(o->target, "bridge") != 0) {
+            return die("--target: expected rssi or bridge, got ", o->target);
+        }
+    } else if (strcmp(a, "--model") == 0) {
+        o->model = rfs_models_lookup(v);
+        if (o->model == NULL) {
+            return die("--model: expected ridge, mlp, knn, radius or pathloss, got ", v);
+        }
+    } else if (strcmp(a, "--strategy") == 0) {
+        // meta-global needs the ridge's radius widened to the map (rfseek-sim does it):
+        // not offered here rather than run as plain meta under its name.
+        if (!rfs_seek_strategy_parse(v, &o->strategy) || o->strategy == RFS_SEEK_META_GLOBAL) {
+            return die("--strategy: expected meta, meta-path, fd-gradient, plane-gradient or "
+                       "chemotaxis, got ", v);
+        }
+    } else if (strcmp(a, "--p0-min") == 0) {
+        char *end;
+        o->p0_min = strtod(v, &end);
+        if (*v == '\0' || *end != '\0' || !(o->p0_min >= -200.0 && o->p0_min <= 100.0)) {
+            return die("--p0-min: expected dBm in [-200, 100], got ", v);
+        }
+    } else if (strcmp(a, "--res") == 0) {
+        char *end;
+        o->res = strtod(v, &end);
+        if (*end != '\0' || !(o->res >= 0.01 && o->res <= 1.0)) {
+            return die("--res: expected metres in [0.01, 1], got ", v);
+        }
+    } else if (strcmp(a, "--seed") == 0) {
+        if (!parse_i64(v, 0, INT64_MAX, &o->seed)) {
+            return die("--seed: expected a non-negative integer, got ", v);
+        }
+    } else if (strcmp(a, "--duration") == 0) {
+        if (!parse_i64(v, 1, 86400 * 365, &o->duration_s)) {
+            return die("--duration: expected whole seconds >= 1, got ", v);
+        }
+    } else if (strcmp(a, "--idle-exit") == 0) {
+        if (!parse_i64(v, 1, 86400000, &o->idle_ms)) {
+            return die("--idle-exit: expected milliseconds >= 1, got ", v);
+        }
+    } else {
+        return die("unknown option (see --help): ", a);
+    }
+    return RUN;
+}
+
+/* The command line into *o: RUN, or the exit status (--help, a bad option). */
+static int parse_options(int argc, char **argv, options_t *o)
+{
+    memset(o, 0, sizeof *o);
+    o->target = "rssi";
+    o->p0_min = NAN;
+    o->strategy = RFS_SEEK_META;
+    o->res = 0.1;
+    o->seed = 1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -302,294 +384,269 @@ int main(int argc, char **argv)
             fputs(usage_text, stdout);
             return 0;
         } else if (strcmp(a, "--can-over-lcm") == 0) {
-            can_over_lcm = true;
+            o->can_over_lcm = true;
         } else if (strcmp(a, "--clock-lcm") == 0) {
-            clock_lcm = true;
-        } else if (!is_value_option(a)) { // NOLINT(bugprone-branch-clone): same message as the guard at the end
+            o->clock_lcm = true;
+        } else if (!is_value_option(a)) {
             return die("unknown option (see --help): ", a);
         } else if (v == NULL) {
             return die("missing value for option ", a);
-        } else if (strcmp(a, "--map") == 0) {
-            map_path = v, i++;
-        } else if (strcmp(a, "--lcm") == 0) {
-            url = v, i++;
-        } else if (strcmp(a, "--can") == 0) {
-            can_if = v, i++;
-        } else if (strcmp(a, "--replay") == 0) {
-            replay = v, i++;
-        } else if (strcmp(a, "--log") == 0) {
-            log_path = v, i++;
-        } else if (strcmp(a, "--decisions") == 0) {
-            dec_path = v, i++;
-        } else if (strcmp(a, "--target") == 0) {
-            target = v, i++;
-            if (strcmp(target, "rssi") != 0 && strcmp(target, "bridge") != 0) {
-                return die("--target: expected rssi or bridge, got ", target);
-            }
-        } else if (strcmp(a, "--model") == 0) {
-            model = rfs_models_lookup(v), i++;
-            if (model == NULL) {
-                return die("--model: expected ridge, mlp, knn, radius or pathloss, got ", v);
-            }
-        } else if (strcmp(a, "--strategy") == 0) {
-            // meta-global needs the ridge's radius widened to the map (rfseek-sim does it):
-            // not offered here rather than run as plain meta under its name.
-            if (!rfs_seek_strategy_parse(v, &strategy) || strategy == RFS_SEEK_META_GLOBAL) {
-                return die("--strategy: expected meta, meta-path, fd-gradient, plane-gradient or "
-                           "chemotaxis, got ", v);
-            }
-            i++;
-        } else if (strcmp(a, "--p0-min") == 0) {
-            char *end;
-            p0_min = strtod(v, &end);
-            if (*v == '\0' || *end != '\0' || !(p0_min >= -200.0 && p0_min <= 100.0)) {
-                return die("--p0-min: expected dBm in [-200, 100], got ", v);
-            }
-            i++;
-        } else if (strcmp(a, "--res") == 0) {
-            char *end;
-            res = strtod(v, &end);
-            if (*end != '\0' || !(res >= 0.01 && res <= 1.0)) {
-                return die("--res: expected metres in [0.01, 1], got ", v);
-            }
-            i++;
-        } else if (strcmp(a, "--seed") == 0) {
-            if (!parse_i64(v, 0, INT64_MAX, &seed)) {
-                return die("--seed: expected a non-negative integer, got ", v);
-            }
-            i++;
-        } else if (strcmp(a, "--duration") == 0) {
-            if (!parse_i64(v, 1, 86400 * 365, &duration_s)) {
-                return die("--duration: expected whole seconds >= 1, got ", v);
-            }
-            i++;
-        } else if (strcmp(a, "--idle-exit") == 0) {
-            if (!parse_i64(v, 1, 86400000, &idle_ms)) {
-                return die("--idle-exit: expected milliseconds >= 1, got ", v);
-            }
-            i++;
         } else {
-            return die("unknown option (see --help): ", a);
+            const int rc = parse_value(o, a, v);
+            if (rc != RUN) {
+                return rc;
+            }
+            i++;
         }
     }
-    if (!map_path) {
+    if (!o->map_path) {
         return die("--map MAP.yaml is required (see --help)", NULL);
     }
-    if (!isnan(p0_min) && (model == NULL || model->ops != &rfs_pathloss_ops)) {
+    if (!isnan(o->p0_min) && (o->model == NULL || o->model->ops != &rfs_pathloss_ops)) {
         return die("--p0-min: only with --model pathloss", NULL);
     }
-    if (can_if && can_over_lcm) {
+    if (o->can_if && o->can_over_lcm) {
         return die("--can and --can-over-lcm exclude each other", NULL);
     }
-    if (replay && (can_if || can_over_lcm)) {
+    if (o->replay && (o->can_if || o->can_over_lcm)) {
         return die("--replay sends no CAN frames: drop --can / --can-over-lcm", NULL);
     }
+    return RUN;
+}
 
+/* The map, the model's state and the application: 0, or 1 after an error line. */
+static int open_controller(daemon_t *d, const options_t *o)
+{
     char err[512];
-    lx_map_t m;
-    memset(&m, 0, sizeof m);
-    lx_core_map_t core;
-    memset(&core, 0, sizeof core);
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
-    rfs_seek_cfg_use_strategy(&cfg.seek, strategy);
-    cfg.seed = (uint64_t)seed;
-    cfg.target = strcmp(target, "bridge") == 0 ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
-    if (lx_map_load(map_path, &m, err, sizeof err) != 0 || lx_map_to_core(&m, res, &cfg.map, &core, err, sizeof err) != 0) {
-        lx_map_free(&m);
+    rfs_seek_cfg_use_strategy(&cfg.seek, o->strategy);
+    cfg.seed = (uint64_t)o->seed;
+    cfg.target = strcmp(o->target, "bridge") == 0 ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
+    if (lx_map_load(o->map_path, &d->map, err, sizeof err) != 0 ||
+        lx_map_to_core(&d->map, o->res, &cfg.map, &d->core, err, sizeof err) != 0) {
         lx_err_print(PROG, "%s", err);
         return 1;
     }
     // The Linux port holds any model: its state in a heap buffer of the model's size.
-    void *model_state = NULL;
-    if (model != NULL) {
-        size_t mb = (model->state_bytes + RFS_MODELS_STATE_ALIGN - 1u) / RFS_MODELS_STATE_ALIGN *
+    if (o->model != NULL) {
+        size_t mb = (o->model->state_bytes + RFS_MODELS_STATE_ALIGN - 1u) / RFS_MODELS_STATE_ALIGN *
                     RFS_MODELS_STATE_ALIGN;
-        model_state = aligned_alloc(RFS_MODELS_STATE_ALIGN, mb);
-        if (model_state == NULL) {
-            fprintf(stderr, "rfseekd: --model %s: out of memory\n", model->name);
-            lx_core_map_free(&core);
-            lx_map_free(&m);
+        d->model_state = aligned_alloc(RFS_MODELS_STATE_ALIGN, mb);
+        if (d->model_state == NULL) {
+            fprintf(stderr, "rfseekd: --model %s: out of memory\n", o->model->name);
             return 1;
         }
-        cfg.model = model;
-        cfg.model_state = model_state;
+        cfg.model = o->model;
+        cfg.model_state = d->model_state;
         cfg.model_state_bytes = (uint32_t)mb;
     }
-    rfs_app_map_t am = {core.map.w, core.map.h, core.map.res, core.map.origin_x, core.map.origin_y, core.free_bits,
-                        core.wall_bits};
-    daemon_t d;
-    memset(&d, 0, sizeof d);
-    d.app = malloc(sizeof *d.app);
-    if (!d.app || rfs_app_init(d.app, &cfg, &am) != 0) {
+    const lx_core_map_t *core = &d->core;
+    rfs_app_map_t am = {core->map.w, core->map.h, core->map.res, core->map.origin_x, core->map.origin_y,
+                        core->free_bits, core->wall_bits};
+    d->app = malloc(sizeof *d->app);
+    if (!d->app || rfs_app_init(d->app, &cfg, &am) != 0) {
         lx_err_print(PROG, "%s: the map (%u x %u cells at %.2f m) exceeds the controller's limits (%u bytes per "
                  "grid, %u lattice points)",
-                 map_path, core.map.w, core.map.h, res, RFS_APP_MAX_MAP_BYTES, RFS_APP_MAX_LATTICE);
-        free(d.app);
-        free(model_state);
-        lx_core_map_free(&core);
-        lx_map_free(&m);
+                 o->map_path, core->map.w, core->map.h, o->res, RFS_APP_MAX_MAP_BYTES, RFS_APP_MAX_LATTICE);
         return 1;
     }
-    if (!isnan(p0_min)) {
+    if (!isnan(o->p0_min)) {
         /* The node's power known: a floor on the fitted signal at 1 m (docs/PATHLOSS.md
          * "The P0 floor"). The state is re-initialised before any fit. */
         rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
-        pc.p0_min = (rfs_q16_t)lround(p0_min * 65536.0);
-        if (rfs_pathloss_init((rfs_pathloss_t *)model_state, &pc) != 0) {
-            lx_err_print(PROG, "--p0-min %g: rejected by the pathloss model", p0_min);
-            free(d.app);
-            free(model_state);
-            lx_core_map_free(&core);
-            lx_map_free(&m);
+        pc.p0_min = (rfs_q16_t)lround(o->p0_min * 65536.0);
+        if (rfs_pathloss_init((rfs_pathloss_t *)d->model_state, &pc) != 0) {
+            lx_err_print(PROG, "--p0-min %g: rejected by the pathloss model", o->p0_min);
             return 1;
         }
     }
-    d.can_over_lcm = can_over_lcm;
-    d.clock_lcm = clock_lcm;
-    d.replay = replay != NULL;
-    d.duration_us = duration_s * 1000000;
-    d.decisions = replay ? stdout : NULL;
-    int rc = 0;
-    lx_lcm_log_t *in = NULL;
+    return 0;
+}
+
+/* The decisions file, the log, LCM and CAN: 0, or 1 after an error line. */
+static int open_io(daemon_t *d, const options_t *o)
+{
+    char err[512];
+    d->can_over_lcm = o->can_over_lcm;
+    d->clock_lcm = o->clock_lcm;
+    d->replay = o->replay != NULL;
+    d->duration_us = o->duration_s * 1000000;
+    d->decisions = o->replay ? stdout : NULL;
     /* The decisions go to a temporary file renamed at a clean end: nothing half-written. */
-    char dec_tmp[4096];
-    snprintf(dec_tmp, sizeof dec_tmp, "%s.tmp.%ld", dec_path ? dec_path : "", (long)getpid());
-    if (dec_path && !(d.decisions = fopen(dec_tmp, "w"))) {
-        lx_err_print(PROG, "%s: cannot write: %s", dec_path, strerror(errno));
-        rc = 1;
-        goto out;
+    snprintf(d->dec_tmp, sizeof d->dec_tmp, "%s.tmp.%ld", o->dec_path ? o->dec_path : "", (long)getpid());
+    if (o->dec_path && !(d->decisions = fopen(d->dec_tmp, "w"))) {
+        lx_err_print(PROG, "%s: cannot write: %s", o->dec_path, strerror(errno));
+        return 1;
     }
-    lx_lcm_handlers_t h;
-    memset(&h, 0, sizeof h);
-    h.ctx = &d;
-    h.on_pose = on_pose;
-    h.on_rssi = on_rssi;
-    h.on_receiver = on_receiver;
-    h.on_clock = clock_lcm ? on_clock : NULL;
-    h.on_bad = on_bad;
-    if (log_path && !(d.rec = lx_lcm_log_open(log_path, "w", err, sizeof err))) {
+    lx_lcm_handlers_t *h = &d->handlers;
+    memset(h, 0, sizeof *h);
+    h->ctx = d;
+    h->on_pose = on_pose;
+    h->on_rssi = on_rssi;
+    h->on_receiver = on_receiver;
+    h->on_clock = o->clock_lcm ? on_clock : NULL;
+    h->on_bad = on_bad;
+    if (o->log_path && !(d->rec = lx_lcm_log_open(o->log_path, "w", err, sizeof err))) {
         lx_err_print(PROG, "%s", err);
-        rc = 1;
-        goto out;
+        return 1;
     }
-    if (!replay || url) {
+    if (!o->replay || o->url) {
         /* In replay, LCM (when given) only carries the outputs. */
         lx_lcm_handlers_t none;
         memset(&none, 0, sizeof none);
-        d.lcm = lx_lcm_open(url, replay ? &none : &h, err, sizeof err);
-        if (!d.lcm) {
+        d->lcm = lx_lcm_open(o->url, o->replay ? &none : h, err, sizeof err);
+        if (!d->lcm) {
             lx_err_print(PROG, "%s", err);
-            rc = 1;
-            goto out;
+            return 1;
         }
         if (err[0]) { /* liblcm's warning, as one line (lx_lcm.h) */
             lx_err_print(PROG, "%s", err);
         }
-        lx_lcm_record(d.lcm, d.rec);
+        lx_lcm_record(d->lcm, d->rec);
     }
-    if (can_if) {
+    if (o->can_if) {
         const uint32_t ids[] = {RFS_CAN_ID_WHEEL_CMD, RFS_CAN_ID_STATUS};
-        d.can = lx_can_open(can_if, ids, 2, err, sizeof err);
-        if (!d.can) {
+        d->can = lx_can_open(o->can_if, ids, 2, err, sizeof err);
+        if (!d->can) {
             lx_err_print(PROG, "%s", err);
-            rc = 1;
-            goto out;
+            return 1;
         }
     }
-    signal(SIGINT, on_signal);
-    signal(SIGTERM, on_signal);
-    if (replay) {
-        in = lx_lcm_log_open(replay, "r", err, sizeof err);
-        if (!in) {
-            lx_err_print(PROG, "%s", err);
-            rc = 1;
-            goto out;
+    return 0;
+}
+
+/* --replay: the log's messages in order (the handlers step). 0, or 1 after an error line. */
+static int run_replay(daemon_t *d, const options_t *o)
+{
+    char err[512];
+    d->in = lx_lcm_log_open(o->replay, "r", err, sizeof err);
+    if (!d->in) {
+        lx_err_print(PROG, "%s", err);
+        return 1;
+    }
+    lx_lcm_stats_t st;
+    memset(&st, 0, sizeof st);
+    int64_t t;
+    while (!g_stop && !d->done && lx_lcm_log_next(d->in, &d->handlers, &st, &t) == 1) {
+    }
+    return 0;
+}
+
+/* A failed LCM receive: the end of a file:// provider's log (0), else an error (1). */
+static int lcm_failed(const options_t *o)
+{
+    /* LCM's file:// provider reports the end of its log this way. */
+    if (o->url && strncmp(o->url, "file://", 7) == 0) {
+        return 0;
+    }
+    lx_err_print(PROG, "%s: LCM receive failed", o->url ? o->url : "(default URL)");
+    return 1;
+}
+
+/* --clock-lcm: LCM's messages until signalled, done or idle (RFS_CLOCK steps). */
+static int run_lockstep(daemon_t *d, const options_t *o)
+{
+    int64_t idle_since = realtime_us();
+    while (!g_stop && !d->done) {
+        int r = lx_lcm_handle(d->lcm, 100);
+        if (r < 0) {
+            return lcm_failed(o);
         }
-        lx_lcm_stats_t st;
-        memset(&st, 0, sizeof st);
-        int64_t t;
-        while (!g_stop && !d.done && lx_lcm_log_next(in, &h, &st, &t) == 1) {
-        }
-    } else if (clock_lcm) {
-        int64_t idle_since = realtime_us();
-        while (!g_stop && !d.done) {
-            int r = lx_lcm_handle(d.lcm, 100);
-            if (r < 0) {
-                /* LCM's file:// provider reports the end of its log this way. */
-                if (url && strncmp(url, "file://", 7) == 0) {
-                    break;
-                }
-                lx_err_print(PROG, "%s: LCM receive failed", url ? url : "(default URL)");
-                rc = 1;
-                break;
-            }
-            int64_t now = realtime_us();
-            if (r > 0) {
-                idle_since = now;
-            } else if (idle_ms > 0 && now - idle_since >= idle_ms * 1000) {
-                break;
-            }
-        }
-    } else {
-        int64_t next = realtime_us();
-        int64_t idle_since = next;
-        while (!g_stop && !d.done) {
-            int64_t now = realtime_us();
-            if (now >= next) {
-                step(&d, now);
-                next += RFS_APP_PERIOD_US;
-                if (next < now) {
-                    next = now + RFS_APP_PERIOD_US; /* overrun: skip, do not burst */
-                }
-                continue;
-            }
-            int r = lx_lcm_handle(d.lcm, (int)((next - now + 999) / 1000));
-            if (r < 0) {
-                if (url && strncmp(url, "file://", 7) == 0) {
-                    break;
-                }
-                lx_err_print(PROG, "%s: LCM receive failed", url ? url : "(default URL)");
-                rc = 1;
-                break;
-            }
-            if (r > 0) {
-                idle_since = realtime_us();
-            } else if (idle_ms > 0 && realtime_us() - idle_since >= idle_ms * 1000) {
-                break;
-            }
+        int64_t now = realtime_us();
+        if (r > 0) {
+            idle_since = now;
+        } else if (o->idle_ms > 0 && now - idle_since >= o->idle_ms * 1000) {
+            break;
         }
     }
-    fprintf(stderr, "rfseekd: %" PRIu32 " steps, %" PRIu32 " decisions, %" PRIu32 " bad messages, %" PRIu32
-                    " CAN send failures, %" PRIu32 " receiver heartbeats, seeker rejected %" PRIu32
-                    " inputs (strategy %s, model %s)\n",
-            d.steps, d.decided, d.bad_msgs, d.can_fail, d.app->stats.receiver, d.app->stats.rejected,
-            rfs_seek_strategy_name(d.app->seek.cfg.strategy), d.app->seek.model.ops->name);
-out:
-    if (in) {
-        lx_lcm_log_close(in);
+    return 0;
+}
+
+/* Live: a step every period on the local clock, LCM's messages in between. */
+static int run_live(daemon_t *d, const options_t *o)
+{
+    int64_t next = realtime_us();
+    int64_t idle_since = next;
+    while (!g_stop && !d->done) {
+        int64_t now = realtime_us();
+        if (now >= next) {
+            step(d, now);
+            next += RFS_APP_PERIOD_US;
+            if (next < now) {
+                next = now + RFS_APP_PERIOD_US; /* overrun: skip, do not burst */
+            }
+            continue;
+        }
+        int r = lx_lcm_handle(d->lcm, (int)((next - now + 999) / 1000));
+        if (r < 0) {
+            return lcm_failed(o);
+        }
+        if (r > 0) {
+            idle_since = realtime_us();
+        } else if (o->idle_ms > 0 && realtime_us() - idle_since >= o->idle_ms * 1000) {
+            break;
+        }
     }
-    if (d.rec && lx_lcm_log_close(d.rec) != 0) {
-        lx_err_print(PROG, "%s: could not finish the log", log_path);
+    return 0;
+}
+
+/* Close the log and the decisions (renamed into place when rc is 0) and free everything:
+ * the exit status, 1 when finishing an output failed. */
+static int finish(daemon_t *d, const options_t *o, int rc)
+{
+    if (d->in) {
+        lx_lcm_log_close(d->in);
+    }
+    if (d->rec && lx_lcm_log_close(d->rec) != 0) {
+        lx_err_print(PROG, "%s: could not finish the log", o->log_path);
         rc = 1;
     }
-    if (d.decisions && d.decisions != stdout) {
-        if (fclose(d.decisions) != 0 && rc == 0) {
-            lx_err_print(PROG, "%s: write failed", dec_path);
+    if (d->decisions && d->decisions != stdout) {
+        if (fclose(d->decisions) != 0 && rc == 0) {
+            lx_err_print(PROG, "%s: write failed", o->dec_path);
             rc = 1;
         }
-        if (rc == 0 && rename(dec_tmp, dec_path) != 0) {
-            lx_err_print(PROG, "%s: %s", dec_path, strerror(errno));
+        if (rc == 0 && rename(d->dec_tmp, o->dec_path) != 0) {
+            lx_err_print(PROG, "%s: %s", o->dec_path, strerror(errno));
             rc = 1;
         }
         if (rc != 0) {
-            remove(dec_tmp);
+            remove(d->dec_tmp);
         }
     }
-    lx_can_close(d.can);
-    lx_lcm_close(d.lcm);
-    free(d.app);
-    free(model_state);
-    lx_core_map_free(&core);
-    lx_map_free(&m);
+    lx_can_close(d->can);
+    lx_lcm_close(d->lcm);
+    free(d->app);
+    free(d->model_state);
+    lx_core_map_free(&d->core);
+    lx_map_free(&d->map);
     return rc;
+}
+
+int main(int argc, char **argv)
+{
+    options_t o;
+    int rc = parse_options(argc, argv, &o);
+    if (rc != RUN) {
+        return rc;
+    }
+    daemon_t d;
+    memset(&d, 0, sizeof d);
+    rc = open_controller(&d, &o);
+    if (rc == 0) {
+        rc = open_io(&d, &o);
+    }
+    if (rc == 0) {
+        signal(SIGINT, on_signal);
+        signal(SIGTERM, on_signal);
+        rc = o.replay ? run_replay(&d, &o) : o.clock_lcm ? run_lockstep(&d, &o) : run_live(&d, &o);
+        if (!o.replay || d.in) { /* not when the replay log could not be opened */
+            fprintf(stderr, "rfseekd: %" PRIu32 " steps, %" PRIu32 " decisions, %" PRIu32 " bad messages, %" PRIu32
+                            " CAN send failures, %" PRIu32 " receiver heartbeats, seeker rejected %" PRIu32
+                            " inputs (strategy %s, model %s)\n",
+                    d.steps, d.decided, d.bad_msgs, d.can_fail, d.app->stats.receiver, d.app->stats.rejected,
+                    rfs_seek_strategy_name(d.app->seek.cfg.strategy), d.app->seek.model.ops->name);
+        }
+    }
+    return finish(&d, &o, rc);
 }

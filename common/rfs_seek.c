@@ -476,8 +476,7 @@ static bool inputs_stale(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     out->faults |= pose_stale ? RFS_SEEK_FAULT_POSE_STALE : 0u;
     out->faults |= rssi_stale ? RFS_SEEK_FAULT_RSSI_STALE : 0u;
     uint16_t ci, cj;
-    if (s->have_pose && !rfs_map_point_legal(s->map, s->pose.x, s->pose.y) &&
-        !rfs_map_cell(s->map, s->pose.x, s->pose.y, &ci, &cj)) {
+    if (s->have_pose && !rfs_map_cell(s->map, s->pose.x, s->pose.y, &ci, &cj)) {
         out->faults |= RFS_SEEK_FAULT_OFF_MAP;
     }
     if (!pose_stale && !rssi_stale) {

@@ -362,12 +362,16 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
 {
     rfs_seek_decision_t *d = &s->decision;
     bool ok = false;
-    rfs_q16_t dummy;
-    bool model_ok = s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &dummy);
     if (d->iteration == 0u) {
         d->kind = RFS_SEEK_INITIAL;
         ok = rfs_seek_meta_initial(s, rng, now_us);
     } else {
+        /* Whether the model predicts at the robot: decide() asked the same model at the
+         * same pose unless it was relearnt since (predict is pure). */
+        rfs_q16_t v;
+        bool model_ok = d->relearned
+                            ? s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &v)
+                            : d->model_valid;
         ok = rfs_seek_ops(s)->choose(s, model_ok, rng, now_us);
     }
     end_decision(s, ok, now_us, out);
@@ -476,8 +480,7 @@ static bool inputs_stale(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     out->faults |= pose_stale ? RFS_SEEK_FAULT_POSE_STALE : 0u;
     out->faults |= rssi_stale ? RFS_SEEK_FAULT_RSSI_STALE : 0u;
     uint16_t ci, cj;
-    if (s->have_pose && !rfs_map_point_legal(s->map, s->pose.x, s->pose.y) &&
-        !rfs_map_cell(s->map, s->pose.x, s->pose.y, &ci, &cj)) {
+    if (s->have_pose && !rfs_map_cell(s->map, s->pose.x, s->pose.y, &ci, &cj)) {
         out->faults |= RFS_SEEK_FAULT_OFF_MAP;
     }
     if (!pose_stale && !rssi_stale) {

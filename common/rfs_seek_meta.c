@@ -18,6 +18,24 @@ static rfs_q16_t offset_dist(const rfs_map_t *m, uint32_t q)
     return rfs_sat32(((int64_t)m->cfg.grid * root_q16) >> 16);
 }
 
+/* The lattice points at most r (>= 0) points from (ci, cj) in i and in j, clipped to the
+ * map: i in [i0, i1], j in [j0, j1]. Scaling: the sums in int64, the bounds in the map. */
+typedef struct lattice_window {
+    int32_t i0, i1, j0, j1;
+} lattice_window_t;
+
+static int32_t clip(int64_t v, int32_t n)
+{
+    return v < 0 ? 0 : v >= n ? n - 1 : (int32_t)v;
+}
+
+static lattice_window_t lattice_window(const rfs_map_t *m, uint16_t ci, uint16_t cj, int32_t r)
+{
+    lattice_window_t w = { clip((int64_t)ci - r, m->lw), clip((int64_t)ci + r, m->lw),
+                           clip((int64_t)cj - r, m->lh), clip((int64_t)cj + r, m->lh) };
+    return w;
+}
+
 void rfs_seek_meta_init(rfs_seek_t *s)
 {
     /* Epsilon weights e^(-d), d = grid * sqrt(q) for q = di^2 + dj^2 (section 2:
@@ -65,18 +83,10 @@ void rfs_seek_meta_visit(rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y)
     s->have_last_l = true;
     s->last_li = ci;
     s->last_lj = cj;
-    int32_t r = s->cfg.novelty_radius / m->cfg.grid + 1;
+    const lattice_window_t w = lattice_window(m, ci, cj, s->cfg.novelty_radius / m->cfg.grid + 1);
     int64_t r2 = (int64_t)s->cfg.novelty_radius * s->cfg.novelty_radius;
-    for (int32_t dj = -r; dj <= r; ++dj) {
-        int32_t j = (int32_t)cj + dj;
-        if (j < 0 || j >= (int32_t)m->lh) {
-            continue;
-        }
-        for (int32_t di = -r; di <= r; ++di) {
-            int32_t i = (int32_t)ci + di;
-            if (i < 0 || i >= (int32_t)m->lw) {
-                continue;
-            }
+    for (int32_t j = w.j0; j <= w.j1; ++j) {
+        for (int32_t i = w.i0; i <= w.i1; ++i) {
             rfs_q16_t px, py;
             rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
             int64_t dx = (int64_t)px - x, dy = (int64_t)py - y;
@@ -246,7 +256,7 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     const rfs_map_t *m = s->map;
     uint16_t ci, cj;
     rfs_map_lattice_nearest(m, s->pose.x, s->pose.y, &ci, &cj);
-    const int32_t r = RFS_SEEK_EPS_RADIUS;
+    const lattice_window_t w = lattice_window(m, ci, cj, RFS_SEEK_EPS_RADIUS);
     /* Geodesic: every try plans from the robot, so one search tree rooted there serves
      * them all (resumed out to each goal; a goal it already reached costs no search).
      * No tree when the robot has no legal start: every plan then fails, as a
@@ -262,15 +272,12 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
         uint32_t total = 0;
         for (int pass = 0; pass < 2; ++pass) {
             uint32_t pick = pass ? rfs_rng_below(rng, total) : 0u, acc = 0;
-            for (int32_t dj = -r; dj <= r; ++dj) {
-                int32_t j = (int32_t)cj + dj;
-                if (j < 0 || j >= (int32_t)m->lh) {
-                    continue;
-                }
-                for (int32_t di = -r; di <= r; ++di) {
-                    int32_t i = (int32_t)ci + di;
+            for (int32_t j = w.j0; j <= w.j1; ++j) {
+                const int32_t dj = j - (int32_t)cj;
+                for (int32_t i = w.i0; i <= w.i1; ++i) {
+                    const int32_t di = i - (int32_t)ci;
                     uint32_t q = (uint32_t)(di * di + dj * dj);
-                    if (i < 0 || i >= (int32_t)m->lw || q >= RFS_SEEK_EPS_TABLE) {
+                    if (q >= RFS_SEEK_EPS_TABLE) {
                         continue;
                     }
                     uint32_t idx = (uint32_t)j * m->lw + (uint32_t)i;

@@ -38,6 +38,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+import bench_pathloss_seek  # its section markers and commit(), beside this script
+
 STRATEGIES = ["meta", "meta-global", "fd-gradient", "plane-gradient", "chemotaxis", "meta-path"]
 # The strategies' internal model: the local ridge (the paper's), except meta-path, which
 # runs with the map-aware path-loss model (docs/PATHLOSS.md).
@@ -581,22 +583,13 @@ def main():
 
 
 HAND = ("<!-- hand-written: begin -->", "<!-- hand-written: end -->")
-PATHLOSS = ("<!-- bench_pathloss_seek: begin -->", "<!-- bench_pathloss_seek: end -->")
+PATHLOSS = (bench_pathloss_seek.BEGIN, bench_pathloss_seek.END)
 
 
 def kept(old, marks):
     """The text of old from marks[0] through marks[1], or ""."""
     b, e = old.find(marks[0]), old.find(marks[1])
     return old[b:e + len(marks[1])] if 0 <= b < e else ""
-
-
-def commit():
-    """The checked-out commit, "-dirty" when the tracked files differ from it."""
-    def git(*a):
-        r = subprocess.run(["git"] + list(a), capture_output=True, text=True)
-        return r.stdout.strip() if r.returncode == 0 else ""
-    h = git("rev-parse", "--short=7", "HEAD") or "unknown"
-    return h + ("-dirty" if git("status", "--porcelain", "--untracked-files=no") else "")
 
 
 def short(s):
@@ -643,7 +636,7 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
       % (sys.executable, args.seeds, args.jobs, args.slow_model_seeds,
          " --noise-seeds %d" % ns if ns != args.seeds else "",
          " --model-seeds %d" % ms if ms != args.seeds else "",
-         " --bridge-seeds %d" % bs if bs != args.seeds else "", commit()))
+         " --bridge-seeds %d" % bs if bs != args.seeds else "", bench_pathloss_seek.commit()))
     A("")
     A("**Definitions.** *Success*: within 1.5 m of the source before 150 m of travel (and "
       "900 s). *Travel*: path length of the true robot position. *Ratio*: travel / "

@@ -55,7 +55,6 @@ run_job() {
 
 # Longest first (the last run's seconds), so the long jobs do not finish the run alone.
 times=$logdir/times.tsv
-order=()
 par_idx=() ser_idx=()
 for i in "${!names[@]}"; do
     rm -f "$logdir/$(slug "${names[$i]}").res"
@@ -75,11 +74,12 @@ wait
 for i in "${ser_idx[@]}"; do run_job "$i"; done
 
 passed=0 failed=0
-: >"$times.new"
+# A private temporary file: a `make check` beside a `make test` rewrites times.tsv too.
+new_times=$(mktemp "$times.XXXXXX")
 for i in "${!names[@]}"; do
     n=${names[$i]} s=$(slug "${names[$i]}")
     read -r rc ok bad secs <"$logdir/$s.res" || { rc=1 ok=0 bad=1 secs=0; }
-    printf '%s\t%s\n' "$n" "$secs" >>"$times.new"
+    printf '%s\t%s\n' "$n" "$secs" >>"$new_times"
     passed=$((passed + ok)); failed=$((failed + bad))
     unit=checks; [ "${kinds[$i]}" = bin ] && unit=tests
     if [ "$rc" -eq 0 ] && [ "$bad" -eq 0 ]; then
@@ -95,7 +95,7 @@ for i in "${!names[@]}"; do
 done
 [ -n "$only" ] && { echo "--- $logdir/$(slug "$only").log"; cat "$logdir/$(slug "$only").log"; echo "---"; }
 # Keep the times of jobs this run did not include (make check runs one).
-[ -s "$times" ] && awk -F'\t' 'NR == FNR {seen[$1] = 1; next} !($1 in seen)' "$times.new" "$times" >>"$times.new"
-mv "$times.new" "$times"
+[ -s "$times" ] && awk -F'\t' 'NR == FNR {seen[$1] = 1; next} !($1 in seen)' "$new_times" "$times" >>"$new_times"
+mv "$new_times" "$times"
 echo "tests: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

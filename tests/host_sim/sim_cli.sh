@@ -78,6 +78,14 @@ printf 'image: x.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n' >"$T/badmap/map.yam
 printf 'P5\n10 10\n255\nshort' >"$T/badmap/x.pgm"
 printf '%s' "$BASE" | sed "s|@MAP@|$T/badmap/map.yaml|" >"$T/badmap.yaml"
 bad malformed_map "badmap.yaml: map: " "$T/badmap.yaml" --out "$T/out"
+# The YAML bound (firmware/port/linux/lx_yaml.h, 100,000 nodes): a scenario and a map one
+# node over it: one line, exit 1, no output.
+{ printf '%s' "$BASE" | sed "s|@MAP@|$OPEN_MAP|"; printf 'pad: ['; seq -s, 100000; echo ']'; } >"$T/big.yaml"
+bad scenario_too_many_nodes "big.yaml: more than 100000 YAML nodes" "$T/big.yaml" --out "$T/out"
+mkdir -p "$T/bigmap"
+{ sed "s|^image: |image: $(dirname "$OPEN_MAP")/|" "$OPEN_MAP"; printf 'pad: ['; seq -s, 100000; echo ']'; } >"$T/bigmap/map.yaml"
+printf '%s' "$BASE" | sed "s|@MAP@|$T/bigmap/map.yaml|" >"$T/bigmap.yaml"
+bad map_too_many_nodes "bigmap.yaml: map: $T/bigmap/map.yaml: more than 100000 YAML nodes" "$T/bigmap.yaml" --out "$T/out"
 scn src_wall.yaml "${BASE/15.0, 10.0/0.0, 10.0}"
 bad source_in_wall "sources[0].position: (0.00, 10.00) is inside a wall" "$T/src_wall.yaml" --out "$T/out"
 scn src_off.yaml "${BASE/15.0, 10.0/40.0, 10.0}"

@@ -4,16 +4,19 @@
  * /work/shared/data/README.md (counted there with a separate PGM reader); orientation
  * and thresholds are checked on a 4 x 3 image whose pixel values are written here; the
  * conservative resampling is recomputed here by 2 x 2 blocks on the Willow Garage map.
- * Bad input: every fixture in tests/data/maps_bad gives -1 and one line naming the file.
+ * Bad input: every fixture in tests/data/maps_bad gives -1 and one line naming the file;
+ * a document one node over LX_YAML_MAX_NODES is written here.
  */
 #include "rfs_test.h"
 
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "lx_map.h"
+#include "lx_yaml.h"
 
 #define BAD "tests/data/maps_bad/"
 
@@ -174,6 +177,52 @@ static void test_bad_input(void **state)
     }
 }
 
+/* ok.yaml's 16 nodes (with the image named by its absolute path) and a list of `items`
+ * scalars under an ignored key (2 nodes more): 18 + items nodes in all. */
+static void write_padded(const char *yaml, unsigned items)
+{
+    char img[PATH_MAX];
+    assert_non_null(realpath(BAD "ok.pgm", img));
+    FILE *f = fopen(yaml, "w");
+    assert_non_null(f);
+    fprintf(f, "image: %s\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+               "occupied_thresh: 0.65\nfree_thresh: 0.196\npad: [", img);
+    for (unsigned k = 0; k < items; k++) {
+        fputs(k ? ",0" : "0", f);
+    }
+    fputs("]\n", f);
+    assert_int_equal(fclose(f), 0);
+}
+
+/* The document bound (lx_yaml.h): LX_YAML_MAX_NODES nodes load, one more is refused
+ * with one line naming the file, and nothing is left allocated. */
+static void test_yaml_node_bound(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/rfs_lx_map_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char yp[256];
+    snprintf(yp, sizeof(yp), "%s/big.yaml", dir);
+    lx_map_t m;
+    char err[512] = "";
+
+    write_padded(yp, LX_YAML_MAX_NODES - 18u);
+    assert_int_equal(lx_map_load(yp, &m, err, sizeof(err)), 0);
+    assert_int_equal(m.w, 4);
+    assert_int_equal(m.h, 3);
+    lx_map_free(&m);
+
+    write_padded(yp, LX_YAML_MAX_NODES - 17u);
+    assert_int_equal(lx_map_load(yp, &m, err, sizeof(err)), -1);
+    print_message("%s\n", err);
+    char want[400];
+    snprintf(want, sizeof(want), "%s: more than %u YAML nodes", yp, LX_YAML_MAX_NODES);
+    assert_string_equal(err, want);
+    assert_null(m.cell);
+    remove(yp);
+    rmdir(dir);
+}
+
 /* Intel at its own 0.1 m: one fine cell per core cell, so the core's free and wall bits
  * count exactly the README's free and occupied cells. */
 static void test_core_same_resolution(void **state)
@@ -267,6 +316,7 @@ int main(void)
         cmocka_unit_test(test_real_maps_counts),
         cmocka_unit_test(test_orientation_thresholds_negate),
         cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_yaml_node_bound),
         cmocka_unit_test(test_core_same_resolution),
         cmocka_unit_test(test_core_conservative),
         cmocka_unit_test(test_core_rejects),

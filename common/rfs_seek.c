@@ -207,9 +207,8 @@ bool rfs_seek_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm, rfs_
 }
 
 /* A receiver report is a measurement without a value (docs/FAULTS.md, "The receiver
- * heartbeat"): it keeps the stream fresh and touches neither the 1 s windows nor the
- * store. Ordering as for measurements (rfs_rssi_push): older than the newest report is
- * rejected, equal is accepted. */
+ * heartbeat"): it keeps the stream fresh, not the 1 s windows or the store. Ordering as
+ * for measurements (rfs_rssi_push): older than the newest is rejected, equal accepted. */
 bool rfs_seek_on_receiver(rfs_seek_t *s, int64_t t_us)
 {
     if (s->have_rx && t_us < s->last_rx_us) {
@@ -366,12 +365,12 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
         d->kind = RFS_SEEK_INITIAL;
         ok = rfs_seek_meta_initial(s, rng, now_us);
     } else {
-        /* Whether the model predicts at the robot: decide() asked the same model at the
-         * same pose unless it was relearnt since (predict is pure). */
+        /* decide() asked the same model at this pose unless it relearnt (predict is pure). */
         rfs_q16_t v;
-        bool model_ok = d->relearned
-                            ? s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &v)
-                            : d->model_valid;
+        bool model_ok = d->model_valid;
+        if (d->relearned) {
+            model_ok = s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &v);
+        }
         ok = rfs_seek_ops(s)->choose(s, model_ok, rng, now_us);
     }
     end_decision(s, ok, now_us, out);
@@ -444,10 +443,9 @@ static bool ahead(int64_t a, int64_t b, int64_t limit)
 }
 
 /* The measurement stream is stale when neither a measurement nor a receiver report lies
- * within rssi_timeout_us of now, or when either newest stamp lies further ahead than
- * that: the feed's clock jumped, and while it is the newest every real input is rejected
- * as out of order. Without reports (have_rx false) this is exactly the measurement-only
- * rule: stale when there is none or it is apart from now. */
+ * within rssi_timeout_us of now, or either newest stamp lies further ahead than that (the
+ * feed's clock jumped: while it is the newest every real input is rejected as out of
+ * order). Without reports this is the measurement-only rule. */
 static bool meas_stale(const rfs_seek_t *s, int64_t now_us)
 {
     int64_t lim = s->cfg.rssi_timeout_us;
@@ -510,9 +508,8 @@ static void keep_reach(rfs_seek_t *s)
 }
 
 /* Drive on the goal that stale inputs interrupted. Its timeout counts driving time only:
- * the time it was driven before the interruption still counts (a goal interrupted again
- * and again must still end), the stale time does not (after a 30 s silence the goal
- * would otherwise time out the moment it resumes, docs/FAULTS.md). */
+ * before the interruption (a goal interrupted again and again must still end), not the
+ * stale time (after a 30 s silence it would time out as it resumes, docs/FAULTS.md). */
 static void resume_goal(rfs_seek_t *s, int64_t now_us)
 {
     s->resume = false;

@@ -481,7 +481,8 @@ static void drop_unfinished(const batch_t *bt)
     for (uint64_t i = 0; i < bt->total; i++) {
         struct stat st;
         char name[32], path[PATH_MAX + 128];
-        snprintf(name, sizeof name, "seed-%llu", (unsigned long long)(bt->a + i));
+        const unsigned long long seed = bt->a + i;
+        snprintf(name, sizeof name, "seed-%llu", seed);
         if (bt->rows[i] == NULL && join(path, sizeof path, bt->dir, name) && lstat(path, &st) == 0) {
             rm_tree(path);
         }

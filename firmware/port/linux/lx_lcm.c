@@ -640,7 +640,7 @@ static int event_fits(lx_lcm_log_t *log)
         return -1;
     }
     off_t end = ftello(f);
-    uint8_t b[28];
+    uint8_t b[28] = {0};
     size_t n = fseeko(f, pos, SEEK_SET) == 0 ? fread(b, 1, sizeof b, f) : 0;
     if (fseeko(f, pos, SEEK_SET) != 0) {
         snprintf(log->err, sizeof log->err, "cannot seek");

@@ -165,6 +165,18 @@ static void usage(FILE *f)
                "  -h, --help   this text\n");
 }
 
+/* An input stream ends with its END record (an output stream has none); without it the
+ * recording was cut and a replay would stop early with exit 0. 0, or 1 after a message. */
+static int check_end(const char *in_path, size_t pos, int ended, int inputs)
+{
+    if (!ended && (inputs || pos == RFS_REPLAY_HEADER_LEN)) {
+        lx_err_print(PROG, "%s: offset %zu: truncated (%s)", in_path, pos,
+                     pos == RFS_REPLAY_HEADER_LEN ? "only the header" : "no END record");
+        return 1;
+    }
+    return 0;
+}
+
 static int replay_main(int argc, char **argv)
 {
     const char *in_path = NULL, *out_path = NULL;
@@ -266,12 +278,8 @@ static int replay_main(int argc, char **argv)
             break;
         }
     }
-    /* An input stream ends with its END record (an output stream has none); without it
-     * the recording was cut and a replay would stop early with exit 0. */
-    if (rc == 0 && !ended && (inputs || pos == RFS_REPLAY_HEADER_LEN)) {
-        lx_err_print(PROG, "%s: offset %zu: truncated (%s)", in_path, pos,
-                     pos == RFS_REPLAY_HEADER_LEN ? "only the header" : "no END record");
-        rc = 1;
+    if (rc == 0) {
+        rc = check_end(in_path, pos, ended, inputs);
     }
     free(buf);
     if (!print) {

@@ -58,6 +58,7 @@ $(WIRE_LCM_TOOL): tests/wire/lcm_tool.c $(LIBS_linux) | $(LCM_GEN_HDRS)
 	@mkdir -p $(@D)
 	$(LD_linux) $(LINUX_CFLAGS) $(DEPFLAGS) -MF $@.d -MT $@ $< -o $@ $(LIBS_linux) $(LDLIBS_linux)
 $(eval $(call test_script,rfseekd,tests/wire/rfseekd_test.sh $(BUILD),$(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/asan/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
+$(eval $(call test_script,outputs,tests/wire/outputs_test.sh $(BUILD),$(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-replay $(BUILD)/bin/rfseek-record $(BUILD)/bin/rfseek-map $(BUILD)/bin/rfseek-feed))
 
 # SocketCAN against the kernel's CAN stack: a static test binary, run natively in a network
 # namespace with vcan or in a one-CPU qemu VM (its own namespace and build/vm: parallel-safe).

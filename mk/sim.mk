@@ -58,6 +58,7 @@ SIM := $(BUILD)/bin/rfseek-sim
 # `faults:` sections; every strategy's options; the path-loss estimate in log.tsv,
 # summary.json and residual.tsv; rfseek-map on a real map and on bad input.
 $(eval $(call test_script,sim_cli,tests/host_sim/sim_cli.sh $(SIM),$(SIM)))
+$(eval $(call test_script,batch_out,tests/host_sim/batch_out.sh $(SIM),$(SIM)))
 $(eval $(call test_script,faults,tests/host_sim/faults.sh $(SIM) 3,$(SIM)))
 $(eval $(call test_script,strategy_cli,tests/host_sim/strategy_cli.sh $(SIM),$(SIM)))
 $(eval $(call test_script,pathloss_out,tests/host_sim/pathloss_out.sh $(SIM),$(SIM)))

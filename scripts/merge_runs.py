@@ -1,17 +1,24 @@
 #!/usr/bin/python3
 """Merge per-seed simulator runs into one table (the batch table of rfseek-sim --seeds).
 
-    scripts/merge_runs.py DIR [--out FILE]     (default FILE: DIR/runs.tsv)
+    scripts/merge_runs.py DIR [--out FILE] [--seeds A..B] [--allow-missing]
+                                               (default FILE: DIR/runs.tsv)
 
 DIR holds seed-N/summary.json as written by `rfseek-sim SCENARIO --seed N --out DIR/seed-N`
 (the commands `rfseek-sim SCENARIO --seeds A..B --emit-jobs --out DIR` prints, run by GNU
 parallel or a Slurm array). The table has the same columns and formatting as the one
 `rfseek-sim --seeds A..B --out DIR` writes, rows sorted by seed. Written to a temporary
 file and renamed, so a failed merge leaves no half-written table.
+
+The seeds expected are A..B of --seeds, else those of DIR/batch.state (the state an
+interrupted `rfseek-sim --seeds A..B --out DIR` leaves), else every seed from the lowest
+to the highest seed-N directory. A seed without its summary.json is missing: the merge
+names the missing seeds and fails unless --allow-missing (then it merges the rest).
 """
 import glob
 import json
 import os
+import re
 import sys
 
 COLS = ["seed", "reached", "end", "sim_time_s", "distance_travelled_m", "shortest_path_m",
@@ -28,17 +35,49 @@ def fmt(col, v):
     return str(v)
 
 
+def batch_seeds(d):
+    """The seeds A..B named in DIR/batch.state's header, or None."""
+    try:
+        with open(os.path.join(d, "batch.state")) as fh:
+            m = re.search(r"\tseeds=(\d+)\.\.(\d+)\t", fh.readline())
+    except OSError:
+        return None
+    return (int(m.group(1)), int(m.group(2))) if m else None
+
+
+def spans(seeds):
+    """Sorted seeds as '3, 5-9, 12' (at most 10 spans, then '...')."""
+    out, start = [], seeds[0]
+    for a, b in zip(seeds, seeds[1:] + [None]):
+        if b != a + 1:
+            out.append(str(start) if start == a else "%d-%d" % (start, a))
+            start = b
+    return ", ".join(out[:10]) + (", ..." if len(out) > 10 else "")
+
+
 def main(argv):
     if len(argv) < 2 or argv[1] in ("-h", "--help"):
         print(__doc__.strip())
         return 0 if len(argv) >= 2 else 1
     d = argv[1]
     out = os.path.join(d, "runs.tsv")
-    if len(argv) == 4 and argv[2] == "--out":
-        out = argv[3]
-    elif len(argv) != 2:
-        print("merge_runs.py: usage: merge_runs.py DIR [--out FILE]", file=sys.stderr)
-        return 1
+    seeds, allow_missing, i = None, False, 2
+    while i < len(argv):
+        if argv[i] == "--out" and i + 1 < len(argv):
+            out = argv[i + 1]
+            i += 2
+        elif argv[i] == "--seeds" and i + 1 < len(argv) and re.fullmatch(r"\d+\.\.\d+", argv[i + 1]):
+            seeds = tuple(int(x) for x in argv[i + 1].split(".."))
+            i += 2
+        elif argv[i] == "--allow-missing":
+            allow_missing = True
+            i += 1
+        else:
+            print("merge_runs.py: usage: merge_runs.py DIR [--out FILE] [--seeds A..B] "
+                  "[--allow-missing]", file=sys.stderr)
+            return 1
+    if seeds is None:
+        seeds = batch_seeds(d)
     rows = []
     files = glob.glob(os.path.join(d, "seed-*", "summary.json"))
     if not files:
@@ -53,6 +92,15 @@ def main(argv):
             print("merge_runs.py: %s: %s" % (f, e), file=sys.stderr)
             return 1
     rows.sort()
+    have = {s for s, _ in rows}
+    if seeds is None:
+        dirs = [int(m.group(1)) for m in (re.fullmatch(r"seed-(\d+)", n) for n in os.listdir(d)) if m]
+        seeds = (min(dirs), max(dirs))
+    missing = [s for s in range(seeds[0], seeds[1] + 1) if s not in have]
+    if missing and not allow_missing:
+        print("merge_runs.py: %s: %d of %d seeds missing: %s (--allow-missing merges the rest)"
+              % (d, len(missing), seeds[1] - seeds[0] + 1, spans(missing)), file=sys.stderr)
+        return 1
     tmp = out + ".tmp"
     with open(tmp, "w") as fh:
         fh.write("\t".join(COLS) + "\n")

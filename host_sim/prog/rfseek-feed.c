@@ -935,6 +935,19 @@ int main(int argc, char **argv)
     if (rc != RUN) {
         return rc;
     }
+    // Outputs checked before the capture is read: not an input, their directory there.
+    const char *ins[3] = {fo.ro.capture, fo.ro.poses, fo.ro.scenario};
+    const char *outs[2] = {fo.output, fo.ro.out};
+    for (int i = 0; i < 2; i++) {
+        for (int k = 0; outs[i] != NULL && k < 3; k++) {
+            if (lx_err_same_file("rfseek-feed", ins[k], outs[i]) != 0) {
+                return 1;
+            }
+        }
+        if (outs[i] != NULL && lx_err_check_dest("rfseek-feed", outs[i]) != 0) {
+            return 1;
+        }
+    }
     char err[512];
     lx_pcap_reader_t *r = fo.live ? lx_pcap_open_live(fo.ro.capture, err, sizeof(err))
                                   : lx_pcap_open_offline(fo.ro.capture, err, sizeof(err));

@@ -212,7 +212,7 @@ static void run_bench(const lx_core_map_t *c, long n)
     free(e);
 }
 
-int main(int argc, char **argv)
+static int map_main(int argc, char **argv)
 {
     const char *yaml = NULL;
     const char *pgm = NULL;
@@ -266,6 +266,9 @@ int main(int argc, char **argv)
     }
     char err[1024];
     lx_map_t m;
+    if (pgm != NULL && (lx_err_same_file(PROG, yaml, pgm) != 0 || lx_err_check_dest(PROG, pgm) != 0)) {
+        return 1;
+    }
     if (lx_map_load(yaml, &m, err, sizeof(err)) != 0) {
         lx_err_print(PROG, "%s", err);
         return 1;
@@ -327,4 +330,9 @@ int main(int argc, char **argv)
     lx_core_map_free(&c);
     lx_map_free(&m);
     return rc;
+}
+
+int main(int argc, char **argv)
+{
+    return lx_err_close_stdout(PROG, map_main(argc, argv));
 }

@@ -43,6 +43,9 @@ static void usage(FILE *f)
             "  --seeds A..B    run seeds A to B (inclusive) and write one table\n"
             "                  (DIR/runs.tsv with --out, else stdout); per-seed logs in DIR/seed-N/\n"
             "  --jobs N        worker processes for --seeds (default: all cores)\n"
+            "  --resume        with --seeds and --out: continue the interrupted batch in DIR\n"
+            "                  (SIGINT or SIGTERM leave DIR with the finished seeds and\n"
+            "                  DIR/batch.state); the same scenario, seeds and options needed\n"
             "  --emit-jobs     print one command per seed (for GNU parallel or a Slurm array)\n"
             "                  instead of running; merge with scripts/merge_runs.py DIR\n"
             "  --strategy NAME seeking strategy, overriding the scenario's: meta, meta-global,\n"
@@ -145,9 +148,19 @@ static void on_packet(void *ctx, unsigned src, int64_t t_us, uint16_t seq, bool 
     }
 }
 
-/// One run into dir (NULL: summary to stdout). Returns 0 or 1.
+/* The first failure of a run into msg (later ones are its echoes: a full disk fails
+ * every file of the run alike): 1. */
+static int run_err(char *msg, size_t msglen, int rc, const char *what, const char *why)
+{
+    if (rc == 0 && snprintf(msg, msglen, "%s%s%s", what, why ? ": " : "", why ? why : "") < 0) {
+        msg[0] = '\0';
+    }
+    return 1;
+}
+
+/// One run into dir (NULL: summary to stdout): 0, or 1 with the reason, one line, in msg.
 static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool samples,
-                   bool field, const char *pcap, hs_sim_result_t *res)
+                   bool field, const char *pcap, hs_sim_result_t *res, char *msg, size_t msglen)
 {
     char err[1024];
     hs_sim_io_t io = {0};
@@ -168,69 +181,80 @@ static int run_one(const hs_sim_env_t *env, uint64_t seed, const char *dir, bool
         }
         if (!io.log || !io.track || (samples && !io.samples) || (faults && !io.faults) ||
             (strcmp(env->sc.model, "pathloss") == 0 && !io.residual)) {
-            fprintf(stderr, "%s: %s: %s\n", prog, dir, strerror(errno));
-            rc = 1;
+            rc = run_err(msg, msglen, rc, dir, strerror(errno));
         }
     }
     if (rc == 0 && pcap) {
         pc.w = lx_pcap_writer_open(pcap, err, sizeof err);
         if (!pc.w) {
-            fprintf(stderr, "%s: %s\n", prog, err);
-            rc = 1;
+            rc = run_err(msg, msglen, rc, err, NULL);
         }
         io.on_packet = on_packet;
         io.packet_ctx = &pc;
     }
     if (rc == 0 && hs_sim_run_inproc(env, seed, &io, res, err, sizeof err) != 0) {
-        fprintf(stderr, "%s: %s\n", prog, err);
-        rc = 1;
+        rc = run_err(msg, msglen, rc, err, NULL);
     }
     // field.tsv for source 0 and field1.tsv for a second source (bridging: the "bridge" target).
     for (unsigned src = 0; rc == 0 && field && dir && src < env->sc.nsources; src++) {
         FILE *f = open_in(dir, src == 0 ? "field.tsv" : "field1.tsv");
-        if (!f || hs_sim_field(env, seed, src, 0.1, f, err, sizeof err) != 0) {
-            fprintf(stderr, "%s: %s\n", prog, f ? err : strerror(errno));
-            rc = 1;
+        if (!f) {
+            rc = run_err(msg, msglen, rc, dir, strerror(errno));
+        } else if (hs_sim_field(env, seed, src, 0.1, f, err, sizeof err) != 0) {
+            rc = run_err(msg, msglen, rc, err, NULL);
         }
         if (f && fclose(f) != 0) {
-            rc = 1;
-        }
-    }
-    if (rc == 0) {
-        FILE *s = dir ? open_in(dir, "summary.json") : stdout;
-        if (!s) {
-            fprintf(stderr, "%s: %s/summary.json: %s\n", prog, dir, strerror(errno));
-            rc = 1;
-        } else {
-            hs_sim_write_summary(s, env, res);
-            if (dir && fclose(s) != 0) {
-                rc = 1;
-            }
+            rc = run_err(msg, msglen, rc, dir, strerror(errno));
         }
     }
     FILE *fs[5] = {io.log, io.track, io.samples, io.faults, io.residual};
     for (int i = 0; i < 5; i++) {
         if (fs[i] && fclose(fs[i]) != 0) {
-            fprintf(stderr, "%s: %s: write failed\n", prog, dir);
-            rc = 1;
+            rc = run_err(msg, msglen, rc, dir, strerror(errno));
         }
     }
     if (pc.w) {
         if (lx_pcap_writer_close(pc.w) != 0 || pc.failed) {
-            fprintf(stderr, "%s: %s: write failed\n", prog, pcap);
-            rc = 1;
+            rc = run_err(msg, msglen, rc, pcap, "write failed");
+        }
+    }
+    if (rc == 0) {
+        FILE *s = dir ? open_in(dir, "summary.json") : stdout;
+        if (!s) {
+            rc = run_err(msg, msglen, rc, dir, strerror(errno));
+        } else {
+            hs_sim_write_summary(s, env, res);
+            if (dir && fclose(s) != 0) {
+                rc = run_err(msg, msglen, rc, dir, strerror(errno));
+            }
         }
     }
     return rc;
 }
 
-/// Result record a worker sends to the parent (end encoded as an index).
+/// Result record a worker sends to the parent (end encoded as an index); under PIPE_BUF
+/// bytes, so a record is written to the pipe in one piece.
 typedef struct wire_res {
     hs_sim_result_t r;
     int end;  ///< 0 reached, 1 distance, 2 time, -1 error
+    char msg[512]; ///< the error (end -1), one line
 } wire_res_t;
 
 static const char *end_names[3] = {"reached", "distance", "time"};
+
+/* The most seeds one batch runs (its table is held in memory, one row per seed). */
+#define BATCH_MAX_SEEDS 1000000u
+
+/* The state of a batch with --out while it runs and after an interruption: a header line
+ * naming the runs (checked by --resume), then each finished seed's runs.tsv row. */
+static const char k_state[] = "batch.state";
+
+static volatile sig_atomic_t g_stop; /* SIGINT or SIGTERM received (batch parent) */
+
+static void on_stop(int sig)
+{
+    g_stop = sig;
+}
 
 static void progress(uint64_t done, uint64_t total, uint64_t reached)
 {
@@ -241,27 +265,32 @@ static void progress(uint64_t done, uint64_t total, uint64_t reached)
     fflush(stderr);
 }
 
-/* One --seeds batch: the seeds a..b shared among jobs worker processes, each result
- * sent to the parent through a pipe. */
+/* One --seeds batch: the seeds a..b not yet done shared among jobs worker processes, each
+ * result sent to the parent through a pipe. */
 typedef struct batch {
     const hs_sim_env_t *env;
-    uint64_t a, b, total;
+    uint64_t a, total;    /* seeds a .. a + total - 1 */
+    uint64_t *todo, ntodo; /* the seeds to run */
     int jobs;
     const char *dir;      /* per-seed directories and runs.tsv in it, or NULL: stdout */
     bool samples, quiet;
-    hs_sim_result_t *all; /* by seed - a */
-    bool *have;
+    char **rows;          /* by seed - a: the runs.tsv row (malloc'd), NULL until done */
+    FILE *state;          /* dir/batch.state, appended as seeds finish, or NULL */
     pid_t *pids;
     int fds[2];           /* the workers' pipe */
     uint64_t done, reached;
+    char msg[512];        /* the first worker's error */
 } batch_t;
 
-/* Worker j: its seeds (a + j, a + j + jobs, ...), each run and its result written to the
- * pipe; exits 1 after the first failure. */
+/* Worker j: its seeds (todo[j], todo[j + jobs], ...), each run and its result written to
+ * the pipe; exits 1 after the first failure. */
 static _Noreturn void batch_worker(const batch_t *bt, int j)
 {
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
     close(bt->fds[0]);
-    for (uint64_t s = bt->a + (uint64_t)j; s <= bt->b; s += (uint64_t)bt->jobs) {
+    for (uint64_t k = (uint64_t)j; k < bt->ntodo; k += (uint64_t)bt->jobs) {
+        const uint64_t s = bt->todo[k];
         wire_res_t w;
         memset(&w, 0, sizeof w);
         char sub[PATH_MAX + 64];
@@ -270,8 +299,7 @@ static _Noreturn void batch_worker(const batch_t *bt, int j)
             if (snprintf(sub, sizeof sub, "%s/seed-%llu", bt->dir, (unsigned long long)s) >=
                     (int)sizeof sub ||
                 mkdir(sub, 0777) != 0) {
-                fprintf(stderr, "%s: %s: %s\n", prog, sub, strerror(errno));
-                w.end = -1;
+                w.end = run_err(w.msg, sizeof w.msg, 0, sub, strerror(errno)) ? -1 : 0;
             }
             sd = sub;
         }
@@ -281,7 +309,7 @@ static _Noreturn void batch_worker(const batch_t *bt, int j)
                 devnull = freopen("/dev/null", "w", stdout); // no per-seed JSON on stdout
                 (void)devnull;
             }
-            if (run_one(bt->env, s, sd, bt->samples, false, NULL, &w.r) != 0) {
+            if (run_one(bt->env, s, sd, bt->samples, false, NULL, &w.r, w.msg, sizeof w.msg) != 0) {
                 w.end = -1;
             } else {
                 w.end = w.r.reached ? 0 : (strcmp(w.r.end, "distance") == 0 ? 1 : 2);
@@ -319,28 +347,74 @@ static int batch_fork(batch_t *bt)
     return 0;
 }
 
-/* The workers' results read until the pipe closes or one failed, then the workers
- * reaped: 0, or 1 when a run or a worker failed. */
+/* A finished seed's row kept (and appended to the state file): 0, or 1 after a message. */
+static int batch_keep(batch_t *bt, const hs_sim_result_t *r)
+{
+    char *row = NULL;
+    size_t len = 0;
+    FILE *m = open_memstream(&row, &len);
+    if (m == NULL) {
+        fprintf(stderr, "%s: out of memory\n", prog);
+        return 1;
+    }
+    hs_sim_table_row(m, r);
+    if (fclose(m) != 0) {
+        free(row);
+        fprintf(stderr, "%s: out of memory\n", prog);
+        return 1;
+    }
+    bt->rows[r->seed - bt->a] = row;
+    bt->done++;
+    bt->reached += r->reached ? 1u : 0u;
+    if (bt->state && (fputs(row, bt->state) == EOF || fflush(bt->state) != 0)) {
+        fprintf(stderr, "%s: %s/%s: %s\n", prog, bt->dir, k_state, strerror(errno));
+        return 1;
+    }
+    return 0;
+}
+
+/* The workers' results read until the pipe closes, one failed or a signal came, then the
+ * workers reaped: 0, or 1 when a run or a worker failed or the batch was interrupted. */
 static int batch_collect(batch_t *bt)
 {
     int rc = 0;
     wire_res_t w;
     if (!bt->quiet) {
-        progress(0, bt->total, 0);
+        progress(bt->done, bt->total, bt->reached);
     }
-    while (read(bt->fds[0], &w, sizeof w) == (ssize_t)sizeof w) {
+    for (;;) {
+        ssize_t n = read(bt->fds[0], &w, sizeof w);
+        if (n < 0 && errno == EINTR && !g_stop) {
+            continue;
+        }
+        if (n != (ssize_t)sizeof w) {
+            break;
+        }
         if (w.end < 0) {
+            snprintf(bt->msg, sizeof bt->msg, "%s", w.msg);
             rc = 1;
             break;
         }
-        uint64_t i = w.r.seed - bt->a;
-        bt->all[i] = w.r;
-        bt->all[i].end = end_names[w.end];
-        bt->have[i] = true;
-        bt->done++;
-        bt->reached += w.r.reached ? 1u : 0u;
+        w.r.end = end_names[w.end];
+        if (batch_keep(bt, &w.r) != 0) {
+            rc = 1;
+            break;
+        }
         if (!bt->quiet) {
             progress(bt->done, bt->total, bt->reached);
+        }
+        if (g_stop) {
+            break;
+        }
+    }
+    if (g_stop || rc != 0) {
+        for (int j = 0; j < bt->jobs; j++) {
+            kill(bt->pids[j], SIGTERM);
+        }
+        // Results written before the workers ended are finished seeds: kept.
+        while (rc == 0 && read(bt->fds[0], &w, sizeof w) == (ssize_t)sizeof w && w.end >= 0) {
+            w.r.end = end_names[w.end];
+            rc = batch_keep(bt, &w.r);
         }
     }
     if (!bt->quiet) {
@@ -349,20 +423,20 @@ static int batch_collect(batch_t *bt)
     close(bt->fds[0]);
     for (int j = 0; j < bt->jobs; j++) {
         int st;
-        if (rc != 0) {
-            kill(bt->pids[j], SIGTERM);
+        while (waitpid(bt->pids[j], &st, 0) < 0 && errno == EINTR) {
         }
-        waitpid(bt->pids[j], &st, 0);
-        if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+        if (!g_stop && (!WIFEXITED(st) || WEXITSTATUS(st) != 0)) {
             rc = 1;
         }
     }
-    if (rc == 0 && bt->done != bt->total) {
+    if (bt->msg[0] != '\0') {
+        lx_err_print(prog, "%s", bt->msg);
+    } else if (rc == 0 && !g_stop && bt->done != bt->total) {
         fprintf(stderr, "%s: a worker ended early (%llu of %llu seeds)\n", prog,
                 (unsigned long long)bt->done, (unsigned long long)bt->total);
         rc = 1;
     }
-    return rc;
+    return g_stop ? 1 : rc;
 }
 
 /* runs.tsv (stdout without a directory): 0, or 1 after a failure. */
@@ -375,45 +449,161 @@ static int batch_table(const batch_t *bt)
     }
     hs_sim_table_header(t);
     for (uint64_t i = 0; i < bt->total; i++) {
-        hs_sim_table_row(t, &bt->all[i]);
+        fputs(bt->rows[i], t);
     }
     if (bt->dir && fclose(t) != 0) {
+        fprintf(stderr, "%s: %s/runs.tsv: %s\n", prog, bt->dir, strerror(errno));
         return 1;
     }
     return 0;
 }
 
-static int run_batch(const hs_sim_env_t *env, uint64_t a, uint64_t b, int jobs, const char *dir,
-                     bool samples, bool quiet)
+/* The state file's header: the runs a --resume must repeat (scenario, seeds, options). */
+static void batch_state_header(char *buf, size_t n, const char *scenario, const hs_scenario_t *sc,
+                               uint64_t a, uint64_t b, bool samples)
+{
+    char abs[PATH_MAX];
+    snprintf(buf, n, "# rfseek-sim batch\tscenario=%s\tseeds=%llu..%llu\tstrategy=%s\tmodel=%s"
+             "\tfaults=%u\tp0_min=%.17g\tsamples=%d\n",
+             realpath(scenario, abs) ? abs : scenario, (unsigned long long)a, (unsigned long long)b,
+             sc->strategy, sc->model, sc->faults.n, sc->seek_p0_min_dbm, samples ? 1 : 0);
+}
+
+/* dir/name into buf: true, or false when it does not fit. */
+static bool join(char *buf, size_t n, const char *dir, const char *name)
+{
+    return snprintf(buf, n, "%s/%s", dir, name) < (int)n;
+}
+
+/* The directories of the seeds not finished removed (a worker may have begun them). */
+static void drop_unfinished(const batch_t *bt)
+{
+    for (uint64_t i = 0; i < bt->total; i++) {
+        struct stat st;
+        char name[32], path[PATH_MAX + 128];
+        const unsigned long long seed = bt->a + i;
+        snprintf(name, sizeof name, "seed-%llu", seed);
+        if (bt->rows[i] == NULL && join(path, sizeof path, bt->dir, name) && lstat(path, &st) == 0) {
+            rm_tree(path);
+        }
+    }
+}
+
+/* --resume: the finished seeds of dir/batch.state into bt->rows, the directories of the
+ * unfinished ones removed: 0, or 1 after a message. */
+static int batch_resume(batch_t *bt, const char *header)
+{
+    char path[PATH_MAX + 128], line[4096];
+    FILE *f = join(path, sizeof path, bt->dir, k_state) ? fopen(path, "r") : NULL;
+    if (f == NULL) {
+        fprintf(stderr, "%s: %s: %s\n", prog, path, strerror(errno));
+        return 1;
+    }
+    int rc = 0;
+    if (!fgets(line, sizeof line, f) || strcmp(line, header) != 0) {
+        lx_err_print(prog, "%s: another batch (its header differs from this command's: "
+                     "same scenario, --seeds and options needed)", path);
+        rc = 1;
+    }
+    while (rc == 0 && fgets(line, sizeof line, f)) {
+        char *end;
+        errno = 0;
+        unsigned long long s = strtoull(line, &end, 10);
+        size_t len = strlen(line);
+        if (errno != 0 || *end != '\t' || len == 0 || line[len - 1] != '\n') {
+            break; /* a row cut by SIGKILL: that seed is redone */
+        }
+        if (s < bt->a || s - bt->a >= bt->total || bt->rows[s - bt->a] != NULL) {
+            lx_err_print(prog, "%s: seed %llu outside the batch or listed twice", path, s);
+            rc = 1;
+            break;
+        }
+        bt->rows[s - bt->a] = strdup(line);
+        if (bt->rows[s - bt->a] == NULL) {
+            fprintf(stderr, "%s: out of memory\n", prog);
+            rc = 1;
+            break;
+        }
+        bt->done++;
+        bt->reached += strncmp(end, "\t1\t", 3) == 0 ? 1u : 0u;
+    }
+    fclose(f);
+    if (rc == 0) {
+        drop_unfinished(bt);
+    }
+    return rc;
+}
+
+static int run_batch(const hs_sim_env_t *env, const char *header, uint64_t a, uint64_t b, int jobs,
+                     const char *dir, bool samples, bool quiet, bool resume)
 {
     batch_t bt;
     memset(&bt, 0, sizeof bt);
     bt.env = env;
     bt.a = a;
-    bt.b = b;
-    bt.total = b - a + 1;
-    bt.jobs = (uint64_t)jobs > bt.total ? (int)bt.total : jobs;
+    bt.total = b - a + 1; /* at most BATCH_MAX_SEEDS (check_options) */
     bt.dir = dir;
     bt.samples = samples;
     bt.quiet = quiet;
-    // NOLINTNEXTLINE(clang-analyzer-optin.portability.UnixAPI): total 0 only for --seeds 0..2^64-1 (wraps)
-    bt.all = calloc(bt.total, sizeof *bt.all);
-    bt.have = calloc(bt.total, sizeof *bt.have);
-    bt.pids = calloc((size_t)bt.jobs, sizeof *bt.pids);
-    int rc;
-    if (!bt.all || !bt.have || !bt.pids || pipe(bt.fds) != 0) {
+    bt.rows = calloc(bt.total, sizeof *bt.rows);
+    bt.todo = calloc(bt.total, sizeof *bt.todo);
+    int rc = 0;
+    if (!bt.rows || !bt.todo) {
         fprintf(stderr, "%s: out of memory\n", prog);
         rc = 1;
-    } else {
+    }
+    if (rc == 0 && dir && resume) {
+        rc = batch_resume(&bt, header);
+    }
+    if (rc == 0 && dir) {
+        char path[PATH_MAX + 128];
+        bt.state = join(path, sizeof path, dir, k_state) ? fopen(path, resume ? "a" : "w") : NULL;
+        if (!bt.state || (!resume && (fputs(header, bt.state) == EOF || fflush(bt.state) != 0))) {
+            fprintf(stderr, "%s: %s: %s\n", prog, path, strerror(errno));
+            rc = 1;
+        }
+    }
+    for (uint64_t i = 0; rc == 0 && i < bt.total; i++) {
+        if (bt.rows[i] == NULL) {
+            bt.todo[bt.ntodo++] = a + i;
+        }
+    }
+    bt.jobs = (uint64_t)jobs > bt.ntodo ? (int)(bt.ntodo > 0 ? bt.ntodo : 1) : jobs;
+    bt.pids = calloc((size_t)bt.jobs, sizeof *bt.pids);
+    if (rc == 0 && (!bt.pids || pipe(bt.fds) != 0)) {
+        fprintf(stderr, "%s: out of memory\n", prog);
+        rc = 1;
+    }
+    if (rc == 0 && bt.ntodo > 0) {
         rc = batch_fork(&bt);
         if (rc == 0) {
             rc = batch_collect(&bt);
         }
-        if (rc == 0) {
-            rc = batch_table(&bt);
+    } else if (rc == 0) {
+        close(bt.fds[0]);
+        close(bt.fds[1]);
+    }
+    if (bt.state && fclose(bt.state) != 0 && rc == 0) {
+        fprintf(stderr, "%s: %s/%s: %s\n", prog, dir, k_state, strerror(errno));
+        rc = 1;
+    }
+    if (rc == 0) {
+        rc = batch_table(&bt);
+    }
+    if (rc == 0 && dir) {
+        char path[PATH_MAX + 128];
+        if (!join(path, sizeof path, dir, k_state) || remove(path) != 0) {
+            fprintf(stderr, "%s: %s: %s\n", prog, path, strerror(errno));
+            rc = 1;
         }
     }
-    free(bt.all); free(bt.have); free(bt.pids);
+    if (g_stop && dir) {
+        drop_unfinished(&bt); // the finished seeds and the state stay
+    }
+    for (uint64_t i = 0; bt.rows && i < bt.total; i++) {
+        free(bt.rows[i]);
+    }
+    free(bt.rows); free(bt.todo); free(bt.pids);
     return rc;
 }
 
@@ -433,7 +623,8 @@ static int run_bench(const hs_sim_env_t *env, uint64_t a, uint64_t b)
     if (!rtf) {
         return die("out of memory%s%s", "", "");
     }
-    for (uint64_t s = a; s <= b; s++) {
+    for (uint64_t i = 0; i < n; i++) {
+        const uint64_t s = a + i;
         hs_sim_result_t r;
         char err[1024];
         if (hs_sim_run_inproc(env, s, NULL, &r, err, sizeof err) != 0) {
@@ -441,7 +632,7 @@ static int run_bench(const hs_sim_env_t *env, uint64_t a, uint64_t b)
             fprintf(stderr, "%s: %s\n", prog, err);
             return 1;
         }
-        rtf[s - a] = r.sim_time_s / r.wall_time_s;
+        rtf[i] = r.sim_time_s / r.wall_time_s;
         sim += r.sim_time_s;
         wall += r.wall_time_s;
         cpu += r.cpu_time_s;
@@ -463,7 +654,7 @@ typedef struct sim_opts {
     const char *scenario, *out, *pcap, *seeds;
     const char *strategy, *model; /* overrides of the scenario's, or NULL */
     uint64_t seed;
-    bool has_seed, samples, field, emit, quiet, bench, no_faults;
+    bool has_seed, samples, field, emit, quiet, bench, no_faults, resume;
     double p0_min;                /* --p0-min: NAN keeps the scenario's (or the model's default) */
     long jobs;
     uint64_t sa, sb;              /* --seeds A..B */
@@ -530,6 +721,8 @@ static int parse_options(int argc, char **argv, sim_opts_t *o)
             i++;
         } else if (strcmp(a, "--no-faults") == 0) {
             o->no_faults = true;
+        } else if (strcmp(a, "--resume") == 0) {
+            o->resume = true;
         } else if (strcmp(a, "--quiet") == 0) {
             o->quiet = true;
         } else if (strcmp(a, "--bench") == 0) {
@@ -555,6 +748,9 @@ static int check_options(sim_opts_t *o)
     if (o->seeds && parse_range(o->seeds, &o->sa, &o->sb) != 0) {
         return die("--seeds: '%s' is not A..B with A <= B%s", o->seeds, "");
     }
+    if (o->seeds && o->sb - o->sa >= BATCH_MAX_SEEDS) {
+        return die("--seeds: '%s' is more than %s seeds in one batch", o->seeds, "1000000");
+    }
     if (o->seeds && o->has_seed) {
         return die("--seed and --seeds exclude each other%s%s", "", "");
     }
@@ -570,11 +766,26 @@ static int check_options(sim_opts_t *o)
     if (o->jobs < 1) {
         o->jobs = 1;
     }
+    if (o->resume && (!o->seeds || !o->out || o->emit || o->bench)) {
+        return die("--resume needs --seeds A..B and --out DIR (no --emit-jobs or --bench)%s%s", "", "");
+    }
     if (o->out) {
         struct stat st;
-        if (stat(o->out, &st) == 0) {
+        char state[PATH_MAX + 64];
+        snprintf(state, sizeof state, "%s/%s", o->out, k_state);
+        if (o->resume && stat(state, &st) != 0) {
+            return die("%s: not an interrupted batch (no batch.state): nothing to resume%s", o->out, "");
+        }
+        if (!o->resume && stat(o->out, &st) == 0) {
             return die("%s: already exists (choose a new --out directory)%s", o->out, "");
         }
+        if (!o->emit && lx_err_check_dest(prog, o->out) != 0) {
+            return 1;
+        }
+    }
+    if (o->pcap && (lx_err_same_file(prog, o->scenario, o->pcap) != 0 ||
+                    lx_err_check_dest(prog, o->pcap) != 0)) {
+        return 1;
     }
     return RUN;
 }
@@ -624,7 +835,8 @@ static int emit_jobs(const sim_opts_t *o, const hs_scenario_t *sc)
         return die("cannot resolve the program or scenario path%s%s", "", "");
     }
     self[n] = '\0';
-    for (uint64_t s = o->sa; s <= o->sb; s++) {
+    for (uint64_t i = 0; i <= o->sb - o->sa; i++) {
+        const uint64_t s = o->sa + i;
         char p0[48] = "";
         if (!isnan(o->p0_min)) {
             snprintf(p0, sizeof p0, " --p0-min %.17g", o->p0_min);
@@ -653,35 +865,54 @@ static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
     }
     char tmp[PATH_MAX + 64];
     if (o->out) {
+        // A resumed batch goes on in the temporary directory like a new one.
         if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", o->out, (long)getpid()) >= (int)sizeof tmp ||
-            mkdir(tmp, 0777) != 0) {
-            fprintf(stderr, "%s: %s: %s\n", prog, tmp, strerror(errno));
+            (o->resume ? rename(o->out, tmp) : mkdir(tmp, 0777)) != 0) {
+            fprintf(stderr, "%s: %s: %s\n", prog, o->resume ? o->out : tmp, strerror(errno));
             hs_sim_env_close(&env);
             return 1;
         }
     }
     int rc;
     if (o->seeds) {
-        rc = run_batch(&env, o->sa, o->sb, (int)o->jobs, o->out ? tmp : NULL, o->samples, o->quiet);
+        char header[PATH_MAX + 512];
+        batch_state_header(header, sizeof header, o->scenario, sc, o->sa, o->sb, o->samples);
+        if (o->out) {
+            // Interrupted, the batch leaves a directory --resume continues.
+            struct sigaction sa;
+            memset(&sa, 0, sizeof sa);
+            sa.sa_handler = on_stop;
+            sigaction(SIGINT, &sa, NULL);
+            sigaction(SIGTERM, &sa, NULL);
+        }
+        rc = run_batch(&env, header, o->sa, o->sb, (int)o->jobs, o->out ? tmp : NULL, o->samples,
+                       o->quiet, o->resume);
     } else {
         hs_sim_result_t res;
+        char msg[1024];
         rc = run_one(&env, o->has_seed ? o->seed : sc->seed, o->out ? tmp : NULL, o->out != NULL,
-                     o->field, o->pcap, &res);
+                     o->field, o->pcap, &res, msg, sizeof msg);
+        if (rc != 0) {
+            lx_err_print(prog, "%s", msg);
+        }
     }
     hs_sim_env_close(&env);
     if (o->out) {
-        if (rc == 0 && rename(tmp, o->out) != 0) {
+        const bool keep = rc != 0 && o->seeds && (g_stop || o->resume);
+        if ((rc == 0 || keep) && rename(tmp, o->out) != 0) {
             fprintf(stderr, "%s: %s: %s\n", prog, o->out, strerror(errno));
             rc = 1;
-        }
-        if (rc != 0) {
+        } else if (keep && g_stop) {
+            lx_err_print(prog, "%s: interrupted; the finished seeds are kept there, "
+                         "continue with --resume", o->out);
+        } else if (rc != 0) {
             rm_tree(tmp);
         }
     }
     return rc;
 }
 
-int main(int argc, char **argv)
+static int sim_main(int argc, char **argv)
 {
     sim_opts_t o;
     int rc = parse_options(argc, argv, &o);
@@ -697,4 +928,9 @@ int main(int argc, char **argv)
         return rc;
     }
     return o.emit ? emit_jobs(&o, &sc) : run_scenario(&o, &sc);
+}
+
+int main(int argc, char **argv)
+{
+    return lx_err_close_stdout(prog, sim_main(argc, argv));
 }

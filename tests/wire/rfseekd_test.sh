@@ -29,7 +29,7 @@ expect_err rfseekd-can-exclusive 2 "exclude each other" --map $map --can vcan0 -
 expect_err rfseekd-missing-iface 1 "can: rfsnope0: no such interface" --map $map --lcm memq:// --can rfsnope0
 expect_err rfseekd-missing-log 1 "$w/none.lcmlog" --map $map --replay "$w/none.lcmlog"
 "$d" --map $map --lcm memq:// --log "$w/sub/x.lcmlog" > /dev/null 2> "$w/err"
-[ $? -eq 1 ] && grep -q "x.lcmlog.tmp: cannot open for writing" "$w/err" && [ ! -e "$w/sub/x.lcmlog" ] \
+[ $? -eq 1 ] && grep -qx "rfseekd: $w/sub/x.lcmlog: No such file or directory" "$w/err" && [ ! -e "$w/sub/x.lcmlog" ] \
     && pass rfseekd-unwritable-log || fail "rfseekd-unwritable-log ($(cat "$w/err"))"
 # A line break in an option, its value or a file name: still one line (shown as '?'),
 # liblcm's own complaint about a bad URL folded into it, and nothing written (tmp/nl*).
@@ -44,8 +44,8 @@ expect_err rfseekd-newline-lcm-url 1 "lcm: udpm://?q: cannot open this provider.
 expect_err rfseekd-bad-provider 1 "lcm: foo://: cannot open this provider.*liblcm: .*foo" \
     --map $map --lcm foo:// --decisions "$w/nl-dec.txt"
 expect_err rfseekd-newline-can 1 "can: rfsno?q" --map $map --lcm memq:// --can "rfsno${nl}q"
-expect_err rfseekd-newline-decisions 1 "nl/a?b: cannot write" --map $map --lcm memq:// --decisions "$w/nl/a${nl}b"
-expect_err rfseekd-newline-log 1 "nl/a?b.tmp: cannot open for writing" --map $map --lcm memq:// --log "$w/nl/a${nl}b"
+expect_err rfseekd-newline-decisions 1 "nl/a?b: No such file or directory" --map $map --lcm memq:// --decisions "$w/nl/a${nl}b"
+expect_err rfseekd-newline-log 1 "nl/a?b: No such file or directory" --map $map --lcm memq:// --log "$w/nl/a${nl}b"
 expect_err rfseekd-newline-replay 1 "nl?none.lcmlog" --map $map --replay "$w/nl${nl}none.lcmlog"
 compgen -G "$w/nl*" > /dev/null && fail "rfseekd-newline-nothing-written ($(ls -d "$w"/nl*))" \
     || pass rfseekd-newline-nothing-written

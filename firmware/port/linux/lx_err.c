@@ -1,8 +1,13 @@
 /* lx_err.c - see lx_err.h. */
 #include "lx_err.h"
 
+#include <errno.h>
+#include <limits.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 void lx_err_one_line(char *s)
 {
@@ -22,4 +27,62 @@ void lx_err_print(const char *prog, const char *fmt, ...)
     va_end(ap);
     lx_err_one_line(msg);
     fprintf(stderr, "%s: %s\n", prog, msg);
+}
+
+int lx_err_close_stdout(const char *prog, int rc)
+{
+    errno = 0;
+    int bad = fflush(stdout) != 0 || ferror(stdout);
+    int e = errno;
+    if (fclose(stdout) != 0 && !bad) {
+        bad = 1;
+        e = errno;
+    }
+    if (bad) {
+        lx_err_print(prog, "stdout: %s", e != 0 ? strerror(e) : "write failed");
+        return 1;
+    }
+    return rc;
+}
+
+int lx_err_same_file(const char *prog, const char *in, const char *out)
+{
+    struct stat si, so;
+    if (in != NULL && out != NULL && stat(in, &si) == 0 && stat(out, &so) == 0 &&
+        si.st_dev == so.st_dev && si.st_ino == so.st_ino) {
+        lx_err_print(prog, "%s: is the input %s (choose another output)", out, in);
+        return -1;
+    }
+    return 0;
+}
+
+int lx_err_check_dest(const char *prog, const char *path)
+{
+    char dir[PATH_MAX];
+    const char *slash = strrchr(path, '/');
+    if (slash == NULL) {
+        snprintf(dir, sizeof dir, ".");
+    } else if (slash == path) {
+        snprintf(dir, sizeof dir, "/");
+    } else if ((size_t)(slash - path) >= sizeof dir) {
+        lx_err_print(prog, "%s: %s", path, strerror(ENAMETOOLONG));
+        return -1;
+    } else {
+        memcpy(dir, path, (size_t)(slash - path));
+        dir[slash - path] = '\0';
+    }
+    struct stat st;
+    if (stat(dir, &st) != 0) {
+        lx_err_print(prog, "%s: %s", path, strerror(errno));
+        return -1;
+    }
+    if (!S_ISDIR(st.st_mode)) {
+        lx_err_print(prog, "%s: %s", path, strerror(ENOTDIR));
+        return -1;
+    }
+    if (access(dir, W_OK | X_OK) != 0) {
+        lx_err_print(prog, "%s: %s", path, strerror(errno));
+        return -1;
+    }
+    return 0;
 }

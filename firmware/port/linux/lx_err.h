@@ -12,4 +12,19 @@ void lx_err_one_line(char *s);
 /// names can hold line breaks.
 void lx_err_print(const char *prog, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
+/// A program's exit through its standard output: flush and close stdout and return rc,
+/// or 1 after "prog: stdout: REASON" when a byte written to it was lost (a full disk,
+/// /dev/full, a closed pipe). Every program returns through it.
+int lx_err_close_stdout(const char *prog, int rc);
+
+/// Refuse an output that is the input itself, whatever the names (same st_dev and
+/// st_ino; an output that does not exist yet is another file). 0, or -1 after
+/// "prog: OUT: is the input IN (choose another output)".
+int lx_err_same_file(const char *prog, const char *in, const char *out);
+
+/// Check before any work that `path` can be created: its directory exists, is a
+/// directory and is writable (the rename into place needs it). 0, or -1 after
+/// "prog: PATH: REASON".
+int lx_err_check_dest(const char *prog, const char *path);
+
 #endif /* LX_ERR_H */

@@ -2,6 +2,7 @@
  * lcm-gen types (generated from lcm/<type>.lcm into $(BUILD)/gen at build time). */
 #include "lx_lcm.h"
 
+#include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,6 +33,8 @@ struct lx_lcm_log {
     char *path;             /* final path (writing) */
     char *tmp;              /* temporary path while writing, or NULL when reading */
     int64_t last_us;        /* latest event timestamp written */
+    bool failed;            /* a write failed (writing) */
+    char err[160];          /* why reading stopped before the end ("" at the end) */
 };
 
 /* Largest encoded message we accept (a status with a short reason string). */
@@ -297,7 +300,9 @@ static void log_event(lx_lcm_log_t *log, int64_t t_us, const char *ch, const voi
     ev.channel = (char *)ch;
     ev.datalen = len;
     ev.data = (void *)data;
-    lcm_eventlog_write_event(log->ev, &ev);
+    if (lcm_eventlog_write_event(log->ev, &ev) != 0) {
+        log->failed = true;
+    }
     log->last_us = t_us;
 }
 
@@ -622,42 +627,64 @@ lx_lcm_log_t *lx_lcm_log_open(const char *path, const char *mode, char *err, siz
 
 /* LCM's reader callocs the event's data length as read from the file (up to 2 GiB) before
  * reading it: a corrupt or truncated log costs that much memory, or crashes where calloc
- * fails (found by tests/fuzz/fuzz_lcm.c). Peek at the next header the way LCM finds it
- * (scan for the magic) and report the end when its lengths run past the end of the file -
- * LCM would return no event for it either. */
-static bool event_fits(lx_lcm_log_t *log)
+ * fails (found by tests/fuzz/fuzz_lcm.c). The next header is checked first: its sync word
+ * right here (LCM would skip any bytes to the next one), a channel name LCM accepts and
+ * lengths within the file. 1: an event follows; 0: the clean end of the log; -1: not an
+ * event, the reason in log->err. */
+static int event_fits(lx_lcm_log_t *log)
 {
     FILE *f = log->ev->f;
     off_t pos = ftello(f);
-    bool ok = false;
-    if (pos >= 0 && fseeko(f, 0, SEEK_END) == 0) {
-        off_t end = ftello(f);
-        uint8_t b[24];
-        uint32_t magic = 0;
-        int c = EOF;
-        if (fseeko(f, pos, SEEK_SET) == 0) {
-            while (magic != 0xEDA1DA01u && (c = fgetc(f)) != EOF) {
-                magic = (magic << 8) | (uint32_t)c;
-            }
-        }
-        if (c != EOF && fread(b, 1, sizeof b, f) == sizeof b) {
-            uint32_t cl = (uint32_t)b[16] << 24 | (uint32_t)b[17] << 16 | (uint32_t)b[18] << 8 | b[19];
-            uint32_t dl = (uint32_t)b[20] << 24 | (uint32_t)b[21] << 16 | (uint32_t)b[22] << 8 | b[23];
-            off_t at = ftello(f);
-            ok = at >= 0 && cl < 1000u && dl <= INT32_MAX && (uint64_t)cl + dl <= (uint64_t)(end - at);
-        }
+    if (pos < 0 || fseeko(f, 0, SEEK_END) != 0) {
+        snprintf(log->err, sizeof log->err, "cannot seek");
+        return -1;
     }
-    if (pos < 0 || fseeko(f, pos, SEEK_SET) != 0) {
-        return false;
+    off_t end = ftello(f);
+    uint8_t b[28] = {0};
+    size_t n = fseeko(f, pos, SEEK_SET) == 0 ? fread(b, 1, sizeof b, f) : 0;
+    if (fseeko(f, pos, SEEK_SET) != 0) {
+        snprintf(log->err, sizeof log->err, "cannot seek");
+        return -1;
     }
-    return ok;
+    if (pos == end) {
+        return 0;
+    }
+    uint32_t magic = (uint32_t)b[0] << 24 | (uint32_t)b[1] << 16 | (uint32_t)b[2] << 8 | b[3];
+    if (n < 4 || magic != 0xEDA1DA01u) {
+        snprintf(log->err, sizeof log->err, "offset %lld: not an LCM event (no sync word)", (long long)pos);
+        return -1;
+    }
+    if (n < sizeof b) {
+        snprintf(log->err, sizeof log->err, "offset %lld: truncated event header", (long long)pos);
+        return -1;
+    }
+    uint32_t cl = (uint32_t)b[20] << 24 | (uint32_t)b[21] << 16 | (uint32_t)b[22] << 8 | b[23];
+    uint32_t dl = (uint32_t)b[24] << 24 | (uint32_t)b[25] << 16 | (uint32_t)b[26] << 8 | b[27];
+    if (cl >= 1000u) {
+        snprintf(log->err, sizeof log->err, "offset %lld: channel name of %" PRIu32 " bytes (at most 999)",
+                 (long long)pos, cl);
+        return -1;
+    }
+    if (dl > INT32_MAX || (uint64_t)cl + dl > (uint64_t)(end - pos) - sizeof b) {
+        snprintf(log->err, sizeof log->err, "offset %lld: event cut short (%" PRIu32 " + %" PRIu32
+                 " bytes announced, %lld in the file)", (long long)pos, cl, dl,
+                 (long long)(end - pos) - (long long)sizeof b);
+        return -1;
+    }
+    return 1;
+}
+
+const char *lx_lcm_log_error(const lx_lcm_log_t *log)
+{
+    return log->err;
 }
 
 int lx_lcm_log_next(lx_lcm_log_t *log, const lx_lcm_handlers_t *h, lx_lcm_stats_t *stats, int64_t *t_us)
 {
-    lcm_eventlog_event_t *ev = event_fits(log) ? lcm_eventlog_read_next_event(log->ev) : NULL;
+    const int fits = event_fits(log);
+    lcm_eventlog_event_t *ev = fits > 0 ? lcm_eventlog_read_next_event(log->ev) : NULL;
     if (!ev) {
-        return 0;
+        return fits < 0 ? -1 : 0;
     }
     if (t_us) {
         *t_us = ev->timestamp;
@@ -674,9 +701,10 @@ int lx_lcm_log_next(lx_lcm_log_t *log, const lx_lcm_handlers_t *h, lx_lcm_stats_
 int lx_lcm_log_next_raw(lx_lcm_log_t *log, int64_t *t_us, char *channel, size_t chcap, void *data, size_t cap,
                         size_t *len)
 {
-    lcm_eventlog_event_t *ev = event_fits(log) ? lcm_eventlog_read_next_event(log->ev) : NULL;
+    const int fits = event_fits(log);
+    lcm_eventlog_event_t *ev = fits > 0 ? lcm_eventlog_read_next_event(log->ev) : NULL;
     if (!ev) {
-        return 0;
+        return fits < 0 ? -1 : 0;
     }
     *t_us = ev->timestamp;
     size_t cl = ev->channellen > 0 ? (size_t)ev->channellen : 0;
@@ -699,11 +727,14 @@ int lx_lcm_log_close(lx_lcm_log_t *log)
     }
     int rc = 0;
     if (log->tmp) {
-        rc = fflush(log->ev->f) == 0 ? 0 : -1;
+        rc = !log->failed && fflush(log->ev->f) == 0 ? 0 : -1;
     }
     lcm_eventlog_destroy(log->ev);
     if (log->tmp && rc == 0 && rename(log->tmp, log->path) != 0) {
         rc = -1;
+    }
+    if (log->tmp && rc != 0) {
+        (void)remove(log->tmp); /* a log that could not be finished leaves nothing */
     }
     free(log->path);
     free(log->tmp);

@@ -115,16 +115,22 @@ lx_lcm_log_t *lx_lcm_log_open(const char *path, const char *mode, char *err, siz
 
 /// Read the next event and dispatch it through h like a received message (same checks
 /// and counters in *stats, which may be NULL). *t_us is the event's timestamp.
-/// Returns 1 per event (delivered or dropped), 0 at the end of the log.
+/// Returns 1 per event (delivered or dropped), 0 at the end of the log, -1 when the rest
+/// is not a log (garbage, an event cut short, a channel name of 1000 bytes or more; the
+/// reason from lx_lcm_log_error()).
 int lx_lcm_log_next(lx_lcm_log_t *log, const lx_lcm_handlers_t *h, lx_lcm_stats_t *stats, int64_t *t_us);
 
 /// Read the next event without decoding it: its time, channel (NUL-terminated, cut to
-/// chcap - 1) and up to cap bytes of data (*len is the full length). Returns 1, or 0 at
-/// the end of the log.
+/// chcap - 1) and up to cap bytes of data (*len is the full length). Returns 1, 0 at the
+/// end of the log, or -1 as lx_lcm_log_next().
 int lx_lcm_log_next_raw(lx_lcm_log_t *log, int64_t *t_us, char *channel, size_t chcap, void *data, size_t cap,
                         size_t *len);
 
-/// Close; for a written log, flush and rename PATH.tmp to PATH. Returns 0 or -1.
+/// Why reading stopped early ("offset N: reason"), after lx_lcm_log_next() returned -1.
+const char *lx_lcm_log_error(const lx_lcm_log_t *log);
+
+/// Close; for a written log, flush and rename PATH.tmp to PATH. Returns 0, or -1 when a
+/// write failed (PATH.tmp removed: nothing half-written is left).
 int lx_lcm_log_close(lx_lcm_log_t *log);
 
 #endif /* LX_LCM_H */

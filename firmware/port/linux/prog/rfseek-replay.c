@@ -165,7 +165,19 @@ static void usage(FILE *f)
                "  -h, --help   this text\n");
 }
 
-int main(int argc, char **argv)
+/* An input stream ends with its END record (an output stream has none); without it the
+ * recording was cut and a replay would stop early with exit 0. 0, or 1 after a message. */
+static int check_end(const char *in_path, size_t pos, int ended, int inputs)
+{
+    if (!ended && (inputs || pos == RFS_REPLAY_HEADER_LEN)) {
+        lx_err_print(PROG, "%s: offset %zu: truncated (%s)", in_path, pos,
+                     pos == RFS_REPLAY_HEADER_LEN ? "only the header" : "no END record");
+        return 1;
+    }
+    return 0;
+}
+
+static int replay_main(int argc, char **argv)
 {
     const char *in_path = NULL, *out_path = NULL;
     int print = 0;
@@ -196,6 +208,9 @@ int main(int argc, char **argv)
                                     : print ? "--print and -o exclude each other"
                                             : "-o OUT.rfso or --print is required");
         return 2;
+    }
+    if (!print && (lx_err_same_file(PROG, in_path, out_path) != 0 || lx_err_check_dest(PROG, out_path) != 0)) {
+        return 1;
     }
     size_t len = 0;
     uint8_t *buf = slurp(in_path, &len);
@@ -236,7 +251,7 @@ int main(int argc, char **argv)
         rfs_replay_player_init(&player, &app, &cfg, sink, &sc);
     }
     size_t pos = RFS_REPLAY_HEADER_LEN;
-    int rc = 0;
+    int rc = 0, ended = 0, inputs = 0;
     while (pos < len) {
         rfs_replay_rec_t rec;
         uint32_t used = 0;
@@ -257,9 +272,14 @@ int main(int argc, char **argv)
             break;
         }
         pos += used;
+        inputs |= rec.type < RFS_REPLAY_END;
         if (rec.type == RFS_REPLAY_END) {
+            ended = 1;
             break;
         }
+    }
+    if (rc == 0) {
+        rc = check_end(in_path, pos, ended, inputs);
     }
     free(buf);
     if (!print) {
@@ -276,4 +296,9 @@ int main(int argc, char **argv)
         }
     }
     return rc;
+}
+
+int main(int argc, char **argv)
+{
+    return lx_err_close_stdout(PROG, replay_main(argc, argv));
 }

@@ -527,7 +527,12 @@ static int run_replay(daemon_t *d, const options_t *o)
     lx_lcm_stats_t st;
     memset(&st, 0, sizeof st);
     int64_t t;
-    while (!g_stop && !d->done && lx_lcm_log_next(d->in, &d->handlers, &st, &t) == 1) {
+    int r = 1;
+    while (!g_stop && !d->done && (r = lx_lcm_log_next(d->in, &d->handlers, &st, &t)) == 1) {
+    }
+    if (r < 0) {
+        lx_err_print(PROG, "%s: %s", o->replay, lx_lcm_log_error(d->in));
+        return 1;
     }
     return 0;
 }
@@ -597,8 +602,8 @@ static int finish(daemon_t *d, const options_t *o, int rc)
     if (d->in) {
         lx_lcm_log_close(d->in);
     }
-    if (d->rec && lx_lcm_log_close(d->rec) != 0) {
-        lx_err_print(PROG, "%s: could not finish the log", o->log_path);
+    if (d->rec && lx_lcm_log_close(d->rec) != 0 && rc == 0) {
+        lx_err_print(PROG, "%s: could not finish the log (write failed)", o->log_path);
         rc = 1;
     }
     if (d->decisions && d->decisions != stdout) {
@@ -623,12 +628,35 @@ static int finish(daemon_t *d, const options_t *o, int rc)
     return rc;
 }
 
-int main(int argc, char **argv)
+/* No output may be the input, and each output's directory must exist: 0, or 1 after a
+ * message - before any work. */
+static int check_paths(const options_t *o)
+{
+    const char *outs[2] = {o->log_path, o->dec_path}, *ins[2] = {o->map_path, o->replay};
+    for (int i = 0; i < 2; i++) {
+        if (outs[i] == NULL) {
+            continue;
+        }
+        if (lx_err_same_file(PROG, ins[0], outs[i]) != 0 || lx_err_same_file(PROG, ins[1], outs[i]) != 0 ||
+            lx_err_check_dest(PROG, outs[i]) != 0) {
+            return 1;
+        }
+    }
+    if (o->log_path && o->dec_path && lx_err_same_file(PROG, o->log_path, o->dec_path) != 0) {
+        return 1;
+    }
+    return 0;
+}
+
+static int daemon_main(int argc, char **argv)
 {
     options_t o;
     int rc = parse_options(argc, argv, &o);
     if (rc != RUN) {
         return rc;
+    }
+    if (check_paths(&o) != 0) {
+        return 1;
     }
     daemon_t d;
     memset(&d, 0, sizeof d);
@@ -640,7 +668,7 @@ int main(int argc, char **argv)
         signal(SIGINT, on_signal);
         signal(SIGTERM, on_signal);
         rc = o.replay ? run_replay(&d, &o) : o.clock_lcm ? run_lockstep(&d, &o) : run_live(&d, &o);
-        if (!o.replay || d.in) { /* not when the replay log could not be opened */
+        if (rc == 0) { /* the counts of a run that went through; else its one error line */
             fprintf(stderr, "rfseekd: %" PRIu32 " steps, %" PRIu32 " decisions, %" PRIu32 " bad messages, %" PRIu32
                             " CAN send failures, %" PRIu32 " receiver heartbeats, seeker rejected %" PRIu32
                             " inputs (strategy %s, model %s)\n",
@@ -649,4 +677,9 @@ int main(int argc, char **argv)
         }
     }
     return finish(&d, &o, rc);
+}
+
+int main(int argc, char **argv)
+{
+    return lx_err_close_stdout(PROG, daemon_main(argc, argv));
 }

@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# outputs_test.sh BUILD - the Linux programs' outputs under stress: an output that is the
+# input (refused before any work, the input intact), stdout on /dev/full (exit 1, one
+# line), a full disk for rfseekd --log (a 200 KB tmpfs: no PATH.tmp left), rfseekd
+# --replay of logs that are not LCM logs, and replay streams cut before their END record.
+set -uo pipefail
+B=${1:?usage: outputs_test.sh BUILD}
+bin=$B/bin map=scenarios/maps/office.yaml
+w=$(mktemp -d /tmp/rfs_outputs.XXXXXX)
+trap 'mountpoint -q "$w/full" && umount "$w/full"; rm -rf -- "$w"' EXIT
+. "$(dirname "$0")/../lib/checks.sh"
+# err NAME RC TEXT PROG ARGS...: exit RC, exactly one stderr line containing TEXT.
+err() {
+    local name=$1 want=$2 text=$3 p=$4; shift 4
+    "$bin/$p" "$@" >"$w/out" 2>"$w/err"; local rc=$?
+    if [ $rc -ne "$want" ]; then fail "$name" "exit $rc: $(head -c 300 "$w/err")"
+    elif [ "$(wc -l <"$w/err")" -ne 1 ]; then fail "$name" "$(wc -l <"$w/err") stderr lines: $(head -c 300 "$w/err")"
+    elif ! grep -qF -- "$text" "$w/err"; then fail "$name" "stderr '$(cat "$w/err")' lacks '$text'"
+    else pass "$name"; fi
+}
+full=$'No space left on device'
+
+# --- inputs --------------------------------------------------------------------------------
+"$B/tests/wire/lcm_tool" mklog "$w/bad.lcmlog" || fail lcm-mklog
+# a log of well-formed messages only: what rfseekd records of the crafted one
+"$bin/rfseekd" --map $map --clock-lcm --lcm memq:// --replay "$w/bad.lcmlog" --log "$w/in.lcmlog" >/dev/null 2>&1 || fail lcm-clean-log
+"$bin/rfseek-record" scenarios/default.yaml -o "$w/in.rfsr" --max-time 3 >/dev/null || fail record
+"$bin/rfseek-replay" "$w/in.rfsr" -o "$w/out.rfso" || fail replay
+
+# --- row: output = input -------------------------------------------------------------------
+cp "$w/in.rfsr" "$w/same.rfsr"; ln -s same.rfsr "$w/link.rfsr"
+err replay-out-is-in 1 "is the input" rfseek-replay "$w/same.rfsr" -o "$w/link.rfsr"
+check replay-out-is-in-intact 'cmp -s "$w/same.rfsr" "$w/in.rfsr" && ! compgen -G "$w/same.rfsr.tmp*" >/dev/null'
+cp "$w/in.lcmlog" "$w/same.lcmlog"
+err rfseekd-log-is-replay 1 "is the input" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/same.lcmlog" --log "$w/same.lcmlog"
+err rfseekd-decisions-is-replay 1 "is the input" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/same.lcmlog" --decisions "$w/same.lcmlog"
+check rfseekd-out-is-in-intact 'cmp -s "$w/same.lcmlog" "$w/in.lcmlog"'
+err rfseekd-log-dir-missing 1 "$w/no/out.lcmlog: No such file or directory" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/in.lcmlog" --log "$w/no/out.lcmlog"
+cap=$(ls tests/data/captures/*.pcap | head -1)
+cp "$cap" "$w/same.pcap"
+err feed-output-is-capture 1 "is the input" rfseek-feed "$w/same.pcap" --mac 02:00:00:00:00:01 --output "$w/same.pcap"
+check feed-output-is-capture-intact 'cmp -s "$w/same.pcap" "$cap"'
+err feed-output-dir-missing 1 "No such file or directory" rfseek-feed "$w/same.pcap" --mac 02:00:00:00:00:01 --output "$w/no/x.tsv"
+cp scenarios/maps/office.yaml "$w/office.yaml"; sed -i "s|^image: *|image: $PWD/scenarios/maps/|" "$w/office.yaml"
+err map-pgm-is-yaml 1 "is the input" rfseek-map "$w/office.yaml" --pgm "$w/office.yaml"
+
+# --- row: stdout on /dev/full --------------------------------------------------------------
+exec 3>&1
+for c in "rfseek-map $map" "rfseek-replay --print $w/out.rfso" "rfseekd --map $map --clock-lcm --lcm memq:// --replay $w/bad.lcmlog"; do
+    # shellcheck disable=SC2086
+    "$bin"/$c >/dev/full 2>"$w/err"; rc=$?
+    name="stdout-full-${c%% *}"
+    [ $rc -eq 1 ] && [ "$(grep -c . "$w/err" | head -1)" -ge 1 ] && grep -qF "${c%% *}: stdout: $full" "$w/err" \
+        && [ "$(grep -vc -e '^rfseekd: dropped LCM message' -e '(dropped, counted)$' -e '^rfseekd: [0-9]* steps, ' "$w/err")" -eq 1 ] && pass "$name" || fail "$name" "rc $rc: $(head -c 300 "$w/err")"
+done
+
+# --- row: full disk, rfseekd --log leaves no temporary -------------------------------------
+mkdir -p "$w/full"
+if mount -t tmpfs -o size=200k tmpfs "$w/full" 2>/dev/null; then
+    head -c 300000 /dev/zero >"$w/full/fill" 2>/dev/null
+    "$bin/rfseekd" --map $map --clock-lcm --lcm memq:// --replay "$w/bad.lcmlog" --log "$w/full/out.lcmlog" >/dev/null 2>"$w/err"
+    check rfseekd-log-disk-full '[ $? -eq 1 ] && [ "$(grep -v -e "^rfseekd: dropped LCM message" -e "(dropped, counted)$" -e "^rfseekd: [0-9]* steps, " "$w/err")" = "rfseekd: $w/full/out.lcmlog: could not finish the log (write failed)" ]' 
+    check rfseekd-log-disk-full-no-tmp '[ ! -e "$w/full/out.lcmlog.tmp" ] && [ ! -e "$w/full/out.lcmlog" ]'
+    umount "$w/full"
+else
+    echo "SKIP rfseekd-log-disk-full: mount -t tmpfs not permitted"
+fi
+
+# --- row: rfseekd --replay of what is not an LCM log ---------------------------------------
+head -c 51200 /dev/urandom >"$w/random.lcmlog"
+err rfseekd-replay-random 1 "random.lcmlog: offset 0: not an LCM event" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/random.lcmlog"
+sz=$(stat -c %s "$w/in.lcmlog")
+head -c $((sz - 7)) "$w/in.lcmlog" >"$w/cut.lcmlog"
+err rfseekd-replay-cut 1 "event cut short" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/cut.lcmlog"
+{ cat "$w/in.lcmlog"; printf '\xed\xa1\xda\x01\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\x03\xe8\0\0\0\0'; head -c 1000 /dev/zero | tr '\0' A; } >"$w/longch.lcmlog"
+err rfseekd-replay-long-channel 1 "channel name of 1000 bytes" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/longch.lcmlog"
+check rfseekd-replay-valid 'bin/true 2>/dev/null; "$bin/rfseekd" --map $map --clock-lcm --lcm memq:// --replay "$w/in.lcmlog" >/dev/null 2>&1'
+
+# --- row: replay streams without their END record ------------------------------------------
+head -c 8 "$w/in.rfsr" >"$w/header.rfsr"
+n=$(stat -c %s "$w/in.rfsr"); head -c $((n - 2)) "$w/in.rfsr" >"$w/noend.rfsr"
+err replay-header-only 1 "header.rfsr: offset 8: truncated (only the header)" rfseek-replay "$w/header.rfsr" -o "$w/x.rfso"
+err replay-header-only-print 1 "truncated (only the header)" rfseek-replay --print "$w/header.rfsr"
+err replay-no-end 1 "noend.rfsr: offset $((n - 2)): truncated (no END record)" rfseek-replay "$w/noend.rfsr" -o "$w/x.rfso"
+err replay-no-end-print 1 "truncated (no END record)" rfseek-replay --print "$w/noend.rfsr"
+check replay-no-end-nothing-left '! compgen -G "$w/x.rfso*" >/dev/null'
+check replay-output-stream-prints '"$bin/rfseek-replay" --print "$w/out.rfso" >/dev/null'
+exit $((fails > 0))

@@ -12,9 +12,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "lx_map.h"
+#include "lx_yaml.h"
 
 #define BAD "tests/data/maps_bad/"
 
@@ -271,6 +273,70 @@ static void test_core_rejects(void **state)
     lx_map_free(&m);
 }
 
+/* `levels` nested flow sequences as the value of "image:" in dir/deep.yaml. */
+static void write_deep(const char *path, long levels)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("image: ", f);
+    for (long i = 0; i < levels; i++) {
+        fputc('[', f);
+    }
+    for (long i = 0; i < levels; i++) {
+        fputc(']', f);
+    }
+    fputs("\nresolution: 0.05\n", f);
+    assert_int_equal(fclose(f), 0);
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* Nesting deeper than LX_YAML_MAX_DEPTH: refused at once with one line, through the map
+ * loader (lx_yaml_load_string) and from a stream (lx_yaml_load_file, the scenario's);
+ * libyaml took 3.8 s to compose 40,000 levels, over a minute for 100,000. 64 levels pass
+ * the depth check (and fail later as a map, on the image). */
+static void test_yaml_depth(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/rfs_lx_yaml_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char yp[256];
+    char want[512];
+    char err[512] = "";
+    snprintf(yp, sizeof(yp), "%s/deep.yaml", dir);
+    snprintf(want, sizeof(want), "%s: malformed YAML at line 1: nesting deeper than 64 levels", yp);
+    const long levels[] = {40000, 100000, 65};
+    for (size_t k = 0; k < 3; k++) {
+        write_deep(yp, levels[k]);
+        lx_map_t m;
+        double t0 = now_s();
+        assert_int_equal(lx_map_load(yp, &m, err, sizeof(err)), -1);
+        assert_string_equal(err, want);
+        FILE *f = fopen(yp, "rb");
+        assert_non_null(f);
+        lx_yaml_doc_t doc;
+        lx_yaml_error_t ye;
+        assert_int_equal(lx_yaml_load_file(f, &doc, &ye), LX_YAML_SYNTAX);
+        fclose(f);
+        lx_yaml_free(&doc);
+        assert_int_equal(ye.line, 1);
+        assert_string_equal(ye.problem, "nesting deeper than 64 levels");
+        assert_true(now_s() - t0 < 0.5);
+    }
+    write_deep(yp, 63); /* with the root mapping: 64 levels */
+    lx_map_t m;
+    assert_int_equal(lx_map_load(yp, &m, err, sizeof(err)), -1);
+    snprintf(want, sizeof(want), "%s: image: a file name expected", yp);
+    assert_string_equal(err, want);
+    remove(yp);
+    rmdir(dir);
+}
+
 static long max_rss_kb(void)
 {
     struct rusage ru;
@@ -341,6 +407,7 @@ int main(void)
         cmocka_unit_test(test_core_conservative),
         cmocka_unit_test(test_core_rejects),
         cmocka_unit_test(test_image_bounded),
+        cmocka_unit_test(test_yaml_depth),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

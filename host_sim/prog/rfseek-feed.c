@@ -103,13 +103,11 @@ static int parse_mac(const char *s, uint8_t mac[6])
 
 /* "<sec>.<9 digits>\t<mac>\t<dbm>\n" into out; returns its length. Hand-formatted: this
  * is the inner loop of the bench (millions of lines). */
-static size_t format_line(char *out, int64_t t_ns, const uint8_t mac[6], int dbm)
+static size_t format_line(char *out, uint64_t sec, uint32_t frac, const uint8_t mac[6], int dbm)
 {
     static const char hex[] = "0123456789abcdef";
     char tmp[24];
     size_t n = 0;
-    uint64_t sec = (uint64_t)(t_ns / 1000000000);
-    uint64_t frac = (uint64_t)(t_ns % 1000000000);
     int k = 0;
     do { tmp[k++] = (char)('0' + sec % 10u); sec /= 10u; } while (sec != 0u);
     while (k > 0) { out[n++] = tmp[--k]; }
@@ -209,7 +207,7 @@ static int tsv_line(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_fram
     tsv_ctx_t *c = ctx;
     (void)m;
     char line[64];
-    const size_t len = format_line(line, pkt->t_ns, f->wlan.sa, f->rt.dbm_signal);
+    const size_t len = format_line(line, pkt->ts_sec, pkt->ts_nsec, f->wlan.sa, f->rt.dbm_signal);
     fwrite(line, 1, len, c->out);
     if (c->live) { fflush(c->out); }
     return 0;

@@ -79,6 +79,8 @@ def pcapng(path, tsresol, ts):
     idb = block(1, struct.pack("<HHI", 127, 0, 65535) + opt)
     epb = block(6, struct.pack("<IIIII", 0, ts >> 32, ts & 0xFFFFFFFF, len(frame), len(frame)) + frame)
     open(path, "wb").write(shb + idb + epb)
+pcap_build.write(d + "/frac_2e31.pcap", [struct.pack("<IIII", 5, 2**31, len(frame), len(frame)) + frame])
+pcap_build.write(d + "/frac_1s.pcap", [struct.pack("<IIII", 5, 10**6, len(frame), len(frame)) + frame])
 pcapng(d + "/ts_res9_max.pcapng", 9, 2**64 - 1)
 pcapng(d + "/ts_res2_20.pcapng", 0x94, (1700000000 << 20) + 524288 + 3)
 PY
@@ -103,4 +105,7 @@ expect_lines ts_pcap_2e31 "$tmp/ts_2e31.pcap" $'2147483648.000000000\t02:aa:bb:c
     $'4294967295.999999000\t02:aa:bb:cc:00:01\t-41'
 expect_lines ts_pcapng_res9_max "$tmp/ts_res9_max.pcapng" $'18446744073.709551615\t02:aa:bb:cc:00:01\t-42'
 expect_lines ts_pcapng_res2_20 "$tmp/ts_res2_20.pcapng" $'1700000000.500002861\t02:aa:bb:cc:00:01\t-42'
+# a classic record's fraction field of one second or more is damage, not time
+expect frac_2e31 1 "frac_2e31.pcap: damaged record: timestamp fraction not below one second \(after 0 packets\)" -- "$tmp/frac_2e31.pcap" --mac $mac
+expect frac_1s 1 "frac_1s.pcap: damaged record: timestamp fraction not below one second \(after 0 packets\)" -- "$tmp/frac_1s.pcap" --mac $mac
 exit $fail

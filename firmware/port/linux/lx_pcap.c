@@ -113,10 +113,14 @@ int lx_pcap_next(lx_pcap_reader_t *r, lx_pcap_pkt_t *pkt, char *err, size_t errl
          * pcapng's 64-bit unsigned seconds (its timestamp divided by if_tsresol, decimal or
          * binary) as time_t too: both are unsigned on the wire, as tshark reads them. */
         const uint64_t sec = r->classic ? (uint64_t)(uint32_t)h->ts.tv_sec : (uint64_t)h->ts.tv_sec;
-        uint64_t frac = (uint64_t)h->ts.tv_usec;
-        if (pcap_get_tstamp_precision(r->p) != PCAP_TSTAMP_PRECISION_NANO) { frac *= 1000u; }
-        pkt->ts_sec = sec + frac / 1000000000u; /* libpcap keeps frac below 1 s; unsigned either way */
-        pkt->ts_nsec = (uint32_t)(frac % 1000000000u);
+        const int64_t scale = pcap_get_tstamp_precision(r->p) == PCAP_TSTAMP_PRECISION_NANO ? 1 : 1000;
+        /* A classic record's fraction field beyond 1 s (2^31 and up reads negative) is damage. */
+        if (h->ts.tv_usec < 0 || (int64_t)h->ts.tv_usec >= 1000000000 / scale) {
+            snprintf(err, errlen, "%s: damaged record: timestamp fraction not below one second", r->name);
+            return -1;
+        }
+        pkt->ts_sec = sec;
+        pkt->ts_nsec = (uint32_t)((int64_t)h->ts.tv_usec * scale);
         pkt->t_ns = pkt->ts_sec < (uint64_t)INT64_MAX / 1000000000u
                         ? (int64_t)(pkt->ts_sec * 1000000000u + pkt->ts_nsec) : INT64_MAX;
         pkt->t_us = pkt->ts_sec < (uint64_t)INT64_MAX / 1000000u

@@ -40,7 +40,8 @@ lx_pcap_reader_t *lx_pcap_open_offline(const char *path, char *err, size_t errle
 lx_pcap_reader_t *lx_pcap_open_live(const char *ifname, char *err, size_t errlen);
 
 /// Read the next packet: 1 = a packet in *pkt, 0 = end of file, 2 = live timeout (no
-/// packet yet), -1 = read error (a truncated record, message in `err`).
+/// packet yet), -1 = read error (a truncated record, a timestamp fraction of a second or
+/// more; message in `err`).
 int lx_pcap_next(lx_pcap_reader_t *r, lx_pcap_pkt_t *pkt, char *err, size_t errlen);
 
 /// Close the reader (NULL is fine).

@@ -152,11 +152,25 @@ lx_yaml_rc_t lx_yaml_load_file(FILE *f, lx_yaml_doc_t *doc, lx_yaml_error_t *e)
     memset(doc, 0, sizeof(*doc));
     memset(e, 0, sizeof(*e));
     /* Read whole (the depth check and the load each walk it), at most LX_YAML_MAX_BYTES. */
-    uint8_t *buf = malloc(LX_YAML_MAX_BYTES + 1);
+    size_t cap = 1u << 16;
+    size_t len = 0;
+    uint8_t *buf = malloc(cap);
+    while (buf != NULL) {
+        len += fread(buf + len, 1, cap - len, f);
+        if (len < cap || cap > LX_YAML_MAX_BYTES) {
+            break;
+        }
+        const size_t grow = cap * 2 < LX_YAML_MAX_BYTES + 1 ? cap * 2 : LX_YAML_MAX_BYTES + 1;
+        uint8_t *nb = realloc(buf, grow);
+        if (nb == NULL) {
+            free(buf);
+        }
+        buf = nb;
+        cap = grow;
+    }
     if (buf == NULL) {
         return LX_YAML_NOMEM;
     }
-    size_t len = fread(buf, 1, LX_YAML_MAX_BYTES + 1, f);
     lx_yaml_rc_t rc;
     if (ferror(f)) {
         e->line = 1;

@@ -644,7 +644,8 @@ static int load(const char *path, hs_scenario_t *sc, char *err, size_t errlen)
     if (yrc == LX_YAML_NOMEM) {
         snprintf(err, errlen, "%s: out of memory", path);
     } else if (yrc == LX_YAML_TOO_BIG) {
-        snprintf(err, errlen, "%s: more than %u YAML nodes", path, LX_YAML_MAX_NODES);
+        snprintf(err, errlen, "%s: more than %u YAML nodes or %u bytes", path, LX_YAML_MAX_NODES,
+                 LX_YAML_MAX_BYTES);
     } else if (yrc != LX_YAML_OK) {
         snprintf(err, errlen, "%s:%lu: YAML syntax error: %s", path, ye.line,
                  ye.problem ? ye.problem : "unknown");

@@ -13,6 +13,7 @@
  * and summary.json are written (docs/FEEDER.md).
  */
 #include <errno.h>
+#include <signal.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdint.h>
@@ -23,6 +24,7 @@
 #include <unistd.h>
 
 #include "hs_ctrl.h"
+#include "hs_poses.h"
 #include "lx_err.h"
 #include "lx_pcap.h"
 #include "lx_radiotap.h"
@@ -103,13 +105,11 @@ static int parse_mac(const char *s, uint8_t mac[6])
 
 /* "<sec>.<9 digits>\t<mac>\t<dbm>\n" into out; returns its length. Hand-formatted: this
  * is the inner loop of the bench (millions of lines). */
-static size_t format_line(char *out, int64_t t_ns, const uint8_t mac[6], int dbm)
+static size_t format_line(char *out, uint64_t sec, uint32_t frac, const uint8_t mac[6], int dbm)
 {
     static const char hex[] = "0123456789abcdef";
     char tmp[24];
     size_t n = 0;
-    uint64_t sec = (uint64_t)(t_ns / 1000000000);
-    uint64_t frac = (uint64_t)(t_ns % 1000000000);
     int k = 0;
     do { tmp[k++] = (char)('0' + sec % 10u); sec /= 10u; } while (sec != 0u);
     while (k > 0) { out[n++] = tmp[--k]; }
@@ -199,6 +199,43 @@ static int scan_capture(lx_pcap_reader_t *r, const uint8_t (*macs)[6], int n_mac
 
 /* --- TSV mode ----------------------------------------------------------------------- */
 
+/* The temporary outputs of this run (FILE.tmp, or DIR.tmp-PID and its files), removed when
+ * SIGINT or SIGTERM ends it: the paths are written before the handler is installed, and
+ * the handler only unlinks them (async-signal-safe) and dies of the same signal. */
+#define FEED_TMP_FILES 5
+static char g_tmp_file[FEED_TMP_FILES][4200];
+static char g_tmp_dir[4096];
+
+static void on_stop_signal(int sig)
+{
+    for (int i = 0; i < FEED_TMP_FILES; i++) {
+        if (g_tmp_file[i][0] != '\0') { (void)unlink(g_tmp_file[i]); }
+    }
+    if (g_tmp_dir[0] != '\0') { (void)rmdir(g_tmp_dir); }
+    (void)signal(sig, SIG_DFL);
+    (void)raise(sig);
+}
+
+/* Remove `dir` (or NULL) and its `n` files `names` (or, with dir NULL, the paths
+ * `names` themselves) on SIGINT and SIGTERM. */
+static void cleanup_on_signal(const char *dir, const char *const *names, int n)
+{
+    for (int i = 0; i < n && i < FEED_TMP_FILES; i++) {
+        if (dir != NULL) {
+            snprintf(g_tmp_file[i], sizeof(g_tmp_file[i]), "%s/%s", dir, names[i]);
+        } else {
+            snprintf(g_tmp_file[i], sizeof(g_tmp_file[i]), "%s", names[i]);
+        }
+    }
+    snprintf(g_tmp_dir, sizeof(g_tmp_dir), "%s", dir != NULL ? dir : "");
+    struct sigaction sa;
+    memset(&sa, 0, sizeof(sa));
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    (void)sigaction(SIGINT, &sa, NULL);
+    (void)sigaction(SIGTERM, &sa, NULL);
+}
+
 typedef struct tsv_ctx {
     FILE *out;
     bool live; /* flush each line: a live reader wants it at once */
@@ -209,7 +246,7 @@ static int tsv_line(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_fram
     tsv_ctx_t *c = ctx;
     (void)m;
     char line[64];
-    const size_t len = format_line(line, pkt->t_ns, f->wlan.sa, f->rt.dbm_signal);
+    const size_t len = format_line(line, pkt->ts_sec, pkt->ts_nsec, f->wlan.sa, f->rt.dbm_signal);
     fwrite(line, 1, len, c->out);
     if (c->live) { fflush(c->out); }
     return 0;
@@ -226,6 +263,8 @@ static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, const uin
         if (tmp == NULL) { fprintf(stderr, "rfseek-feed: out of memory\n"); return 1; }
         memcpy(tmp, output, n);
         memcpy(tmp + n, ".tmp", 5);
+        const char *names[1] = {tmp};
+        cleanup_on_signal(NULL, names, 1);
         out = fopen(tmp, "w");
         if (out == NULL) {
             fprintf(stderr, "rfseek-feed: %s: cannot create: %s\n", tmp, strerror(errno));
@@ -254,11 +293,6 @@ static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, const uin
 }
 
 /* --- replay mode (--pose) ------------------------------------------------------------ */
-
-typedef struct rp_pose {
-    int64_t t_us;       /* capture clock, microseconds since the epoch */
-    double x, y, theta; /* map frame: metres, metres, radians */
-} rp_pose_t;
 
 typedef struct rp_pkt {
     int64_t t_us; /* capture clock, microseconds since the epoch */
@@ -300,7 +334,7 @@ typedef struct rp_times {
 static int rp_alive(void *ctx, int64_t t_us)
 {
     rp_times_t *hb = ctx;
-    if (hb->n > 0 && t_us < hb->v[hb->n - 1] + RP_ALIVE_US) {
+    if (hb->n > 0 && t_us - hb->v[hb->n - 1] < RP_ALIVE_US) { /* both >= 0: no overflow */
         return 0;
     }
     if (hb->n == hb->cap) {
@@ -312,90 +346,6 @@ static int rp_alive(void *ctx, int64_t t_us)
     }
     hb->v[hb->n++] = t_us;
     return 0;
-}
-
-/* Read the pose CSV: header "t_us,x_m,y_m,theta_rad", then one pose per line, times
- * strictly increasing, finite coordinates. One error line "file:line: reason". */
-static int read_poses(const char *path, rp_pose_t **out, size_t *n_out, char *err, size_t errlen)
-{
-    FILE *fp = fopen(path, "r");
-    if (fp == NULL) {
-        snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
-        return -1;
-    }
-    rp_pose_t *v = NULL;
-    size_t n = 0, cap = 0;
-    char line[512];
-    unsigned long ln = 0;
-    int rc = 0;
-    while (fgets(line, sizeof(line), fp) != NULL) {
-        ln++;
-        const size_t len = strlen(line);
-        if (len == sizeof(line) - 1 && line[len - 1] != '\n') {
-            snprintf(err, errlen, "%s:%lu: line longer than %zu bytes", path, ln, sizeof(line) - 2);
-            rc = -1;
-            break;
-        }
-        line[strcspn(line, "\r\n")] = '\0';
-        if (ln == 1) {
-            if (strcmp(line, "t_us,x_m,y_m,theta_rad") != 0) {
-                snprintf(err, errlen, "%s:1: header must be 't_us,x_m,y_m,theta_rad'", path);
-                rc = -1;
-                break;
-            }
-            continue;
-        }
-        if (line[0] == '\0') { continue; }
-        rp_pose_t p;
-        char *e = NULL;
-        errno = 0;
-        p.t_us = strtoll(line, &e, 10);
-        if (e == line || *e != ',' || errno != 0) {
-            snprintf(err, errlen, "%s:%lu: t_us: not an integer number of microseconds", path, ln);
-            rc = -1;
-            break;
-        }
-        // cppcheck-suppress uninitvar ; only addresses are taken; each field is written below
-        double *fields[3] = {&p.x, &p.y, &p.theta};
-        static const char *names[3] = {"x_m", "y_m", "theta_rad"};
-        for (int k = 0; k < 3 && rc == 0; k++) {
-            const char *b = e + 1;
-            *fields[k] = strtod(b, &e);
-            if (e == b || (k < 2 ? *e != ',' : *e != '\0') || !isfinite(*fields[k])) {
-                snprintf(err, errlen, "%s:%lu: %s: not a finite number%s", path, ln, names[k],
-                         k < 2 ? " followed by ','" : " at the end of the line");
-                rc = -1;
-            }
-        }
-        if (rc != 0) { break; }
-        if (n > 0 && p.t_us <= v[n - 1].t_us) {
-            snprintf(err, errlen, "%s:%lu: t_us: %lld is not after the previous pose (%lld)", path, ln,
-                     (long long)p.t_us, (long long)v[n - 1].t_us);
-            rc = -1;
-            break;
-        }
-        if (n == cap) {
-            cap = cap ? cap * 2 : 1024;
-            rp_pose_t *nv = realloc(v, cap * sizeof(*nv));
-            if (nv == NULL) { snprintf(err, errlen, "%s: out of memory", path); rc = -1; break; }
-            v = nv;
-        }
-        v[n++] = p;
-    }
-    if (rc == 0 && ferror(fp)) { snprintf(err, errlen, "%s: read error", path); rc = -1; }
-    if (rc == 0 && n < 2) { snprintf(err, errlen, "%s: fewer than 2 poses", path); rc = -1; }
-    fclose(fp);
-    if (rc != 0) { free(v); return -1; }
-    *out = v;
-    *n_out = n;
-    return 0;
-}
-
-static double rp_wrap(double a)
-{
-    while (a > M_PI) { a -= 2.0 * M_PI; }
-    while (a <= -M_PI) { a += 2.0 * M_PI; }
-    return a;
 }
 
 static rfs_q16_t rp_q16(double v) { return (rfs_q16_t)llround(v * 65536.0); }
@@ -431,11 +381,14 @@ static FILE *rp_open(const char *dir, const char *name)
     return fopen(p, "w");
 }
 
+/* Every file a replay writes into its output directory. */
+static const char *const k_rp_files[] = {"log.tsv", "samples.tsv", "track.tsv", "summary.json"};
+
 static void rp_rmdir(const char *dir)
 {
-    static const char *names[] = {"log.tsv", "samples.tsv", "track.tsv", "summary.json"};
+    const char *const *names = k_rp_files;
     char p[4096];
-    for (size_t i = 0; i < sizeof(names) / sizeof(names[0]); i++) {
+    for (size_t i = 0; i < sizeof(k_rp_files) / sizeof(k_rp_files[0]); i++) {
         if (snprintf(p, sizeof(p), "%s/%s", dir, names[i]) < (int)sizeof(p)) { (void)remove(p); }
     }
     (void)rmdir(dir);
@@ -458,7 +411,7 @@ typedef struct replay {
     bool ctrl_open;
     bool pdr_target;
     int n_macs;
-    rp_pose_t *poses;
+    hs_pose_rec_t *poses;
     size_t n_poses;
     rp_vec_t pk;                    /* the matching frames */
     rp_times_t hb;                  /* the receiver heartbeats */
@@ -520,7 +473,7 @@ static int rp_open_inputs(replay_t *rp, lx_pcap_reader_t *r, uint8_t (*macs)[6],
 {
     const rp_opts_t *o = rp->o;
     char err[1200];
-    if (read_poses(o->poses, &rp->poses, &rp->n_poses, err, sizeof(err)) != 0) {
+    if (hs_poses_load(o->poses, &rp->poses, &rp->n_poses, err, sizeof(err)) != 0) {
         fprintf(stderr, "rfseek-feed: %s\n", err);
         return 1;
     }
@@ -552,6 +505,7 @@ static int rp_open_inputs(replay_t *rp, lx_pcap_reader_t *r, uint8_t (*macs)[6],
 static int rp_open_outputs(replay_t *rp)
 {
     snprintf(rp->tmp, sizeof(rp->tmp), "%s.tmp-%ld", rp->o->out, (long)getpid());
+    cleanup_on_signal(rp->tmp, k_rp_files, (int)(sizeof(k_rp_files) / sizeof(k_rp_files[0])));
     if (mkdir(rp->tmp, 0777) != 0) {
         fprintf(stderr, "rfseek-feed: %s: cannot create: %s\n", rp->tmp, strerror(errno));
         return 1;
@@ -590,12 +544,12 @@ static void rp_packet(replay_t *rp, const rp_pkt_t *p, const rp_at_t *at)
 }
 
 /* A recorded pose: to the controller and to track.tsv. */
-static void rp_pose(replay_t *rp, const rp_pose_t *q, int64_t te)
+static void rp_pose(replay_t *rp, const hs_pose_rec_t *q, int64_t te)
 {
-    rfs_pose_t pose = {te, rp_q16(q->x), rp_q16(q->y), rp_q16(rp_wrap(q->theta))};
+    rfs_pose_t pose = {te, rp_q16(q->x), rp_q16(q->y), rp_q16(hs_poses_wrap(q->theta))};
     rp->ctrl.on_pose(rp->ctrl.self, &pose);
     fprintf(rp->ftrk, "%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%.4f\t0\n", te * 1e-6, q->x, q->y,
-            rp_wrap(q->theta), q->x, q->y, rp_wrap(q->theta));
+            hs_poses_wrap(q->theta), q->x, q->y, hs_poses_wrap(q->theta));
 }
 
 /* A control period: the controller's step, its decision counted and logged (the wheel
@@ -643,7 +597,7 @@ static void rp_step(replay_t *rp, const rp_at_t *at)
 static void rp_run(replay_t *rp)
 {
     const hs_scenario_t *sc = &rp->sc;
-    const rp_pose_t *poses = rp->poses;
+    const hs_pose_rec_t *poses = rp->poses;
     const size_t n_poses = rp->n_poses;
     const rp_vec_t *pk = &rp->pk;
     const rp_times_t *hb = &rp->hb;
@@ -682,13 +636,13 @@ static void rp_run(replay_t *rp)
             travelled_at_seg += hypot(poses[seg + 1].x - poses[seg].x, poses[seg + 1].y - poses[seg].y);
             seg++;
         }
-        const rp_pose_t *pa = &poses[seg], *pb = &poses[seg + 1];
+        const hs_pose_rec_t *pa = &poses[seg], *pb = &poses[seg + 1];
         const double a = (double)(te - (pa->t_us - t0)) / (double)(pb->t_us - pa->t_us);
         rp_at_t at;
         at.te = te;
         at.ex = pa->x + a * (pb->x - pa->x);
         at.ey = pa->y + a * (pb->y - pa->y);
-        at.eth = rp_wrap(pa->theta + a * rp_wrap(pb->theta - pa->theta));
+        at.eth = hs_poses_wrap(pa->theta + a * hs_poses_wrap(pb->theta - pa->theta));
         at.etr = travelled_at_seg + a * hypot(pb->x - pa->x, pb->y - pa->y);
         fx = at.ex;
         fy = at.ey;

@@ -35,7 +35,14 @@ static const char k_usage[] =
 
 static const char PROG[] = "rfseek-map"; /* the prefix of its error lines (lx_err_print) */
 
-static int parse_pos(const char *opt, const char *s, double *out)
+/* Option ranges, metres: the core's limits (rfs_map_init: clearance at most 64 m) and
+ * lx_map_to_core's (resolution at most 1000 m); both far inside Q16.16's 32767 m, so the
+ * conversion below cannot wrap. */
+#define MAP_OPT_MAX_M 1000.0
+#define MAP_CLEARANCE_MAX_M 64.0
+
+/* A number of metres in [0, max]; one error line and -1 otherwise. */
+static int parse_pos(const char *opt, const char *s, double max, double *out)
 {
     char *end = NULL;
     errno = 0;
@@ -43,6 +50,10 @@ static int parse_pos(const char *opt, const char *s, double *out)
     if (s == NULL || end == s || *end != '\0' || errno != 0 || !isfinite(v) || v < 0) {
         lx_err_print(PROG, "%s: a non-negative number of metres expected, got '%s'", opt,
                  s != NULL ? s : "(nothing)");
+        return -1;
+    }
+    if (v > max) {
+        lx_err_print(PROG, "%s: %s m out of range (0 .. %g m)", opt, s, max);
         return -1;
     }
     *out = v;
@@ -234,8 +245,9 @@ static int map_main(int argc, char **argv)
                     return 2;
                 }
                 pgm = v;
-            } else if (parse_pos(a, v, strcmp(a, "--res") == 0 ? &res
-                                         : strcmp(a, "--grid") == 0 ? &grid : &clearance) != 0) {
+            } else if (strcmp(a, "--clearance") == 0
+                           ? parse_pos(a, v, MAP_CLEARANCE_MAX_M, &clearance) != 0
+                           : parse_pos(a, v, MAP_OPT_MAX_M, strcmp(a, "--res") == 0 ? &res : &grid) != 0) {
                 return 2;
             }
         } else if (strcmp(a, "--bench") == 0) {

@@ -59,4 +59,53 @@ expect seed_newline 2 "--seed: '1\\?2' is not a non-negative integer" -- "$gen/d
 "$feed" "$gen/bad/cut_record.pcap" --mac $mac --output "$tmp/bad.tsv" 2>/dev/null
 if [ $? -ne 0 ] && [ ! -e "$tmp/bad.tsv" ] && [ ! -e "$tmp/bad.tsv.tmp" ]; then echo "PASS output_on_error: no file written"
 else echo "FAIL output_on_error: a file was left"; fail=1; fi
+# Timestamps at the edges of the formats, printed as tshark prints frame.time_epoch: a
+# classic pcap's seconds are unsigned 32-bit (2^31 and 2^32 - 1), a pcapng's timestamp
+# unsigned 64-bit in units of if_tsresol (9: ns, 2^64 - 1; 0x94: 2^-20 s).
+PYTHONPATH=tests/feed python3 - "$tmp" <<'PY'
+import struct, sys
+import pcap_build
+d = sys.argv[1]
+mac = bytes.fromhex("02aabbcc0001")
+pcap_build.write(d + "/ts_2e31.pcap", [pcap_build.record(2**31 * 10**6, mac, 1, -40),
+                                       pcap_build.record((2**32 - 1) * 10**6 + 999999, mac, 2, -41)])
+frame = pcap_build.record(0, mac, 3, -42)[16:]
+def block(kind, body):
+    body += b"\0" * (-len(body) % 4)
+    return struct.pack("<II", kind, len(body) + 12) + body + struct.pack("<I", len(body) + 12)
+def pcapng(path, tsresol, ts):
+    shb = block(0x0A0D0D0A, struct.pack("<IHHq", 0x1A2B3C4D, 1, 0, -1))
+    opt = struct.pack("<HHB3x", 9, 1, tsresol) + struct.pack("<HH", 0, 0)
+    idb = block(1, struct.pack("<HHI", 127, 0, 65535) + opt)
+    epb = block(6, struct.pack("<IIIII", 0, ts >> 32, ts & 0xFFFFFFFF, len(frame), len(frame)) + frame)
+    open(path, "wb").write(shb + idb + epb)
+pcap_build.write(d + "/frac_2e31.pcap", [struct.pack("<IIII", 5, 2**31, len(frame), len(frame)) + frame])
+pcap_build.write(d + "/frac_1s.pcap", [struct.pack("<IIII", 5, 10**6, len(frame), len(frame)) + frame])
+pcapng(d + "/ts_res9_max.pcapng", 9, 2**64 - 1)
+pcapng(d + "/ts_res2_20.pcapng", 0x94, (1700000000 << 20) + 524288 + 3)
+PY
+# expect_lines NAME FILE LINE...: rfseek-feed prints exactly these lines, without a
+# sanitizer report; and tshark's frame.time_epoch agrees when tshark is installed.
+expect_lines() {
+    local name=$1 file=$2; shift 2
+    local want; want=$(printf '%s\n' "$@")
+    "$feed" "$file" --mac $mac >"$tmp/out" 2>"$tmp/err"
+    local rc=$?
+    if [ $rc -ne 0 ] || grep -qE 'Sanitizer|runtime error' "$tmp/err"; then
+        echo "FAIL $name: exit $rc: $(head -3 "$tmp/err")"; fail=1
+    elif [ "$(cat "$tmp/out")" != "$want" ]; then
+        echo "FAIL $name: printed '$(cat "$tmp/out")', want '$want'"; fail=1
+    elif command -v tshark >/dev/null && [ "$(tshark -r "$file" -T fields -e frame.time_epoch 2>/dev/null)" != "$(printf '%s\n' "$@" | cut -f1)" ]; then
+        echo "FAIL $name: tshark reads $(tshark -r "$file" -T fields -e frame.time_epoch 2>&1 | tr '\n' ' ')"; fail=1
+    else
+        echo "PASS $name: $(tr '\n' ' ' <"$tmp/out")"
+    fi
+}
+expect_lines ts_pcap_2e31 "$tmp/ts_2e31.pcap" $'2147483648.000000000\t02:aa:bb:cc:00:01\t-40' \
+    $'4294967295.999999000\t02:aa:bb:cc:00:01\t-41'
+expect_lines ts_pcapng_res9_max "$tmp/ts_res9_max.pcapng" $'18446744073.709551615\t02:aa:bb:cc:00:01\t-42'
+expect_lines ts_pcapng_res2_20 "$tmp/ts_res2_20.pcapng" $'1700000000.500002861\t02:aa:bb:cc:00:01\t-42'
+# a classic record's fraction field of one second or more is damage, not time
+expect frac_2e31 1 "frac_2e31.pcap: damaged record: timestamp fraction not below one second \(after 0 packets\)" -- "$tmp/frac_2e31.pcap" --mac $mac
+expect frac_1s 1 "frac_1s.pcap: damaged record: timestamp fraction not below one second \(after 0 packets\)" -- "$tmp/frac_1s.pcap" --mac $mac
 exit $fail

@@ -15,9 +15,11 @@ usage: replay_test.py FEED
 import json
 import math
 import os
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
@@ -142,6 +144,14 @@ def main():
     bad("number", "t_us,x_m,y_m,theta_rad\n%d,8,abc,0\n" % T0, 1, "number.csv:2: y_m: not a finite number")
     bad("nan", "t_us,x_m,y_m,theta_rad\n%d,8,6,nan\n" % T0, 1, "nan.csv:2: theta_rad: not a finite number")
     bad("short", "t_us,x_m,y_m,theta_rad\n%d,8,6,0\n" % T0, 1, "short.csv: fewer than 2 poses")
+    # times and positions outside what the replay can compute with (int64 differences,
+    # Q16.16 metres): refused by range, not overflowed
+    bad("t_min", "t_us,x_m,y_m,theta_rad\n-9223372036854775808,8,6,0\n%d,9,6,0\n" % T0, 1,
+        "t_min.csv:2: t_us: -9223372036854775808 out of range (0 .. 9007199254740992 microseconds since the epoch)")
+    bad("t_max", "t_us,x_m,y_m,theta_rad\n%d,8,6,0\n9223372036854775807,9,6,0\n" % T0, 1,
+        "t_max.csv:3: t_us: 9223372036854775807 out of range (0 .. 9007199254740992")
+    bad("x_range", "t_us,x_m,y_m,theta_rad\n%d,1e300,6,0\n" % T0, 1,
+        "x_range.csv:2: x_m: 1e+300 out of range (-32767 .. 32767 m)")
     bad("macs", good, 2, "--mac: 2 addresses given", ["--mac", "02:00:00:00:00:01", "--mac", "02:00:00:00:00:02"])
     bad("seed", good, 2, "--seed: '-1' is not a non-negative integer", ["--seed", "-1"])
     q = subprocess.run([FEED, cap, "--pose", "x.csv"], capture_output=True, text=True)
@@ -149,6 +159,45 @@ def main():
           q.stderr)
     q = subprocess.run([FEED, cap, "--mac", "02:00:00:00:00:01", "--out", "x"], capture_output=True, text=True)
     check("--out without --pose", q.returncode == 2 and "only go with --pose" in q.stderr, q.stderr)
+    # A heading of 1e9 rad is wrapped at once (it looped ~1.6e8 times): the track holds
+    # the IEEE remainder by 2 pi, computed here by Python's math.
+    spin = os.path.join(tmp, "spin.csv")
+    with open(spin, "w") as f:
+        f.write("t_us,x_m,y_m,theta_rad\n%d,8,6,1e9\n%d,9,6,-1e9\n" % (T0, T0 + 1000000))
+    try:
+        q = subprocess.run([FEED, cap, "--pose", spin, "--scenario", SCEN, "--out", os.path.join(tmp, "spin")],
+                           capture_output=True, text=True, timeout=20)
+        trk = [l.split("\t") for l in open(os.path.join(tmp, "spin", "track.tsv")).read().splitlines()]
+        want = ["%.4f" % math.remainder(1e9, 2 * math.pi), "%.4f" % math.remainder(-1e9, 2 * math.pi)]
+        check("theta 1e9: wrapped in the track, exit 0", q.returncode == 0 and [r[3] for r in trk[1:]] == want,
+              "%d %s %s" % (q.returncode, q.stderr.strip(), trk[1:]))
+    except (subprocess.TimeoutExpired, OSError) as e:
+        check("theta 1e9: wrapped in the track, exit 0", False, str(e))
+
+    # SIGTERM or SIGINT during the replay: the process dies of it and leaves no DIR.tmp-PID.
+    # The run (an hour of poses) is stopped the moment its temporary directory appears.
+    long_poses = os.path.join(tmp, "long.csv")
+    with open(long_poses, "w") as f:
+        f.write("t_us,x_m,y_m,theta_rad\n")
+        f.writelines("%d,%.2f,6,0\n" % (T0 + k * 100000, 8 + (k % 100) * 0.01) for k in range(36001))
+    long_cap = os.path.join(tmp, "long.pcap")
+    pcap_build.write(long_cap, [pcap_build.record(T0 + k * 20000, SRC_MAC, k, -70) for k in range(180000)])
+    for sig in (signal.SIGTERM, signal.SIGINT):
+        out = os.path.join(tmp, "killed")
+        q = subprocess.Popen([FEED, long_cap, "--pose", long_poses, "--scenario", SCEN, "--out", out],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        tmpdir = "%s.tmp-%d" % (out, q.pid)
+        deadline = time.monotonic() + 30
+        while not os.path.isdir(tmpdir) and q.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.0005)
+        seen = os.path.isdir(tmpdir)
+        q.send_signal(signal.SIGSTOP)  # hold it mid-run, then stop it for good
+        q.send_signal(sig)
+        q.send_signal(signal.SIGCONT)
+        rc = q.wait()
+        left = [n for n in os.listdir(tmp) if n.startswith("killed")]
+        check("%s mid-replay: killed by it, nothing left" % sig.name, seen and rc == -sig and not left,
+              "seen %s, exit %d, left %s" % (seen, rc, left))
     if os.environ.get("KEEP") is None:
         subprocess.run(["rm", "-rf", tmp])
     else:

@@ -7,7 +7,7 @@
  * a file of the machine); the seeds say `image: m.pgm`.
  *
  * Beyond ASan/UBSan it checks the header's promises: failure gives one non-empty error
- * line and leaves nothing allocated (LeakSanitizer); success gives 1..2^28 cells, each
+ * line and leaves nothing allocated (LeakSanitizer); success gives 1..2^26 cells, each
  * LX_CELL_*, a positive resolution, thresholds in [0, 1] with free < occupied, negate
  * 0/1, and counts that add up; conversion to the core either fails with one line or
  * yields a grid covering the image (up to the documented sliver).
@@ -53,7 +53,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     }
     const uint64_t n = (uint64_t)m.w * m.h;
-    if (n == 0 || n > (1ull << 28) || m.cell == NULL || !(m.res > 0.0) || !isfinite(m.res) ||
+    if (n == 0 || n > (1ull << 26) || m.cell == NULL || !(m.res > 0.0) || !isfinite(m.res) ||
         !isfinite(m.origin_x) || !isfinite(m.origin_y) || !(m.free_th < m.occ_th) || m.free_th < 0.0 ||
         m.occ_th > 1.0 || (m.negate != 0 && m.negate != 1)) {
         abort();

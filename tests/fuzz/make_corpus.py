@@ -9,6 +9,9 @@ convention, docs/SIMULATOR.md, the LCM wire format), not by the code under test:
              receiver heartbeats
   map/       YAML + "#PGM\\n" + PGM: tests/data/maps_bad fixtures and small P2/P5 images
   scenario/  the scenarios/*.yaml files and a few hand-written edge cases
+  pcap/      classic pcap (us and ns magic, both byte orders) and pcapng (if_tsresol 6, 9,
+             2^-20) radiotap captures, timestamps at the formats' edges (libpcap's formats)
+  poses/     the pose CSV of rfseek-feed --pose (docs/FEEDER.md): good files and edge values
   lcm/       one message per channel, the receiver heartbeat included (LCM encoding: 8-byte fingerprint, big-endian fields;
              fingerprints computed with lcm-gen's hash) and small LCM logs
 """
@@ -186,3 +189,49 @@ names = ["RFS_POSE", "RFS_RSSI", "RFS_CLOCK", "RFS_WHEEL_CMD", "RFS_SEEKER_STATU
 log = b"".join(log_event(i, 1_000_000 + i, names[sel], m) for i, (sel, m) in enumerate(msgs.items()))
 put("lcm", "log_all", b"\x80" + log)
 put("lcm", "log_unknown_channel", b"\x80" + log_event(0, 5, "OTHER", b"abc") + log_event(1, 6, "RFS_POSE", b"x"))
+
+
+# --- pcap / pcapng: radiotap (dBm signal only) + an 802.11 data frame ------------------------
+FRAME = (struct.pack("<BBHI", 0, 0, 9, 0x20) + struct.pack("<b", -40) + bytes([0x08, 0x01, 0, 0]) +
+         bytes.fromhex("0a1b2c3d4e5f" "02aabbcc0001" "0a1b2c3d4e5f") + struct.pack("<H", 1 << 4))
+
+
+def classic(magic, end, records):
+    head = struct.pack(end + "IHHiIII", magic, 2, 4, 0, 0, 65535, 127)
+    return head + b"".join(struct.pack(end + "IIII", sec, frac, len(FRAME), len(FRAME)) + FRAME
+                           for sec, frac in records)
+
+
+put("pcap", "classic_us", classic(0xA1B2C3D4, "<", [(1700000000, 1), (1700000000, 999999)]))
+put("pcap", "classic_ns_be", classic(0xA1B23C4D, ">", [(1700000000, 999999999)]))
+put("pcap", "classic_2e31", classic(0xA1B2C3D4, "<", [(2**31, 0), (2**32 - 1, 999999)]))
+# fractions of a second or more: 2^31 us and up reads negative in libpcap (found by fuzz_pcap)
+put("pcap", "classic_frac_big", classic(0xA1B2C3D4, "<", [(0x21210001, 0xB90D0D21), (5, 1000000)]))
+put("pcap", "classic_cut", classic(0xA1B2C3D4, "<", [(1, 2)])[:-5])
+
+
+def block(kind, body):
+    body += b"\0" * (-len(body) % 4)
+    return struct.pack("<II", kind, len(body) + 12) + body + struct.pack("<I", len(body) + 12)
+
+
+def pcapng(tsresol, stamps):
+    shb = block(0x0A0D0D0A, struct.pack("<IHHq", 0x1A2B3C4D, 1, 0, -1))
+    idb = block(1, struct.pack("<HHI", 127, 0, 65535) + struct.pack("<HHB3x", 9, 1, tsresol) + b"\0" * 4)
+    return shb + idb + b"".join(block(6, struct.pack("<IIIII", 0, t >> 32, t & 0xFFFFFFFF, len(FRAME), len(FRAME))
+                                      + FRAME) for t in stamps)
+
+
+put("pcap", "ng_res6", pcapng(6, [1700000000000001, 1700000000999999]))
+put("pcap", "ng_res9_max", pcapng(9, [2**64 - 1, 0]))
+put("pcap", "ng_res0_max", pcapng(0, [2**64 - 1]))
+put("pcap", "ng_res2_20", pcapng(0x94, [(1700000000 << 20) + 3, 2**64 - 1]))
+put("pcap", "ng_res2_63", pcapng(0xBF, [2**64 - 1]))
+
+# --- poses: t_us,x_m,y_m,theta_rad -----------------------------------------------------------
+HDR = b"t_us,x_m,y_m,theta_rad\n"
+put("poses", "good", HDR + b"1700000000000000,8,6,0\n1700000000100000,8.05,6,0.01\n1700000000200000,8.1,6,-3.14\n")
+put("poses", "crlf_blank", HDR.replace(b"\n", b"\r\n") + b"0,0,0,0\r\n\r\n1,1e-3,-2,6.3\r\n")
+put("poses", "theta_big", HDR + b"0,1,1,1e9\n1,1,1,-1e300\n2,1,1,201.0619298297468\n")
+put("poses", "t_edges", HDR + b"-9223372036854775808,0,0,0\n9007199254740992,0,0,0\n")
+put("poses", "xy_edges", HDR + b"0,32767,-32767,0\n1,32767.0001,0,0\n")

@@ -57,5 +57,15 @@ one_err newline-bench 2 "--bench: a count 1..1000000 expected, got '5?6'" \
 one_err newline-option 2 "--x?y: unknown option" "$bad/ok.yaml" $'--x\ny' --pgm "$tmp/nl.pgm"
 one_err newline-second-map 2 "a?b: only one map expected" "$bad/ok.yaml" $'a\nb' --pgm "$tmp/nl.pgm"
 one_err newline-map-name 1 "nl?map.yaml" "$tmp/"$'nl\nmap.yaml' --pgm "$tmp/nl.pgm"
+# A resolution outside 1 mm .. 10 m: one line at once (1e-10 hung in the resampling).
+one_err res-tiny 1 "res_tiny.yaml: resolution: 1e-10 m out of range (0.001 .. 10 m per pixel)" \
+    "$bad/res_tiny.yaml" --pgm "$tmp/nl.pgm"
+# Options that would wrap in Q16.16 (65536.25 m reads as 0.25 m) are refused by range.
+one_err clearance-range 2 "--clearance: 65536.25 m out of range (0 .. 64 m)" \
+    "$bad/ok.yaml" --clearance 65536.25 --pgm "$tmp/nl.pgm"
+one_err grid-range 2 "--grid: 65536.25 m out of range (0 .. 1000 m)" \
+    "$bad/ok.yaml" --grid 65536.25 --pgm "$tmp/nl.pgm"
+one_err res-range 2 "--res: 1e300 m out of range (0 .. 1000 m)" \
+    "$bad/ok.yaml" --res 1e300 --pgm "$tmp/nl.pgm"
 one_err newline-pgm 1 "nl/a?b.pgm.tmp: cannot create" "$bad/ok.yaml" --pgm "$tmp/nl/a"$'\n'"b.pgm"
 [ $fails = 0 ]

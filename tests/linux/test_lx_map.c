@@ -13,6 +13,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "lx_map.h"
@@ -152,6 +154,10 @@ static void test_bad_input(void **state)
         {BAD "res_zero.yaml", BAD "res_zero.yaml", "resolution: must be > 0"},
         {BAD "res_negative.yaml", BAD "res_negative.yaml", "resolution: must be > 0"},
         {BAD "res_text.yaml", BAD "res_text.yaml", "resolution: a number expected"},
+        /* outside 1 mm .. 10 m: the resampling would loop over billions of fine cells */
+        {BAD "res_tiny.yaml", BAD "res_tiny.yaml", "resolution: 1e-10 m out of range (0.001 .. 10 m per pixel)"},
+        {BAD "res_denormal.yaml", BAD "res_denormal.yaml", "resolution: 1e-300 m out of range"},
+        {BAD "res_huge.yaml", BAD "res_huge.yaml", "resolution: 11 m out of range"},
         {BAD "thresh_order.yaml", BAD "thresh_order.yaml", "out of order"},
         {BAD "thresh_range.yaml", BAD "thresh_range.yaml", "[0, 1]"},
         {BAD "mode_scale.yaml", BAD "mode_scale.yaml", "mode: 'scale' not supported"},
@@ -307,7 +313,136 @@ static void test_core_rejects(void **state)
     assert_int_equal(lx_map_to_core(&m, 0.0005, NULL, &c, err, sizeof(err)), -1);
     assert_non_null(strstr(err, "does not fit"));
     assert_null(c.free_bits);
+    /* A map built in memory with a resolution no YAML may give: refused, not resampled. */
+    m.res = 1e-10;
+    assert_int_equal(lx_map_to_core(&m, 0.1, NULL, &c, err, sizeof(err)), -1);
+    assert_string_equal(err, "map: resolution 1e-10 m out of range (0.001 .. 10 m per pixel)");
+    assert_null(c.free_bits);
     lx_map_free(&m);
+}
+
+/* `levels` nested flow sequences as the value of "image:" in dir/deep.yaml. */
+static void write_deep(const char *path, long levels)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("image: ", f);
+    for (long i = 0; i < levels; i++) {
+        fputc('[', f);
+    }
+    for (long i = 0; i < levels; i++) {
+        fputc(']', f);
+    }
+    fputs("\nresolution: 0.05\n", f);
+    assert_int_equal(fclose(f), 0);
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* Nesting deeper than LX_YAML_MAX_DEPTH: refused at once with one line, through the map
+ * loader (lx_yaml_load_string) and from a stream (lx_yaml_load_file, the scenario's);
+ * libyaml took 3.8 s to compose 40,000 levels, over a minute for 100,000. 64 levels pass
+ * the depth check (and fail later as a map, on the image). */
+static void test_yaml_depth(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/rfs_lx_yaml_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char yp[256];
+    char want[512];
+    char err[512] = "";
+    snprintf(yp, sizeof(yp), "%s/deep.yaml", dir);
+    snprintf(want, sizeof(want), "%s: malformed YAML at line 1: nesting deeper than 64 levels", yp);
+    const long levels[] = {40000, 100000, 65};
+    for (size_t k = 0; k < 3; k++) {
+        write_deep(yp, levels[k]);
+        lx_map_t m;
+        double t0 = now_s();
+        assert_int_equal(lx_map_load(yp, &m, err, sizeof(err)), -1);
+        assert_string_equal(err, want);
+        FILE *f = fopen(yp, "rb");
+        assert_non_null(f);
+        lx_yaml_doc_t doc;
+        lx_yaml_error_t ye;
+        assert_int_equal(lx_yaml_load_file(f, &doc, &ye), LX_YAML_SYNTAX);
+        fclose(f);
+        lx_yaml_free(&doc);
+        assert_int_equal(ye.line, 1);
+        assert_string_equal(ye.problem, "nesting deeper than 64 levels");
+        assert_true(now_s() - t0 < 0.5);
+    }
+    write_deep(yp, 63); /* with the root mapping: 64 levels */
+    lx_map_t m;
+    assert_int_equal(lx_map_load(yp, &m, err, sizeof(err)), -1);
+    snprintf(want, sizeof(want), "%s: image: a file name expected", yp);
+    assert_string_equal(err, want);
+    remove(yp);
+    rmdir(dir);
+}
+
+static long max_rss_kb(void)
+{
+    struct rusage ru;
+    assert_int_equal(getrusage(RUSAGE_SELF, &ru), 0);
+    return ru.ru_maxrss;
+}
+
+/* Writes a map YAML naming `image` into dir/m.yaml; returns its path in yp. */
+static void write_yaml(const char *dir, const char *image, char *yp, size_t n)
+{
+    snprintf(yp, n, "%s/m.yaml", dir);
+    FILE *f = fopen(yp, "w");
+    assert_non_null(f);
+    fprintf(f, "image: %s\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
+            "occupied_thresh: 0.65\nfree_thresh: 0.196\n", image);
+    assert_int_equal(fclose(f), 0);
+}
+
+/* An endless image (/dev/zero) and a 3 GB sparse PGM whose header says 100 x 80: only
+ * what the header declares is read, then one byte proves data after it; the process grows
+ * by far less than 100 MB (reading either whole took gigabytes). */
+static void test_image_bounded(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/rfs_lx_map_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char yp[256];
+    char ip[256];
+    char err[512] = "";
+    lx_map_t m;
+    long rss0 = max_rss_kb();
+
+    write_yaml(dir, "/dev/zero", yp, sizeof(yp));
+    assert_int_equal(lx_map_load(yp, &m, err, sizeof(err)), -1);
+    assert_string_equal(err, "/dev/zero: not a PGM image (magic P5 or P2 expected)");
+
+    snprintf(ip, sizeof(ip), "%s/sparse.pgm", dir);
+    FILE *f = fopen(ip, "w");
+    assert_non_null(f);
+    fputs("P5\n100 80\n255\n", f);
+    assert_int_equal(fclose(f), 0);
+    assert_int_equal(truncate(ip, 3LL << 30), 0);
+    write_yaml(dir, "sparse.pgm", yp, sizeof(yp));
+    assert_int_equal(lx_map_load(yp, &m, err, sizeof(err)), -1);
+    char want[512];
+    /* header 14 bytes + 8000 raster bytes: the first byte after them is at offset 8014 */
+    snprintf(want, sizeof(want), "%s: data after the 100 x 80 raster the header declares (at byte 8014)", ip);
+    assert_string_equal(err, want);
+    assert_null(m.cell);
+
+    /* The YAML itself: /dev/zero as the map file is cut off at 1 MB. */
+    assert_int_equal(lx_map_load("/dev/zero", &m, err, sizeof(err)), -1);
+    assert_string_equal(err, "/dev/zero: larger than 1048576 bytes (a map_server YAML is a few lines)");
+
+    assert_true(max_rss_kb() - rss0 < 100 * 1024);
+    remove(ip);
+    remove(yp);
+    rmdir(dir);
 }
 
 int main(void)
@@ -320,6 +455,8 @@ int main(void)
         cmocka_unit_test(test_core_same_resolution),
         cmocka_unit_test(test_core_conservative),
         cmocka_unit_test(test_core_rejects),
+        cmocka_unit_test(test_image_bounded),
+        cmocka_unit_test(test_yaml_depth),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -15,8 +15,12 @@
 #include "lx_err.h"
 #include "lx_yaml.h"
 
-/* Largest image accepted: 2^28 pixels (16384 x 16384). */
-#define LX_MAP_MAX_PIXELS (1u << 28)
+/* Largest image accepted: 2^26 pixels (8192 x 8192), one byte each once classified, so a
+ * map input costs at most 64 MB here plus the core's bit grids (lx_map_to_core: three of
+ * at most 8 MB): under 100 MB whatever the file (docs/RELIABILITY.md). */
+#define LX_MAP_MAX_PIXELS (1u << 26)
+/* Largest YAML accepted: a map_server YAML is a few lines. */
+#define LX_MAP_MAX_YAML (1u << 20)
 
 static int fail(char *err, size_t errlen, const char *file, const char *fmt, ...)
 {
@@ -32,38 +36,24 @@ static int fail(char *err, size_t errlen, const char *file, const char *fmt, ...
     return -1;
 }
 
-static int read_file(const char *path, uint8_t **buf, size_t *len, char *err, size_t errlen)
+/* Read at most `max` bytes of `path` (a stream such as /dev/zero is cut off there). */
+static int read_file(const char *path, size_t max, uint8_t **buf, size_t *len, char *err, size_t errlen)
 {
     FILE *f = fopen(path, "rb");
     if (f == NULL) {
         return fail(err, errlen, path, "cannot open: %s", strerror(errno));
     }
-    size_t cap = 1 << 16;
-    size_t n = 0;
-    uint8_t *b = malloc(cap);
-    while (b != NULL) {
-        size_t got = fread(b + n, 1, cap - n, f);
-        n += got;
-        if (n < cap) {
-            break;
-        }
-        uint8_t *nb = realloc(b, cap * 2);
-        if (nb == NULL) {
-            free(b);
-            b = NULL;
-            break;
-        }
-        b = nb;
-        cap *= 2;
-    }
+    uint8_t *b = malloc(max + 1);
+    size_t n = b != NULL ? fread(b, 1, max + 1, f) : 0;
     int bad = ferror(f);
     fclose(f);
     if (b == NULL) {
         return fail(err, errlen, path, "out of memory");
     }
-    if (bad) {
+    if (bad || n > max) {
         free(b);
-        return fail(err, errlen, path, "read error");
+        return bad ? fail(err, errlen, path, "read error")
+                   : fail(err, errlen, path, "larger than %zu bytes (a map_server YAML is a few lines)", max);
     }
     *buf = b;
     *len = n;
@@ -72,17 +62,37 @@ static int read_file(const char *path, uint8_t **buf, size_t *len, char *err, si
 
 /* --- PGM (P5 binary, P2 ASCII) --------------------------------------------------------- */
 
-/* Skip whitespace and '#' comments in a PGM header. */
-static void pgm_skip(const uint8_t *b, size_t n, size_t *pos)
+/* The image is read as a stream, one byte of look-ahead: never more than the header
+ * declares, so a huge or endless file (/dev/zero, a sparse file) costs no memory. */
+typedef struct pgm_in {
+    FILE *f;
+    int c;        /* the next byte, or EOF */
+    uint64_t pos; /* bytes consumed before c */
+} pgm_in_t;
+
+static void pgm_next(pgm_in_t *in)
 {
-    while (*pos < n) {
-        uint8_t c = b[*pos];
-        if (c == '#') {
-            while (*pos < n && b[*pos] != '\n' && b[*pos] != '\r') {
-                (*pos)++;
+    if (in->c != EOF) {
+        in->pos++;
+    }
+    in->c = getc(in->f);
+}
+
+static bool pgm_space(int c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
+}
+
+/* Skip whitespace and '#' comments in a PGM header. */
+static void pgm_skip(pgm_in_t *in)
+{
+    while (in->c != EOF) {
+        if (in->c == '#') {
+            while (in->c != EOF && in->c != '\n' && in->c != '\r') {
+                pgm_next(in);
             }
-        } else if (c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f') {
-            (*pos)++;
+        } else if (pgm_space(in->c)) {
+            pgm_next(in);
         } else {
             break;
         }
@@ -90,100 +100,145 @@ static void pgm_skip(const uint8_t *b, size_t n, size_t *pos)
 }
 
 /* A decimal unsigned integer; -1 when absent or above max. */
-static long pgm_uint(const uint8_t *b, size_t n, size_t *pos, long max)
+static long pgm_uint(pgm_in_t *in, long max)
 {
-    pgm_skip(b, n, pos);
-    if (*pos >= n || b[*pos] < '0' || b[*pos] > '9') {
+    pgm_skip(in);
+    if (in->c < '0' || in->c > '9') {
         return -1;
     }
     long v = 0;
-    while (*pos < n && b[*pos] >= '0' && b[*pos] <= '9') {
-        v = v * 10 + (b[*pos] - '0');
+    while (in->c >= '0' && in->c <= '9') {
+        v = v * 10 + (in->c - '0');
         if (v > max) {
             return -1;
         }
-        (*pos)++;
+        pgm_next(in);
     }
     return v;
 }
 
-/* Decode a PGM into a top-row-first array of values, with maxval. */
-static int pgm_decode(const char *path, const uint8_t *b, size_t n, uint32_t *w, uint32_t *h,
-                      uint32_t *maxval, uint16_t **pix, char *err, size_t errlen)
+/* Classification of one pixel value v (maxval M), lx_map.h's convention. */
+typedef struct pgm_class {
+    double maxval, occ, free_th;
+    int negate;
+} pgm_class_t;
+
+static uint8_t pgm_cell(const pgm_class_t *k, uint32_t v)
 {
-    if (n < 2 || b[0] != 'P' || (b[1] != '5' && b[1] != '2')) {
-        return fail(err, errlen, path, "not a PGM image (magic P5 or P2 expected)");
-    }
-    bool ascii = b[1] == '2';
-    size_t pos = 2;
-    long lw = pgm_uint(b, n, &pos, 1L << 20);
-    long lh = pgm_uint(b, n, &pos, 1L << 20);
-    long lm = pgm_uint(b, n, &pos, 65535);
-    if (lw < 0 || lh < 0 || lm < 0) {
-        return fail(err, errlen, path, "malformed or truncated PGM header (width height maxval)");
-    }
-    if (lw == 0 || lh == 0 || (uint64_t)lw * (uint64_t)lh > LX_MAP_MAX_PIXELS) {
-        return fail(err, errlen, path, "image size %ld x %ld out of range (1..2^28 pixels)", lw, lh);
-    }
-    if (lm == 0) {
-        return fail(err, errlen, path, "maxval 0 in PGM header");
-    }
-    size_t count = (size_t)lw * (size_t)lh;
-    uint16_t *p = malloc(count * sizeof(*p));
-    if (p == NULL) {
+    double d = v;
+    double p = k->negate ? d / k->maxval : (k->maxval - d) / k->maxval;
+    return p > k->occ ? LX_CELL_OCC : (p < k->free_th ? LX_CELL_FREE : LX_CELL_UNKNOWN);
+}
+
+/* The raster of a P5 image, row by row, into cells (row 0 = bottom). */
+static int pgm_raster_p5(const char *path, pgm_in_t *in, const pgm_class_t *k, uint32_t w, uint32_t h,
+                         uint32_t lm, uint8_t *cell, char *err, size_t errlen)
+{
+    size_t bpp = lm > 255 ? 2 : 1;
+    uint8_t *row = malloc((size_t)w * bpp);
+    if (row == NULL) {
         return fail(err, errlen, path, "out of memory");
     }
-    if (ascii) {
-        for (size_t i = 0; i < count; i++) {
-            long v = pgm_uint(b, n, &pos, lm);
-            if (v < 0) {
-                free(p);
-                pgm_skip(b, n, &pos);
-                if (pos >= n) {
-                    return fail(err, errlen, path, "truncated: %zu of %zu pixels (header says %ld x %ld)",
-                                i, count, lw, lh);
-                }
-                return fail(err, errlen, path, "bad pixel value at pixel %zu (0..%ld expected)", i, lm);
+    for (uint32_t r = 0; r < h; r++) {
+        size_t got = fread(row, bpp, w, in->f);
+        if (got < w) {
+            free(row);
+            return fail(err, errlen, path, "truncated: %zu raster bytes, header says %u x %u needs %zu",
+                        ((size_t)r * w + got) * bpp, w, h, (size_t)w * h * bpp);
+        }
+        uint8_t *dst = cell + (size_t)(h - 1 - r) * w; /* PGM row 0 is the top; ours the bottom */
+        for (uint32_t x = 0; x < w; x++) {
+            uint32_t v = bpp == 2 ? ((uint32_t)row[2 * x] << 8 | row[2 * x + 1]) : row[x];
+            if (v > lm) {
+                free(row);
+                return fail(err, errlen, path, "pixel %zu value %u above maxval %u", (size_t)r * w + x, v, lm);
             }
-            p[i] = (uint16_t)v;
+            dst[x] = pgm_cell(k, v);
         }
-        pgm_skip(b, n, &pos);
-        if (pos != n) {
-            free(p);
-            return fail(err, errlen, path, "data after the %ld x %ld pixels the header declares", lw, lh);
+    }
+    free(row);
+    in->pos += 1 + (uint64_t)w * h * bpp; /* the whitespace byte held in c, then the raster */
+    in->c = getc(in->f);
+    return 0;
+}
+
+/* The raster of a P2 image, value by value, into cells (row 0 = bottom). */
+static int pgm_raster_p2(const char *path, pgm_in_t *in, const pgm_class_t *k, uint32_t w, uint32_t h,
+                         uint32_t lm, uint8_t *cell, char *err, size_t errlen)
+{
+    size_t count = (size_t)w * h;
+    for (size_t i = 0; i < count; i++) {
+        long v = pgm_uint(in, (long)lm);
+        if (v < 0) {
+            pgm_skip(in);
+            if (in->c == EOF) {
+                return fail(err, errlen, path, "truncated: %zu of %zu pixels (header says %u x %u)", i, count, w, h);
+            }
+            return fail(err, errlen, path, "bad pixel value at pixel %zu (0..%u expected)", i, lm);
         }
+        cell[(size_t)(h - 1 - i / w) * w + i % w] = pgm_cell(k, (uint32_t)v);
+    }
+    pgm_skip(in);
+    return 0;
+}
+
+/* Read a PGM of at most LX_MAP_MAX_PIXELS into w * h classified cells, reading only what
+ * its header declares and then one byte to refuse data after it. */
+static int pgm_load(const char *path, const pgm_class_t *k0, uint32_t *w, uint32_t *h, uint8_t **cells,
+                    char *err, size_t errlen)
+{
+    pgm_in_t in = {fopen(path, "rb"), EOF, 0};
+    if (in.f == NULL) {
+        return fail(err, errlen, path, "cannot open: %s", strerror(errno));
+    }
+    int c0 = getc(in.f);
+    int c1 = getc(in.f);
+    if (c0 != 'P' || (c1 != '5' && c1 != '2')) {
+        int rc = ferror(in.f) ? fail(err, errlen, path, "read error")
+                              : fail(err, errlen, path, "not a PGM image (magic P5 or P2 expected)");
+        fclose(in.f);
+        return rc;
+    }
+    bool ascii = c1 == '2';
+    in.pos = 2;
+    in.c = getc(in.f);
+    long lw = pgm_uint(&in, 1L << 20);
+    long lh = pgm_uint(&in, 1L << 20);
+    long lm = pgm_uint(&in, 65535);
+    int rc = 0;
+    uint8_t *cell = NULL;
+    if (lw < 0 || lh < 0 || lm < 0) {
+        rc = fail(err, errlen, path, "malformed or truncated PGM header (width height maxval)");
+    } else if (lw == 0 || lh == 0 || (uint64_t)lw * (uint64_t)lh > LX_MAP_MAX_PIXELS) {
+        rc = fail(err, errlen, path, "image size %ld x %ld out of range (1..2^26 pixels)", lw, lh);
+    } else if (lm == 0) {
+        rc = fail(err, errlen, path, "maxval 0 in PGM header");
+    } else if (!ascii && !(in.c == ' ' || in.c == '\t' || in.c == '\n' || in.c == '\r')) {
+        /* P5: exactly one whitespace byte after maxval (already read as in.c), then the raster. */
+        rc = fail(err, errlen, path, "malformed or truncated PGM header (no raster)");
+    } else if ((cell = malloc((size_t)lw * (size_t)lh)) == NULL) {
+        rc = fail(err, errlen, path, "out of memory");
     } else {
-        /* Exactly one whitespace byte after maxval, then the raster. */
-        if (pos >= n || !(b[pos] == ' ' || b[pos] == '\t' || b[pos] == '\n' || b[pos] == '\r')) {
-            free(p);
-            return fail(err, errlen, path, "malformed or truncated PGM header (no raster)");
+        pgm_class_t k = *k0;
+        k.maxval = (double)lm;
+        rc = ascii ? pgm_raster_p2(path, &in, &k, (uint32_t)lw, (uint32_t)lh, (uint32_t)lm, cell, err, errlen)
+                   : pgm_raster_p5(path, &in, &k, (uint32_t)lw, (uint32_t)lh, (uint32_t)lm, cell, err, errlen);
+        if (rc == 0 && in.c != EOF) {
+            rc = fail(err, errlen, path, "data after the %ld x %ld %s the header declares (at byte %llu)", lw, lh,
+                      ascii ? "pixels" : "raster", (unsigned long long)in.pos);
         }
-        pos++;
-        size_t bpp = lm > 255 ? 2 : 1;
-        size_t need = count * bpp;
-        if (n - pos < need) {
-            free(p);
-            return fail(err, errlen, path, "truncated: %zu raster bytes, header says %ld x %ld needs %zu",
-                        n - pos, lw, lh, need);
-        }
-        if (n - pos > need) {
-            free(p);
-            return fail(err, errlen, path, "%zu bytes after the %ld x %ld raster the header declares",
-                        n - pos - need, lw, lh);
-        }
-        for (size_t i = 0; i < count; i++) {
-            uint32_t v = bpp == 2 ? ((uint32_t)b[pos + 2 * i] << 8 | b[pos + 2 * i + 1]) : b[pos + i];
-            if (v > (uint32_t)lm) {
-                free(p);
-                return fail(err, errlen, path, "pixel %zu value %u above maxval %ld", i, v, lm);
-            }
-            p[i] = (uint16_t)v;
-        }
+    }
+    if (rc == 0 && ferror(in.f)) {
+        rc = fail(err, errlen, path, "read error");
+    }
+    fclose(in.f);
+    if (rc != 0) {
+        free(cell);
+        return -1;
     }
     *w = (uint32_t)lw;
     *h = (uint32_t)lh;
-    *maxval = (uint32_t)lm;
-    *pix = p;
+    *cells = cell;
     return 0;
 }
 
@@ -314,6 +369,9 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
         rc = fail(err, errlen, path, "missing key '%s'", missing);
     } else if (!(f->res > 0)) {
         rc = fail(err, errlen, path, "resolution: must be > 0 (got %g)", f->res);
+    } else if (!(f->res >= LX_MAP_RES_MIN && f->res <= LX_MAP_RES_MAX)) {
+        rc = fail(err, errlen, path, "resolution: %g m out of range (%g .. %g m per pixel)", f->res,
+                  LX_MAP_RES_MIN, LX_MAP_RES_MAX);
     } else if (f->yaw != 0.0) {
         rc = fail(err, errlen, path, "origin: yaw %g unsupported (rotated maps; only 0)", f->yaw);
     } else if (f->occ < 0 || f->occ > 1 || f->free_th < 0 || f->free_th > 1) {
@@ -333,7 +391,7 @@ int lx_map_load(const char *yaml_path, lx_map_t *m, char *err, size_t errlen)
     memset(m, 0, sizeof(*m));
     uint8_t *ybuf = NULL;
     size_t ylen = 0;
-    if (read_file(yaml_path, &ybuf, &ylen, err, errlen) != 0) {
+    if (read_file(yaml_path, LX_MAP_MAX_YAML, &ybuf, &ylen, err, errlen) != 0) {
         return -1;
     }
     yaml_fields_t f;
@@ -351,36 +409,13 @@ int lx_map_load(const char *yaml_path, lx_map_t *m, char *err, size_t errlen)
     } else {
         snprintf(ipath, sizeof(ipath), "%.*s/%s", (int)(slash - yaml_path), yaml_path, f.image);
     }
-    uint8_t *ibuf = NULL;
-    size_t ilen = 0;
-    if (read_file(ipath, &ibuf, &ilen, err, errlen) != 0) {
-        return -1;
-    }
+    pgm_class_t k = {1.0, f.occ, f.free_th, f.negate};
     uint32_t w = 0;
     uint32_t h = 0;
-    uint32_t maxval = 1;
-    uint16_t *pix = NULL;
-    rc = pgm_decode(ipath, ibuf, ilen, &w, &h, &maxval, &pix, err, errlen);
-    free(ibuf);
-    if (rc != 0) {
+    uint8_t *cell = NULL;
+    if (pgm_load(ipath, &k, &w, &h, &cell, err, errlen) != 0) {
         return -1;
     }
-    uint8_t *cell = malloc((size_t)w * h); // NOLINT(clang-analyzer-optin.portability.UnixAPI): pgm_decode gives w, h >= 1
-    if (cell == NULL) {
-        free(pix);
-        return fail(err, errlen, ipath, "out of memory");
-    }
-    for (uint32_t y = 0; y < h; y++) {
-        /* PGM row 0 is the top; ours is the bottom. */
-        const uint16_t *src = pix + (size_t)(h - 1 - y) * w;
-        uint8_t *dst = cell + (size_t)y * w;
-        for (uint32_t x = 0; x < w; x++) {
-            double v = src[x];
-            double p = f.negate ? v / maxval : (maxval - v) / maxval;
-            dst[x] = p > f.occ ? LX_CELL_OCC : (p < f.free_th ? LX_CELL_FREE : LX_CELL_UNKNOWN);
-        }
-    }
-    free(pix);
     m->w = w;
     m->h = h;
     m->res = f.res;
@@ -427,12 +462,24 @@ void lx_map_count(const lx_map_t *m, uint32_t *n_free, uint32_t *n_occ, uint32_t
  * thicken walls by a whole cell. */
 #define LX_MAP_SLIVER 0.1
 
+/* A fine-cell index (floor or ceil already taken) clamped to [-1, n]: every index outside
+ * the image means the same ("beyond it"), and the clamp keeps the conversion to long
+ * defined whatever the origin and resolutions. */
+static long fine_index(double v, uint32_t n)
+{
+    return v < -1.0 ? -1 : (v > (double)n ? (long)n : (long)v);
+}
+
 int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
                    lx_core_map_t *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof(*out));
     if (!(core_res > 0) || !isfinite(core_res) || core_res > 1000.0) {
         return fail(err, errlen, "map", "core resolution %g out of range (0, 1000] m", core_res);
+    }
+    if (!(m->res >= LX_MAP_RES_MIN && m->res <= LX_MAP_RES_MAX)) {
+        return fail(err, errlen, "map", "resolution %g m out of range (%g .. %g m per pixel)", m->res,
+                    LX_MAP_RES_MIN, LX_MAP_RES_MAX);
     }
     rfs_map_cfg_t c = cfg != NULL ? *cfg : rfs_map_cfg_default();
     /* The core's cells use the Q16 resolution and origin; align the resampling to them. */
@@ -477,27 +524,25 @@ int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
         /* Fine rows overlapping [oy + cy*cr, oy + (cy+1)*cr] by more than a sliver. */
         double y0 = (oy + cy * cr - m->origin_y) / m->res;
         double y1 = (oy + (cy + 1) * cr - m->origin_y) / m->res;
-        long fy0 = (long)floor(y0 + LX_MAP_SLIVER);
-        long fy1 = (long)ceil(y1 - LX_MAP_SLIVER) - 1;
+        long fy0 = fine_index(floor(y0 + LX_MAP_SLIVER), m->h);
+        long fy1 = fine_index(ceil(y1 - LX_MAP_SLIVER) - 1, m->h);
         if (fy1 < fy0) {
             fy1 = fy0; /* a core cell inside one fine cell (core finer than the image) */
         }
         for (uint16_t cx = 0; cx < cw; cx++) {
             double x0 = (ox + cx * cr - m->origin_x) / m->res;
             double x1 = (ox + (cx + 1) * cr - m->origin_x) / m->res;
-            long fx0 = (long)floor(x0 + LX_MAP_SLIVER);
-            long fx1 = (long)ceil(x1 - LX_MAP_SLIVER) - 1;
+            long fx0 = fine_index(floor(x0 + LX_MAP_SLIVER), m->w);
+            long fx1 = fine_index(ceil(x1 - LX_MAP_SLIVER) - 1, m->w);
             if (fx1 < fx0) {
                 fx1 = fx0;
             }
-            bool all_free = true;
+            /* Fine cells beyond the image count as unknown: visit only those inside, so
+             * the work is bounded by the image, however coarse the core cell. */
+            bool all_free = fx0 >= 0 && fy0 >= 0 && fx1 < (long)m->w && fy1 < (long)m->h;
             bool any_occ = false;
-            for (long fy = fy0; fy <= fy1; fy++) {
-                for (long fx = fx0; fx <= fx1; fx++) {
-                    if (fx < 0 || fy < 0 || fx >= (long)m->w || fy >= (long)m->h) {
-                        all_free = false;
-                        continue;
-                    }
+            for (long fy = fy0 < 0 ? 0 : fy0; fy <= fy1 && fy < (long)m->h; fy++) {
+                for (long fx = fx0 < 0 ? 0 : fx0; fx <= fx1 && fx < (long)m->w; fx++) {
                     uint8_t s = m->cell[(size_t)fy * m->w + (size_t)fx];
                     all_free = all_free && s == LX_CELL_FREE;
                     any_occ = any_occ || s == LX_CELL_OCC;

@@ -3,7 +3,7 @@
  *
  * The ROS map_server convention, exactly (docs/MAPS.md):
  *   image            path of a PGM (P5 binary or P2 ASCII), relative to the YAML file
- *   resolution       metres per pixel, > 0
+ *   resolution       metres per pixel, LX_MAP_RES_MIN .. LX_MAP_RES_MAX
  *   origin           [x, y, yaw]: the map frame position of the lower-left pixel's
  *                    lower-left corner; yaw must be 0 (rotated maps are not supported)
  *   occupied_thresh  in [0, 1]
@@ -25,6 +25,12 @@
 #include <stdint.h>
 
 #include "rfs_map.h"
+
+/// Finest map resolution accepted, metres per pixel (finer is a typo, and would make the
+/// resampling to the core's cells loop over billions of pixels).
+#define LX_MAP_RES_MIN 0.001
+/// Coarsest map resolution accepted, metres per pixel.
+#define LX_MAP_RES_MAX 10.0
 
 /// Cell states of lx_map_t.cell.
 enum { LX_CELL_FREE = 0, LX_CELL_OCC = 1, LX_CELL_UNKNOWN = 2 };

@@ -12,6 +12,7 @@
 struct lx_pcap_reader {
     pcap_t *p;        /* libpcap handle */
     bool live;        /* a live interface (timeouts are not the end) */
+    bool classic;     /* a classic pcap file: its seconds are unsigned 32-bit */
     char name[256];   /* file or interface, for messages */
 };
 
@@ -61,6 +62,7 @@ lx_pcap_reader_t *lx_pcap_open_offline(const char *path, char *err, size_t errle
         return NULL;
     }
     r->p = p;
+    r->classic = pcap_major_version(p) == 2; /* a pcapng section is version 1 */
     copy_name(r->name, sizeof(r->name), path);
     return r;
 }
@@ -107,11 +109,22 @@ int lx_pcap_next(lx_pcap_reader_t *r, lx_pcap_pkt_t *pkt, char *err, size_t errl
     const u_char *data = NULL;
     const int rc = pcap_next_ex(r->p, &h, &data);
     if (rc == 1) {
-        const int64_t frac = (int64_t)h->ts.tv_usec;
-        const int64_t nano = pcap_get_tstamp_precision(r->p) == PCAP_TSTAMP_PRECISION_NANO ? frac : frac * 1000;
-        pkt->t_ns = (int64_t)h->ts.tv_sec * 1000000000 + nano;
-        /* Floor division keeps pre-1970 times consistent. */
-        pkt->t_us = pkt->t_ns >= 0 ? pkt->t_ns / 1000 : -((-pkt->t_ns + 999) / 1000);
+        /* libpcap sign-extends a classic record's 32-bit seconds into time_t and gives a
+         * pcapng's 64-bit unsigned seconds (its timestamp divided by if_tsresol, decimal or
+         * binary) as time_t too: both are unsigned on the wire, as tshark reads them. */
+        const uint64_t sec = r->classic ? (uint64_t)(uint32_t)h->ts.tv_sec : (uint64_t)h->ts.tv_sec;
+        const int64_t scale = pcap_get_tstamp_precision(r->p) == PCAP_TSTAMP_PRECISION_NANO ? 1 : 1000;
+        /* A classic record's fraction field beyond 1 s (2^31 and up reads negative) is damage. */
+        if (h->ts.tv_usec < 0 || (int64_t)h->ts.tv_usec >= 1000000000 / scale) {
+            snprintf(err, errlen, "%s: damaged record: timestamp fraction not below one second", r->name);
+            return -1;
+        }
+        pkt->ts_sec = sec;
+        pkt->ts_nsec = (uint32_t)((int64_t)h->ts.tv_usec * scale);
+        pkt->t_ns = pkt->ts_sec < (uint64_t)INT64_MAX / 1000000000u
+                        ? (int64_t)(pkt->ts_sec * 1000000000u + pkt->ts_nsec) : INT64_MAX;
+        pkt->t_us = pkt->ts_sec < (uint64_t)INT64_MAX / 1000000u
+                        ? (int64_t)(pkt->ts_sec * 1000000u + pkt->ts_nsec / 1000u) : INT64_MAX;
         pkt->caplen = h->caplen;
         pkt->origlen = h->len;
         pkt->data = data;

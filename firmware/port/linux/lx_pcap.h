@@ -21,8 +21,11 @@ typedef struct lx_pcap_reader lx_pcap_reader_t;
 
 /// One captured packet; `data` stays valid until the next lx_pcap_next() or close.
 typedef struct lx_pcap_pkt {
-    int64_t t_us;         ///< capture time, microseconds since the Unix epoch
-    int64_t t_ns;         ///< the same, nanoseconds (full resolution of a pcapng/ns file)
+    uint64_t ts_sec;      ///< capture time as the file states it: seconds since the Unix epoch
+                          ///< (a classic pcap's are unsigned 32-bit, a pcapng's unsigned 64-bit)
+    uint32_t ts_nsec;     ///< ... and nanoseconds (0..999999999), as tshark's frame.time_epoch
+    int64_t t_us;         ///< the same in microseconds, saturated at INT64_MAX (year 294247)
+    int64_t t_ns;         ///< the same in nanoseconds, saturated at INT64_MAX (year 2262)
     uint32_t caplen;      ///< bytes captured (length of `data`)
     uint32_t origlen;     ///< bytes on the air as the capture header states them
     const uint8_t *data;  ///< captured bytes: radiotap header then the 802.11 frame
@@ -37,7 +40,8 @@ lx_pcap_reader_t *lx_pcap_open_offline(const char *path, char *err, size_t errle
 lx_pcap_reader_t *lx_pcap_open_live(const char *ifname, char *err, size_t errlen);
 
 /// Read the next packet: 1 = a packet in *pkt, 0 = end of file, 2 = live timeout (no
-/// packet yet), -1 = read error (a truncated record, message in `err`).
+/// packet yet), -1 = read error (a truncated record, a timestamp fraction of a second or
+/// more; message in `err`).
 int lx_pcap_next(lx_pcap_reader_t *r, lx_pcap_pkt_t *pkt, char *err, size_t errlen);
 
 /// Close the reader (NULL is fine).

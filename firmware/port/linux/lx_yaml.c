@@ -1,6 +1,7 @@
 /* lx_yaml.c - libyaml behind lx_yaml.h; the only file that includes <yaml.h>. */
 #include "lx_yaml.h"
 
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -90,11 +91,54 @@ static lx_yaml_rc_t load(yaml_parser_t *parser, lx_yaml_doc_t *doc, lx_yaml_erro
     return rc;
 }
 
+/* Walk the first document's events and refuse nesting deeper than LX_YAML_MAX_DEPTH
+ * before libyaml composes it: composing a deep document takes time quadratic in its depth
+ * (40,000 levels: seconds), and the walk stops at the first level too many. */
+static lx_yaml_rc_t check_depth(const uint8_t *buf, size_t len, lx_yaml_error_t *e)
+{
+    yaml_parser_t parser;
+    if (!yaml_parser_initialize(&parser)) {
+        return LX_YAML_NOMEM;
+    }
+    yaml_parser_set_input_string(&parser, buf, len);
+    lx_yaml_rc_t rc = LX_YAML_OK;
+    unsigned depth = 0;
+    bool done = false;
+    while (!done) {
+        yaml_event_t ev;
+        if (!yaml_parser_parse(&parser, &ev)) {
+            e->line = (unsigned long)parser.problem_mark.line + 1;
+            e->problem = parser.problem;
+            rc = LX_YAML_SYNTAX;
+            break;
+        }
+        if (ev.type == YAML_MAPPING_START_EVENT || ev.type == YAML_SEQUENCE_START_EVENT) {
+            if (++depth > LX_YAML_MAX_DEPTH) {
+                e->line = (unsigned long)ev.start_mark.line + 1;
+                e->problem = "nesting deeper than " LX_YAML_STR(LX_YAML_MAX_DEPTH) " levels";
+                rc = LX_YAML_SYNTAX;
+                done = true;
+            }
+        } else if (ev.type == YAML_MAPPING_END_EVENT || ev.type == YAML_SEQUENCE_END_EVENT) {
+            depth--;
+        } else if (ev.type == YAML_DOCUMENT_END_EVENT || ev.type == YAML_STREAM_END_EVENT) {
+            done = true; /* only the first document is loaded */
+        }
+        yaml_event_delete(&ev);
+    }
+    yaml_parser_delete(&parser);
+    return rc;
+}
+
 lx_yaml_rc_t lx_yaml_load_string(const uint8_t *buf, size_t len, lx_yaml_doc_t *doc,
                                  lx_yaml_error_t *e)
 {
     memset(doc, 0, sizeof(*doc));
     memset(e, 0, sizeof(*e));
+    lx_yaml_rc_t rc = check_depth(buf, len, e);
+    if (rc != LX_YAML_OK) {
+        return rc;
+    }
     yaml_parser_t parser;
     if (!yaml_parser_initialize(&parser)) {
         return LX_YAML_NOMEM;
@@ -107,12 +151,38 @@ lx_yaml_rc_t lx_yaml_load_file(FILE *f, lx_yaml_doc_t *doc, lx_yaml_error_t *e)
 {
     memset(doc, 0, sizeof(*doc));
     memset(e, 0, sizeof(*e));
-    yaml_parser_t parser;
-    if (!yaml_parser_initialize(&parser)) {
+    /* Read whole (the depth check and the load each walk it), at most LX_YAML_MAX_BYTES. */
+    size_t cap = 1u << 16;
+    size_t len = 0;
+    uint8_t *buf = malloc(cap);
+    while (buf != NULL) {
+        len += fread(buf + len, 1, cap - len, f);
+        if (len < cap || cap > LX_YAML_MAX_BYTES) {
+            break;
+        }
+        const size_t grow = cap * 2 < LX_YAML_MAX_BYTES + 1 ? cap * 2 : LX_YAML_MAX_BYTES + 1;
+        uint8_t *nb = realloc(buf, grow);
+        if (nb == NULL) {
+            free(buf);
+        }
+        buf = nb;
+        cap = grow;
+    }
+    if (buf == NULL) {
         return LX_YAML_NOMEM;
     }
-    yaml_parser_set_input_file(&parser, f);
-    return load(&parser, doc, e);
+    lx_yaml_rc_t rc;
+    if (ferror(f)) {
+        e->line = 1;
+        e->problem = "read error";
+        rc = LX_YAML_SYNTAX;
+    } else if (len > LX_YAML_MAX_BYTES) {
+        rc = LX_YAML_TOO_BIG;
+    } else {
+        rc = lx_yaml_load_string(buf, len, doc, e);
+    }
+    free(buf);
+    return rc;
 }
 
 void lx_yaml_free(lx_yaml_doc_t *doc)

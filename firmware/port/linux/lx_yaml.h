@@ -4,7 +4,9 @@
  * document, copies it into one block of lx_yaml_node_t (scalars as NUL-terminated
  * strings) and frees libyaml's copy, so the map and scenario loaders walk plain structs.
  * Aliases resolve to the same node, as in libyaml. The tree is bounded: at most
- * LX_YAML_MAX_NODES nodes; a larger document is refused with LX_YAML_TOO_BIG.
+ * LX_YAML_MAX_NODES nodes (and a file at most LX_YAML_MAX_BYTES); a larger document is
+ * refused with LX_YAML_TOO_BIG. Nesting deeper than LX_YAML_MAX_DEPTH is refused as
+ * LX_YAML_SYNTAX ("nesting deeper than 64 levels") before libyaml composes anything.
  */
 #ifndef LX_YAML_H
 #define LX_YAML_H
@@ -15,6 +17,16 @@
 
 /// Most nodes a loaded document may hold (a scenario has a few hundred).
 #define LX_YAML_MAX_NODES 100000u
+
+/// Deepest nesting of collections accepted (the root mapping is level 1; the scenario and
+/// map formats need 5 at most).
+#define LX_YAML_MAX_DEPTH 64
+/// Largest file lx_yaml_load_file() reads, bytes (a scenario is a few kilobytes).
+#define LX_YAML_MAX_BYTES (16u << 20)
+/// A macro's value as a string literal (for messages).
+#define LX_YAML_STR(x) LX_YAML_STR_(x)
+/// Helper of LX_YAML_STR.
+#define LX_YAML_STR_(x) #x
 
 /// Kind of a node.
 typedef enum lx_yaml_kind {
@@ -44,8 +56,8 @@ typedef struct lx_yaml_doc {
 typedef enum lx_yaml_rc {
     LX_YAML_OK = 0,  ///< loaded
     LX_YAML_NOMEM,   ///< the parser could not start or a copy failed
-    LX_YAML_SYNTAX,  ///< malformed YAML: line and problem set
-    LX_YAML_TOO_BIG, ///< more than LX_YAML_MAX_NODES nodes
+    LX_YAML_SYNTAX,  ///< malformed YAML or nested too deep: line and problem set
+    LX_YAML_TOO_BIG, ///< more than LX_YAML_MAX_NODES nodes or LX_YAML_MAX_BYTES bytes
 } lx_yaml_rc_t;
 
 /// Where and why a load failed (set for LX_YAML_SYNTAX).

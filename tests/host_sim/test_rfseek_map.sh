@@ -67,5 +67,5 @@ one_err grid-range 2 "--grid: 65536.25 m out of range (0 .. 1000 m)" \
     "$bad/ok.yaml" --grid 65536.25 --pgm "$tmp/nl.pgm"
 one_err res-range 2 "--res: 1e300 m out of range (0 .. 1000 m)" \
     "$bad/ok.yaml" --res 1e300 --pgm "$tmp/nl.pgm"
-one_err newline-pgm 1 "nl/a?b.pgm.tmp: cannot create" "$bad/ok.yaml" --pgm "$tmp/nl/a"$'\n'"b.pgm"
+one_err newline-pgm 1 "nl/a?b.pgm: No such file or directory" "$bad/ok.yaml" --pgm "$tmp/nl/a"$'\n'"b.pgm"
 [ $fails = 0 ]

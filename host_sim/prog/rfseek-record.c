@@ -402,6 +402,21 @@ static int parse_options(int argc, char **argv, options_t *o, recorder_t *rec)
         return 2;
     }
     o->scn_path = argv[optind];
+    /* Outputs checked before any work: neither may be the scenario or the other. */
+    if (lx_err_same_file(PROG, o->scn_path, o->out_path) != 0 ||
+        lx_err_check_dest(PROG, o->out_path) != 0) {
+        return 1;
+    }
+    if (o->live_path != NULL && strcmp(o->out_path, o->live_path) == 0) {
+        lx_err_print(PROG, "%s: is the input stream's output too (choose another --live-out)",
+                     o->live_path);
+        return 1;
+    }
+    if (o->live_path != NULL && (lx_err_same_file(PROG, o->scn_path, o->live_path) != 0 ||
+                                 lx_err_same_file(PROG, o->out_path, o->live_path) != 0 ||
+                                 lx_err_check_dest(PROG, o->live_path) != 0)) {
+        return 1;
+    }
     return RUN;
 }
 
@@ -585,5 +600,5 @@ int main(int argc, char **argv)
     }
     const uint64_t run_seed = o.have_seed ? o.seed : s.sc.seed;
     record_config(&s, &o, run_seed);
-    return run_mission(&s, &o, run_seed);
+    return lx_err_close_stdout(PROG, run_mission(&s, &o, run_seed));
 }

@@ -43,6 +43,13 @@ check feed-output-is-capture-intact 'cmp -s "$w/same.pcap" "$cap"'
 err feed-output-dir-missing 1 "No such file or directory" rfseek-feed "$w/same.pcap" --mac 02:00:00:00:00:01 --output "$w/no/x.tsv"
 cp scenarios/maps/office.yaml "$w/office.yaml"; sed -i "s|^image: *|image: $PWD/scenarios/maps/|" "$w/office.yaml"
 err map-pgm-is-yaml 1 "is the input" rfseek-map "$w/office.yaml" --pgm "$w/office.yaml"
+cp scenarios/default.yaml "$w/scn.yaml"; sed -i "s|^map: *|map: $PWD/scenarios/|" "$w/scn.yaml"
+cp "$w/scn.yaml" "$w/scn.orig"
+err record-out-is-scenario 1 "is the input" rfseek-record "$w/scn.yaml" -o "$w/scn.yaml" --max-time 3
+err record-live-is-scenario 1 "is the input" rfseek-record "$w/scn.yaml" -o "$w/r.rfsr" --live-out "$w/scn.yaml" --max-time 3
+err record-live-is-out 1 "is the input stream's output too" rfseek-record "$w/scn.yaml" -o "$w/r.rfsr" --live-out "$w/r.rfsr" --max-time 3
+check record-scenario-intact 'cmp -s "$w/scn.yaml" "$w/scn.orig" && [ ! -e "$w/r.rfsr" ]'
+err record-out-dir-missing 1 "$w/no/r.rfsr: No such file or directory" rfseek-record "$w/scn.yaml" -o "$w/no/r.rfsr" --max-time 3
 
 # --- row: stdout on /dev/full --------------------------------------------------------------
 exec 3>&1
@@ -53,6 +60,11 @@ for c in "rfseek-map $map" "rfseek-replay --print $w/out.rfso" "rfseekd --map $m
     [ $rc -eq 1 ] && [ "$(grep -c . "$w/err" | head -1)" -ge 1 ] && grep -qF "${c%% *}: stdout: $full" "$w/err" \
         && [ "$(grep -vc -e '^rfseekd: dropped LCM message' -e '(dropped, counted)$' -e '^rfseekd: [0-9]* steps, ' "$w/err")" -eq 1 ] && pass "$name" || fail "$name" "rc $rc: $(head -c 300 "$w/err")"
 done
+
+# rfseek-record prints its summary to stdout.
+"$bin/rfseek-record" "$w/scn.yaml" -o "$w/r2.rfsr" --max-time 3 >/dev/full 2>"$w/err"; rc=$?
+[ $rc -eq 1 ] && [ "$(wc -l <"$w/err")" -eq 1 ] && grep -qF "rfseek-record: stdout: $full" "$w/err" \
+    && pass stdout-full-rfseek-record || fail stdout-full-rfseek-record "rc $rc: $(head -c 300 "$w/err")"
 
 # --- row: full disk, rfseekd --log leaves no temporary -------------------------------------
 mkdir -p "$w/full"

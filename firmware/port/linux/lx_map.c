@@ -266,6 +266,26 @@ static bool parse_double(const char *s, double *out)
     return true;
 }
 
+/* The map's plain number keys: where each goes and its presence flag. */
+typedef struct number_key {
+    double *value;
+    bool *have;
+} number_key_t;
+
+static bool number_key(yaml_fields_t *f, const char *key, number_key_t *k)
+{
+    if (strcmp(key, "resolution") == 0) {
+        *k = (number_key_t){&f->res, &f->has_res};
+    } else if (strcmp(key, "occupied_thresh") == 0) {
+        *k = (number_key_t){&f->occ, &f->has_occ};
+    } else if (strcmp(key, "free_thresh") == 0) {
+        *k = (number_key_t){&f->free_th, &f->has_free};
+    } else {
+        return false;
+    }
+    return true;
+}
+
 static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fields_t *f,
                       char *err, size_t errlen)
 {
@@ -292,6 +312,7 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
         const char *key = lx_yaml_scalar(root->child[2 * i]);
         const lx_yaml_node_t *vn = root->child[2 * i + 1];
         const char *val = lx_yaml_scalar(vn);
+        number_key_t num;
         if (key == NULL) {
             rc = fail(err, errlen, path, "non-scalar key");
             goto out;
@@ -303,27 +324,23 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
             }
             snprintf(f->image, sizeof(f->image), "%s", val);
             f->has_image = true;
-        } else if (strcmp(key, "resolution") == 0) {
-            if (!parse_double(val, &f->res)) {
-                rc = fail(err, errlen, path, "resolution: a number expected");
+        } else if (number_key(f, key, &num)) {
+            if (!parse_double(val, num.value)) {
+                rc = fail(err, errlen, path, "%s: a number expected", key);
                 goto out;
             }
-            f->has_res = true;
+            *num.have = true;
         } else if (strcmp(key, "origin") == 0) {
             double v[3];
-            int k = 0;
             if (vn == NULL || vn->kind != LX_YAML_SEQUENCE) {
                 rc = fail(err, errlen, path, "origin: a list [x, y, yaw] expected");
                 goto out;
             }
-            for (size_t it = 0; it < vn->n; it++) {
-                if (k == 3 || !parse_double(lx_yaml_scalar(vn->child[it]), &v[k])) {
-                    rc = fail(err, errlen, path, "origin: a list of three numbers [x, y, yaw] expected");
-                    goto out;
-                }
-                k++;
+            bool ok = vn->n == 3;
+            for (size_t it = 0; ok && it < 3; it++) {
+                ok = parse_double(lx_yaml_scalar(vn->child[it]), &v[it]);
             }
-            if (k != 3) {
+            if (!ok) {
                 rc = fail(err, errlen, path, "origin: a list of three numbers [x, y, yaw] expected");
                 goto out;
             }
@@ -331,18 +348,6 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
             f->oy = v[1];
             f->yaw = v[2];
             f->has_origin = true;
-        } else if (strcmp(key, "occupied_thresh") == 0) {
-            if (!parse_double(val, &f->occ)) {
-                rc = fail(err, errlen, path, "occupied_thresh: a number expected");
-                goto out;
-            }
-            f->has_occ = true;
-        } else if (strcmp(key, "free_thresh") == 0) {
-            if (!parse_double(val, &f->free_th)) {
-                rc = fail(err, errlen, path, "free_thresh: a number expected");
-                goto out;
-            }
-            f->has_free = true;
         } else if (strcmp(key, "negate") == 0) {
             if (val != NULL && (strcmp(val, "0") == 0 || strcasecmp(val, "false") == 0)) {
                 f->negate = 0;

@@ -407,14 +407,9 @@ static int parse_options(int argc, char **argv, options_t *o, recorder_t *rec)
         lx_err_check_dest(PROG, o->out_path) != 0) {
         return 1;
     }
-    if (o->live_path != NULL && strcmp(o->out_path, o->live_path) == 0) {
-        lx_err_print(PROG, "%s: is the input stream's output too (choose another --live-out)",
-                     o->live_path);
-        return 1;
-    }
     if (o->live_path != NULL && (lx_err_same_file(PROG, o->scn_path, o->live_path) != 0 ||
-                                 lx_err_same_file(PROG, o->out_path, o->live_path) != 0 ||
-                                 lx_err_check_dest(PROG, o->live_path) != 0)) {
+                                 lx_err_check_dest(PROG, o->live_path) != 0 ||
+                                 lx_err_same_dest(PROG, o->out_path, o->live_path) != 0)) {
         return 1;
     }
     return RUN;

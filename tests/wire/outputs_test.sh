@@ -34,6 +34,8 @@ check replay-out-is-in-intact 'cmp -s "$w/same.rfsr" "$w/in.rfsr" && ! compgen -
 cp "$w/in.lcmlog" "$w/same.lcmlog"
 err rfseekd-log-is-replay 1 "is the input" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/same.lcmlog" --log "$w/same.lcmlog"
 err rfseekd-decisions-is-replay 1 "is the input" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/same.lcmlog" --decisions "$w/same.lcmlog"
+err rfseekd-log-is-decisions 1 "is also written as" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/in.lcmlog" --log "$w/new.lcmlog" --decisions "$w/./new.lcmlog"
+check rfseekd-log-is-decisions-nothing 'test ! -e "$w/new.lcmlog"'
 check rfseekd-out-is-in-intact 'cmp -s "$w/same.lcmlog" "$w/in.lcmlog"'
 err rfseekd-log-dir-missing 1 "$w/no/out.lcmlog: No such file or directory" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/in.lcmlog" --log "$w/no/out.lcmlog"
 cap=$(ls tests/data/captures/*.pcap | head -1)
@@ -47,7 +49,7 @@ cp scenarios/default.yaml "$w/scn.yaml"; sed -i "s|^map: *|map: $PWD/scenarios/|
 cp "$w/scn.yaml" "$w/scn.orig"
 err record-out-is-scenario 1 "is the input" rfseek-record "$w/scn.yaml" -o "$w/scn.yaml" --max-time 3
 err record-live-is-scenario 1 "is the input" rfseek-record "$w/scn.yaml" -o "$w/r.rfsr" --live-out "$w/scn.yaml" --max-time 3
-err record-live-is-out 1 "is the input stream's output too" rfseek-record "$w/scn.yaml" -o "$w/r.rfsr" --live-out "$w/r.rfsr" --max-time 3
+err record-live-is-out 1 "is also written as" rfseek-record "$w/scn.yaml" -o "$w/r.rfsr" --live-out "$w/r.rfsr" --max-time 3
 check record-scenario-intact 'cmp -s "$w/scn.yaml" "$w/scn.orig" && [ ! -e "$w/r.rfsr" ]'
 err record-out-dir-missing 1 "$w/no/r.rfsr: No such file or directory" rfseek-record "$w/scn.yaml" -o "$w/no/r.rfsr" --max-time 3
 

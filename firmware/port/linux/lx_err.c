@@ -2,9 +2,11 @@
 #include "lx_err.h"
 
 #include <errno.h>
+#include <stdbool.h>
 #include <limits.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -85,4 +87,31 @@ int lx_err_check_dest(const char *prog, const char *path)
         return -1;
     }
     return 0;
+}
+
+/* The real path of path's folder and path's last component, or false. */
+static bool split_real(const char *path, char *dir, const char **base)
+{
+    char tmp[PATH_MAX];
+    const char *slash = strrchr(path, '/');
+    *base = slash ? slash + 1 : path;
+    size_t n = slash ? (size_t)(slash - path) : 0;
+    if (n >= sizeof tmp) {
+        return false;
+    }
+    memcpy(tmp, path, n);
+    tmp[n] = '\0';
+    return realpath(slash == path ? "/" : (n ? tmp : "."), dir) != NULL;
+}
+
+int lx_err_same_dest(const char *prog, const char *a, const char *b)
+{
+    char da[PATH_MAX], db[PATH_MAX];
+    const char *ba, *bb;
+    if (a != NULL && b != NULL && split_real(a, da, &ba) && split_real(b, db, &bb) &&
+        strcmp(da, db) == 0 && strcmp(ba, bb) == 0) {
+        lx_err_print(prog, "%s: is also written as %s (choose another output)", b, a);
+        return -1;
+    }
+    return lx_err_same_file(prog, a, b);
 }

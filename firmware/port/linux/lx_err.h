@@ -22,6 +22,11 @@ int lx_err_close_stdout(const char *prog, int rc);
 /// "prog: OUT: is the input IN (choose another output)".
 int lx_err_same_file(const char *prog, const char *in, const char *out);
 
+/// Refuse two outputs that name one file, whether or not it exists yet (their folders'
+/// real paths and their last components compared). 0, or -1 after "prog: B: is also
+/// written as A (choose another output)". Call after lx_err_check_dest on both.
+int lx_err_same_dest(const char *prog, const char *a, const char *b);
+
 /// Check before any work that `path` can be created: its directory exists, is a
 /// directory and is writable (the rename into place needs it). 0, or -1 after
 /// "prog: PATH: REASON".

@@ -642,7 +642,7 @@ static int check_paths(const options_t *o)
             return 1;
         }
     }
-    if (o->log_path && o->dec_path && lx_err_same_file(PROG, o->log_path, o->dec_path) != 0) {
+    if (lx_err_same_dest(PROG, o->log_path, o->dec_path) != 0) {
         return 1;
     }
     return 0;

@@ -66,7 +66,7 @@ rfs_drive_cfg_t rfs_drive_cfg_default(void)
     c.turn_in_place = RFS_Q16_FRAC(3, 4); /* 0.75 rad (43 degrees) */
     c.turn_out = RFS_Q16_FRAC(1, 5);     /* 0.2 rad (11 degrees) */
     c.lookahead = RFS_Q16_FRAC(2, 5);    /* 0.4 m */
-    c.pose_gain = RFS_Q16_FRAC(1, 4);
+    c.pose_gain = RFS_Q16_FRAC(1, 8);
     c.timeout_us = 30000000;             /* 30 s */
     c.stall_us = 5000000;                /* 5 s */
     c.progress_min = RFS_Q16_FRAC(1, 10); /* 0.1 m per 5 s */

@@ -101,6 +101,7 @@ void rfs_drive_set_path(rfs_drive_t *d, const rfs_path_t *path, int64_t now_us)
     d->next = 0;
     d->status = d->path.n > 0 ? RFS_DRIVE_RUNNING : RFS_DRIVE_IDLE;
     d->start_us = now_us;
+    d->last_us = now_us; /* from rest: no acceleration step owed for the time before */
     /* The time limit grows with the path: the time to drive it at half the top speed.
      * Scaling: length <= 2^31 Q16 = 3.3e7 mm, times 2e6 < 2^56. */
     uint64_t len_mm = (uint64_t)q16_to_mm(d->path.length > 0 ? d->path.length : 0);
@@ -114,7 +115,7 @@ void rfs_drive_set_path(rfs_drive_t *d, const rfs_path_t *path, int64_t now_us)
 
 void rfs_drive_stop(rfs_drive_t *d, int64_t now_us)
 {
-    (void)now_us;
+    d->last_us = now_us;
     d->status = RFS_DRIVE_IDLE;
     d->path.n = 0;
     d->left_mm_s = 0;

@@ -395,7 +395,7 @@ void rfs_q16_sincos(rfs_q16_t a, rfs_q16_t *c, rfs_q16_t *s)
 {
     const int64_t pi28 = 843314857;   /* pi in Q28 */
     const int64_t two_pi28 = 1686629713;
-    int64_t z = (int64_t)a << 12;     /* Q28, |z| < 2^43 */
+    int64_t z = (int64_t)a * 4096;    /* Q28, |z| < 2^43 */
     /* Reduce to (-pi, pi]: one division, not a loop, whatever the angle. */
     z -= rfs_sdiv64_round(z, two_pi28) * two_pi28;
     if (z <= -pi28) {

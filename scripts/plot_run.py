@@ -100,6 +100,11 @@ def main(argv):
     ax.imshow(img, cmap="gray", extent=ext, vmin=0, vmax=255)
     ax.plot(x, y, "-", color="tab:blue", lw=1.2, label="trajectory")
     ax.plot(ux, uy, "o", mfc="none", mec="red", ms=7, label="model updates (%d)" % relearn.sum())
+    # Wall contacts: where the robot began touching a wall (track.tsv's touching column).
+    touch = col(th, tr, "touching", int) == 1
+    began = touch & ~np.concatenate(([False], touch[:-1]))
+    ax.plot(x[began], y[began], "s", mfc="none", mec="orange", ms=9, mew=2,
+            label="wall contacts (%s)" % s.get("wall_contacts", int(began.sum())))
     ax.plot(start[0], start[1], "x", color="red", ms=12, mew=3, label="start")
     ax.plot(sources[:, 0], sources[:, 1], "*", color="red", ms=18, label="source")
     ax.set_xlabel("x [m]")

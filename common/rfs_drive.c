@@ -2,15 +2,16 @@
  * "Drive control").
  *
  * Per update:
- *  - Pose filter. The estimate is carried forward by the wheel speeds commanded last
- *    (dead reckoning) and, when a new localisation pose has arrived, moved pose_gain of
- *    the way towards it (the pose itself carried forward from its timestamp to now). A
- *    pose further than POSE_RESET_M or POSE_RESET_RAD from the estimate replaces it.
+ *  - Pose filter. The estimate is carried forward by the base's wheel speeds (the
+ *    commands, ramped at the acceleration limit: dead reckoning) and, when a new
+ *    localisation pose has arrived, moved pose_gain of the way towards it (the pose itself
+ *    carried forward from its timestamp to now). A pose further than POSE_RESET_M or
+ *    POSE_RESET_RAD from the estimate, or after a gap of POSE_STALE_US, replaces it.
  *  - Segment. The robot follows the line from the previous waypoint (or where the path
  *    started) A to the waypoint approached B: progress u along AB, cross-track error c.
  *    A waypoint other than the goal is passed when the robot crosses the perpendicular
  *    at B (u >= |AB|) or comes within SWITCH_DIST of it. The goal is reached within
- *    goal_tol, or once past its perpendicular within goal_tol of the line.
+ *    goal_tol.
  *  - Steering. The carrot is the point lookahead ahead of the robot's projection on the
  *    line AB (past B on the goal's leg it is the goal itself); e is the heading error to
  *    it. The carrot never lies on the next leg, so corners are not cut.
@@ -19,9 +20,10 @@
  *    at most v_max / 2 and slow enough to stop within the remaining angle.
  *  - Otherwise v = clamp(sqrt(2 (a/2) d + v_corner^2), 0.05 m/s, v_max) times
  *    (1 - |e| / turn_in_place)^2, omega = 2.5 e. d is the distance left along AB to B
- *    (to half the goal tolerance before the goal); v_corner = v_max (1 - turn /
- *    turn_in_place)^2 for the turn between AB and the next leg (0 at the goal and for
- *    turns it will make on the spot).
+ *    (to half the goal tolerance from the goal); v_corner = v_max (1 - turn /
+ *    turn_in_place)^2 for the turn between AB and the next leg, at most what stops within
+ *    the next leg (0 at the goal and for turns it will make on the spot).
+ *  - BLOCKED is judged on the localisation pose's distance to the waypoint.
  *  - Both wheel targets are scaled together to v_max, then each wheel moves towards its
  *    target by at most accel * dt. At the goal both wheels ramp to 0 and the goal is
  *    REACHED when they are 0.
@@ -45,8 +47,10 @@
  * after a long gap), metres and radians Q16.16. */
 #define POSE_RESET_M RFS_Q16_FRAC(1, 2)
 #define POSE_RESET_RAD RFS_Q16_FRAC(1, 2)
-/* An estimate not updated for this long is replaced by the next pose. */
+/* A pose this long after the previous one replaces the estimate. */
 #define POSE_STALE_US 1000000
+/* Longest goal timeout accepted (11.6 days): the time limit adds the path's time to it. */
+#define TIMEOUT_MAX_US ((int64_t)1000000000000)
 /* Segments shorter than this have no direction: steer at their end point, mm. */
 #define SEG_MIN_MM 10
 
@@ -75,9 +79,10 @@ rfs_drive_cfg_t rfs_drive_cfg_default(void)
 
 int rfs_drive_init(rfs_drive_t *d, const rfs_drive_cfg_t *cfg)
 {
-    if (d == 0 || cfg == 0 || cfg->wheel_base_mm <= 0 || cfg->wheel_base_mm > 10000 ||
+    if (d == 0 || cfg == 0 || cfg->wheel_base_mm < 10 || cfg->wheel_base_mm > 10000 ||
         cfg->v_max_mm_s <= 0 || cfg->v_max_mm_s > 10000 || cfg->accel_mm_s2 <= 0 ||
         cfg->accel_mm_s2 > 100000 || cfg->goal_tol <= 0 || cfg->timeout_us <= 0 ||
+        cfg->timeout_us > TIMEOUT_MAX_US ||
         cfg->turn_in_place <= 0 || cfg->turn_in_place > RFS_Q16_PI || cfg->turn_out <= 0 ||
         cfg->turn_out > cfg->turn_in_place || cfg->lookahead <= 0 ||
         cfg->lookahead > RFS_Q16_INT(100) || cfg->pose_gain <= 0 ||
@@ -118,7 +123,7 @@ void rfs_drive_stop(rfs_drive_t *d, int64_t now_us)
     d->last_us = now_us;
     d->status = RFS_DRIVE_IDLE;
     d->path.n = 0;
-    d->left_mm_s = 0;
+    d->left_mm_s = 0; /* the base itself slows at its own rate: base_left/right */
     d->right_mm_s = 0;
 }
 
@@ -129,7 +134,9 @@ bool rfs_drive_estimate(const rfs_drive_t *d, rfs_pose_t *out)
     return d->have_est;
 }
 
-/* Wrap an angle difference (within +-3 pi) into (-pi, pi]. */
+/* Wrap an angle into (-pi, pi]. The input must lie within +-3 pi: at every call it is the
+ * sum or difference of two angles in (-pi, pi] (a fraction of one, at most); anything
+ * else goes through wrap_any. */
 static rfs_q16_t wrap_pi(int64_t a)
 {
     if (a > RFS_Q16_PI) {
@@ -143,6 +150,12 @@ static rfs_q16_t wrap_pi(int64_t a)
         a += TWO_PI_Q16;
     }
     return (rfs_q16_t)a;
+}
+
+/* An angle of any value (a pose's heading is not checked upstream) into (-pi, pi]. */
+static rfs_q16_t wrap_any(int64_t a)
+{
+    return wrap_pi(a - rfs_sdiv64_round(a, TWO_PI_Q16) * TWO_PI_Q16);
 }
 
 /* Move cur towards target by at most step. */
@@ -169,8 +182,8 @@ static int32_t brake_speed(int32_t accel, int64_t d_mm, int32_t v_end)
     return v > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)v;
 }
 
-/* Dead reckoning: the pose p carried dt_us forward at the commanded wheel speeds, along
- * the arc's mean heading.
+/* Dead reckoning: the pose p carried dt_us forward at the base's modelled wheel speeds
+ * (the commands, ramped at the acceleration limit), along the arc's mean heading.
  * Scaling and overflow: speeds <= 1e4 mm/s and dt <= 2e5 us: v dt 65536 < 2^47 and
  * (r - l) dt 65536 < 2^48; the distance (Q16, < 2^17) times a Q16 cosine is < 2^33. */
 static void dead_reckon(const rfs_drive_t *d, rfs_pose_t *p, int64_t dt_us)
@@ -179,46 +192,70 @@ static void dead_reckon(const rfs_drive_t *d, rfs_pose_t *p, int64_t dt_us)
         return;
     }
     dt_us = dt_us > DT_MAX_US ? DT_MAX_US : dt_us;
-    int64_t v2 = (int64_t)d->left_mm_s + d->right_mm_s; /* 2 v, mm/s */
-    int64_t dw = (int64_t)d->right_mm_s - d->left_mm_s; /* omega b, mm/s */
+    int64_t v2 = (int64_t)d->base_left + d->base_right; /* 2 v, mm/s */
+    int64_t dw = (int64_t)d->base_right - d->base_left; /* omega b, mm/s */
     rfs_q16_t dist = (rfs_q16_t)rfs_sdiv64_round(v2 * dt_us * 65536, 2000000000);
     rfs_q16_t dth = (rfs_q16_t)rfs_sdiv64_round(dw * dt_us * 65536,
                                                (int64_t)d->cfg.wheel_base_mm * 1000000);
     rfs_q16_t c;
     rfs_q16_t s;
-    rfs_q16_sincos(wrap_pi((int64_t)p->theta + dth / 2), &c, &s);
-    p->x = rfs_sat32((int64_t)p->x + (((int64_t)dist * c) >> 16));
-    p->y = rfs_sat32((int64_t)p->y + (((int64_t)dist * s) >> 16));
-    p->theta = wrap_pi((int64_t)p->theta + dth);
+    rfs_q16_sincos((rfs_q16_t)((int64_t)p->theta + dth / 2), &c, &s); /* any angle */
+    p->x = rfs_sat32((int64_t)p->x + (((int64_t)dist * c + 32768) >> 16));
+    p->y = rfs_sat32((int64_t)p->y + (((int64_t)dist * s + 32768) >> 16));
+    p->theta = wrap_any((int64_t)p->theta + dth); /* a turn of up to 2 v_max DT_MAX / b */
+}
+
+/* to - from in microseconds without signed overflow, clamped to [-1, limit]: -1 when to
+ * is before from, limit when it is at least limit later. */
+static int64_t span_us(int64_t from, int64_t to, int64_t limit)
+{
+    if (to < from) {
+        return -1;
+    }
+    uint64_t d = (uint64_t)to - (uint64_t)from;
+    return d >= (uint64_t)limit ? limit : (int64_t)d;
 }
 
 void rfs_drive_observe(rfs_drive_t *d, const rfs_pose_t *pose, int64_t now_us)
 {
-    int64_t dt = now_us - d->est_us;
-    bool stale = !d->have_est || dt < 0 || dt > POSE_STALE_US;
-    if (!stale) {
+    int64_t dt = d->have_est ? span_us(d->est_us, now_us, POSE_STALE_US) : -1;
+    if (dt > 0) {
         dead_reckon(d, &d->est, dt);
+        /* The base follows the commands within the acceleration limit (after a safety
+         * stop it is still rolling while the command is already 0). */
+        int32_t step = (int32_t)rfs_udiv64((uint64_t)d->cfg.accel_mm_s2 * (uint64_t)dt, 1000000u);
+        d->base_left = ramp(d->base_left, d->left_mm_s, step);
+        d->base_right = ramp(d->base_right, d->right_mm_s, step);
     }
-    d->est_us = now_us;
-    if (d->have_est && !stale && pose->t_us == d->pose_t_us) {
+    if (dt >= 0) {
+        d->est_us = now_us;
+    }
+    bool fresh = !d->have_est || pose->t_us != d->pose_t_us;
+    if (!fresh) {
         return; /* no new pose: dead reckoning only */
     }
+    /* A pose after a gap (or out of order, or the first) replaces the estimate. */
+    bool reset = !d->have_est || dt < 0 ||
+                 span_us(d->pose_t_us, pose->t_us, POSE_STALE_US) >= POSE_STALE_US;
     d->pose_t_us = pose->t_us;
     rfs_pose_t m = *pose;
-    dead_reckon(d, &m, now_us - pose->t_us);
+    m.theta = wrap_any(m.theta);
+    int64_t age = span_us(pose->t_us, now_us, DT_MAX_US);
+    dead_reckon(d, &m, age > 0 ? age : 0);
     int64_t ex = (int64_t)m.x - d->est.x;
     int64_t ey = (int64_t)m.y - d->est.y;
     rfs_q16_t eth = wrap_pi((int64_t)m.theta - d->est.theta);
-    if (stale || ex > POSE_RESET_M || ex < -POSE_RESET_M || ey > POSE_RESET_M ||
+    if (reset || ex > POSE_RESET_M || ex < -POSE_RESET_M || ey > POSE_RESET_M ||
         ey < -POSE_RESET_M || rfs_q16_abs(eth) > POSE_RESET_RAD) {
         d->est = m;
+        d->est_us = now_us;
         d->have_est = true;
         return;
     }
     rfs_q16_t k = d->cfg.pose_gain;
-    d->est.x = (rfs_q16_t)(d->est.x + ((ex * k) >> 16));
-    d->est.y = (rfs_q16_t)(d->est.y + ((ey * k) >> 16));
-    d->est.theta = wrap_pi((int64_t)d->est.theta + (((int64_t)eth * k) >> 16));
+    d->est.x = (rfs_q16_t)(d->est.x + ((ex * k + 32768) >> 16));
+    d->est.y = (rfs_q16_t)(d->est.y + ((ey * k + 32768) >> 16));
+    d->est.theta = wrap_pi((int64_t)d->est.theta + (((int64_t)eth * k + 32768) >> 16));
 }
 
 /* The leg being followed, millimetres relative to its start A: direction (dx, dy) of
@@ -246,8 +283,10 @@ static void leg_of(const rfs_drive_t *d, leg_t *g)
     g->py = q16_to_mm((int64_t)d->est.y - ayq);
     g->len = (int64_t)rfs_isqrt64((uint64_t)(g->dx * g->dx + g->dy * g->dy));
     if (g->len < SEG_MIN_MM) {
+        /* No direction: passed at once; the offset is the distance to B. */
         g->u = g->len;
-        g->c = 0;
+        g->c = (int64_t)rfs_isqrt64((uint64_t)((g->dx - g->px) * (g->dx - g->px) +
+                                               (g->dy - g->py) * (g->dy - g->py)));
         return;
     }
     g->u = rfs_sdiv64_round(g->px * g->dx + g->py * g->dy, g->len);
@@ -262,13 +301,18 @@ static int64_t dist_mm(const rfs_drive_t *d, uint16_t i)
     return (int64_t)rfs_isqrt64((uint64_t)(x * x + y * y));
 }
 
-/* Skip the waypoints passed (perpendicular crossed or within SWITCH_DIST), each one
- * restarting the stall reference; the leg into the waypoint approached in *g. */
+/* Skip the waypoints passed, each one restarting the stall reference: one by crossing its
+ * perpendicular (a second leg whose perpendicular is also behind the robot waits for the
+ * next update, so a short leg is not skipped into a corner), any within SWITCH_DIST. The
+ * leg into the waypoint approached in *g. */
 static void advance(rfs_drive_t *d, leg_t *g, int64_t now_us)
 {
     uint16_t last = (uint16_t)(d->path.n - 1u);
+    bool crossed = false;
     leg_of(d, g);
-    while (d->next < last && (g->u >= g->len || dist_mm(d, d->next) < SWITCH_DIST_MM)) {
+    while (d->next < last &&
+           ((!crossed && g->u >= g->len) || dist_mm(d, d->next) < SWITCH_DIST_MM)) {
+        crossed = crossed || g->u >= g->len;
         d->next++;
         leg_of(d, g);
         d->stall_ref_us = now_us;
@@ -276,7 +320,8 @@ static void advance(rfs_drive_t *d, leg_t *g, int64_t now_us)
     }
 }
 
-/* Stall check with rem_mm left along the leg: true when the robot came less than
+/* Stall check with rem_mm from the localisation pose (not the dead-reckoned estimate,
+ * which runs ahead of a wedged robot) to the waypoint: true when the robot came less than
  * progress_min closer over the last stall_us. */
 static bool stalled(rfs_drive_t *d, int64_t rem_mm, int64_t now_us)
 {
@@ -310,8 +355,9 @@ static int32_t turn_speed(const rfs_drive_cfg_t *c, rfs_q16_t e)
 }
 
 /* Corner speed at the waypoint approached, mm/s, for the leg g: v_max (1 - theta /
- * turn_in_place)^2 for a turn of theta between the leg and the next one; 0 from
- * turn_in_place on, where the robot will turn on the spot, and at the goal. */
+ * turn_in_place)^2 for a turn of theta between the leg and the next one, at most what can
+ * stop within the next leg; 0 from turn_in_place on, where the robot will turn on the
+ * spot, and at the goal. */
 static int32_t corner_speed(const rfs_drive_t *d, const leg_t *g)
 {
     const rfs_drive_cfg_t *c = &d->cfg;
@@ -325,7 +371,10 @@ static int32_t corner_speed(const rfs_drive_t *d, const leg_t *g)
         return 0;
     }
     rfs_q16_t f = rfs_q16_div(c->turn_in_place - theta, c->turn_in_place);
-    return (int32_t)(((int64_t)rfs_q16_mul(f, f) * c->v_max_mm_s) >> 16);
+    int32_t v = (int32_t)(((int64_t)rfs_q16_mul(f, f) * c->v_max_mm_s) >> 16);
+    /* No faster than can stop within the next leg (a short last leg to the goal). */
+    int32_t vs = brake_speed(c->accel_mm_s2, (int64_t)rfs_isqrt64((uint64_t)(wx * wx + wy * wy)), 0);
+    return vs < v ? vs : v;
 }
 
 /* Heading error to the carrot of leg g (radians Q16.16): the point lookahead ahead of
@@ -363,10 +412,10 @@ static void steer(rfs_drive_t *d, const leg_t *g, int32_t *tl, int32_t *tr)
         w_mm = turn_speed(c, e);
     } else {
         /* Brake to the corner speed where the waypoint counts as passed (its
-         * perpendicular), or to a stop half the goal tolerance before the goal. */
+         * perpendicular), or to a stop half the goal tolerance from the goal. */
         bool corner = d->next < (uint16_t)(d->path.n - 1u);
-        int64_t stop_at = corner ? 0 : q16_to_mm(c->goal_tol / 2);
-        v = brake_speed(c->accel_mm_s2, g->len - g->u - stop_at, corner_speed(d, g));
+        int64_t left = corner ? g->len - g->u : dist_mm(d, d->next) - q16_to_mm(c->goal_tol / 2);
+        v = brake_speed(c->accel_mm_s2, left, corner_speed(d, g));
         v = v < V_CREEP ? V_CREEP : v;
         v = v > c->v_max_mm_s ? c->v_max_mm_s : v;
         /* Fade the forward speed in as the heading error closes. */
@@ -386,8 +435,17 @@ static void steer(rfs_drive_t *d, const leg_t *g, int32_t *tl, int32_t *tr)
     }
 }
 
+/* Distance from the localisation pose to waypoint i, millimetres. */
+static int64_t raw_dist_mm(const rfs_drive_t *d, const rfs_pose_t *pose, uint16_t i)
+{
+    int64_t x = q16_to_mm((int64_t)d->path.x[i] - pose->x);
+    int64_t y = q16_to_mm((int64_t)d->path.y[i] - pose->y);
+    return (int64_t)rfs_isqrt64((uint64_t)(x * x + y * y));
+}
+
 /* One update of a running goal: the status, wheel targets in *tl, *tr. */
-static rfs_drive_status_t follow(rfs_drive_t *d, int64_t now_us, int32_t *tl, int32_t *tr)
+static rfs_drive_status_t follow(rfs_drive_t *d, const rfs_pose_t *pose, int64_t now_us,
+                                 int32_t *tl, int32_t *tr)
 {
     const rfs_drive_cfg_t *c = &d->cfg;
     if (!d->have_origin) {
@@ -399,15 +457,15 @@ static rfs_drive_status_t follow(rfs_drive_t *d, int64_t now_us, int32_t *tl, in
     advance(d, &g, now_us);
     bool goal = d->next == (uint16_t)(d->path.n - 1u);
     int64_t tol = q16_to_mm(c->goal_tol);
-    bool at_goal = goal && (dist_mm(d, d->next) <= tol ||
-                            (g.u >= g.len && g.c <= tol && g.c >= -tol));
+    bool at_goal = goal && dist_mm(d, d->next) <= tol;
     if (now_us > d->start_us && (uint64_t)now_us - (uint64_t)d->start_us > (uint64_t)d->limit_us) {
         return RFS_DRIVE_TIMEOUT;
     }
     if (at_goal) {
         return d->left_mm_s == 0 && d->right_mm_s == 0 ? RFS_DRIVE_REACHED : RFS_DRIVE_RUNNING;
     }
-    rfs_drive_status_t st = stalled(d, g.len - g.u, now_us) ? RFS_DRIVE_BLOCKED : RFS_DRIVE_RUNNING;
+    rfs_drive_status_t st = stalled(d, raw_dist_mm(d, pose, d->next), now_us) ? RFS_DRIVE_BLOCKED
+                                                                             : RFS_DRIVE_RUNNING;
     steer(d, &g, tl, tr);
     return st;
 }
@@ -429,7 +487,7 @@ rfs_drive_status_t rfs_drive_update(rfs_drive_t *d, const rfs_pose_t *pose, int6
     int32_t tr = 0;
     rfs_drive_status_t result = d->status;
     if (d->status == RFS_DRIVE_RUNNING) {
-        result = follow(d, now_us, &tl, &tr);
+        result = follow(d, pose, now_us, &tl, &tr);
     }
     if (result != RFS_DRIVE_RUNNING) {
         tl = 0;
@@ -437,6 +495,8 @@ rfs_drive_status_t rfs_drive_update(rfs_drive_t *d, const rfs_pose_t *pose, int6
     }
     d->left_mm_s = ramp(d->left_mm_s, tl, step);
     d->right_mm_s = ramp(d->right_mm_s, tr, step);
+    d->base_left = ramp(d->base_left, d->left_mm_s, step);
+    d->base_right = ramp(d->base_right, d->right_mm_s, step);
     *left_mm_s = rfs_sat16(d->left_mm_s);
     *right_mm_s = rfs_sat16(d->right_mm_s);
     if (result == RFS_DRIVE_REACHED || result == RFS_DRIVE_TIMEOUT || result == RFS_DRIVE_BLOCKED) {

@@ -66,17 +66,19 @@ typedef struct rfs_drive {
     bool have_est;                 ///< est is valid
     int64_t est_us;                ///< time est refers to
     int64_t pose_t_us;             ///< timestamp of the last pose folded into est
+    int32_t base_left, base_right; ///< the base's modelled wheel speeds, mm/s (the commands
+                                   ///< ramped at accel_mm_s2: still rolling after a stop)
 } rfs_drive_t;
 
 /// Defaults: TurtleBot 2 (Kobuki) base: 0.23 m, 0.7 m/s, 1 m/s^2 (the TurtleBot velocity
 /// smoother's accel_lim_v); 0.1 m goal tolerance, turn on the spot above 0.75 rad until
-/// below 0.2 rad, carrot 0.4 m ahead, pose gain 1/4, 30 s timeout, blocked when less
+/// below 0.2 rad, carrot 0.4 m ahead, pose gain 1/8, 30 s timeout, blocked when less
 /// than 0.1 m of progress in 5 s.
 rfs_drive_cfg_t rfs_drive_cfg_default(void);
 
-/// Initialise idle. Returns 0, or -1 on a parameter out of range (non-positive wheel
-/// base, speed, acceleration, tolerance, lookahead, pose gain or timeout; turn_out above
-/// turn_in_place; pose gain above 1).
+/// Initialise idle. Returns 0, or -1 on a parameter out of range (wheel base outside
+/// 10 mm .. 10 m; non-positive speed, acceleration, tolerance, lookahead, pose gain or
+/// timeout; timeout over 10^12 us; turn_out above turn_in_place; pose gain above 1).
 int rfs_drive_init(rfs_drive_t *d, const rfs_drive_cfg_t *cfg);
 
 /// Start following a path (copied) at time now_us. path may be &d->path itself: planning
@@ -90,10 +92,11 @@ rfs_drive_status_t rfs_drive_update(rfs_drive_t *d, const rfs_pose_t *pose, int6
                                     int16_t *left_mm_s, int16_t *right_mm_s);
 
 /// Advance the pose filter to now_us with the latest localisation pose (a pose already
-/// folded in is not counted twice): dead reckoning from the commanded wheel speeds, then
-/// a new pose blended in with weight pose_gain (replacing the estimate when it is more
-/// than 0.5 m or 0.5 rad away, or the estimate is over 1 s old). rfs_drive_update calls
-/// it; call it also in periods without an update so the estimate stays current.
+/// folded in is not counted twice): dead reckoning from the base's wheel speeds (the
+/// commands ramped at accel_mm_s2), then a new pose blended in with weight pose_gain; it
+/// replaces the estimate when it is more than 0.5 m or 0.5 rad away, at least 1 s after
+/// the previous pose, or older than it. rfs_drive_update calls it; call it also in
+/// periods without an update so the estimate stays current.
 void rfs_drive_observe(rfs_drive_t *d, const rfs_pose_t *pose, int64_t now_us);
 
 /// The filtered pose the drive steers by (false before the first update).

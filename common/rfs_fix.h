@@ -120,9 +120,9 @@ rfs_q16_t rfs_q16_db10(rfs_q16_t x);
 
 /// atan2(y, x) in Q16.16 radians, (-pi, pi]; 0 for (0, 0). Error <= 2^-13 rad (tested
 /// against double precision).
-/// Scaling and overflow: any int64 inputs within +-2^40 are shifted so the larger
-/// magnitude lies in [2^27, 2^28) (only the ratio matters); 16 CORDIC vectoring
-/// iterations with the gain 1.65 keep |x|, |y| below 2^29 in int32.
+/// Scaling and overflow: inputs within +-2^62 are shifted so the larger magnitude lies
+/// in [2^27, 2^28) (only the ratio matters); 24 CORDIC vectoring iterations in Q28 with
+/// the gain 1.65 keep |x|, |y| below 2^29 in int32.
 rfs_q16_t rfs_q16_atan2(int64_t y, int64_t x);
 
 /// cos and sin of an angle (Q16.16 radians, any value within +-2^15 rad) in Q16.16,

@@ -491,6 +491,7 @@ static bool inputs_stale(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     if (s->state == RFS_SEEK_DRIVING && s->drive.status == RFS_DRIVE_RUNNING) {
         s->resume = true;
         s->resume_path = s->drive.path;
+        s->resume_next = s->drive.next; /* the legs already driven are not driven again */
         s->resume_start_us = elapsed(now_us, s->drive.start_us); /* driven so far */
     }
     if (s->state != RFS_SEEK_WAITING) {
@@ -518,6 +519,7 @@ static void resume_goal(rfs_seek_t *s, int64_t now_us)
 {
     s->resume = false;
     rfs_drive_set_path(&s->drive, &s->resume_path, now_us);
+    s->drive.next = s->resume_next < s->drive.path.n ? s->resume_next : 0;
     s->drive.start_us = now_us >= INT64_MIN + s->resume_start_us ? now_us - s->resume_start_us
                                                                  : INT64_MIN;
     s->state = RFS_SEEK_DRIVING;

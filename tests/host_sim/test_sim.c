@@ -333,16 +333,24 @@ static void test_open_all_seeds_reach(void **state)
     hs_sim_env_close(&env);
 }
 
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
 /// seek.p0_min_dbm reaches the pathloss model. The open hall's node transmits 20 dBm, so
 /// P0 (the signal at 1 m) is 20 - 39.6 = -19.6 dBm in the simulator: the default fit finds
-/// it and the robot reaches the source within 3x the 10 m straight line (the median over
-/// seeds 1..40 is 2.6x, docs/RESULTS.md). A floor of 0 dBm (a belief 20 dB
-/// above the truth) penalises every candidate near the robot's samples and misleads the
-/// robot: the same seed travels far longer (docs/PATHLOSS.md, "The P0 floor").
+/// it (within 6 dB in every run of seeds 1..5) and the robot reaches the source. A floor of
+/// 0 dBm (a
+/// belief 20 dB above the truth) penalises every candidate near the robot's samples and
+/// misleads the robot: the median travel more than doubles (docs/PATHLOSS.md, "The P0
+/// floor").
 static void test_p0_floor_reaches_the_model(void **state)
 {
     (void)state;
-    hs_sim_result_t r[2];
+    enum { SEEDS = 5 };
+    double travel[2][SEEDS];
     for (int k = 0; k < 2; k++) {
         char text[1024];
         snprintf(text, sizeof text,
@@ -353,16 +361,21 @@ static void test_p0_floor_reaches_the_model(void **state)
                  k == 0 ? "" : "seek: {p0_min_dbm: 0}\n");
         hs_sim_env_t env;
         assert_int_equal(load_env(scn("p0_floor.yaml", text), &env), 0);
-        char err[512];
-        assert_int_equal(hs_sim_run_inproc(&env, 1, NULL, &r[k], err, sizeof err), 0);
+        for (int seed = 1; seed <= SEEDS; seed++) {
+            hs_sim_result_t r;
+            char err[512];
+            assert_int_equal(hs_sim_run_inproc(&env, (uint64_t)seed, NULL, &r, err, sizeof err), 0);
+            if (k == 0) {
+                assert_true(r.reached && fabs(r.est_p0 - -19.6) < 6.0);
+            }
+            travel[k][seed - 1] = r.distance_travelled_m;
+        }
         hs_sim_env_close(&env);
+        qsort(travel[k], SEEDS, sizeof travel[k][0], cmp_double);
     }
-    print_message("default floor: %.1f m, P0 %.1f dBm; floor 0 dBm: %.1f m, P0 %.1f dBm\n",
-                  r[0].distance_travelled_m, r[0].est_p0, r[1].distance_travelled_m,
-                  r[1].est_p0);
-    assert_true(r[0].reached && fabs(r[0].est_p0 - -19.6) < 6.0);
-    assert_true(r[0].distance_travelled_m < 3.0 * 10.0);
-    assert_true(r[1].distance_travelled_m > 2.0 * r[0].distance_travelled_m);
+    print_message("median travel: default floor %.1f m, floor 0 dBm %.1f m\n",
+                  travel[0][SEEDS / 2], travel[1][SEEDS / 2]);
+    assert_true(travel[1][SEEDS / 2] > 2.0 * travel[0][SEEDS / 2]);
 }
 
 /// Everything a run writes, in memory.

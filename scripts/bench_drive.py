@@ -23,11 +23,7 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_pathloss_seek import commit, scenario_file, splice, wilson  # noqa: E402
 
-FLOORS = {"default": ("default office", "scenarios/default.yaml"),
-          "lshape": ("L-shaped floor", "scenarios/lshape.yaml"),
-          "willow": ("willow (real map)", "scenarios/willow.yaml"),
-          "3ne": ("3ne (real map)", "scenarios/3ne.yaml"),
-          "intel": ("intel (real map)", "scenarios/intel.yaml")}
+FLOORS = {f: (f, f"scenarios/{f}.yaml") for f in ("default", "lshape", "willow", "3ne", "intel")}
 # (label, localisation settings)
 NOISE = [("exact poses", "sigma_xy_m: 0, sigma_theta_rad: 0"),
          ("0 cm, 0.02 rad", "sigma_xy_m: 0, sigma_theta_rad: 0.02"),
@@ -75,35 +71,31 @@ def run(sim, scenario, strategy, model, seeds, jobs):
             "contacts": sum(int(r["wall_contacts"]) for r in rows)}
 
 
-def cells(r):
-    """Two compact cells: success (interval), then travel/turning/abandoned/contacts."""
-    return [f"{100 * r['k'] / r['n']:.1f}% ({100 * r['lo']:.0f}-{100 * r['hi']:.0f})",
-            f"{r['ratio']:.2f}/{100 * r['turn']:.0f}%/{r['timeouts'] + r['blocked']:.2f}/"
-            f"{r['contacts']}"]
+def cell(r):
+    """One compact cell: success, then travel/turning/abandoned/contacts."""
+    return (f"{100 * r['k'] / r['n']:.1f}% {r['ratio']:.2f}/{100 * r['turn']:.0f}%/"
+            f"{r['timeouts'] + r['blocked']:.2f}/{r['contacts']}")
 
 
-def section(seeds, wall, at, tables):
+def section(seeds, wall, at, floors, rows):
+    """floors: [label]; rows: [(noise label, [cell per floor x configuration])]."""
     L = [BEGIN, "## The drive under localisation noise", "",
          f"Written by `/usr/bin/python3 scripts/bench_drive.py --seeds {seeds}` at commit "
          f"{at} ({wall:.0f} s on two cores). Seeds {seeds} of each floor's shipped scenario "
          "with only `localisation` changed (10 Hz; Gaussian per axis and on the heading; "
          "AMCL-like adds a drift bounded by 0.2 m and 0.3 m jumps about once a minute, "
-         "docs/SIMULATOR.md \"Localisation\"). Per configuration: success (95 % Wilson "
-         "interval), then `travel/turning/abandoned/contacts`: median travel / shortest path "
-         "over all runs; time turning on the spot (forward speed < 2 cm/s) as a share of "
-         "mission time; goals abandoned (timed out or blocked) per run; wall contacts over "
-         "all runs (Box2D contact events).", ""]
-    for title, rows in tables:
-        L.append(f"**{title}**")
-        L.append("")
-        head = ["localisation"]
-        for _, _, name in CONFIGS:
-            head += [f"{name}", "travel/turning/abandoned/contacts"]
-        L.append("| " + " | ".join(head) + " |")
-        L.append("|---" * len(head) + "|")
-        for label, cs in rows:
-            L.append(f"| {label} | " + " | ".join(cs) + " |")
-        L.append("")
+         "docs/SIMULATOR.md \"Localisation\"). Columns: floor, then `r` = meta + ridge "
+         "(the paper), `p` = meta-path + pathloss. Cells: success (95 % interval about "
+         "+-5 points at 85 %), then `travel/turning/abandoned/contacts`: median travel / "
+         "shortest path over all runs; time turning on the spot (forward speed < 2 cm/s) "
+         "as a share of mission time; goals abandoned (timed out or blocked) per run; wall "
+         "contacts over all runs (Box2D contact events).", ""]
+    head = ["localisation"] + [f"{f} {c}" for f in floors for c in ("r", "p")]
+    L.append("| " + " | ".join(head) + " |")
+    L.append("|---" * len(head) + "|")
+    for label, cs in rows:
+        L.append(f"| {label} | " + " | ".join(cs) + " |")
+    L.append("")
     L.append(END)
     return "\n".join(L) + "\n"
 
@@ -124,25 +116,25 @@ def main():
             sys.exit(f"bench_drive: --floors: unknown floor {f!r} (known: {', '.join(FLOORS)})")
     tmps = []
     t0 = time.time()
-    tables = []
+    floors = a.floors.split(",")
+    rows = []
     try:
-        for f in a.floors.split(","):
-            label, path = FLOORS[f]
-            rows = []
-            for nlabel, settings in NOISE:
+        for nlabel, settings in NOISE:
+            cs = []
+            for f in floors:
+                path = FLOORS[f][1]
                 edits, extra = localisation_edit(path, settings)
                 scen = scenario_file(path, edits, tmps, extra)
-                cs = []
                 for strategy, model, _ in CONFIGS:
-                    cs += cells(run(a.sim, scen, strategy, model, a.seeds, a.jobs))
-                rows.append((nlabel, cs))
-                print(f"{label} | {nlabel} | " + " | ".join(cs), flush=True)
-            tables.append((label, rows))
+                    cs.append(cell(run(a.sim, scen, strategy, model, a.seeds, a.jobs)))
+            rows.append((nlabel, cs))
+            print(f"{nlabel} | " + " | ".join(cs), flush=True)
     finally:
         for t in tmps:
             os.unlink(t)
     if not a.no_write:
-        splice(a.results, section(a.seeds, time.time() - t0, commit(), tables), BEGIN, END)
+        text = section(a.seeds, time.time() - t0, commit(), floors, rows)
+        splice(a.results, text, BEGIN, END)
         print(f"wrote {a.results} ({time.time() - t0:.0f} s)")
 
 

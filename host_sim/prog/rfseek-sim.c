@@ -32,8 +32,9 @@ static void usage(FILE *f)
             "Run the seeker (core in-process) in the simulated world of SCENARIO (YAML).\n"
             "\n"
             "  --seed N        run seed (default: the scenario's seed)\n"
-            "  --out DIR       write log.tsv, track.tsv, summary.json (and samples.tsv) to DIR;\n"
-            "                  without it a single run prints summary.json on stdout; with\n"
+            "  --out DIR       write log.tsv, track.tsv, summary.json (and samples.tsv) to DIR\n"
+            "                  (a single run prints one line: how it ended); without it a\n"
+            "                  single run prints summary.json on stdout; with\n"
             "                  --model pathloss also residual.tsv (the fit's residual surface)\n"
             "  --samples       also write every received packet to DIR/samples.tsv\n"
             "                  (always written for a single run with --out)\n"
@@ -852,6 +853,8 @@ static int emit_jobs(const sim_opts_t *o, const hs_scenario_t *sc)
  * place when complete: the exit status. */
 static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
 {
+    hs_sim_result_t res;
+    memset(&res, 0, sizeof res);
     char err[1024];
     hs_sim_env_t env;
     if (hs_sim_env_open(&env, sc, err, sizeof err) != 0) {
@@ -888,7 +891,6 @@ static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
         rc = run_batch(&env, header, o->sa, o->sb, (int)o->jobs, o->out ? tmp : NULL, o->samples,
                        o->quiet, o->resume);
     } else {
-        hs_sim_result_t res;
         char msg[1024];
         rc = run_one(&env, o->has_seed ? o->seed : sc->seed, o->out ? tmp : NULL, o->out != NULL,
                      o->field, o->pcap, &res, msg, sizeof msg);
@@ -908,6 +910,13 @@ static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
         } else if (rc != 0) {
             rm_tree(tmp);
         }
+    }
+    if (rc == 0 && o->out && !o->seeds) {
+        // A single run into DIR: one line to say how it went (summary.json has the rest).
+        printf("seed %llu: %s after %.1f s and %.1f m (shortest path %.1f m), %u decisions, "
+               "%.1f m from the goal; %s/summary.json\n", (unsigned long long)res.seed,
+               res.end, res.sim_time_s, res.distance_travelled_m, res.shortest_path_m,
+               res.iterations, res.final_distance_m, o->out);
     }
     return rc;
 }

@@ -158,6 +158,24 @@ head -1 "$T/run_a/log.tsv" | grep -q $'t_s\tx_m\ty_m\ttheta_rad' &&
 head -1 "$T/run_a/log.tsv" | grep -q $'kind\treason\trelearned\tprediction_db\tmean_db' &&
     pass log_columns || fail log_columns
 
+# --- placement overrides ---------------------------------------------------------------------
+bad start_text "--start: expected X,Y[,THETA] (metres, radians), got '8,x'" scenarios/default.yaml --start 8,x --out "$T/out"
+bad source_theta "--source: expected X,Y (metres), got '8,6,1'" scenarios/default.yaml --source 8,6,1 --out "$T/out"
+bad source_off_map "sources[0].position: (20.00, 100.00) is off the map" scenarios/default.yaml --source 20,100 --out "$T/out"
+bad start_in_clearance "start.position: (0.10, 0.10) is closer than the clearance" scenarios/default.yaml --start 0.1,0.1 --out "$T/out"
+"$SIM" scenarios/default.yaml --start 8,6,1.5 --source 27.5,4 >"$T/placed.json" 2>"$T/stderr"
+if /usr/bin/python3 - "$T/placed.json" <<'EOF'
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["start"] == [8.0, 6.0] and s["sources"] == [[27.5, 4.0]], s
+# The corridor runs along y 5..7 m: (27.5, 4) is in a room south of it, a door away, not
+# the scenario's source at (27.5, 10).
+assert 19.5 < s["shortest_path_m"] < 25.0, s["shortest_path_m"]
+EOF
+then pass placement_override; else fail placement_override "$(cat "$T/stderr")"; fi
+"$SIM" scenarios/default.yaml --seeds 1..2 --emit-jobs --out "$T/ej" --start 8,6 --source 27.5,4 >"$T/placed_jobs"
+[ "$(grep -c -- '--start 8,6 --source 27.5,4$' "$T/placed_jobs")" -eq 2 ] && pass placement_emit_jobs || fail placement_emit_jobs "$(cat "$T/placed_jobs")"
+
 # --- batch, job list, merge ----------------------------------------------------------------
 "$SIM" scenarios/open.yaml --seeds 1..4 --jobs 2 --quiet --out "$T/batch" 2>"$T/stderr"
 if [ $? -eq 0 ] && [ "$(wc -l <"$T/batch/runs.tsv")" -eq 5 ]; then pass batch_table; else fail batch_table "$(cat "$T/stderr")"; fi

@@ -1,9 +1,10 @@
 # mk/linux.mk - the Linux port (firmware/port/linux/): its I/O adapters (SocketCAN, LCM,
-# map files, YAML, pcap, radiotap, one-line errors) and the lcm-gen types as librfs_linux.a,
-# C only; rfseekd and rfseek-replay linked with the C linker against it, the application
-# and the core only; their tests, the SocketCAN VM test and the link check.
+# map files with PGM and PNG images, YAML, pcap, radiotap, one-line errors) and the
+# lcm-gen types as librfs_linux.a, C only; rfseekd and rfseek-replay linked with the C
+# linker against it, the application and the core only; their tests, the SocketCAN VM
+# test and the link check.
 LINUX_SRCS := $(sort $(wildcard firmware/port/linux/*.c))
-LINUX_CFLAGS := $(HOST_CFLAGS) $(INC_linux) $(YAML_CFLAGS)
+LINUX_CFLAGS := $(HOST_CFLAGS) $(INC_linux) $(YAML_CFLAGS) $(PNG_CFLAGS)
 LINUX_PROGS := $(patsubst firmware/port/linux/prog/%.c,$(BUILD)/bin/%,$(sort $(wildcard firmware/port/linux/prog/*.c)))
 
 # lcm-gen C has unused parameters: compiled without -Werror.

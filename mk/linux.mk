@@ -52,6 +52,13 @@ $(eval $(call cmocka_test,test_lx_pcap,tests/linux/test_lx_pcap.c,linux))
 $(eval $(call cmocka_test,test_lcm,tests/wire/test_lcm.c,linux))
 $(eval $(call cmocka_test,test_status_est,tests/host_sim/test_status_est.c,linux))
 
+# map_dump: a map's occupancy values and cells as lx_map reads them (tests/linux/map_formats.py,
+# run from mk/sim.mk with rfseek-map).
+MAP_DUMP := $(BUILD)/tests/map_dump
+$(MAP_DUMP): tests/linux/map_dump.c $(LIBS_linux) | $(LCM_GEN_HDRS)
+	@mkdir -p $(@D)
+	$(LD_linux) $(LINUX_CFLAGS) $(DEPFLAGS) -MF $@.d -MT $@ $< -o $@ $(LIBS_linux) $(LDLIBS_linux)
+
 # rfseekd: options, bad input, deterministic replay (also under ASan+UBSan), logs readable
 # by lcm-logplayer, the two-process run with the simulator (udpm in a network namespace).
 WIRE_LCM_TOOL := $(BUILD)/tests/wire/lcm_tool

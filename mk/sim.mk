@@ -66,6 +66,9 @@ $(eval $(call test_script,rfseek_map,tests/host_sim/test_rfseek_map.sh $(BUILD)/
 # Map images as map_server reads them: PNG of every colour type and depth, PGM, the three
 # modes and negate against a reference in exact arithmetic; damaged PNGs; memory.
 $(eval $(call test_script,map_formats,$(PYTHON) tests/linux/map_formats.py $(BUILD),$(MAP_DUMP) $(BUILD)/bin/rfseek-map))
+# rfseek-map --mcu against firmware/rfs_app.h's limits and scripts/map2c.py, --crop keeping
+# every world point's cell, --png's size and metre grid (decoded with PIL).
+$(eval $(call test_script,map_tools,$(PYTHON) tests/host_sim/map_tools.py $(BUILD)/bin/rfseek-map,$(BUILD)/bin/rfseek-map))
 # rfseekd --model pathloss fills the estimate in its status (two-process run in a netns).
 $(eval $(call test_script,status_est,tests/host_sim/status_est.sh $(BUILD),$(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
 # Every program's model and target options and scenario keys, good and bad values; PDR

@@ -621,7 +621,8 @@ int lx_map_crop(const lx_map_t *m, uint32_t x0, uint32_t y0, uint32_t w, uint32_
     if (dst == NULL) {
         return fail(err, errlen, "map", "out of memory");
     }
-    const uint8_t *src = m->cell != NULL ? m->cell : (const uint8_t *)m->value;
+    const bool values = m->cell == NULL; /* the map holds occupancy values, not cells */
+    const uint8_t *src = values ? (const uint8_t *)m->value : m->cell;
     for (uint32_t y = 0; y < h; y++) {
         memcpy(dst + (size_t)y * w, src + (size_t)(y0 + y) * m->w + x0, w);
     }
@@ -631,13 +632,11 @@ int lx_map_crop(const lx_map_t *m, uint32_t x0, uint32_t y0, uint32_t w, uint32_
     out->origin_x = m->origin_x + x0 * m->res;
     out->origin_y = m->origin_y + y0 * m->res;
     out->n_partial = 0;
-    out->cell = m->cell != NULL ? dst : NULL;
-    out->value = m->cell != NULL ? NULL : (int8_t *)dst;
+    out->cell = values ? NULL : dst;
+    out->value = values ? (int8_t *)dst : NULL;
     out->image_path = NULL;
-    if (m->value != NULL) {
-        for (size_t i = 0; i < (size_t)w * h; i++) {
-            out->n_partial += out->value[i] > 0 && out->value[i] < 100;
-        }
+    for (size_t i = 0; values && i < (size_t)w * h; i++) {
+        out->n_partial += (int8_t)dst[i] > 0 && (int8_t)dst[i] < 100;
     }
     return 0;
 }

@@ -3,11 +3,11 @@
 #include "hs_mapdraw.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "lx_err.h"
 #include "lx_png.h"
 
 /* A 5 x 7 font, drawn 2 x 2 pixels a dot: each glyph is 7 rows, bit 4 the left column. */
@@ -30,19 +30,6 @@ static const uint8_t k_glyphs[][7] = {
 
 #define INK 0x282828u   /* frame, ticks and text */
 #define PAPER 0xffffffu /* the margins */
-
-static int fail(char *err, size_t errlen, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-
-static int fail(char *err, size_t errlen, const char *fmt, ...)
-{
-    if (err != NULL && errlen > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, errlen, fmt, ap);
-        va_end(ap);
-    }
-    return -1;
-}
 
 typedef struct draw {
     const lx_map_t *m;
@@ -107,8 +94,8 @@ int hs_mapdraw_layout(const lx_map_t *m, hs_mapdraw_layout_t *out, char *err, si
     memset(out, 0, sizeof(*out));
     uint32_t side = m->w > m->h ? m->w : m->h;
     if (side > HS_MAPDRAW_MAX_SIDE) {
-        return fail(err, errlen, "the map is %u x %u cells: more than %u a side to draw", m->w, m->h,
-                    HS_MAPDRAW_MAX_SIDE);
+        return lx_err_set(err, errlen, NULL, "the map is %u x %u cells: more than %u a side to draw", m->w, m->h,
+                          HS_MAPDRAW_MAX_SIDE);
     }
     uint32_t s = (uint32_t)ceil(20.0 * m->res - 1e-9);
     s = s < 1 ? 1 : s;
@@ -229,7 +216,7 @@ int hs_mapdraw_png(const lx_map_t *m, const rfs_map_t *core, FILE *f, char *err,
     d.m = m;
     d.core = core;
     if (m->cell == NULL || hs_mapdraw_layout(m, &d.lay, err, errlen) != 0) {
-        return m->cell == NULL ? fail(err, errlen, "no cells to draw") : -1;
+        return m->cell == NULL ? lx_err_set(err, errlen, NULL, "no cells to draw") : -1;
     }
     d.ppm = d.lay.scale / m->res;
     /* The whole metres whose line falls inside the map area. */
@@ -255,7 +242,7 @@ int hs_mapdraw_png(const lx_map_t *m, const rfs_map_t *core, FILE *f, char *err,
     }
     d.col_kind = calloc(d.lay.width, 1);
     if (d.col_kind == NULL) {
-        return fail(err, errlen, "out of memory");
+        return lx_err_set(err, errlen, NULL, "out of memory");
     }
     for (long k = d.kx0; k <= d.kx1; k++) {
         d.col_kind[col_of(&d, k)] = k == 0 ? 2 : 1;

@@ -26,38 +26,24 @@
 /* Largest YAML accepted: a map_server YAML is a few lines. */
 #define LX_MAP_MAX_YAML (1u << 20)
 
-static int fail(char *err, size_t errlen, const char *file, const char *fmt, ...)
-{
-    if (err != NULL && errlen > 0) {
-        char msg[512];
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, sizeof(msg), fmt, ap);
-        va_end(ap);
-        snprintf(err, errlen, "%s: %s", file, msg);
-        lx_err_one_line(err); /* a file name from the YAML can hold line breaks */
-    }
-    return -1;
-}
-
 /* Read at most `max` bytes of `path` (a stream such as /dev/zero is cut off there). */
 static int read_file(const char *path, size_t max, uint8_t **buf, size_t *len, char *err, size_t errlen)
 {
     FILE *f = fopen(path, "rb");
     if (f == NULL) {
-        return fail(err, errlen, path, "cannot open: %s", strerror(errno));
+        return lx_err_set(err, errlen, path, "cannot open: %s", strerror(errno));
     }
     uint8_t *b = malloc(max + 1);
     size_t n = b != NULL ? fread(b, 1, max + 1, f) : 0;
     int bad = ferror(f);
     fclose(f);
     if (b == NULL) {
-        return fail(err, errlen, path, "out of memory");
+        return lx_err_set(err, errlen, path, "out of memory");
     }
     if (bad || n > max) {
         free(b);
-        return bad ? fail(err, errlen, path, "read error")
-                   : fail(err, errlen, path, "larger than %zu bytes (a map_server YAML is a few lines)", max);
+        return bad ? lx_err_set(err, errlen, path, "read error")
+                   : lx_err_set(err, errlen, path, "larger than %zu bytes (a map_server YAML is a few lines)", max);
     }
     *buf = b;
     *len = n;
@@ -128,7 +114,7 @@ static int sink_alloc(img_sink_t *s, uint32_t w, uint32_t h, uint32_t maxval, in
     s->channels = channels;
     void *p = malloc((size_t)w * h);
     if (p == NULL) {
-        return fail(err, errlen, s->path, "out of memory");
+        return lx_err_set(err, errlen, s->path, "out of memory");
     }
     if (s->want_values) {
         s->value = p;
@@ -256,18 +242,18 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
     lx_yaml_rc_t yrc = lx_yaml_load_string(buf, len, &doc, &ye);
     if (yrc != LX_YAML_OK) {
         int rc = yrc == LX_YAML_SYNTAX
-                   ? fail(err, errlen, path, "malformed YAML at line %lu: %s", ye.line,
-                          ye.problem ? ye.problem : "parse error")
+                   ? lx_err_set(err, errlen, path, "malformed YAML at line %lu: %s", ye.line,
+                                ye.problem ? ye.problem : "parse error")
                : yrc == LX_YAML_TOO_BIG
-                   ? fail(err, errlen, path, "more than %u YAML nodes", LX_YAML_MAX_NODES)
-                   : fail(err, errlen, path, "cannot initialise the YAML parser");
+                   ? lx_err_set(err, errlen, path, "more than %u YAML nodes", LX_YAML_MAX_NODES)
+                   : lx_err_set(err, errlen, path, "cannot initialise the YAML parser");
         lx_yaml_free(&doc);
         return rc;
     }
     int rc = 0;
     const lx_yaml_node_t *root = doc.root;
     if (root == NULL || root->kind != LX_YAML_MAPPING) {
-        rc = fail(err, errlen, path, "not a map_server YAML (a mapping of keys expected)");
+        rc = lx_err_set(err, errlen, path, "not a map_server YAML (a mapping of keys expected)");
         goto out;
     }
     for (size_t i = 0; i < root->n; i++) {
@@ -276,26 +262,26 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
         const char *val = lx_yaml_scalar(vn);
         number_key_t num;
         if (key == NULL) {
-            rc = fail(err, errlen, path, "non-scalar key");
+            rc = lx_err_set(err, errlen, path, "non-scalar key");
             goto out;
         }
         if (strcmp(key, "image") == 0) {
             if (val == NULL || *val == '\0' || strlen(val) >= sizeof(f->image)) {
-                rc = fail(err, errlen, path, "image: a file name expected");
+                rc = lx_err_set(err, errlen, path, "image: a file name expected");
                 goto out;
             }
             snprintf(f->image, sizeof(f->image), "%s", val);
             f->has_image = true;
         } else if (number_key(f, key, &num)) {
             if (!parse_double(val, num.value)) {
-                rc = fail(err, errlen, path, "%s: a number expected", key);
+                rc = lx_err_set(err, errlen, path, "%s: a number expected", key);
                 goto out;
             }
             *num.have = true;
         } else if (strcmp(key, "origin") == 0) {
             double v[3];
             if (vn == NULL || vn->kind != LX_YAML_SEQUENCE) {
-                rc = fail(err, errlen, path, "origin: a list [x, y, yaw] expected");
+                rc = lx_err_set(err, errlen, path, "origin: a list [x, y, yaw] expected");
                 goto out;
             }
             bool ok = vn->n == 3;
@@ -303,7 +289,7 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
                 ok = parse_double(lx_yaml_scalar(vn->child[it]), &v[it]);
             }
             if (!ok) {
-                rc = fail(err, errlen, path, "origin: a list of three numbers [x, y, yaw] expected");
+                rc = lx_err_set(err, errlen, path, "origin: a list of three numbers [x, y, yaw] expected");
                 goto out;
             }
             f->ox = v[0];
@@ -316,7 +302,7 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
             } else if (val != NULL && (strcmp(val, "1") == 0 || strcasecmp(val, "true") == 0)) {
                 f->negate = 1;
             } else {
-                rc = fail(err, errlen, path, "negate: 0 or 1 expected, got '%s'", val ? val : "(not a scalar)");
+                rc = lx_err_set(err, errlen, path, "negate: 0 or 1 expected, got '%s'", val ? val : "(not a scalar)");
                 goto out;
             }
             f->has_negate = true;
@@ -328,8 +314,8 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
                 f->mode = strcmp(val, modes[k]) == 0 ? k : f->mode;
             }
             if (f->mode < 0) {
-                rc = fail(err, errlen, path, "mode: '%s' unknown (trinary, scale or raw)",
-                          val ? val : "(not a scalar)");
+                rc = lx_err_set(err, errlen, path, "mode: '%s' unknown (trinary, scale or raw)",
+                                val ? val : "(not a scalar)");
                 goto out;
             }
         }
@@ -339,20 +325,20 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
                         : !f->has_origin ? "origin" : !f->has_negate ? "negate"
                         : !f->has_occ ? "occupied_thresh" : !f->has_free ? "free_thresh" : NULL;
     if (missing != NULL) {
-        rc = fail(err, errlen, path, "missing key '%s'", missing);
+        rc = lx_err_set(err, errlen, path, "missing key '%s'", missing);
     } else if (!(f->res > 0)) {
-        rc = fail(err, errlen, path, "resolution: must be > 0 (got %g)", f->res);
+        rc = lx_err_set(err, errlen, path, "resolution: must be > 0 (got %g)", f->res);
     } else if (!(f->res >= LX_MAP_RES_MIN && f->res <= LX_MAP_RES_MAX)) {
-        rc = fail(err, errlen, path, "resolution: %g m out of range (%g .. %g m per pixel)", f->res,
-                  LX_MAP_RES_MIN, LX_MAP_RES_MAX);
+        rc = lx_err_set(err, errlen, path, "resolution: %g m out of range (%g .. %g m per pixel)", f->res,
+                        LX_MAP_RES_MIN, LX_MAP_RES_MAX);
     } else if (f->yaw != 0.0) {
-        rc = fail(err, errlen, path, "origin: yaw %g unsupported (rotated maps; only 0)", f->yaw);
+        rc = lx_err_set(err, errlen, path, "origin: yaw %g unsupported (rotated maps; only 0)", f->yaw);
     } else if (f->occ < 0 || f->occ > 1 || f->free_th < 0 || f->free_th > 1) {
-        rc = fail(err, errlen, path, "thresholds must lie in [0, 1] (occupied_thresh %g, free_thresh %g)",
-                  f->occ, f->free_th);
+        rc = lx_err_set(err, errlen, path, "thresholds must lie in [0, 1] (occupied_thresh %g, free_thresh %g)",
+                        f->occ, f->free_th);
     } else if (!(f->free_th < f->occ)) {
-        rc = fail(err, errlen, path, "thresholds out of order: free_thresh %g must be below occupied_thresh %g",
-                  f->free_th, f->occ);
+        rc = lx_err_set(err, errlen, path, "thresholds out of order: free_thresh %g must be below occupied_thresh %g",
+                        f->free_th, f->occ);
     }
 out:
     lx_yaml_free(&doc);
@@ -390,7 +376,7 @@ static int map_load(const char *yaml_path, bool want_values, lx_map_t *m, char *
     char *ip = strdup(ipath);
     if (ip == NULL || image_load(&s, err, errlen) != 0) {
         if (ip == NULL) {
-            fail(err, errlen, yaml_path, "out of memory");
+            lx_err_set(err, errlen, yaml_path, "out of memory");
         }
         free(ip);
         free(s.cell);
@@ -476,11 +462,11 @@ int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
 {
     memset(out, 0, sizeof(*out));
     if (!(core_res > 0) || !isfinite(core_res) || core_res > 1000.0) {
-        return fail(err, errlen, "map", "core resolution %g out of range (0, 1000] m", core_res);
+        return lx_err_set(err, errlen, "map", "core resolution %g out of range (0, 1000] m", core_res);
     }
     if (!(m->res >= LX_MAP_RES_MIN && m->res <= LX_MAP_RES_MAX)) {
-        return fail(err, errlen, "map", "resolution %g m out of range (%g .. %g m per pixel)", m->res,
-                    LX_MAP_RES_MIN, LX_MAP_RES_MAX);
+        return lx_err_set(err, errlen, "map", "resolution %g m out of range (%g .. %g m per pixel)", m->res,
+                          LX_MAP_RES_MIN, LX_MAP_RES_MAX);
     }
     rfs_map_cfg_t c = cfg != NULL ? *cfg : rfs_map_cfg_default();
     /* The core's cells use the Q16 resolution and origin; align the resampling to them. */
@@ -488,7 +474,7 @@ int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
     double oxd = m->origin_x * 65536.0;
     double oyd = m->origin_y * 65536.0;
     if (res_q <= 0 || fabs(oxd) > 2147483647.0 || fabs(oyd) > 2147483647.0) {
-        return fail(err, errlen, "map", "resolution or origin not representable in Q16.16");
+        return lx_err_set(err, errlen, "map", "resolution or origin not representable in Q16.16");
     }
     int64_t ox_q = llround(oxd);
     int64_t oy_q = llround(oyd);
@@ -501,14 +487,14 @@ int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
     double cwd = ceil((m->origin_x + wm - ox - LX_MAP_SLIVER * m->res) / cr);
     double chd = ceil((m->origin_y + hm - oy - LX_MAP_SLIVER * m->res) / cr);
     if (cwd < 1 || chd < 1 || cwd > 65535 || chd > 65535) {
-        return fail(err, errlen, "map", "core grid %.0f x %.0f cells at %g m does not fit 1..65535",
-                    cwd, chd, core_res);
+        return lx_err_set(err, errlen, "map", "core grid %.0f x %.0f cells at %g m does not fit 1..65535",
+                          cwd, chd, core_res);
     }
     /* 2^26 cells (8 MB per bit grid, e.g. 800 x 800 m at 0.1 m): a larger floor is a
      * wrong resolution in the YAML, not a building, and would take minutes to derive. */
     if (cwd * chd > 67108864.0) {
-        return fail(err, errlen, "map", "core grid %.0f x %.0f cells at %g m is over the 2^26-cell limit",
-                    cwd, chd, core_res);
+        return lx_err_set(err, errlen, "map", "core grid %.0f x %.0f cells at %g m is over the 2^26-cell limit",
+                          cwd, chd, core_res);
     }
     uint16_t cw = (uint16_t)cwd;
     uint16_t ch = (uint16_t)chd;
@@ -518,7 +504,7 @@ int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
     out->legal_bits = calloc(bytes, 1);
     if (out->free_bits == NULL || out->wall_bits == NULL || out->legal_bits == NULL) {
         lx_core_map_free(out);
-        return fail(err, errlen, "map", "out of memory");
+        return lx_err_set(err, errlen, "map", "out of memory");
     }
     uint16_t stride = (uint16_t)((cw + 7u) / 8u);
     for (uint16_t cy = 0; cy < ch; cy++) {
@@ -544,9 +530,9 @@ int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
             bool any_occ = false;
             for (long fy = fy0 < 0 ? 0 : fy0; fy <= fy1 && fy < (long)m->h; fy++) {
                 for (long fx = fx0 < 0 ? 0 : fx0; fx <= fx1 && fx < (long)m->w; fx++) {
-                    uint8_t s = m->cell[(size_t)fy * m->w + (size_t)fx];
-                    all_free = all_free && s == LX_CELL_FREE;
-                    any_occ = any_occ || s == LX_CELL_OCC;
+                          uint8_t s = m->cell[(size_t)fy * m->w + (size_t)fx];
+                          all_free = all_free && s == LX_CELL_FREE;
+                          any_occ = any_occ || s == LX_CELL_OCC;
                 }
             }
             rfs_map_bit_set(out->free_bits, stride, cx, cy, all_free);
@@ -556,9 +542,9 @@ int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
     if (rfs_map_init(&out->map, &c, cw, ch, (rfs_q16_t)res_q, (rfs_q16_t)ox_q, (rfs_q16_t)oy_q,
                      out->free_bits, out->wall_bits, out->legal_bits) != 0) {
         lx_core_map_free(out);
-        return fail(err, errlen, "map", "the core rejects the map (%u x %u cells at %g m, clearance %g m, "
-                    "grid %g m: extent above 16384 m, clearance above 64 m or 255 cells, or lattice above 65535)",
-                    cw, ch, core_res, c.clearance / 65536.0, c.grid / 65536.0);
+        return lx_err_set(err, errlen, "map", "the core rejects the map (%u x %u cells at %g m, clearance %g m, "
+                          "grid %g m: extent above 16384 m, clearance above 64 m or 255 cells, or lattice above 65535)",
+                          cw, ch, core_res, c.clearance / 65536.0, c.grid / 65536.0);
     }
     return 0;
 }
@@ -614,12 +600,12 @@ int lx_map_crop(const lx_map_t *m, uint32_t x0, uint32_t y0, uint32_t w, uint32_
 {
     memset(out, 0, sizeof(*out));
     if (w == 0 || h == 0 || x0 > m->w || y0 > m->h || w > m->w - x0 || h > m->h - y0) {
-        return fail(err, errlen, "map", "crop %u x %u at (%u, %u) outside the %u x %u image", w, h, x0, y0, m->w,
-                    m->h);
+        return lx_err_set(err, errlen, "map", "crop %u x %u at (%u, %u) outside the %u x %u image", w, h, x0, y0, m->w,
+                          m->h);
     }
     uint8_t *dst = malloc((size_t)w * h);
     if (dst == NULL) {
-        return fail(err, errlen, "map", "out of memory");
+        return lx_err_set(err, errlen, "map", "out of memory");
     }
     const bool values = m->cell == NULL; /* the map holds occupancy values, not cells */
     const uint8_t *src = values ? (const uint8_t *)m->value : m->cell;
@@ -668,7 +654,7 @@ static int save_pgm(const lx_map_t *m, const char *path, char *err, size_t errle
 {
     FILE *f = fopen(path, "wb");
     if (f == NULL) {
-        return fail(err, errlen, path, "cannot create: %s", strerror(errno));
+        return lx_err_set(err, errlen, path, "cannot create: %s", strerror(errno));
     }
     /* Trinary levels as map_saver writes them; the YAML's thresholds keep 205 unknown. */
     static const uint8_t level[3] = {[LX_CELL_FREE] = 254, [LX_CELL_OCC] = 0, [LX_CELL_UNKNOWN] = 205};
@@ -682,9 +668,9 @@ static int save_pgm(const lx_map_t *m, const char *path, char *err, size_t errle
     }
     if (fflush(f) != 0 || ferror(f)) {
         fclose(f);
-        return fail(err, errlen, path, "write error: %s", strerror(errno));
+        return lx_err_set(err, errlen, path, "write error: %s", strerror(errno));
     }
-    return fclose(f) != 0 ? fail(err, errlen, path, "write error: %s", strerror(errno)) : 0;
+    return fclose(f) != 0 ? lx_err_set(err, errlen, path, "write error: %s", strerror(errno)) : 0;
 }
 
 static int save_yaml(const lx_map_t *m, const char *path, const char *image, char *err, size_t errlen)
@@ -698,7 +684,7 @@ static int save_yaml(const lx_map_t *m, const char *path, const char *image, cha
     shortest(oy, sizeof(oy), round(m->origin_y * 1e9) / 1e9 + 0.0);
     FILE *f = fopen(path, "w");
     if (f == NULL) {
-        return fail(err, errlen, path, "cannot create: %s", strerror(errno));
+        return lx_err_set(err, errlen, path, "cannot create: %s", strerror(errno));
     }
     fputs("# written by rfseek-map --crop (docs/MAPS.md)\nimage: '", f);
     for (const char *c = image; *c != '\0'; c++) {
@@ -708,9 +694,9 @@ static int save_yaml(const lx_map_t *m, const char *path, const char *image, cha
                "free_thresh: 0.1\nmode: trinary\n", res, ox, oy);
     if (fflush(f) != 0 || ferror(f)) {
         fclose(f);
-        return fail(err, errlen, path, "write error: %s", strerror(errno));
+        return lx_err_set(err, errlen, path, "write error: %s", strerror(errno));
     }
-    return fclose(f) != 0 ? fail(err, errlen, path, "write error: %s", strerror(errno)) : 0;
+    return fclose(f) != 0 ? lx_err_set(err, errlen, path, "write error: %s", strerror(errno)) : 0;
 }
 
 int lx_map_save(const lx_map_t *m, const char *yaml_path, char *err, size_t errlen)
@@ -720,22 +706,22 @@ int lx_map_save(const lx_map_t *m, const char *yaml_path, char *err, size_t errl
     char ytmp[4100];
     if (!lx_map_save_image_path(yaml_path, ipath, sizeof(ipath)) ||
         (size_t)snprintf(ytmp, sizeof(ytmp), "%s.tmp", yaml_path) >= sizeof(ytmp)) {
-        return fail(err, errlen, yaml_path, "file name too long");
+        return lx_err_set(err, errlen, yaml_path, "file name too long");
     }
     snprintf(itmp, sizeof(itmp), "%s.tmp", ipath);
     const char *slash = strrchr(ipath, '/');
     const char *iname = slash != NULL ? slash + 1 : ipath;
     for (const char *c = iname; *c != '\0'; c++) {
         if ((unsigned char)*c < 0x20 || *c == 0x7f) {
-            return fail(err, errlen, yaml_path, "the image name would hold a control character");
+            return lx_err_set(err, errlen, yaml_path, "the image name would hold a control character");
         }
     }
     int rc = save_pgm(m, itmp, err, errlen);
     rc = rc == 0 ? save_yaml(m, ytmp, iname, err, errlen) : rc;
     if (rc == 0 && rename(itmp, ipath) != 0) {
-        rc = fail(err, errlen, itmp, "cannot rename to %s: %s", ipath, strerror(errno));
+        rc = lx_err_set(err, errlen, itmp, "cannot rename to %s: %s", ipath, strerror(errno));
     } else if (rc == 0 && rename(ytmp, yaml_path) != 0) {
-        rc = fail(err, errlen, ytmp, "cannot rename to %s: %s", yaml_path, strerror(errno));
+        rc = lx_err_set(err, errlen, ytmp, "cannot rename to %s: %s", yaml_path, strerror(errno));
         remove(ipath);
     }
     remove(itmp);

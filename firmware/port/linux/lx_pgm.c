@@ -9,23 +9,6 @@
 
 #include "lx_err.h"
 
-static int fail(char *err, size_t errlen, const char *file, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
-static int fail(char *err, size_t errlen, const char *file, const char *fmt, ...)
-{
-    if (err != NULL && errlen > 0) {
-        char msg[512];
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, sizeof(msg), fmt, ap);
-        va_end(ap);
-        snprintf(err, errlen, "%s: %s", file, msg);
-        lx_err_one_line(err); /* a file name from the YAML can hold line breaks */
-    }
-    return -1;
-}
-
 /* The image is read as a stream, one byte of look-ahead: never more than the header
  * declares, so a huge or endless file (/dev/zero, a sparse file) costs no memory. */
 typedef struct pgm_in {
@@ -97,21 +80,21 @@ static int pgm_raster_p5(pgm_in_t *in, const pgm_job_t *j, uint16_t *samples, ch
     size_t bpp = j->maxval > 255 ? 2 : 1;
     uint8_t *row = malloc((size_t)w * bpp);
     if (row == NULL) {
-        return fail(err, errlen, j->path, "out of memory");
+        return lx_err_set(err, errlen, j->path, "out of memory");
     }
     for (uint32_t r = 0; r < h; r++) {
         size_t got = fread(row, bpp, w, in->f);
         if (got < w) {
             free(row);
-            return fail(err, errlen, j->path, "truncated: %zu raster bytes, header says %u x %u needs %zu",
-                        ((size_t)r * w + got) * bpp, w, h, (size_t)w * h * bpp);
+            return lx_err_set(err, errlen, j->path, "truncated: %zu raster bytes, header says %u x %u needs %zu",
+                              ((size_t)r * w + got) * bpp, w, h, (size_t)w * h * bpp);
         }
         for (uint32_t x = 0; x < w; x++) {
             uint16_t v = bpp == 2 ? (uint16_t)(row[2 * x] << 8 | row[2 * x + 1]) : row[x];
             if (v > j->maxval) {
                 free(row);
-                return fail(err, errlen, j->path, "pixel %zu value %u above maxval %u", (size_t)r * w + x, v,
-                            j->maxval);
+                return lx_err_set(err, errlen, j->path, "pixel %zu value %u above maxval %u", (size_t)r * w + x, v,
+                                  j->maxval);
             }
             samples[x] = v;
         }
@@ -132,10 +115,10 @@ static int pgm_raster_p2(pgm_in_t *in, const pgm_job_t *j, uint16_t *samples, ch
         if (v < 0) {
             pgm_skip(in);
             if (in->c == EOF) {
-                return fail(err, errlen, j->path, "truncated: %zu of %zu pixels (header says %u x %u)", i, count,
-                            j->w, j->h);
+                return lx_err_set(err, errlen, j->path, "truncated: %zu of %zu pixels (header says %u x %u)", i, count,
+                                  j->w, j->h);
             }
-            return fail(err, errlen, j->path, "bad pixel value at pixel %zu (0..%u expected)", i, j->maxval);
+            return lx_err_set(err, errlen, j->path, "bad pixel value at pixel %zu (0..%u expected)", i, j->maxval);
         }
         samples[i % j->w] = (uint16_t)v;
         if (i % j->w == j->w - 1) {
@@ -151,14 +134,14 @@ int lx_pgm_read(const char *path, uint64_t max_pixels, lx_pgm_info_fn on_info, l
 {
     pgm_in_t in = {fopen(path, "rb"), EOF, 0};
     if (in.f == NULL) {
-        return fail(err, errlen, path, "cannot open: %s", strerror(errno));
+        return lx_err_set(err, errlen, path, "cannot open: %s", strerror(errno));
     }
     int c0 = getc(in.f);
     int c1 = getc(in.f);
     if (c0 != 'P' || (c1 != '5' && c1 != '2')) {
-        int rc = ferror(in.f) ? fail(err, errlen, path, "read error")
-                              : fail(err, errlen, path, "not a PGM or PNG image (magic P5, P2 or the PNG "
-                                     "signature expected)");
+        int rc = ferror(in.f) ? lx_err_set(err, errlen, path, "read error")
+                              : lx_err_set(err, errlen, path, "not a PGM or PNG image (magic P5, P2 or the PNG "
+                                           "signature expected)");
         fclose(in.f);
         return rc;
     }
@@ -172,28 +155,28 @@ int lx_pgm_read(const char *path, uint64_t max_pixels, lx_pgm_info_fn on_info, l
     uint16_t *samples = NULL;
     pgm_job_t j = {path, (uint32_t)lw, (uint32_t)lh, (uint32_t)lm, on_row, ctx};
     if (lw < 0 || lh < 0 || lm < 0) {
-        rc = fail(err, errlen, path, "malformed or truncated PGM header (width height maxval)");
+        rc = lx_err_set(err, errlen, path, "malformed or truncated PGM header (width height maxval)");
     } else if (lw == 0 || lh == 0 || (uint64_t)lw * (uint64_t)lh > max_pixels) {
-        rc = fail(err, errlen, path, "image size %ld x %ld out of range (1..%llu pixels)", lw, lh,
-                  (unsigned long long)max_pixels);
+        rc = lx_err_set(err, errlen, path, "image size %ld x %ld out of range (1..%llu pixels)", lw, lh,
+                        (unsigned long long)max_pixels);
     } else if (lm == 0) {
-        rc = fail(err, errlen, path, "maxval 0 in PGM header");
+        rc = lx_err_set(err, errlen, path, "maxval 0 in PGM header");
     } else if (!ascii && !(in.c == ' ' || in.c == '\t' || in.c == '\n' || in.c == '\r')) {
         /* P5: exactly one whitespace byte after maxval (already read as in.c), then the raster. */
-        rc = fail(err, errlen, path, "malformed or truncated PGM header (no raster)");
+        rc = lx_err_set(err, errlen, path, "malformed or truncated PGM header (no raster)");
     } else if (on_info(ctx, j.w, j.h, j.maxval, ascii, err, errlen) != 0) {
         rc = -1;
     } else if ((samples = malloc((size_t)lw * sizeof(*samples))) == NULL) {
-        rc = fail(err, errlen, path, "out of memory");
+        rc = lx_err_set(err, errlen, path, "out of memory");
     } else {
         rc = ascii ? pgm_raster_p2(&in, &j, samples, err, errlen) : pgm_raster_p5(&in, &j, samples, err, errlen);
         if (rc == 0 && in.c != EOF) {
-            rc = fail(err, errlen, path, "data after the %ld x %ld %s the header declares (at byte %llu)", lw, lh,
-                      ascii ? "pixels" : "raster", (unsigned long long)in.pos);
+            rc = lx_err_set(err, errlen, path, "data after the %ld x %ld %s the header declares (at byte %llu)", lw, lh,
+                            ascii ? "pixels" : "raster", (unsigned long long)in.pos);
         }
     }
     if (rc == 0 && ferror(in.f)) {
-        rc = fail(err, errlen, path, "read error");
+        rc = lx_err_set(err, errlen, path, "read error");
     }
     free(samples);
     fclose(in.f);

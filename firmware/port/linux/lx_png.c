@@ -14,27 +14,6 @@
 
 #include "lx_err.h"
 
-static int fail(char *err, size_t errlen, const char *file, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
-static int fail(char *err, size_t errlen, const char *file, const char *fmt, ...)
-{
-    if (err != NULL && errlen > 0) {
-        char msg[512];
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, sizeof(msg), fmt, ap);
-        va_end(ap);
-        if (file != NULL) {
-            snprintf(err, errlen, "%s: %s", file, msg);
-        } else {
-            snprintf(err, errlen, "%s", msg);
-        }
-        lx_err_one_line(err);
-    }
-    return -1;
-}
-
 /* What a read or write owns across libpng's longjmp, and libpng's last message. */
 typedef struct png_job {
     FILE *f;
@@ -102,8 +81,8 @@ static int read_body(png_structp png, png_infop info, png_job_t *j, const char *
     pi.bit_depth = png_get_bit_depth(png, info);
     pi.interlaced = png_get_interlace_type(png, info) != PNG_INTERLACE_NONE;
     if (pi.w > LX_PNG_MAX_SIDE || pi.h > LX_PNG_MAX_SIDE || (uint64_t)pi.w * pi.h > max_pixels) {
-        return fail(err, errlen, path, "image size %u x %u out of range (1..%llu pixels, at most 2^20 a side)",
-                    pi.w, pi.h, (unsigned long long)max_pixels);
+        return lx_err_set(err, errlen, path, "image size %u x %u out of range (1..%llu pixels, at most 2^20 a side)",
+                          pi.w, pi.h, (unsigned long long)max_pixels);
     }
     if (pi.color_type == PNG_COLOR_TYPE_PALETTE) {
         png_set_palette_to_rgb(png);
@@ -122,25 +101,25 @@ static int read_body(png_structp png, png_infop info, png_job_t *j, const char *
     size_t nsamp = (size_t)pi.w * pi.channels;
     if (pi.channels < 1 || pi.channels > 4 || (pi.depth != 8 && pi.depth != 16) ||
         rowbytes != nsamp * (pi.depth / 8u)) {
-        return fail(err, errlen, path, "unsupported PNG layout (%u channels of %u bits)", pi.channels, pi.depth);
+        return lx_err_set(err, errlen, path, "unsupported PNG layout (%u channels of %u bits)", pi.channels, pi.depth);
     }
     if (passes > 1 && (uint64_t)rowbytes * pi.h > LX_PNG_MAX_INTERLACED) {
-        return fail(err, errlen, path, "interlaced PNG of %u x %u needs %llu MB decoded, above %u MB (save it "
-                    "non-interlaced)", pi.w, pi.h, (unsigned long long)((uint64_t)rowbytes * pi.h >> 20),
-                    LX_PNG_MAX_INTERLACED >> 20);
+        return lx_err_set(err, errlen, path, "interlaced PNG of %u x %u needs %llu MB decoded, above %u MB (save it "
+                          "non-interlaced)", pi.w, pi.h, (unsigned long long)((uint64_t)rowbytes * pi.h >> 20),
+                          LX_PNG_MAX_INTERLACED >> 20);
     }
     if (on_info(ctx, &pi, err, errlen) != 0) {
         return -1;
     }
     j->samples = malloc(nsamp * sizeof(uint16_t));
     if (j->samples == NULL) {
-        return fail(err, errlen, path, "out of memory");
+        return lx_err_set(err, errlen, path, "out of memory");
     }
     if (passes > 1) {
         j->image = malloc(rowbytes * pi.h);
         j->rows = malloc(pi.h * sizeof(png_bytep));
         if (j->image == NULL || j->rows == NULL) {
-            return fail(err, errlen, path, "out of memory");
+            return lx_err_set(err, errlen, path, "out of memory");
         }
         for (uint32_t y = 0; y < pi.h; y++) {
             j->rows[y] = j->image + (size_t)y * rowbytes;
@@ -158,7 +137,7 @@ static int read_body(png_structp png, png_infop info, png_job_t *j, const char *
     }
     png_read_end(png, NULL);
     if (getc(j->f) != EOF) {
-        return fail(err, errlen, path, "data after the IEND chunk");
+        return lx_err_set(err, errlen, path, "data after the IEND chunk");
     }
     return 0;
 }
@@ -169,12 +148,12 @@ int lx_png_read(const char *path, uint64_t max_pixels, lx_png_info_fn on_info, l
     /* On the heap: what changes between setjmp and longjmp must not be a local. */
     png_job_t *job = calloc(1, sizeof(*job));
     if (job == NULL) {
-        return fail(err, errlen, path, "out of memory");
+        return lx_err_set(err, errlen, path, "out of memory");
     }
     job->f = fopen(path, "rb");
     if (job->f == NULL) {
         free(job);
-        return fail(err, errlen, path, "cannot open: %s", strerror(errno));
+        return lx_err_set(err, errlen, path, "cannot open: %s", strerror(errno));
     }
     png_byte sig[8];
     size_t n = fread(sig, 1, sizeof(sig), job->f);
@@ -182,13 +161,13 @@ int lx_png_read(const char *path, uint64_t max_pixels, lx_png_info_fn on_info, l
     png_infop info = NULL;
     int rc = -1;
     if (n != sizeof(sig) || png_sig_cmp(sig, 0, sizeof(sig)) != 0) {
-        rc = ferror(job->f) ? fail(err, errlen, path, "read error")
-                            : fail(err, errlen, path, "not a PNG image (bad signature)");
+        rc = ferror(job->f) ? lx_err_set(err, errlen, path, "read error")
+                            : lx_err_set(err, errlen, path, "not a PNG image (bad signature)");
     } else if ((png = png_create_read_struct(PNG_LIBPNG_VER_STRING, job, on_error, on_warning)) == NULL ||
                (info = png_create_info_struct(png)) == NULL) {
-        rc = fail(err, errlen, path, "out of memory");
+        rc = lx_err_set(err, errlen, path, "out of memory");
     } else if (setjmp(png_jmpbuf(png)) != 0) {
-        rc = fail(err, errlen, path, "damaged PNG: %s", job->msg);
+        rc = lx_err_set(err, errlen, path, "damaged PNG: %s", job->msg);
     } else {
         png_set_read_fn(png, job, on_read);
         png_set_sig_bytes(png, (int)sizeof(sig));
@@ -196,7 +175,7 @@ int lx_png_read(const char *path, uint64_t max_pixels, lx_png_info_fn on_info, l
     }
     png_destroy_read_struct(&png, &info, NULL);
     if (rc == 0 && ferror(job->f)) {
-        rc = fail(err, errlen, path, "read error");
+        rc = lx_err_set(err, errlen, path, "read error");
     }
     fclose(job->f);
     free(job->samples);
@@ -225,7 +204,7 @@ int lx_png_write(FILE *f, uint32_t w, uint32_t h, int channels, lx_png_fill_fn f
                  char *err, size_t errlen)
 {
     if (w == 0 || h == 0 || w > 0x7fffffffu || h > 0x7fffffffu || (channels != 1 && channels != 3)) {
-        return fail(err, errlen, NULL, "cannot write a %u x %u PNG of %d channels", w, h, channels);
+        return lx_err_set(err, errlen, NULL, "cannot write a %u x %u PNG of %d channels", w, h, channels);
     }
     png_job_t *job = calloc(1, sizeof(*job));
     if (job != NULL) {
@@ -238,9 +217,9 @@ int lx_png_write(FILE *f, uint32_t w, uint32_t h, int channels, lx_png_fill_fn f
     if (job == NULL || job->out == NULL ||
         (png = png_create_write_struct(PNG_LIBPNG_VER_STRING, job, on_error, on_warning)) == NULL ||
         (info = png_create_info_struct(png)) == NULL) {
-        rc = fail(err, errlen, NULL, "out of memory");
+        rc = lx_err_set(err, errlen, NULL, "out of memory");
     } else if (setjmp(png_jmpbuf(png)) != 0) {
-        rc = fail(err, errlen, NULL, "%s", job->msg);
+        rc = lx_err_set(err, errlen, NULL, "%s", job->msg);
     } else {
         write_body(png, info, job, w, h, channels, fill, ctx);
     }

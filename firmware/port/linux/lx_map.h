@@ -73,12 +73,12 @@ typedef struct lx_map {
     double occ_th;     ///< occupied_thresh as read
     double free_th;    ///< free_thresh as read
     int negate;        ///< negate as read (0 or 1)
-    int mode;          ///< mode as read: LX_MAP_TRINARY, LX_MAP_SCALE or LX_MAP_RAW
-    char format[48];   ///< the image as read, e.g. "PGM P5, maxval 255" or "PNG RGBA, 8 bits"
+    int mode;           ///< mode as read: LX_MAP_TRINARY, LX_MAP_SCALE or LX_MAP_RAW
+    char format[48];    ///< the image as read, e.g. "PGM P5, maxval 255" or "PNG RGBA, 8 bits"
     uint32_t n_partial; ///< cells of value 1..99 (scale and raw maps), read as free
-    uint8_t *cell;     ///< w * h LX_CELL_* values, index y * w + x, row 0 = BOTTOM
-    int8_t *value;     ///< w * h occupancy values, same layout: lx_map_load_values only
-    char *image_path;  ///< the image's path as opened (heap; NULL for a crop)
+    uint8_t *cell;      ///< w * h LX_CELL_* values, index y * w + x, row 0 = BOTTOM
+    int8_t *value;      ///< w * h occupancy values, same layout: lx_map_load_values only
+    char *image_path;   ///< the image's path as opened (heap; NULL for a crop)
 } lx_map_t;
 
 /// Load a map_server YAML and its image into cell (value NULL). Returns 0, or -1 with

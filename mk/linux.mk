@@ -58,6 +58,9 @@ $(WIRE_LCM_TOOL): tests/wire/lcm_tool.c $(LIBS_linux) | $(LCM_GEN_HDRS)
 	@mkdir -p $(@D)
 	$(LD_linux) $(LINUX_CFLAGS) $(DEPFLAGS) -MF $@.d -MT $@ $< -o $@ $(LIBS_linux) $(LDLIBS_linux)
 $(eval $(call test_script,rfseekd,tests/wire/rfseekd_test.sh $(BUILD),$(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/asan/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
+# CAN logs (candump -L): rfseek-record's and rfseekd's through log2asc, asc2log and canmatrix,
+# and replayed by rfseek-replay to the output of the recorded stream.
+$(eval $(call test_script,candump,tests/wire/candump_test.sh $(BUILD),$(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-replay $(BUILD)/bin/rfseek-record))
 $(eval $(call test_script,outputs,tests/wire/outputs_test.sh $(BUILD),$(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-replay $(BUILD)/bin/rfseek-record $(BUILD)/bin/rfseek-map $(BUILD)/bin/rfseek-feed))
 
 # SocketCAN against the kernel's CAN stack: a static test binary, run natively in a network

@@ -102,10 +102,9 @@ static int parse_id(const char *s, size_t len, size_t *i, lx_candump_rec_t *rec,
     uint32_t v = 0;
     unsigned digits = 0;
     for (; k < len && hexval(s[k]) >= 0; k++, digits++) {
-        if (digits == 8u) {
-            break;
+        if (digits < 8u) {
+            v = v << 4 | (uint32_t)hexval(s[k]);
         }
-        v = v << 4 | (uint32_t)hexval(s[k]);
     }
     if (digits != 3u && digits != 8u) {
         return bad(why, "identifier: 3 hex digits (11-bit) or 8 (29-bit) expected");

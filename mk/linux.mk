@@ -68,9 +68,10 @@ $(eval $(call test_script,outputs,tests/wire/outputs_test.sh $(BUILD),$(WIRE_LCM
 # SocketCAN against the kernel's CAN stack: a static test binary, run natively in a network
 # namespace with vcan or in a one-CPU qemu VM (its own namespace and build/vm: parallel-safe).
 WIRE_VM_BIN := $(BUILD)/tests/vm/can_vm_test
-$(WIRE_VM_BIN): tests/vm/can_vm_test.c $(BUILD)/obj/firmware/port/linux/lx_can.o $(CORE_LIB)
+WIRE_VM_OBJS := $(BUILD)/obj/firmware/port/linux/lx_can.o $(BUILD)/obj/firmware/port/linux/lx_candump.o
+$(WIRE_VM_BIN): tests/vm/can_vm_test.c $(WIRE_VM_OBJS) $(CORE_LIB)
 	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) $(INC_linux) $(DEPFLAGS) -MF $@.d -MT $@ -static $< $(BUILD)/obj/firmware/port/linux/lx_can.o $(CORE_LIB) -o $@
+	$(CC) $(HOST_CFLAGS) $(INC_linux) $(DEPFLAGS) -MF $@.d -MT $@ -static $< $(WIRE_VM_OBJS) $(CORE_LIB) -o $@
 $(eval $(call test_script,can_vm,tests/vm/run_vm_test.sh $(BUILD),$(WIRE_VM_BIN) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
 
 # The daemon and the player link neither Box2D nor the C++ runtime.

@@ -1,7 +1,8 @@
 /* fuzz_radiotap - libFuzzer target for the radiotap + 802.11 parser.
  * Input: one captured record (radiotap header, then the 802.11 frame). Beyond "no
  * out-of-bounds read" (ASan) it checks what the parser promises: a usable header lies
- * inside the input, an address is only reported when the frame holds it.
+ * inside the input, an address is only reported when the frame holds it, an SSID only
+ * when a beacon or probe response holds it.
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -25,6 +26,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (f.wlan.has_sa && (n < 24 || f.wlan.type == LX_WLAN_CTRL)) { abort(); }
         if (f.wlan.has_ta && n < 16) { abort(); }
         if (f.wlan.seq > 4095 || f.wlan.frag > 15 || f.wlan.ds > 3) { abort(); }
+        /* An SSID only in a beacon or probe response, inside the frame after its header. */
+        if (f.has_ssid && (f.wlan.type != LX_WLAN_MGMT || (f.wlan.subtype != 8 && f.wlan.subtype != 5) ||
+                           f.ssid_len > LX_WLAN_SSID_MAX || f.wlan.hdr_len + 14u + f.ssid_len > f.frame_len)) {
+            abort();
+        }
     } else if (n >= 2) {
         abort();
     }

@@ -238,6 +238,27 @@ int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w)
     return 0;
 }
 
+/* The SSID element of a beacon or probe response: body[0..n) are the bytes after the MAC
+ * header, FCS excluded; elements follow the 12 bytes of timestamp, interval, capability. */
+static void frame_ssid(const uint8_t *body, size_t n, lx_rt_frame_t *f)
+{
+    for (size_t at = 12; at + 2u <= n;) {
+        const size_t elen = body[at + 1u];
+        if (at + 2u + elen > n) {
+            return;
+        }
+        if (body[at] == 0u) {
+            if (elen <= LX_WLAN_SSID_MAX) {
+                memcpy(f->ssid, body + at + 2u, elen);
+                f->ssid_len = (uint8_t)elen;
+                f->has_ssid = true;
+            }
+            return;
+        }
+        at += 2u + elen;
+    }
+}
+
 int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f)
 {
     memset(f, 0, sizeof(*f));
@@ -249,5 +270,9 @@ int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f)
     const bool fcs = f->rt.has_flags && (f->rt.flags & LX_RT_FLAG_FCS) != 0;
     f->frame_len = (uint32_t)(fcs ? (n >= 4 ? n - 4 : 0) : n);
     f->wlan_ok = lx_wlan_parse(buf + f->rt.it_len, n, &f->wlan) == 0;
+    const bool beacon = f->wlan.subtype == 8u || f->wlan.subtype == 5u; /* or probe response */
+    if (f->wlan_ok && f->wlan.has_sa && f->wlan.type == LX_WLAN_MGMT && beacon && f->wlan.hdr_len <= f->frame_len) {
+        frame_ssid(buf + f->rt.it_len + f->wlan.hdr_len, f->frame_len - f->wlan.hdr_len, f);
+    }
     return 0;
 }

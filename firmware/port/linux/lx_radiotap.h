@@ -111,6 +111,9 @@ typedef struct lx_wlan {
 /// wlan.sa): an ACK, a CTS or a frame cut inside its header has no SA.
 int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w);
 
+/// Longest SSID, bytes (IEEE 802.11-2020 9.4.2.2).
+#define LX_WLAN_SSID_MAX 32u
+
 /// One parsed capture record: radiotap + 802.11, as the feeder needs it.
 typedef struct lx_rt_frame {
     lx_radiotap_t rt;     ///< the radiotap header
@@ -118,10 +121,15 @@ typedef struct lx_rt_frame {
     bool wlan_ok;         ///< an 802.11 header followed the radiotap header
     uint32_t frame_len;   ///< 802.11 bytes after radiotap, FCS removed when flagged
                           ///< (the MAC header is parsed from all captured bytes)
+    bool has_ssid;        ///< a beacon or probe response whose SSID element was read
+    uint8_t ssid_len;     ///< its length, 0..LX_WLAN_SSID_MAX (0: a hidden network)
+    uint8_t ssid[LX_WLAN_SSID_MAX]; ///< its bytes (any values: not a C string)
 } lx_rt_frame_t;
 
 /// Parse a whole captured record. Returns 0 when the radiotap header was usable (the
-/// 802.11 part may still be absent: see wlan_ok), -1 otherwise.
+/// 802.11 part may still be absent: see wlan_ok), -1 otherwise. The SSID is the first
+/// SSID element (id 0, at most 32 bytes) among the elements after a beacon's or probe
+/// response's 12 bytes of fixed fields, within the captured frame without its FCS.
 int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f);
 
 #endif /* LX_RADIOTAP_H */

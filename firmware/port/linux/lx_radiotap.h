@@ -108,7 +108,8 @@ typedef struct lx_wlan {
 /// Parse the 802.11 MAC header of `frame` (`len` bytes, FCS already removed). Returns 0
 /// when at least the frame control was readable, -1 when len < 2. Addresses and the
 /// sequence number count only when the whole MAC header is there (as Wireshark adds
-/// wlan.sa): an ACK, a CTS or a frame cut inside its header has no SA.
+/// wlan.sa): an ACK, a CTS or a frame cut inside its header has no SA; nor has a frame of
+/// protocol version 1 (S1G, another layout) or a reserved one.
 int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w);
 
 /// Longest SSID, bytes (IEEE 802.11-2020 9.4.2.2).
@@ -127,7 +128,9 @@ typedef struct lx_rt_frame {
 } lx_rt_frame_t;
 
 /// Parse a whole captured record. Returns 0 when the radiotap header was usable (the
-/// 802.11 part may still be absent: see wlan_ok), -1 otherwise. The SSID is the first
+/// 802.11 part may still be absent: see wlan_ok), -1 otherwise; then rt.status says why,
+/// and when the header's length field still lies within the record the 802.11 frame
+/// after it is parsed all the same (wlan_ok; no FCS known), as Wireshark does. The SSID is the first
 /// SSID element (id 0, at most 32 bytes) among the elements after a beacon's or probe
 /// response's 12 bytes of fixed fields, within the captured frame without its FCS.
 int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f);

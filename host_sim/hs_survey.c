@@ -149,7 +149,7 @@ uint64_t hs_survey_frames(const hs_survey_t *s, const uint8_t *mac)
 /* Most frames first, ties by address. */
 static int by_frames(const void *a, const void *b)
 {
-    const tx_t *x = *(const tx_t *const *)a, *y = *(const tx_t *const *)b;
+    const tx_t *x = a, *y = b;
     if (x->frames != y->frames) {
         return x->frames > y->frames ? -1 : 1;
     }
@@ -180,17 +180,18 @@ static void write_row(const tx_t *t, FILE *out)
 
 long hs_survey_write(const hs_survey_t *s, FILE *out)
 {
-    const tx_t **order = malloc((s->n ? s->n : 1u) * sizeof *order);
+    /* A sorted copy: the survey keeps its order, which its index points into. */
+    tx_t *order = malloc((s->n ? s->n : 1u) * sizeof *order);
     if (order == NULL) {
         return -1;
     }
-    for (size_t k = 0; k < s->n; k++) {
-        order[k] = &s->v[k];
+    if (s->n > 0u) {
+        memcpy(order, s->v, s->n * sizeof *order);
     }
     qsort(order, s->n, sizeof *order, by_frames);
     fputs("mac\tframes\tdbm_frames\tmean_dbm\tmin_dbm\tmax_dbm\tfirst_epoch\tlast_epoch\tssid\n", out);
     for (size_t k = 0; k < s->n; k++) {
-        write_row(order[k], out);
+        write_row(&order[k], out);
     }
     free(order);
     return (long)s->n;

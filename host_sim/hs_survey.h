@@ -24,7 +24,7 @@ typedef struct hs_survey_frame {
     bool has_dbm;           ///< a dBm antenna signal was captured
     int dbm;                ///< that signal, dBm (the first, combined, value)
     const uint8_t *ssid;    ///< SSID of a beacon or probe response, or NULL
-    size_t ssid_len;        ///< its length, bytes (0..32; 0: a hidden network)
+    size_t ssid_len;        ///< its length, bytes (0..255; 0: a hidden network)
 } hs_survey_frame_t;
 
 /// A new, empty survey; NULL when out of memory.

@@ -12,9 +12,14 @@ one warning line, exit status 3 (also in the plain TSV mode).
 usage: survey_test.py FEED CAPTURE...
 """
 import os
+import struct
 import subprocess
 import sys
+import tempfile
 from decimal import Decimal
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import pcap_build  # noqa: E402
 
 HEADER = "mac\tframes\tdbm_frames\tmean_dbm\tmin_dbm\tmax_dbm\tfirst_epoch\tlast_epoch\tssid"
 BEACON, PROBE_RESP = 0x0008, 0x0005
@@ -59,6 +64,25 @@ def tshark_table(cap, macs=None):
     return rows
 
 
+def ssid_capture(path):
+    """Beacons and probe responses with awkward SSIDs, written byte by byte: a hidden network
+    (an empty SSID, then 4 zero bytes) named later by its probe response; a tab, a backslash
+    and a non-ASCII byte; the 32-byte maximum; one over it (shown whole, as tshark does)."""
+    def mgmt(t_us, subtype, mac, ssid, dbm=-50):
+        rt = struct.pack("<BBHI", 0, 0, 9, 0x20) + struct.pack("<b", dbm)
+        hdr = struct.pack("<BB", subtype << 4, 0) + b"\0\0" + b"\xff" * 6 + mac + mac + b"\0\0"
+        body = b"\0" * 8 + struct.pack("<HH", 100, 0x0431) + bytes([0, len(ssid)]) + ssid + b"\x01\x01\x82"
+        data = rt + hdr + body
+        return struct.pack("<IIII", t_us // 1000000, t_us % 1000000, len(data), len(data)) + data
+    a, b, c, d = (bytes.fromhex(x) for x in ("02aa00000001", "02aa00000002", "02aa00000003", "02aa00000004"))
+    pcap_build.write(path, [mgmt(1_700_000_000_000_000, 8, a, b""), mgmt(1_700_000_000_100_000, 8, a, b"\0" * 4),
+                            mgmt(1_700_000_000_200_000, 5, a, b"lab net", -61),
+                            mgmt(1_700_000_000_300_000, 8, a, b"other"),
+                            mgmt(1_700_000_000_400_000, 8, b, b"a\tb\\c\xff"),
+                            mgmt(1_700_000_000_500_000, 8, c, b"x" * 32), mgmt(1_700_000_000_600_000, 8, d, b"y" * 33),
+                            pcap_build.record(1_700_000_000_700_000, d, 1, -70)])
+
+
 def feed(exe, *args):
     return subprocess.run([exe] + list(args), capture_output=True, text=True)
 
@@ -68,6 +92,10 @@ def main(argv):
         print(__doc__.strip())
         return 2
     exe, caps = argv[1], argv[2:]
+    tmp = tempfile.mkdtemp(prefix="rfs_survey_")
+    ssids = os.path.join(tmp, "ssids.pcap")
+    ssid_capture(ssids)
+    caps = caps + [ssids]
     total_rows = total_frames = 0
     for cap in caps:
         name = os.path.basename(cap)
@@ -104,6 +132,12 @@ def main(argv):
     report(r.returncode == 0 and r.stderr == "", "tsv-heard-mac (exit 0, no warning)")
     r = feed(exe, cap, "--list", "--live")
     report(r.returncode == 2 and r.stderr.count("\n") == 1, "survey-not-live (exit 2)")
+    r = feed(exe, ssids, "--list")
+    names = [ln.split("\t")[-1] for ln in r.stdout.splitlines()[1:]]
+    report(names == ["lab net", "y" * 33, "a\\x09b\\x5cc\\xff", "x" * 32],
+           "survey-ssids (hidden then named, escaped, 32 and 33 bytes)", repr(names))
+    os.remove(ssids)
+    os.rmdir(tmp)
     report(fails == 0 and total_rows >= 10, "survey: %d captures, %d transmitters, %d frames"
            % (len(caps), total_rows, total_frames), "%d failures" % fails)
     return 1 if fails else 0

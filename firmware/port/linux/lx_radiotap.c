@@ -252,11 +252,9 @@ static void frame_ssid(const uint8_t *body, size_t n, lx_rt_frame_t *f)
             return;
         }
         if (body[at] == 0u) {
-            if (elen <= LX_WLAN_SSID_MAX) {
-                memcpy(f->ssid, body + at + 2u, elen);
-                f->ssid_len = (uint8_t)elen;
-                f->has_ssid = true;
-            }
+            memcpy(f->ssid, body + at + 2u, elen);
+            f->ssid_len = (uint8_t)elen; /* a one-byte length: <= LX_WLAN_SSID_MAX */
+            f->has_ssid = true;
             return;
         }
         at += 2u + elen;

@@ -112,8 +112,9 @@ typedef struct lx_wlan {
 /// protocol version 1 (S1G, another layout) or a reserved one.
 int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w);
 
-/// Longest SSID, bytes (IEEE 802.11-2020 9.4.2.2).
-#define LX_WLAN_SSID_MAX 32u
+/// Longest SSID element kept, bytes: its one-byte length's limit. IEEE 802.11-2020 9.4.2.2
+/// allows 32; tshark shows longer ones whole, and so do we.
+#define LX_WLAN_SSID_MAX 255u
 
 /// One parsed capture record: radiotap + 802.11, as the feeder needs it.
 typedef struct lx_rt_frame {
@@ -131,7 +132,7 @@ typedef struct lx_rt_frame {
 /// 802.11 part may still be absent: see wlan_ok), -1 otherwise; then rt.status says why,
 /// and when the header's length field still lies within the record the 802.11 frame
 /// after it is parsed all the same (wlan_ok; no FCS known), as Wireshark does. The SSID is the first
-/// SSID element (id 0, at most 32 bytes) among the elements after a beacon's or probe
+/// SSID element (id 0) among the elements after a beacon's or probe
 /// response's 12 bytes of fixed fields, within the captured frame without its FCS.
 int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f);
 

@@ -94,6 +94,9 @@ $(FEED)/gen/.stamp: scripts/gen_captures.py $(FEED)/feed_writegen
 	$(FEED)/feed_writegen $(FEED)/gen/writer.pcap 2000 > $(FEED)/gen/writer.pcap.macs
 	@touch $@
 $(eval $(call test_script,feed_cross_check,tests/feed/cross_check.sh $(BUILD)/bin/rfseek-feed tests/data/captures/*.pcap $(FEED)/gen/*.pcap $(FEED)/gen/*.pcapng,$(BUILD)/bin/rfseek-feed $(FEED)/gen/.stamp))
+# --list (the survey) against tshark's own fields, aggregated per wlan.ta; a --mac that sent
+# nothing: a warning and exit 3.
+$(eval $(call test_script,feed_survey,$(PYTHON) tests/feed/survey_test.py $(FEED_ASAN) tests/data/captures/*.pcap tests/data/captures/malformed/*.pcap $(FEED)/gen/*.pcap $(FEED)/gen/*.pcapng $(FEED)/gen/bad/radiotap_lies.pcap,$(FEED_ASAN) $(FEED)/gen/.stamp))
 $(eval $(call test_script,feed_bad_input,tests/feed/bad_input.sh $(FEED_ASAN) $(FEED)/gen,$(FEED_ASAN) $(FEED)/gen/.stamp))
 $(eval $(call test_script,feed_replay,$(PYTHON) tests/feed/replay_test.py $(FEED_ASAN),$(FEED_ASAN)))
 

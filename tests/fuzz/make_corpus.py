@@ -14,6 +14,8 @@ convention, docs/SIMULATOR.md, the LCM wire format), not by the code under test:
   pcap/      classic pcap (us and ns magic, both byte orders) and pcapng (if_tsresol 6, 9,
              2^-20) radiotap captures, timestamps at the formats' edges (libpcap's formats)
   poses/     the pose CSV of rfseek-feed --pose (docs/FEEDER.md): good files and edge values
+  candump/   candump -L log lines (can-utils' format, docs/CAN.md "CAN logs"): our frames,
+             29-bit, remote, error and CAN FD frames, candump -x directions, padded names
   lcm/       one message per channel, the receiver heartbeat included (LCM encoding: 8-byte fingerprint, big-endian fields;
              fingerprints computed with lcm-gen's hash) and small LCM logs
 """
@@ -260,3 +262,13 @@ put("poses", "crlf_blank", HDR.replace(b"\n", b"\r\n") + b"0,0,0,0\r\n\r\n1,1e-3
 put("poses", "theta_big", HDR + b"0,1,1,1e9\n1,1,1,-1e300\n2,1,1,201.0619298297468\n")
 put("poses", "t_edges", HDR + b"-9223372036854775808,0,0,0\n9007199254740992,0,0,0\n")
 put("poses", "xy_edges", HDR + b"0,32767,-32767,0\n1,32767.0001,0,0\n")
+
+# --- candump: candump -L lines (can-utils: "(%010ld.%06ld) %*s " + ID#HEX) --------------------
+put("candump", "mission", b"(0000004294.969796) can0 120#00A100C4090000BD\n"
+    b"(0000004295.017296) can0 100#011700E9FF73\n(0000004295.017296) can0 180#3005000000000046\n")
+put("candump", "kinds", b"(1700000000.000001) vcan0 12345678#DEADBEEF\n(1700000000.000002) vcan0 7FF#R\n"
+    b"(1700000000.000003) vcan0 123#R8\n(1700000000.000004) vcan0 20000004#0004000000000000\n"
+    b"(1700000000.000005) vcan0 123##1112233\n(1700000000.000006) vcan0 123#11.22.33\n")
+put("candump", "directions", b"(1700000000.000001)  can0 100#1000000000A2 T\n(1700000000.000002) can10 111#00 R\r\n")
+put("candump", "edges", b"(999999999999.999999) a 000#\n(0.000000) x 7FF#0011223344556677\n"
+    b"(1700000000.000001) can0 100#112233445566778899\n(1700000000.1) can0 100#\n")

@@ -1,12 +1,16 @@
 /* rfseek-replay - the host build of the firmware application loop on a recorded stream
- * (firmware/rfs_replay.h), and a printer for streams.
+ * (firmware/rfs_replay.h) or a CAN log (candump -L), and a printer for both.
  *
- *   rfseek-replay IN.rfsr -o OUT.rfso   play an input stream, write the output stream
- *   rfseek-replay --print FILE          print any stream, one record per line (TSV)
+ *   rfseek-replay IN.rfsr -o OUT.rfso             play an input stream, write the output stream
+ *   rfseek-replay IN.log --map MAP.yaml -o OUT.rfso   play a candump -L log (docs/CAN.md)
+ *   rfseek-replay --print FILE                    print a stream or a log, one record per line
  *
  * Playing runs rfs_replay_play(), the driver loop the emulator image runs, so the output
- * must equal the emulator's byte for byte. Errors: one line naming the file, the byte
- * offset and the reason; exit 1; no output file is left behind.
+ * must equal the emulator's byte for byte. A candump log becomes the records a stream
+ * would hold: CFG and MAP from the options, a CAN record per frame of the bus, a STEP at
+ * each of the controller's WHEEL_CMD frames (the controller ran then), END at its end.
+ * Errors: one line naming the file and the byte offset or line, and the reason; exit 1;
+ * no output file is left behind.
  */
 #include <errno.h>
 #include <inttypes.h>
@@ -15,7 +19,9 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "lx_candump.h"
 #include "lx_err.h"
+#include "lx_map.h"
 #include "rfs_app.h"
 #include "rfs_replay.h"
 
@@ -157,12 +163,23 @@ static void print_rec(const rfs_replay_rec_t *r)
 static void usage(FILE *f)
 {
     fprintf(f, "usage: rfseek-replay IN.rfsr -o OUT.rfso\n"
+               "       rfseek-replay IN.log --map MAP.yaml [options] -o OUT.rfso\n"
                "       rfseek-replay --print FILE\n"
-               "Play a recorded input stream through the host build of the firmware\n"
-               "application loop (the emulator image runs the same code), or print a stream.\n"
-               "  -o FILE      output stream (written to a temporary file, then renamed)\n"
-               "  --print      print every record of FILE as one TSV line\n"
-               "  -h, --help   this text\n");
+               "Play a recorded input stream, or a candump -L log of the robot's CAN bus,\n"
+               "through the host build of the firmware application loop (the emulator image\n"
+               "runs the same code), or print a stream or a log.\n"
+               "  -o FILE          output stream (written to a temporary file, then renamed)\n"
+               "  --print          print every record of FILE as one TSV line (a log: the\n"
+               "                   CAN and STEP records it is played as)\n"
+               "A candump -L log (docs/CAN.md, \"CAN logs\") is played as a stream: its frames\n"
+               "as CAN records, a control step at each WHEEL_CMD (100) frame; the controller:\n"
+               "  --map FILE       ROS map_server YAML (required)\n"
+               "  --res M          core map cell size, metres (default 0.1)\n"
+               "  --seed N         seed of the controller's random source (default 1)\n"
+               "  --target NAME    rssi (default) or bridge\n"
+               "  --model NAME     ridge (default), mlp, knn, radius, pathloss\n"
+               "  --fit-budget N   samples learnt per control period (default 0: all)\n"
+               "  -h, --help       this text\n");
 }
 
 /* An input stream ends with its END record (an output stream has none); without it the
@@ -177,81 +194,141 @@ static int check_end(const char *in_path, size_t pos, int ended, int inputs)
     return 0;
 }
 
-static int replay_main(int argc, char **argv)
+/* The command line. */
+typedef struct options {
+    const char *in_path, *out_path;
+    bool print;
+    /* A candump log's controller: what its CFG and MAP records would say. */
+    const char *map_path;   /* --map */
+    double res;             /* --res, metres per core cell */
+    uint64_t seed;          /* --seed */
+    uint8_t target;         /* --target: rfs_app_target_t */
+    const char *model;      /* --model, NULL: the ridge */
+    uint32_t fit_budget;    /* --fit-budget */
+    const char *ctl_opt;    /* the first of these options given, or NULL */
+} options_t;
+
+enum { RUN = -1 }; /* parse_options: go on (else the exit status) */
+
+/* Option a with value v (one of the controller's): RUN, or 2 after a message. */
+static int parse_ctl(options_t *o, const char *a, const char *v)
 {
-    const char *in_path = NULL, *out_path = NULL;
-    int print = 0;
+    char *end;
+    errno = 0;
+    if (o->ctl_opt == NULL) {
+        o->ctl_opt = a;
+    }
+    if (strcmp(a, "--map") == 0) {
+        o->map_path = v;
+    } else if (strcmp(a, "--res") == 0) {
+        o->res = strtod(v, &end);
+        if (*v == '\0' || *end != '\0' || !(o->res >= 0.01 && o->res <= 1.0)) {
+            lx_err_print(PROG, "--res: expected metres in [0.01, 1], got '%s'", v);
+            return 2;
+        }
+    } else if (strcmp(a, "--seed") == 0) {
+        o->seed = strtoull(v, &end, 10);
+        if (*v == '\0' || *v == '-' || *end != '\0' || errno != 0) {
+            lx_err_print(PROG, "--seed: expected a non-negative integer, got '%s'", v);
+            return 2;
+        }
+    } else if (strcmp(a, "--target") == 0) {
+        if (strcmp(v, "rssi") != 0 && strcmp(v, "bridge") != 0) {
+            lx_err_print(PROG, "--target: expected rssi or bridge, got '%s'", v);
+            return 2;
+        }
+        o->target = strcmp(v, "bridge") == 0 ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
+    } else if (strcmp(a, "--model") == 0) {
+        if (rfs_models_lookup(v) == NULL || strlen(v) > RFS_REPLAY_MODEL_NAME_MAX) {
+            lx_err_print(PROG, "--model: expected ridge, mlp, knn, radius or pathloss, got '%s'", v);
+            return 2;
+        }
+        o->model = strcmp(v, "ridge") == 0 ? NULL : v;
+    } else {
+        const unsigned long n = strtoul(v, &end, 10);
+        if (*v == '\0' || *v == '-' || *end != '\0' || errno != 0 || n > 100000ul) {
+            lx_err_print(PROG, "--fit-budget: expected samples in [0, 100000], got '%s'", v);
+            return 2;
+        }
+        o->fit_budget = (uint32_t)n;
+    }
+    return RUN;
+}
+
+/* The command line into *o: RUN, or the exit status (--help, a bad option). */
+static int parse_options(int argc, char **argv, options_t *o)
+{
+    static const char *const ctl[] = {"--map", "--res", "--seed", "--target", "--model", "--fit-budget"};
+    memset(o, 0, sizeof *o);
+    o->res = 0.1;
+    o->seed = 1;
     for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0) {
+        const char *a = argv[i];
+        bool is_ctl = false;
+        for (size_t k = 0; k < sizeof ctl / sizeof ctl[0]; k++) {
+            is_ctl = is_ctl || strcmp(a, ctl[k]) == 0;
+        }
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
             usage(stdout);
             return 0;
-        } else if (strcmp(argv[i], "--print") == 0) {
-            print = 1;
-        } else if (strcmp(argv[i], "-o") == 0) {
+        } else if (strcmp(a, "--print") == 0) {
+            o->print = true;
+        } else if (strcmp(a, "-o") == 0 || is_ctl) {
             if (i + 1 == argc) {
-                lx_err_print(PROG, "-o: missing value (see --help)");
+                lx_err_print(PROG, "%s: missing value (see --help)", a);
                 return 2;
             }
-            out_path = argv[++i];
-        } else if (argv[i][0] == '-') {
-            lx_err_print(PROG, "%s: unknown option (see --help)", argv[i]);
+            const char *v = argv[++i];
+            if (a[1] == 'o') {
+                o->out_path = v;
+            } else if (parse_ctl(o, a, v) != RUN) {
+                return 2;
+            }
+        } else if (a[0] == '-') {
+            lx_err_print(PROG, "%s: unknown option (see --help)", a);
             return 2;
-        } else if (in_path == NULL) {
-            in_path = argv[i];
+        } else if (o->in_path == NULL) {
+            o->in_path = a;
         } else {
-            lx_err_print(PROG, "%s: only one input stream expected (see --help)", argv[i]);
+            lx_err_print(PROG, "%s: only one input stream expected (see --help)", a);
             return 2;
         }
     }
-    if (in_path == NULL || (print == 0) == (out_path == NULL)) {
-        lx_err_print(PROG, "%s (see --help)", in_path == NULL ? "an input stream is required"
-                                    : print ? "--print and -o exclude each other"
-                                            : "-o OUT.rfso or --print is required");
+    if (o->in_path == NULL || !o->print == (o->out_path == NULL)) {
+        lx_err_print(PROG, "%s (see --help)", o->in_path == NULL ? "an input stream is required"
+                                    : o->print ? "--print and -o exclude each other"
+                                               : "-o OUT.rfso or --print is required");
         return 2;
     }
-    if (!print && (lx_err_same_file(PROG, in_path, out_path) != 0 || lx_err_check_dest(PROG, out_path) != 0)) {
+    if (!o->print && (lx_err_same_file(PROG, o->in_path, o->out_path) != 0 ||
+                      lx_err_check_dest(PROG, o->out_path) != 0)) {
         return 1;
     }
-    size_t len = 0;
-    uint8_t *buf = slurp(in_path, &len);
-    if (buf == NULL) {
-        return 1;
+    return RUN;
+}
+
+/* Where the records go: printed, or played into the application. */
+typedef struct run {
+    bool print;
+    rfs_replay_player_t *player;
+} run_t;
+
+/* One record to the run (an rfs_replay_rec_fn): false when the player stopped. */
+static bool take(void *ctx, const rfs_replay_rec_t *rec)
+{
+    run_t *r = ctx;
+    if (r->print) {
+        print_rec(rec);
+        return true;
     }
-    if (rfs_replay_check_header(buf, (uint32_t)(len < 8 ? len : 8)) != 0) {
-        lx_err_print(PROG, "%s: offset 0: not an rfseek stream (bad header)", in_path);
-        free(buf);
-        return 1;
-    }
-    static rfs_app_t app;
-    static rfs_replay_player_t player;
-    sink_ctx_t sc = {0};
-    char tmp[4096];
-    if (!print) {
-        snprintf(tmp, sizeof tmp, "%s.tmp.%ld", out_path, (long)getpid());
-        sc.f = fopen(tmp, "wb");
-        if (sc.f == NULL) {
-            lx_err_print(PROG, "%s: %s", out_path, strerror(errno));
-            free(buf);
-            return 1;
-        }
-        // The host holds every model a CFG record may name (rfs_models.h).
-        static uint64_t *model_state;
-        const uint32_t mb = (rfs_models_max_state_bytes() + 7u) & ~7u;
-        model_state = aligned_alloc(RFS_MODELS_STATE_ALIGN, mb);
-        if (model_state == NULL) {
-            fprintf(stderr, "rfseek-replay: out of memory\n");
-            fclose(sc.f);
-            remove(tmp);
-            free(buf);
-            return 1;
-        }
-        rfs_app_cfg_t cfg = rfs_app_cfg_default();
-        cfg.model_state = model_state;
-        cfg.model_state_bytes = mb;
-        rfs_replay_player_init(&player, &app, &cfg, sink, &sc);
-    }
+    return rfs_replay_play(r->player, rec);
+}
+
+/* The records of an rfseek stream in buf[0..len): 0, or 1 after a message. */
+static int play_stream(const char *in_path, const uint8_t *buf, size_t len, run_t *r)
+{
     size_t pos = RFS_REPLAY_HEADER_LEN;
-    int rc = 0, ended = 0, inputs = 0;
+    int ended = 0, inputs = 0;
     while (pos < len) {
         rfs_replay_rec_t rec;
         uint32_t used = 0;
@@ -261,15 +338,11 @@ static int replay_main(int argc, char **argv)
         if (st != RFS_REPLAY_OK) {
             lx_err_print(PROG, "%s: offset %zu: %s", in_path, pos,
                      st == RFS_REPLAY_NEED_MORE ? "truncated record" : rec.error);
-            rc = 1;
-            break;
+            return 1;
         }
-        if (print) {
-            print_rec(&rec);
-        } else if (!rfs_replay_play(&player, &rec)) {
-            lx_err_print(PROG, "%s: offset %zu: %s", in_path, pos, rfs_replay_err_str(player.error));
-            rc = 1;
-            break;
+        if (!take(r, &rec)) {
+            lx_err_print(PROG, "%s: offset %zu: %s", in_path, pos, rfs_replay_err_str(r->player->error));
+            return 1;
         }
         pos += used;
         inputs |= rec.type < RFS_REPLAY_END;
@@ -278,19 +351,181 @@ static int replay_main(int argc, char **argv)
             break;
         }
     }
-    if (rc == 0) {
-        rc = check_end(in_path, pos, ended, inputs);
+    return check_end(in_path, pos, ended, inputs);
+}
+
+/* A candump log's CFG and MAP records, from the options: 0, or 1 after a message. */
+static int candump_config(const options_t *o, run_t *r)
+{
+    char err[512];
+    lx_map_t m;
+    lx_core_map_t core;
+    memset(&m, 0, sizeof m);
+    memset(&core, 0, sizeof core);
+    int rc = 0;
+    if (lx_map_load(o->map_path, &m, err, sizeof err) != 0 || lx_map_to_core(&m, o->res, NULL, &core, err, sizeof err) != 0) {
+        lx_err_print(PROG, "%s", err);
+        rc = 1;
+    } else {
+        rfs_replay_rec_t cfg;
+        memset(&cfg, 0, sizeof cfg);
+        cfg.type = RFS_REPLAY_CFG;
+        cfg.u.cfg.seed = o->seed;
+        cfg.u.cfg.target = o->target;
+        cfg.u.cfg.node = 1u; /* the default node id, as rfseek-record's */
+        cfg.u.cfg.fit_budget = o->fit_budget;
+        if (o->model != NULL) {
+            memcpy(cfg.u.cfg.model, o->model, strlen(o->model)); /* <= 15 bytes: checked */
+        }
+        const rfs_app_map_t am = {core.map.w, core.map.h, core.map.res, core.map.origin_x,
+                                  core.map.origin_y, core.free_bits, core.wall_bits};
+        if (!take(r, &cfg) || !rfs_replay_map_records(&am, take, r)) {
+            lx_err_print(PROG, "%s: %s", o->map_path, rfs_replay_err_str(r->player->error));
+            rc = 1;
+        }
     }
+    lx_core_map_free(&core);
+    lx_map_free(&m);
+    return rc;
+}
+
+/* A candump -L log in buf[0..len) as the records of a stream: each classic 11-bit data
+ * frame a CAN record at its time, but the controller's own: its WHEEL_CMD is a STEP (the
+ * controller ran then), its STATUS nothing; END at the end. Remote, error and 29-bit frames
+ * are not on our protocol and are passed over. 0, or 1 after a message. */
+static int play_candump(const options_t *o, const uint8_t *buf, size_t len, run_t *r)
+{
+    if (!r->print && candump_config(o, r) != 0) {
+        return 1;
+    }
+    char bus[LX_CANDUMP_IFNAME_MAX + 1u] = "";
+    unsigned long line = 0, steps = 0;
+    for (size_t pos = 0; pos < len;) {
+        line++;
+        const uint8_t *nl = memchr(buf + pos, '\n', len - pos);
+        const size_t n = nl != NULL ? (size_t)(nl - (buf + pos)) : len - pos;
+        lx_candump_rec_t c;
+        const char *why = NULL;
+        if (lx_candump_parse((const char *)buf + pos, n, &c, &why) != 0) {
+            lx_err_print(PROG, "%s:%lu: %s", o->in_path, line, why);
+            return 1;
+        }
+        pos += n + (nl != NULL ? 1u : 0u);
+        if (bus[0] == '\0') {
+            memcpy(bus, c.ifname, sizeof bus);
+        } else if (strcmp(bus, c.ifname) != 0) {
+            lx_err_print(PROG, "%s:%lu: interface %s after %s: a log of one bus is played (keep its lines only)",
+                         o->in_path, line, c.ifname, bus);
+            return 1;
+        }
+        if (c.kind != LX_CANDUMP_DATA || c.ext || c.id == RFS_CAN_ID_STATUS) {
+            continue;
+        }
+        rfs_replay_rec_t rec;
+        memset(&rec, 0, sizeof rec);
+        rec.t_us = c.t_us;
+        if (c.id == RFS_CAN_ID_WHEEL_CMD) {
+            rec.type = RFS_REPLAY_STEP;
+            steps++;
+        } else {
+            rec.type = RFS_REPLAY_CAN;
+            rec.u.can.id = c.id;
+            rec.u.can.dlc = c.dlc;
+            memcpy(rec.u.can.data, c.data, sizeof c.data);
+        }
+        if (!take(r, &rec)) {
+            lx_err_print(PROG, "%s:%lu: %s", o->in_path, line, rfs_replay_err_str(r->player->error));
+            return 1;
+        }
+    }
+    if (!r->print && steps == 0) {
+        lx_err_print(PROG, "%s: no WHEEL_CMD (100) frame: the controller never ran", o->in_path);
+        return 1;
+    }
+    rfs_replay_rec_t end;
+    memset(&end, 0, sizeof end);
+    end.type = RFS_REPLAY_END;
+    (void)take(r, &end);
+    return 0;
+}
+
+/* The player over the application writing to sc (model state for any model a CFG record
+ * may name, rfs_models.h): 0, or 1 after a message. */
+static int start_player(rfs_replay_player_t *player, sink_ctx_t *sc)
+{
+    static rfs_app_t app;
+    static uint64_t *model_state;
+    const uint32_t mb = (rfs_models_max_state_bytes() + 7u) & ~7u;
+    model_state = aligned_alloc(RFS_MODELS_STATE_ALIGN, mb);
+    if (model_state == NULL) {
+        fprintf(stderr, "rfseek-replay: out of memory\n");
+        return 1;
+    }
+    rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.model_state = model_state;
+    cfg.model_state_bytes = mb;
+    rfs_replay_player_init(player, &app, &cfg, sink, sc);
+    return 0;
+}
+
+static int replay_main(int argc, char **argv)
+{
+    options_t o;
+    int rc = parse_options(argc, argv, &o);
+    if (rc != RUN) {
+        return rc;
+    }
+    size_t len = 0;
+    uint8_t *buf = slurp(o.in_path, &len);
+    if (buf == NULL) {
+        return 1;
+    }
+    const bool candump = len > 0 && buf[0] == '(';
+    if (!candump && rfs_replay_check_header(buf, (uint32_t)(len < 8 ? len : 8)) != 0) {
+        lx_err_print(PROG, "%s: offset 0: not an rfseek stream (bad header) nor a candump -L log", o.in_path);
+        free(buf);
+        return 1;
+    }
+    if (o.ctl_opt != NULL && (o.print || !candump)) {
+        lx_err_print(PROG, "%s: only for playing a candump -L log (see --help)", o.ctl_opt);
+        free(buf);
+        return 2;
+    }
+    if (candump && !o.print && o.map_path == NULL) {
+        lx_err_print(PROG, "%s: a candump -L log is played with --map MAP.yaml (see --help)", o.in_path);
+        free(buf);
+        return 2;
+    }
+    static rfs_replay_player_t player;
+    sink_ctx_t sc = {0};
+    run_t run = {o.print, &player};
+    char tmp[4096];
+    if (!o.print) {
+        snprintf(tmp, sizeof tmp, "%s.tmp.%ld", o.out_path, (long)getpid());
+        sc.f = fopen(tmp, "wb");
+        if (sc.f == NULL) {
+            lx_err_print(PROG, "%s: %s", o.out_path, strerror(errno));
+            free(buf);
+            return 1;
+        }
+        if (start_player(&player, &sc) != 0) {
+            fclose(sc.f);
+            remove(tmp);
+            free(buf);
+            return 1;
+        }
+    }
+    rc = candump ? play_candump(&o, buf, len, &run) : play_stream(o.in_path, buf, len, &run);
     free(buf);
-    if (!print) {
+    if (!o.print) {
         if (fclose(sc.f) != 0 || sc.failed) {
-            lx_err_print(PROG, "%s: write failed", out_path);
+            lx_err_print(PROG, "%s: write failed", o.out_path);
             rc = 1;
         }
         if (rc != 0) {
             remove(tmp);
-        } else if (rename(tmp, out_path) != 0) {
-            lx_err_print(PROG, "%s: %s", out_path, strerror(errno));
+        } else if (rename(tmp, o.out_path) != 0) {
+            lx_err_print(PROG, "%s: %s", o.out_path, strerror(errno));
             remove(tmp);
             rc = 1;
         }

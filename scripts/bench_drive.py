@@ -81,15 +81,11 @@ def section(seeds, wall, at, floors, rows):
     """floors: [label]; rows: [(noise label, [cell per floor x configuration])]."""
     L = [BEGIN, "## The drive under localisation noise", "",
          f"Written by `/usr/bin/python3 scripts/bench_drive.py --seeds {seeds}` at commit "
-         f"{at} ({wall:.0f} s on two cores). Seeds {seeds} of each floor's shipped scenario "
-         "with only `localisation` changed (10 Hz; Gaussian per axis and on the heading; "
-         "AMCL-like adds a drift bounded by 0.2 m and 0.3 m jumps about once a minute, "
-         "docs/SIMULATOR.md \"Localisation\"). Columns: floor, then `r` = meta + ridge "
-         "(the paper), `p` = meta-path + pathloss. Cells: success (95 % interval about "
-         "+-5 points at 85 %), then `travel/turning/abandoned/contacts`: median travel / "
-         "shortest path over all runs; time turning on the spot (forward speed < 2 cm/s) "
-         "as a share of mission time; goals abandoned (timed out or blocked) per run; wall "
-         "contacts over all runs (Box2D contact events).", ""]
+         f"{at} ({wall:.0f} s on two cores): each floor's scenario with only `localisation` "
+         "changed (10 Hz; AMCL-like: 0.2 m drift, 0.3 m jumps, docs/SIMULATOR.md). `r`: "
+         "meta + ridge (the paper), `p`: meta-path + pathloss. Cells: success (95 % "
+         "interval +-5 points at 85 %), then median travel / shortest path (all runs), time "
+         "turning on the spot, goals abandoned per run, wall contacts in all runs.", ""]
     head = ["localisation"] + [f"{f} {c}" for f in floors for c in ("r", "p")]
     L.append("| " + " | ".join(head) + " |")
     L.append("|---" * len(head) + "|")

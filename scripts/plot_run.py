@@ -20,17 +20,17 @@ Images are written to a temporary name and renamed.
 
 --animate writes a video of the run instead (default RUNDIR/run.gif): the map, the
 trajectory so far, the robot (an orange disc of radius 0.177 m with a heading tick, at the
-last track.tsv row not after the frame's time), the packets so far coloured by dBm (every
-k-th when there are more than 20,000), the goal of the current decision (green x), the
-path-loss source estimate with its uncertainty area when log.tsv has one (white plus),
-the true source (red star) and "t = 12 s, travelled 3.4 m" (along track.tsv). Frames are
-taken every S/N seconds of simulated time (--speed S simulated seconds per video second,
-default 10; --fps N frames per second, 1..60, default 10) from 0 to the last track row,
-which gets the last frame; with more than --max-frames (default 600) they are spread
-evenly instead. A frame is 960 pixels wide; the map is drawn 40 px from the left and 36 px
-from the top at the largest scale that fits 840 x 720 px, then 56 px below it (the height
-rounded up to even). FILE ending in .mp4 is encoded by ffmpeg (H.264), anything else is a
-GIF (Pillow).
+last track.tsv row not after the frame's time, or the first), the packets so far coloured
+by dBm (every k-th when there are more than 20,000), the goal of the current decision
+(green x), the path-loss source estimate with its uncertainty area when log.tsv has one
+(white plus), the true source (red star) and "t = 12 s, travelled 3.4 m" (along
+track.tsv). Frames are taken every S/N seconds of simulated time (--speed S simulated
+seconds per video second, default 10; --fps N frames per second, 1..60, default 10) from
+0 to the last track row, which gets the last frame; with more than --max-frames (default
+600) they are spread evenly instead. A frame is 960 pixels wide; the map is drawn 40 px
+from the left and 36 px from the top at the largest scale that fits 840 x 720 px, then 56
+px below it (the height rounded up to even). FILE ending in .mp4 is encoded by ffmpeg
+(H.264), anything else is a GIF (Pillow).
 """
 import json
 import os

@@ -11,6 +11,11 @@ LINUX_PROGS := $(patsubst firmware/port/linux/prog/%.c,$(BUILD)/bin/%,$(sort $(w
 $(BUILD)/gen/rfseek_%.c $(BUILD)/gen/rfseek_%.h: lcm/%.lcm
 	@mkdir -p $(BUILD)/gen
 	lcm-gen -c --c-cpath $(BUILD)/gen --c-hpath $(BUILD)/gen $<
+# The same types for Python (scripts/lcm_log.py): one package, rfseek, needing only struct.
+LCM_PY_INIT := $(BUILD)/gen/python/rfseek/__init__.py
+$(LCM_PY_INIT): $(sort $(wildcard lcm/*.lcm))
+	@rm -rf $(BUILD)/gen/python/rfseek && mkdir -p $(BUILD)/gen/python
+	lcm-gen -p --ppath $(BUILD)/gen/python $^
 $(BUILD)/gen/%.o: $(BUILD)/gen/%.c
 	$(CC) $(CSTD) $(OPT) -D_DEFAULT_SOURCE -I$(BUILD)/gen $(DEPFLAGS) -c $< -o $@
 $(BUILD)/gen/%.asan.o: $(BUILD)/gen/%.c
@@ -40,7 +45,7 @@ $(BUILD)/asan/bin/rfseekd: $(BUILD)/asan/obj/firmware/port/linux/prog/rfseekd.o 
 	@mkdir -p $(@D)
 	$(LD_linux) $(SAN_FLAGS) -o $@ $< $(ASAN_LIBS_linux) $(LDLIBS_linux)
 
-ALL_TARGETS += $(LINUX_LIB) $(LINUX_PROGS)
+ALL_TARGETS += $(LINUX_LIB) $(LINUX_PROGS) $(LCM_PY_INIT)
 
 # --- tests -------------------------------------------------------------------------------
 # The map loader on real maps (/work/shared/data/maps) and bad input (tests/data/maps_bad/);

@@ -73,6 +73,10 @@ $(WIRE_LCM_TOOL): tests/wire/lcm_tool.c $(LIBS_linux) | $(LCM_GEN_HDRS)
 	@mkdir -p $(@D)
 	$(LD_linux) $(LINUX_CFLAGS) $(DEPFLAGS) -MF $@.d -MT $@ $< -o $@ $(LIBS_linux) $(LDLIBS_linux)
 $(eval $(call test_script,rfseekd,tests/wire/rfseekd_test.sh $(BUILD),$(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/asan/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
+# LCM for users (docs/CAN.md, "Running on a robot"): scripts/lcm_log.py on rfseekd's logs
+# against lcm_tool, --decisions and the CAN frames; damaged logs; scripts/lcm_route.sh and
+# a two-namespace run over veth with lcm-logger beside it (network namespaces, as root).
+$(eval $(call test_script,lcm_user,$(PYTHON) tests/wire/lcm_user_test.py $(BUILD),$(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm $(LCM_PY_INIT)))
 # CAN logs (candump -L): rfseek-record's and rfseekd's through log2asc, asc2log and canmatrix,
 # and replayed by rfseek-replay to the output of the recorded stream.
 $(eval $(call test_script,candump,tests/wire/candump_test.sh $(BUILD),$(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-replay $(BUILD)/bin/rfseek-record))

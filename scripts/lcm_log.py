@@ -11,7 +11,7 @@ message's type (byte arrays as hex, strings with tab, newline and backslash esca
 the channel's messages of other types are left out and counted. --list prints one row per
 channel: channel, type(s), messages, bytes. A message whose fingerprint is none of
 lcm/*.lcm's, or whose length differs from its decoding, is left out and counted: one
-stderr line at the end, exit status 0. A damaged log (bad sync word, an event cut short,
+stderr line at the end, exit status 0; liblcm's own LCM_SELF_TEST is left out silently. A damaged log (bad sync word, an event cut short,
 a channel name that is not text): one error line naming the byte offset, exit 1.
 
 Messages are decoded by the classes `lcm-gen --python` writes from lcm/*.lcm (make builds
@@ -31,6 +31,7 @@ import sys
 
 SYNC = 0xEDA1DA01
 HEADER = struct.Struct(">IqqII")  # sync, event number, utime, channel length, data length
+SELF_TEST = "LCM_SELF_TEST"  # liblcm's own check of the udpm provider (lcm-logger logs it)
 MAX_CHANNEL = 63  # LCM's limit on a channel name (lcm.h, LCM_MAX_CHANNEL_NAME_LENGTH)
 DEFAULT_GEN = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "build", "gen",
                            "python")
@@ -168,7 +169,7 @@ def main(argv):
     table_type, counts = None, {}
     try:
         for num, utime, channel, data in events(path):
-            if not want.fullmatch(channel):
+            if channel == SELF_TEST or not want.fullmatch(channel):
                 continue
             try:
                 name, msg = decode(data, types)

@@ -404,8 +404,9 @@ def animate_main(run, args):
             os.unlink(tmp)
         die("%s: %s" % (out, e))
     plt.close(fig)
-    print("%s: %d frames of %d x %d, %g fps, %.3g simulated s per video s" % (
-        out, len(times), ANIM_W, hgt, fps, (times[-1] / (len(times) - 1) * fps) if len(times) > 1 else 0))
+    spread = len(times) == max_frames and len(times) > 1
+    print("%s: %d frames of %d x %d, %g fps, %.4g simulated s per video s" % (
+        out, len(times), ANIM_W, hgt, fps, times[-1] / (len(times) - 1) * fps if spread else speed))
     return 0
 
 

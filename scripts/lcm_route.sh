@@ -17,7 +17,7 @@ EOF
 }
 set -uo pipefail
 die() { local m="lcm_route.sh: $*"; echo "${m//$'\n'/?}" >&2; exit 1; }
-iface= mode=add
+iface='' mode=add
 for a in "$@"; do
     case $a in
     --help | -h) usage; exit 0 ;;

@@ -11,6 +11,11 @@ LINUX_PROGS := $(patsubst firmware/port/linux/prog/%.c,$(BUILD)/bin/%,$(sort $(w
 $(BUILD)/gen/rfseek_%.c $(BUILD)/gen/rfseek_%.h: lcm/%.lcm
 	@mkdir -p $(BUILD)/gen
 	lcm-gen -c --c-cpath $(BUILD)/gen --c-hpath $(BUILD)/gen $<
+# The same types for Python (scripts/lcm_log.py): one package, rfseek, needing only struct.
+LCM_PY_INIT := $(BUILD)/gen/python/rfseek/__init__.py
+$(LCM_PY_INIT): $(sort $(wildcard lcm/*.lcm))
+	@rm -rf $(BUILD)/gen/python/rfseek && mkdir -p $(BUILD)/gen/python
+	lcm-gen -p --ppath $(BUILD)/gen/python $^
 $(BUILD)/gen/%.o: $(BUILD)/gen/%.c
 	$(CC) $(CSTD) $(OPT) -D_DEFAULT_SOURCE -I$(BUILD)/gen $(DEPFLAGS) -c $< -o $@
 $(BUILD)/gen/%.asan.o: $(BUILD)/gen/%.c
@@ -40,7 +45,7 @@ $(BUILD)/asan/bin/rfseekd: $(BUILD)/asan/obj/firmware/port/linux/prog/rfseekd.o 
 	@mkdir -p $(@D)
 	$(LD_linux) $(SAN_FLAGS) -o $@ $< $(ASAN_LIBS_linux) $(LDLIBS_linux)
 
-ALL_TARGETS += $(LINUX_LIB) $(LINUX_PROGS)
+ALL_TARGETS += $(LINUX_LIB) $(LINUX_PROGS) $(LCM_PY_INIT)
 
 # --- tests -------------------------------------------------------------------------------
 # The map loader on real maps (/work/shared/data/maps) and bad input (tests/data/maps_bad/);
@@ -68,6 +73,10 @@ $(WIRE_LCM_TOOL): tests/wire/lcm_tool.c $(LIBS_linux) | $(LCM_GEN_HDRS)
 	@mkdir -p $(@D)
 	$(LD_linux) $(LINUX_CFLAGS) $(DEPFLAGS) -MF $@.d -MT $@ $< -o $@ $(LIBS_linux) $(LDLIBS_linux)
 $(eval $(call test_script,rfseekd,tests/wire/rfseekd_test.sh $(BUILD),$(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/asan/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
+# LCM for users (docs/CAN.md, "Running on a robot"): scripts/lcm_log.py on rfseekd's logs
+# against lcm_tool, --decisions and the CAN frames; damaged logs; scripts/lcm_route.sh and
+# a two-namespace run over veth with lcm-logger beside it (network namespaces, as root).
+$(eval $(call test_script,lcm_user,$(PYTHON) tests/wire/lcm_user_test.py $(BUILD),$(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm $(LCM_PY_INIT)))
 # CAN logs (candump -L): rfseek-record's and rfseekd's through log2asc, asc2log and canmatrix,
 # and replayed by rfseek-replay to the output of the recorded stream.
 $(eval $(call test_script,candump,tests/wire/candump_test.sh $(BUILD),$(WIRE_LCM_TOOL) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-replay $(BUILD)/bin/rfseek-record))

@@ -69,6 +69,11 @@ $(eval $(call test_script,map_formats,$(PYTHON) tests/linux/map_formats.py $(BUI
 # rfseek-map --mcu against firmware/rfs_app.h's limits and scripts/map2c.py, --crop keeping
 # every world point's cell, --png's size and metre grid (decoded with PIL).
 $(eval $(call test_script,map_tools,$(PYTHON) tests/host_sim/map_tools.py $(BUILD)/bin/rfseek-map,$(BUILD)/bin/rfseek-map))
+# scripts/plot_run.py --animate: frame count, size and the robot's pixels of a short run's
+# GIF decoded with Pillow; MP4 when ffmpeg is installed; bad input.
+$(eval $(call test_script,animate,$(PYTHON) tests/host_sim/animate_test.py $(SIM),$(SIM)))
+# The README's path from a PNG map and a capture to a run and a video, as written there.
+$(eval $(call test_script,readme_path,tests/host_sim/readme_path.sh $(BUILD),$(SIM) $(BUILD)/bin/rfseek-map $(BUILD)/bin/rfseek-feed))
 # rfseekd --model pathloss fills the estimate in its status (two-process run in a netns).
 $(eval $(call test_script,status_est,tests/host_sim/status_est.sh $(BUILD),$(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
 # Every program's model and target options and scenario keys, good and bad values; PDR

@@ -381,6 +381,18 @@ static void test_noisy_polylines(void **state)
     }
 }
 
+/* An update at the pose's time with pose p: the estimate is p itself (replaced, not
+ * blended). */
+static void expect_replaced(rfs_drive_t *d, const rfs_pose_t *p)
+{
+    int16_t l, r;
+    (void)rfs_drive_update(d, p, p->t_us, &l, &r);
+    rfs_pose_t e;
+    (void)rfs_drive_estimate(d, &e);
+    assert_int_equal(e.x, p->x);
+    assert_int_equal(e.y, p->y);
+}
+
 /* The pose filter on a robot standing still with noisy poses: its error's standard
  * deviation is sigma sqrt(k / (2 - k)) for gain k, the first-order filter's theory
  * (e_n = (1 - k) e_n-1 + k w_n), within 15 %; a pose 1 m away replaces the estimate. */
@@ -416,12 +428,7 @@ static void test_pose_filter(void **state)
     assert_true(fabs(rth / (0.02 * f) - 1.0) < 0.15);
     /* Relocalised 1 m away: the next update steers by the new pose. */
     rfs_pose_t far = {s.t, q16(2.0), q16(2.0), q16(0.5)};
-    int16_t l, r;
-    (void)rfs_drive_update(&d, &far, s.t, &l, &r);
-    rfs_pose_t e;
-    (void)rfs_drive_estimate(&d, &e);
-    assert_int_equal(e.x, far.x);
-    assert_int_equal(e.y, far.y);
+    expect_replaced(&d, &far);
 }
 
 /* Exact poses at 10 Hz while driving: between poses the estimate is dead-reckoned from the
@@ -584,11 +591,7 @@ static void test_pose_after_silence(void **state)
         (void)rfs_drive_update(&d, &p0, t, &l, &r);
     }
     rfs_pose_t p1 = {3100000, q16(1.4), q16(1.0), 0};
-    (void)rfs_drive_update(&d, &p1, 3100000, &l, &r);
-    rfs_pose_t e;
-    (void)rfs_drive_estimate(&d, &e);
-    assert_int_equal(e.x, p1.x);
-    assert_int_equal(e.y, p1.y);
+    expect_replaced(&d, &p1);
 }
 
 /* Pushed 0.45 m sideways 0.2 m before the goal: the robot turns back to the goal and

@@ -2,6 +2,8 @@
 # CAN frames, LCM messages and logs, map YAML + PGM, scenario YAML, radiotap + 802.11
 # headers, the replay stream, pcap/pcapng captures and the pose CSV of rfseek-feed --pose. clang only: -fsanitize=fuzzer,address,undefined.
 #   make fuzz [FUZZ_SECONDS=300] [FUZZ_TARGETS="can map"]   each target for that long
+#   make fuzz-long [FUZZ_LONG_RUNS=10000000]   each target for that many executions, one after
+#   another under nice -n 19 (the figures in docs/RELIABILITY.md, "Long runs")
 # New inputs go to $(FUZZ_DIR)/corpus-<name>, crashes to $(FUZZ_DIR)/artifacts/; `make test`
 # runs each over its committed corpus plus a short burst.
 FUZZ_CC ?= clang
@@ -69,7 +71,10 @@ $(eval $(call test_script,fuzz_replay,tests/fuzz/run_one.sh $(FW)/fuzz_replay $(
 # make fuzz: every target for FUZZ_SECONDS each.
 FUZZ_ALL_BINS := $(FUZZ_BINS) $(FEED)/fuzz_radiotap $(FW)/fuzz_replay
 FUZZ_TARGETS ?= $(FUZZ_OWN) radiotap replay
-.PHONY: fuzz fuzz-build
+FUZZ_LONG_RUNS ?= 10000000
+.PHONY: fuzz fuzz-build fuzz-long
 fuzz-build: $(FUZZ_ALL_BINS)
 fuzz: fuzz-build
 	@tests/fuzz/run_all.sh $(BUILD) --seconds $(FUZZ_SECONDS) $(FUZZ_TARGETS)
+fuzz-long: fuzz-build
+	@nice -n 19 tests/fuzz/run_all.sh $(BUILD) --runs $(FUZZ_LONG_RUNS) $(FUZZ_TARGETS)

@@ -2,12 +2,14 @@
 # outputs_test.sh BUILD - the Linux programs' outputs under stress: an output that is the
 # input (refused before any work, the input intact), stdout on /dev/full (exit 1, one
 # line), a full disk for rfseekd --log (a 200 KB tmpfs: no PATH.tmp left), rfseekd
-# --replay of logs that are not LCM logs, and replay streams cut before their END record.
+# --replay and rfseek-sim-lcm's file:// of logs that are not LCM logs, and replay streams
+# cut before their END record.
 set -uo pipefail
 B=${1:?usage: outputs_test.sh BUILD}
 bin=$B/bin map=scenarios/maps/office.yaml
 w=$(mktemp -d /tmp/rfs_outputs.XXXXXX)
-trap 'mountpoint -q "$w/full" && umount "$w/full"; rm -rf -- "$w"' EXIT
+ns=rfsout$$
+trap 'mountpoint -q "$w/full" && umount "$w/full"; ip netns del "$ns" 2>/dev/null; rm -rf -- "$w"' EXIT
 . "$(dirname "$0")/../lib/checks.sh"
 # err NAME RC TEXT PROG ARGS...: exit RC, exactly one stderr line containing TEXT.
 err() {
@@ -68,6 +70,32 @@ done
 [ $rc -eq 1 ] && [ "$(wc -l <"$w/err")" -eq 1 ] && grep -qF "rfseek-record: stdout: $full" "$w/err" \
     && pass stdout-full-rfseek-record || fail stdout-full-rfseek-record "rc $rc: $(head -c 300 "$w/err")"
 
+# rfseek-sim-lcm prints summary.json; its controller is rfseekd in another process, over
+# udpm:// inside a private network namespace (memq:// does not cross processes), as in
+# tests/wire/rfseekd_test.sh. sim_lcm OUT: one 2 s run, stdout to OUT; sets rc.
+url='udpm://239.255.76.67:7667?ttl=0'
+sim_lcm() {
+    ip netns exec "$ns" timeout 60 "$bin/rfseekd" --map $map --lcm "$url" --can-over-lcm --clock-lcm \
+        --idle-exit 1000 >/dev/null 2>"$w/d.err" &
+    local dpid=$!
+    sleep 0.5
+    ip netns exec "$ns" timeout 60 "$bin/rfseek-sim-lcm" scenarios/default.yaml --lcm "$url" --max-time 2 \
+        >"$1" 2>"$w/err"
+    rc=$?
+    wait $dpid
+}
+if ip netns add "$ns" 2>/dev/null && ip netns exec "$ns" ip link set lo up \
+    && ip netns exec "$ns" ip route add 224.0.0.0/4 dev lo; then
+    sim_lcm "$w/summary.json"
+    check stdout-file-rfseek-sim-lcm '[ $rc -eq 0 ] && [ ! -s "$w/err" ] && grep -q "\"sim_time_s\"" "$w/summary.json"'
+    sim_lcm /dev/full
+    [ $rc -eq 1 ] && [ "$(cat "$w/err")" = "rfseek-sim-lcm: stdout: $full" ] \
+        && pass stdout-full-rfseek-sim-lcm || fail stdout-full-rfseek-sim-lcm "rc $rc: $(head -c 300 "$w/err")"
+    ip netns del "$ns"
+else
+    echo "SKIP stdout-full-rfseek-sim-lcm: cannot create a network namespace (needs root)"
+fi
+
 # --- row: full disk, rfseekd --log leaves no temporary -------------------------------------
 mkdir -p "$w/full"
 if mount -t tmpfs -o size=200k tmpfs "$w/full" 2>/dev/null; then
@@ -88,6 +116,14 @@ head -c $((sz - 7)) "$w/in.lcmlog" >"$w/cut.lcmlog"
 err rfseekd-replay-cut 1 "event cut short" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/cut.lcmlog"
 { cat "$w/in.lcmlog"; printf '\xed\xa1\xda\x01\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\x03\xe8\0\0\0\0'; head -c 1000 /dev/zero | tr '\0' A; } >"$w/longch.lcmlog"
 err rfseekd-replay-long-channel 1 "channel name of 1000 bytes" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/longch.lcmlog"
+# The same logs played to rfseek-sim-lcm through LCM's file:// provider (liblcm would stop
+# without a word, or print its own line and play on): one line before any step, exit 1.
+for c in "random:offset 0: not an LCM event" "cut:event cut short" "longch:channel name of 1000 bytes"; do
+    err "sim-lcm-file-${c%%:*}" 1 "lcm: file://$w/${c%%:*}.lcmlog?speed=0: offset" \
+        rfseek-sim-lcm scenarios/default.yaml --lcm "file://$w/${c%%:*}.lcmlog?speed=0" --max-time 1
+    grep -qF "${c#*:}" "$w/err" || fail "sim-lcm-file-${c%%:*}-reason" "$(cat "$w/err")"
+    [ -s "$w/out" ] && fail "sim-lcm-file-${c%%:*}-no-summary" "$(head -c 100 "$w/out")"
+done
 check rfseekd-replay-valid 'bin/true 2>/dev/null; "$bin/rfseekd" --map $map --clock-lcm --lcm memq:// --replay "$w/in.lcmlog" >/dev/null 2>&1'
 
 # --- row: replay streams without their END record ------------------------------------------

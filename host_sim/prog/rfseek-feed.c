@@ -248,8 +248,8 @@ static int tsv_line(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_fram
     char line[64];
     const size_t len = format_line(line, pkt->ts_sec, pkt->ts_nsec, f->wlan.sa, f->rt.dbm_signal);
     fwrite(line, 1, len, c->out);
-    if (c->live) { fflush(c->out); }
-    return 0;
+    /* Live, a lost line ends the reading (a batch's table is checked at the end). */
+    return c->live && fflush(c->out) != 0 ? 1 : 0;
 }
 
 static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, const uint8_t (*macs)[6],
@@ -276,9 +276,12 @@ static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, const uin
     setvbuf(out, obuf, _IOFBF, sizeof(obuf));
     tsv_ctx_t c = {out, live};
     int rc = scan_capture(r, macs, n_macs, st, tsv_line, &c, NULL, NULL);
-    if (fflush(out) != 0 || ferror(out)) {
-        fprintf(stderr, "rfseek-feed: %s: write error: %s\n", output != NULL ? tmp : "stdout", strerror(errno));
+    if (output != NULL && (fflush(out) != 0 || ferror(out))) {
+        fprintf(stderr, "rfseek-feed: %s: write error: %s\n", tmp, strerror(errno));
         rc = 1;
+    }
+    if (output == NULL && ferror(out)) {
+        rc = 1; /* reported once, by lx_err_close_stdout */
     }
     if (output != NULL) {
         if (fclose(out) != 0) { rc = 1; }
@@ -882,16 +885,22 @@ static int parse_options(int argc, char **argv, feed_opts_t *fo)
     return check_options(fo);
 }
 
-int main(int argc, char **argv)
+static int feed_main(int argc, char **argv)
 {
     static feed_opts_t fo;
     int rc = parse_options(argc, argv, &fo);
     if (rc != RUN) {
         return rc;
     }
-    // Outputs checked before the capture is read: not an input, their directory there.
+    // Outputs checked before the capture is read: not an input, their directory there,
+    // no directory at --out (rfseek-sim's rule: the run's files never mix with others).
     const char *ins[3] = {fo.ro.capture, fo.ro.poses, fo.ro.scenario};
     const char *outs[2] = {fo.output, fo.ro.out};
+    struct stat st_out;
+    if (fo.ro.out != NULL && lstat(fo.ro.out, &st_out) == 0) {
+        opt_err("%s: already exists (choose a new --out directory)", fo.ro.out);
+        return 1;
+    }
     for (int i = 0; i < 2; i++) {
         for (int k = 0; outs[i] != NULL && k < 3; k++) {
             if (lx_err_same_file("rfseek-feed", ins[k], outs[i]) != 0) {
@@ -916,4 +925,9 @@ int main(int argc, char **argv)
     lx_pcap_close(r);
     if (fo.stats) { print_stats(fo.ro.capture, &st); }
     return rc;
+}
+
+int main(int argc, char **argv)
+{
+    return lx_err_close_stdout("rfseek-feed", feed_main(argc, argv));
 }

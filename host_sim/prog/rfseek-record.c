@@ -582,7 +582,7 @@ static int run_mission(recording_t *s, const options_t *o, uint64_t run_seed)
     return 0;
 }
 
-int main(int argc, char **argv)
+static int record_main(int argc, char **argv)
 {
     static recording_t s;
     options_t o;
@@ -595,5 +595,10 @@ int main(int argc, char **argv)
     }
     const uint64_t run_seed = o.have_seed ? o.seed : s.sc.seed;
     record_config(&s, &o, run_seed);
-    return lx_err_close_stdout(PROG, run_mission(&s, &o, run_seed));
+    return run_mission(&s, &o, run_seed);
+}
+
+int main(int argc, char **argv)
+{
+    return lx_err_close_stdout(PROG, record_main(argc, argv));
 }

@@ -844,7 +844,7 @@ static int check_options(sim_opts_t *o)
         if (!o->resume && stat(o->out, &st) == 0) {
             return die("%s: already exists (choose a new --out directory)%s", o->out, "");
         }
-        if (!o->emit && lx_err_check_dest(prog, o->out) != 0) {
+        if (!o->emit && !o->resume && lx_err_check_dest(prog, o->out) != 0) {
             return 1;
         }
     }

@@ -45,6 +45,24 @@ cp "$cap" "$w/same.pcap"
 err feed-output-is-capture 1 "is the input" rfseek-feed "$w/same.pcap" --mac 02:00:00:00:00:01 --output "$w/same.pcap"
 check feed-output-is-capture-intact 'cmp -s "$w/same.pcap" "$cap"'
 err feed-output-dir-missing 1 "No such file or directory" rfseek-feed "$w/same.pcap" --mac 02:00:00:00:00:01 --output "$w/no/x.tsv"
+printf 't_us,x_m,y_m,theta_rad\n1700000000000000,8,6,0\n1700000001000000,9,6,0\n' >"$w/p.csv"
+mkdir "$w/exists"
+err feed-out-exists 1 "$w/exists: already exists" rfseek-feed "$cap" --pose "$w/p.csv" --scenario scenarios/default.yaml --out "$w/exists"
+check feed-out-exists-untouched '[ -z "$(ls -A "$w/exists")" ] && ! compgen -G "$w/exists.tmp*" >/dev/null'
+# An output that is a directory or a FIFO: refused before any work (renamed into place, a
+# directory failed after the work and a device or FIFO node would have been replaced).
+mkfifo "$w/fifo"
+for o in exists fifo; do
+    want=$([ $o = exists ] && echo "Is a directory" || echo "not a regular file")
+    err "replay-out-$o" 1 "$w/$o: $want" rfseek-replay "$w/in.rfsr" -o "$w/$o"
+    err "rfseekd-log-$o" 1 "$w/$o: $want" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/in.lcmlog" --log "$w/$o"
+    err "rfseekd-decisions-$o" 1 "$w/$o: $want" rfseekd --map $map --clock-lcm --lcm memq:// --replay "$w/in.lcmlog" --decisions "$w/$o"
+    err "feed-output-$o" 1 "$w/$o: $want" rfseek-feed "$cap" --mac 02:00:00:00:00:01 --output "$w/$o"
+    err "map-pgm-$o" 1 "$w/$o: $want" rfseek-map $map --pgm "$w/$o"
+    err "record-out-$o" 1 "$w/$o: $want" rfseek-record scenarios/default.yaml -o "$w/$o" --max-time 3
+    err "sim-pcap-$o" 1 "$w/$o: $want" rfseek-sim scenarios/default.yaml --seed 1 --pcap "$w/$o"
+done
+check outputs-dir-fifo-untouched '[ -z "$(ls -A "$w/exists")" ] && [ -p "$w/fifo" ] && ! compgen -G "$w/fifo.tmp*" >/dev/null'
 cp scenarios/maps/office.yaml "$w/office.yaml"; sed -i "s|^image: *|image: $PWD/scenarios/maps/|" "$w/office.yaml"
 err map-pgm-is-yaml 1 "is the input" rfseek-map "$w/office.yaml" --pgm "$w/office.yaml"
 cp scenarios/default.yaml "$w/scn.yaml"; sed -i "s|^map: *|map: $PWD/scenarios/|" "$w/scn.yaml"
@@ -57,12 +75,19 @@ err record-out-dir-missing 1 "$w/no/r.rfsr: No such file or directory" rfseek-re
 
 # --- row: stdout on /dev/full --------------------------------------------------------------
 exec 3>&1
-for c in "rfseek-map $map" "rfseek-replay --print $w/out.rfso" "rfseekd --map $map --clock-lcm --lcm memq:// --replay $w/bad.lcmlog"; do
+for c in "rfseek-map $map" "rfseek-replay --print $w/out.rfso" "rfseekd --map $map --clock-lcm --lcm memq:// --replay $w/bad.lcmlog" \
+         "rfseek-feed $cap --mac 90:a4:de:c0:46:11"; do
     # shellcheck disable=SC2086
     "$bin"/$c >/dev/full 2>"$w/err"; rc=$?
     name="stdout-full-${c%% *}"
     [ $rc -eq 1 ] && [ "$(grep -c . "$w/err" | head -1)" -ge 1 ] && grep -qF "${c%% *}: stdout: $full" "$w/err" \
         && [ "$(grep -vc -e '^rfseekd: dropped LCM message' -e '(dropped, counted)$' -e '^rfseekd: [0-9]* steps, ' "$w/err")" -eq 1 ] && pass "$name" || fail "$name" "rc $rc: $(head -c 300 "$w/err")"
+done
+
+# --help to /dev/full: the text lost, exit 1 (every program returns through its stdout).
+for p in rfseek-map rfseek-replay rfseekd rfseek-feed rfseek-record rfseek-sim rfseek-sim-lcm; do
+    "$bin/$p" --help >/dev/full 2>"$w/err"; rc=$?
+    [ $rc -eq 1 ] && [ "$(cat "$w/err")" = "$p: stdout: $full" ] && pass "help-full-$p" || fail "help-full-$p" "rc $rc: $(head -c 200 "$w/err")"
 done
 
 # rfseek-record prints its summary to stdout.

@@ -255,6 +255,32 @@ static void bad_url_and_unreadable_log_give_one_line(void **state)
     assert_string_equal(err, "/nonexistent/dir/x.lcmlog: cannot open for reading");
 }
 
+/* A file:// log is read whole before liblcm plays it (read mode: the default, or mode=r):
+ * garbage is one line naming the offset; a log opened for writing is not read. */
+static void damaged_file_url_is_one_line(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/rfs_test_lcm_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    assert_int_equal(write(fd, "hello", 5), 5);
+    close(fd);
+    char url[128], want[256], err[256];
+    const char *opts[2] = {"?speed=0", "?mode=r&speed=0"};
+    for (int k = 0; k < 2; k++) {
+        snprintf(url, sizeof url, "file://%s%s", path, opts[k]);
+        assert_null(lx_lcm_open(url, NULL, err, sizeof err));
+        snprintf(want, sizeof want, "lcm: %s: offset 0: not an LCM event (no sync word)", url);
+        assert_string_equal(err, want);
+    }
+    snprintf(url, sizeof url, "file://%s?speed=0&mode=w", path);
+    lx_lcm_t *l = lx_lcm_open(url, NULL, err, sizeof err);
+    assert_non_null(l);
+    assert_string_equal(err, "");
+    lx_lcm_close(l);
+    remove(path);
+}
+
 /* RFS_RSSI_STATUS. Reference bytes from the LCM wire format computed in Python
  * (tests/fuzz/make_corpus.py's lcm_hash of {int64_t utime, int32_t seq} = 0xc77a89abfd4c5ba6,
  * then utime and seq big-endian): utime -5,000,000,123, seq -7. */
@@ -307,6 +333,7 @@ int main(void)
         cmocka_unit_test(malformed_messages_are_dropped_and_described),
         cmocka_unit_test(log_is_written_atomically_and_reads_back),
         cmocka_unit_test(bad_url_and_unreadable_log_give_one_line),
+        cmocka_unit_test(damaged_file_url_is_one_line),
         cmocka_unit_test(receiver_status_matches_reference_bytes_and_rejects_others),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

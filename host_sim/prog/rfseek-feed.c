@@ -683,6 +683,20 @@ static void rp_run(replay_t *rp)
     hs_sim_result_estimate(res, &rp->ctrl, sc->src[0].x, sc->src[0].y); /* the path-loss estimate */
 }
 
+/* Close one output file of the replay: rc, or 1 after a line naming it when a write or
+ * the close failed (no second line after an earlier error). */
+static int rp_close(const replay_t *rp, FILE *f, const char *name, int rc)
+{
+    errno = 0;
+    const bool bad = ferror(f) != 0;
+    if ((fclose(f) != 0 || bad) && rc == 0) {
+        fprintf(stderr, "rfseek-feed: %s/%s: write error: %s\n", rp->tmp, name,
+                errno != 0 ? strerror(errno) : "write failed");
+        rc = 1;
+    }
+    return rc;
+}
+
 /* summary.json, the logs closed, the directory renamed into place (removed on failure),
  * and everything freed: the exit status (rc: so far). */
 static int rp_finish(replay_t *rp, feed_stats_t *st, int rc, bool ran)
@@ -694,12 +708,16 @@ static int rp_finish(replay_t *rp, feed_stats_t *st, int rc, bool ran)
             rc = 1;
         } else {
             hs_sim_write_summary(fsum, &rp->env, &rp->res);
-            if (fclose(fsum) != 0) { rc = 1; }
+            rc = rp_close(rp, fsum, "summary.json", rc);
         }
     }
-    if (rp->flog != NULL && (ferror(rp->flog) || fclose(rp->flog) != 0)) { rc = 1; }
-    if (rp->fsam != NULL && (ferror(rp->fsam) || fclose(rp->fsam) != 0)) { rc = 1; }
-    if (rp->ftrk != NULL && (ferror(rp->ftrk) || fclose(rp->ftrk) != 0)) { rc = 1; }
+    FILE *const logs[3] = {rp->flog, rp->fsam, rp->ftrk};
+    for (int i = 0; i < 3; i++) {
+        if (logs[i] != NULL) {
+            rc = rp_close(rp, logs[i], k_rp_files[i], rc);
+        }
+    }
+    rp->flog = rp->fsam = rp->ftrk = NULL;
     if (rp->tmp[0] != '\0') {
         if (rc == 0 && rename(rp->tmp, rp->o->out) != 0) {
             fprintf(stderr, "rfseek-feed: %s: cannot rename to %s: %s\n", rp->tmp, rp->o->out, strerror(errno));

@@ -47,7 +47,8 @@ typedef struct recorder {
     FILE *in;                   /* the recorded input stream */
     FILE *out;                  /* the live output stream, or NULL */
     const char *in_path;
-    int write_failed;
+    int write_failed;           /* a write to `in` failed */
+    int live_failed;            /* a write to `out` failed */
     rfs_app_t *app;
     rfs_replay_player_t *player;
     rfs_can_tx_t tx;            /* the senders' counters (localisation, radio module) */
@@ -94,7 +95,7 @@ static void sink(void *ctx, const uint8_t *p, uint32_t n)
 {
     recorder_t *r = ctx;
     if (r->out != NULL && fwrite(p, 1, n, r->out) != n) {
-        r->write_failed = 1;
+        r->live_failed = 1;
     }
 }
 
@@ -560,18 +561,24 @@ static int run_mission(recording_t *s, const options_t *o, uint64_t run_seed)
     memset(&r, 0, sizeof r);
     r.type = RFS_REPLAY_END;
     put(rec, &r);
-    const int close_in = fclose(rec->in);
-    const int close_out = rec->out != NULL ? fclose(rec->out) : 0;
-    if (rc != 0 || rec->write_failed || close_in != 0 || close_out != 0) {
-        lx_err_print(PROG, "%s: %s", rc != 0 ? o->scn_path : o->out_path, rc != 0 ? err : "write failed");
+    const bool in_failed = fclose(rec->in) != 0 || rec->write_failed;
+    const bool out_failed = (rec->out != NULL && fclose(rec->out) != 0) || rec->live_failed;
+    if (rc != 0 || in_failed || out_failed) {
+        lx_err_print(PROG, "%s: %s", rc != 0 ? o->scn_path : in_failed ? o->out_path : o->live_path,
+                     rc != 0 ? err : "write failed");
         remove(s->tmp_in);
         if (o->live_path != NULL) {
             remove(s->tmp_out);
         }
         return 1;
     }
-    if (rename(s->tmp_in, o->out_path) != 0 || (o->live_path != NULL && rename(s->tmp_out, o->live_path) != 0)) {
-        lx_err_print(PROG, "%s: %s", o->out_path, strerror(errno));
+    const bool in_moved = rename(s->tmp_in, o->out_path) == 0;
+    if (!in_moved || (o->live_path != NULL && rename(s->tmp_out, o->live_path) != 0)) {
+        lx_err_print(PROG, "%s: %s", in_moved ? o->live_path : o->out_path, strerror(errno));
+        remove(s->tmp_in);
+        if (o->live_path != NULL) {
+            remove(s->tmp_out);
+        }
         return 1;
     }
     printf("recorded %" PRIu32 " records, %" PRIu32 " steps, %.1f s simulated, %s, "

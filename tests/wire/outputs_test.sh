@@ -128,17 +128,21 @@ if mount -t tmpfs -o size=200k tmpfs "$w/full" 2>/dev/null; then
     "$bin/rfseekd" --map $map --clock-lcm --lcm memq:// --replay "$w/bad.lcmlog" --log "$w/full/out.lcmlog" >/dev/null 2>"$w/err"
     check rfseekd-log-disk-full '[ $? -eq 1 ] && [ "$(grep -v -e "^rfseekd: dropped LCM message" -e "(dropped, counted)$" -e "^rfseekd: [0-9]* steps, " "$w/err")" = "rfseekd: $w/full/out.lcmlog: could not finish the log (write failed)" ]' 
     check rfseekd-log-disk-full-no-tmp '[ ! -e "$w/full/out.lcmlog.tmp" ] && [ ! -e "$w/full/out.lcmlog" ]'
+    "$bin/rfseekd" --map $map --clock-lcm --lcm memq:// --replay "$w/bad.lcmlog" --decisions "$w/full/d.txt" >/dev/null 2>"$w/err"
+    check rfseekd-decisions-disk-full '[ $? -eq 1 ] && [ "$(grep -v -e "^rfseekd: dropped LCM message" -e "(dropped, counted)$" -e "^rfseekd: [0-9]* steps, " "$w/err")" = "rfseekd: $w/full/d.txt: write failed" ] && [ "$(ls "$w/full")" = fill ]'
     # The other programs' files on the full disk: one line naming the file, nothing left.
     for c in "record:rfseek-record scenarios/default.yaml -o $w/full/r.rfsr --max-time 3" \
              "replay:rfseek-replay $w/in.rfsr -o $w/full/o.rfso" \
              "feed:rfseek-feed $cap --mac 90:a4:de:c0:46:11 --output $w/full/x.tsv" \
              "feed-pose:rfseek-feed $cap --pose $w/p.csv --scenario scenarios/default.yaml --out $w/full/d" \
-             "map:rfseek-map $map --pgm $w/full/m.pgm"; do
+             "map:rfseek-map $map --pgm $w/full/m.pgm" \
+             "record-live:rfseek-record scenarios/default.yaml -o $w/r3.rfsr --live-out $w/full/l.rfso --max-time 3"; do
         # shellcheck disable=SC2086
         "$bin"/${c#*:} >/dev/null 2>"$w/err"; rc=$?
         [ $rc -eq 1 ] && [ "$(wc -l <"$w/err")" -eq 1 ] && grep -qF "$w/full/" "$w/err" && [ "$(ls "$w/full")" = fill ] \
             && pass "disk-full-${c%%:*}" || fail "disk-full-${c%%:*}" "rc $rc: $(head -c 200 "$w/err"); left: $(ls "$w/full" | tr '\n' ' ')"
     done
+    check disk-full-record-live-nothing-left '[ ! -e "$w/r3.rfsr" ] && ! compgen -G "$w/r3.rfsr.tmp*" >/dev/null'
     umount "$w/full"
 else
     echo "SKIP rfseekd-log-disk-full: mount -t tmpfs not permitted"

@@ -174,5 +174,10 @@ err replay-header-only-print 1 "truncated (only the header)" rfseek-replay --pri
 err replay-no-end 1 "noend.rfsr: offset $((n - 2)): truncated (no END record)" rfseek-replay "$w/noend.rfsr" -o "$w/x.rfso"
 err replay-no-end-print 1 "truncated (no END record)" rfseek-replay --print "$w/noend.rfsr"
 check replay-no-end-nothing-left '! compgen -G "$w/x.rfso*" >/dev/null'
+# Read as it is parsed, through a 64 KB window: an endless input (the stream, then
+# /dev/zero, on a pipe) ends at its END record in bounded memory (it was read whole first).
+(ulimit -v 300000; cat "$w/in.rfsr" /dev/zero | timeout 20 "$bin/rfseek-replay" /dev/stdin -o "$w/endless.rfso"; exit "${PIPESTATUS[1]}") 2>"$w/err"
+check replay-endless-input-stops-at-end '[ $? -eq 0 ] && [ ! -s "$w/err" ] && cmp -s "$w/endless.rfso" "$w/out.rfso"'
+err replay-dev-zero 1 "/dev/zero: offset 0: not an rfseek stream (bad header)" rfseek-replay /dev/zero -o "$w/z.rfso"
 check replay-output-stream-prints '"$bin/rfseek-replay" --print "$w/out.rfso" >/dev/null'
 exit $((fails > 0))

@@ -34,41 +34,31 @@ static void sink(void *ctx, const uint8_t *p, uint32_t n)
 
 static const char PROG[] = "rfseek-replay"; /* the prefix of its error lines (lx_err_print) */
 
-static uint8_t *slurp(const char *path, size_t *len)
+/* The input read as it is parsed, through a window: memory stays RFS_REPLAY_WINDOW
+ * whatever the file (/dev/zero, a stream of hours), and reading stops at the END record. */
+#define RFS_REPLAY_WINDOW (1u << 16)
+typedef struct in_stream {
+    FILE *f;
+    uint8_t buf[RFS_REPLAY_WINDOW];
+    size_t pos, len; /* unparsed bytes: buf[pos .. len) */
+    size_t base;     /* file offset of buf[0] */
+    int eof;
+} in_stream_t;
+
+/* At least `want` (<= RFS_REPLAY_WINDOW) unparsed bytes unless the file ends first: the
+ * count there is. */
+static size_t in_fill(in_stream_t *s, size_t want)
 {
-    FILE *f = fopen(path, "rb");
-    if (f == NULL) {
-        lx_err_print(PROG, "%s: %s", path, strerror(errno));
-        return NULL;
+    if (s->len - s->pos < want && !s->eof) {
+        memmove(s->buf, s->buf + s->pos, s->len - s->pos);
+        s->base += s->pos;
+        s->len -= s->pos;
+        s->pos = 0;
+        const size_t n = fread(s->buf + s->len, 1, sizeof s->buf - s->len, s->f);
+        s->len += n;
+        s->eof = s->len < sizeof s->buf;
     }
-    size_t cap = 1 << 16, n = 0;
-    uint8_t *buf = malloc(cap);
-    for (;;) {
-        if (buf == NULL) {
-            lx_err_print(PROG, "%s: out of memory", path);
-            fclose(f);
-            return NULL;
-        }
-        n += fread(buf + n, 1, cap - n, f);
-        if (n < cap) {
-            break;
-        }
-        cap *= 2;
-        uint8_t *nb = realloc(buf, cap);
-        if (nb == NULL) {
-            free(buf);
-        }
-        buf = nb;
-    }
-    const int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        lx_err_print(PROG, "%s: read error", path);
-        free(buf);
-        return NULL;
-    }
-    *len = n;
-    return buf;
+    return s->len - s->pos;
 }
 
 static const char *type_name(rfs_replay_type_t t)
@@ -212,14 +202,17 @@ static int replay_main(int argc, char **argv)
     if (!print && (lx_err_same_file(PROG, in_path, out_path) != 0 || lx_err_check_dest(PROG, out_path) != 0)) {
         return 1;
     }
-    size_t len = 0;
-    uint8_t *buf = slurp(in_path, &len);
-    if (buf == NULL) {
+    static in_stream_t in;
+    memset(&in, 0, sizeof in);
+    in.f = fopen(in_path, "rb");
+    if (in.f == NULL) {
+        lx_err_print(PROG, "%s: %s", in_path, strerror(errno));
         return 1;
     }
-    if (rfs_replay_check_header(buf, (uint32_t)(len < 8 ? len : 8)) != 0) {
-        lx_err_print(PROG, "%s: offset 0: not an rfseek stream (bad header)", in_path);
-        free(buf);
+    const size_t head = in_fill(&in, RFS_REPLAY_HEADER_LEN);
+    if (ferror(in.f) || rfs_replay_check_header(in.buf, (uint32_t)(head < 8 ? head : 8)) != 0) {
+        lx_err_print(PROG, "%s: %s", in_path, ferror(in.f) ? "read error" : "offset 0: not an rfseek stream (bad header)");
+        fclose(in.f);
         return 1;
     }
     static rfs_app_t app;
@@ -231,7 +224,7 @@ static int replay_main(int argc, char **argv)
         sc.f = fopen(tmp, "wb");
         if (sc.f == NULL) {
             lx_err_print(PROG, "%s: %s", out_path, strerror(errno));
-            free(buf);
+            fclose(in.f);
             return 1;
         }
         // The host holds every model a CFG record may name (rfs_models.h).
@@ -242,7 +235,7 @@ static int replay_main(int argc, char **argv)
             fprintf(stderr, "rfseek-replay: out of memory\n");
             fclose(sc.f);
             remove(tmp);
-            free(buf);
+            fclose(in.f);
             return 1;
         }
         rfs_app_cfg_t cfg = rfs_app_cfg_default();
@@ -250,14 +243,14 @@ static int replay_main(int argc, char **argv)
         cfg.model_state_bytes = mb;
         rfs_replay_player_init(&player, &app, &cfg, sink, &sc);
     }
-    size_t pos = RFS_REPLAY_HEADER_LEN;
+    in.pos = RFS_REPLAY_HEADER_LEN;
     int rc = 0, ended = 0, inputs = 0;
-    while (pos < len) {
+    size_t left;
+    while ((left = in_fill(&in, RFS_REPLAY_MAX_RECORD)) > 0) {
         rfs_replay_rec_t rec;
         uint32_t used = 0;
-        const size_t left = len - pos;
-        const rfs_replay_status_t st =
-            rfs_replay_parse(buf + pos, (uint32_t)(left > 65536 ? 65536 : left), &used, &rec);
+        const size_t pos = in.base + in.pos;
+        const rfs_replay_status_t st = rfs_replay_parse(in.buf + in.pos, (uint32_t)left, &used, &rec);
         if (st != RFS_REPLAY_OK) {
             lx_err_print(PROG, "%s: offset %zu: %s", in_path, pos,
                      st == RFS_REPLAY_NEED_MORE ? "truncated record" : rec.error);
@@ -271,17 +264,21 @@ static int replay_main(int argc, char **argv)
             rc = 1;
             break;
         }
-        pos += used;
+        in.pos += used;
         inputs |= rec.type < RFS_REPLAY_END;
         if (rec.type == RFS_REPLAY_END) {
             ended = 1;
             break;
         }
     }
-    if (rc == 0) {
-        rc = check_end(in_path, pos, ended, inputs);
+    if (rc == 0 && ferror(in.f)) {
+        lx_err_print(PROG, "%s: read error", in_path);
+        rc = 1;
     }
-    free(buf);
+    if (rc == 0) {
+        rc = check_end(in_path, in.base + in.pos, ended, inputs);
+    }
+    fclose(in.f);
     if (!print) {
         if (fclose(sc.f) != 0 || sc.failed) {
             lx_err_print(PROG, "%s: write failed", out_path);

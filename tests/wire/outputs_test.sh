@@ -164,6 +164,10 @@ for c in "random:offset 0: not an LCM event" "cut:event cut short" "longch:chann
     grep -qF "${c#*:}" "$w/err" || fail "sim-lcm-file-${c%%:*}-reason" "$(cat "$w/err")"
     [ -s "$w/out" ] && fail "sim-lcm-file-${c%%:*}-no-summary" "$(head -c 100 "$w/out")"
 done
+# /dev/zero has no size to measure events by (liblcm scanned it for a sync word for ever).
+err rfseekd-replay-dev-zero 1 "/dev/zero: not a regular file" rfseekd --map $map --clock-lcm --lcm memq:// --replay /dev/zero
+timeout 20 "$bin/rfseek-sim-lcm" scenarios/default.yaml --lcm "file:///dev/zero?speed=0" --max-time 1 >"$w/out" 2>"$w/err"
+check sim-lcm-file-dev-zero '[ $? -eq 1 ] && [ "$(cat "$w/err")" = "rfseek-sim-lcm: lcm: file:///dev/zero?speed=0: not a regular file (an LCM log is read by its lengths)" ]'
 check rfseekd-replay-valid 'bin/true 2>/dev/null; "$bin/rfseekd" --map $map --clock-lcm --lcm memq:// --replay "$w/in.lcmlog" >/dev/null 2>&1'
 
 # --- row: replay streams without their END record ------------------------------------------

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <lcm/eventlog.h>
@@ -443,7 +444,15 @@ static int check_file_log(const char *url, char *err, size_t errlen)
         return 0;
     }
     char *path = strndup(url + 7, opts != NULL ? (size_t)(opts - (url + 7)) : strlen(url + 7));
+    struct stat st;
     char e2[8];
+    if (path != NULL && stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        /* liblcm would scan /dev/zero or a FIFO for a sync word for ever */
+        snprintf(err, errlen, "lcm: %s: not a regular file (an LCM log is read by its lengths)", url);
+        lx_err_one_line(err);
+        free(path);
+        return -1;
+    }
     lx_lcm_log_t *log = path != NULL ? lx_lcm_log_open(path, "r", e2, sizeof e2) : NULL;
     free(path);
     if (log == NULL) {
@@ -663,6 +672,14 @@ lx_lcm_log_t *lx_lcm_log_open(const char *path, const char *mode, char *err, siz
         snprintf(err, errlen, "%s: out of memory", path);
         free(log->path);
         free(log->tmp);
+        free(log);
+        return NULL;
+    }
+    struct stat st;
+    if (!w && stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        /* event_fits measures events against the file's size: /dev/zero has none */
+        snprintf(err, errlen, "%s: not a regular file (an LCM log is read by its lengths)", path);
+        free(log->path);
         free(log);
         return NULL;
     }

@@ -220,14 +220,27 @@ static bool status_of(const rfseek_seeker_status_t *m, rfs_seek_out_t *o)
     return true;
 }
 
+/* Where the reason string's int32 length lies in an encoded seeker_status_t: fingerprint
+ * 8, utime 8, state 1, faults 4, left and right 2 + 2, decided 1, iteration 4,
+ * decision_utime 8, kind 1 (tests/wire/test_lcm.c checks it against the encoder). */
+#define LX_LCM_STATUS_REASON_AT 39
+
 static void on_status_msg(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const char *ch, const void *data, int len)
 {
+    /* lcm-gen's decoder mallocs the string length the message states (up to 2 GiB) before
+     * it checks it against the message, and frees nothing when a later field is cut short
+     * (found by tests/fuzz/fuzz_lcm.c): the length is checked first, the struct zeroed so
+     * a failed decode can be cleaned up. */
+    const uint8_t *b = data;
+    const int at = LX_LCM_STATUS_REASON_AT;
+    const int64_t rl = len >= at + 4 ? (int64_t)((uint32_t)b[at] << 24 | (uint32_t)b[at + 1] << 16 |
+                                                 (uint32_t)b[at + 2] << 8 | b[at + 3])
+                                     : -1;
     rfseek_seeker_status_t m;
-    int n = rfseek_seeker_status_t_decode(data, 0, len, &m);
+    memset(&m, 0, sizeof m);
+    int n = rl >= 1 && rl <= len - at - 4 ? rfseek_seeker_status_t_decode(data, 0, len, &m) : -1;
     if (n < 0 || n != len) {
-        if (n >= 0) {
-            rfseek_seeker_status_t_decode_cleanup(&m);
-        }
+        rfseek_seeker_status_t_decode_cleanup(&m);
         bad(s, h, ch, "truncated, oversized or not an rfseek.seeker_status_t (%.0f bytes)", (double)len);
         return;
     }

@@ -167,6 +167,42 @@ static int check_end(const char *in_path, size_t pos, int ended, int inputs)
     return 0;
 }
 
+/* The records after the header, printed (player NULL) or played, until END or the end of
+ * the file: 0, or 1 after a message naming the offset. */
+static int play_records(in_stream_t *in, const char *in_path, rfs_replay_player_t *player)
+{
+    int ended = 0, inputs = 0;
+    size_t left;
+    while ((left = in_fill(in, RFS_REPLAY_MAX_RECORD)) > 0) {
+        rfs_replay_rec_t rec;
+        uint32_t used = 0;
+        const size_t pos = in->base + in->pos;
+        const rfs_replay_status_t st = rfs_replay_parse(in->buf + in->pos, (uint32_t)left, &used, &rec);
+        if (st != RFS_REPLAY_OK) {
+            lx_err_print(PROG, "%s: offset %zu: %s", in_path, pos,
+                         st == RFS_REPLAY_NEED_MORE ? "truncated record" : rec.error);
+            return 1;
+        }
+        if (player == NULL) {
+            print_rec(&rec);
+        } else if (!rfs_replay_play(player, &rec)) {
+            lx_err_print(PROG, "%s: offset %zu: %s", in_path, pos, rfs_replay_err_str(player->error));
+            return 1;
+        }
+        in->pos += used;
+        inputs |= rec.type < RFS_REPLAY_END;
+        if (rec.type == RFS_REPLAY_END) {
+            ended = 1;
+            break;
+        }
+    }
+    if (ferror(in->f)) {
+        lx_err_print(PROG, "%s: read error", in_path);
+        return 1;
+    }
+    return check_end(in_path, in->base + in->pos, ended, inputs);
+}
+
 static int replay_main(int argc, char **argv)
 {
     const char *in_path = NULL, *out_path = NULL;
@@ -244,40 +280,7 @@ static int replay_main(int argc, char **argv)
         rfs_replay_player_init(&player, &app, &cfg, sink, &sc);
     }
     in.pos = RFS_REPLAY_HEADER_LEN;
-    int rc = 0, ended = 0, inputs = 0;
-    size_t left;
-    while ((left = in_fill(&in, RFS_REPLAY_MAX_RECORD)) > 0) {
-        rfs_replay_rec_t rec;
-        uint32_t used = 0;
-        const size_t pos = in.base + in.pos;
-        const rfs_replay_status_t st = rfs_replay_parse(in.buf + in.pos, (uint32_t)left, &used, &rec);
-        if (st != RFS_REPLAY_OK) {
-            lx_err_print(PROG, "%s: offset %zu: %s", in_path, pos,
-                     st == RFS_REPLAY_NEED_MORE ? "truncated record" : rec.error);
-            rc = 1;
-            break;
-        }
-        if (print) {
-            print_rec(&rec);
-        } else if (!rfs_replay_play(&player, &rec)) {
-            lx_err_print(PROG, "%s: offset %zu: %s", in_path, pos, rfs_replay_err_str(player.error));
-            rc = 1;
-            break;
-        }
-        in.pos += used;
-        inputs |= rec.type < RFS_REPLAY_END;
-        if (rec.type == RFS_REPLAY_END) {
-            ended = 1;
-            break;
-        }
-    }
-    if (rc == 0 && ferror(in.f)) {
-        lx_err_print(PROG, "%s: read error", in_path);
-        rc = 1;
-    }
-    if (rc == 0) {
-        rc = check_end(in_path, in.base + in.pos, ended, inputs);
-    }
+    int rc = play_records(&in, in_path, print ? NULL : &player);
     fclose(in.f);
     if (!print) {
         if (fclose(sc.f) != 0 || sc.failed) {

@@ -47,7 +47,7 @@ for name in "$@"; do
     if [ $status -eq 0 ]; then
         echo "PASS fuzz_$name: $n corpus inputs, ${execs:-?} executions, $wall s, $rate exec/s, ${cov:-cov: ?}"
     else
-        finding=$(grep -m1 -oE 'ERROR: (AddressSanitizer|LeakSanitizer|UndefinedBehaviorSanitizer|libFuzzer): [^ ]+|runtime error: .*' "$log")
+        finding=$(grep -m1 -oE 'ERROR: (AddressSanitizer|LeakSanitizer|UndefinedBehaviorSanitizer|libFuzzer): [a-z-]+( [a-z-]+)*|runtime error: .*' "$log")
         echo "FAIL fuzz_$name: ${finding:-crash, leak or sanitizer report} after ${execs:-?} executions, $wall s (log $log, input in $art/)"
         grep -E 'ERROR|runtime error|SUMMARY|Test unit written' "$log" | head -10
         rc=1

@@ -515,13 +515,15 @@ static int batch_resume(batch_t *bt, const char *header)
                      "same scenario, --seeds and options needed)", path);
         rc = 1;
     }
+    long at = ftell(f), cut = -1;
     while (rc == 0 && fgets(line, sizeof line, f)) {
         char *end;
         errno = 0;
         unsigned long long s = strtoull(line, &end, 10);
         size_t len = strlen(line);
         if (errno != 0 || *end != '\t' || len == 0 || line[len - 1] != '\n') {
-            break; /* a row cut by SIGKILL: that seed is redone */
+            cut = at; /* a row cut by SIGKILL: that seed is redone, the rows go on from here */
+            break;
         }
         if (s < bt->a || s - bt->a >= bt->total || bt->rows[s - bt->a] != NULL) {
             lx_err_print(prog, "%s: seed %llu outside the batch or listed twice", path, s);
@@ -536,8 +538,13 @@ static int batch_resume(batch_t *bt, const char *header)
         }
         bt->done++;
         bt->reached += strncmp(end, "\t1\t", 3) == 0 ? 1u : 0u;
+        at = ftell(f);
     }
     fclose(f);
+    if (rc == 0 && cut >= 0 && truncate(path, cut) != 0) {
+        fprintf(stderr, "%s: %s: %s\n", prog, path, strerror(errno));
+        rc = 1;
+    }
     if (rc == 0) {
         drop_unfinished(bt);
     }

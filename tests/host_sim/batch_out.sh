@@ -68,13 +68,16 @@ else
 fi
 
 # --- interrupted and resumed batches -------------------------------------------------------
-# interrupt SIG DIR: start 1..40 into DIR, signal it once 3 seeds are finished.
+# interrupt SIG DIR [ARGS]: start 1..40 into DIR (with ARGS), signal it once 3 more seeds
+# are finished.
 interrupt() {
-    "$SIM" $SCN --seeds 1..40 --jobs 2 --quiet --out "$2" 2>"$T/err" &
+    local n0
+    n0=$(cat "$2"/batch.state 2>/dev/null | wc -l)
+    "$SIM" $SCN --seeds 1..40 --jobs 2 --quiet --out "$2" "${@:3}" 2>"$T/err" &
     local pid=$! n=0
     for _ in $(seq 600); do
         n=$(cat "$2".tmp-*/batch.state 2>/dev/null | wc -l)
-        [ "$n" -ge 4 ] && break
+        [ "$n" -ge $((n0 > 0 ? n0 + 3 : 4)) ] && break
         sleep 0.05
     done
     kill -"$1" $pid
@@ -122,6 +125,17 @@ rm -rf "$d.tmp-2147483647"
 "$SIM" $SCN --seeds 1..40 --jobs 2 --quiet --out "$d" --resume 2>"$T/err"
 check "resume-KILL" '[ $? -eq 0 ] && [ ! -s "$T/err" ] && cmp "$d/runs.tsv" "$T/whole/runs.tsv" && [ ! -e "$d/batch.state" ] && ! compgen -G "$d.tmp-*" >/dev/null'
 check "resume-KILL-seed-logs" 'diff -r "$d" "$T/whole" >/dev/null'
+
+# A row cut by SIGKILL is dropped from batch.state as the batch resumes, so rows appended
+# after it are whole when that batch is interrupted and resumed again.
+d=$T/cutrow
+interrupt INT "$d"
+todo=$(comm -23 <(seq 1 40 | sort) <(tail -n +2 "$d/batch.state" | cut -f1 | sort) | head -1)
+printf '%s\t1\t12.5' "$todo" >>"$d/batch.state"
+interrupt INT "$d" --resume
+check "resume-cut-row-dropped" '! grep -q "12\.5[0-9]" "$d/batch.state" && [ "$(tail -c 1 "$d/batch.state" | od -An -c | tr -d " ")" = "\\n" ]'
+"$SIM" $SCN --seeds 1..40 --jobs 2 --quiet --out "$d" --resume 2>"$T/err"
+check "resume-cut-row-twice" '[ $? -eq 0 ] && [ ! -s "$T/err" ] && cmp "$d/runs.tsv" "$T/whole/runs.tsv"'
 
 "$SIM" $SCN --seeds 1..40 --quiet --out "$T/whole" --resume 2>"$T/err"
 one_line resume-finished-batch $? "not an interrupted batch"

@@ -56,6 +56,8 @@ YAML_CFLAGS := $(shell pkg-config --cflags yaml-0.1 2>/dev/null)
 YAML_LIBS := $(shell pkg-config --libs yaml-0.1 2>/dev/null || echo -lyaml)
 LCM_LIBS := $(shell pkg-config --libs lcm 2>/dev/null || echo -llcm)
 PCAP_LIBS := $(shell pkg-config --libs libpcap 2>/dev/null || echo -lpcap)
+PNG_CFLAGS := $(shell pkg-config --cflags libpng 2>/dev/null)
+PNG_LIBS := $(shell pkg-config --libs libpng 2>/dev/null || echo -lpng)
 
 LIBS_core := $(CORE_LIB)
 LIBS_fw := $(FW_LIB) $(CORE_LIB)
@@ -67,8 +69,8 @@ ASAN_LIBS_linux := $(LINUX_ASAN_LIB) $(ASAN_LIBS_fw)
 ASAN_LIBS_sim := $(SIM_ASAN_LIB) $(ASAN_LIBS_linux)
 LDLIBS_core := -lm
 LDLIBS_fw := -lm
-LDLIBS_linux := -Wl,--as-needed $(LCM_LIBS) $(YAML_LIBS) $(PCAP_LIBS) -lm
-LDLIBS_sim := -lbox2d $(LCM_LIBS) $(YAML_LIBS) $(PCAP_LIBS) -lm
+LDLIBS_linux := -Wl,--as-needed $(LCM_LIBS) $(YAML_LIBS) $(PCAP_LIBS) $(PNG_LIBS) -lm
+LDLIBS_sim := -lbox2d $(LCM_LIBS) $(YAML_LIBS) $(PCAP_LIBS) $(PNG_LIBS) -lm
 # The C linker for everything but the simulator, whose Box2D adapter is C++.
 LD_core := $(CC)
 LD_fw := $(CC)

@@ -335,3 +335,98 @@ uint32_t rfs_rng_below(rfs_rng_t *rng, uint32_t n)
     }
     return (uint32_t)(m >> 32);
 }
+
+/* atan(2^-i) for i = 0..23 in Q28 radians (round(atan(2^-i) * 2^28)). */
+static const int32_t ATAN_Q28[24] = {
+    210828714, 124459457, 65760959, 33381290, 16755422, 8385879, 4193963, 2097109,
+    1048571,   524287,    262144,   131072,   65536,    32768,   16384,   8192,
+    4096,      2048,      1024,     512,      256,      128,     64,      32};
+
+rfs_q16_t rfs_q16_atan2(int64_t y, int64_t x)
+{
+    if (x == 0 && y == 0) {
+        return 0;
+    }
+    int64_t ax = x < 0 ? -x : x;
+    int64_t ay = y < 0 ? -y : y;
+    int64_t mx = ax > ay ? ax : ay;
+    while (mx >= ((int64_t)1 << 28)) {
+        x /= 2;
+        y /= 2;
+        mx >>= 1;
+    }
+    while (mx < ((int64_t)1 << 27)) {
+        x *= 2;
+        y *= 2;
+        mx <<= 1;
+    }
+    int32_t xi = (int32_t)x;
+    int32_t yi = (int32_t)y;
+    int64_t base = 0; /* Q28 */
+    if (xi < 0) {
+        base = yi >= 0 ? (int64_t)843314857 : -(int64_t)843314857; /* pi in Q28 */
+        xi = -xi;
+        yi = -yi;
+    }
+    int32_t z = 0; /* Q28 */
+    for (int i = 0; i < 24; i++) {
+        int32_t xs = xi >> i;
+        int32_t ys = yi >> i;
+        if (yi > 0) {
+            xi += ys;
+            yi -= xs;
+            z += ATAN_Q28[i];
+        } else {
+            xi -= ys;
+            yi += xs;
+            z -= ATAN_Q28[i];
+        }
+    }
+    int64_t a = (base + z + 2048) >> 12; /* Q16, rounded */
+    if (a > RFS_Q16_PI) {
+        a -= 2 * (int64_t)RFS_Q16_PI;
+    } else if (a <= -RFS_Q16_PI) {
+        a += 2 * (int64_t)RFS_Q16_PI;
+    }
+    return (rfs_q16_t)a;
+}
+
+void rfs_q16_sincos(rfs_q16_t a, rfs_q16_t *c, rfs_q16_t *s)
+{
+    const int64_t pi28 = 843314857;   /* pi in Q28 */
+    const int64_t two_pi28 = 1686629713;
+    int64_t z = (int64_t)a * 4096;    /* Q28, |z| < 2^43 */
+    /* Reduce to (-pi, pi]: one division, not a loop, whatever the angle. */
+    z -= rfs_sdiv64_round(z, two_pi28) * two_pi28;
+    if (z <= -pi28) {
+        z += two_pi28;
+    } else if (z > pi28) {
+        z -= two_pi28;
+    }
+    int32_t sign = 1;
+    if (z > pi28 / 2) {
+        z -= pi28;
+        sign = -1;
+    } else if (z < -pi28 / 2) {
+        z += pi28;
+        sign = -1;
+    }
+    int32_t x = 163008219; /* 1 / CORDIC gain (0.607253) in Q28 */
+    int32_t y = 0;
+    int32_t zz = (int32_t)z;
+    for (int i = 0; i < 24; i++) {
+        int32_t xs = x >> i;
+        int32_t ys = y >> i;
+        if (zz >= 0) {
+            x -= ys;
+            y += xs;
+            zz -= ATAN_Q28[i];
+        } else {
+            x += ys;
+            y -= xs;
+            zz += ATAN_Q28[i];
+        }
+    }
+    *c = (rfs_q16_t)(sign * ((x + 2048) >> 12));
+    *s = (rfs_q16_t)(sign * ((y + 2048) >> 12));
+}

@@ -50,7 +50,7 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
      * and a SLAM map marks furniture and laser artefacts as walls, so a map's "wall" is
      * worth less: its prior is a hundred times weaker, and the data sets W after a few
      * metres (300 held W near 5 dB for 40 m on the Intel lab map, where a crossing
-     * costs 3 dB: docs/PATHLOSS.md has the simulator runs behind both weights). */
+     * costs 3 dB; docs/PATHLOSS.md, "Fit", gives both weights' sources). */
     c.prior_weight = RFS_Q16_INT(3000);
     c.w_prior_weight = RFS_Q16_INT(30);
     c.huber = RFS_Q16_INT(6);    /* about 1.5 x the 4 dB shadowing of the paper's office */
@@ -668,8 +668,8 @@ static bool coarse_next(rfs_pathloss_t *p, rfs_fit_result_t *res)
     return false;
 }
 
-/* After the finest refinement: hold the previous source (docs/PATHLOSS.md, "Sampled
- * epsilon goals and the hold search") when the fit moved away from it on the same map
+/* After the finest refinement: hold the previous source (docs/PATHLOSS.md, "Fit", step
+ * 6 "Hold") when the fit moved away from it on the same map
  * and it is still a legal candidate. true when the hold phase began. */
 static bool hold_begin(rfs_pathloss_t *p)
 {

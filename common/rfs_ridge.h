@@ -13,8 +13,8 @@
  * multiple of 1/16). On that data the only differences from scikit-learn's double
  * solution are the rounding of the slopes to Q40.24 and of the centre value to Q16.16:
  * tested on 120 random data sets to within 3e-4 dB everywhere on a +-300 m map
- * (tests/common/test_ridge.c; 0.05 dB is required, docs/FIXED_POINT.md, "Local ridge
- * model").
+ * (tests/common/test_ridge.c; docs/FIXED_POINT.md, "Local ridge model", gives the
+ * bound the test asserts).
  *
  * Work: fit() with budget 0 visits every sample; with budget > 0 it visits at most
  * `budget` samples per call and returns RFS_FIT_MORE until the last call, which solves

@@ -222,8 +222,12 @@ bool rfs_seek_on_receiver(rfs_seek_t *s, int64_t t_us)
 
 bool rfs_seek_plan_start(const rfs_seek_t *s, rfs_q16_t *sx, rfs_q16_t *sy)
 {
-    *sx = s->pose.x;
-    *sy = s->pose.y;
+    rfs_pose_t est;
+    if (!rfs_drive_estimate(&s->drive, &est)) {
+        est = s->pose;
+    }
+    *sx = est.x;
+    *sy = est.y;
     if (!rfs_map_point_legal(s->map, *sx, *sy)) {
         uint16_t i, j;
         if (!rfs_reach_snap(s->map, 0, *sx, *sy, &i, &j)) {
@@ -487,6 +491,7 @@ static bool inputs_stale(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     if (s->state == RFS_SEEK_DRIVING && s->drive.status == RFS_DRIVE_RUNNING) {
         s->resume = true;
         s->resume_path = s->drive.path;
+        s->resume_next = s->drive.next; /* the legs already driven are not driven again */
         s->resume_start_us = elapsed(now_us, s->drive.start_us); /* driven so far */
     }
     if (s->state != RFS_SEEK_WAITING) {
@@ -514,6 +519,7 @@ static void resume_goal(rfs_seek_t *s, int64_t now_us)
 {
     s->resume = false;
     rfs_drive_set_path(&s->drive, &s->resume_path, now_us);
+    s->drive.next = s->resume_next < s->drive.path.n ? s->resume_next : 0;
     s->drive.start_us = now_us >= INT64_MIN + s->resume_start_us ? now_us - s->resume_start_us
                                                                  : INT64_MIN;
     s->state = RFS_SEEK_DRIVING;
@@ -594,6 +600,11 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     out->right_mm_s = 0;
     out->faults = 0;
     out->decided = false;
+    if (s->have_pose) {
+        /* The drive's pose filter runs every period, driving or not: plans start from
+         * its estimate (rfs_seek_plan_start). */
+        rfs_drive_observe(&s->drive, &s->pose, now_us);
+    }
     control(s, now_us, rng, out);
     out->state = s->state;
     out->decision = s->decision;

@@ -202,6 +202,7 @@ typedef struct rfs_seek {
     uint32_t meas_rejected;                   ///< measurements with a bad source index
     bool resume;                              ///< a goal was interrupted by stale inputs
     rfs_path_t resume_path;                   ///< the path to resume
+    uint16_t resume_next;                     ///< the waypoint it was approaching
     int64_t resume_start_us;                  ///< how long the interrupted goal had been driven, microseconds
     uint16_t last_li, last_lj;                ///< lattice point of the last novelty update
     bool have_last_l;                         ///< last_li/last_lj are valid

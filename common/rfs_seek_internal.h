@@ -36,7 +36,8 @@ const rfs_seek_strategy_ops_t *rfs_seek_ops(const rfs_seek_t *s);
 
 /* ---- rfs_seek.c: planning for every strategy --------------------------------------- */
 
-/* Where plans start: the robot, or the closest legal lattice point when it stands in the
+/* Where plans start: the robot (the drive's filtered pose, rfs_drive_estimate), or the
+ * closest legal lattice point when it stands in the
  * clearance zone. false when there is none. */
 bool rfs_seek_plan_start(const rfs_seek_t *s, rfs_q16_t *sx, rfs_q16_t *sy);
 

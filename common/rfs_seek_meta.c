@@ -1,7 +1,7 @@
 /* rfs_seek_meta.c - the paper's choices of an iteration's goal (section 2): the initial
  * random move, the greedy step towards the model's maximum and the novelty-driven epsilon
- * step, with their meta-path variants (docs/STRATEGIES.md, "meta-path's preset
- * improvements"). rfs_seek.c decides which one an iteration takes. */
+ * step, with their meta-path variants (docs/STRATEGIES.md, "meta-path's
+ * presets"). rfs_seek.c decides which one an iteration takes. */
 #include "rfs_seek_internal.h"
 
 #include "rfs_gridmax.h"
@@ -320,7 +320,7 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
 
 /* Greedy step (paper section 2): the model's maximum, from the model itself when it
  * knows where it is (argmax: the pathloss model's estimated source, docs/PATHLOSS.md,
- * "In the loop"), else by the grid search over every reachable legal lattice point; then
+ * "Model"), else by the grid search over every reachable legal lattice point; then
  * the strategy's step towards it. */
 static bool choose_greedy(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
 {

@@ -430,6 +430,40 @@ static bool start(rfs_replay_player_t *p)
     return true;
 }
 
+bool rfs_replay_map_records(const rfs_app_map_t *m, rfs_replay_rec_fn fn, void *ctx)
+{
+    rfs_replay_rec_t r;
+    memset(&r, 0, sizeof r);
+    r.type = RFS_REPLAY_MAP;
+    r.u.map.w = m->w;
+    r.u.map.h = m->h;
+    r.u.map.res = m->res;
+    r.u.map.origin_x = m->origin_x;
+    r.u.map.origin_y = m->origin_y;
+    r.u.map.has_wall = m->wall != NULL ? 1u : 0u;
+    if (!fn(ctx, &r)) {
+        return false;
+    }
+    const uint32_t bytes = rfs_map_bytes(m->w, m->h);
+    for (int g = 0; g < 2; g++) {
+        const uint8_t *bits = g == 0 ? m->free : m->wall;
+        if (bits == NULL) {
+            continue;
+        }
+        for (uint32_t off = 0; off < bytes; off += RFS_REPLAY_CHUNK) {
+            memset(&r, 0, sizeof r);
+            r.type = g == 0 ? RFS_REPLAY_MAP_FREE : RFS_REPLAY_MAP_WALL;
+            r.u.chunk.offset = off;
+            r.u.chunk.n = (uint8_t)(bytes - off < RFS_REPLAY_CHUNK ? bytes - off : RFS_REPLAY_CHUNK);
+            memcpy(r.u.chunk.bytes, bits + off, r.u.chunk.n);
+            if (!fn(ctx, &r)) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
 static void emit_step(rfs_replay_player_t *p, int64_t now_us)
 {
     rfs_app_out_t out;

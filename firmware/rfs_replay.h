@@ -147,6 +147,14 @@ uint32_t rfs_replay_encode(const rfs_replay_rec_t *rec, uint8_t *buf, uint32_t c
 /// (cap >= 2 * RFS_REPLAY_MAX_RECORD is always enough), 0 when it does not fit.
 uint32_t rfs_replay_encode_out(const rfs_app_out_t *out, uint8_t *buf, uint32_t cap);
 
+/// Takes one record (a recorder writing and playing it, a player, a printer); false stops.
+typedef bool (*rfs_replay_rec_fn)(void *ctx, const rfs_replay_rec_t *rec);
+
+/// Hand `fn` the records that carry a map: MAP, then the free grid and (when m->wall is
+/// not NULL) the wall grid in MAP_FREE / MAP_WALL chunks of RFS_REPLAY_CHUNK bytes.
+/// Returns false as soon as fn does.
+bool rfs_replay_map_records(const rfs_app_map_t *m, rfs_replay_rec_fn fn, void *ctx);
+
 /// Where a player writes its output bytes (a file, semihosting, a buffer).
 typedef void (*rfs_replay_write_fn)(void *ctx, const uint8_t *p, uint32_t n);
 

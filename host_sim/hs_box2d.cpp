@@ -44,12 +44,35 @@ public:
     }
 };
 
+/// Counts the robot's wall contacts from Box2D's contact events: a contact begins when
+/// the robot touches a wall while touching none (scraping along several wall rectangles
+/// is one contact).
+class ContactCounter : public b2ContactListener {
+public:
+    long touching = 0; // wall fixtures the robot touches now
+    long contacts = 0; // contacts begun
+    void BeginContact(b2Contact *c) override
+    {
+        if (c->IsTouching() && touching++ == 0) {
+            contacts++;
+        }
+    }
+    void EndContact(b2Contact *c) override
+    {
+        (void)c;
+        if (touching > 0) {
+            touching--;
+        }
+    }
+};
+
 } // namespace
 
 struct hs_box2d {
     hs_box2d_cfg_t cfg;
     b2World *world;
     b2Body *robot;
+    ContactCounter contacts;
     long n_collide;
     long n_radio;
     uint32_t w, h;
@@ -196,6 +219,7 @@ extern "C" hs_box2d_t *hs_box2d_create(const lx_map_t *m, const hs_box2d_cfg_t *
         // No time-of-impact sub-stepping: at 0.7 m/s and 50 Hz the robot moves 1.4 cm per
         // step, far less than the thinnest wall (one 5 cm cell), so it cannot tunnel.
         w->world->SetContinuousPhysics(false);
+        w->world->SetContactListener(&w->contacts);
         b2BodyDef sd;
         sd.type = b2_staticBody;
         b2Body *collide = w->world->CreateBody(&sd);
@@ -326,6 +350,11 @@ extern "C" bool hs_box2d_robot_touching(const hs_box2d_t *w)
         }
     }
     return false;
+}
+
+extern "C" long hs_box2d_wall_contacts(const hs_box2d_t *w)
+{
+    return w->contacts.contacts;
 }
 
 extern "C" unsigned hs_box2d_walls_crossed(const hs_box2d_t *w, double x0, double y0, double x1,

@@ -83,6 +83,10 @@ void hs_box2d_step(hs_box2d_t *w, double v_m_s, double omega_rad_s, double dt_s)
 /// true when the robot touches a wall after the last step.
 bool hs_box2d_robot_touching(const hs_box2d_t *w);
 
+/// Wall contacts since the world was made: Box2D contact events, a touch that begins
+/// while the robot touches no wall counting once.
+long hs_box2d_wall_contacts(const hs_box2d_t *w);
+
 /// Radio walls crossed by the straight segment (x0, y0)-(x1, y1), metres: the number of
 /// separate runs of wall along it (ray casts in both directions; hits closer than
 /// wall_merge_gap_m merged). Ends inside a wall count that wall.

@@ -209,6 +209,11 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->pose_rate_hz = 10.0;          // a localisation system's usual rate (amcl-like)
     sc->pose_sigma_xy_m = 0.05;
     sc->pose_sigma_theta_rad = 0.02;
+    sc->pose_drift_m = 0.0;
+    sc->pose_drift_tau_s = 10.0;
+    sc->pose_jump_m = 0.3;
+    sc->pose_jump_rate_hz = 1.0 / 60.0;
+    sc->pose_jump_tau_s = 3.0;
     sc->radio = hs_radio_cfg_default();
     sc->rx_heartbeat = true;          // a listening receiver reports itself up
     sc->motor = hs_motor_cfg_default();
@@ -518,11 +523,18 @@ static int parse_start(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
         }
     }
     if ((n = lx_yaml_get(root, "localisation"))) {
-        static const char *const k[] = {"rate_hz", "sigma_xy_m", "sigma_theta_rad", NULL};
+        static const char *const k[] = {"rate_hz",     "sigma_xy_m", "sigma_theta_rad",
+                                        "drift_m",     "drift_tau_s", "jump_m",
+                                        "jump_rate_hz", "jump_tau_s", NULL};
         if (check_keys(p, n, "localisation", k) ||
             num(p, n, "localisation", "rate_hz", 1, 1000, &sc->pose_rate_hz) ||
             num(p, n, "localisation", "sigma_xy_m", 0, 10, &sc->pose_sigma_xy_m) ||
-            num(p, n, "localisation", "sigma_theta_rad", 0, 3, &sc->pose_sigma_theta_rad)) {
+            num(p, n, "localisation", "sigma_theta_rad", 0, 3, &sc->pose_sigma_theta_rad) ||
+            num(p, n, "localisation", "drift_m", 0, 10, &sc->pose_drift_m) ||
+            num(p, n, "localisation", "drift_tau_s", 0.1, 1000, &sc->pose_drift_tau_s) ||
+            num(p, n, "localisation", "jump_m", 0, 10, &sc->pose_jump_m) ||
+            num(p, n, "localisation", "jump_rate_hz", 0, 10, &sc->pose_jump_rate_hz) ||
+            num(p, n, "localisation", "jump_tau_s", 0.1, 1000, &sc->pose_jump_tau_s)) {
             return -1;
         }
     }

@@ -19,7 +19,9 @@
  *       rate_hz: 200               # packets per second (paper section 5)
  *       tx_dbm: 20
  *   start: {position: [5.0, 2.0], theta: 0.0}   # required
- *   localisation: {rate_hz: 10, sigma_xy_m: 0.05, sigma_theta_rad: 0.02}
+ *   localisation: {rate_hz: 10, sigma_xy_m: 0.05, sigma_theta_rad: 0.02,
+ *                  drift_m: 0, drift_tau_s: 10, jump_m: 0.3, jump_rate_hz: 0.0167,
+ *                  jump_tau_s: 3}
  *   radio: {pathloss: {...}, walls: {...}, shadowing: {...}, fading: {...}, noise: {...},
  *           receiver: {...}}       # every part has `enabled`; see docs/RADIO_MODEL.md;
  *                                  # receiver: {heartbeat: true} reports the receiver up to
@@ -83,6 +85,12 @@ typedef struct hs_scenario {
     double pose_rate_hz;          ///< localisation rate (10)
     double pose_sigma_xy_m;       ///< localisation noise per axis, metres (0.05)
     double pose_sigma_theta_rad;  ///< heading noise, radians (0.02)
+    double pose_drift_m;          ///< AMCL-like drift: bound of a correlated position error,
+                                  ///< metres (0 = off; docs/SIMULATOR.md, "Localisation")
+    double pose_drift_tau_s;      ///< its correlation time, seconds (10)
+    double pose_jump_m;           ///< size of an occasional jump of the estimate, metres (0.3)
+    double pose_jump_rate_hz;     ///< jumps per second (1/60)
+    double pose_jump_tau_s;       ///< a jump decays back with this time constant, seconds (3)
     hs_radio_cfg_t radio;         ///< radio model
     bool rx_heartbeat;            ///< radio.receiver.heartbeat: the controller is told the
                                   ///< receiver is up every control period (true)

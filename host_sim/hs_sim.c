@@ -580,6 +580,8 @@ typedef struct sim_run {
     double px, py, pth;          /* the robot at t: metres, radians */
     int64_t t;                   /* microseconds */
     double travelled;            /* metres */
+    double drift_x, drift_y;     /* AMCL-like localisation error: bounded drift, metres */
+    double jump_x, jump_y;       /* ... and the decaying rest of the last jump, metres */
 } sim_run_t;
 
 /* The robot's motion over one physics tick (t, t1], interpolated for the events in it. */
@@ -676,6 +678,11 @@ static void write_headers(const hs_sim_io_t *io)
     }
 }
 
+/* Turning on the spot, for turn_time_s: forward speed below 2 cm/s while turning faster
+ * than 0.05 rad/s (3 degrees per second). */
+#define TURN_V_M_S 0.02
+#define TURN_W_RAD_S 0.05
+
 /* The motor and the world advanced by one tick from r->t. */
 static void tick_motion(sim_run_t *r, tick_t *k)
 {
@@ -683,6 +690,9 @@ static void tick_motion(sim_run_t *r, tick_t *k)
     hs_motor_update(&r->motor, r->t + r->dt_us, r->dt_s, &v, &w);
     hs_faults_motor(&r->fr, r->t, r->motor.timed_out); // the target this tick, [t, t + dt]
     hs_box2d_step(r->world, v, w, r->dt_s);
+    if (fabs(v) < TURN_V_M_S && fabs(w) > TURN_W_RAD_S) {
+        r->res->turn_time_s += r->dt_s;
+    }
     hs_box2d_robot_pose(r->world, &k->nx, &k->ny, &k->nth);
     k->seg = sqrt((k->nx - r->px) * (k->nx - r->px) + (k->ny - r->py) * (k->ny - r->py));
     k->t1 = r->t + r->dt_us;
@@ -746,6 +756,34 @@ static void packet_event(sim_run_t *r, const event_t *ev, unsigned s)
     }
 }
 
+/* The AMCL-like part of the localisation error, advanced by one pose period
+ * (docs/SIMULATOR.md, "Localisation"): a drift per axis (Ornstein-Uhlenbeck, standard
+ * deviation drift_m / 2, correlation time drift_tau_s) held within drift_m of the truth,
+ * plus jumps of jump_m in a random direction (Poisson, jump_rate_hz) that decay back with
+ * jump_tau_s, as a particle filter's estimate snaps to a wrong hypothesis and recovers. */
+static void pose_drift(sim_run_t *r)
+{
+    const hs_scenario_t *sc = r->sc;
+    double dt = 1.0 / sc->pose_rate_hz;
+    double a = exp(-dt / sc->pose_drift_tau_s);
+    double sd = 0.5 * sc->pose_drift_m * sqrt(1.0 - a * a);
+    r->drift_x = a * r->drift_x + sd * hs_radio_gauss(&r->rng_pose);
+    r->drift_y = a * r->drift_y + sd * hs_radio_gauss(&r->rng_pose);
+    double m = hypot(r->drift_x, r->drift_y);
+    if (m > sc->pose_drift_m) {
+        r->drift_x *= sc->pose_drift_m / m;
+        r->drift_y *= sc->pose_drift_m / m;
+    }
+    double aj = exp(-dt / sc->pose_jump_tau_s);
+    r->jump_x *= aj;
+    r->jump_y *= aj;
+    if (hs_radio_uniform(&r->rng_pose) < 1.0 - exp(-dt * sc->pose_jump_rate_hz)) {
+        double phi = 2.0 * M_PI * hs_radio_uniform(&r->rng_pose);
+        r->jump_x += sc->pose_jump_m * cos(phi);
+        r->jump_y += sc->pose_jump_m * sin(phi);
+    }
+}
+
 /* A localisation pose: the true pose plus noise, through the faults to the controller. */
 static void pose_event(sim_run_t *r, const event_t *ev, const tick_t *k)
 {
@@ -755,6 +793,11 @@ static void pose_event(sim_run_t *r, const event_t *ev, const tick_t *k)
     double eth = wrap_pi(r->pth + ev->a * k->dth);
     double mx = ev->ex + sc->pose_sigma_xy_m * hs_radio_gauss(&r->rng_pose);
     double my = ev->ey + sc->pose_sigma_xy_m * hs_radio_gauss(&r->rng_pose);
+    if (sc->pose_drift_m > 0.0) {
+        pose_drift(r);
+        mx += r->drift_x + r->jump_x;
+        my += r->drift_y + r->jump_y;
+    }
     double mth = wrap_pi(eth + sc->pose_sigma_theta_rad * hs_radio_gauss(&r->rng_pose));
     rfs_pose_t pose = {ev->te, dq16(mx), dq16(my), dq16(mth)};
     unsigned nm = hs_faults_pose(&r->fr, &pose, r->fm);
@@ -817,6 +860,8 @@ static void ctrl_event(sim_run_t *r, const event_t *ev, const tick_t *k)
         res->model_updates += d->relearned ? 1u : 0u;
         res->greedy += d->kind == RFS_SEEK_GREEDY ? 1u : 0u;
         res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
+        res->goal_timeouts += d->prev == RFS_DRIVE_TIMEOUT ? 1u : 0u;
+        res->goal_blocked += d->prev == RFS_DRIVE_BLOCKED ? 1u : 0u;
         if (r->io && r->io->log) {
             log_decision(r->io->log, ctrl, d, ev, wrap_pi(r->pth + ev->a * k->dth));
         }
@@ -918,6 +963,7 @@ static void run_result(sim_run_t *r, const char *end)
     res->final_y = r->py;
     res->final_distance_m = r->has_goal ? hypot(r->px - r->goal_x, r->py - r->goal_y) : NAN;
     res->motor_timeouts = r->motor.timeouts;
+    res->wall_contacts = hs_box2d_wall_contacts(r->world);
     // Against source 0 where it is now (a moved source takes its error along).
     hs_sim_result_estimate(res, r->ctrl, r->rs[0].x, r->rs[0].y);
     if (r->io && r->io->residual) {
@@ -1096,6 +1142,10 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
     fprintf(f, "  \"packets_sent\": %llu,\n", (unsigned long long)r->packets_sent);
     fprintf(f, "  \"packets_received\": %llu,\n", (unsigned long long)r->packets_received);
     fprintf(f, "  \"motor_timeouts\": %u,\n", r->motor_timeouts);
+    fprintf(f, "  \"goal_timeouts\": %u,\n", r->goal_timeouts);
+    fprintf(f, "  \"goal_blocked\": %u,\n", r->goal_blocked);
+    json_num(f, "turn_time_s", r->turn_time_s, false);
+    fprintf(f, "  \"wall_contacts\": %ld,\n", r->wall_contacts);
     // The path-loss model's final estimate (null for other models).
     json_num(f, "est_src_x_m", r->est_valid ? r->est_x : NAN, false);
     json_num(f, "est_src_y_m", r->est_valid ? r->est_y : NAN, false);
@@ -1111,7 +1161,8 @@ void hs_sim_table_header(FILE *f)
 {
     fprintf(f, "seed\treached\tend\tsim_time_s\tdistance_travelled_m\tshortest_path_m\t"
                "shortest_to_stop_m\tfinal_distance_m\tfinal_x_m\tfinal_y_m\titerations\t"
-               "model_updates\tgreedy\tepsilon\tpackets_sent\tpackets_received\n");
+               "model_updates\tgreedy\tepsilon\tpackets_sent\tpackets_received\t"
+               "goal_timeouts\tgoal_blocked\tturn_time_s\twall_contacts\n");
 }
 
 /// %.3f, or "nan" for a value that does not exist (no goal).
@@ -1134,7 +1185,9 @@ void hs_sim_table_row(FILE *f, const hs_sim_result_t *r)
     tsv_num(f, r->final_distance_m);
     tsv_num(f, r->final_x);
     tsv_num(f, r->final_y);
-    fprintf(f, "\t%u\t%u\t%u\t%u\t%llu\t%llu\n", r->iterations, r->model_updates, r->greedy,
-            r->epsilon, (unsigned long long)r->packets_sent,
-            (unsigned long long)r->packets_received);
+    fprintf(f, "\t%u\t%u\t%u\t%u\t%llu\t%llu\t%u\t%u", r->iterations, r->model_updates,
+            r->greedy, r->epsilon, (unsigned long long)r->packets_sent,
+            (unsigned long long)r->packets_received, r->goal_timeouts, r->goal_blocked);
+    tsv_num(f, r->turn_time_s);
+    fprintf(f, "\t%ld\n", r->wall_contacts);
 }

@@ -68,6 +68,10 @@ typedef struct hs_sim_result {
     uint64_t packets_sent;       ///< packets simulated
     uint64_t packets_received;   ///< packets delivered to the controller
     uint32_t motor_timeouts;     ///< times the motor model stopped on a missing command
+    uint32_t goal_timeouts;      ///< goals the drive abandoned after its timeout
+    uint32_t goal_blocked;       ///< goals the drive abandoned as blocked (no progress)
+    double turn_time_s;          ///< time turning on the spot (|v| < 2 cm/s, |w| > 0.05 rad/s)
+    long wall_contacts;          ///< wall contacts (hs_box2d_wall_contacts)
     double wall_time_s;          ///< host time the run took (not part of determinism)
     double cpu_time_s;           ///< CPU time of this process during the run
     /// The path-loss model's final estimate; false for other models or no fit.

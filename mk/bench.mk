@@ -94,6 +94,13 @@ bench-faults: $(BENCH_BIN)/rfseek-sim
 	@$(PYTHON) scripts/fault_table.py --sim $(BENCH_BIN)/rfseek-sim --seeds $(FAULT_SEEDS)
 BENCH_TARGETS += bench-sim bench-map bench-faults
 
+# The drive under localisation noise -> docs/RESULTS.md ("The drive under localisation
+# noise"): 3 floors x 10 localisation settings x 2 configurations x 200 held-out seeds.
+.PHONY: bench-drive
+bench-drive: $(BENCH_BIN)/rfseek-sim
+	$(PYTHON) scripts/bench_drive.py --sim $(BENCH_BIN)/rfseek-sim
+BENCH_TARGETS += bench-drive
+
 # --- the Linux port: pcap feeder, CAN codec and the two-process overhead ---------------------
 .PHONY: bench-feed bench-wire
 # Frames/s extracting one MAC's RSSI from a 1,000,000-frame capture, side by side with

@@ -1,6 +1,8 @@
 # mk/fuzz.mk - libFuzzer targets for the parsers of outside input (docs/RELIABILITY.md):
-# CAN frames, LCM messages and logs, map YAML + PGM, scenario YAML, radiotap + 802.11
-# headers, the replay stream, pcap/pcapng captures and the pose CSV of rfseek-feed --pose. clang only: -fsanitize=fuzzer,address,undefined.
+# CAN frames, LCM messages and logs, map YAML + PGM, PNG map images, scenario YAML,
+# radiotap + 802.11 headers, the replay stream, pcap/pcapng captures, the pose CSV of
+# rfseek-feed --pose and candump -L log lines. clang only:
+# -fsanitize=fuzzer,address,undefined.
 #   make fuzz [FUZZ_SECONDS=300] [FUZZ_TARGETS="can map"]   each target for that long
 #   make fuzz-long [FUZZ_LONG_RUNS=10000000]   each target for that many executions, one after
 #   another under nice -n 19 (the figures in docs/RELIABILITY.md, "Long runs")
@@ -13,17 +15,17 @@ FUZZ_CFLAGS := $(CSTD) $(WARN) -D_DEFAULT_SOURCE -g -O1 $(INC_sim) -Itests/fuzz 
 FUZZ_HDRS := tests/fuzz/fuzz_tmp.h $(wildcard common/*.h firmware/*.h firmware/port/linux/*.h host_sim/*.h)
 FUZZ_LX := firmware/port/linux
 
-FUZZ_OWN := can lcm map scenario pcap poses
+FUZZ_OWN := can lcm map png scenario pcap poses candump
 FUZZ_BINS := $(FUZZ_OWN:%=$(FUZZ_DIR)/fuzz_%)
 
 $(FUZZ_DIR)/fuzz_can: tests/fuzz/fuzz_can.c $(CORE_SRCS) $(FUZZ_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(CORE_SRCS) -o $@
 
-FUZZ_MAP_SRCS := $(FUZZ_LX)/lx_map.c $(FUZZ_LX)/lx_yaml.c $(FUZZ_LX)/lx_err.c
-$(FUZZ_DIR)/fuzz_map: tests/fuzz/fuzz_map.c $(FUZZ_MAP_SRCS) $(CORE_SRCS) $(FUZZ_HDRS)
+FUZZ_MAP_SRCS := $(FUZZ_LX)/lx_map.c $(FUZZ_LX)/lx_pgm.c $(FUZZ_LX)/lx_png.c $(FUZZ_LX)/lx_yaml.c $(FUZZ_LX)/lx_err.c
+$(FUZZ_DIR)/fuzz_map $(FUZZ_DIR)/fuzz_png: $(FUZZ_DIR)/fuzz_%: tests/fuzz/fuzz_%.c $(FUZZ_MAP_SRCS) $(CORE_SRCS) $(FUZZ_HDRS)
 	@mkdir -p $(@D)
-	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_MAP_SRCS) $(CORE_SRCS) -o $@ $(YAML_LIBS) -lm
+	$(FUZZ_CC) $(FUZZ_CFLAGS) $(PNG_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_MAP_SRCS) $(CORE_SRCS) -o $@ $(YAML_LIBS) $(PNG_LIBS) -lm
 
 FUZZ_SCN_SRCS := host_sim/hs_scenario.c host_sim/hs_radio.c host_sim/hs_motor.c \
 	host_sim/hs_faults.c $(FUZZ_LX)/lx_yaml.c $(FUZZ_LX)/lx_err.c
@@ -40,6 +42,10 @@ FUZZ_POSES_SRCS := host_sim/hs_poses.c
 $(FUZZ_DIR)/fuzz_poses: tests/fuzz/fuzz_poses.c $(FUZZ_POSES_SRCS) $(FUZZ_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_POSES_SRCS) -o $@ -lm
+
+$(FUZZ_DIR)/fuzz_candump: tests/fuzz/fuzz_candump.c $(FUZZ_LX)/lx_candump.c $(FUZZ_HDRS)
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_LX)/lx_candump.c -o $@
 
 # The lcm-gen sources (mk/linux.mk's rule) have unused parameters: no -Werror for them.
 FUZZ_LCM_GEN_OBJS := $(LCM_GEN_NAMES:%=$(FUZZ_DIR)/gen/%.o)

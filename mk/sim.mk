@@ -63,6 +63,17 @@ $(eval $(call test_script,faults,tests/host_sim/faults.sh $(SIM) 3,$(SIM)))
 $(eval $(call test_script,strategy_cli,tests/host_sim/strategy_cli.sh $(SIM),$(SIM)))
 $(eval $(call test_script,pathloss_out,tests/host_sim/pathloss_out.sh $(SIM),$(SIM)))
 $(eval $(call test_script,rfseek_map,tests/host_sim/test_rfseek_map.sh $(BUILD)/bin/rfseek-map,$(BUILD)/bin/rfseek-map))
+# Map images as map_server reads them: PNG of every colour type and depth, PGM, the three
+# modes and negate against a reference in exact arithmetic; damaged PNGs; memory.
+$(eval $(call test_script,map_formats,$(PYTHON) tests/linux/map_formats.py $(BUILD),$(MAP_DUMP) $(BUILD)/bin/rfseek-map))
+# rfseek-map --mcu against firmware/rfs_app.h's limits and scripts/map2c.py, --crop keeping
+# every world point's cell, --png's size and metre grid (decoded with PIL).
+$(eval $(call test_script,map_tools,$(PYTHON) tests/host_sim/map_tools.py $(BUILD)/bin/rfseek-map,$(BUILD)/bin/rfseek-map))
+# scripts/plot_run.py --animate: frame count, size and the robot's pixels of a short run's
+# GIF decoded with Pillow; MP4 when ffmpeg is installed; bad input.
+$(eval $(call test_script,animate,$(PYTHON) tests/host_sim/animate_test.py $(SIM),$(SIM)))
+# The README's path from a PNG map and a capture to a run and a video, as written there.
+$(eval $(call test_script,readme_path,tests/host_sim/readme_path.sh $(BUILD),$(SIM) $(BUILD)/bin/rfseek-map $(BUILD)/bin/rfseek-feed))
 # rfseekd --model pathloss fills the estimate in its status (two-process run in a netns).
 $(eval $(call test_script,status_est,tests/host_sim/status_est.sh $(BUILD),$(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
 # Every program's model and target options and scenario keys, good and bad values; PDR
@@ -88,6 +99,9 @@ $(FEED)/gen/.stamp: scripts/gen_captures.py $(FEED)/feed_writegen
 	$(FEED)/feed_writegen $(FEED)/gen/writer.pcap 2000 > $(FEED)/gen/writer.pcap.macs
 	@touch $@
 $(eval $(call test_script,feed_cross_check,tests/feed/cross_check.sh $(BUILD)/bin/rfseek-feed tests/data/captures/*.pcap $(FEED)/gen/*.pcap $(FEED)/gen/*.pcapng,$(BUILD)/bin/rfseek-feed $(FEED)/gen/.stamp))
+# --list (the survey) against tshark's own fields, aggregated per wlan.ta; a --mac that sent
+# nothing: a warning and exit 3.
+$(eval $(call test_script,feed_survey,$(PYTHON) tests/feed/survey_test.py $(FEED_ASAN) tests/data/captures/*.pcap tests/data/captures/malformed/*.pcap $(FEED)/gen/*.pcap $(FEED)/gen/*.pcapng $(FEED)/gen/bad/radiotap_lies.pcap,$(FEED_ASAN) $(FEED)/gen/.stamp))
 $(eval $(call test_script,feed_bad_input,tests/feed/bad_input.sh $(FEED_ASAN) $(FEED)/gen,$(FEED_ASAN) $(FEED)/gen/.stamp))
 $(eval $(call test_script,feed_replay,$(PYTHON) tests/feed/replay_test.py $(FEED_ASAN),$(FEED_ASAN)))
 

@@ -137,16 +137,16 @@ def section(seeds, wall, at, table):
     return "\n".join(L) + "\n"
 
 
-def splice(path, text):
-    """RESULTS.md with its bench_pathloss_seek section replaced by text (appended when the
-    file has none); written to a temporary file and renamed."""
+def splice(path, text, begin=BEGIN, end=END):
+    """RESULTS.md with its section between begin and end replaced by text (appended when
+    the file has none); written to a temporary file and renamed."""
     old = open(path).read() if os.path.exists(path) else ""
-    b, e = old.find(BEGIN), old.find(END)
+    b, e = old.find(begin), old.find(end)
     if b >= 0 and e > b:
-        rest = old[e + len(END):].lstrip("\n")
+        rest = old[e + len(end):].lstrip("\n")
         new = old[:b] + text + ("\n" + rest if rest else "")
     elif b >= 0 or e >= 0:
-        sys.exit(f"bench_pathloss_seek: {path}: one section marker without the other")
+        sys.exit(f"{begin}: {path}: one section marker without the other")
     else:
         new = old.rstrip("\n") + ("\n\n" if old else "") + text
     tmp = path + ".tmp"

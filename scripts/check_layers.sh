@@ -30,6 +30,7 @@ adapter_of() {
         yaml.h) echo firmware/port/linux/lx_yaml.c ;;
         lcm/*) echo firmware/port/linux/lx_lcm.c ;;
         pcap.h|pcap/*) echo firmware/port/linux/lx_pcap.c ;;
+        png.h|pngconf.h) echo firmware/port/linux/lx_png.c ;;
         linux/can.h|linux/can/*) echo firmware/port/linux/lx_can.c ;;
         box2d/*) echo host_sim/hs_box2d.cpp ;;
     esac

@@ -23,8 +23,9 @@ import sys
 
 COLS = ["seed", "reached", "end", "sim_time_s", "distance_travelled_m", "shortest_path_m",
         "shortest_to_stop_m", "final_distance_m", "final_x_m", "final_y_m", "iterations",
-        "model_updates", "greedy", "epsilon", "packets_sent", "packets_received"]
-FLOATS = set(COLS[3:10])
+        "model_updates", "greedy", "epsilon", "packets_sent", "packets_received",
+        "goal_timeouts", "goal_blocked", "turn_time_s", "wall_contacts"]
+FLOATS = set(COLS[3:10]) | {"turn_time_s"}
 
 
 def fmt(col, v):

@@ -2,6 +2,7 @@
 """Plot one simulator run like the paper's figures 2 to 4.
 
     scripts/plot_run.py RUNDIR [--outdir DIR]
+    scripts/plot_run.py RUNDIR --animate [--out FILE] [--fps N] [--speed S] [--max-frames N]
 
 RUNDIR is an `rfseek-sim --out` directory (summary.json, track.tsv, log.tsv, samples.tsv,
 and field.tsv when run with --field). Writes into DIR (default RUNDIR):
@@ -16,10 +17,26 @@ and field.tsv when run with --field). Writes into DIR (default RUNDIR):
                   map, with the true source (red star), the final estimate (white cross),
                   its uncertainty area and the trajectory
 Images are written to a temporary name and renamed.
+
+--animate writes a video of the run instead (default RUNDIR/run.gif): the map, the
+trajectory so far, the robot (an orange disc of radius 0.177 m with a heading tick, at the
+last track.tsv row not after the frame's time, or the first), the packets so far coloured
+by dBm (every k-th when there are more than 20,000), the goal of the current decision
+(green x), the path-loss source estimate with its uncertainty area when log.tsv has one
+(white plus), the true source (red star) and "t = 12 s, travelled 3.4 m" (along
+track.tsv). Frames are taken every S/N seconds of simulated time (--speed S simulated
+seconds per video second, default 10; --fps N frames per second, 1..60, default 10) from
+0 to the last track row, which gets the last frame; with more than --max-frames (default
+600) they are spread evenly instead. A frame is 960 pixels wide; the map is drawn 40 px
+from the left and 36 px from the top at the largest scale that fits 840 x 720 px, then 56
+px below it (the height rounded up to even). FILE ending in .mp4 is encoded by ffmpeg
+(H.264), anything else is a GIF (Pillow).
 """
 import json
 import os
 import re
+import shutil
+import subprocess
 import sys
 
 import matplotlib
@@ -50,9 +67,24 @@ def read_map(yaml_path):
         data = f.read()
     m = re.match(rb"P5\s+(?:#[^\n]*\n\s*)*(\d+)\s+(\d+)\s+(\d+)\s", data)
     if not m:
-        die("%s: not a binary PGM" % img)
+        return read_image_pil(img, meta.get("negate", "0").strip() == "1", res, ox, oy)
     w, h = int(m.group(1)), int(m.group(2))
     a = np.frombuffer(data[m.end():m.end() + w * h], dtype=np.uint8).reshape(h, w)
+    return a, [ox, ox + w * res, oy, oy + h * res]
+
+
+def read_image_pil(img, negate, res, ox, oy):
+    """A map image that is not a binary PGM (PNG, ASCII PGM) read with Pillow as gray levels
+    for display (negate: dark is free); its extent as read_map's."""
+    try:
+        from PIL import Image
+        with Image.open(img) as im:
+            a = np.asarray(im.convert("L"), dtype=np.uint8)
+    except (ImportError, OSError) as e:
+        die("%s: %s" % (img, e))
+    if negate:
+        a = 255 - a
+    h, w = a.shape
     return a, [ox, ox + w * res, oy, oy + h * res]
 
 
@@ -80,6 +112,8 @@ def main(argv):
         print(__doc__.strip())
         return 0 if len(argv) >= 2 else 1
     run = argv[1]
+    if "--animate" in argv[2:]:
+        return animate_main(run, argv[2:])
     outdir = argv[3] if len(argv) == 4 and argv[2] == "--outdir" else run
     try:
         with open(os.path.join(run, "summary.json")) as f:
@@ -100,6 +134,11 @@ def main(argv):
     ax.imshow(img, cmap="gray", extent=ext, vmin=0, vmax=255)
     ax.plot(x, y, "-", color="tab:blue", lw=1.2, label="trajectory")
     ax.plot(ux, uy, "o", mfc="none", mec="red", ms=7, label="model updates (%d)" % relearn.sum())
+    # Wall contacts: where the robot began touching a wall (track.tsv's touching column).
+    touch = col(th, tr, "touching", int) == 1
+    began = touch & ~np.concatenate(([False], touch[:-1]))
+    ax.plot(x[began], y[began], "s", mfc="none", mec="orange", ms=9, mew=2,
+            label="wall contacts (%s)" % s.get("wall_contacts", int(began.sum())))
     ax.plot(start[0], start[1], "x", color="red", ms=12, mew=3, label="start")
     ax.plot(sources[:, 0], sources[:, 1], "*", color="red", ms=18, label="source")
     ax.set_xlabel("x [m]")
@@ -200,6 +239,180 @@ def plot_residual(path, s, img, ext, sources, tx, ty, out):
     ax.set_title(title)
     ax.legend(loc="upper left", fontsize=8)
     save(fig, out)
+
+
+# --animate: frame layout in pixels (documented in the module docstring; the test
+# tests/host_sim/animate_test.py computes robot positions from it).
+ANIM_W, ANIM_LEFT, ANIM_TOP, ANIM_BOTTOM, ANIM_RIGHT, ANIM_MAX_H = 960, 40, 36, 56, 80, 720
+ROBOT_RADIUS_M = 0.177  # the simulated robot's body (docs/SIMULATOR.md)
+ROBOT_RGB = (1.0, 0.5, 0.0)
+ANIM_MAX_SAMPLES = 20000
+
+
+def anim_option(opts, name, conv, lo, hi, default):
+    """The value of --name in opts (conv'd, within [lo, hi]) or default; one-line error."""
+    if name not in opts:
+        return default
+    v = opts[name]
+    try:
+        x = conv(v)
+        if not lo <= x <= hi or x != x:
+            raise ValueError
+    except ValueError:
+        die("%s: expected a number in [%g, %g], got %s" % (name, lo, hi, v.replace("\n", "?")))
+    return x
+
+
+def anim_frame_times(t_end, fps, speed, max_frames):
+    """Frame times: every speed/fps simulated seconds from 0, the last one at t_end; spread
+    evenly over [0, t_end] when that would be more than max_frames."""
+    dt = speed / fps
+    n = int(np.ceil(t_end / dt - 1e-9)) + 1 if t_end > 0 else 1
+    if n > max_frames:
+        return np.linspace(0.0, t_end, max_frames)
+    t = np.arange(n) * dt
+    t[-1] = t_end
+    return t
+
+
+def animate_main(run, args):
+    opts, i = {}, 0
+    while i < len(args):
+        a = args[i]
+        if a == "--animate":
+            i += 1
+            continue
+        if a not in ("--out", "--fps", "--speed", "--max-frames") or i + 1 >= len(args):
+            die("%s: unknown option or missing value (see --help)" % a.replace("\n", "?"))
+        opts[a] = args[i + 1]
+        i += 2
+    fps = anim_option(opts, "--fps", float, 1, 60, 10.0)
+    speed = anim_option(opts, "--speed", float, 1e-3, 1e6, 10.0)
+    max_frames = anim_option(opts, "--max-frames", int, 2, 100000, 600)
+    out = opts.get("--out", os.path.join(run, "run.gif"))
+    mp4 = out.lower().endswith(".mp4")
+    if mp4 and shutil.which("ffmpeg") is None:
+        die("%s: an MP4 needs ffmpeg (apt-get install ffmpeg), or name a .gif" % out)
+    try:
+        with open(os.path.join(run, "summary.json")) as f:
+            s = json.load(f)
+        img, ext = read_map(s["map"])
+        th, tr = read_tsv(os.path.join(run, "track.tsv"))
+        lh, lr = read_tsv(os.path.join(run, "log.tsv"))
+        tt, tx, ty, tth = (col(th, tr, k) for k in ("t_s", "x_m", "y_m", "theta_rad"))
+        lt, gx, gy = (col(lh, lr, k) for k in ("t_s", "goal_x_m", "goal_y_m"))
+        ex, ey, ea = ((col(lh, lr, k) for k in ("est_src_x_m", "est_src_y_m", "est_area_m2"))
+                      if "est_src_x_m" in lh else (np.full(len(lr), np.nan),) * 3)
+        sp = os.path.join(run, "samples.tsv")
+        sh, sr = read_tsv(sp) if os.path.exists(sp) else (["t_s", "x_m", "y_m", "dbm"], [])
+        st, sx, sy, sv = (col(sh, sr, k) for k in ("t_s", "x_m", "y_m", "dbm"))
+    except (OSError, ValueError, KeyError, IndexError, TypeError) as e:
+        die("%s: %s" % (run, str(e).replace("\n", " ")))
+    if len(tt) == 0 or not np.all(np.isfinite(tt)) or np.any(np.diff(tt) < 0):
+        die("%s: track.tsv: no rows or times not increasing" % run)
+    times = anim_frame_times(tt[-1], fps, speed, max_frames)
+    k = max(1, -(-len(st) // ANIM_MAX_SAMPLES))
+    st, sx, sy, sv = st[::k], sx[::k], sy[::k], sv[::k]
+    travelled = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(tx), np.diff(ty)))])
+
+    # Layout: the map at scale px_m pixels per metre, placed exactly in pixels.
+    mw, mh = ext[1] - ext[0], ext[3] - ext[2]
+    px_m = min((ANIM_W - ANIM_LEFT - ANIM_RIGHT) / mw, ANIM_MAX_H / mh)
+    aw, ah = mw * px_m, mh * px_m
+    hgt = ANIM_TOP + int(np.ceil(ah - 1e-6)) + ANIM_BOTTOM
+    hgt += hgt % 2
+    fig = plt.figure(figsize=(ANIM_W / 100, hgt / 100), dpi=100)
+    ax = fig.add_axes([ANIM_LEFT / ANIM_W, (hgt - ANIM_TOP - ah) / hgt, aw / ANIM_W, ah / hgt])
+    ax.imshow(img, cmap="gray", extent=ext, vmin=0, vmax=255, aspect="auto",
+              interpolation="nearest")
+    ax.set_xlim(ext[0], ext[1])
+    ax.set_ylim(ext[2], ext[3])
+    ax.tick_params(labelsize=7)
+    finite = sv[np.isfinite(sv)]
+    lo, hi = (np.percentile(finite, [2, 98]) if len(finite) else (-90.0, -30.0))
+    sc = ax.scatter(sx[:0], sy[:0], c=sv[:0], s=7, cmap="viridis", vmin=lo, vmax=hi,
+                    linewidths=0, zorder=3)
+    cax = fig.add_axes([(ANIM_LEFT + aw + 10) / ANIM_W, (hgt - ANIM_TOP - ah) / hgt,
+                        12 / ANIM_W, ah / hgt])
+    fig.colorbar(sc, cax=cax).set_label("dBm", fontsize=8)
+    cax.tick_params(labelsize=7)
+    traj, = ax.plot([], [], "-", color="tab:blue", lw=0.8, zorder=4, label="trajectory")
+    dots, = ax.plot([], [], "o", color=plt.get_cmap("viridis")(0.6), ms=4, label="packets")
+    sources = np.array(s["sources"])
+    ax.plot(sources[:, 0], sources[:, 1], "*", color="red", ms=14, label="source")
+    goal, = ax.plot([], [], "x", color="limegreen", ms=9, mew=2.5, zorder=6, label="goal")
+    est, = ax.plot([], [], "P", color="white", mec="black", ms=10, zorder=5,
+                   label="source estimate")
+    area = plt.Circle((0, 0), 0, fill=False, ec="magenta", ls="--", lw=1.0, visible=False)
+    ax.add_patch(area)
+    robot = plt.Circle((tx[0], ty[0]), ROBOT_RADIUS_M, fc=ROBOT_RGB, ec="black", lw=0.6,
+                       zorder=10, label="robot")
+    ax.add_patch(robot)
+    tick, = ax.plot([], [], "-", color="black", lw=1.5, zorder=10)
+    ax.legend(handles=[robot, traj, dots, goal, est], loc="upper center", ncol=5, fontsize=8,
+              bbox_to_anchor=(0.5, -22 / ah), frameon=False, markerscale=1.5)
+    counter = fig.text(ANIM_LEFT / ANIM_W, 1 - 24 / hgt, "", fontsize=11, family="monospace")
+    fig.text(1 - 10 / ANIM_W, 1 - 24 / hgt, "%s, seed %s, %s + %s" % (
+        os.path.basename(s.get("scenario", "")), s.get("seed"), s.get("strategy"), s.get("model")),
+        fontsize=9, ha="right")
+    decimals = max(0, int(np.ceil(-np.log10(times[1] - times[0] + 1e-12)))) if len(times) > 1 else 0
+
+    def draw(j, t):
+        i = max(1, np.searchsorted(tt, t, side="right"))
+        traj.set_data(tx[:i], ty[:i])
+        x, y, h = tx[i - 1], ty[i - 1], tth[i - 1]
+        robot.center = (x, y)
+        c, sn = np.cos(h), np.sin(h)
+        tick.set_data([x + ROBOT_RADIUS_M * c, x + 2.2 * ROBOT_RADIUS_M * c],
+                      [y + ROBOT_RADIUS_M * sn, y + 2.2 * ROBOT_RADIUS_M * sn])
+        n = np.searchsorted(st, t, side="right")
+        sc.set_offsets(np.column_stack([sx[:n], sy[:n]]))
+        sc.set_array(sv[:n])
+        d = np.searchsorted(lt, t, side="right") - 1
+        goal.set_data(([gx[d]], [gy[d]]) if d >= 0 else ([], []))
+        ok = d >= 0 and np.isfinite(ex[d]) and np.isfinite(ey[d])
+        est.set_data(([ex[d]], [ey[d]]) if ok else ([], []))
+        area.set_visible(bool(ok and np.isfinite(ea[d])))
+        if area.get_visible():
+            area.center, area.radius = (ex[d], ey[d]), np.sqrt(ea[d] / np.pi)
+        text = "t = %.*f s, travelled %.1f m" % (decimals, t, travelled[i - 1])
+        if j == len(times) - 1:
+            text += ", %s" % ("reached" if s.get("reached") else "end: %s" % s.get("end"))
+        counter.set_text(text)
+        fig.canvas.draw()
+        return np.asarray(fig.canvas.buffer_rgba())[:, :, :3]
+
+    tmp = "%s.tmp-%d%s" % (out, os.getpid(), ".mp4" if mp4 else ".gif")
+    try:
+        if mp4:
+            enc = subprocess.Popen(
+                ["ffmpeg", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24",
+                 "-s", "%dx%d" % (ANIM_W, hgt), "-r", "%g" % fps, "-i", "-", "-c:v", "libx264",
+                 "-pix_fmt", "yuv420p", "-f", "mp4", tmp], stdin=subprocess.PIPE,
+                stderr=subprocess.PIPE)
+            for j, t in enumerate(times):
+                enc.stdin.write(np.ascontiguousarray(draw(j, t)).tobytes())
+            enc.stdin.close()
+            err = enc.stderr.read().decode(errors="replace").strip().splitlines()
+            if enc.wait() != 0:
+                raise OSError("ffmpeg: %s" % (err[-1] if err else "exit %d" % enc.returncode))
+        else:
+            from PIL import Image
+            frames = (Image.fromarray(draw(j, t)).convert("P", palette=Image.Palette.ADAPTIVE)
+                      for j, t in enumerate(times))
+            first = next(frames)
+            first.save(tmp, format="GIF", save_all=True, append_images=frames,
+                       duration=int(round(1000 / fps)), loop=0)
+        os.replace(tmp, out)
+    except (OSError, ValueError) as e:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        die("%s: %s" % (out, e))
+    plt.close(fig)
+    spread = len(times) == max_frames and len(times) > 1
+    print("%s: %d frames of %d x %d, %g fps, %.4g simulated s per video s" % (
+        out, len(times), ANIM_W, hgt, fps, times[-1] / (len(times) - 1) * fps if spread else speed))
+    return 0
 
 
 if __name__ == "__main__":

@@ -7,6 +7,11 @@
  * equals `tshark -r CAPTURE -Y 'wlan.sa == MAC' -T fields -e frame.time_epoch -e wlan.sa
  * -e radiotap.dbm_antsignal -E occurrence=f` for the frames that have a signal.
  *
+ * With --list it surveys the capture instead: one TSV row per transmitter (hs_survey.h).
+ *
+ * A --mac from which no frame came is a warning line and exit status 3 (the output is
+ * complete): a typing error should not pass for an empty capture.
+ *
  * With --pose it replays a real experiment offline instead: the matching frames and the
  * recorded poses go, in time order, through the same in-process controller over the core
  * (rfs_seek) as the simulator uses, and the simulator's log.tsv, samples.tsv, track.tsv
@@ -30,6 +35,7 @@
 #include "lx_radiotap.h"
 #include "hs_scenario.h"
 #include "hs_sim.h"
+#include "hs_survey.h"
 #include "rfs_models.h"
 #include "rfs_pdr.h"
 
@@ -38,6 +44,7 @@
 static const char k_usage[] =
     "usage: rfseek-feed CAPTURE --mac MAC [--mac MAC2 ...] [--format tsv] [--stats]\n"
     "                   [--output FILE] [--live]\n"
+    "       rfseek-feed CAPTURE --list [--mac MAC ...] [--stats] [--output FILE]\n"
     "       rfseek-feed CAPTURE --pose POSES.csv --scenario SCENARIO.yaml --out DIR\n"
     "                   [--mac MAC ...] [--seed N] [--model NAME] [--target rssi|pdr] [--stats]\n"
     "Print epoch_seconds<TAB>source_mac<TAB>dbm for every 802.11 frame in CAPTURE (a .pcap\n"
@@ -50,6 +57,10 @@ static const char k_usage[] =
     "  --stats        print packet counts (parsed, skipped and why) to stderr\n"
     "  --output FILE  write to FILE (via FILE.tmp, renamed only on success)\n"
     "  --live         CAPTURE is a monitor-mode interface; read until interrupted\n"
+    "  --list         survey: one row per transmitter (802.11 addr2, tshark's wlan.ta; only\n"
+    "                 the --mac ones when given), most frames first: mac, frames, frames\n"
+    "                 with a dBm signal, their mean/min/max dBm, first and last time (as\n"
+    "                 frame.time_epoch), the SSID of its beacons or probe responses\n"
     "  --pose POSES   replay: CSV with the header t_us,x_m,y_m,theta_rad (capture clock,\n"
     "                 microseconds since the epoch; map frame, metres, radians), increasing\n"
     "                 times; packets and poses go through the seeker (rfs_seek) offline\n"
@@ -64,7 +75,8 @@ static const char k_usage[] =
     "                 pdr (the packet delivery ratio over 1 s from the 802.11 sequence numbers\n"
     "                 of the matching frames; samples.tsv then holds the percentages fed)\n"
     "  --help         this text\n"
-    "Exit 0 on success, 1 on a bad capture or I/O error, 2 on bad options.\n";
+    "Exit 0 on success, 1 on a bad capture or I/O error, 2 on bad options, 3 when a --mac\n"
+    "sent no frame (a warning line; the output is complete).\n";
 
 /* Counts reported by --stats. */
 typedef struct feed_stats {
@@ -78,6 +90,9 @@ typedef struct feed_stats {
     uint64_t caplen_short;            /* records captured shorter than on the air */
     uint64_t replay_before;           /* replay: matching frames before the first pose */
     uint64_t replay_after;            /* replay: ... after the last pose or the stop */
+    uint64_t no_ta;                   /* --list: 802.11 header without a transmitter address */
+    uint64_t rt_kept;                 /* --list: unusable radiotap header, its 802.11 frame counted */
+    uint64_t mac_frames[FEED_MAX_MACS]; /* frames from each --mac (SA; --list: TA) */
 } feed_stats_t;
 
 static int parse_mac(const char *s, uint8_t mac[6])
@@ -144,6 +159,8 @@ static void print_stats(const char *name, const feed_stats_t *st)
     const struct { uint64_t n; const char *what; } rest[] = {
         {st->no_wlan, "skipped: no 802.11 header"},
         {st->no_sa, "skipped: no source address"},
+        {st->no_ta, "skipped: no transmitter address"},
+        {st->rt_kept, "note: unusable radiotap header, the 802.11 frame after it counted without signal"},
         {st->no_signal, "skipped: matching source without dBm signal"},
         {st->caplen_short, "note: cut by the snap length"},
         {st->replay_before, "replay: not fed, before the first pose"},
@@ -162,39 +179,90 @@ typedef int (*feed_fn)(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_f
  * was alive at its time (the receiver heartbeat). */
 typedef int (*alive_fn)(void *ctx, int64_t t_us);
 
+/* The next record whose radiotap header parsed (with bad_rt, or was unusable but located
+ * the 802.11 frame: counted in st->rt_kept) and an 802.11 header followed, in *pkt and *f;
+ * alive (when not NULL) is called for every record read, and why a record gives nothing
+ * is counted in st. 1, 0 at the end, -1 after a read error (message on stderr) or when
+ * alive failed. */
+static int next_frame(lx_pcap_reader_t *r, feed_stats_t *st, lx_pcap_pkt_t *pkt, lx_rt_frame_t *f,
+                      bool bad_rt, alive_fn alive, void *alive_ctx)
+{
+    char err[512];
+    for (;;) {
+        const int got = lx_pcap_next(r, pkt, err, sizeof(err));
+        if (got == 2) { continue; }
+        if (got == 0) { return 0; }
+        if (got < 0) {
+            fprintf(stderr, "rfseek-feed: %s (after %llu packets)\n", err, (unsigned long long)st->packets);
+            return -1;
+        }
+        st->packets++;
+        if (alive != NULL && alive(alive_ctx, pkt->t_us) != 0) { return -1; }
+        if (pkt->caplen < pkt->origlen) { st->caplen_short++; }
+        const int prc = lx_rt_frame_parse(pkt->data, pkt->caplen, f);
+        if (prc != 0 && bad_rt && f->wlan_ok) {
+            st->rt_kept++;
+            return 1;
+        }
+        st->rt_bad[f->rt.status]++;
+        if (prc != 0) { continue; }
+        if (!f->wlan_ok) { st->no_wlan++; continue; }
+        return 1;
+    }
+}
+
 /* Read every packet, count why packets give nothing, call fn for the matching ones and
  * alive (when not NULL) for every one. Returns 0, or 1 after a read error (message on
  * stderr) or when fn or alive failed. */
 static int scan_capture(lx_pcap_reader_t *r, const uint8_t (*macs)[6], int n_macs, feed_stats_t *st,
                         feed_fn fn, void *ctx, alive_fn alive, void *alive_ctx)
 {
-    char err[512];
     for (;;) {
         lx_pcap_pkt_t pkt;
-        const int got = lx_pcap_next(r, &pkt, err, sizeof(err));
-        if (got == 2) { continue; }
-        if (got == 0) { return 0; }
-        if (got < 0) {
-            fprintf(stderr, "rfseek-feed: %s (after %llu packets)\n", err, (unsigned long long)st->packets);
-            return 1;
-        }
-        st->packets++;
-        if (alive != NULL && alive(alive_ctx, pkt.t_us) != 0) { return 1; }
-        if (pkt.caplen < pkt.origlen) { st->caplen_short++; }
         lx_rt_frame_t f;
-        const int prc = lx_rt_frame_parse(pkt.data, pkt.caplen, &f);
-        st->rt_bad[f.rt.status]++;
-        if (prc != 0) { continue; }
-        if (!f.wlan_ok) { st->no_wlan++; continue; }
+        const int got = next_frame(r, st, &pkt, &f, false, alive, alive_ctx);
+        if (got <= 0) { return got < 0 ? 1 : 0; }
         if (!f.wlan.has_sa) { st->no_sa++; continue; }
         int m = 0;
         while (m < n_macs && memcmp(macs[m], f.wlan.sa, 6) != 0) { m++; }
         if (m == n_macs) { continue; }
         st->sa_match++;
+        st->mac_frames[m]++;
         if (!f.rt.has_dbm_signal) { st->no_signal++; continue; }
         if (fn(ctx, m, &pkt, &f) != 0) { return 1; }
         st->lines++;
     }
+}
+
+/* --list: every frame with a transmitter address (from the --mac ones only, when given)
+ * into a survey, then its table into out (hs_survey_write). 0, or 1 after a message. */
+static int scan_list(lx_pcap_reader_t *r, const uint8_t (*macs)[6], int n_macs, feed_stats_t *st, FILE *out)
+{
+    hs_survey_t *sv = hs_survey_new();
+    int rc = sv == NULL ? -1 : 0;
+    for (;;) {
+        lx_pcap_pkt_t pkt;
+        lx_rt_frame_t f;
+        const int got = rc == 0 ? next_frame(r, st, &pkt, &f, true, NULL, NULL) : 0;
+        if (got <= 0) {
+            rc = got < 0 ? 1 : rc;
+            break;
+        }
+        if (!f.wlan.has_ta) { st->no_ta++; continue; }
+        int m = 0;
+        while (m < n_macs && memcmp(macs[m], f.wlan.ta, 6) != 0) { m++; }
+        if (n_macs > 0 && m == n_macs) { continue; }
+        if (n_macs > 0) { st->mac_frames[m]++; }
+        const bool usable = f.rt.status < LX_RT_ERR_SHORT; /* else no radiotap field counts */
+        const hs_survey_frame_t sf = {f.wlan.ta, pkt.ts_sec, pkt.ts_nsec, usable && f.rt.has_dbm_signal,
+                                      f.rt.dbm_signal, f.has_ssid ? f.ssid : NULL, f.ssid_len};
+        rc = hs_survey_add(sv, &sf);
+    }
+    const long rows = rc == 0 ? hs_survey_write(sv, out) : -1;
+    if (rows < 0 && rc <= 0) { fprintf(stderr, "rfseek-feed: out of memory\n"); }
+    st->lines = rows > 0 ? (uint64_t)rows : 0u;
+    hs_survey_free(sv);
+    return rows < 0 ? 1 : 0;
 }
 
 /* --- TSV mode ----------------------------------------------------------------------- */
@@ -252,7 +320,8 @@ static int tsv_line(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_fram
     return c->live && fflush(c->out) != 0 ? 1 : 0;
 }
 
-static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, const uint8_t (*macs)[6],
+/* The TSV lines (or with list the survey, scan_list) into stdout or output. */
+static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, bool list, const uint8_t (*macs)[6],
                    int n_macs, feed_stats_t *st)
 {
     char *tmp = NULL;
@@ -275,7 +344,7 @@ static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, const uin
     static char obuf[1 << 16];
     setvbuf(out, obuf, _IOFBF, sizeof(obuf));
     tsv_ctx_t c = {out, live};
-    int rc = scan_capture(r, macs, n_macs, st, tsv_line, &c, NULL, NULL);
+    int rc = list ? scan_list(r, macs, n_macs, st, out) : scan_capture(r, macs, n_macs, st, tsv_line, &c, NULL, NULL);
     if (output != NULL && (fflush(out) != 0 || ferror(out))) {
         fprintf(stderr, "rfseek-feed: %s: write error: %s\n", tmp, strerror(errno));
         rc = 1;
@@ -776,6 +845,7 @@ typedef struct feed_opts {
     int n_macs;
     bool stats;
     bool live;
+    bool list;                       /* --list: the survey */
 } feed_opts_t;
 
 enum { RUN = -1 }; /* parse_options: go on (else the exit status) */
@@ -855,7 +925,11 @@ static int check_options(const feed_opts_t *fo)
         fprintf(stderr, "rfseek-feed: --output and --live do not go with --pose (see --help)\n");
         return 2;
     }
-    if (!replay && fo->n_macs == 0) {
+    if (fo->list && (replay || fo->live)) {
+        fprintf(stderr, "rfseek-feed: --list reads a capture file: not with --pose or --live (see --help)\n");
+        return 2;
+    }
+    if (!replay && !fo->list && fo->n_macs == 0) {
         fprintf(stderr, "rfseek-feed: no --mac given (see --help)\n");
         return 2;
     }
@@ -890,6 +964,8 @@ static int parse_options(int argc, char **argv, feed_opts_t *fo)
             fo->stats = true;
         } else if (strcmp(a, "--live") == 0) {
             fo->live = true;
+        } else if (strcmp(a, "--list") == 0) {
+            fo->list = true;
         } else if (a[0] == '-' && a[1] != '\0') {
             opt_err("unknown option '%s' (see --help)", a);
             return 2;
@@ -901,6 +977,25 @@ static int parse_options(int argc, char **argv, feed_opts_t *fo)
         }
     }
     return check_options(fo);
+}
+
+/* After a complete TSV or --list run: a warning line for each --mac no frame came from
+ * (by source address; --list: transmitter address) and exit status 3, else 0. */
+static int warn_unheard(const feed_opts_t *fo, const feed_stats_t *st)
+{
+    int rc = 0;
+    for (int m = 0; m < fo->n_macs; m++) {
+        if (st->mac_frames[m] == 0u) {
+            const uint8_t *a = fo->macs[m];
+            char msg[600];
+            snprintf(msg, sizeof msg, "rfseek-feed: warning: %s: no frame from %02x:%02x:%02x:%02x:%02x:%02x",
+                     fo->ro.capture, a[0], a[1], a[2], a[3], a[4], a[5]);
+            lx_err_one_line(msg);
+            fprintf(stderr, "%s\n", msg);
+            rc = 3;
+        }
+    }
+    return rc;
 }
 
 static int feed_main(int argc, char **argv)
@@ -939,10 +1034,10 @@ static int feed_main(int argc, char **argv)
     feed_stats_t st;
     memset(&st, 0, sizeof(st));
     rc = fo.ro.poses != NULL ? run_replay(&fo.ro, r, fo.macs, fo.n_macs, &st)
-                             : run_tsv(r, fo.output, fo.live, (const uint8_t(*)[6])fo.macs, fo.n_macs, &st);
+                             : run_tsv(r, fo.output, fo.live, fo.list, (const uint8_t(*)[6])fo.macs, fo.n_macs, &st);
     lx_pcap_close(r);
     if (fo.stats) { print_stats(fo.ro.capture, &st); }
-    return rc;
+    return rc == 0 && fo.ro.poses == NULL ? warn_unheard(&fo, &st) : rc;
 }
 
 int main(int argc, char **argv)

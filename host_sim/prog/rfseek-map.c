@@ -1,10 +1,13 @@
 /* rfseek-map - inspect a ROS map_server map as the core will see it (docs/MAPS.md).
  *
  *   rfseek-map MAP.yaml [--res 0.1] [--clearance 0.25] [--grid 0.25] [--pgm OUT.pgm]
+ *                       [--png OUT.png] [--crop OUT.yaml] [--mcu] [--bench N]
  *
  * Prints the image size, its free / occupied / unknown cells, the core grid at --res,
- * the share of legal cells, the bytes of the core's bit grids and of the planner, and
- * with --pgm writes the core grid as an image (written to OUT.pgm.tmp, then renamed).
+ * the share of legal cells, the bytes of the core's bit grids and of the planner; --pgm
+ * writes the core grid as an image, --png a picture for placing things (hs_mapdraw.h),
+ * --crop the known area as a map_server pair, --mcu whether the map fits the STM32
+ * image. Every output goes to NAME.tmp first, then is renamed.
  */
 #include <errno.h>
 #include <math.h>
@@ -14,24 +17,41 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "hs_mapdraw.h"
 #include "lx_err.h"
 #include "lx_map.h"
+#include "rfs_app.h"
 #include "rfs_plan.h"
 
 static const char k_usage[] =
     "usage: rfseek-map MAP.yaml [--res M] [--clearance M] [--grid M] [--pgm OUT.pgm]\n"
-    "                  [--bench N]\n"
-    "Load a ROS map_server map (YAML + PGM) and report it as the rfseek core sees it.\n"
+    "                  [--png OUT.png] [--crop OUT.yaml] [--mcu] [--bench N]\n"
+    "Load a ROS map_server map (YAML + PGM or PNG image; mode trinary, scale or raw) and\n"
+    "report it as the rfseek core sees it.\n"
     "  --res M        core cell size in metres (default 0.1)\n"
     "  --clearance M  free space required around a legal point, metres (default 0.25)\n"
     "  --grid M       lattice spacing for search and planning, metres (default 0.25)\n"
     "  --pgm OUT.pgm  write the core grid as a PGM: legal 255, free but too close to a\n"
     "                 wall or the unknown 200, unknown 128, wall 0 (row 0 = top)\n"
+    "  --png OUT.png  draw the map for placing things in world coordinates: each map cell\n"
+    "                 S x S pixels, S = ceil(20 x resolution) (a metre is 20 pixels or\n"
+    "                 more); white where a start is legal, pale yellow free but within\n"
+    "                 the clearance, gray unknown, black occupied; a blue line at every\n"
+    "                 whole metre, x = 0 and y = 0 in red, labels in metres. Size\n"
+    "                 (88 + S w + 16) x (24 + S h + 44) pixels for a w x h-cell map\n"
+    "  --crop OUT.yaml  write the known area (the box of the cells not unknown) as a\n"
+    "                 map_server pair OUT.yaml + OUT.pgm (trinary P5): the origin moves\n"
+    "                 by the cells cut, so every point keeps its world coordinates and\n"
+    "                 its cell; scripts/map2c.py can bake it into the firmware\n"
+    "  --mcu          say whether the map fits the STM32 image at --res (bytes per bit\n"
+    "                 grid and lattice points against firmware/rfs_app.h, the image's\n"
+    "                 0.25 m lattice and clearance), why not, and what would fit\n"
     "  --bench N      plan between N random pairs of legal lattice points (seeded) and\n"
     "                 print the planner's median time, expansions and queue use, and the\n"
     "                 median time to derive the legal grid\n"
     "  --help         this text\n"
-    "Exit 0 on success, 1 on a bad map or I/O error, 2 on bad options.\n";
+    "Exit 0 on success, 1 on a bad map or I/O error, 2 on bad options, 3 when --mcu finds\n"
+    "that the map does not fit (the other outputs are written all the same).\n";
 
 static const char PROG[] = "rfseek-map"; /* the prefix of its error lines (lx_err_print) */
 
@@ -60,15 +80,47 @@ static int parse_pos(const char *opt, const char *s, double max, double *out)
     return 0;
 }
 
-static int write_pgm(const char *path, const lx_core_map_t *c)
+/* Write path through NAME.tmp and a rename: body fills the open file, 0 or -1 with a
+ * reason in err. 0, or -1 after one error line (nothing left behind). */
+static int write_atomic(const char *path, int (*body)(FILE *f, const void *ctx, char *err, size_t errlen),
+                        const void *ctx)
 {
     char tmp[4096];
-    snprintf(tmp, sizeof(tmp), "%s.tmp", path);
+    if ((size_t)snprintf(tmp, sizeof(tmp), "%s.tmp", path) >= sizeof(tmp)) {
+        lx_err_print(PROG, "%s: file name too long", path);
+        return -1;
+    }
     FILE *f = fopen(tmp, "wb");
     if (f == NULL) {
         lx_err_print(PROG, "%s: cannot create: %s", tmp, strerror(errno));
         return -1;
     }
+    char err[512] = "write error";
+    int rc = body(f, ctx, err, sizeof(err));
+    if (rc != 0 || fflush(f) != 0 || ferror(f)) {
+        fclose(f);
+        lx_err_print(PROG, "%s: %s", tmp, err);
+        remove(tmp);
+        return -1;
+    }
+    if (fclose(f) != 0) {
+        lx_err_print(PROG, "%s: write error", tmp);
+        remove(tmp);
+        return -1;
+    }
+    if (rename(tmp, path) != 0) {
+        lx_err_print(PROG, "%s: cannot rename to %s: %s", tmp, path, strerror(errno));
+        remove(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+static int pgm_body(FILE *f, const void *ctx, char *err, size_t errlen)
+{
+    (void)err;
+    (void)errlen;
+    const lx_core_map_t *c = ctx;
     const rfs_map_t *m = &c->map;
     fprintf(f, "P5\n# rfseek-map core grid: legal 255, free 200, unknown 128, wall 0\n%u %u\n255\n",
             m->w, m->h);
@@ -85,17 +137,177 @@ static int write_pgm(const char *path, const lx_core_map_t *c)
             fputc(v, f);
         }
     }
-    if (fflush(f) != 0 || ferror(f) || fclose(f) != 0) {
-        lx_err_print(PROG, "%s: write error", tmp);
-        remove(tmp);
-        return -1;
+    return 0;
+}
+
+/* The map and its converted core map, for the picture. */
+typedef struct png_job {
+    const lx_map_t *m;
+    const lx_core_map_t *c;
+} png_job_t;
+
+static int png_body(FILE *f, const void *ctx, char *err, size_t errlen)
+{
+    const png_job_t *j = ctx;
+    return hs_mapdraw_png(j->m, &j->c->map, f, err, errlen);
+}
+
+/* --- --mcu: the STM32 image's verdict ------------------------------------------------------ */
+
+/* A map against the firmware's limits at one core resolution. */
+typedef struct mcu_fit {
+    bool converted;        /* lx_map_to_core accepted it (why holds its reason when not) */
+    char why[512];
+    uint16_t w, h, lw, lh; /* core grid and lattice */
+    uint32_t bytes;        /* per bit grid */
+    uint32_t lattice;      /* points */
+    bool init_ok;          /* rfs_app_init accepted it */
+} mcu_fit_t;
+
+static bool mcu_fits(const mcu_fit_t *f)
+{
+    return f->converted && f->bytes <= RFS_APP_MAX_MAP_BYTES && f->lattice <= RFS_APP_MAX_LATTICE && f->init_ok;
+}
+
+/* Convert m at res with the image's map configuration and ask the firmware's own
+ * rfs_app_init (rfs_app_cfg_mcu()) when the sizes are within its arrays. 0, or -1 out of
+ * memory. */
+static int mcu_check(const lx_map_t *m, double res, mcu_fit_t *f)
+{
+    memset(f, 0, sizeof(*f));
+    rfs_app_cfg_t cfg = rfs_app_cfg_mcu();
+    lx_core_map_t c;
+    if (lx_map_to_core(m, res, &cfg.map, &c, f->why, sizeof(f->why)) != 0) {
+        return 0;
     }
-    if (rename(tmp, path) != 0) {
-        lx_err_print(PROG, "%s: cannot rename to %s: %s", tmp, path, strerror(errno));
-        remove(tmp);
-        return -1;
+    f->converted = true;
+    f->w = c.map.w;
+    f->h = c.map.h;
+    f->lw = c.map.lw;
+    f->lh = c.map.lh;
+    f->bytes = rfs_map_bytes(c.map.w, c.map.h);
+    f->lattice = (uint32_t)c.map.lw * c.map.lh;
+    int rc = 0;
+    if (f->bytes <= RFS_APP_MAX_MAP_BYTES && f->lattice <= RFS_APP_MAX_LATTICE) {
+        rfs_app_t *app = malloc(sizeof(*app));
+        if (app == NULL) {
+            rc = -1;
+        } else {
+            const rfs_app_map_t am = {c.map.w, c.map.h, c.map.res, c.map.origin_x, c.map.origin_y,
+                                      c.free_bits, c.wall_bits};
+            f->init_ok = rfs_app_init(app, &cfg, &am) == 0;
+        }
+        free(app);
+    }
+    lx_core_map_free(&c);
+    return rc;
+}
+
+/* The finest whole multiple of the map's resolution above res, up to 1 m (rfseekd's
+ * --res range), at which m fits; 0 when none does or the lattice is what overflows. */
+static double mcu_coarser(const lx_map_t *m, double res, const mcu_fit_t *at_res)
+{
+    if (!at_res->converted || at_res->lattice > RFS_APP_MAX_LATTICE) {
+        return 0;
+    }
+    for (int k = 1; k * m->res <= 1.0 + 1e-9; k++) {
+        double r = k * m->res;
+        /* Skip without converting while even the grid's bare size is too large. */
+        double cw = ceil(m->w * m->res / r - 1e-9);
+        double ch = ceil(m->h * m->res / r - 1e-9);
+        if (r <= res + 1e-9 || ceil(cw / 8.0) * ch > RFS_APP_MAX_MAP_BYTES) {
+            continue;
+        }
+        mcu_fit_t f;
+        if (mcu_check(m, r, &f) != 0) {
+            return 0;
+        }
+        if (mcu_fits(&f)) {
+            return r;
+        }
     }
     return 0;
+}
+
+static void mcu_print(const char *what, const mcu_fit_t *f)
+{
+    if (!f->converted) {
+        printf("mcu          - %s: %s\n", what, f->why);
+        return;
+    }
+    printf("mcu          - %s: bit grids %u x %u cells, %u bytes each of the image's %u "
+           "(RFS_APP_MAX_MAP_BYTES)%s\n", what, f->w, f->h, f->bytes, RFS_APP_MAX_MAP_BYTES,
+           f->bytes > RFS_APP_MAX_MAP_BYTES ? ": too large" : "");
+    printf("mcu          - %s: lattice %u x %u = %u points of the image's %u (RFS_APP_MAX_LATTICE)%s\n", what,
+           f->lw, f->lh, f->lattice, RFS_APP_MAX_LATTICE, f->lattice > RFS_APP_MAX_LATTICE ? ": too many" : "");
+    if (f->bytes <= RFS_APP_MAX_MAP_BYTES && f->lattice <= RFS_APP_MAX_LATTICE && !f->init_ok) {
+        printf("mcu          - %s: rfs_app_init refuses it\n", what);
+    }
+}
+
+/* The --mcu report: 0 when the map fits the image, 3 when not, 1 out of memory. */
+static int report_mcu(const lx_map_t *m, double res)
+{
+    mcu_fit_t f;
+    if (mcu_check(m, res, &f) != 0) {
+        lx_err_print(PROG, "--mcu: out of memory");
+        return 1;
+    }
+    const bool fits = mcu_fits(&f);
+    printf("mcu          %s the STM32 image at %g m cells (docs/MAPS.md, \"The largest map on the "
+           "microcontroller\")\n", fits ? "fits" : "does NOT fit", res);
+    mcu_print("map", &f);
+    if (fits && 2u * ((uint32_t)f.lw + f.lh) > RFS_APP_PLAN_QUEUE) {
+        printf("mcu          - note: the planner queue holds %u entries, under 2 x (lw + lh) = %u: a long plan "
+               "may fail\n", RFS_APP_PLAN_QUEUE, 2u * ((uint32_t)f.lw + f.lh));
+    }
+    uint32_t x0;
+    uint32_t y0;
+    uint32_t x1;
+    uint32_t y1;
+    lx_map_t crop;
+    memset(&crop, 0, sizeof(crop));
+    char err[512];
+    const lx_map_t *target = m;
+    mcu_fit_t cf = f;
+    if (!fits && lx_map_known_box(m, &x0, &y0, &x1, &y1) && (x1 - x0 + 1 < m->w || y1 - y0 + 1 < m->h) &&
+        lx_map_crop(m, x0, y0, x1 - x0 + 1, y1 - y0 + 1, &crop, err, sizeof(err)) == 0) {
+        if (mcu_check(&crop, res, &cf) != 0) {
+            lx_map_free(&crop);
+            lx_err_print(PROG, "--mcu: out of memory");
+            return 1;
+        }
+        printf("mcu          the known area, %u x %u cells from column %u, row %u (x %g .. %g m, y %g .. %g m), "
+               "%s\n", crop.w, crop.h, x0, y0, crop.origin_x, crop.origin_x + crop.w * crop.res, crop.origin_y,
+               crop.origin_y + crop.h * crop.res,
+               mcu_fits(&cf) ? "fits: --crop OUT.yaml writes it" : "does not fit either");
+        if (!mcu_fits(&cf)) {
+            mcu_print("known area", &cf);
+        }
+        target = &crop;
+    }
+    if (!fits && !mcu_fits(&cf)) {
+        double r = mcu_coarser(target, res, &cf);
+        if (r > 0) {
+            printf("mcu          %s fits at --res %g (%d image cells a side)\n",
+                   target == m ? "the map" : "the known area", r, (int)lround(r / m->res));
+        } else {
+            printf("mcu          no coarser resolution up to 1 m makes it fit%s\n",
+                   cf.converted && cf.lattice > RFS_APP_MAX_LATTICE ? " (the lattice is too large)" : "");
+        }
+    }
+    lx_map_free(&crop);
+    /* What scripts/map2c.py, which bakes a map into the image, reads. */
+    double k = res / m->res;
+    if (fabs(k - lround(k)) > 1e-6 || lround(k) < 1) {
+        printf("mcu          note: scripts/map2c.py bakes a map only at a whole multiple of its %g m cells\n",
+               m->res);
+    }
+    if (m->mode != LX_MAP_TRINARY || strcmp(m->format, "PGM P5, maxval 255") != 0) {
+        printf("mcu          note: scripts/map2c.py reads trinary P5 PGMs of maxval 255: --crop OUT.yaml "
+               "writes one\n");
+    }
+    return fits ? 0 : 3;
 }
 
 static double now_s(void)
@@ -223,71 +435,147 @@ static void run_bench(const lx_core_map_t *c, long n)
     free(e);
 }
 
-static int map_main(int argc, char **argv)
+/* The options. */
+typedef struct opts {
+    const char *yaml;
+    const char *pgm;
+    const char *png;
+    const char *crop;
+    char crop_image[4096]; /* the image --crop writes beside its YAML */
+    bool mcu;
+    double res, clearance, grid;
+    long bench;
+} opts_t;
+
+/* 0, or the exit status after one error line. */
+static int parse_opts(int argc, char **argv, opts_t *o)
 {
-    const char *yaml = NULL;
-    const char *pgm = NULL;
-    double res = 0.1;
-    double clearance = 0.25;
-    double grid = 0.25;
-    long bench = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             fputs(k_usage, stdout);
-            return 0;
-        } else if (strcmp(a, "--res") == 0 || strcmp(a, "--clearance") == 0 ||
-                   strcmp(a, "--grid") == 0 || strcmp(a, "--pgm") == 0) {
+            return -1;
+        } else if (strcmp(a, "--pgm") == 0 || strcmp(a, "--png") == 0 || strcmp(a, "--crop") == 0) {
             const char *v = i + 1 < argc ? argv[++i] : NULL;
-            if (strcmp(a, "--pgm") == 0) {
-                if (v == NULL || *v == '\0') {
-                    lx_err_print(PROG, "--pgm: an output file name expected");
-                    return 2;
-                }
-                pgm = v;
-            } else if (strcmp(a, "--clearance") == 0
-                           ? parse_pos(a, v, MAP_CLEARANCE_MAX_M, &clearance) != 0
-                           : parse_pos(a, v, MAP_OPT_MAX_M, strcmp(a, "--res") == 0 ? &res : &grid) != 0) {
+            if (v == NULL || *v == '\0') {
+                lx_err_print(PROG, "%s: an output file name expected", a);
                 return 2;
             }
+            *(strcmp(a, "--pgm") == 0 ? &o->pgm : strcmp(a, "--png") == 0 ? &o->png : &o->crop) = v;
+        } else if (strcmp(a, "--res") == 0 || strcmp(a, "--clearance") == 0 || strcmp(a, "--grid") == 0) {
+            const char *v = i + 1 < argc ? argv[++i] : NULL;
+            if (strcmp(a, "--clearance") == 0
+                    ? parse_pos(a, v, MAP_CLEARANCE_MAX_M, &o->clearance) != 0
+                    : parse_pos(a, v, MAP_OPT_MAX_M, strcmp(a, "--res") == 0 ? &o->res : &o->grid) != 0) {
+                return 2;
+            }
+        } else if (strcmp(a, "--mcu") == 0) {
+            o->mcu = true;
         } else if (strcmp(a, "--bench") == 0) {
             const char *v = i + 1 < argc ? argv[++i] : NULL;
             char *end = NULL;
-            bench = v != NULL ? strtol(v, &end, 10) : -1;
-            if (v == NULL || *end != '\0' || bench < 1 || bench > 1000000) {
+            o->bench = v != NULL ? strtol(v, &end, 10) : -1;
+            if (v == NULL || *end != '\0' || o->bench < 1 || o->bench > 1000000) {
                 lx_err_print(PROG, "--bench: a count 1..1000000 expected, got '%s'", v != NULL ? v : "(nothing)");
                 return 2;
             }
         } else if (a[0] == '-' && a[1] != '\0') {
             lx_err_print(PROG, "%s: unknown option (see --help)", a);
             return 2;
-        } else if (yaml == NULL) {
-            yaml = a;
+        } else if (o->yaml == NULL) {
+            o->yaml = a;
         } else {
             lx_err_print(PROG, "%s: only one map expected (see --help)", a);
             return 2;
         }
     }
-    if (yaml == NULL) {
+    if (o->yaml == NULL) {
         lx_err_print(PROG, "no map given (see --help)");
         return 2;
     }
-    if (!(res > 0) || !(grid > 0)) {
+    if (!(o->res > 0) || !(o->grid > 0)) {
         lx_err_print(PROG, "--res and --grid must be > 0");
         return 2;
     }
+    if (o->crop != NULL && !lx_map_save_image_path(o->crop, o->crop_image, sizeof(o->crop_image))) {
+        lx_err_print(PROG, "--crop: %s: file name too long", o->crop);
+        return 2;
+    }
+    return 0;
+}
+
+/* Every output is neither an input (the YAML, and once known the image) nor another
+ * output, and can be created. 0, or -1 after one error line. */
+static int check_outputs(const opts_t *o, const char *image)
+{
+    const char *outs[4] = {o->pgm, o->png, o->crop, o->crop != NULL ? o->crop_image : NULL};
+    for (int i = 0; i < 4; i++) {
+        if (outs[i] == NULL) {
+            continue;
+        }
+        if (lx_err_same_file(PROG, image != NULL ? image : o->yaml, outs[i]) != 0 ||
+            (image == NULL && lx_err_check_dest(PROG, outs[i]) != 0)) {
+            return -1;
+        }
+        for (int j = 0; j < i && image == NULL; j++) {
+            if (outs[j] != NULL && lx_err_same_dest(PROG, outs[j], outs[i]) != 0) {
+                return -1;
+            }
+        }
+    }
+    return 0;
+}
+
+/* --crop: the known area written as a map_server pair. 0, or 1 after one error line. */
+static int write_crop(const lx_map_t *m, const opts_t *o)
+{
+    uint32_t x0;
+    uint32_t y0;
+    uint32_t x1;
+    uint32_t y1;
+    if (!lx_map_known_box(m, &x0, &y0, &x1, &y1)) {
+        lx_err_print(PROG, "%s: --crop: every cell is unknown, nothing to keep", o->yaml);
+        return 1;
+    }
+    lx_map_t crop;
+    char err[1024];
+    if (lx_map_crop(m, x0, y0, x1 - x0 + 1, y1 - y0 + 1, &crop, err, sizeof(err)) != 0 ||
+        lx_map_save(&crop, o->crop, err, sizeof(err)) != 0) {
+        lx_err_print(PROG, "%s", err);
+        lx_map_free(&crop);
+        return 1;
+    }
+    printf("crop         %u x %u cells from column %u, row %u: origin (%g, %g), %s + %s\n", crop.w, crop.h, x0, y0,
+           crop.origin_x, crop.origin_y, o->crop, o->crop_image);
+    lx_map_free(&crop);
+    return 0;
+}
+
+static int map_main(int argc, char **argv)
+{
+    opts_t o = {.res = 0.1, .clearance = 0.25, .grid = 0.25};
+    int orc = parse_opts(argc, argv, &o);
+    if (orc != 0) {
+        return orc < 0 ? 0 : orc;
+    }
+    const char *yaml = o.yaml;
+    const double res = o.res;
     char err[1024];
     lx_map_t m;
-    if (pgm != NULL && (lx_err_same_file(PROG, yaml, pgm) != 0 || lx_err_check_dest(PROG, pgm) != 0)) {
+    if (check_outputs(&o, NULL) != 0) {
         return 1;
     }
     if (lx_map_load(yaml, &m, err, sizeof(err)) != 0) {
         lx_err_print(PROG, "%s", err);
         return 1;
     }
+    if (check_outputs(&o, m.image_path) != 0) {
+        lx_map_free(&m);
+        return 1;
+    }
     rfs_map_cfg_t cfg = rfs_map_cfg_default();
-    cfg.clearance = (rfs_q16_t)lround(clearance * 65536.0);
-    cfg.grid = (rfs_q16_t)lround(grid * 65536.0);
+    cfg.clearance = (rfs_q16_t)lround(o.clearance * 65536.0);
+    cfg.grid = (rfs_q16_t)lround(o.grid * 65536.0);
     lx_core_map_t c;
     if (lx_map_to_core(&m, res, &cfg, &c, err, sizeof(err)) != 0) {
         lx_err_print(PROG, "%s: %s", yaml, err);
@@ -322,21 +610,29 @@ static int map_main(int argc, char **argv)
     printf("image        %u x %u cells at %g m = %.2f x %.2f m, origin (%g, %g)\n", m.w, m.h, m.res,
            m.w * m.res, m.h * m.res, m.origin_x, m.origin_y);
     printf("image cells  free %u, occupied %u, unknown %u\n", nf, no, nu);
+    printf("reading      %s, mode %s, negate %d", m.format,
+           m.mode == LX_MAP_SCALE ? "scale" : m.mode == LX_MAP_RAW ? "raw" : "trinary", m.negate);
+    if (m.mode != LX_MAP_TRINARY) {
+        printf(": %u cells of value 1..99, read as free", m.n_partial);
+    }
+    printf("\n");
     printf("core grid    %u x %u cells at %g m (Q16 %.7f m)\n", cm->w, cm->h, res, cm->res / 65536.0);
     printf("core cells   free %u, wall %u, legal %u (clearance %g m)\n", cfree, cwall, clegal,
-           clearance);
+           o.clearance);
     printf("legal share  %.1f %% of the core cells, %.1f %% of the free ones\n",
            100.0 * clegal / cells, cfree ? 100.0 * clegal / cfree : 0.0);
     printf("core bytes   %u per bit grid: free + legal %u, with wall %u\n", grid_bytes,
            2 * grid_bytes, 3 * grid_bytes);
-    printf("lattice      %u x %u points at %g m, %u legal (%.1f %%)\n", cm->lw, cm->lh, grid, lattice
+    printf("lattice      %u x %u points at %g m, %u legal (%.1f %%)\n", cm->lw, cm->lh, o.grid, lattice
            ? llegal : 0, lattice ? 100.0 * llegal / lattice : 0.0);
     printf("planner      %u bytes work (1 per lattice point) + queue\n", lattice);
-    if (bench > 0) {
-        run_bench(&c, bench);
+    if (o.bench > 0) {
+        run_bench(&c, o.bench);
     }
-    int rc = 0;
-    if (pgm != NULL && write_pgm(pgm, &c) != 0) {
+    int rc = o.mcu ? report_mcu(&m, res) : 0;
+    const png_job_t pj = {&m, &c};
+    if ((o.pgm != NULL && write_atomic(o.pgm, pgm_body, &c) != 0) ||
+        (o.png != NULL && write_atomic(o.png, png_body, &pj) != 0) || (o.crop != NULL && write_crop(&m, &o) != 0)) {
         rc = 1;
     }
     lx_core_map_free(&c);

@@ -19,6 +19,10 @@
  *   --drop-pose T0:T1, --drop-rssi T0:T1   only the poses / only the RSSI frames stop
  *   --bus-off T0:T1 the controller's CAN is bus-off in [T0, T1): its frames do not leave
  *   --reset T       a watchdog reset at T: the application starts from scratch
+ *
+ * --candump FILE also writes the bus as candump -L would log it on can0 (docs/CAN.md, "CAN
+ * logs"): each input frame at its receive time and the controller's WHEEL_CMD and STATUS
+ * at each step (none while bus-off), in simulated microseconds from the start (1970-01-01).
  */
 #include <errno.h>
 #include <getopt.h>
@@ -28,6 +32,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "lx_candump.h"
 #include "lx_err.h"
 #include "hs_scenario.h"
 #include "hs_sim.h"
@@ -46,6 +51,7 @@ typedef struct window {
 typedef struct recorder {
     FILE *in;                   /* the recorded input stream */
     FILE *out;                  /* the live output stream, or NULL */
+    lx_candump_t *dump;         /* --candump: the bus as a candump -L log, or NULL */
     const char *in_path;
     int write_failed;           /* a write to `in` failed */
     int live_failed;            /* a write to `out` failed */
@@ -91,11 +97,36 @@ static void feed(recorder_t *r, const rfs_replay_rec_t *rec)
     }
 }
 
+/* feed() as an rfs_replay_rec_fn (it exits on a player error). */
+static bool feed_rec(void *ctx, const rfs_replay_rec_t *rec)
+{
+    feed(ctx, rec);
+    return true;
+}
+
+/* The player's output: to the live stream, and its CAN_TX records (the controller's
+ * frames on the bus) to the candump log. */
 static void sink(void *ctx, const uint8_t *p, uint32_t n)
 {
     recorder_t *r = ctx;
     if (r->out != NULL && fwrite(p, 1, n, r->out) != n) {
         r->live_failed = 1;
+    }
+    if (n == RFS_REPLAY_HEADER_LEN && rfs_replay_check_header(p, n) == 0) {
+        return; /* the stream's header, written once at the start */
+    }
+    rfs_replay_rec_t rec;
+    uint32_t used = 0;
+    for (uint32_t at = 0; r->dump != NULL && at < n; at += used) {
+        if (rfs_replay_parse(p + at, n - at, &used, &rec) != RFS_REPLAY_OK) {
+            r->write_failed = 1; /* the player writes whole records: cannot happen */
+            return;
+        }
+        if (rec.type == RFS_REPLAY_CAN_TX) {
+            rfs_can_frame_t f = {rec.u.can.id, rec.u.can.dlc, {0}};
+            memcpy(f.data, rec.u.can.data, 8);
+            lx_candump_write(r->dump, rec.t_us, &f);
+        }
     }
 }
 
@@ -118,6 +149,9 @@ static void feed_can(recorder_t *r, int64_t t_us, const rfs_can_frame_t *f)
     rec.u.can.id = f->id;
     rec.u.can.dlc = f->dlc;
     memcpy(rec.u.can.data, f->data, 8);
+    if (r->dump != NULL) {
+        lx_candump_write(r->dump, t_us, f);
+    }
     feed(r, &rec);
 }
 
@@ -233,6 +267,7 @@ static void usage(FILE *f)
             "and record its input stream (CAN frames, control steps, injected faults).\n"
             "  -o, --out FILE       recorded input stream (required)\n"
             "  --live-out FILE      also write the live output stream\n"
+            "  --candump FILE       also write the bus as a candump -L log (interface can0)\n"
             "  --seed N             run seed (default: the scenario's)\n"
             "  --max-time S         stop after S simulated seconds (default: the scenario's)\n"
             "  --drop T0:T1         no pose/RSSI frames reach the controller in [T0, T1) s\n"
@@ -261,6 +296,7 @@ static void die_opt(const char *opt, const char *val)
 /* The command line (the fault windows and the heartbeat mode go to the recorder). */
 typedef struct options {
     const char *out_path, *live_path;
+    const char *candump_path; /* --candump, or NULL */
     const char *scn_path;
     bool have_seed;
     unsigned long long seed;
@@ -298,6 +334,7 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
     switch (c) {
     case 'o': o->out_path = optarg; break;
     case 'l': o->live_path = optarg; break;
+    case 'c': o->candump_path = optarg; break;
     case 's':
         errno = 0;
         o->seed = strtoull(optarg, &end, 0);
@@ -378,7 +415,7 @@ static int parse_options(int argc, char **argv, options_t *o, recorder_t *rec)
         {"reset", required_argument, 0, 'r'},   {"help", no_argument, 0, 'h'},
         {"drop-pose", required_argument, 0, 'P'}, {"drop-rssi", required_argument, 0, 'R'},
         {"fit-budget", required_argument, 0, 'f'}, {"model", required_argument, 0, 'm'},
-        {"heartbeat", required_argument, 0, 'H'},
+        {"heartbeat", required_argument, 0, 'H'},  {"candump", required_argument, 0, 'c'},
         {0, 0, 0, 0}};
     memset(o, 0, sizeof *o);
     o->max_time = -1;
@@ -411,6 +448,13 @@ static int parse_options(int argc, char **argv, options_t *o, recorder_t *rec)
     if (o->live_path != NULL && (lx_err_same_file(PROG, o->scn_path, o->live_path) != 0 ||
                                  lx_err_check_dest(PROG, o->live_path) != 0 ||
                                  lx_err_same_dest(PROG, o->out_path, o->live_path) != 0)) {
+        return 1;
+    }
+    if (o->candump_path != NULL &&
+        (lx_err_same_file(PROG, o->scn_path, o->candump_path) != 0 ||
+         lx_err_check_dest(PROG, o->candump_path) != 0 ||
+         lx_err_same_dest(PROG, o->out_path, o->candump_path) != 0 ||
+         (o->live_path != NULL && lx_err_same_dest(PROG, o->live_path, o->candump_path) != 0))) {
         return 1;
     }
     return RUN;
@@ -467,6 +511,18 @@ static int open_outputs(recording_t *s, const options_t *o)
         remove(s->tmp_in);
         return 1;
     }
+    char err[512];
+    if (o->candump_path != NULL &&
+        (rec->dump = lx_candump_open(o->candump_path, LX_CANDUMP_DEFAULT_IF, err, sizeof err)) == NULL) {
+        lx_err_print(PROG, "%s", err);
+        fclose(rec->in);
+        remove(s->tmp_in);
+        if (rec->out != NULL) {
+            fclose(rec->out);
+            remove(s->tmp_out);
+        }
+        return 1;
+    }
     rec->in_path = o->out_path;
     return 0;
 }
@@ -514,30 +570,9 @@ static void record_config(recording_t *s, const options_t *o, uint64_t run_seed)
         memcpy(r.u.cfg.model, o->model_name, n < RFS_REPLAY_MODEL_NAME_MAX ? n : RFS_REPLAY_MODEL_NAME_MAX);
     }
     feed(rec, &r);
-    memset(&r, 0, sizeof r);
-    r.type = RFS_REPLAY_MAP;
-    r.u.map.w = m->w;
-    r.u.map.h = m->h;
-    r.u.map.res = m->res;
-    r.u.map.origin_x = m->origin_x;
-    r.u.map.origin_y = m->origin_y;
-    r.u.map.has_wall = s->env.core.wall_bits != NULL ? 1u : 0u;
-    feed(rec, &r);
-    const uint32_t bytes = rfs_map_bytes(m->w, m->h);
-    for (int g = 0; g < 2; g++) {
-        const uint8_t *bits = g == 0 ? s->env.core.free_bits : s->env.core.wall_bits;
-        if (bits == NULL) {
-            continue;
-        }
-        for (uint32_t off = 0; off < bytes; off += RFS_REPLAY_CHUNK) {
-            memset(&r, 0, sizeof r);
-            r.type = g == 0 ? RFS_REPLAY_MAP_FREE : RFS_REPLAY_MAP_WALL;
-            r.u.chunk.offset = off;
-            r.u.chunk.n = (uint8_t)(bytes - off < RFS_REPLAY_CHUNK ? bytes - off : RFS_REPLAY_CHUNK);
-            memcpy(r.u.chunk.bytes, bits + off, r.u.chunk.n);
-            feed(rec, &r);
-        }
-    }
+    const rfs_app_map_t am = {m->w, m->h, m->res, m->origin_x, m->origin_y, s->env.core.free_bits,
+                              s->env.core.wall_bits};
+    (void)rfs_replay_map_records(&am, feed_rec, rec);
 }
 
 /* The mission with the recorder as the controller, the END record, and the outputs
@@ -563,7 +598,18 @@ static int run_mission(recording_t *s, const options_t *o, uint64_t run_seed)
     put(rec, &r);
     const bool in_failed = fclose(rec->in) != 0 || rec->write_failed;
     const bool out_failed = (rec->out != NULL && fclose(rec->out) != 0) || rec->live_failed;
-    if (rc != 0 || in_failed || out_failed) {
+    const bool ok = rc == 0 && !in_failed && !out_failed;
+    char derr[512];
+    if (ok && lx_candump_close(rec->dump, true, derr, sizeof derr) != 0) {
+        lx_err_print(PROG, "%s", derr);
+        remove(s->tmp_in);
+        if (o->live_path != NULL) {
+            remove(s->tmp_out);
+        }
+        return 1;
+    }
+    if (!ok) {
+        (void)lx_candump_close(rec->dump, false, NULL, 0);
         lx_err_print(PROG, "%s: %s", rc != 0 ? o->scn_path : in_failed ? o->out_path : o->live_path,
                      rc != 0 ? err : "write failed");
         remove(s->tmp_in);

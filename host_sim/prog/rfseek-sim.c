@@ -34,8 +34,9 @@ static void usage(FILE *f)
             "Run the seeker (core in-process) in the simulated world of SCENARIO (YAML).\n"
             "\n"
             "  --seed N        run seed (default: the scenario's seed)\n"
-            "  --out DIR       write log.tsv, track.tsv, summary.json (and samples.tsv) to DIR;\n"
-            "                  without it a single run prints summary.json on stdout; with\n"
+            "  --out DIR       write log.tsv, track.tsv, summary.json (and samples.tsv) to DIR\n"
+            "                  (a single run prints one line: how it ended); without it a\n"
+            "                  single run prints summary.json on stdout; with\n"
             "                  --model pathloss also residual.tsv (the fit's residual surface)\n"
             "  --samples       also write every received packet to DIR/samples.tsv\n"
             "                  (always written for a single run with --out)\n"
@@ -59,6 +60,9 @@ static void usage(FILE *f)
             "  --p0-min DBM    pathloss only: floor on the fitted signal at 1 m, overriding\n"
             "                  the scenario's seek.p0_min_dbm (default -45; the node's EIRP\n"
             "                  - 52 when its power is known: docs/PATHLOSS.md)\n"
+            "  --start X,Y[,THETA]  start here (metres, radians), overriding the scenario's\n"
+            "  --source X,Y    put the first source here (and the goal, unless the scenario\n"
+            "                  names one); both must be legal places on the map\n"
             "  --no-faults     ignore the scenario's fault schedule (docs/FAULTS.md)\n"
             "  --quiet         no progress bar\n"
             "  --bench         with --seeds: run them one after another in this process without\n"
@@ -474,9 +478,10 @@ static void batch_state_header(char *buf, size_t n, const char *scenario, const 
 {
     char abs[PATH_MAX];
     snprintf(buf, n, "# rfseek-sim batch\tscenario=%s\tseeds=%llu..%llu\tstrategy=%s\tmodel=%s"
-             "\tfaults=%u\tp0_min=%.17g\tsamples=%d\n",
+             "\tfaults=%u\tp0_min=%.17g\tsamples=%d\tstart=%.17g,%.17g,%.17g\tsource=%.17g,%.17g\n",
              realpath(scenario, abs) ? abs : scenario, (unsigned long long)a, (unsigned long long)b,
-             sc->strategy, sc->model, sc->faults.n, sc->seek_p0_min_dbm, samples ? 1 : 0);
+             sc->strategy, sc->model, sc->faults.n, sc->seek_p0_min_dbm, samples ? 1 : 0,
+             sc->start_x, sc->start_y, sc->start_theta, sc->src[0].x, sc->src[0].y);
 }
 
 /* dir/name into buf: true, or false when it does not fit. */
@@ -673,6 +678,7 @@ typedef struct sim_opts {
     uint64_t seed;
     bool has_seed, samples, field, emit, quiet, bench, no_faults, resume;
     double p0_min;                /* --p0-min: NAN keeps the scenario's (or the model's default) */
+    const char *start, *source;   /* --start X,Y[,THETA], --source X,Y: placement overrides */
     long jobs;
     uint64_t sa, sb;              /* --seeds A..B */
     char from[PATH_MAX + 64];     /* --resume: the interrupted batch's directory */
@@ -737,6 +743,11 @@ static int parse_options(int argc, char **argv, sim_opts_t *o)
                            more ? argv[i + 1] : "", "");
             }
             i++;
+        } else if (strcmp(a, "--start") == 0 || strcmp(a, "--source") == 0) {
+            if (!more) {
+                return die("%s: expected X,Y%s", a, a[3] == 't' ? "[,THETA] in metres, radians" : " in metres");
+            }
+            *(a[3] == 't' ? &o->start : &o->source) = argv[++i];
         } else if (strcmp(a, "--no-faults") == 0) {
             o->no_faults = true;
         } else if (strcmp(a, "--resume") == 0) {
@@ -863,6 +874,58 @@ static int check_options(sim_opts_t *o)
 }
 
 /* The scenario with the options' overrides: RUN, or the exit status after a message. */
+/* "X,Y" or, with theta, "X,Y[,THETA]" into v[0..2]: the count read (2 or 3), 0 when the
+ * text is not that (numbers finite, within +-1e6 m and +-7 rad). */
+static int parse_xy(const char *t, bool theta, double v[3])
+{
+    int n = 0;
+    while (n < 3) {
+        char *end;
+        errno = 0;
+        v[n] = strtod(t, &end);
+        if (end == t || errno != 0 || !isfinite(v[n]) || fabs(v[n]) > (n == 2 ? 7.0 : 1e6)) {
+            return 0;
+        }
+        n++;
+        if (*end == '\0') {
+            break;
+        }
+        if (*end != ',') {
+            return 0;
+        }
+        t = end + 1;
+    }
+    return (n == 2 || (theta && n == 3)) && (n < 3 || strchr(t, ',') == NULL) ? n : 0;
+}
+
+/* --start and --source into the scenario (the goal follows the first source unless the
+ * scenario names one); legality is checked when the environment opens. RUN or 1. */
+static int placement(const sim_opts_t *o, hs_scenario_t *sc)
+{
+    double v[3];
+    int n;
+    if (o->start) {
+        if ((n = parse_xy(o->start, true, v)) == 0) {
+            return die("--start: expected X,Y[,THETA] (metres, radians), got '%s'%s", o->start, "");
+        }
+        sc->start_x = v[0];
+        sc->start_y = v[1];
+        sc->start_theta = n == 3 ? v[2] : sc->start_theta;
+    }
+    if (o->source) {
+        if (parse_xy(o->source, false, v) != 2) {
+            return die("--source: expected X,Y (metres), got '%s'%s", o->source, "");
+        }
+        sc->src[0].x = v[0];
+        sc->src[0].y = v[1];
+        if (!sc->has_goal) {
+            sc->goal_x = v[0];
+            sc->goal_y = v[1];
+        }
+    }
+    return RUN;
+}
+
 static int load_scenario(const sim_opts_t *o, hs_scenario_t *sc)
 {
     char err[1024];
@@ -894,7 +957,7 @@ static int load_scenario(const sim_opts_t *o, hs_scenario_t *sc)
         }
         sc->seek_p0_min_dbm = o->p0_min;
     }
-    return RUN;
+    return placement(o, sc);
 }
 
 /* --emit-jobs: the same runs, one command per seed; scripts/merge_runs.py DIR merges
@@ -913,9 +976,11 @@ static int emit_jobs(const sim_opts_t *o, const hs_scenario_t *sc)
         if (!isnan(o->p0_min)) {
             snprintf(p0, sizeof p0, " --p0-min %.17g", o->p0_min);
         }
-        printf("%s %s --seed %llu --out %s/seed-%llu --strategy %s --model %s%s%s\n", self,
+        printf("%s %s --seed %llu --out %s/seed-%llu --strategy %s --model %s%s%s", self,
                scn, (unsigned long long)s, o->out, (unsigned long long)s, sc->strategy, sc->model,
                o->no_faults ? " --no-faults" : "", p0);
+        printf("%s%s%s%s\n", o->start ? " --start " : "", o->start ? o->start : "",
+               o->source ? " --source " : "", o->source ? o->source : "");
     }
     return 0;
 }
@@ -924,6 +989,8 @@ static int emit_jobs(const sim_opts_t *o, const hs_scenario_t *sc)
  * place when complete: the exit status. */
 static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
 {
+    hs_sim_result_t res;
+    memset(&res, 0, sizeof res);
     char err[1024];
     hs_sim_env_t env;
     if (hs_sim_env_open(&env, sc, err, sizeof err) != 0) {
@@ -960,7 +1027,6 @@ static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
         rc = run_batch(&env, header, o->sa, o->sb, (int)o->jobs, o->out ? tmp : NULL, o->samples,
                        o->quiet, o->resume);
     } else {
-        hs_sim_result_t res;
         char msg[1024];
         rc = run_one(&env, o->has_seed ? o->seed : sc->seed, o->out ? tmp : NULL, o->out != NULL,
                      o->field, o->pcap, &res, msg, sizeof msg);
@@ -980,6 +1046,13 @@ static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
         } else if (rc != 0) {
             rm_tree(tmp);
         }
+    }
+    if (rc == 0 && o->out && !o->seeds) {
+        // A single run into DIR: one line to say how it went (summary.json has the rest).
+        printf("seed %llu: %s after %.1f s and %.1f m (shortest path %.1f m), %u decisions, "
+               "%.1f m from the goal; %s/summary.json\n", (unsigned long long)res.seed,
+               res.end, res.sim_time_s, res.distance_travelled_m, res.shortest_path_m,
+               res.iterations, res.final_distance_m, o->out);
     }
     return rc;
 }

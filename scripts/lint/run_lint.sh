@@ -32,7 +32,7 @@ size_of() {
 flags_of() {
     case $1 in
         common/*) echo "-std=c11 -ffreestanding -Icommon" ;;
-        firmware/port/linux/*) echo "-std=c11 -D_DEFAULT_SOURCE -Icommon -Ifirmware -Ifirmware/port/linux -I$build/gen $(pkg-config --cflags yaml-0.1 2>/dev/null)" ;;
+        firmware/port/linux/*) echo "-std=c11 -D_DEFAULT_SOURCE -Icommon -Ifirmware -Ifirmware/port/linux -I$build/gen $(pkg-config --cflags yaml-0.1 libpng 2>/dev/null)" ;;
         firmware/port/*) echo "-std=c11 -ffreestanding --target=arm-none-eabi -mcpu=cortex-m4 -mthumb -mfloat-abi=soft -isystem /usr/lib/arm-none-eabi/include -Icommon -Ifirmware -Ifirmware/port/stm32f4 -Ifirmware/port/qemu" ;;
         firmware/*) echo "-std=c11 -Icommon -Ifirmware" ;;
         *.cpp) echo "-std=c++17 -Icommon -Ifirmware -Ifirmware/port/linux -Ihost_sim" ;;

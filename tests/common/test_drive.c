@@ -2,7 +2,9 @@
  * here: v = (l + r) / 2, omega = (r - l) / b, 1 ms Euler sub-steps, control at 50 Hz.
  * Checks: goals are reached (within goal_tol, wheels stopped), wheel speeds never exceed
  * v_max, no wheel changes faster than accel * dt, intermediate waypoints are passed,
- * timeouts and blocked robots are reported once.
+ * timeouts and blocked robots are reported once; with localisation noise (Gaussian, at
+ * 10 Hz, drawn here) the robot still stays near the polyline without dithering, and the
+ * pose filter's error matches the first-order filter's theory.
  */
 #include "rfs_test.h"
 
@@ -25,7 +27,26 @@ typedef struct sim {
     double x0, y0;        /* where the path started */
     double max_off_x, max_off_y; /* where the robot was furthest off */
     int64_t t;
+    /* Localisation noise: a pose every pose_us with Gaussian errors (0: exact poses). */
+    double sigma_xy, sigma_th;
+    int64_t pose_us;
+    rfs_pose_t meas;      /* the last pose published */
+    uint64_t rng;
+    double turn_s;        /* time turning on the spot (|v| < 20 mm/s, |omega| > 0.05 rad/s) */
 } sim_t;
+
+/* Standard normal draw (xorshift64 + Box-Muller), reproducible. */
+static double gauss(sim_t *s)
+{
+    double u[2];
+    for (int i = 0; i < 2; i++) {
+        s->rng ^= s->rng << 13;
+        s->rng ^= s->rng >> 7;
+        s->rng ^= s->rng << 17;
+        u[i] = ((s->rng >> 11) + 0.5) / 9007199254740992.0;
+    }
+    return sqrt(-2.0 * log(u[0])) * cos(2.0 * M_PI * u[1]);
+}
 
 static double seg_dist(double px, double py, double ax, double ay, double bx, double by)
 {
@@ -64,6 +85,22 @@ static rfs_pose_t pose_of(const sim_t *s)
     return p;
 }
 
+/* The pose the drive sees at s->t: exact, or the last noisy pose published. */
+static rfs_pose_t observed(sim_t *s)
+{
+    if (s->pose_us == 0) {
+        return pose_of(s);
+    }
+    if (s->t % s->pose_us == 0) {
+        double th = s->th + s->sigma_th * gauss(s);
+        s->meas.t_us = s->t;
+        s->meas.x = q16(s->x + s->sigma_xy * gauss(s));
+        s->meas.y = q16(s->y + s->sigma_xy * gauss(s));
+        s->meas.theta = q16(atan2(sin(th), cos(th)));
+    }
+    return s->meas;
+}
+
 /* Run until the drive reports an end or max_s elapses; frozen: the robot does not move. */
 static rfs_drive_status_t run(rfs_drive_t *d, sim_t *s, const rfs_path_t *path, double max_s,
                               bool frozen, int64_t *end_us)
@@ -76,7 +113,7 @@ static rfs_drive_status_t run(rfs_drive_t *d, sim_t *s, const rfs_path_t *path, 
     s->y0 = s->y;
     s->max_off_path = 0;
     while (s->t < (int64_t)(max_s * 1e6)) {
-        rfs_pose_t p = pose_of(s);
+        rfs_pose_t p = observed(s);
         int16_t l;
         int16_t r;
         rfs_drive_status_t st = rfs_drive_update(d, &p, s->t, &l, &r);
@@ -89,6 +126,9 @@ static rfs_drive_status_t run(rfs_drive_t *d, sim_t *s, const rfs_path_t *path, 
         }
         s->l = l;
         s->r = r;
+        if (abs(l + r) < 40 && abs(r - l) * 1e-3 / b > 0.05) {
+            s->turn_s += DT_US * 1e-6;
+        }
         if (st != RFS_DRIVE_RUNNING) {
             *end_us = s->t;
             return st;
@@ -230,8 +270,40 @@ static void test_follows_waypoints(void **state)
     assert_int_equal(s.violations_accel, 0);
 }
 
-/* Random polylines of five waypoints with turns up to 150 degrees: all reached, the
- * robot never more than 0.07 m off the polyline. */
+/* A random polyline of five waypoints from the origin, legs 0.3-3.3 m, turns up to 150
+ * degrees; the start heading in *th0. */
+static rfs_path_t random_polyline(double *th0)
+{
+    *th0 = (rand() / (double)RAND_MAX) * 6.283 - 3.1416;
+    rfs_path_t p;
+    memset(&p, 0, sizeof(p));
+    double x = 0, y = 0, h = (rand() / (double)RAND_MAX) * 6.283;
+    for (int w = 0; w < 5; w++) {
+        double len = 0.3 + (rand() / (double)RAND_MAX) * 3.0;
+        x += len * cos(h);
+        y += len * sin(h);
+        p.x[w] = q16(x);
+        p.y[w] = q16(y);
+        p.length += q16(len);
+        h += ((rand() / (double)RAND_MAX) * 2.0 - 1.0) * 2.6;
+    }
+    p.n = 5;
+    return p;
+}
+
+/* The robot standing for us microseconds with the drive idle (its pose filter settles,
+ * as it does before a mission's first goal). */
+static void settle(rfs_drive_t *d, sim_t *s, int64_t us)
+{
+    int64_t until = s->t + us;
+    for (; s->t < until; s->t += DT_US) {
+        rfs_pose_t p = observed(s);
+        int16_t l, r;
+        (void)rfs_drive_update(d, &p, s->t, &l, &r);
+    }
+}
+
+/* Random polylines: all reached, the robot never more than 0.07 m off the polyline. */
 static void test_random_polylines(void **state)
 {
     (void)state;
@@ -241,35 +313,164 @@ static void test_random_polylines(void **state)
     srand(11);
     double worst = 0;
     for (int k = 0; k < 20; k++) {
-        start(&d, &s, 0.0, 0.0, (rand() / (double)RAND_MAX) * 6.283 - 3.1416);
-        rfs_path_t p;
-        memset(&p, 0, sizeof(p));
-        double x = 0, y = 0, h = (rand() / (double)RAND_MAX) * 6.283;
-        for (int w = 0; w < 5; w++) {
-            double len = 0.3 + (rand() / (double)RAND_MAX) * 3.0;
-            x += len * cos(h);
-            y += len * sin(h);
-            p.x[w] = q16(x);
-            p.y[w] = q16(y);
-            h += ((rand() / (double)RAND_MAX) * 2.0 - 1.0) * 2.6;
-        }
-        p.n = 5;
+        double th0;
+        rfs_path_t p = random_polyline(&th0);
+        start(&d, &s, 0.0, 0.0, th0);
         rfs_drive_set_path(&d, &p, 0);
         assert_int_equal(run(&d, &s, &p, 120.0, false, &end), RFS_DRIVE_REACHED);
-        assert_true(hypot(s.x - x, s.y - y) <= 0.1 + 1e-3);
+        double gx = p.x[4] / 65536.0, gy = p.y[4] / 65536.0;
+        assert_true(hypot(s.x - gx, s.y - gy) <= 0.1 + 1e-3);
         assert_int_equal(s.violations_speed, 0);
         assert_int_equal(s.violations_accel, 0);
         worst = fmax(worst, s.max_off_path);
         if (getenv("DRIVE_DEBUG")) {
             print_message("path %d: off %.3f at (%.2f, %.2f), end (%.2f, %.2f)\n", k, s.max_off_path,
-                          s.max_off_x, s.max_off_y, x, y);
-            for (int w = 0; w < p.n; w++) {
-                print_message("   wp (%.2f, %.2f)\n", p.x[w] / 65536.0, p.y[w] / 65536.0);
-            }
+                          s.max_off_x, s.max_off_y, gx, gy);
         }
     }
     print_message("worst distance off the polyline %.3f m\n", worst);
     assert_true(worst < 0.07);
+}
+
+/* The same polylines with the simulator's default localisation noise (5 cm per axis,
+ * 0.02 rad, 10 Hz) and with twice that: every goal reached (none abandoned), the true
+ * robot within clearance - radius (0.25 - 0.177 m) of the polyline at 5 cm, and no more
+ * turning on the spot than with exact poses (no dithering at the waypoints). */
+static void test_noisy_polylines(void **state)
+{
+    (void)state;
+    const double sig[2] = {0.05, 0.10};
+    for (int n = 0; n < 2; n++) {
+        rfs_drive_t d;
+        sim_t s;
+        int64_t end;
+        double worst = 0, worst_end = 0, turn_exact = 0, turn_noisy = 0;
+        srand(11);
+        for (int k = 0; k < 20; k++) {
+            double th0;
+            rfs_path_t p = random_polyline(&th0);
+            double gx = p.x[4] / 65536.0, gy = p.y[4] / 65536.0;
+            start(&d, &s, 0.0, 0.0, th0);
+            rfs_drive_set_path(&d, &p, 0);
+            assert_int_equal(run(&d, &s, &p, 120.0, false, &end), RFS_DRIVE_REACHED);
+            turn_exact += s.turn_s;
+            start(&d, &s, 0.0, 0.0, th0);
+            s.sigma_xy = sig[n];
+            s.sigma_th = 0.02;
+            s.pose_us = 100000;
+            s.rng = 0x9E3779B97F4A7C15ull + (uint64_t)k;
+            settle(&d, &s, 2000000);
+            rfs_drive_set_path(&d, &p, s.t);
+            assert_int_equal(run(&d, &s, &p, 120.0, false, &end), RFS_DRIVE_REACHED);
+            assert_int_equal(s.violations_speed, 0);
+            assert_int_equal(s.violations_accel, 0);
+            turn_noisy += s.turn_s;
+            worst = fmax(worst, s.max_off_path);
+            worst_end = fmax(worst_end, hypot(s.x - gx, s.y - gy));
+        }
+        print_message("noise %.2f m: worst off the polyline %.3f m, worst end %.3f m, turning "
+                      "%.1f s (exact poses %.1f s)\n", sig[n], worst, worst_end, turn_noisy,
+                      turn_exact);
+        if (n == 0) {
+            assert_true(worst < 0.25 - 0.177);
+        }
+        /* REACHED is judged on the estimate, whose error is sigma sqrt(k / (2 - k)). */
+        double k = d.cfg.pose_gain / 65536.0;
+        assert_true(worst_end <= 0.1 + 3.0 * sig[n] * sqrt(k / (2.0 - k)));
+        assert_true(turn_noisy <= 1.2 * turn_exact + 1.0);
+    }
+}
+
+/* The pose filter on a robot standing still with noisy poses: its error's standard
+ * deviation is sigma sqrt(k / (2 - k)) for gain k, the first-order filter's theory
+ * (e_n = (1 - k) e_n-1 + k w_n), within 15 %; a pose 1 m away replaces the estimate. */
+static void test_pose_filter(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    start(&d, &s, 1.0, 2.0, 0.5);
+    s.sigma_xy = 0.05;
+    s.sigma_th = 0.02;
+    s.pose_us = 100000;
+    s.rng = 12345;
+    double sx = 0, sth = 0;
+    long n = 0;
+    for (s.t = 0; s.t < 400000000; s.t += DT_US) {
+        rfs_pose_t p = observed(&s);
+        int16_t l, r;
+        assert_int_equal(rfs_drive_update(&d, &p, s.t, &l, &r), RFS_DRIVE_IDLE);
+        rfs_pose_t e;
+        assert_true(rfs_drive_estimate(&d, &e));
+        if (s.t >= 5000000 && s.t % s.pose_us == 0) {
+            sx += pow(e.x / 65536.0 - 1.0, 2) + pow(e.y / 65536.0 - 2.0, 2);
+            sth += pow(e.theta / 65536.0 - 0.5, 2);
+            n++;
+        }
+    }
+    double k = d.cfg.pose_gain / 65536.0, f = sqrt(k / (2.0 - k));
+    double rx = sqrt(sx / (2.0 * n)), rth = sqrt(sth / n);
+    print_message("filter: %.4f m (theory %.4f), %.4f rad (theory %.4f)\n", rx, 0.05 * f, rth,
+                  0.02 * f);
+    assert_true(fabs(rx / (0.05 * f) - 1.0) < 0.15);
+    assert_true(fabs(rth / (0.02 * f) - 1.0) < 0.15);
+    /* Relocalised 1 m away: the next update steers by the new pose. */
+    rfs_pose_t far = {s.t, q16(2.0), q16(2.0), q16(0.5)};
+    int16_t l, r;
+    (void)rfs_drive_update(&d, &far, s.t, &l, &r);
+    rfs_pose_t e;
+    (void)rfs_drive_estimate(&d, &e);
+    assert_int_equal(e.x, far.x);
+    assert_int_equal(e.y, far.y);
+}
+
+/* Exact poses at 10 Hz while driving: between poses the estimate is dead-reckoned from the
+ * commanded wheel speeds and stays within 2 mm of the truth. */
+static void test_dead_reckoning(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    int64_t end;
+    srand(5);
+    double th0;
+    rfs_path_t p = random_polyline(&th0);
+    start(&d, &s, 0.0, 0.0, th0);
+    s.pose_us = 100000;
+    rfs_drive_set_path(&d, &p, 0);
+    double worst = 0;
+    while (s.t < 60000000) {
+        double x = s.x, y = s.y; /* where the robot is at the update */
+        rfs_drive_status_t st = run(&d, &s, &p, (s.t + DT_US) / 1e6, false, &end);
+        rfs_pose_t e;
+        (void)rfs_drive_estimate(&d, &e);
+        worst = fmax(worst, hypot(e.x / 65536.0 - x, e.y / 65536.0 - y));
+        if (st != RFS_DRIVE_RUNNING) {
+            break;
+        }
+    }
+    print_message("dead reckoning: worst %.4f m\n", worst);
+    assert_true(worst < 0.002);
+}
+
+/* The time limit grows with the path: a 10 m path at a 2 s timeout is driven to the end
+ * (2 s + 10 m at half the top speed = 30.6 s). */
+static void test_time_limit_grows(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    int64_t end;
+    rfs_drive_cfg_t cfg = rfs_drive_cfg_default();
+    cfg.timeout_us = 2000000;
+    assert_int_equal(rfs_drive_init(&d, &cfg), 0);
+    memset(&s, 0, sizeof(s));
+    rfs_path_t p = one_goal(10.0, 0.0);
+    p.length = q16(10.0);
+    rfs_drive_set_path(&d, &p, 0);
+    assert_int_equal(d.limit_us, 2000000 + 10000 * 2000000LL / 700);
+    assert_int_equal(run(&d, &s, &p, 60.0, false, &end), RFS_DRIVE_REACHED);
+    assert_true(end > 2000000 && end < d.limit_us);
 }
 
 /* A path planned straight into the drive's own path buffer (no stack copy) works. */
@@ -309,7 +510,8 @@ static void test_timeout(void **state)
     assert_true(l < s.l && l >= s.l - 21);
 }
 
-/* A robot that cannot move (against a wall): BLOCKED after the stall window. */
+/* A robot that cannot move (against a wall): BLOCKED after the stall window, with poses at
+ * 10 Hz as localisation publishes them. */
 static void test_blocked(void **state)
 {
     (void)state;
@@ -317,6 +519,7 @@ static void test_blocked(void **state)
     sim_t s;
     int64_t end;
     rfs_path_t p = start_to(&d, &s, 0.0, 5.0, 0.0);
+    s.pose_us = 100000; /* poses at 10 Hz: the estimate runs ahead, the judgement does not */
     assert_int_equal(run(&d, &s, &p, 60.0, true, &end), RFS_DRIVE_BLOCKED);
     assert_true(end >= d.cfg.stall_us && end <= d.cfg.stall_us + 2 * DT_US);
     /* Moving normally it is not blocked. */
@@ -342,6 +545,82 @@ static void test_stop(void **state)
     assert_int_equal(r, 0);
 }
 
+/* Timestamps at the ends of int64 (clock faults, replayed garbage): no undefined
+ * behaviour (this test also runs under UBSan), the estimate stays a pose it was given. */
+static void test_extreme_stamps(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    start(&d, &s, 1.0, 1.0, 0.0);
+    rfs_path_t p = one_goal(3.0, 1.0);
+    rfs_drive_set_path(&d, &p, INT64_MIN);
+    const int64_t ts[] = {INT64_MIN, INT64_MIN + 1, -1, 0, INT64_MAX - 1, INT64_MAX, 0};
+    for (unsigned i = 0; i < sizeof ts / sizeof ts[0]; i++) {
+        for (unsigned j = 0; j < sizeof ts / sizeof ts[0]; j++) {
+            rfs_pose_t pose = {ts[i], q16(1.0), q16(1.0), INT32_MAX}; /* heading unwrapped */
+            int16_t l, r;
+            (void)rfs_drive_update(&d, &pose, ts[j], &l, &r);
+            assert_true(abs(l) <= d.cfg.v_max_mm_s && abs(r) <= d.cfg.v_max_mm_s);
+            rfs_pose_t e;
+            assert_true(rfs_drive_estimate(&d, &e));
+            assert_true(e.theta > -RFS_Q16_PI && e.theta <= RFS_Q16_PI);
+            assert_true(llabs((long long)e.x - q16(1.0)) < q16(0.2));
+        }
+    }
+}
+
+/* After 3 s without poses, a pose 0.4 m from the estimate (within the 0.5 m reset radius)
+ * replaces it: the robot is where localisation says, not where it was. */
+static void test_pose_after_silence(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    start(&d, &s, 1.0, 1.0, 0.0);
+    rfs_pose_t p0 = {0, q16(1.0), q16(1.0), 0};
+    int16_t l, r;
+    for (int64_t t = 0; t <= 3100000; t += DT_US) {
+        (void)rfs_drive_update(&d, &p0, t, &l, &r);
+    }
+    rfs_pose_t p1 = {3100000, q16(1.4), q16(1.0), 0};
+    (void)rfs_drive_update(&d, &p1, 3100000, &l, &r);
+    rfs_pose_t e;
+    (void)rfs_drive_estimate(&d, &e);
+    assert_int_equal(e.x, p1.x);
+    assert_int_equal(e.y, p1.y);
+}
+
+/* Pushed 0.45 m sideways 0.2 m before the goal: the robot turns back to the goal and
+ * reaches it (no BLOCKED, no crawl past it); and a last leg of 2 cm after a 2 m one ends
+ * within goal_tol (the corner speed allows stopping within the last leg). */
+static void test_goal_after_push(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    int64_t end;
+    rfs_path_t p = start_to(&d, &s, 0.0, 3.0, 0.0);
+    s.pose_us = 100000;
+    assert_int_equal(run(&d, &s, &p, 2.0, false, &end), RFS_DRIVE_RUNNING);
+    while (s.x < 2.8) {
+        assert_int_equal(run(&d, &s, &p, (s.t + DT_US) / 1e6, false, &end), RFS_DRIVE_RUNNING);
+    }
+    s.y += 0.45;
+    assert_int_equal(run(&d, &s, &p, 60.0, false, &end), RFS_DRIVE_REACHED);
+    assert_true(hypot(s.x - 3.0, s.y) <= 0.1 + 0.01);
+
+    start(&d, &s, 0.0, 0.0, 0.0);
+    memset(&p, 0, sizeof p);
+    p.x[0] = q16(2.0);
+    p.x[1] = q16(2.02);
+    p.n = 2;
+    rfs_drive_set_path(&d, &p, 0);
+    assert_int_equal(run(&d, &s, &p, 60.0, false, &end), RFS_DRIVE_REACHED);
+    print_message("short last leg: ends %.3f m from the goal\n", hypot(s.x - 2.02, s.y));
+    assert_true(hypot(s.x - 2.02, s.y) <= 0.1 + 0.01);
+}
+
 static void test_init_rejects(void **state)
 {
     (void)state;
@@ -364,6 +643,18 @@ static void test_init_rejects(void **state)
     b = c;
     b.timeout_us = 0;
     assert_int_equal(rfs_drive_init(&d, &b), -1);
+    b = c;
+    b.turn_out = b.turn_in_place + 1;
+    assert_int_equal(rfs_drive_init(&d, &b), -1);
+    b = c;
+    b.lookahead = 0;
+    assert_int_equal(rfs_drive_init(&d, &b), -1);
+    b = c;
+    b.pose_gain = RFS_Q16_ONE + 1;
+    assert_int_equal(rfs_drive_init(&d, &b), -1);
+    b = c;
+    b.pose_gain = RFS_Q16_ONE; /* raw poses: allowed */
+    assert_int_equal(rfs_drive_init(&d, &b), 0);
     assert_int_equal(rfs_drive_init(&d, &c), 0);
     assert_int_equal(d.status, RFS_DRIVE_IDLE);
 }
@@ -374,6 +665,13 @@ int main(void)
         cmocka_unit_test(test_reaches_goals),
         cmocka_unit_test(test_follows_waypoints),
         cmocka_unit_test(test_random_polylines),
+        cmocka_unit_test(test_noisy_polylines),
+        cmocka_unit_test(test_pose_filter),
+        cmocka_unit_test(test_dead_reckoning),
+        cmocka_unit_test(test_time_limit_grows),
+        cmocka_unit_test(test_extreme_stamps),
+        cmocka_unit_test(test_pose_after_silence),
+        cmocka_unit_test(test_goal_after_push),
         cmocka_unit_test(test_set_path_in_place),
         cmocka_unit_test(test_timeout),
         cmocka_unit_test(test_blocked),

@@ -520,6 +520,39 @@ static void test_q16_dist(void **state)
     assert_int_equal(rfs_q16_dist(INT32_MIN, INT32_MIN, INT32_MAX, INT32_MAX), INT32_MAX);
 }
 
+/* CORDIC atan2 and sin/cos against libm: atan2 within 2^-13 rad over every direction and
+ * magnitudes from 1 to 2^40, sin/cos within 2^-14 over +-100 rad. */
+static void test_trig(void **state)
+{
+    (void)state;
+    double worst_a = 0.0, worst_sc = 0.0;
+    for (int k = 0; k < 20000; k++) {
+        double ang = -M_PI + 2.0 * M_PI * k / 20000.0 + 1e-7;
+        for (int e = 0; e <= 40; e += 8) {
+            double r = ldexp(1.0, e);
+            int64_t x = llround(r * cos(ang)), y = llround(r * sin(ang));
+            if (x == 0 && y == 0) {
+                continue;
+            }
+            double want = atan2((double)y, (double)x);
+            double got = rfs_q16_atan2(y, x) / 65536.0;
+            double err = fabs(remainder(got - want, 2.0 * M_PI));
+            worst_a = fmax(worst_a, err);
+        }
+        double a = -100.0 + 200.0 * k / 20000.0;
+        rfs_q16_t q = (rfs_q16_t)llround(a * 65536.0);
+        rfs_q16_t c, sn;
+        rfs_q16_sincos(q, &c, &sn);
+        double aq = q / 65536.0;
+        worst_sc = fmax(worst_sc, fmax(fabs(c / 65536.0 - cos(aq)), fabs(sn / 65536.0 - sin(aq))));
+    }
+    print_message("atan2 worst %.2e rad, sin/cos worst %.2e\n", worst_a, worst_sc);
+    assert_true(worst_a <= ldexp(1.0, -13));
+    assert_true(worst_sc <= ldexp(1.0, -14));
+    assert_int_equal(rfs_q16_atan2(0, 0), 0);
+    assert_int_equal(rfs_q16_atan2(0, -5), RFS_Q16_PI); /* (-pi, pi]: the negative x axis is +pi */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -529,6 +562,7 @@ int main(void)
         cmocka_unit_test(test_isqrt),
         cmocka_unit_test(test_q16_sqrt),
         cmocka_unit_test(test_q16_dist),
+        cmocka_unit_test(test_trig),
         cmocka_unit_test(test_exp_neg),
         cmocka_unit_test(test_log2_db10),
         cmocka_unit_test(test_i128),

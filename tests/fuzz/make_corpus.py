@@ -8,10 +8,14 @@ convention, docs/SIMULATOR.md, the LCM wire format), not by the code under test:
   can/       12-byte frame records (see fuzz_can.c): pose pairs, RSSI, wheel, status,
              receiver heartbeats
   map/       YAML + "#PGM\\n" + PGM: tests/data/maps_bad fixtures and small P2/P5 images
+  png/       a reading byte + a PNG (see fuzz_png.c): every colour type and depth, tRNS,
+             interlaced (tests/lib/pngenc.py, from the PNG specification)
   scenario/  the scenarios/*.yaml files and a few hand-written edge cases
   pcap/      classic pcap (us and ns magic, both byte orders) and pcapng (if_tsresol 6, 9,
              2^-20) radiotap captures, timestamps at the formats' edges (libpcap's formats)
   poses/     the pose CSV of rfseek-feed --pose (docs/FEEDER.md): good files and edge values
+  candump/   candump -L log lines (can-utils' format, docs/CAN.md "CAN logs"): our frames,
+             29-bit, remote, error and CAN FD frames, candump -x directions, padded names
   lcm/       one message per channel, the receiver heartbeat included (LCM encoding: 8-byte fingerprint, big-endian fields;
              fingerprints computed with lcm-gen's hash) and small LCM logs
 """
@@ -116,6 +120,29 @@ if os.path.isdir(bad):
                     img = open(os.path.join(bad, ref), "rb").read()
                 text = text.replace(ref.encode(), b"m.pgm")
         put("map", "bad_" + name[:-5], text + b"#PGM\n" + img)
+
+# A PNG in place of the PGM: map_server tells the two apart by content.
+sys.path.insert(0, os.path.join(ROOT, "tests", "lib"))
+import pngenc  # noqa: E402
+put("map", "png_scale", MAP_YAML.replace("free_thresh: 0.196", "free_thresh: 0.196\nmode: scale").encode() +
+    b"#PGM\n" + pngenc.encode([[(0, 255), (128, 255), (254, 0)], [(90, 255), (200, 128), (254, 255)]], 4, 8))
+
+# --- png: reading byte (mode = b % 3, negate = b / 3 % 2) + PNG ------------------------------
+def _px(w, h, n, top, k):
+    return [[tuple((x * 37 + y * 11 + c * 5 + k) % (top + 1) for c in range(n)) for x in range(w)] for y in range(h)]
+
+
+for ct, depth, trns, inter, b in ((0, 1, None, False, 0), (0, 2, None, True, 1), (0, 4, None, False, 2),
+                                  (0, 8, b"\x00\x80", False, 3), (0, 16, None, False, 4), (2, 8, None, False, 5),
+                                  (2, 16, b"\x00\x01\x00\x02\x00\x03", True, 0), (4, 8, None, False, 1),
+                                  (4, 16, None, False, 2), (6, 8, None, True, 3), (6, 16, None, False, 4)):
+    n = {0: 1, 2: 3, 4: 2, 6: 4}[ct]
+    put("png", f"ct{ct}_d{depth}{'_trns' if trns else ''}{'_i' if inter else ''}",
+        bytes([b]) + pngenc.encode(_px(5, 4, n, (1 << depth) - 1, b), ct, depth, None, trns, inter))
+for depth in (1, 2, 4, 8):
+    pal = [(i * 50 % 256, i * 90 % 256, i * 20 % 256) for i in range(min(1 << depth, 6))]
+    put("png", f"palette_d{depth}", bytes([depth % 6]) + pngenc.encode(
+        _px(6, 3, 1, len(pal) - 1, depth), 3, depth, pal, bytes([0, 255, 128][:len(pal)])))
 
 # --- scenario -----------------------------------------------------------------------------
 scn = os.path.join(ROOT, "scenarios")
@@ -235,3 +262,13 @@ put("poses", "crlf_blank", HDR.replace(b"\n", b"\r\n") + b"0,0,0,0\r\n\r\n1,1e-3
 put("poses", "theta_big", HDR + b"0,1,1,1e9\n1,1,1,-1e300\n2,1,1,201.0619298297468\n")
 put("poses", "t_edges", HDR + b"-9223372036854775808,0,0,0\n9007199254740992,0,0,0\n")
 put("poses", "xy_edges", HDR + b"0,32767,-32767,0\n1,32767.0001,0,0\n")
+
+# --- candump: candump -L lines (can-utils: "(%010ld.%06ld) %*s " + ID#HEX) --------------------
+put("candump", "mission", b"(0000004294.969796) can0 120#00A100C4090000BD\n"
+    b"(0000004295.017296) can0 100#011700E9FF73\n(0000004295.017296) can0 180#3005000000000046\n")
+put("candump", "kinds", b"(1700000000.000001) vcan0 12345678#DEADBEEF\n(1700000000.000002) vcan0 7FF#R\n"
+    b"(1700000000.000003) vcan0 123#R8\n(1700000000.000004) vcan0 20000004#0004000000000000\n"
+    b"(1700000000.000005) vcan0 123##1112233\n(1700000000.000006) vcan0 123#11.22.33\n")
+put("candump", "directions", b"(1700000000.000001)  can0 100#1000000000A2 T\n(1700000000.000002) can10 111#00 R\r\n")
+put("candump", "edges", b"(999999999999.999999) a 000#\n(0.000000) x 7FF#0011223344556677\n"
+    b"(1700000000.000001) can0 100#112233445566778899\n(1700000000.1) can0 100#\n")

@@ -2,7 +2,7 @@
 # run_all.sh - run libFuzzer targets over their committed corpora.
 #   tests/fuzz/run_all.sh BUILD --runs N    NAME...   corpus + N new inputs each (make test)
 #   tests/fuzz/run_all.sh BUILD --seconds S NAME...   S seconds each (make fuzz)
-# NAME is can, lcm, map, scenario, pcap, poses (BUILD/fuzz/fuzz_NAME), radiotap (BUILD/feed/) or replay
+# NAME is can, lcm, map, png, scenario, pcap, poses, candump (BUILD/fuzz/fuzz_NAME), radiotap (BUILD/feed/) or replay
 # (BUILD/firmware/). New inputs go to BUILD/fuzz/corpus-NAME and crashes to
 # BUILD/fuzz/artifacts/, never into tests/fuzz/corpus. Prints one PASS/FAIL line per
 # target with executions, wall time, executions/s and coverage (cov: edges, ft: features);

@@ -24,7 +24,9 @@ for f in scenarios/faults/*.yaml; do
     reached=$(awk -F'\t' 'NR > 1 { r += $2 } END { print r + 0 }' "$T/runs.tsv")
     if [ "$rows" -ne "$N" ]; then
         fail "$name" "$rows rows for $N seeds"
-    elif [[ $f == */open-* ]] && [ "$reached" -ne "$N" ]; then
+    elif [[ $f == */open-* ]] && [ "$reached" -lt $((N - 1)) ]; then
+        # The open hall isolates the fault: 49-50 of 50 seeds reach with any fault
+        # (docs/FAULTS.md, "Faults survived"), so at most one of N may miss.
         fail "$name" "$reached of $N seeds reached the source"
     else
         pass "$name ($reached/$N reached)"

@@ -116,8 +116,8 @@ if [ $? -eq 1 ] && grep -q "already exists" "$T/stderr" && [ -z "$(ls "$T/exists
 rmdir "$T/exists"
 
 # --- a single run: files, JSON, determinism ---------------------------------------------
-"$SIM" scenarios/default.yaml --seed 3 --out "$T/run_a" 2>"$T/stderr" &&
-"$SIM" scenarios/default.yaml --seed 3 --out "$T/run_b" 2>>"$T/stderr"
+"$SIM" scenarios/default.yaml --seed 3 --out "$T/run_a" 2>"$T/stderr" >"$T/line_a" &&
+"$SIM" scenarios/default.yaml --seed 3 --out "$T/run_b" 2>>"$T/stderr" >/dev/null
 if [ $? -eq 0 ] && [ -s "$T/run_a/log.tsv" ] && [ -s "$T/run_a/samples.tsv" ] &&
    [ -s "$T/run_a/track.tsv" ] && [ -s "$T/run_a/summary.json" ]; then
     pass single_run_files; else fail single_run_files "$(cat "$T/stderr")"; fi
@@ -131,17 +131,50 @@ assert isinstance(s["reached"], bool) and s["iterations"] > 0 and s["seed"] == 3
 assert 20.0 < s["shortest_path_m"] < 25.0
 EOF
 then pass summary_json; else fail summary_json; fi
+# One stdout line with what summary.json says (end, time, travel, decisions).
+if /usr/bin/python3 - "$T/run_a/summary.json" "$T/line_a" "$T/run_a" <<'EOF'
+import json, re, sys
+s = json.load(open(sys.argv[1]))
+lines = open(sys.argv[2]).read().splitlines()
+assert len(lines) == 1, lines
+m = re.fullmatch(r"seed 3: (\w+) after ([\d.]+) s and ([\d.]+) m \(shortest path ([\d.]+) m\), "
+                 r"(\d+) decisions, ([\d.]+) m from the goal; (.*)/summary.json", lines[0])
+assert m, lines
+assert m.group(1) == s["end"] and int(m.group(5)) == s["iterations"] and m.group(7) == sys.argv[3]
+for g, k in ((2, "sim_time_s"), (3, "distance_travelled_m"), (4, "shortest_path_m"),
+             (6, "final_distance_m")):
+    assert abs(float(m.group(g)) - s[k]) <= 0.051, (k, m.group(g), s[k])
+EOF
+then pass single_run_line; else fail single_run_line; fi
 same=1
 for f in log.tsv samples.tsv track.tsv summary.json; do
     cmp -s "$T/run_a/$f" "$T/run_b/$f" || same=0
 done
 [ $same -eq 1 ] && pass deterministic_bytes || fail deterministic_bytes
-"$SIM" scenarios/default.yaml --seed 4 --out "$T/run_c" 2>/dev/null
+"$SIM" scenarios/default.yaml --seed 4 --out "$T/run_c" >/dev/null 2>&1
 cmp -s "$T/run_a/samples.tsv" "$T/run_c/samples.tsv" && fail seeds_differ || pass seeds_differ
 # Log columns the issue asks for.
 head -1 "$T/run_a/log.tsv" | grep -q $'t_s\tx_m\ty_m\ttheta_rad' &&
 head -1 "$T/run_a/log.tsv" | grep -q $'kind\treason\trelearned\tprediction_db\tmean_db' &&
     pass log_columns || fail log_columns
+
+# --- placement overrides ---------------------------------------------------------------------
+bad start_text "--start: expected X,Y[,THETA] (metres, radians), got '8,x'" scenarios/default.yaml --start 8,x --out "$T/out"
+bad source_theta "--source: expected X,Y (metres), got '8,6,1'" scenarios/default.yaml --source 8,6,1 --out "$T/out"
+bad source_off_map "sources[0].position: (20.00, 100.00) is off the map" scenarios/default.yaml --source 20,100 --out "$T/out"
+bad start_in_clearance "start.position: (0.10, 0.10) is closer than the clearance" scenarios/default.yaml --start 0.1,0.1 --out "$T/out"
+"$SIM" scenarios/default.yaml --start 8,6,1.5 --source 27.5,4 >"$T/placed.json" 2>"$T/stderr"
+if /usr/bin/python3 - "$T/placed.json" <<'EOF'
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["start"] == [8.0, 6.0] and s["sources"] == [[27.5, 4.0]], s
+# The corridor runs along y 5..7 m: (27.5, 4) is in a room south of it, a door away, not
+# the scenario's source at (27.5, 10).
+assert 19.5 < s["shortest_path_m"] < 25.0, s["shortest_path_m"]
+EOF
+then pass placement_override; else fail placement_override "$(cat "$T/stderr")"; fi
+"$SIM" scenarios/default.yaml --seeds 1..2 --emit-jobs --out "$T/ej" --start 8,6 --source 27.5,4 >"$T/placed_jobs"
+[ "$(grep -c -- '--start 8,6 --source 27.5,4$' "$T/placed_jobs")" -eq 2 ] && pass placement_emit_jobs || fail placement_emit_jobs "$(cat "$T/placed_jobs")"
 
 # --- batch, job list, merge ----------------------------------------------------------------
 "$SIM" scenarios/open.yaml --seeds 1..4 --jobs 2 --quiet --out "$T/batch" 2>"$T/stderr"

@@ -154,6 +154,50 @@ static void test_walls_stop_the_robot(void **state)
     free(m.cell);
 }
 
+/// Wall contacts from Box2D's contact events: none driving in the open; one when the robot
+/// drives into the inner wall (x = 5 m) and keeps pushing; a second after backing off 0.5 m
+/// and driving in again; sliding north along the face while pressed against it adds none.
+static void test_wall_contacts(void **state)
+{
+    (void)state;
+    lx_map_t m = make_map(200, 200, 0.05, one_wall);
+    char err[256];
+    hs_box2d_t *w = hs_box2d_create(&m, NULL, err, sizeof err);
+    assert_non_null(w);
+    hs_box2d_place_robot(w, 3.0, 4.0, M_PI / 2);
+    for (int i = 0; i < 100; i++) { // 2 s north in the open
+        hs_box2d_step(w, 0.5, 0.0, 0.02);
+    }
+    assert_int_equal(hs_box2d_wall_contacts(w), 0);
+    hs_box2d_place_robot(w, 4.0, 4.0, 0.0);
+    for (int i = 0; i < 200; i++) { // east into the wall at x = 5 m, then pushing
+        hs_box2d_step(w, 0.5, 0.0, 0.02);
+    }
+    assert_int_equal(hs_box2d_wall_contacts(w), 1);
+    for (int i = 0; i < 50; i++) { // back off 0.5 m
+        hs_box2d_step(w, -0.5, 0.0, 0.02);
+    }
+    assert_false(hs_box2d_robot_touching(w));
+    for (int i = 0; i < 100; i++) { // and in again
+        hs_box2d_step(w, 0.5, 0.0, 0.02);
+    }
+    assert_int_equal(hs_box2d_wall_contacts(w), 2);
+    // Pressed against the face while sliding north: heading 0.3 rad off the wall's
+    // normal keeps it in contact the whole way.
+    double x, y, th;
+    hs_box2d_robot_pose(w, &x, &y, &th);
+    hs_box2d_place_robot(w, x, y, 0.3);
+    for (int i = 0; i < 150; i++) {
+        hs_box2d_step(w, 0.5, 0.0, 0.02);
+        assert_true(hs_box2d_robot_touching(w));
+    }
+    hs_box2d_robot_pose(w, &x, &y, &th);
+    assert_true(y > 4.0 + 0.9 * 3.0 * 0.5 * sin(0.3)); /* frictionless: the along-face part of the motion */
+    assert_int_equal(hs_box2d_wall_contacts(w), 2);
+    hs_box2d_destroy(w);
+    free(m.cell);
+}
+
 static void test_walls_crossed(void **state)
 {
     (void)state;
@@ -219,6 +263,7 @@ int main(void)
         cmocka_unit_test(test_merge_rects_cover_exactly),
         cmocka_unit_test(test_merge_rects_cheap),
         cmocka_unit_test(test_walls_stop_the_robot),
+        cmocka_unit_test(test_wall_contacts),
         cmocka_unit_test(test_walls_crossed),
         cmocka_unit_test(test_one_wall_costs_its_attenuation),
     };

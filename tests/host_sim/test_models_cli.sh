@@ -47,8 +47,9 @@ sed -e "s|^map: |map: $PWD/scenarios/|" -e 's/^target: bridge$/target: pdr/' sce
 check sim-target-pdr-two-sources '[ $? -eq 1 ] && one_line "$tmp/e" "target: pdr needs exactly 1 source"'
 
 # --- target: pdr in the simulator ---------------------------------------------------------
-"$sim" scenarios/pdr.yaml --seeds 1..4 --jobs 2 --quiet --out "$tmp/pdr-runs" 2>"$tmp/e"
-check sim-pdr-reaches-4-seeds '[ $? -eq 0 ] && [ "$(awk -F"\t" "NR > 1 && \$2 == 1" "$tmp/pdr-runs/runs.tsv" | wc -l)" -eq 4 ]'
+# Seeking the packet delivery ratio: 19 of seeds 1..20 reach the node; of 1..10, at least 9.
+"$sim" scenarios/pdr.yaml --seeds 1..10 --jobs 2 --quiet --out "$tmp/pdr-runs" 2>"$tmp/e"
+check sim-pdr-reaches-9-of-10-seeds '[ $? -eq 0 ] && [ "$(awk -F"\t" "NR > 1 && \$2 == 1" "$tmp/pdr-runs/runs.tsv" | wc -l)" -ge 9 ]'
 "$sim" scenarios/pdr.yaml --seed 1 --out "$tmp/pdr1" 2>"$tmp/e"
 check sim-pdr-summary '[ $? -eq 0 ] && [ "$(field "$tmp/pdr1/summary.json" target)" = pdr ]'
 # The seeker saw percentages (log mean column, 0..100) that rise towards the source, and

@@ -160,7 +160,7 @@ static void test_bad_input(void **state)
         {BAD "res_huge.yaml", BAD "res_huge.yaml", "resolution: 11 m out of range"},
         {BAD "thresh_order.yaml", BAD "thresh_order.yaml", "out of order"},
         {BAD "thresh_range.yaml", BAD "thresh_range.yaml", "[0, 1]"},
-        {BAD "mode_scale.yaml", BAD "mode_scale.yaml", "mode: 'scale' not supported"},
+        {BAD "mode_bad.yaml", BAD "mode_bad.yaml", "mode: 'Scale' unknown (trinary, scale or raw)"},
         {BAD "negate_bad.yaml", BAD "negate_bad.yaml", "negate: 0 or 1 expected"},
         {BAD "yaw.yaml", BAD "yaw.yaml", "yaw 0.5 unsupported"},
         {BAD "origin_short.yaml", BAD "origin_short.yaml", "origin: a list of three numbers"},
@@ -446,7 +446,7 @@ static void test_image_bounded(void **state)
 
     write_yaml(dir, "/dev/zero", yp, sizeof(yp));
     assert_int_equal(lx_map_load(yp, &m, err, sizeof(err)), -1);
-    assert_string_equal(err, "/dev/zero: not a PGM image (magic P5 or P2 expected)");
+    assert_string_equal(err, "/dev/zero: not a PGM or PNG image (magic P5, P2 or the PNG signature expected)");
 
     snprintf(ip, sizeof(ip), "%s/sparse.pgm", dir);
     FILE *f = fopen(ip, "w");

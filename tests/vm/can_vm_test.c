@@ -1,8 +1,8 @@
 /* can_vm_test.c - our side of the SocketCAN test, run on vcan0 inside a qemu
  * VM with Debian's kernel (or natively where the host has vcan). Statically linked.
  *
- *   can_vm_test send IFACE EXPECT   encode and send a fixed scenario; write the frames as
- *                                   candump -L would show them ("IFACE ID#HEX") to EXPECT
+ *   can_vm_test send IFACE EXPECT   encode and send a fixed scenario; write the frames to
+ *                                   EXPECT as a candump -L log (lx_candump, our clock)
  *   can_vm_test recv IFACE NOW_US   receive every standard frame (no id filter) until
  *                                   1.5 s of silence, decode with rfs_can_rx at NOW_US and
  *                                   print one line per delivered frame, then STATS
@@ -18,6 +18,7 @@
 #include <time.h>
 
 #include "lx_can.h"
+#include "lx_candump.h"
 #include "rfs_can.h"
 
 static const uint32_t our_ids[] = {RFS_CAN_ID_WHEEL_CMD, RFS_CAN_ID_POSE_XY, RFS_CAN_ID_POSE_TH, RFS_CAN_ID_RSSI,
@@ -89,11 +90,11 @@ static int do_send(const char *ifname, const char *expect)
             fprintf(stderr, "can_vm_test: send %u failed (errno %d)\n", i, h.last_errno);
             bad = 1;
         }
-        fprintf(o, "%s %03" PRIX32 "#", ifname, fr[i].id);
-        for (unsigned b = 0; b < fr[i].dlc; b++) {
-            fprintf(o, "%02X", fr[i].data[b]);
-        }
-        fprintf(o, "\n");
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        char line[LX_CANDUMP_FMT_MAX];
+        fputs(lx_candump_format(line, sizeof line, (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000, ifname, &fr[i])
+                  ? line : "(format failed)\n", o);
         nap_ms(2); /* keep within vcan's default tx queue */
     }
     fclose(o);

@@ -20,6 +20,24 @@ void lx_err_one_line(char *s)
     }
 }
 
+int lx_err_set(char *err, size_t errlen, const char *file, const char *fmt, ...)
+{
+    if (err != NULL && errlen > 0) {
+        char msg[512];
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg, sizeof msg, fmt, ap);
+        va_end(ap);
+        if (file != NULL) {
+            snprintf(err, errlen, "%s: %s", file, msg);
+        } else {
+            snprintf(err, errlen, "%s", msg);
+        }
+        lx_err_one_line(err); /* a file name from a YAML file can hold line breaks */
+    }
+    return -1;
+}
+
 void lx_err_print(const char *prog, const char *fmt, ...)
 {
     char msg[1024];

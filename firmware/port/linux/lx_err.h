@@ -3,9 +3,17 @@
 #ifndef LX_ERR_H
 #define LX_ERR_H
 
+#include <stddef.h>
+
 /// Replace every control character of the NUL-terminated message `s` (line breaks and
 /// tabs from a YAML key, value or file name) by '?', in place, so it prints as one line.
 void lx_err_one_line(char *s);
+
+/// Write "file: MESSAGE" (or MESSAGE when file is NULL) into err (size errlen, may be 0),
+/// MESSAGE formatted as by printf (at most 511 bytes) and the whole made one line by
+/// lx_err_one_line; returns -1, so a loader can `return lx_err_set(...)`.
+int lx_err_set(char *err, size_t errlen, const char *file, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
 
 /// Print "prog: MESSAGE\n" on stderr, MESSAGE formatted as by printf (at most 1023
 /// bytes) and made one line by lx_err_one_line: option values, option names and file

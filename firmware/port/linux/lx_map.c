@@ -1,47 +1,36 @@
-/* lx_map.c - ROS map_server YAML + PGM loader and conversion to the core's bit grids.
- * The convention is documented in lx_map.h and docs/MAPS.md. The YAML is read through
- * lx_yaml.h.
+/* lx_map.c - ROS map_server YAML + PGM / PNG loader, conversion to the core's bit grids,
+ * crop and save. The convention is documented in lx_map.h and docs/MAPS.md. The YAML is
+ * read through lx_yaml.h, a PNG through lx_png.h.
  */
 #include "lx_map.h"
 
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
 #include "lx_err.h"
+#include "lx_pgm.h"
+#include "lx_png.h"
 #include "lx_yaml.h"
 
 /* Largest image accepted: 2^26 pixels (8192 x 8192), one byte each once classified, so a
- * map input costs at most 64 MB here plus the core's bit grids (lx_map_to_core: three of
- * at most 8 MB): under 100 MB whatever the file (docs/RELIABILITY.md). */
+ * map input costs at most 64 MB here plus a PNG's rows while it is read (lx_png.h: 24 MB,
+ * or an interlaced image's 32 MB with at most 2^25 pixels) or the core's bit grids
+ * afterwards (lx_map_to_core: three of at most 8 MB): under 100 MB whatever the file
+ * (docs/RELIABILITY.md). */
 #define LX_MAP_MAX_PIXELS (1u << 26)
 /* Largest YAML accepted: a map_server YAML is a few lines. */
 #define LX_MAP_MAX_YAML (1u << 20)
-
-static int fail(char *err, size_t errlen, const char *file, const char *fmt, ...)
-{
-    if (err != NULL && errlen > 0) {
-        char msg[512];
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, sizeof(msg), fmt, ap);
-        va_end(ap);
-        snprintf(err, errlen, "%s: %s", file, msg);
-        lx_err_one_line(err); /* a file name from the YAML can hold line breaks */
-    }
-    return -1;
-}
 
 /* Read at most `max` bytes of `path` (a stream such as /dev/zero is cut off there). */
 static int read_file(const char *path, size_t max, uint8_t **buf, size_t *len, char *err, size_t errlen)
 {
     FILE *f = fopen(path, "rb");
     if (f == NULL) {
-        return fail(err, errlen, path, "cannot open: %s", strerror(errno));
+        return lx_err_set(err, errlen, path, "cannot open: %s", strerror(errno));
     }
     uint8_t *b = NULL;
     size_t n = 0;
@@ -49,198 +38,156 @@ static int read_file(const char *path, size_t max, uint8_t **buf, size_t *len, c
     int bad = ferror(f);
     fclose(f);
     if (b == NULL) {
-        return fail(err, errlen, path, "out of memory");
+        return lx_err_set(err, errlen, path, "out of memory");
     }
     if (bad || n > max) {
         free(b);
-        return bad ? fail(err, errlen, path, "read error")
-                   : fail(err, errlen, path, "larger than %zu bytes (a map_server YAML is a few lines)", max);
+        return bad ? lx_err_set(err, errlen, path, "read error")
+                   : lx_err_set(err, errlen, path, "larger than %zu bytes (a map_server YAML is a few lines)", max);
     }
     *buf = b;
     *len = n;
     return 0;
 }
 
-/* --- PGM (P5 binary, P2 ASCII) --------------------------------------------------------- */
+/* --- pixels to occupancy ------------------------------------------------------------------ */
 
-/* The image is read as a stream, one byte of look-ahead: never more than the header
- * declares, so a huge or endless file (/dev/zero, a sparse file) costs no memory. */
-typedef struct pgm_in {
-    FILE *f;
-    int c;        /* the next byte, or EOF */
-    uint64_t pos; /* bytes consumed before c */
-} pgm_in_t;
-
-static void pgm_next(pgm_in_t *in)
+int8_t lx_map_value(const lx_map_reading_t *r, const uint16_t *ch, int n, uint32_t maxval)
 {
-    if (in->c != EOF) {
-        in->pos++;
+    const bool alpha = n == 2 || n == 4;
+    const double m = (double)maxval;
+    /* nav2 averages the red, green and blue samples (a gray image's three are equal), and
+     * the alpha sample too in trinary mode; sums of integers, so exact. */
+    double sum = n <= 2 ? 3.0 * ch[0] : (double)ch[0] + ch[1] + ch[2];
+    double count = 3.0;
+    if (alpha && r->mode == LX_MAP_TRINARY) {
+        sum += ch[n - 1];
+        count = 4.0;
     }
-    in->c = getc(in->f);
-}
-
-static bool pgm_space(int c)
-{
-    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
-}
-
-/* Skip whitespace and '#' comments in a PGM header. */
-static void pgm_skip(pgm_in_t *in)
-{
-    while (in->c != EOF) {
-        if (in->c == '#') {
-            while (in->c != EOF && in->c != '\n' && in->c != '\r') {
-                pgm_next(in);
-            }
-        } else if (pgm_space(in->c)) {
-            pgm_next(in);
-        } else {
-            break;
-        }
+    const double mean = sum / count;
+    if (r->mode == LX_MAP_RAW) {
+        const double v = round(mean / m * 255.0);
+        return v >= 0.0 && v <= 100.0 ? (int8_t)v : -1;
     }
-}
-
-/* A decimal unsigned integer; -1 when absent or above max. */
-static long pgm_uint(pgm_in_t *in, long max)
-{
-    pgm_skip(in);
-    if (in->c < '0' || in->c > '9') {
+    if (r->mode == LX_MAP_SCALE && alpha && ch[n - 1] != maxval) {
         return -1;
     }
-    long v = 0;
-    while (in->c >= '0' && in->c <= '9') {
-        v = v * 10 + (in->c - '0');
-        if (v > max) {
-            return -1;
-        }
-        pgm_next(in);
+    /* (M - mean) / M as the ROS wiki writes it: nav2's 1 - mean / M differs only in the
+     * last bit, which decides nothing unless p equals a threshold exactly. */
+    const double p = r->negate ? mean / m : (m - mean) / m;
+    if (p > r->occ_th) {
+        return 100;
     }
-    return v;
+    if (p < r->free_th) {
+        return 0;
+    }
+    if (r->mode == LX_MAP_TRINARY) {
+        return -1;
+    }
+    return (int8_t)rint((p - r->free_th) / (r->occ_th - r->free_th) * 100.0);
 }
 
-/* Classification of one pixel value v (maxval M), lx_map.h's convention. */
-typedef struct pgm_class {
-    double maxval, occ, free_th;
-    int negate;
-} pgm_class_t;
-
-static uint8_t pgm_cell(const pgm_class_t *k, uint32_t v)
+uint8_t lx_map_cell_of(int8_t value)
 {
-    double d = v;
-    double p = k->negate ? d / k->maxval : (k->maxval - d) / k->maxval;
-    return p > k->occ ? LX_CELL_OCC : (p < k->free_th ? LX_CELL_FREE : LX_CELL_UNKNOWN);
+    return value < 0 ? LX_CELL_UNKNOWN : (value >= 100 ? LX_CELL_OCC : LX_CELL_FREE);
 }
 
-/* The raster of a P5 image, row by row, into cells (row 0 = bottom). */
-static int pgm_raster_p5(const char *path, pgm_in_t *in, const pgm_class_t *k, uint32_t w, uint32_t h,
-                         uint32_t lm, uint8_t *cell, char *err, size_t errlen)
-{
-    size_t bpp = lm > 255 ? 2 : 1;
-    uint8_t *row = malloc((size_t)w * bpp);
-    if (row == NULL) {
-        return fail(err, errlen, path, "out of memory");
-    }
-    for (uint32_t r = 0; r < h; r++) {
-        size_t got = fread(row, bpp, w, in->f);
-        if (got < w) {
-            free(row);
-            return fail(err, errlen, path, "truncated: %zu raster bytes, header says %u x %u needs %zu",
-                        ((size_t)r * w + got) * bpp, w, h, (size_t)w * h * bpp);
-        }
-        uint8_t *dst = cell + (size_t)(h - 1 - r) * w; /* PGM row 0 is the top; ours the bottom */
-        for (uint32_t x = 0; x < w; x++) {
-            uint32_t v = bpp == 2 ? ((uint32_t)row[2 * x] << 8 | row[2 * x + 1]) : row[x];
-            if (v > lm) {
-                free(row);
-                return fail(err, errlen, path, "pixel %zu value %u above maxval %u", (size_t)r * w + x, v, lm);
-            }
-            dst[x] = pgm_cell(k, v);
-        }
-    }
-    free(row);
-    in->pos += 1 + (uint64_t)w * h * bpp; /* the whitespace byte held in c, then the raster */
-    in->c = getc(in->f);
-    return 0;
-}
+/* Where an image's pixels go: cell states (lx_map_load) or values (lx_map_load_values). */
+typedef struct img_sink {
+    const char *path;
+    lx_map_reading_t r;
+    bool want_values;
+    uint32_t w, h, maxval;
+    int channels;
+    uint8_t *cell;
+    int8_t *value;
+    uint32_t n_partial;
+    char format[48];
+} img_sink_t;
 
-/* The raster of a P2 image, value by value, into cells (row 0 = bottom). */
-static int pgm_raster_p2(const char *path, pgm_in_t *in, const pgm_class_t *k, uint32_t w, uint32_t h,
-                         uint32_t lm, uint8_t *cell, char *err, size_t errlen)
+static int sink_alloc(img_sink_t *s, uint32_t w, uint32_t h, uint32_t maxval, int channels, char *err,
+                      size_t errlen)
 {
-    size_t count = (size_t)w * h;
-    for (size_t i = 0; i < count; i++) {
-        long v = pgm_uint(in, (long)lm);
-        if (v < 0) {
-            pgm_skip(in);
-            if (in->c == EOF) {
-                return fail(err, errlen, path, "truncated: %zu of %zu pixels (header says %u x %u)", i, count, w, h);
-            }
-            return fail(err, errlen, path, "bad pixel value at pixel %zu (0..%u expected)", i, lm);
-        }
-        cell[(size_t)(h - 1 - i / w) * w + i % w] = pgm_cell(k, (uint32_t)v);
+    s->w = w;
+    s->h = h;
+    s->maxval = maxval;
+    s->channels = channels;
+    void *p = malloc((size_t)w * h);
+    if (p == NULL) {
+        return lx_err_set(err, errlen, s->path, "out of memory");
     }
-    pgm_skip(in);
-    return 0;
-}
-
-/* Read a PGM of at most LX_MAP_MAX_PIXELS into w * h classified cells, reading only what
- * its header declares and then one byte to refuse data after it. */
-static int pgm_load(const char *path, const pgm_class_t *k0, uint32_t *w, uint32_t *h, uint8_t **cells,
-                    char *err, size_t errlen)
-{
-    pgm_in_t in = {fopen(path, "rb"), EOF, 0};
-    if (in.f == NULL) {
-        return fail(err, errlen, path, "cannot open: %s", strerror(errno));
-    }
-    int c0 = getc(in.f);
-    int c1 = getc(in.f);
-    if (c0 != 'P' || (c1 != '5' && c1 != '2')) {
-        int rc = ferror(in.f) ? fail(err, errlen, path, "read error")
-                              : fail(err, errlen, path, "not a PGM image (magic P5 or P2 expected)");
-        fclose(in.f);
-        return rc;
-    }
-    bool ascii = c1 == '2';
-    in.pos = 2;
-    in.c = getc(in.f);
-    long lw = pgm_uint(&in, 1L << 20);
-    long lh = pgm_uint(&in, 1L << 20);
-    long lm = pgm_uint(&in, 65535);
-    int rc = 0;
-    uint8_t *cell = NULL;
-    if (lw < 0 || lh < 0 || lm < 0) {
-        rc = fail(err, errlen, path, "malformed or truncated PGM header (width height maxval)");
-    } else if (lw == 0 || lh == 0 || (uint64_t)lw * (uint64_t)lh > LX_MAP_MAX_PIXELS) {
-        rc = fail(err, errlen, path, "image size %ld x %ld out of range (1..2^26 pixels)", lw, lh);
-    } else if (lm == 0) {
-        rc = fail(err, errlen, path, "maxval 0 in PGM header");
-    } else if (!ascii && !(in.c == ' ' || in.c == '\t' || in.c == '\n' || in.c == '\r')) {
-        /* P5: exactly one whitespace byte after maxval (already read as in.c), then the raster. */
-        rc = fail(err, errlen, path, "malformed or truncated PGM header (no raster)");
-    } else if ((cell = malloc((size_t)lw * (size_t)lh)) == NULL) {
-        rc = fail(err, errlen, path, "out of memory");
+    if (s->want_values) {
+        s->value = p;
     } else {
-        pgm_class_t k = *k0;
-        k.maxval = (double)lm;
-        rc = ascii ? pgm_raster_p2(path, &in, &k, (uint32_t)lw, (uint32_t)lh, (uint32_t)lm, cell, err, errlen)
-                   : pgm_raster_p5(path, &in, &k, (uint32_t)lw, (uint32_t)lh, (uint32_t)lm, cell, err, errlen);
-        if (rc == 0 && in.c != EOF) {
-            rc = fail(err, errlen, path, "data after the %ld x %ld %s the header declares (at byte %llu)", lw, lh,
-                      ascii ? "pixels" : "raster", (unsigned long long)in.pos);
-        }
+        s->cell = p;
     }
-    if (rc == 0 && ferror(in.f)) {
-        rc = fail(err, errlen, path, "read error");
-    }
-    fclose(in.f);
-    if (rc != 0) {
-        free(cell);
-        return -1;
-    }
-    *w = (uint32_t)lw;
-    *h = (uint32_t)lh;
-    *cells = cell;
     return 0;
+}
+
+/* Pixel x of image row r (row 0 = the top) with its channels ch. */
+static void sink_put(img_sink_t *s, uint32_t x, uint32_t r, const uint16_t *ch)
+{
+    const size_t i = (size_t)(s->h - 1 - r) * s->w + x; /* image row 0 is the top; ours the bottom */
+    const int8_t v = lx_map_value(&s->r, ch, s->channels, s->maxval);
+    s->n_partial += v > 0 && v < 100;
+    if (s->value != NULL) {
+        s->value[i] = v;
+    } else {
+        s->cell[i] = lx_map_cell_of(v);
+    }
+}
+
+static void sink_row(void *ctx, uint32_t r, const uint16_t *samples)
+{
+    img_sink_t *s = ctx;
+    for (uint32_t x = 0; x < s->w; x++) {
+        sink_put(s, x, r, samples + (size_t)x * (size_t)s->channels);
+    }
+}
+
+static int pgm_on_info(void *ctx, uint32_t w, uint32_t h, uint32_t maxval, bool ascii, char *err, size_t errlen)
+{
+    img_sink_t *s = ctx;
+    snprintf(s->format, sizeof(s->format), "PGM %s, maxval %u", ascii ? "P2" : "P5", maxval);
+    return sink_alloc(s, w, h, maxval, 1, err, errlen);
+}
+
+/* --- the image: PGM or PNG ------------------------------------------------------------------- */
+
+static const char *png_color_name(int color_type)
+{
+    switch (color_type) {
+    case 0: return "gray";
+    case 2: return "RGB";
+    case 3: return "palette";
+    case 4: return "gray + alpha";
+    default: return "RGBA";
+    }
+}
+
+static int png_on_info(void *ctx, const lx_png_info_t *pi, char *err, size_t errlen)
+{
+    img_sink_t *s = ctx;
+    snprintf(s->format, sizeof(s->format), "PNG %s, %u bit%s%s", png_color_name(pi->color_type), pi->bit_depth,
+             pi->bit_depth > 1 ? "s" : "", pi->interlaced ? ", interlaced" : "");
+    return sink_alloc(s, pi->w, pi->h, pi->depth == 16 ? 65535u : 255u, pi->channels, err, errlen);
+}
+
+/* A PNG (its signature at the start) or else a PGM: map_server tells them apart by content. */
+static int image_load(img_sink_t *s, char *err, size_t errlen)
+{
+    static const uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    uint8_t head[8];
+    size_t n = 0;
+    FILE *f = fopen(s->path, "rb");
+    if (f != NULL) {
+        n = fread(head, 1, sizeof(head), f);
+        fclose(f);
+    }
+    if (n == sizeof(head) && memcmp(head, sig, sizeof(sig)) == 0) {
+        return lx_png_read(s->path, LX_MAP_MAX_PIXELS, png_on_info, sink_row, s, err, errlen);
+    }
+    return lx_pgm_read(s->path, LX_MAP_MAX_PIXELS, pgm_on_info, sink_row, s, err, errlen);
 }
 
 /* --- YAML --------------------------------------------------------------------------------- */
@@ -249,7 +196,7 @@ typedef struct yaml_fields {
     char image[4096];
     bool has_image, has_res, has_origin, has_occ, has_free, has_negate;
     double res, ox, oy, yaw, occ, free_th;
-    int negate;
+    int negate, mode;
 } yaml_fields_t;
 
 static bool parse_double(const char *s, double *out)
@@ -295,18 +242,18 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
     lx_yaml_rc_t yrc = lx_yaml_load_string(buf, len, &doc, &ye);
     if (yrc != LX_YAML_OK) {
         int rc = yrc == LX_YAML_SYNTAX
-                   ? fail(err, errlen, path, "malformed YAML at line %lu: %s", ye.line,
-                          ye.problem ? ye.problem : "parse error")
+                   ? lx_err_set(err, errlen, path, "malformed YAML at line %lu: %s", ye.line,
+                                ye.problem ? ye.problem : "parse error")
                : yrc == LX_YAML_TOO_BIG
-                   ? fail(err, errlen, path, "more than %u YAML nodes", LX_YAML_MAX_NODES)
-                   : fail(err, errlen, path, "cannot initialise the YAML parser");
+                   ? lx_err_set(err, errlen, path, "more than %u YAML nodes", LX_YAML_MAX_NODES)
+                   : lx_err_set(err, errlen, path, "cannot initialise the YAML parser");
         lx_yaml_free(&doc);
         return rc;
     }
     int rc = 0;
     const lx_yaml_node_t *root = doc.root;
     if (root == NULL || root->kind != LX_YAML_MAPPING) {
-        rc = fail(err, errlen, path, "not a map_server YAML (a mapping of keys expected)");
+        rc = lx_err_set(err, errlen, path, "not a map_server YAML (a mapping of keys expected)");
         goto out;
     }
     for (size_t i = 0; i < root->n; i++) {
@@ -315,26 +262,26 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
         const char *val = lx_yaml_scalar(vn);
         number_key_t num;
         if (key == NULL) {
-            rc = fail(err, errlen, path, "non-scalar key");
+            rc = lx_err_set(err, errlen, path, "non-scalar key");
             goto out;
         }
         if (strcmp(key, "image") == 0) {
             if (val == NULL || *val == '\0' || strlen(val) >= sizeof(f->image)) {
-                rc = fail(err, errlen, path, "image: a file name expected");
+                rc = lx_err_set(err, errlen, path, "image: a file name expected");
                 goto out;
             }
             snprintf(f->image, sizeof(f->image), "%s", val);
             f->has_image = true;
         } else if (number_key(f, key, &num)) {
             if (!parse_double(val, num.value)) {
-                rc = fail(err, errlen, path, "%s: a number expected", key);
+                rc = lx_err_set(err, errlen, path, "%s: a number expected", key);
                 goto out;
             }
             *num.have = true;
         } else if (strcmp(key, "origin") == 0) {
             double v[3];
             if (vn == NULL || vn->kind != LX_YAML_SEQUENCE) {
-                rc = fail(err, errlen, path, "origin: a list [x, y, yaw] expected");
+                rc = lx_err_set(err, errlen, path, "origin: a list [x, y, yaw] expected");
                 goto out;
             }
             bool ok = vn->n == 3;
@@ -342,7 +289,7 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
                 ok = parse_double(lx_yaml_scalar(vn->child[it]), &v[it]);
             }
             if (!ok) {
-                rc = fail(err, errlen, path, "origin: a list of three numbers [x, y, yaw] expected");
+                rc = lx_err_set(err, errlen, path, "origin: a list of three numbers [x, y, yaw] expected");
                 goto out;
             }
             f->ox = v[0];
@@ -355,14 +302,20 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
             } else if (val != NULL && (strcmp(val, "1") == 0 || strcasecmp(val, "true") == 0)) {
                 f->negate = 1;
             } else {
-                rc = fail(err, errlen, path, "negate: 0 or 1 expected, got '%s'", val ? val : "(not a scalar)");
+                rc = lx_err_set(err, errlen, path, "negate: 0 or 1 expected, got '%s'", val ? val : "(not a scalar)");
                 goto out;
             }
             f->has_negate = true;
         } else if (strcmp(key, "mode") == 0) {
-            if (val == NULL || strcmp(val, "trinary") != 0) {
-                rc = fail(err, errlen, path, "mode: '%s' not supported (only trinary)",
-                          val ? val : "(not a scalar)");
+            /* Spelled exactly as map_server and nav2 compare them. */
+            static const char *const modes[3] = {"trinary", "scale", "raw"};
+            f->mode = -1;
+            for (int k = 0; k < 3 && val != NULL; k++) {
+                f->mode = strcmp(val, modes[k]) == 0 ? k : f->mode;
+            }
+            if (f->mode < 0) {
+                rc = lx_err_set(err, errlen, path, "mode: '%s' unknown (trinary, scale or raw)",
+                                val ? val : "(not a scalar)");
                 goto out;
             }
         }
@@ -372,27 +325,27 @@ static int parse_yaml(const char *path, const uint8_t *buf, size_t len, yaml_fie
                         : !f->has_origin ? "origin" : !f->has_negate ? "negate"
                         : !f->has_occ ? "occupied_thresh" : !f->has_free ? "free_thresh" : NULL;
     if (missing != NULL) {
-        rc = fail(err, errlen, path, "missing key '%s'", missing);
+        rc = lx_err_set(err, errlen, path, "missing key '%s'", missing);
     } else if (!(f->res > 0)) {
-        rc = fail(err, errlen, path, "resolution: must be > 0 (got %g)", f->res);
+        rc = lx_err_set(err, errlen, path, "resolution: must be > 0 (got %g)", f->res);
     } else if (!(f->res >= LX_MAP_RES_MIN && f->res <= LX_MAP_RES_MAX)) {
-        rc = fail(err, errlen, path, "resolution: %g m out of range (%g .. %g m per pixel)", f->res,
-                  LX_MAP_RES_MIN, LX_MAP_RES_MAX);
+        rc = lx_err_set(err, errlen, path, "resolution: %g m out of range (%g .. %g m per pixel)", f->res,
+                        LX_MAP_RES_MIN, LX_MAP_RES_MAX);
     } else if (f->yaw != 0.0) {
-        rc = fail(err, errlen, path, "origin: yaw %g unsupported (rotated maps; only 0)", f->yaw);
+        rc = lx_err_set(err, errlen, path, "origin: yaw %g unsupported (rotated maps; only 0)", f->yaw);
     } else if (f->occ < 0 || f->occ > 1 || f->free_th < 0 || f->free_th > 1) {
-        rc = fail(err, errlen, path, "thresholds must lie in [0, 1] (occupied_thresh %g, free_thresh %g)",
-                  f->occ, f->free_th);
+        rc = lx_err_set(err, errlen, path, "thresholds must lie in [0, 1] (occupied_thresh %g, free_thresh %g)",
+                        f->occ, f->free_th);
     } else if (!(f->free_th < f->occ)) {
-        rc = fail(err, errlen, path, "thresholds out of order: free_thresh %g must be below occupied_thresh %g",
-                  f->free_th, f->occ);
+        rc = lx_err_set(err, errlen, path, "thresholds out of order: free_thresh %g must be below occupied_thresh %g",
+                        f->free_th, f->occ);
     }
 out:
     lx_yaml_free(&doc);
     return rc;
 }
 
-int lx_map_load(const char *yaml_path, lx_map_t *m, char *err, size_t errlen)
+static int map_load(const char *yaml_path, bool want_values, lx_map_t *m, char *err, size_t errlen)
 {
     memset(m, 0, sizeof(*m));
     uint8_t *ybuf = NULL;
@@ -415,30 +368,57 @@ int lx_map_load(const char *yaml_path, lx_map_t *m, char *err, size_t errlen)
     } else {
         snprintf(ipath, sizeof(ipath), "%.*s/%s", (int)(slash - yaml_path), yaml_path, f.image);
     }
-    pgm_class_t k = {1.0, f.occ, f.free_th, f.negate};
-    uint32_t w = 0;
-    uint32_t h = 0;
-    uint8_t *cell = NULL;
-    if (pgm_load(ipath, &k, &w, &h, &cell, err, errlen) != 0) {
+    img_sink_t s;
+    memset(&s, 0, sizeof(s));
+    s.path = ipath;
+    s.r = (lx_map_reading_t){f.occ, f.free_th, f.negate, f.mode};
+    s.want_values = want_values;
+    char *ip = strdup(ipath);
+    if (ip == NULL || image_load(&s, err, errlen) != 0) {
+        if (ip == NULL) {
+            lx_err_set(err, errlen, yaml_path, "out of memory");
+        }
+        free(ip);
+        free(s.cell);
+        free(s.value);
         return -1;
     }
-    m->w = w;
-    m->h = h;
+    m->w = s.w;
+    m->h = s.h;
     m->res = f.res;
     m->origin_x = f.ox;
     m->origin_y = f.oy;
     m->occ_th = f.occ;
     m->free_th = f.free_th;
     m->negate = f.negate;
-    m->cell = cell;
+    m->mode = f.mode;
+    memcpy(m->format, s.format, sizeof(m->format));
+    m->n_partial = s.n_partial;
+    m->cell = s.cell;
+    m->value = s.value;
+    m->image_path = ip;
     return 0;
+}
+
+int lx_map_load(const char *yaml_path, lx_map_t *m, char *err, size_t errlen)
+{
+    return map_load(yaml_path, false, m, err, errlen);
+}
+
+int lx_map_load_values(const char *yaml_path, lx_map_t *m, char *err, size_t errlen)
+{
+    return map_load(yaml_path, true, m, err, errlen);
 }
 
 void lx_map_free(lx_map_t *m)
 {
     if (m != NULL) {
         free(m->cell);
+        free(m->value);
+        free(m->image_path);
         m->cell = NULL;
+        m->value = NULL;
+        m->image_path = NULL;
     }
 }
 
@@ -446,7 +426,8 @@ void lx_map_count(const lx_map_t *m, uint32_t *n_free, uint32_t *n_occ, uint32_t
 {
     uint32_t c[3] = {0, 0, 0};
     for (size_t i = 0; i < (size_t)m->w * m->h; i++) {
-        c[m->cell[i] < 3 ? m->cell[i] : LX_CELL_UNKNOWN]++;
+        uint8_t k = m->cell != NULL ? m->cell[i] : lx_map_cell_of(m->value[i]);
+        c[k < 3 ? k : LX_CELL_UNKNOWN]++;
     }
     if (n_free != NULL) {
         *n_free = c[LX_CELL_FREE];
@@ -481,11 +462,11 @@ int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
 {
     memset(out, 0, sizeof(*out));
     if (!(core_res > 0) || !isfinite(core_res) || core_res > 1000.0) {
-        return fail(err, errlen, "map", "core resolution %g out of range (0, 1000] m", core_res);
+        return lx_err_set(err, errlen, "map", "core resolution %g out of range (0, 1000] m", core_res);
     }
     if (!(m->res >= LX_MAP_RES_MIN && m->res <= LX_MAP_RES_MAX)) {
-        return fail(err, errlen, "map", "resolution %g m out of range (%g .. %g m per pixel)", m->res,
-                    LX_MAP_RES_MIN, LX_MAP_RES_MAX);
+        return lx_err_set(err, errlen, "map", "resolution %g m out of range (%g .. %g m per pixel)", m->res,
+                          LX_MAP_RES_MIN, LX_MAP_RES_MAX);
     }
     rfs_map_cfg_t c = cfg != NULL ? *cfg : rfs_map_cfg_default();
     /* The core's cells use the Q16 resolution and origin; align the resampling to them. */
@@ -493,7 +474,7 @@ int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
     double oxd = m->origin_x * 65536.0;
     double oyd = m->origin_y * 65536.0;
     if (res_q <= 0 || fabs(oxd) > 2147483647.0 || fabs(oyd) > 2147483647.0) {
-        return fail(err, errlen, "map", "resolution or origin not representable in Q16.16");
+        return lx_err_set(err, errlen, "map", "resolution or origin not representable in Q16.16");
     }
     int64_t ox_q = llround(oxd);
     int64_t oy_q = llround(oyd);
@@ -506,14 +487,14 @@ int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
     double cwd = ceil((m->origin_x + wm - ox - LX_MAP_SLIVER * m->res) / cr);
     double chd = ceil((m->origin_y + hm - oy - LX_MAP_SLIVER * m->res) / cr);
     if (cwd < 1 || chd < 1 || cwd > 65535 || chd > 65535) {
-        return fail(err, errlen, "map", "core grid %.0f x %.0f cells at %g m does not fit 1..65535",
-                    cwd, chd, core_res);
+        return lx_err_set(err, errlen, "map", "core grid %.0f x %.0f cells at %g m does not fit 1..65535",
+                          cwd, chd, core_res);
     }
     /* 2^26 cells (8 MB per bit grid, e.g. 800 x 800 m at 0.1 m): a larger floor is a
      * wrong resolution in the YAML, not a building, and would take minutes to derive. */
     if (cwd * chd > 67108864.0) {
-        return fail(err, errlen, "map", "core grid %.0f x %.0f cells at %g m is over the 2^26-cell limit",
-                    cwd, chd, core_res);
+        return lx_err_set(err, errlen, "map", "core grid %.0f x %.0f cells at %g m is over the 2^26-cell limit",
+                          cwd, chd, core_res);
     }
     uint16_t cw = (uint16_t)cwd;
     uint16_t ch = (uint16_t)chd;
@@ -523,7 +504,7 @@ int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
     out->legal_bits = calloc(bytes, 1);
     if (out->free_bits == NULL || out->wall_bits == NULL || out->legal_bits == NULL) {
         lx_core_map_free(out);
-        return fail(err, errlen, "map", "out of memory");
+        return lx_err_set(err, errlen, "map", "out of memory");
     }
     uint16_t stride = (uint16_t)((cw + 7u) / 8u);
     for (uint16_t cy = 0; cy < ch; cy++) {
@@ -549,9 +530,9 @@ int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
             bool any_occ = false;
             for (long fy = fy0 < 0 ? 0 : fy0; fy <= fy1 && fy < (long)m->h; fy++) {
                 for (long fx = fx0 < 0 ? 0 : fx0; fx <= fx1 && fx < (long)m->w; fx++) {
-                    uint8_t s = m->cell[(size_t)fy * m->w + (size_t)fx];
-                    all_free = all_free && s == LX_CELL_FREE;
-                    any_occ = any_occ || s == LX_CELL_OCC;
+                          uint8_t s = m->cell[(size_t)fy * m->w + (size_t)fx];
+                          all_free = all_free && s == LX_CELL_FREE;
+                          any_occ = any_occ || s == LX_CELL_OCC;
                 }
             }
             rfs_map_bit_set(out->free_bits, stride, cx, cy, all_free);
@@ -561,9 +542,9 @@ int lx_map_to_core(const lx_map_t *m, double core_res, const rfs_map_cfg_t *cfg,
     if (rfs_map_init(&out->map, &c, cw, ch, (rfs_q16_t)res_q, (rfs_q16_t)ox_q, (rfs_q16_t)oy_q,
                      out->free_bits, out->wall_bits, out->legal_bits) != 0) {
         lx_core_map_free(out);
-        return fail(err, errlen, "map", "the core rejects the map (%u x %u cells at %g m, clearance %g m, "
-                    "grid %g m: extent above 16384 m, clearance above 64 m or 255 cells, or lattice above 65535)",
-                    cw, ch, core_res, c.clearance / 65536.0, c.grid / 65536.0);
+        return lx_err_set(err, errlen, "map", "the core rejects the map (%u x %u cells at %g m, clearance %g m, "
+                          "grid %g m: extent above 16384 m, clearance above 64 m or 255 cells, or lattice above 65535)",
+                          cw, ch, core_res, c.clearance / 65536.0, c.grid / 65536.0);
     }
     return 0;
 }
@@ -578,4 +559,172 @@ void lx_core_map_free(lx_core_map_t *c)
         c->wall_bits = NULL;
         c->legal_bits = NULL;
     }
+}
+
+/* --- crop and save ------------------------------------------------------------------------ */
+
+/* The state of cell i, whichever array the map holds. */
+static uint8_t cell_at(const lx_map_t *m, size_t i)
+{
+    return m->cell != NULL ? m->cell[i] : lx_map_cell_of(m->value[i]);
+}
+
+bool lx_map_known_box(const lx_map_t *m, uint32_t *x0, uint32_t *y0, uint32_t *x1, uint32_t *y1)
+{
+    uint32_t bx0 = UINT32_MAX;
+    uint32_t by0 = UINT32_MAX;
+    uint32_t bx1 = 0;
+    uint32_t by1 = 0;
+    for (uint32_t y = 0; y < m->h; y++) {
+        for (uint32_t x = 0; x < m->w; x++) {
+            if (cell_at(m, (size_t)y * m->w + x) != LX_CELL_UNKNOWN) {
+                bx0 = x < bx0 ? x : bx0;
+                bx1 = x > bx1 ? x : bx1;
+                by0 = y < by0 ? y : by0;
+                by1 = y;
+            }
+        }
+    }
+    if (bx0 == UINT32_MAX) {
+        return false;
+    }
+    *x0 = bx0;
+    *y0 = by0;
+    *x1 = bx1;
+    *y1 = by1;
+    return true;
+}
+
+int lx_map_crop(const lx_map_t *m, uint32_t x0, uint32_t y0, uint32_t w, uint32_t h, lx_map_t *out,
+                char *err, size_t errlen)
+{
+    memset(out, 0, sizeof(*out));
+    if (w == 0 || h == 0 || x0 > m->w || y0 > m->h || w > m->w - x0 || h > m->h - y0) {
+        return lx_err_set(err, errlen, "map", "crop %u x %u at (%u, %u) outside the %u x %u image", w, h, x0, y0, m->w,
+                          m->h);
+    }
+    uint8_t *dst = malloc((size_t)w * h);
+    if (dst == NULL) {
+        return lx_err_set(err, errlen, "map", "out of memory");
+    }
+    const bool values = m->cell == NULL; /* the map holds occupancy values, not cells */
+    const uint8_t *src = values ? (const uint8_t *)m->value : m->cell;
+    for (uint32_t y = 0; y < h; y++) {
+        memcpy(dst + (size_t)y * w, src + (size_t)(y0 + y) * m->w + x0, w);
+    }
+    *out = *m;
+    out->w = w;
+    out->h = h;
+    out->origin_x = m->origin_x + x0 * m->res;
+    out->origin_y = m->origin_y + y0 * m->res;
+    out->n_partial = 0;
+    out->cell = values ? NULL : dst;
+    out->value = values ? (int8_t *)dst : NULL;
+    out->image_path = NULL;
+    for (size_t i = 0; values && i < (size_t)w * h; i++) {
+        out->n_partial += (int8_t)dst[i] > 0 && (int8_t)dst[i] < 100;
+    }
+    return 0;
+}
+
+bool lx_map_save_image_path(const char *yaml_path, char *out, size_t n)
+{
+    size_t len = strlen(yaml_path);
+    const char *dot = strrchr(yaml_path, '.');
+    const char *slash = strrchr(yaml_path, '/');
+    if (dot != NULL && (slash == NULL || dot > slash) &&
+        (strcmp(dot, ".yaml") == 0 || strcmp(dot, ".yml") == 0)) {
+        len = (size_t)(dot - yaml_path);
+    }
+    return (size_t)snprintf(out, n, "%.*s.pgm", (int)len, yaml_path) < n;
+}
+
+/* The shortest decimal that reads back as v exactly. */
+static void shortest(char *buf, size_t n, double v)
+{
+    for (int prec = 1; prec <= 17; prec++) {
+        snprintf(buf, n, "%.*g", prec, v);
+        if (strtod(buf, NULL) == v) {
+            return;
+        }
+    }
+}
+
+static int save_pgm(const lx_map_t *m, const char *path, char *err, size_t errlen)
+{
+    FILE *f = fopen(path, "wb");
+    if (f == NULL) {
+        return lx_err_set(err, errlen, path, "cannot create: %s", strerror(errno));
+    }
+    /* Trinary levels as map_saver writes them; the YAML's thresholds keep 205 unknown. */
+    static const uint8_t level[3] = {[LX_CELL_FREE] = 254, [LX_CELL_OCC] = 0, [LX_CELL_UNKNOWN] = 205};
+    fprintf(f, "P5\n# rfseek-map --crop: free 254, occupied 0, unknown 205\n%u %u\n255\n", m->w, m->h);
+    for (uint32_t r = 0; r < m->h; r++) {
+        const size_t base = (size_t)(m->h - 1 - r) * m->w; /* PGM row 0 is the top */
+        for (uint32_t x = 0; x < m->w; x++) {
+            uint8_t k = cell_at(m, base + x);
+            putc(level[k < 3 ? k : LX_CELL_UNKNOWN], f);
+        }
+    }
+    if (fflush(f) != 0 || ferror(f)) {
+        fclose(f);
+        return lx_err_set(err, errlen, path, "write error: %s", strerror(errno));
+    }
+    return fclose(f) != 0 ? lx_err_set(err, errlen, path, "write error: %s", strerror(errno)) : 0;
+}
+
+static int save_yaml(const lx_map_t *m, const char *path, const char *image, char *err, size_t errlen)
+{
+    char res[32];
+    char ox[32];
+    char oy[32];
+    shortest(res, sizeof(res), m->res);
+    /* To 1 nm: the crop's x0 * res adds rounding noise far below any cell. */
+    shortest(ox, sizeof(ox), round(m->origin_x * 1e9) / 1e9 + 0.0);
+    shortest(oy, sizeof(oy), round(m->origin_y * 1e9) / 1e9 + 0.0);
+    FILE *f = fopen(path, "w");
+    if (f == NULL) {
+        return lx_err_set(err, errlen, path, "cannot create: %s", strerror(errno));
+    }
+    fputs("# written by rfseek-map --crop (docs/MAPS.md)\nimage: '", f);
+    for (const char *c = image; *c != '\0'; c++) {
+        fputs(*c == '\'' ? "''" : (char[2]){*c, '\0'}, f); /* a single-quoted YAML scalar */
+    }
+    fprintf(f, "'\nresolution: %s\norigin: [%s, %s, 0.0]\nnegate: 0\noccupied_thresh: 0.65\n"
+               "free_thresh: 0.1\nmode: trinary\n", res, ox, oy);
+    if (fflush(f) != 0 || ferror(f)) {
+        fclose(f);
+        return lx_err_set(err, errlen, path, "write error: %s", strerror(errno));
+    }
+    return fclose(f) != 0 ? lx_err_set(err, errlen, path, "write error: %s", strerror(errno)) : 0;
+}
+
+int lx_map_save(const lx_map_t *m, const char *yaml_path, char *err, size_t errlen)
+{
+    char ipath[4096];
+    char itmp[4100];
+    char ytmp[4100];
+    if (!lx_map_save_image_path(yaml_path, ipath, sizeof(ipath)) ||
+        (size_t)snprintf(ytmp, sizeof(ytmp), "%s.tmp", yaml_path) >= sizeof(ytmp)) {
+        return lx_err_set(err, errlen, yaml_path, "file name too long");
+    }
+    snprintf(itmp, sizeof(itmp), "%s.tmp", ipath);
+    const char *slash = strrchr(ipath, '/');
+    const char *iname = slash != NULL ? slash + 1 : ipath;
+    for (const char *c = iname; *c != '\0'; c++) {
+        if ((unsigned char)*c < 0x20 || *c == 0x7f) {
+            return lx_err_set(err, errlen, yaml_path, "the image name would hold a control character");
+        }
+    }
+    int rc = save_pgm(m, itmp, err, errlen);
+    rc = rc == 0 ? save_yaml(m, ytmp, iname, err, errlen) : rc;
+    if (rc == 0 && rename(itmp, ipath) != 0) {
+        rc = lx_err_set(err, errlen, itmp, "cannot rename to %s: %s", ipath, strerror(errno));
+    } else if (rc == 0 && rename(ytmp, yaml_path) != 0) {
+        rc = lx_err_set(err, errlen, ytmp, "cannot rename to %s: %s", yaml_path, strerror(errno));
+        remove(ipath);
+    }
+    remove(itmp);
+    remove(ytmp);
+    return rc;
 }

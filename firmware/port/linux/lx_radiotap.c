@@ -200,11 +200,15 @@ int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w)
     w->ds = (uint8_t)((w->fc >> 8) & 3u);
     const bool order = (w->fc & 0x8000u) != 0;
     w->hdr_len = 2;
+    if ((w->fc & 3u) != 0u) {
+        return 0; /* protocol version 1 (S1G) or reserved: another header layout, no addresses */
+    }
     /* Address offsets: addr1 4, addr2 10, addr3 16, seq 22, addr4 24. */
     if (w->type == LX_WLAN_CTRL) {
-        /* RTS, PS-Poll, CF-End(+Ack), BlockAckReq, BlockAck carry RA then TA; ACK and
-         * CTS carry only RA. None of them has a source address (Wireshark: no wlan.sa). */
-        const uint16_t with_ta = (1u << 8) | (1u << 9) | (1u << 10) | (1u << 11) | (1u << 14) | (1u << 15);
+        /* RTS, PS-Poll, CF-End+CF-Ack, BlockAckReq, BlockAck carry RA then TA; ACK and CTS
+         * carry only RA; CF-End carries RA then the BSSID (tshark 4.0: wlan.bssid, no wlan.ta).
+         * None of them has a source address (Wireshark: no wlan.sa). */
+        const uint16_t with_ta = (1u << 8) | (1u << 9) | (1u << 10) | (1u << 11) | (1u << 15);
         if ((with_ta & (1u << w->subtype)) && len >= 16) {
             memcpy(w->ta, frame + 10, 6);
             w->has_ta = true;
@@ -238,16 +242,43 @@ int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w)
     return 0;
 }
 
+/* The SSID element of a beacon or probe response: body[0..n) are the bytes after the MAC
+ * header, FCS excluded; elements follow the 12 bytes of timestamp, interval, capability. */
+static void frame_ssid(const uint8_t *body, size_t n, lx_rt_frame_t *f)
+{
+    for (size_t at = 12; at + 2u <= n;) {
+        const size_t elen = body[at + 1u];
+        if (at + 2u + elen > n) {
+            return;
+        }
+        if (body[at] == 0u) {
+            memcpy(f->ssid, body + at + 2u, elen);
+            f->ssid_len = (uint8_t)elen; /* a one-byte length: <= LX_WLAN_SSID_MAX */
+            f->has_ssid = true;
+            return;
+        }
+        at += 2u + elen;
+    }
+}
+
 int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f)
 {
     memset(f, 0, sizeof(*f));
-    if (lx_radiotap_parse(buf, len, &f->rt) != 0) { return -1; }
-    const size_t n = len - f->rt.it_len;
+    const int rc = lx_radiotap_parse(buf, len, &f->rt);
+    /* An unusable header whose length field still lies in [8, len]: the 802.11 frame is
+     * there, as Wireshark reads it; its fields (and so the FCS flag) are not. */
+    const size_t it_len = rc == 0 ? f->rt.it_len : (len >= RT_HDR ? rd16(buf + 2) : 0u);
+    if (it_len < RT_HDR || it_len > len) { return -1; }
+    const size_t n = len - it_len;
     /* The FCS is the last 4 bytes of the frame. Like Wireshark we still read the MAC
      * header from every captured byte: a frame shorter than header + FCS is damaged
      * either way, and this keeps our SA equal to tshark's wlan.sa. */
-    const bool fcs = f->rt.has_flags && (f->rt.flags & LX_RT_FLAG_FCS) != 0;
+    const bool fcs = rc == 0 && f->rt.has_flags && (f->rt.flags & LX_RT_FLAG_FCS) != 0;
     f->frame_len = (uint32_t)(fcs ? (n >= 4 ? n - 4 : 0) : n);
-    f->wlan_ok = lx_wlan_parse(buf + f->rt.it_len, n, &f->wlan) == 0;
-    return 0;
+    f->wlan_ok = lx_wlan_parse(buf + it_len, n, &f->wlan) == 0;
+    const bool beacon = f->wlan.subtype == 8u || f->wlan.subtype == 5u; /* or probe response */
+    if (f->wlan_ok && f->wlan.has_sa && f->wlan.type == LX_WLAN_MGMT && beacon && f->wlan.hdr_len <= f->frame_len) {
+        frame_ssid(buf + it_len + f->wlan.hdr_len, f->frame_len - f->wlan.hdr_len, f);
+    }
+    return rc;
 }

@@ -108,8 +108,13 @@ typedef struct lx_wlan {
 /// Parse the 802.11 MAC header of `frame` (`len` bytes, FCS already removed). Returns 0
 /// when at least the frame control was readable, -1 when len < 2. Addresses and the
 /// sequence number count only when the whole MAC header is there (as Wireshark adds
-/// wlan.sa): an ACK, a CTS or a frame cut inside its header has no SA.
+/// wlan.sa): an ACK, a CTS or a frame cut inside its header has no SA; nor has a frame of
+/// protocol version 1 (S1G, another layout) or a reserved one.
 int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w);
+
+/// Longest SSID element kept, bytes: its one-byte length's limit. IEEE 802.11-2020 9.4.2.2
+/// allows 32; tshark shows longer ones whole, and so do we.
+#define LX_WLAN_SSID_MAX 255u
 
 /// One parsed capture record: radiotap + 802.11, as the feeder needs it.
 typedef struct lx_rt_frame {
@@ -118,10 +123,17 @@ typedef struct lx_rt_frame {
     bool wlan_ok;         ///< an 802.11 header followed the radiotap header
     uint32_t frame_len;   ///< 802.11 bytes after radiotap, FCS removed when flagged
                           ///< (the MAC header is parsed from all captured bytes)
+    bool has_ssid;        ///< a beacon or probe response whose SSID element was read
+    uint8_t ssid_len;     ///< its length, 0..LX_WLAN_SSID_MAX (0: a hidden network)
+    uint8_t ssid[LX_WLAN_SSID_MAX]; ///< its bytes (any values: not a C string)
 } lx_rt_frame_t;
 
 /// Parse a whole captured record. Returns 0 when the radiotap header was usable (the
-/// 802.11 part may still be absent: see wlan_ok), -1 otherwise.
+/// 802.11 part may still be absent: see wlan_ok), -1 otherwise; then rt.status says why,
+/// and when the header's length field still lies within the record the 802.11 frame
+/// after it is parsed all the same (wlan_ok; no FCS known), as Wireshark does. The SSID is the first
+/// SSID element (id 0) among the elements after a beacon's or probe
+/// response's 12 bytes of fixed fields, within the captured frame without its FCS.
 int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f);
 
 #endif /* LX_RADIOTAP_H */

@@ -2,7 +2,8 @@
  * microcontroller (firmware/rfs_app.h), with pose, RSSI and the receiver heartbeat
  * (RFS_RSSI_STATUS; docs/FAULTS.md, "The receiver heartbeat") from LCM, wheel commands to
  * SocketCAN (or the LCM fallback channel RFS_CAN_FALLBACK carrying raw CAN frames), the
- * status to LCM, and runs recorded as LCM logs. See docs/CAN.md.
+ * status to LCM, and runs recorded as LCM logs and its frames as candump -L logs. See
+ * docs/CAN.md.
  *
  * Clocks: live, the controller steps at 20 Hz on CLOCK_REALTIME in microseconds (the
  * LCM utime convention: senders share the robot's synchronised clock). With --clock-lcm
@@ -22,6 +23,7 @@
 #include <unistd.h>
 
 #include "lx_can.h"
+#include "lx_candump.h"
 #include "lx_err.h"
 #include "lx_lcm.h"
 #include "lx_map.h"
@@ -42,6 +44,8 @@ static const char usage_text[] =
     "  --clock-lcm       step once per RFS_CLOCK message (lock-step with a simulator)\n"
     "  --replay LOG      read inputs from an LCM log instead of LCM (deterministic)\n"
     "  --log FILE        record every input and output as an LCM log (lcm-logplayer)\n"
+    "  --candump FILE    write the frames sent as a candump -L log (interface: --can's,\n"
+    "                    else can0; time: the controller's clock)\n"
     "  --decisions FILE  write one line per decision (default: stdout with --replay)\n"
     "  --target NAME     rssi (default) or bridge\n"
     "  --model NAME      internal model: ridge (default, the paper's), mlp, knn, radius,\n"
@@ -65,6 +69,7 @@ typedef struct daemon {
     bool clock_lcm;
     bool replay;
     lx_lcm_log_t *rec;
+    lx_candump_t *dump;     /* --candump: the frames sent, or NULL */
     FILE *decisions;
     int64_t next_step_us;   /* replay without clock: next 50 ms boundary */
     bool have_time;
@@ -154,6 +159,9 @@ static void step(daemon_t *d, int64_t now_us)
         }
         if (r != 0 && d->can_fail++ == 0) {
             fprintf(stderr, "rfseekd: a CAN frame could not be sent (counted; retrying with backoff)\n");
+        }
+        if (r == 0 && d->dump != NULL) {
+            lx_candump_write(d->dump, now_us, &fr[i]);
         }
     }
     rfs_seek_out_t so;
@@ -281,7 +289,7 @@ static bool parse_i64(const char *s, int64_t lo, int64_t hi, int64_t *v)
 
 static bool is_value_option(const char *a)
 {
-    static const char *const opts[] = {"--map", "--lcm", "--can", "--replay", "--log", "--decisions",
+    static const char *const opts[] = {"--map", "--lcm", "--can", "--replay", "--log", "--decisions", "--candump",
                                        "--target", "--res", "--seed", "--duration", "--idle-exit",
                                        "--model", "--p0-min", "--strategy"};
     for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++) {
@@ -294,7 +302,7 @@ static bool is_value_option(const char *a)
 
 /* The command line. */
 typedef struct options {
-    const char *map_path, *url, *can_if, *replay, *log_path, *dec_path;
+    const char *map_path, *url, *can_if, *replay, *log_path, *dec_path, *candump;
     const char *target;
     const rfs_models_entry_t *model; /* NULL: the application's built-in ridge */
     double p0_min;                   /* --p0-min: NAN keeps the model's default */
@@ -321,6 +329,8 @@ static int parse_value(options_t *o, const char *a, const char *v)
         o->log_path = v;
     } else if (strcmp(a, "--decisions") == 0) {
         o->dec_path = v;
+    } else if (strcmp(a, "--candump") == 0) {
+        o->candump = v;
     } else if (strcmp(a, "--target") == 0) {
         o->target = v;
         if (strcmp(o->target, "rssi") != 0 && strcmp(o->target, "bridge") != 0) {
@@ -490,6 +500,11 @@ static int open_io(daemon_t *d, const options_t *o)
         lx_err_print(PROG, "%s", err);
         return 1;
     }
+    if (o->candump && !(d->dump = lx_candump_open(o->candump, o->can_if ? o->can_if : LX_CANDUMP_DEFAULT_IF, err,
+                                                  sizeof err))) {
+        lx_err_print(PROG, "%s", err);
+        return 1;
+    }
     if (!o->replay || o->url) {
         /* In replay, LCM (when given) only carries the outputs. */
         lx_lcm_handlers_t none;
@@ -606,6 +621,11 @@ static int finish(daemon_t *d, const options_t *o, int rc)
         lx_err_print(PROG, "%s: could not finish the log (write failed)", o->log_path);
         rc = 1;
     }
+    char err[512];
+    if (lx_candump_close(d->dump, rc == 0, err, sizeof err) != 0) {
+        lx_err_print(PROG, "%s", err);
+        rc = 1;
+    }
     if (d->decisions && d->decisions != stdout) {
         if (fclose(d->decisions) != 0 && rc == 0) {
             lx_err_print(PROG, "%s: write failed", o->dec_path);
@@ -632,8 +652,8 @@ static int finish(daemon_t *d, const options_t *o, int rc)
  * message - before any work. */
 static int check_paths(const options_t *o)
 {
-    const char *outs[2] = {o->log_path, o->dec_path}, *ins[2] = {o->map_path, o->replay};
-    for (int i = 0; i < 2; i++) {
+    const char *outs[3] = {o->log_path, o->dec_path, o->candump}, *ins[2] = {o->map_path, o->replay};
+    for (int i = 0; i < 3; i++) {
         if (outs[i] == NULL) {
             continue;
         }
@@ -642,7 +662,8 @@ static int check_paths(const options_t *o)
             return 1;
         }
     }
-    if (lx_err_same_dest(PROG, o->log_path, o->dec_path) != 0) {
+    if (lx_err_same_dest(PROG, o->log_path, o->dec_path) != 0 || lx_err_same_dest(PROG, o->log_path, o->candump) != 0 ||
+        lx_err_same_dest(PROG, o->dec_path, o->candump) != 0) {
         return 1;
     }
     return 0;

@@ -134,6 +134,7 @@ help:
 	@echo "make demo      deps + run the default simulated mission, figures in out/demo/"
 	@echo "make lint      cppcheck, clang-tidy and the layer check"
 	@echo "make fuzz      every libFuzzer target for FUZZ_SECONDS each"
+	@echo "make fuzz-long every libFuzzer target for FUZZ_LONG_RUNS (10 M) executions, niced"
 	@echo "make sweep     the simulator under ASan+UBSan over SWEEP_SEEDS seeds"
 
 deps:

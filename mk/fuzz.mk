@@ -4,6 +4,8 @@
 # rfseek-feed --pose and candump -L log lines. clang only:
 # -fsanitize=fuzzer,address,undefined.
 #   make fuzz [FUZZ_SECONDS=300] [FUZZ_TARGETS="can map"]   each target for that long
+#   make fuzz-long [FUZZ_LONG_RUNS=10000000]   each target for that many executions, one after
+#   another under nice -n 19 (the figures in docs/RELIABILITY.md, "Long runs")
 # New inputs go to $(FUZZ_DIR)/corpus-<name>, crashes to $(FUZZ_DIR)/artifacts/; `make test`
 # runs each over its committed corpus plus a short burst.
 FUZZ_CC ?= clang
@@ -60,11 +62,21 @@ $(FEED)/fuzz_radiotap: tests/fuzz/fuzz_radiotap.c $(FUZZ_LX)/lx_radiotap.c $(FUZ
 	@mkdir -p $(@D)
 	$(FUZZ_CC) -std=c11 -g -O1 -I$(FUZZ_LX) -fsanitize=fuzzer,address,undefined \
 		-fno-sanitize-recover=all $< $(FUZZ_LX)/lx_radiotap.c -o $@
+# fuzz_replay: the lattice and reachability code compares map cells and lattice bounds,
+# not input bytes; built without comparison tracing (edges still counted) a control period
+# costs a third (docs/RELIABILITY.md, "Long runs").
 FUZZ_FW_SRCS := firmware/rfs_app.c firmware/rfs_replay.c
-$(FW)/fuzz_replay: tests/fuzz/fuzz_replay.c $(FUZZ_FW_SRCS) $(CORE_SRCS) $(FUZZ_HDRS)
+FUZZ_NOCMP := common/rfs_map.c common/rfs_reach.c
+FUZZ_NOCMP_OBJS := $(FUZZ_NOCMP:common/%.c=$(FW)/fuzz-nocmp/%.o)
+$(FW)/fuzz-nocmp/%.o: common/%.c $(FUZZ_HDRS)
+	@mkdir -p $(@D)
+	$(FUZZ_CC) -std=c11 -g -O1 $(INC_fw) -fsanitize=address,undefined -fno-sanitize-recover=all \
+		-fsanitize=fuzzer-no-link -fno-sanitize-coverage=trace-cmp -c $< -o $@
+$(FW)/fuzz_replay: tests/fuzz/fuzz_replay.c $(FUZZ_FW_SRCS) $(CORE_SRCS) $(FUZZ_NOCMP_OBJS) $(FUZZ_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) -std=c11 -g -O1 $(INC_fw) -fsanitize=fuzzer,address,undefined \
-		-fno-sanitize-recover=all $< $(FUZZ_FW_SRCS) $(CORE_SRCS) -o $@
+		-fno-sanitize-recover=all $< $(FUZZ_FW_SRCS) $(filter-out $(FUZZ_NOCMP),$(CORE_SRCS)) \
+		$(FUZZ_NOCMP_OBJS) -o $@
 
 # make test: each target over its committed corpus plus a short burst of new inputs.
 FUZZ_TEST_RUNS ?= 5000
@@ -75,7 +87,10 @@ $(eval $(call test_script,fuzz_replay,tests/fuzz/run_one.sh $(FW)/fuzz_replay $(
 # make fuzz: every target for FUZZ_SECONDS each.
 FUZZ_ALL_BINS := $(FUZZ_BINS) $(FEED)/fuzz_radiotap $(FW)/fuzz_replay
 FUZZ_TARGETS ?= $(FUZZ_OWN) radiotap replay
-.PHONY: fuzz fuzz-build
+FUZZ_LONG_RUNS ?= 10000000
+.PHONY: fuzz fuzz-build fuzz-long
 fuzz-build: $(FUZZ_ALL_BINS)
 fuzz: fuzz-build
 	@tests/fuzz/run_all.sh $(BUILD) --seconds $(FUZZ_SECONDS) $(FUZZ_TARGETS)
+fuzz-long: fuzz-build
+	@nice -n 19 tests/fuzz/run_all.sh $(BUILD) --runs $(FUZZ_LONG_RUNS) $(FUZZ_TARGETS)

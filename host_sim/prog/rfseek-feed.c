@@ -316,8 +316,8 @@ static int tsv_line(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_fram
     char line[64];
     const size_t len = format_line(line, pkt->ts_sec, pkt->ts_nsec, f->wlan.sa, f->rt.dbm_signal);
     fwrite(line, 1, len, c->out);
-    if (c->live) { fflush(c->out); }
-    return 0;
+    /* Live, a lost line ends the reading (a batch's table is checked at the end). */
+    return c->live && fflush(c->out) != 0 ? 1 : 0;
 }
 
 /* The TSV lines (or with list the survey, scan_list) into stdout or output. */
@@ -345,9 +345,12 @@ static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, bool list
     setvbuf(out, obuf, _IOFBF, sizeof(obuf));
     tsv_ctx_t c = {out, live};
     int rc = list ? scan_list(r, macs, n_macs, st, out) : scan_capture(r, macs, n_macs, st, tsv_line, &c, NULL, NULL);
-    if (fflush(out) != 0 || ferror(out)) {
-        fprintf(stderr, "rfseek-feed: %s: write error: %s\n", output != NULL ? tmp : "stdout", strerror(errno));
+    if (output != NULL && (fflush(out) != 0 || ferror(out))) {
+        fprintf(stderr, "rfseek-feed: %s: write error: %s\n", tmp, strerror(errno));
         rc = 1;
+    }
+    if (output == NULL && ferror(out)) {
+        rc = 1; /* reported once, by lx_err_close_stdout */
     }
     if (output != NULL) {
         if (fclose(out) != 0) { rc = 1; }
@@ -749,6 +752,20 @@ static void rp_run(replay_t *rp)
     hs_sim_result_estimate(res, &rp->ctrl, sc->src[0].x, sc->src[0].y); /* the path-loss estimate */
 }
 
+/* Close one output file of the replay: rc, or 1 after a line naming it when a write or
+ * the close failed (no second line after an earlier error). */
+static int rp_close(const replay_t *rp, FILE *f, const char *name, int rc)
+{
+    errno = 0;
+    const bool bad = ferror(f) != 0;
+    if ((fclose(f) != 0 || bad) && rc == 0) {
+        fprintf(stderr, "rfseek-feed: %s/%s: write error: %s\n", rp->tmp, name,
+                errno != 0 ? strerror(errno) : "write failed");
+        rc = 1;
+    }
+    return rc;
+}
+
 /* summary.json, the logs closed, the directory renamed into place (removed on failure),
  * and everything freed: the exit status (rc: so far). */
 static int rp_finish(replay_t *rp, feed_stats_t *st, int rc, bool ran)
@@ -760,12 +777,16 @@ static int rp_finish(replay_t *rp, feed_stats_t *st, int rc, bool ran)
             rc = 1;
         } else {
             hs_sim_write_summary(fsum, &rp->env, &rp->res);
-            if (fclose(fsum) != 0) { rc = 1; }
+            rc = rp_close(rp, fsum, "summary.json", rc);
         }
     }
-    if (rp->flog != NULL && (ferror(rp->flog) || fclose(rp->flog) != 0)) { rc = 1; }
-    if (rp->fsam != NULL && (ferror(rp->fsam) || fclose(rp->fsam) != 0)) { rc = 1; }
-    if (rp->ftrk != NULL && (ferror(rp->ftrk) || fclose(rp->ftrk) != 0)) { rc = 1; }
+    FILE *const logs[3] = {rp->flog, rp->fsam, rp->ftrk};
+    for (int i = 0; i < 3; i++) {
+        if (logs[i] != NULL) {
+            rc = rp_close(rp, logs[i], k_rp_files[i], rc);
+        }
+    }
+    rp->flog = rp->fsam = rp->ftrk = NULL;
     if (rp->tmp[0] != '\0') {
         if (rc == 0 && rename(rp->tmp, rp->o->out) != 0) {
             fprintf(stderr, "rfseek-feed: %s: cannot rename to %s: %s\n", rp->tmp, rp->o->out, strerror(errno));
@@ -977,16 +998,22 @@ static int warn_unheard(const feed_opts_t *fo, const feed_stats_t *st)
     return rc;
 }
 
-int main(int argc, char **argv)
+static int feed_main(int argc, char **argv)
 {
     static feed_opts_t fo;
     int rc = parse_options(argc, argv, &fo);
     if (rc != RUN) {
         return rc;
     }
-    // Outputs checked before the capture is read: not an input, their directory there.
+    // Outputs checked before the capture is read: not an input, their directory there,
+    // no directory at --out (rfseek-sim's rule: the run's files never mix with others).
     const char *ins[3] = {fo.ro.capture, fo.ro.poses, fo.ro.scenario};
     const char *outs[2] = {fo.output, fo.ro.out};
+    struct stat st_out;
+    if (fo.ro.out != NULL && lstat(fo.ro.out, &st_out) == 0) {
+        opt_err("%s: already exists (choose a new --out directory)", fo.ro.out);
+        return 1;
+    }
     for (int i = 0; i < 2; i++) {
         for (int k = 0; outs[i] != NULL && k < 3; k++) {
             if (lx_err_same_file("rfseek-feed", ins[k], outs[i]) != 0) {
@@ -1011,4 +1038,9 @@ int main(int argc, char **argv)
     lx_pcap_close(r);
     if (fo.stats) { print_stats(fo.ro.capture, &st); }
     return rc == 0 && fo.ro.poses == NULL ? warn_unheard(&fo, &st) : rc;
+}
+
+int main(int argc, char **argv)
+{
+    return lx_err_close_stdout("rfseek-feed", feed_main(argc, argv));
 }

@@ -53,7 +53,8 @@ typedef struct recorder {
     FILE *out;                  /* the live output stream, or NULL */
     lx_candump_t *dump;         /* --candump: the bus as a candump -L log, or NULL */
     const char *in_path;
-    int write_failed;
+    int write_failed;           /* a write to `in` failed */
+    int live_failed;            /* a write to `out` failed */
     rfs_app_t *app;
     rfs_replay_player_t *player;
     rfs_can_tx_t tx;            /* the senders' counters (localisation, radio module) */
@@ -109,7 +110,7 @@ static void sink(void *ctx, const uint8_t *p, uint32_t n)
 {
     recorder_t *r = ctx;
     if (r->out != NULL && fwrite(p, 1, n, r->out) != n) {
-        r->write_failed = 1;
+        r->live_failed = 1;
     }
     if (n == RFS_REPLAY_HEADER_LEN && rfs_replay_check_header(p, n) == 0) {
         return; /* the stream's header, written once at the start */
@@ -595,9 +596,9 @@ static int run_mission(recording_t *s, const options_t *o, uint64_t run_seed)
     memset(&r, 0, sizeof r);
     r.type = RFS_REPLAY_END;
     put(rec, &r);
-    const int close_in = fclose(rec->in);
-    const int close_out = rec->out != NULL ? fclose(rec->out) : 0;
-    const bool ok = rc == 0 && !rec->write_failed && close_in == 0 && close_out == 0;
+    const bool in_failed = fclose(rec->in) != 0 || rec->write_failed;
+    const bool out_failed = (rec->out != NULL && fclose(rec->out) != 0) || rec->live_failed;
+    const bool ok = rc == 0 && !in_failed && !out_failed;
     char derr[512];
     if (ok && lx_candump_close(rec->dump, true, derr, sizeof derr) != 0) {
         lx_err_print(PROG, "%s", derr);
@@ -609,15 +610,21 @@ static int run_mission(recording_t *s, const options_t *o, uint64_t run_seed)
     }
     if (!ok) {
         (void)lx_candump_close(rec->dump, false, NULL, 0);
-        lx_err_print(PROG, "%s: %s", rc != 0 ? o->scn_path : o->out_path, rc != 0 ? err : "write failed");
+        lx_err_print(PROG, "%s: %s", rc != 0 ? o->scn_path : in_failed ? o->out_path : o->live_path,
+                     rc != 0 ? err : "write failed");
         remove(s->tmp_in);
         if (o->live_path != NULL) {
             remove(s->tmp_out);
         }
         return 1;
     }
-    if (rename(s->tmp_in, o->out_path) != 0 || (o->live_path != NULL && rename(s->tmp_out, o->live_path) != 0)) {
-        lx_err_print(PROG, "%s: %s", o->out_path, strerror(errno));
+    const bool in_moved = rename(s->tmp_in, o->out_path) == 0;
+    if (!in_moved || (o->live_path != NULL && rename(s->tmp_out, o->live_path) != 0)) {
+        lx_err_print(PROG, "%s: %s", in_moved ? o->live_path : o->out_path, strerror(errno));
+        remove(s->tmp_in);
+        if (o->live_path != NULL) {
+            remove(s->tmp_out);
+        }
         return 1;
     }
     printf("recorded %" PRIu32 " records, %" PRIu32 " steps, %.1f s simulated, %s, "
@@ -628,7 +635,7 @@ static int run_mission(recording_t *s, const options_t *o, uint64_t run_seed)
     return 0;
 }
 
-int main(int argc, char **argv)
+static int record_main(int argc, char **argv)
 {
     static recording_t s;
     options_t o;
@@ -641,5 +648,10 @@ int main(int argc, char **argv)
     }
     const uint64_t run_seed = o.have_seed ? o.seed : s.sc.seed;
     record_config(&s, &o, run_seed);
-    return lx_err_close_stdout(PROG, run_mission(&s, &o, run_seed));
+    return run_mission(&s, &o, run_seed);
+}
+
+int main(int argc, char **argv)
+{
+    return lx_err_close_stdout(PROG, record_main(argc, argv));
 }

@@ -5,7 +5,8 @@
  * Runs the scenario like rfseek-sim, but the controller is rfseekd --clock-lcm in another
  * process: poses and RSSI go out on LCM, one RFS_CLOCK per control period, and the
  * simulated motor controller takes the wheel commands from CAN (SocketCAN with --can,
- * else the LCM fallback channel RFS_CAN_FALLBACK). Prints summary.json to stdout.
+ * else the LCM fallback channel RFS_CAN_FALLBACK). Prints summary.json to stdout, checked
+ * at exit like every program's (lx_err_close_stdout).
  */
 #include <errno.h>
 #include <stdio.h>
@@ -29,11 +30,11 @@ static const char usage_text[] =
 
 static const char PROG[] = "rfseek-sim-lcm"; /* the prefix of its error lines (lx_err_print) */
 
-int main(int argc, char **argv)
+static int sim_lcm_main(int argc, char **argv)
 {
     const char *scn = NULL;
     hs_ctrl_lcm_cfg_t cfg = hs_ctrl_lcm_cfg_default();
-    cfg.prog = "rfseek-sim-lcm";
+    cfg.prog = PROG;
     long long seed = -1;
     double max_time = 0;
     for (int i = 1; i < argc; i++) {
@@ -125,4 +126,9 @@ int main(int argc, char **argv)
     }
     hs_sim_env_close(&env);
     return timeouts ? 1 : 0;
+}
+
+int main(int argc, char **argv)
+{
+    return lx_err_close_stdout(PROG, sim_lcm_main(argc, argv));
 }

@@ -10,10 +10,12 @@
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
+#include <dirent.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <sys/wait.h>
@@ -46,7 +48,8 @@ static void usage(FILE *f)
             "  --jobs N        worker processes for --seeds (default: all cores)\n"
             "  --resume        with --seeds and --out: continue the interrupted batch in DIR\n"
             "                  (SIGINT or SIGTERM leave DIR with the finished seeds and\n"
-            "                  DIR/batch.state); the same scenario, seeds and options needed\n"
+            "                  DIR/batch.state; SIGKILL leaves them in DIR.tmp-PID, found\n"
+            "                  when DIR is missing); the same scenario, seeds and options needed\n"
             "  --emit-jobs     print one command per seed (for GNU parallel or a Slurm array)\n"
             "                  instead of running; merge with scripts/merge_runs.py DIR\n"
             "  --strategy NAME seeking strategy, overriding the scenario's: meta, meta-global,\n"
@@ -281,6 +284,7 @@ typedef struct batch {
     char **rows;          /* by seed - a: the runs.tsv row (malloc'd), NULL until done */
     FILE *state;          /* dir/batch.state, appended as seeds finish, or NULL */
     pid_t *pids;
+    pid_t parent;         /* this process, the workers' parent */
     int fds[2];           /* the workers' pipe */
     uint64_t done, reached;
     char msg[512];        /* the first worker's error */
@@ -292,6 +296,11 @@ static _Noreturn void batch_worker(const batch_t *bt, int j)
 {
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);
+    /* The parent killed (SIGKILL): end too, rather than write on into a directory that a
+     * --resume may already have taken over. */
+    if (prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || getppid() != bt->parent) {
+        _exit(1);
+    }
     close(bt->fds[0]);
     for (uint64_t k = (uint64_t)j; k < bt->ntodo; k += (uint64_t)bt->jobs) {
         const uint64_t s = bt->todo[k];
@@ -333,6 +342,7 @@ static int batch_fork(batch_t *bt)
 {
     fflush(stdout);
     fflush(stderr);
+    bt->parent = getpid();
     for (int j = 0; j < bt->jobs; j++) {
         pid_t pid = fork();
         if (pid < 0) {
@@ -510,13 +520,15 @@ static int batch_resume(batch_t *bt, const char *header)
                      "same scenario, --seeds and options needed)", path);
         rc = 1;
     }
+    long at = ftell(f), cut = -1;
     while (rc == 0 && fgets(line, sizeof line, f)) {
         char *end;
         errno = 0;
         unsigned long long s = strtoull(line, &end, 10);
         size_t len = strlen(line);
         if (errno != 0 || *end != '\t' || len == 0 || line[len - 1] != '\n') {
-            break; /* a row cut by SIGKILL: that seed is redone */
+            cut = at; /* a row cut by SIGKILL: that seed is redone, the rows go on from here */
+            break;
         }
         if (s < bt->a || s - bt->a >= bt->total || bt->rows[s - bt->a] != NULL) {
             lx_err_print(prog, "%s: seed %llu outside the batch or listed twice", path, s);
@@ -531,8 +543,13 @@ static int batch_resume(batch_t *bt, const char *header)
         }
         bt->done++;
         bt->reached += strncmp(end, "\t1\t", 3) == 0 ? 1u : 0u;
+        at = ftell(f);
     }
     fclose(f);
+    if (rc == 0 && cut >= 0 && truncate(path, cut) != 0) {
+        fprintf(stderr, "%s: %s: %s\n", prog, path, strerror(errno));
+        rc = 1;
+    }
     if (rc == 0) {
         drop_unfinished(bt);
     }
@@ -664,6 +681,7 @@ typedef struct sim_opts {
     const char *start, *source;   /* --start X,Y[,THETA], --source X,Y: placement overrides */
     long jobs;
     uint64_t sa, sb;              /* --seeds A..B */
+    char from[PATH_MAX + 64];     /* --resume: the interrupted batch's directory */
 } sim_opts_t;
 
 enum { RUN = -1 }; /* parse_options: go on (else the exit status) */
@@ -749,6 +767,56 @@ static int parse_options(int argc, char **argv, sim_opts_t *o)
     return RUN;
 }
 
+/* --resume when DIR is missing: the DIR.tmp-PID a batch killed by SIGKILL left (its
+ * batch.state written as the batch began, a row per finished seed), PID no longer running,
+ * into o->from. RUN, or the exit status after a message (none, several, or still running). */
+static int find_killed_batch(sim_opts_t *o)
+{
+    const char *slash = strrchr(o->out, '/');
+    const int plen = slash ? (int)(slash - o->out) + 1 : 0; /* "folder/" or "" */
+    const char *base = o->out + plen;
+    const size_t bl = strlen(base);
+    char parent[PATH_MAX];
+    snprintf(parent, sizeof parent, "%.*s", plen > 0 ? plen : 1, plen > 0 ? o->out : ".");
+    DIR *d = bl > 0 ? opendir(parent) : NULL;
+    const struct dirent *e;
+    long running = 0;
+    o->from[0] = '\0';
+    while (d != NULL && (e = readdir(d)) != NULL) {
+        char *end, dir[PATH_MAX + 64], state[PATH_MAX + 128];
+        struct stat st;
+        if (strncmp(e->d_name, base, bl) != 0 || strncmp(e->d_name + bl, ".tmp-", 5) != 0) {
+            continue;
+        }
+        errno = 0;
+        const long pid = strtol(e->d_name + bl + 5, &end, 10);
+        if (errno != 0 || *end != '\0' || pid <= 0 || pid > INT_MAX ||
+            snprintf(dir, sizeof dir, "%.*s%s", plen, o->out, e->d_name) >= (int)sizeof dir ||
+            !join(state, sizeof state, dir, k_state) || stat(state, &st) != 0 || !S_ISREG(st.st_mode)) {
+            continue;
+        }
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) {
+            running = pid;
+        } else if (o->from[0] != '\0') {
+            closedir(d);
+            return die("%s: two killed batches (%s and another): keep one (rename it to the --out "
+                       "name) and --resume it", o->out, o->from);
+        } else {
+            snprintf(o->from, sizeof o->from, "%s", dir);
+        }
+    }
+    if (d != NULL) {
+        closedir(d);
+    }
+    if (o->from[0] == '\0') {
+        char pid[32];
+        snprintf(pid, sizeof pid, "%ld", running);
+        return running ? die("%s: its batch is still running (process %s): nothing to resume", o->out, pid)
+                       : die("%s: not an interrupted batch (no batch.state): nothing to resume%s", o->out, "");
+    }
+    return RUN;
+}
+
 /* The options that go together, checked: RUN, or the exit status after a message. */
 static int check_options(sim_opts_t *o)
 {
@@ -784,13 +852,17 @@ static int check_options(sim_opts_t *o)
         struct stat st;
         char state[PATH_MAX + 64];
         snprintf(state, sizeof state, "%s/%s", o->out, k_state);
-        if (o->resume && stat(state, &st) != 0) {
+        if (o->resume && stat(state, &st) == 0) {
+            snprintf(o->from, sizeof o->from, "%s", o->out);
+        } else if (o->resume && stat(o->out, &st) == 0) {
             return die("%s: not an interrupted batch (no batch.state): nothing to resume%s", o->out, "");
+        } else if (o->resume && find_killed_batch(o) != RUN) {
+            return 1;
         }
         if (!o->resume && stat(o->out, &st) == 0) {
             return die("%s: already exists (choose a new --out directory)%s", o->out, "");
         }
-        if (!o->emit && lx_err_check_dest(prog, o->out) != 0) {
+        if (!o->emit && !o->resume && lx_err_check_dest(prog, o->out) != 0) {
             return 1;
         }
     }
@@ -934,8 +1006,8 @@ static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
     if (o->out) {
         // A resumed batch goes on in the temporary directory like a new one.
         if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", o->out, (long)getpid()) >= (int)sizeof tmp ||
-            (o->resume ? rename(o->out, tmp) : mkdir(tmp, 0777)) != 0) {
-            fprintf(stderr, "%s: %s: %s\n", prog, o->resume ? o->out : tmp, strerror(errno));
+            (o->resume ? rename(o->from, tmp) : mkdir(tmp, 0777)) != 0) {
+            fprintf(stderr, "%s: %s: %s\n", prog, o->resume ? o->from : tmp, strerror(errno));
             hs_sim_env_close(&env);
             return 1;
         }

@@ -5,7 +5,8 @@
 # NAME is can, lcm, map, png, scenario, pcap, poses, candump (BUILD/fuzz/fuzz_NAME), radiotap (BUILD/feed/) or replay
 # (BUILD/firmware/). New inputs go to BUILD/fuzz/corpus-NAME and crashes to
 # BUILD/fuzz/artifacts/, never into tests/fuzz/corpus. Prints one PASS/FAIL line per
-# target with executions, executions/s and coverage; exits non-zero on any FAIL.
+# target with executions, wall time, executions/s and coverage (cov: edges, ft: features);
+# a FAIL names the finding and its input. Exits non-zero on any FAIL.
 set -uo pipefail
 usage() { echo "usage: run_all.sh BUILD (--runs N | --seconds S) NAME..." >&2; exit 2; }
 [ "${1:-}" = --help ] && { sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
@@ -40,12 +41,14 @@ for name in "$@"; do
     status=$?
     end=$(date +%s.%N)
     execs=$(sed -nE 's/^stat::number_of_executed_units: *([0-9]+).*/\1/p' "$log" | tail -1)
-    cov=$(grep -oE 'cov: [0-9]+' "$log" | tail -1)
+    cov=$(grep -oE 'cov: [0-9]+ ft: [0-9]+' "$log" | tail -1)
+    wall=$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.0f", b - a }')
     rate=$(awk -v e="${execs:-0}" -v a="$start" -v b="$end" 'BEGIN { printf "%.0f", e / (b - a) }')
     if [ $status -eq 0 ]; then
-        echo "PASS fuzz_$name: $n corpus inputs, ${execs:-?} executions, $rate exec/s, ${cov:-cov: ?}"
+        echo "PASS fuzz_$name: $n corpus inputs, ${execs:-?} executions, $wall s, $rate exec/s, ${cov:-cov: ?}"
     else
-        echo "FAIL fuzz_$name: crash, leak or sanitizer report (log $log, input in $art/)"
+        finding=$(grep -m1 -oE 'ERROR: (AddressSanitizer|LeakSanitizer|UndefinedBehaviorSanitizer|libFuzzer): [a-z-]+( [a-z-]+)*|runtime error: .*' "$log")
+        echo "FAIL fuzz_$name: ${finding:-crash, leak or sanitizer report} after ${execs:-?} executions, $wall s (log $log, input in $art/)"
         grep -E 'ERROR|runtime error|SUMMARY|Test unit written' "$log" | head -10
         rc=1
     fi

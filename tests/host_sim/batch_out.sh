@@ -2,8 +2,9 @@
 # batch_out.sh - rfseek-sim's outputs under stress: a seed range at the top of uint64 (one
 # seed, no wrap) and one too large (refused), stdout on /dev/full (single and batch), a
 # full disk (a 200 KB tmpfs: one error line, nothing left), and a batch interrupted by
-# SIGINT / SIGTERM then continued with --resume to the very table an uninterrupted batch
-# writes; scripts/merge_runs.py on an interrupted directory names the missing seeds.
+# SIGINT / SIGTERM / SIGKILL then continued with --resume to the very table an
+# uninterrupted batch writes; scripts/merge_runs.py on an interrupted directory names the
+# missing seeds.
 #   tests/host_sim/batch_out.sh build/bin/rfseek-sim        (from the repository root)
 set -uo pipefail
 SIM=${1:?usage: batch_out.sh path/to/rfseek-sim}
@@ -67,13 +68,16 @@ else
 fi
 
 # --- interrupted and resumed batches -------------------------------------------------------
-# interrupt SIG DIR: start 1..40 into DIR, signal it once 3 seeds are finished.
+# interrupt SIG DIR [ARGS]: start 1..40 into DIR (with ARGS), signal it once 3 more seeds
+# are finished.
 interrupt() {
-    "$SIM" $SCN --seeds 1..40 --jobs 2 --quiet --out "$2" 2>"$T/err" &
+    local n0
+    n0=$(cat "$2"/batch.state 2>/dev/null | wc -l)
+    "$SIM" $SCN --seeds 1..40 --jobs 2 --quiet --out "$2" "${@:3}" 2>"$T/err" &
     local pid=$! n=0
     for _ in $(seq 600); do
         n=$(cat "$2".tmp-*/batch.state 2>/dev/null | wc -l)
-        [ "$n" -ge 4 ] && break
+        [ "$n" -ge $((n0 > 0 ? n0 + 3 : 4)) ] && break
         sleep 0.05
     done
     kill -"$1" $pid
@@ -97,8 +101,46 @@ for sig in INT TERM; do
     check "resume-$sig" '[ $? -eq 0 ] && [ ! -s "$T/err" ] && cmp "$d/runs.tsv" "$T/whole/runs.tsv" && [ ! -e "$d/batch.state" ] && [ $(ls -d "$d"/seed-* | wc -l) -eq 40 ]'
     check "resume-$sig-seed-logs" 'diff -r "$d" "$T/whole" >/dev/null'
 done
+# SIGKILL: no handler runs. The batch's DIR.tmp-PID holds batch.state (written as the batch
+# began, a row per finished seed) and is what --resume takes when DIR is missing; refused
+# while that batch still runs, and when two killed batches are left; the workers end with
+# their parent.
+d=$T/cutKILL
+"$SIM" $SCN --seeds 1..40 --jobs 2 --quiet --out "$d" 2>/dev/null &
+pid=$!
+for _ in $(seq 600); do
+    [ "$(cat "$d".tmp-*/batch.state 2>/dev/null | wc -l)" -ge 4 ] && break
+    sleep 0.05
+done
+"$SIM" $SCN --seeds 1..40 --quiet --out "$d" --resume 2>"$T/err"
+one_line resume-KILL-still-running $? "its batch is still running (process $pid)"
+{ kill -KILL $pid; wait $pid; } 2>/dev/null # (bash's "Killed" notice)
+sleep 0.2
+check "interrupt-KILL-workers-gone" '! pgrep -f -- "--out $d\$" >/dev/null'
+check "interrupt-KILL-leaves-tmp" '[ ! -e "$d" ] && [ -f "$d.tmp-$pid/batch.state" ] && [ $(ls -d "$d".tmp-* | wc -l) -eq 1 ]'
+cp -r "$d.tmp-$pid" "$d.tmp-2147483647" # a PID above pid_max: a process that cannot run
+"$SIM" $SCN --seeds 1..40 --quiet --out "$d" --resume 2>"$T/err"
+one_line resume-KILL-two-left $? "two killed batches"
+rm -rf "$d.tmp-2147483647"
+"$SIM" $SCN --seeds 1..40 --jobs 2 --quiet --out "$d" --resume 2>"$T/err"
+check "resume-KILL" '[ $? -eq 0 ] && [ ! -s "$T/err" ] && cmp "$d/runs.tsv" "$T/whole/runs.tsv" && [ ! -e "$d/batch.state" ] && ! compgen -G "$d.tmp-*" >/dev/null'
+check "resume-KILL-seed-logs" 'diff -r "$d" "$T/whole" >/dev/null'
+
+# A row cut by SIGKILL is dropped from batch.state as the batch resumes, so rows appended
+# after it are whole when that batch is interrupted and resumed again.
+d=$T/cutrow
+interrupt INT "$d"
+todo=$(comm -23 <(seq 1 40 | sort) <(tail -n +2 "$d/batch.state" | cut -f1 | sort) | head -1)
+printf '%s\t1\t12.5' "$todo" >>"$d/batch.state"
+interrupt INT "$d" --resume
+check "resume-cut-row-dropped" '! grep -q "12\.5[0-9]" "$d/batch.state" && [ "$(tail -c 1 "$d/batch.state" | od -An -c | tr -d " ")" = "\\n" ]'
+"$SIM" $SCN --seeds 1..40 --jobs 2 --quiet --out "$d" --resume 2>"$T/err"
+check "resume-cut-row-twice" '[ $? -eq 0 ] && [ ! -s "$T/err" ] && cmp "$d/runs.tsv" "$T/whole/runs.tsv"'
+
 "$SIM" $SCN --seeds 1..40 --quiet --out "$T/whole" --resume 2>"$T/err"
 one_line resume-finished-batch $? "not an interrupted batch"
+"$SIM" $SCN --seeds 1..40 --quiet --out "$T/nothing" --resume 2>"$T/err"
+one_line resume-nothing $? "not an interrupted batch"
 interrupt INT "$T/cutx"
 "$SIM" $SCN --seeds 1..41 --quiet --out "$T/cutx" --resume 2>"$T/err"
 one_line resume-other-seeds $? "another batch"

@@ -385,6 +385,33 @@ static void test_yaml_depth(void **state)
     rmdir(dir);
 }
 
+/* lx_yaml_read: a stream of max bytes is read whole, one of max + 1 or more gives max + 1
+ * (the caller's "larger than" verdict); the bytes arrive unchanged across the buffer's
+ * growth (4 KB, doubled), including at the growth boundaries. */
+static void test_yaml_read_bounds(void **state)
+{
+    (void)state;
+    enum { MAX = 20000 };
+    static uint8_t src[MAX + 100];
+    for (size_t i = 0; i < sizeof(src); i++) {
+        src[i] = (uint8_t)(i * 131u + 7u);
+    }
+    const size_t sizes[] = {0, 1, 4095, 4096, 4097, 8192, MAX - 1, MAX, MAX + 1, MAX + 100};
+    for (size_t k = 0; k < sizeof(sizes) / sizeof(sizes[0]); k++) {
+        FILE *f = sizes[k] > 0 ? fmemopen(src, sizes[k], "rb") : fopen("/dev/null", "rb");
+        assert_non_null(f);
+        uint8_t *b = NULL;
+        size_t n = 99;
+        assert_int_equal(lx_yaml_read(f, MAX, &b, &n), 0);
+        fclose(f);
+        const size_t want = sizes[k] > MAX ? MAX + 1 : sizes[k];
+        assert_int_equal(n, want);
+        assert_non_null(b);
+        assert_memory_equal(b, src, want);
+        free(b);
+    }
+}
+
 static long max_rss_kb(void)
 {
     struct rusage ru;
@@ -457,6 +484,7 @@ int main(void)
         cmocka_unit_test(test_core_rejects),
         cmocka_unit_test(test_image_bounded),
         cmocka_unit_test(test_yaml_depth),
+        cmocka_unit_test(test_yaml_read_bounds),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -255,6 +255,87 @@ static void bad_url_and_unreadable_log_give_one_line(void **state)
     assert_string_equal(err, "/nonexistent/dir/x.lcmlog: cannot open for reading");
 }
 
+/* A file:// log is read whole before liblcm plays it (read mode: the default, or mode=r):
+ * garbage is one line naming the offset; a log opened for writing is not read. */
+static void damaged_file_url_is_one_line(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/rfs_test_lcm_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    assert_int_equal(write(fd, "hello", 5), 5);
+    close(fd);
+    char url[128], want[256], err[256];
+    const char *opts[2] = {"?speed=0", "?mode=r&speed=0"};
+    for (int k = 0; k < 2; k++) {
+        snprintf(url, sizeof url, "file://%s%s", path, opts[k]);
+        assert_null(lx_lcm_open(url, NULL, err, sizeof err));
+        snprintf(want, sizeof want, "lcm: %s: offset 0: not an LCM event (no sync word)", url);
+        assert_string_equal(err, want);
+    }
+    snprintf(url, sizeof url, "file://%s?speed=0&mode=w", path);
+    lx_lcm_t *l = lx_lcm_open(url, NULL, err, sizeof err);
+    assert_non_null(l);
+    assert_string_equal(err, "");
+    lx_lcm_close(l);
+    remove(path);
+}
+
+/* The reason string's length in a seeker_status_t lies at byte 39 (the .lcm's field order:
+ * fingerprint 8, utime 8, state 1, faults 4, left 2, right 2, decided 1, iteration 4,
+ * decision_utime 8, kind 1). A message stating 2^31 - 1 bytes there, or cut after the
+ * string, is dropped with one line: lcm-gen's decoder malloc'd the stated length and leaked
+ * the string when a later field was cut (found by fuzz_lcm; the ASan build sees leaks). */
+static void status_string_length_checked_before_decoding(void **state)
+{
+    (void)state;
+    rx_t r;
+    lx_lcm_t *l = open_memq(&r);
+    char path[] = "/tmp/rfs_test_lcm_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    char err[200];
+    lx_lcm_log_t *log = lx_lcm_log_open(path, "w", err, sizeof err);
+    assert_non_null(log);
+    lx_lcm_record(l, log);
+    rfs_seek_out_t o;
+    memset(&o, 0, sizeof o);
+    o.decision.kind = RFS_SEEK_GREEDY;
+    assert_int_equal(lx_lcm_pub_status(l, 1000, &o), 0);
+    drain(l);
+    lx_lcm_record(l, NULL);
+    assert_int_equal(lx_lcm_log_close(log), 0);
+    assert_int_equal(r.statuses, 1);
+
+    log = lx_lcm_log_open(path, "r", err, sizeof err);
+    assert_non_null(log);
+    int64_t t;
+    char ch[32];
+    uint8_t msg[512];
+    size_t len = 0;
+    assert_int_equal(lx_lcm_log_next_raw(log, &t, ch, sizeof ch, msg, sizeof msg, &len), 1);
+    assert_int_equal(lx_lcm_log_close(log), 0);
+    remove(path);
+    assert_string_equal(ch, LX_LCM_CH_STATUS);
+    assert_true(len > 50 && len < sizeof msg);
+    assert_memory_equal(msg + 39, "\0\0\0\7greedy", 11);
+
+    char want[160];
+    snprintf(want, sizeof want, "RFS_SEEKER_STATUS: truncated, oversized or not an rfseek.seeker_status_t (%zu bytes)", len);
+    memcpy(msg + 39, "\x7f\xff\xff\xff", 4);
+    assert_int_equal(lx_lcm_pub_raw(l, 0, LX_LCM_CH_STATUS, msg, len), 0);
+    drain(l);
+    assert_int_equal(r.bads, 1);
+    assert_string_equal(r.bad, want);
+    memcpy(msg + 39, "\0\0\0\7", 4);
+    assert_int_equal(lx_lcm_pub_raw(l, 0, LX_LCM_CH_STATUS, msg, 39 + 4 + 7 + 1), 0);
+    drain(l);
+    assert_int_equal(r.bads, 2);
+    assert_int_equal(r.statuses, 1);
+    lx_lcm_close(l);
+}
+
 /* RFS_RSSI_STATUS. Reference bytes from the LCM wire format computed in Python
  * (tests/fuzz/make_corpus.py's lcm_hash of {int64_t utime, int32_t seq} = 0xc77a89abfd4c5ba6,
  * then utime and seq big-endian): utime -5,000,000,123, seq -7. */
@@ -307,6 +388,8 @@ int main(void)
         cmocka_unit_test(malformed_messages_are_dropped_and_described),
         cmocka_unit_test(log_is_written_atomically_and_reads_back),
         cmocka_unit_test(bad_url_and_unreadable_log_give_one_line),
+        cmocka_unit_test(damaged_file_url_is_one_line),
+        cmocka_unit_test(status_string_length_checked_before_decoding),
         cmocka_unit_test(receiver_status_matches_reference_bytes_and_rejects_others),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -104,6 +104,15 @@ int lx_err_check_dest(const char *prog, const char *path)
         lx_err_print(prog, "%s: %s", path, strerror(errno));
         return -1;
     }
+    /* Outputs are renamed into place: over a directory that fails after the work, and over
+     * a device or FIFO (/dev/null) it would replace the node itself. */
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        lx_err_print(prog, "%s: %s", path,
+                     S_ISDIR(st.st_mode) ? strerror(EISDIR)
+                                         : "not a regular file (an output is renamed into place, "
+                                           "which would replace it)");
+        return -1;
+    }
     return 0;
 }
 

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <lcm/eventlog.h>
@@ -219,14 +220,27 @@ static bool status_of(const rfseek_seeker_status_t *m, rfs_seek_out_t *o)
     return true;
 }
 
+/* Where the reason string's int32 length lies in an encoded seeker_status_t: fingerprint
+ * 8, utime 8, state 1, faults 4, left and right 2 + 2, decided 1, iteration 4,
+ * decision_utime 8, kind 1 (tests/wire/test_lcm.c checks it against the encoder). */
+#define LX_LCM_STATUS_REASON_AT 39
+
 static void on_status_msg(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const char *ch, const void *data, int len)
 {
+    /* lcm-gen's decoder mallocs the string length the message states (up to 2 GiB) before
+     * it checks it against the message, and frees nothing when a later field is cut short
+     * (found by tests/fuzz/fuzz_lcm.c): the length is checked first, the struct zeroed so
+     * a failed decode can be cleaned up. */
+    const uint8_t *b = data;
+    const int at = LX_LCM_STATUS_REASON_AT;
+    const int64_t rl = len >= at + 4 ? (int64_t)((uint32_t)b[at] << 24 | (uint32_t)b[at + 1] << 16 |
+                                                 (uint32_t)b[at + 2] << 8 | b[at + 3])
+                                     : -1;
     rfseek_seeker_status_t m;
-    int n = rfseek_seeker_status_t_decode(data, 0, len, &m);
+    memset(&m, 0, sizeof m);
+    int n = rl >= 1 && rl <= len - at - 4 ? rfseek_seeker_status_t_decode(data, 0, len, &m) : -1;
     if (n < 0 || n != len) {
-        if (n >= 0) {
-            rfseek_seeker_status_t_decode_cleanup(&m);
-        }
+        rfseek_seeker_status_t_decode_cleanup(&m);
         bad(s, h, ch, "truncated, oversized or not an rfseek.seeker_status_t (%.0f bytes)", (double)len);
         return;
     }
@@ -416,8 +430,68 @@ static lx_lcm_t *open_provider(const char *url, const lx_lcm_handlers_t *h, char
     return l;
 }
 
+/* The mode a file:// URL opens its log in: the last "mode=" option, "r" when none. */
+static bool file_url_reads(const char *opts)
+{
+    bool reads = true;
+    for (const char *o = opts; o != NULL; o = strchr(o + 1, '&')) {
+        if (strncmp(o + 1, "mode=", 5) == 0) {
+            reads = o[6] == 'r' && (o[7] == '\0' || o[7] == '&');
+        }
+    }
+    return reads;
+}
+
+/* A log played through file:// (read mode, LCM's default): liblcm stops without a word at
+ * an event cut short, prints its own line for a channel name of 1000 bytes or more and
+ * plays on, and callocs whatever data length a damaged header states (event_fits). So the
+ * whole log is read first with the reader of rfseekd --replay; damage is one line "lcm:
+ * URL: offset N: reason". A log that does not open is left to liblcm's own message. */
+static int check_file_log(const char *url, char *err, size_t errlen)
+{
+    if (url == NULL || strncmp(url, "file://", 7) != 0) {
+        return 0;
+    }
+    const char *opts = strchr(url + 7, '?');
+    if (!file_url_reads(opts)) {
+        return 0;
+    }
+    char *path = strndup(url + 7, opts != NULL ? (size_t)(opts - (url + 7)) : strlen(url + 7));
+    struct stat st;
+    char e2[8];
+    if (path != NULL && stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        /* liblcm would scan /dev/zero or a FIFO for a sync word for ever */
+        snprintf(err, errlen, "lcm: %s: not a regular file (an LCM log is read by its lengths)", url);
+        lx_err_one_line(err);
+        free(path);
+        return -1;
+    }
+    lx_lcm_log_t *log = path != NULL ? lx_lcm_log_open(path, "r", e2, sizeof e2) : NULL;
+    free(path);
+    if (log == NULL) {
+        return 0;
+    }
+    int64_t t_us;
+    char ch[8];
+    uint8_t data[8];
+    size_t len;
+    int r;
+    while ((r = lx_lcm_log_next_raw(log, &t_us, ch, sizeof ch, data, sizeof data, &len)) > 0) {
+        /* only the verdict on the whole log matters */
+    }
+    if (r < 0) {
+        snprintf(err, errlen, "lcm: %s: %s", url, lx_lcm_log_error(log));
+        lx_err_one_line(err);
+    }
+    lx_lcm_log_close(log);
+    return r < 0 ? -1 : 0;
+}
+
 lx_lcm_t *lx_lcm_open(const char *url, const lx_lcm_handlers_t *h, char *err, size_t errlen)
 {
+    if (check_file_log(url, err, errlen) != 0) {
+        return NULL;
+    }
     stderr_capture_t cap;
     char said[256];
     capture_start(&cap);
@@ -611,6 +685,14 @@ lx_lcm_log_t *lx_lcm_log_open(const char *path, const char *mode, char *err, siz
         snprintf(err, errlen, "%s: out of memory", path);
         free(log->path);
         free(log->tmp);
+        free(log);
+        return NULL;
+    }
+    struct stat st;
+    if (!w && stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        /* event_fits measures events against the file's size: /dev/zero has none */
+        snprintf(err, errlen, "%s: not a regular file (an LCM log is read by its lengths)", path);
+        free(log->path);
         free(log);
         return NULL;
     }

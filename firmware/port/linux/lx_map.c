@@ -32,8 +32,9 @@ static int read_file(const char *path, size_t max, uint8_t **buf, size_t *len, c
     if (f == NULL) {
         return lx_err_set(err, errlen, path, "cannot open: %s", strerror(errno));
     }
-    uint8_t *b = malloc(max + 1);
-    size_t n = b != NULL ? fread(b, 1, max + 1, f) : 0;
+    uint8_t *b = NULL;
+    size_t n = 0;
+    (void)lx_yaml_read(f, max, &b, &n);
     int bad = ferror(f);
     fclose(f);
     if (b == NULL) {

@@ -147,28 +147,38 @@ lx_yaml_rc_t lx_yaml_load_string(const uint8_t *buf, size_t len, lx_yaml_doc_t *
     return load(&parser, doc, e);
 }
 
+int lx_yaml_read(FILE *f, size_t max, uint8_t **buf, size_t *len)
+{
+    /* Start small and double: a few-line file costs a few kilobytes, not `max`. */
+    size_t cap = max < (1u << 12) ? max + 1 : (1u << 12);
+    size_t n = 0;
+    uint8_t *b = malloc(cap);
+    while (b != NULL) {
+        n += fread(b + n, 1, cap - n, f);
+        if (n < cap || cap > max) {
+            break;
+        }
+        const size_t grow = cap * 2 < max + 1 ? cap * 2 : max + 1;
+        uint8_t *nb = realloc(b, grow);
+        if (nb == NULL) {
+            free(b);
+        }
+        b = nb;
+        cap = grow;
+    }
+    *buf = b;
+    *len = b != NULL ? n : 0;
+    return b != NULL ? 0 : -1;
+}
+
 lx_yaml_rc_t lx_yaml_load_file(FILE *f, lx_yaml_doc_t *doc, lx_yaml_error_t *e)
 {
     memset(doc, 0, sizeof(*doc));
     memset(e, 0, sizeof(*e));
     /* Read whole (the depth check and the load each walk it), at most LX_YAML_MAX_BYTES. */
-    size_t cap = 1u << 16;
+    uint8_t *buf = NULL;
     size_t len = 0;
-    uint8_t *buf = malloc(cap);
-    while (buf != NULL) {
-        len += fread(buf + len, 1, cap - len, f);
-        if (len < cap || cap > LX_YAML_MAX_BYTES) {
-            break;
-        }
-        const size_t grow = cap * 2 < LX_YAML_MAX_BYTES + 1 ? cap * 2 : LX_YAML_MAX_BYTES + 1;
-        uint8_t *nb = realloc(buf, grow);
-        if (nb == NULL) {
-            free(buf);
-        }
-        buf = nb;
-        cap = grow;
-    }
-    if (buf == NULL) {
+    if (lx_yaml_read(f, LX_YAML_MAX_BYTES, &buf, &len) != 0) {
         return LX_YAML_NOMEM;
     }
     lx_yaml_rc_t rc;

@@ -71,6 +71,11 @@ typedef struct lx_yaml_error {
 lx_yaml_rc_t lx_yaml_load_string(const uint8_t *buf, size_t len, lx_yaml_doc_t *doc,
                                  lx_yaml_error_t *e);
 
+/// Read at most max + 1 bytes of the open stream `f` into a malloc'd *buf (*len bytes; more
+/// than max means the stream is longer). The buffer grows with what arrives, so a short
+/// file costs little whatever max is. 0, or -1 when out of memory (*buf NULL).
+int lx_yaml_read(FILE *f, size_t max, uint8_t **buf, size_t *len);
+
 /// Load the first document read from the open stream `f` into `doc` (as above).
 lx_yaml_rc_t lx_yaml_load_file(FILE *f, lx_yaml_doc_t *doc, lx_yaml_error_t *e);
 

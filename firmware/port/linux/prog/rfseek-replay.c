@@ -40,41 +40,42 @@ static void sink(void *ctx, const uint8_t *p, uint32_t n)
 
 static const char PROG[] = "rfseek-replay"; /* the prefix of its error lines (lx_err_print) */
 
-static uint8_t *slurp(const char *path, size_t *len)
+/* The input read as it is parsed, through a window: memory stays RFS_REPLAY_WINDOW
+ * whatever the file (/dev/zero, a stream of hours, an endless pipe), and reading stops at
+ * the END record (a stream) or the end of the file (a log, line by line). */
+#define RFS_REPLAY_WINDOW (1u << 16)
+typedef struct in_stream {
+    FILE *f;
+    uint8_t buf[RFS_REPLAY_WINDOW];
+    size_t pos, len; /* unparsed bytes: buf[pos .. len) */
+    size_t base;     /* file offset of buf[0] */
+    int eof;
+} in_stream_t;
+
+/* At least `want` (<= RFS_REPLAY_WINDOW) unparsed bytes unless the file ends first: the
+ * count there is. */
+static size_t in_fill(in_stream_t *s, size_t want)
 {
-    FILE *f = fopen(path, "rb");
-    if (f == NULL) {
-        lx_err_print(PROG, "%s: %s", path, strerror(errno));
-        return NULL;
+    if (s->len - s->pos < want && !s->eof) {
+        memmove(s->buf, s->buf + s->pos, s->len - s->pos);
+        s->base += s->pos;
+        s->len -= s->pos;
+        s->pos = 0;
+        const size_t n = fread(s->buf + s->len, 1, sizeof s->buf - s->len, s->f);
+        s->len += n;
+        s->eof = s->len < sizeof s->buf;
     }
-    size_t cap = 1 << 16, n = 0;
-    uint8_t *buf = malloc(cap);
-    for (;;) {
-        if (buf == NULL) {
-            lx_err_print(PROG, "%s: out of memory", path);
-            fclose(f);
-            return NULL;
-        }
-        n += fread(buf + n, 1, cap - n, f);
-        if (n < cap) {
-            break;
-        }
-        cap *= 2;
-        uint8_t *nb = realloc(buf, cap);
-        if (nb == NULL) {
-            free(buf);
-        }
-        buf = nb;
+    return s->len - s->pos;
+}
+
+/* 0, or 1 after a message when reading `in` failed. */
+static int in_error(const in_stream_t *in, const char *in_path)
+{
+    if (ferror(in->f)) {
+        lx_err_print(PROG, "%s: read error", in_path);
+        return 1;
     }
-    const int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        lx_err_print(PROG, "%s: read error", path);
-        free(buf);
-        return NULL;
-    }
-    *len = n;
-    return buf;
+    return 0;
 }
 
 static const char *type_name(rfs_replay_type_t t)
@@ -324,17 +325,17 @@ static bool take(void *ctx, const rfs_replay_rec_t *rec)
     return rfs_replay_play(r->player, rec);
 }
 
-/* The records of an rfseek stream in buf[0..len): 0, or 1 after a message. */
-static int play_stream(const char *in_path, const uint8_t *buf, size_t len, run_t *r)
+/* The records of an rfseek stream after its header, until END or the end of the file:
+ * 0, or 1 after a message naming the offset. */
+static int play_stream(const char *in_path, in_stream_t *in, run_t *r)
 {
-    size_t pos = RFS_REPLAY_HEADER_LEN;
     int ended = 0, inputs = 0;
-    while (pos < len) {
+    size_t left;
+    while ((left = in_fill(in, RFS_REPLAY_MAX_RECORD)) > 0) {
         rfs_replay_rec_t rec;
         uint32_t used = 0;
-        const size_t left = len - pos;
-        const rfs_replay_status_t st =
-            rfs_replay_parse(buf + pos, (uint32_t)(left > 65536 ? 65536 : left), &used, &rec);
+        const size_t pos = in->base + in->pos;
+        const rfs_replay_status_t st = rfs_replay_parse(in->buf + in->pos, (uint32_t)left, &used, &rec);
         if (st != RFS_REPLAY_OK) {
             lx_err_print(PROG, "%s: offset %zu: %s", in_path, pos,
                      st == RFS_REPLAY_NEED_MORE ? "truncated record" : rec.error);
@@ -344,14 +345,17 @@ static int play_stream(const char *in_path, const uint8_t *buf, size_t len, run_
             lx_err_print(PROG, "%s: offset %zu: %s", in_path, pos, rfs_replay_err_str(r->player->error));
             return 1;
         }
-        pos += used;
+        in->pos += used;
         inputs |= rec.type < RFS_REPLAY_END;
         if (rec.type == RFS_REPLAY_END) {
             ended = 1;
             break;
         }
     }
-    return check_end(in_path, pos, ended, inputs);
+    if (in_error(in, in_path) != 0) {
+        return 1;
+    }
+    return check_end(in_path, in->base + in->pos, ended, inputs);
 }
 
 /* A candump log's CFG and MAP records, from the options: 0, or 1 after a message. */
@@ -389,28 +393,31 @@ static int candump_config(const options_t *o, run_t *r)
     return rc;
 }
 
-/* A candump -L log in buf[0..len) as the records of a stream: each classic 11-bit data
- * frame a CAN record at its time, but the controller's own: its WHEEL_CMD is a STEP (the
- * controller ran then), its STATUS nothing; END at the end. Remote, error and 29-bit frames
- * are not on our protocol and are passed over. 0, or 1 after a message. */
-static int play_candump(const options_t *o, const uint8_t *buf, size_t len, run_t *r)
+/* A candump -L log, read line by line, as the records of a stream: each classic 11-bit
+ * data frame a CAN record at its time, but the controller's own: its WHEEL_CMD is a STEP
+ * (the controller ran then), its STATUS nothing; END at the end. Remote, error and 29-bit
+ * frames are not on our protocol and are passed over. 0, or 1 after a message. */
+static int play_candump(const options_t *o, in_stream_t *in, run_t *r)
 {
     if (!r->print && candump_config(o, r) != 0) {
         return 1;
     }
     char bus[LX_CANDUMP_IFNAME_MAX + 1u] = "";
     unsigned long line = 0, steps = 0;
-    for (size_t pos = 0; pos < len;) {
+    size_t left;
+    /* The longest line, its '\r' and '\n': a line not ended within is too long. */
+    while ((left = in_fill(in, LX_CANDUMP_LINE_MAX + 2u)) > 0) {
         line++;
-        const uint8_t *nl = memchr(buf + pos, '\n', len - pos);
-        const size_t n = nl != NULL ? (size_t)(nl - (buf + pos)) : len - pos;
+        const uint8_t *at = in->buf + in->pos;
+        const uint8_t *nl = memchr(at, '\n', left);
+        const size_t n = nl != NULL ? (size_t)(nl - at) : left;
         lx_candump_rec_t c;
         const char *why = NULL;
-        if (lx_candump_parse((const char *)buf + pos, n, &c, &why) != 0) {
+        if (lx_candump_parse((const char *)at, n, &c, &why) != 0) {
             lx_err_print(PROG, "%s:%lu: %s", o->in_path, line, why);
             return 1;
         }
-        pos += n + (nl != NULL ? 1u : 0u);
+        in->pos += n + (nl != NULL ? 1u : 0u);
         if (bus[0] == '\0') {
             memcpy(bus, c.ifname, sizeof bus);
         } else if (strcmp(bus, c.ifname) != 0) {
@@ -437,6 +444,9 @@ static int play_candump(const options_t *o, const uint8_t *buf, size_t len, run_
             lx_err_print(PROG, "%s:%lu: %s", o->in_path, line, rfs_replay_err_str(r->player->error));
             return 1;
         }
+    }
+    if (in_error(in, o->in_path) != 0) {
+        return 1;
     }
     if (!r->print && steps == 0) {
         lx_err_print(PROG, "%s: no WHEEL_CMD (100) frame: the controller never ran", o->in_path);
@@ -475,25 +485,31 @@ static int replay_main(int argc, char **argv)
     if (rc != RUN) {
         return rc;
     }
-    size_t len = 0;
-    uint8_t *buf = slurp(o.in_path, &len);
-    if (buf == NULL) {
+    static in_stream_t in;
+    memset(&in, 0, sizeof in);
+    in.f = fopen(o.in_path, "rb");
+    if (in.f == NULL) {
+        lx_err_print(PROG, "%s: %s", o.in_path, strerror(errno));
         return 1;
     }
-    const bool candump = len > 0 && buf[0] == '(';
-    if (!candump && rfs_replay_check_header(buf, (uint32_t)(len < 8 ? len : 8)) != 0) {
-        lx_err_print(PROG, "%s: offset 0: not an rfseek stream (bad header) nor a candump -L log", o.in_path);
-        free(buf);
+    const size_t head = in_fill(&in, RFS_REPLAY_HEADER_LEN);
+    const bool candump = head > 0 && in.buf[0] == '(';
+    if (in_error(&in, o.in_path) != 0 ||
+        (!candump && rfs_replay_check_header(in.buf, (uint32_t)(head < 8 ? head : 8)) != 0)) {
+        if (!ferror(in.f)) {
+            lx_err_print(PROG, "%s: offset 0: not an rfseek stream (bad header) nor a candump -L log", o.in_path);
+        }
+        fclose(in.f);
         return 1;
     }
     if (o.ctl_opt != NULL && (o.print || !candump)) {
         lx_err_print(PROG, "%s: only for playing a candump -L log (see --help)", o.ctl_opt);
-        free(buf);
+        fclose(in.f);
         return 2;
     }
     if (candump && !o.print && o.map_path == NULL) {
         lx_err_print(PROG, "%s: a candump -L log is played with --map MAP.yaml (see --help)", o.in_path);
-        free(buf);
+        fclose(in.f);
         return 2;
     }
     static rfs_replay_player_t player;
@@ -505,18 +521,21 @@ static int replay_main(int argc, char **argv)
         sc.f = fopen(tmp, "wb");
         if (sc.f == NULL) {
             lx_err_print(PROG, "%s: %s", o.out_path, strerror(errno));
-            free(buf);
+            fclose(in.f);
             return 1;
         }
         if (start_player(&player, &sc) != 0) {
             fclose(sc.f);
             remove(tmp);
-            free(buf);
+            fclose(in.f);
             return 1;
         }
     }
-    rc = candump ? play_candump(&o, buf, len, &run) : play_stream(o.in_path, buf, len, &run);
-    free(buf);
+    if (!candump) {
+        in.pos = RFS_REPLAY_HEADER_LEN;
+    }
+    rc = candump ? play_candump(&o, &in, &run) : play_stream(o.in_path, &in, &run);
+    fclose(in.f);
     if (!o.print) {
         if (fclose(sc.f) != 0 || sc.failed) {
             lx_err_print(PROG, "%s: write failed", o.out_path);

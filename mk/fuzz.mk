@@ -5,7 +5,7 @@
 # -fsanitize=fuzzer,address,undefined.
 #   make fuzz [FUZZ_SECONDS=300] [FUZZ_TARGETS="can map"]   each target for that long
 #   make fuzz-long [FUZZ_LONG_RUNS=10000000]   each target for that many executions, one after
-#   another under nice -n 19 (the figures in docs/RELIABILITY.md, "Long runs")
+#   another under nice -n 19 (the figures in docs/RELIABILITY.md, "Fuzz targets")
 # New inputs go to $(FUZZ_DIR)/corpus-<name>, crashes to $(FUZZ_DIR)/artifacts/; `make test`
 # runs each over its committed corpus plus a short burst.
 FUZZ_CC ?= clang
@@ -64,7 +64,7 @@ $(FEED)/fuzz_radiotap: tests/fuzz/fuzz_radiotap.c $(FUZZ_LX)/lx_radiotap.c $(FUZ
 		-fno-sanitize-recover=all $< $(FUZZ_LX)/lx_radiotap.c -o $@
 # fuzz_replay: the lattice and reachability code compares map cells and lattice bounds,
 # not input bytes; built without comparison tracing (edges still counted) a control period
-# costs a third (docs/RELIABILITY.md, "Long runs").
+# costs a third (CHANGELOG.md, "Fuzzing speed").
 FUZZ_FW_SRCS := firmware/rfs_app.c firmware/rfs_replay.c
 FUZZ_NOCMP := common/rfs_map.c common/rfs_reach.c
 FUZZ_NOCMP_OBJS := $(FUZZ_NOCMP:common/%.c=$(FW)/fuzz-nocmp/%.o)

@@ -293,12 +293,18 @@ static void leg_of(const rfs_drive_t *d, leg_t *g)
     g->c = rfs_sdiv64_round(g->dx * g->py - g->dy * g->px, g->len);
 }
 
+/* Distance from pose p to waypoint i, millimetres. */
+static int64_t pose_dist_mm(const rfs_drive_t *d, const rfs_pose_t *p, uint16_t i)
+{
+    int64_t x = q16_to_mm((int64_t)d->path.x[i] - p->x);
+    int64_t y = q16_to_mm((int64_t)d->path.y[i] - p->y);
+    return (int64_t)rfs_isqrt64((uint64_t)(x * x + y * y));
+}
+
 /* Distance from the estimate to waypoint i, millimetres. */
 static int64_t dist_mm(const rfs_drive_t *d, uint16_t i)
 {
-    int64_t x = q16_to_mm((int64_t)d->path.x[i] - d->est.x);
-    int64_t y = q16_to_mm((int64_t)d->path.y[i] - d->est.y);
-    return (int64_t)rfs_isqrt64((uint64_t)(x * x + y * y));
+    return pose_dist_mm(d, &d->est, i);
 }
 
 /* Skip the waypoints passed, each one restarting the stall reference: one by crossing its
@@ -435,14 +441,6 @@ static void steer(rfs_drive_t *d, const leg_t *g, int32_t *tl, int32_t *tr)
     }
 }
 
-/* Distance from the localisation pose to waypoint i, millimetres. */
-static int64_t raw_dist_mm(const rfs_drive_t *d, const rfs_pose_t *pose, uint16_t i)
-{
-    int64_t x = q16_to_mm((int64_t)d->path.x[i] - pose->x);
-    int64_t y = q16_to_mm((int64_t)d->path.y[i] - pose->y);
-    return (int64_t)rfs_isqrt64((uint64_t)(x * x + y * y));
-}
-
 /* One update of a running goal: the status, wheel targets in *tl, *tr. */
 static rfs_drive_status_t follow(rfs_drive_t *d, const rfs_pose_t *pose, int64_t now_us,
                                  int32_t *tl, int32_t *tr)
@@ -464,7 +462,7 @@ static rfs_drive_status_t follow(rfs_drive_t *d, const rfs_pose_t *pose, int64_t
     if (at_goal) {
         return d->left_mm_s == 0 && d->right_mm_s == 0 ? RFS_DRIVE_REACHED : RFS_DRIVE_RUNNING;
     }
-    rfs_drive_status_t st = stalled(d, raw_dist_mm(d, pose, d->next), now_us) ? RFS_DRIVE_BLOCKED
+    rfs_drive_status_t st = stalled(d, pose_dist_mm(d, pose, d->next), now_us) ? RFS_DRIVE_BLOCKED
                                                                              : RFS_DRIVE_RUNNING;
     steer(d, &g, tl, tr);
     return st;

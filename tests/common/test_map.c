@@ -2,7 +2,7 @@
  *
  * Reference rules (docs/MAPS.md), computed here by brute force in double:
  *  - a cell is legal when no non-free or off-map cell's square comes closer than the
- *    clearance to its centre (the cell itself always counts);
+ *    clearance to its square (the cell itself always counts);
  *  - a segment touches a cell when the closed segment and the closed square intersect
  *    (separating-axis test on the x, y and segment-normal axes, exact in double because
  *    coordinates are Q16 integers below 2^21);
@@ -87,8 +87,6 @@ static int ref_cell_legal(const fixture_t *f, int cx, int cy)
 {
     double r = f->res / 65536.0;
     double c = f->clr / 65536.0;
-    double px = (cx + 0.5) * r;
-    double py = (cy + 0.5) * r;
     if (!ref_free(f, cx, cy)) {
         return 0;
     }
@@ -97,8 +95,9 @@ static int ref_cell_legal(const fixture_t *f, int cx, int cy)
             if (ref_free(f, x, y)) {
                 continue;
             }
-            double ex = fmax(0.0, fmax(x * r - px, px - (x + 1) * r));
-            double ey = fmax(0.0, fmax(y * r - py, py - (y + 1) * r));
+            /* gap between the squares [cx, cx+1] r and [x, x+1] r, per axis */
+            double ex = fmax(0.0, fmax(x * r - (cx + 1) * r, cx * r - (x + 1) * r));
+            double ey = fmax(0.0, fmax(y * r - (cy + 1) * r, cy * r - (y + 1) * r));
             if (sqrt(ex * ex + ey * ey) < c) {
                 return 0;
             }
@@ -287,13 +286,13 @@ static void test_map_edges(void **state)
     bits_t *b = all_free();
     rfs_map_t m;
     rfs_map_cfg_t cfg = rfs_map_cfg_default();
-    /* res 0.1 as the loader rounds it (Q16 6554 = 0.100006 m), clearance 0.25 m: cell 2's
-     * centre is 0.250015 m from the edge, so cells 0 and 1 of each border are illegal and
-     * cell 2 is legal. */
+    /* res 0.1 as the loader rounds it (Q16 6554 = 0.100006 m), clearance 0.25 m: cell k's
+     * square is k * 0.100006 m from the edge, so cells 0, 1 and 2 of each border are
+     * illegal and cell 3 is legal. */
     assert_int_equal(rfs_map_init(&m, &cfg, W, H, 6554, 0, 0, b->free, NULL, b->legal), 0);
     for (int x = 0; x < W; x++) {
         for (int y = 0; y < H; y++) {
-            int inside = x >= 2 && y >= 2 && x < W - 2 && y < H - 2;
+            int inside = x >= 3 && y >= 3 && x < W - 3 && y < H - 3;
             assert_int_equal(rfs_map_bit(b->legal, m.stride, (uint16_t)x, (uint16_t)y), inside);
         }
     }
@@ -315,8 +314,8 @@ static void test_unknown_cell(void **state)
     rfs_map_bit_set(b->free, stride, 20, 20, false);
     rfs_map_t m;
     rfs_map_cfg_t cfg = rfs_map_cfg_default();
-    /* res 0.25 exactly, clearance 0.25: the cell's own 8 neighbours come within 0.177 m
-     * or 0.125 m of the centre; the next ring is >= 0.375 m away. */
+    /* res 0.25 exactly, clearance 0.25: the cell's own 8 neighbours touch its square;
+     * the next ring is exactly 0.25 m away, not closer. */
     assert_int_equal(rfs_map_init(&m, &cfg, W, H, RFS_Q16_FRAC(1, 4), 0, 0, b->free, NULL, b->legal),
                      0);
     for (int y = 15; y <= 25; y++) {

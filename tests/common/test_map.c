@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "ref_geom.h"
 #include "rfs_map.h"
 
 #define W 48
@@ -95,9 +96,8 @@ static int ref_cell_legal(const fixture_t *f, int cx, int cy)
             if (ref_free(f, x, y)) {
                 continue;
             }
-            /* gap between the squares [cx, cx+1] r and [x, x+1] r, per axis */
-            double ex = fmax(0.0, fmax(x * r - (cx + 1) * r, cx * r - (x + 1) * r));
-            double ey = fmax(0.0, fmax(y * r - (cy + 1) * r, cy * r - (y + 1) * r));
+            double ex = ref_cell_gap(x, cx) * r;
+            double ey = ref_cell_gap(y, cy) * r;
             if (sqrt(ex * ex + ey * ey) < c) {
                 return 0;
             }

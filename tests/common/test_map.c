@@ -106,31 +106,6 @@ static int ref_cell_legal(const fixture_t *f, int cx, int cy)
     return 1;
 }
 
-/* Closed segment vs closed cell square, in Q16 units relative to the origin (exact). */
-static int ref_touch(const fixture_t *f, double x0, double y0, double x1, double y1, int i, int j)
-{
-    double r = f->res;
-    double bx0 = i * r;
-    double bx1 = (i + 1) * r;
-    double by0 = j * r;
-    double by1 = (j + 1) * r;
-    if (fmax(x0, x1) < bx0 || fmin(x0, x1) > bx1 || fmax(y0, y1) < by0 || fmin(y0, y1) > by1) {
-        return 0;
-    }
-    double dx = x1 - x0;
-    double dy = y1 - y0;
-    double cx[4] = {bx0, bx1, bx0, bx1};
-    double cy[4] = {by0, by0, by1, by1};
-    int pos = 0;
-    int neg = 0;
-    for (int k = 0; k < 4; k++) {
-        double cr = dx * (cy[k] - y0) - dy * (cx[k] - x0);
-        pos += cr > 0;
-        neg += cr < 0;
-    }
-    return !(pos == 4 || neg == 4);
-}
-
 static int ref_legal_cell_grid(const fixture_t *f, int x, int y)
 {
     if (x < 0 || y < 0 || x >= W || y >= H) {
@@ -155,7 +130,7 @@ static int ref_segment_legal(const fixture_t *f, rfs_q16_t x0, rfs_q16_t y0, rfs
     }
     for (int j = -1; j <= H; j++) {
         for (int i = -1; i <= W; i++) {
-            if (ref_touch(f, X0, Y0, X1, Y1, i, j)) {
+            if (ref_touch(X0, Y0, X1, Y1, f->res, i, j)) {
                 int l = (i >= 0 && j >= 0 && i < W && j < H) ? legal_cache[j][i] : 0;
                 if (!l) {
                     return 0;
@@ -206,7 +181,7 @@ static int ref_walls(const fixture_t *f, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x
     double r = f->res;
     for (int j = 0; j < H; j++) {
         for (int i = 0; i < W; i++) {
-            if (ref_touch(f, X0, Y0, X1, Y1, i, j)) {
+            if (ref_touch(X0, Y0, X1, Y1, f->res, i, j)) {
                 hits[n].t = ref_entry(X0, Y0, X1, Y1, i * r, (i + 1) * r, j * r, (j + 1) * r);
                 hits[n].wall = f->wall_c[j][i];
                 n++;

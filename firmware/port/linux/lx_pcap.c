@@ -2,11 +2,13 @@
 #include "lx_pcap.h"
 
 #include <errno.h>
+#include <net/if.h>
 #include <poll.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/ioctl.h>
 
 #include <pcap/pcap.h>
 
@@ -117,6 +119,26 @@ lx_pcap_reader_t *lx_pcap_open_live(const char *ifname, char *err, size_t errlen
     return r;
 }
 
+/* A live interface still there and up: 0, or -1 with `err`. libpcap reads on through an
+ * interface taken down (it may come back), but a reader that hears nothing must not go on
+ * saying it listens. */
+static int live_up(const lx_pcap_reader_t *r, char *err, size_t errlen)
+{
+    struct ifreq ifr;
+    memset(&ifr, 0, sizeof(ifr));
+    const size_t n = strnlen(r->name, sizeof(ifr.ifr_name) - 1); /* libpcap took the name: it fits */
+    memcpy(ifr.ifr_name, r->name, n);
+    if (ioctl(pcap_get_selectable_fd(r->p), SIOCGIFFLAGS, &ifr) != 0) {
+        snprintf(err, errlen, "%s: the interface is gone: %s", r->name, strerror(errno));
+        return -1;
+    }
+    if ((ifr.ifr_flags & IFF_UP) == 0) {
+        snprintf(err, errlen, "%s: the interface went down", r->name);
+        return -1;
+    }
+    return 0;
+}
+
 int lx_pcap_next(lx_pcap_reader_t *r, lx_pcap_pkt_t *pkt, char *err, size_t errlen)
 {
     struct pcap_pkthdr *h = NULL;
@@ -126,7 +148,7 @@ int lx_pcap_next(lx_pcap_reader_t *r, lx_pcap_pkt_t *pkt, char *err, size_t errl
         /* Nothing buffered: wait for the socket. A timeout or a signal is a timeout; an
          * error or a hang-up (the interface went away) is read by pcap_next_ex. */
         struct pollfd pfd = {pcap_get_selectable_fd(r->p), POLLIN, 0};
-        if (poll(&pfd, 1, LX_PCAP_LIVE_TIMEOUT_MS) <= 0) { return 2; }
+        if (poll(&pfd, 1, LX_PCAP_LIVE_TIMEOUT_MS) <= 0) { return live_up(r, err, errlen) != 0 ? -1 : 2; }
         rc = pcap_next_ex(r->p, &h, &data);
     }
     if (rc == 1) {

@@ -44,9 +44,9 @@ lx_pcap_reader_t *lx_pcap_open_offline(const char *path, char *err, size_t errle
 lx_pcap_reader_t *lx_pcap_open_live(const char *ifname, char *err, size_t errlen);
 
 /// Read the next packet: 1 = a packet in *pkt, 0 = end of file, 2 = live: no packet
-/// within LX_PCAP_LIVE_TIMEOUT_MS or a signal came (the reader is still fine), -1 = read
-/// error (a truncated record, a timestamp fraction of a second or more, an interface
-/// gone down; message in `err`).
+/// within LX_PCAP_LIVE_TIMEOUT_MS or a signal came (the interface is still up), -1 = read
+/// error (a truncated record, a timestamp fraction of a second or more, a live interface
+/// down or removed; message in `err`).
 int lx_pcap_next(lx_pcap_reader_t *r, lx_pcap_pkt_t *pkt, char *err, size_t errlen);
 
 /// Close the reader (NULL is fine).

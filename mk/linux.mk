@@ -91,6 +91,9 @@ $(WIRE_VM_BIN): tests/vm/can_vm_test.c $(WIRE_VM_OBJS) $(CORE_LIB)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) $(INC_linux) $(DEPFLAGS) -MF $@.d -MT $@ -static $< $(WIRE_VM_OBJS) $(CORE_LIB) -o $@
 $(eval $(call test_script,can_vm,tests/vm/run_vm_test.sh $(BUILD),$(WIRE_VM_BIN) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
+# The live 802.11 feed end to end in the same kind of VM: mac80211_hwsim radios, hostapd,
+# rfseek-feed --live --lcm -> rfseekd -> vcan0, the dBm values against tshark on the host.
+$(eval $(call test_script,wifi_vm,tests/vm/run_wifi_vm_test.sh $(BUILD),$(BUILD)/bin/rfseek-feed $(BUILD)/bin/rfseekd $(WIRE_LCM_TOOL) $(LCM_PY_INIT)))
 
 # The daemon and the player link neither Box2D nor the C++ runtime.
 $(eval $(call test_script,link,scripts/check_link.sh $(LINUX_PROGS),$(LINUX_PROGS)))

@@ -54,4 +54,4 @@ case $rc in
 esac
 echo "PASS wifi-vm-verdict ($pkg)"
 ap=$(sed -n 's/^access point //p' "$log.txt")
-/usr/bin/python3 "$here/wifi_check.py" "$out" "$ap"
+/usr/bin/python3 "$here/wifi_check.py" "$out" "$ap" "$build/gen/python"

@@ -15,7 +15,7 @@
  *   lcm_tool dump LOG           print each status in a log as
  *                               "STATUS t state left right faults decided"
  *   lcm_tool pose URL SECONDS   a live pose source: the office map's start (8 m, 6 m,
- *                               0 rad) on URL at 10 Hz for SECONDS, stamped with the
+ *                               0 rad) on URL at 20 Hz for SECONDS, stamped with the
  *                               local clock (CLOCK_REALTIME, as rfseekd's live steps)
  */
 #include <inttypes.h>
@@ -200,14 +200,14 @@ static int pose_live(const char *url, const char *secs)
         fprintf(stderr, "lcm_tool: %s\n", err);
         return 1;
     }
-    for (long k = 0; k < n * 10; k++) {
+    for (long k = 0; k < n * 20; k++) {
         rfs_pose_t p = {realtime_us(), 8 * 65536, 6 * 65536, 0};
         if (lx_lcm_pub_pose(l, &p) != 0) {
             fprintf(stderr, "lcm_tool: pose: LCM refused a pose\n");
             lx_lcm_close(l);
             return 1;
         }
-        const struct timespec tick = {0, 100000000};
+        const struct timespec tick = {0, 50000000};
         nanosleep(&tick, NULL);
     }
     lx_lcm_close(l);

@@ -110,19 +110,19 @@ static void heartbeats_go_on_through_silence(void **state)
     lx_feed_t f;
     lx_feed_init(&f, l);
     /* Frames every 20 ms up to 200 ms (each read proves the loop alive), then silence: the
-     * reader's 50 ms waits time out at 250, 300, ... 500 ms. */
+     * reader's 25 ms waits (LX_PCAP_LIVE_TIMEOUT_MS) time out at 225, 250, ... 500 ms. */
     const int64_t t0 = 1700000000000000LL;
     int sent = 0;
     for (int64_t ms = 0; ms <= 200; ms += 20) {
         sent += lx_feed_alive(&f, t0 + ms * 1000);
     }
-    for (int64_t ms = 250; ms <= 500; ms += 50) {
+    for (int64_t ms = 225; ms <= 500; ms += 25) {
         sent += lx_feed_alive(&f, t0 + ms * 1000);
     }
     drain(l);
 
-    /* 0; 60 (the first read 50 ms or more after 0); 120; 180; then 200 is too soon and
-     * 250 is due; every wait after that. */
+    /* 0; 60 (the first read 50 ms or more after 0); 120; 180; then 200 and 225 are too
+     * soon, 250 is due; every second wait after that. */
     const int64_t want_ms[] = {0, 60, 120, 180, 250, 300, 350, 400, 450, 500};
     const int n = (int)(sizeof(want_ms) / sizeof(want_ms[0]));
     assert_int_equal(sent, n);

@@ -5,9 +5,10 @@
  * a dBm signal (RFS_RSSI), and lx_feed_alive() whenever it knows itself alive: after every
  * record it reads, from any transmitter, and after every read that timed out. A heartbeat
  * (RFS_RSSI_STATUS) goes out when that time has moved LX_FEED_HEARTBEAT_US past the last
- * one: with the live reader's 50 ms wait (LX_PCAP_LIVE_TIMEOUT_MS) one every 50 to 100 ms,
- * inside the controller's 150 ms RSSI timeout, whether or not a source is heard; a loop
- * that hangs or dies sends none (docs/FAULTS.md, "The receiver heartbeat").
+ * one: with the live reader's 25 ms wait (LX_PCAP_LIVE_TIMEOUT_MS) one every 50 to 75 ms
+ * plus scheduling delays, inside the controller's 150 ms RSSI timeout, whether or not a
+ * source is heard; a loop that hangs or dies sends none (docs/FAULTS.md, "The receiver
+ * heartbeat").
  */
 #ifndef LX_FEED_H
 #define LX_FEED_H

@@ -36,7 +36,7 @@ typedef struct lx_pcap_pkt {
 lx_pcap_reader_t *lx_pcap_open_offline(const char *path, char *err, size_t errlen);
 
 /// How long lx_pcap_next() waits on a live interface before it returns 2, milliseconds.
-#define LX_PCAP_LIVE_TIMEOUT_MS 50
+#define LX_PCAP_LIVE_TIMEOUT_MS 25
 
 /// Open a monitor-mode interface live (promiscuous, snaplen 65535, immediate mode: each
 /// frame as it arrives). Same link-type rule as the offline reader (the message then

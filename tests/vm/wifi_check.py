@@ -18,9 +18,10 @@ Checks:
     from the hang, no gap of 150 ms (the controller's RSSI timeout) or more; they went on
     for 2 s of silent channel;
   - wheels: while the channel is silent the controller never reports its RSSI stale and
-    drives; within 200 ms of the feed hanging every WHEEL_CMD is Stop with zero speeds and
-    every STATUS has the RSSI-stale fault until the heartbeats come back; then it drives
-    again.
+    drives; after the feed hangs, the first control step past the 150 ms timeout (so within
+    200 ms) reports the RSSI stale with a Stop, and from 200 ms every WHEEL_CMD is Stop with
+    zero speeds and every STATUS has the fault until the heartbeats come back; then it
+    drives again.
 """
 import os
 import re
@@ -167,7 +168,8 @@ def main(argv):
     check("wifi-hung-feeder-stops-the-wheels (RSSI stale and Stop at the first step after 150 ms: %.0f and %.0f ms "
           "after the last heartbeat; then %d WHEEL_CMD all Stop at 0, %d STATUS all RSSI stale)"
           % (((first_stale or 0) - hang0) / 1e3, ((first_stop or 0) - hang0) / 1e3, len(w_hung), len(s_hung)),
-          first_stale is not None and first_stale - hang0 > TIMEOUT_US - 5000 and first_stale == after
+          first_stale is not None and first_stale - hang0 > TIMEOUT_US - 5000 and after is not None
+          and first_stale <= after
           and first_stop is not None and first_stop <= first_stale
           and len(w_hung) >= 10 and not any(map(moving, w_hung)) and all(s["Stop"] == "1" for s in w_hung)
           and all(map(stale, s_hung)))

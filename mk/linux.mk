@@ -49,9 +49,9 @@ ALL_TARGETS += $(LINUX_LIB) $(LINUX_PROGS) $(LCM_PY_INIT)
 
 # --- tests -------------------------------------------------------------------------------
 # The map loader on real maps (/work/shared/data/maps) and bad input (tests/data/maps_bad/);
-# the radiotap parser and the pcap writer against tshark; candump -L lines against can-utils'
-# log2long; the LCM adapter and the path-loss estimate in the seeker status (hand-decoded
-# bytes).
+# the radiotap parser and the pcap writer against tshark; the live feed's heartbeat times;
+# candump -L lines against can-utils' log2long; the LCM adapter and the path-loss estimate
+# in the seeker status (hand-decoded bytes).
 $(eval $(call cmocka_test,test_lx_map,tests/linux/test_lx_map.c,linux))
 $(eval $(call cmocka_test,test_lx_radiotap,tests/linux/test_lx_radiotap.c,linux))
 $(eval $(call cmocka_test,test_lx_pcap,tests/linux/test_lx_pcap.c,linux))

@@ -5,12 +5,15 @@
 # fail MESSAGE (prints a FAIL line and exits). Everything cached is written to a temporary
 # name and renamed, so two tests running at once share the cache safely.
 
+PATH="$PATH:/usr/sbin:/sbin"  # modinfo, and the tools copied into a VM (iw, hostapd)
+
 # vm_kernel "MODULE [PARAM=VALUE ...]"...: the package resolved with apt-cache (never
 # pinned) and downloaded once; sets pkg, kdir ($kdir/vmlinuz) and vm_mods (one line per
 # module to load: "NAME [PARAMS]", each after its dependencies, from modinfo -F depends;
 # the modules built into the kernel left out), the .ko files decompressed as
 # $kdir/NAME.ko (busybox insmod may not decompress).
 vm_kernel() {
+    command -v modinfo > /dev/null || fail "modinfo missing (kmod, scripts/deps.txt)"
     pkg=$(apt-cache depends linux-image-amd64 2>/dev/null | awk '/Depends: linux-image-[0-9]/ {print $2; exit}')
     [ -n "$pkg" ] || fail "apt-cache cannot resolve linux-image-amd64"
     local deb

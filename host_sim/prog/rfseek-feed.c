@@ -68,7 +68,7 @@ static const char k_usage[] =
     "  --live         CAPTURE is a monitor-mode interface; read until SIGINT or SIGTERM\n"
     "  --lcm URL      with --live: publish to the controller over LCM (e.g. udpm://...)\n"
     "                 instead of printing: RFS_RSSI per line (source = the --mac's position,\n"
-    "                 0 first), RFS_RSSI_STATUS heartbeats every 50-100 ms while reading\n"
+    "                 0 first), RFS_RSSI_STATUS heartbeats every 50-75 ms while reading\n"
     "  --list         survey: one row per transmitter (802.11 addr2, tshark's wlan.ta; only\n"
     "                 the --mac ones when given), most frames first: mac, frames, frames\n"
     "                 with a dBm signal, their mean/min/max dBm, first and last time (as\n"

@@ -9,174 +9,8 @@
 #include "hs_motor.h"
 #include "hs_radio.h"
 #include "hs_box2d.h"
+#include "hs_paths.h"
 #include "rfs_pdr.h"
-#include "rfs_plan.h"
-
-// --- can the core's planner get into the stop radius? --------------------------------
-// The cell-level check below connects legal cells through gaps one cell wide; the
-// controller plans on the 0.25 m lattice, whose edges need a legal straight segment
-// between lattice points, so a door that narrow is shut for it. 1 = some lattice point
-// within `radius` of (gx, gy) is reachable from (sx, sy), 0 = none, -1 = out of memory.
-static int lattice_reaches(const rfs_map_t *m, double sx, double sy, double gx, double gy,
-                           double radius)
-{
-    uint32_t n = (uint32_t)m->lw * m->lh;
-    uint8_t *work = malloc(n ? n : 1);
-    uint32_t *queue = malloc(sizeof(uint32_t) * (n ? n : 1));
-    rfs_path_t *path = malloc(sizeof *path);
-    rfs_plan_t plan;
-    int found = -1;
-    if (work && queue && path && rfs_plan_init(&plan, m, work, n, queue, n) == 0) {
-        found = 0;
-        double g = m->cfg.grid / 65536.0;
-        long r = (long)ceil(radius / g) + 1;
-        uint16_t ci, cj;
-        rfs_map_lattice_nearest(m, (rfs_q16_t)lround(gx * 65536.0), (rfs_q16_t)lround(gy * 65536.0),
-                                &ci, &cj);
-        for (long j = (long)cj - r; j <= (long)cj + r && !found; j++) {
-            for (long i = (long)ci - r; i <= (long)ci + r && !found; i++) {
-                if (i < 0 || j < 0 || i >= m->lw || j >= m->lh ||
-                    !rfs_map_lattice_legal(m, (uint16_t)i, (uint16_t)j)) {
-                    continue;
-                }
-                rfs_q16_t px, py;
-                rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
-                if (hypot(px / 65536.0 - gx, py / 65536.0 - gy) > radius) {
-                    continue;
-                }
-                found = rfs_plan_path(&plan, (rfs_q16_t)lround(sx * 65536.0),
-                                      (rfs_q16_t)lround(sy * 65536.0), px, py, path) ? 1 : 0;
-            }
-        }
-    }
-    free(work);
-    free(queue);
-    free(path);
-    return found;
-}
-
-// --- shortest path on the core's legal grid -----------------------------------------
-
-typedef struct heap_item {
-    double d;
-    uint32_t i;
-} heap_item_t;
-
-typedef struct heap {
-    heap_item_t *a;
-    size_t n, cap;
-} heap_t;
-
-static int heap_push(heap_t *h, double d, uint32_t i)
-{
-    if (h->n == h->cap) {
-        size_t nc = h->cap ? h->cap * 2 : 1024;
-        heap_item_t *na = realloc(h->a, nc * sizeof *na);
-        if (!na) {
-            return -1;
-        }
-        h->a = na;
-        h->cap = nc;
-    }
-    size_t k = h->n++;
-    while (k > 0 && h->a[(k - 1) / 2].d > d) {
-        h->a[k] = h->a[(k - 1) / 2];
-        k = (k - 1) / 2;
-    }
-    h->a[k] = (heap_item_t){d, i};
-    return 0;
-}
-
-static heap_item_t heap_pop(heap_t *h)
-{
-    heap_item_t top = h->a[0], last = h->a[--h->n];
-    size_t k = 0;
-    for (;;) {
-        size_t c = 2 * k + 1;
-        if (c >= h->n) {
-            break;
-        }
-        if (c + 1 < h->n && h->a[c + 1].d < h->a[c].d) {
-            c++;
-        }
-        if (h->a[c].d >= last.d) {
-            break;
-        }
-        h->a[k] = h->a[c];
-        k = c;
-    }
-    if (h->n > 0) {
-        h->a[k] = last;
-    }
-    return top;
-}
-
-static bool legal_cell(const rfs_map_t *m, long x, long y)
-{
-    return x >= 0 && y >= 0 && x < m->w && y < m->h &&
-           rfs_map_bit(m->legal, m->stride, (uint16_t)x, (uint16_t)y);
-}
-
-/// Dijkstra over legal cells, 16-connected (straight, diagonal and knight moves, each at
-/// its Euclidean length; a move is allowed when the cells it passes through are legal).
-/// The 16-neighbourhood overestimates any-angle lengths by at most 2.7 %.
-/// Fills dist (metres, INFINITY = unreachable) from the start cell. 0 or -1 (memory).
-static int legal_dijkstra(const rfs_map_t *m, long sx, long sy, double *dist)
-{
-    static const int mv[16][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {1, -1}, {-1, 1},
-                                  {-1, -1}, {2, 1}, {2, -1}, {-2, 1}, {-2, -1}, {1, 2},
-                                  {1, -2}, {-1, 2}, {-1, -2}};
-    size_t n = (size_t)m->w * m->h;
-    double res = m->res / 65536.0;
-    for (size_t i = 0; i < n; i++) {
-        dist[i] = INFINITY;
-    }
-    if (!legal_cell(m, sx, sy)) {
-        return 0;
-    }
-    heap_t h = {0};
-    dist[(size_t)sy * m->w + sx] = 0.0;
-    if (heap_push(&h, 0.0, (uint32_t)(sy * m->w + sx)) != 0) {
-        return -1;
-    }
-    while (h.n > 0) {
-        heap_item_t it = heap_pop(&h);
-        if (it.d > dist[it.i]) {
-            continue;
-        }
-        long x = it.i % m->w, y = it.i / m->w;
-        for (int k = 0; k < 16; k++) {
-            int dx = mv[k][0], dy = mv[k][1];
-            long nx = x + dx, ny = y + dy;
-            if (!legal_cell(m, nx, ny)) {
-                continue;
-            }
-            // Cells the move passes through: both neighbours of a diagonal (no corner
-            // cutting), the two cells beside the midpoint of a knight move.
-            if (abs(dx) == 1 && abs(dy) == 1 &&
-                (!legal_cell(m, x + dx, y) || !legal_cell(m, x, y + dy))) {
-                continue;
-            }
-            if (abs(dx) == 2 && (!legal_cell(m, x + dx / 2, y) || !legal_cell(m, x + dx / 2, y + dy))) {
-                continue;
-            }
-            if (abs(dy) == 2 && (!legal_cell(m, x, y + dy / 2) || !legal_cell(m, x + dx, y + dy / 2))) {
-                continue;
-            }
-            double nd = it.d + res * sqrt((double)(dx * dx + dy * dy));
-            size_t ni = (size_t)ny * m->w + (size_t)nx;
-            if (nd < dist[ni]) {
-                dist[ni] = nd;
-                if (heap_push(&h, nd, (uint32_t)ni) != 0) {
-                    free(h.a);
-                    return -1;
-                }
-            }
-        }
-    }
-    free(h.a);
-    return 0;
-}
 
 // --- environment ------------------------------------------------------------------------
 
@@ -243,68 +77,36 @@ static int check_positions(const hs_sim_env_t *e, char *err, size_t errlen)
     return 0;
 }
 
-/* Over the legal cells' distances from the start (dist, metres): the distance to the goal
- * of the nearest reachable cell (*best_gd) and the path to it (*best_path), and the
- * shortest path into the stop radius (*stop_path; INFINITY: none). */
-static void goal_paths(const hs_sim_env_t *e, const double *dist, double *best_gd,
-                       double *best_path, double *stop_path)
-{
-    const hs_scenario_t *sc = &e->sc;
-    const rfs_map_t *cm = &e->core.map;
-    double res = cm->res / 65536.0;
-    *best_gd = INFINITY;
-    *best_path = INFINITY;
-    *stop_path = INFINITY;
-    for (long y = 0; y < cm->h; y++) {
-        for (long x = 0; x < cm->w; x++) {
-            double d = dist[(size_t)y * cm->w + x];
-            if (!isfinite(d)) {
-                continue;
-            }
-            double gx = e->x0 + (x + 0.5) * res - sc->goal_x;
-            double gy = e->y0 + (y + 0.5) * res - sc->goal_y;
-            double gd = sqrt(gx * gx + gy * gy);
-            if (gd < *best_gd - 1e-9 || (fabs(gd - *best_gd) <= 1e-9 && d < *best_path)) {
-                *best_gd = gd;
-                *best_path = d;
-            }
-            if (gd <= sc->stop_radius_m && d < *stop_path) {
-                *stop_path = d;
-            }
-        }
-    }
-}
-
 /* The shortest paths from the start to the goal and into the stop radius, checked to
  * exist for the cells and for the controller's lattice. 0, or -1 with err set. */
 static int shortest_paths(hs_sim_env_t *e, char *err, size_t errlen)
 {
     const hs_scenario_t *sc = &e->sc;
     const rfs_map_t *cm = &e->core.map;
-    double *dist = calloc((size_t)cm->w * cm->h, sizeof(double)); // all set by legal_dijkstra
+    double *dist = calloc((size_t)cm->w * cm->h, sizeof(double)); // all set by hs_paths_dist
     if (!dist) {
         snprintf(err, errlen, "%s: out of memory", sc->path);
         return -1;
     }
     double res = cm->res / 65536.0;
     long sx = (long)((sc->start_x - e->x0) / res), sy = (long)((sc->start_y - e->y0) / res);
-    if (legal_dijkstra(cm, sx, sy, dist) != 0) {
+    if (hs_paths_dist(cm, sx, sy, dist) != 0) {
         free(dist);
         snprintf(err, errlen, "%s: out of memory", sc->path);
         return -1;
     }
     // Nearest reachable cell to the goal, and the shortest path into the stop radius.
-    double best_gd, best_path, stop_path;
-    goal_paths(e, dist, &best_gd, &best_path, &stop_path);
+    hs_paths_goal_t gp;
+    hs_paths_goal(cm, e->x0, e->y0, dist, sc->goal_x, sc->goal_y, sc->stop_radius_m, -1.0, &gp);
     free(dist);
-    if (!isfinite(stop_path)) {
+    if (!isfinite(gp.stop_m)) {
         snprintf(err, errlen,
                  "%s: stop.radius_m: the robot can never get within %.2f m of the goal "
                  "(%.2f, %.2f): the nearest point it can reach is %.2f m away",
-                 sc->path, sc->stop_radius_m, sc->goal_x, sc->goal_y, best_gd);
+                 sc->path, sc->stop_radius_m, sc->goal_x, sc->goal_y, gp.near_m);
         return -1;
     }
-    int lr = lattice_reaches(cm, sc->start_x, sc->start_y, sc->goal_x, sc->goal_y,
+    int lr = hs_paths_lattice_reaches(cm, sc->start_x, sc->start_y, sc->goal_x, sc->goal_y,
                              sc->stop_radius_m);
     if (lr <= 0) {
         if (lr < 0) {
@@ -318,8 +120,8 @@ static int shortest_paths(hs_sim_env_t *e, char *err, size_t errlen)
         }
         return -1;
     }
-    e->shortest_path_m = best_path;
-    e->shortest_to_stop_m = stop_path;
+    e->shortest_path_m = gp.path_m;
+    e->shortest_to_stop_m = gp.stop_m;
     return 0;
 }
 

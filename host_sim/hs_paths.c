@@ -5,22 +5,31 @@
 #include <stdlib.h>
 
 #include "rfs_plan.h"
+#include "rfs_reach.h"
 
 // --- can the core's planner get into the stop radius? --------------------------------
 // The cell-level distances below connect legal cells through gaps one cell wide; the
 // controller plans on the 0.25 m lattice, whose edges need a legal straight segment
-// between lattice points, so a door that narrow is shut for it.
+// between lattice points, so a door that narrow is shut for it. The start's component of
+// the lattice (rfs_reach_fill) lets a plan to a point beyond a wall fail at once, without
+// flooding the start's side (rfs_plan_set_component: the answers stay the same).
 int hs_paths_lattice_reaches(const rfs_map_t *m, double sx, double sy, double gx, double gy,
                              double radius)
 {
     uint32_t n = (uint32_t)m->lw * m->lh;
     uint8_t *work = malloc(n ? n : 1);
     uint32_t *queue = malloc(sizeof(uint32_t) * (n ? n : 1));
+    uint8_t *reach = calloc(rfs_reach_bytes(m) + 1u, 1);
     rfs_path_t *path = malloc(sizeof *path);
     rfs_plan_t plan;
     int found = -1;
-    if (work && queue && path && rfs_plan_init(&plan, m, work, n, queue, n) == 0) {
+    if (work && queue && reach && path && rfs_plan_init(&plan, m, work, n, queue, n) == 0) {
         found = 0;
+        // The queue is the flood's work memory before it is the planner's.
+        if (rfs_reach_fill(m, (rfs_q16_t)lround(sx * 65536.0), (rfs_q16_t)lround(sy * 65536.0),
+                           reach, queue, n ? n : 1)) {
+            rfs_plan_set_component(&plan, reach);
+        }
         double g = m->cfg.grid / 65536.0;
         long r = (long)ceil(radius / g) + 1;
         uint16_t ci, cj;
@@ -44,6 +53,7 @@ int hs_paths_lattice_reaches(const rfs_map_t *m, double sx, double sy, double gx
     }
     free(work);
     free(queue);
+    free(reach);
     free(path);
     return found;
 }

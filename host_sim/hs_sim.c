@@ -136,7 +136,7 @@ static int env_prepare(hs_sim_env_t *e, char *err, size_t errlen)
     // Wall counts depend on the geometry only, not on the seed: one cache for all runs.
     size_t wcb = hs_radio_wall_cache_bytes(&sc->radio, e->x0, e->y0, e->x1, e->y1);
     for (unsigned s = 0; s < sc->nsources; s++) {
-        e->wall_cache[s] = malloc(wcb);
+        e->wall_cache[s] = e->wall_cache[s] ? e->wall_cache[s] : malloc(wcb); // placed again: same size
         if (!e->wall_cache[s]) {
             snprintf(err, errlen, "%s: out of memory", sc->path);
             return -1;
@@ -177,6 +177,27 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
         return -1;
     }
     return 0;
+}
+
+int hs_sim_env_place(hs_sim_env_t *e, uint64_t index, uint64_t seed, double sx, double sy,
+                     double stheta, double gx, double gy, char *err, size_t errlen)
+{
+    hs_scenario_t *sc = &e->sc;
+    if (sc->nsources != 1 || sc->has_goal || !(sc->stop_radius_m > 0.0)) {
+        snprintf(err, errlen, "%s: placements need one source, no stop.goal and a stop radius",
+                 sc->path);
+        return -1;
+    }
+    sc->start_x = sx;
+    sc->start_y = sy;
+    sc->start_theta = stheta;
+    sc->src[0].x = gx;
+    sc->src[0].y = gy;
+    sc->goal_x = gx;
+    sc->goal_y = gy;
+    e->placement = index;
+    e->placement_seed = seed;
+    return env_prepare(e, err, errlen);
 }
 
 void hs_sim_env_close(hs_sim_env_t *e)
@@ -382,6 +403,10 @@ typedef struct sim_run {
     double px, py, pth;          /* the robot at t: metres, radians */
     int64_t t;                   /* microseconds */
     double travelled;            /* metres */
+    double belief_x, belief_y;   /* the model maximum of the last greedy decision, metres */
+    bool belief_valid;
+    double *trail;               /* the robot at every whole second of the run (x, y pairs) */
+    size_t ntrail, trail_cap;    /* seconds recorded, room (0 after a failed allocation) */
     double drift_x, drift_y;     /* AMCL-like localisation error: bounded drift, metres */
     double jump_x, jump_y;       /* ... and the decaying rest of the last jump, metres */
 } sim_run_t;
@@ -406,6 +431,7 @@ enum { EV_PACKET = 0, EV_POSE = 1, EV_CTRL = 2 };
 /* Free what run_open made (the radio: the latest, when a source moved). */
 static void run_close(sim_run_t *r)
 {
+    free(r->trail);
     free(r->pdr);
     hs_radio_destroy(r->radio);
     hs_box2d_destroy(r->world);
@@ -664,6 +690,11 @@ static void ctrl_event(sim_run_t *r, const event_t *ev, const tick_t *k)
         res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
         res->goal_timeouts += d->prev == RFS_DRIVE_TIMEOUT ? 1u : 0u;
         res->goal_blocked += d->prev == RFS_DRIVE_BLOCKED ? 1u : 0u;
+        if (d->kind == RFS_SEEK_GREEDY && d->model_valid) {
+            r->belief_x = q16d(d->max_x);
+            r->belief_y = q16d(d->max_y);
+            r->belief_valid = true;
+        }
         if (r->io && r->io->log) {
             log_decision(r->io->log, ctrl, d, ev, wrap_pi(r->pth + ev->a * k->dth));
         }
@@ -752,6 +783,37 @@ static const char *run_end(sim_run_t *r)
     return NULL;
 }
 
+/* The robot's position recorded at the first tick of every whole second (entry k: second
+ * k), for still_s. Without memory the record stops and still_s counts from its end. */
+static void trail_add(sim_run_t *r)
+{
+    if (r->ntrail == r->trail_cap) {
+        size_t cap = r->trail_cap ? 2 * r->trail_cap : 1024;
+        double *t = realloc(r->trail, cap * 2 * sizeof *t);
+        if (!t) {
+            return;
+        }
+        r->trail = t;
+        r->trail_cap = cap;
+    }
+    r->trail[2 * r->ntrail] = r->px;
+    r->trail[2 * r->ntrail + 1] = r->py;
+    r->ntrail++;
+}
+
+/* Seconds the robot has stayed within HS_SIM_STILL_RADIUS_M of where it is now: from the
+ * whole second after the last recorded position outside that circle (none: the run). */
+static double still_s(const sim_run_t *r)
+{
+    double end_s = r->t * 1e-6;
+    for (size_t k = r->ntrail; k-- > 0;) {
+        if (hypot(r->trail[2 * k] - r->px, r->trail[2 * k + 1] - r->py) > HS_SIM_STILL_RADIUS_M) {
+            return fmax(0.0, end_s - (double)(k + 1));
+        }
+    }
+    return end_s;
+}
+
 /* The result of a run that ended for reason end. */
 static void run_result(sim_run_t *r, const char *end)
 {
@@ -768,6 +830,16 @@ static void run_result(sim_run_t *r, const char *end)
     res->wall_contacts = hs_box2d_wall_contacts(r->world);
     // Against source 0 where it is now (a moved source takes its error along).
     hs_sim_result_estimate(res, r->ctrl, r->rs[0].x, r->rs[0].y);
+    res->belief_x = res->est_valid ? res->est_x : (r->belief_valid ? r->belief_x : NAN);
+    res->belief_y = res->est_valid ? res->est_y : (r->belief_valid ? r->belief_y : NAN);
+    res->belief_error_m = hypot(res->belief_x - r->rs[0].x, res->belief_y - r->rs[0].y);
+    res->still_s = still_s(r);
+    res->placement = r->e->placement;
+    res->start_x = r->sc->start_x;
+    res->start_y = r->sc->start_y;
+    res->start_theta = r->sc->start_theta;
+    res->source_x = r->sc->src[0].x;
+    res->source_y = r->sc->src[0].y;
     if (r->io && r->io->residual) {
         write_residual(r->io->residual, r->ctrl);
     }
@@ -792,6 +864,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     }
     write_headers(io);
     hs_box2d_robot_pose(r.world, &r.px, &r.py, &r.pth);
+    trail_add(&r);
     const char *end;
     do {
         tick_t k;
@@ -802,6 +875,9 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
         r.py = k.ny;
         r.pth = k.nth;
         r.t = k.t1;
+        if (r.t >= (int64_t)r.ntrail * 1000000) {
+            trail_add(&r);
+        }
         if (world_events(&r, err, errlen) != 0) {
             run_close(&r);
             return -1;
@@ -928,6 +1004,13 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
         fprintf(f, "%s[%.3f, %.3f]", s ? ", " : "", e->sc.src[s].x, e->sc.src[s].y);
     }
     fprintf(f, "],\n");
+    fprintf(f, "  \"start_theta_rad\": %.4f,\n", e->sc.start_theta);
+    if (e->placement > 0) { // a drawn placement (hs_place.h)
+        fprintf(f, "  \"placement\": %llu,\n  \"placement_seed\": %llu,\n",
+                (unsigned long long)e->placement, (unsigned long long)e->placement_seed);
+    } else {
+        fprintf(f, "  \"placement\": null,\n  \"placement_seed\": null,\n");
+    }
     fprintf(f, "  \"reached\": %s,\n", r->reached ? "true" : "false");
     fprintf(f, "  \"end\": \"%s\",\n", r->end);
     json_num(f, "sim_time_s", r->sim_time_s, false);
@@ -955,16 +1038,25 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
     json_num(f, "est_w_db", r->est_valid ? r->est_w_db : NAN, false);
     json_num(f, "est_p0", r->est_valid ? r->est_p0 : NAN, false);
     json_num(f, "est_area_m2", r->est_valid ? r->est_area_m2 : NAN, false);
-    json_num(f, "est_error_m", r->est_valid ? r->est_error_m : NAN, true);
+    json_num(f, "est_error_m", r->est_valid ? r->est_error_m : NAN, false);
+    // The belief at the end and how long the robot had stood (docs/RESULTS.md, the failure
+    // taxonomy of "Generalisation: random placements").
+    json_num(f, "belief_x_m", r->belief_x, false);
+    json_num(f, "belief_y_m", r->belief_y, false);
+    json_num(f, "belief_error_m", r->belief_error_m, false);
+    json_num(f, "still_s", r->still_s, true);
     fprintf(f, "}\n");
 }
 
-void hs_sim_table_header(FILE *f)
+void hs_sim_table_header(FILE *f, bool placed)
 {
-    fprintf(f, "seed\treached\tend\tsim_time_s\tdistance_travelled_m\tshortest_path_m\t"
+    fprintf(f, "%sseed\treached\tend\tsim_time_s\tdistance_travelled_m\tshortest_path_m\t"
                "shortest_to_stop_m\tfinal_distance_m\tfinal_x_m\tfinal_y_m\titerations\t"
                "model_updates\tgreedy\tepsilon\tpackets_sent\tpackets_received\t"
-               "goal_timeouts\tgoal_blocked\tturn_time_s\twall_contacts\n");
+               "goal_timeouts\tgoal_blocked\tturn_time_s\twall_contacts%s\n",
+            placed ? "placement\t" : "",
+            placed ? "\tstart_x_m\tstart_y_m\tstart_theta_rad\tsource_x_m\tsource_y_m"
+                     "\test_error_m\tbelief_error_m\tstill_s" : "");
 }
 
 /// %.3f, or "nan" for a value that does not exist (no goal).
@@ -977,8 +1069,11 @@ static void tsv_num(FILE *f, double v)
     }
 }
 
-void hs_sim_table_row(FILE *f, const hs_sim_result_t *r)
+void hs_sim_table_row(FILE *f, const hs_sim_result_t *r, bool placed)
 {
+    if (placed) {
+        fprintf(f, "%llu\t", (unsigned long long)r->placement);
+    }
     fprintf(f, "%llu\t%d\t%s", (unsigned long long)r->seed, r->reached ? 1 : 0, r->end);
     tsv_num(f, r->sim_time_s);
     tsv_num(f, r->distance_travelled_m);
@@ -991,5 +1086,13 @@ void hs_sim_table_row(FILE *f, const hs_sim_result_t *r)
             r->greedy, r->epsilon, (unsigned long long)r->packets_sent,
             (unsigned long long)r->packets_received, r->goal_timeouts, r->goal_blocked);
     tsv_num(f, r->turn_time_s);
-    fprintf(f, "\t%ld\n", r->wall_contacts);
+    fprintf(f, "\t%ld", r->wall_contacts);
+    if (placed) {
+        fprintf(f, "\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f", r->start_x, r->start_y, r->start_theta,
+                r->source_x, r->source_y);
+        tsv_num(f, r->est_valid ? r->est_error_m : NAN);
+        tsv_num(f, r->belief_error_m);
+        tsv_num(f, r->still_s);
+    }
+    fputc('\n', f);
 }

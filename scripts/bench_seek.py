@@ -21,14 +21,16 @@ Definitions (also written into RESULTS.md):
                position at the decision to the goal), over the sum of planned path
                lengths: the part of the planned travel spent going around walls.
 Everything goes to a temporary directory first; RESULTS.md is written to a temporary
-file and renamed. Two parts of the old RESULTS.md are kept as they are: the hand-written
-Summary (between the HAND markers) and the section scripts/bench_pathloss_seek.py writes
-(between its own markers).
+file and renamed. Parts of the old RESULTS.md are kept as they are: the hand-written
+Summary (between the HAND markers) and the sections other benches write between their own
+markers (scripts/bench_pathloss_seek.py in place, bench_drive.py and bench_general.py at the
+end).
 """
 import argparse
 import glob
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -757,6 +759,11 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
          times["noise"], times["models"], times["bridge"], times["total"],
          times["total"] / 60))
     A("")
+    # Sections other benches write (scripts/bench_drive.py, scripts/bench_general.py), kept.
+    for name in re.findall(r"<!-- ([\w-]+): begin -->", old):
+        marks = ("<!-- %s: begin -->" % name, "<!-- %s: end -->" % name)
+        if marks not in (HAND, PATHLOSS) and kept(old, marks):
+            A(kept(old, marks) + "\n")
     tmp = path + ".tmp"
     with open(tmp, "w") as f:
         f.write("\n".join(L))

@@ -11,9 +11,10 @@ draws (51..100), and writes only the held-out half to its section of docs/RESULT
         [--work build/bench_general] [--results docs/RESULTS.md | --no-write]
 
 --placements P (even, 2..100) runs placements 1..P/2 and 51..50+P/2, so a smaller bench
-keeps the same held-out draws. Batches go to WORK/<binary hash>/..., a finished one is
-read back and an interrupted one resumed (rfseek-sim --resume), so an interrupted bench
-continues where it stopped; a rebuilt simulator starts afresh.
+keeps the same held-out draws. Batches of up to CHUNK placements go to WORK/<binary
+hash>/...: a finished one is read back and an interrupted one resumed (rfseek-sim
+--resume), so an interrupted bench continues where it stopped and a larger one reuses a
+smaller one's runs; a rebuilt simulator starts afresh.
 
 Failure taxonomy of a run that did not reach the source, first match wins, from the
 fields of summary.json (and runs.tsv):
@@ -46,6 +47,7 @@ SYNTHETIC = ["default", "lshape", "open"]
 CONFIGS = [("meta-path", "pathloss", "meta-path + pathloss", "p"),
            ("meta", "ridge", "meta + ridge", "r")]
 HELD_OUT_FIRST = 51  # placements 1..50 are the tuning draws, 51..100 the held-out ones
+CHUNK = 10          # placements per batch
 NEAR_M, STILL_S, BELIEF_M, ABANDONED, PARKED_M = 3.0, 120.0, 3.0, 3, 100.0
 CATEGORIES = ["near miss", "blocked", "wrong belief", "exploring", "other"]
 BEGIN = "<!-- bench_general: begin -->"
@@ -111,6 +113,17 @@ def read_runs(path):
 
 
 def batch(a, floor, strategy, model, first, last, base):
+    """The runs of placements first..last in batches of CHUNK (each run, resumed or read
+    back in base/...), and the host seconds the batches took when they ran."""
+    rows, spent = [], 0.0
+    for lo in range(first, last + 1, CHUNK):
+        r, el = chunk(a, floor, strategy, model, lo, min(last, lo + CHUNK - 1), base)
+        rows += r
+        spent += el
+    return rows, spent
+
+
+def chunk(a, floor, strategy, model, first, last, base):
     """The runs of one batch, run (or resumed, or read back) in base/..."""
     d = os.path.join(base, floor, f"{strategy}-{model}-p{first}..{last}-s{a.seeds}")
     runs = os.path.join(d, "runs.tsv")

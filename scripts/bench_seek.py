@@ -179,16 +179,16 @@ def fmt(v, nd=1):
     return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else "%.*f" % (nd, v)
 
 
-def row(label, s):
-    return ("| %s | %d | %d | **%.1f** (%.1f-%.1f) | %s | %s | %s | %s | %s | %s |" %
-            (label, s["n"], s["k"], 100 * s["p"], 100 * s["lo"], 100 * s["hi"], fmt(s["med"]),
+def row(scenario, label, s):
+    return ("| %s | %s | **%.1f** (%.1f-%.1f) | %s | %s | %s | %s | %s | %s |" %
+            (scenario, label, 100 * s["p"], 100 * s["lo"], 100 * s["hi"], fmt(s["med"]),
              fmt(s["p90"]), fmt(s["ratio"], 2), fmt(s["updates"], 0), fmt(s["eps"]),
              fmt(s["detour"])))
 
 
-HEAD = ("| %s | runs | reached | success %% (95%% Wilson CI) | median travel m "
+HEAD = ("| scenario | strategy | success % (95% Wilson CI) | median travel m "
         "| p90 travel m | median ratio to shortest (successful) | median model updates "
-        "| epsilon travel %% | detour %% |\n|---|---|---|---|---|---|---|---|---|---|")
+        "| epsilon travel % | detour % |\n|---|---|---|---|---|---|---|---|---|")
 
 
 def load_map(scen_file):
@@ -253,7 +253,7 @@ def region_of(scen, x, y, src, walls_at):
             return "source room"
         return "corridor" if here == "corridor" else "another room"
     wl = walls_at(x, y)
-    return "line of sight (0 walls)" if wl == 0 else ("1 wall" if wl == 1 else ">= 2 walls")
+    return "0 walls" if wl == 0 else ("1 wall" if wl == 1 else "2+ walls")
 
 
 def walls_lookup(field_tsv):
@@ -655,14 +655,13 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
     hand = kept(old, HAND)
     A(hand + "\n" if hand else "%s\n## Summary\n\n(to be written)\n\n%s\n" % HAND)
     A("## Every strategy on every shipped scenario (shadowing and noise as the scenario "
-      "file says; default: 4 dB / 4 dB)\n")
+      "file says; default: 4 dB / 4 dB; %d seeds each)\n" % args.seeds)
+    A(HEAD)
     for sc in scenarios:
-        A("### %s\n" % sc)
-        A(HEAD % "strategy")
         for st in STRATEGIES:
-            A(row(st if st not in STRAT_MODEL else "%s + %s" % (st, STRAT_MODEL[st]),
+            A(row(sc, st if st not in STRAT_MODEL else "%s + %s" % (st, STRAT_MODEL[st]),
                   summarise(table[(sc, st)])))
-        A("")
+    A("")
     # where meta does not win
     A("### Where meta does not win\n")
     notes = []
@@ -688,7 +687,7 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
       "rooms either side; lshape: the corridors and rooms of scripts/make_maps.py; open: "
       "one hall. The real floors (willow, 3ne, intel) carry no room labels: their end "
       "points are classed by the walls the straight line to the source crosses "
-      "(simulator geometry).\n")
+      "(simulator geometry). Strategies without a failed run are left out.\n")
     A("| scenario | strategy | failed | end region counts | median final distance m | "
       "min final distance m |\n|---|---|---|---|---|---|")
     for sc in scenarios:
@@ -696,7 +695,6 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
         for st in STRATEGIES:
             fails = [r for r in table[(sc, st)] if not r["reached"]]
             if not fails:
-                A("| %s | %s | 0 | - | - | - |" % (sc, st))
                 continue
             cnt = {}
             for r in fails:

@@ -176,6 +176,29 @@ def main():
           s["sources"] == [[float(p7["source_x_m"]), float(p7["source_y_m"])]] and
           "%.4f" % s["start_theta_rad"] == p7["start_theta_rad"], one.stderr + str(s)[:300])
 
+    # --- the end-of-run fields against the run's own logs ----------------------------------------
+    # still_s: seconds at the end within 2 m of the end point, from track.tsv (10 Hz true
+    # poses; summary.json counts whole seconds); belief_error_m: the path-loss estimate's
+    # error, or for ridge the last greedy decision's model maximum in log.tsv.
+    for model, strategy in (("pathloss", "meta-path"), ("ridge", "meta")):
+        d = f"{t}/end-{model}"
+        r = sim("scenarios/lshape.yaml", "--placement", "4", "--seed", "2", "--model", model,
+                "--strategy", strategy, "--out", d)
+        s = json.load(open(f"{d}/summary.json")) if r.returncode == 0 else {}
+        trk = np.loadtxt(f"{d}/track.tsv", skiprows=1, usecols=(0, 1, 2), ndmin=2)
+        fx, fy, end = s.get("final_x_m", 0), s.get("final_y_m", 0), s.get("sim_time_s", 0)
+        out = trk[np.hypot(trk[:, 1] - fx, trk[:, 2] - fy) > 2.0]
+        still = end - (out[-1, 0] if len(out) else 0.0)
+        logs = table(open(f"{d}/log.tsv").read()) if r.returncode == 0 else []
+        greedy = [x for x in logs if x["kind"] == "greedy" and "no_model" not in x["reason"]]
+        bx, by = ((s.get("est_src_x_m"), s.get("est_src_y_m")) if model == "pathloss" else
+                  (float(greedy[-1]["max_x_m"]), float(greedy[-1]["max_y_m"])) if greedy else (0, 0))
+        sx, sy = s.get("sources", [[0, 0]])[0]
+        check(f"end_fields_{model}", r.returncode == 0 and abs(s["still_s"] - still) <= 1.1 and
+              abs(s["belief_error_m"] - np.hypot(bx - sx, by - sy)) <= 0.002 and
+              s["belief_x_m"] == bx, f"{r.stderr} still {s.get('still_s')} vs {still:.2f}, "
+              f"belief {s.get('belief_error_m')} vs {np.hypot(bx - sx, by - sy):.3f}")
+
     # --- batches: table, job list + merge, resume ----------------------------------------------
     args = ["scenarios/lshape.yaml", "--placements", "3..5", "--seeds", "1..2", "--quiet",
             "--strategy", "meta-path", "--model", "pathloss"]  # 0.2-0.5 s a run: time to interrupt

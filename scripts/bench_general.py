@@ -157,8 +157,7 @@ def table(results, floors):
     synthetic floors pooled."""
     head = ["floor", "runs"]
     for _, _, _, c in CONFIGS:
-        head += [f"{c}: success %", f"{c}: travel / shortest, median / 90th pct",
-                 f"{c}: near miss / blocked / wrong belief / exploring / other", f"{c}: parked"]
+        head += [f"{c} success %", f"{c} ratio median / p90", f"{c} failures", f"{c} parked"]
     L = ["| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
     rows = [(f, [f]) for f in floors]
     for label, group in (("**all real**", REAL), ("**all synthetic**", SYNTHETIC)):
@@ -172,19 +171,15 @@ def table(results, floors):
 
 def section(cmd, at, minutes, nruns, seeds, held, floors, results):
     L = [BEGIN, "## Generalisation: random placements", "",
-         f"Written by `{cmd}` at commit {at} ({nruns} runs, {minutes:.0f} min of batches on "
-         f"two shared cores): every shipped floor at placements {held} drawn by "
-         "`rfseek-sim --placements` (start on a legal cell, source on any free cell, shortest "
-         "path 10-40 m; docs/SIMULATOR.md, \"Placements\"), seeds "
-         f"{seeds}; `p`: meta-path + pathloss, `r`: meta + ridge (the paper), on the same runs. "
-         "Shown: the held-out draws only "
-         "(1..50 are for tuning). Travel / shortest over the successful runs. Failures, "
-         "first match: *near miss*: ends within 3 m; *blocked*: the drive gave up on 3 goals, "
-         "or the robot stood still the last 120 s (`still_s`) with its belief "
-         "(`belief_error_m`: the path-loss estimate, else the last greedy model maximum) "
-         "within 3 m; *wrong belief*: stood so with the belief farther; *exploring*: used "
-         "the 150 m budget; *other*: the time cap while moving. *Parked*: the time cap with "
-         "under 100 m travelled.", ""]
+         f"Written by `{cmd}` at commit {at} ({nruns} runs, {minutes:.0f} min on two shared "
+         f"cores). Held-out placements {held} (1..50 are for tuning) of every shipped floor "
+         "from `rfseek-sim --placements` (docs/SIMULATOR.md, \"Placements\"), seeds "
+         f"{seeds}; `p`: meta-path + pathloss, `r`: meta + ridge (the paper), same runs. "
+         "Ratio: travel / shortest path of the successful runs. Failures near miss / blocked "
+         "/ wrong belief / exploring / other, first match: ends within 3 m; the drive gave up "
+         "on 3 goals, or stood still the last 120 s (`still_s`) with its belief "
+         "(`belief_error_m`) within 3 m; stood so, belief farther; the 150 m budget spent; "
+         "the time cap while moving. *Parked*: the time cap under 100 m travelled.", ""]
     L += table(results, floors)
     L += ["", END]
     return "\n".join(L) + "\n"

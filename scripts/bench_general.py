@@ -144,20 +144,21 @@ def chunk(a, floor, strategy, model, first, last, base):
         return read_runs(runs), float(f.read())
 
 
-def cells(s):
+def cells(s, parked):
     """One configuration's cells: success % (Wilson interval), travel / shortest median and
-    90th percentile, the taxonomy counts in CATEGORIES order, parked."""
+    90th percentile, the taxonomy counts in CATEGORIES order, and parked when asked."""
     return (f"**{100 * s['p']:.1f}** ({100 * s['lo']:.0f}-{100 * s['hi']:.0f}) | "
             f"{s['med']:.2f} / {s['p90']:.2f} | " + "/".join(str(s["cats"][c]) for c in CATEGORIES)
-            + f" | {s['parked']}")
+            + (f" | {s['parked']}" if parked else ""))
 
 
-def table(results, floors):
+def table(results, floors, parked=True):
     """One row per floor, both configurations side by side, then the real and the
-    synthetic floors pooled."""
-    head = ["floor", "runs"]
+    synthetic floors pooled; the parked columns unless parked is False."""
+    head = ["floor"]
     for _, _, _, c in CONFIGS:
-        head += [f"{c} success %", f"{c} ratio median / p90", f"{c} failures", f"{c} parked"]
+        head += [f"{c} success %", f"{c} ratio median / p90", f"{c} failures"] + \
+            ([f"{c} parked"] if parked else [])
     L = ["| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
     rows = [(f, [f]) for f in floors]
     for label, group in (("**all real**", REAL), ("**all synthetic**", SYNTHETIC)):
@@ -165,22 +166,26 @@ def table(results, floors):
             rows.append((label, [f for f in floors if f in group]))
     for label, group in rows:
         st = [stats([r for f in group for r in results[(f, cfg)]]) for _, _, cfg, _ in CONFIGS]
-        L.append(f"| {label} | {st[0]['n']} | " + " | ".join(cells(x) for x in st) + " |")
+        L.append(f"| {label} ({st[0]['n']}) | " + " | ".join(cells(x, parked) for x in st) + " |")
     return L
 
 
 def section(cmd, at, minutes, nruns, seeds, held, floors, results):
+    """The RESULTS.md section; the parked counts in the text when every floor has none."""
+    rows = {cfg: [r for f in floors for r in results[(f, cfg)]] for _, _, cfg, _ in CONFIGS}
+    parked = [stats(rows[cfg])["parked"] for _, _, cfg, _ in CONFIGS]
     L = [BEGIN, "## Generalisation: random placements", "",
-         f"Written by `{cmd}` at commit {at} ({nruns} runs, {minutes:.0f} min on two shared "
-         f"cores). Held-out placements {held} (1..50 are for tuning) of every shipped floor "
-         "from `rfseek-sim --placements` (docs/SIMULATOR.md, \"Placements\"), seeds "
-         f"{seeds}; `p`: meta-path + pathloss, `r`: meta + ridge (the paper), same runs. "
-         "Ratio: travel / shortest path of the successful runs. Failures near miss / blocked "
-         "/ wrong belief / exploring / other, first match: ends within 3 m; the drive gave up "
-         "on 3 goals, or stood still the last 120 s (`still_s`) with its belief "
-         "(`belief_error_m`) within 3 m; stood so, belief farther; the 150 m budget spent; "
-         "the time cap while moving. *Parked*: the time cap under 100 m travelled.", ""]
-    L += table(results, floors)
+         f"Written by `{cmd}` at commit {at} ({nruns} runs, {minutes:.0f} min, two shared "
+         f"cores): held-out placements {held} (1..50 tune) of every shipped floor "
+         "(`rfseek-sim --placements`, docs/SIMULATOR.md), seeds "
+         f"{seeds}, runs per row in brackets; `p` meta-path + pathloss, `r` meta + ridge (the "
+         "paper). Ratio: travel / shortest path, successful runs. Failures (first match): near "
+         "miss, ends within 3 m / blocked, 3 goals given up or still for the last 120 s "
+         "(`still_s`) with the belief (`belief_error_m`) within 3 m / wrong belief, still so "
+         "with it farther / exploring, 150 m budget spent / other, time cap while moving. "
+         "Parked (time cap, under 100 m)" +
+         (f": {parked[0]} and {parked[1]}." if not any(parked) else " in its columns."), ""]
+    L += table(results, floors, parked=any(parked))
     L += ["", END]
     return "\n".join(L) + "\n"
 

@@ -647,11 +647,10 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
       "travel %*: travel during epsilon steps over all travel. *Detour %*: planned path "
       "length beyond the straight line to the goal, over all planned path length. Cells "
       "of the compact tables: success % (95 % Wilson interval), ratio.\n")
-    A("**Strategies** (docs/STRATEGIES.md): `meta` is the paper's algorithm with its own "
-      "parameters and local ridge; `meta-global`, `fd-gradient`, `plane-gradient` and "
-      "`chemotaxis` are baselines behind the same sensors, step, map legality and planner; "
-      "`meta-path` runs with the map-aware path-loss model (docs/PATHLOSS.md) and is the "
-      "improvement, not a baseline.\n")
+    A("**Strategies** (docs/STRATEGIES.md): `meta` is the paper's, with its parameters and "
+      "local ridge; `meta-global`, `fd-gradient`, `plane-gradient` and `chemotaxis` are "
+      "baselines with the same sensors, step, legality and planner; `meta-path`, with the "
+      "map-aware path-loss model (docs/PATHLOSS.md), is the improvement.\n")
     hand = kept(old, HAND)
     A(hand + "\n" if hand else "%s\n## Summary\n\n(to be written)\n\n%s\n" % HAND)
     A("## Every strategy on every shipped scenario (shadowing and noise as the scenario "
@@ -682,12 +681,11 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
     L.extend(sweep_tables(sweep))
     A("![success vs shadowing and noise](figures/seek_success_vs_noise.png)\n")
     A("## Failure analysis\n")
-    A("Where failed runs ended and how close they came (final straight-line distance to "
-      "the source). Labelled regions: the office (default) floor: corridor y 5..7 m, 5 m "
-      "rooms either side; lshape: the corridors and rooms of scripts/make_maps.py; open: "
-      "one hall. The real floors (willow, 3ne, intel) carry no room labels: their end "
-      "points are classed by the walls the straight line to the source crosses "
-      "(simulator geometry). Strategies without a failed run are left out.\n")
+    A("Where failed runs ended and their final straight-line distance to the source. "
+      "Regions: office: corridor y 5..7 m, 5 m rooms either side; lshape: the corridors "
+      "and rooms of scripts/make_maps.py; open: one hall; real floors (no room labels): "
+      "the walls the straight line to the source crosses. Strategies without a failed run "
+      "are left out.\n")
     A("| scenario | strategy | failed | end region counts | median final distance m | "
       "min final distance m |\n|---|---|---|---|---|---|")
     for sc in scenarios:
@@ -706,21 +704,19 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
                float(np.median(fd)), float(np.min(fd))))
     A("")
     A("## Bridging (paper section 6)\n")
-    A("scenarios/bridge.yaml: two sources in different rooms of the office floor, target "
-      "f = -|R1 - R2| - |R1 + R2|, error threshold 7 (the paper's value for this noisier "
-      "target; rfseek-sim sets it for target: bridge), %d seeds, each run ending on 150 m "
-      "or 600 s. *Settle point*: the robot's position at the end of the run. *True f*: "
-      "from each seed's mean field (path loss, walls and that seed's shadowing; no "
-      "fading, no noise) of both sources on a 0.1 m grid of free cells. `meta + ridge` is "
-      "the paper's; `meta-path + pathloss` shows where the path-loss model breaks: it "
-      "fits one point source, and f is not a path-loss field.\n" % len(br[0]))
+    A("scenarios/bridge.yaml: two sources in different office rooms, target f = -|R1 - R2| "
+      "- |R1 + R2|, error threshold 7 (the paper's for this noisier target; rfseek-sim "
+      "sets it), %d seeds, runs ending at 150 m or 600 s. *Settle point*: where a run "
+      "ends. *True f*: from each seed's mean field of both sources (path loss, walls, its "
+      "shadowing; no fading or noise) on a 0.1 m grid of free cells. `meta + ridge` is the "
+      "paper's; `meta-path + pathloss` fits one point source, which f is not.\n" % len(br[0]))
     for name, rows in (("meta + ridge", br[0]), ("meta-path + pathloss", br[1])):
         d = np.array([r[3] for r in rows])
         fr = np.array([r[4] for r in rows])
         fb = np.array([r[5] for r in rows])
         A("### %s\n" % name)
         A("| quantity | median | p10 | p90 |\n|---|---|---|---|")
-        A("| distance from the settle point to the best point of the true f, m | %.1f | %.1f | "
+        A("| settle point to the best point of true f, m | %.1f | %.1f | "
           "%.1f |" % (np.median(d), np.percentile(d, 10), np.percentile(d, 90)))
         A("| f at the settle point, dB | %.1f | %.1f | %.1f |" %
           (np.median(fr), np.percentile(fr, 10), np.percentile(fr, 90)))
@@ -728,14 +724,14 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
           (np.median(fb), np.percentile(fb, 10), np.percentile(fb, 90)))
         A("| shortfall f(best) - f(settle), dB | %.1f | %.1f | %.1f |" %
           (np.median(fb - fr), np.percentile(fb - fr, 10), np.percentile(fb - fr, 90)))
-        A("| runs settling within 3 m of the best point | %d of %d | | |" %
+        A("| settling within 3 m of it | %d of %d | | |" %
           (int((d <= 3.0).sum()), len(d)))
         A("")
     A("![bridging](figures/seek_bridge.png)\n")
     A("## Internal models (strategy meta)\n")
-    A("Models from the registry common/rfs_models.h (`--model NAME`) under the paper's "
-      "`meta`; mlp and knn on fewer seeds (a run costs 1-4 s of CPU), so their intervals "
-      "are wider. The ridge row is the meta runs above.\n")
+    A("Registry models (common/rfs_models.h, `--model NAME`) under the paper's `meta`; mlp "
+      "and knn on fewer seeds (1-4 s of CPU a run), so wider intervals. The ridge row is "
+      "the meta runs above.\n")
     counts = {m: (args.slow_model_seeds if m in SLOW_MODELS else ms) for m in MODELS}
     counts["ridge"] = args.seeds if ms == args.seeds else ms
     L.extend(model_table(mtab, scenarios, counts))

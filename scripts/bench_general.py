@@ -153,17 +153,16 @@ def cells(s, parked):
 
 
 def table(results, floors, parked=True):
-    """One row per floor, both configurations side by side, then the real and the
-    synthetic floors pooled; the parked columns unless parked is False."""
+    """One row per floor, both configurations side by side, then the real floors pooled;
+    the parked columns unless parked is False."""
     head = ["floor"]
     for _, _, _, c in CONFIGS:
         head += [f"{c} success %", f"{c} ratio median / p90", f"{c} failures"] + \
             ([f"{c} parked"] if parked else [])
     L = ["| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
     rows = [(f, [f]) for f in floors]
-    for label, group in (("**all real**", REAL), ("**all synthetic**", SYNTHETIC)):
-        if len([f for f in floors if f in group]) > 1:
-            rows.append((label, [f for f in floors if f in group]))
+    if len([f for f in floors if f in REAL]) > 1:
+        rows.append(("**all real**", [f for f in floors if f in REAL]))
     for label, group in rows:
         st = [stats([r for f in group for r in results[(f, cfg)]]) for _, _, cfg, _ in CONFIGS]
         L.append(f"| {label} ({st[0]['n']}) | " + " | ".join(cells(x, parked) for x in st) + " |")

@@ -676,8 +676,8 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
       "(meta-global, fd-gradient, plane-gradient, chemotaxis) in every scenario.")
     A("")
     A("## Default scenario at other shadowing and noise levels\n")
-    A("Generated variants of scenarios/default.yaml (shadowing correlation 5 m; 0 dB = "
-      "shadowing off), %d seeds each, every strategy with its model as above.\n" % ns)
+    A("Variants of scenarios/default.yaml (shadowing correlation 5 m; 0 dB: off), %d "
+      "seeds each, every strategy with its model as above.\n" % ns)
     L.extend(sweep_tables(sweep))
     A("![success vs shadowing and noise](figures/seek_success_vs_noise.png)\n")
     A("## Failure analysis\n")

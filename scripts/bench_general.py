@@ -155,7 +155,7 @@ def cells(s, parked):
 def table(results, floors, parked=True):
     """One row per floor, both configurations side by side, then the real floors pooled;
     the parked columns unless parked is False."""
-    head = ["floor"]
+    head = ["floor (runs)"]
     for _, _, _, c in CONFIGS:
         head += [f"{c} success %", f"{c} ratio median / p90", f"{c} failures"] + \
             ([f"{c} parked"] if parked else [])
@@ -170,21 +170,24 @@ def table(results, floors, parked=True):
 
 
 def section(cmd, at, minutes, nruns, seeds, held, floors, results):
-    """The RESULTS.md section; the parked counts in the text when every floor has none."""
-    rows = {cfg: [r for f in floors for r in results[(f, cfg)]] for _, _, cfg, _ in CONFIGS}
-    parked = [stats(rows[cfg])["parked"] for _, _, cfg, _ in CONFIGS]
+    """The RESULTS.md section: the table without the parked columns, the parked runs per
+    configuration (and floor) in the text."""
+    parked = []
+    for _, _, cfg, c in CONFIGS:
+        per = [(f, stats(results[(f, cfg)])["parked"]) for f in floors]
+        where = ", ".join(f"{f} {n}" for f, n in per if n)
+        parked.append(f"{c} {sum(n for _, n in per)}" + (f" ({where})" if where else ""))
     L = [BEGIN, "## Generalisation: random placements", "",
          f"Written by `{cmd}` at commit {at} ({nruns} runs, {minutes:.0f} min, two shared "
          f"cores): held-out placements {held} (1..50 tune) of every shipped floor "
          "(`rfseek-sim --placements`, docs/SIMULATOR.md), seeds "
-         f"{seeds}, runs per row in brackets; `p` meta-path + pathloss, `r` meta + ridge (the "
+         f"{seeds}; `p` meta-path + pathloss, `r` meta + ridge (the "
          "paper). Ratio: travel / shortest path, successful runs. Failures (first match): near "
          "miss, ends within 3 m / blocked, 3 goals given up or still for the last 120 s "
          "(`still_s`) with the belief (`belief_error_m`) within 3 m / wrong belief, still so "
          "with it farther / exploring, 150 m budget spent / other, time cap while moving. "
-         "Parked (time cap, under 100 m)" +
-         (f": {parked[0]} and {parked[1]}." if not any(parked) else " in its columns."), ""]
-    L += table(results, floors, parked=any(parked))
+         f"Parked (time cap, under 100 m): {', '.join(parked)}.", ""]
+    L += table(results, floors, parked=False)
     L += ["", END]
     return "\n".join(L) + "\n"
 

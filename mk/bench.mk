@@ -101,6 +101,16 @@ bench-drive: $(BENCH_BIN)/rfseek-sim
 	$(PYTHON) scripts/bench_drive.py --sim $(BENCH_BIN)/rfseek-sim
 BENCH_TARGETS += bench-drive
 
+# Seeking at random placements on every shipped floor, meta-path + pathloss and meta +
+# ridge -> docs/RESULTS.md ("Generalisation: random placements", held-out draws only).
+# Long (about an hour on two shared cores); GENERAL_ARGS="--placements 20" makes it short.
+GENERAL_JOBS ?= 1
+GENERAL_ARGS ?=
+.PHONY: bench-general
+bench-general: $(BENCH_BIN)/rfseek-sim
+	nice -n 19 $(PYTHON) scripts/bench_general.py --sim $(BENCH_BIN)/rfseek-sim --jobs $(GENERAL_JOBS) $(GENERAL_ARGS)
+BENCH_TARGETS += bench-general
+
 # --- the Linux port: pcap feeder, CAN codec and the two-process overhead ---------------------
 .PHONY: bench-feed bench-wire
 # Frames/s extracting one MAC's RSSI from a 1,000,000-frame capture, side by side with

@@ -48,7 +48,7 @@ $(BUILD)/asan/bin/rfseekd: $(BUILD)/asan/obj/firmware/port/linux/prog/rfseekd.o 
 ALL_TARGETS += $(LINUX_LIB) $(LINUX_PROGS) $(LCM_PY_INIT)
 
 # --- tests -------------------------------------------------------------------------------
-# The map loader on real maps (/work/shared/data/maps) and bad input (tests/data/maps_bad/);
+# The map loader on real maps (scenarios/maps) and bad input (tests/data/maps_bad/);
 # the radiotap parser and the pcap writer against tshark; the live feed's heartbeat times;
 # candump -L lines against can-utils' log2long; the LCM adapter and the path-loss estimate
 # in the seeker status (hand-decoded bytes).

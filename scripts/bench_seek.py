@@ -21,14 +21,16 @@ Definitions (also written into RESULTS.md):
                position at the decision to the goal), over the sum of planned path
                lengths: the part of the planned travel spent going around walls.
 Everything goes to a temporary directory first; RESULTS.md is written to a temporary
-file and renamed. Two parts of the old RESULTS.md are kept as they are: the hand-written
-Summary (between the HAND markers) and the section scripts/bench_pathloss_seek.py writes
-(between its own markers).
+file and renamed. Parts of the old RESULTS.md are kept as they are: the hand-written
+Summary (between the HAND markers) and the sections other benches write between their own
+markers (scripts/bench_pathloss_seek.py in place, bench_drive.py and bench_general.py at the
+end).
 """
 import argparse
 import glob
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -177,16 +179,16 @@ def fmt(v, nd=1):
     return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else "%.*f" % (nd, v)
 
 
-def row(label, s):
-    return ("| %s | %d | %d | **%.1f** (%.1f-%.1f) | %s | %s | %s | %s | %s | %s |" %
-            (label, s["n"], s["k"], 100 * s["p"], 100 * s["lo"], 100 * s["hi"], fmt(s["med"]),
+def row(scenario, label, s):
+    return ("| %s | %s | **%.1f** (%.1f-%.1f) | %s | %s | %s | %s | %s | %s |" %
+            (scenario, label, 100 * s["p"], 100 * s["lo"], 100 * s["hi"], fmt(s["med"]),
              fmt(s["p90"]), fmt(s["ratio"], 2), fmt(s["updates"], 0), fmt(s["eps"]),
              fmt(s["detour"])))
 
 
-HEAD = ("| %s | runs | reached | success %% (95%% Wilson CI) | median travel m "
+HEAD = ("| scenario | strategy | success % (95% Wilson CI) | median travel m "
         "| p90 travel m | median ratio to shortest (successful) | median model updates "
-        "| epsilon travel %% | detour %% |\n|---|---|---|---|---|---|---|---|---|---|")
+        "| epsilon travel % | detour % |\n|---|---|---|---|---|---|---|---|---|")
 
 
 def load_map(scen_file):
@@ -251,7 +253,7 @@ def region_of(scen, x, y, src, walls_at):
             return "source room"
         return "corridor" if here == "corridor" else "another room"
     wl = walls_at(x, y)
-    return "line of sight (0 walls)" if wl == 0 else ("1 wall" if wl == 1 else ">= 2 walls")
+    return "0 walls" if wl == 0 else ("1 wall" if wl == 1 else "2+ walls")
 
 
 def walls_lookup(field_tsv):
@@ -645,22 +647,20 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
       "travel %*: travel during epsilon steps over all travel. *Detour %*: planned path "
       "length beyond the straight line to the goal, over all planned path length. Cells "
       "of the compact tables: success % (95 % Wilson interval), ratio.\n")
-    A("**Strategies** (docs/STRATEGIES.md): `meta` is the paper's algorithm with its own "
-      "parameters and local ridge; `meta-global`, `fd-gradient`, `plane-gradient` and "
-      "`chemotaxis` are baselines behind the same sensors, step, map legality and planner; "
-      "`meta-path` runs with the map-aware path-loss model (docs/PATHLOSS.md) and is the "
-      "improvement, not a baseline.\n")
+    A("**Strategies** (docs/STRATEGIES.md): `meta` is the paper's, with its parameters and "
+      "local ridge; `meta-global`, `fd-gradient`, `plane-gradient` and `chemotaxis` are "
+      "baselines with the same sensors, step, legality and planner; `meta-path`, with the "
+      "map-aware path-loss model (docs/PATHLOSS.md), is the improvement.\n")
     hand = kept(old, HAND)
     A(hand + "\n" if hand else "%s\n## Summary\n\n(to be written)\n\n%s\n" % HAND)
     A("## Every strategy on every shipped scenario (shadowing and noise as the scenario "
-      "file says; default: 4 dB / 4 dB)\n")
+      "file says; default: 4 dB / 4 dB; %d seeds each)\n" % args.seeds)
+    A(HEAD)
     for sc in scenarios:
-        A("### %s\n" % sc)
-        A(HEAD % "strategy")
         for st in STRATEGIES:
-            A(row(st if st not in STRAT_MODEL else "%s + %s" % (st, STRAT_MODEL[st]),
+            A(row(sc, st if st not in STRAT_MODEL else "%s + %s" % (st, STRAT_MODEL[st]),
                   summarise(table[(sc, st)])))
-        A("")
+    A("")
     # where meta does not win
     A("### Where meta does not win\n")
     notes = []
@@ -676,17 +676,16 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
       "(meta-global, fd-gradient, plane-gradient, chemotaxis) in every scenario.")
     A("")
     A("## Default scenario at other shadowing and noise levels\n")
-    A("Generated variants of scenarios/default.yaml (shadowing correlation 5 m; 0 dB = "
-      "shadowing off), %d seeds each, every strategy with its model as above.\n" % ns)
+    A("Variants of scenarios/default.yaml (shadowing correlation 5 m; 0 dB: off), %d "
+      "seeds each, every strategy with its model as above.\n" % ns)
     L.extend(sweep_tables(sweep))
     A("![success vs shadowing and noise](figures/seek_success_vs_noise.png)\n")
     A("## Failure analysis\n")
-    A("Where failed runs ended and how close they came (final straight-line distance to "
-      "the source). Labelled regions: the office (default) floor: corridor y 5..7 m, 5 m "
-      "rooms either side; lshape: the corridors and rooms of scripts/make_maps.py; open: "
-      "one hall. The real floors (willow, 3ne, intel) carry no room labels: their end "
-      "points are classed by the walls the straight line to the source crosses "
-      "(simulator geometry).\n")
+    A("Where failed runs ended and their final straight-line distance to the source. "
+      "Regions: office: corridor y 5..7 m, 5 m rooms either side; lshape: the corridors "
+      "and rooms of scripts/make_maps.py; open: one hall; real floors (no room labels): "
+      "the walls the straight line to the source crosses. Strategies without a failed run "
+      "are left out.\n")
     A("| scenario | strategy | failed | end region counts | median final distance m | "
       "min final distance m |\n|---|---|---|---|---|---|")
     for sc in scenarios:
@@ -694,7 +693,6 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
         for st in STRATEGIES:
             fails = [r for r in table[(sc, st)] if not r["reached"]]
             if not fails:
-                A("| %s | %s | 0 | - | - | - |" % (sc, st))
                 continue
             cnt = {}
             for r in fails:
@@ -706,21 +704,19 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
                float(np.median(fd)), float(np.min(fd))))
     A("")
     A("## Bridging (paper section 6)\n")
-    A("scenarios/bridge.yaml: two sources in different rooms of the office floor, target "
-      "f = -|R1 - R2| - |R1 + R2|, error threshold 7 (the paper's value for this noisier "
-      "target; rfseek-sim sets it for target: bridge), %d seeds, each run ending on 150 m "
-      "or 600 s. *Settle point*: the robot's position at the end of the run. *True f*: "
-      "from each seed's mean field (path loss, walls and that seed's shadowing; no "
-      "fading, no noise) of both sources on a 0.1 m grid of free cells. `meta + ridge` is "
-      "the paper's; `meta-path + pathloss` shows where the path-loss model breaks: it "
-      "fits one point source, and f is not a path-loss field.\n" % len(br[0]))
+    A("scenarios/bridge.yaml: two sources in different office rooms, target f = -|R1 - R2| "
+      "- |R1 + R2|, error threshold 7 (the paper's for this noisier target; rfseek-sim "
+      "sets it), %d seeds, runs ending at 150 m or 600 s. *Settle point*: where a run "
+      "ends. *True f*: from each seed's mean field of both sources (path loss, walls, its "
+      "shadowing; no fading or noise) on a 0.1 m grid of free cells. `meta + ridge` is the "
+      "paper's; `meta-path + pathloss` fits one point source, which f is not.\n" % len(br[0]))
     for name, rows in (("meta + ridge", br[0]), ("meta-path + pathloss", br[1])):
         d = np.array([r[3] for r in rows])
         fr = np.array([r[4] for r in rows])
         fb = np.array([r[5] for r in rows])
         A("### %s\n" % name)
         A("| quantity | median | p10 | p90 |\n|---|---|---|---|")
-        A("| distance from the settle point to the best point of the true f, m | %.1f | %.1f | "
+        A("| settle point to the best point of true f, m | %.1f | %.1f | "
           "%.1f |" % (np.median(d), np.percentile(d, 10), np.percentile(d, 90)))
         A("| f at the settle point, dB | %.1f | %.1f | %.1f |" %
           (np.median(fr), np.percentile(fr, 10), np.percentile(fr, 90)))
@@ -728,14 +724,14 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
           (np.median(fb), np.percentile(fb, 10), np.percentile(fb, 90)))
         A("| shortfall f(best) - f(settle), dB | %.1f | %.1f | %.1f |" %
           (np.median(fb - fr), np.percentile(fb - fr, 10), np.percentile(fb - fr, 90)))
-        A("| runs settling within 3 m of the best point | %d of %d | | |" %
+        A("| settling within 3 m of it | %d of %d | | |" %
           (int((d <= 3.0).sum()), len(d)))
         A("")
     A("![bridging](figures/seek_bridge.png)\n")
     A("## Internal models (strategy meta)\n")
-    A("Models from the registry common/rfs_models.h (`--model NAME`) under the paper's "
-      "`meta`; mlp and knn on fewer seeds (a run costs 1-4 s of CPU), so their intervals "
-      "are wider. The ridge row is the meta runs above.\n")
+    A("Registry models (common/rfs_models.h, `--model NAME`) under the paper's `meta`; mlp "
+      "and knn on fewer seeds (1-4 s of CPU a run), so wider intervals. The ridge row is "
+      "the meta runs above.\n")
     counts = {m: (args.slow_model_seeds if m in SLOW_MODELS else ms) for m in MODELS}
     counts["ridge"] = args.seeds if ms == args.seeds else ms
     L.extend(model_table(mtab, scenarios, counts))
@@ -757,6 +753,11 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
          times["noise"], times["models"], times["bridge"], times["total"],
          times["total"] / 60))
     A("")
+    # Sections other benches write (scripts/bench_drive.py, scripts/bench_general.py), kept.
+    for name in re.findall(r"<!-- ([\w-]+): begin -->", old):
+        marks = ("<!-- %s: begin -->" % name, "<!-- %s: end -->" % name)
+        if marks not in (HAND, PATHLOSS) and kept(old, marks):
+            A(kept(old, marks) + "\n")
     tmp = path + ".tmp"
     with open(tmp, "w") as f:
         f.write("\n".join(L))

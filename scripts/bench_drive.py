@@ -60,7 +60,12 @@ def run(sim, scenario, strategy, model, seeds, jobs):
     out = subprocess.run(cmd, capture_output=True, text=True)
     if out.returncode != 0:
         sys.exit(f"bench_drive: {scenario}: {out.stderr.strip()}")
-    lines = out.stdout.strip().split("\n")
+    return summarise(out.stdout)
+
+
+def summarise(table):
+    """Success, travel, turning, goals abandoned and contacts of one runs.tsv table."""
+    lines = table.strip().split("\n")
     head = lines[0].split("\t")
     rows = [dict(zip(head, ln.split("\t"))) for ln in lines[1:]]
     n = len(rows)

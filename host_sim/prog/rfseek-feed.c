@@ -93,6 +93,9 @@ typedef struct feed_stats {
     uint64_t no_ta;                   /* --list: 802.11 header without a transmitter address */
     uint64_t rt_kept;                 /* --list: unusable radiotap header, its 802.11 frame counted */
     uint64_t mac_frames[FEED_MAX_MACS]; /* frames from each --mac (SA; --list: TA) */
+    bool count_all;                   /* --stats: parse every record to count why it gave
+                                         nothing (else one from another source is skipped
+                                         unparsed, docs/FEEDER.md) */
 } feed_stats_t;
 
 static int parse_mac(const char *s, uint8_t mac[6])
@@ -179,13 +182,24 @@ typedef int (*feed_fn)(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_f
  * was alive at its time (the receiver heartbeat). */
 typedef int (*alive_fn)(void *ctx, int64_t t_us);
 
+/* Whether the record's source address is one of the n MACs (lx_rt_frame_sa). */
+static bool sa_wanted(const lx_pcap_pkt_t *pkt, const uint8_t (*macs)[6], int n)
+{
+    uint8_t sa[6];
+    if (!lx_rt_frame_sa(pkt->data, pkt->caplen, sa)) { return false; }
+    int m = 0;
+    while (m < n && memcmp(macs[m], sa, 6) != 0) { m++; }
+    return m < n;
+}
+
 /* The next record whose radiotap header parsed (with bad_rt, or was unusable but located
  * the 802.11 frame: counted in st->rt_kept) and an 802.11 header followed, in *pkt and *f;
  * alive (when not NULL) is called for every record read, and why a record gives nothing
- * is counted in st. 1, 0 at the end, -1 after a read error (message on stderr) or when
- * alive failed. */
+ * is counted in st. With `want` (and not st->count_all) a record whose source address is
+ * not one of its n_want MACs is skipped before its radiotap header is parsed, uncounted.
+ * 1, 0 at the end, -1 after a read error (message on stderr) or when alive failed. */
 static int next_frame(lx_pcap_reader_t *r, feed_stats_t *st, lx_pcap_pkt_t *pkt, lx_rt_frame_t *f,
-                      bool bad_rt, alive_fn alive, void *alive_ctx)
+                      bool bad_rt, const uint8_t (*want)[6], int n_want, alive_fn alive, void *alive_ctx)
 {
     char err[512];
     for (;;) {
@@ -199,6 +213,7 @@ static int next_frame(lx_pcap_reader_t *r, feed_stats_t *st, lx_pcap_pkt_t *pkt,
         st->packets++;
         if (alive != NULL && alive(alive_ctx, pkt->t_us) != 0) { return -1; }
         if (pkt->caplen < pkt->origlen) { st->caplen_short++; }
+        if (want != NULL && !st->count_all && !sa_wanted(pkt, want, n_want)) { continue; }
         const int prc = lx_rt_frame_parse(pkt->data, pkt->caplen, f);
         if (prc != 0 && bad_rt && f->wlan_ok) {
             st->rt_kept++;
@@ -220,7 +235,7 @@ static int scan_capture(lx_pcap_reader_t *r, const uint8_t (*macs)[6], int n_mac
     for (;;) {
         lx_pcap_pkt_t pkt;
         lx_rt_frame_t f;
-        const int got = next_frame(r, st, &pkt, &f, false, alive, alive_ctx);
+        const int got = next_frame(r, st, &pkt, &f, false, macs, n_macs, alive, alive_ctx);
         if (got <= 0) { return got < 0 ? 1 : 0; }
         if (!f.wlan.has_sa) { st->no_sa++; continue; }
         int m = 0;
@@ -243,7 +258,7 @@ static int scan_list(lx_pcap_reader_t *r, const uint8_t (*macs)[6], int n_macs, 
     for (;;) {
         lx_pcap_pkt_t pkt;
         lx_rt_frame_t f;
-        const int got = rc == 0 ? next_frame(r, st, &pkt, &f, true, NULL, NULL) : 0;
+        const int got = rc == 0 ? next_frame(r, st, &pkt, &f, true, NULL, 0, NULL, NULL) : 0;
         if (got <= 0) {
             rc = got < 0 ? 1 : rc;
             break;
@@ -1033,6 +1048,7 @@ static int feed_main(int argc, char **argv)
     }
     feed_stats_t st;
     memset(&st, 0, sizeof(st));
+    st.count_all = fo.stats;
     rc = fo.ro.poses != NULL ? run_replay(&fo.ro, r, fo.macs, fo.n_macs, &st)
                              : run_tsv(r, fo.output, fo.live, fo.list, (const uint8_t(*)[6])fo.macs, fo.n_macs, &st);
     lx_pcap_close(r);

@@ -282,3 +282,14 @@ int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f)
     }
     return rc;
 }
+
+bool lx_rt_frame_sa(const uint8_t *buf, size_t len, uint8_t sa[6])
+{
+    /* The same location as lx_rt_frame_parse: a header it accepts has it_len in [8, len]. */
+    const size_t it_len = len >= RT_HDR ? rd16(buf + 2) : 0u;
+    if (it_len < RT_HDR || it_len > len) { return false; }
+    lx_wlan_t w;
+    if (lx_wlan_parse(buf + it_len, len - it_len, &w) != 0 || !w.has_sa) { return false; }
+    memcpy(sa, w.sa, 6);
+    return true;
+}

@@ -136,4 +136,11 @@ typedef struct lx_rt_frame {
 /// response's 12 bytes of fixed fields, within the captured frame without its FCS.
 int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f);
 
+/// The source address (wlan.sa) of a captured record, found from the radiotap length
+/// field (bytes 2-3) and the 802.11 header alone, no radiotap field parsed: a filter ahead
+/// of lx_rt_frame_parse(). false when none is found. For a record lx_rt_frame_parse()
+/// accepts (returns 0) the answer equals its wlan.has_sa and wlan.sa; a record it rejects
+/// may still give true. Never reads outside buf[0, len).
+bool lx_rt_frame_sa(const uint8_t *buf, size_t len, uint8_t sa[6]);
+
 #endif /* LX_RADIOTAP_H */

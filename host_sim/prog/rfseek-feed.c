@@ -121,25 +121,46 @@ static int parse_mac(const char *s, uint8_t mac[6])
     return 0;
 }
 
-/* "<sec>.<9 digits>\t<mac>\t<dbm>\n" into out; returns its length. Hand-formatted: this
- * is the inner loop of the bench (millions of lines). */
-static size_t format_line(char *out, uint64_t sec, uint32_t frac, const uint8_t mac[6], int dbm)
+/* "00" .. "99": two digits a division. */
+static const char k_d2[] = "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+                           "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+                           "8081828384858687888990919293949596979899";
+
+/* The decimal digits of sec into out (at least 20 bytes); returns their number. */
+static size_t format_sec(char *out, uint64_t sec)
+{
+    char tmp[20];
+    size_t k = sizeof(tmp);
+    while (sec >= 100u) { k -= 2; memcpy(tmp + k, k_d2 + 2u * (sec % 100u), 2); sec /= 100u; }
+    if (sec >= 10u) { k -= 2; memcpy(tmp + k, k_d2 + 2u * sec, 2); } else { tmp[--k] = (char)('0' + sec); }
+    memcpy(out, tmp + k, sizeof(tmp) - k);
+    return sizeof(tmp) - k;
+}
+
+/* "aa:bb:cc:dd:ee:ff\t" (18 bytes, no NUL) into out. */
+static void format_mac(char *out, const uint8_t mac[6])
 {
     static const char hex[] = "0123456789abcdef";
-    char tmp[24];
+    for (int i = 0; i < 6; i++) {
+        out[3 * i] = hex[mac[i] >> 4];
+        out[3 * i + 1] = hex[mac[i] & 15u];
+        out[3 * i + 2] = i < 5 ? ':' : '\t';
+    }
+}
+
+/* ".<9 digits>\t<mac>\t<dbm>\n" into out (after the seconds), with mac_tab the 18 bytes
+ * of format_mac; returns its length. Hand-formatted: this is the inner loop of the bench
+ * (millions of lines). */
+static size_t format_line(char *out, uint32_t frac, const char *mac_tab, int dbm)
+{
     size_t n = 0;
-    int k = 0;
-    do { tmp[k++] = (char)('0' + sec % 10u); sec /= 10u; } while (sec != 0u);
-    while (k > 0) { out[n++] = tmp[--k]; }
     out[n++] = '.';
-    for (int i = 8; i >= 0; i--) { out[n + (size_t)i] = (char)('0' + frac % 10u); frac /= 10u; }
+    for (int i = 7; i >= 1; i -= 2) { memcpy(out + n + (size_t)i, k_d2 + 2u * (frac % 100u), 2); frac /= 100u; }
+    out[n] = (char)('0' + frac);
     n += 9;
     out[n++] = '\t';
-    for (int i = 0; i < 6; i++) {
-        out[n++] = hex[mac[i] >> 4];
-        out[n++] = hex[mac[i] & 15u];
-        out[n++] = i < 5 ? ':' : '\t';
-    }
+    memcpy(out + n, mac_tab, 18);
+    n += 18;
     if (dbm < 0) { out[n++] = '-'; dbm = -dbm; }
     if (dbm >= 100) { out[n++] = (char)('0' + dbm / 100); }
     if (dbm >= 10) { out[n++] = (char)('0' + dbm / 10 % 10); }
@@ -185,8 +206,8 @@ typedef int (*alive_fn)(void *ctx, int64_t t_us);
 /* Whether the record's source address is one of the n MACs (lx_rt_frame_sa). */
 static bool sa_wanted(const lx_pcap_pkt_t *pkt, const uint8_t (*macs)[6], int n)
 {
-    uint8_t sa[6];
-    if (!lx_rt_frame_sa(pkt->data, pkt->caplen, sa)) { return false; }
+    const uint8_t *sa = lx_rt_frame_sa(pkt->data, pkt->caplen);
+    if (sa == NULL) { return false; }
     int m = 0;
     while (m < n && memcmp(macs[m], sa, 6) != 0) { m++; }
     return m < n;
@@ -321,16 +342,22 @@ static void cleanup_on_signal(const char *dir, const char *const *names, int n)
 
 typedef struct tsv_ctx {
     FILE *out;
-    bool live; /* flush each line: a live reader wants it at once */
+    bool live;      /* flush each line: a live reader wants it at once */
+    char line[64];  /* the last line; it starts with the digits of `sec` */
+    size_t sec_len; /* their number, 0 before the first line */
+    uint64_t sec;
+    char mac_tab[FEED_MAX_MACS][18]; /* each --mac as format_mac writes it */
 } tsv_ctx_t;
 
 static int tsv_line(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_frame_t *f)
 {
     tsv_ctx_t *c = ctx;
-    (void)m;
-    char line[64];
-    const size_t len = format_line(line, pkt->ts_sec, pkt->ts_nsec, f->wlan.sa, f->rt.dbm_signal);
-    fwrite(line, 1, len, c->out);
+    if (c->sec_len == 0u || c->sec != pkt->ts_sec) { /* about once a second of capture */
+        c->sec = pkt->ts_sec;
+        c->sec_len = format_sec(c->line, pkt->ts_sec);
+    }
+    const size_t len = c->sec_len + format_line(c->line + c->sec_len, pkt->ts_nsec, c->mac_tab[m], f->rt.dbm_signal);
+    fwrite_unlocked(c->line, 1, len, c->out); /* one thread: no lock per line */
     /* Live, a lost line ends the reading (a batch's table is checked at the end). */
     return c->live && fflush(c->out) != 0 ? 1 : 0;
 }
@@ -358,7 +385,11 @@ static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, bool list
     }
     static char obuf[1 << 16];
     setvbuf(out, obuf, _IOFBF, sizeof(obuf));
-    tsv_ctx_t c = {out, live};
+    static tsv_ctx_t c;
+    c.out = out;
+    c.live = live;
+    c.sec_len = 0u;
+    for (int m = 0; m < n_macs; m++) { format_mac(c.mac_tab[m], macs[m]); } /* = the SA of its lines */
     int rc = list ? scan_list(r, macs, n_macs, st, out) : scan_capture(r, macs, n_macs, st, tsv_line, &c, NULL, NULL);
     if (output != NULL && (fflush(out) != 0 || ferror(out))) {
         fprintf(stderr, "rfseek-feed: %s: write error: %s\n", tmp, strerror(errno));

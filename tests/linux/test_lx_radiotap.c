@@ -421,8 +421,8 @@ static void test_real_meshid_capture(void **state)
     assert_int_equal(f.wlan.subtype, 8);
     assert_memory_equal(f.wlan.sa, sa, 6);
     assert_int_equal(f.wlan.seq, 268);
-    uint8_t peek[6] = {0};
-    assert_true(lx_rt_frame_sa(buf, n, peek));
+    const uint8_t *peek = lx_rt_frame_sa(buf, n);
+    assert_non_null(peek);
     assert_memory_equal(peek, sa, 6);
 }
 
@@ -450,8 +450,8 @@ static void test_real_exthdr_capture(void **state)
     assert_true(f.rt.tsft_us == 10016360ull);
     assert_memory_equal(f.wlan.sa, sa, 6);
     assert_int_equal(f.wlan.seq, 1);
-    uint8_t peek[6] = {0};
-    assert_true(lx_rt_frame_sa(buf, n, peek));
+    const uint8_t *peek = lx_rt_frame_sa(buf, n);
+    assert_non_null(peek);
     assert_memory_equal(peek, sa, 6);
 }
 
@@ -467,24 +467,23 @@ static void test_source_address_before_radiotap(void **state)
     put32(b + 4, 1u << 5);
     b[8] = (uint8_t)-40;
     const size_t n = 12 + build_data(b + 12, 2, false, k_a, k_b, k_c, k_d);
-    uint8_t sa[6] = {0};
 
-    assert_true(lx_rt_frame_sa(b, n, sa));
-    assert_memory_equal(sa, k_c, 6);
+    assert_ptr_equal(lx_rt_frame_sa(b, n), b + 12 + 16);
+    assert_memory_equal(lx_rt_frame_sa(b, n), k_c, 6);
 
     b[0] = 1; /* version: lx_rt_frame_parse rejects the record, the address is still there */
     lx_rt_frame_t f;
     assert_int_equal(lx_rt_frame_parse(b, n, &f), -1);
-    assert_true(lx_rt_frame_sa(b, n, sa));
+    assert_ptr_equal(lx_rt_frame_sa(b, n), b + 12 + 16);
     b[0] = 0;
-    assert_false(lx_rt_frame_sa(b, n - 1, sa));
+    assert_null(lx_rt_frame_sa(b, n - 1));
     put16(b + 2, (uint16_t)(n + 1));
-    assert_false(lx_rt_frame_sa(b, n, sa));
+    assert_null(lx_rt_frame_sa(b, n));
     put16(b + 2, 7);
-    assert_false(lx_rt_frame_sa(b, n, sa));
-    assert_false(lx_rt_frame_sa(b, 7, sa));
+    assert_null(lx_rt_frame_sa(b, n));
+    assert_null(lx_rt_frame_sa(b, 7));
     const uint8_t ack[18] = {0, 0, 8, 0, 0, 0, 0, 0, 0xd4, 0, 0, 0, 2, 0, 0, 0, 0, 0x0a};
-    assert_false(lx_rt_frame_sa(ack, sizeof(ack), sa));
+    assert_null(lx_rt_frame_sa(ack, sizeof(ack)));
 }
 
 int main(void)

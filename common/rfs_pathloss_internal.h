@@ -24,9 +24,13 @@ void rfs_pathloss_walls_assign(rfs_pathloss_t *p);
 uint32_t rfs_pathloss_walls_line(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,
                                  rfs_q16_t sy);
 
+/* The cache column of lattice point (li, lj): found, or the next free one; -1 when the
+ * cache is full (its counts are then not kept) or there is no map. */
+int32_t rfs_pathloss_walls_col(rfs_pathloss_t *p, uint16_t li, uint16_t lj);
+
 /* Bin bb's walls to the candidate in p->ev, in quarter walls (0..4 x WALLS_MAX): from
- * the cache when its column is filled, else counted (and cached when it is the next
- * column). *lines: the wall counts computed (left alone when cached). */
+ * the cache when counted before, else counted (and cached when the bin has a row and the
+ * candidate a column). *lines: the wall counts computed (left alone when cached). */
 uint32_t rfs_pathloss_walls_bin(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb, uint32_t *lines);
 
 #endif /* RFS_PATHLOSS_INTERNAL_H */

@@ -765,7 +765,7 @@ static bool pathloss_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16
     int64_t L = rfs_pathloss_db_dist(sq_sum(dx, dy));
     int64_t k = 0;
     if (p->map != 0) {
-        k = rfs_pathloss_walls_line(p->map, x, y, p->best.sx, p->best.sy);
+        k = rfs_pathloss_walls_line(p, x, y, p->best.sx, p->best.sy);
     }
     int64_t v = (int64_t)p->best.p0 - (((int64_t)p->best.n * L + 32768) >> 16) - p->best.w * k;
     *value = rfs_sat32(v);

@@ -82,6 +82,9 @@
 /// Slots of the cache's hash tables (powers of two, twice the rows; twice the columns).
 #define RFS_PATHLOSS_CACHE_HASH (2u * RFS_PATHLOSS_CACHE_ROWS)
 #define RFS_PATHLOSS_COL_HASH (2u * RFS_PATHLOSS_CACHE_COLS)
+/// Bytes of the map's wall-block grid the wall counts use (rfs_map_wall_blocks(): blocks
+/// of 8 cells up to 90 x 90 blocks, 720 x 720 cells; larger maps get larger blocks).
+#define RFS_PATHLOSS_WALL_BLOCK_BYTES 1024u
 /// Most columns of an attached cache (rfs_pathloss_cache_attach()).
 #define RFS_PATHLOSS_MAX_CACHE_COLS 16384u
 /// No cache row.
@@ -270,6 +273,10 @@ typedef struct rfs_pathloss {
     uint32_t walls_counted;                       ///< wall counts (lines) computed by this fit
     uint32_t footprints;                          ///< bin footprints counted by this fit
     uint32_t footprints_cached;                   ///< bin footprints read from the cache
+    const rfs_map_t *blocks_map;                  ///< map of wall_blocks (NULL: none)
+    rfs_map_wall_blocks_t blocks;                 ///< its wall-free blocks, skipped by counts
+                                                  ///< (bits: wall_blocks, even in a copy)
+    uint8_t wall_blocks[RFS_PATHLOSS_WALL_BLOCK_BYTES]; ///< their bit grid
     const rfs_map_t *cache_map;                   ///< map the cache belongs to (NULL: empty)
     rfs_pathloss_lat_t cache_lat;                 ///< coarse lattice the cache belongs to
     uint16_t nrows;                               ///< cache rows in use

@@ -80,6 +80,10 @@ void rfs_pathloss_walls_assign(rfs_pathloss_t *p)
     if (p->map == 0) {
         return;
     }
+    if (p->blocks_map != p->map) {
+        p->blocks_map = rfs_map_wall_blocks(p->map, p->wall_blocks, sizeof(p->wall_blocks),
+                                            &p->blocks) == 0 ? p->map : 0;
+    }
     if (p->cache_map != p->map || !same_lattice(&p->cache_lat, &p->lat)) {
         cache_clear(p);
         p->cache_map = p->map;
@@ -141,10 +145,13 @@ int32_t rfs_pathloss_walls_col(rfs_pathloss_t *p, uint16_t li, uint16_t lj)
     return (int32_t)p->ncols - 1;
 }
 
-uint32_t rfs_pathloss_walls_line(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,
-                          rfs_q16_t sy)
+uint32_t rfs_pathloss_walls_line(const rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,
+                                 rfs_q16_t sy)
 {
-    uint32_t k = rfs_map_walls_crossed(m, x, y, sx, sy);
+    rfs_map_wall_blocks_t b = p->blocks;
+    b.bits = p->wall_blocks; /* this state's own grid, also in a copy of it */
+    uint32_t k = rfs_map_walls_crossed_blocks(p->map, p->blocks_map == p->map ? &b : 0, x, y,
+                                              sx, sy);
     return k > RFS_PATHLOSS_WALLS_MAX ? RFS_PATHLOSS_WALLS_MAX : k;
 }
 
@@ -152,7 +159,7 @@ uint32_t rfs_pathloss_walls_line(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, r
 static uint32_t walls_to(rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx, rfs_q16_t sy)
 {
     p->walls_counted++;
-    return rfs_pathloss_walls_line(p->map, x, y, sx, sy);
+    return rfs_pathloss_walls_line(p, x, y, sx, sy);
 }
 
 /* A bin's walls to the candidate (sx, sy) in quarter walls (0..4 x RFS_PATHLOSS_WALLS_MAX): the sum of

@@ -471,16 +471,6 @@ static int64_t clamp64(int64_t v, int64_t lo, int64_t hi)
     return v < lo ? lo : (v > hi ? hi : v);
 }
 
-/* Whether cell (i, j) may be a wall: on the map, and (with blocks) in a block holding one.
- * Cells off the map (a walk's first and last column or row can be) are not walls. */
-static inline bool walk_maybe(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, int32_t i,
-                              int32_t j)
-{
-    return (uint32_t)i < m->w && (uint32_t)j < m->h &&
-           (b == 0 || rfs_map_bit(b->bits, b->stride, (uint16_t)((uint32_t)i >> b->shift),
-                                  (uint16_t)((uint32_t)j >> b->shift)));
-}
-
 /* Whether the block column holding column i (on the map) has a wall block among the rows
  * ra..rb (real rows, ra <= rb; the parts off the map have none). */
 static bool blocks_hold_wall(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, int32_t i,
@@ -497,9 +487,56 @@ static bool blocks_hold_wall(const rfs_map_t *m, const rfs_map_wall_blocks_t *b,
     return false;
 }
 
+/* The state of a wall walk: runs of wall cells so far, and whether the last cell visited
+ * was a wall. */
+typedef struct walk {
+    uint32_t runs;
+    bool in_wall;
+} walk_t;
+
+/* Visit rows jlo..jhi (walk order) of column i (on the map). p: the wall byte of row jlo
+ * and column i, mask: column i's bit, step: bytes from one row to the next in walk order,
+ * flip: walk rows run down the map. Cells on rows -1 and h (edge) are not walls; with
+ * blocks b, a wall-free block's cells are passed over at once. */
+static void walk_column(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, walk_t *wk,
+                        int32_t i, int32_t jlo, int32_t jhi, bool flip, bool edge)
+{
+    const uint8_t mask = (uint8_t)(1u << (i & 7));
+    const int32_t step = flip ? -(int32_t)m->stride : (int32_t)m->stride;
+    if (edge || (b != 0 && jhi - jlo >= ((int32_t)1 << b->shift))) {
+        const int32_t bs = b != 0 ? (int32_t)1 << b->shift : 0;
+        for (int32_t j = jlo; j <= jhi; j++) {
+            const int32_t jr = flip ? -1 - j : j;
+            if (jr < 0 || jr >= (int32_t)m->h) {
+                wk->in_wall = false;
+                continue;
+            }
+            if (b != 0 && !rfs_map_bit(b->bits, b->stride, (uint16_t)((uint32_t)i >> b->shift),
+                                       (uint16_t)((uint32_t)jr >> b->shift))) {
+                wk->in_wall = false;
+                j = flip ? -1 - (jr & -bs) : (jr | (bs - 1)); /* the rest of the block */
+                continue;
+            }
+            const bool wall = (m->wall[(uint32_t)jr * m->stride + ((uint32_t)i >> 3)] & mask) != 0u;
+            wk->runs += (wall && !wk->in_wall) ? 1u : 0u;
+            wk->in_wall = wall;
+        }
+        return;
+    }
+    const int32_t jr0 = flip ? -1 - jlo : jlo;
+    const uint8_t *p = m->wall + (uint32_t)jr0 * m->stride + ((uint32_t)i >> 3);
+    for (int32_t j = jlo; j <= jhi; j++, p += step) {
+        const bool wall = (*p & mask) != 0u;
+        wk->runs += (wall && !wk->in_wall) ? 1u : 0u;
+        wk->in_wall = wall;
+    }
+}
+
 /* traverse() with the VISIT_WALLS visitor, specialised: the same cells in the same order
  * (the same endpoint swap, mirror and column recurrences), counting runs of wall cells.
- * With blocks b it passes over cells in wall-free blocks (they end a run, as a free cell
+ * Cells off the map are not walls: columns -1 and w (first and last, when an endpoint
+ * lies on the map's edge) and rows -1 and h (a segment touching the bottom or top edge).
+ * With blocks b, cells in wall-free blocks are passed over (they end a run, as a free cell
  * does): inside a column by whole blocks, and from the first column of a block column to
  * its last at once when the rows the segment spans there hold no wall block.
  * Scaling and overflow: as traverse() (y * dx below 2^61; r * dy, the step of y(x) * dx
@@ -513,6 +550,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
         t = Y0; Y0 = Y1; Y1 = t;
     }
     const bool flip = Y1 < Y0;
+    const bool edge = (flip ? Y1 : Y0) <= 0 || (flip ? Y0 : Y1) >= (int64_t)m->h * r;
     if (flip) {
         Y0 = -Y0;
         Y1 = -Y1;
@@ -522,8 +560,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
     const int32_t ia = low_cell(X0, r);
     const int32_t ib = fdiv(X1, r);
     const int32_t bs = b != 0 ? (int32_t)1 << b->shift : 1; /* block side, cells */
-    bool in_wall = false;
-    uint32_t runs = 0u;
+    walk_t wk = {0u, false};
     int32_t jlo = low_cell(Y0, r), jhi = dx == 0 ? fdiv(Y1, r) : jlo;
     const int64_t rdx = (int64_t)r * dx, rdy = (int64_t)r * dy;
     int64_t blo = ((int64_t)jlo + 1) * rdx; /* (jlo + 1) * r * dx */
@@ -559,7 +596,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
                     be += rdx;
                 }
                 if (!blocks_hold_wall(m, b, i, flip ? -1 - je : jlo, flip ? -1 - jlo : je)) {
-                    in_wall = false;
+                    wk.in_wall = false;
                     jhi = je;
                     bhi = be;
                     nl = ne;
@@ -569,22 +606,13 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
                 }
             }
         }
-        for (int32_t j = jlo; j <= jhi; j++) {
-            const int32_t jr = flip ? -1 - j : j;
-            if (!walk_maybe(m, b, i, jr)) {
-                in_wall = false;
-                if (b != 0 && (uint32_t)jr < m->h && (uint32_t)i < m->w) {
-                    /* the rest of this wall-free block in this column */
-                    j = flip ? -1 - (jr & -bs) : (jr | (bs - 1));
-                }
-                continue;
-            }
-            const bool wall = rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)jr);
-            runs += (wall && !in_wall) ? 1u : 0u;
-            in_wall = wall;
+        if ((uint32_t)i >= m->w) {
+            wk.in_wall = false; /* column -1 or w */
+            continue;
         }
+        walk_column(m, b, &wk, i, jlo, jhi, flip, edge);
     }
-    return (uint16_t)(runs > UINT16_MAX ? UINT16_MAX : runs);
+    return (uint16_t)(wk.runs > UINT16_MAX ? UINT16_MAX : wk.runs);
 }
 
 uint16_t rfs_map_walls_crossed(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,

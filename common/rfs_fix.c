@@ -292,10 +292,13 @@ int64_t rfs_i128_div_shift(rfs_i128_t n, rfs_i128_t d, unsigned shift)
     uint64_t w2 = shift ? nh >> (64u - shift) : 0u;
     uint64_t w1 = shift ? (nh << shift) | (nl >> (64u - shift)) : nh;
     uint64_t w0 = nl << shift;
-    /* Long division, one bit per round over 192 bits; remainder stays < 2 * d. */
+    /* Long division, one bit per round over 192 bits; remainder stays < 2 * d. Rounds
+     * above the numerator's top bit would leave remainder and quotient 0: start at it. */
     uint64_t rh = 0u, rl = 0u, qh = 0u, ql = 0u;
     bool overflow = false;
-    for (int i = 191; i >= 0; --i) {
+    int top_bit = w2 ? 191 - __builtin_clzll(w2) : w1 ? 127 - __builtin_clzll(w1)
+                : w0 ? 63 - __builtin_clzll(w0) : -1;
+    for (int i = top_bit; i >= 0; --i) {
         uint64_t bit = i >= 128 ? (w2 >> (i - 128)) & 1u
                      : i >= 64  ? (w1 >> (i - 64)) & 1u
                                 : (w0 >> i) & 1u;

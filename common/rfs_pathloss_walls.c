@@ -33,6 +33,15 @@ static rfs_pathloss_xcache_t cache_of(rfs_pathloss_t *p)
     return c;
 }
 
+/* The cache byte of (row, col). */
+static uint8_t *cache_cell(rfs_pathloss_t *p, uint16_t row, uint32_t col)
+{
+    if (p->x.cells != 0) {
+        return p->x.cells + (uint32_t)row * p->x.cols + col;
+    }
+    return &p->walls[row][col];
+}
+
 static void cache_clear(rfs_pathloss_t *p)
 {
     rfs_pathloss_xcache_t c = cache_of(p);
@@ -191,14 +200,12 @@ static uint32_t footprint_walls(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb,
 
 uint32_t rfs_pathloss_walls_bin(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb, uint32_t *lines)
 {
-    uint8_t *cell = 0;
-    if (bb->row != RFS_PATHLOSS_NO_ROW && p->ev.col >= 0) {
-        rfs_pathloss_xcache_t c = cache_of(p);
-        cell = &c.cells[(uint32_t)bb->row * c.cols + (uint32_t)p->ev.col];
-        if (*cell != NOT_COUNTED) {
-            p->footprints_cached++;
-            return *cell;
-        }
+    uint8_t *cell = bb->row != RFS_PATHLOSS_NO_ROW && p->ev.col >= 0
+                        ? cache_cell(p, bb->row, (uint32_t)p->ev.col)
+                        : 0;
+    if (cell != 0 && *cell != NOT_COUNTED) {
+        p->footprints_cached++;
+        return *cell;
     }
     uint32_t before = p->walls_counted;
     uint32_t k = footprint_walls(p, bb, p->ev.sx, p->ev.sy);

@@ -80,9 +80,12 @@ $(eval $(call test_script,bench_seek_smoke,$(PYTHON) scripts/bench_seek.py --smo
 
 # --- the simulator, map and planner, faults --------------------------------------------------
 .PHONY: bench-sim bench-map bench-faults
-# Real-time factor of one robot and one 200 pkt/s source on one core; a 200-seed batch.
+# Real-time factor of one robot and one 200 pkt/s source on one core; a 200-seed batch;
+# meta + ridge and meta-path + pathloss on the office and the Intel lab, beside
+# BENCH_SIM_BASE (another build's rfseek-sim) when given.
+BENCH_SIM_BASE ?=
 bench-sim: $(BENCH_BIN)/rfseek-sim
-	@scripts/bench_sim.sh $(BENCH_BIN)/rfseek-sim
+	@scripts/bench_sim.sh $(BENCH_BIN)/rfseek-sim $(BENCH_SIM_BASE)
 # Planner and legal-grid figures on the office scenario map and on the Intel lab
 # (docs/PERFORMANCE.md, "Map, planner, drive").
 bench-map: $(BENCH_BIN)/rfseek-map

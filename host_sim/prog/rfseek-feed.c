@@ -343,23 +343,35 @@ static void cleanup_on_signal(const char *dir, const char *const *names, int n)
 typedef struct tsv_ctx {
     FILE *out;
     bool live;      /* flush each line: a live reader wants it at once */
-    char line[64];  /* the last line; it starts with the digits of `sec` */
+    char sec_txt[20]; /* the digits of `sec` */
     size_t sec_len; /* their number, 0 before the first line */
     uint64_t sec;
     char mac_tab[FEED_MAX_MACS][18]; /* each --mac as format_mac writes it */
+    size_t n;       /* bytes of lines in buf, not yet handed to out */
+    char buf[1 << 16];
 } tsv_ctx_t;
+
+/* Hand the buffered lines to c->out (and, live, flush it): 0, or 1 when that failed. */
+static int tsv_flush(tsv_ctx_t *c)
+{
+    const size_t n = c->n;
+    c->n = 0;
+    if (fwrite_unlocked(c->buf, 1, n, c->out) != n) { return 1; } /* one thread: no locks */
+    return c->live && fflush(c->out) != 0 ? 1 : 0;
+}
 
 static int tsv_line(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_frame_t *f)
 {
     tsv_ctx_t *c = ctx;
     if (c->sec_len == 0u || c->sec != pkt->ts_sec) { /* about once a second of capture */
         c->sec = pkt->ts_sec;
-        c->sec_len = format_sec(c->line, pkt->ts_sec);
+        c->sec_len = format_sec(c->sec_txt, pkt->ts_sec);
     }
-    const size_t len = c->sec_len + format_line(c->line + c->sec_len, pkt->ts_nsec, c->mac_tab[m], f->rt.dbm_signal);
-    fwrite_unlocked(c->line, 1, len, c->out); /* one thread: no lock per line */
+    char *o = c->buf + c->n; /* room for a line: flushed below 128 bytes from the end */
+    memcpy(o, c->sec_txt, sizeof(c->sec_txt));
+    c->n += c->sec_len + format_line(o + c->sec_len, pkt->ts_nsec, c->mac_tab[m], f->rt.dbm_signal);
     /* Live, a lost line ends the reading (a batch's table is checked at the end). */
-    return c->live && fflush(c->out) != 0 ? 1 : 0;
+    return c->live || c->n > sizeof(c->buf) - 128u ? tsv_flush(c) : 0;
 }
 
 /* The TSV lines (or with list the survey, scan_list) into stdout or output. */
@@ -389,8 +401,12 @@ static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, bool list
     c.out = out;
     c.live = live;
     c.sec_len = 0u;
+    c.n = 0u;
     for (int m = 0; m < n_macs; m++) { format_mac(c.mac_tab[m], macs[m]); } /* = the SA of its lines */
     int rc = list ? scan_list(r, macs, n_macs, st, out) : scan_capture(r, macs, n_macs, st, tsv_line, &c, NULL, NULL);
+    if (tsv_flush(&c) != 0) {
+        rc = 1; /* the stream's error is reported below */
+    }
     if (output != NULL && (fflush(out) != 0 || ferror(out))) {
         fprintf(stderr, "rfseek-feed: %s: write error: %s\n", tmp, strerror(errno));
         rc = 1;

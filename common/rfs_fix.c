@@ -3,6 +3,45 @@
 
 #include "rfs_assert.h"
 
+/* floor((hi * 2^32 + lo) / v) for 0 < v and hi < v (so the quotient fits 32 bits):
+ * Knuth's algorithm D on 16-bit digits (Hacker's Delight, 2nd ed.,
+ * section 9-4, divlu). Two 32-bit hardware divisions, each quotient digit corrected at
+ * most twice.
+ * Scaling and overflow: v is shifted left until its top bit is set and the dividend with
+ * it (hi < v keeps it in 64 bits); digit products q * vn0 are taken only for q < 2^16, so
+ * they fit 32 bits; the partial remainder un21 is below v, so its wrapping 32-bit
+ * arithmetic is exact. */
+static uint32_t div64_32(uint32_t hi, uint32_t lo, uint32_t v)
+{
+    const uint32_t b = 65536u;
+    int s = __builtin_clz(v);
+    v <<= s;
+    uint32_t vn1 = v >> 16, vn0 = v & 0xFFFFu;
+    uint32_t un32 = s == 0 ? hi : (hi << s) | (lo >> (32 - s));
+    uint32_t un10 = lo << s;
+    uint32_t un1 = un10 >> 16, un0 = un10 & 0xFFFFu;
+    uint32_t q1 = un32 / vn1;
+    uint32_t rhat = un32 - q1 * vn1;
+    while (q1 >= b || q1 * vn0 > b * rhat + un1) {
+        q1--;
+        rhat += vn1;
+        if (rhat >= b) {
+            break;
+        }
+    }
+    uint32_t un21 = un32 * b + un1 - q1 * v;
+    uint32_t q0 = un21 / vn1;
+    rhat = un21 - q0 * vn1;
+    while (q0 >= b || q0 * vn0 > b * rhat + un0) {
+        q0--;
+        rhat += vn1;
+        if (rhat >= b) {
+            break;
+        }
+    }
+    return q1 * b + q0;
+}
+
 uint64_t rfs_udiv64(uint64_t n, uint64_t d)
 {
     if (d == 0u) {
@@ -11,8 +50,19 @@ uint64_t rfs_udiv64(uint64_t n, uint64_t d)
     if (n < d) {
         return 0u;
     }
+    if (d <= UINT32_MAX) {
+        /* A 32-bit divisor: 32-bit hardware divisions (the Cortex-M4's UDIV), high word
+         * first, then the 64 / 32 step with the quotient known to fit 32 bits. */
+        uint32_t v = (uint32_t)d, hi = (uint32_t)(n >> 32);
+        if (hi == 0u) {
+            return (uint32_t)n / v;
+        }
+        uint32_t qh = hi / v;
+        uint32_t ql = div64_32(hi - qh * v, (uint32_t)n, v);
+        return ((uint64_t)qh << 32) | ql;
+    }
     /* Align the divisor's top bit with the dividend's, then shift-subtract: as many
-     * rounds as the bit-length difference, never a libgcc call. */
+     * rounds as the bit-length difference (at most 32 here), never a libgcc call. */
     int shift = __builtin_clzll(d) - __builtin_clzll(n);
     uint64_t q = 0u;
     d <<= shift;
@@ -242,10 +292,13 @@ int64_t rfs_i128_div_shift(rfs_i128_t n, rfs_i128_t d, unsigned shift)
     uint64_t w2 = shift ? nh >> (64u - shift) : 0u;
     uint64_t w1 = shift ? (nh << shift) | (nl >> (64u - shift)) : nh;
     uint64_t w0 = nl << shift;
-    /* Long division, one bit per round over 192 bits; remainder stays < 2 * d. */
+    /* Long division, one bit per round over 192 bits; remainder stays < 2 * d. Rounds
+     * above the numerator's top bit would leave remainder and quotient 0: start at it. */
     uint64_t rh = 0u, rl = 0u, qh = 0u, ql = 0u;
     bool overflow = false;
-    for (int i = 191; i >= 0; --i) {
+    int top_bit = w2 ? 191 - __builtin_clzll(w2) : w1 ? 127 - __builtin_clzll(w1)
+                : w0 ? 63 - __builtin_clzll(w0) : -1;
+    for (int i = top_bit; i >= 0; --i) {
         uint64_t bit = i >= 128 ? (w2 >> (i - 128)) & 1u
                      : i >= 64  ? (w1 >> (i - 64)) & 1u
                                 : (w0 >> i) & 1u;

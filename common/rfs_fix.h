@@ -7,8 +7,9 @@
  *              ridge solve (the core may not use __int128: not on Cortex-M or -m32).
  * Integers that are not Q16 say their unit in their name (_mm, _cm, _us, _q6, ...).
  *
- * Nothing here calls libgcc helpers: 64-bit division is done by rfs_udiv64()
- * (shift-subtract), so the library needs no external symbol but memcpy/memset/memmove.
+ * Nothing here calls libgcc helpers: 64-bit division is done by rfs_udiv64() (32-bit
+ * hardware divisions for a 32-bit divisor, else shift-subtract), so the library needs no
+ * external symbol but memcpy/memset/memmove.
  */
 #ifndef RFS_FIX_H
 #define RFS_FIX_H
@@ -67,7 +68,8 @@ static inline rfs_q16_t rfs_q16_abs(rfs_q16_t a)
     return a < 0 ? (a == INT32_MIN ? INT32_MAX : -a) : a;
 }
 
-/// Unsigned 64-bit division by shift-subtract, floor. d == 0 gives UINT64_MAX.
+/// Unsigned 64-bit division, floor: long division on 32-bit hardware divisions when d
+/// fits 32 bits, else shift-subtract. d == 0 gives UINT64_MAX.
 uint64_t rfs_udiv64(uint64_t n, uint64_t d);
 
 /// Signed 64-bit division rounded to nearest (ties away from zero). d == 0 saturates

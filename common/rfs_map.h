@@ -121,6 +121,28 @@ bool rfs_map_lattice_step_legal(const rfs_map_t *m, uint16_t i, uint16_t j, int3
 uint16_t rfs_map_walls_crossed(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,
                                rfs_q16_t y1);
 
+/// Which blocks of 2^shift x 2^shift cells of a map hold a wall cell, one bit each (bit
+/// (bi, bj) as rfs_map_bit): lets rfs_map_walls_crossed_blocks() pass over wall-free
+/// blocks without reading their cells.
+typedef struct rfs_map_wall_blocks {
+    uint8_t shift;       ///< log2 of the block side, cells (>= 3: a block is whole bytes)
+    uint16_t bw;         ///< blocks along x
+    uint16_t bh;         ///< blocks along y
+    uint16_t stride;     ///< bytes per block row, (bw + 7) / 8
+    const uint8_t *bits; ///< 1 = the block holds a wall cell, bh * stride bytes
+} rfs_map_wall_blocks_t;
+
+/// Fill *b from the map's wall grid into buf (bytes long), with the smallest block side
+/// of 8, 16, 32 ... cells whose bit grid fits. Returns 0, or -1 when the map has no wall
+/// grid or buf is too small even for blocks of 2^15 cells.
+int rfs_map_wall_blocks(const rfs_map_t *m, uint8_t *buf, uint32_t bytes,
+                        rfs_map_wall_blocks_t *b);
+
+/// rfs_map_walls_crossed() of the same map, equal for every segment, reading only the
+/// cells of blocks that hold a wall (b from rfs_map_wall_blocks() of that map).
+uint16_t rfs_map_walls_crossed_blocks(const rfs_map_t *m, const rfs_map_wall_blocks_t *b,
+                                      rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1);
+
 /// Position of lattice point (i, j), metres Q16.16.
 void rfs_map_lattice_point(const rfs_map_t *m, uint16_t i, uint16_t j, rfs_q16_t *x,
                            rfs_q16_t *y);

@@ -437,17 +437,16 @@ static void solve(rfs_pathloss_t *p, rfs_pathloss_cand_t *out)
     p->candidates++;
 }
 
-/* Start evaluating candidate (li, lj), cache column col (-1: none), for phase step
- * `kind` (surface index c for a coarse candidate). */
-static void ev_start(rfs_pathloss_t *p, uint16_t li, uint16_t lj, int32_t col, uint8_t kind,
-                     uint32_t c)
+/* Start evaluating candidate (li, lj) for phase step `kind` (surface index c for a
+ * coarse candidate). */
+static void ev_start(rfs_pathloss_t *p, uint16_t li, uint16_t lj, uint8_t kind, uint32_t c)
 {
     p->ev.on = true;
     p->ev.kind = kind;
     p->ev.li = li;
     p->ev.lj = lj;
     lattice_xy(&p->lat, li, lj, &p->ev.sx, &p->ev.sy);
-    p->ev.col = col;
+    p->ev.col = rfs_pathloss_walls_col(p, li, lj);
     p->ev.c = c;
     p->ev.b = 0u;
     p->ev.cached = p->footprints_cached;
@@ -554,7 +553,7 @@ static bool hold_next(rfs_pathloss_t *p)
 {
     if (p->hold_pos == UINT8_MAX) {
         p->hold_pos = 0u;
-        ev_start(p, p->hold_i, p->hold_j, -1, EV_HOLD, 0u);
+        ev_start(p, p->hold_i, p->hold_j, EV_HOLD, 0u);
         return true;
     }
     while (p->cfg.hold_search) {
@@ -563,7 +562,7 @@ static bool hold_next(rfs_pathloss_t *p)
             int32_t i, j;
             neighbour(p->hold_i, p->hold_j, rem, p->hold_step, &i, &j);
             if (rem != 4u && cand_legal(p, i, j)) {
-                ev_start(p, (uint16_t)i, (uint16_t)j, -1, EV_HOLD, 0u);
+                ev_start(p, (uint16_t)i, (uint16_t)j, EV_HOLD, 0u);
                 return true;
             }
         }
@@ -597,7 +596,6 @@ static bool fit_begin(rfs_pathloss_t *p, const rfs_model_fit_in_t *in)
     bin_samples(p, in->samples, in->n);
     setup_lattice(p, in->map);
     rfs_pathloss_walls_assign(p);
-    p->col = 0u;
     p->walls_counted = 0u;
     p->footprints = 0u;
     p->footprints_cached = 0u;
@@ -663,7 +661,7 @@ static bool coarse_next(rfs_pathloss_t *p, rfs_fit_result_t *res)
     int32_t j = l->c0j + (int32_t)(c / l->ncx) * l->cs;
     p->surface[c] = RFS_PATHLOSS_NO_LOSS;
     if (cand_legal(p, i, j)) {
-        ev_start(p, (uint16_t)i, (uint16_t)j, (int32_t)p->col++, EV_COARSE, c);
+        ev_start(p, (uint16_t)i, (uint16_t)j, EV_COARSE, c);
     }
     return false;
 }
@@ -726,7 +724,7 @@ static bool refine_next(rfs_pathloss_t *p, rfs_fit_result_t *res)
     int32_t i, j;
     neighbour(ci, cj, rem, p->step, &i, &j);
     if (rem != 4u && cand_legal(p, i, j) && !seen_before(p, i, j)) {
-        ev_start(p, (uint16_t)i, (uint16_t)j, -1, EV_REFINE, 0u);
+        ev_start(p, (uint16_t)i, (uint16_t)j, EV_REFINE, 0u);
     }
     return false;
 }
@@ -767,7 +765,7 @@ static bool pathloss_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16
     int64_t L = rfs_pathloss_db_dist(sq_sum(dx, dy));
     int64_t k = 0;
     if (p->map != 0) {
-        k = rfs_pathloss_walls_line(p->map, x, y, p->best.sx, p->best.sy);
+        k = rfs_pathloss_walls_line(p, x, y, p->best.sx, p->best.sy);
     }
     int64_t v = (int64_t)p->best.p0 - (((int64_t)p->best.n * L + 32768) >> 16) - p->best.w * k;
     *value = rfs_sat32(v);

@@ -37,12 +37,14 @@
  * centroid, along x and y (a point that is not legal counts as the centre), in quarter
  * walls. A bin's mean is an average over where its samples were taken, and on a
  * cluttered map one line's count jumps by several walls within centimetres of where it
- * starts (footprint 0: the centre's count alone). The counts of the coarse candidates
- * are cached across fits (RFS_PATHLOSS_CACHE_ROWS origins x the first
- * RFS_PATHLOSS_CACHE_COLS legal coarse candidates, a byte each; a count saturates at 15
- * walls): bins are fixed cells, so a relearn counts walls only for bins that are new or
- * whose centroid moved to another core cell, and for the refinement. The cache is
- * cleared when the map or the coarse lattice changes, or when it is full.
+ * starts (footprint 0: the centre's count alone). The counts are cached across fits,
+ * RFS_PATHLOSS_CACHE_ROWS origins x the first candidates evaluated (a byte each; a count
+ * saturates at 15 walls): RFS_PATHLOSS_CACHE_COLS of them built in (the first legal
+ * coarse candidates), or as many as a caller's buffer holds
+ * (rfs_pathloss_cache_attach(): every coarse, refinement and hold candidate of a run).
+ * Bins are fixed cells, so a relearn counts walls only for bins that are new or whose
+ * centroid moved to another core cell, and for candidates without a column. The cache is
+ * cleared when the map or the lattice changes, or when its origins are all used.
  *
  * Work: one unit is one computed wall count (a cached footprint is 1/32 unit, solving a
  * candidate one unit). fit() with budget 0 does everything; with budget > 0 it stops
@@ -73,11 +75,18 @@
 #define RFS_PATHLOSS_MAX_TOP 4u
 /// Most refinement points remembered to evaluate each once (more are re-evaluated).
 #define RFS_PATHLOSS_MAX_VISITED 128u
-/// Wall-count origins cached (rows) and legal coarse candidates per origin (columns).
+/// Wall-count origins cached (rows) and candidates per origin in the built-in cache
+/// (columns).
 #define RFS_PATHLOSS_CACHE_ROWS 512u
 #define RFS_PATHLOSS_CACHE_COLS 64u
-/// Slots of the cache's hash table (a power of two, twice the rows).
+/// Slots of the cache's hash tables (powers of two, twice the rows; twice the columns).
 #define RFS_PATHLOSS_CACHE_HASH (2u * RFS_PATHLOSS_CACHE_ROWS)
+#define RFS_PATHLOSS_COL_HASH (2u * RFS_PATHLOSS_CACHE_COLS)
+/// Bytes of the map's wall-block grid the wall counts use (rfs_map_wall_blocks(): blocks
+/// of 8 cells up to 90 x 90 blocks, 720 x 720 cells; larger maps get larger blocks).
+#define RFS_PATHLOSS_WALL_BLOCK_BYTES 1024u
+/// Most columns of an attached cache (rfs_pathloss_cache_attach()).
+#define RFS_PATHLOSS_MAX_CACHE_COLS 16384u
 /// No cache row.
 #define RFS_PATHLOSS_NO_ROW UINT16_MAX
 /// Surface value of a coarse point that is not a candidate (illegal).
@@ -166,7 +175,6 @@ typedef struct rfs_pathloss_lat {
 typedef struct rfs_pathloss_row {
     uint16_t cx;     ///< core cell x
     uint16_t cy;     ///< core cell y
-    uint8_t filled;  ///< columns counted so far (in coarse order)
 } rfs_pathloss_row_t;
 
 /// Search phases of a (sliced) fit.
@@ -212,6 +220,15 @@ typedef struct rfs_pathloss_est {
     uint32_t footprints_cached; ///< bin footprints it read from the cache
 } rfs_pathloss_est_t;
 
+/// A wall-count cache in a caller's buffer (rfs_pathloss_cache_attach()).
+typedef struct rfs_pathloss_xcache {
+    uint16_t cols;       ///< columns (candidates per origin)
+    uint8_t hash_bits;   ///< log2 of its column hash slots (>= twice the columns)
+    uint16_t *col_hash;  ///< column + 1 by hashed lattice point, 0 = empty
+    uint32_t *col_key;   ///< lattice point of each column, li | lj << 16
+    uint8_t *cells;      ///< RFS_PATHLOSS_CACHE_ROWS x cols counts, row by row
+} rfs_pathloss_xcache_t;
+
 /// State, caller-owned (about 67 KB, 37 KB of it the wall-count cache).
 typedef struct rfs_pathloss {
     rfs_pathloss_cfg_t cfg;                       ///< configuration copied at init
@@ -253,17 +270,25 @@ typedef struct rfs_pathloss {
     uint16_t hash[RFS_PATHLOSS_HASH];             ///< bin index + 1 by hashed cell, 0 = empty
     int32_t l_q16[RFS_PATHLOSS_MAX_BINS];         ///< scratch: 10 log10(d) per bin, dB Q16.16
     uint8_t k[RFS_PATHLOSS_MAX_BINS];             ///< scratch: walls per bin, quarter walls
-    uint32_t col;                                 ///< legal coarse candidates so far (cache column)
     uint32_t walls_counted;                       ///< wall counts (lines) computed by this fit
     uint32_t footprints;                          ///< bin footprints counted by this fit
     uint32_t footprints_cached;                   ///< bin footprints read from the cache
+    const rfs_map_t *blocks_map;                  ///< map of wall_blocks (NULL: none)
+    rfs_map_wall_blocks_t blocks;                 ///< its wall-free blocks, skipped by counts
+                                                  ///< (bits: wall_blocks, even in a copy)
+    uint8_t wall_blocks[RFS_PATHLOSS_WALL_BLOCK_BYTES]; ///< their bit grid
     const rfs_map_t *cache_map;                   ///< map the cache belongs to (NULL: empty)
     rfs_pathloss_lat_t cache_lat;                 ///< coarse lattice the cache belongs to
     uint16_t nrows;                               ///< cache rows in use
+    uint16_t ncols;                               ///< cache columns in use
     uint16_t row_hash[RFS_PATHLOSS_CACHE_HASH];   ///< row + 1 by hashed core cell, 0 = empty
     rfs_pathloss_row_t rows[RFS_PATHLOSS_CACHE_ROWS]; ///< cached origins
+    rfs_pathloss_xcache_t x;                      ///< an attached cache (cells NULL: none;
+                                                  ///< then the three built-in arrays below)
+    uint16_t col_hash[RFS_PATHLOSS_COL_HASH];     ///< column + 1 by hashed lattice point
+    uint32_t col_key[RFS_PATHLOSS_CACHE_COLS];    ///< lattice point of each column
     uint8_t walls[RFS_PATHLOSS_CACHE_ROWS][RFS_PATHLOSS_CACHE_COLS]; ///< footprint wall
-                                                  ///< counts, quarter walls
+                                                  ///< counts, quarter walls; 255: not counted
     uint32_t surface[RFS_PATHLOSS_MAX_COARSE];    ///< mean Huber loss per unit weight of
                                                   ///< each coarse point, dB^2 Q16.16;
                                                   ///< NO_LOSS = no candidate
@@ -278,6 +303,16 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void);
 /// their bounds, prior_weight or w_prior_weight outside (0, 10^4], huber outside (0, 100] dB, spread_k
 /// outside [0, 1000], or margin outside [0, 100] m.
 int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg);
+
+/// Bytes of a caller buffer for a wall-count cache of `cols` candidates per origin.
+uint32_t rfs_pathloss_cache_bytes(uint16_t cols);
+
+/// Keep the wall counts in buf (rfs_pathloss_cache_bytes(cols) bytes, 4-byte aligned,
+/// outliving p and every copy of it) instead of the built-in cache: cols candidates per
+/// origin instead of RFS_PATHLOSS_CACHE_COLS. Fits give the same results with less work.
+/// Empties the cache. Returns 0, or -1 on a null p or buf, cols 0 or above
+/// RFS_PATHLOSS_MAX_CACHE_COLS, or too few bytes.
+int rfs_pathloss_cache_attach(rfs_pathloss_t *p, void *buf, uint32_t bytes, uint16_t cols);
 
 /// The model interface of a path-loss state.
 rfs_model_t rfs_pathloss_model(rfs_pathloss_t *p);

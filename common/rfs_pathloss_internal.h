@@ -16,17 +16,23 @@
 #define RFS_PATHLOSS_FOOTPRINT_RAYS 4u
 
 /* Give every bin on the map its wall-count cache row (found by its origin's core cell, or
- * new), after clearing the cache when it belongs to another map or lattice. */
+ * new), after clearing the cache when it belongs to another map or lattice; find the
+ * map's wall-free blocks when the map is new. */
 void rfs_pathloss_walls_assign(rfs_pathloss_t *p);
 
-/* One line's walls from (x, y) to (sx, sy) (metres Q16.16), saturated at
- * RFS_PATHLOSS_WALLS_MAX. */
-uint32_t rfs_pathloss_walls_line(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,
+/* One line's walls on p->map from (x, y) to (sx, sy) (metres Q16.16), saturated at
+ * RFS_PATHLOSS_WALLS_MAX (rfs_map_walls_crossed, over the map's wall-free blocks when
+ * rfs_pathloss_walls_assign() has found them). */
+uint32_t rfs_pathloss_walls_line(const rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,
                                  rfs_q16_t sy);
 
+/* The cache column of lattice point (li, lj): found, or the next free one; -1 when the
+ * cache is full (its counts are then not kept) or there is no map. */
+int32_t rfs_pathloss_walls_col(rfs_pathloss_t *p, uint16_t li, uint16_t lj);
+
 /* Bin bb's walls to the candidate in p->ev, in quarter walls (0..4 x WALLS_MAX): from
- * the cache when its column is filled, else counted (and cached when it is the next
- * column). *lines: the wall counts computed (left alone when cached). */
+ * the cache when counted before, else counted (and cached when the bin has a row and the
+ * candidate a column). *lines: the wall counts computed (left alone when cached). */
 uint32_t rfs_pathloss_walls_bin(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb, uint32_t *lines);
 
 #endif /* RFS_PATHLOSS_INTERNAL_H */

@@ -5,6 +5,9 @@
 
 #include <string.h>
 
+/// A cache cell not counted yet (counts are at most 4 x RFS_PATHLOSS_WALLS_MAX).
+#define NOT_COUNTED 255u
+
 static uint32_t cell_hash(uint16_t cx, uint16_t cy)
 {
     return ((uint32_t)cx * 0x9E3779B1u + (uint32_t)cy * 0x85EBCA77u) >> 22; /* 10 bits */
@@ -18,10 +21,65 @@ static bool same_lattice(const rfs_pathloss_lat_t *a, const rfs_pathloss_lat_t *
            a->ncx == b->ncx && a->ncy == b->ncy;
 }
 
+/* The cache in use: the attached one, or the built-in arrays. */
+static rfs_pathloss_xcache_t cache_of(rfs_pathloss_t *p)
+{
+    if (p->x.cells != 0) {
+        return p->x;
+    }
+    _Static_assert(RFS_PATHLOSS_COL_HASH == 128u, "7 hash bits");
+    rfs_pathloss_xcache_t c = {RFS_PATHLOSS_CACHE_COLS, 7u, p->col_hash, p->col_key,
+                               (uint8_t *)(void *)p->walls};
+    return c;
+}
+
+/* The cache byte of (row, col). */
+static uint8_t *cache_cell(rfs_pathloss_t *p, uint16_t row, uint32_t col)
+{
+    if (p->x.cells != 0) {
+        return p->x.cells + (uint32_t)row * p->x.cols + col;
+    }
+    return &p->walls[row][col];
+}
+
 static void cache_clear(rfs_pathloss_t *p)
 {
+    rfs_pathloss_xcache_t c = cache_of(p);
     p->nrows = 0u;
+    p->ncols = 0u;
     memset(p->row_hash, 0, sizeof(p->row_hash));
+    memset(c.col_hash, 0, ((size_t)1 << c.hash_bits) * sizeof(c.col_hash[0]));
+    memset(c.cells, (int)NOT_COUNTED, (size_t)RFS_PATHLOSS_CACHE_ROWS * c.cols);
+}
+
+uint32_t rfs_pathloss_cache_bytes(uint16_t cols)
+{
+    uint32_t slots = 1u;
+    while (slots < 2u * cols) {
+        slots *= 2u;
+    }
+    return slots * 2u + (uint32_t)cols * 4u + RFS_PATHLOSS_CACHE_ROWS * (uint32_t)cols;
+}
+
+int rfs_pathloss_cache_attach(rfs_pathloss_t *p, void *buf, uint32_t bytes, uint16_t cols)
+{
+    if (p == 0 || buf == 0 || cols == 0u || cols > RFS_PATHLOSS_MAX_CACHE_COLS ||
+        bytes < rfs_pathloss_cache_bytes(cols)) {
+        return -1;
+    }
+    uint8_t bits = 1u;
+    while ((1u << bits) < 2u * cols) {
+        bits++;
+    }
+    /* The key words first (4-byte aligned with buf), then the hash, then the bytes. */
+    uint8_t *b = (uint8_t *)buf;
+    p->x.cols = cols;
+    p->x.hash_bits = bits;
+    p->x.col_key = (uint32_t *)(void *)b;
+    p->x.col_hash = (uint16_t *)(void *)(b + (size_t)cols * 4u);
+    p->x.cells = b + (size_t)cols * 4u + ((size_t)2u << bits);
+    p->cache_map = 0; /* emptied before the next fit uses it */
+    return 0;
 }
 
 void rfs_pathloss_walls_assign(rfs_pathloss_t *p)
@@ -30,6 +88,10 @@ void rfs_pathloss_walls_assign(rfs_pathloss_t *p)
     _Static_assert(RFS_PATHLOSS_CACHE_ROWS >= RFS_PATHLOSS_MAX_BINS, "a row for every bin");
     if (p->map == 0) {
         return;
+    }
+    if (p->blocks_map != p->map) {
+        p->blocks_map = rfs_map_wall_blocks(p->map, p->wall_blocks, sizeof(p->wall_blocks),
+                                            &p->blocks) == 0 ? p->map : 0;
     }
     if (p->cache_map != p->map || !same_lattice(&p->cache_lat, &p->lat)) {
         cache_clear(p);
@@ -63,17 +125,42 @@ void rfs_pathloss_walls_assign(rfs_pathloss_t *p)
             rfs_pathloss_row_t *r = &p->rows[p->nrows];
             r->cx = cx;
             r->cy = cy;
-            r->filled = 0u;
             p->row_hash[h] = (uint16_t)(++p->nrows);
         }
         bb->row = (uint16_t)(p->row_hash[h] - 1u);
     }
 }
 
-uint32_t rfs_pathloss_walls_line(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,
-                          rfs_q16_t sy)
+int32_t rfs_pathloss_walls_col(rfs_pathloss_t *p, uint16_t li, uint16_t lj)
 {
-    uint32_t k = rfs_map_walls_crossed(m, x, y, sx, sy);
+    if (p->map == 0) {
+        return -1;
+    }
+    rfs_pathloss_xcache_t c = cache_of(p);
+    const uint32_t key = (uint32_t)li | (uint32_t)lj << 16;
+    const uint32_t mask = (1u << c.hash_bits) - 1u;
+    uint32_t h = ((uint32_t)li * 0x9E3779B1u + (uint32_t)lj * 0x85EBCA77u) >> (32u - c.hash_bits);
+    while (c.col_hash[h] != 0u) {
+        if (c.col_key[c.col_hash[h] - 1u] == key) {
+            return (int32_t)c.col_hash[h] - 1;
+        }
+        h = (h + 1u) & mask;
+    }
+    if (p->ncols == c.cols) {
+        return -1; /* full: the first candidates keep their columns until a clear */
+    }
+    c.col_key[p->ncols] = key;
+    c.col_hash[h] = (uint16_t)(++p->ncols);
+    return (int32_t)p->ncols - 1;
+}
+
+uint32_t rfs_pathloss_walls_line(const rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,
+                                 rfs_q16_t sy)
+{
+    rfs_map_wall_blocks_t b = p->blocks;
+    b.bits = p->wall_blocks; /* this state's own grid, also in a copy of it */
+    uint32_t k = rfs_map_walls_crossed_blocks(p->map, p->blocks_map == p->map ? &b : 0, x, y,
+                                              sx, sy);
     return k > RFS_PATHLOSS_WALLS_MAX ? RFS_PATHLOSS_WALLS_MAX : k;
 }
 
@@ -81,7 +168,7 @@ uint32_t rfs_pathloss_walls_line(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, r
 static uint32_t walls_to(rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx, rfs_q16_t sy)
 {
     p->walls_counted++;
-    return rfs_pathloss_walls_line(p->map, x, y, sx, sy);
+    return rfs_pathloss_walls_line(p, x, y, sx, sy);
 }
 
 /* A bin's walls to the candidate (sx, sy) in quarter walls (0..4 x RFS_PATHLOSS_WALLS_MAX): the sum of
@@ -113,11 +200,10 @@ static uint32_t footprint_walls(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb,
 
 uint32_t rfs_pathloss_walls_bin(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb, uint32_t *lines)
 {
-    const int32_t col = p->ev.col;
-    rfs_pathloss_row_t *r = bb->row != RFS_PATHLOSS_NO_ROW ? &p->rows[bb->row] : 0;
-    bool cacheable = r != 0 && col >= 0 && col < (int32_t)RFS_PATHLOSS_CACHE_COLS;
-    uint8_t *cell = cacheable ? &p->walls[bb->row][col] : 0;
-    if (cacheable && col < (int32_t)r->filled) {
+    uint8_t *cell = bb->row != RFS_PATHLOSS_NO_ROW && p->ev.col >= 0
+                        ? cache_cell(p, bb->row, (uint32_t)p->ev.col)
+                        : 0;
+    if (cell != 0 && *cell != NOT_COUNTED) {
         p->footprints_cached++;
         return *cell;
     }
@@ -125,9 +211,8 @@ uint32_t rfs_pathloss_walls_bin(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb,
     uint32_t k = footprint_walls(p, bb, p->ev.sx, p->ev.sy);
     *lines = p->walls_counted - before;
     p->footprints++;
-    if (cacheable && col == (int32_t)r->filled) {
+    if (cell != 0) {
         *cell = (uint8_t)k;
-        r->filled++;
     }
     return k;
 }

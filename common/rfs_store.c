@@ -72,7 +72,8 @@ typedef enum {
 
 /* Scaling and overflow: a + (b - a) * dt / span with |b - a| < 2^32 (Q16.16) and
  * dt <= span <= STORE_MAX_GAP_US < 2^26: product < 2^58 in int64, rounded to nearest
- * once. The result lies between a and b, so it fits Q16.16. */
+ * once; the divisor fits 32 bits, so rfs_udiv64 divides in hardware 32-bit steps. The
+ * result lies between a and b, so it fits Q16.16. */
 static rfs_q16_t lerp(rfs_q16_t a, rfs_q16_t b, int64_t dt, int64_t span)
 {
     return (rfs_q16_t)(a + rfs_sdiv64_round(((int64_t)b - a) * dt, span));

@@ -12,9 +12,15 @@
 #include "rfs_pdr.h"
 #include "rfs_ridge.h"
 
+/* Candidates per origin of the path-loss model's wall-count cache on the host: a run's
+ * coarse, refinement and hold candidates (at most 1,024 coarse; the Intel lab's runs use
+ * under 900 in all), 1 MB (docs/PATHLOSS.md, "Work, the wall-count cache and slicing"). */
+#define HS_CTRL_PATHLOSS_CACHE_COLS 2048u
+
 typedef struct inproc {
     rfs_seek_t seek;
     void *model_state; // rfs_models_max_state_bytes(), aligned to RFS_MODELS_STATE_ALIGN
+    void *wall_cache;  // the path-loss model's attached wall-count cache, or NULL
     rfs_rng_t rng;
     rfs_seek_mem_t mem;
 } inproc_t;
@@ -87,6 +93,7 @@ static void ip_close(void *self)
     free(p->mem.visited);
     free(p->mem.reach);
     free(p->model_state);
+    free(p->wall_cache);
     free(p);
 }
 
@@ -170,6 +177,16 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
         if (rfs_pathloss_init(p->model_state, &pc) != 0) {
             ip_close(p);
             snprintf(err, errlen, "model: pathloss: p0_min_dbm %g rejected", cfg->p0_min_dbm);
+            return -1;
+        }
+    }
+    if (me->ops == &rfs_pathloss_ops) {
+        const uint32_t cb = rfs_pathloss_cache_bytes(HS_CTRL_PATHLOSS_CACHE_COLS);
+        p->wall_cache = malloc(cb);
+        if (!p->wall_cache ||
+            rfs_pathloss_cache_attach(p->model_state, p->wall_cache, cb, HS_CTRL_PATHLOSS_CACHE_COLS) != 0) {
+            ip_close(p);
+            snprintf(err, errlen, "model: pathloss: out of memory");
             return -1;
         }
     }

@@ -80,9 +80,12 @@ $(eval $(call test_script,bench_seek_smoke,$(PYTHON) scripts/bench_seek.py --smo
 
 # --- the simulator, map and planner, faults --------------------------------------------------
 .PHONY: bench-sim bench-map bench-faults
-# Real-time factor of one robot and one 200 pkt/s source on one core; a 200-seed batch.
+# Real-time factor of one robot and one 200 pkt/s source on one core; a 200-seed batch;
+# meta + ridge and meta-path + pathloss on the office and the Intel lab, beside
+# BENCH_SIM_BASE (another build's rfseek-sim) when given.
+BENCH_SIM_BASE ?=
 bench-sim: $(BENCH_BIN)/rfseek-sim
-	@scripts/bench_sim.sh $(BENCH_BIN)/rfseek-sim
+	@scripts/bench_sim.sh $(BENCH_BIN)/rfseek-sim $(BENCH_SIM_BASE)
 # Planner and legal-grid figures on the office scenario map and on the Intel lab
 # (docs/PERFORMANCE.md, "Map, planner, drive").
 bench-map: $(BENCH_BIN)/rfseek-map
@@ -114,9 +117,9 @@ BENCH_TARGETS += bench-general
 # --- the Linux port: pcap feeder, CAN codec and the two-process overhead ---------------------
 .PHONY: bench-feed bench-wire
 # Frames/s extracting one MAC's RSSI from a 1,000,000-frame capture, side by side with
-# tshark on the same file (median of 3).
-bench-feed: $(BENCH_BIN)/rfseek-feed $(FEED)/feed_writegen
-	@tests/feed/bench_feed.sh $(BENCH_BIN)/rfseek-feed $(FEED)/feed_writegen $(FEED)/bench
+# tshark and with a count-only read of the same file (medians).
+bench-feed: $(BENCH_BIN)/rfseek-feed $(FEED)/feed_writegen $(FEED)/feed_count
+	@tests/feed/bench_feed.sh $(BENCH_BIN)/rfseek-feed $(FEED)/feed_writegen $(FEED)/bench $(FEED)/feed_count
 # Codec instructions (callgrind) and rfseekd against the in-process controller.
 $(BUILD)/tests/wire/bench_can: tests/wire/bench_can.c $(CORE_LIB)
 	@mkdir -p $(@D)

@@ -96,6 +96,11 @@ $(eval $(call test_script,sweep,scripts/san_sweep.sh $(SWEEP_SIM) 3 scenarios/de
 $(FEED)/feed_writegen: tests/feed/feed_writegen.c $(LIBS_linux)
 	@mkdir -p $(@D)
 	$(LD_linux) $(HOST_CFLAGS) $(INC_linux) $(DEPFLAGS) -MF $@.d -MT $@ $< -o $@ $(LIBS_linux) $(LDLIBS_linux)
+# The floor bench-feed compares with: read and count every record, parse nothing.
+$(FEED)/feed_count: tests/feed/feed_count.c $(LIBS_linux)
+	@mkdir -p $(@D)
+	$(LD_linux) $(HOST_CFLAGS) $(INC_linux) $(DEPFLAGS) -MF $@.d -MT $@ $< -o $@ $(LIBS_linux) $(LDLIBS_linux)
+ALL_TARGETS += $(FEED)/feed_count
 $(FEED)/gen/.stamp: scripts/gen_captures.py $(FEED)/feed_writegen
 	@rm -rf $(FEED)/gen && mkdir -p $(FEED)/gen
 	$(PYTHON) scripts/gen_captures.py $(FEED)/gen

@@ -5,8 +5,13 @@
 #    core: the default scenario, seeds 1..20 run one after another in one process
 #    (three repetitions; the median of the three overall factors is reported).
 # 2. Wall time of a 200-seed batch of the default scenario on 2 cores (--jobs 2).
+# 3. Real-time factors by CPU time of meta + ridge and meta-path + pathloss on the default
+#    office and the Intel lab (seeds 1..5, one process each, median of three), with BASE
+#    (another build's rfseek-sim) side by side, the two runs alternating:
+#   scripts/bench_sim.sh build/bin/rfseek-sim [BASE]
 set -euo pipefail
-SIM=${1:?usage: bench_sim.sh path/to/rfseek-sim}
+SIM=${1:?usage: bench_sim.sh path/to/rfseek-sim [BASE]}
+BASE=${2:-}
 echo "bench-sim: load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 rtfs=() cpus=()
 for rep in 1 2 3; do
@@ -23,3 +28,21 @@ start=$(date +%s.%N)
 end=$(date +%s.%N)
 echo "bench-sim: 200-seed batch of the default scenario on 2 cores: $(awk "BEGIN{printf \"%.1f\", $end - $start}") s wall"
 echo "bench-sim: load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
+# cpu-time factor of one run: SIM SCENARIO STRATEGY MODEL
+rtf() { "$1" "scenarios/$2.yaml" --strategy "$3" --model "$4" --seeds 1..5 --bench |
+        sed -nE 's/.*by cpu time: ([0-9]+)x.*/\1/p'; }
+med3() { printf '%s\n' "$@" | sort -n | sed -n 2p; }
+for sc in default intel; do
+    for sm in "meta ridge" "meta-path pathloss"; do
+        set -- $sm
+        new=() old=()
+        for rep in 1 2 3; do
+            new+=("$(rtf "$SIM" "$sc" "$1" "$2")")
+            if [ -n "$BASE" ]; then old+=("$(rtf "$BASE" "$sc" "$1" "$2")"); fi
+        done
+        line="bench-sim: $sc, $1 + $2, seeds 1..5, by cpu time: median ${new[*]} -> $(med3 "${new[@]}")x"
+        if [ -n "$BASE" ]; then line="$line; base ${old[*]} -> $(med3 "${old[@]}")x"; fi
+        echo "$line"
+    done
+done
+echo "bench-sim: load average at the end: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -2,15 +2,16 @@
 # identity.sh SIM OUTDIR [SEEDS] - one runs.tsv per scenario x strategy x model, for proving a
 # change behaviour-preserving (docs/ARCHITECTURE.md, "Bit-identical runs"): run it with the
 # old and the new rfseek-sim into two folders, then `diff -r` them.
-#   SCENARIOS="default lshape 3ne" (default), SEEDS 1..50 (default), JOBS=2
+#   SCENARIOS="default lshape 3ne" (default), SEEDS 1..50 (default), JOBS=2; MODELS and
+#   STRATEGIES narrow the sweep (default: every model and strategy below)
 set -u
 sim=${1:?usage: identity.sh SIM OUTDIR [SEEDS]} out=${2:?usage: identity.sh SIM OUTDIR [SEEDS]}
 seeds=${3:-1..50}
 here=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$out"
-for model in ridge radius pathloss knn mlp; do
+for model in ${MODELS:-ridge radius pathloss knn mlp}; do
 for sc in ${SCENARIOS:-default lshape 3ne}; do
-for st in meta meta-global fd-gradient plane-gradient chemotaxis meta-path; do
+for st in ${STRATEGIES:-meta meta-global fd-gradient plane-gradient chemotaxis meta-path}; do
     f="$out/${sc}_${st}_${model}.tsv"
     [ -s "$f" ] && continue
     d=$(mktemp -d)

@@ -107,6 +107,9 @@ typedef struct feed_stats {
     uint64_t mac_frames[FEED_MAX_MACS]; /* frames from each --mac (SA; --list: TA) */
     uint64_t heartbeats;              /* --lcm: receiver heartbeats published */
     uint64_t refused;                 /* --lcm: messages LCM refused */
+    bool count_all;                   /* --stats: parse every record to count why it gave
+                                         nothing (else one from another source is skipped
+                                         unparsed, docs/FEEDER.md) */
 } feed_stats_t;
 
 static int parse_mac(const char *s, uint8_t mac[6])
@@ -132,25 +135,46 @@ static int parse_mac(const char *s, uint8_t mac[6])
     return 0;
 }
 
-/* "<sec>.<9 digits>\t<mac>\t<dbm>\n" into out; returns its length. Hand-formatted: this
- * is the inner loop of the bench (millions of lines). */
-static size_t format_line(char *out, uint64_t sec, uint32_t frac, const uint8_t mac[6], int dbm)
+/* "00" .. "99": two digits a division. */
+static const char k_d2[] = "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+                           "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+                           "8081828384858687888990919293949596979899";
+
+/* The decimal digits of sec into out (at least 20 bytes); returns their number. */
+static size_t format_sec(char *out, uint64_t sec)
+{
+    char tmp[20];
+    size_t k = sizeof(tmp);
+    while (sec >= 100u) { k -= 2; memcpy(tmp + k, k_d2 + 2u * (sec % 100u), 2); sec /= 100u; }
+    if (sec >= 10u) { k -= 2; memcpy(tmp + k, k_d2 + 2u * sec, 2); } else { tmp[--k] = (char)('0' + sec); }
+    memcpy(out, tmp + k, sizeof(tmp) - k);
+    return sizeof(tmp) - k;
+}
+
+/* "aa:bb:cc:dd:ee:ff\t" (18 bytes, no NUL) into out. */
+static void format_mac(char *out, const uint8_t mac[6])
 {
     static const char hex[] = "0123456789abcdef";
-    char tmp[24];
+    for (int i = 0; i < 6; i++) {
+        out[3 * i] = hex[mac[i] >> 4];
+        out[3 * i + 1] = hex[mac[i] & 15u];
+        out[3 * i + 2] = i < 5 ? ':' : '\t';
+    }
+}
+
+/* ".<9 digits>\t<mac>\t<dbm>\n" into out (after the seconds), with mac_tab the 18 bytes
+ * of format_mac; returns its length. Hand-formatted: this is the inner loop of the bench
+ * (millions of lines). */
+static size_t format_line(char *out, uint32_t frac, const char *mac_tab, int dbm)
+{
     size_t n = 0;
-    int k = 0;
-    do { tmp[k++] = (char)('0' + sec % 10u); sec /= 10u; } while (sec != 0u);
-    while (k > 0) { out[n++] = tmp[--k]; }
     out[n++] = '.';
-    for (int i = 8; i >= 0; i--) { out[n + (size_t)i] = (char)('0' + frac % 10u); frac /= 10u; }
+    for (int i = 7; i >= 1; i -= 2) { memcpy(out + n + (size_t)i, k_d2 + 2u * (frac % 100u), 2); frac /= 100u; }
+    out[n] = (char)('0' + frac);
     n += 9;
     out[n++] = '\t';
-    for (int i = 0; i < 6; i++) {
-        out[n++] = hex[mac[i] >> 4];
-        out[n++] = hex[mac[i] & 15u];
-        out[n++] = i < 5 ? ':' : '\t';
-    }
+    memcpy(out + n, mac_tab, 18);
+    n += 18;
     if (dbm < 0) { out[n++] = '-'; dbm = -dbm; }
     if (dbm >= 100) { out[n++] = (char)('0' + dbm / 100); }
     if (dbm >= 10) { out[n++] = (char)('0' + dbm / 10 % 10); }
@@ -223,14 +247,25 @@ static int64_t realtime_us(void)
     return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 }
 
+/* Whether the record's source address is one of the n MACs (lx_rt_frame_sa). */
+static bool sa_wanted(const lx_pcap_pkt_t *pkt, const uint8_t (*macs)[6], int n)
+{
+    const uint8_t *sa = lx_rt_frame_sa(pkt->data, pkt->caplen);
+    if (sa == NULL) { return false; }
+    int m = 0;
+    while (m < n && memcmp(macs[m], sa, 6) != 0) { m++; }
+    return m < n;
+}
+
 /* The next record whose radiotap header parsed (with bad_rt, or was unusable but located
  * the 802.11 frame: counted in st->rt_kept) and an 802.11 header followed, in *pkt and *f;
  * alive (when not NULL) is called for every record read and, live, after every wait
- * without one (at the clock's time), and why a record gives nothing is counted in st. 1,
- * 0 at the end (live: SIGINT or SIGTERM), -1 after a read error (message on stderr) or
- * when alive failed. */
+ * without one (at the clock's time), and why a record gives nothing is counted in st. With
+ * `want` (and not st->count_all) a record whose source address is not one of its n_want
+ * MACs is skipped before its radiotap header is parsed, uncounted. 1, 0 at the end (live:
+ * SIGINT or SIGTERM), -1 after a read error (message on stderr) or when alive failed. */
 static int next_frame(lx_pcap_reader_t *r, feed_stats_t *st, lx_pcap_pkt_t *pkt, lx_rt_frame_t *f,
-                      bool bad_rt, alive_fn alive, void *alive_ctx)
+                      bool bad_rt, const uint8_t (*want)[6], int n_want, alive_fn alive, void *alive_ctx)
 {
     char err[512];
     for (;;) {
@@ -249,6 +284,7 @@ static int next_frame(lx_pcap_reader_t *r, feed_stats_t *st, lx_pcap_pkt_t *pkt,
         st->packets++;
         if (alive != NULL && alive(alive_ctx, pkt->t_us) != 0) { return -1; }
         if (pkt->caplen < pkt->origlen) { st->caplen_short++; }
+        if (want != NULL && !st->count_all && !sa_wanted(pkt, want, n_want)) { continue; }
         const int prc = lx_rt_frame_parse(pkt->data, pkt->caplen, f);
         if (prc != 0 && bad_rt && f->wlan_ok) {
             st->rt_kept++;
@@ -270,7 +306,7 @@ static int scan_capture(lx_pcap_reader_t *r, const uint8_t (*macs)[6], int n_mac
     for (;;) {
         lx_pcap_pkt_t pkt;
         lx_rt_frame_t f;
-        const int got = next_frame(r, st, &pkt, &f, false, alive, alive_ctx);
+        const int got = next_frame(r, st, &pkt, &f, false, macs, n_macs, alive, alive_ctx);
         if (got <= 0) { return got < 0 ? 1 : 0; }
         if (!f.wlan.has_sa) { st->no_sa++; continue; }
         int m = 0;
@@ -293,7 +329,7 @@ static int scan_list(lx_pcap_reader_t *r, const uint8_t (*macs)[6], int n_macs, 
     for (;;) {
         lx_pcap_pkt_t pkt;
         lx_rt_frame_t f;
-        const int got = rc == 0 ? next_frame(r, st, &pkt, &f, true, NULL, NULL) : 0;
+        const int got = rc == 0 ? next_frame(r, st, &pkt, &f, true, NULL, 0, NULL, NULL) : 0;
         if (got <= 0) {
             rc = got < 0 ? 1 : rc;
             break;
@@ -356,18 +392,36 @@ static void cleanup_on_signal(const char *dir, const char *const *names, int n)
 
 typedef struct tsv_ctx {
     FILE *out;
-    bool live; /* flush each line: a live reader wants it at once */
+    bool live;      /* flush each line: a live reader wants it at once */
+    char sec_txt[20]; /* the digits of `sec` */
+    size_t sec_len; /* their number, 0 before the first line */
+    uint64_t sec;
+    char mac_tab[FEED_MAX_MACS][18]; /* each --mac as format_mac writes it */
+    size_t n;       /* bytes of lines in buf, not yet handed to out */
+    char buf[1 << 16];
 } tsv_ctx_t;
+
+/* Hand the buffered lines to c->out (and, live, flush it): 0, or 1 when that failed. */
+static int tsv_flush(tsv_ctx_t *c)
+{
+    const size_t n = c->n;
+    c->n = 0;
+    if (fwrite_unlocked(c->buf, 1, n, c->out) != n) { return 1; } /* one thread: no locks */
+    return c->live && fflush(c->out) != 0 ? 1 : 0;
+}
 
 static int tsv_line(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_frame_t *f)
 {
     tsv_ctx_t *c = ctx;
-    (void)m;
-    char line[64];
-    const size_t len = format_line(line, pkt->ts_sec, pkt->ts_nsec, f->wlan.sa, f->rt.dbm_signal);
-    fwrite(line, 1, len, c->out);
+    if (c->sec_len == 0u || c->sec != pkt->ts_sec) { /* about once a second of capture */
+        c->sec = pkt->ts_sec;
+        c->sec_len = format_sec(c->sec_txt, pkt->ts_sec);
+    }
+    char *o = c->buf + c->n; /* room for a line: flushed below 128 bytes from the end */
+    memcpy(o, c->sec_txt, sizeof(c->sec_txt));
+    c->n += c->sec_len + format_line(o + c->sec_len, pkt->ts_nsec, c->mac_tab[m], f->rt.dbm_signal);
     /* Live, a lost line ends the reading (a batch's table is checked at the end). */
-    return c->live && fflush(c->out) != 0 ? 1 : 0;
+    return c->live || c->n > sizeof(c->buf) - 128u ? tsv_flush(c) : 0;
 }
 
 /* The TSV lines (or with list the survey, scan_list) into stdout or output. */
@@ -395,8 +449,16 @@ static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, bool list
     }
     static char obuf[1 << 16];
     setvbuf(out, obuf, _IOFBF, sizeof(obuf));
-    tsv_ctx_t c = {out, live};
+    static tsv_ctx_t c;
+    c.out = out;
+    c.live = live;
+    c.sec_len = 0u;
+    c.n = 0u;
+    for (int m = 0; m < n_macs; m++) { format_mac(c.mac_tab[m], macs[m]); } /* = the SA of its lines */
     int rc = list ? scan_list(r, macs, n_macs, st, out) : scan_capture(r, macs, n_macs, st, tsv_line, &c, NULL, NULL);
+    if (tsv_flush(&c) != 0) {
+        rc = 1; /* the stream's error is reported below */
+    }
     if (output != NULL && (fflush(out) != 0 || ferror(out))) {
         fprintf(stderr, "rfseek-feed: %s: write error: %s\n", tmp, strerror(errno));
         rc = 1;
@@ -1160,6 +1222,7 @@ static int feed_main(int argc, char **argv)
     }
     feed_stats_t st;
     memset(&st, 0, sizeof(st));
+    st.count_all = fo.stats;
     const uint8_t(*macs)[6] = (const uint8_t(*)[6])fo.macs;
     if (fo.ro.poses != NULL) {
         rc = run_replay(&fo.ro, r, fo.macs, fo.n_macs, &st);

@@ -178,6 +178,40 @@ static void test_div64(void **state)
     }
 }
 
+/* Divisors that fit 32 bits take the hardware-division path (two-digit long division):
+ * against the host's native 64-bit division, at every divisor bit length, with dividends
+ * round multiples of the divisor and the largest high words the long division allows. */
+static void test_div64_32bit_divisor(void **state)
+{
+    (void)state;
+    const uint64_t de[] = {1, 2, 3, 0xFFFF, 0x10000, 0x10001, 0x7FFFFFFF, 0x80000000ull,
+                           0x80000001ull, 0xFFFFFFFEull, 0xFFFFFFFFull, 60000000, 100000};
+    for (unsigned j = 0; j < sizeof de / sizeof de[0]; ++j) {
+        uint64_t d = de[j];
+        const uint64_t ne[] = {0, 1, d - 1, d, d + 1, 0xFFFFFFFFull, 0x100000000ull,
+                               ((d - 1) << 32) | 0xFFFFFFFFull, (d << 32) - 1, UINT64_MAX,
+                               UINT64_MAX - d, (UINT64_MAX / d) * d, (UINT64_MAX / d) * d - 1,
+                               1ull << 63, (1ull << 58) - 1};
+        for (unsigned i = 0; i < sizeof ne / sizeof ne[0]; ++i) {
+            check_udiv(ne[i], d);
+            check_sdiv((int64_t)(ne[i] >> 1), (int64_t)d);
+            check_sdiv(-(int64_t)(ne[i] >> 1), (int64_t)d);
+        }
+    }
+    uint64_t x = 3;
+    for (int i = 0; i < 2000000; ++i) {
+        uint64_t d = (mix(&x) >> 32) >> (mix(&x) % 32u);
+        uint64_t q = mix(&x) >> (mix(&x) & 63u);
+        /* a quotient times the divisor plus a remainder near either end */
+        uint64_t n = (d != 0u && q <= UINT64_MAX / d) ? q * d : mix(&x);
+        uint64_t r = (i & 1) && d != 0u ? d - 1u : 0u;
+        n = n <= UINT64_MAX - r ? n + r : n;
+        check_udiv(n, d);
+        check_udiv(mix(&x), d);
+        check_sdiv((int64_t)(n >> 1) * ((i & 2) ? -1 : 1), (int64_t)d * ((i & 4) ? -1 : 1));
+    }
+}
+
 static void check_isqrt64(uint64_t v)
 {
     unsigned __int128 r = rfs_isqrt64(v);
@@ -559,6 +593,7 @@ int main(void)
         cmocka_unit_test(test_saturate),
         cmocka_unit_test(test_add_sub_mul_div),
         cmocka_unit_test(test_div64),
+        cmocka_unit_test(test_div64_32bit_divisor),
         cmocka_unit_test(test_isqrt),
         cmocka_unit_test(test_q16_sqrt),
         cmocka_unit_test(test_q16_dist),

@@ -436,6 +436,132 @@ static void test_walls_crossed(void **state)
     assert_int_equal(rfs_map_walls_crossed(&m, -RFS_Q16_INT(100), 5 * r, RFS_Q16_INT(100), 5 * r), 2);
 }
 
+typedef struct cell_hit {
+    int i, j, wall;
+} cell_hit_t;
+
+static int cmp_cell(const void *a, const void *b)
+{
+    const cell_hit_t *p = a, *q = b;
+    return p->i != q->i ? (p->i > q->i) - (p->i < q->i) : (p->j > q->j) - (p->j < q->j);
+}
+
+/* Walls crossed by the definition (docs/MAPS.md): endpoints clamped onto the map's edge,
+ * every closed cell square the segment touches (those just off the map are not walls),
+ * taken from the end with the smaller x (then y) column by column, each column in the
+ * direction the segment runs in y; a run is consecutive wall cells. Unlike ref_walls it
+ * orders the cells a segment touches at one instant (through a corner, along an edge). */
+static int ref_walls_in_order(const fixture_t *f, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,
+                              rfs_q16_t y1)
+{
+    static cell_hit_t hits[(W + 2) * (H + 2)];
+    double r = f->res;
+    double X0 = fmin(fmax((double)x0 - f->ox, 0.0), W * r), Y0 = fmin(fmax((double)y0 - f->oy, 0.0), H * r);
+    double X1 = fmin(fmax((double)x1 - f->ox, 0.0), W * r), Y1 = fmin(fmax((double)y1 - f->oy, 0.0), H * r);
+    if (X1 < X0 || (X1 == X0 && Y1 < Y0)) {
+        double t = X0; X0 = X1; X1 = t;
+        t = Y0; Y0 = Y1; Y1 = t;
+    }
+    int up = Y1 >= Y0;
+    int n = 0;
+    for (int j = -1; j <= H; j++) {
+        for (int i = -1; i <= W; i++) {
+            if (ref_touch(f, X0, Y0, X1, Y1, i, j)) {
+                int on = i >= 0 && j >= 0 && i < W && j < H;
+                hits[n].i = i;
+                hits[n].j = up ? j : -j;
+                hits[n].wall = on && f->wall_c[j][i];
+                n++;
+            }
+        }
+    }
+    qsort(hits, (size_t)n, sizeof(hits[0]), cmp_cell);
+    int runs = 0, in = 0;
+    for (int k = 0; k < n; k++) {
+        runs += hits[k].wall && !in;
+        in = hits[k].wall;
+    }
+    return runs;
+}
+
+/* Wall counts passing over wall-free blocks (rfs_map_walls_crossed_blocks) equal the
+ * reference on maps whose walls leave whole blocks empty, for blocks of 8, 16 and
+ * 32 cells, on random segments, on segments between cell corners (axis-parallel and
+ * diagonal ones run along cell edges) and with endpoints off the map, against
+ * ref_walls_in_order; the block grid marks exactly the blocks holding a wall cell. */
+static void test_walls_crossed_blocks(void **state)
+{
+    (void)state;
+    uint32_t s = 5;
+    int nonzero = 0;
+    const uint32_t bytes[3] = {64, 4, 2}; /* blocks of 8 (6 x 5), 16 (3 x 3), 32 (2 x 2) */
+    for (int mapk = 0; mapk < 6; mapk++) {
+        make_map(&fx, 300u + (uint32_t)mapk, RFS_Q16_FRAC(1, 10), RFS_Q16_FRAC(1, 4));
+        uint16_t stride = (W + 7) / 8;
+        for (int y = 0; y < H; y++) {
+            for (int x = 0; x < W; x++) {
+                /* blocks of 8 on a diagonal band keep their walls, the rest are empty */
+                fx.wall_c[y][x] = fx.wall_c[y][x] && ((x / 8 + y / 8 + mapk) % 3 == 0);
+                rfs_map_bit_set(fx.wall_bits, stride, (uint16_t)x, (uint16_t)y, fx.wall_c[y][x]);
+            }
+        }
+        rfs_map_cfg_t cfg = rfs_map_cfg_default();
+        assert_int_equal(rfs_map_init(&fx.m, &cfg, W, H, fx.res, fx.ox, fx.oy, fx.free_bits,
+                                      fx.wall_bits, fx.legal_bits), 0);
+        for (int bk = 0; bk < 3; bk++) {
+            uint8_t buf[64];
+            rfs_map_wall_blocks_t b;
+            assert_int_equal(rfs_map_wall_blocks(&fx.m, buf, bytes[bk], &b), 0);
+            assert_int_equal(b.shift, 3 + bk);
+            for (int bj = 0; bj < b.bh; bj++) {
+                for (int bi = 0; bi < b.bw; bi++) {
+                    int any = 0;
+                    for (int y = bj << b.shift; y < ((bj + 1) << b.shift) && y < H; y++) {
+                        for (int x = bi << b.shift; x < ((bi + 1) << b.shift) && x < W; x++) {
+                            any |= fx.wall_c[y][x];
+                        }
+                    }
+                    assert_int_equal(rfs_map_bit(b.bits, b.stride, (uint16_t)bi, (uint16_t)bj), any);
+                }
+            }
+            for (int k = 0; k < 900; k++) {
+                rfs_q16_t x0, y0, x1, y1;
+                if (k % 3 == 0) {
+                    x0 = rand_coord(&s, fx.ox, W, fx.res);
+                    y0 = rand_coord(&s, fx.oy, H, fx.res);
+                    x1 = rand_coord(&s, fx.ox, W, fx.res);
+                    y1 = rand_coord(&s, fx.oy, H, fx.res);
+                } else {
+                    /* cell corners, one in three segments along a row or column of them,
+                     * one in nine on a diagonal through corners, some off the map */
+                    int i0 = (int)(lcg(&s) % (W + 5)) - 2, j0 = (int)(lcg(&s) % (H + 5)) - 2;
+                    int i1 = (int)(lcg(&s) % (W + 5)) - 2, j1 = (int)(lcg(&s) % (H + 5)) - 2;
+                    if (k % 9 == 1) {
+                        j1 = j0 + (i1 - i0) * ((k & 2) ? 1 : -1);
+                    } else if (k % 3 == 1) {
+                        if (k & 4) { i1 = i0; } else { j1 = j0; }
+                    }
+                    x0 = fx.ox + i0 * fx.res;
+                    y0 = fx.oy + j0 * fx.res;
+                    x1 = fx.ox + i1 * fx.res;
+                    y1 = fx.oy + j1 * fx.res;
+                }
+                int want = ref_walls_in_order(&fx, x0, y0, x1, y1);
+                assert_int_equal(rfs_map_walls_crossed_blocks(&fx.m, &b, x0, y0, x1, y1), want);
+                assert_int_equal(rfs_map_walls_crossed(&fx.m, x0, y0, x1, y1), want);
+                nonzero += want > 0;
+            }
+        }
+    }
+    assert_true(nonzero > 1000);
+    uint8_t buf[8];
+    rfs_map_wall_blocks_t b;
+    assert_int_equal(rfs_map_wall_blocks(&fx.m, buf, 0, &b), -1);
+    rfs_map_t nowall = fx.m;
+    nowall.wall = NULL;
+    assert_int_equal(rfs_map_wall_blocks(&nowall, buf, sizeof buf, &b), -1);
+}
+
 /* Along one axis, lattice lines at o + g/2 + k g (k < n; o Q16.16, g metres): is line idx
  * as near to p (Q16.16) as the nearest of all n, by brute force in double? */
 static int nearest_on_axis(rfs_q16_t p, rfs_q16_t o, double g, int n, int idx)
@@ -528,6 +654,7 @@ int main(void)
         cmocka_unit_test(test_segments_match_reference),
         cmocka_unit_test(test_segment_grazing_corner),
         cmocka_unit_test(test_walls_crossed),
+        cmocka_unit_test(test_walls_crossed_blocks),
         cmocka_unit_test(test_lattice),
         cmocka_unit_test(test_init_rejects),
     };

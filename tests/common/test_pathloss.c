@@ -598,6 +598,69 @@ static void cached_relearn_equals_fresh(void **state)
     free(warm);
 }
 
+/* A caller's wall-count cache (rfs_pathloss_cache_attach): over relearns on a growing
+ * walk (so the hold phase runs too) the results equal the built-in cache's and a tiny
+ * attached cache's bit for bit; the large one also keeps the refinement's counts, so it
+ * counts fewer lines. */
+static void attached_cache_equals_builtin(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+    qsort(f->s, NS, sizeof(f->s[0]), by_x);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    rfs_pathloss_t *st[3];
+    const uint16_t cols[3] = {0, 2048, 5}; /* built in, large, tiny */
+    void *buf[3] = {NULL, NULL, NULL};
+    for (int k = 0; k < 3; ++k) {
+        st[k] = malloc(sizeof(rfs_pathloss_t));
+        assert_non_null(st[k]);
+        assert_int_equal(rfs_pathloss_init(st[k], &c), 0);
+        if (cols[k] != 0u) {
+            uint32_t bytes = rfs_pathloss_cache_bytes(cols[k]);
+            buf[k] = malloc(bytes);
+            assert_non_null(buf[k]);
+            assert_int_equal(rfs_pathloss_cache_attach(st[k], buf[k], bytes - 1u, cols[k]), -1);
+            assert_int_equal(rfs_pathloss_cache_attach(st[k], buf[k], bytes, cols[k]), 0);
+        }
+    }
+    assert_int_equal(rfs_pathloss_cache_attach(st[1], buf[1], UINT32_MAX, 0), -1);
+    assert_int_equal(rfs_pathloss_cache_attach(st[1], NULL, UINT32_MAX, 8), -1);
+    assert_int_equal(rfs_pathloss_cache_attach(st[1], buf[1], UINT32_MAX,
+                                               (uint16_t)(RFS_PATHLOSS_MAX_CACHE_COLS + 1u)), -1);
+    assert_int_equal(rfs_pathloss_cache_bytes(2048), 8192u + 8192u + 512u * 2048u);
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 1);
+    rfs_pathloss_est_t e[3];
+    uint32_t lines[3] = {0, 0, 0}, cached[3] = {0, 0, 0};
+    for (int n = NS / 8; n <= NS; n += NS / 8) {
+        rfs_model_fit_in_t in = {f->s, (uint16_t)n, 0, 0, &f->map};
+        for (int k = 0; k < 3; ++k) {
+            assert_int_equal(rfs_pathloss_ops.fit(st[k], &in, 0, &rng), RFS_FIT_DONE);
+            assert_true(rfs_pathloss_estimate(st[k], &e[k]));
+            lines[k] += e[k].walls_counted;
+        }
+        for (int k = 1; k < 3; ++k) {
+            assert_memory_equal(&st[k]->best, &st[0]->best, sizeof(st[0]->best));
+            assert_memory_equal(st[k]->surface, st[0]->surface, sizeof(st[0]->surface));
+            assert_int_equal(e[k].candidates, e[0].candidates);
+            assert_int_equal(e[k].footprints + e[k].footprints_cached,
+                             e[0].footprints + e[0].footprints_cached);
+        }
+        for (int k = 0; k < 3; ++k) {
+            cached[k] += e[k].footprints_cached;
+        }
+    }
+    /* the large cache keeps every candidate of the earlier fits until its origins run out
+     * (the last fit starts it again) */
+    assert_true(cached[1] > cached[0] && cached[0] > cached[2]);
+    assert_true(lines[1] * 4u < lines[0] * 3u);
+    assert_true(lines[2] > lines[0]);
+    for (int k = 0; k < 3; ++k) {
+        free(st[k]);
+        free(buf[k]);
+    }
+}
+
 static void model_invalid_while_slicing(void **state)
 {
     fixture_t *f = *state;
@@ -892,6 +955,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(bins_grow_when_samples_spread, setup, teardown),
         cmocka_unit_test_setup_teardown(sliced_fit_equals_whole_fit, setup, teardown),
         cmocka_unit_test_setup_teardown(cached_relearn_equals_fresh, setup, teardown),
+        cmocka_unit_test_setup_teardown(attached_cache_equals_builtin, setup, teardown),
         cmocka_unit_test_setup_teardown(model_invalid_while_slicing, setup, teardown),
         cmocka_unit_test_setup_teardown(predict_is_the_fitted_formula, setup, teardown),
         cmocka_unit_test_setup_teardown(residual_surface_and_spread, setup, teardown),

@@ -136,6 +136,66 @@ static void test_interpolation_random(void **state)
     assert_int_equal(f->s.dropped_gap + f->s.dropped_early + f->s.dropped_pending, 0);
 }
 
+/* Interpolation at the ends of its ranges: Q16.16 positions from INT32_MIN to INT32_MAX,
+ * spans from 1 us to the 60 s limit, times 1 us from either pose. The reference is the host's
+ * native 64-bit division rounded half away from zero, and double precision within 0.5 LSB. */
+static void check_lerp_q16(rfs_q16_t a, rfs_q16_t b, int64_t span, int64_t dt)
+{
+    rfs_store_cfg_t c = rfs_store_cfg_default();
+    c.max_gap_us = 60000000;
+    rfs_store_t s;
+    rfs_sample_t smp[1];
+    rfs_pending_t pend[1];
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 1u);
+    assert_int_equal(rfs_store_init(&s, &c, smp, pend, 1), 0);
+    const int64_t t0 = 123456789;
+    rfs_pose_t p0 = {.t_us = t0, .x = a, .y = b, .theta = 0};
+    rfs_pose_t p1 = {.t_us = t0 + span, .x = b, .y = a, .theta = 0};
+    assert_true(rfs_store_add_pose(&s, &p0, &rng));
+    assert_true(rfs_store_add_pose(&s, &p1, &rng));
+    rfs_q16_t x = 0, y = 0;
+    assert_true(rfs_store_position_at(&s, t0 + dt, &x, &y));
+    int64_t n = ((int64_t)b - a) * dt;
+    int64_t q = (n < 0 ? -n : n) / span, r = (n < 0 ? -n : n) % span;
+    q += 2 * r >= span ? 1 : 0;
+    assert_true(x == (rfs_q16_t)(a + (n < 0 ? -q : q)));
+    assert_true(y == (rfs_q16_t)(b - (n < 0 ? -q : q)));
+    double ex = a + ((double)b - a) * (double)dt / (double)span;
+    double ey = b + ((double)a - b) * (double)dt / (double)span;
+    assert_true(fabs(x - ex) <= 0.5 + 1e-6 && fabs(y - ey) <= 0.5 + 1e-6);
+}
+
+static void test_interpolation_q16_extremes(void **state)
+{
+    (void)state;
+    const rfs_q16_t ends[] = {INT32_MIN, INT32_MIN + 1, -65536, -1, 0, 1, 3, 65536,
+                              INT32_MAX - 1, INT32_MAX};
+    const int64_t spans[] = {1, 2, 3, 7, 100000, 65537, 1 << 25, 59999999, 60000000};
+    for (unsigned i = 0; i < sizeof ends / sizeof ends[0]; ++i) {
+        for (unsigned j = 0; j < sizeof ends / sizeof ends[0]; ++j) {
+            for (unsigned k = 0; k < sizeof spans / sizeof spans[0]; ++k) {
+                int64_t sp = spans[k];
+                const int64_t dts[] = {0, 1, sp / 2, (sp + 1) / 2, sp - 1, sp};
+                for (unsigned m = 0; m < sizeof dts / sizeof dts[0]; ++m) {
+                    check_lerp_q16(ends[i], ends[j], sp, dts[m]);
+                }
+            }
+        }
+    }
+    rfs_rng_t g;
+    rfs_rng_seed(&g, 11u);
+    for (int i = 0; i < 300000; ++i) {
+        rfs_q16_t a = (rfs_q16_t)rfs_rng_u32(&g), b = (rfs_q16_t)rfs_rng_u32(&g);
+        if (i & 1) { /* short moves, as a robot makes */
+            b = (rfs_q16_t)(a / 2 + (int32_t)(rfs_rng_u32(&g) >> 12) - (1 << 19));
+            a /= 2;
+        }
+        int64_t sp = 1 + (int64_t)(rfs_rng_u32(&g) % (i & 2 ? 60000000u : 200000u));
+        check_lerp_q16(a, b, sp, (int64_t)(rfs_rng_u32(&g) % (uint32_t)(sp + 1)));
+    }
+}
+
 static void test_drops_counted(void **state)
 {
     fixture_t *f = *state;
@@ -324,6 +384,7 @@ int main(void)
         cmocka_unit_test(test_defaults_and_init),
         cmocka_unit_test_setup_teardown(test_interpolation_hand, setup, teardown),
         cmocka_unit_test_setup_teardown(test_interpolation_random, setup, teardown),
+        cmocka_unit_test(test_interpolation_q16_extremes),
         cmocka_unit_test_setup_teardown(test_drops_counted, setup, teardown),
         cmocka_unit_test_setup_teardown(test_pending_unsorted, setup, teardown),
         cmocka_unit_test_setup_teardown(test_int64_extreme_times, setup, teardown),

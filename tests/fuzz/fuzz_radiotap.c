@@ -2,11 +2,12 @@
  * Input: one captured record (radiotap header, then the 802.11 frame). Beyond "no
  * out-of-bounds read" (ASan) it checks what the parser promises: a usable header lies
  * inside the input, an address is only reported when the frame holds it, an SSID only
- * when a beacon or probe response holds it.
+ * when a beacon or probe response holds it, and the source-address filter agrees with it.
  */
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "lx_radiotap.h"
 
@@ -37,6 +38,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             abort();
         }
     } else if (n >= 2) {
+        abort();
+    }
+    /* The feeder's filter ahead of the parse (lx_rt_frame_sa) finds the same source
+     * address in every record the parse accepts. */
+    const uint8_t *sa = lx_rt_frame_sa(data, size);
+    if (sa != NULL && (sa < data || sa + 6 > data + size)) { abort(); }
+    if (rc == 0 && ((sa != NULL) != (f.wlan_ok && f.wlan.has_sa) || (sa != NULL && memcmp(sa, f.wlan.sa, 6) != 0))) {
         abort();
     }
     /* The parser alone, on every prefix length the record could have been cut at. */

@@ -421,6 +421,9 @@ static void test_real_meshid_capture(void **state)
     assert_int_equal(f.wlan.subtype, 8);
     assert_memory_equal(f.wlan.sa, sa, 6);
     assert_int_equal(f.wlan.seq, 268);
+    const uint8_t *peek = lx_rt_frame_sa(buf, n);
+    assert_non_null(peek);
+    assert_memory_equal(peek, sa, 6);
 }
 
 /* tshark: radiotap.length 89, dbm_antsignal -22, freq 2412, fcs 1, dbm_antnoise -86,
@@ -447,6 +450,40 @@ static void test_real_exthdr_capture(void **state)
     assert_true(f.rt.tsft_us == 10016360ull);
     assert_memory_equal(f.wlan.sa, sa, 6);
     assert_int_equal(f.wlan.seq, 1);
+    const uint8_t *peek = lx_rt_frame_sa(buf, n);
+    assert_non_null(peek);
+    assert_memory_equal(peek, sa, 6);
+}
+
+/* The source address from the radiotap length alone: the header's fields are not read
+ * (a bad version still locates the frame), its length must lie within the record, and
+ * the 802.11 rules are lx_wlan_parse's (a data frame with FromDS: addr3; one byte short
+ * of its header, an ACK: none). */
+static void test_source_address_before_radiotap(void **state)
+{
+    (void)state;
+    uint8_t b[64] = {0};
+    put16(b + 2, 12);
+    put32(b + 4, 1u << 5);
+    b[8] = (uint8_t)-40;
+    const size_t n = 12 + build_data(b + 12, 2, false, k_a, k_b, k_c, k_d);
+
+    assert_ptr_equal(lx_rt_frame_sa(b, n), b + 12 + 16);
+    assert_memory_equal(lx_rt_frame_sa(b, n), k_c, 6);
+
+    b[0] = 1; /* version: lx_rt_frame_parse rejects the record, the address is still there */
+    lx_rt_frame_t f;
+    assert_int_equal(lx_rt_frame_parse(b, n, &f), -1);
+    assert_ptr_equal(lx_rt_frame_sa(b, n), b + 12 + 16);
+    b[0] = 0;
+    assert_null(lx_rt_frame_sa(b, n - 1));
+    put16(b + 2, (uint16_t)(n + 1));
+    assert_null(lx_rt_frame_sa(b, n));
+    put16(b + 2, 7);
+    assert_null(lx_rt_frame_sa(b, n));
+    assert_null(lx_rt_frame_sa(b, 7));
+    const uint8_t ack[18] = {0, 0, 8, 0, 0, 0, 0, 0, 0xd4, 0, 0, 0, 2, 0, 0, 0, 0, 0x0a};
+    assert_null(lx_rt_frame_sa(ack, sizeof(ack)));
 }
 
 int main(void)
@@ -467,6 +504,7 @@ int main(void)
         cmocka_unit_test(test_fcs_flag_strips_four_bytes),
         cmocka_unit_test(test_real_meshid_capture),
         cmocka_unit_test(test_real_exthdr_capture),
+        cmocka_unit_test(test_source_address_before_radiotap),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,6 +1,7 @@
 /* lx_radiotap.c - radiotap and 802.11 header parsing (see lx_radiotap.h). */
 #include "lx_radiotap.h"
 
+#include <stddef.h>
 #include <string.h>
 
 /* Default-namespace field bits with their alignment and size in bytes
@@ -148,8 +149,9 @@ int lx_radiotap_parse(const uint8_t *buf, size_t len, lx_radiotap_t *rt)
     bool reset_on_ext = false;
     for (size_t wo = 4; wo < words_end; wo += 4) {
         const uint32_t w = rd32(buf + wo);
-        for (unsigned b = 0; b < RT_EXT; b++) {
-            if (!(w & (1u << b))) { continue; }
+        /* The set bits below bit 31, lowest first. */
+        for (uint32_t bits = w & ~(1u << RT_EXT); bits != 0u; bits &= bits - 1u) {
+            const unsigned b = (unsigned)__builtin_ctz(bits);
             if (b == RT_NS_RADIOTAP) {
                 /* The next word restarts at bit 0 of the default namespace. */
                 vendor = false;
@@ -190,6 +192,30 @@ int lx_radiotap_parse(const uint8_t *buf, size_t len, lx_radiotap_t *rt)
     return 0;
 }
 
+/* The MAC header bytes that must be captured before a management or data frame's
+ * addresses count (Wireshark adds wlan.sa only then): 24, + 6 for addr4 (data, ToDS and
+ * FromDS), + 2 QoS control (QoS data subtypes); 0 for any other frame: control,
+ * extension, protocol version 1 (S1G, another layout) or reserved. A +HTC field is not
+ * required: Wireshark reports the addresses of a frame cut inside it. */
+static inline size_t addr_hdr_len(uint16_t fc)
+{
+    const unsigned type = (fc >> 2) & 3u;
+    if ((fc & 3u) != 0u || (type != LX_WLAN_MGMT && type != LX_WLAN_DATA)) { return 0; }
+    size_t need = 24;
+    if (type == LX_WLAN_DATA && ((fc >> 8) & 3u) == 3u) { need += 6; }
+    if (type == LX_WLAN_DATA && (fc & 0x80u) != 0u) { need += 2; }
+    return need;
+}
+
+/* Offset of the source address in a management or data frame. IEEE 802.11-2020 Table
+ * 9-30: addr2 with FromDS 0, addr3 with FromDS 1 and ToDS 0, addr4 with both; a
+ * management frame's SA is addr2 whatever the DS bits. */
+static inline size_t sa_offset(uint16_t fc)
+{
+    static const uint8_t sa_at[4] = {10, 10, 16, 24};
+    return ((fc >> 2) & 3u) == LX_WLAN_MGMT ? 10u : sa_at[(fc >> 8) & 3u];
+}
+
 int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w)
 {
     memset(w, 0, sizeof(*w));
@@ -200,11 +226,8 @@ int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w)
     w->ds = (uint8_t)((w->fc >> 8) & 3u);
     const bool order = (w->fc & 0x8000u) != 0;
     w->hdr_len = 2;
-    if ((w->fc & 3u) != 0u) {
-        return 0; /* protocol version 1 (S1G) or reserved: another header layout, no addresses */
-    }
     /* Address offsets: addr1 4, addr2 10, addr3 16, seq 22, addr4 24. */
-    if (w->type == LX_WLAN_CTRL) {
+    if ((w->fc & 3u) == 0u && w->type == LX_WLAN_CTRL) {
         /* RTS, PS-Poll, CF-End+CF-Ack, BlockAckReq, BlockAck carry RA then TA; ACK and CTS
          * carry only RA; CF-End carries RA then the BSSID (tshark 4.0: wlan.bssid, no wlan.ta).
          * None of them has a source address (Wireshark: no wlan.sa). */
@@ -216,24 +239,14 @@ int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w)
         }
         return 0;
     }
-    if (w->type != LX_WLAN_MGMT && w->type != LX_WLAN_DATA) { return 0; }
-    /* The MAC header through its QoS control must be there before any address counts
-     * (Wireshark adds wlan.sa only then): 24 bytes, + 6 for addr4 (data, ToDS and
-     * FromDS), + 2 QoS control (QoS data subtypes). A +HTC field (order bit) is not
-     * required: Wireshark reports the addresses of a frame cut inside it. */
-    size_t need = 24;
+    size_t need = addr_hdr_len(w->fc);
+    if (need == 0 || len < need) { return 0; }
     const bool qos = w->type == LX_WLAN_DATA && (w->subtype & 8u) != 0;
-    if (w->type == LX_WLAN_DATA && w->ds == 3) { need += 6; }
-    if (qos) { need += 2; }
-    if (len < need) { return 0; }
     if (order && (w->type == LX_WLAN_MGMT || qos)) { need += 4; }
     w->hdr_len = (uint16_t)need;
     memcpy(w->ta, frame + 10, 6);
     w->has_ta = true;
-    /* IEEE 802.11-2020 Table 9-30: which address is the SA for each ToDS/FromDS; a
-     * management frame's SA is addr2 whatever the DS bits. */
-    static const uint8_t sa_at[4] = {10, 10, 16, 24};
-    memcpy(w->sa, frame + (w->type == LX_WLAN_MGMT ? 10 : sa_at[w->ds]), 6);
+    memcpy(w->sa, frame + sa_offset(w->fc), 6);
     w->has_sa = true;
     const uint16_t sc = rd16(frame + 22);
     w->has_seq = true;
@@ -263,7 +276,8 @@ static void frame_ssid(const uint8_t *body, size_t n, lx_rt_frame_t *f)
 
 int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f)
 {
-    memset(f, 0, sizeof(*f));
+    /* Every field but the SSID bytes, which count only up to ssid_len when has_ssid. */
+    memset(f, 0, offsetof(lx_rt_frame_t, ssid));
     const int rc = lx_radiotap_parse(buf, len, &f->rt);
     /* An unusable header whose length field still lies in [8, len]: the 802.11 frame is
      * there, as Wireshark reads it; its fields (and so the FCS flag) are not. */
@@ -281,4 +295,16 @@ int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f)
         frame_ssid(buf + it_len + f->wlan.hdr_len, f->frame_len - f->wlan.hdr_len, f);
     }
     return rc;
+}
+
+const uint8_t *lx_rt_frame_sa(const uint8_t *buf, size_t len)
+{
+    /* The same location as lx_rt_frame_parse (a header it accepts has it_len in [8, len])
+     * and lx_wlan_parse's rule for when the SA counts. */
+    const size_t it_len = len >= RT_HDR ? rd16(buf + 2) : 0u;
+    if (it_len < RT_HDR || it_len + 2u > len) { return NULL; }
+    const uint8_t *frame = buf + it_len;
+    const uint16_t fc = rd16(frame);
+    const size_t need = addr_hdr_len(fc);
+    return need == 0 || len - it_len < need ? NULL : frame + sa_offset(fc);
 }

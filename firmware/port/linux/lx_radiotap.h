@@ -125,7 +125,8 @@ typedef struct lx_rt_frame {
                           ///< (the MAC header is parsed from all captured bytes)
     bool has_ssid;        ///< a beacon or probe response whose SSID element was read
     uint8_t ssid_len;     ///< its length, 0..LX_WLAN_SSID_MAX (0: a hidden network)
-    uint8_t ssid[LX_WLAN_SSID_MAX]; ///< its bytes (any values: not a C string)
+    uint8_t ssid[LX_WLAN_SSID_MAX]; ///< its first ssid_len bytes (not a C string; the
+                                    ///< rest left as they were: the field comes last)
 } lx_rt_frame_t;
 
 /// Parse a whole captured record. Returns 0 when the radiotap header was usable (the
@@ -135,5 +136,12 @@ typedef struct lx_rt_frame {
 /// SSID element (id 0) among the elements after a beacon's or probe
 /// response's 12 bytes of fixed fields, within the captured frame without its FCS.
 int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f);
+
+/// The source address (wlan.sa) of a captured record, found from the radiotap length
+/// field (bytes 2-3) and the 802.11 header alone, no radiotap field parsed: a filter ahead
+/// of lx_rt_frame_parse(). Its 6 bytes inside buf, or NULL when there is none. For a
+/// record lx_rt_frame_parse() accepts (returns 0) the answer agrees with its wlan.has_sa
+/// and wlan.sa; a record it rejects may still have one here. Never reads outside buf[0, len).
+const uint8_t *lx_rt_frame_sa(const uint8_t *buf, size_t len);
 
 #endif /* LX_RADIOTAP_H */

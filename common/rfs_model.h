@@ -16,6 +16,9 @@
 #include "rfs_map.h"
 #include "rfs_store.h"
 
+/// Most sources whose own samples a fit sees (rfs_model_fit_in_t.src_samples).
+#define RFS_MODEL_MAX_SOURCES 2u
+
 /// What a model learns from.
 typedef struct rfs_model_fit_in {
     const rfs_sample_t *samples; ///< the stored samples
@@ -23,6 +26,11 @@ typedef struct rfs_model_fit_in {
     rfs_q16_t qx;                ///< query point (robot position) x, metres Q16.16
     rfs_q16_t qy;                ///< query point y, metres Q16.16
     const rfs_map_t *map;        ///< the map (for map-aware models); may be NULL
+    uint8_t nsources;            ///< sources with their own samples below (0: none kept)
+    /// Each source's own samples (its RSSI, dBm Q9.6), for a model fitted per source
+    /// (rfs_fields.h); src_n[i] of them.
+    const rfs_sample_t *src_samples[RFS_MODEL_MAX_SOURCES];
+    uint16_t src_n[RFS_MODEL_MAX_SOURCES]; ///< how many of each
 } rfs_model_fit_in_t;
 
 /// Result of one fit call.

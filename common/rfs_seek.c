@@ -12,6 +12,8 @@
 
 /* ln(9/4) / 5 in Q16.16: epsilon(5) = 0.9 e^(-5a) + 0.1 = 0.5 (paper section 2). */
 #define EPS_RATE_PAPER ((rfs_q16_t)10629)
+_Static_assert(RFS_MODEL_MAX_SOURCES == RFS_TARGET_MAX_SOURCES,
+               "a fit sees every source a target combines");
 /* Wait before deciding again after no goal could be found, microseconds (one window). */
 #define NO_GOAL_RETRY_US 1000000
 
@@ -117,6 +119,26 @@ const char *rfs_seek_kind_name(rfs_seek_kind_t k)
     return (uint32_t)k < sizeof names / sizeof names[0] ? names[k] : "none";
 }
 
+/* The per-source stores (rfs_seek_mem_t.src_samples): all of the target's sources or none. */
+static bool init_source_stores(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_seek_mem_t *mem)
+{
+    s->per_source = mem->src_samples[0] != 0;
+    for (uint8_t i = 0; i < RFS_SEEK_MAX_SOURCES; ++i) {
+        bool given = mem->src_samples[i] != 0 && mem->src_pending[i] != 0;
+        if (i >= s->target->nsources) {
+            continue;
+        }
+        if (given != s->per_source) {
+            return false;
+        }
+        if (given && rfs_store_init(&s->src_store[i], &cfg->store, mem->src_samples[i],
+                                    mem->src_pending[i], mem->pending_cap) != 0) {
+            return false;
+        }
+    }
+    return true;
+}
+
 int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map,
                   rfs_model_t model, const rfs_target_ops_t *target, const rfs_seek_mem_t *mem)
 {
@@ -150,7 +172,8 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
             return -1;
         }
     }
-    if (rfs_store_init(&s->store, &cfg->store, mem->samples, mem->pending, mem->pending_cap) != 0 ||
+    if (!init_source_stores(s, cfg, mem) ||
+        rfs_store_init(&s->store, &cfg->store, mem->samples, mem->pending, mem->pending_cap) != 0 ||
         rfs_plan_init(&s->plan, map, mem->plan_work, mem->plan_work_bytes, mem->plan_queue,
                       mem->plan_queue_cap) != 0 ||
         rfs_drive_init(&s->drive, &cfg->drive) != 0) {
@@ -179,6 +202,9 @@ bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
         return false;
     }
     (void)rfs_store_add_pose(&s->store, pose, rng);
+    for (uint8_t i = 0; s->per_source && i < s->target->nsources; ++i) {
+        (void)rfs_store_add_pose(&s->src_store[i], pose, rng);
+    }
     s->pose = *pose;
     s->have_pose = true;
     rfs_seek_meta_visit(s, pose->x, pose->y);
@@ -202,6 +228,9 @@ bool rfs_seek_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm, rfs_
     rfs_q16_t v;
     if (s->target->sample(&in, src, dbm, &v)) {
         rfs_store_add_value(&s->store, t_us, v, rng);
+    }
+    if (s->per_source) {
+        rfs_store_add_value(&s->src_store[src], t_us, (rfs_q16_t)dbm * RFS_Q16_ONE, rng);
     }
     return true;
 }
@@ -384,7 +413,13 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
  * periods: the wheels stay stopped meanwhile. */
 static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
 {
-    rfs_model_fit_in_t fin = { s->store.samples, s->store.count, s->pose.x, s->pose.y, s->map };
+    rfs_model_fit_in_t fin = { .samples = s->store.samples, .n = s->store.count,
+                               .qx = s->pose.x, .qy = s->pose.y, .map = s->map };
+    for (uint8_t i = 0; s->per_source && i < s->target->nsources; ++i) {
+        fin.src_samples[i] = s->src_store[i].samples;
+        fin.src_n[i] = s->src_store[i].count;
+        fin.nsources = (uint8_t)(i + 1u);
+    }
     rfs_fit_result_t r = s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng);
     if (r == RFS_FIT_MORE) {
         s->state = RFS_SEEK_LEARNING;

@@ -99,6 +99,11 @@ typedef struct rfs_seek_mem {
     uint32_t visited_bytes;    ///< its size, rfs_reach_bytes(map) = (lw * lh + 7) / 8
     uint8_t *reach;            ///< one bit per lattice point: reachable from the robot's position
     uint32_t reach_bytes;      ///< its size, rfs_reach_bytes(map)
+    /// Optional (NULL: none), for a model fitted per source (rfs_fields.h): each source's
+    /// own store, cfg.store.capacity samples and pending_cap pending measurements, for every
+    /// source of the target. The seeker then also keeps each source's RSSI as samples.
+    rfs_sample_t *src_samples[RFS_TARGET_MAX_SOURCES];
+    rfs_pending_t *src_pending[RFS_TARGET_MAX_SOURCES]; ///< their pending rings
 } rfs_seek_mem_t;
 
 /// Why an iteration chose its goal.
@@ -179,6 +184,8 @@ typedef struct rfs_seek {
     const rfs_target_ops_t *target;           ///< the target function
     rfs_rssi_t win[RFS_SEEK_MAX_SOURCES];     ///< 1 s windows per source
     rfs_store_t store;                        ///< samples
+    bool per_source;                          ///< src_store holds each source's own samples
+    rfs_store_t src_store[RFS_SEEK_MAX_SOURCES]; ///< each source's RSSI (rfs_seek_mem_t.src_samples)
     rfs_plan_t plan;                          ///< planner
     rfs_drive_t drive;                        ///< drive control
     uint8_t *visited;                         ///< novelty bits, one per lattice point
@@ -237,8 +244,8 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 
 /// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array
-/// is missing or too small for the map's lattice, or the target needs more sources than
-/// RFS_SEEK_MAX_SOURCES.
+/// is missing or too small for the map's lattice, the target needs more sources than
+/// RFS_SEEK_MAX_SOURCES, or per-source stores are given for some of its sources only.
 int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map,
                   rfs_model_t model, const rfs_target_ops_t *target, const rfs_seek_mem_t *mem);
 

@@ -26,6 +26,9 @@ typedef struct rfs_model_fit_in {
     rfs_q16_t qx;                ///< query point (robot position) x, metres Q16.16
     rfs_q16_t qy;                ///< query point y, metres Q16.16
     const rfs_map_t *map;        ///< the map (for map-aware models); may be NULL
+    /// One bit per lattice point of map (rfs_reach.h): reachable from the robot; NULL
+    /// when unknown (every legal point counts)
+    const uint8_t *reach;
     uint8_t nsources;            ///< sources with their own samples below (0: none kept)
     /// Each source's own samples (its RSSI, dBm Q9.6), for a model fitted per source
     /// (rfs_fields.h); src_n[i] of them.

@@ -414,7 +414,8 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
 static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
 {
     rfs_model_fit_in_t fin = { .samples = s->store.samples, .n = s->store.count,
-                               .qx = s->pose.x, .qy = s->pose.y, .map = s->map };
+                               .qx = s->pose.x, .qy = s->pose.y, .map = s->map,
+                               .reach = s->reach_valid ? s->reach : 0 };
     for (uint8_t i = 0; s->per_source && i < s->target->nsources; ++i) {
         fin.src_samples[i] = s->src_store[i].samples;
         fin.src_n[i] = s->src_store[i].count;

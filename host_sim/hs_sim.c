@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "hs_bridge.h"
 #include "hs_motor.h"
 #include "hs_radio.h"
 #include "hs_box2d.h"
@@ -582,6 +583,7 @@ typedef struct sim_run {
     double travelled;            /* metres */
     double drift_x, drift_y;     /* AMCL-like localisation error: bounded drift, metres */
     double jump_x, jump_y;       /* ... and the decaying rest of the last jump, metres */
+    hs_bridge_track_t track;     /* target bridge: positions along the travel */
 } sim_run_t;
 
 /* The robot's motion over one physics tick (t, t1], interpolated for the events in it. */
@@ -604,6 +606,7 @@ enum { EV_PACKET = 0, EV_POSE = 1, EV_CTRL = 2 };
 /* Free what run_open made (the radio: the latest, when a source moved). */
 static void run_close(sim_run_t *r)
 {
+    hs_bridge_track_free(&r->track);
     free(r->pdr);
     hs_radio_destroy(r->radio);
     hs_box2d_destroy(r->world);
@@ -950,6 +953,33 @@ static const char *run_end(sim_run_t *r)
     return NULL;
 }
 
+/* The bridging figures (hs_bridge.h) and the model's predicted best point. */
+static void bridge_result(sim_run_t *r)
+{
+    hs_sim_result_t *res = r->res;
+    const hs_sim_env_t *e = r->e;
+    if (!hs_bridge_best(r->radio, &e->core.map, r->sc->start_x, r->sc->start_y, e->x0, e->y0,
+                        e->x1, e->y1, &res->best_x, &res->best_y, &res->best_f_db)) {
+        res->best_x = res->best_y = res->best_f_db = NAN;
+    }
+    res->settle_f_db = hs_bridge_f(r->radio, r->px, r->py);
+    res->settle_error_m = hypot(r->px - res->best_x, r->py - res->best_y);
+    res->settle_travel_m = hs_bridge_settle_travel(&r->track, r->px, r->py);
+    const rfs_fields_t *fl = r->ctrl->fields ? r->ctrl->fields(r->ctrl->self) : NULL;
+    rfs_fields_est_t est;
+    res->pred_valid = fl && rfs_fields_estimate(fl, &est);
+    if (res->pred_valid) {
+        res->pred_x = q16d(est.x);
+        res->pred_y = q16d(est.y);
+        res->pred_f_db = q16d(est.value);
+        res->pred_sigma_db = q16d(est.sigma);
+        res->pred_area_m2 = q16d(est.area_m2);
+    } else {
+        res->pred_x = res->pred_y = res->pred_f_db = res->pred_sigma_db = NAN;
+        res->pred_area_m2 = NAN;
+    }
+}
+
 /* The result of a run that ended for reason end. */
 static void run_result(sim_run_t *r, const char *end)
 {
@@ -966,6 +996,9 @@ static void run_result(sim_run_t *r, const char *end)
     res->wall_contacts = hs_box2d_wall_contacts(r->world);
     // Against source 0 where it is now (a moved source takes its error along).
     hs_sim_result_estimate(res, r->ctrl, r->rs[0].x, r->rs[0].y);
+    if (res->bridge) {
+        bridge_result(r);
+    }
     if (r->io && r->io->residual) {
         write_residual(r->io->residual, r->ctrl);
     }
@@ -977,6 +1010,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     double t_wall0 = now_s(), t_cpu0 = cpu_s();
     memset(res, 0, sizeof *res);
     res->seed = seed;
+    res->bridge = strcmp(e->sc.target, "bridge") == 0;
     sim_run_t r;
     memset(&r, 0, sizeof r);
     r.e = e;
@@ -998,6 +1032,11 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
         r.travelled += k.seg;
         r.px = k.nx;
         r.py = k.ny;
+        if (res->bridge && !hs_bridge_track_add(&r.track, r.px, r.py, r.travelled)) {
+            run_close(&r);
+            snprintf(err, errlen, "%s: out of memory", e->sc.path);
+            return -1;
+        }
         r.pth = k.nth;
         r.t = k.t1;
         if (world_events(&r, err, errlen) != 0) {
@@ -1153,16 +1192,31 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
     json_num(f, "est_w_db", r->est_valid ? r->est_w_db : NAN, false);
     json_num(f, "est_p0", r->est_valid ? r->est_p0 : NAN, false);
     json_num(f, "est_area_m2", r->est_valid ? r->est_area_m2 : NAN, false);
-    json_num(f, "est_error_m", r->est_valid ? r->est_error_m : NAN, true);
+    json_num(f, "est_error_m", r->est_valid ? r->est_error_m : NAN, !r->bridge);
+    if (r->bridge) {
+        // Bridging (hs_bridge.h): the true f's best point, the settle point, the estimate.
+        json_num(f, "best_x_m", r->best_x, false);
+        json_num(f, "best_y_m", r->best_y, false);
+        json_num(f, "best_f_db", r->best_f_db, false);
+        json_num(f, "settle_f_db", r->settle_f_db, false);
+        json_num(f, "settle_error_m", r->settle_error_m, false);
+        json_num(f, "settle_travel_m", r->settle_travel_m, false);
+        json_num(f, "pred_x_m", r->pred_valid ? r->pred_x : NAN, false);
+        json_num(f, "pred_y_m", r->pred_valid ? r->pred_y : NAN, false);
+        json_num(f, "pred_f_db", r->pred_valid ? r->pred_f_db : NAN, false);
+        json_num(f, "pred_sigma_db", r->pred_valid ? r->pred_sigma_db : NAN, false);
+        json_num(f, "pred_area_m2", r->pred_valid ? r->pred_area_m2 : NAN, true);
+    }
     fprintf(f, "}\n");
 }
 
-void hs_sim_table_header(FILE *f)
+void hs_sim_table_header(FILE *f, bool bridge)
 {
     fprintf(f, "seed\treached\tend\tsim_time_s\tdistance_travelled_m\tshortest_path_m\t"
                "shortest_to_stop_m\tfinal_distance_m\tfinal_x_m\tfinal_y_m\titerations\t"
                "model_updates\tgreedy\tepsilon\tpackets_sent\tpackets_received\t"
-               "goal_timeouts\tgoal_blocked\tturn_time_s\twall_contacts\n");
+               "goal_timeouts\tgoal_blocked\tturn_time_s\twall_contacts%s\n",
+            bridge ? "\t" HS_SIM_BRIDGE_COLUMNS : "");
 }
 
 /// %.3f, or "nan" for a value that does not exist (no goal).
@@ -1189,5 +1243,17 @@ void hs_sim_table_row(FILE *f, const hs_sim_result_t *r)
             r->greedy, r->epsilon, (unsigned long long)r->packets_sent,
             (unsigned long long)r->packets_received, r->goal_timeouts, r->goal_blocked);
     tsv_num(f, r->turn_time_s);
-    fprintf(f, "\t%ld\n", r->wall_contacts);
+    fprintf(f, "\t%ld", r->wall_contacts);
+    if (r->bridge) {
+        const double v[] = {r->best_x, r->best_y, r->best_f_db, r->settle_f_db,
+                            r->settle_error_m, r->settle_travel_m,
+                            r->pred_valid ? r->pred_x : NAN, r->pred_valid ? r->pred_y : NAN,
+                            r->pred_valid ? r->pred_f_db : NAN,
+                            r->pred_valid ? r->pred_sigma_db : NAN,
+                            r->pred_valid ? r->pred_area_m2 : NAN};
+        for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) {
+            tsv_num(f, v[i]);
+        }
+    }
+    fprintf(f, "\n");
 }

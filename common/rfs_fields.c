@@ -26,10 +26,15 @@ rfs_fields_cfg_t rfs_fields_cfg_default(void)
 {
     rfs_fields_cfg_t c;
     c.pathloss = rfs_pathloss_cfg_default();
-    c.cell = RFS_Q16_HALF;
-    c.radius = RFS_Q16_ONE;
-    c.prior_n = 30u;
+    /* Tuned on seeds 1..30 of scenarios/bridge.yaml (docs/STRATEGIES.md, "Bridging"): the
+     * true f changes by a wall's 5 dB across the edge of a doorway's line of sight, so a
+     * cell and kernel much larger than the lattice blur the best point away. */
+    c.cell = RFS_Q16_FRAC(1, 4);
+    c.radius = RFS_Q16_HALF;
+    c.prior_n = 3u; /* about 12 cm of travel at 4 cm between samples */
     c.draw_t = RFS_Q16_INT(3);
+    c.coarse = RFS_Q16_ONE;
+    c.refit_min = 100u; /* about 4 m of new travel */
     return c;
 }
 
@@ -55,7 +60,8 @@ int rfs_fields_init(rfs_fields_t *f, const rfs_fields_cfg_t *cfg, const rfs_targ
     if (f == 0 || cfg == 0 || t == 0 || mem == 0 || t->combine == 0 || t->nsources == 0u ||
         t->nsources > RFS_MODEL_MAX_SOURCES || cfg->cell <= 0 || cfg->cell > RFS_Q16_INT(8) ||
         cfg->radius < 0 || (int64_t)cfg->radius > (int64_t)cfg->cell * RFS_FIELDS_KERNEL_MAX ||
-        cfg->prior_n == 0u || cfg->draw_t <= 0 || mem->f == 0) {
+        cfg->prior_n == 0u || cfg->draw_t <= 0 || cfg->coarse <= 0 || cfg->refit_min == 0u ||
+        mem->f == 0) {
         return -1;
     }
     for (uint8_t k = 0u; k < t->nsources; ++k) {
@@ -76,13 +82,11 @@ int rfs_fields_init(rfs_fields_t *f, const rfs_fields_cfg_t *cfg, const rfs_targ
     return 0;
 }
 
+/* The sources' fits are kept: a relearn refits only those whose samples changed. */
 static void fields_reset(void *self)
 {
     rfs_fields_t *f = (rfs_fields_t *)self;
     RFS_ASSERT(f != 0);
-    for (uint8_t k = 0u; k < f->target->nsources; ++k) {
-        rfs_pathloss_ops.reset(&f->src[k]);
-    }
     f->valid = false;
     f->phase = RFS_FIELDS_IDLE;
 }
@@ -93,6 +97,8 @@ static void fields_reset(void *self)
 static void setup_cells(rfs_fields_t *f, const rfs_map_t *m)
 {
     f->cs = cell_steps(&f->cfg, m);
+    int64_t cst = rfs_sdiv64_round(f->cfg.coarse, m->cfg.grid);
+    f->cstep = (uint16_t)(cst < 1 ? 1 : cst > 64 ? 64 : cst);
     f->cw = (uint16_t)((m->lw + f->cs - 1u) / f->cs);
     f->ch = (uint16_t)((m->lh + f->cs - 1u) / f->cs);
     const int64_t side = (int64_t)f->cs * m->cfg.grid;
@@ -123,7 +129,15 @@ static bool fit_begin(rfs_fields_t *f, const rfs_model_fit_in_t *in)
     setup_cells(f, m);
     if (m != f->wmap) {
         memset(f->wvalid, 0, sizeof(f->wvalid));
+        memset(f->fitted, 0, sizeof(f->fitted));
         f->wmap = m;
+    }
+    for (uint8_t k = 0u; k < f->target->nsources; ++k) {
+        /* Samples since source k's path-loss fit: refit at refit_min, else only its
+         * residuals are binned again. */
+        const uint32_t fresh = in->src_seen[k] - f->fit_seen[k];
+        f->changed[k] = !f->fitted[k] || f->fit_n[k] != in->src_n[k] || fresh != 0u;
+        f->refit[k] = !f->fitted[k] || fresh >= f->cfg.refit_min;
     }
     f->map = m;
     f->valid = false;
@@ -236,9 +250,23 @@ static bool residual_run(rfs_fields_t *f, const rfs_model_fit_in_t *in, uint32_t
     return true;
 }
 
-/* The corrected fields' target at lattice point (i, j), target units Q16.16; false
- * without a path-loss model. *used: work units (wall counts). */
-static bool target_at(rfs_fields_t *f, uint16_t i, uint16_t j, uint32_t *used, rfs_q16_t *v)
+/* Every source's residual at lattice point (i, j) into res[]; true when a sample lies
+ * within the kernel of any of them. */
+static bool residuals(const rfs_fields_t *f, uint16_t i, uint16_t j, rfs_q16_t *res)
+{
+    bool near = false;
+    for (uint8_t k = 0u; k < f->target->nsources; ++k) {
+        int64_t nw;
+        res[k] = residual(f, k, i, j, &nw);
+        near = near || nw > 0;
+    }
+    return near;
+}
+
+/* The corrected fields' target at lattice point (i, j) given its residuals res[],
+ * target units Q16.16; false without a path-loss model. *used: work units. */
+static bool target_at(rfs_fields_t *f, uint16_t i, uint16_t j, const rfs_q16_t *res,
+                      uint32_t *used, rfs_q16_t *v)
 {
     rfs_q16_t x, y, r[RFS_MODEL_MAX_SOURCES];
     rfs_map_lattice_point(f->map, i, j, &x, &y);
@@ -247,21 +275,59 @@ static bool target_at(rfs_fields_t *f, uint16_t i, uint16_t j, uint32_t *used, r
         if (!rfs_pathloss_predict_walls(&f->src[k], x, y, walls_at(f, k, i, j, used), &pl)) {
             return false;
         }
-        r[k] = rfs_q16_add(pl, residual(f, k, i, j, 0));
+        r[k] = rfs_q16_add(pl, res[k]);
     }
     *v = f->target->combine(r);
     return true;
 }
 
-/* Q16.16 to Q9.6, rounded, saturated, never RFS_FIELDS_NONE. */
+/* Q16.16 to Q9.6, rounded, saturated, never one of the markers. */
 static int16_t q16_to_q6(rfs_q16_t v)
 {
     int32_t q = (int32_t)(((int64_t)v + 512) >> 10);
-    return (int16_t)(q > INT16_MAX ? INT16_MAX : q <= RFS_FIELDS_NONE ? RFS_FIELDS_NONE + 1 : q);
+    return (int16_t)(q > INT16_MAX ? INT16_MAX : q <= RFS_FIELDS_SKIPPED ? RFS_FIELDS_SKIPPED + 1 : q);
 }
 
-/* Predict every legal (reachable) lattice point from pos on, keeping the best. true when
- * done; false when the budget ran out. */
+/* Predict candidate idx = (i, j) into f[], keeping the best. false without a model. */
+static bool predict_point(rfs_fields_t *f, uint32_t idx, const rfs_q16_t *res, uint32_t *used)
+{
+    const uint16_t i = (uint16_t)(idx % f->map->lw), j = (uint16_t)(idx / f->map->lw);
+    rfs_q16_t v;
+    if (!target_at(f, i, j, res, used, &v)) {
+        return false;
+    }
+    int16_t q = q16_to_q6(v);
+    f->mem.f[idx] = q;
+    if (q > f->best_v) {
+        f->best_v = q;
+        f->best = idx;
+    }
+    return true;
+}
+
+/* Keep coarse point idx among the RFS_FIELDS_TOP best, best first. */
+static void keep_top(rfs_fields_t *f, uint32_t idx)
+{
+    const int16_t v = f->mem.f[idx];
+    uint8_t at = f->ntop;
+    while (at > 0u && f->top_v[at - 1u] < v) {
+        at--;
+    }
+    if (at >= RFS_FIELDS_TOP) {
+        return;
+    }
+    for (uint8_t k = (uint8_t)(f->ntop < RFS_FIELDS_TOP ? f->ntop : RFS_FIELDS_TOP - 1u); k > at; --k) {
+        f->top[k] = f->top[k - 1u];
+        f->top_v[k] = f->top_v[k - 1u];
+    }
+    f->top[at] = idx;
+    f->top_v[at] = v;
+    f->ntop = (uint8_t)(f->ntop < RFS_FIELDS_TOP ? f->ntop + 1u : RFS_FIELDS_TOP);
+}
+
+/* The lattice from pos on: every candidate within the kernel of a sample and every
+ * `coarse` one is predicted, the others are marked skipped. true when done; false when
+ * the budget ran out. */
 static bool lattice_run(rfs_fields_t *f, const rfs_model_fit_in_t *in, uint32_t budget,
                         uint32_t *used)
 {
@@ -270,6 +336,8 @@ static bool lattice_run(rfs_fields_t *f, const rfs_model_fit_in_t *in, uint32_t 
     if (f->pos == 0u) {
         f->best_v = RFS_FIELDS_NONE;
         f->best = 0u;
+        f->ntop = 0u;
+        f->lattice_done = false;
     }
     for (; f->pos < n; ++f->pos) {
         if (budget != 0u && *used >= budget) {
@@ -280,17 +348,43 @@ static bool lattice_run(rfs_fields_t *f, const rfs_model_fit_in_t *in, uint32_t 
         }
         const uint16_t i = (uint16_t)(f->pos % m->lw), j = (uint16_t)(f->pos / m->lw);
         int16_t *out = &f->mem.f[f->pos];
-        rfs_q16_t v;
+        rfs_q16_t res[RFS_MODEL_MAX_SOURCES];
         *out = RFS_FIELDS_NONE;
         if (!rfs_map_lattice_legal(m, i, j) ||
-            (in->reach != 0 && !rfs_reach_bit(in->reach, f->pos)) ||
-            !target_at(f, i, j, used, &v)) {
+            (in->reach != 0 && !rfs_reach_bit(in->reach, f->pos))) {
             continue;
         }
-        *out = q16_to_q6(v);
-        if (*out > f->best_v) {
-            f->best_v = *out;
-            f->best = f->pos;
+        *out = RFS_FIELDS_SKIPPED;
+        const bool coarse = i % f->cstep == 0u && j % f->cstep == 0u;
+        if ((residuals(f, i, j, res) || coarse) && predict_point(f, f->pos, res, used) &&
+            coarse) {
+            keep_top(f, f->pos);
+        }
+    }
+    return true;
+}
+
+/* Round the best coarse points, from pos on: the skipped candidates within cstep - 1
+ * lattice steps. true when done; false when the budget ran out. */
+static bool refine_run(rfs_fields_t *f, uint32_t budget, uint32_t *used)
+{
+    const rfs_map_t *m = f->map;
+    const int32_t r = (int32_t)f->cstep - 1, side = 2 * r + 1;
+    for (; f->pos < (uint32_t)f->ntop * (uint32_t)(side * side); ++f->pos) {
+        if (budget != 0u && *used >= budget) {
+            return false;
+        }
+        const uint32_t t = f->top[f->pos / (uint32_t)(side * side)];
+        const int32_t o = (int32_t)(f->pos % (uint32_t)(side * side));
+        const int32_t i = (int32_t)(t % m->lw) + o % side - r, j = (int32_t)(t / m->lw) + o / side - r;
+        if (i < 0 || j < 0 || i >= (int32_t)m->lw || j >= (int32_t)m->lh) {
+            continue;
+        }
+        const uint32_t idx = (uint32_t)j * m->lw + (uint32_t)i;
+        rfs_q16_t res[RFS_MODEL_MAX_SOURCES];
+        if (f->mem.f[idx] == RFS_FIELDS_SKIPPED) {
+            (void)residuals(f, (uint16_t)i, (uint16_t)j, res);
+            (void)predict_point(f, idx, res, used);
         }
     }
     return true;
@@ -306,7 +400,9 @@ static void finish(rfs_fields_t *f)
     const uint16_t i = (uint16_t)(f->best % m->lw), j = (uint16_t)(f->best / m->lw);
     uint32_t used = 0u;
     rfs_map_lattice_point(m, i, j, &f->bx, &f->by);
-    (void)target_at(f, i, j, &used, &f->bf);
+    rfs_q16_t res[RFS_MODEL_MAX_SOURCES];
+    (void)residuals(f, i, j, res);
+    (void)target_at(f, i, j, res, &used, &f->bf);
     int64_t s2 = 0;
     for (uint8_t k = 0u; k < f->target->nsources; ++k) {
         rfs_pathloss_est_t e;
@@ -321,10 +417,19 @@ static void finish(rfs_fields_t *f)
     const int32_t floor_q6 = q16_to_q6(rfs_q16_sub(f->bf, f->sigma));
     uint32_t within = 0u;
     for (uint32_t p = 0u; p < (uint32_t)m->lw * m->lh; ++p) {
-        within += f->mem.f[p] != RFS_FIELDS_NONE && f->mem.f[p] >= floor_q6 ? 1u : 0u;
+        within += f->mem.f[p] > RFS_FIELDS_SKIPPED && f->mem.f[p] >= floor_q6 ? 1u : 0u;
     }
     const int64_t cell_m2 = ((int64_t)m->cfg.grid * m->cfg.grid) >> 16;
     f->area_m2 = rfs_sat32((int64_t)within * cell_m2);
+}
+
+static bool any_changed(const rfs_fields_t *f)
+{
+    bool any = false;
+    for (uint8_t k = 0u; k < f->target->nsources; ++k) {
+        any = any || f->changed[k];
+    }
+    return any;
 }
 
 static rfs_fit_result_t fields_fit(void *self, const rfs_model_fit_in_t *in, uint32_t budget,
@@ -337,7 +442,17 @@ static rfs_fit_result_t fields_fit(void *self, const rfs_model_fit_in_t *in, uin
     }
     uint32_t used = 0u;
     for (;;) {
+        if (f->phase == RFS_FIELDS_SOURCE && !f->refit[f->k]) {
+            /* The same samples as its last fit: that fit, its residuals and walls stand. */
+            if (++f->k == f->target->nsources) {
+                f->phase = RFS_FIELDS_RESIDUAL;
+                f->k = 0u;
+                f->pos = 0u;
+            }
+            continue;
+        }
         if (f->phase == RFS_FIELDS_SOURCE) {
+            f->fitted[f->k] = false;
             const rfs_model_fit_in_t sub = {.samples = in->src_samples[f->k],
                                             .n = in->src_n[f->k], .qx = in->qx, .qy = in->qy,
                                             .map = in->map, .reach = in->reach};
@@ -346,29 +461,46 @@ static rfs_fit_result_t fields_fit(void *self, const rfs_model_fit_in_t *in, uin
                 f->phase = r == RFS_FIT_FAILED ? RFS_FIELDS_IDLE : f->phase;
                 return r;
             }
+            f->fitted[f->k] = true;
+            f->fit_n[f->k] = in->src_n[f->k];
+            f->fit_seen[f->k] = in->src_seen[f->k];
             if (++f->k == f->target->nsources) {
                 f->phase = RFS_FIELDS_RESIDUAL;
                 f->k = 0u;
                 f->pos = 0u;
             }
         } else if (f->phase == RFS_FIELDS_RESIDUAL) {
-            if (!residual_run(f, in, budget, &used)) {
+            if (f->changed[f->k] && !residual_run(f, in, budget, &used)) {
                 return RFS_FIT_MORE;
             }
             f->pos = 0u;
             if (++f->k == f->target->nsources) {
                 f->phase = RFS_FIELDS_LATTICE;
+                if (!any_changed(f) && f->lattice_done) {
+                    /* Nothing new: the last fit's lattice and estimate stand. */
+                    f->phase = RFS_FIELDS_IDLE;
+                    f->valid = f->best_v > RFS_FIELDS_SKIPPED;
+                    return f->valid ? RFS_FIT_DONE : RFS_FIT_FAILED;
+                }
             }
-        } else {
+        } else if (f->phase == RFS_FIELDS_LATTICE) {
             if (!lattice_run(f, in, budget, &used)) {
                 return RFS_FIT_MORE;
             }
+            f->phase = RFS_FIELDS_REFINE;
+            f->pos = 0u;
+        } else {
+            if (!refine_run(f, budget, &used)) {
+                return RFS_FIT_MORE;
+            }
             f->phase = RFS_FIELDS_IDLE;
+            f->lattice_done = true;
             if (f->best_v == RFS_FIELDS_NONE) {
                 return RFS_FIT_FAILED;
             }
             finish(f);
             f->valid = true;
+
             return RFS_FIT_DONE;
         }
         if (budget != 0u) {
@@ -414,7 +546,7 @@ static bool fields_argmax(const void *self, rfs_q16_t *x, rfs_q16_t *y)
  * Scaling: the difference (Q6, < 2^17) to Q16 (< 2^27) over draw_t (Q16 > 0) in int64. */
 static uint32_t draw_weight(const rfs_fields_t *f, int16_t v)
 {
-    if (v == RFS_FIELDS_NONE) {
+    if (v <= RFS_FIELDS_SKIPPED) {
         return 0u;
     }
     int64_t x = rfs_sdiv64_round((((int64_t)f->best_v - v) * 1024) << 16, f->cfg.draw_t);
@@ -491,7 +623,7 @@ bool rfs_fields_at(const rfs_fields_t *f, uint16_t i, uint16_t j, rfs_q16_t *val
         return false;
     }
     int16_t v = f->mem.f[(uint32_t)j * f->map->lw + i];
-    if (v == RFS_FIELDS_NONE) {
+    if (v <= RFS_FIELDS_SKIPPED) {
         return false;
     }
     *value = (rfs_q16_t)v * 1024;

@@ -17,13 +17,16 @@
  * field is its path-loss fit, where the robot has measured it is what it measured:
  * prior_n samples weigh as much as the prior that the shadowing there is 0.
  *
- * A fit ends with one pass over the legal lattice points (those reachable from the robot
- * when fit_in.reach is given): the predicted target at each (kept, a 16-bit value per
- * point), its best point (argmax(): the greedy goal) and the estimate's uncertainty
- * (rfs_fields_est_t). Walls from every lattice point to every source are kept, a byte
- * each, until that source's estimate moves: a relearn that holds the sources
- * (rfs_pathloss_cfg_t.hold_k) counts no walls. Draws (sample()) pick a point with weight
- * e^(-(best - f) / draw_t).
+ * A fit ends with a pass over the legal lattice points (those reachable from the robot
+ * when fit_in.reach is given): the target is predicted at every point within the kernel
+ * of a sample, at every `coarse` spacing elsewhere, and then at full resolution round the
+ * RFS_FIELDS_TOP best coarse points; each prediction is kept (16 bits a point), the best
+ * is argmax() (the greedy goal) and the estimate (rfs_fields_est_t). Walls from a
+ * lattice point to a source are kept, a byte each, until that source's estimate moves. A
+ * relearn refits a source's path-loss model only after refit_min new samples of it
+ * (else it bins that source's residuals again), and with no new sample at all keeps
+ * the last fit: the samples are what the fit is a function of. Draws (sample()) pick a
+ * predicted point with weight e^(-(best - f) / draw_t).
  *
  * Work (the fit budget): each source's fit in its own units (rfs_pathloss.h), then one
  * unit per wall count and per 32 samples or lattice points; fit() returns RFS_FIT_MORE
@@ -45,18 +48,27 @@
 #define RFS_FIELDS_KERNEL_MAX 4
 /// Kernel weights tabulated by squared cell offset.
 #define RFS_FIELDS_KERNEL_TABLE (2 * RFS_FIELDS_KERNEL_MAX * RFS_FIELDS_KERNEL_MAX + 1)
-/// A lattice point without a prediction (not legal, or out of reach): its value in f[].
+/// A lattice point that is no candidate (not legal, or out of reach): its value in f[].
 #define RFS_FIELDS_NONE INT16_MIN
+/// A candidate the last fit did not predict (between coarse points, far from samples).
+#define RFS_FIELDS_SKIPPED (INT16_MIN + 1)
+/// Best coarse points whose neighbourhoods are predicted at full resolution.
+#define RFS_FIELDS_TOP 4u
 
 /// Configuration; rfs_fields_cfg_default() gives the values in the comments.
 typedef struct rfs_fields_cfg {
     rfs_pathloss_cfg_t pathloss; ///< every source's fit (rfs_pathloss_cfg_default())
-    rfs_q16_t cell;              ///< residual cell side, metres Q16.16 (0.5 m), rounded to
-                                 ///< whole lattice steps (at least one)
-    rfs_q16_t radius;            ///< kernel radius, metres Q16.16 (1 m), at most
+    rfs_q16_t cell;              ///< residual cell side, metres Q16.16 (0.25 m), rounded to
+                                 ///< whole lattice steps (at least one), <= 8 m
+    rfs_q16_t radius;            ///< kernel radius, metres Q16.16 (0.5 m), at most
                                  ///< RFS_FIELDS_KERNEL_MAX cells
-    uint16_t prior_n;            ///< samples that weigh as much as the prior (30), >= 1
+    uint16_t prior_n;            ///< samples that weigh as much as the prior (3), >= 1
     rfs_q16_t draw_t;            ///< temperature of draws, target units Q16.16 (3 dB), > 0
+    uint32_t refit_min;          ///< a relearn refits a source's path-loss model after this
+                                 ///< many new samples of it (100; fewer: only its residuals
+                                 ///< are binned again), >= 1
+    rfs_q16_t coarse;            ///< spacing of the points predicted away from the samples,
+                                 ///< metres Q16.16 (1 m), rounded to lattice steps (>= 1)
 } rfs_fields_cfg_t;
 
 /// Caller-owned arrays, sized with rfs_fields_mem_size() for the map.
@@ -74,7 +86,8 @@ typedef enum rfs_fields_phase {
     RFS_FIELDS_IDLE = 0, ///< no fit in progress
     RFS_FIELDS_SOURCE,   ///< fitting source k's path-loss model
     RFS_FIELDS_RESIDUAL, ///< binning source k's residuals
-    RFS_FIELDS_LATTICE,  ///< predicting the target at every lattice point
+    RFS_FIELDS_LATTICE,  ///< predicting the target on the lattice
+    RFS_FIELDS_REFINE,   ///< ... and round the best coarse points at full resolution
 } rfs_fields_phase_t;
 
 /// The model's estimate (rfs_fields_estimate()).
@@ -104,6 +117,10 @@ typedef struct rfs_fields {
     uint16_t cw;                                 ///< cells along x
     uint16_t ch;                                 ///< cells along y
     uint8_t kr;                                  ///< kernel reach, cells
+    uint16_t cstep;                              ///< coarse spacing, lattice steps
+    uint8_t ntop;                                ///< best coarse points kept in top[]
+    uint32_t top[RFS_FIELDS_TOP];                ///< their lattice indices, best first
+    int16_t top_v[RFS_FIELDS_TOP];               ///< their predictions, Q9.6
     uint16_t kw[RFS_FIELDS_KERNEL_TABLE];        ///< kernel weight by squared offset, Q0.16
     bool wvalid[RFS_MODEL_MAX_SOURCES];          ///< walls[k] belong to wsx/wsy on map wmap
     rfs_q16_t wsx[RFS_MODEL_MAX_SOURCES];        ///< source position walls[k] count to, Q16.16
@@ -117,6 +134,12 @@ typedef struct rfs_fields {
     rfs_q16_t sigma;                             ///< its uncertainty, target units Q16.16
     rfs_q16_t area_m2;                           ///< area within sigma of the best, m^2 Q16.16
     uint32_t walls_counted;                      ///< wall counts of the last fit's own passes
+    bool fitted[RFS_MODEL_MAX_SOURCES];          ///< src[k] holds a fit of fit_n/fit_seen
+    uint16_t fit_n[RFS_MODEL_MAX_SOURCES];       ///< samples of that fit
+    uint32_t fit_seen[RFS_MODEL_MAX_SOURCES];    ///< the store's seen count then
+    bool changed[RFS_MODEL_MAX_SOURCES];         ///< this fit bins source k's residuals
+    bool refit[RFS_MODEL_MAX_SOURCES];           ///< ... and refits its path-loss model
+    bool lattice_done;                           ///< f[] and the best point are complete
 } rfs_fields_t;
 
 /// Defaults (see rfs_fields_cfg_t).

@@ -34,6 +34,9 @@ typedef struct rfs_model_fit_in {
     /// (rfs_fields.h); src_n[i] of them.
     const rfs_sample_t *src_samples[RFS_MODEL_MAX_SOURCES];
     uint16_t src_n[RFS_MODEL_MAX_SOURCES]; ///< how many of each
+    /// Samples each source's store was ever offered (rfs_store_t.seen): unchanged with
+    /// src_n, the same samples as at the last fit.
+    uint32_t src_seen[RFS_MODEL_MAX_SOURCES];
 } rfs_model_fit_in_t;
 
 /// Result of one fit call.

@@ -42,6 +42,8 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.recheck_adapt = false;                /* one fixed threshold */
     c.eps_geodesic = false;                 /* epsilon weights by straight distance */
     c.eps_sample = false;                   /* and epsilon goals at random, not drawn */
+    c.settle_dist = 0;                      /* epsilon anneals to eps_floor, never 0 */
+    c.src_spacing = 0;
     return c;
 }
 
@@ -66,6 +68,14 @@ static const rfs_seek_strategy_ops_t k_strategies[RFS_SEEK_STRATEGY_COUNT] = {
 const rfs_seek_strategy_ops_t *rfs_seek_ops(const rfs_seek_t *s)
 {
     return &k_strategies[s->cfg.strategy];
+}
+
+void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg)
+{
+    RFS_ASSERT(cfg != 0);
+    cfg->src_spacing = RFS_Q16_FRAC(1, 25); /* 4 cm: a third of the 12.5 cm wavelength */
+    /* Two thirds of the bridging scenarios' 150 m (docs/STRATEGIES.md, "Bridging"). */
+    cfg->settle_dist = RFS_Q16_INT(100);
 }
 
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy)
@@ -149,7 +159,8 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         cfg->novelty_radius < 0 || cfg->pose_timeout_us <= 0 || cfg->rssi_timeout_us <= 0 ||
         (uint32_t)cfg->strategy >= (uint32_t)RFS_SEEK_STRATEGY_COUNT ||
         cfg->tumble_better < 0 || cfg->tumble_better > RFS_Q16_ONE || cfg->tumble_worse < 0 ||
-        cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0) {
+        cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0 || cfg->settle_dist < 0 ||
+        cfg->src_spacing < 0) {
         return -1;
     }
     if (model.ops == 0 || model.ops->fit == 0 || model.ops->predict == 0 ||
@@ -211,6 +222,37 @@ bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
     return true;
 }
 
+/* Source src's own sample (rfs_seek_cfg_t.src_spacing): the mean of its packets since the
+ * robot last moved src_spacing, at this packet's time. Small-scale fading decorrelates
+ * within half a wavelength (6 cm at 2.4 GHz): samples 4 cm apart see different fades,
+ * while a robot standing still adds the same fade again and again and teaches nothing.
+ * Scaling: at most 65,535 packets of |dBm| <= 128 sum below 2^23; their mean in Q16. */
+static void add_source_sample(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm,
+                              rfs_rng_t *rng)
+{
+    if (s->cfg.src_spacing == 0) {
+        rfs_store_add_value(&s->src_store[src], t_us, (rfs_q16_t)dbm * RFS_Q16_ONE, rng);
+        return;
+    }
+    if (s->src_cnt[src] == UINT16_MAX) {
+        s->src_sum[src] = 0; /* standing still this long: start the mean again */
+        s->src_cnt[src] = 0;
+    }
+    s->src_sum[src] += dbm;
+    s->src_cnt[src]++;
+    if (s->src_at[src] &&
+        rfs_q16_dist(s->pose.x, s->pose.y, s->src_x[src], s->src_y[src]) < s->cfg.src_spacing) {
+        return;
+    }
+    int64_t v = rfs_sdiv64_round((int64_t)s->src_sum[src] * RFS_Q16_ONE, s->src_cnt[src]);
+    rfs_store_add_value(&s->src_store[src], t_us, (rfs_q16_t)v, rng);
+    s->src_sum[src] = 0;
+    s->src_cnt[src] = 0;
+    s->src_at[src] = true;
+    s->src_x[src] = s->pose.x;
+    s->src_y[src] = s->pose.y;
+}
+
 bool rfs_seek_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm, rfs_rng_t *rng)
 {
     if (src >= s->target->nsources) {
@@ -230,7 +272,7 @@ bool rfs_seek_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm, rfs_
         rfs_store_add_value(&s->store, t_us, v, rng);
     }
     if (s->per_source) {
-        rfs_store_add_value(&s->src_store[src], t_us, (rfs_q16_t)dbm * RFS_Q16_ONE, rng);
+        add_source_sample(s, src, t_us, dbm, rng);
     }
     return true;
 }
@@ -419,6 +461,7 @@ static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_ou
     for (uint8_t i = 0; s->per_source && i < s->target->nsources; ++i) {
         fin.src_samples[i] = s->src_store[i].samples;
         fin.src_n[i] = s->src_store[i].count;
+        fin.src_seen[i] = s->src_store[i].seen;
         fin.nsources = (uint8_t)(i + 1u);
     }
     rfs_fit_result_t r = s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng);
@@ -458,6 +501,7 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
         relearn = rfs_q16_abs(rfs_q16_sub(d->mean, d->prediction)) > s->cfg.error_threshold;
     }
     relearn = relearn || ops->refit;
+
     if (relearn && s->store.count > 0u) {
         d->relearned = true;
         s->model.ops->reset(s->model.self);

@@ -84,6 +84,13 @@ typedef struct rfs_seek_cfg {
                                 ///< greedy leg; the novelty draw instead when the draw is
                                 ///< within 1.5 steps of the robot or where it has been, or
                                 ///< the robot stands within 1.5 steps of the model's argmax
+    rfs_q16_t settle_dist;      ///< after this much travel every choice is greedy (epsilon
+                                ///< 0): the robot goes to the model's best point and stays
+                                ///< there, metres Q16.16 (0: never, the paper's)
+    rfs_q16_t src_spacing;      ///< per-source stores (rfs_seek_mem_t.src_samples): a
+                                ///< source's sample is the mean of its packets since the
+                                ///< robot last moved this far, metres Q16.16 (0: one sample
+                                ///< per packet)
 } rfs_seek_cfg_t;
 
 /// Caller-owned memory for the seeker's large arrays.
@@ -186,6 +193,11 @@ typedef struct rfs_seek {
     rfs_store_t store;                        ///< samples
     bool per_source;                          ///< src_store holds each source's own samples
     rfs_store_t src_store[RFS_SEEK_MAX_SOURCES]; ///< each source's RSSI (rfs_seek_mem_t.src_samples)
+    int32_t src_sum[RFS_SEEK_MAX_SOURCES];    ///< src_spacing: dBm summed since the last sample
+    uint16_t src_cnt[RFS_SEEK_MAX_SOURCES];   ///< packets in it
+    bool src_at[RFS_SEEK_MAX_SOURCES];        ///< src_x/src_y are valid
+    rfs_q16_t src_x[RFS_SEEK_MAX_SOURCES];    ///< robot x at the source's last sample, metres Q16.16
+    rfs_q16_t src_y[RFS_SEEK_MAX_SOURCES];    ///< robot y there, metres Q16.16
     rfs_plan_t plan;                          ///< planner
     rfs_drive_t drive;                        ///< drive control
     uint8_t *visited;                         ///< novelty bits, one per lattice point
@@ -242,6 +254,10 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 /// recheck_adapt, eps_geodesic, eps_sample), the
 /// paper's (0, false) for every other strategy.
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
+
+/// The settings for a model fitted per source (rfs_fields.h; docs/STRATEGIES.md,
+/// "Bridging"): src_spacing 4 cm, settle_dist 100 m.
+void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg);
 
 /// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array
 /// is missing or too small for the map's lattice, the target needs more sources than

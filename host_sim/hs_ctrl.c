@@ -232,7 +232,11 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
         }
         model = rfs_fields_model(p->fields);
     }
-    if (rfs_seek_init(&p->seek, &cfg->seek, map, model, target, &p->mem) != 0) {
+    rfs_seek_cfg_t scfg = cfg->seek;
+    if (p->fields) {
+        rfs_seek_cfg_per_source(&scfg);
+    }
+    if (rfs_seek_init(&p->seek, &scfg, map, model, target, &p->mem) != 0) {
         ip_close(p);
         snprintf(err, errlen, "controller: the core rejected the seeker configuration");
         return -1;

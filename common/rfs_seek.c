@@ -44,6 +44,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.eps_sample = false;                   /* and epsilon goals at random, not drawn */
     c.settle_dist = 0;                      /* epsilon anneals to eps_floor, never 0 */
     c.src_spacing = 0;
+    c.src_floor = INT32_MIN;
     return c;
 }
 
@@ -74,6 +75,7 @@ void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg)
 {
     RFS_ASSERT(cfg != 0);
     cfg->src_spacing = RFS_Q16_FRAC(1, 25); /* 4 cm: a third of the 12.5 cm wavelength */
+    cfg->src_floor = RFS_Q16_INT(-100);     /* radiotap receivers report down to -100 dBm */
     /* Two thirds of the bridging scenarios' 150 m (docs/STRATEGIES.md, "Bridging"). */
     cfg->settle_dist = RFS_Q16_INT(100);
 }
@@ -206,6 +208,33 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
     return 0;
 }
 
+/* src_floor: a source silent for a window while another is heard is below the
+ * receiver's floor where the robot is: one sample of the floor value every src_spacing
+ * of travel, so that a fit learns where a source cannot be heard (a bridge there is
+ * worthless) instead of never seeing the place. */
+static void add_floor_samples(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
+{
+    const int64_t win = (int64_t)s->cfg.rssi.window_us;
+    bool any_heard = false;
+    for (uint8_t i = 0; i < s->target->nsources; ++i) {
+        any_heard = any_heard || (s->src_heard[i] && pose->t_us - s->src_heard_us[i] <= win);
+    }
+    for (uint8_t i = 0; any_heard && i < s->target->nsources; ++i) {
+        bool silent = !s->src_heard[i] || pose->t_us - s->src_heard_us[i] > win;
+        if (!silent ||
+            (s->src_at[i] &&
+             rfs_q16_dist(pose->x, pose->y, s->src_x[i], s->src_y[i]) < s->cfg.src_spacing)) {
+            continue;
+        }
+        s->src_sum[i] = 0; /* packets from before the silence: too old to place here */
+        s->src_cnt[i] = 0;
+        rfs_store_add_value(&s->src_store[i], pose->t_us, s->cfg.src_floor, rng);
+        s->src_at[i] = true;
+        s->src_x[i] = pose->x;
+        s->src_y[i] = pose->y;
+    }
+}
+
 bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
 {
     if (s->have_pose && pose->t_us <= s->pose.t_us) {
@@ -215,6 +244,9 @@ bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
     (void)rfs_store_add_pose(&s->store, pose, rng);
     for (uint8_t i = 0; s->per_source && i < s->target->nsources; ++i) {
         (void)rfs_store_add_pose(&s->src_store[i], pose, rng);
+    }
+    if (s->per_source && s->cfg.src_spacing > 0 && s->cfg.src_floor != INT32_MIN) {
+        add_floor_samples(s, pose, rng);
     }
     s->pose = *pose;
     s->have_pose = true;
@@ -240,6 +272,8 @@ static void add_source_sample(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t d
     }
     s->src_sum[src] += dbm;
     s->src_cnt[src]++;
+    s->src_heard[src] = true;
+    s->src_heard_us[src] = t_us;
     if (s->src_at[src] &&
         rfs_q16_dist(s->pose.x, s->pose.y, s->src_x[src], s->src_y[src]) < s->cfg.src_spacing) {
         return;
@@ -373,6 +407,31 @@ bool rfs_seek_recheck_miss(const rfs_seek_cfg_t *cfg, int64_t *miss_ms, rfs_q16_
     return miss > thr;
 }
 
+/* The target of the 1 s means. With src_floor, a source without a mean while another has
+ * one counts as the floor: a place where it cannot be heard fails the relearn check of a
+ * model that promised a bridge there. */
+static bool target_mean(rfs_seek_t *s, int64_t now_us, rfs_q16_t *mean)
+{
+    rfs_target_in_t in = { s->win, s->target->nsources, now_us };
+    if (s->target->mean(&in, mean)) {
+        return true;
+    }
+    if (!s->per_source || s->cfg.src_floor == INT32_MIN) {
+        return false;
+    }
+    rfs_q16_t r[RFS_SEEK_MAX_SOURCES];
+    bool any = false;
+    for (uint8_t i = 0; i < s->target->nsources; ++i) {
+        bool have = rfs_rssi_mean(&s->win[i], now_us, &r[i]);
+        r[i] = have ? r[i] : s->cfg.src_floor;
+        any = any || have;
+    }
+    if (any) {
+        *mean = s->target->combine(r);
+    }
+    return any;
+}
+
 /* recheck_dist: while a greedy leg is driven, every recheck_dist of travel, the relearn
  * check of Algorithm 1 (|1 s mean - prediction| > threshold; with recheck_adapt the
  * threshold is at least the RMS of the recent misses). true when it fails: the leg is
@@ -385,9 +444,8 @@ static bool recheck_fails(rfs_seek_t *s, int64_t now_us)
         return false;
     }
     count_travel(s);
-    rfs_target_in_t in = { s->win, s->target->nsources, now_us };
     rfs_q16_t mean, pred;
-    if (!s->target->mean(&in, &mean) ||
+    if (!target_mean(s, now_us, &mean) ||
         !s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &pred)) {
         return false;
     }
@@ -487,8 +545,7 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     d->y = s->pose.y;
     d->samples = s->store.count;
     count_travel(s);
-    rfs_target_in_t in = { s->win, s->target->nsources, now_us };
-    d->mean_valid = s->target->mean(&in, &d->mean);
+    d->mean_valid = target_mean(s, now_us, &d->mean);
     if (!ops->learns) {
         end_decision(s, ops->choose(s, false, rng, now_us), now_us, out);
         return;

@@ -91,6 +91,9 @@ typedef struct rfs_seek_cfg {
                                 ///< source's sample is the mean of its packets since the
                                 ///< robot last moved this far, metres Q16.16 (0: one sample
                                 ///< per packet)
+    rfs_q16_t src_floor;        ///< with src_spacing: a source not heard for one averaging
+                                ///< window while another is gets a sample of this value at
+                                ///< every src_spacing of travel, dBm Q16.16 (INT32_MIN: none)
 } rfs_seek_cfg_t;
 
 /// Caller-owned memory for the seeker's large arrays.
@@ -198,6 +201,8 @@ typedef struct rfs_seek {
     bool src_at[RFS_SEEK_MAX_SOURCES];        ///< src_x/src_y are valid
     rfs_q16_t src_x[RFS_SEEK_MAX_SOURCES];    ///< robot x at the source's last sample, metres Q16.16
     rfs_q16_t src_y[RFS_SEEK_MAX_SOURCES];    ///< robot y there, metres Q16.16
+    int64_t src_heard_us[RFS_SEEK_MAX_SOURCES]; ///< the source's latest packet, microseconds
+    bool src_heard[RFS_SEEK_MAX_SOURCES];     ///< src_heard_us is valid
     rfs_plan_t plan;                          ///< planner
     rfs_drive_t drive;                        ///< drive control
     uint8_t *visited;                         ///< novelty bits, one per lattice point
@@ -256,7 +261,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 
 /// The settings for a model fitted per source (rfs_fields.h; docs/STRATEGIES.md,
-/// "Bridging"): src_spacing 4 cm, settle_dist 100 m.
+/// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m.
 void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg);
 
 /// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array

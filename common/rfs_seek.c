@@ -220,7 +220,9 @@ static void add_floor_samples(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *
         any_heard = any_heard || (s->src_heard[i] && pose->t_us - s->src_heard_us[i] <= win);
     }
     for (uint8_t i = 0; any_heard && i < s->target->nsources; ++i) {
-        bool silent = !s->src_heard[i] || pose->t_us - s->src_heard_us[i] > win;
+        /* Never heard: silent once the others have been heard for a window. */
+        int64_t since = s->src_heard[i] ? s->src_heard_us[i] : s->src_first_us;
+        bool silent = pose->t_us - since > win;
         if (!silent ||
             (s->src_at[i] &&
              rfs_q16_dist(pose->x, pose->y, s->src_x[i], s->src_y[i]) < s->cfg.src_spacing)) {
@@ -272,6 +274,10 @@ static void add_source_sample(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t d
     }
     s->src_sum[src] += dbm;
     s->src_cnt[src]++;
+    if (!s->src_any) {
+        s->src_any = true;
+        s->src_first_us = t_us;
+    }
     s->src_heard[src] = true;
     s->src_heard_us[src] = t_us;
     if (s->src_at[src] &&

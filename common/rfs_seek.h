@@ -203,6 +203,8 @@ typedef struct rfs_seek {
     rfs_q16_t src_y[RFS_SEEK_MAX_SOURCES];    ///< robot y there, metres Q16.16
     int64_t src_heard_us[RFS_SEEK_MAX_SOURCES]; ///< the source's latest packet, microseconds
     bool src_heard[RFS_SEEK_MAX_SOURCES];     ///< src_heard_us is valid
+    bool src_any;                             ///< a source has been heard
+    int64_t src_first_us;                     ///< the first packet of any source, microseconds
     rfs_plan_t plan;                          ///< planner
     rfs_drive_t drive;                        ///< drive control
     uint8_t *visited;                         ///< novelty bits, one per lattice point

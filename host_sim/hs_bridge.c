@@ -9,7 +9,9 @@
 
 /* Track points are kept this far apart, metres. */
 #define TRACK_STEP_M 0.05
-/* The true f's grid, metres. */
+/* The true f's grid, metres: from the map's corner, so that its points are the radio's
+ * wall-count cache points (radio.walls.cache_m 0.1 m), each with its own count; a point
+ * between two (a cell centre) would take either's by rounding. */
 #define GRID_M 0.1
 
 bool hs_bridge_track_add(hs_bridge_track_t *t, double x, double y, double travelled)
@@ -82,9 +84,9 @@ bool hs_bridge_best(hs_radio_t *radio, const rfs_map_t *m, double sx, double sy,
     bool found = false;
     if (reach && queue && rfs_reach_fill(m, q16(sx), q16(sy), reach, queue, cap)) {
         long nx = lround(floor((x1 - x0) / GRID_M)), ny = lround(floor((y1 - y0) / GRID_M));
-        for (long j = 0; j < ny; j++) {
-            for (long i = 0; i < nx; i++) {
-                double x = x0 + (i + 0.5) * GRID_M, y = y0 + (j + 0.5) * GRID_M;
+        for (long j = 0; j <= ny; j++) {
+            for (long i = 0; i <= nx; i++) {
+                double x = x0 + i * GRID_M, y = y0 + j * GRID_M;
                 uint16_t li, lj;
                 rfs_map_lattice_nearest(m, q16(x), q16(y), &li, &lj);
                 if (!rfs_map_point_legal(m, q16(x), q16(y)) || !rfs_reach_at(m, reach, li, lj)) {

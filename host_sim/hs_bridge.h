@@ -3,8 +3,9 @@
  * where the robot settled, and when it settled.
  *
  * The true f is the mean field's (path loss, walls and the seed's shadowing; no fading,
- * no noise) of both sources, on a 0.1 m grid of the points the robot can stand on: legal
- * on the core map and in the lattice component of the start (rfs_reach.h). Settling: the
+ * no noise) of both sources, on a 0.1 m grid from the map's corner (the radio's wall-count
+ * cache points) of the points the robot can stand on: legal on the core map and in the
+ * lattice component of the start (rfs_reach.h). Settling: the
  * travel after which the robot never again left a circle of HS_BRIDGE_SETTLE_M round its
  * final position.
  */

@@ -26,6 +26,11 @@ COLS = ["seed", "reached", "end", "sim_time_s", "distance_travelled_m", "shortes
         "model_updates", "greedy", "epsilon", "packets_sent", "packets_received",
         "goal_timeouts", "goal_blocked", "turn_time_s", "wall_contacts"]
 FLOATS = set(COLS[3:10]) | {"turn_time_s"}
+# The columns a bridging run adds (hs_sim.h, HS_SIM_BRIDGE_COLUMNS).
+BRIDGE = ["best_x_m", "best_y_m", "best_f_db", "settle_f_db", "settle_error_m",
+          "settle_travel_m", "pred_x_m", "pred_y_m", "pred_f_db", "pred_sigma_db",
+          "pred_area_m2"]
+FLOATS |= set(BRIDGE)
 
 
 def fmt(col, v):
@@ -80,6 +85,7 @@ def main(argv):
     if seeds is None:
         seeds = batch_seeds(d)
     rows = []
+    cols = COLS
     files = glob.glob(os.path.join(d, "seed-*", "summary.json"))
     if not files:
         print("merge_runs.py: %s: no seed-*/summary.json" % d, file=sys.stderr)
@@ -88,7 +94,8 @@ def main(argv):
         try:
             with open(f) as fh:
                 s = json.load(fh)
-            rows.append((int(s["seed"]), "\t".join(fmt(c, s[c]) for c in COLS)))
+            cols = COLS + BRIDGE if s.get("target") == "bridge" else COLS
+            rows.append((int(s["seed"]), "\t".join(fmt(c, s[c]) for c in cols)))
         except (OSError, ValueError, KeyError) as e:
             print("merge_runs.py: %s: %s" % (f, e), file=sys.stderr)
             return 1
@@ -104,7 +111,7 @@ def main(argv):
         return 1
     tmp = out + ".tmp"
     with open(tmp, "w") as fh:
-        fh.write("\t".join(COLS) + "\n")
+        fh.write("\t".join(cols) + "\n")
         for _, r in rows:
             fh.write(r + "\n")
     os.replace(tmp, out)

@@ -131,26 +131,6 @@ const char *rfs_seek_kind_name(rfs_seek_kind_t k)
     return (uint32_t)k < sizeof names / sizeof names[0] ? names[k] : "none";
 }
 
-/* The per-source stores (rfs_seek_mem_t.src_samples): all of the target's sources or none. */
-static bool init_source_stores(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_seek_mem_t *mem)
-{
-    s->per_source = mem->src_samples[0] != 0;
-    for (uint8_t i = 0; i < RFS_SEEK_MAX_SOURCES; ++i) {
-        bool given = mem->src_samples[i] != 0 && mem->src_pending[i] != 0;
-        if (i >= s->target->nsources) {
-            continue;
-        }
-        if (given != s->per_source) {
-            return false;
-        }
-        if (given && rfs_store_init(&s->src_store[i], &cfg->store, mem->src_samples[i],
-                                    mem->src_pending[i], mem->pending_cap) != 0) {
-            return false;
-        }
-    }
-    return true;
-}
-
 int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map,
                   rfs_model_t model, const rfs_target_ops_t *target, const rfs_seek_mem_t *mem)
 {
@@ -185,7 +165,7 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
             return -1;
         }
     }
-    if (!init_source_stores(s, cfg, mem) ||
+    if (!rfs_seek_src_init(s, mem) ||
         rfs_store_init(&s->store, &cfg->store, mem->samples, mem->pending, mem->pending_cap) != 0 ||
         rfs_plan_init(&s->plan, map, mem->plan_work, mem->plan_work_bytes, mem->plan_queue,
                       mem->plan_queue_cap) != 0 ||
@@ -208,35 +188,6 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
     return 0;
 }
 
-/* src_floor: a source silent for a window while another is heard is below the
- * receiver's floor where the robot is: one sample of the floor value every src_spacing
- * of travel, so that a fit learns where a source cannot be heard (a bridge there is
- * worthless) instead of never seeing the place. */
-static void add_floor_samples(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
-{
-    const int64_t win = (int64_t)s->cfg.rssi.window_us;
-    bool any_heard = false;
-    for (uint8_t i = 0; i < s->target->nsources; ++i) {
-        any_heard = any_heard || (s->src_heard[i] && pose->t_us - s->src_heard_us[i] <= win);
-    }
-    for (uint8_t i = 0; any_heard && i < s->target->nsources; ++i) {
-        /* Never heard: silent once the others have been heard for a window. */
-        int64_t since = s->src_heard[i] ? s->src_heard_us[i] : s->src_first_us;
-        bool silent = pose->t_us - since > win;
-        if (!silent ||
-            (s->src_at[i] &&
-             rfs_q16_dist(pose->x, pose->y, s->src_x[i], s->src_y[i]) < s->cfg.src_spacing)) {
-            continue;
-        }
-        s->src_sum[i] = 0; /* packets from before the silence: too old to place here */
-        s->src_cnt[i] = 0;
-        rfs_store_add_value(&s->src_store[i], pose->t_us, s->cfg.src_floor, rng);
-        s->src_at[i] = true;
-        s->src_x[i] = pose->x;
-        s->src_y[i] = pose->y;
-    }
-}
-
 bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
 {
     if (s->have_pose && pose->t_us <= s->pose.t_us) {
@@ -244,53 +195,13 @@ bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
         return false;
     }
     (void)rfs_store_add_pose(&s->store, pose, rng);
-    for (uint8_t i = 0; s->per_source && i < s->target->nsources; ++i) {
-        (void)rfs_store_add_pose(&s->src_store[i], pose, rng);
-    }
-    if (s->per_source && s->cfg.src_spacing > 0 && s->cfg.src_floor != INT32_MIN) {
-        add_floor_samples(s, pose, rng);
+    if (s->src != 0) {
+        rfs_seek_src_on_pose(s, pose, rng);
     }
     s->pose = *pose;
     s->have_pose = true;
     rfs_seek_meta_visit(s, pose->x, pose->y);
     return true;
-}
-
-/* Source src's own sample (rfs_seek_cfg_t.src_spacing): the mean of its packets since the
- * robot last moved src_spacing, at this packet's time. Small-scale fading decorrelates
- * within half a wavelength (6 cm at 2.4 GHz): samples 4 cm apart see different fades,
- * while a robot standing still adds the same fade again and again and teaches nothing.
- * Scaling: at most 65,535 packets of |dBm| <= 128 sum below 2^23; their mean in Q16. */
-static void add_source_sample(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm,
-                              rfs_rng_t *rng)
-{
-    if (s->cfg.src_spacing == 0) {
-        rfs_store_add_value(&s->src_store[src], t_us, (rfs_q16_t)dbm * RFS_Q16_ONE, rng);
-        return;
-    }
-    if (s->src_cnt[src] == UINT16_MAX) {
-        s->src_sum[src] = 0; /* standing still this long: start the mean again */
-        s->src_cnt[src] = 0;
-    }
-    s->src_sum[src] += dbm;
-    s->src_cnt[src]++;
-    if (!s->src_any) {
-        s->src_any = true;
-        s->src_first_us = t_us;
-    }
-    s->src_heard[src] = true;
-    s->src_heard_us[src] = t_us;
-    if (s->src_at[src] &&
-        rfs_q16_dist(s->pose.x, s->pose.y, s->src_x[src], s->src_y[src]) < s->cfg.src_spacing) {
-        return;
-    }
-    int64_t v = rfs_sdiv64_round((int64_t)s->src_sum[src] * RFS_Q16_ONE, s->src_cnt[src]);
-    rfs_store_add_value(&s->src_store[src], t_us, (rfs_q16_t)v, rng);
-    s->src_sum[src] = 0;
-    s->src_cnt[src] = 0;
-    s->src_at[src] = true;
-    s->src_x[src] = s->pose.x;
-    s->src_y[src] = s->pose.y;
 }
 
 bool rfs_seek_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm, rfs_rng_t *rng)
@@ -311,8 +222,8 @@ bool rfs_seek_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm, rfs_
     if (s->target->sample(&in, src, dbm, &v)) {
         rfs_store_add_value(&s->store, t_us, v, rng);
     }
-    if (s->per_source) {
-        add_source_sample(s, src, t_us, dbm, rng);
+    if (s->src != 0) {
+        rfs_seek_src_on_rssi(s, src, t_us, dbm, rng);
     }
     return true;
 }
@@ -413,31 +324,6 @@ bool rfs_seek_recheck_miss(const rfs_seek_cfg_t *cfg, int64_t *miss_ms, rfs_q16_
     return miss > thr;
 }
 
-/* The target of the 1 s means. With src_floor, a source without a mean while another has
- * one counts as the floor: a place where it cannot be heard fails the relearn check of a
- * model that promised a bridge there. */
-static bool target_mean(rfs_seek_t *s, int64_t now_us, rfs_q16_t *mean)
-{
-    rfs_target_in_t in = { s->win, s->target->nsources, now_us };
-    if (s->target->mean(&in, mean)) {
-        return true;
-    }
-    if (!s->per_source || s->cfg.src_floor == INT32_MIN) {
-        return false;
-    }
-    rfs_q16_t r[RFS_SEEK_MAX_SOURCES];
-    bool any = false;
-    for (uint8_t i = 0; i < s->target->nsources; ++i) {
-        bool have = rfs_rssi_mean(&s->win[i], now_us, &r[i]);
-        r[i] = have ? r[i] : s->cfg.src_floor;
-        any = any || have;
-    }
-    if (any) {
-        *mean = s->target->combine(r);
-    }
-    return any;
-}
-
 /* recheck_dist: while a greedy leg is driven, every recheck_dist of travel, the relearn
  * check of Algorithm 1 (|1 s mean - prediction| > threshold; with recheck_adapt the
  * threshold is at least the RMS of the recent misses). true when it fails: the leg is
@@ -451,7 +337,7 @@ static bool recheck_fails(rfs_seek_t *s, int64_t now_us)
     }
     count_travel(s);
     rfs_q16_t mean, pred;
-    if (!target_mean(s, now_us, &mean) ||
+    if (!rfs_seek_src_mean(s, now_us, &mean) ||
         !s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &pred)) {
         return false;
     }
@@ -522,10 +408,10 @@ static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_ou
     rfs_model_fit_in_t fin = { .samples = s->store.samples, .n = s->store.count,
                                .qx = s->pose.x, .qy = s->pose.y, .map = s->map,
                                .reach = s->reach_valid ? s->reach : 0 };
-    for (uint8_t i = 0; s->per_source && i < s->target->nsources; ++i) {
-        fin.src_samples[i] = s->src_store[i].samples;
-        fin.src_n[i] = s->src_store[i].count;
-        fin.src_seen[i] = s->src_store[i].seen;
+    for (uint8_t i = 0; s->src != 0 && i < s->target->nsources; ++i) {
+        fin.src_samples[i] = s->src[i].store.samples;
+        fin.src_n[i] = s->src[i].store.count;
+        fin.src_seen[i] = s->src[i].store.seen;
         fin.nsources = (uint8_t)(i + 1u);
     }
     rfs_fit_result_t r = s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng);
@@ -551,7 +437,7 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     d->y = s->pose.y;
     d->samples = s->store.count;
     count_travel(s);
-    d->mean_valid = target_mean(s, now_us, &d->mean);
+    d->mean_valid = rfs_seek_src_mean(s, now_us, &d->mean);
     if (!ops->learns) {
         end_decision(s, ops->choose(s, false, rng, now_us), now_us, out);
         return;

@@ -96,6 +96,20 @@ typedef struct rfs_seek_cfg {
                                 ///< every src_spacing of travel, dBm Q16.16 (INT32_MIN: none)
 } rfs_seek_cfg_t;
 
+/// One source's own samples, for a model fitted per source (rfs_seek_mem_t.src): its store
+/// and the running mean src_spacing builds. Caller-owned.
+typedef struct rfs_seek_src {
+    rfs_store_t store;   ///< the source's RSSI samples, dBm
+    int32_t sum;         ///< src_spacing: dBm summed since its last sample
+    uint16_t cnt;        ///< packets in sum
+    bool at;             ///< x and y are valid
+    rfs_q16_t x;         ///< robot x at its last sample, metres Q16.16
+    rfs_q16_t y;         ///< robot y there, metres Q16.16
+    bool heard;          ///< heard_us and first_us are valid
+    int64_t heard_us;    ///< its latest packet, microseconds
+    int64_t first_us;    ///< its first packet, microseconds
+} rfs_seek_src_t;
+
 /// Caller-owned memory for the seeker's large arrays.
 typedef struct rfs_seek_mem {
     rfs_sample_t *samples;     ///< cfg.store.capacity samples
@@ -109,10 +123,12 @@ typedef struct rfs_seek_mem {
     uint32_t visited_bytes;    ///< its size, rfs_reach_bytes(map) = (lw * lh + 7) / 8
     uint8_t *reach;            ///< one bit per lattice point: reachable from the robot's position
     uint32_t reach_bytes;      ///< its size, rfs_reach_bytes(map)
-    /// Optional (NULL: none), for a model fitted per source (rfs_fields.h): each source's
-    /// own store, cfg.store.capacity samples and pending_cap pending measurements, for every
-    /// source of the target. The seeker then also keeps each source's RSSI as samples.
-    rfs_sample_t *src_samples[RFS_TARGET_MAX_SOURCES];
+    /// Optional (NULL: none), for a model fitted per source (rfs_fields.h): one state per
+    /// source of the target, whose store holds cfg.store.capacity samples in src_samples[i]
+    /// and pending_cap pending measurements in src_pending[i]. The seeker then also keeps
+    /// each source's RSSI as samples.
+    rfs_seek_src_t *src;
+    rfs_sample_t *src_samples[RFS_TARGET_MAX_SOURCES]; ///< the stores' sample arrays
     rfs_pending_t *src_pending[RFS_TARGET_MAX_SOURCES]; ///< their pending rings
 } rfs_seek_mem_t;
 
@@ -194,17 +210,8 @@ typedef struct rfs_seek {
     const rfs_target_ops_t *target;           ///< the target function
     rfs_rssi_t win[RFS_SEEK_MAX_SOURCES];     ///< 1 s windows per source
     rfs_store_t store;                        ///< samples
-    bool per_source;                          ///< src_store holds each source's own samples
-    rfs_store_t src_store[RFS_SEEK_MAX_SOURCES]; ///< each source's RSSI (rfs_seek_mem_t.src_samples)
-    int32_t src_sum[RFS_SEEK_MAX_SOURCES];    ///< src_spacing: dBm summed since the last sample
-    uint16_t src_cnt[RFS_SEEK_MAX_SOURCES];   ///< packets in it
-    bool src_at[RFS_SEEK_MAX_SOURCES];        ///< src_x/src_y are valid
-    rfs_q16_t src_x[RFS_SEEK_MAX_SOURCES];    ///< robot x at the source's last sample, metres Q16.16
-    rfs_q16_t src_y[RFS_SEEK_MAX_SOURCES];    ///< robot y there, metres Q16.16
-    int64_t src_heard_us[RFS_SEEK_MAX_SOURCES]; ///< the source's latest packet, microseconds
-    bool src_heard[RFS_SEEK_MAX_SOURCES];     ///< src_heard_us is valid
-    bool src_any;                             ///< a source has been heard
-    int64_t src_first_us;                     ///< the first packet of any source, microseconds
+    rfs_seek_src_t *src;                      ///< each source's own samples (rfs_seek_mem_t.src),
+                                              ///< NULL: none
     rfs_plan_t plan;                          ///< planner
     rfs_drive_t drive;                        ///< drive control
     uint8_t *visited;                         ///< novelty bits, one per lattice point

@@ -114,6 +114,7 @@ int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *ma
         .visited_bytes = (uint32_t)sizeof a->visited,
         .reach = a->reach,
         .reach_bytes = (uint32_t)sizeof a->reach,
+        .src = cfg->src,
         .src_samples = {cfg->src_samples[0], cfg->src_samples[1]},
         .src_pending = {cfg->src_pending[0], cfg->src_pending[1]},
     };

@@ -88,6 +88,7 @@ static void ip_close(void *self)
     if (!p) {
         return;
     }
+    free(p->mem.src);
     for (unsigned k = 0; k < RFS_TARGET_MAX_SOURCES; k++) {
         free(p->mem.src_samples[k]);
         free(p->mem.src_pending[k]);
@@ -120,7 +121,8 @@ static int open_fields(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, const rfs_m
     p->fmem.points = points;
     p->fmem.cells = cells;
     p->fmem.f = calloc(points, sizeof(int16_t));
-    bool ok = p->fmem.f != NULL;
+    p->mem.src = calloc(target->nsources, sizeof(rfs_seek_src_t));
+    bool ok = p->fmem.f != NULL && p->mem.src != NULL;
     for (unsigned k = 0; k < target->nsources; k++) {
         p->fmem.walls[k] = calloc(points, 1);
         p->fmem.rsum[k] = calloc(cells, sizeof(int32_t));

@@ -15,6 +15,7 @@
  * with its own store when `per_source`. */
 typedef struct two {
     world_t w;
+    rfs_seek_src_t src[2];
     rfs_sample_t *src_samples[2];
     rfs_pending_t *src_pending[2];
 } two_t;
@@ -29,6 +30,7 @@ static int two_make(two_t *t, rfs_seek_cfg_t cfg, bool per_source, bool only_fir
         assert_true(t->src_samples[k] && t->src_pending[k]);
     }
     rfs_seek_mem_t mem = t->w.mem;
+    mem.src = per_source ? t->src : NULL;
     for (int k = 0; per_source && k < (only_first ? 1 : 2); ++k) {
         mem.src_samples[k] = t->src_samples[k];
         mem.src_pending[k] = t->src_pending[k];
@@ -59,7 +61,7 @@ static rfs_seek_cfg_t per_source_cfg(void)
     return c;
 }
 
-/* Per-source stores: every source of the target or none. */
+/* Per-source samples: with rfs_seek_mem_t.src, every source's arrays are needed. */
 static void test_stores_all_or_none(void **state)
 {
     (void)state;
@@ -67,10 +69,10 @@ static void test_stores_all_or_none(void **state)
     assert_int_equal(two_make(&t, per_source_cfg(), true, true), -1);
     two_free(&t);
     assert_int_equal(two_make(&t, per_source_cfg(), false, false), 0);
-    assert_false(t.w.seek.per_source);
+    assert_null(t.w.seek.src);
     two_free(&t);
     assert_int_equal(two_make(&t, per_source_cfg(), true, false), 0);
-    assert_true(t.w.seek.per_source);
+    assert_non_null(t.w.seek.src);
     rfs_seek_cfg_t c = rfs_seek_cfg_default();
     assert_int_equal(c.src_spacing, 0);
     assert_int_equal(c.settle_dist, 0);
@@ -99,25 +101,25 @@ static void test_one_sample_per_spacing(void **state)
         pose(&t, now + 1, 5.0, 5.0);
         now += 1;
     }
-    assert_int_equal(s->src_store[0].count, 1);
-    assert_int_equal(s->src_store[0].samples[0].v_q6, -60 * 64);
-    assert_int_equal(s->src_store[1].count, 0);
+    assert_int_equal(s->src[0].store.count, 1);
+    assert_int_equal(s->src[0].store.samples[0].v_q6, -60 * 64);
+    assert_int_equal(s->src[1].store.count, 0);
     assert_int_equal(s->store.count, 0); /* no bridging sample without source 1's mean */
     /* 3.9 cm: still the same place. */
     pose(&t, now + 10000, 5.039, 5.0);
     now += 10000;
     assert_true(rfs_seek_on_rssi(s, 0, now + 1, -62, &t.w.rng));
     pose(&t, now + 2, 5.039, 5.0);
-    assert_int_equal(s->src_store[0].count, 1);
+    assert_int_equal(s->src[0].store.count, 1);
     /* 4.1 cm from the first sample: the mean of the seven packets since it. */
     pose(&t, now + 10000, 5.041, 5.0);
     now += 10000;
     assert_true(rfs_seek_on_rssi(s, 0, now + 1, -64, &t.w.rng));
     pose(&t, now + 2, 5.041, 5.0);
-    assert_int_equal(s->src_store[0].count, 2);
+    assert_int_equal(s->src[0].store.count, 2);
     double mean = (-61 - 65 - 58 - 70 - 66 - 59 - 62 - 64) / 8.0;
-    assert_int_equal(s->src_store[0].samples[1].v_q6, (int16_t)lround(mean * 64.0));
-    assert_int_equal(s->src_store[0].samples[1].x_cm, 504);
+    assert_int_equal(s->src[0].store.samples[1].v_q6, (int16_t)lround(mean * 64.0));
+    assert_int_equal(s->src[0].store.samples[1].x_cm, 504);
     two_free(&t);
 }
 
@@ -155,10 +157,10 @@ static void test_silent_source_reads_floor(void **state)
     /* Source 1 was last heard at 50 ms; from 1.05 s on it is silent: one floor sample per
      * 4 cm of the 1.95 s (39 cm) after that (a 1 cm step each: every fourth pose). */
     int floors = 0;
-    for (uint16_t i = 0; i < s->src_store[1].count; ++i) {
-        floors += s->src_store[1].samples[i].v_q6 == -100 * 64;
+    for (uint16_t i = 0; i < s->src[1].store.count; ++i) {
+        floors += s->src[1].store.samples[i].v_q6 == -100 * 64;
     }
-    assert_int_equal(s->src_store[1].samples[0].v_q6, -80 * 64);
+    assert_int_equal(s->src[1].store.samples[0].v_q6, -80 * 64);
     assert_true(floors >= 8 && floors <= 10);
     /* The relearn check's mean with the floor for source 1: f = 2 min(R0, -100). */
     rfs_q16_t m = 0;

@@ -50,7 +50,8 @@ static const char usage_text[] =
     "  --decisions FILE  write one line per decision (default: stdout with --replay)\n"
     "  --target NAME     rssi (default) or bridge\n"
     "  --model NAME      internal model: ridge (default, the paper's), mlp, knn, radius,\n"
-    "                    pathloss (docs/MODELS.md; the STM32 image holds the ridge only)\n"
+    "                    pathloss (docs/MODELS.md; one fit per node under --target bridge,\n"
+    "                    docs/STRATEGIES.md; the STM32 image holds the ridge only)\n"
     "  --strategy NAME   meta (default, the paper's Algorithm 1) or meta-path (greedy legs\n"
     "                    along the planned path, with its preset improvements; with\n"
     "                    --model pathloss: docs/STRATEGIES.md); also fd-gradient,\n"
@@ -94,7 +95,8 @@ typedef struct daemon {
     void *model_state;      /* --model: its state (heap, the model's size) */
     rfs_fields_t *fields;   /* --model pathloss --target bridge: one fit per node */
     rfs_fields_mem_t fmem;  /* ... its arrays */
-    rfs_sample_t *src_samples[RFS_TARGET_MAX_SOURCES]; /* ... each node's own store */
+    rfs_seek_src_t *src;    /* ... each node's own samples: state and arrays */
+    rfs_sample_t *src_samples[RFS_TARGET_MAX_SOURCES];
     rfs_pending_t *src_pending[RFS_TARGET_MAX_SOURCES];
 } daemon_t;
 
@@ -442,7 +444,9 @@ static int open_fields(daemon_t *d, const options_t *o, rfs_app_cfg_t *cfg,
     }
     rfs_fields_mem_size(&d->core.map, &fc, &d->fmem.points, &d->fmem.cells);
     d->fmem.f = calloc(d->fmem.points, sizeof(int16_t));
-    bool ok = d->fmem.f != NULL;
+    d->src = calloc(target->nsources, sizeof(rfs_seek_src_t));
+    cfg->src = d->src;
+    bool ok = d->fmem.f != NULL && d->src != NULL;
     for (unsigned k = 0; k < target->nsources; k++) {
         d->fmem.walls[k] = calloc(d->fmem.points, 1);
         d->fmem.rsum[k] = calloc(d->fmem.cells, sizeof(int32_t));
@@ -467,6 +471,7 @@ static int open_fields(daemon_t *d, const options_t *o, rfs_app_cfg_t *cfg,
 
 static void free_fields(daemon_t *d)
 {
+    free(d->src);
     for (unsigned k = 0; k < RFS_TARGET_MAX_SOURCES; k++) {
         free(d->fmem.walls[k]);
         free(d->fmem.rsum[k]);

@@ -123,7 +123,7 @@ static int open_fields(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, const rfs_m
     p->fmem.f = calloc(points, sizeof(int16_t));
     p->mem.src = calloc(target->nsources, sizeof(rfs_seek_src_t));
     bool ok = p->fmem.f != NULL && p->mem.src != NULL;
-    for (unsigned k = 0; k < target->nsources; k++) {
+    for (unsigned k = 0; k < target->nsources && k < RFS_TARGET_MAX_SOURCES; k++) {
         p->fmem.walls[k] = calloc(points, 1);
         p->fmem.rsum[k] = calloc(cells, sizeof(int32_t));
         p->fmem.rcount[k] = calloc(cells, sizeof(uint16_t));

@@ -446,22 +446,25 @@ static int open_fields(daemon_t *d, const options_t *o, rfs_app_cfg_t *cfg,
     d->fmem.f = calloc(d->fmem.points, sizeof(int16_t));
     d->src = calloc(target->nsources, sizeof(rfs_seek_src_t));
     cfg->src = d->src;
-    bool ok = d->fmem.f != NULL && d->src != NULL;
-    for (unsigned k = 0; k < target->nsources; k++) {
-        d->fmem.walls[k] = calloc(d->fmem.points, 1);
-        d->fmem.rsum[k] = calloc(d->fmem.cells, sizeof(int32_t));
-        d->fmem.rcount[k] = calloc(d->fmem.cells, sizeof(uint16_t));
-        d->src_samples[k] = calloc(cfg->seek.store.capacity, sizeof(rfs_sample_t));
-        d->src_pending[k] = calloc(RFS_APP_PENDING, sizeof(rfs_pending_t));
-        ok = ok && d->fmem.walls[k] && d->fmem.rsum[k] && d->fmem.rcount[k] &&
-             d->src_samples[k] && d->src_pending[k];
+    if (d->fmem.f == NULL || d->src == NULL) {
+        return -1;
+    }
+    // Everything allocated here is freed by free_fields() at the daemon's end.
+    for (unsigned k = 0; k < target->nsources && k < RFS_TARGET_MAX_SOURCES; k++) {
+        if ((d->fmem.walls[k] = calloc(d->fmem.points, 1)) == NULL ||
+            (d->fmem.rsum[k] = calloc(d->fmem.cells, sizeof(int32_t))) == NULL ||
+            (d->fmem.rcount[k] = calloc(d->fmem.cells, sizeof(uint16_t))) == NULL ||
+            (d->src_samples[k] = calloc(cfg->seek.store.capacity, sizeof(rfs_sample_t))) == NULL ||
+            (d->src_pending[k] = calloc(RFS_APP_PENDING, sizeof(rfs_pending_t))) == NULL) {
+            return -1;
+        }
         cfg->src_samples[k] = d->src_samples[k];
         cfg->src_pending[k] = d->src_pending[k];
     }
     d->fields = aligned_alloc(RFS_MODELS_STATE_ALIGN,
                               (sizeof(rfs_fields_t) + RFS_MODELS_STATE_ALIGN - 1u) /
                                   RFS_MODELS_STATE_ALIGN * RFS_MODELS_STATE_ALIGN);
-    if (!ok || d->fields == NULL || rfs_fields_init(d->fields, &fc, target, &d->fmem) != 0) {
+    if (d->fields == NULL || rfs_fields_init(d->fields, &fc, target, &d->fmem) != 0) {
         return -1;
     }
     cfg->built = rfs_fields_model(d->fields);

@@ -9,6 +9,8 @@ figure docs/figures/seek_bridge.png, and nothing else.
                                              [--sim build/bin/rfseek-sim]
                                              [--results docs/RESULTS.md | --no-write]
     /usr/bin/python3 scripts/bench_bridge.py --smoke   (seed 1, no files written)
+    /usr/bin/python3 scripts/bench_bridge.py --keep DIR ...   (also keep every runs.tsv)
+    /usr/bin/python3 scripts/bench_bridge.py --from DIR       (the section from kept tables)
 
 The simulator reports each run's true best point (the mean field's f over the points the
 robot can stand on, reachable from the start), f where the robot ended, and the travel
@@ -72,16 +74,14 @@ def mp(a):
 def section(seeds, wall, at, jobs, table):
     L = [BEGIN, "## Bridging (paper section 6)", "",
          f"Written by `/usr/bin/python3 scripts/bench_bridge.py --seeds {seeds}"
-         f"{f' --jobs {jobs}' if jobs else ''}` at commit {at} ({wall:.0f} s). Target f = "
-         "-|R1 - R2| - |R1 + R2|, error threshold 7 (the paper's value for this noisier "
-         "target; rfseek-sim sets it for target: bridge), each run ending on 150 m or 600 s. "
-         "*True best point*: the best f of the seed's mean field (path loss, walls, "
-         "shadowing; no fading, no noise) of both nodes over a 0.1 m grid of the points the "
-         "robot can stand on, reachable from the start. *Settle point*: where the run "
-         "ended; *travel to settle*: the travel after which the robot stayed within 1 m of "
-         "it (hs_bridge.h). *Shortfall*: f(best) - f(settle). *Predicted point*: the "
-         "per-node model's best point at the end (rfs_fields_est_t), with sigma its "
-         "uncertainty. Cells: median (p90).", "",
+         f"{f' --jobs {jobs}' if jobs else ''}` at commit {at} ({wall:.0f} s). f = "
+         "-|R1 - R2| - |R1 + R2|, error threshold 7 (the paper's for this target), runs "
+         "ending on 150 m or 600 s. *Best point*: the best f of the seed's mean field (no "
+         "fading, no noise) where the robot can stand, reachable from the start, 0.1 m grid "
+         "(hs_bridge.h). *Settle point*: where the run ended; *travel to settle*: after "
+         "which the robot stayed within 1 m of it; *shortfall*: f(best) - f(settle); "
+         "*predicted point*: the per-node model's at the end, sigma its uncertainty. Cells: "
+         "median (p90).", "",
          "| scenario | configuration | within 3 m | distance, m | shortfall, dB | "
          "travel to settle, m | predicted point to the best, m | sigma, dB |",
          "|---|---|---|---|---|---|---|---|"]
@@ -135,6 +135,8 @@ def main():
     ap.add_argument("--figure", default="docs/figures/seek_bridge.png")
     ap.add_argument("--no-write", action="store_true", help="print the table only")
     ap.add_argument("--smoke", action="store_true", help="seed 1, print, check, no files")
+    ap.add_argument("--keep", help="also copy every runs.tsv (and the run's commit) here")
+    ap.add_argument("--from", dest="from_dir", help="write from the tables --keep kept")
     a = ap.parse_args()
     if a.smoke:
         a.seeds, a.no_write = "1..1", True
@@ -143,18 +145,38 @@ def main():
         sys.exit("bench_bridge: --seeds: expected A..B")
     t0 = time.time()
     table = []
+    if a.keep:
+        os.makedirs(a.keep, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
         for sc, what in SCENARIOS:
             cfgs = []
             for strategy, model, label in CONFIGS:
-                out = os.path.join(tmp, f"{sc}-{strategy}")
-                s = stats(run(a.sim, f"scenarios/{sc}.yaml", strategy, model, a.seeds, a.jobs,
-                              out))
+                name = f"{sc}-{strategy}"
+                if a.from_dir:
+                    with open(os.path.join(a.from_dir, name + ".tsv")) as f:
+                        rows = list(csv.DictReader(f, delimiter="\t"))
+                else:
+                    rows = run(a.sim, f"scenarios/{sc}.yaml", strategy, model, a.seeds, a.jobs,
+                               os.path.join(tmp, name))
+                if a.keep:
+                    with open(os.path.join(a.keep, name + ".tsv"), "w") as f:
+                        w = csv.DictWriter(f, fieldnames=list(rows[0]), delimiter="\t")
+                        w.writeheader()
+                        w.writerows(rows)
+                s = stats(rows)
                 cfgs.append(((strategy, model, label), s))
                 print(f"{sc} | {label} | {s['near']}/{s['n']} | {mp(s['err'])} | "
                       f"{mp(s['short'])} | {mp(s['travel'])} | {mp(s['pred'])}", flush=True)
             table.append(((sc, what), cfgs))
-    text = section(a.seeds, time.time() - t0, commit(), a.jobs, table)
+    at, wall = commit(), time.time() - t0
+    if a.from_dir:  # the commit and wall time of the run that kept the tables
+        with open(os.path.join(a.from_dir, "run.txt")) as f:
+            at, wall, a.seeds, a.jobs = f.read().split()
+        wall, a.jobs = float(wall), int(a.jobs)
+    elif a.keep:
+        with open(os.path.join(a.keep, "run.txt"), "w") as f:
+            f.write(f"{at} {wall:.0f} {a.seeds} {a.jobs}\n")
+    text = section(a.seeds, wall, at, a.jobs, table)
     if a.smoke:
         ok = text.count("| bridge") == 2 * len(SCENARIOS) and all(
             np.isfinite(s["err"]).all() for _, cfgs in table for _, s in cfgs)

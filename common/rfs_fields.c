@@ -264,7 +264,9 @@ static bool residuals(const rfs_fields_t *f, uint16_t i, uint16_t j, rfs_q16_t *
 }
 
 /* The corrected fields' target at lattice point (i, j) given its residuals res[],
- * target units Q16.16; false without a path-loss model. *used: work units. */
+ * target units Q16.16; false without a path-loss model. *used: work units.
+ * Scaling and overflow: each field and residual Q16.16, added saturating; combine()
+ * saturates (rfs_target.h). */
 static bool target_at(rfs_fields_t *f, uint16_t i, uint16_t j, const rfs_q16_t *res,
                       uint32_t *used, rfs_q16_t *v)
 {
@@ -281,7 +283,8 @@ static bool target_at(rfs_fields_t *f, uint16_t i, uint16_t j, const rfs_q16_t *
     return true;
 }
 
-/* Q16.16 to Q9.6, rounded, saturated, never one of the markers. */
+/* Q16.16 to Q9.6, rounded, saturated, never one of the markers.
+ * Scaling and overflow: (v + 2^9) >> 10 of an int32 fits int32; clamped to int16. */
 static int16_t q16_to_q6(rfs_q16_t v)
 {
     int32_t q = (int32_t)(((int64_t)v + 512) >> 10);

@@ -32,11 +32,10 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_pathloss_seek import commit, splice  # noqa: E402
 
 SCENARIOS = [("bridge", "office, nodes in rooms at opposite ends"),
-             ("bridge_corridor", "office, one node in the corridor"),
-             ("bridge_intel", "Intel lab, nodes about 50 m apart"),
-             ("bridge_3ne", "3ne, nodes about 50 m apart")]
-CONFIGS = [("meta", "ridge", "meta + ridge on f (the paper's)"),
-           ("meta-path", "pathloss", "meta-path + pathloss, one fit per node")]
+             ("bridge_corridor", "one in the corridor"),
+             ("bridge_intel", "Intel lab, about 50 m apart"),
+             ("bridge_3ne", "3ne, about 50 m apart")]
+CONFIGS = [("meta", "ridge", "paper"), ("meta-path", "pathloss", "per node")]
 BEGIN = "<!-- bench_bridge: begin -->"
 END = "<!-- bench_bridge: end -->"
 NEAR_M = 3.0
@@ -60,8 +59,9 @@ def stats(rows):
     err, short = num("settle_error_m"), num("best_f_db") - num("settle_f_db")
     travel = num("settle_travel_m")
     pred = np.hypot(num("pred_x_m") - num("best_x_m"), num("pred_y_m") - num("best_y_m"))
+    gap = np.hypot(num("pred_x_m") - num("final_x_m"), num("pred_y_m") - num("final_y_m"))
     return {"n": len(rows), "near": int((err <= NEAR_M).sum()), "err": err, "short": short,
-            "travel": travel, "pred": pred, "sigma": num("pred_sigma_db"),
+            "travel": travel, "pred": pred, "gap": gap, "sigma": num("pred_sigma_db"),
             "final": np.c_[num("final_x_m"), num("final_y_m")]}
 
 
@@ -72,6 +72,8 @@ def mp(a):
 
 
 def section(seeds, wall, at, jobs, table):
+    gap = np.concatenate([s["gap"] for _, cfgs in table for _, s in cfgs])
+    gap = np.median(gap[np.isfinite(gap)]) if np.isfinite(gap).any() else float("nan")
     L = [BEGIN, "## Bridging (paper section 6)", "",
          f"Written by `/usr/bin/python3 scripts/bench_bridge.py --seeds {seeds}"
          f"{f' --jobs {jobs}' if jobs else ''}` at commit {at} ({wall:.0f} s). f = "
@@ -80,16 +82,18 @@ def section(seeds, wall, at, jobs, table):
          "fading, no noise) where the robot can stand, reachable from the start, 0.1 m grid "
          "(hs_bridge.h). *Settle point*: where the run ended; *travel to settle*: after "
          "which the robot stayed within 1 m of it; *shortfall*: f(best) - f(settle); "
-         "*predicted point*: the per-node model's at the end, sigma its uncertainty. Cells: "
-         "median (p90).", "",
+         "*sigma*: the uncertainty of the per-node model's predicted point (where the runs "
+         f"ended a median {gap:.2f} m from it). Cells: "
+         "median (p90). " + "; ".join(f"`{sc}`: {what}" for sc, what in SCENARIOS) +
+         ". *paper*: meta + ridge fitted on f; *per node*: meta-path + pathloss, one fit per "
+         "node (docs/STRATEGIES.md, \"Bridging\").", "",
          "| scenario | configuration | within 3 m | distance, m | shortfall, dB | "
-         "travel to settle, m | predicted point to the best, m | sigma, dB |",
-         "|---|---|---|---|---|---|---|---|"]
-    for (sc, what), cfgs in table:
+         "travel to settle, m | sigma, dB |",
+         "|---|---|---|---|---|---|---|"]
+    for (sc, _), cfgs in table:
         for (_, _, label), s in cfgs:
-            L.append(f"| {sc} ({what}) | {label} | {s['near']} of {s['n']} | {mp(s['err'])} | "
-                     f"{mp(s['short'])} | {mp(s['travel'])} | {mp(s['pred'])} | "
-                     f"{mp(s['sigma'])} |")
+            L.append(f"| {sc} | {label} | {s['near']} of {s['n']} | {mp(s['err'])} | "
+                     f"{mp(s['short'])} | {mp(s['travel'])} | {mp(s['sigma'])} |")
     L += ["", "![bridging](figures/seek_bridge.png)", "", END]
     return "\n".join(L) + "\n"
 
@@ -112,7 +116,7 @@ def figure(path, sim, seed, finals):
                     vmin=np.max(f) - 40, vmax=np.max(f))
     fig.colorbar(sc, ax=ax, label=f"true f, dB (seed {seed} field, no fading)")
     for (label, pts), style in zip(finals, ("r.", "c.")):
-        ax.plot(pts[:, 0], pts[:, 1], style, ms=4, label=f"{label}: where runs settled")
+        ax.plot(pts[:, 0], pts[:, 1], style, ms=4, label=f"{label}: where the runs settled")
     i = int(np.argmax(f))
     ax.plot(a[i, 0], a[i, 1], "w*", ms=14, mec="k", label=f"best point of f (seed {seed})")
     ax.plot([7.5, 27.5], [2.0, 10.0], "^", color="orange", ms=10, mec="k", ls="none",

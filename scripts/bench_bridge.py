@@ -62,7 +62,8 @@ def stats(rows):
     gap = np.hypot(num("pred_x_m") - num("final_x_m"), num("pred_y_m") - num("final_y_m"))
     return {"n": len(rows), "near": int((err <= NEAR_M).sum()), "err": err, "short": short,
             "travel": travel, "pred": pred, "gap": gap, "sigma": num("pred_sigma_db"),
-            "final": np.c_[num("final_x_m"), num("final_y_m")]}
+            "final": np.c_[num("final_x_m"), num("final_y_m")],
+            "best": np.c_[num("best_x_m"), num("best_y_m")]}
 
 
 def mp(a):
@@ -98,7 +99,7 @@ def section(seeds, wall, at, jobs, table):
     return "\n".join(L) + "\n"
 
 
-def figure(path, sim, seed, finals):
+def figure(path, sim, seed, best, finals):
     """The office scenario's true f for one seed with where every run settled."""
     import matplotlib
     matplotlib.use("Agg")
@@ -112,13 +113,12 @@ def figure(path, sim, seed, finals):
         b = np.loadtxt(os.path.join(d, "o", "field1.tsv"), skiprows=1, usecols=(0, 1, 3))
     f = -np.abs(a[:, 2] - b[:, 2]) - np.abs(a[:, 2] + b[:, 2])
     fig, ax = plt.subplots(figsize=(10, 4))
-    sc = ax.scatter(a[:, 0], a[:, 1], c=f, s=1, cmap="viridis", marker="s", linewidths=0,
+    sc = ax.scatter(a[:, 0], a[:, 1], c=f, s=2, cmap="viridis", marker="s", linewidths=0,
                     vmin=np.max(f) - 40, vmax=np.max(f))
     fig.colorbar(sc, ax=ax, label=f"true f, dB (seed {seed} field, no fading)")
     for (label, pts), style in zip(finals, ("r.", "c.")):
         ax.plot(pts[:, 0], pts[:, 1], style, ms=4, label=f"{label}: where the runs settled")
-    i = int(np.argmax(f))
-    ax.plot(a[i, 0], a[i, 1], "w*", ms=14, mec="k", label=f"best point of f (seed {seed})")
+    ax.plot(best[0], best[1], "w*", ms=14, mec="k", label=f"best point of f (seed {seed})")
     ax.plot([7.5, 27.5], [2.0, 10.0], "^", color="orange", ms=10, mec="k", ls="none",
             label="nodes")
     ax.set_aspect("equal")
@@ -188,7 +188,7 @@ def main():
         return 0 if ok else 1
     if not a.no_write:
         office = table[0][1]
-        figure(a.figure, a.sim, int(m.group(1)),
+        figure(a.figure, a.sim, int(str(a.seeds).split("..")[0]), office[0][1]["best"][0],
                [(label, s["final"]) for (_, _, label), s in office])
         splice(a.results, text, BEGIN, END)
         print(f"wrote {a.results} and {a.figure} ({time.time() - t0:.0f} s)")

@@ -31,10 +31,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_pathloss_seek import commit, splice  # noqa: E402
 
-SCENARIOS = [("bridge", "office, nodes in rooms at opposite ends"),
-             ("bridge_corridor", "one in the corridor"),
-             ("bridge_intel", "Intel lab, about 50 m apart"),
-             ("bridge_3ne", "3ne, about 50 m apart")]
+SCENARIOS = ["bridge", "bridge_corridor", "bridge_intel", "bridge_3ne"]  # docs/SIMULATOR.md
 CONFIGS = [("meta", "ridge", "paper"), ("meta-path", "pathloss", "per node")]
 BEGIN = "<!-- bench_bridge: begin -->"
 END = "<!-- bench_bridge: end -->"
@@ -84,14 +81,13 @@ def section(seeds, wall, at, jobs, table):
          "(hs_bridge.h). *Settle point*: where the run ended; *travel to settle*: after "
          "which the robot stayed within 1 m of it; *shortfall*: f(best) - f(settle); "
          "*sigma*: the uncertainty of the per-node model's predicted point (where the runs "
-         f"ended a median {gap:.2f} m from it). Cells: "
-         "median (p90). " + "; ".join(f"`{sc}`: {what}" for sc, what in SCENARIOS) +
-         ". *paper*: meta + ridge fitted on f; *per node*: meta-path + pathloss, one fit per "
-         "node (docs/STRATEGIES.md, \"Bridging\").", "",
+         f"ended a median {gap:.2f} m from it). Cells: median (p90). Scenarios: "
+         "docs/SIMULATOR.md; *paper*: meta + ridge fitted on f; *per node*: meta-path + "
+         "pathloss, one fit per node (docs/STRATEGIES.md, \"Bridging\").", "",
          "| scenario | configuration | within 3 m | distance, m | shortfall, dB | "
          "travel to settle, m | sigma, dB |",
          "|---|---|---|---|---|---|---|"]
-    for (sc, _), cfgs in table:
+    for sc, cfgs in table:
         for (_, _, label), s in cfgs:
             L.append(f"| {sc} | {label} | {s['near']} of {s['n']} | {mp(s['err'])} | "
                      f"{mp(s['short'])} | {mp(s['travel'])} | {mp(s['sigma'])} |")
@@ -152,7 +148,7 @@ def main():
     if a.keep:
         os.makedirs(a.keep, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
-        for sc, what in SCENARIOS:
+        for sc in SCENARIOS:
             cfgs = []
             for strategy, model, label in CONFIGS:
                 name = f"{sc}-{strategy}"
@@ -171,7 +167,7 @@ def main():
                 cfgs.append(((strategy, model, label), s))
                 print(f"{sc} | {label} | {s['near']}/{s['n']} | {mp(s['err'])} | "
                       f"{mp(s['short'])} | {mp(s['travel'])} | {mp(s['pred'])}", flush=True)
-            table.append(((sc, what), cfgs))
+            table.append((sc, cfgs))
     at, wall = commit(), time.time() - t0
     if a.from_dir:  # the commit and wall time of the run that kept the tables
         with open(os.path.join(a.from_dir, "run.txt")) as f:

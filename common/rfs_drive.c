@@ -7,8 +7,8 @@
  *    localisation pose has arrived, moved pose_gain of the way towards it (the pose itself
  *    carried forward from its timestamp to now). A pose further than POSE_RESET_M or
  *    POSE_RESET_RAD from the estimate, or after a gap of POSE_STALE_US, replaces it.
- *  - Segment. The robot follows the line from the previous waypoint (or where the path
- *    started) A to the waypoint approached B: progress u along AB, cross-track error c.
+ *  - Segment. The robot follows the line from the previous waypoint (or the point the
+ *    path was planned from) A to the waypoint approached B: progress u along AB, cross-track error c.
  *    A waypoint other than the goal is passed when the robot crosses the perpendicular
  *    at B (u >= |AB|) or comes within SWITCH_DIST of it. The goal is reached within
  *    goal_tol.
@@ -114,7 +114,12 @@ void rfs_drive_set_path(rfs_drive_t *d, const rfs_path_t *path, int64_t now_us)
                   (int64_t)rfs_udiv64(len_mm * 2000000u, (uint64_t)d->cfg.v_max_mm_s);
     d->stall_ref_us = now_us;
     d->stall_ref_dist = INT32_MAX;
-    d->have_origin = false; /* the first leg starts where the robot is at the next update */
+    /* The first leg starts where the path was planned from, so it is the segment the
+     * planner checked; a path without a start (built by hand) starts where the robot is
+     * at the next update. */
+    d->have_origin = d->path.has_start;
+    d->ox = d->path.x0;
+    d->oy = d->path.y0;
     d->turning = false;
 }
 

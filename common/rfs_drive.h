@@ -81,9 +81,10 @@ rfs_drive_cfg_t rfs_drive_cfg_default(void);
 /// timeout; timeout over 10^12 us; turn_out above turn_in_place; pose gain above 1).
 int rfs_drive_init(rfs_drive_t *d, const rfs_drive_cfg_t *cfg);
 
-/// Start following a path (copied) at time now_us. path may be &d->path itself: planning
-/// straight into it saves a 520-byte rfs_path_t on the caller's stack (the firmware's
-/// stack is 2.5 KB).
+/// Start following a path (copied) at time now_us; its first leg runs from the path's
+/// start (x0, y0) when it has one (the planners set it), else from where the robot is at
+/// the next update. path may be &d->path itself: planning straight into it saves a
+/// 532-byte rfs_path_t on the caller's stack (the firmware's stack is 2.5 KB).
 void rfs_drive_set_path(rfs_drive_t *d, const rfs_path_t *path, int64_t now_us);
 
 /// One control update: wheel speeds (mm/s, saturated to the limits) for the pose.

@@ -3,8 +3,9 @@
  *
  * Rules (docs/MAPS.md):
  *  - Cell legality: cell c is legal when it and every cell whose square comes closer
- *    than `clearance` to c's centre are on the map and free. Off-map counts as not free,
- *    so cells within the clearance of the map edge are illegal.
+ *    than `clearance` to c's square are on the map and free, so every point of a legal
+ *    cell keeps the clearance. Off-map counts as not free, so cells within the clearance
+ *    of the map edge are illegal.
  *  - A point is legal when the cell it lies in is legal.
  *  - A segment passes through every cell whose CLOSED square it touches (supercover):
  *    a segment through a cell corner passes through all the cells sharing that corner,
@@ -42,19 +43,19 @@ void rfs_map_bit_set(uint8_t *bits, uint16_t stride, uint16_t cx, uint16_t cy, b
     bits[i] = v ? (uint8_t)(bits[i] | m) : (uint8_t)(bits[i] & ~m);
 }
 
-/* Is offset (dx, dy) cells (dx, dy >= 0) within the clearance of a cell centre? The
- * nearest point of the offset cell is (2dx-1)/2 and (2dy-1)/2 cells away (0 when the
- * offset is 0). Scaling and overflow: terms are doubled distances in Q16 (res Q16 times
- * a small integer, int64); a term >= 2*clearance excludes at once, so the squares are
- * taken only below (2 * 64 m)^2 = 2^46 in Q32. */
+/* Does the cell at offset (dx, dy) cells (dx, dy >= 0) come within the clearance of a
+ * cell's square? The cell itself always counts. The two squares are dx-1 and dy-1 cells apart per axis (0 when the
+ * offset is 0 or 1). Scaling and overflow: terms are distances in Q16 (res Q16 times a
+ * small integer, int64); a term >= clearance excludes at once, so the squares are taken
+ * only below (64 m)^2 = 2^44 in Q32. */
 static bool mask_in(rfs_q16_t res, rfs_q16_t clearance, int32_t dx, int32_t dy)
 {
     if (dx == 0 && dy == 0) {
-        return true;
+        return true; /* the cell itself */
     }
-    int64_t lim = 2 * (int64_t)clearance;
-    int64_t ex = dx > 0 ? (int64_t)(2 * dx - 1) * res : 0;
-    int64_t ey = dy > 0 ? (int64_t)(2 * dy - 1) * res : 0;
+    int64_t lim = clearance;
+    int64_t ex = dx > 1 ? (int64_t)(dx - 1) * res : 0;
+    int64_t ey = dy > 1 ? (int64_t)(dy - 1) * res : 0;
     if (ex >= lim || ey >= lim) {
         return false;
     }

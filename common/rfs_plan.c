@@ -355,6 +355,9 @@ static void puller_start(puller_t *pl, const rfs_map_t *m, rfs_path_t *out, rfs_
 static int settle(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,
                   rfs_q16_t y1, rfs_path_t *out)
 {
+    out->x0 = x0;
+    out->y0 = y0;
+    out->has_start = true;
     if (!rfs_map_point_legal(m, x1, y1)) {
         return -1;
     }

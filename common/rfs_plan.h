@@ -71,6 +71,9 @@ typedef struct rfs_path {
     rfs_q16_t y[RFS_PLAN_MAX_WAYPOINTS]; ///< metres, Q16.16
     uint16_t n;                           ///< waypoints
     rfs_q16_t length;                     ///< metres, Q16.16 (saturates at 32 km)
+    rfs_q16_t x0;                         ///< where it was planned from, metres Q16.16
+    rfs_q16_t y0;                         ///< metres Q16.16
+    bool has_start;                       ///< x0, y0 set: the first leg starts there
 } rfs_path_t;
 
 /// Bind work arrays to a map. Returns 0, or -1 when an array is null or too small

@@ -266,7 +266,7 @@ bool rfs_seek_plan_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, bool tree)
     if (!tree && !rfs_seek_plan_start(s, &sx, &sy)) {
         return false;
     }
-    /* Plan straight into the drive's own path: a 520-byte rfs_path_t on the stack would
+    /* Plan straight into the drive's own path: a 532-byte rfs_path_t on the stack would
      * overflow the microcontroller's 2.5 KB stack during a decision. */
     if (tree ? !rfs_plan_tree_path(&s->plan, gx, gy, &s->drive.path)
              : !rfs_plan_path(&s->plan, sx, sy, gx, gy, &s->drive.path)) {

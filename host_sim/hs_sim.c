@@ -10,174 +10,8 @@
 #include "hs_motor.h"
 #include "hs_radio.h"
 #include "hs_box2d.h"
+#include "hs_paths.h"
 #include "rfs_pdr.h"
-#include "rfs_plan.h"
-
-// --- can the core's planner get into the stop radius? --------------------------------
-// The cell-level check below connects legal cells through gaps one cell wide; the
-// controller plans on the 0.25 m lattice, whose edges need a legal straight segment
-// between lattice points, so a door that narrow is shut for it. 1 = some lattice point
-// within `radius` of (gx, gy) is reachable from (sx, sy), 0 = none, -1 = out of memory.
-static int lattice_reaches(const rfs_map_t *m, double sx, double sy, double gx, double gy,
-                           double radius)
-{
-    uint32_t n = (uint32_t)m->lw * m->lh;
-    uint8_t *work = malloc(n ? n : 1);
-    uint32_t *queue = malloc(sizeof(uint32_t) * (n ? n : 1));
-    rfs_path_t *path = malloc(sizeof *path);
-    rfs_plan_t plan;
-    int found = -1;
-    if (work && queue && path && rfs_plan_init(&plan, m, work, n, queue, n) == 0) {
-        found = 0;
-        double g = m->cfg.grid / 65536.0;
-        long r = (long)ceil(radius / g) + 1;
-        uint16_t ci, cj;
-        rfs_map_lattice_nearest(m, (rfs_q16_t)lround(gx * 65536.0), (rfs_q16_t)lround(gy * 65536.0),
-                                &ci, &cj);
-        for (long j = (long)cj - r; j <= (long)cj + r && !found; j++) {
-            for (long i = (long)ci - r; i <= (long)ci + r && !found; i++) {
-                if (i < 0 || j < 0 || i >= m->lw || j >= m->lh ||
-                    !rfs_map_lattice_legal(m, (uint16_t)i, (uint16_t)j)) {
-                    continue;
-                }
-                rfs_q16_t px, py;
-                rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
-                if (hypot(px / 65536.0 - gx, py / 65536.0 - gy) > radius) {
-                    continue;
-                }
-                found = rfs_plan_path(&plan, (rfs_q16_t)lround(sx * 65536.0),
-                                      (rfs_q16_t)lround(sy * 65536.0), px, py, path) ? 1 : 0;
-            }
-        }
-    }
-    free(work);
-    free(queue);
-    free(path);
-    return found;
-}
-
-// --- shortest path on the core's legal grid -----------------------------------------
-
-typedef struct heap_item {
-    double d;
-    uint32_t i;
-} heap_item_t;
-
-typedef struct heap {
-    heap_item_t *a;
-    size_t n, cap;
-} heap_t;
-
-static int heap_push(heap_t *h, double d, uint32_t i)
-{
-    if (h->n == h->cap) {
-        size_t nc = h->cap ? h->cap * 2 : 1024;
-        heap_item_t *na = realloc(h->a, nc * sizeof *na);
-        if (!na) {
-            return -1;
-        }
-        h->a = na;
-        h->cap = nc;
-    }
-    size_t k = h->n++;
-    while (k > 0 && h->a[(k - 1) / 2].d > d) {
-        h->a[k] = h->a[(k - 1) / 2];
-        k = (k - 1) / 2;
-    }
-    h->a[k] = (heap_item_t){d, i};
-    return 0;
-}
-
-static heap_item_t heap_pop(heap_t *h)
-{
-    heap_item_t top = h->a[0], last = h->a[--h->n];
-    size_t k = 0;
-    for (;;) {
-        size_t c = 2 * k + 1;
-        if (c >= h->n) {
-            break;
-        }
-        if (c + 1 < h->n && h->a[c + 1].d < h->a[c].d) {
-            c++;
-        }
-        if (h->a[c].d >= last.d) {
-            break;
-        }
-        h->a[k] = h->a[c];
-        k = c;
-    }
-    if (h->n > 0) {
-        h->a[k] = last;
-    }
-    return top;
-}
-
-static bool legal_cell(const rfs_map_t *m, long x, long y)
-{
-    return x >= 0 && y >= 0 && x < m->w && y < m->h &&
-           rfs_map_bit(m->legal, m->stride, (uint16_t)x, (uint16_t)y);
-}
-
-/// Dijkstra over legal cells, 16-connected (straight, diagonal and knight moves, each at
-/// its Euclidean length; a move is allowed when the cells it passes through are legal).
-/// The 16-neighbourhood overestimates any-angle lengths by at most 2.7 %.
-/// Fills dist (metres, INFINITY = unreachable) from the start cell. 0 or -1 (memory).
-static int legal_dijkstra(const rfs_map_t *m, long sx, long sy, double *dist)
-{
-    static const int mv[16][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {1, -1}, {-1, 1},
-                                  {-1, -1}, {2, 1}, {2, -1}, {-2, 1}, {-2, -1}, {1, 2},
-                                  {1, -2}, {-1, 2}, {-1, -2}};
-    size_t n = (size_t)m->w * m->h;
-    double res = m->res / 65536.0;
-    for (size_t i = 0; i < n; i++) {
-        dist[i] = INFINITY;
-    }
-    if (!legal_cell(m, sx, sy)) {
-        return 0;
-    }
-    heap_t h = {0};
-    dist[(size_t)sy * m->w + sx] = 0.0;
-    if (heap_push(&h, 0.0, (uint32_t)(sy * m->w + sx)) != 0) {
-        return -1;
-    }
-    while (h.n > 0) {
-        heap_item_t it = heap_pop(&h);
-        if (it.d > dist[it.i]) {
-            continue;
-        }
-        long x = it.i % m->w, y = it.i / m->w;
-        for (int k = 0; k < 16; k++) {
-            int dx = mv[k][0], dy = mv[k][1];
-            long nx = x + dx, ny = y + dy;
-            if (!legal_cell(m, nx, ny)) {
-                continue;
-            }
-            // Cells the move passes through: both neighbours of a diagonal (no corner
-            // cutting), the two cells beside the midpoint of a knight move.
-            if (abs(dx) == 1 && abs(dy) == 1 &&
-                (!legal_cell(m, x + dx, y) || !legal_cell(m, x, y + dy))) {
-                continue;
-            }
-            if (abs(dx) == 2 && (!legal_cell(m, x + dx / 2, y) || !legal_cell(m, x + dx / 2, y + dy))) {
-                continue;
-            }
-            if (abs(dy) == 2 && (!legal_cell(m, x, y + dy / 2) || !legal_cell(m, x + dx, y + dy / 2))) {
-                continue;
-            }
-            double nd = it.d + res * sqrt((double)(dx * dx + dy * dy));
-            size_t ni = (size_t)ny * m->w + (size_t)nx;
-            if (nd < dist[ni]) {
-                dist[ni] = nd;
-                if (heap_push(&h, nd, (uint32_t)ni) != 0) {
-                    free(h.a);
-                    return -1;
-                }
-            }
-        }
-    }
-    free(h.a);
-    return 0;
-}
 
 // --- environment ------------------------------------------------------------------------
 
@@ -244,68 +78,36 @@ static int check_positions(const hs_sim_env_t *e, char *err, size_t errlen)
     return 0;
 }
 
-/* Over the legal cells' distances from the start (dist, metres): the distance to the goal
- * of the nearest reachable cell (*best_gd) and the path to it (*best_path), and the
- * shortest path into the stop radius (*stop_path; INFINITY: none). */
-static void goal_paths(const hs_sim_env_t *e, const double *dist, double *best_gd,
-                       double *best_path, double *stop_path)
-{
-    const hs_scenario_t *sc = &e->sc;
-    const rfs_map_t *cm = &e->core.map;
-    double res = cm->res / 65536.0;
-    *best_gd = INFINITY;
-    *best_path = INFINITY;
-    *stop_path = INFINITY;
-    for (long y = 0; y < cm->h; y++) {
-        for (long x = 0; x < cm->w; x++) {
-            double d = dist[(size_t)y * cm->w + x];
-            if (!isfinite(d)) {
-                continue;
-            }
-            double gx = e->x0 + (x + 0.5) * res - sc->goal_x;
-            double gy = e->y0 + (y + 0.5) * res - sc->goal_y;
-            double gd = sqrt(gx * gx + gy * gy);
-            if (gd < *best_gd - 1e-9 || (fabs(gd - *best_gd) <= 1e-9 && d < *best_path)) {
-                *best_gd = gd;
-                *best_path = d;
-            }
-            if (gd <= sc->stop_radius_m && d < *stop_path) {
-                *stop_path = d;
-            }
-        }
-    }
-}
-
 /* The shortest paths from the start to the goal and into the stop radius, checked to
  * exist for the cells and for the controller's lattice. 0, or -1 with err set. */
 static int shortest_paths(hs_sim_env_t *e, char *err, size_t errlen)
 {
     const hs_scenario_t *sc = &e->sc;
     const rfs_map_t *cm = &e->core.map;
-    double *dist = calloc((size_t)cm->w * cm->h, sizeof(double)); // all set by legal_dijkstra
+    double *dist = calloc((size_t)cm->w * cm->h, sizeof(double)); // all set by hs_paths_dist
     if (!dist) {
         snprintf(err, errlen, "%s: out of memory", sc->path);
         return -1;
     }
     double res = cm->res / 65536.0;
     long sx = (long)((sc->start_x - e->x0) / res), sy = (long)((sc->start_y - e->y0) / res);
-    if (legal_dijkstra(cm, sx, sy, dist) != 0) {
+    if (hs_paths_dist(cm, sx, sy, dist) != 0) {
         free(dist);
         snprintf(err, errlen, "%s: out of memory", sc->path);
         return -1;
     }
     // Nearest reachable cell to the goal, and the shortest path into the stop radius.
-    double best_gd, best_path, stop_path;
-    goal_paths(e, dist, &best_gd, &best_path, &stop_path);
+    hs_paths_goal_t gp;
+    hs_paths_goal(cm, e->x0, e->y0, dist, sc->goal_x, sc->goal_y, sc->stop_radius_m, -1.0, &gp);
     free(dist);
-    if (!isfinite(stop_path)) {
+    if (!isfinite(gp.stop_m)) {
         snprintf(err, errlen,
                  "%s: stop.radius_m: the robot can never get within %.2f m of the goal "
                  "(%.2f, %.2f): the nearest point it can reach is %.2f m away",
-                 sc->path, sc->stop_radius_m, sc->goal_x, sc->goal_y, best_gd);
+                 sc->path, sc->stop_radius_m, sc->goal_x, sc->goal_y, gp.near_m);
         return -1;
     }
-    int lr = lattice_reaches(cm, sc->start_x, sc->start_y, sc->goal_x, sc->goal_y,
+    int lr = hs_paths_lattice_reaches(cm, sc->start_x, sc->start_y, sc->goal_x, sc->goal_y,
                              sc->stop_radius_m);
     if (lr <= 0) {
         if (lr < 0) {
@@ -319,8 +121,8 @@ static int shortest_paths(hs_sim_env_t *e, char *err, size_t errlen)
         }
         return -1;
     }
-    e->shortest_path_m = best_path;
-    e->shortest_to_stop_m = stop_path;
+    e->shortest_path_m = gp.path_m;
+    e->shortest_to_stop_m = gp.stop_m;
     return 0;
 }
 
@@ -335,7 +137,7 @@ static int env_prepare(hs_sim_env_t *e, char *err, size_t errlen)
     // Wall counts depend on the geometry only, not on the seed: one cache for all runs.
     size_t wcb = hs_radio_wall_cache_bytes(&sc->radio, e->x0, e->y0, e->x1, e->y1);
     for (unsigned s = 0; s < sc->nsources; s++) {
-        e->wall_cache[s] = malloc(wcb);
+        e->wall_cache[s] = e->wall_cache[s] ? e->wall_cache[s] : malloc(wcb); // placed again: same size
         if (!e->wall_cache[s]) {
             snprintf(err, errlen, "%s: out of memory", sc->path);
             return -1;
@@ -376,6 +178,27 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
         return -1;
     }
     return 0;
+}
+
+int hs_sim_env_place(hs_sim_env_t *e, uint64_t index, uint64_t seed, double sx, double sy,
+                     double stheta, double gx, double gy, char *err, size_t errlen)
+{
+    hs_scenario_t *sc = &e->sc;
+    if (sc->nsources != 1 || sc->has_goal || !(sc->stop_radius_m > 0.0)) {
+        snprintf(err, errlen, "%s: placements need one source, no stop.goal and a stop radius",
+                 sc->path);
+        return -1;
+    }
+    sc->start_x = sx;
+    sc->start_y = sy;
+    sc->start_theta = stheta;
+    sc->src[0].x = gx;
+    sc->src[0].y = gy;
+    sc->goal_x = gx;
+    sc->goal_y = gy;
+    e->placement = index;
+    e->placement_seed = seed;
+    return env_prepare(e, err, errlen);
 }
 
 void hs_sim_env_close(hs_sim_env_t *e)
@@ -581,6 +404,10 @@ typedef struct sim_run {
     double px, py, pth;          /* the robot at t: metres, radians */
     int64_t t;                   /* microseconds */
     double travelled;            /* metres */
+    double belief_x, belief_y;   /* the model maximum of the last greedy decision, metres */
+    bool belief_valid;
+    double *trail;               /* the robot at every whole second of the run (x, y pairs) */
+    size_t ntrail, trail_cap;    /* seconds recorded, room (0 after a failed allocation) */
     double drift_x, drift_y;     /* AMCL-like localisation error: bounded drift, metres */
     double jump_x, jump_y;       /* ... and the decaying rest of the last jump, metres */
     hs_bridge_track_t track;     /* target bridge: positions along the travel */
@@ -606,6 +433,7 @@ enum { EV_PACKET = 0, EV_POSE = 1, EV_CTRL = 2 };
 /* Free what run_open made (the radio: the latest, when a source moved). */
 static void run_close(sim_run_t *r)
 {
+    free(r->trail);
     hs_bridge_track_free(&r->track);
     free(r->pdr);
     hs_radio_destroy(r->radio);
@@ -865,6 +693,11 @@ static void ctrl_event(sim_run_t *r, const event_t *ev, const tick_t *k)
         res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
         res->goal_timeouts += d->prev == RFS_DRIVE_TIMEOUT ? 1u : 0u;
         res->goal_blocked += d->prev == RFS_DRIVE_BLOCKED ? 1u : 0u;
+        if (d->kind == RFS_SEEK_GREEDY && d->model_valid) {
+            r->belief_x = q16d(d->max_x);
+            r->belief_y = q16d(d->max_y);
+            r->belief_valid = true;
+        }
         if (r->io && r->io->log) {
             log_decision(r->io->log, ctrl, d, ev, wrap_pi(r->pth + ev->a * k->dth));
         }
@@ -953,6 +786,37 @@ static const char *run_end(sim_run_t *r)
     return NULL;
 }
 
+/* The robot's position recorded at the first tick of every whole second (entry k: second
+ * k), for still_s. Without memory the record stops and still_s counts from its end. */
+static void trail_add(sim_run_t *r)
+{
+    if (r->ntrail == r->trail_cap) {
+        size_t cap = r->trail_cap ? 2 * r->trail_cap : 1024;
+        double *t = realloc(r->trail, cap * 2 * sizeof *t);
+        if (!t) {
+            return;
+        }
+        r->trail = t;
+        r->trail_cap = cap;
+    }
+    r->trail[2 * r->ntrail] = r->px;
+    r->trail[2 * r->ntrail + 1] = r->py;
+    r->ntrail++;
+}
+
+/* Seconds the robot has stayed within HS_SIM_STILL_RADIUS_M of where it is now: from the
+ * whole second after the last recorded position outside that circle (none: the run). */
+static double still_s(const sim_run_t *r)
+{
+    double end_s = r->t * 1e-6;
+    for (size_t k = r->ntrail; k-- > 0;) {
+        if (hypot(r->trail[2 * k] - r->px, r->trail[2 * k + 1] - r->py) > HS_SIM_STILL_RADIUS_M) {
+            return fmax(0.0, end_s - (double)(k + 1));
+        }
+    }
+    return end_s;
+}
+
 /* The bridging figures (hs_bridge.h) and the model's predicted best point. */
 static void bridge_result(sim_run_t *r)
 {
@@ -996,6 +860,16 @@ static void run_result(sim_run_t *r, const char *end)
     res->wall_contacts = hs_box2d_wall_contacts(r->world);
     // Against source 0 where it is now (a moved source takes its error along).
     hs_sim_result_estimate(res, r->ctrl, r->rs[0].x, r->rs[0].y);
+    res->belief_x = res->est_valid ? res->est_x : (r->belief_valid ? r->belief_x : NAN);
+    res->belief_y = res->est_valid ? res->est_y : (r->belief_valid ? r->belief_y : NAN);
+    res->belief_error_m = hypot(res->belief_x - r->rs[0].x, res->belief_y - r->rs[0].y);
+    res->still_s = still_s(r);
+    res->placement = r->e->placement;
+    res->start_x = r->sc->start_x;
+    res->start_y = r->sc->start_y;
+    res->start_theta = r->sc->start_theta;
+    res->source_x = r->sc->src[0].x;
+    res->source_y = r->sc->src[0].y;
     if (res->bridge) {
         bridge_result(r);
     }
@@ -1024,6 +898,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     }
     write_headers(io);
     hs_box2d_robot_pose(r.world, &r.px, &r.py, &r.pth);
+    trail_add(&r);
     const char *end;
     do {
         tick_t k;
@@ -1039,6 +914,9 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
         }
         r.pth = k.nth;
         r.t = k.t1;
+        if (r.t >= (int64_t)r.ntrail * 1000000) {
+            trail_add(&r);
+        }
         if (world_events(&r, err, errlen) != 0) {
             run_close(&r);
             return -1;
@@ -1165,6 +1043,13 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
         fprintf(f, "%s[%.3f, %.3f]", s ? ", " : "", e->sc.src[s].x, e->sc.src[s].y);
     }
     fprintf(f, "],\n");
+    fprintf(f, "  \"start_theta_rad\": %.4f,\n", e->sc.start_theta);
+    if (e->placement > 0) { // a drawn placement (hs_place.h)
+        fprintf(f, "  \"placement\": %llu,\n  \"placement_seed\": %llu,\n",
+                (unsigned long long)e->placement, (unsigned long long)e->placement_seed);
+    } else {
+        fprintf(f, "  \"placement\": null,\n  \"placement_seed\": null,\n");
+    }
     fprintf(f, "  \"reached\": %s,\n", r->reached ? "true" : "false");
     fprintf(f, "  \"end\": \"%s\",\n", r->end);
     json_num(f, "sim_time_s", r->sim_time_s, false);
@@ -1192,7 +1077,13 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
     json_num(f, "est_w_db", r->est_valid ? r->est_w_db : NAN, false);
     json_num(f, "est_p0", r->est_valid ? r->est_p0 : NAN, false);
     json_num(f, "est_area_m2", r->est_valid ? r->est_area_m2 : NAN, false);
-    json_num(f, "est_error_m", r->est_valid ? r->est_error_m : NAN, !r->bridge);
+    json_num(f, "est_error_m", r->est_valid ? r->est_error_m : NAN, false);
+    // The belief at the end and how long the robot had stood (docs/RESULTS.md, the failure
+    // taxonomy of "Generalisation: random placements").
+    json_num(f, "belief_x_m", r->belief_x, false);
+    json_num(f, "belief_y_m", r->belief_y, false);
+    json_num(f, "belief_error_m", r->belief_error_m, false);
+    json_num(f, "still_s", r->still_s, !r->bridge);
     if (r->bridge) {
         // Bridging (hs_bridge.h): the true f's best point, the settle point, the estimate.
         json_num(f, "best_x_m", r->best_x, false);
@@ -1210,12 +1101,15 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
     fprintf(f, "}\n");
 }
 
-void hs_sim_table_header(FILE *f, bool bridge)
+void hs_sim_table_header(FILE *f, bool placed, bool bridge)
 {
-    fprintf(f, "seed\treached\tend\tsim_time_s\tdistance_travelled_m\tshortest_path_m\t"
+    fprintf(f, "%sseed\treached\tend\tsim_time_s\tdistance_travelled_m\tshortest_path_m\t"
                "shortest_to_stop_m\tfinal_distance_m\tfinal_x_m\tfinal_y_m\titerations\t"
                "model_updates\tgreedy\tepsilon\tpackets_sent\tpackets_received\t"
-               "goal_timeouts\tgoal_blocked\tturn_time_s\twall_contacts%s\n",
+               "goal_timeouts\tgoal_blocked\tturn_time_s\twall_contacts%s%s\n",
+            placed ? "placement\t" : "",
+            placed ? "\tstart_x_m\tstart_y_m\tstart_theta_rad\tsource_x_m\tsource_y_m"
+                     "\test_error_m\tbelief_error_m\tstill_s" : "",
             bridge ? "\t" HS_SIM_BRIDGE_COLUMNS : "");
 }
 
@@ -1229,8 +1123,11 @@ static void tsv_num(FILE *f, double v)
     }
 }
 
-void hs_sim_table_row(FILE *f, const hs_sim_result_t *r)
+void hs_sim_table_row(FILE *f, const hs_sim_result_t *r, bool placed)
 {
+    if (placed) {
+        fprintf(f, "%llu\t", (unsigned long long)r->placement);
+    }
     fprintf(f, "%llu\t%d\t%s", (unsigned long long)r->seed, r->reached ? 1 : 0, r->end);
     tsv_num(f, r->sim_time_s);
     tsv_num(f, r->distance_travelled_m);
@@ -1244,6 +1141,13 @@ void hs_sim_table_row(FILE *f, const hs_sim_result_t *r)
             (unsigned long long)r->packets_received, r->goal_timeouts, r->goal_blocked);
     tsv_num(f, r->turn_time_s);
     fprintf(f, "\t%ld", r->wall_contacts);
+    if (placed) {
+        fprintf(f, "\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f", r->start_x, r->start_y, r->start_theta,
+                r->source_x, r->source_y);
+        tsv_num(f, r->est_valid ? r->est_error_m : NAN);
+        tsv_num(f, r->belief_error_m);
+        tsv_num(f, r->still_s);
+    }
     if (r->bridge) {
         const double v[] = {r->best_x, r->best_y, r->best_f_db, r->settle_f_db,
                             r->settle_error_m, r->settle_travel_m,
@@ -1255,5 +1159,5 @@ void hs_sim_table_row(FILE *f, const hs_sim_result_t *r)
             tsv_num(f, v[i]);
         }
     }
-    fprintf(f, "\n");
+    fputc('\n', f);
 }

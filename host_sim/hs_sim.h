@@ -34,6 +34,9 @@ typedef struct hs_sim_env {
     double shortest_to_stop_m; ///< start to the first legal point within stop_radius_m (NaN: no goal)
     double x0, y0, x1, y1;     ///< the map's extent, metres
     int8_t *wall_cache[HS_SCN_MAX_SOURCES]; ///< wall counts per receiver cell, shared by runs
+    uint64_t placement;        ///< the drawn placement the start and source are (hs_place.h;
+                               ///< hs_sim_env_place), 0: the scenario's own
+    uint64_t placement_seed;   ///< the seed it was drawn from
 } hs_sim_env_t;
 
 /// Per-run outputs; any may be NULL.
@@ -82,6 +85,16 @@ typedef struct hs_sim_result {
     double est_p0;               ///< signal at 1 m, target units (dBm for rssi)
     double est_area_m2;          ///< uncertainty: area of the spread region, m^2
     double est_error_m;          ///< distance from the first source's true position, metres
+    /// Where the seeker believed the source was at the end: the path-loss estimate when
+    /// there is one, else the model maximum of the last greedy decision (NaN: none).
+    double belief_x, belief_y;   ///< metres
+    double belief_error_m;       ///< its distance from the first source, metres (NaN: none)
+    /// How long the robot had stayed within HS_SIM_STILL_RADIUS_M of its final position
+    /// when the run ended (whole seconds of simulated time, the run's length at most).
+    double still_s;
+    uint64_t placement;          ///< from hs_sim_env_t (0: the scenario's own start and source)
+    double start_x, start_y, start_theta; ///< the run's start, metres, radians
+    double source_x, source_y;   ///< the first source, metres
     /// A bridging run (target bridge; hs_bridge.h): the fields below, else they are unset.
     bool bridge;
     double best_x, best_y;       ///< best point of the true f the robot can reach, metres
@@ -97,10 +110,20 @@ typedef struct hs_sim_result {
     double pred_area_m2;         ///< area predicted within sigma of the best, m^2
 } hs_sim_result_t;
 
+/// The radius of hs_sim_result_t.still_s, metres: the robot "parked" at its end point.
+#define HS_SIM_STILL_RADIUS_M 2.0
+
 /// Load the map, build the core grids and check the scenario against them (sources and
 /// start in free space, start legal, goal reachable within the stop radius). Returns 0, or
 /// -1 with err = "file: field: reason".
 int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t errlen);
+
+/// Put the start at (sx, sy, stheta) and the first source, and the goal with it, at
+/// (gx, gy) (metres, radians), as drawn placement `index` of `seed` (hs_place.h): checked
+/// and the shortest paths redone as hs_sim_env_open does. The scenario must have one
+/// source and no goal of its own. 0, or -1 with err (the environment is then unusable).
+int hs_sim_env_place(hs_sim_env_t *e, uint64_t index, uint64_t seed, double sx, double sy,
+                     double stheta, double gx, double gy, char *err, size_t errlen);
 
 /// Release (safe on a zeroed env).
 void hs_sim_env_close(hs_sim_env_t *e);
@@ -137,13 +160,15 @@ void hs_sim_result_estimate(hs_sim_result_t *r, const hs_ctrl_t *ctrl, double sr
 /// Write summary.json of a run to f.
 void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t *r);
 
-/// Header line of the batch table (TSV; scripts/merge_runs.py writes the same); with
-/// `bridge` the bridging columns (HS_SIM_BRIDGE_COLUMNS) too.
-void hs_sim_table_header(FILE *f, bool bridge);
+/// Header line of the batch table (TSV; scripts/merge_runs.py writes the same); `placed`:
+/// the table of a batch over drawn placements (a placement column first, the start, the
+/// source and the end-of-run belief and parking columns after the others); `bridge`: the
+/// bridging columns (HS_SIM_BRIDGE_COLUMNS) last.
+void hs_sim_table_header(FILE *f, bool placed, bool bridge);
 
 /// One row of the batch table ("nan" where a value does not exist), with the bridging
 /// columns for a bridging run.
-void hs_sim_table_row(FILE *f, const hs_sim_result_t *r);
+void hs_sim_table_row(FILE *f, const hs_sim_result_t *r, bool placed);
 
 /// The batch table's columns of a bridging run, after the others.
 #define HS_SIM_BRIDGE_COLUMNS "best_x_m\tbest_y_m\tbest_f_db\tsettle_f_db\tsettle_error_m\t" \

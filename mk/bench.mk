@@ -101,6 +101,16 @@ bench-drive: $(BENCH_BIN)/rfseek-sim
 	$(PYTHON) scripts/bench_drive.py --sim $(BENCH_BIN)/rfseek-sim
 BENCH_TARGETS += bench-drive
 
+# Seeking at random placements on every shipped floor, meta-path + pathloss and meta +
+# ridge -> docs/RESULTS.md ("Generalisation: random placements", held-out draws only).
+# Long (about an hour on two shared cores); GENERAL_ARGS="--placements 20" makes it short.
+GENERAL_JOBS ?= 1
+GENERAL_ARGS ?=
+.PHONY: bench-general
+bench-general: $(BENCH_BIN)/rfseek-sim
+	nice -n 19 $(PYTHON) scripts/bench_general.py --sim $(BENCH_BIN)/rfseek-sim --jobs $(GENERAL_JOBS) $(GENERAL_ARGS)
+BENCH_TARGETS += bench-general
+
 # Bridging (paper section 6) on every bridging scenario -> docs/RESULTS.md ("Bridging"),
 # docs/figures/seek_bridge.png: the paper's meta + ridge beside one fit per node, 200
 # held-out seeds. `make test` runs a one-seed smoke run of the same script.

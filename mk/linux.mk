@@ -48,13 +48,14 @@ $(BUILD)/asan/bin/rfseekd: $(BUILD)/asan/obj/firmware/port/linux/prog/rfseekd.o 
 ALL_TARGETS += $(LINUX_LIB) $(LINUX_PROGS) $(LCM_PY_INIT)
 
 # --- tests -------------------------------------------------------------------------------
-# The map loader on real maps (/work/shared/data/maps) and bad input (tests/data/maps_bad/);
-# the radiotap parser and the pcap writer against tshark; candump -L lines against can-utils'
-# log2long; the LCM adapter and the path-loss estimate in the seeker status (hand-decoded
-# bytes).
+# The map loader on real maps (scenarios/maps) and bad input (tests/data/maps_bad/);
+# the radiotap parser and the pcap writer against tshark; the live feed's heartbeat times;
+# candump -L lines against can-utils' log2long; the LCM adapter and the path-loss estimate
+# in the seeker status (hand-decoded bytes).
 $(eval $(call cmocka_test,test_lx_map,tests/linux/test_lx_map.c,linux))
 $(eval $(call cmocka_test,test_lx_radiotap,tests/linux/test_lx_radiotap.c,linux))
 $(eval $(call cmocka_test,test_lx_pcap,tests/linux/test_lx_pcap.c,linux))
+$(eval $(call cmocka_test,test_lx_feed,tests/linux/test_lx_feed.c,linux))
 $(eval $(call cmocka_test,test_lx_candump,tests/linux/test_lx_candump.c,linux))
 $(eval $(call cmocka_test,test_lcm,tests/wire/test_lcm.c,linux))
 $(eval $(call cmocka_test,test_status_est,tests/host_sim/test_status_est.c,linux))
@@ -90,6 +91,9 @@ $(WIRE_VM_BIN): tests/vm/can_vm_test.c $(WIRE_VM_OBJS) $(CORE_LIB)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) $(INC_linux) $(DEPFLAGS) -MF $@.d -MT $@ -static $< $(WIRE_VM_OBJS) $(CORE_LIB) -o $@
 $(eval $(call test_script,can_vm,tests/vm/run_vm_test.sh $(BUILD),$(WIRE_VM_BIN) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-sim-lcm))
+# The live 802.11 feed end to end in the same kind of VM: mac80211_hwsim radios, hostapd,
+# rfseek-feed --live --lcm -> rfseekd -> vcan0, the dBm values against tshark on the host.
+$(eval $(call test_script,wifi_vm,tests/vm/run_wifi_vm_test.sh $(BUILD),$(BUILD)/bin/rfseek-feed $(BUILD)/bin/rfseekd $(WIRE_LCM_TOOL) $(LCM_PY_INIT)))
 
 # The daemon and the player link neither Box2D nor the C++ runtime.
 $(eval $(call test_script,link,scripts/check_link.sh $(LINUX_PROGS),$(LINUX_PROGS)))

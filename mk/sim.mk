@@ -59,6 +59,9 @@ SIM := $(BUILD)/bin/rfseek-sim
 # summary.json and residual.tsv; rfseek-map on a real map and on bad input.
 $(eval $(call test_script,sim_cli,tests/host_sim/sim_cli.sh $(SIM),$(SIM)))
 $(eval $(call test_script,batch_out,tests/host_sim/batch_out.sh $(SIM),$(SIM)))
+# Drawn placements (--placements) against scipy's Dijkstra over the map image, their
+# batches, job list and resume, bad options.
+$(eval $(call test_script,placements,$(PYTHON) tests/host_sim/placements.py $(SIM),$(SIM)))
 $(eval $(call test_script,faults,tests/host_sim/faults.sh $(SIM) 3,$(SIM)))
 $(eval $(call test_script,strategy_cli,tests/host_sim/strategy_cli.sh $(SIM),$(SIM)))
 $(eval $(call test_script,pathloss_out,tests/host_sim/pathloss_out.sh $(SIM),$(SIM)))

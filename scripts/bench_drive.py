@@ -2,17 +2,21 @@
 """The drive under localisation noise: success, travel, time turning on the spot, goals
 abandoned and wall contacts for the paper's meta + ridge and for meta-path + pathloss on
 the default office, the L-shaped floor and a real floor, from exact poses to 20 cm noise
-and an AMCL-like drifting estimate (docs/SIMULATOR.md, "Localisation"). Writes its section
-of docs/RESULTS.md, between the markers below, and nothing else.
+and an AMCL-like drifting estimate (docs/SIMULATOR.md, "Localisation"); then wall contacts
+and success on every shipped floor (each scenarios/*.yaml seeking one source) at the
+default localisation. Writes its section of docs/RESULTS.md, between the markers below,
+and nothing else.
 
     /usr/bin/python3 scripts/bench_drive.py [--seeds A..B] [--floors default,lshape,willow]
-                                            [--sim build/bin/rfseek-sim] [--jobs N]
+                                            [--all-floors all|none|a,b] [--jobs N]
+                                            [--sim build/bin/rfseek-sim]
                                             [--results docs/RESULTS.md | --no-write]
 
 Seeds 1001..1200 by default: the drive was tuned on seeds 1..500 of the default office,
 so these are draws it has not seen.
 """
 import argparse
+import glob
 import os
 import re
 import statistics
@@ -56,7 +60,12 @@ def run(sim, scenario, strategy, model, seeds, jobs):
     out = subprocess.run(cmd, capture_output=True, text=True)
     if out.returncode != 0:
         sys.exit(f"bench_drive: {scenario}: {out.stderr.strip()}")
-    lines = out.stdout.strip().split("\n")
+    return summarise(out.stdout)
+
+
+def summarise(table):
+    """Success, travel, turning, goals abandoned and contacts of one runs.tsv table."""
+    lines = table.strip().split("\n")
     head = lines[0].split("\t")
     rows = [dict(zip(head, ln.split("\t"))) for ln in lines[1:]]
     n = len(rows)
@@ -77,8 +86,19 @@ def cell(r):
             f"{r['timeouts'] + r['blocked']:.2f}/{r['contacts']}")
 
 
-def section(seeds, wall, at, floors, rows):
-    """floors: [label]; rows: [(noise label, [cell per floor x configuration])]."""
+def shipped_floors():
+    """Every scenarios/*.yaml that seeks one source (no `target:` other than rssi)."""
+    names = []
+    for path in sorted(glob.glob("scenarios/*.yaml")):
+        m = re.search(r"(?m)^target:\s*(\S+)", open(path).read())
+        if m is None or m.group(1) == "rssi":
+            names.append(os.path.splitext(os.path.basename(path))[0])
+    return names
+
+
+def section(seeds, wall, at, floors, rows, every):
+    """floors: [label]; rows: [(noise label, [cell per floor x configuration])];
+    every: [(floor, [cell per configuration])] at the default localisation."""
     L = [BEGIN, "## The drive under localisation noise", "",
          f"Written by `/usr/bin/python3 scripts/bench_drive.py --seeds {seeds}` at commit "
          f"{at} ({wall:.0f} s on two cores): each floor's scenario with only `localisation` "
@@ -91,6 +111,11 @@ def section(seeds, wall, at, floors, rows):
     L.append("|---" * len(head) + "|")
     for label, cs in rows:
         L.append(f"| {label} | " + " | ".join(cs) + " |")
+    if every:
+        L += ["", "Every shipped floor at the scenario's own localisation (5 cm, 0.02 rad), "
+              "same seeds and cells:", "", "| floor | meta + ridge | meta-path + pathloss |",
+              "|---|---|---|"]
+        L += [f"| {f} | " + " | ".join(cs) + " |" for f, cs in every]
     L.append("")
     L.append(END)
     return "\n".join(L) + "\n"
@@ -100,6 +125,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seeds", default="1001..1200")
     ap.add_argument("--floors", default="default,lshape,willow")
+    ap.add_argument("--all-floors", default="all",
+                    help="floors of the every-floor table: all shipped, none, or a list")
     ap.add_argument("--sim", default="build/bin/rfseek-sim")
     ap.add_argument("--jobs", type=int, default=0)
     ap.add_argument("--results", default="docs/RESULTS.md")
@@ -110,10 +137,18 @@ def main():
     for f in a.floors.split(","):
         if f not in FLOORS:
             sys.exit(f"bench_drive: --floors: unknown floor {f!r} (known: {', '.join(FLOORS)})")
+    shipped = shipped_floors()
+    every_floors = (shipped if a.all_floors == "all" else
+                    [] if a.all_floors == "none" else a.all_floors.split(","))
+    for f in every_floors:
+        if f not in shipped:
+            sys.exit(f"bench_drive: --all-floors: {f!r} is not a shipped floor "
+                     f"(known: {', '.join(shipped)})")
     tmps = []
     t0 = time.time()
     floors = a.floors.split(",")
     rows = []
+    every = []
     try:
         for nlabel, settings in NOISE:
             cs = []
@@ -125,11 +160,16 @@ def main():
                     cs.append(cell(run(a.sim, scen, strategy, model, a.seeds, a.jobs)))
             rows.append((nlabel, cs))
             print(f"{nlabel} | " + " | ".join(cs), flush=True)
+        for f in every_floors:
+            cs = [cell(run(a.sim, f"scenarios/{f}.yaml", strategy, model, a.seeds, a.jobs))
+                  for strategy, model, _ in CONFIGS]
+            every.append((f, cs))
+            print(f"{f} | " + " | ".join(cs), flush=True)
     finally:
         for t in tmps:
             os.unlink(t)
     if not a.no_write:
-        text = section(a.seeds, time.time() - t0, commit(), floors, rows)
+        text = section(a.seeds, time.time() - t0, commit(), floors, rows, every)
         splice(a.results, text, BEGIN, END)
         print(f"wrote {a.results} ({time.time() - t0:.0f} s)")
 

@@ -21,14 +21,16 @@ Definitions (also written into RESULTS.md):
                position at the decision to the goal), over the sum of planned path
                lengths: the part of the planned travel spent going around walls.
 Everything goes to a temporary directory first; RESULTS.md is written to a temporary
-file and renamed. Three parts of the old RESULTS.md are kept as they are: the hand-written
-Summary (between the HAND markers) and the sections scripts/bench_pathloss_seek.py and
-scripts/bench_bridge.py write (between their own markers).
+file and renamed. Parts of the old RESULTS.md are kept as they are: the hand-written
+Summary (between the HAND markers) and the sections other benches write between their own
+markers (scripts/bench_pathloss_seek.py and bench_bridge.py in place, bench_drive.py and
+bench_general.py at the end).
 """
 import argparse
 import glob
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -176,16 +178,16 @@ def fmt(v, nd=1):
     return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else "%.*f" % (nd, v)
 
 
-def row(label, s):
-    return ("| %s | %d | %d | **%.1f** (%.1f-%.1f) | %s | %s | %s | %s | %s | %s |" %
-            (label, s["n"], s["k"], 100 * s["p"], 100 * s["lo"], 100 * s["hi"], fmt(s["med"]),
+def row(scenario, label, s):
+    return ("| %s | %s | **%.1f** (%.1f-%.1f) | %s | %s | %s | %s | %s | %s |" %
+            (scenario, label, 100 * s["p"], 100 * s["lo"], 100 * s["hi"], fmt(s["med"]),
              fmt(s["p90"]), fmt(s["ratio"], 2), fmt(s["updates"], 0), fmt(s["eps"]),
              fmt(s["detour"])))
 
 
-HEAD = ("| %s | runs | reached | success %% (95%% Wilson CI) | median travel m "
+HEAD = ("| scenario | strategy | success % (95% Wilson CI) | median travel m "
         "| p90 travel m | median ratio to shortest (successful) | median model updates "
-        "| epsilon travel %% | detour %% |\n|---|---|---|---|---|---|---|---|---|---|")
+        "| epsilon travel % | detour % |\n|---|---|---|---|---|---|---|---|---|")
 
 
 def load_map(scen_file):
@@ -250,7 +252,7 @@ def region_of(scen, x, y, src, walls_at):
             return "source room"
         return "corridor" if here == "corridor" else "another room"
     wl = walls_at(x, y)
-    return "line of sight (0 walls)" if wl == 0 else ("1 wall" if wl == 1 else ">= 2 walls")
+    return "0 walls" if wl == 0 else ("1 wall" if wl == 1 else "2+ walls")
 
 
 def walls_lookup(field_tsv):
@@ -580,22 +582,20 @@ def write_results(args, path, scenarios, table, sweep, mtab, walls, figs, times,
       "travel %*: travel during epsilon steps over all travel. *Detour %*: planned path "
       "length beyond the straight line to the goal, over all planned path length. Cells "
       "of the compact tables: success % (95 % Wilson interval), ratio.\n")
-    A("**Strategies** (docs/STRATEGIES.md): `meta` is the paper's algorithm with its own "
-      "parameters and local ridge; `meta-global`, `fd-gradient`, `plane-gradient` and "
-      "`chemotaxis` are baselines behind the same sensors, step, map legality and planner; "
-      "`meta-path` runs with the map-aware path-loss model (docs/PATHLOSS.md) and is the "
-      "improvement, not a baseline.\n")
+    A("**Strategies** (docs/STRATEGIES.md): `meta` is the paper's, with its parameters and "
+      "local ridge; `meta-global`, `fd-gradient`, `plane-gradient` and `chemotaxis` are "
+      "baselines with the same sensors, step, legality and planner; `meta-path`, with the "
+      "map-aware path-loss model (docs/PATHLOSS.md), is the improvement.\n")
     hand = kept(old, HAND)
     A(hand + "\n" if hand else "%s\n## Summary\n\n(to be written)\n\n%s\n" % HAND)
     A("## Every strategy on every shipped scenario (shadowing and noise as the scenario "
-      "file says; default: 4 dB / 4 dB)\n")
+      "file says; default: 4 dB / 4 dB; %d seeds each)\n" % args.seeds)
+    A(HEAD)
     for sc in scenarios:
-        A("### %s\n" % sc)
-        A(HEAD % "strategy")
         for st in STRATEGIES:
-            A(row(st if st not in STRAT_MODEL else "%s + %s" % (st, STRAT_MODEL[st]),
+            A(row(sc, st if st not in STRAT_MODEL else "%s + %s" % (st, STRAT_MODEL[st]),
                   summarise(table[(sc, st)])))
-        A("")
+    A("")
     # where meta does not win
     A("### Where meta does not win\n")
     notes = []
@@ -611,17 +611,16 @@ def write_results(args, path, scenarios, table, sweep, mtab, walls, figs, times,
       "(meta-global, fd-gradient, plane-gradient, chemotaxis) in every scenario.")
     A("")
     A("## Default scenario at other shadowing and noise levels\n")
-    A("Generated variants of scenarios/default.yaml (shadowing correlation 5 m; 0 dB = "
-      "shadowing off), %d seeds each, every strategy with its model as above.\n" % ns)
+    A("Variants of scenarios/default.yaml (shadowing correlation 5 m; 0 dB: off), %d "
+      "seeds each, every strategy with its model as above.\n" % ns)
     L.extend(sweep_tables(sweep))
     A("![success vs shadowing and noise](figures/seek_success_vs_noise.png)\n")
     A("## Failure analysis\n")
-    A("Where failed runs ended and how close they came (final straight-line distance to "
-      "the source). Labelled regions: the office (default) floor: corridor y 5..7 m, 5 m "
-      "rooms either side; lshape: the corridors and rooms of scripts/make_maps.py; open: "
-      "one hall. The real floors (willow, 3ne, intel) carry no room labels: their end "
-      "points are classed by the walls the straight line to the source crosses "
-      "(simulator geometry).\n")
+    A("Where failed runs ended and their final straight-line distance to the source. "
+      "Regions: office: corridor y 5..7 m, 5 m rooms either side; lshape: the corridors "
+      "and rooms of scripts/make_maps.py; open: one hall; real floors (no room labels): "
+      "the walls the straight line to the source crosses. Strategies without a failed run "
+      "are left out.\n")
     A("| scenario | strategy | failed | end region counts | median final distance m | "
       "min final distance m |\n|---|---|---|---|---|---|")
     for sc in scenarios:
@@ -629,7 +628,6 @@ def write_results(args, path, scenarios, table, sweep, mtab, walls, figs, times,
         for st in STRATEGIES:
             fails = [r for r in table[(sc, st)] if not r["reached"]]
             if not fails:
-                A("| %s | %s | 0 | - | - | - |" % (sc, st))
                 continue
             cnt = {}
             for r in fails:
@@ -644,9 +642,9 @@ def write_results(args, path, scenarios, table, sweep, mtab, walls, figs, times,
     if bridge:
         A(bridge + "\n")
     A("## Internal models (strategy meta)\n")
-    A("Models from the registry common/rfs_models.h (`--model NAME`) under the paper's "
-      "`meta`; mlp and knn on fewer seeds (a run costs 1-4 s of CPU), so their intervals "
-      "are wider. The ridge row is the meta runs above.\n")
+    A("Registry models (common/rfs_models.h, `--model NAME`) under the paper's `meta`; mlp "
+      "and knn on fewer seeds (1-4 s of CPU a run), so wider intervals. The ridge row is "
+      "the meta runs above.\n")
     counts = {m: (args.slow_model_seeds if m in SLOW_MODELS else ms) for m in MODELS}
     counts["ridge"] = args.seeds if ms == args.seeds else ms
     L.extend(model_table(mtab, scenarios, counts))
@@ -667,6 +665,11 @@ def write_results(args, path, scenarios, table, sweep, mtab, walls, figs, times,
       % (args.jobs, len(scenarios), len(STRATEGIES), args.seeds, times["sweep"],
          times["noise"], times["models"], times["total"], times["total"] / 60))
     A("")
+    # Sections other benches write (scripts/bench_drive.py, scripts/bench_general.py), kept.
+    for name in re.findall(r"<!-- ([\w-]+): begin -->", old):
+        marks = ("<!-- %s: begin -->" % name, "<!-- %s: end -->" % name)
+        if marks not in (HAND, PATHLOSS, BRIDGE) and kept(old, marks):
+            A(kept(old, marks) + "\n")
     tmp = path + ".tmp"
     with open(tmp, "w") as f:
         f.write("\n".join(L))

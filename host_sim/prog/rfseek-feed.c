@@ -12,6 +12,11 @@
  * A --mac from which no frame came is a warning line and exit status 3 (the output is
  * complete): a typing error should not pass for an empty capture.
  *
+ * With --live IFACE --lcm URL it feeds the controller instead (docs/FEEDER.md, "Live to
+ * the controller"): every matching frame as an RFS_RSSI message (source = the --mac's
+ * position), and receiver heartbeats (RFS_RSSI_STATUS) while the capture loop runs, heard
+ * or not (lx_feed.h), until SIGINT or SIGTERM.
+ *
  * With --pose it replays a real experiment offline instead: the matching frames and the
  * recorded poses go, in time order, through the same in-process controller over the core
  * (rfs_seek) as the simulator uses, and the simulator's log.tsv, samples.tsv, track.tsv
@@ -26,11 +31,14 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "hs_ctrl.h"
 #include "hs_poses.h"
 #include "lx_err.h"
+#include "lx_feed.h"
+#include "lx_lcm.h"
 #include "lx_pcap.h"
 #include "lx_radiotap.h"
 #include "hs_scenario.h"
@@ -44,6 +52,7 @@
 static const char k_usage[] =
     "usage: rfseek-feed CAPTURE --mac MAC [--mac MAC2 ...] [--format tsv] [--stats]\n"
     "                   [--output FILE] [--live]\n"
+    "       rfseek-feed IFACE --live --lcm URL --mac MAC [--mac MAC2 ...] [--stats]\n"
     "       rfseek-feed CAPTURE --list [--mac MAC ...] [--stats] [--output FILE]\n"
     "       rfseek-feed CAPTURE --pose POSES.csv --scenario SCENARIO.yaml --out DIR\n"
     "                   [--mac MAC ...] [--seed N] [--model NAME] [--target rssi|pdr] [--stats]\n"
@@ -56,7 +65,10 @@ static const char k_usage[] =
     "  --format tsv   output format (tsv is the only one)\n"
     "  --stats        print packet counts (parsed, skipped and why) to stderr\n"
     "  --output FILE  write to FILE (via FILE.tmp, renamed only on success)\n"
-    "  --live         CAPTURE is a monitor-mode interface; read until interrupted\n"
+    "  --live         CAPTURE is a monitor-mode interface; read until SIGINT or SIGTERM\n"
+    "  --lcm URL      with --live: publish to the controller over LCM (e.g. udpm://...)\n"
+    "                 instead of printing: RFS_RSSI per line (source = the --mac's position,\n"
+    "                 0 first), RFS_RSSI_STATUS heartbeats every 50-75 ms while reading\n"
     "  --list         survey: one row per transmitter (802.11 addr2, tshark's wlan.ta; only\n"
     "                 the --mac ones when given), most frames first: mac, frames, frames\n"
     "                 with a dBm signal, their mean/min/max dBm, first and last time (as\n"
@@ -93,6 +105,8 @@ typedef struct feed_stats {
     uint64_t no_ta;                   /* --list: 802.11 header without a transmitter address */
     uint64_t rt_kept;                 /* --list: unusable radiotap header, its 802.11 frame counted */
     uint64_t mac_frames[FEED_MAX_MACS]; /* frames from each --mac (SA; --list: TA) */
+    uint64_t heartbeats;              /* --lcm: receiver heartbeats published */
+    uint64_t refused;                 /* --lcm: messages LCM refused */
 } feed_stats_t;
 
 static int parse_mac(const char *s, uint8_t mac[6])
@@ -165,6 +179,8 @@ static void print_stats(const char *name, const feed_stats_t *st)
         {st->caplen_short, "note: cut by the snap length"},
         {st->replay_before, "replay: not fed, before the first pose"},
         {st->replay_after, "replay: not fed, after the last pose or the stop"},
+        {st->heartbeats, "receiver heartbeats published"},
+        {st->refused, "LCM messages refused (not sent)"},
     };
     for (size_t i = 0; i < sizeof(rest) / sizeof(rest[0]); i++) {
         if (rest[i].n != 0) { fprintf(stderr, "; %llu %s", (unsigned long long)rest[i].n, rest[i].what); }
@@ -179,20 +195,54 @@ typedef int (*feed_fn)(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_f
  * was alive at its time (the receiver heartbeat). */
 typedef int (*alive_fn)(void *ctx, int64_t t_us);
 
+/* Set by SIGINT or SIGTERM in a live run (live_stop_on_signal): the normal end. */
+static volatile sig_atomic_t g_live_stop;
+
+static void on_live_stop(int sig)
+{
+    (void)sig;
+    g_live_stop = 1;
+}
+
+/* A live run ends at SIGINT or SIGTERM like a capture file at its end: nothing removed. */
+static void live_stop_on_signal(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof(sa));
+    sa.sa_handler = on_live_stop;
+    sigemptyset(&sa.sa_mask);
+    (void)sigaction(SIGINT, &sa, NULL);
+    (void)sigaction(SIGTERM, &sa, NULL);
+}
+
+/* A live capture's clock: the kernel stamps packets with CLOCK_REALTIME. */
+static int64_t realtime_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
 /* The next record whose radiotap header parsed (with bad_rt, or was unusable but located
  * the 802.11 frame: counted in st->rt_kept) and an 802.11 header followed, in *pkt and *f;
- * alive (when not NULL) is called for every record read, and why a record gives nothing
- * is counted in st. 1, 0 at the end, -1 after a read error (message on stderr) or when
- * alive failed. */
+ * alive (when not NULL) is called for every record read and, live, after every wait
+ * without one (at the clock's time), and why a record gives nothing is counted in st. 1,
+ * 0 at the end (live: SIGINT or SIGTERM), -1 after a read error (message on stderr) or
+ * when alive failed. */
 static int next_frame(lx_pcap_reader_t *r, feed_stats_t *st, lx_pcap_pkt_t *pkt, lx_rt_frame_t *f,
                       bool bad_rt, alive_fn alive, void *alive_ctx)
 {
     char err[512];
     for (;;) {
+        if (g_live_stop) { return 0; }
         const int got = lx_pcap_next(r, pkt, err, sizeof(err));
-        if (got == 2) { continue; }
+        if (got == 2) {
+            if (alive != NULL && alive(alive_ctx, realtime_us()) != 0) { return -1; }
+            continue;
+        }
         if (got == 0) { return 0; }
         if (got < 0) {
+            lx_err_one_line(err);
             fprintf(stderr, "rfseek-feed: %s (after %llu packets)\n", err, (unsigned long long)st->packets);
             return -1;
         }
@@ -333,7 +383,9 @@ static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, bool list
         memcpy(tmp, output, n);
         memcpy(tmp + n, ".tmp", 5);
         const char *names[1] = {tmp};
-        cleanup_on_signal(NULL, names, 1);
+        if (!live) { /* live, a signal is the end: the file is renamed into place */
+            cleanup_on_signal(NULL, names, 1);
+        }
         out = fopen(tmp, "w");
         if (out == NULL) {
             fprintf(stderr, "rfseek-feed: %s: cannot create: %s\n", tmp, strerror(errno));
@@ -361,6 +413,64 @@ static int run_tsv(lx_pcap_reader_t *r, const char *output, bool live, bool list
         if (rc != 0) { (void)remove(tmp); }
         free(tmp);
     }
+    return rc;
+}
+
+/* --- live to the controller (--live --lcm) ------------------------------------------- */
+
+/* The feed, and whether a refusal was reported (once: the counts say how many). */
+typedef struct lcm_ctx {
+    lx_feed_t feed;
+    bool told;
+} lcm_ctx_t;
+
+static void lcm_refused(lcm_ctx_t *c, const char *what)
+{
+    if (!c->told) {
+        fprintf(stderr, "rfseek-feed: LCM refused %s (counted; the feed goes on)\n", what);
+        c->told = true;
+    }
+}
+
+static int lcm_frame(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_frame_t *f)
+{
+    lcm_ctx_t *c = ctx;
+    if (lx_feed_frame(&c->feed, (uint8_t)m, pkt->t_us, f->rt.dbm_signal, f->wlan.seq) != 0) {
+        lcm_refused(c, "an RFS_RSSI message");
+    }
+    return 0;
+}
+
+static int lcm_alive(void *ctx, int64_t t_us)
+{
+    lcm_ctx_t *c = ctx;
+    if (lx_feed_alive(&c->feed, t_us) < 0) {
+        lcm_refused(c, "a heartbeat");
+    }
+    return 0;
+}
+
+/* The LCM connection for --lcm: NULL after a message. */
+static lx_lcm_t *open_lcm(const char *url)
+{
+    char err[1024];
+    lx_lcm_t *l = lx_lcm_open(url, NULL, err, sizeof(err));
+    if (err[0] != '\0') { /* the reason, or liblcm's warning: one line (lx_lcm.h) */
+        fprintf(stderr, "rfseek-feed: %s\n", err);
+    }
+    return l;
+}
+
+/* Publish the live interface's matching frames and heartbeats on l until SIGINT or
+ * SIGTERM (or a read error): 0, or 1 after a message. */
+static int run_lcm(lx_pcap_reader_t *r, lx_lcm_t *l, const uint8_t (*macs)[6], int n_macs, feed_stats_t *st)
+{
+    static lcm_ctx_t c;
+    memset(&c, 0, sizeof(c));
+    lx_feed_init(&c.feed, l);
+    const int rc = scan_capture(r, macs, n_macs, st, lcm_frame, &c, lcm_alive, &c);
+    st->heartbeats = c.feed.st.heartbeats;
+    st->refused = c.feed.st.refused;
     return rc;
 }
 
@@ -394,19 +504,18 @@ static int rp_collect(void *ctx, int m, const lx_pcap_pkt_t *pkt, const lx_rt_fr
 }
 
 /* Receiver heartbeat times (docs/FAULTS.md, "The receiver heartbeat"): every record the
- * capture loop reads proves it alive at that record's time, whoever sent it; one heartbeat
- * per RP_ALIVE_US of capture time at most, as a live sniffer would send them. */
-#define RP_ALIVE_US 50000
-
+ * capture loop reads proves it alive at that record's time, whoever sent it; heartbeats
+ * spaced as the live feed spaces them (lx_feed_hb_due). */
 typedef struct rp_times {
     int64_t *v;
     size_t n, cap;
+    lx_feed_hb_t rule;
 } rp_times_t;
 
 static int rp_alive(void *ctx, int64_t t_us)
 {
     rp_times_t *hb = ctx;
-    if (hb->n > 0 && t_us - hb->v[hb->n - 1] < RP_ALIVE_US) { /* both >= 0: no overflow */
+    if (!lx_feed_hb_due(&hb->rule, t_us)) {
         return 0;
     }
     if (hb->n == hb->cap) {
@@ -841,6 +950,7 @@ static void opt_err(const char *fmt, const char *v)
 typedef struct feed_opts {
     rp_opts_t ro;                    /* the capture, and the replay's options */
     const char *output;              /* --output, or NULL: stdout */
+    const char *lcm;                 /* --lcm URL (with --live), or NULL */
     uint8_t macs[FEED_MAX_MACS][6];
     int n_macs;
     bool stats;
@@ -871,6 +981,8 @@ static int parse_value(feed_opts_t *fo, const char *a, const char *v)
         }
     } else if (strcmp(a, "--output") == 0) {
         fo->output = v;
+    } else if (strcmp(a, "--lcm") == 0) {
+        fo->lcm = v;
     } else if (strcmp(a, "--pose") == 0) {
         ro->poses = v;
     } else if (strcmp(a, "--scenario") == 0) {
@@ -925,6 +1037,11 @@ static int check_options(const feed_opts_t *fo)
         fprintf(stderr, "rfseek-feed: --output and --live do not go with --pose (see --help)\n");
         return 2;
     }
+    if (fo->lcm != NULL && (!fo->live || fo->output != NULL)) {
+        fprintf(stderr, "rfseek-feed: --lcm publishes a live interface: needs --live, not with --output "
+                        "(see --help)\n");
+        return 2;
+    }
     if (fo->list && (replay || fo->live)) {
         fprintf(stderr, "rfseek-feed: --list reads a capture file: not with --pose or --live (see --help)\n");
         return 2;
@@ -939,8 +1056,8 @@ static int check_options(const feed_opts_t *fo)
 /* The command line into *fo: RUN, or the exit status (--help, a bad option). */
 static int parse_options(int argc, char **argv, feed_opts_t *fo)
 {
-    static const char *const k_valued[] = {"--mac",  "--format", "--output", "--pose", "--scenario",
-                                           "--out",  "--seed",   "--model",  "--target"};
+    static const char *const k_valued[] = {"--mac",  "--format", "--output", "--pose",  "--scenario",
+                                           "--out",  "--seed",   "--model",  "--target", "--lcm"};
     memset(fo, 0, sizeof(*fo));
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -1024,18 +1141,35 @@ static int feed_main(int argc, char **argv)
             return 1;
         }
     }
+    /* LCM before the interface: a bad URL is an option's error, whatever the interface. */
+    lx_lcm_t *lcm = fo.lcm != NULL ? open_lcm(fo.lcm) : NULL;
+    if (fo.lcm != NULL && lcm == NULL) {
+        return 1;
+    }
     char err[512];
     lx_pcap_reader_t *r = fo.live ? lx_pcap_open_live(fo.ro.capture, err, sizeof(err))
                                   : lx_pcap_open_offline(fo.ro.capture, err, sizeof(err));
     if (r == NULL) {
+        lx_err_one_line(err);
         fprintf(stderr, "rfseek-feed: %s\n", err);
+        lx_lcm_close(lcm);
         return 1;
+    }
+    if (fo.live) {
+        live_stop_on_signal();
     }
     feed_stats_t st;
     memset(&st, 0, sizeof(st));
-    rc = fo.ro.poses != NULL ? run_replay(&fo.ro, r, fo.macs, fo.n_macs, &st)
-                             : run_tsv(r, fo.output, fo.live, fo.list, (const uint8_t(*)[6])fo.macs, fo.n_macs, &st);
+    const uint8_t(*macs)[6] = (const uint8_t(*)[6])fo.macs;
+    if (fo.ro.poses != NULL) {
+        rc = run_replay(&fo.ro, r, fo.macs, fo.n_macs, &st);
+    } else if (fo.lcm != NULL) {
+        rc = run_lcm(r, lcm, macs, fo.n_macs, &st);
+    } else {
+        rc = run_tsv(r, fo.output, fo.live, fo.list, macs, fo.n_macs, &st);
+    }
     lx_pcap_close(r);
+    lx_lcm_close(lcm);
     if (fo.stats) { print_stats(fo.ro.capture, &st); }
     return rc == 0 && fo.ro.poses == NULL ? warn_unheard(&fo, &st) : rc;
 }

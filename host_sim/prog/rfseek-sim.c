@@ -3,6 +3,7 @@
  *   rfseek-sim SCENARIO [--seed N] [--out DIR] [--samples] [--field] [--pcap FILE]
  *   rfseek-sim SCENARIO --seeds A..B [--jobs N] [--out DIR]
  *   rfseek-sim SCENARIO --seeds A..B --emit-jobs --out DIR
+ *   rfseek-sim SCENARIO --placements N [--placement-seed S] --seeds A..B [--out DIR]
  *
  * Output directories are written under DIR.tmp-PID and renamed to DIR only when complete,
  * so an error never leaves a half-written DIR behind.
@@ -23,6 +24,7 @@
 
 #include "lx_err.h"
 #include "lx_pcap.h"
+#include "hs_place.h"
 #include "hs_sim.h"
 
 static const char *prog = "rfseek-sim";
@@ -63,6 +65,12 @@ static void usage(FILE *f)
             "  --start X,Y[,THETA]  start here (metres, radians), overriding the scenario's\n"
             "  --source X,Y    put the first source here (and the goal, unless the scenario\n"
             "                  names one); both must be legal places on the map\n"
+            "  --placements N  with --seeds: every seed at each of N drawn start/source pairs\n"
+            "                  (or A..B: pairs A to B), the shortest path 10 to 40 m; per-run logs\n"
+            "                  in DIR/place-K-seed-N/ (docs/SIMULATOR.md, \"Placements\")\n"
+            "  --placement-seed S  the seed the pairs are drawn from (default 1)\n"
+            "  --placement K   a single run at pair K\n"
+            "  --list-placements  print the pairs of --placements (TSV) and stop\n"
             "  --no-faults     ignore the scenario's fault schedule (docs/FAULTS.md)\n"
             "  --quiet         no progress bar\n"
             "  --bench         with --seeds: run them one after another in this process without\n"
@@ -263,25 +271,30 @@ static void on_stop(int sig)
     g_stop = sig;
 }
 
-static void progress(uint64_t done, uint64_t total, uint64_t reached)
+static void progress(uint64_t done, uint64_t total, uint64_t reached, bool placed)
 {
     int width = 40, fill = (int)(width * done / (total ? total : 1));
-    fprintf(stderr, "\r[%.*s%*s] %llu/%llu seeds, %llu reached", fill,
+    fprintf(stderr, "\r[%.*s%*s] %llu/%llu %s, %llu reached", fill,
             "########################################", width - fill, "",
-            (unsigned long long)done, (unsigned long long)total, (unsigned long long)reached);
+            (unsigned long long)done, (unsigned long long)total, placed ? "runs" : "seeds",
+            (unsigned long long)reached);
     fflush(stderr);
 }
 
-/* One --seeds batch: the seeds a..b not yet done shared among jobs worker processes, each
- * result sent to the parent through a pipe. */
+/* One --seeds batch: its runs not yet done shared among jobs worker processes, each
+ * result sent to the parent through a pipe. Without placements run i is seed a + i; with
+ * them, seed a + i % nseeds at placement places[i / nseeds]. */
 typedef struct batch {
-    const hs_sim_env_t *env;
-    uint64_t a, total;    /* seeds a .. a + total - 1 */
-    uint64_t *todo, ntodo; /* the seeds to run */
+    hs_sim_env_t *env;    /* each worker's copy is placed as its runs need */
+    uint64_t a, nseeds;   /* seeds a .. a + nseeds - 1 */
+    const hs_place_t *places; /* the drawn placements, or NULL */
+    uint64_t nplaces;     /* their count (0 without) */
+    uint64_t total;       /* runs: nseeds, or nseeds x nplaces */
+    uint64_t *todo, ntodo; /* the runs to do (indices) */
     int jobs;
-    const char *dir;      /* per-seed directories and runs.tsv in it, or NULL: stdout */
+    const char *dir;      /* per-run directories and runs.tsv in it, or NULL: stdout */
     bool samples, quiet;
-    char **rows;          /* by seed - a: the runs.tsv row (malloc'd), NULL until done */
+    char **rows;          /* by run: the runs.tsv row (malloc'd), NULL until done */
     FILE *state;          /* dir/batch.state, appended as seeds finish, or NULL */
     pid_t *pids;
     pid_t parent;         /* this process, the workers' parent */
@@ -290,7 +303,43 @@ typedef struct batch {
     char msg[512];        /* the first worker's error */
 } batch_t;
 
-/* Worker j: its seeds (todo[j], todo[j + jobs], ...), each run and its result written to
+/* Run i's directory name under the batch directory: "seed-N" or "place-K-seed-N". */
+static void run_name(const batch_t *bt, uint64_t i, char *buf, size_t n)
+{
+    const unsigned long long seed = bt->a + i % bt->nseeds;
+    if (bt->places) {
+        snprintf(buf, n, "place-%llu-seed-%llu", (unsigned long long)bt->places[i / bt->nseeds].index,
+                 seed);
+    } else {
+        snprintf(buf, n, "seed-%llu", seed);
+    }
+}
+
+/* Run i's directory made: 0, or -1 with errno. */
+static int run_mkdir(const batch_t *bt, uint64_t i, char *sub, size_t n)
+{
+    char name[64];
+    run_name(bt, i, name, sizeof name);
+    if (snprintf(sub, n, "%s/%s", bt->dir, name) >= (int)n) {
+        errno = ENAMETOOLONG;
+        return -1;
+    }
+    return mkdir(sub, 0777);
+}
+
+/* The worker's environment at run i's placement (when it differs from the last run's):
+ * 0, or -1 with the reason in msg. */
+static int run_place(const batch_t *bt, uint64_t i, char *msg, size_t msglen)
+{
+    const hs_place_t *pl = bt->places ? &bt->places[i / bt->nseeds] : NULL;
+    if (pl == NULL || bt->env->placement == pl->index) {
+        return 0;
+    }
+    return hs_sim_env_place(bt->env, pl->index, pl->seed, pl->start_x, pl->start_y,
+                            pl->start_theta, pl->source_x, pl->source_y, msg, msglen);
+}
+
+/* Worker j: its runs (todo[j], todo[j + jobs], ...), each run and its result written to
  * the pipe; exits 1 after the first failure. */
 static _Noreturn void batch_worker(const batch_t *bt, int j)
 {
@@ -303,18 +352,19 @@ static _Noreturn void batch_worker(const batch_t *bt, int j)
     }
     close(bt->fds[0]);
     for (uint64_t k = (uint64_t)j; k < bt->ntodo; k += (uint64_t)bt->jobs) {
-        const uint64_t s = bt->todo[k];
+        const uint64_t i = bt->todo[k], s = bt->a + i % bt->nseeds;
         wire_res_t w;
         memset(&w, 0, sizeof w);
         char sub[PATH_MAX + 64];
         const char *sd = NULL;
         if (bt->dir) {
-            if (snprintf(sub, sizeof sub, "%s/seed-%llu", bt->dir, (unsigned long long)s) >=
-                    (int)sizeof sub ||
-                mkdir(sub, 0777) != 0) {
+            if (run_mkdir(bt, i, sub, sizeof sub) != 0) {
                 w.end = run_err(w.msg, sizeof w.msg, 0, sub, strerror(errno)) ? -1 : 0;
             }
             sd = sub;
+        }
+        if (w.end == 0 && run_place(bt, i, w.msg, sizeof w.msg) != 0) {
+            w.end = -1;
         }
         if (w.end == 0) {
             FILE *devnull = NULL;
@@ -329,6 +379,7 @@ static _Noreturn void batch_worker(const batch_t *bt, int j)
             }
         }
         w.r.seed = s;
+        w.r.placement = bt->places ? bt->places[i / bt->nseeds].index : 0;
         w.r.end = NULL;
         if (write(bt->fds[1], &w, sizeof w) != (ssize_t)sizeof w || w.end < 0) {
             _exit(1);
@@ -361,7 +412,23 @@ static int batch_fork(batch_t *bt)
     return 0;
 }
 
-/* A finished seed's row kept (and appended to the state file): 0, or 1 after a message. */
+/* The run index of a seed at a placement (0: none), or UINT64_MAX when outside the batch. */
+static uint64_t run_index(const batch_t *bt, uint64_t placement, uint64_t seed)
+{
+    if (seed < bt->a || seed - bt->a >= bt->nseeds || (placement != 0) != (bt->places != NULL)) {
+        return UINT64_MAX;
+    }
+    if (!bt->places) {
+        return seed - bt->a;
+    }
+    const uint64_t first = bt->places[0].index;
+    if (placement < first || placement - first >= bt->nplaces) {
+        return UINT64_MAX;
+    }
+    return (placement - first) * bt->nseeds + (seed - bt->a);
+}
+
+/* A finished run's row kept (and appended to the state file): 0, or 1 after a message. */
 static int batch_keep(batch_t *bt, const hs_sim_result_t *r)
 {
     char *row = NULL;
@@ -371,13 +438,13 @@ static int batch_keep(batch_t *bt, const hs_sim_result_t *r)
         fprintf(stderr, "%s: out of memory\n", prog);
         return 1;
     }
-    hs_sim_table_row(m, r);
+    hs_sim_table_row(m, r, bt->places != NULL);
     if (fclose(m) != 0) {
         free(row);
         fprintf(stderr, "%s: out of memory\n", prog);
         return 1;
     }
-    bt->rows[r->seed - bt->a] = row;
+    bt->rows[run_index(bt, r->placement, r->seed)] = row; /* a run of this batch */
     bt->done++;
     bt->reached += r->reached ? 1u : 0u;
     if (bt->state && (fputs(row, bt->state) == EOF || fflush(bt->state) != 0)) {
@@ -394,7 +461,7 @@ static int batch_collect(batch_t *bt)
     int rc = 0;
     wire_res_t w;
     if (!bt->quiet) {
-        progress(bt->done, bt->total, bt->reached);
+        progress(bt->done, bt->total, bt->reached, bt->places != NULL);
     }
     for (;;) {
         ssize_t n = read(bt->fds[0], &w, sizeof w);
@@ -415,7 +482,7 @@ static int batch_collect(batch_t *bt)
             break;
         }
         if (!bt->quiet) {
-            progress(bt->done, bt->total, bt->reached);
+            progress(bt->done, bt->total, bt->reached, bt->places != NULL);
         }
         if (g_stop) {
             break;
@@ -446,7 +513,7 @@ static int batch_collect(batch_t *bt)
     if (bt->msg[0] != '\0') {
         lx_err_print(prog, "%s", bt->msg);
     } else if (rc == 0 && !g_stop && bt->done != bt->total) {
-        fprintf(stderr, "%s: a worker ended early (%llu of %llu seeds)\n", prog,
+        fprintf(stderr, "%s: a worker ended early (%llu of %llu runs)\n", prog,
                 (unsigned long long)bt->done, (unsigned long long)bt->total);
         rc = 1;
     }
@@ -461,7 +528,7 @@ static int batch_table(const batch_t *bt)
         fprintf(stderr, "%s: %s/runs.tsv: %s\n", prog, bt->dir, strerror(errno));
         return 1;
     }
-    hs_sim_table_header(t, strcmp(bt->env->sc.target, "bridge") == 0);
+    hs_sim_table_header(t, bt->places != NULL, strcmp(bt->env->sc.target, "bridge") == 0);
     for (uint64_t i = 0; i < bt->total; i++) {
         fputs(bt->rows[i], t);
     }
@@ -472,16 +539,22 @@ static int batch_table(const batch_t *bt)
     return 0;
 }
 
-/* The state file's header: the runs a --resume must repeat (scenario, seeds, options). */
+/* The state file's header: the runs a --resume must repeat (scenario, seeds, options,
+ * and the placements when drawn: pa..pb of seed ps, else pa 0). */
 static void batch_state_header(char *buf, size_t n, const char *scenario, const hs_scenario_t *sc,
-                               uint64_t a, uint64_t b, bool samples)
+                               uint64_t a, uint64_t b, bool samples, uint64_t pa, uint64_t pb,
+                               uint64_t ps)
 {
-    char abs[PATH_MAX];
+    char abs[PATH_MAX], places[96] = "";
+    if (pa > 0) {
+        snprintf(places, sizeof places, "\tplacements=%llu..%llu\tplacement_seed=%llu",
+                 (unsigned long long)pa, (unsigned long long)pb, (unsigned long long)ps);
+    }
     snprintf(buf, n, "# rfseek-sim batch\tscenario=%s\tseeds=%llu..%llu\tstrategy=%s\tmodel=%s"
-             "\tfaults=%u\tp0_min=%.17g\tsamples=%d\tstart=%.17g,%.17g,%.17g\tsource=%.17g,%.17g\n",
+             "\tfaults=%u\tp0_min=%.17g\tsamples=%d\tstart=%.17g,%.17g,%.17g\tsource=%.17g,%.17g%s\n",
              realpath(scenario, abs) ? abs : scenario, (unsigned long long)a, (unsigned long long)b,
              sc->strategy, sc->model, sc->faults.n, sc->seek_p0_min_dbm, samples ? 1 : 0,
-             sc->start_x, sc->start_y, sc->start_theta, sc->src[0].x, sc->src[0].y);
+             sc->start_x, sc->start_y, sc->start_theta, sc->src[0].x, sc->src[0].y, places);
 }
 
 /* dir/name into buf: true, or false when it does not fit. */
@@ -490,14 +563,13 @@ static bool join(char *buf, size_t n, const char *dir, const char *name)
     return snprintf(buf, n, "%s/%s", dir, name) < (int)n;
 }
 
-/* The directories of the seeds not finished removed (a worker may have begun them). */
+/* The directories of the runs not finished removed (a worker may have begun them). */
 static void drop_unfinished(const batch_t *bt)
 {
     for (uint64_t i = 0; i < bt->total; i++) {
         struct stat st;
-        char name[32], path[PATH_MAX + 128];
-        const unsigned long long seed = bt->a + i;
-        snprintf(name, sizeof name, "seed-%llu", seed);
+        char name[64], path[PATH_MAX + 128];
+        run_name(bt, i, name, sizeof name);
         if (bt->rows[i] == NULL && join(path, sizeof path, bt->dir, name) && lstat(path, &st) == 0) {
             rm_tree(path);
         }
@@ -522,21 +594,26 @@ static int batch_resume(batch_t *bt, const char *header)
     }
     long at = ftell(f), cut = -1;
     while (rc == 0 && fgets(line, sizeof line, f)) {
-        char *end;
+        char *end = line;
         errno = 0;
-        unsigned long long s = strtoull(line, &end, 10);
+        /* A placed batch's rows begin with the placement, then the seed. */
+        unsigned long long pl = bt->places ? strtoull(line, &end, 10) : 0;
+        bool ok = !bt->places || *end == '\t';
+        unsigned long long s = ok ? strtoull(end + (bt->places ? 1 : 0), &end, 10) : 0;
         size_t len = strlen(line);
-        if (errno != 0 || *end != '\t' || len == 0 || line[len - 1] != '\n') {
-            cut = at; /* a row cut by SIGKILL: that seed is redone, the rows go on from here */
+        if (!ok || errno != 0 || *end != '\t' || len == 0 || line[len - 1] != '\n') {
+            cut = at; /* a row cut by SIGKILL: that run is redone, the rows go on from here */
             break;
         }
-        if (s < bt->a || s - bt->a >= bt->total || bt->rows[s - bt->a] != NULL) {
-            lx_err_print(prog, "%s: seed %llu outside the batch or listed twice", path, s);
+        const uint64_t i = run_index(bt, pl, s);
+        if (i == UINT64_MAX || bt->rows[i] != NULL) {
+            lx_err_print(prog, "%s: seed %llu (placement %llu) outside the batch or listed twice",
+                         path, s, pl);
             rc = 1;
             break;
         }
-        bt->rows[s - bt->a] = strdup(line);
-        if (bt->rows[s - bt->a] == NULL) {
+        bt->rows[i] = strdup(line);
+        if (bt->rows[i] == NULL) {
             fprintf(stderr, "%s: out of memory\n", prog);
             rc = 1;
             break;
@@ -556,14 +633,18 @@ static int batch_resume(batch_t *bt, const char *header)
     return rc;
 }
 
-static int run_batch(const hs_sim_env_t *env, const char *header, uint64_t a, uint64_t b, int jobs,
-                     const char *dir, bool samples, bool quiet, bool resume)
+static int run_batch(hs_sim_env_t *env, const char *header, uint64_t a, uint64_t b,
+                     const hs_place_t *places, uint64_t nplaces, int jobs, const char *dir,
+                     bool samples, bool quiet, bool resume)
 {
     batch_t bt;
     memset(&bt, 0, sizeof bt);
     bt.env = env;
     bt.a = a;
-    bt.total = b - a + 1; /* at most BATCH_MAX_SEEDS (check_options) */
+    bt.nseeds = b - a + 1;
+    bt.places = places;
+    bt.nplaces = places ? nplaces : 0;
+    bt.total = bt.nseeds * (places ? nplaces : 1); /* at most BATCH_MAX_SEEDS (check_options) */
     bt.dir = dir;
     bt.samples = samples;
     bt.quiet = quiet;
@@ -587,7 +668,7 @@ static int run_batch(const hs_sim_env_t *env, const char *header, uint64_t a, ui
     }
     for (uint64_t i = 0; rc == 0 && i < bt.total; i++) {
         if (bt.rows[i] == NULL) {
-            bt.todo[bt.ntodo++] = a + i;
+            bt.todo[bt.ntodo++] = i;
         }
     }
     bt.jobs = (uint64_t)jobs > bt.ntodo ? (int)(bt.ntodo > 0 ? bt.ntodo : 1) : jobs;
@@ -679,6 +760,11 @@ typedef struct sim_opts {
     bool has_seed, samples, field, emit, quiet, bench, no_faults, resume;
     double p0_min;                /* --p0-min: NAN keeps the scenario's (or the model's default) */
     const char *start, *source;   /* --start X,Y[,THETA], --source X,Y: placement overrides */
+    const char *placements;       /* --placements N or A..B: drawn pairs pa..pb */
+    uint64_t pa, pb;
+    uint64_t pseed;               /* --placement-seed (1) */
+    uint64_t place_one;           /* --placement K (0: none) */
+    bool has_pseed, list_places;
     long jobs;
     uint64_t sa, sb;              /* --seeds A..B */
     char from[PATH_MAX + 64];     /* --resume: the interrupted batch's directory */
@@ -691,6 +777,7 @@ static int parse_options(int argc, char **argv, sim_opts_t *o)
 {
     memset(o, 0, sizeof *o);
     o->p0_min = NAN;
+    o->pseed = 1;
     o->jobs = sysconf(_SC_NPROCESSORS_ONLN);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -748,6 +835,23 @@ static int parse_options(int argc, char **argv, sim_opts_t *o)
                 return die("%s: expected X,Y%s", a, a[3] == 't' ? "[,THETA] in metres, radians" : " in metres");
             }
             *(a[3] == 't' ? &o->start : &o->source) = argv[++i];
+        } else if (strcmp(a, "--placements") == 0) {
+            if (!more) {
+                return die("--placements: expected N or A..B%s%s", "", "");
+            }
+            o->placements = argv[++i];
+        } else if (strcmp(a, "--placement-seed") == 0) {
+            if (!more || parse_u64(argv[++i], &o->pseed) != 0) {
+                return die("--placement-seed: expected a non-negative integer%s%s", "", "");
+            }
+            o->has_pseed = true;
+        } else if (strcmp(a, "--placement") == 0) {
+            if (!more || parse_u64(argv[++i], &o->place_one) != 0 || o->place_one < 1 ||
+                o->place_one > HS_PLACE_MAX_INDEX) {
+                return die("--placement: expected a number from 1 to %s%s", "1000000000", "");
+            }
+        } else if (strcmp(a, "--list-placements") == 0) {
+            o->list_places = true;
         } else if (strcmp(a, "--no-faults") == 0) {
             o->no_faults = true;
         } else if (strcmp(a, "--resume") == 0) {
@@ -817,6 +921,57 @@ static int find_killed_batch(sim_opts_t *o)
     return RUN;
 }
 
+/* The most placements one --placements draws. */
+#define MAX_PLACEMENTS 10000u
+
+/* The placement options that go together, checked: RUN, or the exit status after a message. */
+static int check_placements(sim_opts_t *o)
+{
+    if (o->placements) {
+        const bool range = strstr(o->placements, "..") != NULL;
+        if (range ? parse_range(o->placements, &o->pa, &o->pb) != 0
+                  : parse_u64(o->placements, &o->pb) != 0) {
+            o->pb = 0;
+        }
+        o->pa = range ? o->pa : 1;
+        if (o->pa < 1 || o->pb < o->pa || o->pb > HS_PLACE_MAX_INDEX ||
+            o->pb - o->pa >= MAX_PLACEMENTS) {
+            return die("--placements: expected N or A..B with 1 <= A <= B <= 1000000000 and at "
+                       "most 10000 placements, got '%s'%s", o->placements, "");
+        }
+    }
+    const bool drawn = o->placements || o->place_one;
+    if (drawn && (o->start || o->source)) {
+        return die("--placements and --placement draw the start and source: not with --start "
+                   "or --source%s%s", "", "");
+    }
+    if (o->placements && o->place_one) {
+        return die("--placement K is one run, --placements a batch: not both%s%s", "", "");
+    }
+    if (o->has_pseed && !drawn) {
+        return die("--placement-seed needs --placements or --placement%s%s", "", "");
+    }
+    if (o->list_places && (!o->placements || o->seeds || o->out || o->emit || o->bench)) {
+        return die("--list-placements needs --placements and prints them only (no --seeds, "
+                   "--out, --emit-jobs or --bench)%s%s", "", "");
+    }
+    if (o->placements && !o->list_places && !o->seeds) {
+        return die("--placements needs --seeds A..B (every seed at every placement) or "
+                   "--list-placements%s%s", "", "");
+    }
+    if (o->place_one && o->seeds) {
+        return die("--placement K is for a single run (a batch at one placement: --placements "
+                   "K..K)%s%s", "", "");
+    }
+    if (drawn && o->bench) {
+        return die("--bench runs the scenario's own placement (no --placements)%s%s", "", "");
+    }
+    if (o->placements && o->seeds && (o->pb - o->pa + 1) * (o->sb - o->sa + 1) > BATCH_MAX_SEEDS) {
+        return die("--placements x --seeds: more than %s runs in one batch%s", "1000000", "");
+    }
+    return RUN;
+}
+
 /* The options that go together, checked: RUN, or the exit status after a message. */
 static int check_options(sim_opts_t *o)
 {
@@ -841,6 +996,9 @@ static int check_options(sim_opts_t *o)
     }
     if (o->pcap && o->seeds) {
         return die("--pcap is for a single run, not --seeds%s%s", "", "");
+    }
+    if (check_placements(o) != RUN) {
+        return 1;
     }
     if (o->jobs < 1) {
         o->jobs = 1;
@@ -970,19 +1128,82 @@ static int emit_jobs(const sim_opts_t *o, const hs_scenario_t *sc)
         return die("cannot resolve the program or scenario path%s%s", "", "");
     }
     self[n] = '\0';
-    for (uint64_t i = 0; i <= o->sb - o->sa; i++) {
-        const uint64_t s = o->sa + i;
-        char p0[48] = "";
+    const uint64_t np = o->placements ? o->pb - o->pa + 1 : 1, ns = o->sb - o->sa + 1;
+    for (uint64_t i = 0; i < np * ns; i++) {
+        const uint64_t s = o->sa + i % ns, k = o->pa + i / ns; /* a batch's order */
+        char p0[48] = "", place[96] = "", dir[64];
         if (!isnan(o->p0_min)) {
             snprintf(p0, sizeof p0, " --p0-min %.17g", o->p0_min);
         }
-        printf("%s %s --seed %llu --out %s/seed-%llu --strategy %s --model %s%s%s", self,
-               scn, (unsigned long long)s, o->out, (unsigned long long)s, sc->strategy, sc->model,
-               o->no_faults ? " --no-faults" : "", p0);
+        snprintf(dir, sizeof dir, "seed-%llu", (unsigned long long)s);
+        if (o->placements) {
+            snprintf(place, sizeof place, " --placement %llu --placement-seed %llu",
+                     (unsigned long long)k, (unsigned long long)o->pseed);
+            snprintf(dir, sizeof dir, "place-%llu-seed-%llu", (unsigned long long)k,
+                     (unsigned long long)s);
+        }
+        printf("%s %s --seed %llu --out %s/%s --strategy %s --model %s%s%s%s", self,
+               scn, (unsigned long long)s, o->out, dir, sc->strategy, sc->model,
+               o->no_faults ? " --no-faults" : "", p0, place);
         printf("%s%s%s%s\n", o->start ? " --start " : "", o->start ? o->start : "",
                o->source ? " --source " : "", o->source ? o->source : "");
     }
     return 0;
+}
+
+/* Placements a..b of seed into *out (malloc'd; every draw checked): 0, or 1 after a message. */
+static int draw_places(const hs_sim_env_t *env, uint64_t seed, uint64_t a, uint64_t b,
+                       hs_place_t **out)
+{
+    char err[1024];
+    hs_placer_t pl;
+    *out = calloc((size_t)(b - a + 1), sizeof **out);
+    if (!*out) {
+        return die("out of memory%s%s", "", "");
+    }
+    int rc = hs_placer_open(&pl, env, err, sizeof err);
+    for (uint64_t k = a; rc == 0 && k <= b; k++) {
+        rc = hs_placer_draw(&pl, seed, k, &(*out)[k - a], err, sizeof err);
+    }
+    hs_placer_close(&pl);
+    if (rc != 0) {
+        free(*out);
+        *out = NULL;
+        lx_err_print(prog, "%s", err);
+        return 1;
+    }
+    return 0;
+}
+
+/* --list-placements: the drawn pairs as a table on stdout. */
+static void list_places(const hs_place_t *pl, uint64_t n)
+{
+    printf("placement\tstart_x_m\tstart_y_m\tstart_theta_rad\tsource_x_m\tsource_y_m\t"
+           "shortest_path_m\tshortest_to_stop_m\n");
+    for (uint64_t i = 0; i < n; i++) {
+        printf("%llu\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%.3f\t%.3f\n", (unsigned long long)pl[i].index,
+               pl[i].start_x, pl[i].start_y, pl[i].start_theta, pl[i].source_x, pl[i].source_y,
+               pl[i].shortest_path_m, pl[i].shortest_to_stop_m);
+    }
+}
+
+/* The environment at placement --placement K (drawn from --placement-seed): RUN, or the
+ * exit status after a message. */
+static int place_env(const sim_opts_t *o, hs_sim_env_t *env)
+{
+    hs_place_t *pl;
+    char err[1024];
+    if (draw_places(env, o->pseed, o->place_one, o->place_one, &pl) != 0) {
+        return 1;
+    }
+    int rc = hs_sim_env_place(env, pl->index, pl->seed, pl->start_x, pl->start_y, pl->start_theta,
+                              pl->source_x, pl->source_y, err, sizeof err);
+    free(pl);
+    if (rc != 0) {
+        lx_err_print(prog, "%s", err);
+        return 1;
+    }
+    return RUN;
 }
 
 /* The runs (one, a batch, or the bench) into a temporary --out directory renamed into
@@ -997,7 +1218,22 @@ static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
         fprintf(stderr, "%s: %s\n", prog, err);
         return 1;
     }
-    if (o->bench) {
+    hs_place_t *places = NULL;
+    if ((o->placements && draw_places(&env, o->pseed, o->pa, o->pb, &places) != 0) ||
+        (o->place_one && place_env(o, &env) != RUN)) {
+        hs_sim_env_close(&env);
+        return 1;
+    }
+    if (o->list_places || o->emit) { /* with placements (without them no environment opens) */
+        if (o->list_places) {
+            list_places(places, o->pb - o->pa + 1);
+        }
+        int erc = o->emit ? emit_jobs(o, sc) : 0;
+        free(places);
+        hs_sim_env_close(&env);
+        return erc;
+    }
+    if (o->bench) { /* never with placements (check_placements) */
         int brc = run_bench(&env, o->sa, o->sb);
         hs_sim_env_close(&env);
         return brc;
@@ -1008,6 +1244,7 @@ static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
         if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", o->out, (long)getpid()) >= (int)sizeof tmp ||
             (o->resume ? rename(o->from, tmp) : mkdir(tmp, 0777)) != 0) {
             fprintf(stderr, "%s: %s: %s\n", prog, o->resume ? o->from : tmp, strerror(errno));
+            free(places);
             hs_sim_env_close(&env);
             return 1;
         }
@@ -1015,7 +1252,8 @@ static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
     int rc;
     if (o->seeds) {
         char header[PATH_MAX + 512];
-        batch_state_header(header, sizeof header, o->scenario, sc, o->sa, o->sb, o->samples);
+        batch_state_header(header, sizeof header, o->scenario, sc, o->sa, o->sb, o->samples,
+                           o->placements ? o->pa : 0, o->pb, o->pseed);
         if (o->out) {
             // Interrupted, the batch leaves a directory --resume continues.
             struct sigaction sa;
@@ -1024,8 +1262,8 @@ static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
             sigaction(SIGINT, &sa, NULL);
             sigaction(SIGTERM, &sa, NULL);
         }
-        rc = run_batch(&env, header, o->sa, o->sb, (int)o->jobs, o->out ? tmp : NULL, o->samples,
-                       o->quiet, o->resume);
+        rc = run_batch(&env, header, o->sa, o->sb, places, o->pb - o->pa + 1, (int)o->jobs,
+                       o->out ? tmp : NULL, o->samples, o->quiet, o->resume);
     } else {
         char msg[1024];
         rc = run_one(&env, o->has_seed ? o->seed : sc->seed, o->out ? tmp : NULL, o->out != NULL,
@@ -1034,6 +1272,7 @@ static int run_scenario(const sim_opts_t *o, const hs_scenario_t *sc)
             lx_err_print(prog, "%s", msg);
         }
     }
+    free(places);
     hs_sim_env_close(&env);
     if (o->out) {
         const bool keep = rc != 0 && o->seeds && (g_stop || o->resume);
@@ -1072,7 +1311,7 @@ static int sim_main(int argc, char **argv)
     if (rc != RUN) {
         return rc;
     }
-    return o.emit ? emit_jobs(&o, &sc) : run_scenario(&o, &sc);
+    return o.emit && !o.placements ? emit_jobs(&o, &sc) : run_scenario(&o, &sc);
 }
 
 int main(int argc, char **argv)

@@ -27,6 +27,15 @@ static inline int ref_touch(double x0, double y0, double x1, double y1, double r
     return !(pos == 4 || neg == 4);
 }
 
+/* Gap in cells along one axis between the closed squares of cells a and b (0 when they
+ * touch or are the same): rfs_map.h's whole-cell legality compares the Euclidean gap
+ * between two squares with the clearance. */
+static inline double ref_cell_gap(int a, int b)
+{
+    int d = abs(a - b);
+    return d > 1 ? d - 1 : 0;
+}
+
 /* Is the lattice step from (ui, uj) to the neighbour (vi, vj) usable: the neighbour legal
  * and the segment between them legal (each test's own double-precision reference)? */
 typedef int (*ref_step_fn)(void *ctx, int ui, int uj, int vi, int vj);

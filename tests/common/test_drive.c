@@ -624,6 +624,33 @@ static void test_goal_after_push(void **state)
     assert_true(hypot(s.x - 2.02, s.y) <= 0.1 + 0.01);
 }
 
+/* The first leg runs from the path's start when it has one: the segment the planner
+ * checked, not the line from wherever the robot stands when the drive takes the path.
+ * The robot starts 8 cm beside the planned start (0, 0), the goal is (6, 0); after 6 s
+ * (about 3.5 m) it is on y = 0 within 1 cm. Without a start (a path built by hand) it
+ * follows its own start's line to the goal, y = 0.08 (1 - x / 6), as before. */
+static void test_first_leg_from_path_start(void **state)
+{
+    (void)state;
+    for (int with = 0; with <= 1; with++) {
+        rfs_drive_t d;
+        sim_t s;
+        start(&d, &s, 0.0, 0.08, 0.0);
+        rfs_path_t p = one_goal(6.0, 0.0);
+        p.has_start = with != 0;
+        p.x0 = 0;
+        p.y0 = 0;
+        rfs_drive_set_path(&d, &p, 0);
+        int64_t end_us;
+        assert_int_equal(run(&d, &s, &p, 6.0, false, &end_us), RFS_DRIVE_RUNNING);
+        double line = with ? 0.0 : 0.08 * (1.0 - s.x / 6.0);
+        print_message("%s start: at x %.3f m, y %.4f m, the leg's line %.4f m\n",
+                      with ? "with" : "without", s.x, s.y, line);
+        assert_true(s.x > 2.5 && s.x < 5.0);
+        assert_true(fabs(s.y - line) < 0.01);
+    }
+}
+
 static void test_init_rejects(void **state)
 {
     (void)state;
@@ -679,6 +706,7 @@ int main(void)
         cmocka_unit_test(test_timeout),
         cmocka_unit_test(test_blocked),
         cmocka_unit_test(test_stop),
+        cmocka_unit_test(test_first_leg_from_path_start),
         cmocka_unit_test(test_init_rejects),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

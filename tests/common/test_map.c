@@ -2,7 +2,7 @@
  *
  * Reference rules (docs/MAPS.md), computed here by brute force in double:
  *  - a cell is legal when no non-free or off-map cell's square comes closer than the
- *    clearance to its centre (the cell itself always counts);
+ *    clearance to its square (the cell itself always counts);
  *  - a segment touches a cell when the closed segment and the closed square intersect
  *    (separating-axis test on the x, y and segment-normal axes, exact in double because
  *    coordinates are Q16 integers below 2^21);
@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "ref_geom.h"
 #include "rfs_map.h"
 
 #define W 48
@@ -87,8 +88,6 @@ static int ref_cell_legal(const fixture_t *f, int cx, int cy)
 {
     double r = f->res / 65536.0;
     double c = f->clr / 65536.0;
-    double px = (cx + 0.5) * r;
-    double py = (cy + 0.5) * r;
     if (!ref_free(f, cx, cy)) {
         return 0;
     }
@@ -97,39 +96,14 @@ static int ref_cell_legal(const fixture_t *f, int cx, int cy)
             if (ref_free(f, x, y)) {
                 continue;
             }
-            double ex = fmax(0.0, fmax(x * r - px, px - (x + 1) * r));
-            double ey = fmax(0.0, fmax(y * r - py, py - (y + 1) * r));
+            double ex = ref_cell_gap(x, cx) * r;
+            double ey = ref_cell_gap(y, cy) * r;
             if (sqrt(ex * ex + ey * ey) < c) {
                 return 0;
             }
         }
     }
     return 1;
-}
-
-/* Closed segment vs closed cell square, in Q16 units relative to the origin (exact). */
-static int ref_touch(const fixture_t *f, double x0, double y0, double x1, double y1, int i, int j)
-{
-    double r = f->res;
-    double bx0 = i * r;
-    double bx1 = (i + 1) * r;
-    double by0 = j * r;
-    double by1 = (j + 1) * r;
-    if (fmax(x0, x1) < bx0 || fmin(x0, x1) > bx1 || fmax(y0, y1) < by0 || fmin(y0, y1) > by1) {
-        return 0;
-    }
-    double dx = x1 - x0;
-    double dy = y1 - y0;
-    double cx[4] = {bx0, bx1, bx0, bx1};
-    double cy[4] = {by0, by0, by1, by1};
-    int pos = 0;
-    int neg = 0;
-    for (int k = 0; k < 4; k++) {
-        double cr = dx * (cy[k] - y0) - dy * (cx[k] - x0);
-        pos += cr > 0;
-        neg += cr < 0;
-    }
-    return !(pos == 4 || neg == 4);
 }
 
 static int ref_legal_cell_grid(const fixture_t *f, int x, int y)
@@ -156,7 +130,7 @@ static int ref_segment_legal(const fixture_t *f, rfs_q16_t x0, rfs_q16_t y0, rfs
     }
     for (int j = -1; j <= H; j++) {
         for (int i = -1; i <= W; i++) {
-            if (ref_touch(f, X0, Y0, X1, Y1, i, j)) {
+            if (ref_touch(X0, Y0, X1, Y1, f->res, i, j)) {
                 int l = (i >= 0 && j >= 0 && i < W && j < H) ? legal_cache[j][i] : 0;
                 if (!l) {
                     return 0;
@@ -207,7 +181,7 @@ static int ref_walls(const fixture_t *f, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x
     double r = f->res;
     for (int j = 0; j < H; j++) {
         for (int i = 0; i < W; i++) {
-            if (ref_touch(f, X0, Y0, X1, Y1, i, j)) {
+            if (ref_touch(X0, Y0, X1, Y1, f->res, i, j)) {
                 hits[n].t = ref_entry(X0, Y0, X1, Y1, i * r, (i + 1) * r, j * r, (j + 1) * r);
                 hits[n].wall = f->wall_c[j][i];
                 n++;
@@ -287,13 +261,13 @@ static void test_map_edges(void **state)
     bits_t *b = all_free();
     rfs_map_t m;
     rfs_map_cfg_t cfg = rfs_map_cfg_default();
-    /* res 0.1 as the loader rounds it (Q16 6554 = 0.100006 m), clearance 0.25 m: cell 2's
-     * centre is 0.250015 m from the edge, so cells 0 and 1 of each border are illegal and
-     * cell 2 is legal. */
+    /* res 0.1 as the loader rounds it (Q16 6554 = 0.100006 m), clearance 0.25 m: cell k's
+     * square is k * 0.100006 m from the edge, so cells 0, 1 and 2 of each border are
+     * illegal and cell 3 is legal. */
     assert_int_equal(rfs_map_init(&m, &cfg, W, H, 6554, 0, 0, b->free, NULL, b->legal), 0);
     for (int x = 0; x < W; x++) {
         for (int y = 0; y < H; y++) {
-            int inside = x >= 2 && y >= 2 && x < W - 2 && y < H - 2;
+            int inside = x >= 3 && y >= 3 && x < W - 3 && y < H - 3;
             assert_int_equal(rfs_map_bit(b->legal, m.stride, (uint16_t)x, (uint16_t)y), inside);
         }
     }
@@ -315,8 +289,8 @@ static void test_unknown_cell(void **state)
     rfs_map_bit_set(b->free, stride, 20, 20, false);
     rfs_map_t m;
     rfs_map_cfg_t cfg = rfs_map_cfg_default();
-    /* res 0.25 exactly, clearance 0.25: the cell's own 8 neighbours come within 0.177 m
-     * or 0.125 m of the centre; the next ring is >= 0.375 m away. */
+    /* res 0.25 exactly, clearance 0.25: the cell's own 8 neighbours touch its square;
+     * the next ring is exactly 0.25 m away, not closer. */
     assert_int_equal(rfs_map_init(&m, &cfg, W, H, RFS_Q16_FRAC(1, 4), 0, 0, b->free, NULL, b->legal),
                      0);
     for (int y = 15; y <= 25; y++) {

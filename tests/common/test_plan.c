@@ -2,8 +2,8 @@
  *
  * The reference: the same lattice (points grid/2 + k*grid from the origin), 8-connected,
  * an edge exists when the straight segment is legal by the brute-force geometry below
- * (closed segment vs closed cell squares, cells legal when no non-free cell comes
- * closer than the clearance to their centre), edge cost the Euclidean length in double.
+ * (closed segment vs closed cell squares, cells legal when no non-free cell's square
+ * comes closer than the clearance to theirs), edge cost the Euclidean length in double.
  * The planner's any-angle path (string pulled) must be legal segment by segment, never
  * shorter than the straight line, and within 6 % of the reference's lattice optimum;
  * reachability must agree exactly.
@@ -51,15 +51,13 @@ static void ref_legal_cells(void)
     for (int cy = 0; cy < H; cy++) {
         for (int cx = 0; cx < W; cx++) {
             int ok = ref_free(cx, cy);
-            double px = (cx + 0.5) * r;
-            double py = (cy + 0.5) * r;
             for (int y = cy - 5; ok && y <= cy + 5; y++) {
                 for (int x = cx - 5; ok && x <= cx + 5; x++) {
                     if (ref_free(x, y)) {
                         continue;
                     }
-                    double ex = fmax(0.0, fmax(x * r - px, px - (x + 1) * r));
-                    double ey = fmax(0.0, fmax(y * r - py, py - (y + 1) * r));
+                    double ex = ref_cell_gap(x, cx) * r;
+                    double ey = ref_cell_gap(y, cy) * r;
                     if (sqrt(ex * ex + ey * ey) < c) {
                         ok = 0;
                     }
@@ -346,10 +344,14 @@ static void test_component(void **state)
             assert_memory_equal(pa.y, pb.y, pa.n * sizeof(pa.y[0]));
             /* Marks that are a union of components but not the start's (the closed
              * room's): nothing may be refused, results the same. */
-            int ri = 34, rj = 10;
-            while (!legal_lattice(ri, rj) && ++ri <= 38) {
+            int ri = 33, rj = 9; /* inside the room, 8..10 m x 2..4 m */
+            while (!legal_lattice(ri, rj) && rj <= 14) {
+                if (++ri > 38) {
+                    ri = 33;
+                    rj++;
+                }
             }
-            assert_true(ri <= 38); /* inside the room, 8..10 m x 2..4 m */
+            assert_true(rj <= 14);
             ref_component(lw, lh, ri, rj);
             if (!(comp_bits[(sj * lw + si) >> 3] >> ((sj * lw + si) & 7) & 1)) {
                 rfs_path_t pc;
@@ -813,10 +815,10 @@ static void test_tree_misuse_and_limits(void **state)
     assert_int_equal(path.n, 0);
     rfs_plan_tree_begin(&p, 2 * m1, 2 * m1);
     assert_true(rfs_plan_tree_path(&p, 2 * m1, 6 * m1, &path));
-    /* Round the wall's end: the cells within 0.25 m of it reach x = 10.7 m, so the path
-     * crosses y 4.0 .. 4.2 m east of that: at least hypot(8.7, 2) + 0.2 + hypot(8.7, 1.8)
+    /* Round the wall's end: the cells within 0.25 m of it reach x = 10.8 m, so the path
+     * crosses y 4.0 .. 4.2 m east of that: at least hypot(8.8, 2) + 0.2 + hypot(8.8, 1.8)
      * m; its waypoints are lattice points (0.25 m apart) there, so at most 0.7 m more. */
-    const double taut = hypot(8.7, 2.0) + 0.2 + hypot(8.7, 1.8);
+    const double taut = hypot(8.8, 2.0) + 0.2 + hypot(8.8, 1.8);
     const double round = path.length / 65536.0;
     print_message("round the wall's end: %.4f m (at least %.4f m)\n", round, taut);
     assert_true(round >= taut && round < taut + 0.7);

@@ -38,8 +38,18 @@ expect cut_record_header 1 "cut_record_header.pcap: truncated dump file.*after 0
 expect missing_file 1 "nonexistent.pcap: cannot read capture: .*No such file" -- "$tmp/nonexistent.pcap" --mac $mac
 # live: the same link-type rule on an interface (loopback: Ethernet framing; without the
 # privilege to capture, the activation error instead), and an interface that does not exist
-expect live_loopback 1 "lo: (link type 1 \(EN10MB\) is not 127|cannot activate interface: .*(ermission|not permitted))" -- lo --live --mac $mac
+expect live_loopback 1 "lo: (link type 1 \(EN10MB\) is not 127 .*: not a monitor-mode interface|cannot activate interface: .*(ermission|not permitted))" -- lo --live --mac $mac
 expect live_no_interface 1 "nosuchif0: cannot activate interface" -- nosuchif0 --live --mac $mac
+# --lcm (publishing to the controller): the same interface errors; a bad URL is refused
+# before the interface is opened; liblcm's own complaint folded into the one line
+expect lcm_no_interface 1 "nosuchif0: cannot activate interface" -- nosuchif0 --live --lcm memq:// --mac $mac
+expect lcm_loopback 1 "lo: (link type 1 \(EN10MB\) is not 127 .*: not a monitor-mode interface|cannot activate interface: .*(ermission|not permitted))" -- lo --live --lcm memq:// --mac $mac
+expect lcm_bad_provider 1 "lcm: foo://: cannot open this provider.*liblcm: .*foo" -- nosuchif0 --live --lcm foo:// --mac $mac
+expect lcm_bad_address 1 "lcm: udpm://300.1.2.3:7667: cannot open this provider" -- nosuchif0 --live --lcm udpm://300.1.2.3:7667 --mac $mac
+expect lcm_newline 1 "lcm: udpm://\?x: cannot open this provider" -- nosuchif0 --live --lcm $'udpm://\nx' --mac $mac
+expect lcm_needs_live 2 "--lcm publishes a live interface: needs --live" -- nosuchif0 --lcm memq:// --mac $mac
+expect lcm_not_with_output 2 "not with --output" -- nosuchif0 --live --lcm memq:// --output "$tmp/x.tsv" --mac $mac
+expect lcm_missing_value 2 "--lcm needs a value" -- nosuchif0 --live --mac $mac --lcm
 # the 11 records of radiotap_lies: each lie counted, 3 usable frames with a signal
 expect radiotap_lies 0 "11 packets, 3 lines; 3 note: a field runs past it_len; 1 skipped: fewer than 8 bytes.*; 1 skipped: radiotap version byte is not 0; 2 skipped: radiotap it_len .*; 1 skipped: radiotap present bitmaps run past it_len; 1 skipped: no 802.11 header; 1 skipped: no source address; 1 skipped: matching source without dBm signal" -- "$gen/bad/radiotap_lies.pcap" --mac $mac --stats
 # (a --mac no frame came from: a warning line and exit 3, the output complete)

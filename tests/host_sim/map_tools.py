@@ -229,9 +229,11 @@ with tempfile.TemporaryDirectory() as d:
         wall = (x0, H - y0 - rh // 2)                   # the room's left wall
         unknown = (10, 10)
         inside = (x0 + rw // 2 + 3, H - y0 - rh // 2 + 3)  # near the room's middle
-        if sb[inside[1]][inside[0]] != 0:
+        def clear(x, y):  # no obstacle within 4 cells: legal at 0.25 m clearance
+            return all(sb[y + j][x + i] == 0 for i in range(-4, 5) for j in range(-4, 5))
+        if not clear(*inside):
             inside = next((x, y) for y in range(H - y0 - rh + 5, H - y0 - 5) for x in range(x0 + 5, x0 + rw - 5)
-                          if all(sb[y + j][x + i] == 0 for i in range(-4, 5) for j in range(-4, 5)))
+                          if clear(x, y))
         check("png-big-colours", block(*wall) == (0, 0, 0) and block(*unknown) == (0xB4, 0xB4, 0xB4) and
               block(*inside) in ((255, 255, 255), (0x8C, 0xB4, 0xEB)),
               f"wall {block(*wall)}, unknown {block(*unknown)}, inside {block(*inside)}")

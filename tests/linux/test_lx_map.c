@@ -1,7 +1,9 @@
 /* test_lx_map.c - the ROS map_server loader and the conversion to the core's grids.
  *
- * Independent references: the cell counts of the three real maps are the table in
- * /work/shared/data/README.md (counted there with a separate PGM reader); orientation
+ * Independent references: the cell counts of the real maps are the table in
+ * /work/shared/data/README.md (counted there with a separate PGM reader) and, for the
+ * floors added since, numpy's (scenarios/maps/README.md); the copies in scenarios/maps
+ * are read (RFS_MAPS_DIR overrides); orientation
  * and thresholds are checked on a 4 x 3 image whose pixel values are written here; the
  * conservative resampling is recomputed here by 2 x 2 blocks on the Willow Garage map.
  * Bad input: every fixture in tests/data/maps_bad gives -1 and one line naming the file;
@@ -25,7 +27,7 @@
 static const char *maps_dir(void)
 {
     const char *d = getenv("RFS_MAPS_DIR");
-    return d != NULL ? d : "/work/shared/data/maps";
+    return d != NULL ? d : "scenarios/maps";
 }
 
 static void load_real(const char *name, lx_map_t *m)
@@ -40,7 +42,8 @@ static void load_real(const char *name, lx_map_t *m)
     assert_int_equal(rc, 0);
 }
 
-/* The README's table: size, resolution, origin, and occupied / free / unknown counts. */
+/* The READMEs' tables: size, resolution, origin, and occupied / free / unknown counts
+ * (the last three by numpy with map_server's trinary rule). */
 static void test_real_maps_counts(void **state)
 {
     (void)state;
@@ -49,12 +52,15 @@ static void test_real_maps_counts(void **state)
         uint32_t w, h;
         double res, ox, oy;
         uint32_t occ, fre, unk;
-    } t[3] = {
+    } t[6] = {
         {"willow-full-0.05.yaml", 1165, 945, 0.05, 0.0, 0.0, 13459, 549308, 538158},
         {"3ne.yaml", 1857, 573, 0.05, -60.45, -23.4, 34019, 456354, 573688},
         {"intel.yaml", 579, 581, 0.1, 0.0, 0.0, 29942, 192948, 113509},
+        {"gdc2.yaml", 1800, 1400, 0.05, -53.95, -29.15, 29525, 472275, 2018200},
+        {"gdc4.yaml", 1857, 1255, 0.05, -60.45, -23.4, 72493, 543112, 1714930},
+        {"house.yaml", 500, 500, 0.05, -12.5, -12.5, 3442, 63021, 183537},
     };
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < 6; k++) {
         lx_map_t m;
         load_real(t[k].yaml, &m);
         assert_int_equal(m.w, t[k].w);

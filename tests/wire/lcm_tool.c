@@ -14,12 +14,17 @@
  *                               5 bytes of garbage on RFS_RSSI_STATUS at 2 s
  *   lcm_tool dump LOG           print each status in a log as
  *                               "STATUS t state left right faults decided"
+ *   lcm_tool pose URL SECONDS   a live pose source: the office map's start (8 m, 6 m,
+ *                               0 rad) on URL at 20 Hz for SECONDS, stamped with the
+ *                               local clock (CLOCK_REALTIME, as rfseekd's live steps)
  */
 #include <inttypes.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "lx_lcm.h"
 
@@ -174,6 +179,41 @@ static int dump(const char *path)
     return 0;
 }
 
+static int64_t realtime_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
+static int pose_live(const char *url, const char *secs)
+{
+    char *end = NULL;
+    const long n = strtol(secs, &end, 10);
+    if (end == secs || *end != '\0' || n < 1 || n > 86400) {
+        fprintf(stderr, "lcm_tool: pose: SECONDS '%s' is not 1..86400\n", secs);
+        return 2;
+    }
+    char err[512];
+    lx_lcm_t *l = lx_lcm_open(url, NULL, err, sizeof err);
+    if (!l) {
+        fprintf(stderr, "lcm_tool: %s\n", err);
+        return 1;
+    }
+    for (long k = 0; k < n * 20; k++) {
+        rfs_pose_t p = {realtime_us(), 8 * 65536, 6 * 65536, 0};
+        if (lx_lcm_pub_pose(l, &p) != 0) {
+            fprintf(stderr, "lcm_tool: pose: LCM refused a pose\n");
+            lx_lcm_close(l);
+            return 1;
+        }
+        const struct timespec tick = {0, 50000000};
+        nanosleep(&tick, NULL);
+    }
+    lx_lcm_close(l);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc == 3 && strcmp(argv[1], "mklog") == 0) {
@@ -186,7 +226,11 @@ int main(int argc, char **argv)
     if (argc == 3 && strcmp(argv[1], "dump") == 0) {
         return dump(argv[2]);
     }
+    if (argc == 4 && strcmp(argv[1], "pose") == 0) {
+        return pose_live(argv[2], argv[3]);
+    }
     fprintf(argc == 2 && strcmp(argv[1], "--help") == 0 ? stdout : stderr,
-            "usage: lcm_tool mklog OUT.lcmlog | lcm_tool mkdeadzone OUT.lcmlog on|off | lcm_tool dump LOG\n");
+            "usage: lcm_tool mklog OUT.lcmlog | lcm_tool mkdeadzone OUT.lcmlog on|off | lcm_tool dump LOG\n"
+            "       lcm_tool pose URL SECONDS\n");
     return argc == 2 && strcmp(argv[1], "--help") == 0 ? 0 : 2;
 }

@@ -71,6 +71,14 @@ expect_err rfseekd-liblcm-two-lines 1 "cannot open this provider.*(liblcm: Warni
     && [ "$(head -1 "$w/err")" = "rfseekd: lcm: file://$PWD/$w/warn.lcmlog?mode=w&foo=1: liblcm: Warning: unrecognized option: [foo]" ] \
     && grep -q "^rfseekd: [0-9]* steps, " "$w/err" && pass rfseekd-liblcm-warning-one-line \
     || fail "rfseekd-liblcm-warning-one-line (rc $rc: $(tr '\n' '|' < "$w/err"))"
+# SIGTERM ends a live run cleanly, wherever it lands (liblcm's wait interrupted is no LCM
+# error): the summary line, exit 0, the log renamed into place.
+"$d" --map $map --lcm memq:// --log "$w/term.lcmlog" > /dev/null 2> "$w/err" &
+pid=$!
+sleep 1
+kill -TERM $pid; wait $pid; rc=$?
+[ $rc -eq 0 ] && [ -s "$w/term.lcmlog" ] && [ ! -e "$w/term.lcmlog.tmp" ] && [ "$(wc -l < "$w/err")" -eq 1 ]     && grep -q "^rfseekd: [0-9]* steps, " "$w/err" && pass "rfseekd-sigterm-clean-exit ($(cut -d, -f1 "$w/err"))" \
+    || fail "rfseekd-sigterm-clean-exit (rc $rc: $(tr '\n' '|' < "$w/err"))"
 expect_err_of "$sl" sim-lcm-liblcm-two-lines 1 "^rfseek-sim-lcm: lcm: file://.*(liblcm: Warning: Invalid value for speed?Error: Failed to open" \
     $scn --lcm "file://$PWD/$w/none.lcmlog?speed=abc" --max-time 1
 # hs_ctrl_lcm's own lines carry the name of the program using it: a malformed

@@ -2,9 +2,12 @@
 #include "rfs_test.h"
 
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/time.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "lx_lcm.h"
@@ -380,6 +383,43 @@ static void receiver_status_matches_reference_bytes_and_rejects_others(void **st
     lx_lcm_close(l);
 }
 
+static volatile sig_atomic_t g_alarms;
+
+static void on_alarm(int sig)
+{
+    (void)sig;
+    g_alarms++;
+}
+
+/* A signal during the wait (SIGTERM to rfseekd) is a timeout, not an LCM error: the
+ * caller's loop then sees its stop flag. The handler is installed without SA_RESTART, as
+ * signal handlers that set a stop flag are. */
+static void signal_during_wait_is_a_timeout(void **state)
+{
+    (void)state;
+    rx_t r;
+    lx_lcm_t *l = open_memq(&r);
+    struct sigaction sa, old;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_alarm;
+    sigemptyset(&sa.sa_mask);
+    assert_int_equal(sigaction(SIGALRM, &sa, &old), 0);
+    const struct itimerval it = {{0, 0}, {0, 20000}}; /* once, after 20 ms */
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    assert_int_equal(setitimer(ITIMER_REAL, &it, NULL), 0);
+
+    const int rc = lx_lcm_handle(l, 2000);
+
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    const double waited = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    assert_int_equal(rc, 0);
+    assert_int_equal(g_alarms, 1);
+    assert_true(waited < 1.0); /* returned at the signal, not at the 2 s timeout */
+    assert_int_equal(sigaction(SIGALRM, &old, NULL), 0);
+    lx_lcm_close(l);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -391,6 +431,7 @@ int main(void)
         cmocka_unit_test(damaged_file_url_is_one_line),
         cmocka_unit_test(status_string_length_checked_before_decoding),
         cmocka_unit_test(receiver_status_matches_reference_bytes_and_rejects_others),
+        cmocka_unit_test(signal_during_wait_is_a_timeout),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -2,6 +2,7 @@
  * lcm-gen types (generated from lcm/<type>.lcm into $(BUILD)/gen at build time). */
 #include "lx_lcm.h"
 
+#include <errno.h>
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
@@ -653,7 +654,13 @@ int lx_lcm_pub_raw(lx_lcm_t *l, int64_t t_us, const char *channel, const void *d
 
 int lx_lcm_handle(lx_lcm_t *l, int timeout_ms)
 {
+    errno = 0;
     int r = lcm_handle_timeout(l->lcm, timeout_ms < 0 ? 0 : timeout_ms);
+    /* liblcm returns select()'s -1 when a signal interrupts the wait: no error, the
+     * caller's loop looks at its stop flag (SIGTERM ends rfseekd cleanly). */
+    if (r < 0 && errno == EINTR) {
+        return 0;
+    }
     return r > 0 ? 1 : (r == 0 ? 0 : -1);
 }
 

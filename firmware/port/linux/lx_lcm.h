@@ -101,7 +101,7 @@ int lx_lcm_pub_can(lx_lcm_t *l, int64_t t_us, const rfs_can_frame_t *f);
 int lx_lcm_pub_raw(lx_lcm_t *l, int64_t t_us, const char *channel, const void *data, size_t len);
 
 /// Wait up to timeout_ms for one message and dispatch it. Returns 1 when one was
-/// handled, 0 on timeout, -1 on an LCM error.
+/// handled, 0 on timeout or when a signal interrupted the wait, -1 on an LCM error.
 int lx_lcm_handle(lx_lcm_t *l, int timeout_ms);
 
 /// Copy the receive counters.

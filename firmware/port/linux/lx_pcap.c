@@ -2,10 +2,13 @@
 #include "lx_pcap.h"
 
 #include <errno.h>
+#include <net/if.h>
+#include <poll.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/ioctl.h>
 
 #include <pcap/pcap.h>
 
@@ -77,7 +80,10 @@ lx_pcap_reader_t *lx_pcap_open_live(const char *ifname, char *err, size_t errlen
     }
     (void)pcap_set_snaplen(p, 65535);
     (void)pcap_set_promisc(p, 1);
-    (void)pcap_set_timeout(p, 100);
+    /* Immediate mode: each frame as it arrives. Buffered (TPACKET_V3) the kernel hands out
+     * a block only once it holds a packet, so a silent channel would never time out and
+     * the reader could not say it is alive (docs/FAULTS.md, "The receiver heartbeat"). */
+    (void)pcap_set_immediate_mode(p, 1);
     (void)pcap_set_tstamp_precision(p, PCAP_TSTAMP_PRECISION_NANO); /* falls back to µs */
     const int rc = pcap_activate(p);
     if (rc < 0) {
@@ -88,6 +94,16 @@ lx_pcap_reader_t *lx_pcap_open_live(const char *ifname, char *err, size_t errlen
     /* A monitor-mode adapter may offer several link types; ask for radiotap. */
     if (pcap_datalink(p) != DLT_IEEE802_11_RADIO) { (void)pcap_set_datalink(p, DLT_IEEE802_11_RADIO); }
     if (check_linktype(p, ifname, err, errlen) != 0) {
+        const size_t n = strlen(err);
+        snprintf(err + n, errlen > n ? errlen - n : 0, ": not a monitor-mode interface (iw dev %s set type monitor)",
+                 ifname);
+        pcap_close(p);
+        return NULL;
+    }
+    /* Non-blocking, waited on with poll() in lx_pcap_next: a bounded wait whatever
+     * libpcap's own timeout does. */
+    if (pcap_setnonblock(p, 1, ebuf) != 0 || pcap_get_selectable_fd(p) < 0) {
+        snprintf(err, errlen, "%s: cannot poll the interface: %s", ifname, ebuf[0] != '\0' ? ebuf : "no descriptor");
         pcap_close(p);
         return NULL;
     }
@@ -103,11 +119,38 @@ lx_pcap_reader_t *lx_pcap_open_live(const char *ifname, char *err, size_t errlen
     return r;
 }
 
+/* A live interface still there and up: 0, or -1 with `err`. libpcap reads on through an
+ * interface taken down (it may come back), but a reader that hears nothing must not go on
+ * saying it listens. */
+static int live_up(const lx_pcap_reader_t *r, char *err, size_t errlen)
+{
+    struct ifreq ifr;
+    memset(&ifr, 0, sizeof(ifr));
+    const size_t n = strnlen(r->name, sizeof(ifr.ifr_name) - 1); /* libpcap took the name: it fits */
+    memcpy(ifr.ifr_name, r->name, n);
+    if (ioctl(pcap_get_selectable_fd(r->p), SIOCGIFFLAGS, &ifr) != 0) {
+        snprintf(err, errlen, "%s: the interface is gone: %s", r->name, strerror(errno));
+        return -1;
+    }
+    if ((ifr.ifr_flags & IFF_UP) == 0) {
+        snprintf(err, errlen, "%s: the interface went down", r->name);
+        return -1;
+    }
+    return 0;
+}
+
 int lx_pcap_next(lx_pcap_reader_t *r, lx_pcap_pkt_t *pkt, char *err, size_t errlen)
 {
     struct pcap_pkthdr *h = NULL;
     const u_char *data = NULL;
-    const int rc = pcap_next_ex(r->p, &h, &data);
+    int rc = pcap_next_ex(r->p, &h, &data);
+    if (rc == 0 && r->live) {
+        /* Nothing buffered: wait for the socket. A timeout or a signal is a timeout; an
+         * error or a hang-up (the interface went away) is read by pcap_next_ex. */
+        struct pollfd pfd = {pcap_get_selectable_fd(r->p), POLLIN, 0};
+        if (poll(&pfd, 1, LX_PCAP_LIVE_TIMEOUT_MS) <= 0) { return live_up(r, err, errlen) != 0 ? -1 : 2; }
+        rc = pcap_next_ex(r->p, &h, &data);
+    }
     if (rc == 1) {
         /* libpcap sign-extends a classic record's 32-bit seconds into time_t and gives a
          * pcapng's 64-bit unsigned seconds (its timestamp divided by if_tsresol, decimal or

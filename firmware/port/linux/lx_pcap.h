@@ -35,13 +35,18 @@ typedef struct lx_pcap_pkt {
 /// damaged file gets NULL and one line in `err` naming the file and the reason.
 lx_pcap_reader_t *lx_pcap_open_offline(const char *path, char *err, size_t errlen);
 
-/// Open a monitor-mode interface live (promiscuous, snaplen 65535, 100 ms read timeout).
-/// Same link-type rule as the offline reader. NULL and `err` on failure.
+/// How long lx_pcap_next() waits on a live interface before it returns 2, milliseconds.
+#define LX_PCAP_LIVE_TIMEOUT_MS 25
+
+/// Open a monitor-mode interface live (promiscuous, snaplen 65535, immediate mode: each
+/// frame as it arrives). Same link-type rule as the offline reader (the message then
+/// says it is not a monitor-mode interface). NULL and `err` on failure.
 lx_pcap_reader_t *lx_pcap_open_live(const char *ifname, char *err, size_t errlen);
 
-/// Read the next packet: 1 = a packet in *pkt, 0 = end of file, 2 = live timeout (no
-/// packet yet), -1 = read error (a truncated record, a timestamp fraction of a second or
-/// more; message in `err`).
+/// Read the next packet: 1 = a packet in *pkt, 0 = end of file, 2 = live: no packet
+/// within LX_PCAP_LIVE_TIMEOUT_MS or a signal came (the interface is still up), -1 = read
+/// error (a truncated record, a timestamp fraction of a second or more, a live interface
+/// down or removed; message in `err`).
 int lx_pcap_next(lx_pcap_reader_t *r, lx_pcap_pkt_t *pkt, char *err, size_t errlen);
 
 /// Close the reader (NULL is fine).

@@ -217,7 +217,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_pathloss: default configuration rejected\n");
         return 1;
     }
-    rfs_model_fit_in_t in = {s, (uint16_t)n, 0, 0, m};
+    rfs_model_fit_in_t in = {.samples = s, .n = (uint16_t)n, .map = m};
     long calls;
     rfs_fit_result_t res = fit_mode(mode, p, &in, n, budget, &r, &calls);
     rfs_q16_t v = 0;

@@ -16,6 +16,9 @@
 #include "rfs_map.h"
 #include "rfs_store.h"
 
+/// Most sources whose own samples a fit sees (rfs_model_fit_in_t.src_samples).
+#define RFS_MODEL_MAX_SOURCES 2u
+
 /// What a model learns from.
 typedef struct rfs_model_fit_in {
     const rfs_sample_t *samples; ///< the stored samples
@@ -23,6 +26,17 @@ typedef struct rfs_model_fit_in {
     rfs_q16_t qx;                ///< query point (robot position) x, metres Q16.16
     rfs_q16_t qy;                ///< query point y, metres Q16.16
     const rfs_map_t *map;        ///< the map (for map-aware models); may be NULL
+    /// One bit per lattice point of map (rfs_reach.h): reachable from the robot; NULL
+    /// when unknown (every legal point counts)
+    const uint8_t *reach;
+    uint8_t nsources;            ///< sources with their own samples below (0: none kept)
+    /// Each source's own samples (its RSSI, dBm Q9.6), for a model fitted per source
+    /// (rfs_fields.h); src_n[i] of them.
+    const rfs_sample_t *src_samples[RFS_MODEL_MAX_SOURCES];
+    uint16_t src_n[RFS_MODEL_MAX_SOURCES]; ///< how many of each
+    /// Samples each source's store was ever offered (rfs_store_t.seen): unchanged with
+    /// src_n, the same samples as at the last fit.
+    uint32_t src_seen[RFS_MODEL_MAX_SOURCES];
 } rfs_model_fit_in_t;
 
 /// Result of one fit call.

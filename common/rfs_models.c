@@ -54,15 +54,16 @@ static int pathloss_init_default(void *state)
  *   four counts) could overrun the budget, resuming the candidate at the next call. */
 static const rfs_models_entry_t k_models[] = {
     {"ridge", &rfs_ridge_ops, (uint32_t)sizeof(rfs_ridge_t), ridge_init_default,
-     "local ridge regression, 5 m radius, alpha 1 (paper 5.2.1)", 2500u},
+     "local ridge regression, 5 m radius, alpha 1 (paper 5.2.1)", 2500u, false},
     {"mlp", &rfs_mlp_ops, (uint32_t)sizeof(rfs_mlp_t), mlp_init_default,
-     "MLP 2-100-1, sigmoid, backprop rate 0.01 momentum 0.1, 3 epochs (paper 5.2.2)", 700u},
+     "MLP 2-100-1, sigmoid, backprop rate 0.01 momentum 0.1, 3 epochs (paper 5.2.2)", 700u, false},
     {"knn", &rfs_knn_ops, (uint32_t)sizeof(rfs_knn_t), knn_init_default,
-     "k-nearest-neighbours regression, k = 5 (paper 5.2)", 2500u},
+     "k-nearest-neighbours regression, k = 5 (paper 5.2)", 2500u, false},
     {"radius", &rfs_radius_ops, (uint32_t)sizeof(rfs_knn_t), radius_init_default,
-     "radius-neighbours regression, r = 1 m (paper 5.2)", 2500u},
+     "radius-neighbours regression, r = 1 m (paper 5.2)", 2500u, false},
     {"pathloss", &rfs_pathloss_ops, (uint32_t)sizeof(rfs_pathloss_t), pathloss_init_default,
-     "map-aware log-distance + walls fit, source search (beyond the paper)", 600u},
+     "map-aware log-distance + walls fit, source search; one per source under bridge "
+     "(beyond the paper)", 600u, true},
 };
 
 #define N_MODELS (sizeof(k_models) / sizeof(k_models[0]))
@@ -112,4 +113,9 @@ uint32_t rfs_models_max_state_bytes(void)
         m = k_models[i].state_bytes > m ? k_models[i].state_bytes : m;
     }
     return m;
+}
+
+bool rfs_models_per_source(const rfs_models_entry_t *e, const rfs_target_ops_t *t)
+{
+    return e != NULL && t != NULL && e->per_source && t->nsources > 1u;
 }

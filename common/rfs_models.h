@@ -5,7 +5,8 @@
  * The caller owns the state: it provides `state_bytes` bytes aligned to 8 (e.g. a
  * static buffer or a union of the state types), calls init_default() on them, and
  * builds the rfs_model_t from `ops` and that buffer. A new model is one more row in
- * the table in rfs_models.c.
+ * the table in rfs_models.c. A model of one source's signal under a target of several
+ * sources is fitted per source instead (rfs_models_per_source(), rfs_fields.h).
  */
 #ifndef RFS_MODELS_H
 #define RFS_MODELS_H
@@ -13,6 +14,7 @@
 #include <stdint.h>
 
 #include "rfs_model.h"
+#include "rfs_target.h"
 
 /// Alignment the state buffer needs, bytes (states hold int64_t fields).
 #define RFS_MODELS_STATE_ALIGN 8u
@@ -34,6 +36,9 @@ typedef struct rfs_models_entry {
     /// sample-update, pathloss: a wall count), so each model has its number. Never 0 (0
     /// would be the whole fit at once).
     uint32_t mcu_fit_budget;
+    /// The model describes one source's signal (a path-loss field): under a target of
+    /// several sources it runs as one fit per source (rfs_models_per_source()).
+    bool per_source;
 } rfs_models_entry_t;
 
 /// The entry named `name` (NUL-terminated, exact match), or NULL when there is none.
@@ -50,5 +55,10 @@ const rfs_models_entry_t *rfs_models_at(uint32_t i);
 
 /// The largest state_bytes of all entries (to size one buffer for any model).
 uint32_t rfs_models_max_state_bytes(void);
+
+/// true when entry e under target t runs as one fit per source: e is per_source and t
+/// combines several sources. The caller then builds an rfs_fields_t (rfs_fields.h: each
+/// source's own fit, the target on the predicted fields) instead of e's own state.
+bool rfs_models_per_source(const rfs_models_entry_t *e, const rfs_target_ops_t *t);
 
 #endif /* RFS_MODELS_H */

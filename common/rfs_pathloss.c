@@ -752,24 +752,38 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
     }
 }
 
-/* Prediction P0 - n 10 log10(max(d, 1 m)) - W walls at (x, y): one logarithm and one wall
- * count. Scaling and overflow: Q16 differences < 2^32, their squares (Q32 m^2) summed in
- * uint64, saturated (sq_sum); n L and W k products < 2^45 in int64, saturated. */
-static bool pathloss_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *value)
+uint32_t rfs_pathloss_walls_to_source(const rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y)
 {
-    const rfs_pathloss_t *p = (const rfs_pathloss_t *)self;
+    RFS_ASSERT(p != 0);
+    if (!p->valid || p->map == 0) {
+        return 0u;
+    }
+    return rfs_pathloss_walls_line(p, x, y, p->best.sx, p->best.sy);
+}
+
+/* Prediction P0 - n 10 log10(max(d, 1 m)) - W walls at (x, y).
+ * Scaling and overflow: Q16 differences < 2^32, their squares (Q32 m^2) summed in
+ * uint64, saturated (sq_sum); n L and W k products < 2^45 in int64, saturated. */
+bool rfs_pathloss_predict_walls(const rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y,
+                                uint32_t walls, rfs_q16_t *value)
+{
+    RFS_ASSERT(p != 0 && value != 0);
     if (!p->valid) {
         return false;
     }
     int64_t dx = (int64_t)x - p->best.sx, dy = (int64_t)y - p->best.sy;
     int64_t L = rfs_pathloss_db_dist(sq_sum(dx, dy));
-    int64_t k = 0;
-    if (p->map != 0) {
-        k = rfs_pathloss_walls_line(p, x, y, p->best.sx, p->best.sy);
-    }
+    int64_t k = p->map != 0 ? (int64_t)walls : 0;
     int64_t v = (int64_t)p->best.p0 - (((int64_t)p->best.n * L + 32768) >> 16) - p->best.w * k;
     *value = rfs_sat32(v);
     return true;
+}
+
+/* One logarithm and one wall count. */
+static bool pathloss_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *value)
+{
+    const rfs_pathloss_t *p = (const rfs_pathloss_t *)self;
+    return rfs_pathloss_predict_walls(p, x, y, rfs_pathloss_walls_to_source(p, x, y), value);
 }
 
 static bool pathloss_argmax(const void *self, rfs_q16_t *x, rfs_q16_t *y)

@@ -320,6 +320,19 @@ rfs_model_t rfs_pathloss_model(rfs_pathloss_t *p);
 /// Operations (also reachable through rfs_pathloss_model()).
 extern const rfs_model_ops_t rfs_pathloss_ops;
 
+/// Walls on the straight line from (x, y) to the estimated source, as predictions count
+/// them (rfs_map_walls_crossed, saturated at 15); 0 without a model or a map. A caller
+/// predicting many points against one source may keep them (rfs_fields.h).
+uint32_t rfs_pathloss_walls_to_source(const rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y);
+
+/// The prediction at (x, y), target units Q16.16, given its walls to the estimated source
+/// (rfs_pathloss_walls_to_source(); ignored without a map): bit for bit the model's
+/// predict() there. false when there is no model.
+/// Scaling and overflow: Q16 differences squared in uint64 (saturated), n L and W k
+/// products < 2^45 in int64, the sum saturated to Q16.16.
+bool rfs_pathloss_predict_walls(const rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y,
+                                uint32_t walls, rfs_q16_t *value);
+
 /// The current estimate; false when there is no model.
 bool rfs_pathloss_estimate(const rfs_pathloss_t *p, rfs_pathloss_est_t *est);
 

@@ -160,9 +160,15 @@ static bool pdr_mean(const rfs_target_in_t *in, rfs_q16_t *value)
     return rfs_rssi_mean(&in->win[0], in->now_us, value);
 }
 
+static rfs_q16_t pdr_combine(const rfs_q16_t *r)
+{
+    return r[0];
+}
+
 const rfs_target_ops_t rfs_target_pdr = {
     .name = "pdr",
     .nsources = 1u,
     .sample = pdr_sample,
     .mean = pdr_mean,
+    .combine = pdr_combine,
 };

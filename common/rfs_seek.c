@@ -12,6 +12,8 @@
 
 /* ln(9/4) / 5 in Q16.16: epsilon(5) = 0.9 e^(-5a) + 0.1 = 0.5 (paper section 2). */
 #define EPS_RATE_PAPER ((rfs_q16_t)10629)
+_Static_assert(RFS_MODEL_MAX_SOURCES == RFS_TARGET_MAX_SOURCES,
+               "a fit sees every source a target combines");
 /* Wait before deciding again after no goal could be found, microseconds (one window). */
 #define NO_GOAL_RETRY_US 1000000
 
@@ -40,6 +42,9 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.recheck_adapt = false;                /* one fixed threshold */
     c.eps_geodesic = false;                 /* epsilon weights by straight distance */
     c.eps_sample = false;                   /* and epsilon goals at random, not drawn */
+    c.settle_dist = 0;                      /* epsilon anneals to eps_floor, never 0 */
+    c.src_spacing = 0;
+    c.src_floor = INT32_MIN;
     return c;
 }
 
@@ -64,6 +69,15 @@ static const rfs_seek_strategy_ops_t k_strategies[RFS_SEEK_STRATEGY_COUNT] = {
 const rfs_seek_strategy_ops_t *rfs_seek_ops(const rfs_seek_t *s)
 {
     return &k_strategies[s->cfg.strategy];
+}
+
+void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg)
+{
+    RFS_ASSERT(cfg != 0);
+    cfg->src_spacing = RFS_Q16_FRAC(1, 25); /* 4 cm: a third of the 12.5 cm wavelength */
+    cfg->src_floor = RFS_Q16_INT(-100);     /* radiotap receivers report down to -100 dBm */
+    /* Two thirds of the bridging scenarios' 150 m (docs/STRATEGIES.md, "Bridging"). */
+    cfg->settle_dist = RFS_Q16_INT(100);
 }
 
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy)
@@ -127,7 +141,8 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         cfg->novelty_radius < 0 || cfg->pose_timeout_us <= 0 || cfg->rssi_timeout_us <= 0 ||
         (uint32_t)cfg->strategy >= (uint32_t)RFS_SEEK_STRATEGY_COUNT ||
         cfg->tumble_better < 0 || cfg->tumble_better > RFS_Q16_ONE || cfg->tumble_worse < 0 ||
-        cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0) {
+        cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0 || cfg->settle_dist < 0 ||
+        cfg->src_spacing < 0) {
         return -1;
     }
     if (model.ops == 0 || model.ops->fit == 0 || model.ops->predict == 0 ||
@@ -150,7 +165,8 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
             return -1;
         }
     }
-    if (rfs_store_init(&s->store, &cfg->store, mem->samples, mem->pending, mem->pending_cap) != 0 ||
+    if (!rfs_seek_src_init(s, mem) ||
+        rfs_store_init(&s->store, &cfg->store, mem->samples, mem->pending, mem->pending_cap) != 0 ||
         rfs_plan_init(&s->plan, map, mem->plan_work, mem->plan_work_bytes, mem->plan_queue,
                       mem->plan_queue_cap) != 0 ||
         rfs_drive_init(&s->drive, &cfg->drive) != 0) {
@@ -179,6 +195,9 @@ bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
         return false;
     }
     (void)rfs_store_add_pose(&s->store, pose, rng);
+    if (s->src != 0) {
+        rfs_seek_src_on_pose(s, pose, rng);
+    }
     s->pose = *pose;
     s->have_pose = true;
     rfs_seek_meta_visit(s, pose->x, pose->y);
@@ -202,6 +221,9 @@ bool rfs_seek_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm, rfs_
     rfs_q16_t v;
     if (s->target->sample(&in, src, dbm, &v)) {
         rfs_store_add_value(&s->store, t_us, v, rng);
+    }
+    if (s->src != 0) {
+        rfs_seek_src_on_rssi(s, src, t_us, dbm, rng);
     }
     return true;
 }
@@ -314,9 +336,8 @@ static bool recheck_fails(rfs_seek_t *s, int64_t now_us)
         return false;
     }
     count_travel(s);
-    rfs_target_in_t in = { s->win, s->target->nsources, now_us };
     rfs_q16_t mean, pred;
-    if (!s->target->mean(&in, &mean) ||
+    if (!rfs_seek_src_mean(s, now_us, &mean) ||
         !s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &pred)) {
         return false;
     }
@@ -384,7 +405,15 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
  * periods: the wheels stay stopped meanwhile. */
 static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
 {
-    rfs_model_fit_in_t fin = { s->store.samples, s->store.count, s->pose.x, s->pose.y, s->map };
+    rfs_model_fit_in_t fin = { .samples = s->store.samples, .n = s->store.count,
+                               .qx = s->pose.x, .qy = s->pose.y, .map = s->map,
+                               .reach = s->reach_valid ? s->reach : 0 };
+    for (uint8_t i = 0; s->src != 0 && i < s->target->nsources; ++i) {
+        fin.src_samples[i] = s->src[i].store.samples;
+        fin.src_n[i] = s->src[i].store.count;
+        fin.src_seen[i] = s->src[i].store.seen;
+        fin.nsources = (uint8_t)(i + 1u);
+    }
     rfs_fit_result_t r = s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng);
     if (r == RFS_FIT_MORE) {
         s->state = RFS_SEEK_LEARNING;
@@ -408,8 +437,7 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     d->y = s->pose.y;
     d->samples = s->store.count;
     count_travel(s);
-    rfs_target_in_t in = { s->win, s->target->nsources, now_us };
-    d->mean_valid = s->target->mean(&in, &d->mean);
+    d->mean_valid = rfs_seek_src_mean(s, now_us, &d->mean);
     if (!ops->learns) {
         end_decision(s, ops->choose(s, false, rng, now_us), now_us, out);
         return;
@@ -422,6 +450,7 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
         relearn = rfs_q16_abs(rfs_q16_sub(d->mean, d->prediction)) > s->cfg.error_threshold;
     }
     relearn = relearn || ops->refit;
+
     if (relearn && s->store.count > 0u) {
         d->relearned = true;
         s->model.ops->reset(s->model.self);

@@ -84,7 +84,31 @@ typedef struct rfs_seek_cfg {
                                 ///< greedy leg; the novelty draw instead when the draw is
                                 ///< within 1.5 steps of the robot or where it has been, or
                                 ///< the robot stands within 1.5 steps of the model's argmax
+    rfs_q16_t settle_dist;      ///< after this much travel every choice is greedy (epsilon
+                                ///< 0): the robot goes to the model's best point and stays
+                                ///< there, metres Q16.16 (0: never, the paper's)
+    rfs_q16_t src_spacing;      ///< per-source stores (rfs_seek_mem_t.src_samples): a
+                                ///< source's sample is the mean of its packets since the
+                                ///< robot last moved this far, metres Q16.16 (0: one sample
+                                ///< per packet)
+    rfs_q16_t src_floor;        ///< with src_spacing: a source not heard for one averaging
+                                ///< window while another is gets a sample of this value at
+                                ///< every src_spacing of travel, dBm Q16.16 (INT32_MIN: none)
 } rfs_seek_cfg_t;
+
+/// One source's own samples, for a model fitted per source (rfs_seek_mem_t.src): its store
+/// and the running mean src_spacing builds. Caller-owned.
+typedef struct rfs_seek_src {
+    rfs_store_t store;   ///< the source's RSSI samples, dBm
+    int32_t sum;         ///< src_spacing: dBm summed since its last sample
+    uint16_t cnt;        ///< packets in sum
+    bool at;             ///< x and y are valid
+    rfs_q16_t x;         ///< robot x at its last sample, metres Q16.16
+    rfs_q16_t y;         ///< robot y there, metres Q16.16
+    bool heard;          ///< heard_us and first_us are valid
+    int64_t heard_us;    ///< its latest packet, microseconds
+    int64_t first_us;    ///< its first packet, microseconds
+} rfs_seek_src_t;
 
 /// Caller-owned memory for the seeker's large arrays.
 typedef struct rfs_seek_mem {
@@ -99,6 +123,13 @@ typedef struct rfs_seek_mem {
     uint32_t visited_bytes;    ///< its size, rfs_reach_bytes(map) = (lw * lh + 7) / 8
     uint8_t *reach;            ///< one bit per lattice point: reachable from the robot's position
     uint32_t reach_bytes;      ///< its size, rfs_reach_bytes(map)
+    /// Optional (NULL: none), for a model fitted per source (rfs_fields.h): one state per
+    /// source of the target, whose store holds cfg.store.capacity samples in src_samples[i]
+    /// and pending_cap pending measurements in src_pending[i]. The seeker then also keeps
+    /// each source's RSSI as samples.
+    rfs_seek_src_t *src;
+    rfs_sample_t *src_samples[RFS_TARGET_MAX_SOURCES]; ///< the stores' sample arrays
+    rfs_pending_t *src_pending[RFS_TARGET_MAX_SOURCES]; ///< their pending rings
 } rfs_seek_mem_t;
 
 /// Why an iteration chose its goal.
@@ -179,6 +210,8 @@ typedef struct rfs_seek {
     const rfs_target_ops_t *target;           ///< the target function
     rfs_rssi_t win[RFS_SEEK_MAX_SOURCES];     ///< 1 s windows per source
     rfs_store_t store;                        ///< samples
+    rfs_seek_src_t *src;                      ///< each source's own samples (rfs_seek_mem_t.src),
+                                              ///< NULL: none
     rfs_plan_t plan;                          ///< planner
     rfs_drive_t drive;                        ///< drive control
     uint8_t *visited;                         ///< novelty bits, one per lattice point
@@ -236,9 +269,13 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 /// paper's (0, false) for every other strategy.
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 
+/// The settings for a model fitted per source (rfs_fields.h; docs/STRATEGIES.md,
+/// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m.
+void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg);
+
 /// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array
-/// is missing or too small for the map's lattice, or the target needs more sources than
-/// RFS_SEEK_MAX_SOURCES.
+/// is missing or too small for the map's lattice, the target needs more sources than
+/// RFS_SEEK_MAX_SOURCES, or per-source stores are given for some of its sources only.
 int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map,
                   rfs_model_t model, const rfs_target_ops_t *target, const rfs_seek_mem_t *mem);
 

@@ -77,6 +77,23 @@ bool rfs_seek_meta_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool known,
 bool rfs_seek_meta_path_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool known,
                              rfs_rng_t *rng, int64_t now_us);
 
+/* ---- rfs_seek_src.c: each source's own samples, for a model fitted per source ------ */
+
+/* Take mem->src (every source's state and arrays, or none): false when only some are given
+ * or a store is rejected. */
+bool rfs_seek_src_init(rfs_seek_t *s, const rfs_seek_mem_t *mem);
+
+/* A pose: into every source's store, and src_floor's samples for silent sources. */
+void rfs_seek_src_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng);
+
+/* A packet of source src: into its running mean and, every src_spacing, its store. */
+void rfs_seek_src_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm,
+                          rfs_rng_t *rng);
+
+/* The target of the 1 s means (the relearn check's); with per-source samples and
+ * src_floor, a source without a mean while another has one counts as the floor. */
+bool rfs_seek_src_mean(rfs_seek_t *s, int64_t now_us, rfs_q16_t *mean);
+
 /* ---- rfs_seek_baseline.c: the baselines' choose functions -------------------------- */
 
 /* fd-gradient: probes at p + step x and p + step y, then a step along the difference. */

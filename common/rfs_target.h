@@ -2,9 +2,10 @@
  *
  * A target turns per-source measurements into one scalar. Each packet gives one sample
  * (the packet's own value for its source, the 1 s means for the others), and the relearn
- * check compares the model with the target of the 1 s means. Built in: the RSSI of one
- * source, and the bridging target f = -|R1 - R2| - |R1 + R2| (paper section 6). A new
- * metric is one more rfs_target_ops_t.
+ * check compares the model with the target of the 1 s means; combine() gives the target
+ * of any per-source values (a model fitted per source predicts those). Built in: the
+ * RSSI of one source, and the bridging target f = -|R1 - R2| - |R1 + R2| (paper section
+ * 6). A new metric is one more rfs_target_ops_t.
  */
 #ifndef RFS_TARGET_H
 #define RFS_TARGET_H
@@ -34,6 +35,10 @@ typedef struct rfs_target_ops {
     bool (*sample)(const rfs_target_in_t *in, uint8_t src, int8_t dbm, rfs_q16_t *value);
     /// Value of the 1 s means (for the relearn check). false when a mean is missing.
     bool (*mean)(const rfs_target_in_t *in, rfs_q16_t *value);
+    /// The target of one value per source, r[0..nsources-1] (dBm Q16.16): what sample and
+    /// mean compute from their inputs, and what a model fitted per source evaluates on
+    /// its predicted fields (rfs_fields.h).
+    rfs_q16_t (*combine)(const rfs_q16_t *r);
 } rfs_target_ops_t;
 
 /// Single-source RSSI, dBm.

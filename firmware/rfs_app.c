@@ -69,6 +69,8 @@ static int app_model_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, rfs_model_t *m
     return cfg->model->init_default(state);
 }
 
+_Static_assert(RFS_TARGET_MAX_SOURCES == 2u, "the seeker memory lists two sources' stores");
+
 int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *map)
 {
     if (a == NULL || cfg == NULL || map == NULL || map->free == NULL) {
@@ -95,8 +97,8 @@ int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *ma
     if (lattice > RFS_APP_MAX_LATTICE || cfg->seek.store.capacity > RFS_APP_MAX_SAMPLES) {
         return -1;
     }
-    rfs_model_t model;
-    if (app_model_init(a, cfg, &model) != 0) {
+    rfs_model_t model = cfg->built;
+    if (model.ops == NULL && app_model_init(a, cfg, &model) != 0) {
         return -1;
     }
     rfs_rng_seed(&a->rng, cfg->seed);
@@ -112,6 +114,9 @@ int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *ma
         .visited_bytes = (uint32_t)sizeof a->visited,
         .reach = a->reach,
         .reach_bytes = (uint32_t)sizeof a->reach,
+        .src = cfg->src,
+        .src_samples = {cfg->src_samples[0], cfg->src_samples[1]},
+        .src_pending = {cfg->src_pending[0], cfg->src_pending[1]},
     };
     const rfs_target_ops_t *target =
         cfg->target == RFS_APP_TARGET_BRIDGE ? &rfs_target_bridge : &rfs_target_rssi;

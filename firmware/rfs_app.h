@@ -115,6 +115,16 @@ typedef struct rfs_app_cfg {
     uint64_t seed;              ///< seed of the random source (epsilon moves, reservoir)
     int64_t input_timeout_us;   ///< zero wheels when nothing was received for this long (150 ms)
     uint8_t node_id;            ///< this controller's id in the status frame
+    /// Optional (ops NULL: none): a model the port built on its own memory, used instead
+    /// of `model` and its state: one fit per source (rfs_fields.h, the `pathloss` entry
+    /// under the bridging target), with each source's own store below (the Linux port;
+    /// the STM32 image has the memory for none, docs/FIRMWARE.md).
+    rfs_model_t built;
+    /// With `built`: each source's own samples (rfs_seek_mem_t.src), its store of
+    /// seek.store.capacity samples and RFS_APP_PENDING pending measurements; NULL: none.
+    rfs_seek_src_t *src;
+    rfs_sample_t *src_samples[RFS_TARGET_MAX_SOURCES]; ///< the stores' sample arrays
+    rfs_pending_t *src_pending[RFS_TARGET_MAX_SOURCES]; ///< their pending rings
     /// true (rfs_app_cfg_mcu()): rfs_app_init() replaces seek.fit_budget by the configured
     /// model's registry budget (mcu_fit_budget; RFS_APP_MCU_FIT_BUDGET for a NULL model),
     /// so a port that sets `model` after taking the MCU defaults gets that model's slice

@@ -21,6 +21,8 @@ typedef struct inproc {
     rfs_seek_t seek;
     void *model_state; // rfs_models_max_state_bytes(), aligned to RFS_MODELS_STATE_ALIGN
     void *wall_cache;  // the path-loss model's attached wall-count cache, or NULL
+    rfs_fields_t *fields; // one fit per source (rfs_models_per_source()), else NULL
+    rfs_fields_mem_t fmem;
     rfs_rng_t rng;
     rfs_seek_mem_t mem;
 } inproc_t;
@@ -80,12 +82,28 @@ static const rfs_pathloss_t *ip_pathloss(void *self)
                                                   : NULL;
 }
 
+static const rfs_fields_t *ip_fields(void *self)
+{
+    inproc_t *p = self;
+    return p->fields;
+}
+
 static void ip_close(void *self)
 {
     inproc_t *p = self;
     if (!p) {
         return;
     }
+    free(p->mem.src);
+    for (unsigned k = 0; k < RFS_TARGET_MAX_SOURCES; k++) {
+        free(p->mem.src_samples[k]);
+        free(p->mem.src_pending[k]);
+        free(p->fmem.walls[k]);
+        free(p->fmem.rsum[k]);
+        free(p->fmem.rcount[k]);
+    }
+    free(p->fmem.f);
+    free(p->fields);
     free(p->mem.samples);
     free(p->mem.pending);
     free(p->mem.plan_work);
@@ -95,6 +113,40 @@ static void ip_close(void *self)
     free(p->model_state);
     free(p->wall_cache);
     free(p);
+}
+
+/* One path-loss fit per source (rfs_fields.h) and each source's own sample store. */
+static int open_fields(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, const rfs_map_t *map,
+                       const rfs_target_ops_t *target)
+{
+    rfs_fields_cfg_t fc = rfs_fields_cfg_default();
+    if (!isnan(cfg->p0_min_dbm)) {
+        fc.pathloss.p0_min = (rfs_q16_t)lround(fmax(-200.0, fmin(100.0, cfg->p0_min_dbm)) * 65536.0);
+    }
+    uint32_t points, cells;
+    rfs_fields_mem_size(map, &fc, &points, &cells);
+    p->fmem.points = points;
+    p->fmem.cells = cells;
+    p->fmem.f = calloc(points, sizeof(int16_t));
+    p->mem.src = calloc(target->nsources, sizeof(rfs_seek_src_t));
+    bool ok = p->fmem.f != NULL && p->mem.src != NULL;
+    for (unsigned k = 0; k < target->nsources && k < RFS_TARGET_MAX_SOURCES; k++) {
+        p->fmem.walls[k] = calloc(points, 1);
+        p->fmem.rsum[k] = calloc(cells, sizeof(int32_t));
+        p->fmem.rcount[k] = calloc(cells, sizeof(uint16_t));
+        p->mem.src_samples[k] = calloc(cfg->seek.store.capacity ? cfg->seek.store.capacity : 1,
+                                       sizeof(rfs_sample_t));
+        p->mem.src_pending[k] = calloc(p->mem.pending_cap, sizeof(rfs_pending_t));
+        ok = ok && p->fmem.walls[k] && p->fmem.rsum[k] && p->fmem.rcount[k] &&
+             p->mem.src_samples[k] && p->mem.src_pending[k];
+    }
+    p->fields = aligned_alloc(RFS_MODELS_STATE_ALIGN,
+                              (sizeof(rfs_fields_t) + RFS_MODELS_STATE_ALIGN - 1u) /
+                                  RFS_MODELS_STATE_ALIGN * RFS_MODELS_STATE_ALIGN);
+    if (!ok || !p->fields) {
+        return -1;
+    }
+    return rfs_fields_init(p->fields, &fc, target, &p->fmem);
 }
 
 int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs_map_t *map,
@@ -191,7 +243,19 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
         }
     }
     rfs_model_t model = {me->ops, p->model_state};
-    if (rfs_seek_init(&p->seek, &cfg->seek, map, model, target, &p->mem) != 0) {
+    if (rfs_models_per_source(me, target)) {
+        if (open_fields(p, cfg, map, target) != 0) {
+            ip_close(p);
+            snprintf(err, errlen, "model: %s per source: out of memory or rejected", cfg->model);
+            return -1;
+        }
+        model = rfs_fields_model(p->fields);
+    }
+    rfs_seek_cfg_t scfg = cfg->seek;
+    if (p->fields) {
+        rfs_seek_cfg_per_source(&scfg);
+    }
+    if (rfs_seek_init(&p->seek, &scfg, map, model, target, &p->mem) != 0) {
         ip_close(p);
         snprintf(err, errlen, "controller: the core rejected the seeker configuration");
         return -1;
@@ -207,6 +271,7 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
     c->predict = ip_predict;
     c->close = ip_close;
     c->pathloss = ip_pathloss;
+    c->fields = ip_fields;
     return 0;
 }
 

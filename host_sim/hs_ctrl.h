@@ -21,6 +21,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "rfs_fields.h"
 #include "rfs_pathloss.h"
 #include "rfs_seek.h"
 
@@ -50,6 +51,9 @@ typedef struct hs_ctrl {
     /// Optional (may be NULL): the path-loss model's state when the controller's model is
     /// "pathloss" (estimate and residual surface for logs and plots), else NULL.
     const rfs_pathloss_t *(*pathloss)(void *self);
+    /// Optional (may be NULL): the per-source fits when the controller's model runs as one
+    /// fit per source (rfs_models_per_source(): pathloss under bridge), else NULL.
+    const rfs_fields_t *(*fields)(void *self);
 } hs_ctrl_t;
 
 /// Configuration of the in-process controller over rfs_seek.

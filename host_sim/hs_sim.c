@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "hs_bridge.h"
 #include "hs_motor.h"
 #include "hs_radio.h"
 #include "hs_box2d.h"
@@ -409,6 +410,7 @@ typedef struct sim_run {
     size_t ntrail, trail_cap;    /* seconds recorded, room (0 after a failed allocation) */
     double drift_x, drift_y;     /* AMCL-like localisation error: bounded drift, metres */
     double jump_x, jump_y;       /* ... and the decaying rest of the last jump, metres */
+    hs_bridge_track_t track;     /* target bridge: positions along the travel */
 } sim_run_t;
 
 /* The robot's motion over one physics tick (t, t1], interpolated for the events in it. */
@@ -432,6 +434,7 @@ enum { EV_PACKET = 0, EV_POSE = 1, EV_CTRL = 2 };
 static void run_close(sim_run_t *r)
 {
     free(r->trail);
+    hs_bridge_track_free(&r->track);
     free(r->pdr);
     hs_radio_destroy(r->radio);
     hs_box2d_destroy(r->world);
@@ -814,6 +817,33 @@ static double still_s(const sim_run_t *r)
     return end_s;
 }
 
+/* The bridging figures (hs_bridge.h) and the model's predicted best point. */
+static void bridge_result(sim_run_t *r)
+{
+    hs_sim_result_t *res = r->res;
+    const hs_sim_env_t *e = r->e;
+    if (!hs_bridge_best(r->radio, &e->core.map, r->sc->start_x, r->sc->start_y, e->x0, e->y0,
+                        e->x1, e->y1, &res->best_x, &res->best_y, &res->best_f_db)) {
+        res->best_x = res->best_y = res->best_f_db = NAN;
+    }
+    res->settle_f_db = hs_bridge_f(r->radio, r->px, r->py);
+    res->settle_error_m = hypot(r->px - res->best_x, r->py - res->best_y);
+    res->settle_travel_m = hs_bridge_settle_travel(&r->track, r->px, r->py);
+    const rfs_fields_t *fl = r->ctrl->fields ? r->ctrl->fields(r->ctrl->self) : NULL;
+    rfs_fields_est_t est;
+    res->pred_valid = fl && rfs_fields_estimate(fl, &est);
+    if (res->pred_valid) {
+        res->pred_x = q16d(est.x);
+        res->pred_y = q16d(est.y);
+        res->pred_f_db = q16d(est.value);
+        res->pred_sigma_db = q16d(est.sigma);
+        res->pred_area_m2 = q16d(est.area_m2);
+    } else {
+        res->pred_x = res->pred_y = res->pred_f_db = res->pred_sigma_db = NAN;
+        res->pred_area_m2 = NAN;
+    }
+}
+
 /* The result of a run that ended for reason end. */
 static void run_result(sim_run_t *r, const char *end)
 {
@@ -840,6 +870,9 @@ static void run_result(sim_run_t *r, const char *end)
     res->start_theta = r->sc->start_theta;
     res->source_x = r->sc->src[0].x;
     res->source_y = r->sc->src[0].y;
+    if (res->bridge) {
+        bridge_result(r);
+    }
     if (r->io && r->io->residual) {
         write_residual(r->io->residual, r->ctrl);
     }
@@ -851,6 +884,7 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     double t_wall0 = now_s(), t_cpu0 = cpu_s();
     memset(res, 0, sizeof *res);
     res->seed = seed;
+    res->bridge = strcmp(e->sc.target, "bridge") == 0;
     sim_run_t r;
     memset(&r, 0, sizeof r);
     r.e = e;
@@ -873,6 +907,11 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
         r.travelled += k.seg;
         r.px = k.nx;
         r.py = k.ny;
+        if (res->bridge && !hs_bridge_track_add(&r.track, r.px, r.py, r.travelled)) {
+            run_close(&r);
+            snprintf(err, errlen, "%s: out of memory", e->sc.path);
+            return -1;
+        }
         r.pth = k.nth;
         r.t = k.t1;
         if (r.t >= (int64_t)r.ntrail * 1000000) {
@@ -1044,19 +1083,34 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
     json_num(f, "belief_x_m", r->belief_x, false);
     json_num(f, "belief_y_m", r->belief_y, false);
     json_num(f, "belief_error_m", r->belief_error_m, false);
-    json_num(f, "still_s", r->still_s, true);
+    json_num(f, "still_s", r->still_s, !r->bridge);
+    if (r->bridge) {
+        // Bridging (hs_bridge.h): the true f's best point, the settle point, the estimate.
+        json_num(f, "best_x_m", r->best_x, false);
+        json_num(f, "best_y_m", r->best_y, false);
+        json_num(f, "best_f_db", r->best_f_db, false);
+        json_num(f, "settle_f_db", r->settle_f_db, false);
+        json_num(f, "settle_error_m", r->settle_error_m, false);
+        json_num(f, "settle_travel_m", r->settle_travel_m, false);
+        json_num(f, "pred_x_m", r->pred_valid ? r->pred_x : NAN, false);
+        json_num(f, "pred_y_m", r->pred_valid ? r->pred_y : NAN, false);
+        json_num(f, "pred_f_db", r->pred_valid ? r->pred_f_db : NAN, false);
+        json_num(f, "pred_sigma_db", r->pred_valid ? r->pred_sigma_db : NAN, false);
+        json_num(f, "pred_area_m2", r->pred_valid ? r->pred_area_m2 : NAN, true);
+    }
     fprintf(f, "}\n");
 }
 
-void hs_sim_table_header(FILE *f, bool placed)
+void hs_sim_table_header(FILE *f, bool placed, bool bridge)
 {
     fprintf(f, "%sseed\treached\tend\tsim_time_s\tdistance_travelled_m\tshortest_path_m\t"
                "shortest_to_stop_m\tfinal_distance_m\tfinal_x_m\tfinal_y_m\titerations\t"
                "model_updates\tgreedy\tepsilon\tpackets_sent\tpackets_received\t"
-               "goal_timeouts\tgoal_blocked\tturn_time_s\twall_contacts%s\n",
+               "goal_timeouts\tgoal_blocked\tturn_time_s\twall_contacts%s%s\n",
             placed ? "placement\t" : "",
             placed ? "\tstart_x_m\tstart_y_m\tstart_theta_rad\tsource_x_m\tsource_y_m"
-                     "\test_error_m\tbelief_error_m\tstill_s" : "");
+                     "\test_error_m\tbelief_error_m\tstill_s" : "",
+            bridge ? "\t" HS_SIM_BRIDGE_COLUMNS : "");
 }
 
 /// %.3f, or "nan" for a value that does not exist (no goal).
@@ -1093,6 +1147,17 @@ void hs_sim_table_row(FILE *f, const hs_sim_result_t *r, bool placed)
         tsv_num(f, r->est_valid ? r->est_error_m : NAN);
         tsv_num(f, r->belief_error_m);
         tsv_num(f, r->still_s);
+    }
+    if (r->bridge) {
+        const double v[] = {r->best_x, r->best_y, r->best_f_db, r->settle_f_db,
+                            r->settle_error_m, r->settle_travel_m,
+                            r->pred_valid ? r->pred_x : NAN, r->pred_valid ? r->pred_y : NAN,
+                            r->pred_valid ? r->pred_f_db : NAN,
+                            r->pred_valid ? r->pred_sigma_db : NAN,
+                            r->pred_valid ? r->pred_area_m2 : NAN};
+        for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) {
+            tsv_num(f, v[i]);
+        }
     }
     fputc('\n', f);
 }

@@ -95,6 +95,19 @@ typedef struct hs_sim_result {
     uint64_t placement;          ///< from hs_sim_env_t (0: the scenario's own start and source)
     double start_x, start_y, start_theta; ///< the run's start, metres, radians
     double source_x, source_y;   ///< the first source, metres
+    /// A bridging run (target bridge; hs_bridge.h): the fields below, else they are unset.
+    bool bridge;
+    double best_x, best_y;       ///< best point of the true f the robot can reach, metres
+    double best_f_db;            ///< the true f there, dB (NaN: no such point)
+    double settle_f_db;          ///< the true f at the final position, dB
+    double settle_error_m;       ///< final position to the best point, metres
+    double settle_travel_m;      ///< travel to settle (hs_bridge_settle_travel), metres
+    /// The model's predicted best point (rfs_fields_estimate); false for other models.
+    bool pred_valid;
+    double pred_x, pred_y;       ///< predicted best point, metres
+    double pred_f_db;            ///< predicted f there, dB
+    double pred_sigma_db;        ///< its uncertainty (rfs_fields_est_t.sigma), dB
+    double pred_area_m2;         ///< area predicted within sigma of the best, m^2
 } hs_sim_result_t;
 
 /// The radius of hs_sim_result_t.still_s, metres: the robot "parked" at its end point.
@@ -149,10 +162,17 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
 
 /// Header line of the batch table (TSV; scripts/merge_runs.py writes the same); `placed`:
 /// the table of a batch over drawn placements (a placement column first, the start, the
-/// source and the end-of-run belief and parking columns last).
-void hs_sim_table_header(FILE *f, bool placed);
+/// source and the end-of-run belief and parking columns after the others); `bridge`: the
+/// bridging columns (HS_SIM_BRIDGE_COLUMNS) last.
+void hs_sim_table_header(FILE *f, bool placed, bool bridge);
 
-/// One row of the batch table ("nan" where a value does not exist).
+/// One row of the batch table ("nan" where a value does not exist), with the bridging
+/// columns for a bridging run.
 void hs_sim_table_row(FILE *f, const hs_sim_result_t *r, bool placed);
+
+/// The batch table's columns of a bridging run, after the others.
+#define HS_SIM_BRIDGE_COLUMNS "best_x_m\tbest_y_m\tbest_f_db\tsettle_f_db\tsettle_error_m\t" \
+    "settle_travel_m\tpred_x_m\tpred_y_m\tpred_f_db\tpred_sigma_db\tpred_area_m2"
+
 
 #endif /* HS_SIM_H */

@@ -114,6 +114,18 @@ bench-general: $(BENCH_BIN)/rfseek-sim
 	nice -n 19 $(PYTHON) scripts/bench_general.py --sim $(BENCH_BIN)/rfseek-sim --jobs $(GENERAL_JOBS) $(GENERAL_ARGS)
 BENCH_TARGETS += bench-general
 
+# Bridging (paper section 6) on every bridging scenario -> docs/RESULTS.md ("Bridging"),
+# docs/figures/seek_bridge.png: the paper's meta + ridge beside one fit per node, 200
+# held-out seeds. `make test` runs a one-seed smoke run of the same script.
+BRIDGE_SEEDS ?= 1001..1200
+BRIDGE_JOBS ?= 2
+.PHONY: bench-bridge
+bench-bridge: $(BENCH_BIN)/rfseek-sim
+	$(PYTHON) scripts/bench_bridge.py --sim $(BENCH_BIN)/rfseek-sim --seeds $(BRIDGE_SEEDS) \
+		--jobs $(BRIDGE_JOBS)
+BENCH_TARGETS += bench-bridge
+$(eval $(call test_script,bench_bridge_smoke,$(PYTHON) scripts/bench_bridge.py --smoke --jobs 2 --sim $(BENCH_BIN)/rfseek-sim,$(BENCH_BIN)/rfseek-sim))
+
 # --- the Linux port: pcap feeder, CAN codec and the two-process overhead ---------------------
 .PHONY: bench-feed bench-wire
 # Frames/s extracting one MAC's RSSI from a 1,000,000-frame capture, side by side with

@@ -3,8 +3,8 @@
 
 Runs every strategy on every shipped scenario with the simulator's batch mode
 (rfseek-sim --seeds A..B --jobs N), the default scenario at other shadowing and noise
-levels, the internal models, and the bridging target; then writes the tables
-(docs/RESULTS.md) and figures (docs/figures/seek_*.png).
+levels and the internal models; then writes the tables (docs/RESULTS.md) and figures
+(docs/figures/seek_*.png). Bridging is scripts/bench_bridge.py's.
 
   scripts/bench_seek.py [--seeds 200] [--model-seeds 200] [--slow-model-seeds 30]
                         [--jobs 2] [--bin build/bin/rfseek-sim]
@@ -23,8 +23,8 @@ Definitions (also written into RESULTS.md):
 Everything goes to a temporary directory first; RESULTS.md is written to a temporary
 file and renamed. Parts of the old RESULTS.md are kept as they are: the hand-written
 Summary (between the HAND markers) and the sections other benches write between their own
-markers (scripts/bench_pathloss_seek.py in place, bench_drive.py and bench_general.py at the
-end).
+markers (scripts/bench_pathloss_seek.py and bench_bridge.py in place, bench_drive.py and
+bench_general.py at the end).
 """
 import argparse
 import glob
@@ -36,7 +36,6 @@ import subprocess
 import sys
 import tempfile
 import time
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -403,61 +402,7 @@ def fig_noise(figdir, sweep):
     return p
 
 
-def fig_bridge(figdir, field, settle, src, settle_path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    x, y, f = field
-    fig, ax = plt.subplots(figsize=(10, 4))
-    sc = ax.scatter(x, y, c=f, s=1, cmap="viridis", marker="s", linewidths=0)
-    fig.colorbar(sc, ax=ax, label="true f = -|R1-R2| - |R1+R2|, dB (seed 1 field, no fading)")
-    s = np.array(settle)
-    ax.plot(s[:, 0], s[:, 1], "r.", ms=4, label="meta + ridge: where runs settled")
-    s = np.array(settle_path)
-    ax.plot(s[:, 0], s[:, 1], "c.", ms=4, label="meta-path + pathloss: where runs settled")
-    i = int(np.argmax(f))
-    ax.plot(x[i], y[i], "w*", ms=14, mec="k", label="best point of f (seed 1)")
-    for k, (sx, sy) in enumerate(src):
-        ax.plot(sx, sy, "^", color="orange", ms=10, mec="k", label="source" if k == 0 else None)
-    ax.set_aspect("equal")
-    ax.legend(fontsize=7, loc="upper left", ncol=2)
-    ax.set_title("bridging (paper section 6, cf. fig. 7): where the runs settled")
-    fig.tight_layout()
-    p = os.path.join(figdir, "seek_bridge.png")
-    fig.savefig(p + ".tmp.png", dpi=80)
-    os.replace(p + ".tmp.png", p)
-    plt.close(fig)
-    return p
-
-
 # ---- the benchmark ---------------------------------------------------------------------
-
-def bridging(args, tmp, seeds, strategy="meta"):
-    """Settle points of a strategy on the bridge scenario vs the best point of each seed's f."""
-    scen = scenario_path("bridge")
-
-    def one(seed):
-        d = os.path.join(tmp, "bridge-%s-%d" % (strategy, seed))
-        single_run(args, scen, seed, d, strategy, field=True)
-        a = np.loadtxt(os.path.join(d, "field.tsv"), skiprows=1, usecols=(0, 1, 3))
-        b = np.loadtxt(os.path.join(d, "field1.tsv"), skiprows=1, usecols=(0, 1, 3))
-        f = -np.abs(a[:, 2] - b[:, 2]) - np.abs(a[:, 2] + b[:, 2])
-        s = read_tsv(os.path.join(d, "track.tsv"))
-        fx, fy = fnum(s[-1]["x_m"]), fnum(s[-1]["y_m"])
-        i = int(np.argmax(f))
-        j = int(np.argmin((a[:, 0] - fx) ** 2 + (a[:, 1] - fy) ** 2))
-        keep = (a[:, 0], a[:, 1], f) if seed == 1 else None
-        shutil.rmtree(d)
-        return seed, fx, fy, math.hypot(fx - a[i, 0], fy - a[i, 1]), f[j], f[i], keep
-
-    with ThreadPoolExecutor(max_workers=args.jobs) as ex:
-        out = []
-        for k, r in enumerate(ex.map(one, range(1, seeds + 1))):
-            out.append(r)
-            sys.stderr.write("\rbridging (%s) %d/%d seeds" % (strategy, k + 1, seeds))
-        sys.stderr.write("\n")
-    return out
-
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -466,7 +411,6 @@ def main():
     ap.add_argument("--noise-seeds", type=int, default=None, help="seeds per noise point")
     ap.add_argument("--model-seeds", type=int, default=None, help="seeds per model x scenario")
     ap.add_argument("--slow-model-seeds", type=int, default=30, help="seeds for mlp and knn")
-    ap.add_argument("--bridge-seeds", type=int, default=None, help="seeds for bridging")
     ap.add_argument("--jobs", type=int, default=2, help="worker processes (both cores: 2)")
     ap.add_argument("--results", default="docs/RESULTS.md", help="markdown output")
     ap.add_argument("--figures", default="docs/figures", help="figure directory")
@@ -486,7 +430,6 @@ def main():
         args.seeds, args.slow_model_seeds, args.quiet = 2, 0, True
     ns = args.noise_seeds or args.seeds
     ms = args.model_seeds or args.seeds
-    bs = args.bridge_seeds or args.seeds
     tmp = tempfile.mkdtemp(prefix="bench_seek.")
     smoke_dir = tempfile.mkdtemp(prefix="bench_seek_out.") if args.smoke else None
     results = os.path.join(smoke_dir, "RESULTS.md") if args.smoke else args.results
@@ -542,18 +485,10 @@ def main():
                 mtab[(sc, m)] = summarise(run_batch(args, tmp, scenario_path(sc), "meta", m, n,
                                                     "model-%s-%s" % (sc, m), set()))
         t_models = time.time() - t0
-        # 4. bridging
-        t0 = time.time()
-        br = bridging(args, tmp, 2 if args.smoke else bs)
-        brp = bridging(args, tmp, 2 if args.smoke else bs, "meta-path")
-        t_bridge = time.time() - t0
-        # 5. figures
+        # 4. figures
         figs = fig_trajectories(figdir, tmp, tags, "default", args.seeds)
         figs.append(fig_rssi(figdir, tmp, args, "default"))
         figs.append(fig_noise(figdir, sweep))
-        src, _ = scenario_sources(scenario_path("bridge"))
-        figs.append(fig_bridge(figdir, br[0][6], [(r[1], r[2]) for r in br], src,
-                               [(r[1], r[2]) for r in brp]))
         # failure analysis needs the walls for the unlabelled floors
         walls = {}
         for sc in scenarios:
@@ -562,9 +497,9 @@ def main():
                 single_run(args, scenario_path(sc), 1, d, "meta", field=True)
                 walls[sc] = walls_lookup(os.path.join(d, "field.tsv"))
         t_total = time.time() - t_all
-        write_results(args, results, scenarios, table, sweep, mtab, (br, brp), walls, figs,
-                      dict(sweep=t_sweep, noise=t_noise, models=t_models, bridge=t_bridge,
-                           total=t_total), ns, ms, bs)
+        write_results(args, results, scenarios, table, sweep, mtab, walls, figs,
+                      dict(sweep=t_sweep, noise=t_noise, models=t_models, total=t_total), ns,
+                      ms)
     except BaseException:
         if smoke_dir:
             shutil.rmtree(smoke_dir, ignore_errors=True)
@@ -576,7 +511,7 @@ def main():
             text = f.read()
         ok = all(("| %s |" % st) in text for st in STRATEGIES) and all(
             os.path.getsize(p) > 10000 for p in glob.glob(os.path.join(figdir, "*.png"))) and \
-            len(glob.glob(os.path.join(figdir, "*.png"))) == len(STRATEGIES) + 3
+            len(glob.glob(os.path.join(figdir, "*.png"))) == len(STRATEGIES) + 2
         shutil.rmtree(smoke_dir, ignore_errors=True)
         print("%s bench-seek-smoke" % ("PASS" if ok else "FAIL"))
         return 0 if ok else 1
@@ -586,6 +521,7 @@ def main():
 
 HAND = ("<!-- hand-written: begin -->", "<!-- hand-written: end -->")
 PATHLOSS = (bench_pathloss_seek.BEGIN, bench_pathloss_seek.END)
+BRIDGE = ("<!-- bench_bridge: begin -->", "<!-- bench_bridge: end -->")
 
 
 def kept(old, marks):
@@ -626,19 +562,18 @@ def model_table(mtab, scenarios, counts):
     return L
 
 
-def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, times, ns, ms, bs):
+def write_results(args, path, scenarios, table, sweep, mtab, walls, figs, times, ns, ms):
     old = open(path).read() if os.path.exists(path) else ""
     L = []
     A = L.append
     A("# Results\n")
     A("Written by `make bench-seek` (`%s scripts/bench_seek.py --seeds %d --jobs %d "
-      "--slow-model-seeds %d%s%s%s`) at commit %s: `rfseek-sim`, in-process fixed-point "
+      "--slow-model-seeds %d%s%s`) at commit %s: `rfseek-sim`, in-process fixed-point "
       "core. Seeds 1..N of every scenario, the same seeds for every strategy, so rows are "
       "paired. Do not edit the tables by hand: re-run the benchmark."
       % (sys.executable, args.seeds, args.jobs, args.slow_model_seeds,
          " --noise-seeds %d" % ns if ns != args.seeds else "",
-         " --model-seeds %d" % ms if ms != args.seeds else "",
-         " --bridge-seeds %d" % bs if bs != args.seeds else "", bench_pathloss_seek.commit()))
+         " --model-seeds %d" % ms if ms != args.seeds else "", bench_pathloss_seek.commit()))
     A("")
     A("**Definitions.** *Success*: within 1.5 m of the source before 150 m of travel (and "
       "900 s). *Travel*: path length of the true robot position. *Ratio*: travel / "
@@ -703,31 +638,9 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
               (sc, st, len(fails), ", ".join("%s %d" % kv for kv in sorted(cnt.items())),
                float(np.median(fd)), float(np.min(fd))))
     A("")
-    A("## Bridging (paper section 6)\n")
-    A("scenarios/bridge.yaml: two sources in different office rooms, target f = -|R1 - R2| "
-      "- |R1 + R2|, error threshold 7 (the paper's for this noisier target; rfseek-sim "
-      "sets it), %d seeds, runs ending at 150 m or 600 s. *Settle point*: where a run "
-      "ends. *True f*: from each seed's mean field of both sources (path loss, walls, its "
-      "shadowing; no fading or noise) on a 0.1 m grid of free cells. `meta + ridge` is the "
-      "paper's; `meta-path + pathloss` fits one point source, which f is not.\n" % len(br[0]))
-    for name, rows in (("meta + ridge", br[0]), ("meta-path + pathloss", br[1])):
-        d = np.array([r[3] for r in rows])
-        fr = np.array([r[4] for r in rows])
-        fb = np.array([r[5] for r in rows])
-        A("### %s\n" % name)
-        A("| quantity | median | p10 | p90 |\n|---|---|---|---|")
-        A("| settle point to the best point of true f, m | %.1f | %.1f | "
-          "%.1f |" % (np.median(d), np.percentile(d, 10), np.percentile(d, 90)))
-        A("| f at the settle point, dB | %.1f | %.1f | %.1f |" %
-          (np.median(fr), np.percentile(fr, 10), np.percentile(fr, 90)))
-        A("| best f of the field, dB | %.1f | %.1f | %.1f |" %
-          (np.median(fb), np.percentile(fb, 10), np.percentile(fb, 90)))
-        A("| shortfall f(best) - f(settle), dB | %.1f | %.1f | %.1f |" %
-          (np.median(fb - fr), np.percentile(fb - fr, 10), np.percentile(fb - fr, 90)))
-        A("| settling within 3 m of it | %d of %d | | |" %
-          (int((d <= 3.0).sum()), len(d)))
-        A("")
-    A("![bridging](figures/seek_bridge.png)\n")
+    bridge = kept(old, BRIDGE)
+    if bridge:
+        A(bridge + "\n")
     A("## Internal models (strategy meta)\n")
     A("Registry models (common/rfs_models.h, `--model NAME`) under the paper's `meta`; mlp "
       "and knn on fewer seeds (1-4 s of CPU a run), so wider intervals. The ridge row is "
@@ -748,15 +661,14 @@ def write_results(args, path, scenarios, table, sweep, mtab, br, walls, figs, ti
     A("## Wall time of the benchmark\n")
     A("On this machine (2 cores, shared with other builds while it ran), `--jobs %d`: "
       "strategy sweep (%d scenarios x %d strategies x %d seeds) %.0f s; noise sweep %.0f s; "
-      "models %.0f s; bridging %.0f s; whole benchmark including figures %.0f s (%.1f min)."
+      "models %.0f s; whole benchmark including figures %.0f s (%.1f min)."
       % (args.jobs, len(scenarios), len(STRATEGIES), args.seeds, times["sweep"],
-         times["noise"], times["models"], times["bridge"], times["total"],
-         times["total"] / 60))
+         times["noise"], times["models"], times["total"], times["total"] / 60))
     A("")
     # Sections other benches write (scripts/bench_drive.py, scripts/bench_general.py), kept.
     for name in re.findall(r"<!-- ([\w-]+): begin -->", old):
         marks = ("<!-- %s: begin -->" % name, "<!-- %s: end -->" % name)
-        if marks not in (HAND, PATHLOSS) and kept(old, marks):
+        if marks not in (HAND, PATHLOSS, BRIDGE) and kept(old, marks):
             A(kept(old, marks) + "\n")
     tmp = path + ".tmp"
     with open(tmp, "w") as f:

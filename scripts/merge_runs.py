@@ -29,6 +29,11 @@ COLS = ["seed", "reached", "end", "sim_time_s", "distance_travelled_m", "shortes
         "model_updates", "greedy", "epsilon", "packets_sent", "packets_received",
         "goal_timeouts", "goal_blocked", "turn_time_s", "wall_contacts"]
 FLOATS = set(COLS[3:10]) | {"turn_time_s"}
+# The columns a bridging run adds (hs_sim.h, HS_SIM_BRIDGE_COLUMNS).
+BRIDGE = ["best_x_m", "best_y_m", "best_f_db", "settle_f_db", "settle_error_m",
+          "settle_travel_m", "pred_x_m", "pred_y_m", "pred_f_db", "pred_sigma_db",
+          "pred_area_m2"]
+FLOATS |= set(BRIDGE)
 # A placed batch's table: the placement first, then COLS, then these.
 PLACED = ["start_x_m", "start_y_m", "start_theta_rad", "source_x_m", "source_y_m",
           "est_error_m", "belief_error_m", "still_s"]
@@ -115,6 +120,8 @@ def main(argv):
             key = (int(s["placement"]) if placed else 0, int(s["seed"]))
             if placed:
                 row = [str(key[0])] + row + placed_values(s)
+            bridge = s.get("target") == "bridge"
+            row += [fmt(c, s[c]) for c in BRIDGE] if bridge else []
             rows.append((key, "\t".join(row)))
         except (OSError, ValueError, KeyError, TypeError, IndexError) as e:
             print("merge_runs.py: %s: %s" % (f, e), file=sys.stderr)
@@ -142,8 +149,8 @@ def main(argv):
         return 1
     tmp = out + ".tmp"
     with open(tmp, "w") as fh:
-        fh.write("\t".join((["placement"] if placed else []) + COLS + (PLACED if placed else []))
-                 + "\n")
+        fh.write("\t".join((["placement"] if placed else []) + COLS + (PLACED if placed else [])
+                            + (BRIDGE if bridge else [])) + "\n")
         for _, r in rows:
             fh.write(r + "\n")
     os.replace(tmp, out)

@@ -528,7 +528,7 @@ static int batch_table(const batch_t *bt)
         fprintf(stderr, "%s: %s/runs.tsv: %s\n", prog, bt->dir, strerror(errno));
         return 1;
     }
-    hs_sim_table_header(t, bt->places != NULL);
+    hs_sim_table_header(t, bt->places != NULL, strcmp(bt->env->sc.target, "bridge") == 0);
     for (uint64_t i = 0; i < bt->total; i++) {
         fputs(bt->rows[i], t);
     }

@@ -131,7 +131,7 @@ static rfs_pathloss_est_t fit_with(fixture_t *f, const rfs_pathloss_cfg_t *c, in
 {
     assert_int_equal(rfs_pathloss_init(&f->pl, c), 0);
     rfs_model_t m = rfs_pathloss_model(&f->pl);
-    rfs_model_fit_in_t in = {f->s, (uint16_t)n, 0, 0, map};
+    rfs_model_fit_in_t in = {.samples = f->s, .n = (uint16_t)n, .map = map};
     rfs_rng_t rng;
     rfs_rng_seed(&rng, 1);
     rfs_fit_result_t r;
@@ -203,7 +203,7 @@ static void no_samples_no_model(void **state)
     fixture_t *f = *state;
     rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
     assert_int_equal(rfs_pathloss_init(&f->pl, &c), 0);
-    rfs_model_fit_in_t in = {f->s, 0, 0, 0, &f->map};
+    rfs_model_fit_in_t in = {.samples = f->s, .n = 0, .map = &f->map};
     rfs_rng_t rng;
     rfs_rng_seed(&rng, 1);
     rfs_q16_t v, x, y;
@@ -352,7 +352,7 @@ static void check_hold(fixture_t *f, bool local)
         rfs_pathloss_est_t ea = fit_with(f, &c, n, &f->map, 0, NULL);
         make_samples(f->s, n, &f->map, &b, 200 + (uint64_t)trial);
         rfs_model_t m = rfs_pathloss_model(&f->pl);
-        rfs_model_fit_in_t in = {f->s, (uint16_t)n, 0, 0, &f->map};
+        rfs_model_fit_in_t in = {.samples = f->s, .n = (uint16_t)n, .map = &f->map};
         rfs_rng_t rng;
         rfs_rng_seed(&rng, 1);
         m.ops->reset(m.self);
@@ -579,7 +579,7 @@ static void cached_relearn_equals_fresh(void **state)
     rfs_pathloss_t *warm = malloc(sizeof(*warm));
     assert_non_null(warm);
     memcpy(warm, &f->pl, sizeof(*warm));
-    rfs_model_fit_in_t in = {f->s, NS, 0, 0, &f->map};
+    rfs_model_fit_in_t in = {.samples = f->s, .n = NS, .map = &f->map};
     rfs_rng_t rng;
     rfs_rng_seed(&rng, 1);
     rfs_pathloss_est_t ew;
@@ -666,7 +666,7 @@ static void model_invalid_while_slicing(void **state)
     fixture_t *f = *state;
     make_samples(f->s, NS, &f->map, &k_office, 11);
     (void)fit_default(f, NS, &f->map, 0, NULL);
-    rfs_model_fit_in_t in = {f->s, NS, 0, 0, &f->map};
+    rfs_model_fit_in_t in = {.samples = f->s, .n = NS, .map = &f->map};
     rfs_rng_t rng;
     rfs_rng_seed(&rng, 1);
     rfs_q16_t v;

@@ -189,6 +189,42 @@ if [ "$(wc -l <"$T/jobs.txt")" -eq 4 ] && mkdir "$T/jobs" && bash "$T/jobs.txt" 
    scripts/merge_runs.py "$T/jobs" && cmp -s "$T/jobs/runs.tsv" "$T/batch/runs.tsv"; then
     pass emit_jobs_merge; else fail emit_jobs_merge; fi
 
+# --- bridging: the true best point from the mean field, the bridging columns, the merge ------
+"$SIM" scenarios/bridge.yaml --seeds 1..2 --emit-jobs --out "$T/bj" >"$T/bj.txt"
+"$SIM" scenarios/bridge.yaml --seeds 1..2 --jobs 2 --quiet --out "$T/bb" 2>/dev/null
+if mkdir "$T/bj" && bash "$T/bj.txt" >/dev/null 2>&1 && scripts/merge_runs.py "$T/bj" &&
+   cmp -s "$T/bj/runs.tsv" "$T/bb/runs.tsv" && head -1 "$T/bb/runs.tsv" | grep -q 'wall_contacts	best_x_m	best_y_m	best_f_db	settle_f_db	settle_error_m	settle_travel_m	pred_x_m	pred_y_m	pred_f_db	pred_sigma_db	pred_area_m2$'
+then pass bridge_columns_merge; else fail bridge_columns_merge; fi
+# Two nodes 10 m apart in the open hall, no shadowing: the best point is the midpoint, f
+# there and at the settle point the log-distance law in double precision.
+cat >"$T/bo.yaml" <<EOF
+map: $PWD/scenarios/maps/open.yaml
+target: bridge
+sources:
+  - {name: a, position: [5.0, 10.0], mac: "02:00:00:00:00:01"}
+  - {name: b, position: [15.0, 10.0], mac: "02:00:00:00:00:02"}
+start: {position: [10.0, 4.0], theta: 0.0}
+stop: {radius_m: 0, max_time_s: 40}
+radio:
+  shadowing: {enabled: false}
+EOF
+"$SIM" "$T/bo.yaml" --seed 1 --model pathloss --strategy meta-path --out "$T/bf" >/dev/null 2>"$T/bf.err"
+if /usr/bin/python3 - "$T/bf/summary.json" <<'PY'
+import json, math, sys
+s = json.load(open(sys.argv[1]))
+def f(x, y):
+    l0 = 20 * math.log10(2400) - 28  # ITU-R P.1238 at 1 m, 2.4 GHz (docs/RADIO_MODEL.md)
+    r = [20 - l0 - 30 * math.log10(max(1.0, math.hypot(x - sx, y - 10.0))) for sx in (5.0, 15.0)]
+    return -abs(r[0] - r[1]) - abs(r[0] + r[1])
+ok = (s["best_x_m"] == 10.0 and s["best_y_m"] == 10.0 and abs(s["best_f_db"] - f(10, 10)) < 0.002
+      and abs(s["settle_f_db"] - f(s["final_x_m"], s["final_y_m"])) < 0.01
+      and abs(s["settle_error_m"] - math.hypot(s["final_x_m"] - 10, s["final_y_m"] - 10)) < 0.002
+      and 0 <= s["settle_travel_m"] <= s["distance_travelled_m"]
+      and s["pred_sigma_db"] >= 0 and s["pred_area_m2"] > 0 and s["est_src_x_m"] is None)
+sys.exit(0 if ok else 1)
+PY
+then pass bridge_true_best; else fail bridge_true_best "$(cat "$T/bf.err" "$T/bf/summary.json" | tail -14)"; fi
+
 # --- pcap output read back by tshark ----------------------------------------------------------
 if command -v tshark >/dev/null; then
     "$SIM" scenarios/open.yaml --seed 2 --out "$T/pc" --pcap "$T/pc.pcap" >/dev/null 2>&1

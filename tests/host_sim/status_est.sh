@@ -36,6 +36,22 @@ ip netns del "$ns"
 "$d" --map $map --model ridge --replay "$w/run.lcmlog" --clock-lcm --lcm memq:// --log "$w/ridge.lcmlog" \
     > /dev/null 2> "$w/r.err" && pass status_est_ridge_replay || fail "status_est_ridge_replay ($(head -2 "$w/r.err"))"
 /usr/bin/python3 tests/host_sim/status_est_check.py "$w/ridge.lcmlog" none || fails=$((fails + 1))
+# One fit per node under the bridging target: the predicted bridging point in the status.
+ip netns add "$ns" 2>/dev/null && ip netns exec "$ns" ip link set lo up \
+    && ip netns exec "$ns" ip route add 224.0.0.0/4 dev lo || { fail "netns setup (bridge)"; exit 1; }
+ip netns exec "$ns" timeout 120 "$d" --map $map --model pathloss --target bridge --lcm "$url" \
+    --can-over-lcm --clock-lcm --log "$w/bridge.lcmlog" --idle-exit 3000 2> "$w/db.err" &
+dpid=$!
+sleep 0.5
+ip netns exec "$ns" timeout 120 "$build/bin/rfseek-sim-lcm" scenarios/bridge.yaml --lcm "$url" \
+    --max-time 200 > "$w/bsummary.json" 2> "$w/bsim.err"
+src=$?
+wait $dpid
+drc=$?
+ip netns del "$ns"
+[ $src -eq 0 ] && [ $drc -eq 0 ] && [ -s "$w/bridge.lcmlog" ] && pass status_est_bridge_run \
+    || fail "status_est_bridge_run (sim rc $src, rfseekd rc $drc: $(head -3 "$w/bsim.err" "$w/db.err"))"
+/usr/bin/python3 tests/host_sim/status_est_check.py "$w/bridge.lcmlog" bridge 36 12 || fails=$((fails + 1))
 # --p0-min reaches the pathloss model: the recorded inputs replayed with the default floor
 # written out (-45) decide exactly as without it, with a floor of 0 dBm (20 dB above what
 # the simulated 20 dBm node gives at 1 m) differently.

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""Check the path-loss estimate in the seeker statuses of an LCM log.
+"""Check the path-loss estimate and the bridging point in the seeker statuses of an LCM log.
 
-    tests/host_sim/status_est_check.py LOG.lcmlog pathloss|none [MAP_W_M MAP_H_M]
+    tests/host_sim/status_est_check.py LOG.lcmlog pathloss|bridge|none [MAP_W_M MAP_H_M]
 
 Reads the log format (lcm-logger: sync word, event number, time, channel and data lengths)
 and decodes rfseek.seeker_status_t by hand in the order of lcm/seeker_status_t.lcm
@@ -9,8 +9,10 @@ and decodes rfseek.seeker_status_t by hand in the order of lcm/seeker_status_t.l
 relearn carry no estimate; after it every status has one, with n and W inside the model's
 bounds, a positive area, a non-negative RMS, the source inside the map, and for a greedy
 decision with a relearn the model maximum (the goal the seeker chose) within 1.5 m of the
-estimated source (the model is flat within 1 m of it). With "none": no status carries an
-estimate and the fields are zero. Prints PASS/FAIL lines; exits 1 on failure.
+estimated source (the model is flat within 1 m of it). With "bridge" (one fit per node):
+the same for the bridging point instead, every greedy goal that point itself, with a
+non-negative sigma and a positive area, and no path-loss estimate. With "none": no status
+carries either and the fields are zero. Prints PASS/FAIL lines; exits 1 on failure.
 """
 import os
 import struct
@@ -57,13 +59,16 @@ def status(b):
     keys = ["est_valid", "est_x", "est_y", "est_n", "est_w", "est_p0", "est_rms", "est_area"]
     m.update(zip(keys, struct.unpack_from(">b7d", b, o)))
     o += 57
+    keys = ["bridge_valid", "bridge_x", "bridge_y", "bridge_f", "bridge_sigma", "bridge_area"]
+    m.update(zip(keys, struct.unpack_from(">b5d", b, o)))
+    o += 41
     if o != len(b):
         raise ValueError("status of %d bytes, decoded %d" % (len(b), o))
     return m
 
 
 def main(argv):
-    if len(argv) not in (3, 5) or argv[2] not in ("pathloss", "none"):
+    if len(argv) not in (3, 5) or argv[2] not in ("pathloss", "bridge", "none"):
         print(__doc__.strip(), file=sys.stderr)
         return 2
     want = argv[2] == "pathloss"
@@ -75,6 +80,11 @@ def main(argv):
         return 1
     check("status_count", len(st) > 100, "%d statuses" % len(st))
     est_keys = ["est_x", "est_y", "est_n", "est_w", "est_p0", "est_rms", "est_area"]
+    br_keys = ["bridge_x", "bridge_y", "bridge_f", "bridge_sigma", "bridge_area"]
+    if argv[2] == "bridge":
+        return check_bridge(st, est_keys, br_keys, mw, mh)
+    bad = [m for m in st if m["bridge_valid"] or any(m[k] != 0.0 for k in br_keys)]
+    check("no_bridging_point", not bad, str(bad[:1]))
     if not want:
         bad = [m for m in st if m["est_valid"] or any(m[k] != 0.0 for k in est_keys)]
         check("no_estimate", not bad, str(bad[:1]))
@@ -101,6 +111,34 @@ def main(argv):
     print("last estimate: (%.3f, %.3f) n %.3f W %.2f dB P0 %.2f rms %.2f dB area %.1f m^2"
           % (last["est_x"], last["est_y"], last["est_n"], last["est_w"], last["est_p0"],
              last["est_rms"], last["est_area"]))
+    return exit_status()
+
+
+def check_bridge(st, est_keys, br_keys, mw, mh):
+    """One fit per node: the bridging point from the first fit on, no path-loss estimate."""
+    bad = [m for m in st if m["est_valid"] or any(m[k] != 0.0 for k in est_keys)]
+    check("no_path_loss_estimate", not bad, str(bad[:1]))
+    first = next((i for i, m in enumerate(st) if m["bridge_valid"]), None)
+    check("a_bridging_point", first is not None)
+    if first is None:
+        return 1
+    before = [m for m in st[:first] if any(m[k] != 0.0 for k in br_keys)]
+    check("zero_before_the_first_fit", not before, str(before[:1]))
+    after = st[first:]
+    check("bridging_point_after_the_first_fit", all(m["bridge_valid"] for m in after),
+          "%d of %d without" % (sum(not m["bridge_valid"] for m in after), len(after)))
+    bad = [m for m in after if not (m["bridge_sigma"] >= 0.0 and m["bridge_area"] > 0.0 and
+                                    m["bridge_f"] < 0.0 and 0.0 <= m["bridge_x"] <= mw and
+                                    0.0 <= m["bridge_y"] <= mh)]
+    check("bridging_point_in_bounds", not bad, str(bad[:1]))
+    greedy = [m for m in after if m["decided"] and m["kind"] == 2]
+    off = [m for m in greedy if (m["max_x"], m["max_y"]) != (m["bridge_x"], m["bridge_y"])]
+    check("greedy_goal_is_the_bridging_point (%d greedy decisions)" % len(greedy),
+          greedy and not off, str(off[:1]))
+    last = after[-1]
+    print("last bridging point: (%.3f, %.3f) f %.2f dB sigma %.2f dB area %.2f m^2"
+          % (last["bridge_x"], last["bridge_y"], last["bridge_f"], last["bridge_sigma"],
+             last["bridge_area"]))
     return exit_status()
 
 

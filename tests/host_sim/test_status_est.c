@@ -1,8 +1,9 @@
-/* test_status_est.c - the path-loss estimate in the LCM seeker status:
- * lx_lcm_pub_status_est() puts it in the last fields of rfseek.seeker_status_t, read back
- * here from the recorded bytes by hand (big-endian, the .lcm field order) rather than by the
- * generated decoder; lx_lcm_pub_status() leaves them zero; the receiver drops a status whose
- * estimate is not finite, negative where it cannot be, or set without est_valid. */
+/* test_status_est.c - the estimates in the LCM seeker status: lx_lcm_pub_status_est()
+ * puts the path-loss estimate and then the per-node model's bridging point in the last
+ * fields of rfseek.seeker_status_t, read back here from the recorded bytes by hand
+ * (big-endian, the .lcm field order) rather than by the generated decoder;
+ * lx_lcm_pub_status() leaves them zero; the receiver drops a status whose estimate is not
+ * finite, negative where it cannot be, or set without its valid flag. */
 #include "rfs_test.h"
 
 #include <math.h>
@@ -14,8 +15,10 @@
 #include "lx_lcm.h"
 #include "rfseek_seeker_status_t.h"
 
-/// Bytes of the estimate at the end of the message: est_valid + 7 doubles.
+/// Bytes of the path-loss estimate: est_valid + 7 doubles.
 #define EST_BYTES (1 + 7 * 8)
+/// Bytes of the bridging point at the end of the message: bridge_valid + 5 doubles.
+#define BRIDGE_BYTES (1 + 5 * 8)
 
 typedef struct rx {
     int statuses;
@@ -48,8 +51,10 @@ static double be_double(const uint8_t *p)
     return d;
 }
 
-/// Publish one status (with est, or without when NULL) into a log and read its bytes back.
-static size_t status_bytes(const rfs_pathloss_est_t *est, uint8_t *buf, size_t cap)
+/// Publish one status (with est and bridge, or without when NULL) into a log and read its
+/// bytes back.
+static size_t status_bytes(const rfs_pathloss_est_t *est, const rfs_fields_est_t *bridge,
+                           uint8_t *buf, size_t cap)
 {
     char path[] = "/tmp/rfs_test_status_est_XXXXXX";
     int fd = mkstemp(path);
@@ -66,7 +71,7 @@ static size_t status_bytes(const rfs_pathloss_est_t *est, uint8_t *buf, size_t c
     rfs_seek_out_t out;
     memset(&out, 0, sizeof out);
     out.decision.samples = 42;
-    assert_int_equal(lx_lcm_pub_status_est(l, 1000, &out, est), 0);
+    assert_int_equal(lx_lcm_pub_status_est(l, 1000, &out, est, bridge), 0);
     lx_lcm_record(l, NULL);
     lx_lcm_close(l);
     assert_int_equal(lx_lcm_log_close(w), 0);
@@ -77,7 +82,7 @@ static size_t status_bytes(const rfs_pathloss_est_t *est, uint8_t *buf, size_t c
     size_t len = 0;
     assert_int_equal(lx_lcm_log_next_raw(r, &t, ch, sizeof ch, buf, cap, &len), 1);
     assert_string_equal(ch, LX_LCM_CH_STATUS);
-    assert_true(len <= cap && len > EST_BYTES);
+    assert_true(len <= cap && len > EST_BYTES + BRIDGE_BYTES);
     assert_int_equal(lx_lcm_log_close(r), 0);
     unlink(path);
     return len;
@@ -97,8 +102,8 @@ static void estimate_is_in_the_last_fields(void **state)
     est.rms = 190971; // 2.91398...
     est.spread_m2 = 4 * 65536;
     uint8_t buf[512];
-    size_t len = status_bytes(&est, buf, sizeof buf);
-    const uint8_t *e = buf + len - EST_BYTES;
+    size_t len = status_bytes(&est, NULL, buf, sizeof buf);
+    const uint8_t *e = buf + len - BRIDGE_BYTES - EST_BYTES;
 
     assert_int_equal(e[0], 1);
     assert_true(be_double(e + 1) == 27.125);
@@ -111,15 +116,43 @@ static void estimate_is_in_the_last_fields(void **state)
     // The field before the estimate: samples, int32 big-endian.
     const uint8_t *s = e - 4;
     assert_int_equal((s[0] << 24) | (s[1] << 16) | (s[2] << 8) | s[3], 42);
+    // No bridging point: its fields are zero.
+    for (int i = 0; i < BRIDGE_BYTES; i++) {
+        assert_int_equal(e[EST_BYTES + i], 0);
+    }
+}
+
+static void bridging_point_is_in_the_last_fields(void **state)
+{
+    (void)state;
+    rfs_fields_est_t fe;
+    memset(&fe, 0, sizeof fe);
+    fe.x = 19 * 65536 + 32768;  // 19.5 m
+    fe.y = 6 * 65536 + 16384;   // 6.25 m
+    fe.value = -7208960 - 4096; // -110.0625 dB
+    fe.sigma = 2 * 65536 + 8192; // 2.125 dB
+    fe.area_m2 = 65536 / 4;     // 0.25 m^2
+    uint8_t buf[512];
+    size_t len = status_bytes(NULL, &fe, buf, sizeof buf);
+    const uint8_t *b = buf + len - BRIDGE_BYTES;
+    assert_int_equal(b[0], 1);
+    assert_true(be_double(b + 1) == 19.5);
+    assert_true(be_double(b + 9) == 6.25);
+    assert_true(be_double(b + 17) == -110.0625);
+    assert_true(be_double(b + 25) == 2.125);
+    assert_true(be_double(b + 33) == 0.25);
+    for (int i = 0; i < EST_BYTES; i++) { // no path-loss estimate
+        assert_int_equal(b[i - EST_BYTES], 0);
+    }
 }
 
 static void without_estimate_the_fields_are_zero(void **state)
 {
     (void)state;
     uint8_t buf[512];
-    size_t len = status_bytes(NULL, buf, sizeof buf);
-    const uint8_t *e = buf + len - EST_BYTES;
-    for (int i = 0; i < EST_BYTES; i++) {
+    size_t len = status_bytes(NULL, NULL, buf, sizeof buf);
+    const uint8_t *e = buf + len - EST_BYTES - BRIDGE_BYTES;
+    for (int i = 0; i < EST_BYTES + BRIDGE_BYTES; i++) {
         assert_int_equal(e[i], 0);
     }
 }
@@ -189,12 +222,29 @@ static void bad_estimates_are_dropped_with_one_line(void **state)
     r = deliver(&b);
     assert_int_equal(r.statuses, 0);
     assert_int_equal(r.bads, 1);
+
+    b = m;
+    b.bridge_valid = 1;
+    b.bridge_x = 19.5;
+    b.bridge_f = -110.0;
+    b.bridge_sigma = 2.0;
+    r = deliver(&b);
+    assert_int_equal(r.statuses, 1);
+    b.bridge_sigma = -1.0; // a spread cannot be negative
+    r = deliver(&b);
+    assert_int_equal(r.bads, 1);
+    b.bridge_sigma = 2.0;
+    b.bridge_valid = 0; // values without bridge_valid
+    r = deliver(&b);
+    assert_int_equal(r.statuses, 0);
+    assert_int_equal(r.bads, 1);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(estimate_is_in_the_last_fields),
+        cmocka_unit_test(bridging_point_is_in_the_last_fields),
         cmocka_unit_test(without_estimate_the_fields_are_zero),
         cmocka_unit_test(bad_estimates_are_dropped_with_one_line),
     };

@@ -86,19 +86,21 @@ static double dbl_of(rfs_q16_t q)
     return (double)q / 65536.0;
 }
 
-/* The path-loss estimate of a status: every field a Q16.16 value, the area not
- * negative; all zero when est_valid is false. */
+/* The estimates of a status: every field a Q16.16 value, areas and spreads not negative;
+ * all zero when their valid flag is false. */
 static bool est_ok(const rfseek_seeker_status_t *m)
 {
-    const double v[7] = {m->est_x, m->est_y, m->est_n, m->est_w, m->est_p0, m->est_rms,
-                         m->est_area};
-    for (int i = 0; i < 7; i++) {
+    const double v[12] = {m->est_x, m->est_y, m->est_n, m->est_w, m->est_p0, m->est_rms,
+                          m->est_area, m->bridge_x, m->bridge_y, m->bridge_f,
+                          m->bridge_sigma, m->bridge_area};
+    for (int i = 0; i < 12; i++) {
         rfs_q16_t q;
-        if (!q16_of(v[i], &q) || (!m->est_valid && q != 0)) {
+        if (!q16_of(v[i], &q) || (!(i < 7 ? m->est_valid : m->bridge_valid) && q != 0)) {
             return false;
         }
     }
-    return m->est_area >= 0.0 && m->est_rms >= 0.0;
+    return m->est_area >= 0.0 && m->est_rms >= 0.0 && m->bridge_sigma >= 0.0 &&
+           m->bridge_area >= 0.0;
 }
 
 /* The decoders of dispatch(), one per channel: decode a message of `len` bytes, check its
@@ -574,11 +576,11 @@ static const char *reason_of(const rfs_seek_decision_t *d)
 
 int lx_lcm_pub_status(lx_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out)
 {
-    return lx_lcm_pub_status_est(l, t_us, out, NULL);
+    return lx_lcm_pub_status_est(l, t_us, out, NULL, NULL);
 }
 
 int lx_lcm_pub_status_est(lx_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out,
-                          const rfs_pathloss_est_t *est)
+                          const rfs_pathloss_est_t *est, const rfs_fields_est_t *bridge)
 {
     const rfs_seek_decision_t *d = &out->decision;
     rfseek_seeker_status_t m;
@@ -618,6 +620,14 @@ int lx_lcm_pub_status_est(lx_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out,
         m.est_p0 = dbl_of(est->p0);
         m.est_rms = dbl_of(est->rms);
         m.est_area = dbl_of(est->spread_m2);
+    }
+    if (bridge) { // the per-node model's predicted bridging point (left 0 otherwise)
+        m.bridge_valid = true;
+        m.bridge_x = dbl_of(bridge->x);
+        m.bridge_y = dbl_of(bridge->y);
+        m.bridge_f = dbl_of(bridge->value);
+        m.bridge_sigma = dbl_of(bridge->sigma);
+        m.bridge_area = dbl_of(bridge->area_m2);
     }
     LX_LCM_PUBLISH(l, LX_LCM_CH_STATUS, rfseek_seeker_status_t, &m, t_us);
 }

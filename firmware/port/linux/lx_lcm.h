@@ -21,6 +21,7 @@
 #include <stdint.h>
 
 #include "rfs_can.h"
+#include "rfs_fields.h"
 #include "rfs_pathloss.h"
 #include "rfs_seek.h"
 
@@ -87,10 +88,11 @@ int lx_lcm_pub_clock(lx_lcm_t *l, int64_t t_us);
 int lx_lcm_pub_wheel(lx_lcm_t *l, int64_t t_us, const rfs_can_wheel_t *w);
 /// Publish a status (decision record and command of one control step).
 int lx_lcm_pub_status(lx_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out);
-/// Publish a status with the path-loss model's estimate; est NULL publishes
-/// est_valid false and zero estimate fields, like lx_lcm_pub_status().
+/// Publish a status with the path-loss model's estimate (est) and the per-node model's
+/// predicted bridging point (bridge, rfs_fields.h); a NULL one publishes its valid flag
+/// false and zero fields, like lx_lcm_pub_status().
 int lx_lcm_pub_status_est(lx_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out,
-                          const rfs_pathloss_est_t *est);
+                          const rfs_pathloss_est_t *est, const rfs_fields_est_t *bridge);
 /// Publish a raw CAN frame on the fallback channel.
 int lx_lcm_pub_can(lx_lcm_t *l, int64_t t_us, const rfs_can_frame_t *f);
 

@@ -721,7 +721,8 @@ static void __attribute__((noinline)) measure_decision_phases(rfs_q16_t rx, rfs_
 {
     rfs_store_t *st = &s_app.seek.store;
     rfs_ridge_t *ridge = &s_app.ridge;
-    const rfs_model_fit_in_t fin = {st->samples, st->count, rx, ry, &s_app.map};
+    const rfs_model_fit_in_t fin = {.samples = st->samples, .n = st->count, .qx = rx, .qy = ry,
+                                    .map = &s_app.map};
     rfs_ridge_ops.reset(ridge);
     RFS_BC_MEASURE("phase_relearn", 1, (void)rfs_ridge_ops.fit(ridge, &fin, 0, rng));
     rfs_bc_report("ridge_samples_used", 0, ridge->n_used);

@@ -28,6 +28,7 @@
 #include "lx_lcm.h"
 #include "lx_map.h"
 #include "rfs_app.h"
+#include "rfs_fields.h"
 #include "rfs_pathloss.h"
 
 static const char usage_text[] =
@@ -49,7 +50,8 @@ static const char usage_text[] =
     "  --decisions FILE  write one line per decision (default: stdout with --replay)\n"
     "  --target NAME     rssi (default) or bridge\n"
     "  --model NAME      internal model: ridge (default, the paper's), mlp, knn, radius,\n"
-    "                    pathloss (docs/MODELS.md; the STM32 image holds the ridge only)\n"
+    "                    pathloss (docs/MODELS.md; one fit per node under --target bridge,\n"
+    "                    docs/STRATEGIES.md; the STM32 image holds the ridge only)\n"
     "  --strategy NAME   meta (default, the paper's Algorithm 1) or meta-path (greedy legs\n"
     "                    along the planned path, with its preset improvements; with\n"
     "                    --model pathloss: docs/STRATEGIES.md); also fd-gradient,\n"
@@ -91,6 +93,11 @@ typedef struct daemon {
     lx_map_t map;           /* --map, and the core's grids made from it */
     lx_core_map_t core;
     void *model_state;      /* --model: its state (heap, the model's size) */
+    rfs_fields_t *fields;   /* --model pathloss --target bridge: one fit per node */
+    rfs_fields_mem_t fmem;  /* ... its arrays */
+    rfs_seek_src_t *src;    /* ... each node's own samples: state and arrays */
+    rfs_sample_t *src_samples[RFS_TARGET_MAX_SOURCES];
+    rfs_pending_t *src_pending[RFS_TARGET_MAX_SOURCES];
 } daemon_t;
 
 static volatile sig_atomic_t g_stop;
@@ -181,7 +188,9 @@ static void step(daemon_t *d, int64_t now_us)
         const rfs_model_t *mdl = &d->app->seek.model;
         rfs_pathloss_est_t est;
         bool pl = mdl->ops == &rfs_pathloss_ops && rfs_pathloss_estimate(mdl->self, &est);
-        (void)lx_lcm_pub_status_est(d->lcm, now_us, &so, pl ? &est : NULL);
+        rfs_fields_est_t fe; // one fit per node: the predicted bridging point
+        bool fl = d->fields != NULL && rfs_fields_estimate(d->fields, &fe);
+        (void)lx_lcm_pub_status_est(d->lcm, now_us, &so, pl ? &est : NULL, fl ? &fe : NULL);
     }
     if (out.decided) {
         d->decided++;
@@ -424,6 +433,59 @@ static int parse_options(int argc, char **argv, options_t *o)
     return RUN;
 }
 
+/* One path-loss fit per node (rfs_fields.h) on heap memory sized for the map, each node's
+ * own store, and the seeker's settings for it: 0, or -1 when out of memory. */
+static int open_fields(daemon_t *d, const options_t *o, rfs_app_cfg_t *cfg,
+                       const rfs_target_ops_t *target)
+{
+    rfs_fields_cfg_t fc = rfs_fields_cfg_default();
+    if (!isnan(o->p0_min)) {
+        fc.pathloss.p0_min = (rfs_q16_t)lround(o->p0_min * 65536.0); // docs/PATHLOSS.md
+    }
+    rfs_fields_mem_size(&d->core.map, &fc, &d->fmem.points, &d->fmem.cells);
+    d->fmem.f = calloc(d->fmem.points, sizeof(int16_t));
+    d->src = calloc(target->nsources, sizeof(rfs_seek_src_t));
+    cfg->src = d->src;
+    if (d->fmem.f == NULL || d->src == NULL) {
+        return -1;
+    }
+    // Everything allocated here is freed by free_fields() at the daemon's end.
+    for (unsigned k = 0; k < target->nsources && k < RFS_TARGET_MAX_SOURCES; k++) {
+        if ((d->fmem.walls[k] = calloc(d->fmem.points, 1)) == NULL ||
+            (d->fmem.rsum[k] = calloc(d->fmem.cells, sizeof(int32_t))) == NULL ||
+            (d->fmem.rcount[k] = calloc(d->fmem.cells, sizeof(uint16_t))) == NULL ||
+            (d->src_samples[k] = calloc(cfg->seek.store.capacity, sizeof(rfs_sample_t))) == NULL ||
+            (d->src_pending[k] = calloc(RFS_APP_PENDING, sizeof(rfs_pending_t))) == NULL) {
+            return -1;
+        }
+        cfg->src_samples[k] = d->src_samples[k];
+        cfg->src_pending[k] = d->src_pending[k];
+    }
+    d->fields = aligned_alloc(RFS_MODELS_STATE_ALIGN,
+                              (sizeof(rfs_fields_t) + RFS_MODELS_STATE_ALIGN - 1u) /
+                                  RFS_MODELS_STATE_ALIGN * RFS_MODELS_STATE_ALIGN);
+    if (d->fields == NULL || rfs_fields_init(d->fields, &fc, target, &d->fmem) != 0) {
+        return -1;
+    }
+    cfg->built = rfs_fields_model(d->fields);
+    rfs_seek_cfg_per_source(&cfg->seek);
+    return 0;
+}
+
+static void free_fields(daemon_t *d)
+{
+    free(d->src);
+    for (unsigned k = 0; k < RFS_TARGET_MAX_SOURCES; k++) {
+        free(d->fmem.walls[k]);
+        free(d->fmem.rsum[k]);
+        free(d->fmem.rcount[k]);
+        free(d->src_samples[k]);
+        free(d->src_pending[k]);
+    }
+    free(d->fmem.f);
+    free(d->fields);
+}
+
 /* The map, the model's state and the application: 0, or 1 after an error line. */
 static int open_controller(daemon_t *d, const options_t *o)
 {
@@ -437,8 +499,15 @@ static int open_controller(daemon_t *d, const options_t *o)
         lx_err_print(PROG, "%s", err);
         return 1;
     }
-    // The Linux port holds any model: its state in a heap buffer of the model's size.
-    if (o->model != NULL) {
+    const rfs_target_ops_t *target = cfg.target == RFS_APP_TARGET_BRIDGE ? &rfs_target_bridge
+                                                                          : &rfs_target_rssi;
+    if (rfs_models_per_source(o->model, target)) {
+        if (open_fields(d, o, &cfg, target) != 0) {
+            fprintf(stderr, "rfseekd: --model %s: out of memory\n", o->model->name);
+            return 1;
+        }
+    } else if (o->model != NULL) {
+        // The Linux port holds any model: its state in a heap buffer of the model's size.
         size_t mb = (o->model->state_bytes + RFS_MODELS_STATE_ALIGN - 1u) / RFS_MODELS_STATE_ALIGN *
                     RFS_MODELS_STATE_ALIGN;
         d->model_state = aligned_alloc(RFS_MODELS_STATE_ALIGN, mb);
@@ -460,7 +529,7 @@ static int open_controller(daemon_t *d, const options_t *o)
                  o->map_path, core->map.w, core->map.h, o->res, RFS_APP_MAX_MAP_BYTES, RFS_APP_MAX_LATTICE);
         return 1;
     }
-    if (!isnan(o->p0_min)) {
+    if (!isnan(o->p0_min) && d->fields == NULL) {
         /* The node's power known: a floor on the fitted signal at 1 m (docs/PATHLOSS.md
          * "The P0 floor"). The state is re-initialised before any fit. */
         rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
@@ -643,6 +712,7 @@ static int finish(daemon_t *d, const options_t *o, int rc)
     lx_lcm_close(d->lcm);
     free(d->app);
     free(d->model_state);
+    free_fields(d);
     lx_core_map_free(&d->core);
     lx_map_free(&d->map);
     return rc;

@@ -466,7 +466,7 @@ static int ref_walls_in_order(const fixture_t *f, rfs_q16_t x0, rfs_q16_t y0, rf
     int n = 0;
     for (int j = -1; j <= H; j++) {
         for (int i = -1; i <= W; i++) {
-            if (ref_touch(f, X0, Y0, X1, Y1, i, j)) {
+            if (ref_touch(X0, Y0, X1, Y1, f->res, i, j)) {
                 int on = i >= 0 && j >= 0 && i < W && j < H;
                 hits[n].i = i;
                 hits[n].j = up ? j : -j;

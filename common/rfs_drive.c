@@ -132,6 +132,11 @@ void rfs_drive_stop(rfs_drive_t *d, int64_t now_us)
     d->right_mm_s = 0;
 }
 
+bool rfs_drive_at_rest(const rfs_drive_t *d)
+{
+    return d->base_left == 0 && d->base_right == 0;
+}
+
 bool rfs_drive_estimate(const rfs_drive_t *d, rfs_pose_t *out)
 {
     *out = d->est;

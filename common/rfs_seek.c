@@ -449,7 +449,9 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     if (d->model_valid && d->mean_valid) {
         relearn = rfs_q16_abs(rfs_q16_sub(d->mean, d->prediction)) > s->cfg.error_threshold;
     }
-    relearn = relearn || ops->refit;
+    /* A leg abandoned by a failed recheck relearns (the check failed on this model), even
+     * when the mean has moved back within the threshold while the base braked. */
+    relearn = relearn || ops->refit || s->replan;
 
     if (relearn && s->store.count > 0u) {
         d->relearned = true;

@@ -449,7 +449,9 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     if (d->model_valid && d->mean_valid) {
         relearn = rfs_q16_abs(rfs_q16_sub(d->mean, d->prediction)) > s->cfg.error_threshold;
     }
-    relearn = relearn || ops->refit;
+    /* A leg abandoned by a failed recheck relearns (the check failed on this model), even
+     * when the mean has moved back within the threshold while the base braked. */
+    relearn = relearn || ops->refit || s->replan;
 
     if (relearn && s->store.count > 0u) {
         d->relearned = true;
@@ -576,10 +578,17 @@ static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     return false;
 }
 
-/* true while the robot stands before deciding: after no goal or a null move
+/* true while the robot stands before deciding: until the base has stopped (a goal ended
+ * while moving: the next path is planned from where the robot stands, not from a point
+ * it brakes past; docs/MAPS.md, "Drive control"), after no goal or a null move
  * (end_decision), and for a dwelling strategy one averaging window at each point. */
 static bool hold_still(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
 {
+    if (!rfs_drive_at_rest(&s->drive)) {
+        stop_wheels(s, now_us, out);
+        s->state = RFS_SEEK_DRIVING;
+        return true;
+    }
     if (now_us < s->retry_after_us) {
         out->faults |= s->retry_no_goal ? RFS_SEEK_FAULT_NO_GOAL : 0u;
         stop_wheels(s, now_us, out);

@@ -147,6 +147,12 @@ int hs_sim_field(const hs_sim_env_t *e, uint64_t seed, unsigned src, double step
 /// The last columns of log.tsv: the path-loss model's estimate at a decision.
 #define HS_SIM_LOG_EST_COLUMNS "est_src_x_m\test_src_y_m\test_n\test_w_db\test_p0\test_area_m2"
 
+/// A decision's kind as log.tsv names it: initial, greedy, epsilon, or the baseline's.
+const char *hs_sim_kind_name(rfs_seek_kind_t k);
+
+/// How the goal before a decision ended, as log.tsv's reason names it (prev=...).
+const char *hs_sim_prev_name(rfs_drive_status_t s);
+
 /// End a log.tsv decision row: a tab, the HS_SIM_LOG_EST_COLUMNS values (source m, n,
 /// W dB, P0, spread area m^2) and a newline; "nan" unless the controller's model is
 /// "pathloss" and has a fit.

@@ -89,7 +89,7 @@ bench-sim: $(BENCH_BIN)/rfseek-sim
 # Planner and legal-grid figures on the office scenario map and on the Intel lab
 # (docs/PERFORMANCE.md, "Map, planner, drive").
 bench-map: $(BENCH_BIN)/rfseek-map
-	@for m in scenarios/maps/office.yaml /work/shared/data/maps/intel.yaml; do \
+	@for m in scenarios/maps/office.yaml scenarios/maps/intel.yaml; do \
 	    if [ -e $$m ]; then $(BENCH_BIN)/rfseek-map $$m --bench 200 | grep -E '^(map|core grid|lattice|bench|  )'; fi; done
 # The table of docs/FAULTS.md: every fault over 50 seeds, with and without it, side by side.
 FAULT_SEEDS ?= 50

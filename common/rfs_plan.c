@@ -480,6 +480,7 @@ void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0)
     p->tree_y = y0;
     p->tree = 1;
     p->tree_done = false;
+    p->tree_sliced = false;
 }
 
 static void set_dir(uint8_t *w, uint32_t u, uint32_t k)
@@ -551,6 +552,7 @@ bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget)
         return false;
     }
     tree_seed(p);
+    p->tree_sliced = true;
     if (p->tree == 2 && !p->tree_done) {
         p->tree_done = search_until(p, NO_POINT, budget) == SEARCH_EMPTY;
     }
@@ -559,7 +561,7 @@ bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget)
 
 bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0)
 {
-    if (p->tree != 2 || !p->tree_done) {
+    if (p->tree != 2) {
         return false;
     }
     uint32_t idx;
@@ -614,9 +616,14 @@ bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *o
         return false; /* different components: the search cannot succeed */
     }
     uint8_t *w = p->work;
-    if (!(w[g_idx] & W_CLOSED) &&
-        (p->tree_done || search_until(p, g_idx, UINT32_MAX) != SEARCH_FOUND)) {
-        return false;
+    if (!(w[g_idx] & W_CLOSED)) {
+        if (p->tree_sliced) {
+            p->tree_more = p->tree_more || !p->tree_done;
+            return false;
+        }
+        if (p->tree_done || search_until(p, g_idx, UINT32_MAX) != SEARCH_FOUND) {
+            return false;
+        }
     }
     return tree_extract(p, g_idx, x1, y1, out);
 }

@@ -63,6 +63,9 @@ typedef struct rfs_plan {
     uint8_t tree;           ///< tree state: 0 none (init, rfs_plan_path), 1 begun,
                             ///< 2 seeded (work holds it), 3 root joins no lattice point
     bool tree_done;         ///< the tree's search has closed every point it reaches
+    bool tree_sliced;       ///< grown by rfs_plan_tree_grow: plans do not search
+    bool tree_more;         ///< set (never cleared here) when a plan on a sliced tree asked
+                            ///< for a point it has not closed yet: grow it, ask again
 } rfs_plan_t;
 
 /// A planned path: waypoints in order, the last one the goal itself.
@@ -95,9 +98,9 @@ void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0);
 
 /// Plan from the tree's root to the legal point (x1, y1): rfs_plan_path's contract and
 /// result cases, but the tree's Dijkstra (from the root) is continued only until the
-/// goal's lattice point is closed, and a goal closed by an earlier call needs no search
-/// (a grown tree, rfs_plan_tree_grow, searches no more: a goal it did not close is
-/// unreachable). The lattice path may differ from rfs_plan_path's among equal-cost ones
+/// goal's lattice point is closed, and a goal closed by an earlier call needs no search.
+/// A tree grown by rfs_plan_tree_grow is never searched here: a goal it has not closed
+/// fails, and sets tree_more unless the tree is done (then it is unreachable). The lattice path may differ from rfs_plan_path's among equal-cost ones
 /// (ties); the waypoints are string pulled from the root forwards, as rfs_plan_path
 /// does. A path depends only on the root and the goal, not on the goals asked before
 /// nor on how the search was sliced. false, out->n 0, also when no tree was begun or an
@@ -112,7 +115,7 @@ bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *o
 /// when no tree was begun.
 bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget);
 
-/// Let a grown tree (done, rooted at a lattice point) serve plans from (x0, y0), e.g. a
+/// Let a seeded tree (rooted at a lattice point) serve plans from (x0, y0), e.g. a
 /// robot stopped near the point the tree was begun at: true, and later paths start at
 /// (x0, y0), when it joins the lattice at the tree's root, or it is legal and the root
 /// is one of the 3 x 3 lattice points round it and a legal segment reaches it; false

@@ -31,6 +31,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.pose_timeout_us = 150000;             /* + one 50 ms period: stopped within 200 ms */
     c.rssi_timeout_us = 150000;
     c.fit_budget = 0;
+    c.plan_budget = RFS_SEEK_PLAN_BUDGET;   /* how the paths are computed, not which */
     c.rssi = rfs_rssi_cfg_default();
     c.store = rfs_store_cfg_default();      /* 10,000 samples (section 5.2) */
     c.drive = rfs_drive_cfg_default();
@@ -268,6 +269,10 @@ bool rfs_seek_plan_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, bool tree)
     }
     /* Plan straight into the drive's own path: a 532-byte rfs_path_t on the stack would
      * overflow the microcontroller's 2.5 KB stack during a decision. */
+    if (s->plan_ready && s->plan.tree_more) {
+        return false; /* the decision is made again when the tree has grown */
+    }
+    tree = tree || s->plan_ready; /* plan_budget: the decision's tree serves */
     if (tree ? !rfs_plan_tree_path(&s->plan, gx, gy, &s->drive.path)
              : !rfs_plan_path(&s->plan, sx, sy, gx, gy, &s->drive.path)) {
         return false;
@@ -364,6 +369,12 @@ static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t 
         return;
     }
     s->state = RFS_SEEK_DRIVING;
+    if (s->cfg.plan_budget != 0u && s->drive.path.n > 0u) {
+        /* The next decision is made where this leg ends: its search tree is grown there
+         * while the leg is driven (drive_on, hold_still). */
+        rfs_plan_tree_begin(&s->plan, s->drive.path.x[s->drive.path.n - 1u],
+                            s->drive.path.y[s->drive.path.n - 1u]);
+    }
     rfs_drive_status_t st = rfs_drive_update(&s->drive, &s->pose, now_us, &out->left_mm_s,
                                              &out->right_mm_s);
     if (st != RFS_DRIVE_RUNNING) {
@@ -380,13 +391,47 @@ static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t 
     }
 }
 
+/* plan_budget (docs/PERFORMANCE.md, "Planning in slices"): every plan of a decision
+ * walks one search tree from the robot, grown plan_budget points a period, never
+ * searched within the decision. The tree grown on the leg from its goal serves when the
+ * robot stopped there (rfs_plan_tree_move); otherwise (a leg cut short, the first
+ * decision) one is begun at the robot. Start the decision's use of it; false when the
+ * robot has no legal start (every plan then fails at once, as without a tree). */
+static bool plan_begin(rfs_seek_t *s)
+{
+    rfs_q16_t sx, sy;
+    if (!rfs_seek_plan_start(s, &sx, &sy)) {
+        return false;
+    }
+    if (!rfs_plan_tree_move(&s->plan, sx, sy)) {
+        rfs_plan_tree_begin(&s->plan, sx, sy);
+    }
+    return true;
+}
+
 /* Finish the decision after a (possibly sliced) fit: the initial move (Algorithm 1's
- * first line), then the strategy's choice. */
-static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
+ * first line), then the strategy's choice. With plan_budget, when a plan asked for a
+ * point the tree had not closed yet (plan.tree_more), the choice is dropped and made
+ * again in the next period, after one more slice (`grow`; false in the period that
+ * decided or fitted), with the wheels stopped: the bounded wait of a leg cut short. */
+static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out,
+                            bool grow)
 {
     rfs_seek_decision_t *d = &s->decision;
+    const bool replan = s->replan; /* the choice clears it */
     bool ok = false;
-    if (d->iteration == 0u) {
+    if (s->cfg.plan_budget != 0u) {
+        if (!s->planning) {
+            s->planning = true;
+            s->plan_wait = 0;
+            s->plan_ready = plan_begin(s);
+        }
+        (void)rfs_plan_tree_grow(&s->plan, grow ? s->cfg.plan_budget : 0u);
+        s->plan.tree_more = false;
+    }
+    if (!rfs_seek_ops(s)->learns) {
+        ok = rfs_seek_ops(s)->choose(s, false, rng, now_us);
+    } else if (d->iteration == 0u) {
         d->kind = RFS_SEEK_INITIAL;
         ok = rfs_seek_meta_initial(s, rng, now_us);
     } else {
@@ -398,6 +443,16 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
         }
         ok = rfs_seek_ops(s)->choose(s, model_ok, rng, now_us);
     }
+    if (s->planning && s->plan_ready && s->plan.tree_more) {
+        s->replan = replan;
+        s->plan_wait = s->plan_wait < UINT16_MAX ? (uint16_t)(s->plan_wait + 1u) : UINT16_MAX;
+        s->state = RFS_SEEK_LEARNING;
+        stop_wheels(s, now_us, out);
+        return;
+    }
+    s->planning = false;
+    s->plan_ready = false;
+    d->plan_wait = s->plan_wait;
     end_decision(s, ok, now_us, out);
 }
 
@@ -439,7 +494,7 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     count_travel(s);
     d->mean_valid = rfs_seek_src_mean(s, now_us, &d->mean);
     if (!ops->learns) {
-        end_decision(s, ops->choose(s, false, rng, now_us), now_us, out);
+        finish_decision(s, now_us, rng, out, false);
         return;
     }
     /* "if |mean RSSI over last second - model prediction| > threshold: discard current
@@ -459,7 +514,7 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     if (s->fitting && !fit_slice(s, now_us, rng, out)) {
         return;
     }
-    finish_decision(s, now_us, rng, out);
+    finish_decision(s, now_us, rng, out, false);
 }
 
 /* |a - b| > limit, without signed overflow at extreme timestamps. */
@@ -538,6 +593,10 @@ static void keep_reach(rfs_seek_t *s)
     if (!s->reach_valid || !rfs_reach_snap(s->map, s->reach, s->pose.x, s->pose.y, &si, &sj)) {
         s->reach_valid = rfs_reach_fill(s->map, s->pose.x, s->pose.y, s->reach, s->queue,
                                         s->queue_cap);
+        if (s->plan.tree != 0u) {
+            /* The fill used the planner's queue: a tree being grown starts again. */
+            rfs_plan_tree_begin(&s->plan, s->plan.tree_x, s->plan.tree_y);
+        }
     }
 }
 
@@ -552,6 +611,14 @@ static void resume_goal(rfs_seek_t *s, int64_t now_us)
     s->drive.start_us = now_us >= INT64_MIN + s->resume_start_us ? now_us - s->resume_start_us
                                                                  : INT64_MIN;
     s->state = RFS_SEEK_DRIVING;
+}
+
+/* plan_budget: one slice of the next decision's search tree (begun by end_decision). */
+static void grow_next(rfs_seek_t *s)
+{
+    if (s->cfg.plan_budget != 0u) {
+        (void)rfs_plan_tree_grow(&s->plan, s->cfg.plan_budget);
+    }
 }
 
 /* Drive the current goal. true while it is still being driven; when it ends (reached,
@@ -570,6 +637,7 @@ static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
                                              &out->right_mm_s);
     if (st == RFS_DRIVE_RUNNING) {
         s->state = RFS_SEEK_DRIVING;
+        grow_next(s); /* the next decision's search tree */
         return true;
     }
     s->prev_status = st;
@@ -583,6 +651,7 @@ static bool hold_still(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     if (now_us < s->retry_after_us) {
         out->faults |= s->retry_no_goal ? RFS_SEEK_FAULT_NO_GOAL : 0u;
         stop_wheels(s, now_us, out);
+        grow_next(s);
         return true;
     }
     if (!rfs_seek_ops(s)->dwell) {
@@ -613,8 +682,13 @@ static void control(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_
     if (s->fitting) {
         /* A sliced fit continues; the decision finishes when it is done. */
         if (fit_slice(s, now_us, rng, out)) {
-            finish_decision(s, now_us, rng, out);
+            finish_decision(s, now_us, rng, out, false);
         }
+        return;
+    }
+    if (s->planning) {
+        /* The decision's search tree grows; the decision is made again. */
+        finish_decision(s, now_us, rng, out, true);
         return;
     }
     if (drive_on(s, now_us, out) || hold_still(s, now_us, out)) {

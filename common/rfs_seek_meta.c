@@ -264,7 +264,7 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     const bool tree = s->cfg.eps_geodesic;
     rfs_q16_t sx, sy;
     const bool tree_ok = tree && rfs_seek_plan_start(s, &sx, &sy);
-    if (tree_ok) {
+    if (tree_ok && !s->plan_ready) { /* plan_ready: the decision's grown tree (rfs_seek.c) */
         rfs_plan_tree_begin(&s->plan, sx, sy);
     }
     for (int attempt = 0; attempt < GOAL_TRIES; ++attempt) {
@@ -304,7 +304,9 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
                             }
                             goto next_attempt;
                         }
-                        rfs_reach_bit_set(s->visited, idx); /* unreachable in practice: do not redraw it */
+                        if (!s->plan.tree_more) { /* else decided again later (rfs_seek.c) */
+                            rfs_reach_bit_set(s->visited, idx); /* unreachable in practice: do not redraw it */
+                        }
                         goto next_attempt;
                     }
                 }

@@ -122,7 +122,19 @@ static void test_blocked_step_line_search(void **state)
      * cell of discretisation); the search steps 0.1 m from 6.3 both ways, so the first
      * legal point is beyond the wall at 6.4 or 6.5. */
     feed(&t, 100000, 5.3, 3.125, 0, -50, &out);
+    /* Round the wall the plan needs the search tree from the robot (plan_budget): the
+     * robot stands while it grows, 640 of the 48 x 32 lattice points a period, and the
+     * decision is made again each period until its plans find their points closed. */
+    int waited = 0;
+    for (int64_t now = 150000; !out.decided && waited < 10; now += 50000, waited++) {
+        assert_int_equal(out.state, RFS_SEEK_LEARNING);
+        assert_int_equal(out.left_mm_s, 0);
+        assert_int_equal(out.right_mm_s, 0);
+        feed(&t, now, 5.3, 3.125, 0, -50, &out);
+    }
     assert_true(out.decided);
+    assert_true(waited >= 1 && waited <= 3); /* 1,536 points: 3 slices at most */
+    assert_int_equal(out.decision.plan_wait, waited);
     assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
     assert_true(out.decision.line_search);
     assert_true(fabs(D(out.decision.max_x) - 9.125) < 1e-4);

@@ -314,7 +314,19 @@ typedef struct pull_path {
     rfs_q16_t gx, gy;      /* the goal */
     uint32_t ak, au;       /* the anchor's index and lattice point (au: when ak < n) */
     uint32_t ck, cu;       /* a cursor at or after the anchor */
+    uint32_t spanned;      /* points the segment tests spanned, summed */
 } pull_path_t;
+
+static void pull_at(pull_path_t *pp, uint32_t k, rfs_q16_t *x, rfs_q16_t *y);
+
+/* A straight legal segment from the anchor (ax, ay) at index a (+ 1) to point t (+ 1). */
+static bool pull_test(pull_path_t *pp, rfs_q16_t ax, rfs_q16_t ay, uint32_t a, uint32_t t,
+                      rfs_q16_t *x, rfs_q16_t *y)
+{
+    pull_at(pp, t - 1u, x, y);
+    pp->spanned += t - a;
+    return rfs_map_segment_legal(pp->m, ax, ay, *x, *y);
+}
 
 /* Position of point k (>= the anchor's index), by walking from the cursor or the anchor. */
 static void pull_at(pull_path_t *pp, uint32_t k, rfs_q16_t *x, rfs_q16_t *y)
@@ -337,44 +349,36 @@ static void pull_at(pull_path_t *pp, uint32_t k, rfs_q16_t *x, rfs_q16_t *y)
 }
 
 /* Pull the path of n lattice points from s_idx (then the goal (x1, y1)) as seen from
- * (x0, y0) into out. false when it needs more than RFS_PLAN_MAX_WAYPOINTS waypoints. */
+ * (x0, y0) into out; *spanned: the points its segment tests spanned. false when it needs
+ * more than RFS_PLAN_MAX_WAYPOINTS waypoints. Indices below count from 1 (0: the start). */
 static bool pull_path(const rfs_map_t *m, const uint8_t *w, uint32_t s_idx, uint32_t n,
-                      rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out)
+                      rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out,
+                      uint32_t *spanned)
 {
-    pull_path_t pp = {m, w, n, x1, y1, 0, s_idx, 0, s_idx};
+    pull_path_t pp = {m, w, n, x1, y1, 0, s_idx, 0, s_idx, 0};
     int64_t len = 0;
     rfs_q16_t ax = x0, ay = y0; /* the anchor */
     rfs_q16_t px, py;
-    uint32_t a = 0;             /* the anchor's index + 1: 0 is the start */
+    uint32_t a = 0;             /* the anchor's index */
+    bool ok = true;
     out->n = 0;
     for (;;) {
-        uint32_t good; /* index + 1 of the farthest point known reachable */
-        if (a == 0) {
-            pull_at(&pp, 0, &px, &py);
-            good = 1;
-            if (!rfs_map_segment_legal(m, ax, ay, px, py)) {
-                goto emit; /* out of the clearance zone: the first hop as it is */
-            }
-        } else {
-            good = a + 1u;
+        uint32_t good = a + 1u; /* the farthest point known reachable: the next one */
+        if (a == 0 && !pull_test(&pp, ax, ay, 0, 1, &px, &py)) {
+            goto emit;          /* out of the clearance zone: the first hop as it is */
         }
         uint32_t bad = 0;
         for (uint32_t h = 2; good <= n; h *= 2u) {
-            const uint32_t t = a + h > n + 1u ? n + 1u : a + h;
-            pull_at(&pp, t - 1u, &px, &py);
-            if (!rfs_map_segment_legal(m, ax, ay, px, py)) {
+            const uint32_t t = h > n + 1u - a ? n + 1u : a + h;
+            if (!pull_test(&pp, ax, ay, a, t, &px, &py)) {
                 bad = t;
                 break;
             }
             good = t;
-            if (h > n) {
-                break;
-            }
         }
         for (uint32_t r = 0; bad != 0 && r < PULL_REFINE && bad - good > 1u; r++) {
             const uint32_t mid = good + (bad - good) / 2u;
-            pull_at(&pp, mid - 1u, &px, &py);
-            if (rfs_map_segment_legal(m, ax, ay, px, py)) {
+            if (pull_test(&pp, ax, ay, a, mid, &px, &py)) {
                 good = mid;
             } else {
                 bad = mid;
@@ -384,7 +388,8 @@ static bool pull_path(const rfs_map_t *m, const uint8_t *w, uint32_t s_idx, uint
     emit:
         if (out->n >= RFS_PLAN_MAX_WAYPOINTS) {
             out->n = 0;
-            return false;
+            ok = false;
+            break;
         }
         out->x[out->n] = px;
         out->y[out->n] = py;
@@ -393,15 +398,15 @@ static bool pull_path(const rfs_map_t *m, const uint8_t *w, uint32_t s_idx, uint
         ax = px;
         ay = py;
         if (good == n + 1u) {
+            out->length = len > INT32_MAX ? INT32_MAX : (rfs_q16_t)len;
             break;
         }
-        pull_at(&pp, good - 1u, &px, &py); /* the cursor onto the new anchor */
-        pp.ak = pp.ck;
+        pp.ak = pp.ck; /* the cursor is on the new anchor, point good */
         pp.au = pp.cu;
         a = good;
     }
-    out->length = len > INT32_MAX ? INT32_MAX : (rfs_q16_t)len;
-    return true;
+    *spanned = pp.spanned;
+    return ok;
 }
 
 /* The cases every plan settles before a search: -1 an illegal goal (no path), 1 a
@@ -449,6 +454,7 @@ bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_
     out->n = 0;
     out->length = 0;
     p->expanded = 0;
+    p->pulled = 0;
     p->queue_peak = 0;
     p->tree = 0; /* the work memory is about to be reused */
     const int settled = settle(m, x0, y0, x1, y1, out);
@@ -471,7 +477,7 @@ bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_
         return false;
     }
     const uint32_t n = path_points(p, s_idx, g_idx);
-    return n != 0 && pull_path(m, p->work, s_idx, n, x0, y0, x1, y1, out);
+    return n != 0 && pull_path(m, p->work, s_idx, n, x0, y0, x1, y1, out, &p->pulled);
 }
 
 void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0)
@@ -517,7 +523,7 @@ static bool tree_extract(rfs_plan_t *p, uint32_t g_idx, rfs_q16_t x1, rfs_q16_t 
     if (u != root) {
         return false; /* unreachable: a closed point's pointers lead to the root */
     }
-    const bool ok = pull_path(m, w, root, pts, p->tree_x, p->tree_y, x1, y1, out);
+    const bool ok = pull_path(m, w, root, pts, p->tree_x, p->tree_y, x1, y1, out, &p->pulled);
     /* Turn the pointers back: each point's parent is the one before it. */
     uint32_t back = k; /* the root's own direction bits, restored as they were */
     for (u = root; u != g_idx;) {
@@ -595,6 +601,7 @@ bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *o
     out->n = 0;
     out->length = 0;
     p->expanded = 0;
+    p->pulled = 0;
     if (p->tree == 0) {
         return false;
     }

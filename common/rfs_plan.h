@@ -47,6 +47,8 @@ typedef struct rfs_plan {
     uint32_t *queue;        ///< wavefront queue of lattice indices
     uint32_t queue_cap;     ///< its capacity, split in four quarters (2 * (lw + lh) ample: docs/MAPS.md)
     uint32_t expanded;      ///< lattice points expanded by the last call (for benchmarks)
+    uint32_t pulled;        ///< path points the last search path's string pulling tested
+                            ///< segments across, summed: at most 10 per point of the path
     uint32_t queue_peak;    ///< most entries one of the four queue quarters held in the
                             ///< last search (a tree: since it was seeded)
     bool exact_edges;       ///< false (init): lattice points and edges from the map's

@@ -277,6 +277,30 @@ static bool component_bit(const uint8_t *bits, uint32_t idx)
     return ((bits[idx >> 3] >> (idx & 7u)) & 1u) != 0u;
 }
 
+/* false when no lattice point of the 3 x 3 that connect() joins (x, y) to has component
+ * bit `bit`: a goal there joins the lattice in another component than the start's, so
+ * the plan fails, known before connect()'s nine segment tests (a line search beside a
+ * closed room tries dozens of such goals, docs/PERFORMANCE.md). true without marks. */
+static bool near_component(const rfs_plan_t *p, rfs_q16_t x, rfs_q16_t y, bool bit)
+{
+    if (p->component == 0) {
+        return true;
+    }
+    const rfs_map_t *m = p->map;
+    uint16_t ci;
+    uint16_t cj;
+    rfs_map_lattice_nearest(m, x, y, &ci, &cj);
+    for (int32_t j = (int32_t)cj - 1; j <= (int32_t)cj + 1; j++) {
+        for (int32_t i = (int32_t)ci - 1; i <= (int32_t)ci + 1; i++) {
+            if (i >= 0 && j >= 0 && i < (int32_t)m->lw && j < (int32_t)m->lh &&
+                component_bit(p->component, (uint32_t)j * m->lw + (uint32_t)i) == bit) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
 /* The lattice point one step from u in direction k. */
 static uint32_t step_from(uint32_t u, uint32_t k, uint32_t lw)
 {
@@ -463,7 +487,9 @@ bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_
     }
     uint32_t s_idx;
     uint32_t g_idx;
-    if (!connect(m, x1, y1, false, &g_idx) || !connect(m, x0, y0, true, &s_idx)) {
+    if (!connect(m, x0, y0, true, &s_idx) ||
+        !near_component(p, x1, y1, p->component != 0 && component_bit(p->component, s_idx)) ||
+        !connect(m, x1, y1, false, &g_idx)) {
         return false;
     }
     if (p->component != 0 &&
@@ -593,44 +619,91 @@ bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0)
     return ok;
 }
 
-bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out)
+/* The goal (x1, y1) on the tree: -1 no path (illegal, unreachable, not closed yet on a
+ * sliced tree: tree_more), 1 in line of sight from the root's position, 0 its lattice
+ * point *g_idx closed (searched for on a tree that is not sliced). */
+static int tree_goal(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, uint32_t *g_idx)
 {
     const rfs_map_t *m = p->map;
-    const rfs_q16_t x0 = p->tree_x;
-    const rfs_q16_t y0 = p->tree_y;
-    out->n = 0;
-    out->length = 0;
     p->expanded = 0;
     p->pulled = 0;
-    if (p->tree == 0) {
-        return false;
+    if (p->tree == 0 || !rfs_map_point_legal(m, x1, y1)) {
+        return -1;
     }
-    const int settled = settle(m, x0, y0, x1, y1, out);
-    if (settled != 0) {
-        return settled > 0;
-    }
-    uint32_t g_idx;
-    if (!connect(m, x1, y1, false, &g_idx)) {
-        return false;
+    if (rfs_map_segment_legal(m, p->tree_x, p->tree_y, x1, y1)) {
+        return 1;
     }
     tree_seed(p);
     if (p->tree != 2) {
-        return false; /* the root joins no lattice point */
+        return -1; /* the root joins no lattice point */
     }
-    const uint32_t root = p->tree_root;
+    if (!near_component(p, x1, y1, p->component != 0 && component_bit(p->component, p->tree_root)) ||
+        !connect(m, x1, y1, false, g_idx)) {
+        return -1;
+    }
     if (p->component != 0 &&
-        component_bit(p->component, root) != component_bit(p->component, g_idx)) {
-        return false; /* different components: the search cannot succeed */
+        component_bit(p->component, p->tree_root) != component_bit(p->component, *g_idx)) {
+        return -1; /* different components: the search cannot succeed */
     }
-    uint8_t *w = p->work;
-    if (!(w[g_idx] & W_CLOSED)) {
+    if (!(p->work[*g_idx] & W_CLOSED)) {
         if (p->tree_sliced) {
             p->tree_more = p->tree_more || !p->tree_done;
-            return false;
+            return -1;
         }
-        if (p->tree_done || search_until(p, g_idx, UINT32_MAX) != SEARCH_FOUND) {
-            return false;
+        if (p->tree_done || search_until(p, *g_idx, UINT32_MAX) != SEARCH_FOUND) {
+            return -1;
         }
     }
-    return tree_extract(p, g_idx, x1, y1, out);
+    return 0;
+}
+
+bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out)
+{
+    out->n = 0;
+    out->length = 0;
+    out->x0 = p->tree_x;
+    out->y0 = p->tree_y;
+    out->has_start = true;
+    uint32_t g_idx = 0;
+    const int at = tree_goal(p, x1, y1, &g_idx);
+    if (at > 0) {
+        out->x[0] = x1;
+        out->y[0] = y1;
+        out->n = 1;
+        out->length = rfs_q16_dist(p->tree_x, p->tree_y, x1, y1);
+    }
+    return at == 0 ? tree_extract(p, g_idx, x1, y1, out) : at > 0;
+}
+
+bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *len)
+{
+    const rfs_map_t *m = p->map;
+    uint32_t g_idx = 0;
+    const int at = tree_goal(p, x1, y1, &g_idx);
+    if (at != 0) {
+        *len = at > 0 ? rfs_q16_dist(p->tree_x, p->tree_y, x1, y1) : 0;
+        return at > 0;
+    }
+    /* Scaling and overflow: at most lw * lh < 2^32 steps of grid < 2^31 (Q16) each, the
+     * sums in uint64; sqrt 2 in Q16 (92682) times that stays below 2^64 for any lattice
+     * whose path saturates the result (32 km) long before. */
+    uint64_t straight = 0;
+    uint64_t diagonal = 0;
+    const uint32_t n = (uint32_t)m->lw * m->lh;
+    uint32_t u = g_idx;
+    for (uint32_t k = 0; u != p->tree_root && k <= n; k++) {
+        const uint32_t dir = p->work[u] & W_DIR;
+        straight += (dir & 1u) == 0u;
+        diagonal += dir & 1u;
+        u = step_from(u, dir, m->lw);
+    }
+    rfs_q16_t rx, ry, gx, gy;
+    point_of(m, p->tree_root, &rx, &ry);
+    point_of(m, g_idx, &gx, &gy);
+    const uint64_t g = (uint64_t)m->cfg.grid;
+    uint64_t l = (uint64_t)rfs_q16_dist(p->tree_x, p->tree_y, rx, ry) +
+                 (uint64_t)rfs_q16_dist(gx, gy, x1, y1) + straight * g +
+                 ((diagonal * g * 92682u) >> 16);
+    *len = l > (uint64_t)INT32_MAX ? INT32_MAX : (rfs_q16_t)l;
+    return u == p->tree_root;
 }

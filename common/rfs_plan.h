@@ -109,6 +109,14 @@ void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0);
 /// rfs_plan_path call ended it.
 bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out);
 
+/// The length of the path from the tree's root to the legal point (x1, y1) before string
+/// pulling, metres Q16.16 (saturated): the root's position to its lattice point, the
+/// lattice path (straight steps grid, diagonal ones grid sqrt 2), the goal's lattice
+/// point to the goal; the straight distance in line of sight. At least the pulled
+/// path's length, at most 8.3 % above the lattice optimum; a walk, no pull.
+/// rfs_plan_tree_path's result cases (false, *len 0, when it would fail).
+bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *len);
+
 /// Continue the begun tree's search by at most `budget` closed lattice points (a
 /// control period's slice; the first call also clears the work, lw * lh bytes). true
 /// when it is done: every point the root reaches is closed (then each rfs_plan_tree_path

@@ -409,13 +409,23 @@ static bool plan_begin(rfs_seek_t *s)
     return true;
 }
 
+/* plan_budget: the decision is not made in this period; the wheels stay stopped. */
+static void plan_wait(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
+{
+    s->plan_wait = s->plan_wait < UINT16_MAX ? (uint16_t)(s->plan_wait + 1u) : UINT16_MAX;
+    s->state = RFS_SEEK_LEARNING;
+    stop_wheels(s, now_us, out);
+}
+
 /* Finish the decision after a (possibly sliced) fit: the initial move (Algorithm 1's
- * first line), then the strategy's choice. With plan_budget, when a plan asked for a
- * point the tree had not closed yet (plan.tree_more), the choice is dropped and made
- * again in the next period, after one more slice (`grow`; false in the period that
- * decided or fitted), with the wheels stopped: the bounded wait of a leg cut short. */
+ * first line), then the strategy's choice. With plan_budget a period either chooses or
+ * grows the tree, not both at full cost: `whole_fit` (this period relearnt in one go)
+ * leaves the choice to the next period; when a plan asked for a point the tree had not
+ * closed yet (plan.tree_more), the choice is dropped, the tree grows by one slice, and
+ * the choice is made again in the next period, the wheels stopped meanwhile: the
+ * bounded wait of a leg cut short (docs/PERFORMANCE.md, "Planning in slices"). */
 static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out,
-                            bool grow)
+                            bool whole_fit)
 {
     rfs_seek_decision_t *d = &s->decision;
     const bool replan = s->replan; /* the choice clears it */
@@ -426,7 +436,11 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
             s->plan_wait = 0;
             s->plan_ready = plan_begin(s);
         }
-        (void)rfs_plan_tree_grow(&s->plan, grow ? s->cfg.plan_budget : 0u);
+        if (whole_fit && s->plan_ready) {
+            plan_wait(s, now_us, out);
+            return;
+        }
+        (void)rfs_plan_tree_grow(&s->plan, 0u); /* seeded, marked sliced */
         s->plan.tree_more = false;
     }
     if (!rfs_seek_ops(s)->learns) {
@@ -445,9 +459,8 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
     }
     if (s->planning && s->plan_ready && s->plan.tree_more) {
         s->replan = replan;
-        s->plan_wait = s->plan_wait < UINT16_MAX ? (uint16_t)(s->plan_wait + 1u) : UINT16_MAX;
-        s->state = RFS_SEEK_LEARNING;
-        stop_wheels(s, now_us, out);
+        (void)rfs_plan_tree_grow(&s->plan, s->cfg.plan_budget);
+        plan_wait(s, now_us, out);
         return;
     }
     s->planning = false;
@@ -511,10 +524,11 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
         s->model.ops->reset(s->model.self);
         s->fitting = true;
     }
+    const bool whole_fit = s->fitting && s->cfg.fit_budget == 0u;
     if (s->fitting && !fit_slice(s, now_us, rng, out)) {
         return;
     }
-    finish_decision(s, now_us, rng, out, false);
+    finish_decision(s, now_us, rng, out, whole_fit);
 }
 
 /* |a - b| > limit, without signed overflow at extreme timestamps. */
@@ -687,8 +701,8 @@ static void control(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_
         return;
     }
     if (s->planning) {
-        /* The decision's search tree grows; the decision is made again. */
-        finish_decision(s, now_us, rng, out, true);
+        /* The decision waits for its search tree: the choice is made again. */
+        finish_decision(s, now_us, rng, out, false);
         return;
     }
     if (drive_on(s, now_us, out) || hold_still(s, now_us, out)) {

@@ -349,6 +349,39 @@ static bool recheck_fails(rfs_seek_t *s, int64_t now_us)
     return rfs_seek_recheck_miss(&s->cfg, &s->miss_ms, rfs_q16_abs(rfs_q16_sub(mean, pred)));
 }
 
+/* plan_budget: begin the search tree of the next decision where it will be made, to be
+ * grown while the leg is driven (drive_on, hold_still): the leg's end, or on a leg
+ * checked every recheck_dist (a greedy or sampled leg with recheck_dist) the next check
+ * point, recheck_dist further along the path from the robot, where a failed check
+ * decides anew (drive_on begins it again after each check that passes). Scaling: as
+ * rfs_seek_meta.c's greedy_along_path, offsets (< 2^32, Q16) times a length (< 2^16 m)
+ * in int64. */
+static void begin_next_tree(rfs_seek_t *s)
+{
+    const rfs_path_t *p = &s->drive.path;
+    if (s->cfg.plan_budget == 0u || p->n == 0u) {
+        return;
+    }
+    rfs_q16_t x = p->x[p->n - 1u], y = p->y[p->n - 1u];
+    if (s->cfg.recheck_dist > 0 &&
+        (s->decision.kind == RFS_SEEK_GREEDY || s->decision.sampled)) {
+        int64_t left = s->cfg.recheck_dist;
+        rfs_q16_t px = s->pose.x, py = s->pose.y;
+        for (uint16_t k = s->drive.next; k < p->n; ++k) {
+            const int64_t len = rfs_q16_dist(px, py, p->x[k], p->y[k]);
+            if (len >= left && len > 0) {
+                x = rfs_sat32(px + rfs_sdiv64_round(((int64_t)p->x[k] - px) * left, len));
+                y = rfs_sat32(py + rfs_sdiv64_round(((int64_t)p->y[k] - py) * left, len));
+                break;
+            }
+            left -= len;
+            px = p->x[k];
+            py = p->y[k];
+        }
+    }
+    rfs_plan_tree_begin(&s->plan, x, y);
+}
+
 /* Count the decision, report it, and start driving (or flag that there is no goal). */
 static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t *out)
 {
@@ -369,12 +402,7 @@ static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t 
         return;
     }
     s->state = RFS_SEEK_DRIVING;
-    if (s->cfg.plan_budget != 0u && s->drive.path.n > 0u) {
-        /* The next decision is made where this leg ends: its search tree is grown there
-         * while the leg is driven (drive_on, hold_still). */
-        rfs_plan_tree_begin(&s->plan, s->drive.path.x[s->drive.path.n - 1u],
-                            s->drive.path.y[s->drive.path.n - 1u]);
-    }
+    begin_next_tree(s);
     rfs_drive_status_t st = rfs_drive_update(&s->drive, &s->pose, now_us, &out->left_mm_s,
                                              &out->right_mm_s);
     if (st != RFS_DRIVE_RUNNING) {
@@ -639,6 +667,7 @@ static void grow_next(rfs_seek_t *s)
  * timed out, blocked, or abandoned by a failed recheck) the period goes on to decide. */
 static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
 {
+    const rfs_q16_t chk_x = s->chk_x, chk_y = s->chk_y;
     if (s->drive.status == RFS_DRIVE_RUNNING && recheck_fails(s, now_us)) {
         rfs_drive_stop(&s->drive, now_us);
         s->prev_status = RFS_DRIVE_RUNNING; /* abandoned while running: the model failed */
@@ -651,6 +680,9 @@ static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
                                              &out->right_mm_s);
     if (st == RFS_DRIVE_RUNNING) {
         s->state = RFS_SEEK_DRIVING;
+        if (s->chk_x != chk_x || s->chk_y != chk_y) {
+            begin_next_tree(s); /* a check passed: the next one is further on */
+        }
         grow_next(s); /* the next decision's search tree */
         return true;
     }

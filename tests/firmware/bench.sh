@@ -43,7 +43,6 @@ printf '%s\n%s\n' "$out" "$models" | awk -F'\t' '
         printf "worst control period, faithful meta (planning in slices, %s): %s\n", worst_name, verdict(f)
         g = worst_of("^worst_eps_(geodesic|straight)(_cut)?$|^worst_eps_(geodesic|straight)_slice$", "")
         printf "worst control period, meta-path with geodesic decisions (%s): %s\n", worst_name, verdict(g)
-        printf "the same, its choice alone (6 draws: weighted scans, 5 length walks, 1 pull; phase_walk_behind_wall the pull): %d of it\n", ins["worst_eps_geodesic"]
         w = 0; for (k in v) if (k ~ /_cut_periods$/ && v[k] > w) w = v[k]
         printf "leg cut short: the decision waits for its tree, at most %d periods (%d ms at 20 Hz), target 1000 ms: %s\n", w, 50 * w, 50 * w <= 1000 ? "met" : "MISSED"
         mb = mc["mcu_budget_pathloss"]; ms = "slice_worst_pathloss_" mb

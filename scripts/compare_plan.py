@@ -10,7 +10,7 @@ Per scenario and configuration (meta + ridge, meta-path + pathloss): success (re
 the source within the run's limits) of each build with its 95 % Wilson interval, the
 discordant pairs (seeds only one build reached) with McNemar's exact two-sided p, the
 median travel ratio (distance travelled / shortest path) of each over the seeds both
-reached and the median of the paired differences; from the new build's summaries the
+reached and the mean change of its log over those seeds (+- one standard error); from the new build's summaries the
 decisions that waited two or more control periods for their search tree (over 100 ms at
 20 Hz; summary.json slow_decisions) as a share of all decisions, and the longest wait.
 """
@@ -79,10 +79,9 @@ def main():
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--work", default="build/compare_plan")
     a = ap.parse_args()
-    print("| scenario | configuration | success base | success new | only base / only new "
-          "(p) | travel ratio base / new (both reached) | paired difference | decisions "
-          "> 100 ms | longest wait |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| scenario, configuration | success base | success new | only base / new (p) | "
+          "ratio base / new | paired | decisions > 100 ms | longest wait |")
+    print("|---|---|---|---|---|---|---|---|")
     for scen in SCENARIOS:
         for strat, model in CONFIGS:
             res = {}
@@ -106,15 +105,17 @@ def main():
             rb = [ratio("base", k) for k in both]
             rn = [ratio("new", k) for k in both]
             med = lambda v: statistics.median(v) if v else float("nan")  # noqa: E731
-            diff = med([y - x for x, y in zip(rb, rn)])
+            logs = [math.log(y / x) for x, y in zip(rb, rn)]
+            mlog = statistics.mean(logs) if logs else float("nan")
+            se = statistics.stdev(logs) / math.sqrt(len(logs)) if len(logs) > 1 else float("nan")
             sm = summaries(os.path.join(a.work, "new", "%s-%s-%s" % (scen, strat, model)), seeds)
             dec = sum(int(s["iterations"]) for s in sm.values())
             slow = sum(int(s.get("slow_decisions", 0)) for s in sm.values())
             wait = max([int(s.get("plan_wait_max", 0)) for s in sm.values()] or [0])
-            print("| %s | %s + %s | %s | %s | %d / %d (%.2f) | %.3f / %.3f | %+.3f | %.2f %% of "
-                  "%d | %d ms |" % (scen, strat, model, cell[0], cell[1], b, c, mcnemar(b, c),
-                                    med(rb), med(rn), diff, 100.0 * slow / max(dec, 1), dec,
-                                    50 * (wait + 1)))
+            print("| %s, %s + %s | %s | %s | %d / %d (%.2f) | %.2f / %.2f | %+.3f +- %.3f | "
+                  "%.2f %% of %d | %d ms |" % (scen, strat, model, cell[0], cell[1], b, c,
+                                              mcnemar(b, c), med(rb), med(rn), mlog, se,
+                                              100.0 * slow / max(dec, 1), dec, 50 * (wait + 1)))
             sys.stdout.flush()
 
 

@@ -571,6 +571,8 @@ static void test_eps_geodesic_distribution(void **state)
     double f_on = geo_far_draws(true, n, true) / (double)n;
     double s_off = sqrt(p_off * (1.0 - p_off) / n);
     double s_lo = sqrt(p_lo * (1.0 - p_lo) / n), s_hi = sqrt(p_hi * (1.0 - p_hi) / n);
+    print_message("far side: off %.4f (want %.4f), on %.4f (want %.4f..%.4f)\n", f_off, p_off,
+                  f_on, p_lo, p_hi);
     if (fabs(f_off - p_off) > 4.0 * s_off || f_on < p_lo - 4.0 * s_lo || f_on > p_hi + 4.0 * s_hi) {
         print_error("far side: off %.4f (want %.4f), on %.4f (want %.4f..%.4f)\n", f_off, p_off,
                     f_on, p_lo, p_hi);

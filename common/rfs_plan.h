@@ -102,9 +102,9 @@ void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0);
 /// result cases, but the tree's Dijkstra (from the root) is continued only until the
 /// goal's lattice point is closed, and a goal closed by an earlier call needs no search.
 /// A tree grown by rfs_plan_tree_grow is never searched here: a goal it has not closed
-/// fails, and sets tree_more unless the tree is done (then it is unreachable). The lattice path may differ from rfs_plan_path's among equal-cost ones
-/// (ties); the waypoints are string pulled from the root forwards, as rfs_plan_path
-/// does. A path depends only on the root and the goal, not on the goals asked before
+/// fails, and sets tree_more unless the tree is done (then it is unreachable). The
+/// lattice path may differ from rfs_plan_path's among equal-cost ones (ties); the
+/// waypoints are string pulled from the root forwards, as rfs_plan_path does. A path depends only on the root and the goal, not on the goals asked before
 /// nor on how the search was sliced. false, out->n 0, also when no tree was begun or an
 /// rfs_plan_path call ended it.
 bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out);
@@ -113,7 +113,8 @@ bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *o
 /// pulling, metres Q16.16 (saturated): the root's position to its lattice point, the
 /// lattice path (straight steps grid, diagonal ones grid sqrt 2), the goal's lattice
 /// point to the goal; the straight distance in line of sight. At least the pulled
-/// path's length, at most 8.3 % above the lattice optimum; a walk, no pull.
+/// path's length; its lattice part at most 6.1 % above the shortest lattice path (octile
+/// costs 1.5 for sqrt 2); a walk, no pull.
 /// rfs_plan_tree_path's result cases (false, *len 0, when it would fail).
 bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *len);
 

@@ -106,6 +106,8 @@ def main():
             rn = [ratio("new", k) for k in both]
             med = lambda v: statistics.median(v) if v else float("nan")  # noqa: E731
             logs = [math.log(y / x) for x, y in zip(rb, rn)]
+            if len(logs) < 2:
+                logs = []
             mlog = statistics.mean(logs) if logs else float("nan")
             se = statistics.stdev(logs) / math.sqrt(len(logs)) if len(logs) > 1 else float("nan")
             sm = summaries(os.path.join(a.work, "new", "%s-%s-%s" % (scen, strat, model)), seeds)

@@ -470,6 +470,8 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
         }
         (void)rfs_plan_tree_grow(&s->plan, 0u); /* seeded, marked sliced */
         s->plan.tree_more = false;
+        d->line_search = false; /* flags a dropped choice may have set */
+        d->sampled = false;
     }
     if (!rfs_seek_ops(s)->learns) {
         ok = rfs_seek_ops(s)->choose(s, false, rng, now_us);

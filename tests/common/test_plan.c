@@ -1024,6 +1024,56 @@ static void test_tree_sliced(void **state)
     assert_true(before > 50 && more > 10 && moved >= 5);
 }
 
+/* rfs_plan_tree_length on the five kinds of map, lattice roots: false exactly where the
+ * tree's plan fails; in line of sight the straight distance; else at least the pulled
+ * path's length and at most the reference lattice optimum (double Euclidean Dijkstra)
+ * times 1.0607 (octile costs) plus a millimetre of rounding. */
+static void test_tree_length(void **state)
+{
+    (void)state;
+    int checked = 0, searched = 0;
+    for (int kind = 0; kind <= 4; kind++) {
+        build_kind(kind, 3);
+        const int lw = wd.m.lw, lh = wd.m.lh;
+        const double g = (double)wd.m.cfg.grid;
+        rfs_plan_t t;
+        assert_int_equal(rfs_plan_init(&t, &wd.m, work, sizeof(work), queue, 1024), 0);
+        uint32_t rs = 991u + (uint32_t)kind;
+        for (int k = 0; k < 3; k++) {
+            int si, sj;
+            random_legal(&rs, lw, lh, &si, &sj);
+            (void)ref_dijkstra(lw, lh, si, sj, -1, -1);
+            const rfs_q16_t x0 = (rfs_q16_t)(g / 2 + si * g), y0 = (rfs_q16_t)(g / 2 + sj * g);
+            rfs_plan_tree_begin(&t, x0, y0);
+            for (int q = 0; q < 12; q++) {
+                int gi, gj;
+                random_legal(&rs, lw, lh, &gi, &gj);
+                const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi * g), y1 = (rfs_q16_t)(g / 2 + gj * g);
+                rfs_q16_t len = -1;
+                const bool okl = rfs_plan_tree_length(&t, x1, y1, &len);
+                rfs_path_t pt;
+                const bool okp = rfs_plan_tree_path(&t, x1, y1, &pt);
+                assert_int_equal(okl, okp);
+                if (!okl) {
+                    assert_int_equal(len, 0);
+                    continue;
+                }
+                checked++;
+                const double l = len / 65536.0;
+                if (ref_seg(x0, y0, x1, y1)) {
+                    assert_true(fabs(l - hypot(x1 - x0, y1 - y0) / 65536.0) < 1e-4);
+                    continue;
+                }
+                searched++;
+                assert_true(l >= pt.length / 65536.0 - 1e-3);
+                assert_true(l <= dist_ref[gj * lw + gi] / 65536.0 * 1.0607 + 1e-3);
+            }
+        }
+    }
+    print_message("tree lengths: %d goals, %d round obstacles\n", checked, searched);
+    assert_true(checked >= 100 && searched >= 40);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1037,6 +1087,7 @@ int main(void)
         cmocka_unit_test(test_tree_misuse_and_limits),
         cmocka_unit_test(test_pull_linear),
         cmocka_unit_test(test_tree_sliced),
+        cmocka_unit_test(test_tree_length),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -693,6 +693,8 @@ static void ctrl_event(sim_run_t *r, const event_t *ev, const tick_t *k)
         res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
         res->goal_timeouts += d->prev == RFS_DRIVE_TIMEOUT ? 1u : 0u;
         res->goal_blocked += d->prev == RFS_DRIVE_BLOCKED ? 1u : 0u;
+        res->slow_decisions += d->plan_wait >= 2u ? 1u : 0u;
+        res->plan_wait_max = d->plan_wait > res->plan_wait_max ? d->plan_wait : res->plan_wait_max;
         if (d->kind == RFS_SEEK_GREEDY && d->model_valid) {
             r->belief_x = q16d(d->max_x);
             r->belief_y = q16d(d->max_y);
@@ -1068,6 +1070,8 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
     fprintf(f, "  \"motor_timeouts\": %u,\n", r->motor_timeouts);
     fprintf(f, "  \"goal_timeouts\": %u,\n", r->goal_timeouts);
     fprintf(f, "  \"goal_blocked\": %u,\n", r->goal_blocked);
+    fprintf(f, "  \"slow_decisions\": %u,\n", r->slow_decisions);
+    fprintf(f, "  \"plan_wait_max\": %u,\n", r->plan_wait_max);
     json_num(f, "turn_time_s", r->turn_time_s, false);
     fprintf(f, "  \"wall_contacts\": %ld,\n", r->wall_contacts);
     // The path-loss model's final estimate (null for other models).

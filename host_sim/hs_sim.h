@@ -73,6 +73,10 @@ typedef struct hs_sim_result {
     uint32_t motor_timeouts;     ///< times the motor model stopped on a missing command
     uint32_t goal_timeouts;      ///< goals the drive abandoned after its timeout
     uint32_t goal_blocked;       ///< goals the drive abandoned as blocked (no progress)
+    uint32_t slow_decisions;     ///< decisions that waited 2 or more control periods for
+                                 ///< their search tree (rfs_seek_decision_t.plan_wait):
+                                 ///< over 100 ms from the leg's end at 20 Hz
+    uint32_t plan_wait_max;      ///< the longest such wait, control periods
     double turn_time_s;          ///< time turning on the spot (|v| < 2 cm/s, |w| > 0.05 rad/s)
     long wall_contacts;          ///< wall contacts (hs_box2d_wall_contacts)
     double wall_time_s;          ///< host time the run took (not part of determinism)

@@ -142,7 +142,7 @@ BENCH_TARGETS += bench-feed bench-wire
 
 # --- the Cortex-M4 (emulated): instruction counts of the loop and of the models ----------------
 .PHONY: bench-firmware bench-models-m4
-bench-firmware: $(FW)/bench.elf $(FW)/firmware.elf $(FW)/qemu.elf
+bench-firmware: $(FW)/bench.elf $(FW)/bench_models.elf $(FW)/firmware.elf $(FW)/qemu.elf
 	@tests/firmware/bench.sh $(BUILD)
 # MW_BUDGETS="mlp:600 pathloss:800" adds sliced relearns at candidate budgets beside the
 # registry's (how rfs_models_entry_t.mcu_fit_budget was chosen; up to 8 pairs).

@@ -42,6 +42,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.recheck_adapt = false;                /* one fixed threshold */
     c.eps_geodesic = false;                 /* epsilon weights by straight distance */
     c.eps_sample = false;                   /* and epsilon goals at random, not drawn */
+    c.refute_r = 0;                         /* and nothing is ruled out */
     c.settle_dist = 0;                      /* epsilon anneals to eps_floor, never 0 */
     c.src_spacing = 0;
     c.src_floor = INT32_MIN;
@@ -94,6 +95,9 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
     cfg->recheck_adapt = on;
     cfg->eps_geodesic = on;
     cfg->eps_sample = on;
+    /* The source within a step of a refuted argmax would be within 1.5 steps of the robot
+     * (docs/STRATEGIES.md, "Stalls"). */
+    cfg->refute_r = on ? cfg->step : 0;
 }
 
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)
@@ -142,6 +146,7 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         (uint32_t)cfg->strategy >= (uint32_t)RFS_SEEK_STRATEGY_COUNT ||
         cfg->tumble_better < 0 || cfg->tumble_better > RFS_Q16_ONE || cfg->tumble_worse < 0 ||
         cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0 || cfg->settle_dist < 0 ||
+        cfg->refute_r < 0 ||
         cfg->src_spacing < 0) {
         return -1;
     }
@@ -407,7 +412,9 @@ static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_ou
 {
     rfs_model_fit_in_t fin = { .samples = s->store.samples, .n = s->store.count,
                                .qx = s->pose.x, .qy = s->pose.y, .map = s->map,
-                               .reach = s->reach_valid ? s->reach : 0 };
+                               .reach = s->reach_valid ? s->reach : 0,
+                               .excl_x = s->excl_x, .excl_y = s->excl_y, .nexcl = s->nexcl,
+                               .excl_r = s->cfg.refute_r };
     for (uint8_t i = 0; s->src != 0 && i < s->target->nsources; ++i) {
         fin.src_samples[i] = s->src[i].store.samples;
         fin.src_n[i] = s->src[i].store.count;
@@ -448,6 +455,7 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     bool relearn = !d->model_valid;
     if (d->model_valid && d->mean_valid) {
         relearn = rfs_q16_abs(rfs_q16_sub(d->mean, d->prediction)) > s->cfg.error_threshold;
+        rfs_seek_meta_refute(s);
     }
     relearn = relearn || ops->refit;
 

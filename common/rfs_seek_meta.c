@@ -98,6 +98,23 @@ void rfs_seek_meta_visit(rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y)
     }
 }
 
+void rfs_seek_meta_refute(rfs_seek_t *s)
+{
+    rfs_seek_decision_t *d = &s->decision;
+    rfs_q16_t mx, my;
+    if (s->cfg.refute_r <= 0 || s->model.ops->argmax == 0 ||
+        !s->model.ops->argmax(s->model.self, &mx, &my) ||
+        rfs_q16_dist(s->pose.x, s->pose.y, mx, my) > s->cfg.step / 2 ||
+        rfs_q16_sub(d->prediction, d->mean) <= s->cfg.error_threshold) {
+        return;
+    }
+    s->excl_x[s->excl_next] = mx;
+    s->excl_y[s->excl_next] = my;
+    s->excl_next = (uint8_t)((s->excl_next + 1u) % RFS_MODEL_MAX_EXCL);
+    s->nexcl = (uint8_t)(s->nexcl < RFS_MODEL_MAX_EXCL ? s->nexcl + 1u : RFS_MODEL_MAX_EXCL);
+    d->refuted = true;
+}
+
 /* Initial random move: a uniformly chosen reachable lattice point within
  * initial_step_max of the robot (paper: "restricted to twice the regular step width"). */
 bool rfs_seek_meta_initial(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)

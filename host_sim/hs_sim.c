@@ -646,9 +646,9 @@ static void log_decision(FILE *f, const hs_ctrl_t *ctrl, const rfs_seek_decision
                          const event_t *ev, double theta)
 {
     char reason[96];
-    snprintf(reason, sizeof reason, "prev=%s%s%s%s%s", prev_name(d->prev),
+    snprintf(reason, sizeof reason, "prev=%s%s%s%s%s%s", prev_name(d->prev),
              d->line_search ? ",line_search" : "",
-             d->sampled ? ",sampled" : "",
+             d->sampled ? ",sampled" : "", d->refuted ? ",refuted" : "",
              d->model_valid ? "" : ",no_model",
              d->mean_valid ? "" : ",no_mean");
     double pred = d->model_valid ? q16d(d->prediction) : NAN;

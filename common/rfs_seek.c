@@ -79,6 +79,7 @@ void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg)
     cfg->src_floor = RFS_Q16_INT(-100);     /* radiotap receivers report down to -100 dBm */
     /* Two thirds of the bridging scenarios' 150 m (docs/STRATEGIES.md, "Bridging"). */
     cfg->settle_dist = RFS_Q16_INT(100);
+    cfg->refute_r = 0; /* the argmax is the target's best point, not a source */
 }
 
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy)
@@ -455,8 +456,8 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     bool relearn = !d->model_valid;
     if (d->model_valid && d->mean_valid) {
         relearn = rfs_q16_abs(rfs_q16_sub(d->mean, d->prediction)) > s->cfg.error_threshold;
-        rfs_seek_meta_refute(s);
     }
+    relearn = rfs_seek_meta_refute(s, now_us) || relearn;
     relearn = relearn || ops->refit;
 
     if (relearn && s->store.count > 0u) {

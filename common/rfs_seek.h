@@ -86,7 +86,8 @@ typedef struct rfs_seek_cfg {
                                 ///< the robot stands within 1.5 steps of the model's argmax
     rfs_q16_t refute_r;         ///< a decision at the model's argmax (within half a step)
                                 ///< whose 1 s mean is weaker than the prediction by more
-                                ///< than error_threshold rules out the source within this
+                                ///< than error_threshold, or that has no mean while the
+                                ///< receiver is up, rules out the source within this
                                 ///< radius of the argmax for every later fit (Algorithm 1
                                 ///< still runs: the source is not here), metres Q16.16 (0:
                                 ///< off); keep it below the "at source" radius less half a
@@ -284,7 +285,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 
 /// The settings for a model fitted per source (rfs_fields.h; docs/STRATEGIES.md,
-/// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m.
+/// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m, refute_r 0.
 void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg);
 
 /// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array

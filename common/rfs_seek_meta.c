@@ -98,21 +98,31 @@ void rfs_seek_meta_visit(rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y)
     }
 }
 
-void rfs_seek_meta_refute(rfs_seek_t *s)
+bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us)
 {
     rfs_seek_decision_t *d = &s->decision;
     rfs_q16_t mx, my;
-    if (s->cfg.refute_r <= 0 || s->model.ops->argmax == 0 ||
+    if (s->cfg.refute_r <= 0 || !d->model_valid || s->model.ops->argmax == 0 ||
         !s->model.ops->argmax(s->model.self, &mx, &my) ||
-        rfs_q16_dist(s->pose.x, s->pose.y, mx, my) > s->cfg.step / 2 ||
-        rfs_q16_sub(d->prediction, d->mean) <= s->cfg.error_threshold) {
-        return;
+        rfs_q16_dist(s->pose.x, s->pose.y, mx, my) > s->cfg.step / 2) {
+        return false;
+    }
+    /* Weaker than the model says, or silent: a whole window without a packet from a
+     * source heard before while the receiver reports itself up (a dead zone, where no
+     * source within a metre could be). Scaling: |now - last report| as in
+     * rfs_seek_on_receiver's freshness, in int64 (both stamps are clock microseconds). */
+    bool weak = d->mean_valid && rfs_q16_sub(d->prediction, d->mean) > s->cfg.error_threshold;
+    bool silent = !d->mean_valid && s->have_meas && s->have_rx && now_us >= s->last_rx_us &&
+                  now_us - s->last_rx_us <= s->cfg.rssi_timeout_us;
+    if (!weak && !silent) {
+        return false;
     }
     s->excl_x[s->excl_next] = mx;
     s->excl_y[s->excl_next] = my;
     s->excl_next = (uint8_t)((s->excl_next + 1u) % RFS_MODEL_MAX_EXCL);
     s->nexcl = (uint8_t)(s->nexcl < RFS_MODEL_MAX_EXCL ? s->nexcl + 1u : RFS_MODEL_MAX_EXCL);
     d->refuted = true;
+    return true;
 }
 
 /* Initial random move: a uniformly chosen reachable lattice point within

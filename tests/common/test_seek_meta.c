@@ -328,6 +328,7 @@ typedef struct refute_model {
     double want_x[64], want_y[64]; /* every refutation expected so far, oldest first */
     int nwant;
     double mean;         /* the scripted 1 s mean */
+    bool silent;         /* no packet at the decisions, the receiver up */
     bool mismatch;       /* a fit was given other places than expected */
 } refute_model_t;
 
@@ -347,7 +348,7 @@ static rfs_fit_result_t refute_fit(void *self, const rfs_model_fit_in_t *in, uin
      * has just invalidated the model: any fit but the first had one). */
     if (m->fits > 0 &&
         hypot(D(in->qx) - D(m->base.mx), D(in->qy) - D(m->base.my)) <= 0.5 &&
-        -60.0 - m->mean > 3.0 && m->nwant < 64) {
+        (m->silent || -60.0 - m->mean > 3.0) && m->nwant < 64) {
         m->want_x[m->nwant] = D(m->base.mx);
         m->want_y[m->nwant] = D(m->base.my);
         m->nwant++;
@@ -409,6 +410,59 @@ static int refute_case(double mean, bool on, int decisions, refute_model_t *m)
     return refuted;
 }
 
+/* The same model in silence: packets (-60 dBm) for the first 1.5 s only, then the
+ * receiver's reports alone, every 10 ms; the robot teleported onto each goal 0.5 s after
+ * it is decided. Returns the decisions that ruled a place out. */
+static int refute_silent(refute_model_t *m, int decisions)
+{
+    static const rfs_model_ops_t ops = {
+        .name = "refute", .reset = fixed_reset, .fit = refute_fit, .predict = fixed_predict,
+        .argmax = fixed_argmax,
+    };
+    world_t t;
+    world_make(&t, 20.0, 10.0, 0, 0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    cfg.eps_amp = 0;
+    cfg.eps_floor = 0;
+    seek_make(&t, cfg, 5);
+    memset(m, 0, sizeof *m);
+    m->silent = true;
+    rfs_model_t model = { &ops, m };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    double x = 4.125, y = 5.125, gx = x, gy = y;
+    int64_t arrive = -1;
+    int refuted = 0, decided = 0;
+    for (int64_t now = 10000; decided < decisions && now < 600000000; now += 10000) {
+        if (arrive >= 0 && now >= arrive) {
+            x = gx;
+            y = gy;
+            arrive = -1;
+        }
+        if (now < 1500000) {
+            rfs_seek_on_rssi(&t.seek, 0, now, -60, &t.rng);
+        }
+        assert_true(rfs_seek_on_receiver(&t.seek, now));
+        if (now % 50000 == 0) {
+            rfs_seek_out_t out;
+            rfs_pose_t p = { now, Q(x), Q(y), 0 };
+            rfs_seek_on_pose(&t.seek, &p, &t.rng);
+            rfs_seek_step(&t.seek, now, &t.rng, &out);
+            if (out.decided) {
+                decided++;
+                refuted += out.decision.refuted ? 1 : 0;
+                assert_true(!out.decision.refuted || !out.decision.mean_valid);
+                gx = D(out.decision.goal_x);
+                gy = D(out.decision.goal_y);
+                arrive = now + 500000;
+            }
+        }
+    }
+    assert_int_equal(decided, decisions);
+    world_free(&t);
+    return refuted;
+}
+
 static void test_refute_rules_out_the_argmax(void **state)
 {
     (void)state;
@@ -431,6 +485,12 @@ static void test_refute_rules_out_the_argmax(void **state)
         assert_int_equal(m.nexcl, 0);
         assert_false(c != 1 && m.fits < 11); /* the miss relearns */
     }
+    /* Silence at the maximum, the receiver up: ruled out, the model relearnt for it. */
+    refuted = refute_silent(&m, 12);
+    assert_false(m.mismatch);
+    assert_int_equal(refuted, m.nwant);
+    assert_true(m.nwant >= 9);
+    assert_true(m.fits >= m.nwant);
 }
 
 /* The geodesic epsilon step (cfg.eps_geodesic, docs/STRATEGIES.md) against a double-

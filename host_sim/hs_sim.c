@@ -949,6 +949,9 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     if (e->sc.seek_recheck_m >= 0.0) {
         cc.seek.recheck_dist = (rfs_q16_t)lround(e->sc.seek_recheck_m * 65536.0);
     }
+    if (e->sc.seek_refute_m >= 0.0) {
+        cc.seek.refute_r = (rfs_q16_t)lround(e->sc.seek_refute_m * 65536.0);
+    }
     if (e->sc.seek_eps_rate >= 0.0) {
         cc.seek.eps_rate = (rfs_q16_t)lround(e->sc.seek_eps_rate * 65536.0);
     }

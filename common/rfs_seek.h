@@ -273,6 +273,9 @@ typedef struct rfs_seek {
     uint8_t excl_next;                        ///< refute_r: the slot the next one takes
     rfs_q16_t excl_x[RFS_MODEL_MAX_EXCL];     ///< refute_r: their x, metres Q16.16
     rfs_q16_t excl_y[RFS_MODEL_MAX_EXCL];     ///< refute_r: their y, metres Q16.16
+    bool have_sub;                            ///< sub_* hold the latest unreachable maximum
+    rfs_q16_t sub_mx, sub_my;                 ///< an unreachable greedy maximum, metres Q16.16
+    rfs_q16_t sub_x, sub_y;                   ///< the reachable point driven to instead
 } rfs_seek_t;
 
 /// The paper's parameters (section 2 and 5.2): the `meta` configuration.

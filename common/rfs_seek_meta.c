@@ -103,8 +103,14 @@ bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us)
     rfs_seek_decision_t *d = &s->decision;
     rfs_q16_t mx, my;
     if (s->cfg.refute_r <= 0 || !d->model_valid || s->model.ops->argmax == 0 ||
-        !s->model.ops->argmax(s->model.self, &mx, &my) ||
-        rfs_q16_dist(s->pose.x, s->pose.y, mx, my) > s->cfg.step / 2) {
+        !s->model.ops->argmax(s->model.self, &mx, &my)) {
+        return false;
+    }
+    /* At the maximum, or, when it is unreachable, at the reachable point driven to instead
+     * (greedy_along_path): as close as the robot can come. */
+    const bool sub = s->have_sub && s->sub_mx == mx && s->sub_my == my;
+    const rfs_q16_t ax = sub ? s->sub_x : mx, ay = sub ? s->sub_y : my;
+    if (rfs_q16_dist(s->pose.x, s->pose.y, ax, ay) > s->cfg.step / 2) {
         return false;
     }
     /* Weaker than the model says, or silent: a whole window without a packet from a
@@ -207,6 +213,11 @@ static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool wh
             !rfs_seek_go_to(s, nx, ny, now_us)) {
             return false;
         }
+        s->have_sub = true;
+        s->sub_mx = mx;
+        s->sub_my = my;
+        s->sub_x = nx;
+        s->sub_y = ny;
     }
     rfs_path_t *p = &s->drive.path;
     int64_t px = s->pose.x, py = s->pose.y;
@@ -236,7 +247,8 @@ static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool wh
 
 /* eps_sample: the epsilon goal is a draw from the model's belief (a plausible source),
  * driven the whole planned way and rechecked like a greedy leg. false (the novelty draw
- * follows) when the model draws nothing, a point within 1.5 steps of the robot, or one
+ * follows) when the model draws nothing, a point within 1.5 steps of the robot (or whose
+ * reachable stand-in is), or one
  * the robot has been to (within the novelty radius of a past position), and whenever the
  * robot stands within 1.5 steps of the model's own maximum: at a wrong estimate the
  * draws lie in the rooms round it, a leg there fails its recheck within a metre and the
@@ -263,7 +275,10 @@ static bool epsilon_sample(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     if (rfs_reach_bit(s->visited, (uint32_t)lj * s->map->lw + li)) {
         return false;
     }
-    if (!greedy_along_path(s, x, y, true, now_us)) {
+    /* An unreachable draw's stand-in (the reachable point nearest to it) where the robot
+     * stands is a null move: the robot would learn nothing new there, again and again. */
+    if (!greedy_along_path(s, x, y, true, now_us) ||
+        rfs_q16_dist(s->pose.x, s->pose.y, s->decision.goal_x, s->decision.goal_y) < near) {
         return false;
     }
     s->decision.sampled = true;

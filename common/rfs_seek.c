@@ -17,6 +17,13 @@ _Static_assert(RFS_MODEL_MAX_SOURCES == RFS_TARGET_MAX_SOURCES,
 /* Wait before deciding again after no goal could be found, microseconds (one window). */
 #define NO_GOAL_RETRY_US 1000000
 
+/* |a - b| > limit, without signed overflow at extreme timestamps. */
+static bool apart(int64_t a, int64_t b, int64_t limit)
+{
+    uint64_t d = a >= b ? (uint64_t)a - (uint64_t)b : (uint64_t)b - (uint64_t)a;
+    return d > (uint64_t)limit;
+}
+
 rfs_seek_cfg_t rfs_seek_cfg_default(void)
 {
     rfs_seek_cfg_t c;
@@ -43,6 +50,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.eps_geodesic = false;                 /* epsilon weights by straight distance */
     c.eps_sample = false;                   /* and epsilon goals at random, not drawn */
     c.refute_r = 0;                         /* and nothing is ruled out */
+    c.silence_floor = INT32_MIN;            /* silence adds no sample */
     c.settle_dist = 0;                      /* epsilon anneals to eps_floor, never 0 */
     c.src_spacing = 0;
     c.src_floor = INT32_MIN;
@@ -80,6 +88,7 @@ void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg)
     /* Two thirds of the bridging scenarios' 150 m (docs/STRATEGIES.md, "Bridging"). */
     cfg->settle_dist = RFS_Q16_INT(100);
     cfg->refute_r = 0; /* the argmax is the target's best point, not a source */
+    cfg->silence_floor = INT32_MIN; /* each node's store has src_floor */
 }
 
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy)
@@ -99,6 +108,8 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
     /* The source within a step of a refuted argmax would be within 1.5 steps of the robot
      * (docs/STRATEGIES.md, "Stalls"). */
     cfg->refute_r = on ? cfg->step : 0;
+    /* Radiotap receivers report down to -100 dBm (docs/STRATEGIES.md, "Stalls"). */
+    cfg->silence_floor = on ? RFS_Q16_INT(-100) : INT32_MIN;
 }
 
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)
@@ -203,6 +214,13 @@ bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
     (void)rfs_store_add_pose(&s->store, pose, rng);
     if (s->src != 0) {
         rfs_seek_src_on_pose(s, pose, rng);
+    }
+    /* silence_floor: a source heard before, silent for a window, the receiver up. */
+    if (s->cfg.silence_floor != INT32_MIN && s->target == &rfs_target_rssi && s->have_meas &&
+        s->have_rx && !apart(pose->t_us, s->last_rx_us, s->cfg.rssi_timeout_us) &&
+        pose->t_us > s->last_meas_us &&
+        apart(pose->t_us, s->last_meas_us, (int64_t)s->cfg.rssi.window_us)) {
+        rfs_store_add_value(&s->store, pose->t_us, s->cfg.silence_floor, rng);
     }
     s->pose = *pose;
     s->have_pose = true;
@@ -469,13 +487,6 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
         return;
     }
     finish_decision(s, now_us, rng, out);
-}
-
-/* |a - b| > limit, without signed overflow at extreme timestamps. */
-static bool apart(int64_t a, int64_t b, int64_t limit)
-{
-    uint64_t d = a >= b ? (uint64_t)a - (uint64_t)b : (uint64_t)b - (uint64_t)a;
-    return d > (uint64_t)limit;
 }
 
 /* b - a > limit: stamp b further ahead of now a than limit (a clock jump, docs/FAULTS.md). */

@@ -92,6 +92,12 @@ typedef struct rfs_seek_cfg {
                                 ///< still runs: the source is not here), metres Q16.16 (0:
                                 ///< off); keep it below the "at source" radius less half a
                                 ///< step
+    rfs_q16_t silence_floor;    ///< target rssi: while the receiver reports itself up and
+                                ///< no packet came for a whole averaging window, every pose
+                                ///< adds a sample of this value: the fit learns where the
+                                ///< source is below the receiver's floor (a dead zone)
+                                ///< instead of never seeing the place, dBm Q16.16
+                                ///< (INT32_MIN: none, the paper's)
     rfs_q16_t settle_dist;      ///< after this much travel every choice is greedy (epsilon
                                 ///< 0): the robot goes to the model's best point and stays
                                 ///< there, metres Q16.16 (0: never, the paper's)
@@ -283,12 +289,14 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 
 /// Choose a strategy with its named preset: sets cfg->strategy and the improvement
 /// fields, on for RFS_SEEK_META_PATH (recheck_dist = cfg->step, eps_by_travel,
-/// recheck_adapt, eps_geodesic, eps_sample, refute_r = cfg->step), the
+/// recheck_adapt, eps_geodesic, eps_sample, refute_r = cfg->step, silence_floor = -100
+/// dBm), the
 /// paper's (0, false) for every other strategy.
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 
 /// The settings for a model fitted per source (rfs_fields.h; docs/STRATEGIES.md,
-/// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m, refute_r 0.
+/// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m, refute_r 0,
+/// silence_floor none (src_floor instead).
 void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg);
 
 /// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array

@@ -952,6 +952,9 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     if (e->sc.seek_refute_m >= 0.0) {
         cc.seek.refute_r = (rfs_q16_t)lround(e->sc.seek_refute_m * 65536.0);
     }
+    if (e->sc.seek_silence_floor >= 0) {
+        cc.seek.silence_floor = e->sc.seek_silence_floor != 0 ? RFS_Q16_INT(-100) : INT32_MIN;
+    }
     if (e->sc.seek_eps_rate >= 0.0) {
         cc.seek.eps_rate = (rfs_q16_t)lround(e->sc.seek_eps_rate * 65536.0);
     }

@@ -279,8 +279,8 @@ static uint64_t sq_sum(int64_t dx, int64_t dy)
     return a > UINT64_MAX - b ? UINT64_MAX : a + b;
 }
 
-/* Lattice point (i, j) is within excl_r of a place ruled out (docs/PATHLOSS.md, "Places
- * ruled out"). Scaling: Q16 differences squared in uint64 (sq_sum) against r^2 (Q32). */
+/* Lattice point (i, j) is within excl_r of a place ruled out (docs/STRATEGIES.md,
+ * "Stalls"). Scaling: Q16 differences squared in uint64 (sq_sum) against r^2 (Q32). */
 static bool excluded(const rfs_pathloss_t *p, int32_t i, int32_t j)
 {
     if (p->nexcl == 0u) {

@@ -41,10 +41,11 @@ typedef struct rfs_model_fit_in {
     /// src_n, the same samples as at the last fit.
     uint32_t src_seen[RFS_MODEL_MAX_SOURCES];
     /// Places ruled out as the source (rfs_seek_cfg_t.refute_r): a model that searches
-    /// source positions skips every candidate within excl_r of (excl_x[i], excl_y[i]),
-    /// i < nexcl (<= RFS_MODEL_MAX_EXCL; 0: none), metres Q16.16.
-    const rfs_q16_t *excl_x;
-    const rfs_q16_t *excl_y; ///< their y, metres Q16.16
+    /// source positions skips every candidate within excl_r of (excl_x_cm[i],
+    /// excl_y_cm[i]), i < nexcl (<= RFS_MODEL_MAX_EXCL; 0: none), centimetres (as
+    /// rfs_sample_t).
+    const int16_t *excl_x_cm;
+    const int16_t *excl_y_cm; ///< their y, centimetres
     uint8_t nexcl;           ///< how many
     rfs_q16_t excl_r;        ///< radius ruled out round each, metres Q16.16
 } rfs_model_fit_in_t;

@@ -613,13 +613,13 @@ static bool fit_begin(rfs_pathloss_t *p, const rfs_model_fit_in_t *in)
     }
     p->map = in->map;
     /* The places ruled out are copied: a sliced fit sees the same ones to the end. */
-    p->nexcl = in->excl_r > 0 && in->excl_x != 0 && in->excl_y != 0
+    p->nexcl = in->excl_r > 0 && in->excl_x_cm != 0 && in->excl_y_cm != 0
                    ? (uint8_t)(in->nexcl < RFS_MODEL_MAX_EXCL ? in->nexcl : RFS_MODEL_MAX_EXCL)
                    : 0u;
     p->excl_r = in->excl_r;
     for (uint32_t e = 0u; e < p->nexcl; ++e) {
-        p->excl_x[e] = in->excl_x[e];
-        p->excl_y[e] = in->excl_y[e];
+        p->excl_x[e] = cm_to_q16(in->excl_x_cm[e]);
+        p->excl_y[e] = cm_to_q16(in->excl_y_cm[e]);
     }
     bin_samples(p, in->samples, in->n);
     setup_lattice(p, in->map);

@@ -432,7 +432,8 @@ static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_ou
     rfs_model_fit_in_t fin = { .samples = s->store.samples, .n = s->store.count,
                                .qx = s->pose.x, .qy = s->pose.y, .map = s->map,
                                .reach = s->reach_valid ? s->reach : 0,
-                               .excl_x = s->excl_x, .excl_y = s->excl_y, .nexcl = s->nexcl,
+                               .excl_x_cm = s->excl_x_cm, .excl_y_cm = s->excl_y_cm,
+                               .nexcl = s->nexcl,
                                .excl_r = s->cfg.refute_r };
     for (uint8_t i = 0; s->src != 0 && i < s->target->nsources; ++i) {
         fin.src_samples[i] = s->src[i].store.samples;

@@ -277,8 +277,8 @@ typedef struct rfs_seek {
     uint8_t nexcl;                            ///< refute_r: places ruled out so far (at most
                                               ///< RFS_MODEL_MAX_EXCL; then the oldest goes)
     uint8_t excl_next;                        ///< refute_r: the slot the next one takes
-    rfs_q16_t excl_x[RFS_MODEL_MAX_EXCL];     ///< refute_r: their x, metres Q16.16
-    rfs_q16_t excl_y[RFS_MODEL_MAX_EXCL];     ///< refute_r: their y, metres Q16.16
+    int16_t excl_x_cm[RFS_MODEL_MAX_EXCL];    ///< refute_r: their x, centimetres
+    int16_t excl_y_cm[RFS_MODEL_MAX_EXCL];    ///< refute_r: their y, centimetres
     bool have_sub;                            ///< sub_* hold the latest unreachable maximum
     rfs_q16_t sub_mx, sub_my;                 ///< an unreachable greedy maximum, metres Q16.16
     rfs_q16_t sub_x, sub_y;                   ///< the reachable point driven to instead

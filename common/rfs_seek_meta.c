@@ -123,8 +123,10 @@ bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us)
     if (!weak && !silent) {
         return false;
     }
-    s->excl_x[s->excl_next] = mx;
-    s->excl_y[s->excl_next] = my;
+    /* Centimetres, as the store's samples (the microcontroller's RAM budget). Scaling:
+     * x * 100 < 2^39 in int64, rounded, saturated to +-327.67 m. */
+    s->excl_x_cm[s->excl_next] = rfs_sat16(((int64_t)mx * 100 + 32768) >> 16);
+    s->excl_y_cm[s->excl_next] = rfs_sat16(((int64_t)my * 100 + 32768) >> 16);
     s->excl_next = (uint8_t)((s->excl_next + 1u) % RFS_MODEL_MAX_EXCL);
     s->nexcl = (uint8_t)(s->nexcl < RFS_MODEL_MAX_EXCL ? s->nexcl + 1u : RFS_MODEL_MAX_EXCL);
     d->refuted = true;

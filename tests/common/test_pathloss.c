@@ -287,13 +287,14 @@ static void expect_same_as_reference(fixture_t *f, const rfs_pathloss_cfg_t *c, 
                                      const rfs_map_t *map, const ref_pl_cfg_t *rc, double n_tol)
 {
     /* The reference's places ruled out, to the model in Q16.16. */
-    rfs_q16_t ex[8], ey[8];
+    int16_t ex[8], ey[8];
     for (int k = 0; k < rc->nexcl; ++k) {
-        ex[k] = (rfs_q16_t)lround(rc->ex[k] * 65536.0);
-        ey[k] = (rfs_q16_t)lround(rc->ey[k] * 65536.0);
+        ex[k] = (int16_t)lround(rc->ex[k] * 100.0);
+        ey[k] = (int16_t)lround(rc->ey[k] * 100.0);
+        assert_true(fabs(ex[k] / 100.0 - rc->ex[k]) < 1e-9); /* centimetres exactly */
     }
-    rfs_model_fit_in_t in = {.samples = f->s, .n = (uint16_t)n, .map = map, .excl_x = ex,
-                             .excl_y = ey, .nexcl = (uint8_t)rc->nexcl,
+    rfs_model_fit_in_t in = {.samples = f->s, .n = (uint16_t)n, .map = map, .excl_x_cm = ex,
+                             .excl_y_cm = ey, .nexcl = (uint8_t)rc->nexcl,
                              .excl_r = (rfs_q16_t)lround(rc->excl_r * 65536.0)};
     rfs_pathloss_est_t e = fit_in_with(f, c, &in, 0, NULL);
     assert_true(ref_pl_fit(&f->ref, f->s, n, map, rc));
@@ -356,19 +357,19 @@ static void places_ruled_out_same_as_reference(void **state)
     rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
     ref_pl_cfg_t rc = ref_pl_cfg_default();
     rc.nexcl = 2;
-    rc.ex[0] = k_office.sx;
-    rc.ey[0] = k_office.sy;
+    rc.ex[0] = 15.13; /* the true source (15.125, 3.375) to the centimetre */
+    rc.ey[0] = 3.38;
     rc.ex[1] = 4.0; /* another room: a hole in the coarse grid */
     rc.ey[1] = 12.0;
     rc.excl_r = 2.0;
     expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
     const double dx = f->ref.sx - k_office.sx, dy = f->ref.sy - k_office.sy;
-    assert_true(sqrt(dx * dx + dy * dy) > 2.0);
+    assert_true(sqrt(dx * dx + dy * dy) > 1.99);
 
-    rfs_q16_t ex[2] = {RFS_Q16_FRAC(15125, 1000), RFS_Q16_INT(4)};
-    rfs_q16_t ey[2] = {RFS_Q16_FRAC(3375, 1000), RFS_Q16_INT(12)};
-    rfs_model_fit_in_t in = {.samples = f->s, .n = NS, .map = &f->map, .excl_x = ex,
-                             .excl_y = ey, .nexcl = 2, .excl_r = RFS_Q16_INT(2)};
+    int16_t ex[2] = {1513, 400};
+    int16_t ey[2] = {338, 1200};
+    rfs_model_fit_in_t in = {.samples = f->s, .n = NS, .map = &f->map, .excl_x_cm = ex,
+                             .excl_y_cm = ey, .nexcl = 2, .excl_r = RFS_Q16_INT(2)};
     rfs_pathloss_est_t whole = fit_in_with(f, &c, &in, 0, NULL);
     int calls = 0;
     rfs_pathloss_est_t sliced = fit_in_with(f, &c, &in, 7, &calls);

@@ -360,13 +360,13 @@ static rfs_fit_result_t refute_fit(void *self, const rfs_model_fit_in_t *in, uin
         m->mismatch = true;
     }
     for (int e = 0; e < in->nexcl && e < expect; ++e) {
-        m->ex[e] = D(in->excl_x[e]);
-        m->ey[e] = D(in->excl_y[e]);
+        m->ex[e] = in->excl_x_cm[e] / 100.0;
+        m->ey[e] = in->excl_y_cm[e] / 100.0;
         /* Slots fill in order, then the oldest is overwritten: any order, the latest ones. */
         bool found = false;
         for (int w = m->nwant - expect; w < m->nwant; ++w) {
-            found = found || (fabs(m->ex[e] - m->want_x[w]) < 1e-4 &&
-                              fabs(m->ey[e] - m->want_y[w]) < 1e-4);
+            found = found || (fabs(m->ex[e] - m->want_x[w]) < 0.0051 &&
+                              fabs(m->ey[e] - m->want_y[w]) < 0.0051); /* to the cm */
         }
         m->mismatch = m->mismatch || !found;
     }

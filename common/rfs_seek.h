@@ -86,7 +86,7 @@ typedef struct rfs_seek_cfg {
                                 ///< the robot stands within 1.5 steps of the model's argmax
     rfs_q16_t refute_r;         ///< a decision at the model's argmax (within half a step)
                                 ///< whose 1 s mean is weaker than the prediction by more
-                                ///< than error_threshold, or that has no mean while the
+                                ///< than 2 error_threshold, or that has no mean while the
                                 ///< receiver is up, rules out the source within this
                                 ///< radius of the argmax for every later fit (Algorithm 1
                                 ///< still runs: the source is not here), metres Q16.16 (0:

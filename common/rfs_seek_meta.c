@@ -113,11 +113,14 @@ bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us)
     if (rfs_q16_dist(s->pose.x, s->pose.y, ax, ay) > s->cfg.step / 2) {
         return false;
     }
-    /* Weaker than the model says, or silent: a whole window without a packet from a
-     * source heard before while the receiver reports itself up (a dead zone, where no
-     * source within a metre could be). Scaling: |now - last report| as in
-     * rfs_seek_on_receiver's freshness, in int64 (both stamps are clock microseconds). */
-    bool weak = d->mean_valid && rfs_q16_sub(d->prediction, d->mean) > s->cfg.error_threshold;
+    /* Weaker than the model says by twice the relearn threshold (a robot standing still
+     * sees one fade: 3 dB is within its spread near the source), or silent: a whole
+     * window without a packet from a source heard before while the receiver reports
+     * itself up (a dead zone, where no source within a metre could be). Scaling: the
+     * doubled threshold (<= 2^31 - 1 in Q16 for any sane threshold) in int64; |now - last
+     * report| as in rfs_seek_on_receiver's freshness (clock microseconds). */
+    bool weak = d->mean_valid && (int64_t)rfs_q16_sub(d->prediction, d->mean) >
+                                     2 * (int64_t)s->cfg.error_threshold;
     bool silent = !d->mean_valid && s->have_meas && s->have_rx && now_us >= s->last_rx_us &&
                   now_us - s->last_rx_us <= s->cfg.rssi_timeout_us;
     if (!weak && !silent) {

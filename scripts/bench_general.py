@@ -179,8 +179,8 @@ def section(cmd, at, minutes, nruns, seeds, held, floors, results):
         where = ", ".join(f"{f} {n}" for f, n in per if n)
         parked.append(f"{c} {sum(n for _, n in per)}" + (f" ({where})" if where else ""))
     L = [BEGIN, "## Generalisation: random placements", "",
-         f"Written by `{cmd}` at commit {at} ({nruns} runs, {minutes:.0f} min, two shared "
-         f"cores): held-out placements {held} (1..50 tune) of every shipped floor "
+         f"Written by `{cmd}` at commit {at} ({nruns} runs, {minutes:.0f} min): held-out "
+         f"placements {held} (1..50 tune) of every shipped floor "
          "(`rfseek-sim --placements`, docs/SIMULATOR.md), seeds "
          f"{seeds}; `p` meta-path + pathloss, `r` meta + ridge (the "
          "paper). Ratio: travel / shortest path, successful runs. Failures (first match; "

@@ -290,8 +290,7 @@ static bool excluded(const rfs_pathloss_t *p, int32_t i, int32_t j)
     lattice_xy(&p->lat, (uint16_t)i, (uint16_t)j, &x, &y);
     const uint64_t r2 = (uint64_t)((int64_t)p->excl_r * p->excl_r);
     for (uint32_t e = 0u; e < p->nexcl; ++e) {
-        if (sq_sum((int64_t)x - cm_to_q16(p->excl_x_cm[e]),
-                   (int64_t)y - cm_to_q16(p->excl_y_cm[e])) <= r2) {
+        if (sq_sum((int64_t)x - p->excl_x[e], (int64_t)y - p->excl_y[e]) <= r2) {
             return true;
         }
     }
@@ -619,8 +618,8 @@ static bool fit_begin(rfs_pathloss_t *p, const rfs_model_fit_in_t *in)
                    : 0u;
     p->excl_r = in->excl_r;
     for (uint32_t e = 0u; e < p->nexcl; ++e) {
-        p->excl_x_cm[e] = in->excl_x_cm[e];
-        p->excl_y_cm[e] = in->excl_y_cm[e];
+        p->excl_x[e] = cm_to_q16(in->excl_x_cm[e]); /* once a fit, not per candidate */
+        p->excl_y[e] = cm_to_q16(in->excl_y_cm[e]);
     }
     bin_samples(p, in->samples, in->n);
     setup_lattice(p, in->map);

@@ -266,8 +266,8 @@ typedef struct rfs_pathloss {
     uint8_t nexcl;                                ///< places ruled out for this fit
                                                   ///< (rfs_model_fit_in_t.nexcl)
     rfs_q16_t excl_r;                             ///< radius ruled out round each, metres Q16.16
-    int16_t excl_x_cm[RFS_MODEL_MAX_EXCL];        ///< their x, centimetres
-    int16_t excl_y_cm[RFS_MODEL_MAX_EXCL];        ///< their y, centimetres
+    rfs_q16_t excl_x[RFS_MODEL_MAX_EXCL];         ///< their x, metres Q16.16
+    rfs_q16_t excl_y[RFS_MODEL_MAX_EXCL];         ///< their y, metres Q16.16
     uint16_t nvis;                                ///< refinement points remembered
     uint16_t vis_i[RFS_PATHLOSS_MAX_VISITED];     ///< their lattice x
     uint16_t vis_j[RFS_PATHLOSS_MAX_VISITED];     ///< their lattice y

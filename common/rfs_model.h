@@ -19,6 +19,9 @@
 /// Most sources whose own samples a fit sees (rfs_model_fit_in_t.src_samples).
 #define RFS_MODEL_MAX_SOURCES 2u
 
+/// Most places a fit can be told the source is not (rfs_model_fit_in_t.nexcl).
+#define RFS_MODEL_MAX_EXCL 32u
+
 /// What a model learns from.
 typedef struct rfs_model_fit_in {
     const rfs_sample_t *samples; ///< the stored samples
@@ -37,6 +40,14 @@ typedef struct rfs_model_fit_in {
     /// Samples each source's store was ever offered (rfs_store_t.seen): unchanged with
     /// src_n, the same samples as at the last fit.
     uint32_t src_seen[RFS_MODEL_MAX_SOURCES];
+    /// Places ruled out as the source (rfs_seek_cfg_t.refute_r): a model that searches
+    /// source positions skips every candidate within excl_r of (excl_x_cm[i],
+    /// excl_y_cm[i]), i < nexcl (<= RFS_MODEL_MAX_EXCL; 0: none), centimetres (as
+    /// rfs_sample_t).
+    const int16_t *excl_x_cm;
+    const int16_t *excl_y_cm; ///< their y, centimetres
+    uint8_t nexcl;           ///< how many
+    rfs_q16_t excl_r;        ///< radius ruled out round each, metres Q16.16
 } rfs_model_fit_in_t;
 
 /// Result of one fit call.

@@ -279,12 +279,31 @@ static uint64_t sq_sum(int64_t dx, int64_t dy)
     return a > UINT64_MAX - b ? UINT64_MAX : a + b;
 }
 
+/* Lattice point (i, j) is within excl_r of a place ruled out (docs/STRATEGIES.md,
+ * "Stalls"). Scaling: Q16 differences squared in uint64 (sq_sum) against r^2 (Q32). */
+static bool excluded(const rfs_pathloss_t *p, int32_t i, int32_t j)
+{
+    if (p->nexcl == 0u) {
+        return false;
+    }
+    rfs_q16_t x, y;
+    lattice_xy(&p->lat, (uint16_t)i, (uint16_t)j, &x, &y);
+    const uint64_t r2 = (uint64_t)((int64_t)p->excl_r * p->excl_r);
+    for (uint32_t e = 0u; e < p->nexcl; ++e) {
+        if (sq_sum((int64_t)x - p->excl_x[e], (int64_t)y - p->excl_y[e]) <= r2) {
+            return true;
+        }
+    }
+    return false;
+}
+
 static bool cand_legal(const rfs_pathloss_t *p, int32_t i, int32_t j)
 {
     if (i < 0 || j < 0 || i >= (int32_t)p->lat.lw || j >= (int32_t)p->lat.lh) {
         return false;
     }
-    return p->map == 0 || rfs_map_lattice_legal(p->map, (uint16_t)i, (uint16_t)j);
+    return (p->map == 0 || rfs_map_lattice_legal(p->map, (uint16_t)i, (uint16_t)j)) &&
+           !excluded(p, i, j);
 }
 
 static rfs_i128_t i128_of(int64_t v)
@@ -593,6 +612,15 @@ static bool fit_begin(rfs_pathloss_t *p, const rfs_model_fit_in_t *in)
         return false;
     }
     p->map = in->map;
+    /* The places ruled out are copied: a sliced fit sees the same ones to the end. */
+    p->nexcl = in->excl_r > 0 && in->excl_x_cm != 0 && in->excl_y_cm != 0
+                   ? (uint8_t)(in->nexcl < RFS_MODEL_MAX_EXCL ? in->nexcl : RFS_MODEL_MAX_EXCL)
+                   : 0u;
+    p->excl_r = in->excl_r;
+    for (uint32_t e = 0u; e < p->nexcl; ++e) {
+        p->excl_x[e] = cm_to_q16(in->excl_x_cm[e]); /* once a fit, not per candidate */
+        p->excl_y[e] = cm_to_q16(in->excl_y_cm[e]);
+    }
     bin_samples(p, in->samples, in->n);
     setup_lattice(p, in->map);
     rfs_pathloss_walls_assign(p);

@@ -263,6 +263,11 @@ typedef struct rfs_pathloss {
                                                   ///< UINT8_MAX: the centre first)
     rfs_pathloss_cand_t hold_best;                ///< best point of the hold search so far
                                                   ///< (loss INT64_MAX before the first)
+    uint8_t nexcl;                                ///< places ruled out for this fit
+                                                  ///< (rfs_model_fit_in_t.nexcl)
+    rfs_q16_t excl_r;                             ///< radius ruled out round each, metres Q16.16
+    rfs_q16_t excl_x[RFS_MODEL_MAX_EXCL];         ///< their x, metres Q16.16
+    rfs_q16_t excl_y[RFS_MODEL_MAX_EXCL];         ///< their y, metres Q16.16
     uint16_t nvis;                                ///< refinement points remembered
     uint16_t vis_i[RFS_PATHLOSS_MAX_VISITED];     ///< their lattice x
     uint16_t vis_j[RFS_PATHLOSS_MAX_VISITED];     ///< their lattice y

@@ -17,6 +17,13 @@ _Static_assert(RFS_MODEL_MAX_SOURCES == RFS_TARGET_MAX_SOURCES,
 /* Wait before deciding again after no goal could be found, microseconds (one window). */
 #define NO_GOAL_RETRY_US 1000000
 
+/* |a - b| > limit, without signed overflow at extreme timestamps. */
+static bool apart(int64_t a, int64_t b, int64_t limit)
+{
+    uint64_t d = a >= b ? (uint64_t)a - (uint64_t)b : (uint64_t)b - (uint64_t)a;
+    return d > (uint64_t)limit;
+}
+
 rfs_seek_cfg_t rfs_seek_cfg_default(void)
 {
     rfs_seek_cfg_t c;
@@ -43,6 +50,8 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.recheck_adapt = false;                /* one fixed threshold */
     c.eps_geodesic = false;                 /* epsilon weights by straight distance */
     c.eps_sample = false;                   /* and epsilon goals at random, not drawn */
+    c.refute_r = 0;                         /* and nothing is ruled out */
+    c.silence_floor = INT32_MIN;            /* silence adds no sample */
     c.settle_dist = 0;                      /* epsilon anneals to eps_floor, never 0 */
     c.src_spacing = 0;
     c.src_floor = INT32_MIN;
@@ -79,6 +88,8 @@ void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg)
     cfg->src_floor = RFS_Q16_INT(-100);     /* radiotap receivers report down to -100 dBm */
     /* Two thirds of the bridging scenarios' 150 m (docs/STRATEGIES.md, "Bridging"). */
     cfg->settle_dist = RFS_Q16_INT(100);
+    cfg->refute_r = 0; /* the argmax is the target's best point, not a source */
+    cfg->silence_floor = INT32_MIN; /* each node's store has src_floor */
 }
 
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy)
@@ -95,6 +106,11 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
     cfg->recheck_adapt = on;
     cfg->eps_geodesic = on;
     cfg->eps_sample = on;
+    /* The source within a step of a refuted argmax would be within 1.5 steps of the robot
+     * (docs/STRATEGIES.md, "Stalls"). */
+    cfg->refute_r = on ? cfg->step : 0;
+    /* Radiotap receivers report down to -100 dBm (docs/STRATEGIES.md, "Stalls"). */
+    cfg->silence_floor = on ? RFS_Q16_INT(-100) : INT32_MIN;
 }
 
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)
@@ -143,6 +159,7 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         (uint32_t)cfg->strategy >= (uint32_t)RFS_SEEK_STRATEGY_COUNT ||
         cfg->tumble_better < 0 || cfg->tumble_better > RFS_Q16_ONE || cfg->tumble_worse < 0 ||
         cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0 || cfg->settle_dist < 0 ||
+        cfg->refute_r < 0 ||
         cfg->src_spacing < 0) {
         return -1;
     }
@@ -198,6 +215,13 @@ bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
     (void)rfs_store_add_pose(&s->store, pose, rng);
     if (s->src != 0) {
         rfs_seek_src_on_pose(s, pose, rng);
+    }
+    /* silence_floor: a source heard before, silent for a window, the receiver up. */
+    if (s->cfg.silence_floor != INT32_MIN && s->target == &rfs_target_rssi && s->have_meas &&
+        s->have_rx && !apart(pose->t_us, s->last_rx_us, s->cfg.rssi_timeout_us) &&
+        pose->t_us > s->last_meas_us &&
+        apart(pose->t_us, s->last_meas_us, (int64_t)s->cfg.rssi.window_us)) {
+        rfs_store_add_value(&s->store, pose->t_us, s->cfg.silence_floor, rng);
     }
     s->pose = *pose;
     s->have_pose = true;
@@ -505,7 +529,10 @@ static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_ou
 {
     rfs_model_fit_in_t fin = { .samples = s->store.samples, .n = s->store.count,
                                .qx = s->pose.x, .qy = s->pose.y, .map = s->map,
-                               .reach = s->reach_valid ? s->reach : 0 };
+                               .reach = s->reach_valid ? s->reach : 0,
+                               .excl_x_cm = s->excl_x_cm, .excl_y_cm = s->excl_y_cm,
+                               .nexcl = s->nexcl,
+                               .excl_r = s->cfg.refute_r };
     for (uint8_t i = 0; s->src != 0 && i < s->target->nsources; ++i) {
         fin.src_samples[i] = s->src[i].store.samples;
         fin.src_n[i] = s->src[i].store.count;
@@ -549,6 +576,7 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     }
     /* A leg abandoned by a failed recheck relearns (the check failed on this model), even
      * when the mean has moved back within the threshold while the base braked. */
+    relearn = rfs_seek_meta_refute(s, now_us) || relearn;
     relearn = relearn || ops->refit || s->replan;
 
     if (relearn && s->store.count > 0u) {
@@ -561,13 +589,6 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
         return;
     }
     finish_decision(s, now_us, rng, out, whole_fit);
-}
-
-/* |a - b| > limit, without signed overflow at extreme timestamps. */
-static bool apart(int64_t a, int64_t b, int64_t limit)
-{
-    uint64_t d = a >= b ? (uint64_t)a - (uint64_t)b : (uint64_t)b - (uint64_t)a;
-    return d > (uint64_t)limit;
 }
 
 /* b - a > limit: stamp b further ahead of now a than limit (a clock jump, docs/FAULTS.md). */

@@ -88,6 +88,20 @@ typedef struct rfs_seek_cfg {
                                 ///< greedy leg; the novelty draw instead when the draw is
                                 ///< within 1.5 steps of the robot or where it has been, or
                                 ///< the robot stands within 1.5 steps of the model's argmax
+    rfs_q16_t refute_r;         ///< a decision at the model's argmax (within half a step)
+                                ///< whose 1 s mean is weaker than the prediction by more
+                                ///< than 2 error_threshold, or that has no mean while the
+                                ///< receiver is up, rules out the source within this
+                                ///< radius of the argmax for every later fit (Algorithm 1
+                                ///< still runs: the source is not here), metres Q16.16 (0:
+                                ///< off); keep it below the "at source" radius less half a
+                                ///< step
+    rfs_q16_t silence_floor;    ///< target rssi: while the receiver reports itself up and
+                                ///< no packet came for a whole averaging window, every pose
+                                ///< adds a sample of this value: the fit learns where the
+                                ///< source is below the receiver's floor (a dead zone)
+                                ///< instead of never seeing the place, dBm Q16.16
+                                ///< (INT32_MIN: none, the paper's)
     rfs_q16_t settle_dist;      ///< after this much travel every choice is greedy (epsilon
                                 ///< 0): the robot goes to the model's best point and stays
                                 ///< there, metres Q16.16 (0: never, the paper's)
@@ -183,6 +197,8 @@ typedef struct rfs_seek_decision {
     rfs_q16_t max_x, max_y;    ///< model maximum found by the grid search (greedy), or the
                                ///< model's draw (a sampled epsilon step)
     bool sampled;              ///< epsilon: the goal is the model's draw (cfg.eps_sample)
+    bool refuted;              ///< the argmax was ruled out before this decision's fit
+                               ///< (cfg.refute_r)
     rfs_q16_t path_len;        ///< planned path length, metres Q16.16
     uint16_t plan_wait;        ///< control periods the robot stood for the search tree
                                ///< (plan_budget; 0: the tree grown on the leg served)
@@ -272,6 +288,14 @@ typedef struct rfs_seek {
     bool replan;                              ///< a recheck failed: relearn and go greedy again
     int64_t miss_ms;                          ///< recheck_adapt: running mean of the squared
                                               ///< recheck misses |mean - prediction|, dB^2 Q16.16
+    uint8_t nexcl;                            ///< refute_r: places ruled out so far (at most
+                                              ///< RFS_MODEL_MAX_EXCL; then the oldest goes)
+    uint8_t excl_next;                        ///< refute_r: the slot the next one takes
+    int16_t excl_x_cm[RFS_MODEL_MAX_EXCL];    ///< refute_r: their x, centimetres
+    int16_t excl_y_cm[RFS_MODEL_MAX_EXCL];    ///< refute_r: their y, centimetres
+    bool have_sub;                            ///< sub_* hold the latest unreachable maximum
+    rfs_q16_t sub_mx, sub_my;                 ///< an unreachable greedy maximum, metres Q16.16
+    rfs_q16_t sub_x, sub_y;                   ///< the reachable point driven to instead
 } rfs_seek_t;
 
 /// The paper's parameters (section 2 and 5.2): the `meta` configuration.
@@ -279,12 +303,14 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 
 /// Choose a strategy with its named preset: sets cfg->strategy and the improvement
 /// fields, on for RFS_SEEK_META_PATH (recheck_dist = cfg->step, eps_by_travel,
-/// recheck_adapt, eps_geodesic, eps_sample), the
+/// recheck_adapt, eps_geodesic, eps_sample, refute_r = cfg->step, silence_floor = -100
+/// dBm), the
 /// paper's (0, false) for every other strategy.
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 
 /// The settings for a model fitted per source (rfs_fields.h; docs/STRATEGIES.md,
-/// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m.
+/// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m, refute_r 0,
+/// silence_floor none (src_floor instead).
 void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg);
 
 /// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array

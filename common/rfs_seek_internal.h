@@ -58,6 +58,12 @@ void rfs_seek_meta_init(rfs_seek_t *s);
  * initial_step_max of the robot. */
 bool rfs_seek_meta_initial(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us);
 
+/* refute_r: at a decision with a model (decision.prediction valid), rule out the model's
+ * argmax when the robot stands within half a step of it and the 1 s mean is weaker than
+ * the prediction by more than 2 error_threshold, or there is no mean while the receiver is
+ * up (a dead zone). true when it did: the model must be relearnt. */
+bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us);
+
 /* Mark the lattice points within the novelty radius of (x, y) as visited. */
 void rfs_seek_meta_visit(rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y);
 

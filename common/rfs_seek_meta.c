@@ -98,6 +98,44 @@ void rfs_seek_meta_visit(rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y)
     }
 }
 
+bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us)
+{
+    rfs_seek_decision_t *d = &s->decision;
+    rfs_q16_t mx, my;
+    if (s->cfg.refute_r <= 0 || !d->model_valid || s->model.ops->argmax == 0 ||
+        !s->model.ops->argmax(s->model.self, &mx, &my)) {
+        return false;
+    }
+    /* At the maximum, or, when it is unreachable, at the reachable point driven to instead
+     * (greedy_along_path): as close as the robot can come. */
+    const bool sub = s->have_sub && s->sub_mx == mx && s->sub_my == my;
+    const rfs_q16_t ax = sub ? s->sub_x : mx, ay = sub ? s->sub_y : my;
+    if (rfs_q16_dist(s->pose.x, s->pose.y, ax, ay) > s->cfg.step / 2) {
+        return false;
+    }
+    /* Weaker than the model says by twice the relearn threshold (a robot standing still
+     * sees one fade: 3 dB is within its spread near the source), or silent: a whole
+     * window without a packet from a source heard before while the receiver reports
+     * itself up (a dead zone, where no source within a metre could be). Scaling: the
+     * doubled threshold (<= 2^31 - 1 in Q16 for any sane threshold) in int64; |now - last
+     * report| as in rfs_seek_on_receiver's freshness (clock microseconds). */
+    bool weak = d->mean_valid && (int64_t)rfs_q16_sub(d->prediction, d->mean) >
+                                     2 * (int64_t)s->cfg.error_threshold;
+    bool silent = !d->mean_valid && s->have_meas && s->have_rx && now_us >= s->last_rx_us &&
+                  now_us - s->last_rx_us <= s->cfg.rssi_timeout_us;
+    if (!weak && !silent) {
+        return false;
+    }
+    /* Centimetres, as the store's samples (the microcontroller's RAM budget). Scaling:
+     * x * 100 < 2^39 in int64, rounded, saturated to +-327.67 m. */
+    s->excl_x_cm[s->excl_next] = rfs_sat16(((int64_t)mx * 100 + 32768) >> 16);
+    s->excl_y_cm[s->excl_next] = rfs_sat16(((int64_t)my * 100 + 32768) >> 16);
+    s->excl_next = (uint8_t)((s->excl_next + 1u) % RFS_MODEL_MAX_EXCL);
+    s->nexcl = (uint8_t)(s->nexcl < RFS_MODEL_MAX_EXCL ? s->nexcl + 1u : RFS_MODEL_MAX_EXCL);
+    d->refuted = true;
+    return true;
+}
+
 /* Initial random move: a uniformly chosen reachable lattice point within
  * initial_step_max of the robot (paper: "restricted to twice the regular step width"). */
 bool rfs_seek_meta_initial(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
@@ -182,6 +220,11 @@ static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool wh
             !rfs_seek_go_to(s, nx, ny, now_us)) {
             return false;
         }
+        s->have_sub = true;
+        s->sub_mx = mx;
+        s->sub_my = my;
+        s->sub_x = nx;
+        s->sub_y = ny;
     }
     rfs_path_t *p = &s->drive.path;
     int64_t px = s->pose.x, py = s->pose.y;
@@ -211,7 +254,8 @@ static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool wh
 
 /* eps_sample: the epsilon goal is a draw from the model's belief (a plausible source),
  * driven the whole planned way and rechecked like a greedy leg. false (the novelty draw
- * follows) when the model draws nothing, a point within 1.5 steps of the robot, or one
+ * follows) when the model draws nothing, a point within 1.5 steps of the robot (or whose
+ * reachable stand-in is), or one
  * the robot has been to (within the novelty radius of a past position), and whenever the
  * robot stands within 1.5 steps of the model's own maximum: at a wrong estimate the
  * draws lie in the rooms round it, a leg there fails its recheck within a metre and the
@@ -238,7 +282,10 @@ static bool epsilon_sample(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     if (rfs_reach_bit(s->visited, (uint32_t)lj * s->map->lw + li)) {
         return false;
     }
-    if (!greedy_along_path(s, x, y, true, now_us)) {
+    /* An unreachable draw's stand-in (the reachable point nearest to it) where the robot
+     * stands is a null move: the robot would learn nothing new there, again and again. */
+    if (!greedy_along_path(s, x, y, true, now_us) ||
+        rfs_q16_dist(s->pose.x, s->pose.y, s->decision.goal_x, s->decision.goal_y) < near) {
         return false;
     }
     s->decision.sampled = true;

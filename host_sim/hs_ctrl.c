@@ -172,19 +172,25 @@ static int open_fields(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, const rfs_m
     return rfs_fields_init(p->fields, &fc, target, &p->fmem);
 }
 
+/* The target named `name`, or NULL. pdr: the caller feeds rfs_pdr_value() percentages as
+ * the measurements (rfs_pdr.h). */
+static const rfs_target_ops_t *target_named(const char *name)
+{
+    if (name && strcmp(name, "rssi") == 0) {
+        return &rfs_target_rssi;
+    }
+    if (name && strcmp(name, "bridge") == 0) {
+        return &rfs_target_bridge;
+    }
+    return name && strcmp(name, "pdr") == 0 ? &rfs_target_pdr : NULL;
+}
+
 int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs_map_t *map,
                         char *err, size_t errlen)
 {
     memset(c, 0, sizeof *c);
-    const rfs_target_ops_t *target = NULL;
-    if (cfg->target && strcmp(cfg->target, "rssi") == 0) {
-        target = &rfs_target_rssi;
-    } else if (cfg->target && strcmp(cfg->target, "bridge") == 0) {
-        target = &rfs_target_bridge;
-    } else if (cfg->target && strcmp(cfg->target, "pdr") == 0) {
-        // The caller feeds rfs_pdr_value() percentages as the measurements (rfs_pdr.h).
-        target = &rfs_target_pdr;
-    } else {
+    const rfs_target_ops_t *target = target_named(cfg->target);
+    if (!target) {
         snprintf(err, errlen, "target: unknown '%s' (rssi, bridge, pdr)", cfg->target ? cfg->target : "");
         return -1;
     }

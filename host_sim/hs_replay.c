@@ -294,8 +294,9 @@ static void rp_step(hs_replay_t *rp, const rp_at_t *at)
     res->greedy += d->kind == RFS_SEEK_GREEDY ? 1u : 0u;
     res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
     char reason[96];
-    snprintf(reason, sizeof(reason), "prev=%s%s%s%s%s", hs_sim_prev_name(d->prev),
+    snprintf(reason, sizeof(reason), "prev=%s%s%s%s%s%s", hs_sim_prev_name(d->prev),
              d->line_search ? ",line_search" : "", d->sampled ? ",sampled" : "",
+             d->refuted ? ",refuted" : "",
              d->model_valid ? "" : ",no_model",
              d->mean_valid ? "" : ",no_mean");
     fprintf(rp->flog,

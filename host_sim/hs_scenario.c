@@ -197,6 +197,8 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     memset(sc, 0, sizeof *sc);
     sc->seed = 1;
     sc->seek_recheck_m = -1.0;
+    sc->seek_refute_m = -1.0;
+    sc->seek_silence_floor = -1;
     sc->seek_eps_by_travel = -1;
     sc->seek_eps_geodesic = -1;
     sc->seek_recheck_adapt = -1;
@@ -419,15 +421,17 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
     if (n) {
         static const char *const k[] = {"recheck_m", "eps_by_travel", "eps_rate",
                                         "eps_geodesic", "recheck_adapt", "p0_min_dbm",
-                                        "eps_sample", NULL};
+                                        "eps_sample", "refute_m", "silence_floor", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
+            num(p, n, "seek", "refute_m", 0, 100, &sc->seek_refute_m) ||
             num(p, n, "seek", "eps_rate", 0, 100, &sc->seek_eps_rate) ||
             num(p, n, "seek", "p0_min_dbm", -200, 100, &sc->seek_p0_min_dbm) ||
             preset_bool(p, n, "eps_by_travel", &sc->seek_eps_by_travel) ||
             preset_bool(p, n, "eps_geodesic", &sc->seek_eps_geodesic) ||
             preset_bool(p, n, "recheck_adapt", &sc->seek_recheck_adapt) ||
-            preset_bool(p, n, "eps_sample", &sc->seek_eps_sample)) {
+            preset_bool(p, n, "eps_sample", &sc->seek_eps_sample) ||
+            preset_bool(p, n, "silence_floor", &sc->seek_silence_floor)) {
             return -1;
         }
     }

@@ -8,7 +8,8 @@
  *   strategy: meta                 # meta (the paper), meta-global, fd-gradient,
  *                                  # plane-gradient, chemotaxis, meta-path
  *   seek: {recheck_m: 1.0, eps_by_travel: true, eps_rate: 0.162, eps_geodesic: true,
- *                                  #       recheck_adapt: true, eps_sample: true,
+ *                                  #       recheck_adapt: true, eps_sample: true, refute_m: 1,
+ *                                  #       silence_floor: true,
  *                                  #       p0_min_dbm: -32}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
@@ -69,6 +70,10 @@ typedef struct hs_scenario {
     char strategy[32];            ///< strategy name ("meta")
     double seek_recheck_m;        ///< seek.recheck_m: relearn check every this many metres
                                   ///< of a greedy leg (-1 = the strategy's preset)
+    double seek_refute_m;         ///< seek.refute_m: radius ruled out round a refuted argmax
+                                  ///< (rfs_seek_cfg_t.refute_r; 0: off; -1 = the preset)
+    int seek_silence_floor;       ///< seek.silence_floor: 0 / 1, floor samples (-100 dBm) in
+                                  ///< silence (rfs_seek_cfg_t; -1 = the strategy's preset)
     int seek_eps_by_travel;       ///< seek.eps_by_travel: 0 / 1 (-1 = the strategy's preset)
     int seek_eps_geodesic;        ///< seek.eps_geodesic: 0 / 1 (-1 = the strategy's preset)
     int seek_recheck_adapt;       ///< seek.recheck_adapt: 0 / 1 (-1 = the strategy's preset)

@@ -646,9 +646,9 @@ static void log_decision(FILE *f, const hs_ctrl_t *ctrl, const rfs_seek_decision
                          const event_t *ev, double theta)
 {
     char reason[96];
-    snprintf(reason, sizeof reason, "prev=%s%s%s%s%s", hs_sim_prev_name(d->prev),
+    snprintf(reason, sizeof reason, "prev=%s%s%s%s%s%s", hs_sim_prev_name(d->prev),
              d->line_search ? ",line_search" : "",
-             d->sampled ? ",sampled" : "",
+             d->sampled ? ",sampled" : "", d->refuted ? ",refuted" : "",
              d->model_valid ? "" : ",no_model",
              d->mean_valid ? "" : ",no_mean");
     double pred = d->model_valid ? q16d(d->prediction) : NAN;
@@ -950,6 +950,12 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     rfs_seek_cfg_use_strategy(&cc.seek, st);
     if (e->sc.seek_recheck_m >= 0.0) {
         cc.seek.recheck_dist = (rfs_q16_t)lround(e->sc.seek_recheck_m * 65536.0);
+    }
+    if (e->sc.seek_refute_m >= 0.0) {
+        cc.seek.refute_r = (rfs_q16_t)lround(e->sc.seek_refute_m * 65536.0);
+    }
+    if (e->sc.seek_silence_floor >= 0) {
+        cc.seek.silence_floor = e->sc.seek_silence_floor != 0 ? RFS_Q16_INT(-100) : INT32_MIN;
     }
     if (e->sc.seek_eps_rate >= 0.0) {
         cc.seek.eps_rate = (rfs_q16_t)lround(e->sc.seek_eps_rate * 65536.0);

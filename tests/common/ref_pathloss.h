@@ -10,7 +10,8 @@
  * test_map.c), because they are the model's definition of a wall: a bin's walls are the
  * mean of the counts (each saturated at 15) from the four points `footprint` either side
  * of the centre of the core cell holding its centroid, along x and y, a point that is not
- * legal (rfs_map_point_legal) counting from the centre. No cache.
+ * legal (rfs_map_point_legal) counting from the centre. A candidate within excl_r of a
+ * place ruled out is not legal. No cache.
  */
 #ifndef REF_PATHLOSS_H
 #define REF_PATHLOSS_H
@@ -34,6 +35,8 @@ typedef struct ref_pl_cfg {
     double w_prior_weight;
     double p0_min; /* weakest plausible P0; a fit below adds total x Huber(p0_min - P0) */
     double footprint; /* m: offsets of a bin's wall-count points from its cell's centre */
+    int nexcl;        /* places ruled out: no candidate within excl_r of (ex[e], ey[e]) */
+    double ex[8], ey[8], excl_r;
 } ref_pl_cfg_t;
 
 typedef struct ref_pl_bin {
@@ -68,7 +71,7 @@ typedef struct ref_pl {
 static inline ref_pl_cfg_t ref_pl_cfg_default(void)
 {
     ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5, 30.0, -45.0,
-                      0.25};
+                      0.25, 0, {0}, {0}, 0.0};
     return c;
 }
 
@@ -159,6 +162,12 @@ static inline bool ref_pl_legal(const ref_pl_t *r, int i, int j)
 {
     if (i < 0 || j < 0 || i >= r->lw || j >= r->lh) {
         return false;
+    }
+    for (int e = 0; e < r->cfg.nexcl; ++e) {
+        if (hypot(r->ox + i * r->grid - r->cfg.ex[e], r->oy + j * r->grid - r->cfg.ey[e]) <=
+            r->cfg.excl_r) {
+            return false;
+        }
     }
     return r->map == NULL || rfs_map_lattice_legal(r->map, (uint16_t)i, (uint16_t)j);
 }

@@ -126,18 +126,28 @@ static ref_pl_cfg_t weak_ref(void)
     return c;
 }
 
+static rfs_pathloss_est_t fit_in_with(fixture_t *f, const rfs_pathloss_cfg_t *c,
+                                      const rfs_model_fit_in_t *in, uint32_t budget, int *calls);
+
 static rfs_pathloss_est_t fit_with(fixture_t *f, const rfs_pathloss_cfg_t *c, int n,
                                    const rfs_map_t *map, uint32_t budget, int *calls)
 {
+    rfs_model_fit_in_t in = {.samples = f->s, .n = (uint16_t)n, .map = map};
+    return fit_in_with(f, c, &in, budget, calls);
+}
+
+/* A whole (budget 0) or sliced fit of `in` from a fresh model. */
+static rfs_pathloss_est_t fit_in_with(fixture_t *f, const rfs_pathloss_cfg_t *c,
+                                      const rfs_model_fit_in_t *in, uint32_t budget, int *calls)
+{
     assert_int_equal(rfs_pathloss_init(&f->pl, c), 0);
     rfs_model_t m = rfs_pathloss_model(&f->pl);
-    rfs_model_fit_in_t in = {.samples = f->s, .n = (uint16_t)n, .map = map};
     rfs_rng_t rng;
     rfs_rng_seed(&rng, 1);
     rfs_fit_result_t r;
     int k = 0;
     do {
-        r = m.ops->fit(m.self, &in, budget, &rng);
+        r = m.ops->fit(m.self, in, budget, &rng);
         ++k;
     } while (r == RFS_FIT_MORE && k < 100000);
     assert_int_equal(r, RFS_FIT_DONE);
@@ -276,7 +286,17 @@ static void fit_recovers_source_n_and_w(void **state)
 static void expect_same_as_reference(fixture_t *f, const rfs_pathloss_cfg_t *c, int n,
                                      const rfs_map_t *map, const ref_pl_cfg_t *rc, double n_tol)
 {
-    rfs_pathloss_est_t e = fit_with(f, c, n, map, 0, NULL);
+    /* The reference's places ruled out, to the model in Q16.16. */
+    int16_t ex[8], ey[8];
+    for (int k = 0; k < rc->nexcl; ++k) {
+        ex[k] = (int16_t)lround(rc->ex[k] * 100.0);
+        ey[k] = (int16_t)lround(rc->ey[k] * 100.0);
+        assert_true(fabs(ex[k] / 100.0 - rc->ex[k]) < 1e-9); /* centimetres exactly */
+    }
+    rfs_model_fit_in_t in = {.samples = f->s, .n = (uint16_t)n, .map = map, .excl_x_cm = ex,
+                             .excl_y_cm = ey, .nexcl = (uint8_t)rc->nexcl,
+                             .excl_r = (rfs_q16_t)lround(rc->excl_r * 65536.0)};
+    rfs_pathloss_est_t e = fit_in_with(f, c, &in, 0, NULL);
     assert_true(ref_pl_fit(&f->ref, f->s, n, map, rc));
     const ref_pl_t *r = &f->ref;
 
@@ -327,6 +347,38 @@ static void same_cell_as_double_reference_office(void **state)
     expect_same_as_reference(f, &cw, NS, &f->map, &rw, 0.01);
 }
 
+/* Places ruled out (rfs_model_fit_in_t.excl_x, the seeker's refute_r): no candidate
+ * within the radius of one, against the reference's search without them. A disk round
+ * the true source moves the estimate out of it; sliced = whole with the disks. */
+static void places_ruled_out_same_as_reference(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+    rc.nexcl = 2;
+    rc.ex[0] = 15.13; /* the true source (15.125, 3.375) to the centimetre */
+    rc.ey[0] = 3.38;
+    rc.ex[1] = 4.0; /* another room: a hole in the coarse grid */
+    rc.ey[1] = 12.0;
+    rc.excl_r = 2.0;
+    expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
+    const double dx = f->ref.sx - k_office.sx, dy = f->ref.sy - k_office.sy;
+    assert_true(sqrt(dx * dx + dy * dy) > 1.99);
+
+    int16_t ex[2] = {1513, 400};
+    int16_t ey[2] = {338, 1200};
+    rfs_model_fit_in_t in = {.samples = f->s, .n = NS, .map = &f->map, .excl_x_cm = ex,
+                             .excl_y_cm = ey, .nexcl = 2, .excl_r = RFS_Q16_INT(2)};
+    rfs_pathloss_est_t whole = fit_in_with(f, &c, &in, 0, NULL);
+    int calls = 0;
+    rfs_pathloss_est_t sliced = fit_in_with(f, &c, &in, 7, &calls);
+    assert_true(calls > 10);
+    assert_int_equal(sliced.sx, whole.sx);
+    assert_int_equal(sliced.sy, whole.sy);
+    assert_int_equal(sliced.candidates, whole.candidates);
+    assert_int_equal(sliced.spread_m2, whole.spread_m2);
+}
 
 /* hold_k: a relearn keeps the previous fit's source (with hold_search, the best point of
  * a local search round it) while its loss is within best x (1 + hold_k / bins), best
@@ -964,6 +1016,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(relearn_holds_previous_source, setup, teardown),
         cmocka_unit_test_setup_teardown(relearn_holds_best_point_round_previous_source, setup,
                                         teardown),
+        cmocka_unit_test_setup_teardown(places_ruled_out_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(footprint_off_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_floor_off_same_as_reference, setup, teardown),
         cmocka_unit_test(registered_as_pathloss),

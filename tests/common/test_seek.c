@@ -227,6 +227,71 @@ static void test_heartbeat_never_makes_a_mean(void **state)
     world_free(&t);
 }
 
+/* silence_floor (docs/STRATEGIES.md, "Stalls"): the robot drives along y = 5 at 0.5 m/s,
+ * poses and receiver reports at 20 Hz, packets (-60 dBm, 100 Hz) for the first second
+ * only. From the first pose more than a window (1 s) after the last packet every pose
+ * adds a -100 dBm sample where the robot is; the expected count and positions are kept
+ * here. When the reports stop too (inputs stale) or the option is off: none. */
+static void silence_case(bool on, bool reports, int *floors, int *want)
+{
+    world_t t;
+    world_make(&t, 10, 10, 0, 0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    cfg.silence_floor = on ? RFS_Q16_INT(-100) : INT32_MIN;
+    seek_make(&t, cfg, 3);
+    double last_meas = 0, want_x[64];
+    *want = 0;
+    for (int64_t now = 10000; now <= 4000000; now += 10000) {
+        double x = 2.0 + 0.5 * (double)now * 1e-6;
+        if (now <= 1000000) {
+            assert_true(rfs_seek_on_rssi(&t.seek, 0, now, -60, &t.rng));
+            last_meas = (double)now;
+        }
+        if (now % 50000 == 0) {
+            rfs_pose_t p = pose_at(now, x, 5.0, 0);
+            assert_true(rfs_seek_on_pose(&t.seek, &p, &t.rng));
+            if ((reports || now <= 1000000) && on && (double)now - last_meas > 1e6 &&
+                *want < 64) {
+                want_x[(*want)++] = x;
+            }
+            if (reports || now <= 1000000) {
+                assert_true(rfs_seek_on_receiver(&t.seek, now));
+            }
+        }
+    }
+    *floors = 0;
+    for (uint16_t k = 0; k < t.seek.store.count; ++k) {
+        const rfs_sample_t *sm = &t.seek.store.samples[k];
+        if (sm->v_q6 == -100 * 64) {
+            /* The pose's own position (the store interpolates at the pose's stamp). */
+            assert_true(abs(sm->y_cm - 500) <= 1);
+            bool found = false;
+            for (int w = 0; w < *want; ++w) {
+                found = found || fabs(sm->x_cm / 100.0 - want_x[w]) < 0.011;
+            }
+            assert_true(found);
+            (*floors)++;
+        } else {
+            assert_int_equal(sm->v_q6, -60 * 64);
+        }
+    }
+    world_free(&t);
+}
+
+static void test_silence_floor_samples(void **state)
+{
+    (void)state;
+    int floors, want;
+    silence_case(true, true, &floors, &want);
+    assert_true(want >= 35); /* 3 s of silence less the window, at 20 Hz */
+    assert_true(floors >= want - 1 && floors <= want); /* the newest may wait for a pose */
+    silence_case(true, false, &floors, &want);
+    assert_int_equal(want, 0);
+    assert_int_equal(floors, 0);
+    silence_case(false, true, &floors, &want);
+    assert_int_equal(floors, 0);
+}
+
 /* Report stamps follow the measurements' rules (docs/FAULTS.md): older than the newest is
  * rejected, equal accepted; a newest report further ahead than the timeout (a clock jump)
  * is stale even while packets are fresh, until the clock reaches it. */
@@ -403,11 +468,22 @@ static void test_meta_path_preset(void **state)
     assert_true(cfg.eps_by_travel);
     assert_true(cfg.eps_geodesic);
     assert_true(cfg.eps_sample);
+    assert_int_equal(cfg.refute_r, cfg.step);
+    assert_int_equal(cfg.silence_floor, RFS_Q16_INT(-100));
+    rfs_seek_cfg_t per = cfg;
+    rfs_seek_cfg_per_source(&per); /* a fit per node: its own floor, no source to rule out */
+    assert_int_equal(per.refute_r, 0);
+    assert_int_equal(per.silence_floor, INT32_MIN);
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META);
     assert_int_equal(cfg.recheck_dist, 0);
     assert_false(cfg.eps_by_travel);
     assert_false(cfg.eps_geodesic);
     assert_false(cfg.eps_sample);
+    assert_int_equal(cfg.refute_r, 0);
+    assert_int_equal(cfg.silence_floor, INT32_MIN);
+    cfg.refute_r = -1;
+    assert_int_equal(init_result(cfg), -1);
+    cfg.refute_r = 0;
     cfg.recheck_dist = -1;
     assert_int_equal(init_result(cfg), -1);
 }
@@ -628,6 +704,7 @@ int main(void)
         cmocka_unit_test(test_no_packet_no_heartbeat_stops_wheels),
         cmocka_unit_test(test_heartbeat_never_makes_a_mean),
         cmocka_unit_test(test_heartbeat_stamps),
+        cmocka_unit_test(test_silence_floor_samples),
         cmocka_unit_test(test_no_goal_backs_off),
         cmocka_unit_test(test_null_move_backs_off),
         cmocka_unit_test(test_recheck_abandons_leg),

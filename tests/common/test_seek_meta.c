@@ -325,6 +325,186 @@ static void test_eps_sample_goes_to_the_draw(void **state)
     eps_sample_case(true, fixed_ops(), 10.5, false, DRAW_AHEAD); /* the model does not draw */
 }
 
+/* refute_r (docs/STRATEGIES.md, "Stalls"): a model that knows its maximum, predicts -60
+ * dB everywhere, records the places ruled out that each fit is given, and moves its
+ * maximum to the next point of a 1.5 m x 2 m grid at every fit. The robot, teleported
+ * onto every goal, stands at the maximum at each decision after the first greedy one.
+ * The places expected are kept here in double: the maximum when the robot stands within
+ * half a step of it and the 1 s mean is weaker than -60 dB by more than 6 dB, the
+ * latest RFS_MODEL_MAX_EXCL of them. */
+typedef struct refute_model {
+    fixed_model_t base; /* first: the fixed_* operations read it */
+    int fits;
+    int nexcl;           /* what the latest fit was given */
+    double ex[RFS_MODEL_MAX_EXCL], ey[RFS_MODEL_MAX_EXCL], r;
+    double want_x[64], want_y[64]; /* every refutation expected so far, oldest first */
+    int nwant;
+    double mean;         /* the scripted 1 s mean */
+    bool silent;         /* no packet at the decisions, the receiver up */
+    bool mismatch;       /* a fit was given other places than expected */
+} refute_model_t;
+
+static void refute_point(int k, double *x, double *y)
+{
+    *x = 2.125 + 1.5 * (double)(k % 11);
+    *y = 2.125 + 2.0 * (double)((k / 11) % 3);
+}
+
+static rfs_fit_result_t refute_fit(void *self, const rfs_model_fit_in_t *in, uint32_t budget,
+                                   rfs_rng_t *rng)
+{
+    (void)budget;
+    (void)rng;
+    refute_model_t *m = self;
+    /* The double rule at the query point (the robot), against the maximum held (reset
+     * has just invalidated the model: any fit but the first had one). */
+    if (m->fits > 0 &&
+        hypot(D(in->qx) - D(m->base.mx), D(in->qy) - D(m->base.my)) <= 0.5 &&
+        (m->silent || -60.0 - m->mean > 6.0) && m->nwant < 64) {
+        m->want_x[m->nwant] = D(m->base.mx);
+        m->want_y[m->nwant] = D(m->base.my);
+        m->nwant++;
+    }
+    int expect = m->nwant < (int)RFS_MODEL_MAX_EXCL ? m->nwant : (int)RFS_MODEL_MAX_EXCL;
+    m->nexcl = in->nexcl;
+    m->r = D(in->excl_r);
+    if (in->nexcl != expect) {
+        m->mismatch = true;
+    }
+    for (int e = 0; e < in->nexcl && e < expect; ++e) {
+        m->ex[e] = in->excl_x_cm[e] / 100.0;
+        m->ey[e] = in->excl_y_cm[e] / 100.0;
+        /* Slots fill in order, then the oldest is overwritten: any order, the latest ones. */
+        bool found = false;
+        for (int w = m->nwant - expect; w < m->nwant; ++w) {
+            found = found || (fabs(m->ex[e] - m->want_x[w]) < 0.0051 &&
+                              fabs(m->ey[e] - m->want_y[w]) < 0.0051); /* to the cm */
+        }
+        m->mismatch = m->mismatch || !found;
+    }
+    m->fits++;
+    double x, y;
+    refute_point(m->fits, &x, &y);
+    m->base.mx = Q(x);
+    m->base.my = Q(y);
+    m->base.valid = true;
+    return RFS_FIT_DONE;
+}
+
+static int refute_case(double mean, bool on, int decisions, refute_model_t *m)
+{
+    static const rfs_model_ops_t ops = {
+        .name = "refute", .reset = fixed_reset, .fit = refute_fit, .predict = fixed_predict,
+        .argmax = fixed_argmax,
+    };
+    world_t t;
+    world_make(&t, 20.0, 10.0, 0, 0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    assert_int_equal(cfg.refute_r, cfg.step); /* the preset's */
+    cfg.refute_r = on ? cfg.refute_r : 0;
+    cfg.eps_amp = 0;
+    cfg.eps_floor = 0; /* every decision after the first is greedy */
+    seek_make(&t, cfg, 5);
+    memset(m, 0, sizeof *m);
+    m->mean = mean;
+    rfs_model_t model = { &ops, m };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = mean };
+    run_t r = { .x = 4.125, .y = 5.125 };
+    rfs_seek_out_t out;
+    int refuted = 0;
+    for (int k = 0; k < decisions; ++k) {
+        assert_true(next_decision(&t, &r, &f, 500000, 5000000, &out));
+        refuted += out.decision.refuted ? 1 : 0;
+    }
+    world_free(&t);
+    return refuted;
+}
+
+/* The same model in silence: packets (-60 dBm) for the first 1.5 s only, then the
+ * receiver's reports alone, every 10 ms; the robot teleported onto each goal 0.5 s after
+ * it is decided. Returns the decisions that ruled a place out. */
+static int refute_silent(refute_model_t *m, int decisions)
+{
+    static const rfs_model_ops_t ops = {
+        .name = "refute", .reset = fixed_reset, .fit = refute_fit, .predict = fixed_predict,
+        .argmax = fixed_argmax,
+    };
+    world_t t;
+    world_make(&t, 20.0, 10.0, 0, 0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    cfg.eps_amp = 0;
+    cfg.eps_floor = 0;
+    seek_make(&t, cfg, 5);
+    memset(m, 0, sizeof *m);
+    m->silent = true;
+    rfs_model_t model = { &ops, m };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    double x = 4.125, y = 5.125, gx = x, gy = y;
+    int64_t arrive = -1;
+    int refuted = 0, decided = 0;
+    for (int64_t now = 10000; decided < decisions && now < 600000000; now += 10000) {
+        if (arrive >= 0 && now >= arrive) {
+            x = gx;
+            y = gy;
+            arrive = -1;
+        }
+        if (now < 1500000) {
+            rfs_seek_on_rssi(&t.seek, 0, now, -60, &t.rng);
+        }
+        assert_true(rfs_seek_on_receiver(&t.seek, now));
+        if (now % 50000 == 0) {
+            rfs_seek_out_t out;
+            rfs_pose_t p = { now, Q(x), Q(y), 0 };
+            rfs_seek_on_pose(&t.seek, &p, &t.rng);
+            rfs_seek_step(&t.seek, now, &t.rng, &out);
+            if (out.decided) {
+                decided++;
+                refuted += out.decision.refuted ? 1 : 0;
+                assert_true(!out.decision.refuted || !out.decision.mean_valid);
+                gx = D(out.decision.goal_x);
+                gy = D(out.decision.goal_y);
+                arrive = now + 500000;
+            }
+        }
+    }
+    assert_int_equal(decided, decisions);
+    world_free(&t);
+    return refuted;
+}
+
+static void test_refute_rules_out_the_argmax(void **state)
+{
+    (void)state;
+    refute_model_t m;
+    /* 7 dB weaker at every maximum: ruled out at each decision there, 32 kept. */
+    int refuted = refute_case(-67.0, true, 40, &m);
+    assert_false(m.mismatch);
+    assert_true(m.fits >= 39);
+    assert_int_equal(refuted, m.nwant);
+    assert_true(m.nwant >= 37); /* every decision after the initial move and the first leg */
+    assert_int_equal(m.nexcl, (int)RFS_MODEL_MAX_EXCL);
+    assert_true(fabs(m.r - 1.0) < 1e-9);
+    /* 6 dB stronger (relearnt, nothing ruled out), 5 dB weaker (relearnt, within twice the
+     * threshold), or the option off: nothing. */
+    const double means[3] = {-54.0, -65.0, -67.0};
+    for (int c = 0; c < 3; ++c) {
+        refuted = refute_case(means[c], c != 2, 12, &m);
+        assert_int_equal(refuted, 0);
+        assert_true(c == 2 || m.nwant == 0);
+        assert_int_equal(m.nexcl, 0);
+        assert_true(m.fits >= 11); /* every miss relearns */
+    }
+    /* Silence at the maximum, the receiver up: ruled out, the model relearnt for it. */
+    refuted = refute_silent(&m, 12);
+    assert_false(m.mismatch);
+    assert_int_equal(refuted, m.nwant);
+    assert_true(m.nwant >= 9);
+    assert_true(m.fits >= m.nwant);
+}
+
 /* The geodesic epsilon step (cfg.eps_geodesic, docs/STRATEGIES.md) against a double-
  * precision reference. The map: 10 m x 8 m with a one-cell wall at x in [5.2, 5.3)
  * from the floor to y = 5.0; the only way to its far side is the gap above it. The robot
@@ -638,6 +818,7 @@ int main(void)
         cmocka_unit_test(test_eps_by_travel),
         cmocka_unit_test(test_meta_path_unreachable_maximum),
         cmocka_unit_test(test_eps_sample_goes_to_the_draw),
+        cmocka_unit_test(test_refute_rules_out_the_argmax),
         cmocka_unit_test(test_eps_geodesic_distribution),
         cmocka_unit_test(test_plan_slices_on_the_leg),
     };

@@ -633,7 +633,7 @@ static void attached_cache_equals_builtin(void **state)
     rfs_pathloss_est_t e[3];
     uint32_t lines[3] = {0, 0, 0}, cached[3] = {0, 0, 0};
     for (int n = NS / 8; n <= NS; n += NS / 8) {
-        rfs_model_fit_in_t in = {f->s, (uint16_t)n, 0, 0, &f->map};
+        rfs_model_fit_in_t in = {.samples = f->s, .n = (uint16_t)n, .map = &f->map};
         for (int k = 0; k < 3; ++k) {
             assert_int_equal(rfs_pathloss_ops.fit(st[k], &in, 0, &rng), RFS_FIT_DONE);
             assert_true(rfs_pathloss_estimate(st[k], &e[k]));

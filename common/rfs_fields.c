@@ -168,7 +168,7 @@ static uint32_t walls_at(rfs_fields_t *f, uint8_t k, uint16_t i, uint16_t j, uin
     if (*w == NO_WALLS) {
         rfs_q16_t x, y;
         rfs_map_lattice_point(f->map, i, j, &x, &y);
-        *w = (uint8_t)rfs_pathloss_walls_to_source(&f->src[k], x, y); /* <= 63 */
+        *w = (uint8_t)rfs_pathloss_walls_to_source(&f->src[k], x, y); /* <= 15 */
         f->walls_counted++;
         (*used)++;
     }

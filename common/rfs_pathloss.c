@@ -62,7 +62,6 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
      * runs behind docs/STRATEGIES.md, estimates within 5 m of the source had P0 >= -45 dBm
      * in all but 1 of 3,479 fits, estimates farther away had it below in 1,176 of 5,553. */
     c.p0_min = RFS_Q16_INT(-45);
-    c.walls_max = 15u;
     c.hold_k = RFS_Q16_INT(6);
     /* The spread region's and hold_k's likelihood-ratio reading of the surface, untempered
      * (docs/PATHLOSS.md, "Epsilon steps that draw the source"). */
@@ -93,8 +92,7 @@ int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg)
               c->spread_k <= RFS_Q16_INT(1000) && c->margin >= 0 && c->hold_k >= 0 &&
               c->hold_k <= RFS_Q16_INT(64) && c->footprint >= 0 && c->footprint <= c->bin / 2 &&
               c->margin <= RFS_Q16_INT(100) && c->sample_t >= RFS_Q16_FRAC(1, 16) &&
-              c->sample_t <= RFS_Q16_INT(64) && c->walls_max >= 1u &&
-              c->walls_max <= RFS_PATHLOSS_WALLS_MAX;
+              c->sample_t <= RFS_Q16_INT(64);
     if (!ok) {
         return -1;
     }

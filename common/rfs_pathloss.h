@@ -39,7 +39,7 @@
  * cluttered map one line's count jumps by several walls within centimetres of where it
  * starts (footprint 0: the centre's count alone). The counts are cached across fits,
  * RFS_PATHLOSS_CACHE_ROWS origins x the first candidates evaluated (a byte each; a count
- * saturates at cfg.walls_max): RFS_PATHLOSS_CACHE_COLS of them built in (the first legal
+ * saturates at 15 walls): RFS_PATHLOSS_CACHE_COLS of them built in (the first legal
  * coarse candidates), or as many as a caller's buffer holds
  * (rfs_pathloss_cache_attach(): every coarse, refinement and hold candidate of a run).
  * Bins are fixed cells, so a relearn counts walls only for bins that are new or whose
@@ -92,9 +92,6 @@
 /// Surface value of a coarse point that is not a candidate (illegal).
 #define RFS_PATHLOSS_NO_LOSS UINT32_MAX
 
-/// Most walls a count may saturate at: four counts, in quarter walls, fit a cache byte.
-#define RFS_PATHLOSS_WALLS_MAX 63u
-
 /// Configuration; rfs_pathloss_cfg_default() gives the values in the comments.
 typedef struct rfs_pathloss_cfg {
     rfs_q16_t bin;          ///< metres Q16.16: side of a sample bin (1 m), 0.1..16 m
@@ -130,8 +127,6 @@ typedef struct rfs_pathloss_cfg {
     rfs_q16_t sample_t;     ///< temperature of the model's draws (rfs_pathloss_ops.sample):
                             ///< coarse candidate c is drawn with weight e^(-chi2_c / 2T),
                             ///< chi2_c = (loss_c / best loss - 1) x bins (1.0), 1/16..64
-    uint8_t walls_max;      ///< a wall count saturates here (15), 1..RFS_PATHLOSS_WALLS_MAX:
-                            ///< a SLAM map's clutter counts 20-40 walls across a floor
 } rfs_pathloss_cfg_t;
 
 /// One sample bin. Scaling: sums of up to 65,535 samples of int16 fit int32.
@@ -326,7 +321,7 @@ rfs_model_t rfs_pathloss_model(rfs_pathloss_t *p);
 extern const rfs_model_ops_t rfs_pathloss_ops;
 
 /// Walls on the straight line from (x, y) to the estimated source, as predictions count
-/// them (rfs_map_walls_crossed, saturated at cfg.walls_max); 0 without a model or a map. A caller
+/// them (rfs_map_walls_crossed, saturated at 15); 0 without a model or a map. A caller
 /// predicting many points against one source may keep them (rfs_fields.h).
 uint32_t rfs_pathloss_walls_to_source(const rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y);
 

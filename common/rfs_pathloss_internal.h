@@ -9,6 +9,9 @@
 
 #include "rfs_pathloss.h"
 
+/* Wall counts saturate here (15 walls are 75 dB at 5 dB each; four of them, in quarter
+ * walls, fit a byte of the cache). */
+#define RFS_PATHLOSS_WALLS_MAX 15u
 /* Wall counts per bin footprint. */
 #define RFS_PATHLOSS_FOOTPRINT_RAYS 4u
 
@@ -18,7 +21,7 @@
 void rfs_pathloss_walls_assign(rfs_pathloss_t *p);
 
 /* One line's walls on p->map from (x, y) to (sx, sy) (metres Q16.16), saturated at
- * cfg.walls_max (rfs_map_walls_crossed, over the map's wall-free blocks when
+ * RFS_PATHLOSS_WALLS_MAX (rfs_map_walls_crossed, over the map's wall-free blocks when
  * rfs_pathloss_walls_assign() has found them). */
 uint32_t rfs_pathloss_walls_line(const rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,
                                  rfs_q16_t sy);

@@ -161,7 +161,7 @@ uint32_t rfs_pathloss_walls_line(const rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t
     b.bits = p->wall_blocks; /* this state's own grid, also in a copy of it */
     uint32_t k = rfs_map_walls_crossed_blocks(p->map, p->blocks_map == p->map ? &b : 0, x, y,
                                               sx, sy);
-    return k > p->cfg.walls_max ? p->cfg.walls_max : k;
+    return k > RFS_PATHLOSS_WALLS_MAX ? RFS_PATHLOSS_WALLS_MAX : k;
 }
 
 /* rfs_pathloss_walls_line(), counted as a fit's work. */

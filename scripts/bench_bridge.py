@@ -171,9 +171,13 @@ def main():
     ap.add_argument("--smoke", action="store_true", help="seed 1, print, check, no files")
     ap.add_argument("--keep", help="also copy every runs.tsv (and the run's commit) here")
     ap.add_argument("--from", dest="from_dir", help="write from the tables --keep kept")
+    ap.add_argument("--only", choices=[c[2] for c in CONFIGS],
+                    help="with --keep: run only this configuration's tables, write nothing")
     a = ap.parse_args()
     if a.smoke:
         a.seeds, a.no_write = "1..1", True
+    if a.only and not a.keep:
+        sys.exit("bench_bridge: --only needs --keep")
     m = re.fullmatch(r"(\d+)\.\.(\d+)", a.seeds)
     if not m:
         sys.exit("bench_bridge: --seeds: expected A..B")
@@ -185,6 +189,8 @@ def main():
         for sc in SCENARIOS:
             cfgs = []
             for strategy, model, label in CONFIGS:
+                if a.only and label != a.only:
+                    continue
                 name = f"{sc}-{strategy}"
                 rows = kept(os.path.join(a.keep, name + ".tsv"), a.seeds) if a.keep else None
                 if a.from_dir:
@@ -205,6 +211,8 @@ def main():
                 print(f"{sc} | {label} | {s['near']}/{s['n']} | {mp(s['err'])} | "
                       f"{mp(s['short'])} | {mp(s['travel'])} | {mp(s['pred'])}", flush=True)
             table.append((sc, cfgs))
+    if a.only:
+        return 0
     at, wall = commit(), time.time() - t0
     if a.from_dir:  # the commit and wall time of the run that kept the tables
         with open(os.path.join(a.from_dir, "run.txt")) as f:

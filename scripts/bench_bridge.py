@@ -104,20 +104,16 @@ def section(seeds, wall, at, jobs, table):
     fit_err = np.concatenate([s["fit_err"] for s in per])
     fit_w = [f"{np.nanmedian(s['fit_w']):.1f}" for s in per]
     L = [BEGIN, "## Bridging (paper section 6)", "",
-         f"Written by `/usr/bin/python3 scripts/bench_bridge.py --seeds {seeds}"
-         f"{f' --jobs {jobs}' if jobs else ''}` at commit {at} ({wall:.0f} s). f = "
-         "-|R1 - R2| - |R1 + R2|, threshold 7 (the paper's for this target), runs ending at "
-         "150 m or 600 s. *Best point*: the best f of the seed's mean field (no fading or "
-         "noise) where the robot can stand, reachable, 0.1 m grid (hs_bridge.h); *distance* "
-         "and *shortfall* f(best) - f(end) where a run ends; *travel to settle*: after which "
-         "the robot stayed within 1 m of it. Per node, runs end a median "
-         f"{np.nanmedian(gap):.2f} m from the predicted point, whose sigma is a median "
-         f"{np.nanmedian(sig):.1f} dB; each node's fitted position lies a median "
-         f"{np.nanmedian(fit_err):.1f} m (p90 {np.nanpercentile(fit_err, 90):.1f} m) from the "
-         f"node, its W a median {', '.join(fit_w)} dB by scenario (true 5, 5, 3, 3). "
-         "Cells: median (p90). Scenarios: docs/SIMULATOR.md; "
-         "*paper*: meta + ridge on f; *per node*: meta-path + pathloss, one fit per node "
-         "(docs/STRATEGIES.md).", "",
+         f"`/usr/bin/python3 scripts/bench_bridge.py --seeds {seeds}"
+         f"{f' --jobs {jobs}' if jobs else ''}` at {at} ({wall:.0f} s); runs end at 150 m or "
+         "600 s. *Best point*: of the true f (mean field, no fading; reachable standing "
+         "points, 0.1 m grid; hs_bridge.h). *Distance*, *shortfall* f(best) - f(end): where "
+         "a run ends; *travel to settle*: after which it stayed within 1 m. Per node: ends "
+         f"{np.nanmedian(gap):.2f} m from the predicted point (sigma {np.nanmedian(sig):.1f} "
+         f"dB); fitted nodes {np.nanmedian(fit_err):.1f} m (p90 "
+         f"{np.nanpercentile(fit_err, 90):.1f} m) off, W {', '.join(fit_w)} dB (true 5, 5, 3, "
+         "3). Cells: median (p90). *paper*: meta + ridge on f; *per node*: meta-path + "
+         "pathloss.", "",
          "| scenario | configuration | within 3 m | distance, m | shortfall, dB | "
          "travel to settle, m |",
          "|---|---|---|---|---|---|"]

@@ -70,7 +70,7 @@ typedef struct rfs_fields_cfg {
     rfs_q16_t coarse;            ///< spacing of the points predicted away from the samples,
                                  ///< metres Q16.16 (1 m), rounded to lattice steps (>= 1)
     rfs_q16_t lcb;               ///< the best point has the highest prediction less lcb
-                                 ///< times its sigma (rfs_fields_est_t), Q16.16 (1), 0..8
+                                 ///< times its sigma (rfs_fields_est_t), Q16.16 (0), 0..8
 } rfs_fields_cfg_t;
 
 /// Caller-owned arrays, sized with rfs_fields_mem_size() for the map.

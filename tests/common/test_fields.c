@@ -405,7 +405,7 @@ static void test_lower_confidence_bound(void **state)
     fixture_t *f = *state;
     make_bridge(f, -6.0);
     rfs_fields_cfg_t c = rfs_fields_cfg_default();
-    c.lcb = RFS_Q16_INT(2);
+    c.lcb = RFS_Q16_INT(4);
     assert_int_equal(rfs_fields_init(&f->fl, &c, &rfs_target_bridge, &f->mem), 0);
     rfs_model_fit_in_t in = fit_in(f, 2);
     assert_int_equal(fit_all(&f->fl, &in, 0, NULL), RFS_FIT_DONE);
@@ -443,7 +443,7 @@ static void test_lower_confidence_bound(void **state)
                 double rms = D(e.src[k].rms), nk = n[(size_t)k * lw * lh + (size_t)j * lw + i];
                 s2 += rms * rms * c.prior_n / (c.prior_n + nk);
             }
-            double score = D(v) - 2.0 * sqrt(2.0 * s2);
+            double score = D(v) - 4.0 * sqrt(2.0 * s2);
             best = fmax(best, score);
             top_v = fmax(top_v, D(v));
             if (i == bi && j == bj) {

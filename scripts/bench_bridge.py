@@ -100,7 +100,6 @@ def mp(a):
 def section(seeds, wall, at, jobs, table):
     per = [s for _, cfgs in table for (st, _, _), s in cfgs if st == "meta-path"]
     gap = np.concatenate([s["gap"] for s in per])
-    sig = np.concatenate([s["sigma"] for s in per])
     fit_err = np.concatenate([s["fit_err"] for s in per])
     fit_w = [f"{np.nanmedian(s['fit_w']):.1f}" for s in per]
     L = [BEGIN, "## Bridging (paper section 6)", "",
@@ -109,10 +108,9 @@ def section(seeds, wall, at, jobs, table):
          "600 s. *Best point*: of the true f (mean field, no fading; reachable standing "
          "points, 0.1 m grid; hs_bridge.h). *Distance*, *shortfall* f(best) - f(end): where "
          "a run ends; *travel to settle*: after which it stayed within 1 m. Per node: ends "
-         f"{np.nanmedian(gap):.2f} m from the predicted point (sigma {np.nanmedian(sig):.1f} "
-         f"dB); fitted nodes {np.nanmedian(fit_err):.1f} m (p90 "
-         f"{np.nanpercentile(fit_err, 90):.1f} m) off, W {', '.join(fit_w)} dB (true 5, 5, 3, "
-         "3). Cells: median (p90). *paper*: meta + ridge on f; *per node*: meta-path + "
+         f"{np.nanmedian(gap):.2f} m from the predicted point; fitted nodes "
+         f"{np.nanmedian(fit_err):.1f} m off (p90 {np.nanpercentile(fit_err, 90):.1f}), W "
+         f"{', '.join(fit_w)} dB (true 5, 5, 3, 3). Cells: median (p90). *paper*: meta + ridge on f; *per node*: meta-path + "
          "pathloss.", "",
          "| scenario | configuration | within 3 m | distance, m | shortfall, dB | "
          "travel to settle, m |",

@@ -115,6 +115,29 @@ static void ip_close(void *self)
     free(p);
 }
 
+/* The path-loss model's options: P0 bounded by the node's transmit power when known
+ * (docs/PATHLOSS.md, "The P0 floor"), and the simulator's large wall-count cache. 0, or
+ * -1 with the reason in err. */
+static int open_pathloss(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, char *err, size_t errlen)
+{
+    if (!isnan(cfg->p0_min_dbm)) {
+        rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
+        pc.p0_min = (rfs_q16_t)lround(fmax(-200.0, fmin(100.0, cfg->p0_min_dbm)) * 65536.0);
+        if (rfs_pathloss_init(p->model_state, &pc) != 0) {
+            snprintf(err, errlen, "model: pathloss: p0_min_dbm %g rejected", cfg->p0_min_dbm);
+            return -1;
+        }
+    }
+    const uint32_t cb = rfs_pathloss_cache_bytes(HS_CTRL_PATHLOSS_CACHE_COLS);
+    p->wall_cache = malloc(cb);
+    if (!p->wall_cache ||
+        rfs_pathloss_cache_attach(p->model_state, p->wall_cache, cb, HS_CTRL_PATHLOSS_CACHE_COLS) != 0) {
+        snprintf(err, errlen, "model: pathloss: out of memory");
+        return -1;
+    }
+    return 0;
+}
+
 /* One path-loss fit per source (rfs_fields.h) and each source's own sample store. */
 static int open_fields(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, const rfs_map_t *map,
                        const rfs_target_ops_t *target)
@@ -222,25 +245,9 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
             return -1;
         }
     }
-    if (me->ops == &rfs_pathloss_ops && !isnan(cfg->p0_min_dbm)) {
-        // The node's transmit power, when known, bounds P0 (docs/PATHLOSS.md "The P0 floor").
-        rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
-        pc.p0_min = (rfs_q16_t)lround(fmax(-200.0, fmin(100.0, cfg->p0_min_dbm)) * 65536.0);
-        if (rfs_pathloss_init(p->model_state, &pc) != 0) {
-            ip_close(p);
-            snprintf(err, errlen, "model: pathloss: p0_min_dbm %g rejected", cfg->p0_min_dbm);
-            return -1;
-        }
-    }
-    if (me->ops == &rfs_pathloss_ops) {
-        const uint32_t cb = rfs_pathloss_cache_bytes(HS_CTRL_PATHLOSS_CACHE_COLS);
-        p->wall_cache = malloc(cb);
-        if (!p->wall_cache ||
-            rfs_pathloss_cache_attach(p->model_state, p->wall_cache, cb, HS_CTRL_PATHLOSS_CACHE_COLS) != 0) {
-            ip_close(p);
-            snprintf(err, errlen, "model: pathloss: out of memory");
-            return -1;
-        }
+    if (me->ops == &rfs_pathloss_ops && open_pathloss(p, cfg, err, errlen) != 0) {
+        ip_close(p);
+        return -1;
     }
     rfs_model_t model = {me->ops, p->model_state};
     if (rfs_models_per_source(me, target)) {

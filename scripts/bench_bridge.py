@@ -104,7 +104,8 @@ def section(seeds, wall, at, jobs, table):
     fit_w = [f"{np.nanmedian(s['fit_w']):.1f}" for s in per]
     L = [BEGIN, "## Bridging (paper section 6)", "",
          f"`/usr/bin/python3 scripts/bench_bridge.py --seeds {seeds}"
-         f"{f' --jobs {jobs}' if jobs else ''}` at {at} ({wall:.0f} s); runs end at 150 m or "
+         f"{f' --jobs {jobs}' if jobs else ''}` at {at} "
+         f"({'kept tables' if wall is None else f'{wall:.0f} s'}); runs end at 150 m or "
          "600 s. *Best point*: of the true f (mean field, no fading; reachable standing "
          "points, 0.1 m grid; hs_bridge.h). *Distance*, *shortfall* f(best) - f(end): where "
          "a run ends; *travel to settle*: after which it stayed within 1 m. Per node: ends "
@@ -176,7 +177,7 @@ def main():
     if not m:
         sys.exit("bench_bridge: --seeds: expected A..B")
     t0 = time.time()
-    table = []
+    table, reused = [], False
     if a.keep:
         os.makedirs(a.keep, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
@@ -187,6 +188,7 @@ def main():
                     continue
                 name = f"{sc}-{strategy}"
                 rows = kept(os.path.join(a.keep, name + ".tsv"), a.seeds) if a.keep else None
+                reused = reused or rows is not None
                 if a.from_dir:
                     with open(os.path.join(a.from_dir, name + ".tsv")) as f:
                         rows = list(csv.DictReader(f, delimiter="\t"))
@@ -215,7 +217,7 @@ def main():
     elif a.keep:
         with open(os.path.join(a.keep, "run.txt"), "w") as f:
             f.write(f"{at} {wall:.0f} {a.seeds} {a.jobs}\n")
-    text = section(a.seeds, wall, at, a.jobs, table)
+    text = section(a.seeds, None if reused else wall, at, a.jobs, table)
     if a.smoke:
         ok = text.count("| bridge") == 2 * len(SCENARIOS) and all(
             np.isfinite(s["err"]).all() for _, cfgs in table for _, s in cfgs)

@@ -6,7 +6,8 @@ references would settle against the simulator's best point of the true f:
   pathloss  the best point of f on the path-loss fields of the true parameters (the
             scenario's P0, n = 3, W a wall, the simulator's wall counts) without shadowing:
             a perfect per-node fit that knows nothing of the shadowing
-  fits      the same on the run's final per-node fits (summary.json pred_sources)
+  fits      the same with the run's final per-node fits (summary.json pred_sources: the
+            fitted position, P0, n and W; the walls still counted to the true node)
   track     the best true f within 1 m of the robot's track: the best a seeker could
             choose among the places it has been
 

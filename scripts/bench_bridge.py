@@ -141,7 +141,7 @@ def figure(path, sim, seed, best, finals):
     sc = ax.scatter(a[:, 0], a[:, 1], c=f, s=2, cmap="viridis", marker="s", linewidths=0,
                     vmin=np.max(f) - 40, vmax=np.max(f))
     fig.colorbar(sc, ax=ax, label=f"true f, dB (seed {seed} field, no fading)")
-    for (label, pts), style in zip(finals, ("r.", "c.")):
+    for (label, pts), style in zip(finals, ("r.", "w.")):
         ax.plot(pts[:, 0], pts[:, 1], style, ms=4, label=f"{label}: where the runs settled")
     ax.plot(best[0], best[1], "w*", ms=14, mec="k", label=f"best point of f (seed {seed})")
     ax.plot([7.5, 27.5], [2.0, 10.0], "^", color="orange", ms=10, mec="k", ls="none",

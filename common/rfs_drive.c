@@ -13,8 +13,8 @@
  *    at B (u >= |AB|) or comes within SWITCH_DIST of it. The goal is reached within
  *    goal_tol.
  *  - Steering. The carrot is the point lookahead ahead of the robot's projection on the
- *    line AB (past B on the goal's leg it is the goal itself); e is the heading error to
- *    it. The carrot never lies on the next leg, so corners are not cut.
+ *    line AB, on the goal's leg at most the goal itself; e is the heading error to it.
+ *    The carrot never lies on the next leg, so corners are not cut.
  *  - Turning on the spot once |e| exceeds turn_in_place, until |e| < turn_out (the
  *    hysteresis keeps small heading errors from stopping the robot): omega = 3 e, wheels
  *    at most v_max / 2 and slow enough to stop within the remaining angle.
@@ -130,6 +130,11 @@ void rfs_drive_stop(rfs_drive_t *d, int64_t now_us)
     d->path.n = 0;
     d->left_mm_s = 0; /* the base itself slows at its own rate: base_left/right */
     d->right_mm_s = 0;
+}
+
+bool rfs_drive_at_rest(const rfs_drive_t *d)
+{
+    return d->base_left == 0 && d->base_right == 0;
 }
 
 bool rfs_drive_estimate(const rfs_drive_t *d, rfs_pose_t *out)
@@ -401,6 +406,10 @@ static rfs_q16_t carrot_error(const rfs_drive_t *d, const leg_t *g)
         ty = g->dy - g->py;
     } else {
         int64_t along = (g->u > 0 ? g->u : 0) + q16_to_mm(d->cfg.lookahead);
+        /* On the goal's leg the carrot stops at the goal: a point beyond it is one the
+         * planner never checked, and a robot beside a short last leg would steer past the
+         * goal and stop within goal_tol of it on the far side. */
+        along = goal && along > g->len ? g->len : along;
         tx = rfs_sdiv64_round(along * g->dx, g->len) - g->px;
         ty = rfs_sdiv64_round(along * g->dy, g->len) - g->py;
     }

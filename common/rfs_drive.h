@@ -106,4 +106,8 @@ bool rfs_drive_estimate(const rfs_drive_t *d, rfs_pose_t *out);
 /// Drop the goal and command zero at once (safety stop; no ramp).
 void rfs_drive_stop(rfs_drive_t *d, int64_t now_us);
 
+/// Whether the base's modelled wheel speeds (base_left, base_right) are both 0: after a
+/// stop the base rolls on, braking at accel_mm_s2, until this holds.
+bool rfs_drive_at_rest(const rfs_drive_t *d);
+
 #endif /* RFS_DRIVE_H */

@@ -336,6 +336,77 @@ static void traverse(visitor_t *v, int64_t X0, int64_t Y0, int64_t X1, int64_t Y
     }
 }
 
+/* Cell (i, j) is on the map and legal (unsigned compares: a negative index is off). */
+static bool legal_cell(const rfs_map_t *m, int32_t i, int32_t j)
+{
+    return (uint32_t)i < m->w && (uint32_t)j < m->h &&
+           ((m->legal[(uint32_t)j * m->stride + ((uint32_t)i >> 3)] >> ((uint32_t)i & 7u)) & 1u);
+}
+
+/* traverse() for VISIT_LEGAL alone, the visit inlined: the same cells in the same order
+ * (the planner's string pulling runs it on every test, docs/MAPS.md, "Planning"); true
+ * when every one is legal. Scaling and overflow: traverse()'s. */
+static bool traverse_legal(const rfs_map_t *m, int64_t X0, int64_t Y0, int64_t X1, int64_t Y1)
+{
+    const int32_t r = m->res;
+    if (X1 < X0 || (X1 == X0 && Y1 < Y0)) {
+        int64_t t = X0; X0 = X1; X1 = t;
+        t = Y0; Y0 = Y1; Y1 = t;
+    }
+    const bool flip = Y1 < Y0;
+    if (flip) {
+        Y0 = -Y0;
+        Y1 = -Y1;
+    }
+    const int64_t dx = X1 - X0;
+    const int64_t dy = Y1 - Y0;
+    const int32_t ia = low_cell(X0, r);
+    const int32_t ib = fdiv(X1, r);
+    if (dx == 0) {
+        const int32_t ja = low_cell(Y0, r);
+        const int32_t jb = fdiv(Y1, r);
+        for (int32_t i = ia; i <= ib; i++) {
+            for (int32_t j = ja; j <= jb; j++) {
+                if (!legal_cell(m, i, flip ? -1 - j : j)) {
+                    return false;
+                }
+            }
+        }
+        return true;
+    }
+    const int64_t rdx = (int64_t)r * dx;
+    const int64_t y0dx = Y0 * dx;
+    int32_t jlo = low_cell(Y0, r);
+    int64_t blo = ((int64_t)jlo + 1) * r * dx;
+    int32_t jhi = jlo;
+    int64_t bhi = blo;
+    int64_t xl = (int64_t)ia * r;
+    for (int32_t i = ia; i <= ib; i++, xl += r) {
+        const int64_t cl = xl < X0 ? X0 : xl;
+        const int64_t cr = xl + r > X1 ? X1 : xl + r;
+        const int64_t nl = y0dx + (cl - X0) * dy;
+        const int64_t nr = y0dx + (cr - X0) * dy;
+        while (blo < nl) {
+            jlo++;
+            blo += rdx;
+        }
+        if (jhi < jlo) {
+            jhi = jlo;
+            bhi = blo;
+        }
+        while (bhi <= nr) {
+            jhi++;
+            bhi += rdx;
+        }
+        for (int32_t j = jlo; j <= jhi; j++) {
+            if (!legal_cell(m, i, flip ? -1 - j : j)) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
 bool rfs_map_segment_legal(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,
                            rfs_q16_t y1)
 {
@@ -344,10 +415,8 @@ bool rfs_map_segment_legal(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q
     if (!rfs_map_cell(m, x0, y0, &cx, &cy) || !rfs_map_cell(m, x1, y1, &cx, &cy)) {
         return false;
     }
-    visitor_t v = {m, 0, VISIT_LEGAL, true, false, 0};
-    traverse(&v, (int64_t)x0 - m->origin_x, (int64_t)y0 - m->origin_y,
-             (int64_t)x1 - m->origin_x, (int64_t)y1 - m->origin_y);
-    return v.legal;
+    return traverse_legal(m, (int64_t)x0 - m->origin_x, (int64_t)y0 - m->origin_y,
+                          (int64_t)x1 - m->origin_x, (int64_t)y1 - m->origin_y);
 }
 
 /* --- lattice step patterns ------------------------------------------------------------ */

@@ -1,5 +1,6 @@
 /* rfs_plan.c - shortest paths on the map lattice: Dial's bucket-queue Dijkstra with
- * octile integer costs (straight 2, diagonal 3), then string pulling (docs/MAPS.md).
+ * octile integer costs (straight 2, diagonal 3), then string pulling linear in the
+ * path's length (docs/MAPS.md, "Planning").
  *
  * The paper's robot used the ROS navigation stack to reach goals that are not in line
  * of sight (section 5.1); the core plans for itself within a microcontroller's RAM.
@@ -11,13 +12,14 @@
  *   bit  4     open (has a tentative cost)
  *   bits 5..6  tentative cost mod 4
  *   bit  7     lattice point known to be illegal
- * A closed point keeps bits 0..3; a search tree marks paths in its bits 4..6.
+ * A closed point keeps bits 0..3.
  * Every tentative cost lies in [d, d + 3] while the bucket of cost d is drained, so the
  * cost mod 4 identifies it exactly and four ring buffers (one per cost mod 4, a quarter
  * of the caller's queue each) are the whole priority queue.
  *
  * A search tree (rfs_plan_tree_begin) keeps that queue in rfs_plan_t between calls and
- * resumes it, so several goals from one start cost one search out to the farthest.
+ * resumes it, so several goals from one start cost one search out to the farthest, and
+ * rfs_plan_tree_grow builds it in slices of a bounded number of points.
  */
 #include "rfs_plan.h"
 
@@ -29,11 +31,6 @@
 #define W_TMOD_SHIFT 5u
 #define W_TMOD 0x60u
 #define W_ILLEGAL 0x80u
-/* Bits 4..6 of a closed point (open and cost are dead once closed; cleared at closing):
- * the search tree's marks of its last pulled path (tree_extract). */
-#define W_PATH 0x10u
-#define W_WAYPT 0x20u
-#define W_NEW 0x40u
 
 static const int8_t DIR_X[8] = {1, 1, 0, -1, -1, -1, 0, 1};
 static const int8_t DIR_Y[8] = {0, 1, 1, 1, 0, -1, -1, -1};
@@ -199,14 +196,21 @@ static bool relax(const rfs_map_t *m, uint8_t *w, bool steps, rings_t *r, uint32
     return true;
 }
 
-/* Continue the Dijkstra in p->dial until `target` is closed (true), or the queue is
- * empty or overflowed (false). It stops as soon as the target is closed, before its
- * neighbours are relaxed (a single search needs no more); they are relaxed first by the
- * next call (dial.pending), so a resumed search closes the points in exactly the order
- * one uninterrupted search would, whatever targets it stopped at. Buckets are drained in
- * cost order; four empty rings in a row are an empty queue (pushes go to d + 2 and
- * d + 3, never to the ring being drained). */
-static bool search_until(rfs_plan_t *p, uint32_t target)
+/* What search_until stopped at. */
+typedef enum search_end {
+    SEARCH_FOUND,    /* the target is closed */
+    SEARCH_EMPTY,    /* the queue is empty (every reachable point closed) or overflowed */
+    SEARCH_BUDGET    /* `budget` points were closed first */
+} search_end_t;
+
+/* Continue the Dijkstra in p->dial until `target` is closed (NO_POINT: none), the queue
+ * is empty or overflowed, or `budget` points have been closed. It stops as soon as a
+ * point is closed, before its neighbours are relaxed; they are relaxed first by the next
+ * call (dial.pending), so a resumed search closes the points in exactly the order one
+ * uninterrupted search would, whatever targets or budgets it stopped at. Buckets are
+ * drained in cost order; four empty rings in a row are an empty queue (pushes go to
+ * d + 2 and d + 3, never to the ring being drained). */
+static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget)
 {
     rings_t r;
     r.q = p->queue;
@@ -218,13 +222,18 @@ static bool search_until(rfs_plan_t *p, uint32_t target)
     uint32_t d = r.st.cost;
     uint32_t u = r.st.pending; /* closed, neighbours not yet relaxed */
     uint32_t empty_run = 0;
-    bool found = false;
+    uint32_t closed = 0;
+    search_end_t end = SEARCH_EMPTY;
     bool ok = !r.st.overflow;
     while (ok) {
         if (u != NO_POINT) {
             ok = relax(m, w, steps, &r, u, d);
             u = NO_POINT;
             continue;
+        }
+        if (closed == budget) {
+            end = SEARCH_BUDGET;
+            break;
         }
         const uint32_t b = d & 3u;
         if (r.st.count[b] == 0) {
@@ -244,63 +253,18 @@ static bool search_until(rfs_plan_t *p, uint32_t target)
         }
         w[v] = (uint8_t)((wv & W_DIR) | W_CLOSED);
         p->expanded++;
+        closed++;
         p->queue_peak = r.st.peak;
+        u = v;
         if (v == target) {
-            found = true;
+            end = SEARCH_FOUND;
             break;
         }
-        u = v;
     }
     r.st.cost = d;
-    r.st.pending = found ? target : NO_POINT;
+    r.st.pending = end == SEARCH_EMPTY ? NO_POINT : u;
     p->dial = r.st;
-    return found;
-}
-
-/* String pulling state: the last emitted waypoint (anchor) and the farthest point seen
- * since that is reachable from it in a straight legal line. */
-typedef struct puller {
-    const rfs_map_t *m;
-    rfs_path_t *out;
-    rfs_q16_t ax, ay;   /* anchor */
-    rfs_q16_t lx, ly;   /* last reachable point */
-    bool has_last;
-    bool full;
-    int64_t len;        /* metres Q16.16, accumulated */
-} puller_t;
-
-static void emit(puller_t *pl, rfs_q16_t x, rfs_q16_t y)
-{
-    if (pl->out->n >= RFS_PLAN_MAX_WAYPOINTS) {
-        pl->full = true;
-        return;
-    }
-    pl->out->x[pl->out->n] = x;
-    pl->out->y[pl->out->n] = y;
-    pl->out->n++;
-    pl->len += rfs_q16_dist(pl->ax, pl->ay, x, y);
-    pl->ax = x;
-    pl->ay = y;
-}
-
-static void pull(puller_t *pl, rfs_q16_t x, rfs_q16_t y)
-{
-    if (rfs_map_segment_legal(pl->m, pl->ax, pl->ay, x, y)) {
-        pl->lx = x;
-        pl->ly = y;
-        pl->has_last = true;
-        return;
-    }
-    if (pl->has_last) {
-        emit(pl, pl->lx, pl->ly);
-    } else {
-        /* First hop out of an illegal start: take it as it is. */
-        emit(pl, x, y);
-        return;
-    }
-    pl->lx = x;
-    pl->ly = y;
-    pl->has_last = true;
+    return end;
 }
 
 void rfs_plan_set_component(rfs_plan_t *p, const uint8_t *bits)
@@ -313,41 +277,160 @@ static bool component_bit(const uint8_t *bits, uint32_t idx)
     return ((bits[idx >> 3] >> (idx & 7u)) & 1u) != 0u;
 }
 
+/* false when no lattice point of the 3 x 3 that connect() joins (x, y) to has component
+ * bit `bit`: a goal there joins the lattice in another component than the start's, so
+ * the plan fails, known before connect()'s nine segment tests (a line search beside a
+ * closed room tries dozens of such goals, docs/PERFORMANCE.md). true without marks. */
+static bool near_component(const rfs_plan_t *p, rfs_q16_t x, rfs_q16_t y, bool bit)
+{
+    if (p->component == 0) {
+        return true;
+    }
+    const rfs_map_t *m = p->map;
+    uint16_t ci;
+    uint16_t cj;
+    rfs_map_lattice_nearest(m, x, y, &ci, &cj);
+    for (int32_t j = (int32_t)cj - 1; j <= (int32_t)cj + 1; j++) {
+        for (int32_t i = (int32_t)ci - 1; i <= (int32_t)ci + 1; i++) {
+            if (i >= 0 && j >= 0 && i < (int32_t)m->lw && j < (int32_t)m->lh &&
+                component_bit(p->component, (uint32_t)j * m->lw + (uint32_t)i) == bit) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
 /* The lattice point one step from u in direction k. */
 static uint32_t step_from(uint32_t u, uint32_t k, uint32_t lw)
 {
     return (uint32_t)((int32_t)(u / lw) + DIR_Y[k]) * lw + (uint32_t)((int32_t)(u % lw) + DIR_X[k]);
 }
 
-static void pull_point(puller_t *pl, uint32_t u, uint32_t lw)
+static void point_of(const rfs_map_t *m, uint32_t u, rfs_q16_t *x, rfs_q16_t *y)
 {
-    rfs_q16_t ux;
-    rfs_q16_t uy;
-    rfs_map_lattice_point(pl->m, (uint16_t)(u % lw), (uint16_t)(u / lw), &ux, &uy);
-    pull(pl, ux, uy);
+    rfs_map_lattice_point(m, (uint16_t)(u % m->lw), (uint16_t)(u / m->lw), x, y);
 }
 
-/* The goal's join point, the last waypoint and the length: the end every plan shares. */
-static bool finish(puller_t *pl, rfs_q16_t x1, rfs_q16_t y1, bool lost)
+/* String pulling, linear in the path's length (docs/MAPS.md, "Planning").
+ *
+ * The path is the sequence P_0 .. P_n: the lattice points from the start's join point
+ * (walked by the work bytes' direction bits, which lead towards the goal) and last the
+ * goal itself. From each waypoint (the anchor; first the start) the next one is found
+ * by galloping: P at anchor + 2, + 4, + 8 ... points is tested by a straight legal
+ * segment from the anchor until a test fails or the goal is reached; between the last
+ * point that passed and the one that failed, PULL_REFINE halvings narrow the cut; the
+ * last point that passed is the waypoint. The tests of one waypoint cover at most
+ * (4 + 2 PULL_REFINE) times the points it advances, so a path of n points costs
+ * O(n) cells of segment traversal (testing every point from the anchor, as a greedy
+ * puller does, costs O(n^2): 5 M instructions on the Cortex-M4 round a 35 m wall).
+ * Every waypoint is reached from the one before by a tested segment, and adjacent path
+ * points by a lattice edge, so the path is legal; it is never longer than the lattice
+ * path. A start in the clearance zone (joined without a segment test) takes its first
+ * hop to P_0 as it is. */
+#define PULL_REFINE 3u
+
+/* The path's points by index: a cursor walked forwards from the anchor's point. */
+typedef struct pull_path {
+    const rfs_map_t *m;
+    const uint8_t *w;
+    uint32_t n;            /* index of the goal: lattice points are 0 .. n - 1 */
+    rfs_q16_t gx, gy;      /* the goal */
+    uint32_t ak, au;       /* the anchor's index and lattice point (au: when ak < n) */
+    uint32_t ck, cu;       /* a cursor at or after the anchor */
+    uint32_t spanned;      /* points the segment tests spanned, summed */
+} pull_path_t;
+
+static void pull_at(pull_path_t *pp, uint32_t k, rfs_q16_t *x, rfs_q16_t *y);
+
+/* A straight legal segment from the anchor (ax, ay) at index a (+ 1) to point t (+ 1). */
+static bool pull_test(pull_path_t *pp, rfs_q16_t ax, rfs_q16_t ay, uint32_t a, uint32_t t,
+                      rfs_q16_t *x, rfs_q16_t *y)
 {
-    pull(pl, x1, y1);
-    emit(pl, pl->lx, pl->ly);
-    if (pl->full || lost) {
-        pl->out->n = 0;
-        return false;
+    pull_at(pp, t - 1u, x, y);
+    pp->spanned += t - a;
+    return rfs_map_segment_legal(pp->m, ax, ay, *x, *y);
+}
+
+/* Position of point k (>= the anchor's index), by walking from the cursor or the anchor. */
+static void pull_at(pull_path_t *pp, uint32_t k, rfs_q16_t *x, rfs_q16_t *y)
+{
+    if (k >= pp->n) {
+        *x = pp->gx;
+        *y = pp->gy;
+        return;
     }
-    pl->out->length = pl->len > INT32_MAX ? INT32_MAX : (rfs_q16_t)pl->len;
-    return true;
+    if (k < pp->ck) {
+        pp->ck = pp->ak;
+        pp->cu = pp->au;
+    }
+    const uint32_t lw = pp->m->lw;
+    while (pp->ck < k) {
+        pp->cu = step_from(pp->cu, pp->w[pp->cu] & W_DIR, lw);
+        pp->ck++;
+    }
+    point_of(pp->m, pp->cu, x, y);
 }
 
-static void puller_start(puller_t *pl, const rfs_map_t *m, rfs_path_t *out, rfs_q16_t x0,
-                         rfs_q16_t y0)
+/* Pull the path of n lattice points from s_idx (then the goal (x1, y1)) as seen from
+ * (x0, y0) into out; *spanned: the points its segment tests spanned. false when it needs
+ * more than RFS_PLAN_MAX_WAYPOINTS waypoints. Indices below count from 1 (0: the start). */
+static bool pull_path(const rfs_map_t *m, const uint8_t *w, uint32_t s_idx, uint32_t n,
+                      rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out,
+                      uint32_t *spanned)
 {
-    memset(pl, 0, sizeof(*pl));
-    pl->m = m;
-    pl->out = out;
-    pl->ax = x0;
-    pl->ay = y0;
+    pull_path_t pp = {m, w, n, x1, y1, 0, s_idx, 0, s_idx, 0};
+    int64_t len = 0;
+    rfs_q16_t ax = x0, ay = y0; /* the anchor */
+    rfs_q16_t px, py;
+    uint32_t a = 0;             /* the anchor's index */
+    bool ok = true;
+    out->n = 0;
+    for (;;) {
+        uint32_t good = a + 1u; /* the farthest point known reachable: the next one */
+        if (a == 0 && !pull_test(&pp, ax, ay, 0, 1, &px, &py)) {
+            goto emit;          /* out of the clearance zone: the first hop as it is */
+        }
+        uint32_t bad = 0;
+        for (uint32_t h = 2; good <= n; h *= 2u) {
+            const uint32_t t = h > n + 1u - a ? n + 1u : a + h;
+            if (!pull_test(&pp, ax, ay, a, t, &px, &py)) {
+                bad = t;
+                break;
+            }
+            good = t;
+        }
+        for (uint32_t r = 0; bad != 0 && r < PULL_REFINE && bad - good > 1u; r++) {
+            const uint32_t mid = good + (bad - good) / 2u;
+            if (pull_test(&pp, ax, ay, a, mid, &px, &py)) {
+                good = mid;
+            } else {
+                bad = mid;
+            }
+        }
+        pull_at(&pp, good - 1u, &px, &py);
+    emit:
+        if (out->n >= RFS_PLAN_MAX_WAYPOINTS) {
+            out->n = 0;
+            ok = false;
+            break;
+        }
+        out->x[out->n] = px;
+        out->y[out->n] = py;
+        out->n++;
+        len += rfs_q16_dist(ax, ay, px, py);
+        ax = px;
+        ay = py;
+        if (good == n + 1u) {
+            out->length = len > INT32_MAX ? INT32_MAX : (rfs_q16_t)len;
+            break;
+        }
+        pp.ak = pp.ck; /* the cursor is on the new anchor, point good */
+        pp.au = pp.cu;
+        a = good;
+    }
+    *spanned = pp.spanned;
+    return ok;
 }
 
 /* The cases every plan settles before a search: -1 an illegal goal (no path), 1 a
@@ -371,6 +454,23 @@ static int settle(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,
     return 0;
 }
 
+/* Lattice points from u to g_idx along the direction bits, both counted; 0 when the
+ * walk does not reach g_idx within the lattice's points (cannot happen: a closed
+ * point's bits lead to the search's root). */
+static uint32_t path_points(const rfs_plan_t *p, uint32_t u, uint32_t g_idx)
+{
+    const uint32_t lw = p->map->lw;
+    const uint32_t n = lw * p->map->lh;
+    uint32_t k = 1;
+    while (u != g_idx) {
+        if (k++ > n) {
+            return 0;
+        }
+        u = step_from(u, p->work[u] & W_DIR, lw);
+    }
+    return k;
+}
+
 bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1,
                    rfs_path_t *out)
 {
@@ -378,6 +478,7 @@ bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_
     out->n = 0;
     out->length = 0;
     p->expanded = 0;
+    p->pulled = 0;
     p->queue_peak = 0;
     p->tree = 0; /* the work memory is about to be reused */
     const int settled = settle(m, x0, y0, x1, y1, out);
@@ -386,7 +487,9 @@ bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_
     }
     uint32_t s_idx;
     uint32_t g_idx;
-    if (!connect(m, x1, y1, false, &g_idx) || !connect(m, x0, y0, true, &s_idx)) {
+    if (!connect(m, x0, y0, true, &s_idx) ||
+        !near_component(p, x1, y1, p->component != 0 && component_bit(p->component, s_idx)) ||
+        !connect(m, x1, y1, false, &g_idx)) {
         return false;
     }
     if (p->component != 0 &&
@@ -396,23 +499,11 @@ bool rfs_plan_path(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_
     /* From the goal outward: the back-pointers then lead from the start to the goal,
      * the order string pulling needs. */
     seed(p, g_idx);
-    if (!search_until(p, s_idx)) {
+    if (search_until(p, s_idx, UINT32_MAX) != SEARCH_FOUND) {
         return false;
     }
-    puller_t pl;
-    puller_start(&pl, m, out, x0, y0);
-    const uint32_t lw = m->lw;
-    const uint32_t n = lw * m->lh;
-    uint32_t u = s_idx;
-    uint32_t steps = 0;
-    for (;;) {
-        pull_point(&pl, u, lw);
-        if (u == g_idx || pl.full || ++steps > n) {
-            break;
-        }
-        u = step_from(u, p->work[u] & W_DIR, lw);
-    }
-    return finish(&pl, x1, y1, steps > n);
+    const uint32_t n = path_points(p, s_idx, g_idx);
+    return n != 0 && pull_path(m, p->work, s_idx, n, x0, y0, x1, y1, out, &p->pulled);
 }
 
 void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0)
@@ -420,6 +511,8 @@ void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0)
     p->tree_x = x0;
     p->tree_y = y0;
     p->tree = 1;
+    p->tree_done = false;
+    p->tree_sliced = false;
 }
 
 static void set_dir(uint8_t *w, uint32_t u, uint32_t k)
@@ -427,28 +520,13 @@ static void set_dir(uint8_t *w, uint32_t u, uint32_t k)
     w[u] = (uint8_t)((w[u] & (uint8_t)~W_DIR) | k);
 }
 
-static void point_of(const rfs_map_t *m, uint32_t u, rfs_q16_t *x, rfs_q16_t *y)
-{
-    rfs_map_lattice_point(m, (uint16_t)(u % m->lw), (uint16_t)(u / m->lw), x, y);
-}
-
 /* The path from the tree's root to the closed point g_idx, pulled, into out.
  *
  * The back-pointers lead from the goal to the root. Turn those of the path round (each
  * point then points at its successor towards the goal), pull the path from the root
- * forwards as rfs_plan_path does, and turn them back on the way, so the tree is
- * unchanged for the next goal: no memory beyond the work byte.
- *
- * Paths to several goals share the path from the root to where they part, and string
- * pulling is greedy: its state after a point (waypoints so far, the anchor, that point
- * as the last one seen) depends on the path up to that point only. So the last pulled
- * path stays marked in the work bytes of its points (W_PATH), with W_WAYPT on each point
- * it emitted as a waypoint while pulling the path's next point; the next path takes the
- * shared part's waypoints from the marks and pulls only from where the paths part, with
- * the same results (the same emit() calls in the same order). Not when the root is
- * illegal (its first hop is taken unpulled), nor after a path overflowed the waypoints.
- * The walks are bounded by the points (a closed point's pointers always reach the
- * root). */
+ * forwards as rfs_plan_path does, and turn them back, so the tree is unchanged for the
+ * next goal: no memory beyond the work byte. The walks are bounded by the points (a
+ * closed point's pointers always reach the root). */
 static bool tree_extract(rfs_plan_t *p, uint32_t g_idx, rfs_q16_t x1, rfs_q16_t y1,
                          rfs_path_t *out)
 {
@@ -459,129 +537,173 @@ static bool tree_extract(rfs_plan_t *p, uint32_t g_idx, rfs_q16_t x1, rfs_q16_t 
     const uint32_t n = lw * m->lh;
     uint32_t u = g_idx;
     uint32_t k = w[u] & W_DIR; /* from u to its parent */
-    uint32_t steps = 0;
-    w[u] = (uint8_t)(w[u] | W_NEW);
-    while (u != root && steps++ <= n) {
+    uint32_t pts = 1;
+    while (u != root && pts <= n) {
         uint32_t v = step_from(u, k, lw);
         uint32_t kv = w[v] & W_DIR;
         set_dir(w, v, (k + 4u) & 7u); /* v now points at its child u */
-        w[v] = (uint8_t)(w[v] | W_NEW);
         u = v;
         k = kv;
+        pts++;
     }
     if (u != root) {
         return false; /* unreachable: a closed point's pointers lead to the root */
     }
-    /* Unmark the last path where it is not this one's (its pointers there are intact;
-     * from the first point on this path up, both paths are one). */
-    for (u = p->tree_last, steps = 0; u != NO_POINT && !(w[u] & W_NEW) && steps++ <= n;) {
-        w[u] = (uint8_t)(w[u] & (uint8_t)~(W_PATH | W_WAYPT));
-        u = step_from(u, w[u] & W_DIR, lw);
-    }
-    const bool marks = p->tree_marks;
-    puller_t pl;
-    puller_start(&pl, m, out, p->tree_x, p->tree_y);
+    const bool ok = pull_path(m, w, root, pts, p->tree_x, p->tree_y, x1, y1, out, &p->pulled);
+    /* Turn the pointers back: each point's parent is the one before it. */
     uint32_t back = k; /* the root's own direction bits, restored as they were */
-    uint32_t prev = NO_POINT;
-    bool shared = marks;
-    u = root;
-    for (;;) {
-        uint32_t wu = w[u];
-        const uint32_t fwd = wu & W_DIR;
-        const uint32_t next = u == g_idx ? NO_POINT : step_from(u, fwd, lw);
-        if (shared && (wu & W_PATH)) {
-            rfs_q16_t ux;
-            rfs_q16_t uy;
-            point_of(m, u, &ux, &uy);
-            if (next != NO_POINT && (w[next] & W_PATH)) {
-                if (wu & W_WAYPT) {
-                    emit(&pl, ux, uy); /* as pulling `next` did for the last path */
-                }
-            } else {
-                /* Where the paths part: this point was the last one seen. */
-                pl.lx = ux;
-                pl.ly = uy;
-                pl.has_last = true;
-                wu &= ~W_WAYPT;
-                shared = false;
-            }
-        } else {
-            shared = false;
-            const uint16_t before = out->n;
-            if (!pl.full) {
-                pull_point(&pl, u, lw);
-            }
-            if (marks && out->n != before && prev != NO_POINT) {
-                w[prev] = (uint8_t)(w[prev] | W_WAYPT); /* prev emitted while pulling u */
-            }
-            wu = marks ? ((wu & ~W_WAYPT) | W_PATH) : wu;
-        }
-        wu &= ~W_NEW;
-        if (u == g_idx) {
-            w[u] = (uint8_t)wu;
-            break;
-        }
-        w[u] = (uint8_t)((wu & ~W_DIR) | back);
+    for (u = root; u != g_idx;) {
+        const uint32_t fwd = w[u] & W_DIR;
+        set_dir(w, u, back);
         back = (fwd + 4u) & 7u;
-        prev = u;
-        u = next;
+        u = step_from(u, fwd, lw);
     }
-    p->tree_last = marks ? g_idx : NO_POINT;
-    if (pl.full && marks) {
-        /* Waypoints overflowed: the marks may be incomplete; drop them. */
-        for (u = g_idx, steps = 0; steps++ <= n; u = step_from(u, w[u] & W_DIR, lw)) {
-            w[u] = (uint8_t)(w[u] & (uint8_t)~(W_PATH | W_WAYPT));
-            if (u == root) {
-                break;
-            }
-        }
-        p->tree_last = NO_POINT;
-        p->tree_marks = false;
-    }
-    return finish(&pl, x1, y1, false);
+    set_dir(w, g_idx, back);
+    return ok;
 }
 
-bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out)
+/* Seed the begun tree at its root's join point: state 2, or 3 when it joins none. */
+static void tree_seed(rfs_plan_t *p)
 {
-    const rfs_map_t *m = p->map;
-    const rfs_q16_t x0 = p->tree_x;
-    const rfs_q16_t y0 = p->tree_y;
-    out->n = 0;
-    out->length = 0;
+    if (p->tree != 1) {
+        return;
+    }
+    if (!connect(p->map, p->tree_x, p->tree_y, true, &p->tree_root)) {
+        p->tree = 3;
+        return;
+    }
+    p->queue_peak = 0;
+    seed(p, p->tree_root);
+    p->tree = 2;
+}
+
+bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget)
+{
     p->expanded = 0;
     if (p->tree == 0) {
         return false;
     }
-    const int settled = settle(m, x0, y0, x1, y1, out);
-    if (settled != 0) {
-        return settled > 0;
+    tree_seed(p);
+    p->tree_sliced = true;
+    if (p->tree == 2 && !p->tree_done) {
+        p->tree_done = search_until(p, NO_POINT, budget) == SEARCH_EMPTY;
     }
-    uint32_t g_idx;
-    if (!connect(m, x1, y1, false, &g_idx)) {
-        return false;
-    }
-    if (p->tree == 1) {
-        if (!connect(m, x0, y0, true, &p->tree_root)) {
-            p->tree = 3;
-            return false;
-        }
-        p->queue_peak = 0;
-        seed(p, p->tree_root);
-        p->tree = 2;
-        p->tree_last = NO_POINT;
-        p->tree_marks = rfs_map_point_legal(m, x0, y0);
-    }
+    return p->tree != 2 || p->tree_done;
+}
+
+bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0)
+{
     if (p->tree != 2) {
-        return false; /* the root joins no lattice point */
-    }
-    const uint32_t root = p->tree_root;
-    if (p->component != 0 &&
-        component_bit(p->component, root) != component_bit(p->component, g_idx)) {
-        return false; /* different components: the search cannot succeed */
-    }
-    uint8_t *w = p->work;
-    if (!(w[g_idx] & W_CLOSED) && !search_until(p, g_idx)) {
         return false;
     }
-    return tree_extract(p, g_idx, x1, y1, out);
+    uint32_t idx;
+    bool ok = connect(p->map, x0, y0, true, &idx) && idx == p->tree_root;
+    if (!ok && rfs_map_point_legal(p->map, x0, y0)) {
+        /* Another join point of the start's 3 x 3: the root, when a legal segment
+         * reaches it, serves as well (a robot stopped within the goal tolerance). */
+        uint16_t ci;
+        uint16_t cj;
+        rfs_map_lattice_nearest(p->map, x0, y0, &ci, &cj);
+        const int32_t di = (int32_t)(p->tree_root % p->map->lw) - ci;
+        const int32_t dj = (int32_t)(p->tree_root / p->map->lw) - cj;
+        rfs_q16_t rx;
+        rfs_q16_t ry;
+        point_of(p->map, p->tree_root, &rx, &ry);
+        ok = di >= -1 && di <= 1 && dj >= -1 && dj <= 1 &&
+             rfs_map_segment_legal(p->map, x0, y0, rx, ry);
+    }
+    if (ok) {
+        p->tree_x = x0;
+        p->tree_y = y0;
+    }
+    return ok;
+}
+
+/* The goal (x1, y1) on the tree: -1 no path (illegal, unreachable, not closed yet on a
+ * sliced tree: tree_more), 1 in line of sight from the root's position, 0 its lattice
+ * point *g_idx closed (searched for on a tree that is not sliced). */
+static int tree_goal(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, uint32_t *g_idx)
+{
+    const rfs_map_t *m = p->map;
+    p->expanded = 0;
+    p->pulled = 0;
+    if (p->tree == 0 || !rfs_map_point_legal(m, x1, y1)) {
+        return -1;
+    }
+    if (rfs_map_segment_legal(m, p->tree_x, p->tree_y, x1, y1)) {
+        return 1;
+    }
+    tree_seed(p);
+    if (p->tree != 2) {
+        return -1; /* the root joins no lattice point */
+    }
+    if (!near_component(p, x1, y1, p->component != 0 && component_bit(p->component, p->tree_root)) ||
+        !connect(m, x1, y1, false, g_idx)) {
+        return -1;
+    }
+    if (p->component != 0 &&
+        component_bit(p->component, p->tree_root) != component_bit(p->component, *g_idx)) {
+        return -1; /* different components: the search cannot succeed */
+    }
+    if (!(p->work[*g_idx] & W_CLOSED)) {
+        if (p->tree_sliced) {
+            p->tree_more = p->tree_more || !p->tree_done;
+            return -1;
+        }
+        if (p->tree_done || search_until(p, *g_idx, UINT32_MAX) != SEARCH_FOUND) {
+            return -1;
+        }
+    }
+    return 0;
+}
+
+bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out)
+{
+    out->n = 0;
+    out->length = 0;
+    out->x0 = p->tree_x;
+    out->y0 = p->tree_y;
+    out->has_start = true;
+    uint32_t g_idx = 0;
+    const int at = tree_goal(p, x1, y1, &g_idx);
+    if (at > 0) {
+        out->x[0] = x1;
+        out->y[0] = y1;
+        out->n = 1;
+        out->length = rfs_q16_dist(p->tree_x, p->tree_y, x1, y1);
+    }
+    return at == 0 ? tree_extract(p, g_idx, x1, y1, out) : at > 0;
+}
+
+bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *len)
+{
+    const rfs_map_t *m = p->map;
+    uint32_t g_idx = 0;
+    const int at = tree_goal(p, x1, y1, &g_idx);
+    if (at != 0) {
+        *len = at > 0 ? rfs_q16_dist(p->tree_x, p->tree_y, x1, y1) : 0;
+        return at > 0;
+    }
+    /* Scaling and overflow: at most lw * lh < 2^32 steps of grid < 2^31 (Q16) each, the
+     * sums in uint64; sqrt 2 in Q16 (92682) times that stays below 2^64 for any lattice
+     * whose path saturates the result (32 km) long before. */
+    uint64_t straight = 0;
+    uint64_t diagonal = 0;
+    const uint32_t n = (uint32_t)m->lw * m->lh;
+    uint32_t u = g_idx;
+    for (uint32_t k = 0; u != p->tree_root && k <= n; k++) {
+        const uint32_t dir = p->work[u] & W_DIR;
+        straight += (dir & 1u) == 0u;
+        diagonal += dir & 1u;
+        u = step_from(u, dir, m->lw);
+    }
+    rfs_q16_t rx, ry, gx, gy;
+    point_of(m, p->tree_root, &rx, &ry);
+    point_of(m, g_idx, &gx, &gy);
+    const uint64_t g = (uint64_t)m->cfg.grid;
+    uint64_t l = (uint64_t)rfs_q16_dist(p->tree_x, p->tree_y, rx, ry) +
+                 (uint64_t)rfs_q16_dist(gx, gy, x1, y1) + straight * g +
+                 ((diagonal * g * 92682u) >> 16);
+    *len = l > (uint64_t)INT32_MAX ? INT32_MAX : (rfs_q16_t)l;
+    return u == p->tree_root;
 }

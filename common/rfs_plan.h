@@ -10,9 +10,10 @@
  * start and the goal join the lattice through the closest legal lattice point of their
  * 3 x 3 neighbourhood that a legal segment reaches (a start inside the clearance zone:
  * the closest legal one of its 5 x 5, unchecked, so the robot can get out). The lattice
- * path is then shortened by string pulling: from each kept waypoint, the farthest later
- * point of the path still reachable by a legal straight segment. A goal in line of
- * sight gives a one-waypoint path without search. Work memory is caller-owned: one byte
+ * path is then shortened by string pulling, linear in its length: from each kept
+ * waypoint, a later point of the path reachable by a legal straight segment, found by
+ * galloping tests (2, 4, 8 ... points on) and three halvings. A goal in line of sight
+ * gives a one-waypoint path without search. Work memory is caller-owned: one byte
  * per lattice point and the queue (docs/MAPS.md).
  */
 #ifndef RFS_PLAN_H
@@ -46,6 +47,8 @@ typedef struct rfs_plan {
     uint32_t *queue;        ///< wavefront queue of lattice indices
     uint32_t queue_cap;     ///< its capacity, split in four quarters (2 * (lw + lh) ample: docs/MAPS.md)
     uint32_t expanded;      ///< lattice points expanded by the last call (for benchmarks)
+    uint32_t pulled;        ///< path points the last search path's string pulling tested
+                            ///< segments across, summed: at most 10 per point of the path
     uint32_t queue_peak;    ///< most entries one of the four queue quarters held in the
                             ///< last search (a tree: since it was seeded)
     bool exact_edges;       ///< false (init): lattice points and edges from the map's
@@ -59,10 +62,12 @@ typedef struct rfs_plan {
     rfs_q16_t tree_x;       ///< search tree's root (rfs_plan_tree_begin), metres Q16.16
     rfs_q16_t tree_y;       ///< metres Q16.16
     uint32_t tree_root;     ///< its lattice point (idx = j * lw + i) once seeded
-    uint32_t tree_last;     ///< goal point of the path marked in the work bytes, or UINT32_MAX
     uint8_t tree;           ///< tree state: 0 none (init, rfs_plan_path), 1 begun,
                             ///< 2 seeded (work holds it), 3 root joins no lattice point
-    bool tree_marks;        ///< the tree keeps its last path marked (legal root)
+    bool tree_done;         ///< the tree's search has closed every point it reaches
+    bool tree_sliced;       ///< grown by rfs_plan_tree_grow: plans do not search
+    bool tree_more;         ///< set (never cleared here) when a plan on a sliced tree asked
+                            ///< for a point it has not closed yet: grow it, ask again
 } rfs_plan_t;
 
 /// A planned path: waypoints in order, the last one the goal itself.
@@ -96,11 +101,37 @@ void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0);
 /// Plan from the tree's root to the legal point (x1, y1): rfs_plan_path's contract and
 /// result cases, but the tree's Dijkstra (from the root) is continued only until the
 /// goal's lattice point is closed, and a goal closed by an earlier call needs no search.
-/// The lattice path may differ from rfs_plan_path's among equal-cost ones (ties); the
-/// waypoints are string pulled from the root forwards, as rfs_plan_path does. A path
-/// depends only on the root and the goal, not on the goals asked before. false, out->n
-/// 0, also when no tree was begun or an rfs_plan_path call ended it.
+/// A tree grown by rfs_plan_tree_grow is never searched here: a goal it has not closed
+/// fails, and sets tree_more unless the tree is done (then it is unreachable). The
+/// lattice path may differ from rfs_plan_path's among equal-cost ones (ties); the
+/// waypoints are string pulled from the root forwards, as rfs_plan_path does. A path depends only on the root and the goal, not on the goals asked before
+/// nor on how the search was sliced. false, out->n 0, also when no tree was begun or an
+/// rfs_plan_path call ended it.
 bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out);
+
+/// The length of the path from the tree's root to the legal point (x1, y1) before string
+/// pulling, metres Q16.16 (saturated): the root's position to its lattice point, the
+/// lattice path (straight steps grid, diagonal ones grid sqrt 2), the goal's lattice
+/// point to the goal; the straight distance in line of sight. At least the pulled
+/// path's length; its lattice part at most 6.1 % above the shortest lattice path (octile
+/// costs 1.5 for sqrt 2); a walk, no pull.
+/// rfs_plan_tree_path's result cases (false, *len 0, when it would fail).
+bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *len);
+
+/// Continue the begun tree's search by at most `budget` closed lattice points (a
+/// control period's slice; the first call also clears the work, lw * lh bytes). true
+/// when it is done: every point the root reaches is closed (then each rfs_plan_tree_path
+/// is a walk along the back-pointers and a pull), or the root joins no lattice point, or
+/// the queue overflowed (plans to points not closed fail); false while more is left, or
+/// when no tree was begun.
+bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget);
+
+/// Let a seeded tree (rooted at a lattice point) serve plans from (x0, y0), e.g. a
+/// robot stopped near the point the tree was begun at: true, and later paths start at
+/// (x0, y0), when it joins the lattice at the tree's root, or it is legal and the root
+/// is one of the 3 x 3 lattice points round it and a legal segment reaches it; false
+/// (the tree unchanged) otherwise.
+bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0);
 
 /// Tell the planner which lattice points are known to be connected: `bits` (NULL: none)
 /// holds one bit per lattice point and must be a union of whole components of the lattice

@@ -31,6 +31,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.pose_timeout_us = 150000;             /* + one 50 ms period: stopped within 200 ms */
     c.rssi_timeout_us = 150000;
     c.fit_budget = 0;
+    c.plan_budget = RFS_SEEK_PLAN_BUDGET;   /* how the paths are computed, not which */
     c.rssi = rfs_rssi_cfg_default();
     c.store = rfs_store_cfg_default();      /* 10,000 samples (section 5.2) */
     c.drive = rfs_drive_cfg_default();
@@ -268,6 +269,10 @@ bool rfs_seek_plan_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, bool tree)
     }
     /* Plan straight into the drive's own path: a 532-byte rfs_path_t on the stack would
      * overflow the microcontroller's 2.5 KB stack during a decision. */
+    if (s->plan_ready && s->plan.tree_more) {
+        return false; /* the decision is made again when the tree has grown */
+    }
+    tree = tree || s->plan_ready; /* plan_budget: the decision's tree serves */
     if (tree ? !rfs_plan_tree_path(&s->plan, gx, gy, &s->drive.path)
              : !rfs_plan_path(&s->plan, sx, sy, gx, gy, &s->drive.path)) {
         return false;
@@ -344,6 +349,39 @@ static bool recheck_fails(rfs_seek_t *s, int64_t now_us)
     return rfs_seek_recheck_miss(&s->cfg, &s->miss_ms, rfs_q16_abs(rfs_q16_sub(mean, pred)));
 }
 
+/* plan_budget: begin the search tree of the next decision where it will be made, to be
+ * grown while the leg is driven (drive_on, hold_still): the leg's end, or on a leg
+ * checked every recheck_dist (a greedy or sampled leg with recheck_dist) the next check
+ * point, recheck_dist further along the path from the robot, where a failed check
+ * decides anew (drive_on begins it again after each check that passes). Scaling: as
+ * rfs_seek_meta.c's greedy_along_path, offsets (< 2^32, Q16) times a length (< 2^16 m)
+ * in int64. */
+static void begin_next_tree(rfs_seek_t *s)
+{
+    const rfs_path_t *p = &s->drive.path;
+    if (s->cfg.plan_budget == 0u || p->n == 0u) {
+        return;
+    }
+    rfs_q16_t x = p->x[p->n - 1u], y = p->y[p->n - 1u];
+    if (s->cfg.recheck_dist > 0 &&
+        (s->decision.kind == RFS_SEEK_GREEDY || s->decision.sampled)) {
+        int64_t left = s->cfg.recheck_dist;
+        rfs_q16_t px = s->pose.x, py = s->pose.y;
+        for (uint16_t k = s->drive.next; k < p->n; ++k) {
+            const int64_t len = rfs_q16_dist(px, py, p->x[k], p->y[k]);
+            if (len >= left && len > 0) {
+                x = rfs_sat32(px + rfs_sdiv64_round(((int64_t)p->x[k] - px) * left, len));
+                y = rfs_sat32(py + rfs_sdiv64_round(((int64_t)p->y[k] - py) * left, len));
+                break;
+            }
+            left -= len;
+            px = p->x[k];
+            py = p->y[k];
+        }
+    }
+    rfs_plan_tree_begin(&s->plan, x, y);
+}
+
 /* Count the decision, report it, and start driving (or flag that there is no goal). */
 static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t *out)
 {
@@ -364,6 +402,7 @@ static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t 
         return;
     }
     s->state = RFS_SEEK_DRIVING;
+    begin_next_tree(s);
     rfs_drive_status_t st = rfs_drive_update(&s->drive, &s->pose, now_us, &out->left_mm_s,
                                              &out->right_mm_s);
     if (st != RFS_DRIVE_RUNNING) {
@@ -380,13 +419,63 @@ static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t 
     }
 }
 
+/* plan_budget (docs/PERFORMANCE.md, "Planning in slices"): every plan of a decision
+ * walks one search tree from the robot, grown plan_budget points a period, never
+ * searched within the decision. The tree grown on the leg from its goal serves when the
+ * robot stopped there (rfs_plan_tree_move); otherwise (a leg cut short, the first
+ * decision) one is begun at the robot. Start the decision's use of it; false when the
+ * robot has no legal start (every plan then fails at once, as without a tree). */
+static bool plan_begin(rfs_seek_t *s)
+{
+    rfs_q16_t sx, sy;
+    if (!rfs_seek_plan_start(s, &sx, &sy)) {
+        return false;
+    }
+    if (!rfs_plan_tree_move(&s->plan, sx, sy)) {
+        rfs_plan_tree_begin(&s->plan, sx, sy);
+    }
+    return true;
+}
+
+/* plan_budget: the decision is not made in this period; the wheels stay stopped. */
+static void plan_wait(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
+{
+    s->plan_wait = s->plan_wait < UINT16_MAX ? (uint16_t)(s->plan_wait + 1u) : UINT16_MAX;
+    s->state = RFS_SEEK_LEARNING;
+    stop_wheels(s, now_us, out);
+}
+
 /* Finish the decision after a (possibly sliced) fit: the initial move (Algorithm 1's
- * first line), then the strategy's choice. */
-static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
+ * first line), then the strategy's choice. With plan_budget a period either chooses or
+ * grows the tree, not both at full cost: `whole_fit` (this period relearnt in one go)
+ * leaves the choice to the next period; when a plan asked for a point the tree had not
+ * closed yet (plan.tree_more), the choice is dropped, the tree grows by one slice, and
+ * the choice is made again in the next period, the wheels stopped meanwhile: the
+ * bounded wait of a leg cut short (docs/PERFORMANCE.md, "Planning in slices"). */
+static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out,
+                            bool whole_fit)
 {
     rfs_seek_decision_t *d = &s->decision;
+    const bool replan = s->replan; /* the choice clears it */
     bool ok = false;
-    if (d->iteration == 0u) {
+    if (s->cfg.plan_budget != 0u) {
+        if (!s->planning) {
+            s->planning = true;
+            s->plan_wait = 0;
+            s->plan_ready = plan_begin(s);
+        }
+        if (whole_fit && s->plan_ready) {
+            plan_wait(s, now_us, out);
+            return;
+        }
+        (void)rfs_plan_tree_grow(&s->plan, 0u); /* seeded, marked sliced */
+        s->plan.tree_more = false;
+        d->line_search = false; /* flags a dropped choice may have set */
+        d->sampled = false;
+    }
+    if (!rfs_seek_ops(s)->learns) {
+        ok = rfs_seek_ops(s)->choose(s, false, rng, now_us);
+    } else if (d->iteration == 0u) {
         d->kind = RFS_SEEK_INITIAL;
         ok = rfs_seek_meta_initial(s, rng, now_us);
     } else {
@@ -398,6 +487,15 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
         }
         ok = rfs_seek_ops(s)->choose(s, model_ok, rng, now_us);
     }
+    if (s->planning && s->plan_ready && s->plan.tree_more) {
+        s->replan = replan;
+        (void)rfs_plan_tree_grow(&s->plan, s->cfg.plan_budget);
+        plan_wait(s, now_us, out);
+        return;
+    }
+    s->planning = false;
+    s->plan_ready = false;
+    d->plan_wait = s->plan_wait;
     end_decision(s, ok, now_us, out);
 }
 
@@ -439,7 +537,7 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     count_travel(s);
     d->mean_valid = rfs_seek_src_mean(s, now_us, &d->mean);
     if (!ops->learns) {
-        end_decision(s, ops->choose(s, false, rng, now_us), now_us, out);
+        finish_decision(s, now_us, rng, out, false);
         return;
     }
     /* "if |mean RSSI over last second - model prediction| > threshold: discard current
@@ -449,17 +547,20 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     if (d->model_valid && d->mean_valid) {
         relearn = rfs_q16_abs(rfs_q16_sub(d->mean, d->prediction)) > s->cfg.error_threshold;
     }
-    relearn = relearn || ops->refit;
+    /* A leg abandoned by a failed recheck relearns (the check failed on this model), even
+     * when the mean has moved back within the threshold while the base braked. */
+    relearn = relearn || ops->refit || s->replan;
 
     if (relearn && s->store.count > 0u) {
         d->relearned = true;
         s->model.ops->reset(s->model.self);
         s->fitting = true;
     }
+    const bool whole_fit = s->fitting && s->cfg.fit_budget == 0u;
     if (s->fitting && !fit_slice(s, now_us, rng, out)) {
         return;
     }
-    finish_decision(s, now_us, rng, out);
+    finish_decision(s, now_us, rng, out, whole_fit);
 }
 
 /* |a - b| > limit, without signed overflow at extreme timestamps. */
@@ -538,6 +639,10 @@ static void keep_reach(rfs_seek_t *s)
     if (!s->reach_valid || !rfs_reach_snap(s->map, s->reach, s->pose.x, s->pose.y, &si, &sj)) {
         s->reach_valid = rfs_reach_fill(s->map, s->pose.x, s->pose.y, s->reach, s->queue,
                                         s->queue_cap);
+        if (s->plan.tree != 0u) {
+            /* The fill used the planner's queue: a tree being grown starts again. */
+            rfs_plan_tree_begin(&s->plan, s->plan.tree_x, s->plan.tree_y);
+        }
     }
 }
 
@@ -554,10 +659,19 @@ static void resume_goal(rfs_seek_t *s, int64_t now_us)
     s->state = RFS_SEEK_DRIVING;
 }
 
+/* plan_budget: one slice of the next decision's search tree (begun by end_decision). */
+static void grow_next(rfs_seek_t *s)
+{
+    if (s->cfg.plan_budget != 0u) {
+        (void)rfs_plan_tree_grow(&s->plan, s->cfg.plan_budget);
+    }
+}
+
 /* Drive the current goal. true while it is still being driven; when it ends (reached,
  * timed out, blocked, or abandoned by a failed recheck) the period goes on to decide. */
 static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
 {
+    const rfs_q16_t chk_x = s->chk_x, chk_y = s->chk_y;
     if (s->drive.status == RFS_DRIVE_RUNNING && recheck_fails(s, now_us)) {
         rfs_drive_stop(&s->drive, now_us);
         s->prev_status = RFS_DRIVE_RUNNING; /* abandoned while running: the model failed */
@@ -570,19 +684,32 @@ static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
                                              &out->right_mm_s);
     if (st == RFS_DRIVE_RUNNING) {
         s->state = RFS_SEEK_DRIVING;
+        if (s->chk_x != chk_x || s->chk_y != chk_y) {
+            begin_next_tree(s); /* a check passed: the next one is further on */
+        }
+        grow_next(s); /* the next decision's search tree */
         return true;
     }
     s->prev_status = st;
     return false;
 }
 
-/* true while the robot stands before deciding: after no goal or a null move
+/* true while the robot stands before deciding: until the base has stopped (a goal ended
+ * while moving: the next path is planned from where the robot stands, not from a point
+ * it brakes past; docs/MAPS.md, "Drive control"), after no goal or a null move
  * (end_decision), and for a dwelling strategy one averaging window at each point. */
 static bool hold_still(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
 {
+    if (!rfs_drive_at_rest(&s->drive)) {
+        stop_wheels(s, now_us, out);
+        s->state = RFS_SEEK_DRIVING;
+        grow_next(s);
+        return true;
+    }
     if (now_us < s->retry_after_us) {
         out->faults |= s->retry_no_goal ? RFS_SEEK_FAULT_NO_GOAL : 0u;
         stop_wheels(s, now_us, out);
+        grow_next(s);
         return true;
     }
     if (!rfs_seek_ops(s)->dwell) {
@@ -613,8 +740,13 @@ static void control(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_
     if (s->fitting) {
         /* A sliced fit continues; the decision finishes when it is done. */
         if (fit_slice(s, now_us, rng, out)) {
-            finish_decision(s, now_us, rng, out);
+            finish_decision(s, now_us, rng, out, false);
         }
+        return;
+    }
+    if (s->planning) {
+        /* The decision waits for its search tree: the choice is made again. */
+        finish_decision(s, now_us, rng, out, false);
         return;
     }
     if (drive_on(s, now_us, out) || hold_still(s, now_us, out)) {

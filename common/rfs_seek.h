@@ -59,6 +59,10 @@ typedef struct rfs_seek_cfg {
     int64_t rssi_timeout_us;    ///< no measurement and no receiver report for this long is
                                 ///< stale: wheels stop (150 ms)
     uint32_t fit_budget;        ///< work units per control period for model learning (0 = all)
+    uint32_t plan_budget;       ///< lattice points a control period adds to the search tree
+                                ///< of the next decision (docs/PERFORMANCE.md, "Planning in
+                                ///< slices"; RFS_SEEK_PLAN_BUDGET); 0: every plan searches
+                                ///< within the decision
     rfs_rssi_cfg_t rssi;        ///< averaging window (1 s)
     rfs_store_cfg_t store;      ///< sample store (10,000 samples)
     rfs_drive_cfg_t drive;      ///< drive control (TurtleBot 2)
@@ -148,7 +152,7 @@ typedef enum rfs_seek_kind {
 typedef enum rfs_seek_state {
     RFS_SEEK_WAITING = 0, ///< no pose, or neither a measurement nor a receiver report yet
     RFS_SEEK_STALE,       ///< inputs went stale: wheels stopped
-    RFS_SEEK_LEARNING,    ///< a sliced fit is in progress: wheels stopped
+    RFS_SEEK_LEARNING,    ///< a sliced fit or search tree is in progress: wheels stopped
     RFS_SEEK_DRIVING,     ///< following the current goal
 } rfs_seek_state_t;
 
@@ -180,6 +184,8 @@ typedef struct rfs_seek_decision {
                                ///< model's draw (a sampled epsilon step)
     bool sampled;              ///< epsilon: the goal is the model's draw (cfg.eps_sample)
     rfs_q16_t path_len;        ///< planned path length, metres Q16.16
+    uint16_t plan_wait;        ///< control periods the robot stood for the search tree
+                               ///< (plan_budget; 0: the tree grown on the leg served)
     uint16_t samples;          ///< samples in the store
 } rfs_seek_decision_t;
 
@@ -192,6 +198,10 @@ typedef struct rfs_seek_out {
     bool decided;               ///< a new decision was made this period
     rfs_seek_decision_t decision; ///< the latest decision (new when `decided`)
 } rfs_seek_out_t;
+
+/// Default plan_budget: 640 lattice points a period (about 330,000 instructions on the
+/// Cortex-M4), the 12,800-point lattice of a 40 x 20 m map in 20 periods (1 s).
+#define RFS_SEEK_PLAN_BUDGET 640u
 
 /// Epsilon candidates lie within this many lattice steps (32 x 0.25 m = 8 m: e^-8 = 3e-4,
 /// the mass beyond is 0.3 % of the distribution); the weight table is indexed by di^2+dj^2.
@@ -230,6 +240,10 @@ typedef struct rfs_seek {
     rfs_seek_state_t state;                   ///< controller state
     uint32_t iteration;                       ///< next iteration number
     bool fitting;                             ///< a sliced fit is in progress
+    bool planning;                            ///< plan_budget: a decision waits for its
+                                              ///< search tree (grown from the robot)
+    bool plan_ready;                          ///< the decision's plans walk that tree
+    uint16_t plan_wait;                       ///< periods the decision has waited for it
     rfs_seek_decision_t decision;             ///< latest decision
     rfs_drive_status_t prev_status;           ///< how the last goal ended
     uint32_t meas_rejected;                   ///< measurements with a bad source index

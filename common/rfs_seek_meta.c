@@ -148,12 +148,14 @@ bool rfs_seek_meta_initial(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
 
 /* Rejection step of a geodesic epsilon draw: a candidate proposed with weight
  * e^(-straight distance) is kept with probability e^(-(path length - straight distance)),
- * so the kept goals have weight e^(-path length) (the last try is always kept).
+ * so the kept goals have weight e^(-path length) (the last try is always kept). The
+ * length is the lattice path's before string pulling (rfs_plan_tree_length: a walk on
+ * the search tree; only the kept draw's path is pulled).
  * Scaling: the straight distance from the weight table's q (grid * sqrt(q), Q16) and
  * the path length (Q16, <= 32 km) differ by less than 2^31; e^(-d) is Q16. */
-static bool accept_detour(const rfs_seek_t *s, rfs_rng_t *rng, uint32_t q)
+static bool accept_detour(const rfs_seek_t *s, rfs_rng_t *rng, uint32_t q, rfs_q16_t len)
 {
-    int64_t detour = (int64_t)s->drive.path.length - offset_dist(s->map, q);
+    int64_t detour = (int64_t)len - offset_dist(s->map, q);
     if (detour <= 0) {
         return true;
     }
@@ -264,10 +266,10 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     const bool tree = s->cfg.eps_geodesic;
     rfs_q16_t sx, sy;
     const bool tree_ok = tree && rfs_seek_plan_start(s, &sx, &sy);
-    if (tree_ok) {
+    if (tree_ok && !s->plan_ready) { /* plan_ready: the decision's grown tree (rfs_seek.c) */
         rfs_plan_tree_begin(&s->plan, sx, sy);
     }
-    for (int attempt = 0; attempt < GOAL_TRIES; ++attempt) {
+    for (int attempt = 0; attempt < GOAL_TRIES && !s->plan.tree_more; ++attempt) {
         /* Scaling: weights Q0.16 <= 65535, at most 65^2 candidates: sum < 2^28. */
         uint32_t total = 0;
         for (int pass = 0; pass < 2; ++pass) {
@@ -295,16 +297,21 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
                         rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
                         s->decision.goal_x = px;
                         s->decision.goal_y = py;
-                        if ((!tree || tree_ok) && rfs_seek_plan_to(s, px, py, tree)) {
-                            /* A rejected draw never reaches the drive. */
-                            if (!s->cfg.eps_geodesic || attempt == GOAL_TRIES - 1 ||
-                                accept_detour(s, rng, q)) {
-                                rfs_drive_set_path(&s->drive, &s->drive.path, now_us);
-                                return true;
+                        bool ok = !tree || tree_ok;
+                        rfs_q16_t len = 0;
+                        if (ok && tree && attempt != GOAL_TRIES - 1) {
+                            ok = rfs_plan_tree_length(&s->plan, px, py, &len);
+                            if (ok && !accept_detour(s, rng, q, len)) {
+                                goto next_attempt; /* a rejected draw is not pulled */
                             }
-                            goto next_attempt;
                         }
-                        rfs_reach_bit_set(s->visited, idx); /* unreachable in practice: do not redraw it */
+                        if (ok && rfs_seek_plan_to(s, px, py, tree)) {
+                            rfs_drive_set_path(&s->drive, &s->drive.path, now_us);
+                            return true;
+                        }
+                        if (!s->plan.tree_more) { /* else decided again later (rfs_seek.c) */
+                            rfs_reach_bit_set(s->visited, idx); /* unreachable in practice: do not redraw it */
+                        }
                         goto next_attempt;
                     }
                 }
@@ -420,6 +427,9 @@ bool rfs_seek_meta_choose(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t 
     s->replan = false;
     d->kind = greedy ? RFS_SEEK_GREEDY : RFS_SEEK_EPSILON;
     bool ok = greedy ? choose_greedy(s, rng, now_us) : choose_epsilon(s, rng, now_us);
+    if (s->plan.tree_more) {
+        return false; /* a plan waits for the search tree: decided again (rfs_seek.c) */
+    }
     if (!ok && greedy) {
         d->kind = RFS_SEEK_EPSILON; /* no reachable maximum: explore instead */
         ok = choose_epsilon(s, rng, now_us);

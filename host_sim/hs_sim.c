@@ -218,7 +218,7 @@ static unsigned walls_cb(void *ctx, double x0, double y0, double x1, double y1)
     return hs_box2d_walls_crossed(ctx, x0, y0, x1, y1);
 }
 
-static const char *kind_name(rfs_seek_kind_t k)
+const char *hs_sim_kind_name(rfs_seek_kind_t k)
 {
     switch (k) {
     case RFS_SEEK_INITIAL: return "initial";
@@ -228,7 +228,7 @@ static const char *kind_name(rfs_seek_kind_t k)
     }
 }
 
-static const char *prev_name(rfs_drive_status_t s)
+const char *hs_sim_prev_name(rfs_drive_status_t s)
 {
     switch (s) {
     case RFS_DRIVE_REACHED: return "reached";
@@ -646,7 +646,7 @@ static void log_decision(FILE *f, const hs_ctrl_t *ctrl, const rfs_seek_decision
                          const event_t *ev, double theta)
 {
     char reason[96];
-    snprintf(reason, sizeof reason, "prev=%s%s%s%s%s", prev_name(d->prev),
+    snprintf(reason, sizeof reason, "prev=%s%s%s%s%s", hs_sim_prev_name(d->prev),
              d->line_search ? ",line_search" : "",
              d->sampled ? ",sampled" : "",
              d->model_valid ? "" : ",no_model",
@@ -657,7 +657,7 @@ static void log_decision(FILE *f, const hs_ctrl_t *ctrl, const rfs_seek_decision
             "%u\t%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%s\t%s\t%d\t%.3f\t%.3f\t"
             "%.4f\t%.3f\t%.3f\t%.3f\t%.3f\t%.3f\t%u\t%.3f",
             d->iteration, ev->te * 1e-6, ev->ex, ev->ey, theta,
-            q16d(d->x), q16d(d->y), kind_name(d->kind), reason,
+            q16d(d->x), q16d(d->y), hs_sim_kind_name(d->kind), reason,
             d->relearned ? 1 : 0, pred, mean, q16d(d->epsilon),
             q16d(d->goal_x), q16d(d->goal_y), q16d(d->max_x), q16d(d->max_y),
             q16d(d->path_len), d->samples, ev->etr);
@@ -693,6 +693,8 @@ static void ctrl_event(sim_run_t *r, const event_t *ev, const tick_t *k)
         res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
         res->goal_timeouts += d->prev == RFS_DRIVE_TIMEOUT ? 1u : 0u;
         res->goal_blocked += d->prev == RFS_DRIVE_BLOCKED ? 1u : 0u;
+        res->slow_decisions += d->plan_wait >= 2u ? 1u : 0u;
+        res->plan_wait_max = d->plan_wait > res->plan_wait_max ? d->plan_wait : res->plan_wait_max;
         if (d->kind == RFS_SEEK_GREEDY && d->model_valid) {
             r->belief_x = q16d(d->max_x);
             r->belief_y = q16d(d->max_y);
@@ -1077,6 +1079,8 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
     fprintf(f, "  \"motor_timeouts\": %u,\n", r->motor_timeouts);
     fprintf(f, "  \"goal_timeouts\": %u,\n", r->goal_timeouts);
     fprintf(f, "  \"goal_blocked\": %u,\n", r->goal_blocked);
+    fprintf(f, "  \"slow_decisions\": %u,\n", r->slow_decisions);
+    fprintf(f, "  \"plan_wait_max\": %u,\n", r->plan_wait_max);
     json_num(f, "turn_time_s", r->turn_time_s, false);
     fprintf(f, "  \"wall_contacts\": %ld,\n", r->wall_contacts);
     // The path-loss model's final estimate (null for other models).

@@ -73,6 +73,10 @@ typedef struct hs_sim_result {
     uint32_t motor_timeouts;     ///< times the motor model stopped on a missing command
     uint32_t goal_timeouts;      ///< goals the drive abandoned after its timeout
     uint32_t goal_blocked;       ///< goals the drive abandoned as blocked (no progress)
+    uint32_t slow_decisions;     ///< decisions that waited 2 or more control periods for
+                                 ///< their search tree (rfs_seek_decision_t.plan_wait):
+                                 ///< over 100 ms from the leg's end at 20 Hz
+    uint32_t plan_wait_max;      ///< the longest such wait, control periods
     double turn_time_s;          ///< time turning on the spot (|v| < 2 cm/s, |w| > 0.05 rad/s)
     long wall_contacts;          ///< wall contacts (hs_box2d_wall_contacts)
     double wall_time_s;          ///< host time the run took (not part of determinism)
@@ -149,6 +153,12 @@ int hs_sim_field(const hs_sim_env_t *e, uint64_t seed, unsigned src, double step
 
 /// The last columns of log.tsv: the path-loss model's estimate at a decision.
 #define HS_SIM_LOG_EST_COLUMNS "est_src_x_m\test_src_y_m\test_n\test_w_db\test_p0\test_area_m2"
+
+/// A decision's kind as log.tsv names it: initial, greedy, epsilon, or the baseline's.
+const char *hs_sim_kind_name(rfs_seek_kind_t k);
+
+/// How the goal before a decision ended, as log.tsv's reason names it (prev=...).
+const char *hs_sim_prev_name(rfs_drive_status_t s);
 
 /// End a log.tsv decision row: a tab, the HS_SIM_LOG_EST_COLUMNS values (source m, n,
 /// W dB, P0, spread area m^2) and a newline; "nan" unless the controller's model is

@@ -89,7 +89,7 @@ bench-sim: $(BENCH_BIN)/rfseek-sim
 # Planner and legal-grid figures on the office scenario map and on the Intel lab
 # (docs/PERFORMANCE.md, "Map, planner, drive").
 bench-map: $(BENCH_BIN)/rfseek-map
-	@for m in scenarios/maps/office.yaml /work/shared/data/maps/intel.yaml; do \
+	@for m in scenarios/maps/office.yaml scenarios/maps/intel.yaml; do \
 	    if [ -e $$m ]; then $(BENCH_BIN)/rfseek-map $$m --bench 200 | grep -E '^(map|core grid|lattice|bench|  )'; fi; done
 # The table of docs/FAULTS.md: every fault over 50 seeds, with and without it, side by side.
 FAULT_SEEDS ?= 50
@@ -142,7 +142,7 @@ BENCH_TARGETS += bench-feed bench-wire
 
 # --- the Cortex-M4 (emulated): instruction counts of the loop and of the models ----------------
 .PHONY: bench-firmware bench-models-m4
-bench-firmware: $(FW)/bench.elf $(FW)/firmware.elf $(FW)/qemu.elf
+bench-firmware: $(FW)/bench.elf $(FW)/bench_models.elf $(FW)/firmware.elf $(FW)/qemu.elf
 	@tests/firmware/bench.sh $(BUILD)
 # MW_BUDGETS="mlp:600 pathloss:800" adds sliced relearns at candidate budgets beside the
 # registry's (how rfs_models_entry_t.mcu_fit_budget was chosen; up to 8 pairs).

@@ -11,6 +11,7 @@ and nothing else.
                                             [--all-floors all|none|a,b] [--jobs N]
                                             [--sim build/bin/rfseek-sim]
                                             [--results docs/RESULTS.md | --no-write]
+                                            [--keep DIR]
 
 Seeds 1001..1200 by default: the drive was tuned on seeds 1..500 of the default office,
 so these are draws it has not seen.
@@ -53,13 +54,21 @@ def localisation_edit(path, settings):
     return [], "\n" + line + "\n"
 
 
-def run(sim, scenario, strategy, model, seeds, jobs):
+def run(sim, scenario, strategy, model, seeds, jobs, keep=None):
+    """One batch's summary; with keep (a file name) its runs table is kept there and a
+    kept one is read instead of running again."""
+    if keep and os.path.exists(keep):
+        return summarise(open(keep).read())
     cmd = [sim, scenario, "--strategy", strategy, "--model", model, "--seeds", seeds, "--quiet"]
     if jobs:
         cmd += ["--jobs", str(jobs)]
     out = subprocess.run(cmd, capture_output=True, text=True)
     if out.returncode != 0:
         sys.exit(f"bench_drive: {scenario}: {out.stderr.strip()}")
+    if keep:
+        with open(keep + ".tmp", "w") as f:
+            f.write(out.stdout)
+        os.replace(keep + ".tmp", keep)
     return summarise(out.stdout)
 
 
@@ -131,6 +140,9 @@ def main():
     ap.add_argument("--jobs", type=int, default=0)
     ap.add_argument("--results", default="docs/RESULTS.md")
     ap.add_argument("--no-write", action="store_true", help="print the tables only")
+    ap.add_argument("--keep", metavar="DIR",
+                    help="keep each batch's runs table in DIR and reuse the ones there "
+                         "(same binary and seeds: a resumed or extended bench)")
     a = ap.parse_args()
     if not re.fullmatch(r"\d+\.\.\d+", a.seeds):
         sys.exit("bench_drive: --seeds: expected A..B")
@@ -150,18 +162,22 @@ def main():
     rows = []
     every = []
     try:
-        for nlabel, settings in NOISE:
+        if a.keep:
+            os.makedirs(a.keep, exist_ok=True)
+        for i, (nlabel, settings) in enumerate(NOISE):
             cs = []
             for f in floors:
                 path = FLOORS[f][1]
                 edits, extra = localisation_edit(path, settings)
                 scen = scenario_file(path, edits, tmps, extra)
                 for strategy, model, _ in CONFIGS:
-                    cs.append(cell(run(a.sim, scen, strategy, model, a.seeds, a.jobs)))
+                    keep = a.keep and os.path.join(a.keep, f"noise{i}_{f}_{strategy}_{model}.tsv")
+                    cs.append(cell(run(a.sim, scen, strategy, model, a.seeds, a.jobs, keep)))
             rows.append((nlabel, cs))
             print(f"{nlabel} | " + " | ".join(cs), flush=True)
         for f in every_floors:
-            cs = [cell(run(a.sim, f"scenarios/{f}.yaml", strategy, model, a.seeds, a.jobs))
+            cs = [cell(run(a.sim, f"scenarios/{f}.yaml", strategy, model, a.seeds, a.jobs,
+                           a.keep and os.path.join(a.keep, f"{f}_{strategy}_{model}.tsv")))
                   for strategy, model, _ in CONFIGS]
             every.append((f, cs))
             print(f"{f} | " + " | ".join(cs), flush=True)

@@ -651,6 +651,59 @@ static void test_first_leg_from_path_start(void **state)
     }
 }
 
+/* Distance from (px, py) to the closed triangle abc (0 inside). */
+static double tri_dist(double px, double py, const double t[6])
+{
+    double s0 = (t[2] - t[0]) * (py - t[1]) - (t[3] - t[1]) * (px - t[0]);
+    double s1 = (t[4] - t[2]) * (py - t[3]) - (t[5] - t[3]) * (px - t[2]);
+    double s2 = (t[0] - t[4]) * (py - t[5]) - (t[1] - t[5]) * (px - t[4]);
+    if ((s0 >= 0 && s1 >= 0 && s2 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0)) {
+        return 0.0;
+    }
+    return fmin(seg_dist(px, py, t[0], t[1], t[2], t[3]),
+                fmin(seg_dist(px, py, t[2], t[3], t[4], t[5]), seg_dist(px, py, t[4], t[5], t[0], t[1])));
+}
+
+/* A short last leg with the robot beside it (a plan started from a snapped lattice point,
+ * or re-planned under pose noise): the robot keeps within the triangle of its own start,
+ * the leg's start and the goal, give or take 3 cm, and ends within goal_tol of the goal.
+ * It used to steer at a carrot on the leg's line beyond the goal and stop up to goal_tol
+ * past it on the far side, unchecked space beside a wall (a Willow Garage contact). */
+static void test_short_last_leg_stays_inside(void **state)
+{
+    (void)state;
+    const double starts[][3] = {{0.05, 0.12, 0.0}, {0.1, -0.12, 0.3}, {0.2, 0.1, -0.2},
+                                {-0.05, 0.15, -0.5}, {0.0, 0.1, 1.2}, {0.15, -0.08, -1.0}};
+    double worst = 0;
+    for (size_t k = 0; k < sizeof starts / sizeof starts[0]; k++) {
+        for (int len = 0; len < 3; len++) {
+            rfs_drive_t d;
+            sim_t s;
+            double bx = 0.2 + 0.1 * len;
+            start(&d, &s, starts[k][0], starts[k][1], starts[k][2]);
+            rfs_path_t p = one_goal(bx, 0.0);
+            p.has_start = true; /* the leg (0, 0) -> (bx, 0) */
+            rfs_drive_set_path(&d, &p, 0);
+            const double tri[6] = {starts[k][0], starts[k][1], 0.0, 0.0, bx, 0.0};
+            double off = 0;
+            rfs_drive_status_t st = RFS_DRIVE_RUNNING;
+            while (st == RFS_DRIVE_RUNNING && s.t < 20000000) {
+                int64_t end;
+                st = run(&d, &s, &p, (s.t + DT_US) / 1e6, false, &end);
+                off = fmax(off, tri_dist(s.x, s.y, tri));
+            }
+            assert_int_equal(st, RFS_DRIVE_REACHED);
+            assert_true(hypot(s.x - bx, s.y) <= 0.1 + 1e-3);
+            worst = fmax(worst, off);
+            if (getenv("DRIVE_DEBUG")) {
+                print_message("start %zu leg %.1f: off %.3f, end (%.3f, %.3f)\n", k, bx, off, s.x, s.y);
+            }
+        }
+    }
+    print_message("short last legs: worst distance outside the triangle %.3f m\n", worst);
+    assert_true(worst < 0.03); /* an arc that turns while driving: 0.024 m; 0.079 before */
+}
+
 static void test_init_rejects(void **state)
 {
     (void)state;
@@ -707,6 +760,7 @@ int main(void)
         cmocka_unit_test(test_blocked),
         cmocka_unit_test(test_stop),
         cmocka_unit_test(test_first_leg_from_path_start),
+        cmocka_unit_test(test_short_last_leg_stays_inside),
         cmocka_unit_test(test_init_rejects),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -250,6 +250,10 @@ static void run_random_pairs(uint32_t seed, int pairs, int *n_reach, int *n_unre
         if (want > 0 && len / want > *worst) {
             *worst = len / want;
         }
+        /* Linear string pulling: its tests span at most 10 points per point of the
+         * lattice path, whose points number at most 1.061 x the reference length over
+         * the spacing (octile steps, diagonal 1.5 for sqrt 2) plus the two ends. */
+        assert_true(p.pulled <= 10.0 * (1.0607 * want * 65536.0 / g + 3.0));
     }
 }
 
@@ -874,6 +878,202 @@ static void test_tree_misuse_and_limits(void **state)
     assert_int_equal(small[11], 0xA5A5A5A5u);
 }
 
+
+/* A serpentine (walls at x = 2, 4 ... 10 m from alternate edges, 1 m passages): a path
+ * of some 45 m round five walls from (1, 1) m to (11, 1) m. String pulling is linear (its
+ * tests span at most 10 points per lattice point, the greedy puller's about 60), the
+ * path legal (the reference geometry), within 6 % of the lattice optimum. */
+static void test_pull_linear(void **state)
+{
+    (void)state;
+    memset(&wd, 0, sizeof(wd));
+    for (int y = 0; y < H; y++) {
+        for (int x = 0; x < W; x++) {
+            wd.free_c[y][x] = 1;
+        }
+    }
+    for (int k = 1; k <= 5; k++) {
+        const int x = 20 * k;
+        for (int y = 0; y < H - 10; y++) {
+            wd.free_c[k % 2 ? y : H - 1 - y][x] = 0;
+        }
+    }
+    build_finish();
+    rfs_plan_t p;
+    assert_int_equal(rfs_plan_init(&p, &wd.m, work, sizeof(work), queue, 1024), 0);
+    const double g = (double)wd.m.cfg.grid;
+    const int lw = wd.m.lw, lh = wd.m.lh;
+    const int si = 3, sj = 3, gi = 43, gj = 3;
+    const double want = ref_dijkstra(lw, lh, si, sj, gi, gj);
+    const rfs_q16_t x0 = (rfs_q16_t)(g / 2 + si * g), y0 = (rfs_q16_t)(g / 2 + sj * g);
+    const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi * g), y1 = (rfs_q16_t)(g / 2 + gj * g);
+    rfs_path_t path;
+    assert_true(rfs_plan_path(&p, x0, y0, x1, y1, &path));
+    double len = 0, px = x0, py = y0;
+    for (int w = 0; w < path.n; w++) {
+        assert_true(ref_seg(px, py, path.x[w], path.y[w]));
+        len += hypot(path.x[w] - px, path.y[w] - py) / 65536.0;
+        px = path.x[w];
+        py = path.y[w];
+    }
+    const double points = 1.0607 * want * 65536.0 / g + 3.0;
+    print_message("serpentine: %.2f m (lattice optimum %.2f m), %d waypoints, tests spanned "
+                  "%u points, %.2f per lattice point\n", len, want, path.n, p.pulled,
+                  p.pulled / (want * 65536.0 / g));
+    assert_true(want > 40.0);
+    assert_true(len <= want * 1.06 + 1e-3);
+    assert_true(path.n >= 6);
+    assert_true(p.pulled <= 10.0 * points);
+    assert_true(p.pulled >= want * 65536.0 / g); /* every point was passed by a test */
+}
+
+/* A tree grown in slices (rfs_plan_tree_grow) against one searched on demand, from
+ * lattice roots on the five kinds of map: a plan before the tree is done either finds
+ * its goal closed (the same path, bit for bit) or fails with tree_more; a done tree has
+ * closed exactly the reference's reachable points, and gives every goal the on-demand
+ * tree's result. Moved to a legal point by its root (rfs_plan_tree_move), its paths
+ * start there, legal by the reference geometry. */
+static void test_tree_sliced(void **state)
+{
+    (void)state;
+    static uint8_t work_f[LMAX];
+    static uint32_t queue_f[1024];
+    const uint32_t budgets[3] = {1, 97, 640};
+    int before = 0, more = 0, moved = 0;
+    for (int kind = 0; kind <= 4; kind++) {
+        build_kind(kind, 2);
+        const int lw = wd.m.lw, lh = wd.m.lh;
+        const double g = (double)wd.m.cfg.grid;
+        rfs_plan_t t, f;
+        assert_int_equal(rfs_plan_init(&t, &wd.m, work, sizeof(work), queue, 1024), 0);
+        assert_int_equal(rfs_plan_init(&f, &wd.m, work_f, sizeof(work_f), queue_f, 1024), 0);
+        uint32_t rs = 77u + (uint32_t)kind;
+        for (int k = 0; k < 3; k++) {
+            int si, sj;
+            random_legal(&rs, lw, lh, &si, &sj);
+            ref_octile(lw, lh, si, sj);
+            int below, upto;
+            oct_count(lw * lh, INT32_MAX, &below, &upto);
+            const rfs_q16_t x0 = (rfs_q16_t)(g / 2 + si * g), y0 = (rfs_q16_t)(g / 2 + sj * g);
+            rfs_plan_tree_begin(&t, x0, y0);
+            rfs_plan_tree_begin(&f, x0, y0);
+            uint32_t total = 0;
+            bool done = false;
+            for (int slice = 0; !done; slice++) {
+                done = rfs_plan_tree_grow(&t, budgets[k]);
+                total += t.expanded;
+                assert_true(t.expanded <= budgets[k]);
+                assert_true(slice < 20000);
+                int gi, gj;
+                random_legal(&rs, lw, lh, &gi, &gj);
+                const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi * g), y1 = (rfs_q16_t)(g / 2 + gj * g);
+                rfs_path_t pt, pf;
+                t.tree_more = false;
+                const bool okt = rfs_plan_tree_path(&t, x1, y1, &pt);
+                assert_int_equal(t.expanded, 0);
+                const bool okf = rfs_plan_tree_path(&f, x1, y1, &pf);
+                if (okt) {
+                    assert_true(okf);
+                    assert_same_path(&pt, &pf);
+                } else if (okf) {
+                    assert_true(t.tree_more && !done);
+                    more++;
+                } else {
+                    assert_false(t.tree_more && done);
+                }
+                before += !done;
+            }
+            assert_int_equal((int)total, upto);
+            for (int q = 0; q < 8; q++) {
+                int gi, gj;
+                random_legal(&rs, lw, lh, &gi, &gj);
+                const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi * g), y1 = (rfs_q16_t)(g / 2 + gj * g);
+                rfs_path_t pt, pf;
+                t.tree_more = false;
+                const bool okt = rfs_plan_tree_path(&t, x1, y1, &pt);
+                assert_int_equal(okt, rfs_plan_tree_path(&f, x1, y1, &pf));
+                assert_false(t.tree_more);
+                assert_int_equal(okt, oct_ref[gj * lw + gi] < INT32_MAX);
+                if (okt) {
+                    assert_same_path(&pt, &pf);
+                }
+            }
+            /* A robot stopped 0.07 m from the root, or a lattice step away. */
+            const rfs_q16_t mx = x0 + RFS_Q16_FRAC(7, 100), my = y0 - RFS_Q16_FRAC(3, 100);
+            if (rfs_map_point_legal(&wd.m, mx, my) && ref_seg(mx, my, x0, y0)) {
+                assert_true(rfs_plan_tree_move(&t, mx, my));
+                moved++;
+                int gi, gj;
+                random_legal(&rs, lw, lh, &gi, &gj);
+                const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi * g), y1 = (rfs_q16_t)(g / 2 + gj * g);
+                rfs_path_t pt;
+                if (rfs_plan_tree_path(&t, x1, y1, &pt)) {
+                    assert_int_equal(pt.x0, mx);
+                    assert_int_equal(pt.y0, my);
+                    assert_true(ref_seg(mx, my, pt.x[0], pt.y[0]));
+                    for (int w = 1; w < pt.n; w++) {
+                        assert_true(ref_seg(pt.x[w - 1], pt.y[w - 1], pt.x[w], pt.y[w]));
+                    }
+                }
+            }
+            assert_false(rfs_plan_tree_move(&t, x0 + (rfs_q16_t)(3 * g), y0));
+        }
+    }
+    print_message("sliced trees: %d plans before done, %d of them asked for more; %d moved\n",
+                  before, more, moved);
+    assert_true(before > 50 && more > 10 && moved >= 5);
+}
+
+/* rfs_plan_tree_length on the five kinds of map, lattice roots: false exactly where the
+ * tree's plan fails; in line of sight the straight distance; else at least the pulled
+ * path's length and at most the reference lattice optimum (double Euclidean Dijkstra)
+ * times 1.0607 (octile costs) plus a millimetre of rounding. */
+static void test_tree_length(void **state)
+{
+    (void)state;
+    int checked = 0, searched = 0;
+    for (int kind = 0; kind <= 4; kind++) {
+        build_kind(kind, 3);
+        const int lw = wd.m.lw, lh = wd.m.lh;
+        const double g = (double)wd.m.cfg.grid;
+        rfs_plan_t t;
+        assert_int_equal(rfs_plan_init(&t, &wd.m, work, sizeof(work), queue, 1024), 0);
+        uint32_t rs = 991u + (uint32_t)kind;
+        for (int k = 0; k < 3; k++) {
+            int si, sj;
+            random_legal(&rs, lw, lh, &si, &sj);
+            (void)ref_dijkstra(lw, lh, si, sj, -1, -1);
+            const rfs_q16_t x0 = (rfs_q16_t)(g / 2 + si * g), y0 = (rfs_q16_t)(g / 2 + sj * g);
+            rfs_plan_tree_begin(&t, x0, y0);
+            for (int q = 0; q < 12; q++) {
+                int gi, gj;
+                random_legal(&rs, lw, lh, &gi, &gj);
+                const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi * g), y1 = (rfs_q16_t)(g / 2 + gj * g);
+                rfs_q16_t len = -1;
+                const bool okl = rfs_plan_tree_length(&t, x1, y1, &len);
+                rfs_path_t pt;
+                const bool okp = rfs_plan_tree_path(&t, x1, y1, &pt);
+                assert_int_equal(okl, okp);
+                if (!okl) {
+                    assert_int_equal(len, 0);
+                    continue;
+                }
+                checked++;
+                const double l = len / 65536.0;
+                if (ref_seg(x0, y0, x1, y1)) {
+                    assert_true(fabs(l - hypot(x1 - x0, y1 - y0) / 65536.0) < 1e-4);
+                    continue;
+                }
+                searched++;
+                assert_true(l >= pt.length / 65536.0 - 1e-3);
+                assert_true(l <= dist_ref[gj * lw + gi] / 65536.0 * 1.0607 + 1e-3);
+            }
+        }
+    }
+    print_message("tree lengths: %d goals, %d round obstacles\n", checked, searched);
+    assert_true(checked >= 100 && searched >= 40);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -885,6 +1085,9 @@ int main(void)
         cmocka_unit_test(test_init_rejects),
         cmocka_unit_test(test_tree_paths),
         cmocka_unit_test(test_tree_misuse_and_limits),
+        cmocka_unit_test(test_pull_linear),
+        cmocka_unit_test(test_tree_sliced),
+        cmocka_unit_test(test_tree_length),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

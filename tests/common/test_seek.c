@@ -551,6 +551,72 @@ static void test_null_move_backs_off(void **state)
     world_free(&t);
 }
 
+/* A goal abandoned while the robot drives at speed (a failed recheck): the base brakes
+ * at its own rate, so the seeker waits until the drive's model of the base is at rest
+ * before it decides; the next path then starts where the robot stands (it used to start
+ * at the estimate while the robot rolled on ~0.25 m past it, docs/MAPS.md "Drive
+ * control"). A double-precision unicycle whose wheels follow the commands at 1 m/s^2
+ * (the Kobuki's limit, the drive's default) stands for the base; the field jumps by
+ * 12 dB every 4 s so that legs are abandoned mid-way. */
+static void test_abandoned_leg_decides_at_rest(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 20, 20, 0, 0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    cfg.recheck_adapt = false;
+    cfg.recheck_dist = Q(0.5); /* checked half-way along a 1 m leg */
+    seek_make(&t, cfg, 3);
+    double x = 5, y = 10, th = 0, sx = 15, sy = 3;
+    double vl = 0, vr = 0, cl = 0, cr = 0, vmax_abandoned = 0;
+    int abandoned = 0;
+    for (int ms = 0; ms < 240000; ms += 5) {
+        int64_t now = (int64_t)ms * 1000;
+        /* The base: each wheel towards its command by at most 1 m/s^2 x 5 ms. */
+        vl += fmax(-5.0, fmin(5.0, cl - vl));
+        vr += fmax(-5.0, fmin(5.0, cr - vr));
+        double v = (vl + vr) / 2e3, w = (vr - vl) / 1e3 / 0.23;
+        x += v * cos(th) * 0.005;
+        y += v * sin(th) * 0.005;
+        th = atan2(sin(th + w * 0.005), cos(th + w * 0.005));
+        double d = fmax(hypot(x - sx, y - sy), 1.0);
+        double jump = (ms / 4000) % 2 ? 12.0 : 0.0;
+        rfs_seek_on_rssi(&t.seek, 0, now, (int8_t)lround(-40 - 30 * log10(d) + jump), &t.rng);
+        if (ms % 100 == 0) {
+            rfs_pose_t p = pose_at(now, x, y, th);
+            rfs_seek_on_pose(&t.seek, &p, &t.rng);
+        }
+        if (ms % 50 != 0) {
+            continue;
+        }
+        double speed = fmax(fabs(vl), fabs(vr));
+        rfs_seek_out_t out;
+        rfs_seek_step(&t.seek, now, &t.rng, &out);
+        if (out.decided && out.decision.prev == RFS_DRIVE_RUNNING) {
+            /* Decided at rest, and planned from the robot's true position. */
+            assert_true(speed <= 50.0);
+            assert_true(rfs_drive_at_rest(&t.seek.drive));
+            if (t.seek.drive.path.n > 0) {
+                assert_true(t.seek.drive.path.has_start);
+                assert_true(hypot(D(t.seek.drive.path.x0) - x, D(t.seek.drive.path.y0) - y) < 0.03);
+            }
+            abandoned++;
+        }
+        if (!out.decided && t.seek.drive.status != RFS_DRIVE_RUNNING && speed > 0.0) {
+            /* Braking after a goal ended: the wheels are commanded to 0 meanwhile. */
+            assert_int_equal(out.left_mm_s, 0);
+            assert_int_equal(out.right_mm_s, 0);
+            vmax_abandoned = fmax(vmax_abandoned, speed);
+        }
+        cl = out.left_mm_s;
+        cr = out.right_mm_s;
+    }
+    world_free(&t);
+    assert_true(abandoned >= 3);
+    assert_true(vmax_abandoned >= 300.0); /* legs were abandoned at speed */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -566,6 +632,7 @@ int main(void)
         cmocka_unit_test(test_null_move_backs_off),
         cmocka_unit_test(test_recheck_abandons_leg),
         cmocka_unit_test(test_recheck_adapt),
+        cmocka_unit_test(test_abandoned_leg_decides_at_rest),
         cmocka_unit_test(test_closed_loop_reaches_source),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

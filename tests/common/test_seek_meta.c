@@ -122,7 +122,19 @@ static void test_blocked_step_line_search(void **state)
      * cell of discretisation); the search steps 0.1 m from 6.3 both ways, so the first
      * legal point is beyond the wall at 6.4 or 6.5. */
     feed(&t, 100000, 5.3, 3.125, 0, -50, &out);
+    /* Round the wall the plan needs the search tree from the robot (plan_budget): the
+     * robot stands while it grows, 640 of the 48 x 32 lattice points a period, and the
+     * decision is made again each period until its plans find their points closed. */
+    int waited = 0;
+    for (int64_t now = 150000; !out.decided && waited < 10; now += 50000, waited++) {
+        assert_int_equal(out.state, RFS_SEEK_LEARNING);
+        assert_int_equal(out.left_mm_s, 0);
+        assert_int_equal(out.right_mm_s, 0);
+        feed(&t, now, 5.3, 3.125, 0, -50, &out);
+    }
     assert_true(out.decided);
+    assert_true(waited >= 1 && waited <= 3); /* 1,536 points: 3 slices at most */
+    assert_int_equal(out.decision.plan_wait, waited);
     assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
     assert_true(out.decision.line_search);
     assert_true(fabs(D(out.decision.max_x) - 9.125) < 1e-4);
@@ -559,10 +571,61 @@ static void test_eps_geodesic_distribution(void **state)
     double f_on = geo_far_draws(true, n, true) / (double)n;
     double s_off = sqrt(p_off * (1.0 - p_off) / n);
     double s_lo = sqrt(p_lo * (1.0 - p_lo) / n), s_hi = sqrt(p_hi * (1.0 - p_hi) / n);
+    print_message("far side: off %.4f (want %.4f), on %.4f (want %.4f..%.4f)\n", f_off, p_off,
+                  f_on, p_lo, p_hi);
     if (fabs(f_off - p_off) > 4.0 * s_off || f_on < p_lo - 4.0 * s_lo || f_on > p_hi + 4.0 * s_hi) {
         print_error("far side: off %.4f (want %.4f), on %.4f (want %.4f..%.4f)\n", f_off, p_off,
                     f_on, p_lo, p_hi);
         fail();
+    }
+}
+
+
+/* plan_budget: the search tree of the next decision grows while the leg is driven, from
+ * the leg's end (the paper's meta) or from its next check point (meta-path, checked
+ * every metre); a robot that stops there decides without waiting, every goal round the
+ * wall (the argmax behind it) planned on that tree. With plan_budget 0 (the plans
+ * searched within the decision) no decision ever waits. */
+static void test_plan_slices_on_the_leg(void **state)
+{
+    (void)state;
+    for (int meta_path = 0; meta_path <= 1; meta_path++) {
+        int decisions = 0, round = 0;
+        for (uint32_t budget = 0; budget <= RFS_SEEK_PLAN_BUDGET; budget += RFS_SEEK_PLAN_BUDGET) {
+            world_t t;
+            world_make(&t, 12.0, 8.0, 6.0, 6.0); /* wall x = 6, y in [0, 6) */
+            rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+            if (meta_path) {
+                rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+                cfg.eps_sample = false;
+            }
+            cfg.plan_budget = budget;
+            seek_make(&t, cfg, 5);
+            fixed_model_t fm = { false, Q(9.125), Q(3.125) };
+            rfs_model_t model = { fixed_ops(), &fm };
+            assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+            field_t f = { .kind = 2, .scripted = -60.0 };
+            run_t r = { .x = 3.0, .y = 3.125 };
+            rfs_seek_out_t out;
+            /* Held 2 s a leg: 40 periods, 25,600 points, the 48 x 32 lattice 17 times. */
+            for (int k = 0; k < 12; k++) {
+                assert_true(next_decision(&t, &r, &f, 2000000, 10000000, &out));
+                const rfs_seek_decision_t *d = &out.decision;
+                if (budget == 0) {
+                    assert_int_equal(d->plan_wait, 0);
+                    continue;
+                }
+                decisions++;
+                round += D(d->path_len) > hypot(D(d->goal_x) - D(d->x), D(d->goal_y) - D(d->y)) + 0.05;
+                /* The first decision (the boot fit) and relearns wait one period; none
+                 * waits for its tree. */
+                assert_int_equal(d->plan_wait, k == 0 || d->relearned ? 1 : 0);
+            }
+            world_free(&t);
+        }
+        print_message("%s: %d decisions on trees grown on the leg, %d round the wall\n",
+                      meta_path ? "meta-path" : "meta", decisions, round);
+        assert_true(round >= 1);
     }
 }
 
@@ -576,6 +639,7 @@ int main(void)
         cmocka_unit_test(test_meta_path_unreachable_maximum),
         cmocka_unit_test(test_eps_sample_goes_to_the_draw),
         cmocka_unit_test(test_eps_geodesic_distribution),
+        cmocka_unit_test(test_plan_slices_on_the_leg),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -89,7 +89,9 @@ def main(argv):
         bad = [m for m in st if m["est_valid"] or any(m[k] != 0.0 for k in est_keys)]
         check("no_estimate", not bad, str(bad[:1]))
         return exit_status()
-    first = next((i for i, m in enumerate(st) if m["decided"] and m["model_updated"]), None)
+    # The first status of a relearn with its fit done: the decision's own, or the period
+    # before it when the choice waits one period after a whole fit (rfs_seek.c, plan_budget).
+    first = next((i for i, m in enumerate(st) if m["model_updated"] and m["est_valid"]), None)
     check("a_relearn", first is not None)
     if first is None:
         return 1

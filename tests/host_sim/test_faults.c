@@ -389,8 +389,19 @@ static void common_checks(const char *name, const hs_sim_result_t *res, const me
 /// bus-off) and make the common checks.
 static void run_checked(const char *name, hs_sim_result_t *res, hs_scenario_t *sc, measured_t *m)
 {
-    FILE *log;
-    run_fault(name, 1, res, &log, sc, NULL);
+    FILE *log = NULL;
+    /* The first seed whose run outlives the fault's window by a second (a run that
+     * reaches the source during the fault shows nothing of the recovery). */
+    for (uint64_t seed = 1; seed <= 8; seed++) {
+        if (log != NULL) {
+            fclose(log);
+        }
+        run_fault(name, seed, res, &log, sc, NULL);
+        const hs_fault_t *f = &sc->faults.f[0];
+        if (res->sim_time_s > f->start_s + f->duration_s + 1.0) {
+            break;
+        }
+    }
     const hs_fault_t *f = &sc->faults.f[0];
     measure(log, f->kind == HS_FAULT_BUS_OFF ? f->start_s : INFINITY, m);
     fclose(log);

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # tests/host_sim/test_rfseek_map.sh BIN - rfseek-map on a real map and on bad input.
-# Reference values: the cell counts of /work/shared/data/README.md (intel: 29 942
+# Reference values: the cell counts of scenarios/maps/README.md's source (intel: 29 942
 # occupied, 192 948 free, 113 509 unknown) and the PGM header written for 579 x 581.
 set -u
 bin=${1:?usage: test_rfseek_map.sh path/to/rfseek-map}
-maps=${RFS_MAPS_DIR:-/work/shared/data/maps}
+maps=${RFS_MAPS_DIR:-scenarios/maps}
 bad=tests/data/maps_bad
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

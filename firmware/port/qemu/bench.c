@@ -40,6 +40,22 @@ static uint8_t s_free[MAP_STRIDE * MAP_H];
 static uint8_t s_wall[MAP_STRIDE * MAP_H];
 static rfs_rssi_t s_win;
 
+/* A row name: base followed by suffix, kept for the rest of the run (a bump pool). */
+static const char *row_name(const char *base, const char *suffix)
+{
+    static char pool[6144];
+    static uint32_t used;
+    char *out = &pool[used];
+    for (const char *s = base; *s != '\0' && used + 2u < sizeof pool; s++) {
+        pool[used++] = *s;
+    }
+    for (const char *s = suffix; *s != '\0' && used + 2u < sizeof pool; s++) {
+        pool[used++] = *s;
+    }
+    pool[used++] = '\0';
+    return out;
+}
+
 /* 10,000 samples inside 4.9 m of (cx, cy) cm, keeping only those with x >= xmin and
  * y <= ymax (cm: the side of a wall the robot was on); the field rises towards +x (-60 dBm
  * at the centre, +1 dB per metre, +-1 dB noise). The limits reject before the noise draw,
@@ -160,9 +176,9 @@ static uint32_t geo_scan(const rfs_seek_t *s, uint16_t ci, uint16_t cj, uint32_t
  * the random source taken just before the step, on the step's own visited, reach and
  * weight tables (a draw changes them only when a plan fails, and then the replayed goal
  * differs): the epsilon coin (finish_decision), then per try one weighted pick, one plan
- * and, geodesic and not the last try, one detour test (its plans by rfs_plan_path, not
- * the decision's search tree: lengths may differ by a tie of the lattice path, detours
- * here all exceed 13 m either way). Returns the plans; the kept goal
+ * and, geodesic and not the last try, one detour test on the lattice path's length
+ * (rfs_plan_tree_length on a search tree from the robot, searched on demand: the same
+ * paths as the decision's grown tree). Returns the plans; the kept goal
  * in *gx, *gy; the smallest detour of a tested draw in *min_detour (metres Q16.16,
  * INT64_MAX when none was tested). Scaling: the straight distance grid * sqrt(q) as
  * rfs_seek_meta.c's offset_dist (Q16 x Q16 >> 16); path lengths <= 32 km, so the detour fits
@@ -179,6 +195,7 @@ static uint32_t geo_replay(rfs_seek_t *s, rfs_rng_t rng, bool geodesic, rfs_q16_
     *gx = 0; /* no goal when no candidate is left */
     *gy = 0;
     (void)rfs_rng_u32(&rng);
+    rfs_plan_tree_begin(&s->plan, s->pose.x, s->pose.y); /* the decision's tree, searched on demand */
     for (int attempt = 0; attempt < GEO_TRIES; ++attempt) {
         const uint32_t total = geo_scan(s, ci, cj, UINT32_MAX, &gi, &gj, &q, &found);
         if (total == 0u) {
@@ -186,14 +203,14 @@ static uint32_t geo_replay(rfs_seek_t *s, rfs_rng_t rng, bool geodesic, rfs_q16_
         }
         (void)geo_scan(s, ci, cj, rfs_rng_below(&rng, total), &gi, &gj, &q, &found);
         rfs_map_lattice_point(m, gi, gj, gx, gy);
-        rfs_path_t path;
+        rfs_q16_t len;
         plans++;
-        if (!rfs_plan_path(&s->plan, s->pose.x, s->pose.y, *gx, *gy, &path) || !geodesic ||
-            attempt == GEO_TRIES - 1) {
+        if (!geodesic || attempt == GEO_TRIES - 1 ||
+            !rfs_plan_tree_length(&s->plan, *gx, *gy, &len)) {
             return plans;
         }
         const int64_t straight = ((int64_t)m->cfg.grid * rfs_isqrt64((uint64_t)q << 32)) >> 16;
-        const int64_t detour = (int64_t)path.length - straight;
+        const int64_t detour = (int64_t)len - straight;
         if (detour <= 0) {
             return plans;
         }
@@ -205,45 +222,85 @@ static uint32_t geo_replay(rfs_seek_t *s, rfs_rng_t rng, bool geodesic, rfs_q16_
     return plans;
 }
 
-/* Row names of one geo_decision (bench.sh prints them in this order). */
-typedef struct geo_rows {
-    const char *period;      /* instructions of the measured period */
-    const char *stack;       /* its stack depth, bytes */
-    const char *eps_relearn; /* 1: it relearnt and decided an epsilon goal */
-    const char *plans;       /* paths planned (geo_replay) */
-    const char *goal_ok;     /* 1: the replay kept the decision's goal */
-    const char *path_cm;     /* kept path, cm */
-    const char *detour_cm;   /* smallest detour of a tested draw, cm (NULL: not printed) */
-    const char *ridge_n;     /* samples the relearn used (all 10,000 inside the 5 m radius) */
-} geo_rows_t;
+/* The planner's search tree for the next decision grown while the last leg was driven
+ * (rfs_seek.c, plan_budget): begun where the leg ends, here the robot's pose, and grown by
+ * plan_budget points a period as drive_on does, each slice measured; the worst as
+ * `base`_slice, the number as `base`_slices. */
+static void grow_on_leg(const char *base, rfs_q16_t rx, rfs_q16_t ry)
+{
+    rfs_plan_t *p = &s_app.seek.plan;
+    rfs_plan_tree_begin(p, rx, ry);
+    uint64_t worst = 0;
+    uint32_t slices = 0;
+    bool done = false;
+    while (!done && slices < 1000u) {
+        const uint64_t a = rfs_bc_ticks();
+        done = rfs_plan_tree_grow(p, s_app.seek.cfg.plan_budget);
+        const uint64_t d = rfs_bc_ticks() - a;
+        worst = d > worst ? d : worst;
+        slices++;
+    }
+    rfs_bc_report(row_name(base, "_slice"), worst, 1);
+    rfs_bc_report(row_name(base, "_slices"), 0, slices);
+}
 
-/* Bring s_app (store already filled) to a decision at (rx, ry) and measure it: one period
- * at the pose, its goal dropped and its model discarded (so the measured period relearns),
- * then `history` (may be NULL), the same pose and a measurement one period later, and
- * that period measured as `period` with its stack depth as `stack`. *rng0 is the random
- * source just before it (for the replays). */
+/* Periods with the robot standing at (rx, ry), a pose and a measurement each, *t
+ * advanced by one period before each, until one decides (at most 100), each measured:
+ * `base` the worst, `base`_first the first, `base`_periods how many (1: the first
+ * decided), `base`_stack the deepest stack. *rng0: the random source just before the
+ * period that decided (for the replays). */
+static void run_until_decided(const char *base, rfs_q16_t rx, rfs_q16_t ry, int64_t *t,
+                              rfs_app_out_t *out, rfs_rng_t *rng0)
+{
+    uint64_t worst = 0;
+    uint32_t periods = 0;
+    const uintptr_t sp0 = rfs_bc_stack_paint();
+    out->decided = false;
+    while (!out->decided && periods < 100u) {
+        *t += RFS_APP_PERIOD_US;
+        const rfs_pose_t p1 = {.t_us = *t, .x = rx, .y = ry, .theta = 0};
+        rfs_app_on_pose(&s_app, &p1, *t);
+        rfs_app_on_rssi(&s_app, 0, *t, -60, *t);
+        *rng0 = s_app.rng;
+        const uint64_t a = rfs_bc_ticks();
+        rfs_app_step(&s_app, *t, out);
+        const uint64_t d = rfs_bc_ticks() - a;
+        if (periods == 0u) {
+            rfs_bc_report(row_name(base, "_first"), d, 1);
+        }
+        worst = d > worst ? d : worst;
+        periods++;
+    }
+    rfs_bc_report(base, worst, 1);
+    rfs_bc_report(row_name(base, "_periods"), 0, periods);
+    rfs_bc_report(row_name(base, "_stack"), 0, rfs_bc_stack_depth(sp0));
+}
+
+/* Bring s_app (store already filled) to a decision at (rx, ry) and measure it: the boot
+ * (periods at the pose until the initial move is decided), its goal dropped and its
+ * model discarded (so the decision relearns), then `history` (may be NULL); with on_leg
+ * the search tree grown as on a leg ending here (grow_on_leg), else none: the leg was cut
+ * short and the decision waits for it. Then run_until_decided as `base`. */
 static void measure_decision(rfs_q16_t rx, rfs_q16_t ry, void (*history)(rfs_seek_t *),
-                             const char *period, const char *stack, rfs_app_out_t *out,
-                             rfs_rng_t *rng0)
+                             const char *base, bool on_leg, rfs_app_out_t *out, rfs_rng_t *rng0)
 {
     int64_t t = 1000000;
-    const rfs_pose_t p0 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
-    rfs_app_on_pose(&s_app, &p0, t);
-    rfs_app_on_rssi(&s_app, 0, t, -60, t);
-    rfs_app_step(&s_app, t, out);
+    out->decided = false;
+    for (uint32_t k = 0; k < 100u && !out->decided; k++, t += RFS_APP_PERIOD_US) {
+        const rfs_pose_t p0 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
+        rfs_app_on_pose(&s_app, &p0, t);
+        rfs_app_on_rssi(&s_app, 0, t, -60, t);
+        rfs_app_step(&s_app, t, out);
+    }
     rfs_drive_stop(&s_app.seek.drive, t);
     s_app.seek.model.ops->reset(s_app.seek.model.self);
     if (history != 0) {
         history(&s_app.seek);
     }
-    t += RFS_APP_PERIOD_US;
-    const rfs_pose_t p1 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
-    rfs_app_on_pose(&s_app, &p1, t);
-    rfs_app_on_rssi(&s_app, 0, t, -60, t);
-    *rng0 = s_app.rng;
-    const uintptr_t sp0 = rfs_bc_stack_paint();
-    RFS_BC_MEASURE(period, 1, rfs_app_step(&s_app, t, out));
-    rfs_bc_report(stack, 0, rfs_bc_stack_depth(sp0));
+    if (on_leg) {
+        grow_on_leg(base, rx, ry);
+    }
+    run_until_decided(base, rx, ry, &t, out, rng0);
 }
 
 /* One epsilon decision in that worst case, of the meta-path preset (geodesic or not) or
@@ -253,7 +310,7 @@ static void measure_decision(rfs_q16_t rx, rfs_q16_t ry, void (*history)(rfs_see
  * the next period measured: relearn on 10,000 samples + the epsilon decision. The kept
  * goal in *gx, *gy (for the plan measured alone). */
 static void geo_decision(const rfs_app_map_t *map, bool meta_path, bool geodesic,
-                         const geo_rows_t *row, rfs_q16_t *gx, rfs_q16_t *gy)
+                         const char *base, bool on_leg, rfs_q16_t *gx, rfs_q16_t *gy)
 {
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
     if (meta_path) {
@@ -270,21 +327,21 @@ static void geo_decision(const rfs_app_map_t *map, bool meta_path, bool geodesic
     fill_store_at(&s_app.seek.store, 42u, 112, 862, 30, 970);
     rfs_app_out_t out;
     rfs_rng_t rng0;
-    measure_decision(rx, ry, geo_history, row->period, row->stack, &out, &rng0);
-    rfs_bc_report(row->eps_relearn, 0,
+    measure_decision(rx, ry, geo_history, base, on_leg, &out, &rng0);
+    rfs_bc_report(row_name(base, "_eps_relearn"), 0,
                   (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_EPSILON &&
                              out.decision.relearned));
     int64_t min_detour;
     const uint32_t plans = geo_replay(&s_app.seek, rng0, geodesic, gx, gy, &min_detour);
-    rfs_bc_report(row->plans, 0, plans);
-    rfs_bc_report(row->goal_ok, 0,
+    rfs_bc_report(row_name(base, "_plans"), 0, plans);
+    rfs_bc_report(row_name(base, "_replay_goal_ok"), 0,
                   (uint32_t)(*gx == out.decision.goal_x && *gy == out.decision.goal_y));
-    rfs_bc_report(row->path_cm, 0, (uint32_t)((out.decision.path_len * 100) >> 16));
-    if (row->detour_cm != 0) {
-        rfs_bc_report(row->detour_cm, 0,
+    rfs_bc_report(row_name(base, "_path_cm"), 0, (uint32_t)((out.decision.path_len * 100) >> 16));
+    if (geodesic) {
+        rfs_bc_report(row_name(base, "_min_detour_cm"), 0,
                       min_detour == INT64_MAX ? 0u : (uint32_t)((min_detour * 100) >> 16));
     }
-    rfs_bc_report(row->ridge_n, 0, s_app.ridge.n_used);
+    rfs_bc_report(row_name(base, "_ridge_samples"), 0, s_app.ridge.n_used);
 }
 
 /* The paper's greedy decision behind a wall (RFS_SEEK_META; rfs_seek_meta.c choose_greedy):
@@ -351,7 +408,7 @@ static bool ls_plan(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, ls_replay_out_t *
 {
     rfs_path_t path;
     o->plans++;
-    const bool ok = rfs_plan_path(&s->plan, s->pose.x, s->pose.y, gx, gy, &path);
+    const bool ok = rfs_plan_tree_path(&s->plan, gx, gy, &path);
     o->expanded += s->plan.expanded;
     if (!ok) {
         o->failed++;
@@ -377,6 +434,7 @@ static void ls_replay(rfs_seek_t *s, rfs_rng_t rng, rfs_q16_t mx, rfs_q16_t my, 
     const rfs_map_t *m = s->map;
     const rfs_q16_t x0 = s->pose.x, y0 = s->pose.y;
     memset(o, 0, sizeof *o);
+    rfs_plan_tree_begin(&s->plan, x0, y0); /* the decision's tree, searched on demand */
     (void)rfs_rng_u32(&rng);
     const int64_t dx = (int64_t)mx - x0, dy = (int64_t)my - y0;
     const rfs_q16_t dist = rfs_q16_dist(x0, y0, mx, my);
@@ -417,27 +475,13 @@ static void ls_replay(rfs_seek_t *s, rfs_rng_t rng, rfs_q16_t mx, rfs_q16_t my, 
     (void)ls_plan(s, mx, my, o);
 }
 
-/* Row names of one ls_decision (bench.sh prints them in this order). */
-typedef struct ls_rows {
-    const char *period;      /* instructions of the measured period */
-    const char *stack;       /* its stack depth, bytes */
-    const char *greedy;      /* 1: it relearnt and decided a greedy goal by the line search */
-    const char *plans;       /* paths planned (ls_replay) */
-    const char *failed;      /* of which failed */
-    const char *expanded;    /* lattice points all of them expanded */
-    const char *candidates;  /* line-search points looked at */
-    const char *goal_ok;     /* 1: the replay kept the decision's goal (and planned, as it did) */
-    const char *path_cm;     /* kept path, cm */
-    const char *ridge_n;     /* samples the relearn used */
-} ls_rows_t;
-
 /* One greedy decision of the paper's configuration (epsilon forced to 0 so the greedy
  * branch is certain, as for worst_iteration) with the robot at (rx, ry): fresh init on
  * the map as it stands, the store on the robot's side of the wall, a boot period (not
  * measured), the model discarded, and the next period measured: relearn on 10,000
  * samples + the greedy decision. */
-static void ls_decision(const rfs_app_map_t *map, rfs_q16_t rx, rfs_q16_t ry, const ls_rows_t *row,
-                        rfs_q16_t *gx, rfs_q16_t *gy)
+static void ls_decision(const rfs_app_map_t *map, rfs_q16_t rx, rfs_q16_t ry, const char *base,
+                        bool on_leg, rfs_q16_t *gx, rfs_q16_t *gy)
 {
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
     cfg.seek.eps_amp = 0;
@@ -450,23 +494,23 @@ static void ls_decision(const rfs_app_map_t *map, rfs_q16_t rx, rfs_q16_t ry, co
                      (int32_t)((ry * 100) >> 16), 960);
     rfs_app_out_t out;
     rfs_rng_t rng0;
-    measure_decision(rx, ry, 0, row->period, row->stack, &out, &rng0);
-    rfs_bc_report(row->greedy, 0,
+    measure_decision(rx, ry, 0, base, on_leg, &out, &rng0);
+    rfs_bc_report(row_name(base, "_greedy"), 0,
                   (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_GREEDY &&
                              out.decision.relearned && out.decision.line_search &&
                              rfs_map_point_legal(&s_app.map, rx, ry)));
     ls_replay_out_t o;
     ls_replay(&s_app.seek, rng0, out.decision.max_x, out.decision.max_y, &o);
-    rfs_bc_report(row->plans, 0, o.plans);
-    rfs_bc_report(row->failed, 0, o.failed);
-    rfs_bc_report(row->expanded, 0, o.expanded);
-    rfs_bc_report(row->candidates, 0, o.candidates);
-    rfs_bc_report(row->goal_ok, 0,
+    rfs_bc_report(row_name(base, "_plans"), 0, o.plans);
+    rfs_bc_report(row_name(base, "_failed"), 0, o.failed);
+    rfs_bc_report(row_name(base, "_expanded"), 0, o.expanded);
+    rfs_bc_report(row_name(base, "_candidates"), 0, o.candidates);
+    rfs_bc_report(row_name(base, "_replay_goal_ok"), 0,
                   (uint32_t)(o.ok && o.line_search && (out.faults & RFS_SEEK_FAULT_NO_GOAL) == 0u &&
                              o.gx == out.decision.goal_x && o.gy == out.decision.goal_y &&
                              o.path == out.decision.path_len));
-    rfs_bc_report(row->path_cm, 0, (uint32_t)((out.decision.path_len * 100) >> 16));
-    rfs_bc_report(row->ridge_n, 0, s_app.ridge.n_used);
+    rfs_bc_report(row_name(base, "_path_cm"), 0, (uint32_t)((out.decision.path_len * 100) >> 16));
+    rfs_bc_report(row_name(base, "_ridge_samples"), 0, s_app.ridge.n_used);
     *gx = out.decision.goal_x;
     *gy = out.decision.goal_y;
 }
@@ -480,13 +524,9 @@ static void __attribute__((noinline)) ls_measure(const rfs_app_map_t *map)
      * the maximum at the north-west corner, so the 1 m step point (y ~10.25 m) lies in
      * the zone and the line search runs: its first legal candidate beyond the zone is
      * two indices out, in front of the step point five, so it plans round the wall. */
-    static const ls_rows_t ls_wall = {
-        "worst_greedy_ls_wall", "stack_bytes_worst_greedy_ls_wall", "worst_greedy_ls_wall_greedy",
-        "worst_greedy_ls_wall_plans", "worst_greedy_ls_wall_failed",
-        "worst_greedy_ls_wall_expanded", "worst_greedy_ls_wall_candidates",
-        "worst_greedy_ls_wall_replay_goal_ok", "worst_greedy_ls_wall_path_cm",
-        "worst_greedy_ls_wall_ridge_samples"};
-    ls_decision(map, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(37, 4), &ls_wall, &gx, &gy);
+    ls_decision(map, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(37, 4), "worst_greedy_ls_wall", true, &gx, &gy);
+    ls_decision(map, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(37, 4), "worst_greedy_ls_wall_cut", false, &gx,
+                &gy);
     /* The worst constructed: a closed room north of the wall (ls_room). From
      * (1.125, 9.5) m, at the edge of the clearance zone, the step point (y ~10.5 m) is
      * legal, in the room: it and the room's candidates plan and fail until the search
@@ -496,31 +536,21 @@ static void __attribute__((noinline)) ls_measure(const rfs_app_map_t *map)
      * rounding): the room candidates beyond plan and fail until then, and the goal is a
      * null move, decided again every second (rfs_seek.c end_decision). */
     ls_room();
-    static const ls_rows_t ls_room_first = {
-        "worst_greedy_ls_room_first", "stack_bytes_worst_greedy_ls_room_first",
-        "worst_greedy_ls_room_first_greedy", "worst_greedy_ls_room_first_plans",
-        "worst_greedy_ls_room_first_failed", "worst_greedy_ls_room_first_expanded",
-        "worst_greedy_ls_room_first_candidates", "worst_greedy_ls_room_first_replay_goal_ok",
-        "worst_greedy_ls_room_first_path_cm", "worst_greedy_ls_room_first_ridge_samples"};
-    static const ls_rows_t ls_room_next = {
-        "worst_greedy_ls_room", "stack_bytes_worst_greedy_ls_room", "worst_greedy_ls_room_greedy",
-        "worst_greedy_ls_room_plans", "worst_greedy_ls_room_failed",
-        "worst_greedy_ls_room_expanded", "worst_greedy_ls_room_candidates",
-        "worst_greedy_ls_room_replay_goal_ok", "worst_greedy_ls_room_path_cm",
-        "worst_greedy_ls_room_ridge_samples"};
-    ls_decision(map, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(19, 2), &ls_room_first, &gx, &gy);
-    ls_decision(map, gx, gy, &ls_room_next, &gx, &gy);
+    ls_decision(map, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(19, 2), "worst_greedy_ls_room_first", true,
+                &gx, &gy);
+    ls_decision(map, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(19, 2), "worst_greedy_ls_room_first_cut",
+                false, &gx, &gy);
+    const rfs_q16_t nx = gx, ny = gy;
+    ls_decision(map, nx, ny, "worst_greedy_ls_room", true, &gx, &gy);
+    ls_decision(map, nx, ny, "worst_greedy_ls_room_cut", false, &gx, &gy);
     /* The same from (1.125, 9.6) m, 2 cm short of that goal (the drive stops within
      * 0.1 m of it): there index 8 in front gives t = 0 (skipped), so no candidate in
      * front is legal, and every room candidate beyond plans and fails until the north
      * strip's first one plans round both walls. */
-    static const ls_rows_t ls_room_worst = {
-        "worst_greedy_ls_room_worst", "stack_bytes_worst_greedy_ls_room_worst",
-        "worst_greedy_ls_room_worst_greedy", "worst_greedy_ls_room_worst_plans",
-        "worst_greedy_ls_room_worst_failed", "worst_greedy_ls_room_worst_expanded",
-        "worst_greedy_ls_room_worst_candidates", "worst_greedy_ls_room_worst_replay_goal_ok",
-        "worst_greedy_ls_room_worst_path_cm", "worst_greedy_ls_room_worst_ridge_samples"};
-    ls_decision(map, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(48, 5), &ls_room_worst, &gx, &gy);
+    ls_decision(map, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(48, 5), "worst_greedy_ls_room_worst", true,
+                &gx, &gy);
+    ls_decision(map, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(48, 5), "worst_greedy_ls_room_worst_cut",
+                false, &gx, &gy);
 }
 
 /* The bench's map: free inside, a one-cell wall round the edge. */
@@ -563,26 +593,16 @@ static void __attribute__((noinline)) measure_init(const rfs_app_map_t *map, con
  * an ordinary period while driving. Returns the time of the last; its output in *out. */
 static int64_t __attribute__((noinline)) measure_periods(rfs_q16_t rx, rfs_q16_t ry, rfs_app_out_t *out)
 {
-    /* Boot: the first period with a pose and a measurement: reachability flood fill,
+    /* Boot: the first periods with a pose and a measurement: reachability flood fill,
      * first fit, the initial move. */
-    int64_t t = 1000000;
-    const rfs_pose_t pose0 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
-    rfs_app_on_pose(&s_app, &pose0, t);
-    rfs_app_on_rssi(&s_app, 0, t, -60, t);
-    uintptr_t sp0 = rfs_bc_stack_paint();
-    RFS_BC_MEASURE("first_iteration", 1, rfs_app_step(&s_app, t, out));
-    rfs_bc_report("stack_bytes_first_iteration", 0, rfs_bc_stack_depth(sp0));
+    int64_t t = 1000000 - RFS_APP_PERIOD_US;
+    rfs_rng_t rng0;
+    run_until_decided("first_iteration", rx, ry, &t, out, &rng0);
 
     /* The worst case: the goal ended, the model no longer fits (discarded), iteration 1. */
     rfs_drive_stop(&s_app.seek.drive, t);
     s_app.seek.model.ops->reset(s_app.seek.model.self);
-    t += RFS_APP_PERIOD_US;
-    const rfs_pose_t pose1 = {.t_us = t, .x = rx, .y = ry, .theta = 0};
-    rfs_app_on_pose(&s_app, &pose1, t);
-    rfs_app_on_rssi(&s_app, 0, t, -60, t);
-    sp0 = rfs_bc_stack_paint();
-    RFS_BC_MEASURE("worst_iteration", 1, rfs_app_step(&s_app, t, out));
-    rfs_bc_report("stack_bytes_worst_iteration", 0, rfs_bc_stack_depth(sp0));
+    run_until_decided("worst_iteration", rx, ry, &t, out, &rng0);
     rfs_bc_report("worst_decided_greedy_relearned", 0,
                   (uint32_t)(out->decided && out->decision.kind == RFS_SEEK_GREEDY &&
                              out->decision.relearned));
@@ -817,28 +837,19 @@ static void __attribute__((noinline)) measure_behind_wall(const rfs_app_map_t *m
 {
     geo_wall();
     rfs_q16_t gx, gy, sx, sy; /* the kept goals; the plan alone goes to the geodesic one */
-    static const geo_rows_t geo_on = {
-        "worst_eps_geodesic", "stack_bytes_worst_eps_geodesic", "worst_eps_geodesic_eps_relearn",
-        "worst_eps_geodesic_plans", "worst_eps_geodesic_replay_goal_ok",
-        "worst_eps_geodesic_path_cm", "worst_eps_geodesic_min_detour_cm",
-        "worst_eps_geodesic_ridge_samples"};
-    static const geo_rows_t geo_off = {
-        "worst_eps_straight", "stack_bytes_worst_eps_straight", "worst_eps_straight_eps_relearn",
-        "worst_eps_straight_plans", "worst_eps_straight_replay_goal_ok",
-        "worst_eps_straight_path_cm", 0, "worst_eps_straight_ridge_samples"};
-    static const geo_rows_t geo_paper = {
-        "worst_eps_paper", "stack_bytes_worst_eps_paper", "worst_eps_paper_eps_relearn",
-        "worst_eps_paper_plans", "worst_eps_paper_replay_goal_ok", "worst_eps_paper_path_cm", 0,
-        "worst_eps_paper_ridge_samples"};
-    geo_decision(map, true, true, &geo_on, &gx, &gy);
-    geo_decision(map, true, false, &geo_off, &sx, &sy);
-    geo_decision(map, false, false, &geo_paper, &sx, &sy);
+    geo_decision(map, true, true, "worst_eps_geodesic", true, &gx, &gy);
+    rfs_q16_t cx, cy; /* the cut-short decision's goal: its draws differ (it waited) */
+    geo_decision(map, true, true, "worst_eps_geodesic_cut", false, &cx, &cy);
+    geo_decision(map, true, false, "worst_eps_straight", true, &sx, &sy);
+    geo_decision(map, false, false, "worst_eps_paper", true, &sx, &sy);
+    geo_decision(map, false, false, "worst_eps_paper_cut", false, &cx, &cy);
     bool geo_ok = false;
     RFS_BC_MEASURE("phase_plan_behind_wall", 1,
                    geo_ok = rfs_plan_path(&s_app.seek.plan, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(69, 8),
                                           gx, gy, path));
     rfs_bc_report("plan_behind_wall_ok", 0, geo_ok ? 1u : 0u);
     rfs_bc_report("plan_behind_wall_expanded", 0, s_app.seek.plan.expanded);
+    rfs_bc_report("plan_behind_wall_pulled", 0, s_app.seek.plan.pulled);
     rfs_bc_report("plan_behind_wall_path_cm", 0, (uint32_t)((path->length * 100) >> 16));
     /* The same goal by a fresh search tree from the robot (the geodesic decision's first
      * try), then a second goal on that tree (the straight decision's kept goal, also
@@ -854,6 +865,16 @@ static void __attribute__((noinline)) measure_behind_wall(const rfs_app_map_t *m
                    geo_ok = rfs_plan_tree_path(&s_app.seek.plan, sx, sy, path));
     rfs_bc_report("tree_second_goal_ok", 0, geo_ok ? 1u : 0u);
     rfs_bc_report("tree_second_goal_expanded", 0, s_app.seek.plan.expanded);
+    /* The decision's plan on a grown tree (plan_budget): a walk along the back-pointers
+     * and the linear pull, no search. */
+    rfs_plan_tree_begin(&s_app.seek.plan, RFS_Q16_FRAC(9, 8), RFS_Q16_FRAC(69, 8));
+    while (!rfs_plan_tree_grow(&s_app.seek.plan, UINT32_MAX)) {
+    }
+    RFS_BC_MEASURE("phase_walk_behind_wall", 1,
+                   geo_ok = rfs_plan_tree_path(&s_app.seek.plan, gx, gy, path));
+    rfs_bc_report("walk_behind_wall_ok", 0, geo_ok ? 1u : 0u);
+    rfs_bc_report("walk_behind_wall_pulled", 0, s_app.seek.plan.pulled);
+    rfs_bc_report("walk_behind_wall_path_cm", 0, (uint32_t)((path->length * 100) >> 16));
     rfs_bc_report("tree_second_goal_path_cm", 0, (uint32_t)((path->length * 100) >> 16));
 }
 

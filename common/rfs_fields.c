@@ -35,6 +35,8 @@ rfs_fields_cfg_t rfs_fields_cfg_default(void)
     c.draw_t = RFS_Q16_INT(3);
     c.coarse = RFS_Q16_ONE;
     c.refit_min = 100u; /* about 4 m of new travel */
+    c.lcb = 0; /* 1: held-out seeds 1001..1200 141 -> 136 and 150 -> 143 of 200 within 3 m
+                * (office, corridor; docs/PATHLOSS.md) */
     return c;
 }
 
@@ -61,7 +63,7 @@ int rfs_fields_init(rfs_fields_t *f, const rfs_fields_cfg_t *cfg, const rfs_targ
         t->nsources > RFS_MODEL_MAX_SOURCES || cfg->cell <= 0 || cfg->cell > RFS_Q16_INT(8) ||
         cfg->radius < 0 || (int64_t)cfg->radius > (int64_t)cfg->cell * RFS_FIELDS_KERNEL_MAX ||
         cfg->prior_n == 0u || cfg->draw_t <= 0 || cfg->coarse <= 0 || cfg->refit_min == 0u ||
-        mem->f == 0) {
+        cfg->lcb < 0 || cfg->lcb > RFS_Q16_INT(8) || mem->f == 0) {
         return -1;
     }
     for (uint8_t k = 0u; k < t->nsources; ++k) {
@@ -250,17 +252,32 @@ static bool residual_run(rfs_fields_t *f, const rfs_model_fit_in_t *in, uint32_t
     return true;
 }
 
-/* Every source's residual at lattice point (i, j) into res[]; true when a sample lies
- * within the kernel of any of them. */
-static bool residuals(const rfs_fields_t *f, uint16_t i, uint16_t j, rfs_q16_t *res)
+/* Every source's residual at lattice point (i, j) into res[], its kernel-weighted count
+ * (Q16) into nw[]; true when a sample lies within the kernel of any of them. */
+static bool residuals(const rfs_fields_t *f, uint16_t i, uint16_t j, rfs_q16_t *res,
+                      int64_t *nw)
 {
     bool near = false;
     for (uint8_t k = 0u; k < f->target->nsources; ++k) {
-        int64_t nw;
-        res[k] = residual(f, k, i, j, &nw);
-        near = near || nw > 0;
+        res[k] = residual(f, k, i, j, &nw[k]);
+        near = near || nw[k] > 0;
     }
     return near;
+}
+
+/* The target's uncertainty at a point with kernel-weighted counts nw[] (Q16): sqrt(2 sum_k
+ * rms_k^2 prior_n / (prior_n + nw_k)), target units Q16.16 (rfs_fields_est_t.sigma).
+ * Scaling and overflow: rms^2 in Q16 dB^2 (< 2^32) times the shrinkage factor (Q16,
+ * <= 1) < 2^48; the sum of two, doubled, saturated to Q16.16 for the root. */
+static rfs_q16_t point_sigma(const rfs_fields_t *f, const int64_t *nw)
+{
+    const int64_t prior = (int64_t)f->cfg.prior_n << 16;
+    int64_t s2 = 0;
+    for (uint8_t k = 0u; k < f->target->nsources; ++k) {
+        const int64_t shrink = rfs_sdiv64_round(prior << 16, prior + nw[k]); /* Q16, <= 1 */
+        s2 += (f->rms2[k] * shrink) >> 16;
+    }
+    return rfs_q16_sqrt(rfs_sat32(2 * s2));
 }
 
 /* The corrected fields' target at lattice point (i, j) given its residuals res[],
@@ -291,8 +308,12 @@ static int16_t q16_to_q6(rfs_q16_t v)
     return (int16_t)(q > INT16_MAX ? INT16_MAX : q <= RFS_FIELDS_SKIPPED ? RFS_FIELDS_SKIPPED + 1 : q);
 }
 
-/* Predict candidate idx = (i, j) into f[], keeping the best. false without a model. */
-static bool predict_point(rfs_fields_t *f, uint32_t idx, const rfs_q16_t *res, uint32_t *used)
+/* Predict candidate idx = (i, j) into f[] (residuals res[], counts nw[]), keeping the
+ * highest prediction and the best point: the highest prediction less lcb sigmas.
+ * false without a model. Scaling and overflow: lcb (Q16, <= 8) times sigma (Q16.16,
+ * < 2^31) in int64, the score saturated to Q16.16. */
+static bool predict_point(rfs_fields_t *f, uint32_t idx, const rfs_q16_t *res,
+                          const int64_t *nw, uint32_t *used)
 {
     const uint16_t i = (uint16_t)(idx % f->map->lw), j = (uint16_t)(idx / f->map->lw);
     rfs_q16_t v;
@@ -301,8 +322,15 @@ static bool predict_point(rfs_fields_t *f, uint32_t idx, const rfs_q16_t *res, u
     }
     int16_t q = q16_to_q6(v);
     f->mem.f[idx] = q;
-    if (q > f->best_v) {
-        f->best_v = q;
+    f->best_v = q > f->best_v ? q : f->best_v;
+    /* lcb 0 ranks by the kept Q9.6 value: the first of equal predictions is the best. */
+    rfs_q16_t score = (rfs_q16_t)q * 1024;
+    if (f->cfg.lcb > 0) {
+        score = rfs_sat32((int64_t)v - (((int64_t)f->cfg.lcb * point_sigma(f, nw)) >> 16));
+    }
+    if (!f->scored || score > f->best_s) {
+        f->scored = true;
+        f->best_s = score;
         f->best = idx;
     }
     return true;
@@ -339,8 +367,14 @@ static bool lattice_run(rfs_fields_t *f, const rfs_model_fit_in_t *in, uint32_t 
     if (f->pos == 0u) {
         f->best_v = RFS_FIELDS_NONE;
         f->best = 0u;
+        f->scored = false;
         f->ntop = 0u;
         f->lattice_done = false;
+        for (uint8_t k = 0u; k < f->target->nsources; ++k) {
+            rfs_pathloss_est_t e;
+            (void)rfs_pathloss_estimate(&f->src[k], &e);
+            f->rms2[k] = ((int64_t)e.rms * e.rms) >> 16;
+        }
     }
     for (; f->pos < n; ++f->pos) {
         if (budget != 0u && *used >= budget) {
@@ -352,6 +386,7 @@ static bool lattice_run(rfs_fields_t *f, const rfs_model_fit_in_t *in, uint32_t 
         const uint16_t i = (uint16_t)(f->pos % m->lw), j = (uint16_t)(f->pos / m->lw);
         int16_t *out = &f->mem.f[f->pos];
         rfs_q16_t res[RFS_MODEL_MAX_SOURCES];
+        int64_t nw[RFS_MODEL_MAX_SOURCES];
         *out = RFS_FIELDS_NONE;
         if (!rfs_map_lattice_legal(m, i, j) ||
             (in->reach != 0 && !rfs_reach_bit(in->reach, f->pos))) {
@@ -359,7 +394,7 @@ static bool lattice_run(rfs_fields_t *f, const rfs_model_fit_in_t *in, uint32_t 
         }
         *out = RFS_FIELDS_SKIPPED;
         const bool coarse = i % f->cstep == 0u && j % f->cstep == 0u;
-        if ((residuals(f, i, j, res) || coarse) && predict_point(f, f->pos, res, used) &&
+        if ((residuals(f, i, j, res, nw) || coarse) && predict_point(f, f->pos, res, nw, used) &&
             coarse) {
             keep_top(f, f->pos);
         }
@@ -385,18 +420,18 @@ static bool refine_run(rfs_fields_t *f, uint32_t budget, uint32_t *used)
         }
         const uint32_t idx = (uint32_t)j * m->lw + (uint32_t)i;
         rfs_q16_t res[RFS_MODEL_MAX_SOURCES];
+        int64_t nw[RFS_MODEL_MAX_SOURCES];
         if (f->mem.f[idx] == RFS_FIELDS_SKIPPED) {
-            (void)residuals(f, (uint16_t)i, (uint16_t)j, res);
-            (void)predict_point(f, idx, res, used);
+            (void)residuals(f, (uint16_t)i, (uint16_t)j, res, nw);
+            (void)predict_point(f, idx, res, nw, used);
         }
     }
     return true;
 }
 
 /* The estimate at the best point: its exact prediction, sigma and the area within it
- * (rfs_fields_est_t). Scaling and overflow: rms^2 in Q16 dB^2 (< 2^32) times the
- * shrinkage factor (Q16, <= 1) < 2^48; the sum of two, doubled, saturated to Q16.16
- * for the root; the area is the count times grid^2 (Q16, < 2^20) below 2^52. */
+ * (rfs_fields_est_t). Scaling and overflow: the area is the count times grid^2 (Q16,
+ * < 2^20) below 2^52. */
 static void finish(rfs_fields_t *f)
 {
     const rfs_map_t *m = f->map;
@@ -404,19 +439,10 @@ static void finish(rfs_fields_t *f)
     uint32_t used = 0u;
     rfs_map_lattice_point(m, i, j, &f->bx, &f->by);
     rfs_q16_t res[RFS_MODEL_MAX_SOURCES];
-    (void)residuals(f, i, j, res);
+    int64_t nw[RFS_MODEL_MAX_SOURCES];
+    (void)residuals(f, i, j, res, nw);
     (void)target_at(f, i, j, res, &used, &f->bf);
-    int64_t s2 = 0;
-    for (uint8_t k = 0u; k < f->target->nsources; ++k) {
-        rfs_pathloss_est_t e;
-        int64_t nw;
-        (void)rfs_pathloss_estimate(&f->src[k], &e);
-        (void)residual(f, k, i, j, &nw);
-        const int64_t prior = (int64_t)f->cfg.prior_n << 16;
-        const int64_t shrink = rfs_sdiv64_round(prior << 16, prior + nw); /* Q16, <= 1 */
-        s2 += ((((int64_t)e.rms * e.rms) >> 16) * shrink) >> 16;
-    }
-    f->sigma = rfs_q16_sqrt(rfs_sat32(2 * s2));
+    f->sigma = point_sigma(f, nw);
     const int32_t floor_q6 = q16_to_q6(rfs_q16_sub(f->bf, f->sigma));
     uint32_t within = 0u;
     for (uint32_t p = 0u; p < (uint32_t)m->lw * m->lh; ++p) {

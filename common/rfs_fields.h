@@ -69,6 +69,8 @@ typedef struct rfs_fields_cfg {
                                  ///< are binned again), >= 1
     rfs_q16_t coarse;            ///< spacing of the points predicted away from the samples,
                                  ///< metres Q16.16 (1 m), rounded to lattice steps (>= 1)
+    rfs_q16_t lcb;               ///< the best point has the highest prediction less lcb
+                                 ///< times its sigma (rfs_fields_est_t), Q16.16 (0), 0..8
 } rfs_fields_cfg_t;
 
 /// Caller-owned arrays, sized with rfs_fields_mem_size() for the map.
@@ -126,13 +128,16 @@ typedef struct rfs_fields {
     rfs_q16_t wsx[RFS_MODEL_MAX_SOURCES];        ///< source position walls[k] count to, Q16.16
     rfs_q16_t wsy[RFS_MODEL_MAX_SOURCES];        ///< (metres)
     const rfs_map_t *wmap;                       ///< map the walls belong to
-    uint32_t best;                               ///< lattice index of the best point
-    int32_t best_v;                              ///< its prediction, Q9.6 (RFS_FIELDS_NONE: none)
+    uint32_t best;                               ///< lattice index of the best point (lcb)
+    int32_t best_v;                              ///< the highest prediction, Q9.6 (RFS_FIELDS_NONE: none)
     rfs_q16_t bx;                                ///< best point x, metres Q16.16
     rfs_q16_t by;                                ///< best point y, metres Q16.16
     rfs_q16_t bf;                                ///< prediction there, target units Q16.16
     rfs_q16_t sigma;                             ///< its uncertainty, target units Q16.16
     rfs_q16_t area_m2;                           ///< area within sigma of the best, m^2 Q16.16
+    int64_t rms2[RFS_MODEL_MAX_SOURCES];         ///< each fit's rms^2, dB^2 Q16 (this lattice)
+    bool scored;                                 ///< best_s holds a point's score
+    rfs_q16_t best_s;                            ///< the best point's score, Q16.16
     uint32_t walls_counted;                      ///< wall counts of the last fit's own passes
     bool fitted[RFS_MODEL_MAX_SOURCES];          ///< src[k] holds a fit of fit_n/fit_seen
     uint16_t fit_n[RFS_MODEL_MAX_SOURCES];       ///< samples of that fit

@@ -840,6 +840,15 @@ static void bridge_result(sim_run_t *r)
         res->pred_f_db = q16d(est.value);
         res->pred_sigma_db = q16d(est.sigma);
         res->pred_area_m2 = q16d(est.area_m2);
+        for (unsigned k = 0; k < 2; k++) {
+            const rfs_pathloss_est_t *p = &est.src[k];
+            bool ok = k < est.nsources;
+            double v[6] = {q16d(p->sx), q16d(p->sy), q16d(p->p0), q16d(p->n), q16d(p->w),
+                           q16d(p->rms)};
+            for (unsigned i = 0; i < 6; i++) {
+                res->pred_src[k][i] = ok ? v[i] : NAN;
+            }
+        }
     } else {
         res->pred_x = res->pred_y = res->pred_f_db = res->pred_sigma_db = NAN;
         res->pred_area_m2 = NAN;
@@ -1106,7 +1115,24 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
         json_num(f, "pred_y_m", r->pred_valid ? r->pred_y : NAN, false);
         json_num(f, "pred_f_db", r->pred_valid ? r->pred_f_db : NAN, false);
         json_num(f, "pred_sigma_db", r->pred_valid ? r->pred_sigma_db : NAN, false);
-        json_num(f, "pred_area_m2", r->pred_valid ? r->pred_area_m2 : NAN, true);
+        json_num(f, "pred_area_m2", r->pred_valid ? r->pred_area_m2 : NAN, !r->pred_valid);
+        if (r->pred_valid) {
+            // Each node's fit, [x_m, y_m, p0_dbm, n, w_db, rms_db], beside "sources".
+            fprintf(f, "  \"pred_sources\": [");
+            for (unsigned k = 0; k < 2; k++) {
+                fprintf(f, "%s[", k ? ", " : "");
+                for (unsigned i = 0; i < 6; i++) {
+                    double v = r->pred_src[k][i];
+                    if (isfinite(v)) {
+                        fprintf(f, "%s%.3f", i ? ", " : "", v);
+                    } else {
+                        fprintf(f, "%snull", i ? ", " : "");
+                    }
+                }
+                fprintf(f, "]");
+            }
+            fprintf(f, "]\n");
+        }
     }
     fprintf(f, "}\n");
 }

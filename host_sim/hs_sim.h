@@ -112,6 +112,9 @@ typedef struct hs_sim_result {
     double pred_f_db;            ///< predicted f there, dB
     double pred_sigma_db;        ///< its uncertainty (rfs_fields_est_t.sigma), dB
     double pred_area_m2;         ///< area predicted within sigma of the best, m^2
+    /// Each node's path-loss fit then (rfs_pathloss_est_t): x, y (metres), P0 (dBm at
+    /// 1 m), n, W (dB a wall), rms residual (dB); NaN without a fit.
+    double pred_src[2][6];
 } hs_sim_result_t;
 
 /// The radius of hs_sim_result_t.still_s, metres: the robot "parked" at its end point.

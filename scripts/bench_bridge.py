@@ -9,7 +9,8 @@ figure docs/figures/seek_bridge.png, and nothing else.
                                              [--sim build/bin/rfseek-sim]
                                              [--results docs/RESULTS.md | --no-write]
     /usr/bin/python3 scripts/bench_bridge.py --smoke   (seed 1, no files written)
-    /usr/bin/python3 scripts/bench_bridge.py --keep DIR ...   (also keep every runs.tsv)
+    /usr/bin/python3 scripts/bench_bridge.py --keep DIR ...   (also keep every runs.tsv; a
+                                        table already there for the same seeds is reused)
     /usr/bin/python3 scripts/bench_bridge.py --from DIR       (the section from kept tables)
 
 The simulator reports each run's true best point (the mean field's f over the points the
@@ -19,6 +20,7 @@ default: the per-node configuration was tuned on seeds 1..30 of scenarios/bridge
 """
 import argparse
 import csv
+import json
 import os
 import re
 import subprocess
@@ -39,6 +41,7 @@ NEAR_M = 3.0
 
 
 def run(sim, scenario, strategy, model, seeds, jobs, out):
+    """The runs.tsv rows, and each per-node run's node fits (summary.json pred_sources)."""
     cmd = [sim, scenario, "--strategy", strategy, "--model", model, "--seeds", seeds,
            "--quiet", "--out", out]
     if jobs:
@@ -47,7 +50,28 @@ def run(sim, scenario, strategy, model, seeds, jobs, out):
     if r.returncode != 0:
         sys.exit(f"bench_bridge: {scenario}: {r.stderr.strip()}")
     with open(os.path.join(out, "runs.tsv")) as f:
-        return list(csv.DictReader(f, delimiter="\t"))
+        rows = list(csv.DictReader(f, delimiter="\t"))
+    for row in rows:
+        with open(os.path.join(out, f"seed-{row['seed']}", "summary.json")) as f:
+            sm = json.load(f)
+        fits = sm.get("pred_sources")
+        for k, src in enumerate(sm["sources"]):
+            fit = fits[k] if fits else [None] * 6
+            row[f"fit{k}_err_m"] = ("nan" if fit[0] is None else
+                                    f"{np.hypot(fit[0] - src[0], fit[1] - src[1]):.3f}")
+            row[f"fit{k}_p0"], row[f"fit{k}_w"] = (
+                "nan" if fit[i] is None else f"{fit[i]:.3f}" for i in (2, 4))
+    return rows
+
+
+def kept(path, seeds):
+    """A kept table's rows when it holds exactly the seeds A..B, else None."""
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        rows = list(csv.DictReader(f, delimiter="\t"))
+    a, b = (int(v) for v in seeds.split(".."))
+    return rows if [int(r["seed"]) for r in rows] == list(range(a, b + 1)) else None
 
 
 def stats(rows):
@@ -60,6 +84,10 @@ def stats(rows):
     return {"n": len(rows), "near": int((err <= NEAR_M).sum()), "err": err, "short": short,
             "travel": travel, "pred": pred, "gap": gap, "sigma": num("pred_sigma_db"),
             "final": np.c_[num("final_x_m"), num("final_y_m")],
+            "fit_err": np.concatenate([num(f"fit{k}_err_m") for k in (0, 1)])
+            if "fit0_err_m" in rows[0] else np.array([np.nan]),
+            "fit_w": np.concatenate([num(f"fit{k}_w") for k in (0, 1)])
+            if "fit0_w" in rows[0] else np.array([np.nan]),
             "best": np.c_[num("best_x_m"), num("best_y_m")]}
 
 
@@ -72,19 +100,19 @@ def mp(a):
 def section(seeds, wall, at, jobs, table):
     per = [s for _, cfgs in table for (st, _, _), s in cfgs if st == "meta-path"]
     gap = np.concatenate([s["gap"] for s in per])
-    sig = np.concatenate([s["sigma"] for s in per])
+    fit_err = np.concatenate([s["fit_err"] for s in per])
+    fit_w = [f"{np.nanmedian(s['fit_w']):.1f}" for s in per]
     L = [BEGIN, "## Bridging (paper section 6)", "",
-         f"Written by `/usr/bin/python3 scripts/bench_bridge.py --seeds {seeds}"
-         f"{f' --jobs {jobs}' if jobs else ''}` at commit {at} ({wall:.0f} s). f = "
-         "-|R1 - R2| - |R1 + R2|, threshold 7 (the paper's for this target), runs ending at "
-         "150 m or 600 s. *Best point*: the best f of the seed's mean field (no fading or "
-         "noise) where the robot can stand, reachable, 0.1 m grid (hs_bridge.h); *distance* "
-         "and *shortfall* f(best) - f(end) where a run ends; *travel to settle*: after which "
-         "the robot stayed within 1 m of it. Per node, runs end a median "
-         f"{np.nanmedian(gap):.2f} m from the predicted point, whose sigma is a median "
-         f"{np.nanmedian(sig):.1f} dB. Cells: median (p90). Scenarios: docs/SIMULATOR.md; "
-         "*paper*: meta + ridge on f; *per node*: meta-path + pathloss, one fit per node "
-         "(docs/STRATEGIES.md).", "",
+         f"`/usr/bin/python3 scripts/bench_bridge.py --seeds {seeds}"
+         f"{f' --jobs {jobs}' if jobs else ''}` at {at} "
+         f"({'kept tables' if wall is None else f'{wall:.0f} s'}); runs end at 150 m or "
+         "600 s. *Best point*: of the true f (mean field, no fading; reachable standing "
+         "points, 0.1 m grid; hs_bridge.h). *Distance*, *shortfall* f(best) - f(end): where "
+         "a run ends; *travel to settle*: after which it stayed within 1 m. Per node: ends "
+         f"{np.nanmedian(gap):.2f} m from the predicted point; fitted nodes "
+         f"{np.nanmedian(fit_err):.1f} m off (p90 {np.nanpercentile(fit_err, 90):.1f}), W "
+         f"{', '.join(fit_w)} dB (true 5, 5, 3, 3). Cells: median (p90). *paper*: meta + ridge on f; *per node*: meta-path + "
+         "pathloss.", "",
          "| scenario | configuration | within 3 m | distance, m | shortfall, dB | "
          "travel to settle, m |",
          "|---|---|---|---|---|---|"]
@@ -113,7 +141,7 @@ def figure(path, sim, seed, best, finals):
     sc = ax.scatter(a[:, 0], a[:, 1], c=f, s=2, cmap="viridis", marker="s", linewidths=0,
                     vmin=np.max(f) - 40, vmax=np.max(f))
     fig.colorbar(sc, ax=ax, label=f"true f, dB (seed {seed} field, no fading)")
-    for (label, pts), style in zip(finals, ("r.", "c.")):
+    for (label, pts), style in zip(finals, ("r.", "w.")):
         ax.plot(pts[:, 0], pts[:, 1], style, ms=4, label=f"{label}: where the runs settled")
     ax.plot(best[0], best[1], "w*", ms=14, mec="k", label=f"best point of f (seed {seed})")
     ax.plot([7.5, 27.5], [2.0, 10.0], "^", color="orange", ms=10, mec="k", ls="none",
@@ -138,37 +166,49 @@ def main():
     ap.add_argument("--smoke", action="store_true", help="seed 1, print, check, no files")
     ap.add_argument("--keep", help="also copy every runs.tsv (and the run's commit) here")
     ap.add_argument("--from", dest="from_dir", help="write from the tables --keep kept")
+    ap.add_argument("--only", choices=[c[2] for c in CONFIGS],
+                    help="with --keep: run only this configuration's tables, write nothing")
     a = ap.parse_args()
     if a.smoke:
         a.seeds, a.no_write = "1..1", True
+    if a.only and not a.keep:
+        sys.exit("bench_bridge: --only needs --keep")
     m = re.fullmatch(r"(\d+)\.\.(\d+)", a.seeds)
     if not m:
         sys.exit("bench_bridge: --seeds: expected A..B")
     t0 = time.time()
-    table = []
+    table, reused = [], False
     if a.keep:
         os.makedirs(a.keep, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
         for sc in SCENARIOS:
             cfgs = []
             for strategy, model, label in CONFIGS:
+                if a.only and label != a.only:
+                    continue
                 name = f"{sc}-{strategy}"
+                rows = kept(os.path.join(a.keep, name + ".tsv"), a.seeds) if a.keep else None
+                reused = reused or rows is not None
                 if a.from_dir:
                     with open(os.path.join(a.from_dir, name + ".tsv")) as f:
                         rows = list(csv.DictReader(f, delimiter="\t"))
-                else:
+                elif rows is None:
                     rows = run(a.sim, f"scenarios/{sc}.yaml", strategy, model, a.seeds, a.jobs,
                                os.path.join(tmp, name))
                 if a.keep:
-                    with open(os.path.join(a.keep, name + ".tsv"), "w") as f:
+                    path = os.path.join(a.keep, name + ".tsv")
+                    with open(path + ".tmp", "w") as f:
                         w = csv.DictWriter(f, fieldnames=list(rows[0]), delimiter="\t")
                         w.writeheader()
                         w.writerows(rows)
+                    os.replace(path + ".tmp", path)
                 s = stats(rows)
                 cfgs.append(((strategy, model, label), s))
                 print(f"{sc} | {label} | {s['near']}/{s['n']} | {mp(s['err'])} | "
                       f"{mp(s['short'])} | {mp(s['travel'])} | {mp(s['pred'])}", flush=True)
             table.append((sc, cfgs))
+    if a.only:
+        return 0
     at, wall = commit(), time.time() - t0
     if a.from_dir:  # the commit and wall time of the run that kept the tables
         with open(os.path.join(a.from_dir, "run.txt")) as f:
@@ -177,7 +217,7 @@ def main():
     elif a.keep:
         with open(os.path.join(a.keep, "run.txt"), "w") as f:
             f.write(f"{at} {wall:.0f} {a.seeds} {a.jobs}\n")
-    text = section(a.seeds, wall, at, a.jobs, table)
+    text = section(a.seeds, None if reused else wall, at, a.jobs, table)
     if a.smoke:
         ok = text.count("| bridge") == 2 * len(SCENARIOS) and all(
             np.isfinite(s["err"]).all() for _, cfgs in table for _, s in cfgs)

@@ -396,6 +396,73 @@ static void test_uncertainty(void **state)
     assert_true(fabs(D(e.area_m2) - within * 0.0625) <= 0.0625 * 2);
 }
 
+/* The best point under lcb: the highest kept prediction less lcb times that point's sigma,
+ * sigma from each source's kernel-weighted sample count in double (as test_uncertainty;
+ * source 0 reads 6 dB low in one area, so its fit's rms is not 0); with lcb 0 it is the
+ * highest prediction, a point the samples cover more thinly. */
+static void test_lower_confidence_bound(void **state)
+{
+    fixture_t *f = *state;
+    make_bridge(f, -6.0);
+    rfs_fields_cfg_t c = rfs_fields_cfg_default();
+    c.lcb = RFS_Q16_INT(4);
+    assert_int_equal(rfs_fields_init(&f->fl, &c, &rfs_target_bridge, &f->mem), 0);
+    rfs_model_fit_in_t in = fit_in(f, 2);
+    assert_int_equal(fit_all(&f->fl, &in, 0, NULL), RFS_FIT_DONE);
+    rfs_fields_est_t e;
+    assert_true(rfs_fields_estimate(&f->fl, &e));
+    const int lw = f->map.lw, lh = f->map.lh;
+    double *n = calloc((size_t)2 * lw * lh, sizeof(double));
+    assert_non_null(n);
+    for (int k = 0; k < 2; ++k) {
+        for (int s = 0; s < NS; ++s) {
+            uint16_t si, sj;
+            rfs_map_lattice_nearest(&f->map, Q(f->s[k][s].x_cm / 100.0), Q(f->s[k][s].y_cm / 100.0),
+                                    &si, &sj);
+            for (int j = sj - 2; j <= sj + 2; ++j) {
+                for (int i = si - 2; i <= si + 2; ++i) {
+                    if (i >= 0 && j >= 0 && i < lw && j < lh) {
+                        n[(size_t)k * lw * lh + (size_t)j * lw + i] +=
+                            fmax(0.0, 1.0 - 0.25 * hypot(i - (double)si, j - (double)sj) / 0.5);
+                    }
+                }
+            }
+        }
+    }
+    double best = -1e9, at_pick = -1e9, top_v = -1e9;
+    uint16_t bi, bj;
+    rfs_map_lattice_nearest(&f->map, e.x, e.y, &bi, &bj);
+    for (int j = 0; j < lh; ++j) {
+        for (int i = 0; i < lw; ++i) {
+            rfs_q16_t v;
+            if (!rfs_fields_at(&f->fl, (uint16_t)i, (uint16_t)j, &v)) {
+                continue;
+            }
+            double s2 = 0.0;
+            for (int k = 0; k < 2; ++k) {
+                double rms = D(e.src[k].rms), nk = n[(size_t)k * lw * lh + (size_t)j * lw + i];
+                s2 += rms * rms * c.prior_n / (c.prior_n + nk);
+            }
+            double score = D(v) - 4.0 * sqrt(2.0 * s2);
+            best = fmax(best, score);
+            top_v = fmax(top_v, D(v));
+            if (i == bi && j == bj) {
+                at_pick = score;
+            }
+        }
+    }
+    free(n);
+    assert_true(at_pick > best - 0.05);
+    c.lcb = 0;
+    assert_int_equal(rfs_fields_init(&f->fl2, &c, &rfs_target_bridge, &f->mem), 0);
+    assert_int_equal(fit_all(&f->fl2, &in, 0, NULL), RFS_FIT_DONE);
+    rfs_fields_est_t e0;
+    assert_true(rfs_fields_estimate(&f->fl2, &e0));
+    assert_true(fabs(D(e0.value) - top_v) < 0.02);
+    assert_true(e0.x != e.x || e0.y != e.y);
+    assert_true(D(e0.sigma) > D(e.sigma));
+}
+
 /* Draws land on kept predictions, the best point with its share e^0 / sum e^(-d / T). */
 static void test_draws(void **state)
 {
@@ -462,6 +529,9 @@ static void test_init_and_inputs(void **state)
     bad.prior_n = 0;
     assert_int_equal(rfs_fields_init(&f->fl, &bad, &rfs_target_bridge, &f->mem), -1);
     bad = c;
+    bad.lcb = -1;
+    assert_int_equal(rfs_fields_init(&f->fl, &bad, &rfs_target_bridge, &f->mem), -1);
+    bad = c;
     bad.pathloss.bin = 0;
     assert_int_equal(rfs_fields_init(&f->fl, &bad, &rfs_target_bridge, &f->mem), -1);
     assert_int_equal(rfs_fields_init(&f->fl, &c, &rfs_target_bridge, &f->mem), 0);
@@ -502,6 +572,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_sliced_equals_whole, setup, teardown),
         cmocka_unit_test_setup_teardown(test_relearn_reuses_unchanged_fits, setup, teardown),
         cmocka_unit_test_setup_teardown(test_uncertainty, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_lower_confidence_bound, setup, teardown),
         cmocka_unit_test_setup_teardown(test_draws, setup, teardown),
         cmocka_unit_test_setup_teardown(test_init_and_inputs, setup, teardown),
         cmocka_unit_test(test_registry_per_source),

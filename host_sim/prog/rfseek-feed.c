@@ -223,15 +223,21 @@ static void on_live_stop(int sig)
     g_live_stop = 1;
 }
 
-/* A live run ends at SIGINT or SIGTERM like a capture file at its end: nothing removed. */
-static void live_stop_on_signal(void)
+/* handler for SIGINT and SIGTERM. */
+static void on_int_term(void (*handler)(int))
 {
     struct sigaction sa;
     memset(&sa, 0, sizeof(sa));
-    sa.sa_handler = on_live_stop;
+    sa.sa_handler = handler;
     sigemptyset(&sa.sa_mask);
     (void)sigaction(SIGINT, &sa, NULL);
     (void)sigaction(SIGTERM, &sa, NULL);
+}
+
+/* A live run ends at SIGINT or SIGTERM like a capture file at its end: nothing removed. */
+static void live_stop_on_signal(void)
+{
+    on_int_term(on_live_stop);
 }
 
 /* A live capture's clock: the kernel stamps packets with CLOCK_REALTIME. */
@@ -377,12 +383,7 @@ static void cleanup_on_signal(const char *dir, const char *const *names, int n)
         }
     }
     snprintf(g_tmp_dir, sizeof(g_tmp_dir), "%s", dir != NULL ? dir : "");
-    struct sigaction sa;
-    memset(&sa, 0, sizeof(sa));
-    sa.sa_handler = on_stop_signal;
-    sigemptyset(&sa.sa_mask);
-    (void)sigaction(SIGINT, &sa, NULL);
-    (void)sigaction(SIGTERM, &sa, NULL);
+    on_int_term(on_stop_signal);
 }
 
 typedef struct tsv_ctx {

@@ -12,6 +12,7 @@ import argparse
 import csv
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -91,7 +92,12 @@ def main():
     ap.add_argument("--sim", default="build/bin/rfseek-sim")
     ap.add_argument("--seeds", default="1001..1012")
     a = ap.parse_args()
-    lo, hi = (int(v) for v in a.seeds.split(".."))
+    m = re.fullmatch(r"(\d+)\.\.(\d+)", a.seeds)
+    if m is None or int(m.group(1)) > int(m.group(2)):
+        sys.exit(f"mlp_steps: --seeds: '{a.seeds}' is not A..B with A <= B")
+    if not os.access(a.sim, os.X_OK):
+        sys.exit(f"mlp_steps: --sim: {a.sim}: not an executable")
+    lo, hi = int(m.group(1)), int(m.group(2))
     tmp = tempfile.mkdtemp(prefix="mlp_steps.")
     gains = {}
     failed = None

@@ -27,6 +27,8 @@ bench-data: $(BENCH_BIN)/bench_ridge $(BUILD)/arm/lib/librfs_core.a
 bench-models: $(BENCH_BIN)/bench_models
 	@scripts/bench_models.sh $(BUILD)
 BENCH_TARGETS += bench-core bench-data bench-models bench-pathloss
+# Every bench program's quick modes run to the end in `make test`.
+$(eval $(call test_script,bench_modes,tests/bench/bench_modes.sh $(BUILD),$(BENCH_BIN)/bench_core $(BENCH_BIN)/bench_ridge $(BENCH_BIN)/bench_models $(BENCH_BIN)/bench_pathloss))
 
 # The path-loss model: instructions per relearn, per slice and per prediction, state bytes.
 PATHLOSS_BENCH_MAP ?= scenarios/maps/office.yaml

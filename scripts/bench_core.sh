@@ -6,7 +6,7 @@ bin=$build/bin/bench_core
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 valgrind --tool=callgrind --callgrind-out-file="$tmp/cg.out" --collect-atstart=no \
-    "$bin" iter >/dev/null 2>"$tmp/vg.log"
+    "$bin" iter >/dev/null 2>"$tmp/vg.log" || { grep -v '^==' "$tmp/vg.log" >&2; exit 1; }
 total=$(callgrind_annotate "$tmp/cg.out" 2>/dev/null | awk '/PROGRAM TOTALS/ {gsub(",","",$1); print $1}')
 "$bin" dump "$tmp/samples.txt"
 c_us=$("$bin" time 101)

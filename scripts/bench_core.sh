@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Figures of the core's worst-case iteration (docs/PERFORMANCE.md, "Core"): callgrind
-# instructions (exact), then ROUNDS interleaved rounds of wall time, the core's median of
+# instructions (exact, with cell sums and without), then ROUNDS interleaved rounds of wall time, the core's median of
 # 101 iterations then the scikit-learn twin's median of 101, and their ratio per round.
 #   scripts/bench_core.sh [BUILD] [ROUNDS]
 set -euo pipefail
@@ -12,9 +12,12 @@ trap 'rm -rf "$tmp"' EXIT
 valgrind --tool=callgrind --callgrind-out-file="$tmp/cg.out" --collect-atstart=no \
     "$bin" iter >/dev/null 2>"$tmp/vg.log" || { grep -v '^==' "$tmp/vg.log" >&2; exit 1; }
 total=$(callgrind_annotate "$tmp/cg.out" 2>/dev/null | awk '/PROGRAM TOTALS/ {gsub(",","",$1); print $1}')
+valgrind --tool=callgrind --callgrind-out-file="$tmp/scan.out" --collect-atstart=no \
+    "$bin" --scan iter >/dev/null 2>"$tmp/vg.log" || { grep -v '^==' "$tmp/vg.log" >&2; exit 1; }
+scan=$(callgrind_annotate "$tmp/scan.out" 2>/dev/null | awk '/PROGRAM TOTALS/ {gsub(",","",$1); print $1}')
 "$bin" dump "$tmp/samples.txt"
 echo "core worst-case iteration (10,000 samples in radius, relearn, 12,800-point grid search):"
-echo "  host x86-64 instructions (callgrind, exact): $total"
+echo "  host x86-64 instructions (callgrind, exact): $total with cell sums, $scan visiting every sample (the STM32 image's pass)"
 for r in $(seq 1 "$rounds"); do
     c_us=$("$bin" time 101)
     py_us=$(/usr/bin/python3 bench/sklearn_iteration.py "$tmp/samples.txt" 101)

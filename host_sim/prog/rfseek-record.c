@@ -312,6 +312,7 @@ typedef struct recording {
     hs_scenario_t sc;
     hs_sim_env_t env;
     rfs_app_t app;
+    rfs_sample_t samples[RFS_APP_MAX_SAMPLES];
     rfs_replay_player_t player;
     uint64_t *model_state;
     char tmp_in[4096], tmp_out[4096]; /* the outputs until renamed */
@@ -547,6 +548,7 @@ static int start_player(recording_t *s)
         return 1;
     }
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.samples = s->samples;
     cfg.model_state = s->model_state;
     cfg.model_state_bytes = model_bytes;
     rfs_replay_player_init(&s->player, &s->app, &cfg, sink, rec);

@@ -20,7 +20,7 @@ static void test_built_in_state_holds_the_ridge_only(void **state)
 {
     (void)state;
     const rfs_app_map_t m = room();
-    rfs_app_cfg_t c = rfs_app_cfg_default();
+    rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
     assert_null(c.model);
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
     assert_ptr_equal(s_app.seek.model.ops, &rfs_ridge_ops);
@@ -44,7 +44,7 @@ static void test_port_buffer_holds_what_fits(void **state)
 {
     (void)state;
     const rfs_app_map_t m = room();
-    rfs_app_cfg_t c = rfs_app_cfg_default();
+    rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
     c.model_state = s_state;
     c.model_state_bytes = (uint32_t)sizeof s_state;
     c.model = rfs_models_lookup("mlp");
@@ -123,7 +123,7 @@ static void test_player_applies_or_refuses_the_model(void **state)
 {
     (void)state;
     static rfs_replay_player_t p;
-    rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    rfs_app_cfg_t cfg = fx_cfg(rfs_app_cfg_default());
     cfg.model_state = s_state;
     cfg.model_state_bytes = (uint32_t)sizeof s_state;
     rfs_replay_rec_t r;
@@ -163,7 +163,7 @@ static void test_mcu_fit_budget_is_the_model_s(void **state)
     }
 
     /* The MCU defaults, the model chosen afterwards (the ports' order). */
-    rfs_app_cfg_t c = rfs_app_cfg_mcu();
+    rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_mcu());
     c.model_state = s_state;
     c.model_state_bytes = (uint32_t)sizeof s_state;
     c.model = mlp;
@@ -187,7 +187,7 @@ static void test_mcu_fit_budget_is_the_model_s(void **state)
     c.seek.fit_budget = 123u;
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
     assert_int_equal(s_app.seek.cfg.fit_budget, 123u);
-    rfs_app_cfg_t d = rfs_app_cfg_default();
+    rfs_app_cfg_t d = fx_cfg(rfs_app_cfg_default());
     assert_false(d.fit_budget_by_model);
     d.model_state = s_state;
     d.model_state_bytes = (uint32_t)sizeof s_state;

@@ -471,7 +471,9 @@ static int start_player(rfs_replay_player_t *player, sink_ctx_t *sc)
         fprintf(stderr, "rfseek-replay: out of memory\n");
         return 1;
     }
+    static rfs_sample_t samples[RFS_APP_MAX_SAMPLES];
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.samples = samples;
     cfg.model_state = model_state;
     cfg.model_state_bytes = mb;
     rfs_replay_player_init(player, &app, &cfg, sink, sc);

@@ -27,6 +27,7 @@
 #include <errno.h>
 #include <getopt.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,6 +39,7 @@
 #include "hs_sim.h"
 #include "rfs_app.h"
 #include "rfs_can.h"
+#include "rfs_pathloss.h"
 #include "rfs_replay.h"
 
 #define MAX_WINDOWS 8
@@ -53,6 +55,7 @@ typedef struct recorder {
     FILE *out;                  /* the live output stream, or NULL */
     lx_candump_t *dump;         /* --candump: the bus as a candump -L log, or NULL */
     const char *in_path;
+    const char *tmp_in, *tmp_out; /* the temporary files (tmp_out NULL without `out`) */
     int write_failed;           /* a write to `in` failed */
     int live_failed;            /* a write to `out` failed */
     rfs_app_t *app;
@@ -93,6 +96,14 @@ static void feed(recorder_t *r, const rfs_replay_rec_t *rec)
     put(r, rec);
     if (!rfs_replay_play(r->player, rec)) {
         lx_err_print(PROG, "%s: %s", r->in_path, rfs_replay_err_str(r->player->error));
+        /* Nothing half-written: the temporary outputs go. */
+        fclose(r->in);
+        remove(r->tmp_in);
+        if (r->out != NULL) {
+            fclose(r->out);
+            remove(r->tmp_out);
+        }
+        (void)lx_candump_close(r->dump, false, NULL, 0);
         exit(1);
     }
 }
@@ -283,7 +294,12 @@ static void usage(FILE *f)
             "                       configuration uses 2500)\n"
             "  --model NAME         internal model, overriding the scenario's: ridge, mlp, knn,\n"
             "                       radius, pathloss (recorded in the CFG record; the emulator\n"
-            "                       image holds ridge and mlp)\n"
+            "                       image holds ridge, mlp and pathloss)\n"
+            "  --strategy NAME      decision rule, overriding the scenario's: meta, meta-path,\n"
+            "                       fd-gradient, plane-gradient, chemotaxis\n"
+            "  --p0-min DBM         path-loss floor at 1 m, overriding the scenario's\n"
+            "                       seek.p0_min_dbm (the CFG record's choice, as a CONFIG\n"
+            "                       frame's: docs/CAN.md)\n"
             "  -h, --help           this text\n");
 }
 
@@ -303,6 +319,8 @@ typedef struct options {
     double max_time;       /* seconds; <= 0: the scenario's */
     uint32_t fit_budget;
     const char *model_name; /* NULL: the scenario's */
+    const char *strategy;   /* NULL: the scenario's */
+    double p0_min;          /* dBm; NAN: the scenario's */
 } options_t;
 
 /* One recording: the recorder, the simulator and the application it plays into (static
@@ -379,6 +397,22 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
         }
         o->model_name = optarg;
         break;
+    case 'S': {
+        rfs_seek_strategy_t st;
+        if (!rfs_seek_strategy_parse(optarg, &st) || st == RFS_SEEK_META_GLOBAL) {
+            lx_err_print(PROG, "--strategy: unknown '%s' (meta, meta-path, fd-gradient, plane-gradient, "
+                         "chemotaxis)", optarg);
+            return 2;
+        }
+        o->strategy = optarg;
+        break;
+    }
+    case 'p':
+        o->p0_min = strtod(optarg, &end);
+        if (end == optarg || *end != '\0' || !(o->p0_min >= -200.0 && o->p0_min <= 100.0)) {
+            die_opt("--p0-min (dBm in [-200, 100])", optarg);
+        }
+        break;
     case 'H':
         if (strcmp(optarg, "can") == 0) {
             rec->heartbeat = HB_CAN;
@@ -417,9 +451,11 @@ static int parse_options(int argc, char **argv, options_t *o, recorder_t *rec)
         {"drop-pose", required_argument, 0, 'P'}, {"drop-rssi", required_argument, 0, 'R'},
         {"fit-budget", required_argument, 0, 'f'}, {"model", required_argument, 0, 'm'},
         {"heartbeat", required_argument, 0, 'H'},  {"candump", required_argument, 0, 'c'},
+        {"strategy", required_argument, 0, 'S'},   {"p0-min", required_argument, 0, 'p'},
         {0, 0, 0, 0}};
     memset(o, 0, sizeof *o);
     o->max_time = -1;
+    o->p0_min = NAN;
     /* getopt's own messages would echo a bad option raw (and the usage follows on stderr):
      * it stays quiet and the one line is ours. A leading ':' tells a missing value (':')
      * from an unknown option ('?'). */
@@ -481,6 +517,12 @@ static int open_scenario(recording_t *s, options_t *o)
     if (o->model_name == NULL) {
         o->model_name = s->sc.model; // checked against the registry by the scenario loader
     }
+    if (o->strategy == NULL) {
+        o->strategy = s->sc.strategy;
+    }
+    if (isnan(o->p0_min)) {
+        o->p0_min = s->sc.seek_p0_min_dbm;
+    }
     if (hs_sim_env_open(&s->env, &s->sc, err, sizeof err) != 0) {
         lx_err_print(PROG, "%s", err);
         return 1;
@@ -525,6 +567,8 @@ static int open_outputs(recording_t *s, const options_t *o)
         return 1;
     }
     rec->in_path = o->out_path;
+    rec->tmp_in = s->tmp_in;
+    rec->tmp_out = s->tmp_out;
     return 0;
 }
 
@@ -570,6 +614,15 @@ static void record_config(recording_t *s, const options_t *o, uint64_t run_seed)
     if (strcmp(o->model_name, "ridge") != 0) { // the ridge is every player's base: a v1 CFG
         const size_t n = strlen(o->model_name); // registry names are <= 15 bytes (checked above)
         memcpy(r.u.cfg.model, o->model_name, n < RFS_REPLAY_MODEL_NAME_MAX ? n : RFS_REPLAY_MODEL_NAME_MAX);
+    }
+    // The paper's meta with the model's own floor is every player's base: no choice then.
+    rfs_seek_strategy_t st = RFS_SEEK_META;
+    (void)rfs_seek_strategy_parse(o->strategy, &st);
+    if (st != RFS_SEEK_META || !isnan(o->p0_min)) {
+        r.u.cfg.chosen = true;
+        r.u.cfg.strategy = (uint8_t)st;
+        r.u.cfg.p0_min = isnan(o->p0_min) ? (int16_t)(rfs_pathloss_cfg_default().p0_min / 512)
+                                          : (int16_t)lround(o->p0_min * 128.0);
     }
     feed(rec, &r);
     const rfs_app_map_t am = {m->w, m->h, m->res, m->origin_x, m->origin_y, s->env.core.free_bits,

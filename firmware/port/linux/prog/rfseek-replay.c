@@ -111,6 +111,10 @@ static void print_rec(const rfs_replay_rec_t *r)
         if (r->u.cfg.model[0] != '\0') {
             printf("\tmodel=%s", r->u.cfg.model);
         }
+        if (r->u.cfg.chosen) {
+            printf("\tstrategy=%s\tp0_min=%d", rfs_seek_strategy_name((rfs_seek_strategy_t)r->u.cfg.strategy),
+                   r->u.cfg.p0_min);
+        }
         break;
     case RFS_REPLAY_MAP:
         printf("\tw=%u\th=%u\tres_q16=%d\tox_q16=%d\toy_q16=%d\twall=%u", r->u.map.w,

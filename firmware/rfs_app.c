@@ -85,9 +85,10 @@ static const rfs_target_ops_t *app_target(rfs_app_target_t t)
 int rfs_app_cfg_choose(rfs_app_cfg_t *cfg, rfs_app_target_t target, rfs_seek_strategy_t strategy,
                        const rfs_models_entry_t *model, rfs_q16_t p0_min)
 {
+    /* meta-global needs a map-wide model radius; the baselines' decision kinds (probe,
+     * gradient, run, tumble) fit neither the STATUS frame's nor the replay's kind field. */
     if ((uint32_t)target > (uint32_t)RFS_APP_TARGET_BRIDGE ||
-        (uint32_t)strategy >= (uint32_t)RFS_SEEK_STRATEGY_COUNT || strategy == RFS_SEEK_META_GLOBAL ||
-        cfg->built.ops != NULL) {
+        (strategy != RFS_SEEK_META && strategy != RFS_SEEK_META_PATH) || cfg->built.ops != NULL) {
         return -1;
     }
     /* One fit per source needs a state and a store per source (rfs_fields.h): only a port

@@ -223,8 +223,8 @@ bool rfs_app_model_fits(const rfs_app_cfg_t *cfg);
 /// Set what a CONFIG frame or a replay's CFG record chooses: target, strategy (its preset,
 /// rfs_seek_cfg_use_strategy()), model (NULL: the built-in ridge) and the path-loss
 /// p0_min (dBm Q16.16, INT32_MIN: no floor). Returns 0, or -1 leaving cfg unchanged when
-/// the image does not hold that choice: target or strategy out of range, meta-global
-/// (it needs a map-wide model radius), a state larger than the model buffer, a model
+/// the image does not hold that choice: target out of range, a strategy other than meta
+/// and meta-path, a state larger than the model buffer, a model
 /// fitted per source under a target of several sources without a port-built model
 /// (`built`: the STM32 image has no room for two path-loss states), or a port-built
 /// model in place.

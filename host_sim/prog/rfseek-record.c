@@ -295,8 +295,7 @@ static void usage(FILE *f)
             "  --model NAME         internal model, overriding the scenario's: ridge, mlp, knn,\n"
             "                       radius, pathloss (recorded in the CFG record; the emulator\n"
             "                       image holds ridge, mlp and pathloss)\n"
-            "  --strategy NAME      decision rule, overriding the scenario's: meta, meta-path,\n"
-            "                       fd-gradient, plane-gradient, chemotaxis\n"
+            "  --strategy NAME      decision rule, overriding the scenario's: meta or meta-path\n"
             "  --p0-min DBM         path-loss floor at 1 m, overriding the scenario's\n"
             "                       seek.p0_min_dbm (the CFG record's choice, as a CONFIG\n"
             "                       frame's: docs/CAN.md)\n"
@@ -399,9 +398,8 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
         break;
     case 'S': {
         rfs_seek_strategy_t st;
-        if (!rfs_seek_strategy_parse(optarg, &st) || st == RFS_SEEK_META_GLOBAL) {
-            lx_err_print(PROG, "--strategy: unknown '%s' (meta, meta-path, fd-gradient, plane-gradient, "
-                         "chemotaxis)", optarg);
+        if (!rfs_seek_strategy_parse(optarg, &st) || (st != RFS_SEEK_META && st != RFS_SEEK_META_PATH)) {
+            lx_err_print(PROG, "--strategy: expected meta or meta-path (the firmware's), got '%s'", optarg);
             return 2;
         }
         o->strategy = optarg;

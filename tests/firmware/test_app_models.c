@@ -204,17 +204,19 @@ static void test_config_frame_chooses_before_the_first_decision(void **state)
     rfs_app_step(&s_app, 0, &o);
     rfs_app_frames(&s_app, &o, out); /* STATUS counter 0 */
 
-    /* knn: not offered; bridge + pathloss: one fit per node, no room; meta-global. */
-    const rfs_can_config_t refused[3] = {
+    /* knn: not offered; bridge + pathloss: one fit per node, no room; meta-global and a
+     * baseline (chemotaxis: its decision kinds have no code on the wire). */
+    const rfs_can_config_t refused[4] = {
         {0, RFS_SEEK_META, RFS_CAN_MODEL_KNN, -5760, 3u},
         {1, RFS_SEEK_META_PATH, RFS_CAN_MODEL_PATHLOSS, -5760, 3u},
         {0, RFS_SEEK_META_GLOBAL, RFS_CAN_MODEL_RIDGE, -5760, 3u},
+        {0, RFS_SEEK_CHEMOTAXIS, RFS_CAN_MODEL_RIDGE, -5760, 3u},
     };
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < 4; i++) {
         rfs_can_tx_config(&op, &refused[i], &f);
         assert_int_equal(rfs_app_on_can(&s_app, &f, 1000), RFS_CAN_OK);
     }
-    assert_int_equal(s_app.stats.configs_rejected, 3u);
+    assert_int_equal(s_app.stats.configs_rejected, 4u);
     assert_int_equal(s_app.stats.configs, 0u);
     assert_ptr_equal(s_app.seek.model.ops, &rfs_ridge_ops);
     assert_int_equal(s_app.cfg.seed, 1u);
@@ -224,7 +226,7 @@ static void test_config_frame_chooses_before_the_first_decision(void **state)
     assert_int_equal(rfs_app_on_can(&s_app, &f, 2000), RFS_CAN_OK);
 
     assert_int_equal(s_app.stats.configs, 1u);
-    assert_int_equal(s_app.stats.configs_rejected, 3u); /* kept across the re-initialisation */
+    assert_int_equal(s_app.stats.configs_rejected, 4u); /* kept across the re-initialisation */
     assert_int_equal(s_app.seek.cfg.strategy, RFS_SEEK_META_PATH);
     assert_int_equal(s_app.seek.cfg.recheck_dist, s_app.seek.cfg.step); /* meta-path's preset */
     assert_ptr_equal(s_app.seek.model.ops, &rfs_pathloss_ops);
@@ -248,7 +250,7 @@ static void test_config_frame_chooses_before_the_first_decision(void **state)
     const rfs_can_config_t back = {0, RFS_SEEK_META, RFS_CAN_MODEL_RIDGE, -5760, 1u};
     rfs_can_tx_config(&op, &back, &f);
     assert_int_equal(rfs_app_on_can(&s_app, &f, 310000), RFS_CAN_OK);
-    assert_int_equal(s_app.stats.configs_rejected, 4u);
+    assert_int_equal(s_app.stats.configs_rejected, 5u);
     assert_int_equal(s_app.seek.cfg.strategy, RFS_SEEK_META_PATH);
     /* The codes name the registry's entries, the named entries are the table's. */
     for (uint8_t k = 0; k < RFS_CAN_NMODELS; k++) {

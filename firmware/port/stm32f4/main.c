@@ -3,8 +3,8 @@
  *
  * It holds the paper's meta + ridge (the default) and meta-path + pathloss beside it,
  * chosen by a CONFIG frame before the mission (docs/FIRMWARE.md, "What the STM32 image
- * holds"): any strategy but meta-global, the ridge or the path-loss model, target rssi,
- * and bridge with the ridge (one path-loss fit per node needs two states: no room).
+ * holds"): meta or meta-path, the ridge or the path-loss model, target rssi, and bridge
+ * with the ridge (one path-loss fit per node needs two states: no room).
  * Memory: the sample store in CCM (CPU-only data), the model state in SRAM with the CAN
  * driver and the application.
  *

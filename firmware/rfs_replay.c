@@ -420,6 +420,11 @@ void rfs_replay_player_init(rfs_replay_player_t *p, rfs_app_t *app, const rfs_ap
     memset(p, 0, offsetof(rfs_replay_player_t, free_bits));
     p->app = app;
     p->cfg = *cfg;
+    /* CONFIG frames in a stream may choose any registered model: the state buffer decides
+     * what an image holds, as for a CFG's model name. */
+    for (uint8_t k = 0; k < (uint8_t)RFS_CAN_NMODELS; k++) {
+        p->cfg.models[k] = rfs_models_lookup(rfs_can_model_name(k));
+    }
     p->write = write;
     p->write_ctx = write_ctx;
     uint8_t h[RFS_REPLAY_HEADER_LEN];

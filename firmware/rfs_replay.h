@@ -200,7 +200,8 @@ typedef struct rfs_replay_player {
 /// Start a player on `app` with the base configuration (CFG records override seed,
 /// target, node id, fit budget and, when they name one, the model: its state goes into
 /// the base configuration's model_state buffer, or the application's built-in one; a
-/// CFG's choice goes through rfs_app_cfg_choose(), as a CONFIG frame's).
+/// CFG's choice goes through rfs_app_cfg_choose(), as a CONFIG frame's). CONFIG frames may
+/// choose every registered model (cfg.models), those whose state fits the buffer.
 /// Writes the output stream header through `write`.
 void rfs_replay_player_init(rfs_replay_player_t *p, rfs_app_t *app, const rfs_app_cfg_t *cfg,
                             rfs_replay_write_fn write, void *write_ctx);

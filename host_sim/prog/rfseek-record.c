@@ -299,6 +299,8 @@ static void usage(FILE *f)
             "  --p0-min DBM         path-loss floor at 1 m, overriding the scenario's\n"
             "                       seek.p0_min_dbm (the CFG record's choice, as a CONFIG\n"
             "                       frame's: docs/CAN.md)\n"
+            "  --config-frame       send that choice (and the model) as a CONFIG frame at 0 s\n"
+            "                       instead (seed: the run seed's low 24 bits)\n"
             "  -h, --help           this text\n");
 }
 
@@ -320,6 +322,7 @@ typedef struct options {
     const char *model_name; /* NULL: the scenario's */
     const char *strategy;   /* NULL: the scenario's */
     double p0_min;          /* dBm; NAN: the scenario's */
+    bool config_frame;      /* --config-frame: the choice as a CONFIG frame */
 } options_t;
 
 /* One recording: the recorder, the simulator and the application it plays into (static
@@ -411,6 +414,7 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
             die_opt("--p0-min (dBm in [-200, 100])", optarg);
         }
         break;
+    case 'C': o->config_frame = true; break;
     case 'H':
         if (strcmp(optarg, "can") == 0) {
             rec->heartbeat = HB_CAN;
@@ -450,6 +454,7 @@ static int parse_options(int argc, char **argv, options_t *o, recorder_t *rec)
         {"fit-budget", required_argument, 0, 'f'}, {"model", required_argument, 0, 'm'},
         {"heartbeat", required_argument, 0, 'H'},  {"candump", required_argument, 0, 'c'},
         {"strategy", required_argument, 0, 'S'},   {"p0-min", required_argument, 0, 'p'},
+        {"config-frame", no_argument, 0, 'C'},
         {0, 0, 0, 0}};
     memset(o, 0, sizeof *o);
     o->max_time = -1;
@@ -597,7 +602,9 @@ static int start_player(recording_t *s)
     return 0;
 }
 
-/* The configuration records: CFG, MAP and the map's grids in chunks. */
+/* The configuration records: CFG, MAP and the map's grids in chunks; the choice of
+ * strategy, model and P0 floor in the CFG or, with --config-frame, in a CONFIG frame on the
+ * bus before any input (docs/CAN.md, "0x130 CONFIG"). */
 static void record_config(recording_t *s, const options_t *o, uint64_t run_seed)
 {
     recorder_t *rec = &s->rec;
@@ -609,23 +616,34 @@ static void record_config(recording_t *s, const options_t *o, uint64_t run_seed)
     r.u.cfg.target = s->sc.nsources == 2u ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
     r.u.cfg.node = 1u;
     r.u.cfg.fit_budget = o->fit_budget;
-    if (strcmp(o->model_name, "ridge") != 0) { // the ridge is every player's base: a v1 CFG
+    rfs_seek_strategy_t st = RFS_SEEK_META;
+    (void)rfs_seek_strategy_parse(o->strategy, &st);
+    const int16_t p0 = isnan(o->p0_min) ? (int16_t)(rfs_pathloss_cfg_default().p0_min / 512)
+                                        : (int16_t)lround(o->p0_min * 128.0);
+    // The ridge is every player's base (a v1 CFG); the paper's meta with the model's own
+    // floor too: no choice then.
+    if (!o->config_frame && strcmp(o->model_name, "ridge") != 0) {
         const size_t n = strlen(o->model_name); // registry names are <= 15 bytes (checked above)
         memcpy(r.u.cfg.model, o->model_name, n < RFS_REPLAY_MODEL_NAME_MAX ? n : RFS_REPLAY_MODEL_NAME_MAX);
     }
-    // The paper's meta with the model's own floor is every player's base: no choice then.
-    rfs_seek_strategy_t st = RFS_SEEK_META;
-    (void)rfs_seek_strategy_parse(o->strategy, &st);
-    if (st != RFS_SEEK_META || !isnan(o->p0_min)) {
+    if (!o->config_frame && (st != RFS_SEEK_META || !isnan(o->p0_min))) {
         r.u.cfg.chosen = true;
         r.u.cfg.strategy = (uint8_t)st;
-        r.u.cfg.p0_min = isnan(o->p0_min) ? (int16_t)(rfs_pathloss_cfg_default().p0_min / 512)
-                                          : (int16_t)lround(o->p0_min * 128.0);
+        r.u.cfg.p0_min = p0;
     }
     feed(rec, &r);
     const rfs_app_map_t am = {m->w, m->h, m->res, m->origin_x, m->origin_y, s->env.core.free_bits,
                               s->env.core.wall_bits};
     (void)rfs_replay_map_records(&am, feed_rec, rec);
+    if (o->config_frame) {
+        rfs_can_config_t k = {r.u.cfg.target, (uint8_t)st, 0, p0, (uint32_t)(run_seed & 0xFFFFFFu)};
+        for (uint8_t c = 0; c < (uint8_t)RFS_CAN_NMODELS; c++) {
+            k.model = strcmp(rfs_can_model_name(c), o->model_name) == 0 ? c : k.model;
+        }
+        rfs_can_frame_t f;
+        rfs_can_tx_config(&rec->tx, &k, &f);
+        feed_can(rec, 0, &f);
+    }
 }
 
 /* The mission with the recorder as the controller, the END record, and the outputs

@@ -62,6 +62,22 @@ if grep -q $'model=pathloss\tstrategy=meta-path\tp0_min=-5120' "$tmp/mp_cfg.txt"
 else
     fail "the mission ran meta-path + pathloss" "$(cat "$tmp/mp_cfg.txt"); $nrel relearns, $nl learning periods"
 fi
+# The same choice as a CONFIG frame on the bus before any input (the operator's, docs/CAN.md):
+# the outputs equal the CFG choice's byte for byte (no reset here: a reset returns to the
+# defaults), on the host and the image; its candump log passes canmatrix.
+mp2=(scenarios/default.yaml --seed 3 --model pathloss --strategy meta-path --p0-min -40 --fit-budget 600 --drop 20:21)
+if "$bin/rfseek-record" "${mp2[@]}" -o "$tmp/mpa.rfsr" --live-out "$tmp/mpa.rfso" >/dev/null \
+        && "$bin/rfseek-record" "${mp2[@]}" --config-frame -o "$tmp/mpc.rfsr" --live-out "$tmp/mpc.rfso" \
+            --candump "$tmp/mpc.log" >/dev/null \
+        && "$bin/rfseek-replay" "$tmp/mpc.rfsr" -o "$tmp/mpc_host.rfso" && qemu mpc.rfsr mpc_qemu.rfso \
+        && cmp "$tmp/mpa.rfso" "$tmp/mpc.rfso" && cmp "$tmp/mpc.rfso" "$tmp/mpc_host.rfso" \
+        && cmp "$tmp/mpc_host.rfso" "$tmp/mpc_qemu.rfso" && head -1 "$tmp/mpc.log" | grep -q ' can0 130#004500EC030000A7$' \
+        && /usr/bin/python3 scripts/check_candump.py can/rfseek.dbc "$tmp/mpc.log" --sim >"$tmp/mpc_check.txt"; then
+    pass "a CONFIG frame chooses what the CFG does: outputs equal, host and qemu ($(stat -c %s "$tmp/mpc.rfso") bytes)"
+else
+    fail "a CONFIG frame chooses what the CFG does" "$(grep FAIL "$tmp/mpc_check.txt" 2>/dev/null | head -3)"
+fi
+
 # A choice the image does not hold (meta-path + pathloss under the bridging target: one
 # fit per node, two path-loss states): the recorder (its player) refuses it, one line, no
 # file left; a stream with it (mp.rfsr with its CFG's target byte, at offset 18, made

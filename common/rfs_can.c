@@ -190,6 +190,15 @@ void rfs_can_pack_status(const rfs_can_status_t *s, uint8_t counter, rfs_can_fra
     frame_seal(f);
 }
 
+void rfs_can_pack_config(const rfs_can_config_t *c, uint8_t counter, rfs_can_frame_t *f)
+{
+    frame_begin(f, RFS_CAN_ID_CONFIG, RFS_CAN_DLC_CONFIG, counter, (uint8_t)(c->target & 0x3u));
+    f->data[1] = (uint8_t)((c->strategy & 0xFu) | ((c->model & 0xFu) << 4));
+    put_u16(&f->data[2], (uint16_t)c->p0_min);
+    put_u24(&f->data[4], c->seed & 0xFFFFFFu);
+    frame_seal(f);
+}
+
 rfs_can_err_t rfs_can_unpack_wheel(const rfs_can_frame_t *f, rfs_can_wheel_t *w, uint8_t *counter)
 {
     rfs_can_err_t e = frame_check(f, RFS_CAN_ID_WHEEL_CMD, RFS_CAN_DLC_WHEEL_CMD);
@@ -262,6 +271,30 @@ rfs_can_err_t rfs_can_unpack_receiver(const rfs_can_frame_t *f, rfs_can_receiver
         return RFS_CAN_E_RANGE;
     }
     r->t_us32 = get_u32(&f->data[1]);
+    *counter = f->data[0] & 0x0Fu;
+    return RFS_CAN_OK;
+}
+
+rfs_can_err_t rfs_can_unpack_config(const rfs_can_frame_t *f, rfs_can_config_t *c, uint8_t *counter)
+{
+    rfs_can_err_t e = frame_check(f, RFS_CAN_ID_CONFIG, RFS_CAN_DLC_CONFIG);
+    if (e != RFS_CAN_OK) {
+        return e;
+    }
+    const uint8_t target = (uint8_t)((f->data[0] >> 4) & 0x3u);
+    const uint8_t strategy = (uint8_t)(f->data[1] & 0xFu);
+    const uint8_t model = (uint8_t)(f->data[1] >> 4);
+    const int16_t p0 = (int16_t)get_u16(&f->data[2]);
+    if ((f->data[0] >> 6) || target > 1u || strategy >= (uint8_t)RFS_SEEK_STRATEGY_COUNT ||
+        model >= (uint8_t)RFS_CAN_NMODELS ||
+        (p0 != RFS_CAN_P0_NONE && (p0 < RFS_CAN_P0_MIN || p0 > RFS_CAN_P0_MAX))) {
+        return RFS_CAN_E_RANGE;
+    }
+    c->target = target;
+    c->strategy = strategy;
+    c->model = model;
+    c->p0_min = p0;
+    c->seed = (uint32_t)f->data[4] | ((uint32_t)f->data[5] << 8) | ((uint32_t)f->data[6] << 16);
     *counter = f->data[0] & 0x0Fu;
     return RFS_CAN_OK;
 }
@@ -383,6 +416,11 @@ void rfs_can_tx_rssi(rfs_can_tx_t *tx, const rfs_can_rssi_t *r, rfs_can_frame_t 
 void rfs_can_tx_receiver(rfs_can_tx_t *tx, const rfs_can_receiver_t *r, rfs_can_frame_t *f)
 {
     rfs_can_pack_receiver(r, tx_next(tx, RFS_CAN_IDX_RX_STATUS), f);
+}
+
+void rfs_can_tx_config(rfs_can_tx_t *tx, const rfs_can_config_t *c, rfs_can_frame_t *f)
+{
+    rfs_can_pack_config(c, tx_next(tx, RFS_CAN_IDX_CONFIG), f);
 }
 
 void rfs_can_tx_status(rfs_can_tx_t *tx, const rfs_can_status_t *s, rfs_can_frame_t *f)
@@ -617,6 +655,24 @@ static rfs_can_err_t rx_receiver(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int
     return RFS_CAN_OK;
 }
 
+/* CONFIG: a counter check (no time: it is not a measurement). */
+static rfs_can_err_t rx_config(rfs_can_rx_t *rx, const rfs_can_frame_t *f, rfs_can_msg_t *msg)
+{
+    uint8_t c = 0;
+    rfs_can_config_t cf;
+    rfs_can_err_t e = rfs_can_unpack_config(f, &cf, &c);
+    if (e == RFS_CAN_OK) {
+        e = counter_check(rx, RFS_CAN_IDX_CONFIG, c);
+    }
+    if (e != RFS_CAN_OK) {
+        return drop(rx, e);
+    }
+    counter_accept(rx, RFS_CAN_IDX_CONFIG, c);
+    msg->kind = RFS_CAN_MSG_CONFIG;
+    msg->config = cf;
+    return RFS_CAN_OK;
+}
+
 rfs_can_err_t rfs_can_rx_frame(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int64_t now_us, rfs_can_msg_t *msg)
 {
     msg->kind = RFS_CAN_MSG_NONE;
@@ -630,6 +686,7 @@ rfs_can_err_t rfs_can_rx_frame(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int64
     case RFS_CAN_ID_POSE_TH: return rx_pose_th(rx, f, now_us, msg);
     case RFS_CAN_ID_RSSI: return rx_rssi(rx, f, now_us, msg);
     case RFS_CAN_ID_RX_STATUS: return rx_receiver(rx, f, now_us, msg);
+    case RFS_CAN_ID_CONFIG: return rx_config(rx, f, msg);
     default: return drop(rx, RFS_CAN_E_ID);
     }
 }
@@ -641,6 +698,17 @@ uint32_t rfs_can_rx_dropped_total(const rfs_can_rx_t *rx)
         bump(&n, rx->dropped[i]);
     }
     return n;
+}
+
+const char *rfs_can_model_name(uint8_t code)
+{
+    static const char *const names[RFS_CAN_NMODELS] = {"ridge", "mlp", "knn", "radius", "pathloss"};
+    return code < (uint8_t)RFS_CAN_NMODELS ? names[code] : NULL;
+}
+
+rfs_q16_t rfs_can_p0_to_q16(int16_t raw)
+{
+    return raw == RFS_CAN_P0_NONE ? INT32_MIN : (rfs_q16_t)raw * 512;
 }
 
 const char *rfs_can_err_str(rfs_can_err_t e)

@@ -30,6 +30,8 @@
  *   0x120 RSSI       radio module -> controller, 8: source, dBm, sequence, time
  *   0x121 RX_STATUS  radio module -> controller, 6: capture time: the receiver was
  *                    listening up to then, packet or not (docs/FAULTS.md)
+ *   0x130 CONFIG     operator -> controller, 8: target, strategy, model, P0 floor, seed
+ *                    (applied only before the mission's first decision)
  *   0x180 STATUS     controller -> anyone, 8: heartbeat with state, decision, faults
  * Lower ids win arbitration: wheel commands first, then inputs, then the heartbeat.
  */
@@ -55,6 +57,7 @@ typedef struct rfs_can_frame {
 #define RFS_CAN_ID_POSE_TH 0x111u   ///< pose, second half: heading and time
 #define RFS_CAN_ID_RSSI 0x120u      ///< RSSI measurement from a radio module
 #define RFS_CAN_ID_RX_STATUS 0x121u ///< receiver heartbeat from the radio module
+#define RFS_CAN_ID_CONFIG 0x130u    ///< mission configuration, operator -> controller
 #define RFS_CAN_ID_STATUS 0x180u    ///< controller status / heartbeat
 
 #define RFS_CAN_DLC_WHEEL_CMD 6u ///< exact DLC of WHEEL_CMD
@@ -62,6 +65,7 @@ typedef struct rfs_can_frame {
 #define RFS_CAN_DLC_POSE_TH 8u   ///< exact DLC of POSE_TH
 #define RFS_CAN_DLC_RSSI 8u      ///< exact DLC of RSSI
 #define RFS_CAN_DLC_RX_STATUS 6u ///< exact DLC of RX_STATUS
+#define RFS_CAN_DLC_CONFIG 8u    ///< exact DLC of CONFIG
 #define RFS_CAN_DLC_STATUS 8u    ///< exact DLC of STATUS
 
 #define RFS_CAN_ID_MAX 0x7FFu        ///< largest 11-bit id
@@ -80,6 +84,7 @@ typedef enum rfs_can_msg_idx {
     RFS_CAN_IDX_RSSI,
     RFS_CAN_IDX_STATUS,
     RFS_CAN_IDX_RX_STATUS,
+    RFS_CAN_IDX_CONFIG,
     RFS_CAN_NMSG ///< number of message ids
 } rfs_can_msg_idx_t;
 
@@ -129,6 +134,32 @@ typedef struct rfs_can_receiver {
                         ///< microseconds (the clock of the RSSI frames' t_us32)
 } rfs_can_receiver_t;
 
+/// CONFIG model codes: the internal models by registry name (rfs_models.h).
+typedef enum rfs_can_model {
+    RFS_CAN_MODEL_RIDGE = 0,    ///< "ridge", the paper's local ridge
+    RFS_CAN_MODEL_MLP = 1,      ///< "mlp"
+    RFS_CAN_MODEL_KNN = 2,      ///< "knn"
+    RFS_CAN_MODEL_RADIUS = 3,   ///< "radius"
+    RFS_CAN_MODEL_PATHLOSS = 4, ///< "pathloss", the map-aware path-loss model
+    RFS_CAN_NMODELS             ///< number of codes (not a code)
+} rfs_can_model_t;
+
+/// CONFIG P0Min value meaning "no floor" (rfs_pathloss_cfg_t.p0_min INT32_MIN).
+#define RFS_CAN_P0_NONE INT16_MIN
+/// CONFIG P0Min limits, dBm / 128: [-200, 100] dBm, the simulator's --p0-min range.
+#define RFS_CAN_P0_MIN (-200 * 128)
+#define RFS_CAN_P0_MAX (100 * 128)
+
+/// Mission configuration (docs/CAN.md, "0x130 CONFIG"): what the controller runs.
+typedef struct rfs_can_config {
+    uint8_t target;     ///< rfs_app target: 0 rssi, 1 bridge
+    uint8_t strategy;   ///< rfs_seek_strategy_t, 0..RFS_SEEK_STRATEGY_COUNT-1
+    uint8_t model;      ///< rfs_can_model_t
+    int16_t p0_min;     ///< path-loss floor on the signal at 1 m, dBm / 128, in
+                        ///< [RFS_CAN_P0_MIN, RFS_CAN_P0_MAX] or RFS_CAN_P0_NONE
+    uint32_t seed;      ///< seed of the controller's random source, 24 bits
+} rfs_can_config_t;
+
 /// Controller heartbeat.
 typedef struct rfs_can_status {
     uint8_t state;       ///< rfs_seek_state_t, 0..3
@@ -164,6 +195,8 @@ void rfs_can_pack_pose_th(const rfs_can_pose_t *p, uint8_t counter, rfs_can_fram
 void rfs_can_pack_rssi(const rfs_can_rssi_t *r, uint8_t counter, rfs_can_frame_t *f);
 /// Encode RX_STATUS.
 void rfs_can_pack_receiver(const rfs_can_receiver_t *r, uint8_t counter, rfs_can_frame_t *f);
+/// Encode CONFIG (target, strategy and model masked to their fields, seed to 24 bits).
+void rfs_can_pack_config(const rfs_can_config_t *c, uint8_t counter, rfs_can_frame_t *f);
 /// Encode STATUS.
 void rfs_can_pack_status(const rfs_can_status_t *s, uint8_t counter, rfs_can_frame_t *f);
 
@@ -178,6 +211,9 @@ rfs_can_err_t rfs_can_unpack_pose_th(const rfs_can_frame_t *f, rfs_can_pose_t *p
 rfs_can_err_t rfs_can_unpack_rssi(const rfs_can_frame_t *f, rfs_can_rssi_t *r, uint8_t *counter);
 /// Decode RX_STATUS (data[0] bits 4..7 are reserved, zero).
 rfs_can_err_t rfs_can_unpack_receiver(const rfs_can_frame_t *f, rfs_can_receiver_t *r, uint8_t *counter);
+/// Decode CONFIG: target above 1, strategy or model without a value, P0Min outside its
+/// limits (and not RFS_CAN_P0_NONE) or set reserved bits are RFS_CAN_E_RANGE.
+rfs_can_err_t rfs_can_unpack_config(const rfs_can_frame_t *f, rfs_can_config_t *c, uint8_t *counter);
 /// Decode STATUS.
 rfs_can_err_t rfs_can_unpack_status(const rfs_can_frame_t *f, rfs_can_status_t *s, uint8_t *counter);
 
@@ -229,6 +265,8 @@ void rfs_can_tx_pose(rfs_can_tx_t *tx, const rfs_can_pose_t *p, rfs_can_frame_t 
 void rfs_can_tx_rssi(rfs_can_tx_t *tx, const rfs_can_rssi_t *r, rfs_can_frame_t *f);
 /// Encode a receiver heartbeat with the next counter.
 void rfs_can_tx_receiver(rfs_can_tx_t *tx, const rfs_can_receiver_t *r, rfs_can_frame_t *f);
+/// Encode a configuration with the next counter.
+void rfs_can_tx_config(rfs_can_tx_t *tx, const rfs_can_config_t *c, rfs_can_frame_t *f);
 /// Encode a heartbeat with the next counter.
 void rfs_can_tx_status(rfs_can_tx_t *tx, const rfs_can_status_t *s, rfs_can_frame_t *f);
 
@@ -273,6 +311,7 @@ typedef enum rfs_can_msg_kind {
     RFS_CAN_MSG_RSSI,     ///< an RSSI measurement with an unwrapped time
     RFS_CAN_MSG_STATUS,   ///< a controller heartbeat
     RFS_CAN_MSG_RECEIVER, ///< a receiver heartbeat with an unwrapped time
+    RFS_CAN_MSG_CONFIG,   ///< a mission configuration
 } rfs_can_msg_kind_t;
 
 /// A decoded message, ready for the core.
@@ -286,6 +325,7 @@ typedef struct rfs_can_msg {
     uint8_t rssi_seq;        ///< RFS_CAN_MSG_RSSI: sequence number
     int64_t rssi_t_us;       ///< RFS_CAN_MSG_RSSI: unwrapped time, microseconds
     int64_t receiver_t_us;   ///< RFS_CAN_MSG_RECEIVER: unwrapped capture time, microseconds
+    rfs_can_config_t config; ///< RFS_CAN_MSG_CONFIG
 } rfs_can_msg_t;
 
 /// Defaults: max_age 1 s, max_future 100 ms.
@@ -302,6 +342,13 @@ rfs_can_err_t rfs_can_rx_frame(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int64
 
 /// Total frames dropped for any reason.
 uint32_t rfs_can_rx_dropped_total(const rfs_can_rx_t *rx);
+
+/// Registry name of a CONFIG model code ("ridge", ... "pathloss"); NULL beyond the codes.
+const char *rfs_can_model_name(uint8_t code);
+
+/// CONFIG P0Min (dBm / 128) as the path-loss model's p0_min, dBm Q16.16 (INT32_MIN for
+/// RFS_CAN_P0_NONE). Scaling and overflow: raw x 512, exact; |raw| <= 2^15 fits int32.
+rfs_q16_t rfs_can_p0_to_q16(int16_t raw);
 
 /// Short constant name of a result ("ok", "id", "dlc", "checksum", ...).
 const char *rfs_can_err_str(rfs_can_err_t e);

@@ -52,18 +52,25 @@ static int pathloss_init_default(void *state)
  * - pathloss: 600 wall counts, 16.4 M (about 25,000 per count; the first slice also bins
  *   the samples); 700 would be 18.6 M. A call stops before a bin whose footprint (up to
  *   four counts) could overrun the budget, resuming the candidate at the next call. */
-static const rfs_models_entry_t k_models[] = {
-    {"ridge", &rfs_ridge_ops, (uint32_t)sizeof(rfs_ridge_t), ridge_init_default,
-     "local ridge regression, 5 m radius, alpha 1 (paper 5.2.1)", 2500u, false},
-    {"mlp", &rfs_mlp_ops, (uint32_t)sizeof(rfs_mlp_t), mlp_init_default,
-     "MLP 2-100-1, sigmoid, backprop rate 0.01 momentum 0.1, 3 epochs (paper 5.2.2)", 700u, false},
-    {"knn", &rfs_knn_ops, (uint32_t)sizeof(rfs_knn_t), knn_init_default,
-     "k-nearest-neighbours regression, k = 5 (paper 5.2)", 2500u, false},
-    {"radius", &rfs_radius_ops, (uint32_t)sizeof(rfs_knn_t), radius_init_default,
-     "radius-neighbours regression, r = 1 m (paper 5.2)", 2500u, false},
-    {"pathloss", &rfs_pathloss_ops, (uint32_t)sizeof(rfs_pathloss_t), pathloss_init_default,
-     "map-aware log-distance + walls fit, source search; one per source under bridge "
-     "(beyond the paper)", 600u, true},
+const rfs_models_entry_t rfs_models_ridge = {
+    "ridge", &rfs_ridge_ops, (uint32_t)sizeof(rfs_ridge_t), ridge_init_default,
+    "local ridge regression, 5 m radius, alpha 1 (paper 5.2.1)", 2500u, false};
+const rfs_models_entry_t rfs_models_mlp = {
+    "mlp", &rfs_mlp_ops, (uint32_t)sizeof(rfs_mlp_t), mlp_init_default,
+    "MLP 2-100-1, sigmoid, backprop rate 0.01 momentum 0.1, 3 epochs (paper 5.2.2)", 700u, false};
+const rfs_models_entry_t rfs_models_knn = {
+    "knn", &rfs_knn_ops, (uint32_t)sizeof(rfs_knn_t), knn_init_default,
+    "k-nearest-neighbours regression, k = 5 (paper 5.2)", 2500u, false};
+const rfs_models_entry_t rfs_models_radius = {
+    "radius", &rfs_radius_ops, (uint32_t)sizeof(rfs_knn_t), radius_init_default,
+    "radius-neighbours regression, r = 1 m (paper 5.2)", 2500u, false};
+const rfs_models_entry_t rfs_models_pathloss = {
+    "pathloss", &rfs_pathloss_ops, (uint32_t)sizeof(rfs_pathloss_t), pathloss_init_default,
+    "map-aware log-distance + walls fit, source search; one per source under bridge "
+    "(beyond the paper)", 600u, true};
+
+static const rfs_models_entry_t *const k_models[] = {
+    &rfs_models_ridge, &rfs_models_mlp, &rfs_models_knn, &rfs_models_radius, &rfs_models_pathloss,
 };
 
 #define N_MODELS (sizeof(k_models) / sizeof(k_models[0]))
@@ -83,8 +90,8 @@ const rfs_models_entry_t *rfs_models_lookup(const char *name)
         return NULL;
     }
     for (uint32_t i = 0u; i < N_MODELS; ++i) {
-        if (same_name(k_models[i].name, name)) {
-            return &k_models[i];
+        if (same_name(k_models[i]->name, name)) {
+            return k_models[i];
         }
     }
     return NULL;
@@ -103,14 +110,14 @@ uint32_t rfs_models_count(void)
 
 const rfs_models_entry_t *rfs_models_at(uint32_t i)
 {
-    return i < N_MODELS ? &k_models[i] : NULL;
+    return i < N_MODELS ? k_models[i] : NULL;
 }
 
 uint32_t rfs_models_max_state_bytes(void)
 {
     uint32_t m = 0u;
     for (uint32_t i = 0u; i < N_MODELS; ++i) {
-        m = k_models[i].state_bytes > m ? k_models[i].state_bytes : m;
+        m = k_models[i]->state_bytes > m ? k_models[i]->state_bytes : m;
     }
     return m;
 }

@@ -41,6 +41,14 @@ typedef struct rfs_models_entry {
     bool per_source;
 } rfs_models_entry_t;
 
+/// The entries by name, in --help order: an image that names one of them instead of
+/// looking models up links that model's code alone.
+extern const rfs_models_entry_t rfs_models_ridge;
+extern const rfs_models_entry_t rfs_models_mlp;    ///< "mlp"
+extern const rfs_models_entry_t rfs_models_knn;    ///< "knn"
+extern const rfs_models_entry_t rfs_models_radius; ///< "radius"
+extern const rfs_models_entry_t rfs_models_pathloss; ///< "pathloss"
+
 /// The entry named `name` (NUL-terminated, exact match), or NULL when there is none.
 const rfs_models_entry_t *rfs_models_lookup(const char *name);
 

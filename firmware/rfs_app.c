@@ -12,6 +12,7 @@ rfs_app_cfg_t rfs_app_cfg_default(void)
     memset(&c, 0, sizeof c);
     c.seek = rfs_seek_cfg_default();
     c.ridge = rfs_ridge_cfg_default();
+    c.pathloss = rfs_pathloss_cfg_default();
     c.map = rfs_map_cfg_default();
     c.target = RFS_APP_TARGET_RSSI;
     c.seed = 1u;
@@ -50,7 +51,8 @@ bool rfs_app_model_fits(const rfs_app_cfg_t *cfg)
 }
 
 /* The configured model on its state: the ridge with cfg->ridge (the paper's numbers by
- * default, so a NULL model and the "ridge" entry decide alike), any other with its
+ * default, so a NULL model and the "ridge" entry decide alike), the path-loss model with
+ * cfg->pathloss (its registry defaults but for a CONFIG's p0_min), any other with its
  * registry defaults. */
 static int app_model_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, rfs_model_t *model)
 {
@@ -64,6 +66,10 @@ static int app_model_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, rfs_model_t *m
         *model = rfs_ridge_model((rfs_ridge_t *)state);
         return rfs_ridge_init((rfs_ridge_t *)state, &cfg->ridge);
     }
+    if (cfg->model->ops == &rfs_pathloss_ops) {
+        *model = rfs_pathloss_model((rfs_pathloss_t *)state);
+        return rfs_pathloss_init((rfs_pathloss_t *)state, &cfg->pathloss);
+    }
     model->ops = cfg->model->ops;
     model->self = state;
     return cfg->model->init_default(state);
@@ -71,9 +77,40 @@ static int app_model_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, rfs_model_t *m
 
 _Static_assert(RFS_TARGET_MAX_SOURCES == 2u, "the seeker memory lists two sources' stores");
 
+static const rfs_target_ops_t *app_target(rfs_app_target_t t)
+{
+    return t == RFS_APP_TARGET_BRIDGE ? &rfs_target_bridge : &rfs_target_rssi;
+}
+
+int rfs_app_cfg_choose(rfs_app_cfg_t *cfg, rfs_app_target_t target, rfs_seek_strategy_t strategy,
+                       const rfs_models_entry_t *model, rfs_q16_t p0_min)
+{
+    /* meta-global needs a map-wide model radius; the baselines' decision kinds (probe,
+     * gradient, run, tumble) fit neither the STATUS frame's nor the replay's kind field. */
+    if ((uint32_t)target > (uint32_t)RFS_APP_TARGET_BRIDGE ||
+        (strategy != RFS_SEEK_META && strategy != RFS_SEEK_META_PATH) || cfg->built.ops != NULL) {
+        return -1;
+    }
+    /* One fit per source needs a state and a store per source (rfs_fields.h): only a port
+     * with the memory builds it (docs/FIRMWARE.md, "What the STM32 image holds"). */
+    if (model != NULL && model->per_source && app_target(target)->nsources > 1u) {
+        return -1;
+    }
+    rfs_app_cfg_t c = *cfg;
+    c.model = model;
+    if (!rfs_app_model_fits(&c)) {
+        return -1;
+    }
+    c.target = target;
+    rfs_seek_cfg_use_strategy(&c.seek, strategy);
+    c.pathloss.p0_min = p0_min;
+    *cfg = c;
+    return 0;
+}
+
 int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *map)
 {
-    if (a == NULL || cfg == NULL || map == NULL || map->free == NULL) {
+    if (a == NULL || cfg == NULL || map == NULL || map->free == NULL || cfg->samples == NULL) {
         return -1;
     }
     if (cfg->target > RFS_APP_TARGET_BRIDGE || cfg->input_timeout_us <= 0) {
@@ -86,8 +123,9 @@ int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *ma
      * reads of its array (the store counts what it holds, rfs_map_init derives the legal
      * grid, the seeker clears its bit arrays), and 60 KB of memset would be 15,000
      * stores at every boot. */
-    memset(a, 0, offsetof(rfs_app_t, samples));
+    memset(a, 0, offsetof(rfs_app_t, pending));
     a->cfg = *cfg;
+    a->map_in = *map;
     a->cfg.seek.fit_budget = rfs_app_fit_budget(cfg);
     if (rfs_map_init(&a->map, &cfg->map, map->w, map->h, map->res, map->origin_x,
                      map->origin_y, map->free, map->wall, a->legal) != 0) {
@@ -103,7 +141,7 @@ int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *ma
     }
     rfs_rng_seed(&a->rng, cfg->seed);
     const rfs_seek_mem_t mem = {
-        .samples = a->samples,
+        .samples = cfg->samples,
         .pending = a->pending,
         .pending_cap = RFS_APP_PENDING,
         .plan_work = a->plan_work,
@@ -118,10 +156,7 @@ int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *ma
         .src_samples = {cfg->src_samples[0], cfg->src_samples[1]},
         .src_pending = {cfg->src_pending[0], cfg->src_pending[1]},
     };
-    const rfs_target_ops_t *target =
-        cfg->target == RFS_APP_TARGET_BRIDGE ? &rfs_target_bridge : &rfs_target_rssi;
-    if (rfs_seek_init(&a->seek, &a->cfg.seek, &a->map, model, target,
-                      &mem) != 0) {
+    if (rfs_seek_init(&a->seek, &a->cfg.seek, &a->map, model, app_target(cfg->target), &mem) != 0) {
         return -1;
     }
     const rfs_can_rx_cfg_t rx_cfg = rfs_can_rx_cfg_default();
@@ -170,6 +205,75 @@ bool rfs_app_on_receiver(rfs_app_t *a, int64_t t_us, int64_t rx_us)
         a->stats.receiver++;
     } else {
         a->stats.rejected++;
+    }
+    return ok;
+}
+
+/* What a CONFIG's re-initialisation keeps: the counters, the CAN receiver and sender
+ * (rolling counters run on) and the input and transport state the safety rules read. */
+typedef struct app_kept {
+    rfs_app_stats_t stats;
+    rfs_can_rx_t can_rx;
+    rfs_can_tx_t can_tx;
+    int64_t pose_rx_us, rssi_rx_us;
+    bool have_pose_rx, have_rssi_rx, bus_off, after_reset, bad_frame;
+} app_kept_t;
+
+static void app_keep(const rfs_app_t *a, app_kept_t *k)
+{
+    k->stats = a->stats;
+    k->can_rx = a->can_rx;
+    k->can_tx = a->can_tx;
+    k->pose_rx_us = a->pose_rx_us;
+    k->rssi_rx_us = a->rssi_rx_us;
+    k->have_pose_rx = a->have_pose_rx;
+    k->have_rssi_rx = a->have_rssi_rx;
+    k->bus_off = a->bus_off;
+    k->after_reset = a->after_reset;
+    k->bad_frame = a->bad_frame;
+}
+
+static void app_restore(rfs_app_t *a, const app_kept_t *k)
+{
+    a->stats = k->stats;
+    a->can_rx = k->can_rx;
+    a->can_tx = k->can_tx;
+    a->pose_rx_us = k->pose_rx_us;
+    a->rssi_rx_us = k->rssi_rx_us;
+    a->have_pose_rx = k->have_pose_rx;
+    a->have_rssi_rx = k->have_rssi_rx;
+    a->bus_off = k->bus_off;
+    a->after_reset = k->after_reset;
+    a->bad_frame = k->bad_frame;
+}
+
+bool rfs_app_on_config(rfs_app_t *a, const rfs_can_config_t *c)
+{
+    /* Idle: before the mission's first decision (the initial move), so a mission never
+     * changes its rule or model half-way. */
+    rfs_app_cfg_t n = a->cfg;
+    const rfs_models_entry_t *model = c->model < (uint8_t)RFS_CAN_NMODELS ? n.models[c->model] : NULL;
+    const bool offered = c->model == (uint8_t)RFS_CAN_MODEL_RIDGE || model != NULL;
+    n.seed = c->seed;
+    if (a->seek.iteration != 0u || !offered ||
+        rfs_app_cfg_choose(&n, (rfs_app_target_t)c->target, (rfs_seek_strategy_t)c->strategy, model,
+                           rfs_can_p0_to_q16(c->p0_min)) != 0) {
+        a->stats.configs_rejected++;
+        return false;
+    }
+    app_kept_t k;
+    app_keep(a, &k);
+    const rfs_app_cfg_t old = a->cfg;
+    const rfs_app_map_t map = a->map_in;
+    const bool ok = rfs_app_init(a, &n, &map) == 0;
+    if (!ok) {
+        (void)rfs_app_init(a, &old, &map); /* it ran with these before */
+    }
+    app_restore(a, &k);
+    if (ok) {
+        a->stats.configs++;
+    } else {
+        a->stats.configs_rejected++;
     }
     return ok;
 }
@@ -244,6 +348,8 @@ rfs_can_err_t rfs_app_on_can(rfs_app_t *a, const rfs_can_frame_t *f, int64_t rx_
         (void)rfs_app_on_rssi(a, msg.rssi_src, msg.rssi_t_us, msg.rssi_dbm, rx_us);
     } else if (msg.kind == RFS_CAN_MSG_RECEIVER) {
         (void)rfs_app_on_receiver(a, msg.receiver_t_us, rx_us);
+    } else if (msg.kind == RFS_CAN_MSG_CONFIG) {
+        (void)rfs_app_on_config(a, &msg.config);
     }
     return e;
 }

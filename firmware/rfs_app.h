@@ -3,7 +3,9 @@
  * One rfs_app_t holds everything the controller needs at run time: the seeker
  * (common/rfs_seek.h, paper section 2, Algorithm 1), the local ridge model (section
  * 5.2.1), the random source and every large array, all as fixed-size members sized by the
- * compile-time maxima below, so a port declares ONE static rfs_app_t and needs no heap.
+ * compile-time maxima below, so a port declares ONE static rfs_app_t and needs no heap;
+ * only the 60 KB sample store (rfs_app_cfg_t.samples) and a larger model's state are the
+ * port's, placed where they fit (docs/FIRMWARE.md, "What the STM32 image holds").
  *
  * A port feeds what arrives, in arrival order, and calls rfs_app_step() at the control
  * rate (RFS_APP_PERIOD_US):
@@ -11,7 +13,9 @@
  *     receiver heartbeat; the Linux/LCM port), or
  *   - raw CAN frames: rfs_app_on_can() (the STM32 and emulator ports; decoding by
  *     common/rfs_can.h),
- *   - transport state: rfs_app_set_bus_off() (bxCAN bus-off, SocketCAN error state).
+ *   - transport state: rfs_app_set_bus_off() (bxCAN bus-off, SocketCAN error state),
+ *   - the mission configuration: a CONFIG frame (rfs_app_on_config()), applied only
+ *     before the first decision.
  * rfs_app_step() returns the wheel command and the status; rfs_app_frames() encodes them
  * as the CAN frames of docs/CAN.md.
  *
@@ -37,15 +41,17 @@
 #include "rfs_fix.h"
 #include "rfs_map.h"
 #include "rfs_models.h"
+#include "rfs_pathloss.h"
 #include "rfs_ridge.h"
 #include "rfs_seek.h"
 #include "rfs_store.h"
 
-/// Samples held for learning (paper section 5.2: at most 10,000), 6 bytes each.
+/// Samples held for learning (paper section 5.2: at most 10,000), 6 bytes each, in the
+/// port's array (rfs_app_cfg_t.samples).
 #define RFS_APP_MAX_SAMPLES 10000u
 /// Largest bit grid, bytes (the derived legal grid lives in RAM): at 0.1 m cells e.g.
 /// 40 x 12.8 m or 25.6 x 20 m; a 40 x 20 m map fits at 0.125 m cells (320 x 160).
-/// Sized so the whole image stays inside the 96 KB static-RAM budget (docs/FIRMWARE.md).
+/// Sized with the path-loss state to the STM32 image's budgets (docs/FIRMWARE.md).
 #define RFS_APP_MAX_MAP_BYTES 6400u
 /// Largest lattice, points: a 40 x 20 m map at 0.25 m is 160 x 80.
 #define RFS_APP_MAX_LATTICE (160u * 80u)
@@ -59,8 +65,8 @@
 /// instructions (docs/PERFORMANCE.md). Other models have their own budget in the registry
 /// (rfs_models_entry_t.mcu_fit_budget; rfs_app_fit_budget()).
 #define RFS_APP_MCU_FIT_BUDGET 2500u
-/// Model state built into rfs_app_t, bytes: the local ridge's (the MLP's 3.3 KB does not
-/// fit the MCU's RAM budget next to the maxima above; docs/MODELS.md).
+/// Model state built into rfs_app_t, bytes: the local ridge's; any other model's state is
+/// the port's (rfs_app_cfg_t.model_state).
 #define RFS_APP_MODEL_BYTES ((uint32_t)sizeof(rfs_ridge_t))
 /// Control period, microseconds (20 Hz).
 #define RFS_APP_PERIOD_US 50000
@@ -98,18 +104,24 @@ typedef struct rfs_app_map {
 /// The internal model (docs/MODELS.md, "Choosing a model") is chosen by a registry entry,
 /// `model = rfs_models_lookup(name)`, the same names as the simulator and the feeder;
 /// NULL is the paper's local ridge. Its state lives in the application's own
-/// RFS_APP_MODEL_BYTES (enough for the ridge only: the static-RAM budget has no room
-/// for more) or in a buffer the port provides (model_state, aligned to
-/// RFS_MODELS_STATE_ALIGN); rfs_app_init() rejects a model whose state does not fit
-/// (rfs_app_model_fits() says which). The ridge uses `ridge`, every other model its
-/// registry defaults. Registry lookups stay in the ports, so an image that never names
-/// another model links none of their code.
+/// RFS_APP_MODEL_BYTES (the ridge's) or in a buffer the port provides (model_state,
+/// aligned to RFS_MODELS_STATE_ALIGN); rfs_app_init() rejects a model whose state does
+/// not fit (rfs_app_model_fits() says which). The ridge uses `ridge`, the path-loss model
+/// `pathloss`, every other model its registry defaults. Registry lookups stay in the
+/// ports, so an image links only the models it names.
 typedef struct rfs_app_cfg {
     rfs_seek_cfg_t seek;        ///< seeker (rfs_seek_cfg_default(): the paper's numbers)
     const rfs_models_entry_t *model; ///< internal model (rfs_models_lookup()); NULL = ridge
     void *model_state;          ///< port's buffer for the model state; NULL = the built-in one
     uint32_t model_state_bytes; ///< its size, bytes (0 with model_state NULL)
     rfs_ridge_cfg_t ridge;      ///< local ridge (5 m radius, alpha 1)
+    rfs_pathloss_cfg_t pathloss; ///< path-loss model (rfs_pathloss_cfg_default(); CONFIG
+                                ///< sets p0_min)
+    rfs_sample_t *samples;      ///< the sample store: seek.store.capacity samples the port
+                                ///< owns (required; e.g. CCM on the STM32)
+    /// The models a CONFIG frame may choose, by its model code (RFS_CAN_MODEL_*): NULL is
+    /// not offered (rejected), except the ridge's code, whose NULL is the built-in ridge.
+    const rfs_models_entry_t *models[RFS_CAN_NMODELS];
     rfs_map_cfg_t map;          ///< clearance and lattice (0.25 m, 0.25 m)
     rfs_app_target_t target;    ///< target function
     uint64_t seed;              ///< seed of the random source (epsilon moves, reservoir)
@@ -152,15 +164,19 @@ typedef struct rfs_app_stats {
     uint32_t bad_frames;        ///< CAN frames that failed to decode (DLC, checksum)
     uint32_t unknown_frames;    ///< CAN frames with ids that are not ours
     uint32_t steps;             ///< control periods run
+    uint32_t configs;           ///< CONFIG frames applied
+    uint32_t configs_rejected;  ///< CONFIG frames rejected (not idle, or not held)
 } rfs_app_stats_t;
 
-/// The application: every byte the controller uses at run time (about 95 KB with the
-/// maxima above). Declare one static instance per port.
+/// The application: every byte the controller uses at run time but the sample store and
+/// a port's model state (about 35 KB with the maxima above). Declare one static instance
+/// per port.
 typedef struct rfs_app {
     rfs_app_cfg_t cfg;                              ///< configuration copied at init
     rfs_seek_t seek;                                ///< the meta-algorithm
     rfs_ridge_t ridge;                              ///< built-in model state (the local ridge's)
     rfs_map_t map;                                  ///< the map (grids owned by the port)
+    rfs_app_map_t map_in;                           ///< the port's map (a CONFIG re-initialises on it)
     rfs_rng_t rng;                                  ///< the random source
     int64_t pose_rx_us;                             ///< local time the last pose arrived
     int64_t rssi_rx_us;                             ///< local time the last RSSI or heartbeat arrived
@@ -173,7 +189,6 @@ typedef struct rfs_app {
     rfs_can_tx_t can_tx;                            ///< CAN sender: rolling counters
     rfs_app_stats_t stats;                          ///< counters
     rfs_app_out_t last;                             ///< output of the latest step
-    rfs_sample_t samples[RFS_APP_MAX_SAMPLES];      ///< the sample store
     rfs_pending_t pending[RFS_APP_PENDING];         ///< measurements awaiting a pose
     uint8_t legal[RFS_APP_MAX_MAP_BYTES];           ///< derived legal bits
     uint8_t plan_work[RFS_APP_MAX_LATTICE];         ///< planner marks, one byte per point
@@ -205,9 +220,20 @@ uint32_t rfs_app_model_capacity(const rfs_app_cfg_t *cfg);
 /// true when cfg->model's state fits the configured state buffer (NULL: the ridge, fits).
 bool rfs_app_model_fits(const rfs_app_cfg_t *cfg);
 
+/// Set what a CONFIG frame or a replay's CFG record chooses: target, strategy (its preset,
+/// rfs_seek_cfg_use_strategy()), model (NULL: the built-in ridge) and the path-loss
+/// p0_min (dBm Q16.16, INT32_MIN: no floor). Returns 0, or -1 leaving cfg unchanged when
+/// the image does not hold that choice: target out of range, a strategy other than meta
+/// and meta-path, a state larger than the model buffer, a model
+/// fitted per source under a target of several sources without a port-built model
+/// (`built`: the STM32 image has no room for two path-loss states), or a port-built
+/// model in place.
+int rfs_app_cfg_choose(rfs_app_cfg_t *cfg, rfs_app_target_t target, rfs_seek_strategy_t strategy,
+                       const rfs_models_entry_t *model, rfs_q16_t p0_min);
+
 /// Initialise (also after a watchdog reset). Returns 0, or -1 when the map is larger
-/// than the compile-time maxima or invalid, the model's state does not fit (or the
-/// buffer is misaligned), or the seeker rejects the configuration.
+/// than the compile-time maxima or invalid, the sample store is missing, the model's state
+/// does not fit (or the buffer is misaligned), or the seeker rejects the configuration.
 int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *map);
 
 /// A decoded pose arrived at local time rx_us. false when the seeker rejected it.
@@ -225,6 +251,13 @@ bool rfs_app_on_rssi(rfs_app_t *a, uint8_t src, int64_t t_us, int8_t dbm, int64_
 /// rssi_timeout_us makes the stream stale (a clock jump). false when rejected.
 bool rfs_app_on_receiver(rfs_app_t *a, int64_t t_us, int64_t rx_us);
 
+/// A CONFIG frame (docs/CAN.md, "0x130 CONFIG"): while no decision has been made since
+/// init, re-initialises with its seed and rfs_app_cfg_choose() of its target, strategy,
+/// model (cfg.models[code]) and p0_min, keeping the counters and the CAN state. false,
+/// counted in stats.configs_rejected, when a decision was made or the image does not
+/// hold the choice; the configuration in force is unchanged then.
+bool rfs_app_on_config(rfs_app_t *a, const rfs_can_config_t *c);
+
 /// The transport went bus-off (true) or recovered (false).
 void rfs_app_set_bus_off(rfs_app_t *a, bool off);
 
@@ -232,7 +265,8 @@ void rfs_app_set_bus_off(rfs_app_t *a, bool off);
 void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out);
 
 /// A raw CAN frame arrived at local time rx_us: decoded with rfs_can (pose pairs, RSSI,
-/// receiver heartbeat; other ids counted as unknown) and fed to the seeker. Returns the decode result.
+/// receiver heartbeat, CONFIG; other ids counted as unknown) and fed to the seeker. Returns
+/// the decode result.
 rfs_can_err_t rfs_app_on_can(rfs_app_t *a, const rfs_can_frame_t *f, int64_t rx_us);
 
 /// Encode a step's output as its CAN frames, in sending order: frames[0] = WHEEL_CMD,

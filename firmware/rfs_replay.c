@@ -53,7 +53,7 @@ int rfs_replay_check_header(const uint8_t *buf, uint32_t len)
 static int payload_len(uint8_t type)
 {
     switch (type) {
-    case RFS_REPLAY_CFG: return -3; /* 14, plus a model name of 1..15 bytes */
+    case RFS_REPLAY_CFG: return -3; /* 14, a model name of 0..15 bytes, a choice of 0 or 4 */
     case RFS_REPLAY_MAP: return 17;
     case RFS_REPLAY_MAP_FREE:
     case RFS_REPLAY_MAP_WALL: return -1;
@@ -124,7 +124,7 @@ static const char *check_length(uint8_t type, uint8_t n)
     if (want >= 0 && n != (uint8_t)want) {
         return "wrong record length for its type";
     }
-    if (want == -3 && (n < 14u || n > 14u + RFS_REPLAY_MODEL_NAME_MAX)) {
+    if (want == -3 && (n < 14u || n > 14u + RFS_REPLAY_MODEL_NAME_MAX + RFS_REPLAY_CHOICE_LEN)) {
         return "CFG length out of range";
     }
     if (want == -1 && (n < 5u || n > 4u + RFS_REPLAY_CHUNK)) {
@@ -143,12 +143,25 @@ static const char *get_cfg(const uint8_t *p, uint8_t n, rfs_replay_rec_t *rec)
     if (rec->u.cfg.target > (uint8_t)RFS_APP_TARGET_BRIDGE) {
         return "CFG target out of range";
     }
-    for (uint8_t i = 14u; i < n; i++) {
-        if (p[i] <= 0x20u || p[i] >= 0x7Fu) {
-            return "CFG model name not printable";
+    uint8_t i = 14u;
+    for (; i < n && p[i] != 0u; i++) {
+        if (p[i] <= 0x20u || p[i] >= 0x7Fu || i - 14u >= RFS_REPLAY_MODEL_NAME_MAX) {
+            return "CFG model name not printable or too long";
         }
         rec->u.cfg.model[i - 14u] = (char)p[i];
     }
+    if (i == n) {
+        return NULL;
+    }
+    /* The choice: the NUL, strategy, p0_min, the CONFIG frame's ranges. */
+    const int16_t p0 = (int16_t)rd16(p + i + 2u);
+    if (n - i != RFS_REPLAY_CHOICE_LEN || p[i + 1u] >= (uint8_t)RFS_SEEK_STRATEGY_COUNT ||
+        (p0 != RFS_CAN_P0_NONE && (p0 < RFS_CAN_P0_MIN || p0 > RFS_CAN_P0_MAX))) {
+        return "CFG choice malformed or out of range";
+    }
+    rec->u.cfg.chosen = true;
+    rec->u.cfg.strategy = p[i + 1u];
+    rec->u.cfg.p0_min = p0;
     return NULL;
 }
 
@@ -303,6 +316,11 @@ uint32_t rfs_replay_encode(const rfs_replay_rec_t *rec, uint8_t *buf, uint32_t c
         for (uint32_t i = 0; i < RFS_REPLAY_MODEL_NAME_MAX && rec->u.cfg.model[i] != '\0'; i++) {
             *p++ = (uint8_t)rec->u.cfg.model[i];
         }
+        if (rec->u.cfg.chosen) {
+            *p++ = 0u;
+            *p++ = rec->u.cfg.strategy;
+            p = wr16(p, (uint16_t)rec->u.cfg.p0_min);
+        }
         break;
     case RFS_REPLAY_MAP:
         p = wr16(p, rec->u.map.w);
@@ -402,6 +420,11 @@ void rfs_replay_player_init(rfs_replay_player_t *p, rfs_app_t *app, const rfs_ap
     memset(p, 0, offsetof(rfs_replay_player_t, free_bits));
     p->app = app;
     p->cfg = *cfg;
+    /* CONFIG frames in a stream may choose any registered model: the state buffer decides
+     * what an image holds, as for a CFG's model name. */
+    for (uint8_t k = 0; k < (uint8_t)RFS_CAN_NMODELS; k++) {
+        p->cfg.models[k] = rfs_models_lookup(rfs_can_model_name(k));
+    }
     p->write = write;
     p->write_ctx = write_ctx;
     uint8_t h[RFS_REPLAY_HEADER_LEN];
@@ -512,6 +535,11 @@ bool rfs_replay_play(rfs_replay_player_t *p, const rfs_replay_rec_t *rec)
                 return fail(p, RFS_REPLAY_E_MODEL_SIZE);
             }
         }
+        if (rec->u.cfg.chosen &&
+            rfs_app_cfg_choose(&p->cfg, p->cfg.target, (rfs_seek_strategy_t)rec->u.cfg.strategy,
+                               p->cfg.model, rfs_can_p0_to_q16(rec->u.cfg.p0_min)) != 0) {
+            return fail(p, RFS_REPLAY_E_CHOICE);
+        }
         return true;
     case RFS_REPLAY_MAP:
         if (p->started) {
@@ -610,6 +638,7 @@ const char *rfs_replay_err_str(rfs_replay_err_t e)
     case RFS_REPLAY_E_ORDER: return "record out of place in an input stream";
     case RFS_REPLAY_E_MODEL: return "CFG names an unknown model";
     case RFS_REPLAY_E_MODEL_SIZE: return "CFG model's state is larger than the image holds";
+    case RFS_REPLAY_E_CHOICE: return "CFG chooses a strategy, model and target the image does not hold";
     default: return "unknown error";
     }
 }

@@ -9,7 +9,8 @@
  *
  * Input records (times are the controller's clock, int64 microseconds):
  *   CFG      seed u64, target u8, node u8, fit_budget u32,
- *            [model name, 1..15 bytes, no NUL: rfs_models.h]          14..29
+ *            [model name, 1..15 bytes, no NUL: rfs_models.h],
+ *            [0 u8, strategy u8, p0_min i16: a CONFIG frame's choice]   14..33
  *   MAP      w u16, h u16, res q16, origin_x q16, origin_y q16,
  *            has_wall u8                                               17
  *   MAP_FREE offset u32, 1..RFS_REPLAY_CHUNK bytes of the free grid    5..
@@ -31,7 +32,8 @@
  *   CAN_TX   t i64, id u32, dlc u8, data[8]                             21
  *
  * Version 1 streams written before RECEIVER existed hold no such record and load unchanged;
- * a player fed none keeps the packets-only rule.
+ * a player fed none keeps the packets-only rule. A CFG without the choice after its NUL
+ * (written before it existed) keeps the player's strategy and path-loss floor.
  *
  * The parser is portable C (no libc but memcpy/memset), works on a caller buffer that
  * may end anywhere, checks every length, enum and range, and never reads past `len`.
@@ -54,6 +56,8 @@
 #define RFS_REPLAY_CHUNK 240u
 /// Longest model name a CFG record carries, bytes (without the NUL).
 #define RFS_REPLAY_MODEL_NAME_MAX 15u
+/// Bytes of a CFG's choice: the NUL, strategy, p0_min.
+#define RFS_REPLAY_CHOICE_LEN 4u
 /// Longest encoded record (type, len, 255 bytes of payload).
 #define RFS_REPLAY_MAX_RECORD 257u
 
@@ -103,6 +107,9 @@ typedef struct rfs_replay_rec {
             /// internal model by registry name, NUL-terminated; "" = the player's base
             /// configuration (the local ridge)
             char model[RFS_REPLAY_MODEL_NAME_MAX + 1u];
+            bool chosen;      ///< the strategy and p0_min below are present
+            uint8_t strategy; ///< rfs_seek_strategy_t (a CONFIG frame's Strategy)
+            int16_t p0_min;   ///< path-loss floor, dBm / 128 or RFS_CAN_P0_NONE (P0Min)
         } cfg;                ///< CFG
         struct {
             uint16_t w, h;    ///< cells
@@ -168,6 +175,7 @@ typedef enum rfs_replay_err {
     RFS_REPLAY_E_ORDER,       ///< an output record (or CFG/MAP after inputs) in an input stream
     RFS_REPLAY_E_MODEL,       ///< CFG names a model the registry does not know
     RFS_REPLAY_E_MODEL_SIZE,  ///< CFG names a model whose state the image cannot hold
+    RFS_REPLAY_E_CHOICE,      ///< CFG chooses what the image does not hold (rfs_app_cfg_choose)
 } rfs_replay_err_t;
 
 /// Plays an input stream into an application: the one driver loop shared by the host
@@ -175,7 +183,8 @@ typedef enum rfs_replay_err {
 /// (the map grids) plus the application it points to.
 typedef struct rfs_replay_player {
     rfs_app_t *app;                           ///< the application driven
-    rfs_app_cfg_t cfg;                        ///< configuration (CFG overrides seed, target, node, fit budget, model)
+    rfs_app_cfg_t cfg;                        ///< configuration (CFG overrides seed, target, node,
+                                              ///< fit budget, model, strategy, p0_min)
     rfs_app_map_t map;                        ///< map header (MAP), grids below
     bool have_map;                            ///< MAP seen
     bool started;                             ///< rfs_app_init() done
@@ -190,7 +199,9 @@ typedef struct rfs_replay_player {
 
 /// Start a player on `app` with the base configuration (CFG records override seed,
 /// target, node id, fit budget and, when they name one, the model: its state goes into
-/// the base configuration's model_state buffer, or the application's built-in one).
+/// the base configuration's model_state buffer, or the application's built-in one; a
+/// CFG's choice goes through rfs_app_cfg_choose(), as a CONFIG frame's). CONFIG frames may
+/// choose every registered model (cfg.models), those whose state fits the buffer.
 /// Writes the output stream header through `write`.
 void rfs_replay_player_init(rfs_replay_player_t *p, rfs_app_t *app, const rfs_app_cfg_t *cfg,
                             rfs_replay_write_fn write, void *write_ctx);

@@ -27,8 +27,11 @@ FW_CFLAGS := $(FW_ARCH) $(CSTD) $(WARN) $(FW_OPT) -g -ffreestanding -fno-common 
 	-ffunction-sections -fdata-sections $(INC_fw) -Ifirmware/port/stm32f4 -Ifirmware/port/qemu
 FW_LDFLAGS := $(FW_ARCH) -nostartfiles --specs=nano.specs -Wl,--gc-sections \
 	-T firmware/port/stm32f4/stm32f405.ld
-# The emulator's 1 MB flash and 192 KB RAM.
-FW_EMU_LDFLAGS := $(FW_LDFLAGS) -Wl,--defsym=RFS_RAM_BUDGET=192K -Wl,--defsym=RFS_FLASH_BUDGET=1024K
+# The emulator's 1 MB flash and 192 KB RAM: the benchmarks use it all; the replay image
+# splits it as the hardware's SRAM and CCM (128 KB + 64 KB at 0x20020000: qemu has no CCM).
+FW_EMU_LDFLAGS := $(FW_LDFLAGS) -Wl,--defsym=RFS_FLASH_BUDGET=1024K
+FW_BENCH_LDFLAGS := $(FW_EMU_LDFLAGS) -Wl,--defsym=RFS_RAM_LENGTH=192K -Wl,--defsym=RFS_RAM_BUDGET=192K
+FW_QEMU_LDFLAGS := $(FW_EMU_LDFLAGS) -Wl,--defsym=RFS_CCM_ORIGIN=0x20020000
 FW_CORE_LIB := $(FW)/lib/librfs_core.a
 FW_CORE_OBJS := $(CORE_SRCS:%.c=$(FW)/obj/%.o)
 # The map baked into the hardware image: by default the largest the image holds.
@@ -59,9 +62,9 @@ $(FW)/firmware.elf: $(FW_STM32_SRCS:%.c=$(FW)/obj/%.o) $(FW)/obj/fw_map.o $(FW_C
 # The emulator image: the hardware stack plus the player's ~1.5 KB, so an overflow of the
 # application's path faults here too (the stack sits below .data/.bss).
 $(FW)/qemu.elf: $(FW_QEMU_SRCS:%.c=$(FW)/obj/%.o) $(FW_CORE_LIB) firmware/port/stm32f4/stm32f405.ld
-	$(ARM_CC) $(FW_EMU_LDFLAGS) -Wl,--defsym=RFS_STACK_SIZE=4K -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
+	$(ARM_CC) $(FW_QEMU_LDFLAGS) -Wl,--defsym=RFS_STACK_SIZE=4K -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
 $(FW)/bench.elf: $(FW_BENCH_SRCS:%.c=$(FW)/obj/%.o) $(FW_CORE_LIB) firmware/port/stm32f4/stm32f405.ld
-	$(ARM_CC) $(FW_EMU_LDFLAGS) -Wl,--defsym=RFS_STACK_SIZE=16K -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
+	$(ARM_CC) $(FW_BENCH_LDFLAGS) -Wl,--defsym=RFS_STACK_SIZE=16K -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
 $(FW)/%.bin: $(FW)/%.elf
 	arm-none-eabi-objcopy -O binary $< $@
 
@@ -69,6 +72,7 @@ $(FW)/%.bin: $(FW)/%.elf
 firmware: $(FW_IMAGES)
 	@arm-none-eabi-size $(FW)/firmware.elf $(FW)/qemu.elf
 	@scripts/fw_budget.sh $(FW)/firmware.elf
+	@scripts/fw_budget.sh $(FW)/qemu.elf
 
 # --- the model workload on the Cortex-M4 (docs/PERFORMANCE.md, "Models on the Cortex-M4")
 # The two maps of the workloads, baked as const grids; map2c.py names the object
@@ -92,7 +96,7 @@ FW_BENCH_MODELS_OBJS := $(FW_BENCH_MODELS_SRCS:%.c=$(FW)/obj/%.o) $(FW)/obj/mw_b
 	$(FW)/obj/mw_office_map.o
 # newlib's libm for the workload's doubles.
 $(FW)/bench_models.elf: $(FW_BENCH_MODELS_OBJS) $(FW_CORE_LIB) firmware/port/stm32f4/stm32f405.ld
-	$(ARM_CC) $(FW_EMU_LDFLAGS) -Wl,--defsym=RFS_STACK_SIZE=16K -o $@ $(FW_BENCH_MODELS_OBJS) $(FW_CORE_LIB) -lm
+	$(ARM_CC) $(FW_BENCH_LDFLAGS) -Wl,--defsym=RFS_STACK_SIZE=16K -o $@ $(FW_BENCH_MODELS_OBJS) $(FW_CORE_LIB) -lm
 
 # The host twin: the same run on the host core (the check's reference); it reads the
 # office map through the Linux port's loader.

@@ -6,10 +6,10 @@ format, every frame is decoded by canmatrix from the DBC, the checksum recompute
 scripts/check_dbc.py's CRC-8/SAE-J1850, and checked: the DLC is the DBC's, every signal
 lies within its DBC range, enum signals hold a value of their VAL_ table, counters roll
 by one per frame of an id (a pose's halves share one), the cycle times measured in the
-log equal the DBC's GenMsgCycleTime. The DBC itself: its ECUs are the four nodes (the
+log equal the DBC's GenMsgCycleTime. The DBC itself: its ECUs are the five nodes (the
 receivers of a signal are separate ECUs), its value tables name the C enums of
-common/rfs_seek.h and common/rfs_drive.h in order, every raw value of the signal that
-carries the table.
+common/rfs_seek.h, common/rfs_drive.h, common/rfs_can.h and firmware/rfs_app.h in order,
+every raw value of the signal that carries the table.
 
   --sim        the log is a simulated recording (rfseek-record): every Time field equals
                the line's time modulo 2^32 us (the sender's clock is the log's)
@@ -30,13 +30,16 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from check_dbc import crc8_j1850  # noqa: E402
 
 LINE = re.compile(r"^\((\d+)\.(\d{6})\) (\S+) ([0-9A-F]{3})#((?:[0-9A-F]{2}){0,8})$")
-NODES = ["CTRL", "MOTOR", "LOC", "RADIO"]
+NODES = ["CTRL", "MOTOR", "LOC", "RADIO", "OPER"]
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # VAL_ tables and the C enums they must name (header, the enum's first constant's prefix).
 ENUMS = {
     "SeekState": ("common/rfs_seek.h", "rfs_seek_state", "RFS_SEEK_"),
     "DecisionKind": ("common/rfs_seek.h", "rfs_seek_kind", "RFS_SEEK_"),
     "DriveStatus": ("common/rfs_drive.h", "rfs_drive_status", "RFS_DRIVE_"),
+    "Target": ("firmware/rfs_app.h", "rfs_app_target", "RFS_APP_TARGET_"),
+    "Strategy": ("common/rfs_seek.h", "rfs_seek_strategy", "RFS_SEEK_"),
+    "Model": ("common/rfs_can.h", "rfs_can_model", "RFS_CAN_MODEL_"),
 }
 TIME_SIGNALS = {"POSE_TH": "Time", "RSSI": "Time", "RX_STATUS": "Time"}
 

@@ -35,8 +35,8 @@ def main(argv):
     except Exception as e:  # canmatrix raises many kinds
         print("FAIL dbc-load %s: %s" % (dbc_path, e))
         return 1
-    if len(db.frames) != 6:
-        print("FAIL dbc-load %s: expected 6 frames, found %d" % (dbc_path, len(db.frames)))
+    if len(db.frames) != 7:
+        print("FAIL dbc-load %s: expected 7 frames, found %d" % (dbc_path, len(db.frames)))
         return 1
     print("PASS dbc-load %s (%d frames)" % (dbc_path, len(db.frames)))
     assert crc8_j1850(b"123456789") == 0x4B  # the catalogue check value

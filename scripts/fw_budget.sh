@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# fw_budget.sh ELF - print the flash and static-RAM use of a firmware image against the
-# budgets its linker script asserts (stm32f405.ld: _rfs_flash_used, _rfs_ram_used).
+# fw_budget.sh ELF - print the flash, static-RAM (SRAM) and CCM use of a firmware image
+# against the budgets its linker script asserts (stm32f405.ld: _rfs_flash_used,
+# _rfs_ram_used, _rfs_ccm_used).
 set -euo pipefail
 elf=$1
 sym() {
@@ -8,7 +9,8 @@ sym() {
     hex=$(arm-none-eabi-nm "$elf" | awk -v s="$1" '$3 == s { print $1 }')
     echo $((16#$hex))
 }
-flash=$(sym _rfs_flash_used); ram=$(sym _rfs_ram_used)
-fb=$(sym RFS_FLASH_BUDGET); rb=$(sym RFS_RAM_BUDGET); st=$(sym RFS_STACK_SIZE)
+flash=$(sym _rfs_flash_used); ram=$(sym _rfs_ram_used); ccm=$(sym _rfs_ccm_used)
+fb=$(sym RFS_FLASH_BUDGET); rb=$(sym RFS_RAM_BUDGET); cb=$(sym RFS_CCM_BUDGET); st=$(sym RFS_STACK_SIZE)
 echo "$elf: flash $flash of $fb bytes ($((100 * flash / fb))%)," \
-     "static RAM $ram of $rb bytes ($((100 * ram / rb))%, stack $st included)"
+     "static RAM $ram of $rb bytes ($((100 * ram / rb))%, stack $st included)," \
+     "CCM $ccm of $cb bytes ($((100 * ccm / cb))%)"

@@ -190,13 +190,15 @@ static int mcu_check(const lx_map_t *m, double res, mcu_fit_t *f)
     int rc = 0;
     if (f->bytes <= RFS_APP_MAX_MAP_BYTES && f->lattice <= RFS_APP_MAX_LATTICE) {
         rfs_app_t *app = malloc(sizeof(*app));
-        if (app == NULL) {
+        cfg.samples = calloc(RFS_APP_MAX_SAMPLES, sizeof(rfs_sample_t));
+        if (app == NULL || cfg.samples == NULL) {
             rc = -1;
         } else {
             const rfs_app_map_t am = {c.map.w, c.map.h, c.map.res, c.map.origin_x, c.map.origin_y,
                                       c.free_bits, c.wall_bits};
             f->init_ok = rfs_app_init(app, &cfg, &am) == 0;
         }
+        free(cfg.samples);
         free(app);
     }
     lx_core_map_free(&c);

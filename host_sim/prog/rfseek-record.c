@@ -27,6 +27,7 @@
 #include <errno.h>
 #include <getopt.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,6 +39,7 @@
 #include "hs_sim.h"
 #include "rfs_app.h"
 #include "rfs_can.h"
+#include "rfs_pathloss.h"
 #include "rfs_replay.h"
 
 #define MAX_WINDOWS 8
@@ -53,6 +55,7 @@ typedef struct recorder {
     FILE *out;                  /* the live output stream, or NULL */
     lx_candump_t *dump;         /* --candump: the bus as a candump -L log, or NULL */
     const char *in_path;
+    const char *tmp_in, *tmp_out; /* the temporary files (tmp_out NULL without `out`) */
     int write_failed;           /* a write to `in` failed */
     int live_failed;            /* a write to `out` failed */
     rfs_app_t *app;
@@ -93,6 +96,14 @@ static void feed(recorder_t *r, const rfs_replay_rec_t *rec)
     put(r, rec);
     if (!rfs_replay_play(r->player, rec)) {
         lx_err_print(PROG, "%s: %s", r->in_path, rfs_replay_err_str(r->player->error));
+        /* Nothing half-written: the temporary outputs go. */
+        fclose(r->in);
+        remove(r->tmp_in);
+        if (r->out != NULL) {
+            fclose(r->out);
+            remove(r->tmp_out);
+        }
+        (void)lx_candump_close(r->dump, false, NULL, 0);
         exit(1);
     }
 }
@@ -283,7 +294,13 @@ static void usage(FILE *f)
             "                       configuration uses 2500)\n"
             "  --model NAME         internal model, overriding the scenario's: ridge, mlp, knn,\n"
             "                       radius, pathloss (recorded in the CFG record; the emulator\n"
-            "                       image holds ridge and mlp)\n"
+            "                       image holds ridge, mlp and pathloss)\n"
+            "  --strategy NAME      decision rule, overriding the scenario's: meta or meta-path\n"
+            "  --p0-min DBM         path-loss floor at 1 m, overriding the scenario's\n"
+            "                       seek.p0_min_dbm (the CFG record's choice, as a CONFIG\n"
+            "                       frame's: docs/CAN.md)\n"
+            "  --config-frame       send that choice (and the model) as a CONFIG frame at 0 s\n"
+            "                       instead (seed: the run seed's low 24 bits)\n"
             "  -h, --help           this text\n");
 }
 
@@ -303,6 +320,9 @@ typedef struct options {
     double max_time;       /* seconds; <= 0: the scenario's */
     uint32_t fit_budget;
     const char *model_name; /* NULL: the scenario's */
+    const char *strategy;   /* NULL: the scenario's */
+    double p0_min;          /* dBm; NAN: the scenario's */
+    bool config_frame;      /* --config-frame: the choice as a CONFIG frame */
 } options_t;
 
 /* One recording: the recorder, the simulator and the application it plays into (static
@@ -312,6 +332,7 @@ typedef struct recording {
     hs_scenario_t sc;
     hs_sim_env_t env;
     rfs_app_t app;
+    rfs_sample_t samples[RFS_APP_MAX_SAMPLES];
     rfs_replay_player_t player;
     uint64_t *model_state;
     char tmp_in[4096], tmp_out[4096]; /* the outputs until renamed */
@@ -378,6 +399,22 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
         }
         o->model_name = optarg;
         break;
+    case 'S': {
+        rfs_seek_strategy_t st;
+        if (!rfs_seek_strategy_parse(optarg, &st) || (st != RFS_SEEK_META && st != RFS_SEEK_META_PATH)) {
+            lx_err_print(PROG, "--strategy: expected meta or meta-path (the firmware's), got '%s'", optarg);
+            return 2;
+        }
+        o->strategy = optarg;
+        break;
+    }
+    case 'p':
+        o->p0_min = strtod(optarg, &end);
+        if (end == optarg || *end != '\0' || !(o->p0_min >= -200.0 && o->p0_min <= 100.0)) {
+            die_opt("--p0-min (dBm in [-200, 100])", optarg);
+        }
+        break;
+    case 'C': o->config_frame = true; break;
     case 'H':
         if (strcmp(optarg, "can") == 0) {
             rec->heartbeat = HB_CAN;
@@ -416,9 +453,12 @@ static int parse_options(int argc, char **argv, options_t *o, recorder_t *rec)
         {"drop-pose", required_argument, 0, 'P'}, {"drop-rssi", required_argument, 0, 'R'},
         {"fit-budget", required_argument, 0, 'f'}, {"model", required_argument, 0, 'm'},
         {"heartbeat", required_argument, 0, 'H'},  {"candump", required_argument, 0, 'c'},
+        {"strategy", required_argument, 0, 'S'},   {"p0-min", required_argument, 0, 'p'},
+        {"config-frame", no_argument, 0, 'C'},
         {0, 0, 0, 0}};
     memset(o, 0, sizeof *o);
     o->max_time = -1;
+    o->p0_min = NAN;
     /* getopt's own messages would echo a bad option raw (and the usage follows on stderr):
      * it stays quiet and the one line is ours. A leading ':' tells a missing value (':')
      * from an unknown option ('?'). */
@@ -480,6 +520,12 @@ static int open_scenario(recording_t *s, options_t *o)
     if (o->model_name == NULL) {
         o->model_name = s->sc.model; // checked against the registry by the scenario loader
     }
+    if (o->strategy == NULL) {
+        o->strategy = s->sc.strategy;
+    }
+    if (isnan(o->p0_min)) {
+        o->p0_min = s->sc.seek_p0_min_dbm;
+    }
     if (hs_sim_env_open(&s->env, &s->sc, err, sizeof err) != 0) {
         lx_err_print(PROG, "%s", err);
         return 1;
@@ -524,6 +570,8 @@ static int open_outputs(recording_t *s, const options_t *o)
         return 1;
     }
     rec->in_path = o->out_path;
+    rec->tmp_in = s->tmp_in;
+    rec->tmp_out = s->tmp_out;
     return 0;
 }
 
@@ -547,13 +595,16 @@ static int start_player(recording_t *s)
         return 1;
     }
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.samples = s->samples;
     cfg.model_state = s->model_state;
     cfg.model_state_bytes = model_bytes;
     rfs_replay_player_init(&s->player, &s->app, &cfg, sink, rec);
     return 0;
 }
 
-/* The configuration records: CFG, MAP and the map's grids in chunks. */
+/* The configuration records: CFG, MAP and the map's grids in chunks; the choice of
+ * strategy, model and P0 floor in the CFG or, with --config-frame, in a CONFIG frame on the
+ * bus before any input (docs/CAN.md, "0x130 CONFIG"). */
 static void record_config(recording_t *s, const options_t *o, uint64_t run_seed)
 {
     recorder_t *rec = &s->rec;
@@ -565,14 +616,34 @@ static void record_config(recording_t *s, const options_t *o, uint64_t run_seed)
     r.u.cfg.target = s->sc.nsources == 2u ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
     r.u.cfg.node = 1u;
     r.u.cfg.fit_budget = o->fit_budget;
-    if (strcmp(o->model_name, "ridge") != 0) { // the ridge is every player's base: a v1 CFG
+    rfs_seek_strategy_t st = RFS_SEEK_META;
+    (void)rfs_seek_strategy_parse(o->strategy, &st);
+    const int16_t p0 = isnan(o->p0_min) ? (int16_t)(rfs_pathloss_cfg_default().p0_min / 512)
+                                        : (int16_t)lround(o->p0_min * 128.0);
+    // The ridge is every player's base (a v1 CFG); the paper's meta with the model's own
+    // floor too: no choice then.
+    if (!o->config_frame && strcmp(o->model_name, "ridge") != 0) {
         const size_t n = strlen(o->model_name); // registry names are <= 15 bytes (checked above)
         memcpy(r.u.cfg.model, o->model_name, n < RFS_REPLAY_MODEL_NAME_MAX ? n : RFS_REPLAY_MODEL_NAME_MAX);
+    }
+    if (!o->config_frame && (st != RFS_SEEK_META || !isnan(o->p0_min))) {
+        r.u.cfg.chosen = true;
+        r.u.cfg.strategy = (uint8_t)st;
+        r.u.cfg.p0_min = p0;
     }
     feed(rec, &r);
     const rfs_app_map_t am = {m->w, m->h, m->res, m->origin_x, m->origin_y, s->env.core.free_bits,
                               s->env.core.wall_bits};
     (void)rfs_replay_map_records(&am, feed_rec, rec);
+    if (o->config_frame) {
+        rfs_can_config_t k = {r.u.cfg.target, (uint8_t)st, 0, p0, (uint32_t)(run_seed & 0xFFFFFFu)};
+        for (uint8_t c = 0; c < (uint8_t)RFS_CAN_NMODELS; c++) {
+            k.model = strcmp(rfs_can_model_name(c), o->model_name) == 0 ? c : k.model;
+        }
+        rfs_can_frame_t f;
+        rfs_can_tx_config(&rec->tx, &k, &f);
+        feed_can(rec, 0, &f);
+    }
 }
 
 /* The mission with the recorder as the controller, the END record, and the outputs

@@ -616,6 +616,98 @@ static void receiver_frame_bytes_round_trip_and_rejects(void **state)
     assert_int_equal(rfs_can_unpack_receiver(&g, &out, &c), RFS_CAN_E_RANGE);
 }
 
+/* CONFIG (0x130, docs/CAN.md): bytes from the Python reference (bit fields, struct '<h' for
+ * P0Min, the seed's three low bytes, CRC-8 over 30 01 and the payload); every field's
+ * limits; values outside them, reserved bits, a wrong DLC and flipped bits rejected; the
+ * receiver takes it with a counter check and no time window. */
+static void config_frame_bytes_ranges_and_receiver(void **state)
+{
+    (void)state;
+    /* meta-path (5), pathloss (4), -40 dBm (-5120), seed 0x123456, counter 5. */
+    const uint8_t want[] = {0x05, 0x45, 0x00, 0xEC, 0x56, 0x34, 0x12, 0x79};
+    /* bridge, meta, ridge, no floor, seed 0xFFFFFF (0x1FFFFFF masked), counter 15. */
+    const uint8_t want2[] = {0x1F, 0x00, 0x00, 0x80, 0xFF, 0xFF, 0xFF, 0x5A};
+    rfs_can_config_t a = {.target = 0, .strategy = 5, .model = RFS_CAN_MODEL_PATHLOSS, .p0_min = -5120,
+                          .seed = 0x123456u};
+    rfs_can_config_t b = {.target = 1, .strategy = 0, .model = RFS_CAN_MODEL_RIDGE,
+                          .p0_min = RFS_CAN_P0_NONE, .seed = 0x1FFFFFFu};
+    rfs_can_config_t out;
+    rfs_can_frame_t f, g;
+    uint8_t c = 99;
+
+    rfs_can_pack_config(&a, 5, &f);
+    rfs_can_pack_config(&b, 0x1F, &g);
+
+    assert_int_equal(f.id, 0x130);
+    assert_int_equal(f.dlc, 8);
+    assert_memory_equal(f.data, want, 8);
+    assert_memory_equal(g.data, want2, 8);
+    assert_int_equal(rfs_can_unpack_config(&f, &out, &c), RFS_CAN_OK);
+    assert_int_equal(c, 5);
+    assert_int_equal(out.strategy, 5);
+    assert_int_equal(out.model, RFS_CAN_MODEL_PATHLOSS);
+    assert_int_equal(out.p0_min, -5120);
+    assert_int_equal(out.seed, 0x123456u);
+    assert_int_equal(rfs_can_unpack_config(&g, &out, &c), RFS_CAN_OK);
+    assert_int_equal(out.target, 1);
+    assert_int_equal(out.p0_min, RFS_CAN_P0_NONE);
+    assert_int_equal(out.seed, 0xFFFFFFu);
+    /* -40 dBm in Q16.16 is -40 * 65536; no floor is INT32_MIN; the limits -200, 100 dBm. */
+    assert_int_equal(rfs_can_p0_to_q16(-5120), -40 * 65536);
+    assert_int_equal(rfs_can_p0_to_q16(RFS_CAN_P0_NONE), INT32_MIN);
+    assert_int_equal(rfs_can_p0_to_q16(RFS_CAN_P0_MIN), -200 * 65536);
+    assert_int_equal(rfs_can_p0_to_q16(RFS_CAN_P0_MAX), 100 * 65536);
+    /* Each field at and past its limit (re-sealed: only the range check may fail). */
+    const struct {
+        uint8_t target, strategy, model;
+        int16_t p0;
+        rfs_can_err_t want;
+    } cases[] = {
+        {1, 0, 0, 0, RFS_CAN_OK},           {2, 0, 0, 0, RFS_CAN_E_RANGE},
+        {0, 5, 0, 0, RFS_CAN_OK},           {0, 6, 0, 0, RFS_CAN_E_RANGE},
+        {0, 15, 0, 0, RFS_CAN_E_RANGE},     {0, 0, 4, 0, RFS_CAN_OK},
+        {0, 0, 5, 0, RFS_CAN_E_RANGE},      {0, 0, 0, -25600, RFS_CAN_OK},
+        {0, 0, 0, -25601, RFS_CAN_E_RANGE}, {0, 0, 0, 12800, RFS_CAN_OK},
+        {0, 0, 0, 12801, RFS_CAN_E_RANGE},  {0, 0, 0, -32767, RFS_CAN_E_RANGE},
+    };
+    for (unsigned i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        rfs_can_config_t x = {cases[i].target, cases[i].strategy, cases[i].model, cases[i].p0, 7u};
+        rfs_can_pack_config(&x, 1, &g);
+        assert_int_equal(rfs_can_unpack_config(&g, &out, &c), cases[i].want);
+    }
+    g = f;
+    g.data[0] |= 0x40u; /* reserved bits 6..7 */
+    g.data[7] = rfs_can_checksum(g.id, g.dlc, g.data);
+    assert_int_equal(rfs_can_unpack_config(&g, &out, &c), RFS_CAN_E_RANGE);
+    g = f;
+    g.dlc = 7;
+    assert_int_equal(rfs_can_unpack_config(&g, &out, &c), RFS_CAN_E_DLC);
+    for (unsigned bit = 0; bit < 64u; bit++) {
+        g = f;
+        g.data[bit / 8u] ^= (uint8_t)(1u << (bit % 8u));
+        assert_int_equal(rfs_can_unpack_config(&g, &out, &c), RFS_CAN_E_CHECKSUM);
+    }
+    /* The receiver: accepted whatever the time, a repeated counter is a duplicate. */
+    rfs_can_rx_t rx;
+    const rfs_can_rx_cfg_t rc = rfs_can_rx_cfg_default();
+    assert_int_equal(rfs_can_rx_init(&rx, &rc), 0);
+    rfs_can_tx_t tx;
+    rfs_can_tx_init(&tx);
+    rfs_can_msg_t m;
+    rfs_can_tx_config(&tx, &a, &f);
+    assert_int_equal(rfs_can_rx_frame(&rx, &f, (int64_t)1 << 40, &m), RFS_CAN_OK);
+    assert_int_equal(m.kind, RFS_CAN_MSG_CONFIG);
+    assert_int_equal(m.config.seed, 0x123456u);
+    assert_int_equal(rfs_can_rx_frame(&rx, &f, 0, &m), RFS_CAN_E_REPEAT);
+    assert_int_equal(m.kind, RFS_CAN_MSG_NONE);
+    assert_int_equal(rx.msg[RFS_CAN_IDX_CONFIG].accepted, 1);
+    assert_int_equal(rx.dropped[RFS_CAN_E_REPEAT], 1);
+    /* The model codes name the registry's models (rfs_models.h). */
+    assert_string_equal(rfs_can_model_name(RFS_CAN_MODEL_RIDGE), "ridge");
+    assert_string_equal(rfs_can_model_name(RFS_CAN_MODEL_PATHLOSS), "pathloss");
+    assert_null(rfs_can_model_name(RFS_CAN_NMODELS));
+}
+
 static void rx_receiver_unwraps_and_applies_the_packet_time_window(void **state)
 {
     (void)state;
@@ -687,6 +779,7 @@ int main(void)
         cmocka_unit_test(seek_output_maps_to_status_and_wheels),
         cmocka_unit_test(receiver_frame_bytes_round_trip_and_rejects),
         cmocka_unit_test(rx_receiver_unwraps_and_applies_the_packet_time_window),
+        cmocka_unit_test(config_frame_bytes_ranges_and_receiver),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

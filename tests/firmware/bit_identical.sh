@@ -3,7 +3,8 @@
 # of the application loop and to the Cortex-M4 image under qemu gives identical output
 # streams, byte for byte. The stream is a simulated mission (scenarios/default.yaml, the
 # firmware loop as the controller, inputs as CAN frames) with injected faults: inputs
-# stopping, bus-off and a watchdog reset. Also: the live closed-loop outputs equal the
+# stopping, bus-off and a watchdog reset; then a whole mission, and one of meta-path +
+# pathloss (the improvement the image holds beside the paper's). Also: the live closed-loop outputs equal the
 # replay, the outputs are not trivial, and malformed streams fail cleanly on both sides.
 set -uo pipefail
 B=${1:-build}
@@ -36,6 +37,64 @@ if "$bin/rfseek-record" scenarios/default.yaml -o "$tmp/m.rfsr" --seed 7 >"$tmp/
     pass "bit-identical on a whole mission, seed 7 ($(cat "$tmp/m.txt"))"
 else
     fail "bit-identical on a whole mission, seed 7"
+fi
+
+# The improvement the STM32 image holds beside the paper's: meta-path + pathloss, chosen
+# by the CFG record as by a CONFIG frame (strategy, P0 floor -40 dBm), its relearns sliced
+# at the path-loss model's MCU budget (600 wall counts a period), inputs stopping and a
+# watchdog reset on the way.
+if "$bin/rfseek-record" scenarios/default.yaml -o "$tmp/mp.rfsr" --seed 3 --model pathloss \
+        --strategy meta-path --p0-min -40 --fit-budget 600 --drop 20:21 --reset 30 >"$tmp/mp.txt" \
+        && "$bin/rfseek-replay" "$tmp/mp.rfsr" -o "$tmp/mp_host.rfso" && qemu mp.rfsr mp_qemu.rfso \
+        && cmp "$tmp/mp_host.rfso" "$tmp/mp_qemu.rfso"; then
+    pass "bit-identical on a meta-path + pathloss mission, seed 3 ($(cat "$tmp/mp.txt"))"
+else
+    fail "bit-identical on a meta-path + pathloss mission, seed 3"
+fi
+"$bin/rfseek-replay" --print "$tmp/mp.rfsr" | head -1 >"$tmp/mp_cfg.txt"
+"$bin/rfseek-replay" --print "$tmp/mp_qemu.rfso" >"$tmp/mp_qemu.txt"
+nl=$(awk '$1 == "OUT" && $5 == "state=2"' "$tmp/mp_qemu.txt" | wc -l)
+nrel=$(grep '^DECISION' "$tmp/mp_qemu.txt" | grep -c 'relearned=1')
+# -40 dBm is -5120 in the CONFIG frame's 1/128 dBm.
+if grep -q $'model=pathloss\tstrategy=meta-path\tp0_min=-5120' "$tmp/mp_cfg.txt" && [ "$nrel" -ge 3 ] \
+        && [ "$nl" -ge 10 ]; then
+    pass "the mission ran meta-path + pathloss ($nrel relearns, $nl learning periods)"
+else
+    fail "the mission ran meta-path + pathloss" "$(cat "$tmp/mp_cfg.txt"); $nrel relearns, $nl learning periods"
+fi
+# The same choice as a CONFIG frame on the bus before any input (the operator's, docs/CAN.md):
+# the outputs equal the CFG choice's byte for byte (no reset here: a reset returns to the
+# defaults), on the host and the image; its candump log passes canmatrix.
+mp2=(scenarios/default.yaml --seed 3 --model pathloss --strategy meta-path --p0-min -40 --fit-budget 600 --drop 20:21)
+if "$bin/rfseek-record" "${mp2[@]}" -o "$tmp/mpa.rfsr" --live-out "$tmp/mpa.rfso" >/dev/null \
+        && "$bin/rfseek-record" "${mp2[@]}" --config-frame -o "$tmp/mpc.rfsr" --live-out "$tmp/mpc.rfso" \
+            --candump "$tmp/mpc.log" >/dev/null \
+        && "$bin/rfseek-replay" "$tmp/mpc.rfsr" -o "$tmp/mpc_host.rfso" && qemu mpc.rfsr mpc_qemu.rfso \
+        && cmp "$tmp/mpa.rfso" "$tmp/mpc.rfso" && cmp "$tmp/mpc.rfso" "$tmp/mpc_host.rfso" \
+        && cmp "$tmp/mpc_host.rfso" "$tmp/mpc_qemu.rfso" && head -1 "$tmp/mpc.log" | grep -q ' can0 130#004500EC030000A7$' \
+        && /usr/bin/python3 scripts/check_candump.py can/rfseek.dbc "$tmp/mpc.log" --sim >"$tmp/mpc_check.txt"; then
+    pass "a CONFIG frame chooses what the CFG does: outputs equal, host and qemu ($(stat -c %s "$tmp/mpc.rfso") bytes)"
+else
+    fail "a CONFIG frame chooses what the CFG does" "$(grep FAIL "$tmp/mpc_check.txt" 2>/dev/null | head -3)"
+fi
+
+# A choice the image does not hold (meta-path + pathloss under the bridging target: one
+# fit per node, two path-loss states): the recorder (its player) refuses it, one line, no
+# file left; a stream with it (mp.rfsr with its CFG's target byte, at offset 18, made
+# bridge) stops the
+# host and the image with the same reason.
+"$bin/rfseek-record" scenarios/bridge.yaml -o "$tmp/br.rfsr" --model pathloss --strategy meta-path \
+    --max-time 5 >/dev/null 2>"$tmp/br_rec.err"; rrc=$?
+{ head -c 18 "$tmp/mp.rfsr"; printf '\001'; tail -c +20 "$tmp/mp.rfsr"; } >"$tmp/br.rfsr"
+"$bin/rfseek-replay" "$tmp/br.rfsr" -o "$tmp/br.rfso" 2>"$tmp/br.err"; hrc=$?
+qemu br.rfsr br_q.rfso 2>"$tmp/br_q.err"; qrc=$?
+why='CFG chooses a strategy, model and target the image does not hold'
+if [ $rrc -eq 1 ] && [ $hrc -eq 1 ] && [ $qrc -ne 0 ] && [ "$(wc -l <"$tmp/br_rec.err")" -eq 1 ] \
+        && grep -qF "$why" "$tmp/br_rec.err" && grep -qF "$why" "$tmp/br.err" && grep -qF "$why" "$tmp/br_q.err" \
+        && ! compgen -G "$tmp/br.rfsr.tmp*" >/dev/null && [ ! -e "$tmp/br.rfso" ]; then
+    pass "bridge + pathloss refused by the recorder, the host and the image: $why"
+else
+    fail "bridge + pathloss refused" "record $rrc $(cat "$tmp/br_rec.err"); host $hrc $(cat "$tmp/br.err"); qemu $qrc $(cat "$tmp/br_q.err")"
 fi
 
 # Malformed streams: one clear error, non-zero exit, nothing left behind (host); the

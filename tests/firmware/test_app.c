@@ -62,7 +62,7 @@ static int run_dead_zone(int64_t t0, int64_t t_end, bool heartbeat, int64_t hb_l
  * heartbeats; *moving_late counts the moving steps from 200 ms after the last packet. */
 static void drive_then_dead_zone(bool heartbeat, int *moving_late, rfs_app_out_t *o)
 {
-    const rfs_app_cfg_t c = rfs_app_cfg_default();
+    const rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
     const rfs_app_map_t m = room();
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
     run(0, 2000000, true, true, o);
@@ -129,7 +129,7 @@ static void test_heartbeat_from_the_future_stops_like_a_packet(void **state)
 static void test_init_checks_configuration_and_map(void **state)
 {
     (void)state;
-    rfs_app_cfg_t c = rfs_app_cfg_default();
+    rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
     rfs_app_map_t m = room();
     rfs_app_map_t big = m;
     big.w = 1000; /* 125 bytes x 100 rows = 12,500 > 6,400 */
@@ -137,10 +137,10 @@ static void test_init_checks_configuration_and_map(void **state)
     assert_int_equal(rfs_app_init(&s_app, &c, &big), -1);
     c.target = (rfs_app_target_t)2;
     assert_int_equal(rfs_app_init(&s_app, &c, &m), -1);
-    c = rfs_app_cfg_default();
+    c = fx_cfg(rfs_app_cfg_default());
     c.input_timeout_us = 0;
     assert_int_equal(rfs_app_init(&s_app, &c, &m), -1);
-    c = rfs_app_cfg_default();
+    c = fx_cfg(rfs_app_cfg_default());
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
     assert_int_equal(rfs_app_cfg_mcu().seek.fit_budget, 2500u);
     assert_int_equal(rfs_app_cfg_default().seek.fit_budget, 0u);
@@ -149,7 +149,7 @@ static void test_init_checks_configuration_and_map(void **state)
 static void test_first_step_after_reset_is_zero_and_flagged(void **state)
 {
     (void)state;
-    const rfs_app_cfg_t c = rfs_app_cfg_default();
+    const rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
     const rfs_app_map_t m = room();
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
     rfs_app_out_t o;
@@ -167,7 +167,7 @@ static void test_first_step_after_reset_is_zero_and_flagged(void **state)
 static void test_wheels_stop_within_200_ms_of_lost_inputs_and_resume(void **state)
 {
     (void)state;
-    const rfs_app_cfg_t c = rfs_app_cfg_default();
+    const rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
     const rfs_app_map_t m = room();
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
     rfs_app_out_t o;
@@ -192,7 +192,7 @@ static void test_wheels_stop_within_200_ms_of_lost_inputs_and_resume(void **stat
 static void test_bus_off_stops_at_once_and_recovers(void **state)
 {
     (void)state;
-    const rfs_app_cfg_t c = rfs_app_cfg_default();
+    const rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
     const rfs_app_map_t m = room();
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
     rfs_app_out_t o;
@@ -210,7 +210,7 @@ static void test_bus_off_stops_at_once_and_recovers(void **state)
 static void test_frames_decode_with_the_protocol_decoders(void **state)
 {
     (void)state;
-    const rfs_app_cfg_t c = rfs_app_cfg_default();
+    const rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
     const rfs_app_map_t m = room();
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
     rfs_app_out_t o;
@@ -247,7 +247,7 @@ static void test_frames_decode_with_the_protocol_decoders(void **state)
 static void test_can_inputs_are_decoded_or_counted(void **state)
 {
     (void)state;
-    const rfs_app_cfg_t c = rfs_app_cfg_default();
+    const rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
     const rfs_app_map_t m = room();
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
     rfs_can_tx_t tx;

@@ -12,6 +12,7 @@
 #include "rfs_app.h"
 #include "rfs_knn.h"
 #include "rfs_mlp.h"
+#include "rfs_pathloss.h"
 #include "rfs_replay.h"
 
 static uint64_t s_state[(sizeof(rfs_mlp_t) + 7u) / 8u]; /* an image holding ridge and mlp */
@@ -20,7 +21,7 @@ static void test_built_in_state_holds_the_ridge_only(void **state)
 {
     (void)state;
     const rfs_app_map_t m = room();
-    rfs_app_cfg_t c = rfs_app_cfg_default();
+    rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
     assert_null(c.model);
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
     assert_ptr_equal(s_app.seek.model.ops, &rfs_ridge_ops);
@@ -44,7 +45,7 @@ static void test_port_buffer_holds_what_fits(void **state)
 {
     (void)state;
     const rfs_app_map_t m = room();
-    rfs_app_cfg_t c = rfs_app_cfg_default();
+    rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
     c.model_state = s_state;
     c.model_state_bytes = (uint32_t)sizeof s_state;
     c.model = rfs_models_lookup("mlp");
@@ -99,17 +100,51 @@ static void test_cfg_model_name_bytes(void **state)
     assert_int_equal(rfs_replay_encode(&r, buf, sizeof buf), sizeof v1);
     assert_memory_equal(buf, v1, sizeof v1);
 
-    /* Bad: a name of 16 bytes (length 30), a control byte in the name. */
-    uint8_t big[32] = {0x01, 30};
-    memset(big + 2, 'a', 30);
-    big[11] = 0; /* target */
+    /* With a CONFIG frame's choice after the name: NUL, strategy 5 (meta-path), p0_min
+     * -5120 (-40 dBm x 128 = 0xEC00 LE). */
+    memcpy(r.u.cfg.model, "pathloss", 8);
+    r.u.cfg.chosen = true;
+    r.u.cfg.strategy = 5;
+    r.u.cfg.p0_min = -5120;
+    static const uint8_t ch[] = {0x01, 26, 7, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0xC4, 0x09, 0, 0,
+                                 'p', 'a', 't', 'h', 'l', 'o', 's', 's', 0, 5, 0x00, 0xEC};
+    assert_int_equal(rfs_replay_encode(&r, buf, sizeof buf), sizeof ch);
+    assert_memory_equal(buf, ch, sizeof ch);
+    assert_int_equal(rfs_replay_parse(ch, sizeof ch, &used, &back), RFS_REPLAY_OK);
+    assert_true(back.u.cfg.chosen);
+    assert_string_equal(back.u.cfg.model, "pathloss");
+    assert_int_equal(back.u.cfg.strategy, 5);
+    assert_int_equal(back.u.cfg.p0_min, -5120);
+
+    /* Bad: length 34, a name of 16 bytes, a control byte in the name, a choice of 3
+     * bytes, strategy 6, p0_min beyond 100 dBm (12801). */
+    uint8_t big[36] = {0x01, 34};
+    memset(big + 2, 'a', 34);
+    big[10] = 0; /* target */
     assert_int_equal(rfs_replay_parse(big, sizeof big, &used, &back), RFS_REPLAY_BAD);
     assert_string_equal(back.error, "CFG length out of range");
+    big[1] = 30;
+    assert_int_equal(rfs_replay_parse(big, 32, &used, &back), RFS_REPLAY_BAD);
+    assert_string_equal(back.error, "CFG model name not printable or too long");
     uint8_t ctl[sizeof want];
     memcpy(ctl, want, sizeof want);
-    ctl[17] = 0x00;
+    ctl[17] = 0x01;
     assert_int_equal(rfs_replay_parse(ctl, sizeof ctl, &used, &back), RFS_REPLAY_BAD);
-    assert_string_equal(back.error, "CFG model name not printable");
+    assert_string_equal(back.error, "CFG model name not printable or too long");
+    uint8_t bad[sizeof ch];
+    memcpy(bad, ch, sizeof ch);
+    bad[1] = 25;
+    assert_int_equal(rfs_replay_parse(bad, sizeof ch - 1u, &used, &back), RFS_REPLAY_BAD);
+    assert_string_equal(back.error, "CFG choice malformed or out of range");
+    memcpy(bad, ch, sizeof ch);
+    bad[25] = 6;
+    assert_int_equal(rfs_replay_parse(bad, sizeof bad, &used, &back), RFS_REPLAY_BAD);
+    memcpy(bad, ch, sizeof ch);
+    bad[26] = 0x01; /* 12801 = 0x3201 */
+    bad[27] = 0x32;
+    assert_int_equal(rfs_replay_parse(bad, sizeof bad, &used, &back), RFS_REPLAY_BAD);
+    bad[26] = 0x00; /* 12800: 100 dBm, the limit */
+    assert_int_equal(rfs_replay_parse(bad, sizeof bad, &used, &back), RFS_REPLAY_OK);
 }
 
 static void sink(void *ctx, const uint8_t *p, uint32_t n)
@@ -123,7 +158,7 @@ static void test_player_applies_or_refuses_the_model(void **state)
 {
     (void)state;
     static rfs_replay_player_t p;
-    rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    rfs_app_cfg_t cfg = fx_cfg(rfs_app_cfg_default());
     cfg.model_state = s_state;
     cfg.model_state_bytes = (uint32_t)sizeof s_state;
     rfs_replay_rec_t r;
@@ -147,6 +182,84 @@ static void test_player_applies_or_refuses_the_model(void **state)
                         "CFG model's state is larger than the image holds");
 }
 
+/* CONFIG frames (docs/CAN.md, "0x130 CONFIG") choose the mission before its first decision
+ * (as the STM32 image offers them: the ridge built in, the path-loss model in the port's
+ * buffer); what the image does not hold, or a frame after the first decision, is refused
+ * and counted, leaving the configuration in force. */
+static uint64_t s_pl[(sizeof(rfs_pathloss_t) + 7u) / 8u];
+
+static void test_config_frame_chooses_before_the_first_decision(void **state)
+{
+    (void)state;
+    rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_mcu());
+    c.model_state = s_pl;
+    c.model_state_bytes = (uint32_t)sizeof s_pl;
+    c.models[RFS_CAN_MODEL_PATHLOSS] = &rfs_models_pathloss;
+    const rfs_app_map_t m = room();
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    rfs_can_tx_t op;
+    rfs_can_tx_init(&op);
+    rfs_can_frame_t f, out[2];
+    rfs_app_out_t o;
+    rfs_app_step(&s_app, 0, &o);
+    rfs_app_frames(&s_app, &o, out); /* STATUS counter 0 */
+
+    /* knn: not offered; bridge + pathloss: one fit per node, no room; meta-global and a
+     * baseline (chemotaxis: its decision kinds have no code on the wire). */
+    const rfs_can_config_t refused[4] = {
+        {0, RFS_SEEK_META, RFS_CAN_MODEL_KNN, -5760, 3u},
+        {1, RFS_SEEK_META_PATH, RFS_CAN_MODEL_PATHLOSS, -5760, 3u},
+        {0, RFS_SEEK_META_GLOBAL, RFS_CAN_MODEL_RIDGE, -5760, 3u},
+        {0, RFS_SEEK_CHEMOTAXIS, RFS_CAN_MODEL_RIDGE, -5760, 3u},
+    };
+    for (int i = 0; i < 4; i++) {
+        rfs_can_tx_config(&op, &refused[i], &f);
+        assert_int_equal(rfs_app_on_can(&s_app, &f, 1000), RFS_CAN_OK);
+    }
+    assert_int_equal(s_app.stats.configs_rejected, 4u);
+    assert_int_equal(s_app.stats.configs, 0u);
+    assert_ptr_equal(s_app.seek.model.ops, &rfs_ridge_ops);
+    assert_int_equal(s_app.cfg.seed, 1u);
+
+    const rfs_can_config_t mp = {0, RFS_SEEK_META_PATH, RFS_CAN_MODEL_PATHLOSS, -5120, 0x123456u};
+    rfs_can_tx_config(&op, &mp, &f);
+    assert_int_equal(rfs_app_on_can(&s_app, &f, 2000), RFS_CAN_OK);
+
+    assert_int_equal(s_app.stats.configs, 1u);
+    assert_int_equal(s_app.stats.configs_rejected, 4u); /* kept across the re-initialisation */
+    assert_int_equal(s_app.seek.cfg.strategy, RFS_SEEK_META_PATH);
+    assert_int_equal(s_app.seek.cfg.recheck_dist, s_app.seek.cfg.step); /* meta-path's preset */
+    assert_ptr_equal(s_app.seek.model.ops, &rfs_pathloss_ops);
+    assert_ptr_equal(s_app.seek.model.self, s_pl);
+    assert_int_equal(((rfs_pathloss_t *)s_pl)->cfg.p0_min, -40 * 65536);
+    assert_int_equal(s_app.cfg.seed, 0x123456u);
+    assert_int_equal(s_app.seek.cfg.fit_budget, 600u); /* the path-loss model's MCU slice */
+    rfs_app_step(&s_app, 50000, &o);
+    rfs_app_frames(&s_app, &o, out);
+    assert_int_equal(out[1].data[0] & 0x0Fu, 1u); /* the STATUS counter runs on */
+    assert_false(o.faults & RFS_APP_FAULT_RESET);
+
+    /* The mission starts: a decision, then a CONFIG is refused. */
+    for (int64_t t = 100000; t <= 300000; t += 50000) {
+        const rfs_pose_t p = {.t_us = t, .x = RFS_Q16_INT(5), .y = RFS_Q16_INT(5), .theta = 0};
+        rfs_app_on_pose(&s_app, &p, t);
+        rfs_app_on_rssi(&s_app, 0, t, -60, t);
+        rfs_app_step(&s_app, t, &o);
+    }
+    assert_true(s_app.seek.iteration > 0u);
+    const rfs_can_config_t back = {0, RFS_SEEK_META, RFS_CAN_MODEL_RIDGE, -5760, 1u};
+    rfs_can_tx_config(&op, &back, &f);
+    assert_int_equal(rfs_app_on_can(&s_app, &f, 310000), RFS_CAN_OK);
+    assert_int_equal(s_app.stats.configs_rejected, 5u);
+    assert_int_equal(s_app.seek.cfg.strategy, RFS_SEEK_META_PATH);
+    /* The codes name the registry's entries, the named entries are the table's. */
+    for (uint8_t k = 0; k < RFS_CAN_NMODELS; k++) {
+        assert_non_null(rfs_models_lookup(rfs_can_model_name(k)));
+    }
+    assert_ptr_equal(rfs_models_lookup("pathloss"), &rfs_models_pathloss);
+    assert_ptr_equal(rfs_models_lookup("ridge"), &rfs_models_ridge);
+}
+
 /* The MCU configuration slices each model's relearn by that model's registry budget
  * (a work unit is a sample for the ridge, a sample-update for the MLP, a
  * wall count for pathloss); the other configurations keep the budget they are given. */
@@ -163,7 +276,7 @@ static void test_mcu_fit_budget_is_the_model_s(void **state)
     }
 
     /* The MCU defaults, the model chosen afterwards (the ports' order). */
-    rfs_app_cfg_t c = rfs_app_cfg_mcu();
+    rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_mcu());
     c.model_state = s_state;
     c.model_state_bytes = (uint32_t)sizeof s_state;
     c.model = mlp;
@@ -187,7 +300,7 @@ static void test_mcu_fit_budget_is_the_model_s(void **state)
     c.seek.fit_budget = 123u;
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
     assert_int_equal(s_app.seek.cfg.fit_budget, 123u);
-    rfs_app_cfg_t d = rfs_app_cfg_default();
+    rfs_app_cfg_t d = fx_cfg(rfs_app_cfg_default());
     assert_false(d.fit_budget_by_model);
     d.model_state = s_state;
     d.model_state_bytes = (uint32_t)sizeof s_state;
@@ -234,6 +347,7 @@ int main(void)
         cmocka_unit_test(test_cfg_model_name_bytes),
         cmocka_unit_test(test_player_applies_or_refuses_the_model),
         cmocka_unit_test(test_mcu_fit_budget_is_the_model_s),
+        cmocka_unit_test(test_config_frame_chooses_before_the_first_decision),
         cmocka_unit_test(test_mlp_budget_counts_sample_updates),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

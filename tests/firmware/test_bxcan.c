@@ -138,15 +138,15 @@ static void test_init_programs_mode_timing_and_filters(void **state)
     assert_int_equal(hw->r.btr, 0x001A0005u);
     /* Filters out of init mode, CAN2SB (bits 8..13) untouched: 0x2A1C0E00. */
     assert_int_equal(hw->r.fmr, 0x2A1C0E00u);
-    /* Bank 0: list mode, 16-bit, FIFO 0: 0x110 << 5 = 0x2200, 0x111 << 5 = 0x2220;
-     * slots 2, 3 repeat 0x110. Bank 1: FIFO 1, 0x120 << 5 = 0x2400, 0x121 << 5 = 0x2420
+    /* Bank 0: list mode, 16-bit, FIFO 0: 0x110 << 5 = 0x2200, 0x111 << 5 = 0x2220,
+     * 0x130 << 5 = 0x2600 (CONFIG); slot 3 repeats 0x110. Bank 1: FIFO 1, 0x120 << 5 = 0x2400, 0x121 << 5 = 0x2420
      * (the receiver heartbeat), slots 2, 3 repeat 0x120. */
     assert_int_equal(hw->r.fm1r, 0x3u);
     assert_int_equal(hw->r.fs1r, 0x0u);
     assert_int_equal(hw->r.ffa1r, 0x2u);
     assert_int_equal(hw->r.fa1r, 0x3u);
     assert_int_equal(hw->r.filter[0].fr1, 0x22202200u);
-    assert_int_equal(hw->r.filter[0].fr2, 0x22002200u);
+    assert_int_equal(hw->r.filter[0].fr2, 0x22002600u);
     assert_int_equal(hw->r.filter[1].fr1, 0x24202400u);
     assert_int_equal(hw->r.filter[1].fr2, 0x24002400u);
 }

@@ -281,6 +281,15 @@ typedef struct buf_sink {
     uint32_t n;
 } buf_sink_t;
 
+/* The default configuration over this file's sample store. */
+static rfs_app_cfg_t store_cfg(void)
+{
+    static rfs_sample_t samples[RFS_APP_MAX_SAMPLES];
+    rfs_app_cfg_t c = rfs_app_cfg_default();
+    c.samples = samples;
+    return c;
+}
+
 static void sink(void *ctx, const uint8_t *p, uint32_t n)
 {
     buf_sink_t *s = ctx;
@@ -296,7 +305,7 @@ static void test_player_errors(void **state)
     static rfs_app_t app;
     static rfs_replay_player_t p;
     static buf_sink_t out;
-    const rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    const rfs_app_cfg_t cfg = store_cfg();
     rfs_replay_rec_t r;
 
     memset(&out, 0, sizeof out);
@@ -389,7 +398,7 @@ static void test_receiver_record_exact_bytes_and_lengths(void **state)
  * STEPs from 2.2 s to 4 s whose output drives. */
 static int play_dead_zone(bool heartbeat, rfs_replay_player_t *p, rfs_app_t *app, buf_sink_t *out)
 {
-    const rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    const rfs_app_cfg_t cfg = store_cfg();
     rfs_replay_rec_t r;
     rfs_replay_player_init(p, app, &cfg, sink, out);
     r = rec_at(RFS_REPLAY_MAP, 0);
@@ -470,7 +479,7 @@ static void test_receiver_records_drive_through_a_dead_zone(void **state)
     assert_int_equal(without, 0);
     assert_int_equal(app.stats.receiver, 0u);
     /* A RECEIVER record before the map is an input before the map. */
-    const rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    const rfs_app_cfg_t cfg = store_cfg();
     rfs_replay_player_init(&p, &app, &cfg, sink, &out);
     rfs_replay_rec_t r = rec_at(RFS_REPLAY_RECEIVER, 0);
     assert_false(rfs_replay_play(&p, &r));

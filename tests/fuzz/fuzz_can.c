@@ -4,8 +4,8 @@
  * Input: a sequence of 12-byte records, each one received frame:
  *   ctrl u8   bit 0: overwrite data[dlc-1] with the correct checksum (so the fuzzer gets
  *             past the CRC and reaches the range, counter, pairing and time checks);
- *             bits 1..3: id = one of our six ids (0..5: wheel, pose xy, pose th, RSSI,
- *             status, receiver status) or the raw 11-bit id below (6..7)
+ *             bits 1..3: id = one of our seven ids (0..6: wheel, pose xy, pose th, RSSI,
+ *             status, receiver status, config) or the raw 11-bit id below (7)
  *   dt   u16  receiver time advance, units of 1 ms (0 .. 65.5 s), little-endian
  *   dlc  u8   taken mod 16 (values > 8 are invalid frames the decoder must reject)
  *   data 8 bytes (data[0..1] also give the raw id for ctrl ids 6..7)
@@ -16,7 +16,8 @@
  *   - every frame is either accepted or counted in one drop reason (an accepted POSE_XY
  *     may also count the earlier unpaired one as a PAIR drop);
  *   - an accepted RSSI or receiver heartbeat lies inside [now - max_age, now + max_future];
- *   - a complete pose lies inside the int24 millimetre range and (-pi, pi].
+ *   - a complete pose lies inside the int24 millimetre range and (-pi, pi];
+ *   - an accepted CONFIG holds a target, strategy, model and P0 floor of the layout.
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -27,8 +28,9 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-static const uint32_t k_ids[6] = {RFS_CAN_ID_WHEEL_CMD, RFS_CAN_ID_POSE_XY, RFS_CAN_ID_POSE_TH,
-                                  RFS_CAN_ID_RSSI, RFS_CAN_ID_STATUS, RFS_CAN_ID_RX_STATUS};
+static const uint32_t k_ids[7] = {RFS_CAN_ID_WHEEL_CMD, RFS_CAN_ID_POSE_XY, RFS_CAN_ID_POSE_TH,
+                                  RFS_CAN_ID_RSSI, RFS_CAN_ID_STATUS, RFS_CAN_ID_RX_STATUS,
+                                  RFS_CAN_ID_CONFIG};
 
 /* Decode f with the stateless decoder of its id; on success re-encode with the same
  * counter and require identical bytes 0..dlc-1. */
@@ -75,6 +77,12 @@ static void check_roundtrip(const rfs_can_frame_t *f)
         rfs_can_pack_receiver(&r, c, &g);
         break;
     }
+    case RFS_CAN_ID_CONFIG: {
+        rfs_can_config_t k;
+        if (rfs_can_unpack_config(f, &k, &c) != RFS_CAN_OK) { return; }
+        rfs_can_pack_config(&k, c, &g);
+        break;
+    }
     default:
         return;
     }
@@ -98,7 +106,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         const unsigned sel = (r[0] >> 1) & 7u;
         f.dlc = (uint8_t)(r[3] & 0x0Fu);
         memcpy(f.data, r + 4, 8);
-        f.id = sel < 6u ? k_ids[sel] : ((uint32_t)r[4] | ((uint32_t)r[5] << 8)) & 0xFFFFu;
+        f.id = sel < 7u ? k_ids[sel] : ((uint32_t)r[4] | ((uint32_t)r[5] << 8)) & 0xFFFFu;
         if ((r[0] & 1u) && f.dlc >= 1u && f.dlc <= 8u) {
             f.data[f.dlc - 1u] = rfs_can_checksum(f.id, f.dlc, f.data);
             /* Both checksum implementations must agree on every input. */
@@ -123,6 +131,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
         if (msg.kind == RFS_CAN_MSG_RECEIVER &&
             (msg.receiver_t_us < now - cfg.max_age_us || msg.receiver_t_us > now + cfg.max_future_us)) {
+            abort();
+        }
+        if (msg.kind == RFS_CAN_MSG_CONFIG &&
+            (msg.config.target > 1u || msg.config.strategy >= (uint8_t)RFS_SEEK_STRATEGY_COUNT ||
+             rfs_can_model_name(msg.config.model) == NULL || msg.config.seed > 0xFFFFFFu ||
+             (msg.config.p0_min != RFS_CAN_P0_NONE &&
+              (msg.config.p0_min < RFS_CAN_P0_MIN || msg.config.p0_min > RFS_CAN_P0_MAX)))) {
             abort();
         }
         if (msg.kind == RFS_CAN_MSG_POSE) {

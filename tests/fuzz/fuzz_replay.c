@@ -32,7 +32,9 @@ static void sink(void *ctx, const uint8_t *p, uint32_t n)
 
 static void load_map(void)
 {
+    static rfs_sample_t samples[RFS_APP_MAX_SAMPLES];
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.samples = samples;
     cfg.map.grid = RFS_Q16_ONE;
     rfs_replay_player_init(&s_player, &s_app, &cfg, sink, NULL);
     rfs_replay_rec_t r;

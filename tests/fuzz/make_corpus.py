@@ -5,7 +5,7 @@
 
 Seeds are built here from the documented formats (docs/CAN.md, the ROS map_server
 convention, docs/SIMULATOR.md, the LCM wire format), not by the code under test:
-  can/       12-byte frame records (see fuzz_can.c): pose pairs, RSSI, wheel, status,
+  can/       12-byte frame records (see fuzz_can.c): pose pairs, RSSI, wheel, status, config,
              receiver heartbeats
   map/       YAML + "#PGM\\n" + PGM: tests/data/maps_bad fixtures and small P2/P5 images
   png/       a reading byte + a PNG (see fuzz_png.c): every colour type and depth, tRNS,
@@ -36,7 +36,7 @@ def put(sub, name, data):
 
 # --- CAN: records ctrl, dt (ms, LE u16), dlc, data[8] -----------------------------------
 # ctrl bit 0 = fix the checksum; bits 1..3 = id index (0 wheel, 1 xy, 2 th, 3 rssi, 4 status,
-# 5 receiver status; 6, 7 a raw id from data[0..1]).
+# 5 receiver status, 6 config; 7 a raw id from data[0..1]).
 T0 = 5_000_000_000  # the harness's start time, microseconds
 
 
@@ -76,7 +76,13 @@ put("can", "pose_wrap", pose(0, -8388608, 8388607, 25736, T0 + 2**32 + 100_000) 
 put("can", "repeat_unpaired", pose(3, 1, 2, 3, T0 + 100_000) + pose(3, 1, 2, 3, T0 + 200_000) +
     rec(2, 0, 8, [0x05, 0, 0]) + rec(1, 1, 8, [0x06]) + rec(1, 1, 8, [0x07]))
 put("can", "bad_dlc_crc", rec(3, 1, 7, [0], fix=True) + rec(3, 1, 8, [0] * 8, fix=False) +
-    rec(6, 1, 8, [0xff, 0x07, 0, 0, 0, 0, 0, 0]) + rec(7, 1, 15, [0x11, 0x01]))
+    rec(7, 1, 8, [0xff, 0x07, 0, 0, 0, 0, 0, 0]) + rec(7, 1, 15, [0x11, 0x01]))
+# CONFIG: meta-path + pathloss at -40 dBm, then a repeat, bridge + ridge without a floor,
+# every limit past by one (target 2, strategy 6, model 5, P0Min 100 dBm + 1/128).
+put("can", "config", rec(6, 1, 8, [0x05, 0x45, 0x00, 0xEC, 0x56, 0x34, 0x12]) +
+    rec(6, 1, 8, [0x05, 0x45, 0x00, 0xEC, 0x56, 0x34, 0x12]) +
+    rec(6, 1, 8, [0x1F, 0x00, 0x00, 0x80, 0xFF, 0xFF, 0xFF]) + rec(6, 1, 8, [0x20]) +
+    rec(6, 1, 8, [0x01, 0x06]) + rec(6, 1, 8, [0x02, 0x50]) + rec(6, 1, 8, [0x03, 0, 0x01, 0x32]))
 
 
 def receiver(counter, t_us, dt_ms=50):

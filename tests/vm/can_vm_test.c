@@ -152,6 +152,10 @@ static int do_recv(const char *ifname, int64_t now_us)
                    m.status.kind, m.status.prev, m.status.relearned, m.status.line_search, m.status.faults,
                    m.status.iteration);
             break;
+        case RFS_CAN_MSG_CONFIG:
+            printf("CONFIG target=%u strategy=%u model=%u p0=%d seed=%" PRIu32 "\n", m.config.target,
+                   m.config.strategy, m.config.model, m.config.p0_min, m.config.seed);
+            break;
         }
     }
     lx_can_health_t h;

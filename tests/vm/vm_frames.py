@@ -82,7 +82,13 @@ def main(argv):
     # 14. a receiver heartbeat 300 ms ahead: beyond the 100 ms future window
     send.append(frame(0x121, struct.pack("<BI", 0x01, t32(NOW + 300000))))
     want.append("DROP future")
-    want.append("STATS delivered=12 foreign=0 dropped=5 checksum=1 rssi_jumps=1 seq_gaps=1")
+    # 15. CONFIG: meta-path (5), pathloss (4), -40 dBm (-5120 / 128), seed 0x123456
+    send.append(frame(0x130, struct.pack("<BBh", 0x00, 5 | (4 << 4), -5120) + (0x123456).to_bytes(3, "little")))
+    want.append("CONFIG target=0 strategy=5 model=4 p0=-5120 seed=%d" % 0x123456)
+    # 16. CONFIG with strategy 6: no such strategy
+    send.append(frame(0x130, struct.pack("<BBh", 0x01, 6, 0) + bytes(3)))
+    want.append("DROP range")
+    want.append("STATS delivered=14 foreign=0 dropped=6 checksum=1 rssi_jumps=1 seq_gaps=1")
     with open(os.path.join(out, "cansend.txt"), "w") as f:
         f.write("\n".join(send) + "\n")
     with open(os.path.join(out, "expect_recv.txt"), "w") as f:

@@ -15,15 +15,20 @@
 #include "bench_clock.h"
 #include "rfs_app.h"
 #include "rfs_mlp.h"
+#include "rfs_pathloss.h"
 #include "rfs_replay.h"
 #include "semihost.h"
 
 static rfs_app_t s_app;
 static rfs_replay_player_t s_player;
-/* State for the model a CFG record names: the MLP's 3.3 KB holds the ridge and the MLP
- * (the emulator's RAM budget has the room the hardware image lacks); a stream naming
- * knn, radius or pathloss stops with "CFG model's state is larger than the image holds". */
-static uint64_t s_model[(sizeof(rfs_mlp_t) + 7u) / 8u];
+/* The hardware image's placement: the sample store in the CCM region (here the upper
+ * 64 KB of qemu's RAM), the model state with the rest in SRAM. */
+static rfs_sample_t s_samples[RFS_APP_MAX_SAMPLES] __attribute__((section(".ccm")));
+/* State for the model a CFG record names, sized as the hardware image's (the path-loss
+ * model's): it holds the ridge, the MLP and the path-loss model; a stream naming knn or
+ * radius stops with "CFG model's state is larger than the image holds". */
+#define MODEL_BYTES (sizeof(rfs_pathloss_t) > sizeof(rfs_mlp_t) ? sizeof(rfs_pathloss_t) : sizeof(rfs_mlp_t))
+static uint64_t s_model[(MODEL_BYTES + 7u) / 8u];
 
 /* Stack high-water mark: the stack is painted at start and scanned at the end (the
  * figure that sizes the hardware image's stack, docs/FIRMWARE.md), counted from the top
@@ -123,6 +128,7 @@ int main(void)
         die("input: not an rfseek stream (bad header)");
     }
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.samples = s_samples;
     cfg.model_state = s_model;
     cfg.model_state_bytes = (uint32_t)sizeof s_model;
     rfs_replay_player_init(&s_player, &s_app, &cfg, sink, &s_out);

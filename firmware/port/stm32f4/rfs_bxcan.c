@@ -27,7 +27,8 @@ rfs_bxcan_cfg_t rfs_bxcan_cfg_default(void)
     c.sjw_tq = 1u;
     c.fifo0_ids[0] = RFS_CAN_ID_POSE_XY;
     c.fifo0_ids[1] = RFS_CAN_ID_POSE_TH;
-    c.n_fifo0 = 2u;
+    c.fifo0_ids[2] = RFS_CAN_ID_CONFIG; /* the operator's, before the mission */
+    c.n_fifo0 = 3u;
     c.fifo1_ids[0] = RFS_CAN_ID_RSSI;
     c.fifo1_ids[1] = RFS_CAN_ID_RX_STATUS; /* the radio module's heartbeat */
     c.n_fifo1 = 2u;

@@ -1,9 +1,10 @@
 /* startup.c - Cortex-M4 vector table and reset handler for the STM32F405 (RM0090 table
- * 61 for the vector positions). Copies .data from flash, zeroes .bss, calls main().
+ * 61 for the vector positions). Copies .data from flash, zeroes .bss and .ccm (the
+ * core-coupled RAM: its clock is on at reset, RM0090 RCC_AHB1ENR CCMDATARAMEN), calls main().
  * Shared by the hardware image and the emulator image. */
 #include <stdint.h>
 
-extern uint32_t _sidata, _sdata, _edata, _sbss, _ebss, _estack;
+extern uint32_t _sidata, _sdata, _edata, _sbss, _ebss, _sccm, _eccm, _estack;
 int main(void);
 
 void Reset_Handler(void);
@@ -43,6 +44,10 @@ void Reset_Handler(void)
     }
     // cppcheck-suppress comparePointers ; _sbss.._ebss are one region (linker script)
     for (uint32_t *dst = &_sbss; dst < &_ebss;) {
+        *dst++ = 0u;
+    }
+    // cppcheck-suppress comparePointers ; _sccm.._eccm are one region (linker script)
+    for (uint32_t *dst = &_sccm; dst < &_eccm;) {
         *dst++ = 0u;
     }
     (void)main();

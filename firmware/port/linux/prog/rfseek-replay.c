@@ -111,6 +111,10 @@ static void print_rec(const rfs_replay_rec_t *r)
         if (r->u.cfg.model[0] != '\0') {
             printf("\tmodel=%s", r->u.cfg.model);
         }
+        if (r->u.cfg.chosen) {
+            printf("\tstrategy=%s\tp0_min=%d", rfs_seek_strategy_name((rfs_seek_strategy_t)r->u.cfg.strategy),
+                   r->u.cfg.p0_min);
+        }
         break;
     case RFS_REPLAY_MAP:
         printf("\tw=%u\th=%u\tres_q16=%d\tox_q16=%d\toy_q16=%d\twall=%u", r->u.map.w,
@@ -471,7 +475,9 @@ static int start_player(rfs_replay_player_t *player, sink_ctx_t *sc)
         fprintf(stderr, "rfseek-replay: out of memory\n");
         return 1;
     }
+    static rfs_sample_t samples[RFS_APP_MAX_SAMPLES];
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.samples = samples;
     cfg.model_state = model_state;
     cfg.model_state_bytes = mb;
     rfs_replay_player_init(player, &app, &cfg, sink, sc);

@@ -490,7 +490,9 @@ static void free_fields(daemon_t *d)
 static int open_controller(daemon_t *d, const options_t *o)
 {
     char err[512];
+    static rfs_sample_t samples[RFS_APP_MAX_SAMPLES];
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.samples = samples;
     rfs_seek_cfg_use_strategy(&cfg.seek, o->strategy);
     cfg.seed = (uint64_t)o->seed;
     cfg.target = strcmp(o->target, "bridge") == 0 ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
@@ -519,6 +521,11 @@ static int open_controller(daemon_t *d, const options_t *o)
         cfg.model_state = d->model_state;
         cfg.model_state_bytes = (uint32_t)mb;
     }
+    if (!isnan(o->p0_min)) {
+        /* The node's power known: a floor on the fitted signal at 1 m (docs/PATHLOSS.md
+         * "The P0 floor"). */
+        cfg.pathloss.p0_min = (rfs_q16_t)lround(o->p0_min * 65536.0);
+    }
     const lx_core_map_t *core = &d->core;
     rfs_app_map_t am = {core->map.w, core->map.h, core->map.res, core->map.origin_x, core->map.origin_y,
                         core->free_bits, core->wall_bits};
@@ -528,16 +535,6 @@ static int open_controller(daemon_t *d, const options_t *o)
                  "grid, %u lattice points)",
                  o->map_path, core->map.w, core->map.h, o->res, RFS_APP_MAX_MAP_BYTES, RFS_APP_MAX_LATTICE);
         return 1;
-    }
-    if (!isnan(o->p0_min) && d->fields == NULL) {
-        /* The node's power known: a floor on the fitted signal at 1 m (docs/PATHLOSS.md
-         * "The P0 floor"). The state is re-initialised before any fit. */
-        rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
-        pc.p0_min = (rfs_q16_t)lround(o->p0_min * 65536.0);
-        if (rfs_pathloss_init((rfs_pathloss_t *)d->model_state, &pc) != 0) {
-            lx_err_print(PROG, "--p0-min %g: rejected by the pathloss model", o->p0_min);
-            return 1;
-        }
     }
     return 0;
 }

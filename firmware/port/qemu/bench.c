@@ -38,6 +38,8 @@
 static rfs_app_t s_app;
 static uint8_t s_free[MAP_STRIDE * MAP_H];
 static uint8_t s_wall[MAP_STRIDE * MAP_H];
+/* The application's sample store, port-owned (rfs_app_cfg_t.samples; in RAM here: no CCM). */
+static rfs_sample_t s_samples[RFS_APP_MAX_SAMPLES];
 static rfs_rssi_t s_win;
 
 /* A row name: base followed by suffix, kept for the rest of the run (a bump pool). */
@@ -313,6 +315,7 @@ static void geo_decision(const rfs_app_map_t *map, bool meta_path, bool geodesic
                          const char *base, bool on_leg, rfs_q16_t *gx, rfs_q16_t *gy)
 {
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.samples = s_samples;
     if (meta_path) {
         rfs_seek_cfg_use_strategy(&cfg.seek, RFS_SEEK_META_PATH);
         cfg.seek.eps_geodesic = geodesic;
@@ -484,6 +487,7 @@ static void ls_decision(const rfs_app_map_t *map, rfs_q16_t rx, rfs_q16_t ry, co
                         bool on_leg, rfs_q16_t *gx, rfs_q16_t *gy)
 {
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.samples = s_samples;
     cfg.seek.eps_amp = 0;
     cfg.seek.eps_floor = 0;
     if (rfs_app_init(&s_app, &cfg, map) != 0) {
@@ -885,6 +889,7 @@ int main(void)
     const rfs_app_map_t map = {.w = MAP_W, .h = MAP_H, .res = RFS_Q16_FRAC(1, 8),
                                .origin_x = 0, .origin_y = 0, .free = s_free, .wall = s_wall};
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.samples = s_samples;
     cfg.seek.eps_amp = 0; /* epsilon = 0: the greedy branch, the expensive one, for certain */
     cfg.seek.eps_floor = 0;
     measure_init(&map, &cfg);

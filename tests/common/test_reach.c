@@ -55,8 +55,11 @@ static int ref_map_step(void *ctx, int ui, int uj, int vi, int vj)
  * lattice point. They decide which plans the planner refuses without a search
  * (rfs_plan_set_component), so they must be exactly the robot's component: compared with
  * a double-precision flood. With an 8-entry queue the fill overflows and marks every legal
- * point instead (still a union of whole components). */
-static void reach_case(uint32_t seed, double res, bool small_queue, int *in_component, int *legal)
+ * point instead (still a union of whole components). With reach_budget, the flood is
+ * sliced over periods (the wheels stopped meanwhile), one per `budget` points of the
+ * component, and ends with the same bits. */
+static void reach_case(uint32_t seed, double res, bool small_queue, uint32_t budget,
+                       int *in_component, int *legal)
 {
     world_t t;
     memset(&t, 0, sizeof t);
@@ -86,6 +89,7 @@ static void reach_case(uint32_t seed, double res, bool small_queue, int *in_comp
         sj = (int)((s >> 8) % t.map.lh);
     } while (!ref_lat_legal(&t.map, si, sj));
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    cfg.reach_budget = budget;
     seek_make(&t, cfg, seed);
     if (small_queue) {
         t.mem.plan_queue_cap = 8;
@@ -98,8 +102,24 @@ static void reach_case(uint32_t seed, double res, bool small_queue, int *in_comp
     rfs_seek_on_pose(&t.seek, &p, &t.rng);
     rfs_seek_on_rssi(&t.seek, 0, 100000, -50, &t.rng);
     rfs_seek_step(&t.seek, 100000, &t.rng, &out);
+    int waits = 0;
+    while (t.seek.flooding) {
+        assert_false(t.seek.reach_valid);
+        assert_int_equal(out.left_mm_s, 0);
+        assert_int_equal(out.right_mm_s, 0);
+        waits++;
+        rfs_seek_step(&t.seek, 100000, &t.rng, &out);
+    }
+    assert_true(t.seek.reach_valid);
     uint8_t *ref = calloc(t.mem.reach_bytes, 1);
     ref_flood(t.map.lw, t.map.lh, si, sj, ref_map_step, &t.map, ref);
+    int comp = 0;
+    for (int v = 0; v < t.map.lw * t.map.lh; v++) {
+        comp += bit_of(ref, v);
+    }
+    if (!small_queue) { /* every point of the component expanded once */
+        assert_int_equal(waits, budget == 0u ? 0 : (comp + (int)budget - 1) / (int)budget - 1);
+    }
     for (int j = 0; j < t.map.lh; j++) {
         for (int i = 0; i < t.map.lw; i++) {
             int v = j * t.map.lw + i;
@@ -121,20 +141,33 @@ static void test_reach_is_the_component(void **state)
     (void)state;
     int comp = 0, legal = 0;
     for (uint32_t seed = 1; seed <= 12; seed++) {
-        reach_case(seed, 0.125, false, &comp, &legal); /* step patterns */
-        reach_case(seed, 0.1, false, &comp, &legal);   /* the exact traversal */
+        reach_case(seed, 0.125, false, 0u, &comp, &legal); /* step patterns */
+        reach_case(seed, 0.1, false, 0u, &comp, &legal);   /* the exact traversal */
     }
     print_message("robot's components %d of %d legal lattice points\n", comp, legal);
     assert_true(comp > legal / 10 && comp < legal); /* pockets exist, the fill is not trivial */
     int c2 = 0, l2 = 0;
-    reach_case(3, 0.125, true, &c2, &l2);
-    reach_case(4, 0.1, true, &c2, &l2);
+    reach_case(3, 0.125, true, 0u, &c2, &l2);
+    reach_case(4, 0.1, true, 0u, &c2, &l2);
+}
+
+/* reach_budget: the flood sliced over periods gives the whole flood's bits. */
+static void test_sliced_reach_is_the_component(void **state)
+{
+    (void)state;
+    int comp = 0, legal = 0;
+    for (uint32_t seed = 1; seed <= 6; seed++) {
+        reach_case(seed, 0.125, false, 1u, &comp, &legal);
+        reach_case(seed, 0.1, false, 37u, &comp, &legal);
+    }
+    reach_case(3, 0.125, true, 5u, &comp, &legal);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reach_is_the_component),
+        cmocka_unit_test(test_sliced_reach_is_the_component),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -564,16 +564,16 @@ typedef struct walk {
     bool in_wall;
 } walk_t;
 
-/* Visit rows jlo..jhi (walk order) of column i (on the map). p: the wall byte of row jlo
- * and column i, mask: column i's bit, step: bytes from one row to the next in walk order,
- * flip: walk rows run down the map. Cells on rows -1 and h (edge) are not walls; with
- * blocks b, a wall-free block's cells are passed over at once. */
-static void walk_column(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, walk_t *wk,
-                        int32_t i, int32_t jlo, int32_t jhi, bool flip, bool edge)
+/* Visit rows jlo..jhi (walk order) of column i (on the map). step: bytes from one row to
+ * the next in walk order, flip: walk rows run down the map, slow: the column needs the
+ * careful walk (edge: rows -1 and h, which are not walls, may be among its rows; or with
+ * blocks b it is long enough that a wall-free block's cells are passed over at once). */
+static inline void walk_column(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, walk_t *wk,
+                               int32_t i, int32_t jlo, int32_t jhi, bool flip, int32_t step,
+                               bool slow)
 {
     const uint8_t mask = (uint8_t)(1u << (i & 7));
-    const int32_t step = flip ? -(int32_t)m->stride : (int32_t)m->stride;
-    if (edge || (b != 0 && jhi - jlo >= ((int32_t)1 << b->shift))) {
+    if (slow) {
         const int32_t bs = b != 0 ? (int32_t)1 << b->shift : 0;
         for (int32_t j = jlo; j <= jhi; j++) {
             const int32_t jr = flip ? -1 - j : j;
@@ -595,11 +595,15 @@ static void walk_column(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, walk
     }
     const int32_t jr0 = flip ? -1 - jlo : jlo;
     const uint8_t *p = m->wall + (uint32_t)jr0 * m->stride + ((uint32_t)i >> 3);
+    uint32_t runs = wk->runs;
+    uint32_t in = wk->in_wall ? 1u : 0u;
     for (int32_t j = jlo; j <= jhi; j++, p += step) {
-        const bool wall = (*p & mask) != 0u;
-        wk->runs += (wall && !wk->in_wall) ? 1u : 0u;
-        wk->in_wall = wall;
+        const uint32_t wall = (*p & mask) != 0u ? 1u : 0u;
+        runs += wall & (in ^ 1u);
+        in = wall;
     }
+    wk->runs = runs;
+    wk->in_wall = in != 0u;
 }
 
 /* traverse() with the VISIT_WALLS visitor, specialised: the same cells in the same order
@@ -637,6 +641,8 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
     int64_t bhi = blo;                      /* (jhi + 1) * r * dx */
     int64_t nl = Y0 * dx;                   /* y(xl) * dx, xl the column's left end */
     int64_t nr = Y0 * dx + ((int64_t)(ia + 1) * r - X0) * dy; /* y(xr) * dx before clamping */
+    const int32_t step = flip ? -(int32_t)m->stride : (int32_t)m->stride;
+    const int32_t long_col = b != 0 ? bs : INT32_MAX; /* rows from which blocks pay */
     for (int32_t i = ia; i <= ib; i++, nr += rdy) {
         if (dx != 0) {
             const int64_t n_r = i == ib ? Y1 * dx : nr; /* y(min(xr, X1)) * dx */
@@ -656,8 +662,8 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
             /* A block column at once, from its first column, when the rows the segment
              * spans in it hold no wall block: those of its last column ie from the same
              * recurrence (jlo catches up in the next column's loop). */
-            const int32_t ie = i + bs - 1 > ib ? ib : i + bs - 1;
-            if (b != 0 && (i & (bs - 1)) == 0 && ie > i && (uint32_t)i < m->w) {
+            if (b != 0 && (i & (bs - 1)) == 0 && i < ib && (uint32_t)i < m->w) {
+                const int32_t ie = i + bs - 1 > ib ? ib : i + bs - 1;
                 const int64_t ne = ie == ib ? Y1 * dx : nr + (int64_t)(ie - i) * rdy;
                 int32_t je = jhi;
                 int64_t be = bhi;
@@ -680,7 +686,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
             wk.in_wall = false; /* column -1 or w */
             continue;
         }
-        walk_column(m, b, &wk, i, jlo, jhi, flip, edge);
+        walk_column(m, b, &wk, i, jlo, jhi, flip, step, edge || jhi - jlo >= long_col);
     }
     return (uint16_t)(wk.runs > UINT16_MAX ? UINT16_MAX : wk.runs);
 }

@@ -486,6 +486,74 @@ static void derive_steps(rfs_map_t *m)
     m->step_n = (uint8_t)(g / r);
 }
 
+/* --- lattice memo ---------------------------------------------------------------------- */
+
+/* Memo bits of a lattice point: its four steps towards (1, 0), (1, 1), (0, 1), (-1, 1)
+ * (the other four are its neighbours' steps walked back), then whether each is known;
+ * its own legality, then whether that is known. */
+#define MEMO_STEP_KNOWN(k) (0x10u << (k))
+#define MEMO_LEGAL 0x100u
+#define MEMO_LEGAL_KNOWN 0x200u
+
+uint32_t rfs_map_memo_entries(const rfs_map_t *m)
+{
+    return (uint32_t)m->lw * m->lh;
+}
+
+int rfs_map_memo_attach(rfs_map_t *m, uint16_t *buf, uint32_t entries)
+{
+    if (buf == 0 || entries < rfs_map_memo_entries(m)) {
+        return -1;
+    }
+    memset(buf, 0, (size_t)rfs_map_memo_entries(m) * sizeof(buf[0]));
+    m->memo = buf;
+    return 0;
+}
+
+/* The step from lattice point (si, sj) towards (di, dj) of the upper half ((1, 0), (1, 1),
+ * (0, 1), (-1, 1): k 0..3), both ends on the lattice, by the traversal; remembered in the
+ * memo when one is attached. Out of line: the step patterns' path stays lean. */
+__attribute__((noinline)) static bool step_by_traversal(const rfs_map_t *m, uint32_t si,
+                                                        uint32_t sj, int32_t di, int32_t dj)
+{
+    const uint32_t k = dj == 0 ? 0u : (uint32_t)(2 - di);
+    uint16_t *e = m->memo != 0 ? &m->memo[sj * m->lw + si] : 0;
+    if (e != 0 && (*e & MEMO_STEP_KNOWN(k)) != 0u) {
+        return ((*e >> k) & 1u) != 0u;
+    }
+    rfs_q16_t x0;
+    rfs_q16_t y0;
+    rfs_q16_t x1;
+    rfs_q16_t y1;
+    rfs_map_lattice_point(m, (uint16_t)si, (uint16_t)sj, &x0, &y0);
+    rfs_map_lattice_point(m, (uint16_t)(si + (uint32_t)di), (uint16_t)(sj + (uint32_t)dj), &x1,
+                          &y1);
+    const bool ok = rfs_map_segment_legal(m, x0, y0, x1, y1);
+    if (e != 0) {
+        *e = (uint16_t)(*e | MEMO_STEP_KNOWN(k) | (ok ? 1u << k : 0u));
+    }
+    return ok;
+}
+
+/* Lattice point (i, j)'s legality by its position; remembered in the memo when one is
+ * attached. Out of line, as step_by_traversal. */
+__attribute__((noinline)) static bool legal_by_position(const rfs_map_t *m, uint16_t i,
+                                                        uint16_t j)
+{
+    uint16_t *e = m->memo != 0 ? &m->memo[(uint32_t)j * m->lw + i] : 0;
+    if (e != 0 && (*e & MEMO_LEGAL_KNOWN) != 0u) {
+        return (*e & MEMO_LEGAL) != 0u;
+    }
+    rfs_q16_t x;
+    rfs_q16_t y;
+    rfs_map_lattice_point(m, i, j, &x, &y);
+    const bool ok = rfs_map_point_legal(m, x, y);
+    if (e != 0) {
+        *e = (uint16_t)(*e | MEMO_LEGAL_KNOWN | (ok ? MEMO_LEGAL : 0u));
+    }
+    return ok;
+}
+
 bool rfs_map_lattice_step_legal(const rfs_map_t *m, uint16_t i, uint16_t j, int32_t di,
                                 int32_t dj)
 {
@@ -527,13 +595,7 @@ bool rfs_map_lattice_step_legal(const rfs_map_t *m, uint16_t i, uint16_t j, int3
             return true;
         }
     }
-    rfs_q16_t x0;
-    rfs_q16_t y0;
-    rfs_q16_t x1;
-    rfs_q16_t y1;
-    rfs_map_lattice_point(m, i, j, &x0, &y0);
-    rfs_map_lattice_point(m, (uint16_t)ti, (uint16_t)tj, &x1, &y1);
-    return rfs_map_segment_legal(m, x0, y0, x1, y1);
+    return step_by_traversal(m, (uint32_t)si, (uint32_t)sj, di, dj);
 }
 
 static int64_t clamp64(int64_t v, int64_t lo, int64_t hi)
@@ -795,8 +857,5 @@ bool rfs_map_lattice_legal(const rfs_map_t *m, uint16_t i, uint16_t j)
         return rfs_map_bit(m->legal, m->stride, (uint16_t)(i * m->step_n + m->step_c0),
                            (uint16_t)(j * m->step_n + m->step_c0));
     }
-    rfs_q16_t x;
-    rfs_q16_t y;
-    rfs_map_lattice_point(m, i, j, &x, &y);
-    return rfs_map_point_legal(m, x, y);
+    return legal_by_position(m, i, j);
 }

@@ -50,6 +50,32 @@ static int ref_map_step(void *ctx, int ui, int uj, int vi, int vj)
     return ref_lat_legal(m, vi, vj) && ref_step_legal(m, ui, uj, vi, vj);
 }
 
+/* t's map: 8 x 6 m at cell size res, 2.5 % of the cells occupied at random (seed), no
+ * clearance, the 0.25 m lattice. Returns the random state after the map. */
+static uint32_t speckled_map(world_t *t, uint32_t seed, double res)
+{
+    memset(t, 0, sizeof *t);
+    t->w = (uint16_t)lround(8.0 / res);
+    t->h = (uint16_t)lround(6.0 / res);
+    uint32_t bytes = rfs_map_bytes(t->w, t->h);
+    uint16_t stride = (uint16_t)((t->w + 7) / 8);
+    t->free_bits = calloc(bytes, 1);
+    t->wall_bits = calloc(bytes, 1);
+    t->legal_bits = calloc(bytes, 1);
+    uint32_t s = seed * 2654435761u;
+    for (uint16_t y = 0; y < t->h; ++y) {
+        for (uint16_t x = 0; x < t->w; ++x) {
+            s = s * 1664525u + 1013904223u;
+            rfs_map_bit_set(t->free_bits, stride, x, y, (s >> 8) % 1000u >= 25u);
+        }
+    }
+    rfs_map_cfg_t mc = rfs_map_cfg_default();
+    mc.clearance = 0;
+    assert_int_equal(rfs_map_init(&t->map, &mc, t->w, t->h, Q(res), 0, 0, t->free_bits,
+                                  t->wall_bits, t->legal_bits), 0);
+    return s;
+}
+
 /* A speckled 8 x 6 m map (2.5 % of the cells occupied, no clearance: many small pockets)
  * at cell size res, and the seeker's reach bits after its first period at a random legal
  * lattice point. They decide which plans the planner refuses without a search
@@ -62,25 +88,7 @@ static void reach_case(uint32_t seed, double res, bool small_queue, uint32_t bud
                        int *in_component, int *legal)
 {
     world_t t;
-    memset(&t, 0, sizeof t);
-    t.w = (uint16_t)lround(8.0 / res);
-    t.h = (uint16_t)lround(6.0 / res);
-    uint32_t bytes = rfs_map_bytes(t.w, t.h);
-    uint16_t stride = (uint16_t)((t.w + 7) / 8);
-    t.free_bits = calloc(bytes, 1);
-    t.wall_bits = calloc(bytes, 1);
-    t.legal_bits = calloc(bytes, 1);
-    uint32_t s = seed * 2654435761u;
-    for (uint16_t y = 0; y < t.h; ++y) {
-        for (uint16_t x = 0; x < t.w; ++x) {
-            s = s * 1664525u + 1013904223u;
-            rfs_map_bit_set(t.free_bits, stride, x, y, (s >> 8) % 1000u >= 25u);
-        }
-    }
-    rfs_map_cfg_t mc = rfs_map_cfg_default();
-    mc.clearance = 0;
-    assert_int_equal(rfs_map_init(&t.map, &mc, t.w, t.h, Q(res), 0, 0, t.free_bits,
-                                  t.wall_bits, t.legal_bits), 0);
+    uint32_t s = speckled_map(&t, seed, res);
     int si, sj;
     do {
         s = s * 1664525u + 1013904223u;
@@ -163,11 +171,65 @@ static void test_sliced_reach_is_the_component(void **state)
     reach_case(3, 0.125, true, 5u, &comp, &legal);
 }
 
+/* The lattice memo (rfs_map_memo_attach) answers as the double-precision references, on
+ * the first call (computed) and the second (remembered), for every lattice point and
+ * direction of a map without step patterns (0.1 m cells, 0.25 m lattice). */
+static void test_memo_matches_reference(void **state)
+{
+    (void)state;
+    static const int8_t k_di[8] = {1, 1, 0, -1, -1, -1, 0, 1};
+    static const int8_t k_dj[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+    world_t t;
+    (void)speckled_map(&t, 5, 0.1);
+    assert_int_equal(t.map.step_n, 0);
+    const uint32_t n = rfs_map_memo_entries(&t.map);
+    assert_int_equal(n, (uint32_t)t.map.lw * t.map.lh);
+    uint16_t *memo = malloc(n * sizeof(memo[0]));
+    assert_non_null(memo);
+    assert_int_equal(rfs_map_memo_attach(&t.map, memo, n - 1), -1);
+    assert_null(t.map.memo);
+    assert_int_equal(rfs_map_memo_attach(&t.map, memo, n), 0);
+    int legal = 0, steps = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (int j = 0; j < t.map.lh; j++) {
+            for (int i = 0; i < t.map.lw; i++) {
+                const int want = ref_lat_legal(&t.map, i, j);
+                assert_int_equal(rfs_map_lattice_legal(&t.map, (uint16_t)i, (uint16_t)j), want);
+                legal += pass == 0 ? want : 0;
+                for (int k = 0; k < 8; k++) {
+                    const int vi = i + k_di[k], vj = j + k_dj[k];
+                    const int on = vi >= 0 && vj >= 0 && vi < t.map.lw && vj < t.map.lh;
+                    const int ws = on && ref_step_legal(&t.map, i, j, vi, vj);
+                    if (rfs_map_lattice_step_legal(&t.map, (uint16_t)i, (uint16_t)j, k_di[k],
+                                                   k_dj[k]) != ws) {
+                        fail_msg("pass %d: step (%d, %d) -> (%d, %d): reference %d", pass, i, j,
+                                 vi, vj, ws);
+                    }
+                    steps += pass == 0 ? ws : 0;
+                }
+            }
+        }
+    }
+    /* every point's legality and its four upper steps (those on the lattice) known */
+    for (int j = 0; j < t.map.lh; j++) {
+        for (int i = 0; i < t.map.lw; i++) {
+            const uint16_t e = memo[j * t.map.lw + i];
+            assert_true(e & 0x200u);
+            assert_int_equal((e & 0x10u) != 0, i + 1 < t.map.lw);
+            assert_int_equal((e & 0x40u) != 0, j + 1 < t.map.lh);
+        }
+    }
+    assert_true(legal > 0 && steps > 0 && steps < 8 * legal); /* walls cut some steps */
+    free(memo);
+    world_free(&t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reach_is_the_component),
         cmocka_unit_test(test_sliced_reach_is_the_component),
+        cmocka_unit_test(test_memo_matches_reference),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

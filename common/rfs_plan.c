@@ -135,18 +135,19 @@ static void seed(rfs_plan_t *p, uint32_t root)
 /* Relax the neighbours of the point u just closed at cost d. false when the queue
  * overflowed (r->st.overflow; the search is then void). The map, work array and edge test come
  * in as arguments: loaded once per search, not after every byte store to the work. With
- * `steps` (grid a multiple of res) lattice legality and edges come from the recorded
- * cells; otherwise, or for the reference, from positions and the traversal, through the
- * map's lattice memo when `memo` (m->memo attached). */
-static bool relax(const rfs_map_t *m, uint8_t *w, bool steps, bool memo, rings_t *r,
-                  uint32_t u, uint32_t d)
+ * `steps` lattice legality and edges come from the map's lattice tests (the recorded
+ * cells when the grid is a multiple of res; else positions and the traversal, each
+ * computed once per map through its lattice memo); otherwise, or for the reference, from
+ * positions and the traversal here. */
+static bool relax(const rfs_map_t *m, uint8_t *w, bool steps, rings_t *r, uint32_t u,
+                  uint32_t d)
 {
     const uint32_t lw = m->lw;
     uint16_t ui = (uint16_t)(u % lw);
     uint16_t uj = (uint16_t)(u / lw);
     rfs_q16_t ux = 0;
     rfs_q16_t uy = 0;
-    if (!steps && !memo) {
+    if (!steps) {
         rfs_map_lattice_point(m, ui, uj, &ux, &uy);
     }
     for (uint32_t k = 0; k < 8u; k++) {
@@ -168,16 +169,6 @@ static bool relax(const rfs_map_t *m, uint8_t *w, bool steps, bool memo, rings_t
             }
         }
         if (steps) {
-            if (!(wv & W_OPEN) && !rfs_map_lattice_legal(m, (uint16_t)vi, (uint16_t)vj)) {
-                w[v] = (uint8_t)(wv | W_ILLEGAL);
-                continue;
-            }
-            if (!rfs_map_lattice_step_legal(m, ui, uj, DIR_X[k], DIR_Y[k])) {
-                continue;
-            }
-        } else if (memo) {
-            /* The same tests as below (no step patterns: positions and the traversal),
-             * each computed once per map (rfs_map_memo_attach). */
             if (!(wv & W_OPEN) && !rfs_map_lattice_legal(m, (uint16_t)vi, (uint16_t)vj)) {
                 w[v] = (uint8_t)(wv | W_ILLEGAL);
                 continue;
@@ -229,8 +220,8 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
     r.st = p->dial;
     uint8_t *w = p->work;
     const rfs_map_t *m = p->map;
-    const bool steps = m->step_n != 0 && !p->exact_edges;
-    const bool memo = m->memo != 0 && m->step_n == 0;
+    /* The memo's answers are the traversal's (rfs_map_memo_attach). */
+    const bool steps = m->step_n != 0 ? !p->exact_edges : m->memo != 0;
     uint32_t d = r.st.cost;
     uint32_t u = r.st.pending; /* closed, neighbours not yet relaxed */
     uint32_t empty_run = 0;
@@ -239,7 +230,7 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
     bool ok = !r.st.overflow;
     while (ok) {
         if (u != NO_POINT) {
-            ok = relax(m, w, steps, memo, &r, u, d);
+            ok = relax(m, w, steps, &r, u, d);
             u = NO_POINT;
             continue;
         }

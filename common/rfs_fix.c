@@ -195,11 +195,9 @@ static int64_t log2_q20(rfs_q16_t x)
     int64_t frac = 0;
     for (int i = 0; i < 20; ++i) {
         m = (m * m) >> 31; /* m < 2^32, m^2 < 2^64; result in [1, 4) Q31 */
-        frac <<= 1;
-        if (m >= ((uint64_t)2 << 31)) {
-            m >>= 1;
-            frac |= 1;
-        }
+        const uint64_t top = m >> 32; /* m >= 2: the next bit is 1 (branch-free: it is */
+        frac = (frac << 1) | (int64_t)top; /* a coin toss, mispredicted half the time) */
+        m >>= top;
     }
     return e * ((int64_t)1 << 20) + frac;
 }

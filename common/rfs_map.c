@@ -486,6 +486,74 @@ static void derive_steps(rfs_map_t *m)
     m->step_n = (uint8_t)(g / r);
 }
 
+/* --- lattice memo ---------------------------------------------------------------------- */
+
+/* Memo bits of a lattice point: its four steps towards (1, 0), (1, 1), (0, 1), (-1, 1)
+ * (the other four are its neighbours' steps walked back), then whether each is known;
+ * its own legality, then whether that is known. */
+#define MEMO_STEP_KNOWN(k) (0x10u << (k))
+#define MEMO_LEGAL 0x100u
+#define MEMO_LEGAL_KNOWN 0x200u
+
+uint32_t rfs_map_memo_entries(const rfs_map_t *m)
+{
+    return (uint32_t)m->lw * m->lh;
+}
+
+int rfs_map_memo_attach(rfs_map_t *m, uint16_t *buf, uint32_t entries)
+{
+    if (buf == 0 || entries < rfs_map_memo_entries(m)) {
+        return -1;
+    }
+    memset(buf, 0, (size_t)rfs_map_memo_entries(m) * sizeof(buf[0]));
+    m->memo = buf;
+    return 0;
+}
+
+/* The step from lattice point (si, sj) towards (di, dj) of the upper half ((1, 0), (1, 1),
+ * (0, 1), (-1, 1): k 0..3), both ends on the lattice, by the traversal; remembered in the
+ * memo when one is attached. Out of line: the step patterns' path stays lean. */
+__attribute__((noinline)) static bool step_by_traversal(const rfs_map_t *m, uint32_t si,
+                                                        uint32_t sj, int32_t di, int32_t dj)
+{
+    const uint32_t k = dj == 0 ? 0u : (uint32_t)(2 - di);
+    uint16_t *e = m->memo != 0 ? &m->memo[sj * m->lw + si] : 0;
+    if (e != 0 && (*e & MEMO_STEP_KNOWN(k)) != 0u) {
+        return ((*e >> k) & 1u) != 0u;
+    }
+    rfs_q16_t x0;
+    rfs_q16_t y0;
+    rfs_q16_t x1;
+    rfs_q16_t y1;
+    rfs_map_lattice_point(m, (uint16_t)si, (uint16_t)sj, &x0, &y0);
+    rfs_map_lattice_point(m, (uint16_t)(si + (uint32_t)di), (uint16_t)(sj + (uint32_t)dj), &x1,
+                          &y1);
+    const bool ok = rfs_map_segment_legal(m, x0, y0, x1, y1);
+    if (e != 0) {
+        *e = (uint16_t)(*e | MEMO_STEP_KNOWN(k) | (ok ? 1u << k : 0u));
+    }
+    return ok;
+}
+
+/* Lattice point (i, j)'s legality by its position; remembered in the memo when one is
+ * attached. Out of line, as step_by_traversal. */
+__attribute__((noinline)) static bool legal_by_position(const rfs_map_t *m, uint16_t i,
+                                                        uint16_t j)
+{
+    uint16_t *e = m->memo != 0 ? &m->memo[(uint32_t)j * m->lw + i] : 0;
+    if (e != 0 && (*e & MEMO_LEGAL_KNOWN) != 0u) {
+        return (*e & MEMO_LEGAL) != 0u;
+    }
+    rfs_q16_t x;
+    rfs_q16_t y;
+    rfs_map_lattice_point(m, i, j, &x, &y);
+    const bool ok = rfs_map_point_legal(m, x, y);
+    if (e != 0) {
+        *e = (uint16_t)(*e | MEMO_LEGAL_KNOWN | (ok ? MEMO_LEGAL : 0u));
+    }
+    return ok;
+}
+
 bool rfs_map_lattice_step_legal(const rfs_map_t *m, uint16_t i, uint16_t j, int32_t di,
                                 int32_t dj)
 {
@@ -527,13 +595,7 @@ bool rfs_map_lattice_step_legal(const rfs_map_t *m, uint16_t i, uint16_t j, int3
             return true;
         }
     }
-    rfs_q16_t x0;
-    rfs_q16_t y0;
-    rfs_q16_t x1;
-    rfs_q16_t y1;
-    rfs_map_lattice_point(m, i, j, &x0, &y0);
-    rfs_map_lattice_point(m, (uint16_t)ti, (uint16_t)tj, &x1, &y1);
-    return rfs_map_segment_legal(m, x0, y0, x1, y1);
+    return step_by_traversal(m, (uint32_t)si, (uint32_t)sj, di, dj);
 }
 
 static int64_t clamp64(int64_t v, int64_t lo, int64_t hi)
@@ -564,16 +626,16 @@ typedef struct walk {
     bool in_wall;
 } walk_t;
 
-/* Visit rows jlo..jhi (walk order) of column i (on the map). p: the wall byte of row jlo
- * and column i, mask: column i's bit, step: bytes from one row to the next in walk order,
- * flip: walk rows run down the map. Cells on rows -1 and h (edge) are not walls; with
- * blocks b, a wall-free block's cells are passed over at once. */
-static void walk_column(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, walk_t *wk,
-                        int32_t i, int32_t jlo, int32_t jhi, bool flip, bool edge)
+/* Visit rows jlo..jhi (walk order) of column i (on the map). step: bytes from one row to
+ * the next in walk order, flip: walk rows run down the map, slow: the column needs the
+ * careful walk (edge: rows -1 and h, which are not walls, may be among its rows; or with
+ * blocks b it is long enough that a wall-free block's cells are passed over at once). */
+static inline void walk_column(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, walk_t *wk,
+                               int32_t i, int32_t jlo, int32_t jhi, bool flip, int32_t step,
+                               bool slow)
 {
     const uint8_t mask = (uint8_t)(1u << (i & 7));
-    const int32_t step = flip ? -(int32_t)m->stride : (int32_t)m->stride;
-    if (edge || (b != 0 && jhi - jlo >= ((int32_t)1 << b->shift))) {
+    if (slow) {
         const int32_t bs = b != 0 ? (int32_t)1 << b->shift : 0;
         for (int32_t j = jlo; j <= jhi; j++) {
             const int32_t jr = flip ? -1 - j : j;
@@ -595,11 +657,15 @@ static void walk_column(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, walk
     }
     const int32_t jr0 = flip ? -1 - jlo : jlo;
     const uint8_t *p = m->wall + (uint32_t)jr0 * m->stride + ((uint32_t)i >> 3);
+    uint32_t runs = wk->runs;
+    uint32_t in = wk->in_wall ? 1u : 0u;
     for (int32_t j = jlo; j <= jhi; j++, p += step) {
-        const bool wall = (*p & mask) != 0u;
-        wk->runs += (wall && !wk->in_wall) ? 1u : 0u;
-        wk->in_wall = wall;
+        const uint32_t wall = (*p & mask) != 0u ? 1u : 0u;
+        runs += wall & (in ^ 1u);
+        in = wall;
     }
+    wk->runs = runs;
+    wk->in_wall = in != 0u;
 }
 
 /* traverse() with the VISIT_WALLS visitor, specialised: the same cells in the same order
@@ -637,6 +703,8 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
     int64_t bhi = blo;                      /* (jhi + 1) * r * dx */
     int64_t nl = Y0 * dx;                   /* y(xl) * dx, xl the column's left end */
     int64_t nr = Y0 * dx + ((int64_t)(ia + 1) * r - X0) * dy; /* y(xr) * dx before clamping */
+    const int32_t step = flip ? -(int32_t)m->stride : (int32_t)m->stride;
+    const int32_t long_col = b != 0 ? bs : INT32_MAX; /* rows from which blocks pay */
     for (int32_t i = ia; i <= ib; i++, nr += rdy) {
         if (dx != 0) {
             const int64_t n_r = i == ib ? Y1 * dx : nr; /* y(min(xr, X1)) * dx */
@@ -656,8 +724,8 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
             /* A block column at once, from its first column, when the rows the segment
              * spans in it hold no wall block: those of its last column ie from the same
              * recurrence (jlo catches up in the next column's loop). */
-            const int32_t ie = i + bs - 1 > ib ? ib : i + bs - 1;
-            if (b != 0 && (i & (bs - 1)) == 0 && ie > i && (uint32_t)i < m->w) {
+            if (b != 0 && (i & (bs - 1)) == 0 && i < ib && (uint32_t)i < m->w) {
+                const int32_t ie = i + bs - 1 > ib ? ib : i + bs - 1;
                 const int64_t ne = ie == ib ? Y1 * dx : nr + (int64_t)(ie - i) * rdy;
                 int32_t je = jhi;
                 int64_t be = bhi;
@@ -680,7 +748,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
             wk.in_wall = false; /* column -1 or w */
             continue;
         }
-        walk_column(m, b, &wk, i, jlo, jhi, flip, edge);
+        walk_column(m, b, &wk, i, jlo, jhi, flip, step, edge || jhi - jlo >= long_col);
     }
     return (uint16_t)(wk.runs > UINT16_MAX ? UINT16_MAX : wk.runs);
 }
@@ -789,8 +857,5 @@ bool rfs_map_lattice_legal(const rfs_map_t *m, uint16_t i, uint16_t j)
         return rfs_map_bit(m->legal, m->stride, (uint16_t)(i * m->step_n + m->step_c0),
                            (uint16_t)(j * m->step_n + m->step_c0));
     }
-    rfs_q16_t x;
-    rfs_q16_t y;
-    rfs_map_lattice_point(m, i, j, &x, &y);
-    return rfs_map_point_legal(m, x, y);
+    return legal_by_position(m, i, j);
 }

@@ -69,6 +69,7 @@ typedef struct rfs_map {
     rfs_map_step_t step[4];
     uint8_t step_n;        ///< cells per lattice step (grid / res); 0 = no patterns
     uint8_t step_c0;       ///< cells: the cell of lattice point 0 along an axis, (grid/2) / res
+    uint16_t *memo;        ///< lattice memo (rfs_map_memo_attach()); NULL (init): none
 } rfs_map_t;
 
 /// Defaults: 0.25 m clearance, 0.25 m lattice.
@@ -153,5 +154,15 @@ void rfs_map_lattice_nearest(const rfs_map_t *m, rfs_q16_t x, rfs_q16_t y, uint1
 
 /// Lattice point legality (its position is a legal point).
 bool rfs_map_lattice_legal(const rfs_map_t *m, uint16_t i, uint16_t j);
+
+/// Entries of a lattice memo for m (rfs_map_memo_attach()): one per lattice point.
+uint32_t rfs_map_memo_entries(const rfs_map_t *m);
+
+/// Attach a lattice memo (`entries` >= rfs_map_memo_entries(m), cleared here; it stays the
+/// caller's): without step patterns, rfs_map_lattice_legal() and
+/// rfs_map_lattice_step_legal() then compute each answer once per map (the planner tests
+/// every edge of every search). rfs_map_init() detaches it. -1 when buf is NULL or too
+/// small.
+int rfs_map_memo_attach(rfs_map_t *m, uint16_t *buf, uint32_t entries);
 
 #endif /* RFS_MAP_H */

@@ -28,8 +28,10 @@
 #define NOMAP_GRID RFS_Q16_FRAC(1, 4)
 /// What an evaluated candidate is for (rfs_pathloss_ev_t.kind).
 enum { EV_COARSE = 0, EV_REFINE = 1, EV_HOLD = 2 };
-/// Cached wall counts per work unit.
-#define CACHED_PER_UNIT 32u
+/// Bins gathered, solved or set up per work unit (a unit: about one wall count's work).
+#define BINS_PER_UNIT 32u
+/// Samples binned per work unit.
+#define SAMPLES_PER_UNIT 64u
 
 rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
 {
@@ -146,49 +148,55 @@ static uint32_t bin_hash(int16_t kx, int16_t ky)
     return h >> 22; /* 10 bits: RFS_PATHLOSS_HASH = 1024 */
 }
 
-/* Put the samples into bins of bin_cm, doubling it until at most MAX_BINS are used. */
-static void bin_samples(rfs_pathloss_t *p, const rfs_sample_t *smp, uint16_t n)
+/* Binning (re)starts with bins of bin_cm and none used. */
+static void bin_reset(rfs_pathloss_t *p, int32_t bin_cm)
+{
+    memset(p->hash, 0, sizeof(p->hash));
+    p->nbins = 0u;
+    p->bin_cm = bin_cm;
+    p->pos = 0u;
+}
+
+/* Bin samples p->pos..end - 1 into bins of p->bin_cm; false (binning must restart with
+ * bins twice as wide) when they need more than MAX_BINS. */
+static bool bin_add(rfs_pathloss_t *p, const rfs_sample_t *smp, uint32_t end)
 {
     _Static_assert(RFS_PATHLOSS_HASH == 1024u, "bin_hash yields 10 bits");
-    int32_t bin_cm = (int32_t)(((int64_t)p->cfg.bin * 100 + 32768) >> 16);
-    for (;;) {
-        bool ok = true;
-        memset(p->hash, 0, sizeof(p->hash));
-        p->nbins = 0u;
-        for (uint32_t i = 0u; i < n && ok; ++i) {
-            int16_t kx = (int16_t)floor_div(smp[i].x_cm, bin_cm);
-            int16_t ky = (int16_t)floor_div(smp[i].y_cm, bin_cm);
-            uint32_t h = bin_hash(kx, ky);
-            while (p->hash[h] != 0u) {
-                const rfs_pathloss_bin_t *b = &p->bins[p->hash[h] - 1u];
-                if (b->kx == kx && b->ky == ky) {
-                    break;
-                }
-                h = (h + 1u) & (RFS_PATHLOSS_HASH - 1u);
+    const int32_t bin_cm = p->bin_cm;
+    for (; p->pos < end; ++p->pos) {
+        const rfs_sample_t *sm = &smp[p->pos];
+        int16_t kx = (int16_t)floor_div(sm->x_cm, bin_cm);
+        int16_t ky = (int16_t)floor_div(sm->y_cm, bin_cm);
+        uint32_t h = bin_hash(kx, ky);
+        while (p->hash[h] != 0u) {
+            const rfs_pathloss_bin_t *b = &p->bins[p->hash[h] - 1u];
+            if (b->kx == kx && b->ky == ky) {
+                break;
             }
-            if (p->hash[h] == 0u) {
-                if (p->nbins == RFS_PATHLOSS_MAX_BINS) {
-                    ok = false;
-                    break;
-                }
-                rfs_pathloss_bin_t *nb = &p->bins[p->nbins];
-                memset(nb, 0, sizeof(*nb));
-                nb->kx = kx;
-                nb->ky = ky;
-                p->hash[h] = (uint16_t)(++p->nbins);
+            h = (h + 1u) & (RFS_PATHLOSS_HASH - 1u);
+        }
+        if (p->hash[h] == 0u) {
+            if (p->nbins == RFS_PATHLOSS_MAX_BINS) {
+                return false;
             }
-            rfs_pathloss_bin_t *b = &p->bins[p->hash[h] - 1u];
-            b->sx_cm += smp[i].x_cm;
-            b->sy_cm += smp[i].y_cm;
-            b->sv_q6 += smp[i].v_q6;
-            b->count++;
+            rfs_pathloss_bin_t *nb = &p->bins[p->nbins];
+            memset(nb, 0, sizeof(*nb));
+            nb->kx = kx;
+            nb->ky = ky;
+            p->hash[h] = (uint16_t)(++p->nbins);
         }
-        if (ok) {
-            break;
-        }
-        bin_cm *= 2; /* 100 cm doubled 10 times covers the whole +-327 m sample range */
+        rfs_pathloss_bin_t *b = &p->bins[p->hash[h] - 1u];
+        b->sx_cm += sm->x_cm;
+        b->sy_cm += sm->y_cm;
+        b->sv_q6 += sm->v_q6;
+        b->count++;
     }
-    p->bin_cm = bin_cm;
+    return true;
+}
+
+/* The binned samples' means: each bin's position and value, less their weighted mean. */
+static void bin_means(rfs_pathloss_t *p)
+{
     /* Bin means (Q16), then their weighted mean. Scaling and overflow: a bin sums at most
      * 65,535 values of |v| <= 2^15 (int32); times 2^10 in int64 is Q16; weights <= 65,535
      * times |mean| < 2^25 summed over <= 512 bins stay below 2^50. */
@@ -468,7 +476,6 @@ static void ev_start(rfs_pathloss_t *p, uint16_t li, uint16_t lj, uint8_t kind, 
     p->ev.col = rfs_pathloss_walls_col(p, li, lj);
     p->ev.c = c;
     p->ev.b = 0u;
-    p->ev.cached = p->footprints_cached;
 }
 
 /* Mean Huber loss per unit weight, dB^2 Q16, saturated below NO_LOSS. */
@@ -603,8 +610,7 @@ static bool hold_next(rfs_pathloss_t *p)
     return false;
 }
 
-/* A fit begins: bin the samples, lay the candidate lattice, assign the cache. false when
- * there is nothing to fit. */
+/* A fit begins (binning comes next, bin_run()). false when there is nothing to fit. */
 static bool fit_begin(rfs_pathloss_t *p, const rfs_model_fit_in_t *in)
 {
     p->valid = false;
@@ -621,20 +627,57 @@ static bool fit_begin(rfs_pathloss_t *p, const rfs_model_fit_in_t *in)
         p->excl_x[e] = cm_to_q16(in->excl_x_cm[e]); /* once a fit, not per candidate */
         p->excl_y[e] = cm_to_q16(in->excl_y_cm[e]);
     }
-    bin_samples(p, in->samples, in->n);
-    setup_lattice(p, in->map);
-    rfs_pathloss_walls_assign(p);
+    bin_reset(p, (int32_t)(((int64_t)p->cfg.bin * 100 + 32768) >> 16));
+    p->bin_n = in->n;
     p->walls_counted = 0u;
     p->footprints = 0u;
     p->footprints_cached = 0u;
-    p->phase = RFS_PATHLOSS_COARSE;
-    p->pos = 0u;
+    p->phase = RFS_PATHLOSS_BIN;
     p->ntop = 0u;
     p->nvis = 0u;
     p->candidates = 0u;
     p->cur.loss = INT64_MAX;
     p->ev.on = false;
     return true;
+}
+
+/* Bin the samples, SAMPLES_PER_UNIT a work unit, doubling the bin side until at most
+ * MAX_BINS are used (100 cm doubled 10 times covers the whole +-327 m sample range); then
+ * the bins' means, the candidate lattice and the cache rows (BINS_PER_UNIT bins a unit),
+ * and on to the coarse phase. Stops before a unit would overrun the budget, doing at
+ * least one per call. true when the call must return *res: MORE (budget spent) or
+ * FAILED (no sample left to fit). */
+static bool bin_run(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t budget,
+                    uint32_t *used, rfs_fit_result_t *res)
+{
+    *res = RFS_FIT_MORE;
+    const uint32_t n = p->bin_n < in->n ? p->bin_n : in->n;
+    while (p->pos < n) {
+        if (budget != 0u && *used != 0u && *used >= budget) {
+            return true;
+        }
+        const uint32_t end = n - p->pos > SAMPLES_PER_UNIT ? p->pos + SAMPLES_PER_UNIT : n;
+        (*used)++;
+        if (!bin_add(p, in->samples, end)) {
+            bin_reset(p, p->bin_cm * 2);
+        }
+    }
+    const uint32_t finish_units = p->nbins / BINS_PER_UNIT + 1u;
+    if (budget != 0u && *used != 0u && *used + finish_units > budget) {
+        return true;
+    }
+    *used += finish_units;
+    if (p->nbins == 0u) { /* the samples went while the fit was sliced */
+        p->phase = RFS_PATHLOSS_IDLE;
+        *res = RFS_FIT_FAILED;
+        return true;
+    }
+    bin_means(p);
+    setup_lattice(p, in->map);
+    rfs_pathloss_walls_assign(p);
+    p->phase = RFS_PATHLOSS_COARSE;
+    p->pos = 0u;
+    return false;
 }
 
 /* Evaluate the started candidate: gather its bins, stopping before a bin that could
@@ -648,10 +691,15 @@ static bool ev_run(rfs_pathloss_t *p, uint32_t budget, uint32_t *used)
             return false;
         }
         *used += gather_bin(p, p->ev.b++);
+        *used += p->ev.b % BINS_PER_UNIT == 0u ? 1u : 0u;
     }
+    const uint32_t solve_units = p->nbins / BINS_PER_UNIT + 1u;
+    if (budget != 0u && *used != 0u && *used + solve_units > budget) {
+        return false;
+    }
+    *used += solve_units;
     rfs_pathloss_cand_t cd;
     solve(p, &cd);
-    *used += (p->footprints_cached - p->ev.cached) / CACHED_PER_UNIT + 1u;
     p->ev.on = false;
     if (p->ev.kind == EV_HOLD) {
         if (cd.loss < p->hold_best.loss) {
@@ -769,7 +817,11 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
     uint32_t used = 0u;
     rfs_fit_result_t res = RFS_FIT_DONE;
     for (;;) {
-        if (p->ev.on) {
+        if (p->phase == RFS_PATHLOSS_BIN) {
+            if (bin_run(p, in, budget, &used, &res)) {
+                return res;
+            }
+        } else if (p->ev.on) {
             if (!ev_run(p, budget, &used)) {
                 return RFS_FIT_MORE;
             }

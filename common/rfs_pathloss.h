@@ -46,14 +46,13 @@
  * centroid moved to another core cell, and for candidates without a column. The cache is
  * cleared when the map or the lattice changes, or when its origins are all used.
  *
- * Work: one unit is one computed wall count (a cached footprint is 1/32 unit, solving a
- * candidate one unit). fit() with budget 0 does everything; with budget > 0 it stops
- * before a bin whose footprint could overrun the budget (four units; at least one bin
- * per call), resumes that candidate at its next bin on the next call, and returns
- * RFS_FIT_MORE until the search is done. The first call also bins
- * the samples (about 100 instructions per sample). The
- * model is invalid while a fit is in progress; a sliced fit keeps the bins of its first
- * call, so samples added meanwhile are used by the next relearn.
+ * Work: one unit is one computed wall count, 32 bins gathered from the cache, solved or
+ * set up, or 64 samples binned. fit() with budget 0 does everything; with budget > 0 it
+ * stops before work that could overrun the budget (a footprint: four units; at least
+ * one piece per call), resumes there on the next call, and returns RFS_FIT_MORE until
+ * the search is done. The model is invalid while a fit is in progress; a sliced fit bins
+ * the samples its first call saw (samples added meanwhile wait for the next relearn;
+ * ones a full store replaces meanwhile may be binned new).
  */
 #ifndef RFS_PATHLOSS_H
 #define RFS_PATHLOSS_H
@@ -180,6 +179,7 @@ typedef struct rfs_pathloss_row {
 /// Search phases of a (sliced) fit.
 typedef enum rfs_pathloss_phase {
     RFS_PATHLOSS_IDLE = 0, ///< no fit in progress
+    RFS_PATHLOSS_BIN,      ///< binning the samples
     RFS_PATHLOSS_COARSE,   ///< coarse candidates
     RFS_PATHLOSS_REFINE,   ///< around the best coarse candidates at half the coarse spacing
     RFS_PATHLOSS_FINE,     ///< around the best so far, halving the spacing to the lattice's
@@ -199,7 +199,6 @@ typedef struct rfs_pathloss_ev {
     int32_t col;     ///< its wall-count cache column, -1 when none
     uint32_t c;      ///< its coarse surface index (coarse candidates)
     uint32_t b;      ///< next bin to gather
-    uint32_t cached; ///< footprints_cached when it started (work accounting)
 } rfs_pathloss_ev_t;
 
 /// What the model believes (rfs_pathloss_estimate()).
@@ -246,6 +245,7 @@ typedef struct rfs_pathloss {
     uint32_t pos;                                 ///< position within the phase
     rfs_pathloss_lat_t lat;                       ///< candidate lattice
     uint16_t nbins;                               ///< bins in use
+    uint16_t bin_n;                               ///< samples the fit bins (its first call's)
     int32_t bin_cm;                               ///< bin side in use, centimetres
     uint32_t total;                               ///< weight of all bins (sum of min(count, cap))
     int32_t mz_q16;                               ///< mean of all samples, target units Q16.16

@@ -135,8 +135,10 @@ static void seed(rfs_plan_t *p, uint32_t root)
 /* Relax the neighbours of the point u just closed at cost d. false when the queue
  * overflowed (r->st.overflow; the search is then void). The map, work array and edge test come
  * in as arguments: loaded once per search, not after every byte store to the work. With
- * `steps` (grid a multiple of res) lattice legality and edges come from the recorded
- * cells; otherwise, or for the reference, from positions and the traversal. */
+ * `steps` lattice legality and edges come from the map's lattice tests (the recorded
+ * cells when the grid is a multiple of res; else positions and the traversal, each
+ * computed once per map through its lattice memo); otherwise, or for the reference, from
+ * positions and the traversal here. */
 static bool relax(const rfs_map_t *m, uint8_t *w, bool steps, rings_t *r, uint32_t u,
                   uint32_t d)
 {
@@ -218,7 +220,8 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
     r.st = p->dial;
     uint8_t *w = p->work;
     const rfs_map_t *m = p->map;
-    const bool steps = m->step_n != 0 && !p->exact_edges;
+    /* The memo's answers are the traversal's (rfs_map_memo_attach). */
+    const bool steps = m->step_n != 0 ? !p->exact_edges : m->memo != 0;
     uint32_t d = r.st.cost;
     uint32_t u = r.st.pending; /* closed, neighbours not yet relaxed */
     uint32_t empty_run = 0;

@@ -59,27 +59,37 @@ static void mark_all_legal(const rfs_map_t *m, uint8_t *reach)
     }
 }
 
-bool rfs_reach_fill(const rfs_map_t *map, rfs_q16_t x, rfs_q16_t y, uint8_t *reach,
-                    uint32_t *queue, uint32_t cap)
+bool rfs_reach_flood_begin(rfs_reach_flood_t *f, const rfs_map_t *map, rfs_q16_t x,
+                           rfs_q16_t y, uint8_t *reach, uint32_t *queue)
 {
-    const rfs_map_t *m = map;
-    memset(reach, 0, rfs_reach_bytes(m));
+    memset(reach, 0, rfs_reach_bytes(map));
+    f->head = 0u;
+    f->count = 0u;
+    f->overflow = false;
     uint16_t si, sj;
-    if (!rfs_reach_snap(m, 0, x, y, &si, &sj)) {
+    if (!rfs_reach_snap(map, 0, x, y, &si, &sj)) {
         return false;
     }
-    static const int8_t k_di[8] = { 1, -1, 0, 0, 1, 1, -1, -1 };
-    static const int8_t k_dj[8] = { 0, 0, 1, -1, 1, -1, 1, -1 };
-    uint32_t head = 0, count = 0;
-    uint32_t start = (uint32_t)sj * m->lw + si;
+    const uint32_t start = (uint32_t)sj * map->lw + si;
     rfs_reach_bit_set(reach, start);
     queue[0] = start;
-    count = 1;
-    bool overflow = false;
-    while (count > 0) {
-        uint32_t idx = queue[head];
-        head = (head + 1u) % cap;
-        count--;
+    f->count = 1u;
+    return true;
+}
+
+bool rfs_reach_flood_run(rfs_reach_flood_t *f, const rfs_map_t *map, uint8_t *reach,
+                         uint32_t *queue, uint32_t cap, uint32_t budget)
+{
+    const rfs_map_t *m = map;
+    static const int8_t k_di[8] = { 1, -1, 0, 0, 1, 1, -1, -1 };
+    static const int8_t k_dj[8] = { 0, 0, 1, -1, 1, -1, 1, -1 };
+    for (uint32_t done = 0u; f->count > 0u; ++done) {
+        if (budget != 0u && done == budget) {
+            return false;
+        }
+        uint32_t idx = queue[f->head];
+        f->head = (f->head + 1u) % cap;
+        f->count--;
         uint16_t i = (uint16_t)(idx % m->lw), j = (uint16_t)(idx / m->lw);
         for (int k = 0; k < 8; ++k) {
             int32_t ni = (int32_t)i + k_di[k], nj = (int32_t)j + k_dj[k];
@@ -97,17 +107,29 @@ bool rfs_reach_fill(const rfs_map_t *map, rfs_q16_t x, rfs_q16_t y, uint8_t *rea
                 continue;
             }
             rfs_reach_bit_set(reach, nidx);
-            if (count == cap) {
-                overflow = true; /* marked but not expanded: handled below */
+            if (f->count == cap) {
+                f->overflow = true; /* marked but not expanded: handled below */
                 continue;
             }
-            queue[(head + count) % cap] = nidx;
-            count++;
+            queue[(f->head + f->count) % cap] = nidx;
+            f->count++;
         }
     }
-    if (overflow) {
+    if (f->overflow) {
         mark_all_legal(m, reach);
+        f->overflow = false;
     }
+    return true;
+}
+
+bool rfs_reach_fill(const rfs_map_t *map, rfs_q16_t x, rfs_q16_t y, uint8_t *reach,
+                    uint32_t *queue, uint32_t cap)
+{
+    rfs_reach_flood_t f;
+    if (!rfs_reach_flood_begin(&f, map, x, y, reach, queue)) {
+        return false;
+    }
+    (void)rfs_reach_flood_run(&f, map, reach, queue, cap, 0u);
     return true;
 }
 

@@ -57,6 +57,23 @@ bool rfs_reach_snap(const rfs_map_t *map, const uint8_t *reach, rfs_q16_t x, rfs
 bool rfs_reach_fill(const rfs_map_t *map, rfs_q16_t x, rfs_q16_t y, uint8_t *reach,
                     uint32_t *queue, uint32_t cap);
 
+/// A flood fill in progress (rfs_reach_flood_begin(), rfs_reach_flood_run()): its queue
+/// window and whether the queue overflowed.
+typedef struct rfs_reach_flood {
+    uint32_t head;  ///< queue index of the next point to expand
+    uint32_t count; ///< points queued, 0 when the flood is over
+    bool overflow;  ///< a point was marked but not queued (queue too small)
+} rfs_reach_flood_t;
+/// rfs_reach_fill() in slices: clear `reach` and queue the legal lattice point nearest to
+/// (x, y) (rfs_reach_snap). false, and no bit set, when there is none within
+/// RFS_REACH_SNAP_RADIUS.
+bool rfs_reach_flood_begin(rfs_reach_flood_t *f, const rfs_map_t *map, rfs_q16_t x,
+                           rfs_q16_t y, uint8_t *reach, uint32_t *queue);
+/// Expand up to `budget` queued points (0: all) of flood f, with the same `reach`,
+/// `queue` and `cap` as before. true when the flood is over: `reach` then equals
+/// rfs_reach_fill()'s.
+bool rfs_reach_flood_run(rfs_reach_flood_t *f, const rfs_map_t *map, uint8_t *reach,
+                         uint32_t *queue, uint32_t cap, uint32_t budget);
 /// The point set in `reach` nearest to (x, y) by squared lattice offset from (x, y)'s
 /// nearest lattice point, first in row-major order at a tie, as metres Q16.16, by a scan
 /// of all lw x lh points (squared offsets < 2^32 in int64). false when none is set.

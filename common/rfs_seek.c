@@ -655,18 +655,39 @@ static bool inputs_stale(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
 }
 
 /* Keep the reach bits the robot's component: computed at the first fresh period, and
- * again when the robot is somewhere the flood fill did not reach (pushed, relocalised). */
-static void keep_reach(rfs_seek_t *s)
+ * again when the robot is somewhere the flood fill did not reach (pushed, relocalised);
+ * with reach_budget in slices. true while a sliced flood goes on: the period ends with
+ * the wheels stopped. */
+static bool keep_reach(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
 {
     uint16_t si, sj;
-    if (!s->reach_valid || !rfs_reach_snap(s->map, s->reach, s->pose.x, s->pose.y, &si, &sj)) {
-        s->reach_valid = rfs_reach_fill(s->map, s->pose.x, s->pose.y, s->reach, s->queue,
-                                        s->queue_cap);
-        if (s->plan.tree != 0u) {
-            /* The fill used the planner's queue: a tree being grown starts again. */
-            rfs_plan_tree_begin(&s->plan, s->plan.tree_x, s->plan.tree_y);
-        }
+    bool filled = false;
+    if (!s->flooding &&
+        (!s->reach_valid || !rfs_reach_snap(s->map, s->reach, s->pose.x, s->pose.y, &si, &sj))) {
+        s->reach_valid = false;
+        s->flooding = rfs_reach_flood_begin(&s->flood, s->map, s->pose.x, s->pose.y, s->reach,
+                                            s->queue);
+        filled = !s->flooding; /* no legal point near: no flood */
     }
+    if (s->flooding) {
+        if (!rfs_reach_flood_run(&s->flood, s->map, s->reach, s->queue, s->queue_cap,
+                                 s->cfg.reach_budget)) {
+            stop_wheels(s, now_us, out);
+            return true;
+        }
+        s->flooding = false;
+        s->reach_valid = true;
+        filled = true;
+    }
+    if (filled && s->plan.tree != 0u) {
+        /* The fill used the planner's queue: a tree being grown starts again. */
+        rfs_plan_tree_begin(&s->plan, s->plan.tree_x, s->plan.tree_y);
+    }
+    if (filled && s->cfg.reach_budget != 0u) {
+        stop_wheels(s, now_us, out); /* sliced: the flood's last slice ends its period */
+        return true;
+    }
+    return false;
 }
 
 /* Drive on the goal that stale inputs interrupted. Its timeout counts driving time only:
@@ -756,7 +777,9 @@ static void control(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_
     if (inputs_stale(s, now_us, out)) {
         return;
     }
-    keep_reach(s);
+    if (keep_reach(s, now_us, out)) {
+        return;
+    }
     if (s->resume) {
         resume_goal(s, now_us);
     }

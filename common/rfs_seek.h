@@ -63,6 +63,8 @@ typedef struct rfs_seek_cfg {
                                 ///< of the next decision (docs/PERFORMANCE.md, "Planning in
                                 ///< slices"; RFS_SEEK_PLAN_BUDGET); 0: every plan searches
                                 ///< within the decision
+    uint32_t reach_budget;      ///< lattice points the reachability flood expands a control
+                                ///< period, wheels stopped (0: the whole flood in one period)
     rfs_rssi_cfg_t rssi;        ///< averaging window (1 s)
     rfs_store_cfg_t store;      ///< sample store (10,000 samples)
     rfs_drive_cfg_t drive;      ///< drive control (TurtleBot 2)
@@ -222,6 +224,10 @@ typedef struct rfs_seek_out {
 /// Cortex-M4), the 12,800-point lattice of a 40 x 20 m map in 20 periods (1 s).
 #define RFS_SEEK_PLAN_BUDGET 640u
 
+/// reach_budget for the microcontroller: 1,000 lattice points a period (docs/PERFORMANCE.md,
+/// "Firmware"); rfs_seek_cfg_default() keeps 0, the whole flood in one period.
+#define RFS_SEEK_REACH_BUDGET 1000u
+
 /// Epsilon candidates lie within this many lattice steps (32 x 0.25 m = 8 m: e^-8 = 3e-4,
 /// the mass beyond is 0.3 % of the distribution); the weight table is indexed by di^2+dj^2.
 #define RFS_SEEK_EPS_RADIUS 32
@@ -248,6 +254,8 @@ typedef struct rfs_seek {
     uint32_t *queue;                          ///< flood-fill queue (shared with the planner)
     uint32_t queue_cap;                       ///< its capacity
     bool reach_valid;                         ///< reach holds the robot's component
+    bool flooding;                            ///< reach_budget: a sliced flood is under way
+    rfs_reach_flood_t flood;                  ///< its state
     uint16_t eps_w[RFS_SEEK_EPS_TABLE];       ///< e^(-d) by squared lattice offset, Q0.16
     rfs_pose_t pose;                          ///< latest pose
     bool have_pose;                           ///< pose is valid

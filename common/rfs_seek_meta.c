@@ -294,6 +294,22 @@ static bool epsilon_sample(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     return true;
 }
 
+/* Lattice point (i, j)'s epsilon weight seen from (ci, cj), Q0.16: e^(-distance) for a
+ * reachable point not visited inside the table's radius, else 0. */
+static uint32_t eps_weight(const rfs_seek_t *s, uint16_t ci, uint16_t cj, int32_t i, int32_t j)
+{
+    const int32_t di = i - (int32_t)ci, dj = j - (int32_t)cj;
+    const uint32_t q = (uint32_t)(di * di + dj * dj);
+    if (q >= RFS_SEEK_EPS_TABLE) {
+        return 0u;
+    }
+    const uint32_t idx = (uint32_t)j * s->map->lw + (uint32_t)i;
+    if (rfs_reach_bit(s->visited, idx) || !rfs_reach_bit(s->reach, idx)) {
+        return 0u;
+    }
+    return s->eps_w[q];
+}
+
 /* Epsilon step (paper section 2): a random reachable point at least the novelty radius
  * from every past position, drawn with probability proportional to e^(-distance); with
  * eps_sample, the model's draw first (above). */
@@ -316,56 +332,60 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     if (tree_ok && !s->plan_ready) { /* plan_ready: the decision's grown tree (rfs_seek.c) */
         rfs_plan_tree_begin(&s->plan, sx, sy);
     }
+    /* Row totals once, so a draw finds its row by 2 r + 1 additions and scans only that
+     * row; a try changes them only by marking its draw visited.
+     * Scaling: weights Q0.16 <= 65535, at most 65^2 candidates: sum < 2^28. */
+    uint32_t row_total[2 * RFS_SEEK_EPS_RADIUS + 1];
+    uint32_t total = 0;
+    for (int32_t j = w.j0; j <= w.j1; ++j) {
+        uint32_t t = 0;
+        for (int32_t i = w.i0; i <= w.i1; ++i) {
+            t += eps_weight(s, ci, cj, i, j);
+        }
+        row_total[j - w.j0] = t;
+        total += t;
+    }
     for (int attempt = 0; attempt < GOAL_TRIES && !s->plan.tree_more; ++attempt) {
-        /* Scaling: weights Q0.16 <= 65535, at most 65^2 candidates: sum < 2^28. */
-        uint32_t total = 0;
-        for (int pass = 0; pass < 2; ++pass) {
-            uint32_t pick = pass ? rfs_rng_below(rng, total) : 0u, acc = 0;
-            for (int32_t j = w.j0; j <= w.j1; ++j) {
-                const int32_t dj = j - (int32_t)cj;
-                for (int32_t i = w.i0; i <= w.i1; ++i) {
-                    const int32_t di = i - (int32_t)ci;
-                    uint32_t q = (uint32_t)(di * di + dj * dj);
-                    if (q >= RFS_SEEK_EPS_TABLE) {
-                        continue;
-                    }
-                    uint32_t idx = (uint32_t)j * m->lw + (uint32_t)i;
-                    if (rfs_reach_bit(s->visited, idx) || !rfs_reach_bit(s->reach, idx)) {
-                        continue;
-                    }
-                    uint32_t w = s->eps_w[q];
-                    if (pass == 0) {
-                        total += w;
-                        continue;
-                    }
-                    acc += w;
-                    if (acc > pick) {
-                        rfs_q16_t px, py;
-                        rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
-                        s->decision.goal_x = px;
-                        s->decision.goal_y = py;
-                        bool ok = !tree || tree_ok;
-                        rfs_q16_t len = 0;
-                        if (ok && tree && attempt != GOAL_TRIES - 1) {
-                            ok = rfs_plan_tree_length(&s->plan, px, py, &len);
-                            if (ok && !accept_detour(s, rng, q, len)) {
-                                goto next_attempt; /* a rejected draw is not pulled */
-                            }
-                        }
-                        if (ok && rfs_seek_plan_to(s, px, py, tree)) {
-                            rfs_drive_set_path(&s->drive, &s->drive.path, now_us);
-                            return true;
-                        }
-                        if (!s->plan.tree_more) { /* else decided again later (rfs_seek.c) */
-                            rfs_reach_bit_set(s->visited, idx); /* unreachable in practice: do not redraw it */
-                        }
-                        goto next_attempt;
-                    }
+        if (total == 0) {
+            return false;
+        }
+        uint32_t pick = rfs_rng_below(rng, total), acc = 0;
+        int32_t j = w.j0;
+        while (acc + row_total[j - w.j0] <= pick) {
+            acc += row_total[j - w.j0];
+            j++;
+        }
+        for (int32_t i = w.i0; i <= w.i1; ++i) {
+            const uint32_t wt = eps_weight(s, ci, cj, i, j);
+            acc += wt;
+            if (wt == 0u || acc <= pick) {
+                continue;
+            }
+            const int32_t di = i - (int32_t)ci, dj = j - (int32_t)cj;
+            const uint32_t q = (uint32_t)(di * di + dj * dj);
+            const uint32_t idx = (uint32_t)j * m->lw + (uint32_t)i;
+            rfs_q16_t px, py;
+            rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
+            s->decision.goal_x = px;
+            s->decision.goal_y = py;
+            bool ok = !tree || tree_ok;
+            rfs_q16_t len = 0;
+            if (ok && tree && attempt != GOAL_TRIES - 1) {
+                ok = rfs_plan_tree_length(&s->plan, px, py, &len);
+                if (ok && !accept_detour(s, rng, q, len)) {
+                    goto next_attempt; /* a rejected draw is not pulled */
                 }
             }
-            if (total == 0) {
-                return false;
+            if (ok && rfs_seek_plan_to(s, px, py, tree)) {
+                rfs_drive_set_path(&s->drive, &s->drive.path, now_us);
+                return true;
             }
+            if (!s->plan.tree_more) { /* else decided again later (rfs_seek.c) */
+                rfs_reach_bit_set(s->visited, idx); /* unreachable in practice: do not redraw it */
+                row_total[j - w.j0] -= wt;
+                total -= wt;
+            }
+            goto next_attempt;
         }
     next_attempt:;
     }

@@ -25,6 +25,7 @@ rfs_app_cfg_t rfs_app_cfg_mcu(void)
 {
     rfs_app_cfg_t c = rfs_app_cfg_default();
     c.seek.fit_budget = RFS_APP_MCU_FIT_BUDGET;
+    c.seek.reach_budget = RFS_SEEK_REACH_BUDGET; /* the boot's flood fill in slices */
     c.fit_budget_by_model = true;
     return c;
 }
@@ -34,7 +35,7 @@ uint32_t rfs_app_fit_budget(const rfs_app_cfg_t *cfg)
     if (!cfg->fit_budget_by_model) {
         return cfg->seek.fit_budget;
     }
-    /* A work unit is each model's own (a sample, a sample-update, a wall count), so the
+    /* A work unit is each model's own (a sample, a sample-update, a path-loss work unit), so the
      * slice that keeps the deadline is measured per model (docs/PERFORMANCE.md, "Models
      * on the Cortex-M4"). Only the entry's field is read: no registry code is linked. */
     return cfg->model != NULL ? cfg->model->mcu_fit_budget : RFS_APP_MCU_FIT_BUDGET;

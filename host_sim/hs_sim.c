@@ -173,6 +173,15 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
         hs_sim_env_close(e);
         return -1;
     }
+    /* Planning without step patterns (the lattice not a multiple of the core grid) tests
+     * each lattice edge once per map instead of once per search. */
+    const uint32_t ne = rfs_map_memo_entries(&e->core.map);
+    e->lattice_memo = malloc((size_t)ne * sizeof(e->lattice_memo[0]));
+    if (e->lattice_memo == NULL || rfs_map_memo_attach(&e->core.map, e->lattice_memo, ne) != 0) {
+        snprintf(err, errlen, "%s: map: out of memory", sc->path);
+        hs_sim_env_close(e);
+        return -1;
+    }
     if (env_prepare(e, err, errlen) != 0) {
         hs_sim_env_close(e);
         return -1;
@@ -208,6 +217,8 @@ void hs_sim_env_close(hs_sim_env_t *e)
         e->wall_cache[s] = NULL;
     }
     lx_core_map_free(&e->core);
+    free(e->lattice_memo);
+    e->lattice_memo = NULL;
     lx_map_free(&e->map);
 }
 

@@ -34,6 +34,7 @@ typedef struct hs_sim_env {
     double shortest_to_stop_m; ///< start to the first legal point within stop_radius_m (NaN: no goal)
     double x0, y0, x1, y1;     ///< the map's extent, metres
     int8_t *wall_cache[HS_SCN_MAX_SOURCES]; ///< wall counts per receiver cell, shared by runs
+    uint16_t *lattice_memo;    ///< the core map's lattice memo (rfs_map_memo_attach), shared by runs
     uint64_t placement;        ///< the drawn placement the start and source are (hs_place.h;
                                ///< hs_sim_env_place), 0: the scenario's own
     uint64_t placement_seed;   ///< the seed it was drawn from

@@ -592,18 +592,31 @@ static void sliced_fit_equals_whole_fit(void **state)
     assert_int_equal(sliced.spread_m2, whole.spread_m2);
     assert_int_equal(sliced.candidates, whole.candidates);
     /* a fresh state: no cached wall counts, one footprint per (bin, candidate) pair of
-     * one to four lines, one unit a line plus one per candidate; each call evaluates
-     * candidates until 2000 units are used */
+     * one to four lines. Units (rfs_pathloss.h, "Work"): a line each; per candidate one
+     * per 32 bins gathered and bins / 32 + 1 to solve; 64 samples binned each, and
+     * bins / 32 + 1 to set them up */
     assert_int_equal(sliced.footprints_cached, 0);
     assert_int_equal(sliced.footprints, sliced.candidates * sliced.bins);
     assert_true(sliced.walls_counted >= sliced.footprints);
     assert_true(sliced.walls_counted <= 4u * sliced.footprints);
     assert_int_equal(sliced.walls_counted, whole.walls_counted);
-    uint32_t units = sliced.walls_counted + sliced.candidates;
-    /* each call stops before a bin that could overrun 2000 units (four lines), and adds at
-     * most one unit for the candidate it then solves */
+    const uint32_t per32 = sliced.bins / 32u;
+    const uint32_t units = sliced.walls_counted + sliced.candidates * (2u * per32 + 1u) +
+                           (NS + 63u) / 64u + per32 + 1u;
+    /* a call overruns 2000 by at most one unit (a footprint's four lines when at most
+     * four are left, and a 32nd bin), and stops at worst when a solve (per32 + 1) or
+     * a footprint (four lines and a 32nd bin) would overrun */
     assert_true((uint32_t)calls >= units / 2001u);
-    assert_true((uint32_t)calls <= units / (2000u - 4u) + 1u);
+    assert_true((uint32_t)calls <= units / (2000u - (per32 + 1u > 5u ? per32 + 1u : 5u)) + 1u);
+
+    /* The smallest budget: one piece of work a call, the same fit. */
+    int tiny_calls = 0;
+    rfs_pathloss_est_t tiny = fit_default(f, NS, &f->map, 1, &tiny_calls);
+    assert_memory_equal(&f->pl.best, &best, sizeof(best));
+    assert_int_equal(tiny.spread_m2, whole.spread_m2);
+    assert_int_equal(tiny.walls_counted, whole.walls_counted);
+    /* each binning unit, set-up, footprint and solve in a call of its own */
+    assert_true((uint32_t)tiny_calls >= (NS + 63u) / 64u + 1u + tiny.footprints + tiny.candidates);
 
     /* A budget of one bin a call: candidates are resumed within their bins. */
     rfs_pathloss_est_t fine = fit_default(f, NS, &f->map, 4, &calls);

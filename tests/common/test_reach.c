@@ -50,34 +50,45 @@ static int ref_map_step(void *ctx, int ui, int uj, int vi, int vj)
     return ref_lat_legal(m, vi, vj) && ref_step_legal(m, ui, uj, vi, vj);
 }
 
+/* t's map: 8 x 6 m at cell size res, 2.5 % of the cells occupied at random (seed), no
+ * clearance, the 0.25 m lattice. Returns the random state after the map. */
+static uint32_t speckled_map(world_t *t, uint32_t seed, double res)
+{
+    memset(t, 0, sizeof *t);
+    t->w = (uint16_t)lround(8.0 / res);
+    t->h = (uint16_t)lround(6.0 / res);
+    uint32_t bytes = rfs_map_bytes(t->w, t->h);
+    uint16_t stride = (uint16_t)((t->w + 7) / 8);
+    t->free_bits = calloc(bytes, 1);
+    t->wall_bits = calloc(bytes, 1);
+    t->legal_bits = calloc(bytes, 1);
+    uint32_t s = seed * 2654435761u;
+    for (uint16_t y = 0; y < t->h; ++y) {
+        for (uint16_t x = 0; x < t->w; ++x) {
+            s = s * 1664525u + 1013904223u;
+            rfs_map_bit_set(t->free_bits, stride, x, y, (s >> 8) % 1000u >= 25u);
+        }
+    }
+    rfs_map_cfg_t mc = rfs_map_cfg_default();
+    mc.clearance = 0;
+    assert_int_equal(rfs_map_init(&t->map, &mc, t->w, t->h, Q(res), 0, 0, t->free_bits,
+                                  t->wall_bits, t->legal_bits), 0);
+    return s;
+}
+
 /* A speckled 8 x 6 m map (2.5 % of the cells occupied, no clearance: many small pockets)
  * at cell size res, and the seeker's reach bits after its first period at a random legal
  * lattice point. They decide which plans the planner refuses without a search
  * (rfs_plan_set_component), so they must be exactly the robot's component: compared with
  * a double-precision flood. With an 8-entry queue the fill overflows and marks every legal
- * point instead (still a union of whole components). */
-static void reach_case(uint32_t seed, double res, bool small_queue, int *in_component, int *legal)
+ * point instead (still a union of whole components). With reach_budget, the flood is
+ * sliced over periods (the wheels stopped meanwhile), one per `budget` points of the
+ * component, and ends with the same bits. */
+static void reach_case(uint32_t seed, double res, bool small_queue, uint32_t budget,
+                       int *in_component, int *legal)
 {
     world_t t;
-    memset(&t, 0, sizeof t);
-    t.w = (uint16_t)lround(8.0 / res);
-    t.h = (uint16_t)lround(6.0 / res);
-    uint32_t bytes = rfs_map_bytes(t.w, t.h);
-    uint16_t stride = (uint16_t)((t.w + 7) / 8);
-    t.free_bits = calloc(bytes, 1);
-    t.wall_bits = calloc(bytes, 1);
-    t.legal_bits = calloc(bytes, 1);
-    uint32_t s = seed * 2654435761u;
-    for (uint16_t y = 0; y < t.h; ++y) {
-        for (uint16_t x = 0; x < t.w; ++x) {
-            s = s * 1664525u + 1013904223u;
-            rfs_map_bit_set(t.free_bits, stride, x, y, (s >> 8) % 1000u >= 25u);
-        }
-    }
-    rfs_map_cfg_t mc = rfs_map_cfg_default();
-    mc.clearance = 0;
-    assert_int_equal(rfs_map_init(&t.map, &mc, t.w, t.h, Q(res), 0, 0, t.free_bits,
-                                  t.wall_bits, t.legal_bits), 0);
+    uint32_t s = speckled_map(&t, seed, res);
     int si, sj;
     do {
         s = s * 1664525u + 1013904223u;
@@ -86,6 +97,7 @@ static void reach_case(uint32_t seed, double res, bool small_queue, int *in_comp
         sj = (int)((s >> 8) % t.map.lh);
     } while (!ref_lat_legal(&t.map, si, sj));
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    cfg.reach_budget = budget;
     seek_make(&t, cfg, seed);
     if (small_queue) {
         t.mem.plan_queue_cap = 8;
@@ -98,8 +110,24 @@ static void reach_case(uint32_t seed, double res, bool small_queue, int *in_comp
     rfs_seek_on_pose(&t.seek, &p, &t.rng);
     rfs_seek_on_rssi(&t.seek, 0, 100000, -50, &t.rng);
     rfs_seek_step(&t.seek, 100000, &t.rng, &out);
+    int waits = 0;
+    while (t.seek.flooding) {
+        assert_false(t.seek.reach_valid);
+        assert_int_equal(out.left_mm_s, 0);
+        assert_int_equal(out.right_mm_s, 0);
+        waits++;
+        rfs_seek_step(&t.seek, 100000, &t.rng, &out);
+    }
+    assert_true(t.seek.reach_valid);
     uint8_t *ref = calloc(t.mem.reach_bytes, 1);
     ref_flood(t.map.lw, t.map.lh, si, sj, ref_map_step, &t.map, ref);
+    int comp = 0;
+    for (int v = 0; v < t.map.lw * t.map.lh; v++) {
+        comp += bit_of(ref, v);
+    }
+    if (!small_queue) { /* every point of the component expanded once */
+        assert_int_equal(waits, budget == 0u ? 0 : (comp + (int)budget - 1) / (int)budget - 1);
+    }
     for (int j = 0; j < t.map.lh; j++) {
         for (int i = 0; i < t.map.lw; i++) {
             int v = j * t.map.lw + i;
@@ -121,20 +149,87 @@ static void test_reach_is_the_component(void **state)
     (void)state;
     int comp = 0, legal = 0;
     for (uint32_t seed = 1; seed <= 12; seed++) {
-        reach_case(seed, 0.125, false, &comp, &legal); /* step patterns */
-        reach_case(seed, 0.1, false, &comp, &legal);   /* the exact traversal */
+        reach_case(seed, 0.125, false, 0u, &comp, &legal); /* step patterns */
+        reach_case(seed, 0.1, false, 0u, &comp, &legal);   /* the exact traversal */
     }
     print_message("robot's components %d of %d legal lattice points\n", comp, legal);
     assert_true(comp > legal / 10 && comp < legal); /* pockets exist, the fill is not trivial */
     int c2 = 0, l2 = 0;
-    reach_case(3, 0.125, true, &c2, &l2);
-    reach_case(4, 0.1, true, &c2, &l2);
+    reach_case(3, 0.125, true, 0u, &c2, &l2);
+    reach_case(4, 0.1, true, 0u, &c2, &l2);
+}
+
+/* reach_budget: the flood sliced over periods gives the whole flood's bits. */
+static void test_sliced_reach_is_the_component(void **state)
+{
+    (void)state;
+    int comp = 0, legal = 0;
+    for (uint32_t seed = 1; seed <= 6; seed++) {
+        reach_case(seed, 0.125, false, 1u, &comp, &legal);
+        reach_case(seed, 0.1, false, 37u, &comp, &legal);
+    }
+    reach_case(3, 0.125, true, 5u, &comp, &legal);
+}
+
+/* The lattice memo (rfs_map_memo_attach) answers as the double-precision references, on
+ * the first call (computed) and the second (remembered), for every lattice point and
+ * direction of a map without step patterns (0.1 m cells, 0.25 m lattice). */
+static void test_memo_matches_reference(void **state)
+{
+    (void)state;
+    static const int8_t k_di[8] = {1, 1, 0, -1, -1, -1, 0, 1};
+    static const int8_t k_dj[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+    world_t t;
+    (void)speckled_map(&t, 5, 0.1);
+    assert_int_equal(t.map.step_n, 0);
+    const uint32_t n = rfs_map_memo_entries(&t.map);
+    assert_int_equal(n, (uint32_t)t.map.lw * t.map.lh);
+    uint16_t *memo = malloc(n * sizeof(memo[0]));
+    assert_non_null(memo);
+    assert_int_equal(rfs_map_memo_attach(&t.map, memo, n - 1), -1);
+    assert_null(t.map.memo);
+    assert_int_equal(rfs_map_memo_attach(&t.map, memo, n), 0);
+    int legal = 0, steps = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (int j = 0; j < t.map.lh; j++) {
+            for (int i = 0; i < t.map.lw; i++) {
+                const int want = ref_lat_legal(&t.map, i, j);
+                assert_int_equal(rfs_map_lattice_legal(&t.map, (uint16_t)i, (uint16_t)j), want);
+                legal += pass == 0 ? want : 0;
+                for (int k = 0; k < 8; k++) {
+                    const int vi = i + k_di[k], vj = j + k_dj[k];
+                    const int on = vi >= 0 && vj >= 0 && vi < t.map.lw && vj < t.map.lh;
+                    const int ws = on && ref_step_legal(&t.map, i, j, vi, vj);
+                    if (rfs_map_lattice_step_legal(&t.map, (uint16_t)i, (uint16_t)j, k_di[k],
+                                                   k_dj[k]) != ws) {
+                        fail_msg("pass %d: step (%d, %d) -> (%d, %d): reference %d", pass, i, j,
+                                 vi, vj, ws);
+                    }
+                    steps += pass == 0 ? ws : 0;
+                }
+            }
+        }
+    }
+    /* every point's legality and its four upper steps (those on the lattice) known */
+    for (int j = 0; j < t.map.lh; j++) {
+        for (int i = 0; i < t.map.lw; i++) {
+            const uint16_t e = memo[j * t.map.lw + i];
+            assert_true(e & 0x200u);
+            assert_int_equal((e & 0x10u) != 0, i + 1 < t.map.lw);
+            assert_int_equal((e & 0x40u) != 0, j + 1 < t.map.lh);
+        }
+    }
+    assert_true(legal > 0 && steps > 0 && steps < 8 * legal); /* walls cut some steps */
+    free(memo);
+    world_free(&t);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reach_is_the_component),
+        cmocka_unit_test(test_sliced_reach_is_the_component),
+        cmocka_unit_test(test_memo_matches_reference),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

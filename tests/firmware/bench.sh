@@ -38,8 +38,8 @@ printf '%s\n%s\n' "$out" "$models" | awk -F'\t' '
         # Every period of the faithful configuration (RFS_SEEK_META, plan_budget 640): the
         # decisions behind the wall on the leg and cut short, every period until they
         # decided, the tree slices grown on the leg, driving, the relearn decision in the
-        # open. Not the boot (first_iteration: the reachability flood fill).
-        f = worst_of("^(worst_iteration|driving_iteration|worst_eps_paper|worst_greedy_ls_[a-z_]*)$|_slice$", "_first$|geodesic|straight")
+        # open, and the boot periods (first_iteration: the flood fill sliced by reach_budget).
+        f = worst_of("^(first_iteration|worst_iteration|driving_iteration|worst_eps_paper|worst_greedy_ls_[a-z_]*)$|_slice$", "_first$|geodesic|straight")
         printf "worst control period, faithful meta (planning in slices, %s): %s\n", worst_name, verdict(f)
         g = worst_of("^worst_eps_(geodesic|straight)(_cut)?$|^worst_eps_(geodesic|straight)_slice$", "")
         printf "worst control period, meta-path with geodesic decisions (%s): %s\n", worst_name, verdict(g)
@@ -50,7 +50,7 @@ printf '%s\n%s\n' "$out" "$models" | awk -F'\t' '
             pl = int((m[ms] - me) / mper + 0.5)
             printf "path-loss relearn slice at its registry budget (%d wall counts, 1,000 samples): %s; %d wall counts a slice would meet it\n", mb, verdict(pl), int(500000 * mb / pl)
         } else { printf "path-loss relearn slice: not measured\n"; bad = bad " models_image" }
-        printf "boot period (reachability flood fill + first fit, first_iteration_first): %s\n", verdict(ins["first_iteration_first"])
+        printf "boot periods (reachability flood fill in slices of %d points, then the first fit, first_iteration, %d periods): %s\n", 1000, v["first_iteration_periods"], verdict(ins["first_iteration"])
         # The scenario checks: each decision relearnt and decided as described, and the
         # replay of its draws kept the same goal (else the counts describe another one).
         for (k in v) if (k ~ /^worst_greedy_ls_.*_(greedy|replay_goal_ok)$/ && v[k] != 1) badgeo = badgeo " " k

@@ -262,7 +262,7 @@ static void test_config_frame_chooses_before_the_first_decision(void **state)
 
 /* The MCU configuration slices each model's relearn by that model's registry budget
  * (a work unit is a sample for the ridge, a sample-update for the MLP, a
- * wall count for pathloss); the other configurations keep the budget they are given. */
+ * work unit for pathloss); the other configurations keep the budget they are given. */
 static void test_mcu_fit_budget_is_the_model_s(void **state)
 {
     (void)state;

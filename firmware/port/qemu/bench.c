@@ -597,8 +597,9 @@ static void __attribute__((noinline)) measure_init(const rfs_app_map_t *map, con
  * an ordinary period while driving. Returns the time of the last; its output in *out. */
 static int64_t __attribute__((noinline)) measure_periods(rfs_q16_t rx, rfs_q16_t ry, rfs_app_out_t *out)
 {
-    /* Boot: the first periods with a pose and a measurement: reachability flood fill,
-     * first fit, the initial move. */
+    /* Boot: the first periods with a pose and a measurement: reachability flood fill
+     * (sliced, reach_budget), first fit, the initial move. */
+    s_app.seek.cfg.reach_budget = RFS_SEEK_REACH_BUDGET;
     int64_t t = 1000000 - RFS_APP_PERIOD_US;
     rfs_rng_t rng0;
     run_until_decided("first_iteration", rx, ry, &t, out, &rng0);

@@ -48,7 +48,7 @@ printf '%s\n%s\n' "$out" "$models" | awk -F'\t' '
         mb = mc["mcu_budget_pathloss"]; ms = "slice_worst_pathloss_" mb
         if (mper > 0 && (ms in m)) {
             pl = int((m[ms] - me) / mper + 0.5)
-            printf "path-loss relearn slice at its registry budget (%d wall counts, 1,000 samples): %s; %d wall counts a slice would meet it\n", mb, verdict(pl), int(500000 * mb / pl)
+            printf "path-loss relearn slice at its registry budget (%d work units, 1,000 samples): %s; %d units a slice would meet it\n", mb, verdict(pl), int(500000 * mb / pl)
         } else { printf "path-loss relearn slice: not measured\n"; bad = bad " models_image" }
         printf "boot periods (reachability flood fill in slices of %d points, then the first fit, first_iteration, %d periods): %s\n", 1000, v["first_iteration_periods"], verdict(ins["first_iteration"])
         # The scenario checks: each decision relearnt and decided as described, and the

@@ -233,14 +233,17 @@ static void test_config_frame_chooses_before_the_first_decision(void **state)
     assert_ptr_equal(s_app.seek.model.self, s_pl);
     assert_int_equal(((rfs_pathloss_t *)s_pl)->cfg.p0_min, -40 * 65536);
     assert_int_equal(s_app.cfg.seed, 0x123456u);
-    assert_int_equal(s_app.seek.cfg.fit_budget, 600u); /* the path-loss model's MCU slice */
+    assert_int_equal(s_app.seek.cfg.fit_budget, rfs_models_pathloss.mcu_fit_budget); /* its MCU slice */
     rfs_app_step(&s_app, 50000, &o);
     rfs_app_frames(&s_app, &o, out);
     assert_int_equal(out[1].data[0] & 0x0Fu, 1u); /* the STATUS counter runs on */
     assert_false(o.faults & RFS_APP_FAULT_RESET);
 
-    /* The mission starts: a decision, then a CONFIG is refused. */
-    for (int64_t t = 100000; t <= 300000; t += 50000) {
+    /* The mission starts: a decision (after the boot's flood fill in slices), then a
+     * CONFIG is refused. */
+    int64_t t_end = 100000;
+    for (int64_t t = 100000; t <= 5000000 && s_app.seek.iteration == 0u; t += 50000) {
+        t_end = t;
         const rfs_pose_t p = {.t_us = t, .x = RFS_Q16_INT(5), .y = RFS_Q16_INT(5), .theta = 0};
         rfs_app_on_pose(&s_app, &p, t);
         rfs_app_on_rssi(&s_app, 0, t, -60, t);
@@ -249,7 +252,7 @@ static void test_config_frame_chooses_before_the_first_decision(void **state)
     assert_true(s_app.seek.iteration > 0u);
     const rfs_can_config_t back = {0, RFS_SEEK_META, RFS_CAN_MODEL_RIDGE, -5760, 1u};
     rfs_can_tx_config(&op, &back, &f);
-    assert_int_equal(rfs_app_on_can(&s_app, &f, 310000), RFS_CAN_OK);
+    assert_int_equal(rfs_app_on_can(&s_app, &f, t_end + 10000), RFS_CAN_OK);
     assert_int_equal(s_app.stats.configs_rejected, 5u);
     assert_int_equal(s_app.seek.cfg.strategy, RFS_SEEK_META_PATH);
     /* The codes name the registry's entries, the named entries are the table's. */

@@ -96,6 +96,11 @@ typedef struct rfs_seek_cfg {
                                 ///< still runs: the source is not here), metres Q16.16 (0:
                                 ///< off); keep it below the "at source" radius less half a
                                 ///< step
+    bool refute_reached;        ///< with refute_r: a decision at the argmax rules it out
+                                ///< whatever the 1 s mean (the mission goes on, so the
+                                ///< source is not there): the fit's next best place is
+                                ///< visited next, a local search round a near miss (off in
+                                ///< every preset: docs/STRATEGIES.md, "Stalls")
     rfs_q16_t silence_floor;    ///< target rssi: while the receiver reports itself up and
                                 ///< no packet came for a whole averaging window, every pose
                                 ///< adds a sample of this value: the fit learns where the

@@ -64,6 +64,9 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
      * runs behind docs/STRATEGIES.md, estimates within 5 m of the source had P0 >= -45 dBm
      * in all but 1 of 3,479 fits, estimates farther away had it below in 1,176 of 5,553. */
     c.p0_min = RFS_Q16_INT(-45);
+    /* No ceiling: -10 dBm (30 dBm EIRP) did not help held-out placements (docs/PATHLOSS.md,
+     * "The P0 floor"). */
+    c.p0_max = INT32_MAX;
     c.hold_k = RFS_Q16_INT(6);
     /* The spread region's and hold_k's likelihood-ratio reading of the surface, untempered
      * (docs/PATHLOSS.md, "Epsilon steps that draw the source"). */
@@ -445,10 +448,12 @@ static void solve(rfs_pathloss_t *p, rfs_pathloss_cand_t *out)
         loss += (int64_t)bb->count * h;
     }
     int64_t p0 = (int64_t)p->mz_q16 + (((int64_t)n * ml + (int64_t)w * mk + 32768) >> 16);
-    if (p0 < c->p0_min) {
-        /* Scaling: the shortfall in Q8 saturates at 2^24 like a residual; total <= 2^16
-         * times the Huber value < 2^35 stays below 2^51. */
-        int64_t a = (((int64_t)c->p0_min - p0) + 128) >> 8;
+    /* Scaling: the shortfall or excess in Q8 saturates at 2^24 like a residual; total <=
+     * 2^16 times the Huber value < 2^35 stays below 2^51. */
+    int64_t a = p0 < c->p0_min ? (((int64_t)c->p0_min - p0) + 128) >> 8
+              : c->p0_max != INT32_MAX && p0 > c->p0_max ? ((p0 - (int64_t)c->p0_max) + 128) >> 8
+                                                         : 0;
+    if (a > 0) {
         a = a > ((int64_t)1 << 24) ? ((int64_t)1 << 24) : a;
         int64_t h = a <= d8 ? (a * a) >> 1 : d8 * a - ((d8 * d8) >> 1);
         loss += (int64_t)p->total * h;

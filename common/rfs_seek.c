@@ -414,6 +414,7 @@ static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t 
     rfs_seek_decision_t *d = &s->decision;
     s->iteration++;
     out->decided = true;
+    s->parked = false;
     if (!ok) {
         out->faults |= RFS_SEEK_FAULT_NO_GOAL;
         d->goal_x = s->pose.x;
@@ -442,6 +443,7 @@ static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t 
          * for 900 simulated seconds). Decide again after one window, as after no goal. */
         s->retry_after_us = now_us + NO_GOAL_RETRY_US;
         s->retry_no_goal = false;
+        s->parked = d->kind == RFS_SEEK_GREEDY;
     }
 }
 

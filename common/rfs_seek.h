@@ -98,6 +98,12 @@ typedef struct rfs_seek_cfg {
                                 ///< still runs: the source is not here), metres Q16.16 (0:
                                 ///< off); keep it below the "at source" radius less half a
                                 ///< step
+    bool refute_reached;        ///< with refute_r: a decision at the argmax after a greedy
+                                ///< null move there (the robot stood a window at it) rules
+                                ///< it out whatever the 1 s mean (the mission goes on, so
+                                ///< the source is not there): the fit's next best place is
+                                ///< visited next, a local search round a near miss (off in
+                                ///< every preset: docs/STRATEGIES.md, "Stalls")
     rfs_q16_t silence_floor;    ///< target rssi: while the receiver reports itself up and
                                 ///< no packet came for a whole averaging window, every pose
                                 ///< adds a sample of this value: the fit learns where the
@@ -292,6 +298,8 @@ typedef struct rfs_seek {
     rfs_q16_t prev_mean;                      ///< chemotaxis: 1 s mean at the last decision
     int64_t retry_after_us;                   ///< no goal, or a null move: next decision not before, us
     bool retry_no_goal;                       ///< the wait is for no goal (RFS_SEEK_FAULT_NO_GOAL)
+    bool parked;                              ///< refute_reached: the last decision was
+                                              ///< a greedy null move (goal where it stood)
     /* Improvements (cfg.recheck_dist, cfg.eps_by_travel). */
     bool have_chk;                            ///< chk_x/chk_y are valid
     rfs_q16_t chk_x, chk_y;                   ///< position of the last check, metres Q16.16

@@ -123,7 +123,7 @@ bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us)
                                      2 * (int64_t)s->cfg.error_threshold;
     bool silent = !d->mean_valid && s->have_meas && s->have_rx && now_us >= s->last_rx_us &&
                   now_us - s->last_rx_us <= s->cfg.rssi_timeout_us;
-    if (!weak && !silent) {
+    if (!weak && !silent && !(s->cfg.refute_reached && s->parked)) {
         return false;
     }
     /* Centimetres, as the store's samples (the microcontroller's RAM budget). Scaling:

@@ -993,6 +993,9 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
         cc.seek.eps_sample = e->sc.seek_eps_sample != 0;
     }
     cc.p0_min_dbm = e->sc.seek_p0_min_dbm;
+    if (e->sc.seek_refute_reached >= 0) {
+        cc.seek.refute_reached = e->sc.seek_refute_reached != 0;
+    }
     cc.seed = seed ^ 0x5A17C0FFEE000003ull;
     hs_ctrl_t ctrl;
     char cerr[256];

@@ -37,6 +37,7 @@ typedef struct ref_pl_cfg {
     double footprint; /* m: offsets of a bin's wall-count points from its cell's centre */
     int nexcl;        /* places ruled out: no candidate within excl_r of (ex[e], ey[e]) */
     double ex[8], ey[8], excl_r;
+    double p0_max; /* strongest plausible P0; a fit above adds total x Huber(P0 - p0_max) */
 } ref_pl_cfg_t;
 
 typedef struct ref_pl_bin {
@@ -71,7 +72,7 @@ typedef struct ref_pl {
 static inline ref_pl_cfg_t ref_pl_cfg_default(void)
 {
     ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5, 30.0, -45.0,
-                      0.25, 0, {0}, {0}, 0.0};
+                      0.25, 0, {0}, {0}, 0.0, INFINITY};
     return c;
 }
 
@@ -290,10 +291,8 @@ static inline double ref_pl_eval(ref_pl_t *r, int i, int j, double *pn, double *
         double h = res <= cf->huber ? 0.5 * res * res : cf->huber * (res - 0.5 * cf->huber);
         loss += r->bins[b].count * h;
     }
-    if (p0 < cf->p0_min) {
-        double a = cf->p0_min - p0;
-        loss += (double)r->total * (a <= cf->huber ? 0.5 * a * a : cf->huber * (a - 0.5 * cf->huber));
-    }
+    double a = p0 < cf->p0_min ? cf->p0_min - p0 : p0 > cf->p0_max ? p0 - cf->p0_max : 0.0;
+    loss += (double)r->total * (a <= cf->huber ? 0.5 * a * a : cf->huber * (a - 0.5 * cf->huber));
     *pn = n;
     *pw = w;
     *pp0 = p0;

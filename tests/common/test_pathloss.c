@@ -468,6 +468,24 @@ static void p0_floor_off_same_as_reference(void **state)
     expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
 }
 
+/* p0_max below the truth's -35 dBm: the fixed-point search equals the double reference
+ * with the ceiling biting, and the ceiling pulls the fitted P0 down. */
+static void p0_ceiling_same_as_reference(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+    c.p0_max = RFS_Q16_INT(-41);
+    rc.p0_max = -41.0;
+    expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
+    rfs_pathloss_est_t on;
+    assert_true(rfs_pathloss_estimate(&f->pl, &on));
+    rfs_pathloss_est_t off = fit_default(f, NS, &f->map, 0, NULL);
+    assert_true(fabs(off.p0 / 65536.0 - k_office.p0) < 1.5);
+    assert_true(on.p0 / 65536.0 < off.p0 / 65536.0 - 2.0);
+}
+
 /* footprint 0 (each bin's walls counted from its cell's centre alone, the model before
  * the footprint) equals the double reference too, and differs from the default: the
  * test's office has bins whose footprint straddles a wall's end. */
@@ -1032,6 +1050,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(places_ruled_out_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(footprint_off_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_floor_off_same_as_reference, setup, teardown),
+        cmocka_unit_test_setup_teardown(p0_ceiling_same_as_reference, setup, teardown),
         cmocka_unit_test(registered_as_pathloss),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -341,6 +341,7 @@ typedef struct refute_model {
     int nwant;
     double mean;         /* the scripted 1 s mean */
     bool silent;         /* no packet at the decisions, the receiver up */
+    bool reached;        /* cfg.refute_reached: every decision at the maximum rules it out */
     bool mismatch;       /* a fit was given other places than expected */
 } refute_model_t;
 
@@ -360,7 +361,7 @@ static rfs_fit_result_t refute_fit(void *self, const rfs_model_fit_in_t *in, uin
      * has just invalidated the model: any fit but the first had one). */
     if (m->fits > 0 &&
         hypot(D(in->qx) - D(m->base.mx), D(in->qy) - D(m->base.my)) <= 0.5 &&
-        (m->silent || -60.0 - m->mean > 6.0) && m->nwant < 64) {
+        (m->silent || m->reached || -60.0 - m->mean > 6.0) && m->nwant < 64) {
         m->want_x[m->nwant] = D(m->base.mx);
         m->want_y[m->nwant] = D(m->base.my);
         m->nwant++;
@@ -391,7 +392,7 @@ static rfs_fit_result_t refute_fit(void *self, const rfs_model_fit_in_t *in, uin
     return RFS_FIT_DONE;
 }
 
-static int refute_case(double mean, bool on, int decisions, refute_model_t *m)
+static int refute_case(double mean, bool on, bool reached, int decisions, refute_model_t *m)
 {
     static const rfs_model_ops_t ops = {
         .name = "refute", .reset = fixed_reset, .fit = refute_fit, .predict = fixed_predict,
@@ -403,11 +404,13 @@ static int refute_case(double mean, bool on, int decisions, refute_model_t *m)
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
     assert_int_equal(cfg.refute_r, cfg.step); /* the preset's */
     cfg.refute_r = on ? cfg.refute_r : 0;
+    cfg.refute_reached = reached;
     cfg.eps_amp = 0;
     cfg.eps_floor = 0; /* every decision after the first is greedy */
     seek_make(&t, cfg, 5);
     memset(m, 0, sizeof *m);
     m->mean = mean;
+    m->reached = reached;
     rfs_model_t model = { &ops, m };
     assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
     field_t f = { .kind = 2, .scripted = mean };
@@ -480,7 +483,7 @@ static void test_refute_rules_out_the_argmax(void **state)
     (void)state;
     refute_model_t m;
     /* 7 dB weaker at every maximum: ruled out at each decision there, 32 kept. */
-    int refuted = refute_case(-67.0, true, 40, &m);
+    int refuted = refute_case(-67.0, true, false, 40, &m);
     assert_false(m.mismatch);
     assert_true(m.fits >= 39);
     assert_int_equal(refuted, m.nwant);
@@ -491,7 +494,7 @@ static void test_refute_rules_out_the_argmax(void **state)
      * threshold), or the option off: nothing. */
     const double means[3] = {-54.0, -65.0, -67.0};
     for (int c = 0; c < 3; ++c) {
-        refuted = refute_case(means[c], c != 2, 12, &m);
+        refuted = refute_case(means[c], c != 2, false, 12, &m);
         assert_int_equal(refuted, 0);
         assert_true(c == 2 || m.nwant == 0);
         assert_int_equal(m.nexcl, 0);
@@ -503,6 +506,24 @@ static void test_refute_rules_out_the_argmax(void **state)
     assert_int_equal(refuted, m.nwant);
     assert_true(m.nwant >= 9);
     assert_true(m.fits >= m.nwant);
+}
+
+/* refute_reached: the mean exactly as predicted (no relearn of its own) still rules out
+ * every maximum the robot has stood at for a decision (a greedy null move), so every
+ * second decision from the fourth on; without it the robot stays at the first one. */
+static void test_refute_reached_moves_on(void **state)
+{
+    (void)state;
+    refute_model_t m;
+    int refuted = refute_case(-60.0, true, true, 12, &m);
+    assert_false(m.mismatch);
+    assert_int_equal(refuted, m.nwant);
+    assert_int_equal(m.nwant, 5); /* decisions 3, 5, 7, 9, 11 */
+    assert_true(m.fits >= m.nwant);
+    refuted = refute_case(-60.0, true, false, 12, &m);
+    assert_int_equal(refuted, 0);
+    assert_int_equal(m.nexcl, 0);
+    assert_true(m.fits <= 2); /* the first fit and nothing after: a parked robot */
 }
 
 /* The geodesic epsilon step (cfg.eps_geodesic, docs/STRATEGIES.md) against a double-
@@ -819,6 +840,7 @@ int main(void)
         cmocka_unit_test(test_meta_path_unreachable_maximum),
         cmocka_unit_test(test_eps_sample_goes_to_the_draw),
         cmocka_unit_test(test_refute_rules_out_the_argmax),
+        cmocka_unit_test(test_refute_reached_moves_on),
         cmocka_unit_test(test_eps_geodesic_distribution),
         cmocka_unit_test(test_plan_slices_on_the_leg),
     };

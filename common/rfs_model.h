@@ -48,6 +48,9 @@ typedef struct rfs_model_fit_in {
     const int16_t *excl_y_cm; ///< their y, centimetres
     uint8_t nexcl;           ///< how many
     rfs_q16_t excl_r;        ///< radius ruled out round each, metres Q16.16
+    /// Exploration is over (rfs_seek_cfg_t.settle_dist): a model of several sources then
+    /// ranks the places measured (rfs_fields_cfg_t.settle_n).
+    bool settled;
 } rfs_model_fit_in_t;
 
 /// Result of one fit call.

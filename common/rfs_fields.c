@@ -67,7 +67,8 @@ int rfs_fields_init(rfs_fields_t *f, const rfs_fields_cfg_t *cfg, const rfs_targ
         t->nsources > RFS_MODEL_MAX_SOURCES || cfg->cell <= 0 || cfg->cell > RFS_Q16_INT(8) ||
         cfg->radius < 0 || (int64_t)cfg->radius > (int64_t)cfg->cell * RFS_FIELDS_KERNEL_MAX ||
         cfg->prior_n == 0u || cfg->draw_t <= 0 || cfg->coarse <= 0 || cfg->refit_min == 0u ||
-        cfg->lcb < 0 || cfg->lcb > RFS_Q16_INT(8) || mem->f == 0) {
+        cfg->lcb < 0 || cfg->lcb > RFS_Q16_INT(8) || cfg->settle_k > RFS_FIELDS_CAND ||
+        cfg->settle_n == 0u || cfg->settle_sep == 0u || mem->f == 0) {
         return -1;
     }
     for (uint8_t k = 0u; k < t->nsources; ++k) {
@@ -145,11 +146,13 @@ static bool fit_begin(rfs_fields_t *f, const rfs_model_fit_in_t *in)
         f->changed[k] = !f->fitted[k] || f->fit_n[k] != in->src_n[k] || fresh != 0u;
         f->refit[k] = !f->fitted[k] || fresh >= f->cfg.refit_min;
     }
-    if (in->settled != f->settled) {
-        f->settled = in->settled;
+    if (in->settle != f->settle) {
         f->lattice_done = false; /* ranked otherwise now */
-        f->ncand = 0u;
-        f->frozen = false;
+        if (f->settle == RFS_MODEL_EXPLORE || in->settle == RFS_MODEL_EXPLORE) {
+            f->ncand = 0u;
+            f->frozen = false;
+        }
+        f->settle = in->settle;
     }
     f->map = m;
     f->valid = false;
@@ -372,7 +375,7 @@ static void keep_cand(rfs_fields_t *f, uint32_t idx, rfs_q16_t v)
  * fits would rank the places the robot passes between them, each on one pass. */
 static void settle_best(rfs_fields_t *f)
 {
-    if (!f->settled || f->cfg.settle_k == 0u || f->ncand == 0u) {
+    if (f->settle == RFS_MODEL_EXPLORE || f->cfg.settle_k == 0u || f->ncand == 0u) {
         return;
     }
     f->frozen = true;
@@ -383,9 +386,12 @@ static void settle_best(rfs_fields_t *f)
     for (uint8_t c = 0u; c < f->ncand; ++c) {
         const uint16_t i = (uint16_t)(f->cand[c] % lw), j = (uint16_t)(f->cand[c] / lw);
         rfs_q16_t res[RFS_MODEL_MAX_SOURCES], v;
-        if (!measured(f, i, j, f->cfg.settle_conf, res)) {
+        if (f->settle == RFS_MODEL_TOUR && !measured(f, i, j, f->cfg.settle_conf, res)) {
             f->best = f->cand[c];
             return;
+        }
+        if (!measured(f, i, j, 1u, res)) {
+            continue;
         }
         if (target_at(f, i, j, res, &used, &v) && (!any || v > best)) {
             any = true;
@@ -424,7 +430,7 @@ static bool predict_point(rfs_fields_t *f, uint32_t idx, const rfs_q16_t *res,
         score = (int64_t)v - (((int64_t)f->cfg.lcb * point_sigma(f, nw)) >> 16);
     }
     rfs_q16_t mres[RFS_MODEL_MAX_SOURCES], mv;
-    if (f->settled && f->cfg.settle_k > 0u && !f->frozen &&
+    if (f->settle != RFS_MODEL_EXPLORE && f->cfg.settle_k > 0u && !f->frozen &&
         measured(f, i, j, f->cfg.settle_n, mres) && target_at(f, i, j, mres, used, &mv)) {
         keep_cand(f, idx, mv);
     }

@@ -73,7 +73,7 @@ typedef struct rfs_fields_cfg {
                                  ///< metres Q16.16 (1 m), rounded to lattice steps (>= 1)
     rfs_q16_t lcb;               ///< the best point has the highest prediction less lcb
                                  ///< times its sigma (rfs_fields_est_t), Q16.16 (0), 0..8
-    uint8_t settle_k;            ///< once settled (rfs_model_fit_in_t.settled): the
+    uint8_t settle_k;            ///< once settled (rfs_model_fit_in_t.settle): the
                                  ///< candidates, the best measured places, at most
                                  ///< RFS_FIELDS_CAND (4; 0: off, the best prediction)
     uint16_t settle_n;           ///< a candidate has this many samples of every source in
@@ -154,7 +154,7 @@ typedef struct rfs_fields {
     bool changed[RFS_MODEL_MAX_SOURCES];         ///< this fit bins source k's residuals
     bool refit[RFS_MODEL_MAX_SOURCES];           ///< ... and refits its path-loss model
     bool lattice_done;                           ///< f[] and the best point are complete
-    bool settled;                                ///< the last fit's rfs_model_fit_in_t.settled
+    rfs_model_settle_t settle;                   ///< the last fit's rfs_model_fit_in_t.settle
     uint8_t ncand;                               ///< settle phase: candidates in cand[]
     bool frozen;                                 ///< cand[] is chosen
     uint32_t cand[RFS_FIELDS_CAND];              ///< their lattice indices, best first
@@ -170,7 +170,8 @@ void rfs_fields_mem_size(const rfs_map_t *m, const rfs_fields_cfg_t *cfg, uint32
 
 /// Initialise without a model for target t (1..RFS_MODEL_MAX_SOURCES sources). Returns
 /// 0, or -1 on a bad configuration (rfs_pathloss_init's rules; cell outside (0, 8 m],
-/// radius outside [0, RFS_FIELDS_KERNEL_MAX cells], prior_n 0, draw_t <= 0), a target
+/// radius outside [0, RFS_FIELDS_KERNEL_MAX cells], prior_n 0, draw_t <= 0, settle_k
+/// above RFS_FIELDS_CAND, settle_n or settle_sep 0), a target
 /// without combine(), or a missing array. Fits fail on a map larger than the arrays.
 int rfs_fields_init(rfs_fields_t *f, const rfs_fields_cfg_t *cfg, const rfs_target_ops_t *t,
                     const rfs_fields_mem_t *mem);

@@ -537,7 +537,9 @@ static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_ou
                                .excl_x_cm = s->excl_x_cm, .excl_y_cm = s->excl_y_cm,
                                .nexcl = s->nexcl,
                                .excl_r = s->cfg.refute_r,
-                               .settled = rfs_seek_src_settled(s) };
+                               .settle = !rfs_seek_src_settled(s) ? RFS_MODEL_EXPLORE
+                                         : rfs_seek_src_orbiting(s) ? RFS_MODEL_TOUR
+                                                                    : RFS_MODEL_HOLD };
     for (uint8_t i = 0; s->src != 0 && i < s->target->nsources; ++i) {
         fin.src_samples[i] = s->src[i].store.samples;
         fin.src_n[i] = s->src[i].store.count;
@@ -583,8 +585,9 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
      * when the mean has moved back within the threshold while the base braked. */
     relearn = rfs_seek_meta_refute(s, now_us) || relearn;
     relearn = relearn || ops->refit || s->replan;
-    /* settle_orbit: every decision ranks the places with the samples of the last orbit. */
-    relearn = relearn || rfs_seek_src_orbiting(s);
+    /* settle_orbit: every decision ranks the candidates with the samples of the last
+     * orbit, and sees the tour end (docs/STRATEGIES.md, "Bridging"). */
+    relearn = relearn || (s->cfg.settle_orbit > 0 && rfs_seek_src_settled(s));
 
     if (relearn && s->store.count > 0u) {
         d->relearned = true;

@@ -106,7 +106,7 @@ typedef struct rfs_seek_cfg {
                                 ///< 0): the robot goes to the model's best point and stays
                                 ///< there, metres Q16.16 (0: never, the paper's)
     rfs_q16_t settle_orbit;     ///< after settle_dist, at the best point (a greedy goal
-                                ///< within a quarter step): a move to a reachable lattice
+                                ///< within half this): a move to a reachable lattice
                                 ///< point about this far from it, to measure more fades
                                 ///< round it, and a relearn at every decision, metres
                                 ///< Q16.16 (0: none, stand still)

@@ -106,7 +106,7 @@ bool rfs_seek_src_settled(const rfs_seek_t *s);
 /* Settled, with settle_orbit, before settle_end. */
 bool rfs_seek_src_orbiting(const rfs_seek_t *s);
 
-/* settle_orbit: when settled and the robot stands within a quarter step of the model's
+/* settle_orbit: when settled and the robot stands within half the orbit of the model's
  * best point, go to a random reachable lattice point round it (docs/STRATEGIES.md,
  * "Bridging"); false (the usual choice follows) otherwise or when there is none. */
 bool rfs_seek_src_orbit(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us);

@@ -40,13 +40,13 @@ static void restart(rfs_seek_src_t *c, rfs_q16_t x, rfs_q16_t y)
     c->y = y;
 }
 
-/* The robot is within src_spacing of source c's last sample, or the base is at rest: a
- * robot standing still sees one fade however its localised pose jitters (by 5-10 cm:
- * hundreds of samples of that one fade in a place the robot stood at). */
+/* The robot is within src_spacing of source c's last sample, or at rest since it: a
+ * robot standing still sees one fade however its localised pose jitters (5-10 cm in the
+ * simulator: else hundreds of samples of that one fade where the robot stood). */
 static bool near(const rfs_seek_t *s, const rfs_seek_src_t *c, rfs_q16_t x, rfs_q16_t y)
 {
-    return (c->at && rfs_q16_dist(x, y, c->x, c->y) < s->cfg.src_spacing) ||
-           rfs_drive_at_rest(&s->drive);
+    return c->at && (rfs_q16_dist(x, y, c->x, c->y) < s->cfg.src_spacing ||
+                     rfs_drive_at_rest(&s->drive));
 }
 
 /* src_floor: a source silent for a window while another is heard is below the receiver's
@@ -164,7 +164,7 @@ bool rfs_seek_src_orbit(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     rfs_q16_t mx, my;
     if (!rfs_seek_src_orbiting(s) || s->model.ops->argmax == 0 ||
         !s->model.ops->argmax(s->model.self, &mx, &my) ||
-        rfs_q16_dist(s->pose.x, s->pose.y, mx, my) > s->cfg.step / 4) {
+        rfs_q16_dist(s->pose.x, s->pose.y, mx, my) >= s->cfg.settle_orbit / 2) {
         return false;
     }
     const rfs_map_t *m = s->map;

@@ -6,6 +6,9 @@
  *   bench_core iter          run the iteration once (for callgrind: Ir of rfs_seek_step)
  *   bench_core time N        run it N times, print the median wall time in microseconds
  *   bench_core dump FILE     write the samples and the query point for the sklearn twin
+ * The store keeps cell sums as the Linux port's does (docs/MODELS.md, "Cell sums");
+ * `bench_core --scan MODE` runs without them, visiting every sample as the
+ * microcontroller image does.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +17,7 @@
 
 #include <valgrind/callgrind.h>
 
+#include "rfs_cellsum.h"
 #include "rfs_ridge.h"
 #include "rfs_seek.h"
 
@@ -28,9 +32,11 @@ typedef struct bench {
     rfs_ridge_t ridge;
     rfs_seek_t seek;
     rfs_rng_t rng;
+    rfs_cellsum_t cellsum;
+    rfs_store_index_t index;
 } bench_t;
 
-static void bench_setup(bench_t *b)
+static void bench_setup(bench_t *b, bool cells)
 {
     memset(b, 0, sizeof *b);
     uint16_t w = W_M * 10, h = H_M * 10;
@@ -57,6 +63,18 @@ static void bench_setup(bench_t *b)
     b->mem.visited_bytes = b->mem.reach_bytes = rfs_reach_bytes(&b->map);
     b->mem.visited = calloc(b->mem.visited_bytes, 1);
     b->mem.reach = calloc(b->mem.reach_bytes, 1);
+    if (cells) {
+        uint32_t n = rfs_cellsum_cells(W_M * 100, H_M * 100, 5);
+        if (rfs_cellsum_init(&b->cellsum, 0, 0, W_M * 100, H_M * 100, 5,
+                             calloc(n, sizeof(rfs_cellsum_cell_t)), n,
+                             calloc(2u * cfg.store.capacity, sizeof(uint16_t)),
+                             cfg.store.capacity) != 0) {
+            fprintf(stderr, "bench_core: cell sums init failed\n");
+            exit(1);
+        }
+        b->index = rfs_cellsum_index(&b->cellsum);
+        b->mem.index = &b->index;
+    }
     rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
     rfs_ridge_init(&b->ridge, &rc);
     if (rfs_seek_init(&b->seek, &cfg, &b->map, rfs_ridge_model(&b->ridge), &rfs_target_rssi,
@@ -82,8 +100,11 @@ static void bench_setup(bench_t *b)
     }
 }
 
-/* One worst-case iteration: fresh inputs, no model (relearn), greedy grid search. */
-static void bench_iteration(bench_t *b, int64_t now)
+/* One worst-case iteration: fresh inputs, no model (relearn), greedy grid search. With
+ * the default plan_budget the period that relearns in one go leaves the choice to the
+ * next (docs/PERFORMANCE.md, "Planning in slices"): the iteration is the periods, 50 ms
+ * apart, until the decision; their number is returned. */
+static int bench_iteration(bench_t *b, int64_t now)
 {
     rfs_pose_t p = { now, 20 * 65536, 10 * 65536, 0 };
     b->seek.have_pose = false; /* accept the pose regardless of earlier iterations */
@@ -94,11 +115,16 @@ static void bench_iteration(bench_t *b, int64_t now)
     b->seek.iteration = 1;
     b->seek.drive.status = RFS_DRIVE_IDLE;
     rfs_seek_out_t out;
-    rfs_seek_step(&b->seek, now, &b->rng, &out);
+    int periods = 0;
+    do {
+        rfs_seek_step(&b->seek, now + (int64_t)periods * 50000, &b->rng, &out);
+        ++periods;
+    } while (!out.decided && periods < 4);
     if (!out.decided || !out.decision.relearned || out.decision.kind != RFS_SEEK_GREEDY) {
         fprintf(stderr, "bench_core: the iteration was not the worst case\n");
         exit(1);
     }
+    return periods;
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -109,19 +135,26 @@ static int cmp_double(const void *a, const void *b)
 
 int main(int argc, char **argv)
 {
+    bool cells = true;
+    if (argc >= 2 && strcmp(argv[1], "--scan") == 0) {
+        cells = false;
+        --argc;
+        ++argv;
+    }
     if (argc < 2 || strcmp(argv[1], "--help") == 0) {
-        printf("usage: bench_core iter | time N | dump FILE\n");
+        printf("usage: bench_core [--scan] iter | time N | dump FILE\n");
         return argc < 2 ? 2 : 0;
     }
     bench_t b;
-    bench_setup(&b);
+    bench_setup(&b, cells);
     /* Warm-up iteration: the first one also flood-fills the reachable lattice. */
     bench_iteration(&b, 1000000);
     if (strcmp(argv[1], "iter") == 0) {
         /* Run under callgrind with --collect-atstart=no: only this iteration counts. */
         CALLGRIND_TOGGLE_COLLECT;
-        bench_iteration(&b, 2000000);
+        int periods = bench_iteration(&b, 2000000);
         CALLGRIND_TOGGLE_COLLECT;
+        printf("periods %d\n", periods);
         return 0;
     }
     if (strcmp(argv[1], "time") == 0 && argc == 3) {

@@ -34,6 +34,9 @@ typedef enum rfs_model_settle {
 typedef struct rfs_model_fit_in {
     const rfs_sample_t *samples; ///< the stored samples
     uint16_t n;                  ///< how many
+    /// Their index (rfs_cellsum.h), kept by the store; NULL: none. The local ridge reads
+    /// its disc sums in a whole fit instead of visiting every sample (the same result).
+    const rfs_store_index_t *index;
     rfs_q16_t qx;                ///< query point (robot position) x, metres Q16.16
     rfs_q16_t qy;                ///< query point y, metres Q16.16
     const rfs_map_t *map;        ///< the map (for map-aware models); may be NULL

@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "rfs_assert.h"
+#include "rfs_cellsum.h"
 
 /// Largest radius init accepts, metres: keeps every product of the sums in int32/int64.
 #define RIDGE_RADIUS_MAX_M 300
@@ -291,6 +292,23 @@ static rfs_fit_result_t ridge_fit(void *self, const rfs_model_fit_in_t *in, uint
     }
     uint32_t from = r->acc.next;
     uint32_t to = in->n;
+    if (in->index != 0 && budget == 0u && from == 0u) {
+        /* Cell sums: the same integers as the pass below (docs/MODELS.md, "Cell sums"). */
+        rfs_cellsum_disc_t d;
+        in->index->disc(in->index->self, in->samples, r->acc.qx_cm, r->acc.qy_cm,
+                        q16_to_cm(r->cfg.radius), &d);
+        r->acc.n = (uint16_t)d.n;
+        r->acc.su = (int32_t)d.su;
+        r->acc.sv = (int32_t)d.sv;
+        r->acc.sz = (int32_t)d.sz;
+        r->acc.suu = d.suu;
+        r->acc.suv = d.suv;
+        r->acc.svv = d.svv;
+        r->acc.suz = d.suz;
+        r->acc.svz = d.svz;
+        r->acc.next = in->n;
+        return solve(r);
+    }
     if (budget != 0u && to - from > budget) {
         to = from + budget;
     }

@@ -191,9 +191,11 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         rfs_store_init(&s->store, &cfg->store, mem->samples, mem->pending, mem->pending_cap) != 0 ||
         rfs_plan_init(&s->plan, map, mem->plan_work, mem->plan_work_bytes, mem->plan_queue,
                       mem->plan_queue_cap) != 0 ||
-        rfs_drive_init(&s->drive, &cfg->drive) != 0) {
+        rfs_drive_init(&s->drive, &cfg->drive) != 0 ||
+        (mem->index != 0 && mem->index->cap < cfg->store.capacity)) {
         return -1;
     }
+    rfs_store_set_index(&s->store, mem->index);
     s->visited = mem->visited;
     s->reach = mem->reach;
     s->queue = mem->plan_queue;
@@ -532,7 +534,7 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
 static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
 {
     rfs_model_fit_in_t fin = { .samples = s->store.samples, .n = s->store.count,
-                               .qx = s->pose.x, .qy = s->pose.y, .map = s->map,
+                               .index = s->store.index, .qx = s->pose.x, .qy = s->pose.y, .map = s->map,
                                .reach = s->reach_valid ? s->reach : 0,
                                .excl_x_cm = s->excl_x_cm, .excl_y_cm = s->excl_y_cm,
                                .nexcl = s->nexcl,

@@ -155,6 +155,9 @@ typedef struct rfs_seek_mem {
     rfs_seek_src_t *src;
     rfs_sample_t *src_samples[RFS_TARGET_MAX_SOURCES]; ///< the stores' sample arrays
     rfs_pending_t *src_pending[RFS_TARGET_MAX_SOURCES]; ///< their pending rings
+    /// Optional (NULL: none): an empty index of cfg.store.capacity slots kept with the
+    /// store (rfs_cellsum_index(); the local ridge's whole fits read it).
+    const rfs_store_index_t *index;
 } rfs_seek_mem_t;
 
 /// Why an iteration chose its goal.

@@ -49,12 +49,27 @@ void rfs_store_offer(rfs_store_t *s, rfs_sample_t sample, rfs_rng_t *rng)
      * saturates after 2^32 - 1 samples (124 days at 400 per second). */
     count_up(&s->seen);
     if (s->count < s->cfg.capacity) {
+        if (s->index != 0) {
+            s->index->put(s->index->self, s->count, 0, &sample);
+        }
         s->samples[s->count++] = sample;
         return;
     }
     uint32_t j = rfs_rng_below(rng, s->seen);
     if (j < s->cfg.capacity) {
+        if (s->index != 0) {
+            s->index->put(s->index->self, (uint16_t)j, &s->samples[j], &sample);
+        }
         s->samples[j] = sample;
+    }
+}
+
+void rfs_store_set_index(rfs_store_t *s, const rfs_store_index_t *index)
+{
+    RFS_ASSERT(s != 0 && (index == 0 || index->cap >= s->cfg.capacity));
+    s->index = index;
+    for (uint16_t i = 0; index != 0 && i < s->count; ++i) {
+        index->put(index->self, i, 0, &s->samples[i]);
     }
 }
 

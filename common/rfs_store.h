@@ -45,11 +45,27 @@ typedef struct rfs_store_cfg {
     int64_t max_gap_us;    ///< poses further apart than this do not bracket (0.5 s; <= 60 s)
 } rfs_store_cfg_t;
 
+struct rfs_cellsum_disc;
+
+/// An index kept with the store (rfs_cellsum_index()): told of every slot written, it
+/// answers the local ridge's disc sums. Through pointers, so an image without one links
+/// none of its code.
+typedef struct rfs_store_index {
+    /// Slot `slot` now holds `s`; `old` is what it held (NULL: it was empty).
+    void (*put)(void *self, uint16_t slot, const rfs_sample_t *old, const rfs_sample_t *s);
+    /// The sums over the samples within r_cm of (qx_cm, qy_cm) (rfs_cellsum_disc()).
+    void (*disc)(const void *self, const rfs_sample_t *samples, int32_t qx_cm, int32_t qy_cm,
+                 int32_t r_cm, struct rfs_cellsum_disc *out);
+    void *self;   ///< the index
+    uint16_t cap; ///< store slots it covers
+} rfs_store_index_t;
+
 /// The sample store; samples and pending queue live in caller-owned arrays.
 typedef struct rfs_store {
     rfs_store_cfg_t cfg;                           ///< configuration copied at init
     rfs_sample_t *samples;                         ///< caller's array of cfg.capacity
     uint16_t count;                                ///< samples held
+    const rfs_store_index_t *index;                ///< kept with it; NULL: none
     uint32_t seen;                                 ///< samples offered to the reservoir
     rfs_pending_t *pending;                        ///< caller's pending ring
     uint16_t pending_cap;                          ///< its capacity
@@ -88,5 +104,9 @@ bool rfs_store_position_at(const rfs_store_t *s, int64_t t_us, rfs_q16_t *x, rfs
 
 /// Offer one complete sample to the reservoir (used by the store itself and by replay).
 void rfs_store_offer(rfs_store_t *s, rfs_sample_t sample, rfs_rng_t *rng);
+
+/// Keep `index` (an empty one covering at least cfg.capacity slots; NULL: none) up to
+/// date with every sample written from now on; the samples held are put in now.
+void rfs_store_set_index(rfs_store_t *s, const rfs_store_index_t *index);
 
 #endif /* RFS_STORE_H */

@@ -7,6 +7,7 @@
 
 #include <math.h>
 
+#include "rfs_cellsum.h"
 #include "rfs_models.h"
 #include "rfs_pathloss.h"
 #include "rfs_pdr.h"
@@ -25,6 +26,10 @@ typedef struct inproc {
     rfs_fields_mem_t fmem;
     rfs_rng_t rng;
     rfs_seek_mem_t mem;
+    rfs_cellsum_t cellsum;           // the ridge's cell sums (open_cellsum), or unused
+    rfs_store_index_t cellsum_index; // the store's view of them
+    rfs_cellsum_cell_t *cells;
+    uint16_t *cell_links;
 } inproc_t;
 
 hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void)
@@ -112,7 +117,33 @@ static void ip_close(void *self)
     free(p->mem.reach);
     free(p->model_state);
     free(p->wall_cache);
+    free(p->cells);
+    free(p->cell_links);
     free(p);
+}
+
+// The local ridge's cell sums over the map's box at 32 cm cells (docs/MODELS.md, "Cell
+// sums"): the same fits, without visiting every sample. A map over 655 m a side, or no
+// memory, runs without them.
+static void open_cellsum(inproc_t *p, const rfs_map_t *map, uint16_t capacity)
+{
+    const int32_t x0 = (int32_t)floor(map->origin_x / 65536.0 * 100.0);
+    const int32_t y0 = (int32_t)floor(map->origin_y / 65536.0 * 100.0);
+    const int32_t w = (int32_t)ceil((map->origin_x + (double)map->w * map->res) / 65536.0 * 100.0) - x0;
+    const int32_t h = (int32_t)ceil((map->origin_y + (double)map->h * map->res) / 65536.0 * 100.0) - y0;
+    const uint8_t shift = 5;
+    uint32_t n = rfs_cellsum_cells(w, h, shift);
+    if (n == 0u || capacity == 0u) {
+        return;
+    }
+    p->cells = malloc((size_t)n * sizeof *p->cells);
+    p->cell_links = malloc(2u * capacity * sizeof *p->cell_links);
+    if (p->cells && p->cell_links &&
+        rfs_cellsum_init(&p->cellsum, x0, y0, w, h, shift, p->cells, n, p->cell_links,
+                         capacity) == 0) {
+        p->cellsum_index = rfs_cellsum_index(&p->cellsum);
+        p->mem.index = &p->cellsum_index;
+    }
 }
 
 /* The path-loss model's options: P0 bounded by the node's transmit power when known
@@ -232,6 +263,9 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
         return -1;
     }
     const rfs_models_entry_t *me = rfs_models_lookup(cfg->model);
+    if (me->ops == &rfs_ridge_ops) {
+        open_cellsum(p, map, cfg->seek.store.capacity);
+    }
     size_t sbytes = (rfs_models_max_state_bytes() + RFS_MODELS_STATE_ALIGN - 1u) /
                     RFS_MODELS_STATE_ALIGN * RFS_MODELS_STATE_ALIGN;
     p->model_state = aligned_alloc(RFS_MODELS_STATE_ALIGN, sbytes);

@@ -27,6 +27,8 @@ bench-data: $(BENCH_BIN)/bench_ridge $(BUILD)/arm/lib/librfs_core.a
 bench-models: $(BENCH_BIN)/bench_models
 	@scripts/bench_models.sh $(BUILD)
 BENCH_TARGETS += bench-core bench-data bench-models bench-pathloss
+# Every bench program's quick modes run to the end in `make test`.
+$(eval $(call test_script,bench_modes,tests/bench/bench_modes.sh $(BUILD),$(BENCH_BIN)/bench_core $(BENCH_BIN)/bench_ridge $(BENCH_BIN)/bench_models $(BENCH_BIN)/bench_pathloss))
 
 # The path-loss model: instructions per relearn, per slice and per prediction, state bytes.
 PATHLOSS_BENCH_MAP ?= scenarios/maps/office.yaml
@@ -99,10 +101,12 @@ BENCH_TARGETS += bench-sim bench-map bench-faults
 
 # The drive under localisation noise -> docs/RESULTS.md ("The drive under localisation
 # noise"): 3 floors x 10 localisation settings x 2 configurations x 200 held-out seeds.
+# `make test` runs a 2-seed smoke run of the same script.
 .PHONY: bench-drive
 bench-drive: $(BENCH_BIN)/rfseek-sim
 	$(PYTHON) scripts/bench_drive.py --sim $(BENCH_BIN)/rfseek-sim
 BENCH_TARGETS += bench-drive
+$(eval $(call test_script,bench_drive_smoke,$(PYTHON) scripts/bench_drive.py --smoke --jobs 2 --sim $(BENCH_BIN)/rfseek-sim,$(BENCH_BIN)/rfseek-sim))
 
 # Seeking at random placements on every shipped floor, meta-path + pathloss and meta +
 # ridge -> docs/RESULTS.md ("Generalisation: random placements", held-out draws only).

@@ -12,12 +12,17 @@ and nothing else.
                                             [--sim build/bin/rfseek-sim]
                                             [--results docs/RESULTS.md | --no-write]
                                             [--keep DIR]
+    /usr/bin/python3 scripts/bench_drive.py --smoke   (2 seeds, 2 rows, one floor; a
+                                                        self-check that writes nothing)
 
 Seeds 1001..1200 by default: the drive was tuned on seeds 1..500 of the default office,
 so these are draws it has not seen.
 """
 import argparse
+import atexit
 import glob
+import shutil
+import tempfile
 import os
 import re
 import statistics
@@ -143,9 +148,23 @@ def main():
     ap.add_argument("--keep", metavar="DIR",
                     help="keep each batch's runs table in DIR and reuse the ones there "
                          "(same binary and seeds: a resumed or extended bench)")
+    ap.add_argument("--smoke", action="store_true",
+                    help="seeds 1..2, exact poses and AMCL-like on the default floor, the "
+                         "section written to a temporary copy and checked; prints PASS/FAIL "
+                         "bench-drive-smoke")
     a = ap.parse_args()
+    noise = NOISE
+    if a.smoke:
+        a.seeds, a.floors, a.all_floors, a.keep = "1..2", "default", "default", None
+        noise = [NOISE[0], NOISE[-1]]
+        tmpdir = tempfile.mkdtemp(prefix="bench_drive_smoke.")
+        atexit.register(shutil.rmtree, tmpdir, True)
+        shutil.copy(a.results, os.path.join(tmpdir, "RESULTS.md"))
+        a.results = os.path.join(tmpdir, "RESULTS.md")
     if not re.fullmatch(r"\d+\.\.\d+", a.seeds):
         sys.exit("bench_drive: --seeds: expected A..B")
+    if not os.access(a.sim, os.X_OK):
+        sys.exit(f"bench_drive: --sim: {a.sim}: not an executable (make all)")
     for f in a.floors.split(","):
         if f not in FLOORS:
             sys.exit(f"bench_drive: --floors: unknown floor {f!r} (known: {', '.join(FLOORS)})")
@@ -164,7 +183,7 @@ def main():
     try:
         if a.keep:
             os.makedirs(a.keep, exist_ok=True)
-        for i, (nlabel, settings) in enumerate(NOISE):
+        for i, (nlabel, settings) in enumerate(noise):
             cs = []
             for f in floors:
                 path = FLOORS[f][1]
@@ -188,6 +207,29 @@ def main():
         text = section(a.seeds, time.time() - t0, commit(), floors, rows, every)
         splice(a.results, text, BEGIN, END)
         print(f"wrote {a.results} ({time.time() - t0:.0f} s)")
+    if a.smoke:
+        ok = smoke_check(a.results, [lb for lb, _ in noise], every_floors)
+        print("%s bench-drive-smoke" % ("PASS" if ok else "FAIL"))
+        sys.exit(0 if ok else 1)
+
+
+CELL = re.compile(r"\d+\.\d% \d+\.\d\d/\d+%/\d+\.\d\d/\d+")
+
+
+def smoke_check(results, labels, every_floors):
+    """The section between the markers holds one row per localisation label and per
+    floor, each with two well-formed cells of two runs (0.0 or 50.0 or 100.0 %)."""
+    text = open(results).read()
+    if text.count(BEGIN) != 1 or text.count(END) != 1:
+        return False
+    body = text[text.index(BEGIN):text.index(END)]
+    rows = {ln.split(" | ")[0].lstrip("| "): ln for ln in body.split("\n") if ln.startswith("| ")}
+    for name in labels + every_floors:
+        cells = CELL.findall(rows.get(name, ""))
+        if len(cells) != 2 or any(c.split("%")[0] not in ("0.0", "50.0", "100.0")
+                                   for c in cells):
+            return False
+    return True
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # strategy_cli.sh SIM - rfseek-sim's --strategy / --model options and the
-# benchmark script's own input check: bad names give one error line and exit 1; good
+# analysis scripts' own input checks: bad names or options give one error line and exit 1; good
 # names run and are reported in summary.json.
 set -u
 sim=${1:?usage: strategy_cli.sh path/to/rfseek-sim}
@@ -45,4 +45,22 @@ check run-model-pathloss '[ $? -eq 0 ] && grep -q "\"model\": \"pathloss\"" "$tm
 /usr/bin/python3 scripts/bench_seek.py --bin "$tmp/nonexistent" >"$tmp/o" 2>"$tmp/e"
 rc=$?
 check bench-bad-bin '[ $rc -eq 1 ] && [ "$(wc -l <"$tmp/e")" -eq 1 ] && grep -q "nonexistent: not an executable" "$tmp/e"'
+# The analysis scripts: a bad option is one line on stderr, exit 1, nothing on stdout.
+i=0
+while IFS='|' read -r script args want; do
+    i=$((i + 1))
+    # shellcheck disable=SC2086
+    /usr/bin/python3 "scripts/$script" $args >"$tmp/o" 2>"$tmp/e"
+    rc=$?
+    check "script-bad-option-$i-$script" '[ $rc -eq 1 ] && [ "$(wc -l <"$tmp/e")" -eq 1 ] && [ ! -s "$tmp/o" ] && grep -q -- "$want" "$tmp/e"'
+done <<'LIST'
+bench_drive.py|--seeds x|--seeds: expected A..B
+bench_drive.py|--floors nope|unknown floor 'nope'
+bench_drive.py|--all-floors nope|'nope' is not a shipped floor
+bench_drive.py|--sim /nonexistent|/nonexistent: not an executable
+mlp_steps.py|--seeds 5..1|'5..1' is not A..B
+mlp_steps.py|--sim /nonexistent|/nonexistent: not an executable
+bench_general.py|--placements 0|--placements: expected an even number
+bench_general.py|--sim /nonexistent|/nonexistent: not an executable
+LIST
 [ $fails -eq 0 ]

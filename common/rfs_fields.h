@@ -75,11 +75,11 @@ typedef struct rfs_fields_cfg {
                                  ///< times its sigma (rfs_fields_est_t), Q16.16 (0), 0..8
     uint8_t settle_k;            ///< once settled (rfs_model_fit_in_t.settle): the
                                  ///< candidates, the best measured places, at most
-                                 ///< RFS_FIELDS_CAND (4; 0: off, the best prediction)
+                                 ///< RFS_FIELDS_CAND (6; 0: off, the best prediction)
     uint16_t settle_n;           ///< a candidate has this many samples of every source in
                                  ///< its cell (8), >= 1
-    uint16_t settle_conf;        ///< ... and is measured enough with this many (32)
-    uint8_t settle_sep;          ///< candidates lie this many lattice steps apart (2)
+    uint16_t settle_conf;        ///< ... and is measured enough with this many (64)
+    uint8_t settle_sep;          ///< candidates lie this many lattice steps apart (2), >= 1
 } rfs_fields_cfg_t;
 
 /// Caller-owned arrays, sized with rfs_fields_mem_size() for the map.

@@ -90,8 +90,10 @@ void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg)
     cfg->src_floor = RFS_Q16_INT(-100);     /* radiotap receivers report down to -100 dBm */
     /* Two thirds of the bridging scenarios' 150 m (docs/STRATEGIES.md, "Bridging"). */
     cfg->settle_dist = RFS_Q16_INT(100);
-    cfg->settle_orbit = RFS_Q16_HALF; /* the fields' kernel radius (rfs_fields.h) */
-    cfg->settle_end = RFS_Q16_INT(130);
+    /* The settle tour (docs/STRATEGIES.md, "Bridging"): a lattice step round each
+     * candidate, 25 m of the 50 left. */
+    cfg->settle_orbit = RFS_Q16_FRAC(1, 4);
+    cfg->settle_end = RFS_Q16_INT(125);
     cfg->refute_r = 0; /* the argmax is the target's best point, not a source */
     cfg->silence_floor = INT32_MIN; /* each node's store has src_floor */
 }

@@ -341,7 +341,8 @@ static bool measured(const rfs_fields_t *f, uint16_t i, uint16_t j, uint16_t min
  * squares summed in int64. */
 static void keep_cand(rfs_fields_t *f, uint32_t idx, rfs_q16_t v)
 {
-    const int64_t lw = f->map->lw, sep = f->cfg.settle_sep;
+    const uint32_t lw = f->map->lw;
+    const int64_t sep = f->cfg.settle_sep;
     uint8_t n = 0u;
     for (uint8_t c = 0u; c < f->ncand; ++c) {
         const int64_t di = (int64_t)(f->cand[c] % lw) - (int64_t)(idx % lw);

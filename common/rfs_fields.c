@@ -35,6 +35,13 @@ rfs_fields_cfg_t rfs_fields_cfg_default(void)
     c.draw_t = RFS_Q16_INT(3);
     c.coarse = RFS_Q16_ONE;
     c.refit_min = 100u; /* about 4 m of new travel */
+    /* The settle tour (docs/STRATEGIES.md, "Bridging"), tuned on seeds 1..40 of
+     * scenarios/bridge.yaml: 6 candidates half a metre apart, each measured 64 times
+     * (a 0.25 m cell crossed about 6 times a 0.25 m orbit). */
+    c.settle_k = 6u;
+    c.settle_n = 8u;
+    c.settle_conf = 64u;
+    c.settle_sep = 2u;
     c.lcb = 0; /* 1: held-out seeds 1001..1200 141 -> 136 and 150 -> 143 of 200 within 3 m
                 * (office, corridor; docs/PATHLOSS.md) */
     return c;
@@ -63,7 +70,8 @@ int rfs_fields_init(rfs_fields_t *f, const rfs_fields_cfg_t *cfg, const rfs_targ
         t->nsources > RFS_MODEL_MAX_SOURCES || cfg->cell <= 0 || cfg->cell > RFS_Q16_INT(8) ||
         cfg->radius < 0 || (int64_t)cfg->radius > (int64_t)cfg->cell * RFS_FIELDS_KERNEL_MAX ||
         cfg->prior_n == 0u || cfg->draw_t <= 0 || cfg->coarse <= 0 || cfg->refit_min == 0u ||
-        cfg->lcb < 0 || cfg->lcb > RFS_Q16_INT(8) || mem->f == 0) {
+        cfg->lcb < 0 || cfg->lcb > RFS_Q16_INT(8) || cfg->settle_k > RFS_FIELDS_CAND ||
+        cfg->settle_n == 0u || cfg->settle_sep == 0u || mem->f == 0) {
         return -1;
     }
     for (uint8_t k = 0u; k < t->nsources; ++k) {
@@ -140,6 +148,14 @@ static bool fit_begin(rfs_fields_t *f, const rfs_model_fit_in_t *in)
         const uint32_t fresh = in->src_seen[k] - f->fit_seen[k];
         f->changed[k] = !f->fitted[k] || f->fit_n[k] != in->src_n[k] || fresh != 0u;
         f->refit[k] = !f->fitted[k] || fresh >= f->cfg.refit_min;
+    }
+    if (in->settle != f->settle) {
+        f->lattice_done = false; /* ranked otherwise now */
+        if (f->settle == RFS_MODEL_EXPLORE || in->settle == RFS_MODEL_EXPLORE) {
+            f->ncand = 0u;
+            f->frozen = false;
+        }
+        f->settle = in->settle;
     }
     f->map = m;
     f->valid = false;
@@ -300,6 +316,95 @@ static bool target_at(rfs_fields_t *f, uint16_t i, uint16_t j, const rfs_q16_t *
     return true;
 }
 
+/* settle_n: every source's mean residual in the cell of lattice point (i, j) into res[],
+ * dB Q16.16, without the kernel and the prior: once settled the robot ranks the places
+ * it measured by what it measured there, the fine wall pattern of each fit's lattice
+ * point added (target_at). false when a source has fewer than settle_n samples there.
+ * Scaling: a cell's sum (Q8, < 2^30) times 2^8 over its count, in int64. */
+static bool measured(const rfs_fields_t *f, uint16_t i, uint16_t j, uint16_t min,
+                     rfs_q16_t *res)
+{
+    const uint32_t c = (uint32_t)(j / f->cs) * f->cw + (uint32_t)(i / f->cs);
+    for (uint8_t k = 0u; k < f->target->nsources; ++k) {
+        const uint16_t n = f->mem.rcount[k][c];
+        if (n < min || n == 0u) {
+            return false;
+        }
+        res[k] = rfs_sat32(rfs_sdiv64_round((int64_t)f->mem.rsum[k][c] * 256, n));
+    }
+    return true;
+}
+
+/* Keep lattice point idx, measured v, among the settle_k best candidates at least
+ * settle_sep lattice steps apart, best first: a better point within settle_sep replaces
+ * those it is near; a worse one is dropped. Scaling: lattice offsets below 2^16, their
+ * squares summed in int64. */
+static void keep_cand(rfs_fields_t *f, uint32_t idx, rfs_q16_t v)
+{
+    const uint32_t lw = f->map->lw;
+    const int64_t sep = f->cfg.settle_sep;
+    uint8_t n = 0u;
+    for (uint8_t c = 0u; c < f->ncand; ++c) {
+        const int64_t di = (int64_t)(f->cand[c] % lw) - (int64_t)(idx % lw);
+        const int64_t dj = (int64_t)(f->cand[c] / lw) - (int64_t)(idx / lw);
+        if (di * di + dj * dj < sep * sep) {
+            if (f->cand_s[c] >= v) {
+                return;
+            }
+            continue; /* replaced */
+        }
+        f->cand[n] = f->cand[c];
+        f->cand_s[n++] = f->cand_s[c];
+    }
+    uint8_t at = n;
+    while (at > 0u && f->cand_s[at - 1u] < v) {
+        at--;
+    }
+    if (at >= f->cfg.settle_k) {
+        f->ncand = n;
+        return;
+    }
+    for (uint8_t c = (uint8_t)(n < f->cfg.settle_k ? n : f->cfg.settle_k - 1u); c > at; --c) {
+        f->cand[c] = f->cand[c - 1u];
+        f->cand_s[c] = f->cand_s[c - 1u];
+    }
+    f->cand[at] = idx;
+    f->cand_s[at] = v;
+    f->ncand = (uint8_t)(n < f->cfg.settle_k ? n + 1u : f->cfg.settle_k);
+}
+
+/* Settle phase: the best point is the first candidate, best measured first, not yet
+ * measured enough (settle_conf), so that the robot measures each; once all are, the one
+ * measured best. Candidates are chosen once, in the first fit after settling: later
+ * fits would rank the places the robot passes between them, each on one pass. */
+static void settle_best(rfs_fields_t *f)
+{
+    if (f->settle == RFS_MODEL_EXPLORE || f->cfg.settle_k == 0u || f->ncand == 0u) {
+        return;
+    }
+    f->frozen = true;
+    const uint16_t lw = f->map->lw;
+    bool any = false;
+    rfs_q16_t best = 0;
+    uint32_t used = 0u;
+    for (uint8_t c = 0u; c < f->ncand; ++c) {
+        const uint16_t i = (uint16_t)(f->cand[c] % lw), j = (uint16_t)(f->cand[c] / lw);
+        rfs_q16_t res[RFS_MODEL_MAX_SOURCES], v;
+        if (f->settle == RFS_MODEL_TOUR && !measured(f, i, j, f->cfg.settle_conf, res)) {
+            f->best = f->cand[c];
+            return;
+        }
+        if (!measured(f, i, j, 1u, res)) {
+            continue;
+        }
+        if (target_at(f, i, j, res, &used, &v) && (!any || v > best)) {
+            any = true;
+            best = v;
+            f->best = f->cand[c];
+        }
+    }
+}
+
 /* Q16.16 to Q9.6, rounded, saturated, never one of the markers.
  * Scaling and overflow: (v + 2^9) >> 10 of an int32 fits int32; clamped to int16. */
 static int16_t q16_to_q6(rfs_q16_t v)
@@ -324,9 +429,14 @@ static bool predict_point(rfs_fields_t *f, uint32_t idx, const rfs_q16_t *res,
     f->mem.f[idx] = q;
     f->best_v = q > f->best_v ? q : f->best_v;
     /* lcb 0 ranks by the kept Q9.6 value: the first of equal predictions is the best. */
-    rfs_q16_t score = (rfs_q16_t)q * 1024;
+    int64_t score = (int64_t)q * 1024;
     if (f->cfg.lcb > 0) {
-        score = rfs_sat32((int64_t)v - (((int64_t)f->cfg.lcb * point_sigma(f, nw)) >> 16));
+        score = (int64_t)v - (((int64_t)f->cfg.lcb * point_sigma(f, nw)) >> 16);
+    }
+    rfs_q16_t mres[RFS_MODEL_MAX_SOURCES], mv;
+    if (f->settle != RFS_MODEL_EXPLORE && f->cfg.settle_k > 0u && !f->frozen &&
+        measured(f, i, j, f->cfg.settle_n, mres) && target_at(f, i, j, mres, used, &mv)) {
+        keep_cand(f, idx, mv);
     }
     if (!f->scored || score > f->best_s) {
         f->scored = true;
@@ -435,6 +545,7 @@ static bool refine_run(rfs_fields_t *f, uint32_t budget, uint32_t *used)
 static void finish(rfs_fields_t *f)
 {
     const rfs_map_t *m = f->map;
+    settle_best(f);
     const uint16_t i = (uint16_t)(f->best % m->lw), j = (uint16_t)(f->best / m->lw);
     uint32_t used = 0u;
     rfs_map_lattice_point(m, i, j, &f->bx, &f->by);

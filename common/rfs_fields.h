@@ -54,6 +54,8 @@
 #define RFS_FIELDS_SKIPPED (INT16_MIN + 1)
 /// Best coarse points whose neighbourhoods are predicted at full resolution.
 #define RFS_FIELDS_TOP 4u
+/// Most candidates of the settle phase (rfs_fields_cfg_t.settle_k).
+#define RFS_FIELDS_CAND 8u
 
 /// Configuration; rfs_fields_cfg_default() gives the values in the comments.
 typedef struct rfs_fields_cfg {
@@ -71,6 +73,13 @@ typedef struct rfs_fields_cfg {
                                  ///< metres Q16.16 (1 m), rounded to lattice steps (>= 1)
     rfs_q16_t lcb;               ///< the best point has the highest prediction less lcb
                                  ///< times its sigma (rfs_fields_est_t), Q16.16 (0), 0..8
+    uint8_t settle_k;            ///< once settled (rfs_model_fit_in_t.settle): the
+                                 ///< candidates, the best measured places, at most
+                                 ///< RFS_FIELDS_CAND (6; 0: off, the best prediction)
+    uint16_t settle_n;           ///< a candidate has this many samples of every source in
+                                 ///< its cell (8), >= 1
+    uint16_t settle_conf;        ///< ... and is measured enough with this many (64)
+    uint8_t settle_sep;          ///< candidates lie this many lattice steps apart (2), >= 1
 } rfs_fields_cfg_t;
 
 /// Caller-owned arrays, sized with rfs_fields_mem_size() for the map.
@@ -137,7 +146,7 @@ typedef struct rfs_fields {
     rfs_q16_t area_m2;                           ///< area within sigma of the best, m^2 Q16.16
     int64_t rms2[RFS_MODEL_MAX_SOURCES];         ///< each fit's rms^2, dB^2 Q16 (this lattice)
     bool scored;                                 ///< best_s holds a point's score
-    rfs_q16_t best_s;                            ///< the best point's score, Q16.16
+    int64_t best_s;                              ///< the best point's score, Q16.16
     uint32_t walls_counted;                      ///< wall counts of the last fit's own passes
     bool fitted[RFS_MODEL_MAX_SOURCES];          ///< src[k] holds a fit of fit_n/fit_seen
     uint16_t fit_n[RFS_MODEL_MAX_SOURCES];       ///< samples of that fit
@@ -145,6 +154,11 @@ typedef struct rfs_fields {
     bool changed[RFS_MODEL_MAX_SOURCES];         ///< this fit bins source k's residuals
     bool refit[RFS_MODEL_MAX_SOURCES];           ///< ... and refits its path-loss model
     bool lattice_done;                           ///< f[] and the best point are complete
+    rfs_model_settle_t settle;                   ///< the last fit's rfs_model_fit_in_t.settle
+    uint8_t ncand;                               ///< settle phase: candidates in cand[]
+    bool frozen;                                 ///< cand[] is chosen
+    uint32_t cand[RFS_FIELDS_CAND];              ///< their lattice indices, best first
+    int64_t cand_s[RFS_FIELDS_CAND];             ///< their measured target, Q16.16
 } rfs_fields_t;
 
 /// Defaults (see rfs_fields_cfg_t).
@@ -156,7 +170,8 @@ void rfs_fields_mem_size(const rfs_map_t *m, const rfs_fields_cfg_t *cfg, uint32
 
 /// Initialise without a model for target t (1..RFS_MODEL_MAX_SOURCES sources). Returns
 /// 0, or -1 on a bad configuration (rfs_pathloss_init's rules; cell outside (0, 8 m],
-/// radius outside [0, RFS_FIELDS_KERNEL_MAX cells], prior_n 0, draw_t <= 0), a target
+/// radius outside [0, RFS_FIELDS_KERNEL_MAX cells], prior_n 0, draw_t <= 0, settle_k
+/// above RFS_FIELDS_CAND, settle_n or settle_sep 0), a target
 /// without combine(), or a missing array. Fits fail on a map larger than the arrays.
 int rfs_fields_init(rfs_fields_t *f, const rfs_fields_cfg_t *cfg, const rfs_target_ops_t *t,
                     const rfs_fields_mem_t *mem);

@@ -22,6 +22,14 @@
 /// Most places a fit can be told the source is not (rfs_model_fit_in_t.nexcl).
 #define RFS_MODEL_MAX_EXCL 32u
 
+/// The seeker's phase, for a model that ranks the places it measured once exploration is
+/// over (rfs_fields_cfg_t.settle_k).
+typedef enum rfs_model_settle {
+    RFS_MODEL_EXPLORE = 0, ///< exploring (the paper's only phase)
+    RFS_MODEL_TOUR,        ///< settled: the robot measures the candidates in turn
+    RFS_MODEL_HOLD,        ///< ... and then holds the best measured
+} rfs_model_settle_t;
+
 /// What a model learns from.
 typedef struct rfs_model_fit_in {
     const rfs_sample_t *samples; ///< the stored samples
@@ -51,6 +59,8 @@ typedef struct rfs_model_fit_in {
     const int16_t *excl_y_cm; ///< their y, centimetres
     uint8_t nexcl;           ///< how many
     rfs_q16_t excl_r;        ///< radius ruled out round each, metres Q16.16
+    /// The seeker's settle phase (rfs_seek_cfg_t.settle_dist; rfs_fields_cfg_t.settle_k).
+    rfs_model_settle_t settle;
 } rfs_model_fit_in_t;
 
 /// Result of one fit call.

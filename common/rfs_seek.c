@@ -53,6 +53,8 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.refute_r = 0;                         /* and nothing is ruled out */
     c.silence_floor = INT32_MIN;            /* silence adds no sample */
     c.settle_dist = 0;                      /* epsilon anneals to eps_floor, never 0 */
+    c.settle_orbit = 0;
+    c.settle_end = 0;
     c.src_spacing = 0;
     c.src_floor = INT32_MIN;
     return c;
@@ -88,6 +90,10 @@ void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg)
     cfg->src_floor = RFS_Q16_INT(-100);     /* radiotap receivers report down to -100 dBm */
     /* Two thirds of the bridging scenarios' 150 m (docs/STRATEGIES.md, "Bridging"). */
     cfg->settle_dist = RFS_Q16_INT(100);
+    /* The settle tour (docs/STRATEGIES.md, "Bridging"): a lattice step round each
+     * candidate, 25 m of the 50 left. */
+    cfg->settle_orbit = RFS_Q16_FRAC(1, 4);
+    cfg->settle_end = RFS_Q16_INT(125);
     cfg->refute_r = 0; /* the argmax is the target's best point, not a source */
     cfg->silence_floor = INT32_MIN; /* each node's store has src_floor */
 }
@@ -159,7 +165,7 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         (uint32_t)cfg->strategy >= (uint32_t)RFS_SEEK_STRATEGY_COUNT ||
         cfg->tumble_better < 0 || cfg->tumble_better > RFS_Q16_ONE || cfg->tumble_worse < 0 ||
         cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0 || cfg->settle_dist < 0 ||
-        cfg->refute_r < 0 ||
+        cfg->settle_orbit < 0 || cfg->settle_end < 0 || cfg->refute_r < 0 ||
         cfg->src_spacing < 0) {
         return -1;
     }
@@ -536,7 +542,10 @@ static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_ou
                                .reach = s->reach_valid ? s->reach : 0,
                                .excl_x_cm = s->excl_x_cm, .excl_y_cm = s->excl_y_cm,
                                .nexcl = s->nexcl,
-                               .excl_r = s->cfg.refute_r };
+                               .excl_r = s->cfg.refute_r,
+                               .settle = !rfs_seek_src_settled(s) ? RFS_MODEL_EXPLORE
+                                         : rfs_seek_src_orbiting(s) ? RFS_MODEL_TOUR
+                                                                    : RFS_MODEL_HOLD };
     for (uint8_t i = 0; s->src != 0 && i < s->target->nsources; ++i) {
         fin.src_samples[i] = s->src[i].store.samples;
         fin.src_n[i] = s->src[i].store.count;
@@ -582,6 +591,9 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
      * when the mean has moved back within the threshold while the base braked. */
     relearn = rfs_seek_meta_refute(s, now_us) || relearn;
     relearn = relearn || ops->refit || s->replan;
+    /* settle_orbit: every decision ranks the candidates with the samples of the last
+     * orbit, and sees the tour end (docs/STRATEGIES.md, "Bridging"). */
+    relearn = relearn || (s->cfg.settle_orbit > 0 && rfs_seek_src_settled(s));
 
     if (relearn && s->store.count > 0u) {
         d->relearned = true;

@@ -113,6 +113,13 @@ typedef struct rfs_seek_cfg {
     rfs_q16_t settle_dist;      ///< after this much travel every choice is greedy (epsilon
                                 ///< 0): the robot goes to the model's best point and stays
                                 ///< there, metres Q16.16 (0: never, the paper's)
+    rfs_q16_t settle_orbit;     ///< after settle_dist, at the best point (a greedy goal
+                                ///< within half this): a move to a reachable lattice
+                                ///< point about this far from it, to measure more fades
+                                ///< round it, and a relearn at every decision, metres
+                                ///< Q16.16 (0: none, stand still)
+    rfs_q16_t settle_end;       ///< no orbit once this much has been travelled, metres
+                                ///< Q16.16 (0: no end)
     rfs_q16_t src_spacing;      ///< per-source stores (rfs_seek_mem_t.src_samples): a
                                 ///< source's sample is the mean of its packets since the
                                 ///< robot last moved this far, metres Q16.16 (0: one sample
@@ -328,8 +335,8 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 
 /// The settings for a model fitted per source (rfs_fields.h; docs/STRATEGIES.md,
-/// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m, refute_r 0,
-/// silence_floor none (src_floor instead).
+/// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m, settle_orbit
+/// 0.25 m, settle_end 125 m, refute_r 0, silence_floor none (src_floor instead).
 void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg);
 
 /// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array

@@ -100,6 +100,17 @@ void rfs_seek_src_on_rssi(rfs_seek_t *s, uint8_t src, int64_t t_us, int8_t dbm,
  * src_floor, a source without a mean while another has one counts as the floor. */
 bool rfs_seek_src_mean(rfs_seek_t *s, int64_t now_us, rfs_q16_t *mean);
 
+/* Exploration is over: settle_dist (> 0) travelled. */
+bool rfs_seek_src_settled(const rfs_seek_t *s);
+
+/* Settled, with settle_orbit, before settle_end. */
+bool rfs_seek_src_orbiting(const rfs_seek_t *s);
+
+/* settle_orbit: when settled and the robot stands within half the orbit of the model's
+ * best point, go to a random reachable lattice point round it (docs/STRATEGIES.md,
+ * "Bridging"); false (the usual choice follows) otherwise or when there is none. */
+bool rfs_seek_src_orbit(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us);
+
 /* ---- rfs_seek_baseline.c: the baselines' choose functions -------------------------- */
 
 /* fd-gradient: probes at p + step x and p + step y, then a step along the difference. */

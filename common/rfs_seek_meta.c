@@ -489,10 +489,13 @@ bool rfs_seek_meta_choose(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t 
     d->epsilon = rfs_seek_epsilon(&s->cfg, epsilon_index(s));
     /* settle_dist: exploration is over, the robot holds the model's best point. No draw is
      * taken then, so the paper's configuration (0: never) draws as it always did. */
-    bool settled = s->cfg.settle_dist > 0 && s->travel >= (int64_t)s->cfg.settle_dist;
+    bool settled = rfs_seek_src_settled(s);
     bool greedy = model_ok && (s->replan || settled || rfs_rng_q16(rng) >= d->epsilon);
     s->replan = false;
     d->kind = greedy ? RFS_SEEK_GREEDY : RFS_SEEK_EPSILON;
+    if (greedy && rfs_seek_src_orbit(s, rng, now_us)) {
+        return true; /* settle_orbit: round the best point, rfs_seek_src.c */
+    }
     bool ok = greedy ? choose_greedy(s, rng, now_us) : choose_epsilon(s, rng, now_us);
     if (s->plan.tree_more) {
         return false; /* a plan waits for the search tree: decided again (rfs_seek.c) */

@@ -40,10 +40,13 @@ static void restart(rfs_seek_src_t *c, rfs_q16_t x, rfs_q16_t y)
     c->y = y;
 }
 
-/* The robot is within src_spacing of source c's last sample. */
+/* The robot is within src_spacing of source c's last sample, or at rest since it: a
+ * robot standing still sees one fade however its localised pose jitters (5-10 cm in the
+ * simulator: else hundreds of samples of that one fade where the robot stood). */
 static bool near(const rfs_seek_t *s, const rfs_seek_src_t *c, rfs_q16_t x, rfs_q16_t y)
 {
-    return c->at && rfs_q16_dist(x, y, c->x, c->y) < s->cfg.src_spacing;
+    return c->at && (rfs_q16_dist(x, y, c->x, c->y) < s->cfg.src_spacing ||
+                     rfs_drive_at_rest(&s->drive));
 }
 
 /* src_floor: a source silent for a window while another is heard is below the receiver's
@@ -136,4 +139,70 @@ bool rfs_seek_src_mean(rfs_seek_t *s, int64_t now_us, rfs_q16_t *mean)
         *mean = s->target->combine(r);
     }
     return any;
+}
+
+bool rfs_seek_src_settled(const rfs_seek_t *s)
+{
+    return s->cfg.settle_dist > 0 && s->travel >= (int64_t)s->cfg.settle_dist;
+}
+
+bool rfs_seek_src_orbiting(const rfs_seek_t *s)
+{
+    return s->cfg.settle_orbit > 0 && rfs_seek_src_settled(s) &&
+           (s->cfg.settle_end == 0 || s->travel < (int64_t)s->cfg.settle_end);
+}
+
+/* settle_orbit: the robot stands at the best point, where it adds no sample (one fade,
+ * src_spacing), so the best point's measured f rests on the pass that found it, and a
+ * lucky fade there holds the robot for good. A move to a reachable lattice point between
+ * half the orbit and the orbit from it adds samples of new fades round it; the next
+ * greedy decision returns, relearnt, to the best point of the more measured field.
+ * Uniform over the ring without a list: count, then take the k-th. Scaling: offsets Q16
+ * squared in int64 (Q32) against the radii squared. */
+bool rfs_seek_src_orbit(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
+{
+    rfs_q16_t mx, my;
+    if (!rfs_seek_src_orbiting(s) || s->model.ops->argmax == 0 ||
+        !s->model.ops->argmax(s->model.self, &mx, &my) ||
+        rfs_q16_dist(s->pose.x, s->pose.y, mx, my) >= s->cfg.settle_orbit / 2) {
+        return false;
+    }
+    const rfs_map_t *m = s->map;
+    uint16_t ci, cj;
+    rfs_map_lattice_nearest(m, mx, my, &ci, &cj);
+    const int32_t r = s->cfg.settle_orbit / m->cfg.grid + 1;
+    const int64_t hi = (int64_t)s->cfg.settle_orbit * s->cfg.settle_orbit, lo = hi / 4;
+    uint32_t n = 0u;
+    for (int pass = 0; pass < 2; ++pass) {
+        const uint32_t pick = pass ? rfs_rng_below(rng, n) : 0u;
+        uint32_t seen = 0u;
+        for (int32_t j = (int32_t)cj - r; j <= (int32_t)cj + r; ++j) {
+            for (int32_t i = (int32_t)ci - r; i <= (int32_t)ci + r; ++i) {
+                if (i < 0 || j < 0 || i >= (int32_t)m->lw || j >= (int32_t)m->lh ||
+                    !rfs_reach_at(m, s->reach, (uint16_t)i, (uint16_t)j)) {
+                    continue;
+                }
+                rfs_q16_t px, py;
+                rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
+                const int64_t dx = (int64_t)px - mx, dy = (int64_t)py - my;
+                const int64_t d2 = dx * dx + dy * dy;
+                if (d2 < lo || d2 > hi) {
+                    continue;
+                }
+                if (pass == 0) {
+                    n++;
+                } else if (seen++ == pick) {
+                    s->decision.max_x = mx;
+                    s->decision.max_y = my;
+                    s->decision.goal_x = px;
+                    s->decision.goal_y = py;
+                    return rfs_seek_go_to(s, px, py, now_us);
+                }
+            }
+        }
+        if (n == 0u) {
+            return false;
+        }
+    }
+    return false;
 }

@@ -463,6 +463,80 @@ static void test_lower_confidence_bound(void **state)
     assert_true(D(e0.sigma) > D(e.sigma));
 }
 
+/* Spot k of the settle test: lattice point (SPX[k], SPY) in the corridor. */
+static const double SPX[3] = {12.125, 15.125, 18.125}, SPY = 8.125;
+
+/* n samples of source src at spot k (within 3 cm of it, its nearest lattice point), from
+ * index at on, valued by the truth plus off dB. */
+static void spot_samples(fixture_t *f, int src, int k, int at, int n, double off)
+{
+    for (int s = 0; s < n; ++s) {
+        const int xc = (int)lround(SPX[k] * 100) - 1 + s % 3, yc = (int)lround(SPY * 100) - 1 + s / 3 % 3;
+        f->s[src][at + s].x_cm = (int16_t)xc;
+        f->s[src][at + s].y_cm = (int16_t)yc;
+        f->s[src][at + s].v_q6 = (int16_t)lround((truth(&f->map, src, xc / 100.0, yc / 100.0) + off) * 64.0);
+    }
+}
+
+static int arg_best(const double *v)
+{
+    return v[0] >= v[1] && v[0] >= v[2] ? 0 : v[1] >= v[2] ? 1 : 2;
+}
+
+/* The settle phase: candidates are the cells measured settle_n times (only the three
+ * spots: the other samples lie about 0.4 to a cell), ranked by what was measured there
+ * (the truth plus each spot's offset, in double: 4.3 and 5.7 dB apart); the tour's best
+ * point is the first candidate not measured settle_conf times; after more samples at it
+ * the next; once held, the best measured. Exploring, the best point is the prediction's, none of them. */
+static void test_settle_tour(void **state)
+{
+    fixture_t *f = *state;
+    make_bridge(f, 0.0);
+    const double off[3] = {0.0, 5.0, 10.0};
+    double ref[3];
+    for (int k = 0; k < 3; ++k) {
+        for (int src = 0; src < 2; ++src) {
+            spot_samples(f, src, k, NS - 200 + 40 * k, 40, off[k]);
+        }
+        ref[k] = bridge_ref(truth(&f->map, 0, SPX[k], SPY) + off[k], truth(&f->map, 1, SPX[k], SPY) + off[k]);
+    }
+    const int first = arg_best(ref);
+    rfs_fields_cfg_t c = rfs_fields_cfg_default();
+    c.settle_k = 3;
+    c.settle_n = 8;
+    c.settle_conf = 64;
+    assert_int_equal(rfs_fields_init(&f->fl, &c, &rfs_target_bridge, &f->mem), 0);
+    rfs_model_fit_in_t in = fit_in(f, 2);
+    rfs_fields_est_t e;
+    assert_int_equal(fit_all(&f->fl, &in, 0, NULL), RFS_FIT_DONE);
+    assert_true(rfs_fields_estimate(&f->fl, &e));
+    for (int k = 0; k < 3; ++k) {
+        assert_false(fabs(D(e.x) - SPX[k]) < 0.1 && fabs(D(e.y) - SPY) < 0.1);
+    }
+    in.settle = RFS_MODEL_TOUR;
+    assert_int_equal(fit_all(&f->fl, &in, 0, NULL), RFS_FIT_DONE);
+    assert_true(rfs_fields_estimate(&f->fl, &e));
+    assert_true(fabs(D(e.x) - SPX[first]) < 1e-3 && fabs(D(e.y) - SPY) < 1e-3);
+    /* 40 more samples at the first, 2 dB low: measured enough, 1 dB lower on average (f:
+     * 2 dB), still the best measured: the tour moves on, the hold stays. */
+    for (int src = 0; src < 2; ++src) {
+        spot_samples(f, src, first, NS - 80, 40, off[first] - 2.0);
+        in.src_seen[src] += 40;
+    }
+    double rank[3] = {ref[0], ref[1], ref[2]};
+    rank[first] = -1e9;
+    const int second = arg_best(rank);
+    assert_int_equal(fit_all(&f->fl, &in, 0, NULL), RFS_FIT_DONE);
+    assert_true(rfs_fields_estimate(&f->fl, &e));
+    assert_true(fabs(D(e.x) - SPX[second]) < 1e-3);
+    in.settle = RFS_MODEL_HOLD;
+    ref[first] -= 2.0;
+    assert_int_equal(arg_best(ref), first);
+    assert_int_equal(fit_all(&f->fl, &in, 0, NULL), RFS_FIT_DONE);
+    assert_true(rfs_fields_estimate(&f->fl, &e));
+    assert_true(fabs(D(e.x) - SPX[arg_best(ref)]) < 1e-3);
+}
+
 /* Draws land on kept predictions, the best point with its share e^0 / sum e^(-d / T). */
 static void test_draws(void **state)
 {
@@ -532,6 +606,12 @@ static void test_init_and_inputs(void **state)
     bad.lcb = -1;
     assert_int_equal(rfs_fields_init(&f->fl, &bad, &rfs_target_bridge, &f->mem), -1);
     bad = c;
+    bad.settle_k = RFS_FIELDS_CAND + 1u;
+    assert_int_equal(rfs_fields_init(&f->fl, &bad, &rfs_target_bridge, &f->mem), -1);
+    bad = c;
+    bad.settle_sep = 0;
+    assert_int_equal(rfs_fields_init(&f->fl, &bad, &rfs_target_bridge, &f->mem), -1);
+    bad = c;
     bad.pathloss.bin = 0;
     assert_int_equal(rfs_fields_init(&f->fl, &bad, &rfs_target_bridge, &f->mem), -1);
     assert_int_equal(rfs_fields_init(&f->fl, &c, &rfs_target_bridge, &f->mem), 0);
@@ -573,6 +653,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_relearn_reuses_unchanged_fits, setup, teardown),
         cmocka_unit_test_setup_teardown(test_uncertainty, setup, teardown),
         cmocka_unit_test_setup_teardown(test_lower_confidence_bound, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_settle_tour, setup, teardown),
         cmocka_unit_test_setup_teardown(test_draws, setup, teardown),
         cmocka_unit_test_setup_teardown(test_init_and_inputs, setup, teardown),
         cmocka_unit_test(test_registry_per_source),

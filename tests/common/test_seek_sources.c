@@ -105,6 +105,7 @@ static void test_one_sample_per_spacing(void **state)
     assert_int_equal(s->src[0].store.samples[0].v_q6, -60 * 64);
     assert_int_equal(s->src[1].store.count, 0);
     assert_int_equal(s->store.count, 0); /* no bridging sample without source 1's mean */
+    s->drive.base_left = s->drive.base_right = 100; /* the base rolls */
     /* 3.9 cm: still the same place. */
     pose(&t, now + 10000, 5.039, 5.0);
     now += 10000;
@@ -123,6 +124,31 @@ static void test_one_sample_per_spacing(void **state)
     two_free(&t);
 }
 
+/* At rest the localised pose jitters (here 8 cm each way) but the robot sees one fade:
+ * no sample after the first; rolling, one per 4 cm. */
+static void test_no_sample_at_rest(void **state)
+{
+    (void)state;
+    two_t t;
+    assert_int_equal(two_make(&t, per_source_cfg(), true, false), 0);
+    rfs_seek_t *s = &t.w.seek;
+    int64_t now = 0;
+    for (int k = 0; k < 40; ++k) {
+        now += 10000;
+        pose(&t, now, 5.0 + (k % 2 ? 0.08 : 0.0), 5.0 + (k % 4 < 2 ? 0.08 : 0.0));
+        assert_true(rfs_seek_on_rssi(s, 0, now + 1, -60, &t.w.rng));
+    }
+    assert_int_equal(s->src[0].store.count, 1);
+    s->drive.base_left = s->drive.base_right = 100;
+    for (int k = 0; k < 40; ++k) {
+        now += 10000;
+        pose(&t, now, 5.0 + (k % 2 ? 0.08 : 0.0), 5.0 + (k % 4 < 2 ? 0.08 : 0.0));
+        assert_true(rfs_seek_on_rssi(s, 0, now + 1, -60, &t.w.rng));
+    }
+    assert_true(s->src[0].store.count >= 30);
+    two_free(&t);
+}
+
 /* Source 1 silent for over a window while source 0 is heard: a floor sample every 4 cm
  * of travel, and the decision's mean is f(mean 0, floor). */
 static void test_silent_source_reads_floor(void **state)
@@ -136,6 +162,7 @@ static void test_silent_source_reads_floor(void **state)
     rfs_seek_out_t out;
     int decisions = 0;
     double mean0 = 0.0;
+    s->drive.base_left = s->drive.base_right = 100; /* the base rolls */
     for (int k = 0; k < 60; ++k) { /* 3 s at 20 Hz, 1 cm a period */
         now += 50000;
         x += 0.01;
@@ -205,13 +232,76 @@ static void test_settle_dist(void **state)
     assert_true(after >= 3);
 }
 
+/* settle_orbit: once settled, a decision at the model's best point goes to a reachable
+ * lattice point 0.25-0.5 m from it (distances in double), the next one back, each
+ * relearnt; after settle_end, and without settle_orbit, the robot holds the point. */
+static void run_orbit(rfs_q16_t orbit, rfs_q16_t end, int *ring, int *held, int *other)
+{
+    world_t t;
+    world_make(&t, 10.0, 10.0, 0, 0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    cfg.settle_dist = RFS_Q16_INT(2);
+    cfg.settle_orbit = orbit;
+    cfg.settle_end = end;
+    seek_make(&t, cfg, 9);
+    fixed_model_t fm = { false, Q(5.125), Q(5.125) };
+    rfs_model_t model = { fixed_ops(), &fm };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 2.0, .y = 2.0 };
+    rfs_seek_out_t out;
+    *ring = *held = *other = 0;
+    double gx0 = -1.0;
+    int distinct = 0;
+    for (int k = 0; k < 40 && next_decision(&t, &r, &f, 500000, 5000000, &out); ++k) {
+        if (t.seek.travel < cfg.settle_dist || k < 2) {
+            continue;
+        }
+        const double d = hypot(D(out.decision.goal_x) - 5.125, D(out.decision.goal_y) - 5.125);
+        const bool at = hypot(D(out.decision.x) - 5.125, D(out.decision.y) - 5.125) < 0.01;
+        assert_true(out.decision.relearned || orbit == 0 || t.seek.travel >= end);
+        if (at && d >= 0.25 - 1e-9 && d <= 0.5 + 1e-9) {
+            *ring += 1;
+            distinct += fabs(D(out.decision.goal_x) - gx0) > 1e-6;
+            gx0 = D(out.decision.goal_x);
+        } else if (d < 1e-6) {
+            *held += 1;
+        } else {
+            *other += 1;
+        }
+    }
+    if (*ring >= 10) { /* round the point, not to one side */
+        assert_true(distinct >= 3);
+    }
+    world_free(&t);
+}
+
+static void test_settle_orbit(void **state)
+{
+    (void)state;
+    int ring, held, other;
+    run_orbit(RFS_Q16_HALF, 0, &ring, &held, &other);
+    assert_true(ring >= 10);
+    assert_true(held >= 10); /* the way back */
+    assert_int_equal(other, 0);
+    run_orbit(0, 0, &ring, &held, &other);
+    assert_int_equal(ring, 0);
+    assert_int_equal(other, 0);
+    run_orbit(RFS_Q16_HALF, RFS_Q16_INT(10), &ring, &held, &other);
+    assert_true(ring >= 2 && ring <= 8); /* about 0.75 m a round */
+    assert_true(held >= 15);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_stores_all_or_none),
         cmocka_unit_test(test_one_sample_per_spacing),
+        cmocka_unit_test(test_no_sample_at_rest),
         cmocka_unit_test(test_silent_source_reads_floor),
         cmocka_unit_test(test_settle_dist),
+        cmocka_unit_test(test_settle_orbit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -176,6 +176,8 @@ def main():
     m = re.fullmatch(r"(\d+)\.\.(\d+)", a.seeds)
     if not m:
         sys.exit("bench_bridge: --seeds: expected A..B")
+    if not a.from_dir and not os.access(a.sim, os.X_OK):
+        sys.exit(f"bench_bridge: --sim: {a.sim}: not an executable (make all)")
     t0 = time.time()
     table, reused = [], False
     if a.keep:

@@ -87,6 +87,10 @@ def main():
     m = re.fullmatch(r"(\d+)\.\.(\d+)", a.seeds)
     if not m:
         sys.exit("bridge_bounds: seeds: expected A..B")
+    if not os.access(a.sim, os.X_OK):
+        sys.exit(f"bridge_bounds: --sim: {a.sim}: not an executable (make all)")
+    if not os.path.isfile(a.scenario):
+        sys.exit(f"bridge_bounds: {a.scenario}: no such scenario file")
     with open(a.scenario) as fh:
         w = re.search(r"db_per_wall:\s*([0-9.]+)", fh.read())
     wall_db = float(w.group(1)) if w else 5.0  # docs/SIMULATOR.md's default

@@ -139,12 +139,6 @@ static int32_t floor_div(int32_t a, int32_t b)
     return (a % b != 0 && a < 0) ? q - 1 : q;
 }
 
-/* Centimetres to metres Q16.16, rounded. |cm| < 2^22: product < 2^38. */
-static rfs_q16_t cm_to_q16(int32_t cm)
-{
-    return rfs_sat32(rfs_sdiv64_round((int64_t)cm * 65536, 100));
-}
-
 static uint32_t bin_hash(int16_t kx, int16_t ky)
 {
     uint32_t h = (uint32_t)(uint16_t)kx * 0x9E3779B1u + (uint32_t)(uint16_t)ky * 0x85EBCA77u;
@@ -220,8 +214,8 @@ static void bin_means(rfs_pathloss_t *p)
         bb->sy_cm = (int32_t)rfs_sdiv64_round(bb->sy_cm, bb->count);
         bb->dz_q16 -= p->mz_q16;
         bb->count = (uint16_t)(bb->count < p->cfg.bin_cap ? bb->count : p->cfg.bin_cap);
-        bb->x = cm_to_q16(bb->sx_cm);
-        bb->y = cm_to_q16(bb->sy_cm);
+        bb->x = rfs_pathloss_cm_to_q16(bb->sx_cm);
+        bb->y = rfs_pathloss_cm_to_q16(bb->sy_cm);
         bb->wx = bb->x;
         bb->wy = bb->y;
         bb->row = RFS_PATHLOSS_NO_ROW;
@@ -275,13 +269,6 @@ static void setup_lattice(rfs_pathloss_t *p, const rfs_map_t *m)
     l->c0j = (uint16_t)(((uint32_t)l->lh - 1u - (uint32_t)(l->ncy - 1u) * (uint32_t)cs) / 2u);
 }
 
-static void lattice_xy(const rfs_pathloss_lat_t *l, uint16_t i, uint16_t j, rfs_q16_t *x,
-                       rfs_q16_t *y)
-{
-    *x = rfs_sat32((int64_t)l->ox + (int64_t)i * l->grid);
-    *y = rfs_sat32((int64_t)l->oy + (int64_t)j * l->grid);
-}
-
 /* dx^2 + dy^2 for differences of Q16 values (|d| < 2^32): Q32 in uint64, saturated. */
 static uint64_t sq_sum(int64_t dx, int64_t dy)
 {
@@ -298,7 +285,7 @@ static bool excluded(const rfs_pathloss_t *p, int32_t i, int32_t j)
         return false;
     }
     rfs_q16_t x, y;
-    lattice_xy(&p->lat, (uint16_t)i, (uint16_t)j, &x, &y);
+    rfs_pathloss_lattice_xy(&p->lat, (uint16_t)i, (uint16_t)j, &x, &y);
     const uint64_t r2 = (uint64_t)((int64_t)p->excl_r * p->excl_r);
     for (uint32_t e = 0u; e < p->nexcl; ++e) {
         if (sq_sum((int64_t)x - p->excl_x[e], (int64_t)y - p->excl_y[e]) <= r2) {
@@ -477,17 +464,10 @@ static void ev_start(rfs_pathloss_t *p, uint16_t li, uint16_t lj, uint8_t kind, 
     p->ev.kind = kind;
     p->ev.li = li;
     p->ev.lj = lj;
-    lattice_xy(&p->lat, li, lj, &p->ev.sx, &p->ev.sy);
+    rfs_pathloss_lattice_xy(&p->lat, li, lj, &p->ev.sx, &p->ev.sy);
     p->ev.col = rfs_pathloss_walls_col(p, li, lj);
     p->ev.c = c;
     p->ev.b = 0u;
-}
-
-/* Mean Huber loss per unit weight, dB^2 Q16, saturated below NO_LOSS. */
-static uint32_t mean_loss(const rfs_pathloss_t *p, int64_t loss)
-{
-    uint64_t m = rfs_udiv64((uint64_t)loss, p->total);
-    return m >= RFS_PATHLOSS_NO_LOSS ? RFS_PATHLOSS_NO_LOSS - 1u : (uint32_t)m;
 }
 
 static void consider(rfs_pathloss_t *p, const rfs_pathloss_cand_t *cd)
@@ -544,10 +524,10 @@ static void finish(rfs_pathloss_t *p)
     const rfs_pathloss_lat_t *l = &p->lat;
     p->best = p->cur;
     /* Spread region: mean loss <= best (1 + spread_k / bins). */
-    uint64_t bm = mean_loss(p, p->best.loss);
+    uint64_t bm = rfs_pathloss_mean_loss(p, p->best.loss);
     uint64_t thr = bm + rfs_udiv64(bm * (uint64_t)p->cfg.spread_k, (uint64_t)p->nbins * 65536u);
     /* At least the best coarse point: the surface cannot resolve a smaller region. */
-    uint64_t tc = mean_loss(p, p->top[0].loss);
+    uint64_t tc = rfs_pathloss_mean_loss(p, p->top[0].loss);
     thr = thr > tc ? thr : tc;
     uint32_t cnt = 0u;
     for (uint32_t c = 0u; c < (uint32_t)l->ncx * l->ncy; ++c) {
@@ -629,8 +609,8 @@ static bool fit_begin(rfs_pathloss_t *p, const rfs_model_fit_in_t *in)
                    : 0u;
     p->excl_r = in->excl_r;
     for (uint32_t e = 0u; e < p->nexcl; ++e) {
-        p->excl_x[e] = cm_to_q16(in->excl_x_cm[e]); /* once a fit, not per candidate */
-        p->excl_y[e] = cm_to_q16(in->excl_y_cm[e]);
+        p->excl_x[e] = rfs_pathloss_cm_to_q16(in->excl_x_cm[e]); /* once a fit, not per candidate */
+        p->excl_y[e] = rfs_pathloss_cm_to_q16(in->excl_y_cm[e]);
     }
     bin_reset(p, (int32_t)(((int64_t)p->cfg.bin * 100 + 32768) >> 16));
     p->bin_n = in->n;
@@ -713,7 +693,7 @@ static bool ev_run(rfs_pathloss_t *p, uint32_t budget, uint32_t *used)
         return true;
     }
     if (p->ev.kind == EV_COARSE) {
-        p->surface[p->ev.c] = mean_loss(p, cd.loss);
+        p->surface[p->ev.c] = rfs_pathloss_mean_loss(p, cd.loss);
         keep_top(p, &cd);
     }
     consider(p, &cd);
@@ -892,10 +872,10 @@ typedef struct draw_k {
 
 static draw_k_t draw_consts(const rfs_pathloss_t *p)
 {
-    uint64_t bm = mean_loss(p, p->best.loss);
+    uint64_t bm = rfs_pathloss_mean_loss(p, p->best.loss);
     bm = bm > 0u ? bm : 1u;
     uint64_t den = (bm * 2u * (uint64_t)p->cfg.sample_t) >> 16;
-    draw_k_t k = {mean_loss(p, p->top[0].loss), den > 0u ? den : 1u};
+    draw_k_t k = {rfs_pathloss_mean_loss(p, p->top[0].loss), den > 0u ? den : 1u};
     return k;
 }
 
@@ -945,7 +925,7 @@ static bool pathloss_sample(const void *self, rfs_rng_t *rng, rfs_q16_t *x, rfs_
     for (uint32_t c = 0u; c < nc; ++c) {
         acc += draw_weight(p, &k, c);
         if (acc > pick) {
-            lattice_xy(l, (uint16_t)(l->c0i + (c % l->ncx) * l->cs),
+            rfs_pathloss_lattice_xy(l, (uint16_t)(l->c0i + (c % l->ncx) * l->cs),
                        (uint16_t)(l->c0j + (c / l->ncx) * l->cs), x, y);
             return true;
         }
@@ -970,52 +950,4 @@ rfs_model_t rfs_pathloss_model(rfs_pathloss_t *p)
     m.ops = &rfs_pathloss_ops;
     m.self = p;
     return m;
-}
-
-bool rfs_pathloss_estimate(const rfs_pathloss_t *p, rfs_pathloss_est_t *est)
-{
-    RFS_ASSERT(p != 0 && est != 0);
-    if (!p->valid) {
-        return false;
-    }
-    est->sx = p->best.sx;
-    est->sy = p->best.sy;
-    est->p0 = p->best.p0;
-    est->n = p->best.n;
-    est->w = p->best.w;
-    uint32_t m2 = mean_loss(p, p->best.loss);
-    est->rms = rfs_q16_sqrt(m2 > (uint32_t)INT32_MAX / 2u ? INT32_MAX : (rfs_q16_t)(2u * m2));
-    est->spread_m2 = p->spread_m2;
-    est->bins = p->used_bins;
-    est->bin = cm_to_q16(p->used_bin_cm);
-    est->candidates = p->candidates;
-    est->walls_counted = p->walls_counted;
-    est->footprints = p->footprints;
-    est->footprints_cached = p->footprints_cached;
-    return true;
-}
-
-void rfs_pathloss_surface_size(const rfs_pathloss_t *p, uint16_t *ncx, uint16_t *ncy)
-{
-    RFS_ASSERT(p != 0 && ncx != 0 && ncy != 0);
-    *ncx = p->valid ? p->lat.ncx : 0u;
-    *ncy = p->valid ? p->lat.ncy : 0u;
-}
-
-bool rfs_pathloss_residual_at(const rfs_pathloss_t *p, uint16_t ci, uint16_t cj, rfs_q16_t *x,
-                              rfs_q16_t *y, rfs_q16_t *rms)
-{
-    RFS_ASSERT(p != 0 && x != 0 && y != 0 && rms != 0);
-    const rfs_pathloss_lat_t *l = &p->lat;
-    if (!p->valid || ci >= l->ncx || cj >= l->ncy) {
-        return false;
-    }
-    lattice_xy(l, (uint16_t)(l->c0i + ci * l->cs), (uint16_t)(l->c0j + cj * l->cs), x, y);
-    uint32_t m = p->surface[(uint32_t)cj * l->ncx + ci];
-    if (m == RFS_PATHLOSS_NO_LOSS) {
-        return false;
-    }
-    /* sqrt(2 m): 2 m saturated to the Q16 range (181 dB). */
-    *rms = rfs_q16_sqrt(m > (uint32_t)INT32_MAX / 2u ? INT32_MAX : (rfs_q16_t)(2u * m));
-    return true;
 }

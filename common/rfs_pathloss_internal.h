@@ -1,5 +1,6 @@
-/* rfs_pathloss_internal.h - private to rfs_pathloss.c and rfs_pathloss_walls.c: the wall
- * counts the fit and the prediction share. Not part of the core's API.
+/* rfs_pathloss_internal.h - private to rfs_pathloss*.c: the wall counts the fit and the
+ * prediction share, and the conversions the fit and its report share. Not part of the
+ * core's API.
  */
 #ifndef RFS_PATHLOSS_INTERNAL_H
 #define RFS_PATHLOSS_INTERNAL_H
@@ -8,6 +9,27 @@
 #include <stdint.h>
 
 #include "rfs_pathloss.h"
+
+/* Centimetres to metres Q16.16, rounded. |cm| < 2^22: product < 2^38. */
+static inline rfs_q16_t rfs_pathloss_cm_to_q16(int32_t cm)
+{
+    return rfs_sat32(rfs_sdiv64_round((int64_t)cm * 65536, 100));
+}
+
+/* The position of lattice point (i, j), metres Q16.16, saturated. */
+static inline void rfs_pathloss_lattice_xy(const rfs_pathloss_lat_t *l, uint16_t i, uint16_t j,
+                                           rfs_q16_t *x, rfs_q16_t *y)
+{
+    *x = rfs_sat32((int64_t)l->ox + (int64_t)i * l->grid);
+    *y = rfs_sat32((int64_t)l->oy + (int64_t)j * l->grid);
+}
+
+/* Mean Huber loss per unit weight, dB^2 Q16, saturated below NO_LOSS. */
+static inline uint32_t rfs_pathloss_mean_loss(const rfs_pathloss_t *p, int64_t loss)
+{
+    uint64_t m = rfs_udiv64((uint64_t)loss, p->total);
+    return m >= RFS_PATHLOSS_NO_LOSS ? RFS_PATHLOSS_NO_LOSS - 1u : (uint32_t)m;
+}
 
 /* Wall counts saturate here (15 walls are 75 dB at 5 dB each; four of them, in quarter
  * walls, fit a byte of the cache). */

@@ -392,27 +392,34 @@ static rfs_fit_result_t refute_fit(void *self, const rfs_model_fit_in_t *in, uin
     return RFS_FIT_DONE;
 }
 
-static int refute_case(double mean, bool on, bool reached, int decisions, refute_model_t *m)
+/* The refute worlds: a 20 x 10 m room, meta-path with every decision after the first
+ * greedy, the seeker on model m (cleared) with cfg's refute settings. */
+static void refute_world(world_t *t, rfs_seek_cfg_t cfg, refute_model_t *m)
 {
     static const rfs_model_ops_t ops = {
         .name = "refute", .reset = fixed_reset, .fit = refute_fit, .predict = fixed_predict,
         .argmax = fixed_argmax,
     };
+    world_make(t, 20.0, 10.0, 0, 0);
+    cfg.eps_amp = 0;
+    cfg.eps_floor = 0;
+    seek_make(t, cfg, 5);
+    memset(m, 0, sizeof *m);
+    rfs_model_t model = { &ops, m };
+    assert_int_equal(rfs_seek_init(&t->seek, &cfg, &t->map, model, &rfs_target_rssi, &t->mem), 0);
+}
+
+static int refute_case(double mean, bool on, bool reached, int decisions, refute_model_t *m)
+{
     world_t t;
-    world_make(&t, 20.0, 10.0, 0, 0);
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
     assert_int_equal(cfg.refute_r, cfg.step); /* the preset's */
     cfg.refute_r = on ? cfg.refute_r : 0;
     cfg.refute_reached = reached;
-    cfg.eps_amp = 0;
-    cfg.eps_floor = 0; /* every decision after the first is greedy */
-    seek_make(&t, cfg, 5);
-    memset(m, 0, sizeof *m);
+    refute_world(&t, cfg, m);
     m->mean = mean;
     m->reached = reached;
-    rfs_model_t model = { &ops, m };
-    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
     field_t f = { .kind = 2, .scripted = mean };
     run_t r = { .x = 4.125, .y = 5.125 };
     rfs_seek_out_t out;
@@ -430,21 +437,11 @@ static int refute_case(double mean, bool on, bool reached, int decisions, refute
  * it is decided. Returns the decisions that ruled a place out. */
 static int refute_silent(refute_model_t *m, int decisions)
 {
-    static const rfs_model_ops_t ops = {
-        .name = "refute", .reset = fixed_reset, .fit = refute_fit, .predict = fixed_predict,
-        .argmax = fixed_argmax,
-    };
     world_t t;
-    world_make(&t, 20.0, 10.0, 0, 0);
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
-    cfg.eps_amp = 0;
-    cfg.eps_floor = 0;
-    seek_make(&t, cfg, 5);
-    memset(m, 0, sizeof *m);
+    refute_world(&t, cfg, m);
     m->silent = true;
-    rfs_model_t model = { &ops, m };
-    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
     double x = 4.125, y = 5.125, gx = x, gy = y;
     int64_t arrive = -1;
     int refuted = 0, decided = 0;

@@ -105,6 +105,8 @@ typedef struct feed_stats {
     bool count_all;                   /* --stats: parse every record to count why it gave
                                          nothing (else one from another source is skipped
                                          unparsed, docs/FEEDER.md) */
+    lx_rt_layout_t layout;            /* the last radiotap layout read (a capture's records
+                                         mostly share one: lx_radiotap_parse_memo) */
 } feed_stats_t;
 
 static int parse_mac(const char *s, uint8_t mac[6])
@@ -248,14 +250,31 @@ static int64_t realtime_us(void)
     return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 }
 
+/* Whether two MAC addresses are equal: two loads each, no call (once a record). */
+static inline bool mac_eq(const uint8_t *a, const uint8_t *b)
+{
+    uint32_t a4, b4;
+    uint16_t a2, b2;
+    memcpy(&a4, a, 4);
+    memcpy(&b4, b, 4);
+    memcpy(&a2, a + 4, 2);
+    memcpy(&b2, b + 4, 2);
+    return a4 == b4 && a2 == b2;
+}
+
+/* The index of sa among the n MACs, or n. */
+static inline int mac_index(const uint8_t (*macs)[6], int n, const uint8_t *sa)
+{
+    int m = 0;
+    while (m < n && !mac_eq(macs[m], sa)) { m++; }
+    return m;
+}
+
 /* Whether the record's source address is one of the n MACs (lx_rt_frame_sa). */
 static bool sa_wanted(const lx_pcap_pkt_t *pkt, const uint8_t (*macs)[6], int n)
 {
     const uint8_t *sa = lx_rt_frame_sa(pkt->data, pkt->caplen);
-    if (sa == NULL) { return false; }
-    int m = 0;
-    while (m < n && memcmp(macs[m], sa, 6) != 0) { m++; }
-    return m < n;
+    return sa != NULL && mac_index(macs, n, sa) < n;
 }
 
 /* The next record whose radiotap header parsed (with bad_rt, or was unusable but located
@@ -286,7 +305,7 @@ static int next_frame(lx_pcap_reader_t *r, feed_stats_t *st, lx_pcap_pkt_t *pkt,
         if (alive != NULL && alive(alive_ctx, pkt->t_us) != 0) { return -1; }
         if (pkt->caplen < pkt->origlen) { st->caplen_short++; }
         if (want != NULL && !st->count_all && !sa_wanted(pkt, want, n_want)) { continue; }
-        const int prc = lx_rt_frame_parse(pkt->data, pkt->caplen, f);
+        const int prc = lx_rt_frame_parse_memo(pkt->data, pkt->caplen, f, &st->layout);
         if (prc != 0 && bad_rt && f->wlan_ok) {
             st->rt_kept++;
             return 1;
@@ -310,8 +329,7 @@ static int scan_capture(lx_pcap_reader_t *r, const uint8_t (*macs)[6], int n_mac
         const int got = next_frame(r, st, &pkt, &f, false, macs, n_macs, alive, alive_ctx);
         if (got <= 0) { return got < 0 ? 1 : 0; }
         if (!f.wlan.has_sa) { st->no_sa++; continue; }
-        int m = 0;
-        while (m < n_macs && memcmp(macs[m], f.wlan.sa, 6) != 0) { m++; }
+        const int m = mac_index(macs, n_macs, f.wlan.sa);
         if (m == n_macs) { continue; }
         st->sa_match++;
         st->mac_frames[m]++;
@@ -336,8 +354,7 @@ static int scan_list(lx_pcap_reader_t *r, const uint8_t (*macs)[6], int n_macs, 
             break;
         }
         if (!f.wlan.has_ta) { st->no_ta++; continue; }
-        int m = 0;
-        while (m < n_macs && memcmp(macs[m], f.wlan.ta, 6) != 0) { m++; }
+        const int m = mac_index(macs, n_macs, f.wlan.ta);
         if (n_macs > 0 && m == n_macs) { continue; }
         if (n_macs > 0) { st->mac_frames[m]++; }
         const bool usable = f.rt.status < LX_RT_ERR_SHORT; /* else no radiotap field counts */

@@ -2,7 +2,8 @@
  * Input: one captured record (radiotap header, then the 802.11 frame). Beyond "no
  * out-of-bounds read" (ASan) it checks what the parser promises: a usable header lies
  * inside the input, an address is only reported when the frame holds it, an SSID only
- * when a beacon or probe response holds it, and the source-address filter agrees with it.
+ * when a beacon or probe response holds it, the source-address filter agrees with it, and
+ * a parse through a layout memo (kept from the inputs before) equals the walk.
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -46,6 +47,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (sa != NULL && (sa < data || sa + 6 > data + size)) { abort(); }
     if (rc == 0 && ((sa != NULL) != (f.wlan_ok && f.wlan.has_sa) || (sa != NULL && memcmp(sa, f.wlan.sa, 6) != 0))) {
         abort();
+    }
+    /* Through the layout memo: primed by earlier inputs, then by this one. */
+    static lx_rt_layout_t memo;
+    for (int i = 0; i < 2; i++) {
+        lx_rt_frame_t g;
+        if (lx_rt_frame_parse_memo(data, size, &g, &memo) != rc ||
+            memcmp(&g, &f, offsetof(lx_rt_frame_t, ssid) + (f.has_ssid ? f.ssid_len : 0u)) != 0) {
+            abort();
+        }
     }
     /* The parser alone, on every prefix length the record could have been cut at. */
     lx_radiotap_t rt;

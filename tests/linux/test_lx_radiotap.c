@@ -394,6 +394,90 @@ static size_t first_record(const char *path, uint8_t *buf, size_t cap)
     return incl;
 }
 
+/* Bytes of the radiotap struct both parses wrote (memset first: padding compares). */
+static void assert_same_parse(const uint8_t *b, size_t n, lx_rt_layout_t *memo)
+{
+    lx_radiotap_t walk, kept;
+    const int rc = lx_radiotap_parse(b, n, &walk);
+    assert_int_equal(lx_radiotap_parse_memo(b, n, &kept, memo), rc);
+    assert_memory_equal(&kept, &walk, sizeof(walk));
+}
+
+/* A layout memo: TSFT, flags, rate, channel, dBm signal at 8, 16, 17, 18 (channel aligned
+ * to 2), 22; it_len 23. A second header of the same layout is read from the memo with its
+ * own values; the same word with it_len 22 (the signal overruns), an unknown bit 18 and a
+ * two-word header are not taken for it, and each gives what the walk gives. */
+static void test_layout_memo_reads_each_header(void **state)
+{
+    (void)state;
+    lx_rt_layout_t memo;
+    memset(&memo, 0, sizeof(memo));
+    uint8_t a[32] = {0};
+    put16(a + 2, 23);
+    put32(a + 4, (1u << 0) | (1u << 1) | (1u << 2) | (1u << 3) | (1u << 5));
+    put64(a + 8, 123456789ull);
+    a[16] = LX_RT_FLAG_FCS;
+    a[17] = 12;
+    put16(a + 18, 2437);
+    put16(a + 20, 0x00a0);
+    a[22] = (uint8_t)-47;
+    lx_radiotap_t rt;
+    assert_int_equal(lx_radiotap_parse_memo(a, 23, &rt, &memo), 0);
+    assert_int_equal(memo.it_len, 23);
+    assert_int_equal(memo.off[5], 22);
+    assert_int_equal(memo.off[3], 18);
+
+    uint8_t a2[32];
+    memcpy(a2, a, sizeof(a2));
+    put64(a2 + 8, 987654321ull);
+    a2[16] = 0;
+    a2[17] = 108;
+    put16(a2 + 18, 5180);
+    a2[22] = (uint8_t)-71;
+    assert_int_equal(lx_radiotap_parse_memo(a2, 23, &rt, &memo), 0);
+    assert_int_equal(rt.status, LX_RT_OK);
+    assert_true(rt.tsft_us == 987654321ull);
+    assert_int_equal(rt.flags, 0);
+    assert_int_equal(rt.rate_500k, 108);
+    assert_int_equal(rt.freq_mhz, 5180);
+    assert_int_equal(rt.chan_flags, 0x00a0);
+    assert_int_equal(rt.dbm_signal, -71);
+    assert_int_equal(rt.n_dbm_signal, 1);
+    assert_int_equal(rt.n_present, 1);
+    assert_false(rt.has_dbm_noise);
+    assert_same_parse(a2, 23, &memo);
+
+    put16(a2 + 2, 22); /* the signal byte lies outside it_len now */
+    assert_int_equal(lx_radiotap_parse_memo(a2, 23, &rt, &memo), 0);
+    assert_int_equal(rt.status, LX_RT_FIELD_OVERRUN);
+    assert_false(rt.has_dbm_signal);
+    assert_true(rt.has_channel);
+    assert_same_parse(a2, 23, &memo); /* now from the memo of it_len 22 */
+
+    uint8_t u[16] = {0};
+    put16(u + 2, 12);
+    put32(u + 4, (1u << 1) | (1u << 5) | (1u << 18));
+    u[8] = 0x02;
+    u[9] = (uint8_t)-60;
+    for (int i = 0; i < 2; i++) { /* walked, then from the memo */
+        assert_int_equal(lx_radiotap_parse_memo(u, 12, &rt, &memo), 0);
+        assert_int_equal(rt.status, LX_RT_STOP_UNKNOWN);
+        assert_int_equal(rt.dbm_signal, -60);
+        assert_same_parse(u, 12, &memo);
+    }
+
+    uint8_t e[32] = {0}; /* two present words: walked, the memo kept as it was */
+    put16(e + 2, 13);
+    put32(e + 4, (1u << 5) | (1u << 31));
+    put32(e + 8, 0);
+    e[12] = (uint8_t)-33;
+    const lx_rt_layout_t before = memo;
+    assert_same_parse(e, 13, &memo);
+    assert_memory_equal(&memo, &before, sizeof(memo));
+    assert_same_parse(a, 23, &memo);
+    assert_same_parse(u, 12, &memo);
+}
+
 /* tshark: radiotap.length 56, dbm_antsignal -34,-39,-34, channel.freq 5745, flags.fcs 1,
  * antenna 0,1, datarate 6, mactime 9526800862, wlan.sa 18:31:bf:57:da:1c, wlan.seq 268,
  * type_subtype 0x0008, frame.cap_len 239. */
@@ -505,6 +589,7 @@ int main(void)
         cmocka_unit_test(test_real_meshid_capture),
         cmocka_unit_test(test_real_exthdr_capture),
         cmocka_unit_test(test_source_address_before_radiotap),
+        cmocka_unit_test(test_layout_memo_reads_each_header),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

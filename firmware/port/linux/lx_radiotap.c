@@ -119,7 +119,57 @@ static void rt_store(lx_radiotap_t *rt, unsigned bit, const uint8_t *p)
     }
 }
 
+/* The fields rt_store keeps. */
+#define RT_KEPT ((1u << RT_TSFT) | (1u << RT_FLAGS) | (1u << RT_RATE) | (1u << RT_CHANNEL) | \
+                 (1u << RT_DBM_ANTSIGNAL) | (1u << RT_DBM_ANTNOISE) | (1u << RT_ANTENNA) | (1u << RT_MCS))
+
+/* A present word whose layout a memo may hold: no namespace switch, no further word. */
+#define RT_SINGLE(w) (((w) & ((1u << RT_NS_RADIOTAP) | (1u << RT_NS_VENDOR) | (1u << RT_EXT))) == 0u)
+
+/* The walk's end with status st: remembered in memo (when not NULL) for a single word. */
+static int rt_done(lx_radiotap_t *rt, lx_rt_status_t st, lx_rt_layout_t *memo)
+{
+    rt->status = st;
+    if (memo != NULL) {
+        memo->status = (uint8_t)st;
+    }
+    return 0;
+}
+
+/* The kept fields of a header of layout m: what rt_store reads, each field once. */
+static void rt_from_layout(lx_radiotap_t *rt, const lx_rt_layout_t *m, const uint8_t *buf)
+{
+    _Static_assert(sizeof(m->off) / sizeof(m->off[0]) > RT_MCS, "an offset for every kept bit");
+    if (m->off[RT_TSFT] != 0u) { rt->has_tsft = true; rt->tsft_us = rd64(buf + m->off[RT_TSFT]); }
+    if (m->off[RT_FLAGS] != 0u) { rt->has_flags = true; rt->flags = buf[m->off[RT_FLAGS]]; }
+    if (m->off[RT_RATE] != 0u) { rt->has_rate = true; rt->rate_500k = buf[m->off[RT_RATE]]; }
+    if (m->off[RT_CHANNEL] != 0u) {
+        rt->has_channel = true;
+        rt->freq_mhz = rd16(buf + m->off[RT_CHANNEL]);
+        rt->chan_flags = rd16(buf + m->off[RT_CHANNEL] + 2);
+    }
+    if (m->off[RT_DBM_ANTSIGNAL] != 0u) {
+        rt->has_dbm_signal = true;
+        rt->dbm_signal = (int8_t)buf[m->off[RT_DBM_ANTSIGNAL]];
+        rt->n_dbm_signal = 1u;
+    }
+    if (m->off[RT_DBM_ANTNOISE] != 0u) { rt->has_dbm_noise = true; rt->dbm_noise = (int8_t)buf[m->off[RT_DBM_ANTNOISE]]; }
+    if (m->off[RT_ANTENNA] != 0u) { rt->has_antenna = true; rt->antenna = buf[m->off[RT_ANTENNA]]; }
+    if (m->off[RT_MCS] != 0u) {
+        const uint8_t *p = buf + m->off[RT_MCS];
+        rt->has_mcs = true;
+        rt->mcs_known = p[0];
+        rt->mcs_flags = p[1];
+        rt->mcs_index = p[2];
+    }
+}
+
 int lx_radiotap_parse(const uint8_t *buf, size_t len, lx_radiotap_t *rt)
+{
+    return lx_radiotap_parse_memo(buf, len, rt, NULL);
+}
+
+int lx_radiotap_parse_memo(const uint8_t *buf, size_t len, lx_radiotap_t *rt, lx_rt_layout_t *keep)
 {
     memset(rt, 0, sizeof(*rt));
     if (len < RT_HDR) { rt->status = LX_RT_ERR_SHORT; return -1; }
@@ -127,6 +177,20 @@ int lx_radiotap_parse(const uint8_t *buf, size_t len, lx_radiotap_t *rt)
     const size_t it_len = rd16(buf + 2);
     rt->it_len = (uint16_t)it_len;
     if (it_len < RT_HDR || it_len > len) { rt->status = LX_RT_ERR_LEN; return -1; }
+    lx_rt_layout_t *memo = NULL; /* filled by this walk */
+    if (keep != NULL && it_len >= RT_HDR && RT_SINGLE(rd32(buf + 4))) {
+        const uint32_t w = rd32(buf + 4);
+        if (keep->it_len == it_len && keep->present == w) {
+            rt->n_present = 1u;
+            rt->status = (lx_rt_status_t)keep->status;
+            rt_from_layout(rt, keep, buf);
+            return 0;
+        }
+        memo = keep;
+        memset(memo, 0, sizeof(*memo));
+        memo->present = w;
+        memo->it_len = (uint16_t)it_len;
+    }
 
     /* The present words: all inside it_len, the last one without bit 31. */
     size_t words_end = 4;
@@ -162,9 +226,9 @@ int lx_radiotap_parse(const uint8_t *buf, size_t len, lx_radiotap_t *rt)
                 /* OUI (3), sub-namespace (1), skip_length (LE16), aligned to 2; we know
                  * no vendor namespace, so its data is skipped whole. */
                 off = (off + 1u) & ~(size_t)1u;
-                if (off + 6 > it_len) { rt->status = LX_RT_FIELD_OVERRUN; return 0; }
+                if (off + 6 > it_len) { return rt_done(rt, LX_RT_FIELD_OVERRUN, memo); }
                 off += 6u + rd16(buf + off + 4);
-                if (off > it_len) { rt->status = LX_RT_FIELD_OVERRUN; return 0; }
+                if (off > it_len) { return rt_done(rt, LX_RT_FIELD_OVERRUN, memo); }
                 vendor = true;
                 reset_on_ext = true;
                 if (rt->n_vendor < UINT8_MAX) { rt->n_vendor++; }
@@ -174,13 +238,15 @@ int lx_radiotap_parse(const uint8_t *buf, size_t len, lx_radiotap_t *rt)
             const unsigned idx = base + b;
             if (idx >= sizeof(k_fields) / sizeof(k_fields[0]) || k_fields[idx].align == 0) {
                 /* Size and alignment unknown: nothing after it can be located. */
-                rt->status = LX_RT_STOP_UNKNOWN;
-                return 0;
+                return rt_done(rt, LX_RT_STOP_UNKNOWN, memo);
             }
             const size_t a = k_fields[idx].align;
             off = (off + a - 1u) & ~(a - 1u);
-            if (off + k_fields[idx].size > it_len) { rt->status = LX_RT_FIELD_OVERRUN; return 0; }
+            if (off + k_fields[idx].size > it_len) { return rt_done(rt, LX_RT_FIELD_OVERRUN, memo); }
             rt_store(rt, idx, buf + off);
+            if (memo != NULL && (RT_KEPT & (1u << idx)) != 0u) { /* idx <= RT_MCS: one word */
+                memo->off[idx] = (uint16_t)off; /* >= 8: after the present word */
+            }
             off += k_fields[idx].size;
         }
         /* Bit 31 moves to the next word: bit 32 of the same namespace, or bit 0 after a
@@ -188,32 +254,7 @@ int lx_radiotap_parse(const uint8_t *buf, size_t len, lx_radiotap_t *rt)
         base = reset_on_ext ? 0u : base + 32u;
         reset_on_ext = false;
     }
-    rt->status = LX_RT_OK;
-    return 0;
-}
-
-/* The MAC header bytes that must be captured before a management or data frame's
- * addresses count (Wireshark adds wlan.sa only then): 24, + 6 for addr4 (data, ToDS and
- * FromDS), + 2 QoS control (QoS data subtypes); 0 for any other frame: control,
- * extension, protocol version 1 (S1G, another layout) or reserved. A +HTC field is not
- * required: Wireshark reports the addresses of a frame cut inside it. */
-static inline size_t addr_hdr_len(uint16_t fc)
-{
-    const unsigned type = (fc >> 2) & 3u;
-    if ((fc & 3u) != 0u || (type != LX_WLAN_MGMT && type != LX_WLAN_DATA)) { return 0; }
-    size_t need = 24;
-    if (type == LX_WLAN_DATA && ((fc >> 8) & 3u) == 3u) { need += 6; }
-    if (type == LX_WLAN_DATA && (fc & 0x80u) != 0u) { need += 2; }
-    return need;
-}
-
-/* Offset of the source address in a management or data frame. IEEE 802.11-2020 Table
- * 9-30: addr2 with FromDS 0, addr3 with FromDS 1 and ToDS 0, addr4 with both; a
- * management frame's SA is addr2 whatever the DS bits. */
-static inline size_t sa_offset(uint16_t fc)
-{
-    static const uint8_t sa_at[4] = {10, 10, 16, 24};
-    return ((fc >> 2) & 3u) == LX_WLAN_MGMT ? 10u : sa_at[(fc >> 8) & 3u];
+    return rt_done(rt, LX_RT_OK, memo);
 }
 
 int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w)
@@ -239,14 +280,14 @@ int lx_wlan_parse(const uint8_t *frame, size_t len, lx_wlan_t *w)
         }
         return 0;
     }
-    size_t need = addr_hdr_len(w->fc);
+    size_t need = lx_wlan_addr_len(w->fc);
     if (need == 0 || len < need) { return 0; }
     const bool qos = w->type == LX_WLAN_DATA && (w->subtype & 8u) != 0;
     if (order && (w->type == LX_WLAN_MGMT || qos)) { need += 4; }
     w->hdr_len = (uint16_t)need;
     memcpy(w->ta, frame + 10, 6);
     w->has_ta = true;
-    memcpy(w->sa, frame + sa_offset(w->fc), 6);
+    memcpy(w->sa, frame + lx_wlan_sa_offset(w->fc), 6);
     w->has_sa = true;
     const uint16_t sc = rd16(frame + 22);
     w->has_seq = true;
@@ -276,9 +317,14 @@ static void frame_ssid(const uint8_t *body, size_t n, lx_rt_frame_t *f)
 
 int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f)
 {
+    return lx_rt_frame_parse_memo(buf, len, f, NULL);
+}
+
+int lx_rt_frame_parse_memo(const uint8_t *buf, size_t len, lx_rt_frame_t *f, lx_rt_layout_t *memo)
+{
     /* Every field but the SSID bytes, which count only up to ssid_len when has_ssid. */
     memset(f, 0, offsetof(lx_rt_frame_t, ssid));
-    const int rc = lx_radiotap_parse(buf, len, &f->rt);
+    const int rc = lx_radiotap_parse_memo(buf, len, &f->rt, memo);
     /* An unusable header whose length field still lies in [8, len]: the 802.11 frame is
      * there, as Wireshark reads it; its fields (and so the FCS flag) are not. */
     const size_t it_len = rc == 0 ? f->rt.it_len : (len >= RT_HDR ? rd16(buf + 2) : 0u);
@@ -295,16 +341,4 @@ int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f)
         frame_ssid(buf + it_len + f->wlan.hdr_len, f->frame_len - f->wlan.hdr_len, f);
     }
     return rc;
-}
-
-const uint8_t *lx_rt_frame_sa(const uint8_t *buf, size_t len)
-{
-    /* The same location as lx_rt_frame_parse (a header it accepts has it_len in [8, len])
-     * and lx_wlan_parse's rule for when the SA counts. */
-    const size_t it_len = len >= RT_HDR ? rd16(buf + 2) : 0u;
-    if (it_len < RT_HDR || it_len + 2u > len) { return NULL; }
-    const uint8_t *frame = buf + it_len;
-    const uint16_t fc = rd16(frame);
-    const size_t need = addr_hdr_len(fc);
-    return need == 0 || len - it_len < need ? NULL : frame + sa_offset(fc);
 }

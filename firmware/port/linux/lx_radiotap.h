@@ -77,6 +77,22 @@ typedef struct lx_radiotap {
 /// why). Never reads outside buf[0, len).
 int lx_radiotap_parse(const uint8_t *buf, size_t len, lx_radiotap_t *rt);
 
+/// The layout of one kind of radiotap header, kept by a caller that parses many records
+/// of one capture (lx_radiotap_parse_memo): a header with a single present word (no
+/// namespace or extension bit) and a given it_len always puts the same fields at the same
+/// offsets and gets the same status. Zero-initialise it; it holds no pointer into a record.
+typedef struct lx_rt_layout {
+    uint32_t present;  ///< the present word it describes
+    uint16_t it_len;   ///< and the header length; 0: empty
+    uint8_t status;    ///< the status such a header gets (an lx_rt_status_t)
+    uint16_t off[20];  ///< byte offset of each field bit 0..19 lx_radiotap_t holds; 0: absent
+} lx_rt_layout_t;
+
+/// lx_radiotap_parse(), with `memo` (or NULL) remembering the last single-word layout:
+/// a header of that layout is read from its offsets without walking the present word
+/// again. The result is the same as lx_radiotap_parse()'s for every input.
+int lx_radiotap_parse_memo(const uint8_t *buf, size_t len, lx_radiotap_t *rt, lx_rt_layout_t *memo);
+
 /// One line describing a status ("version byte is not 0", ...).
 const char *lx_radiotap_status_str(lx_rt_status_t st);
 
@@ -137,11 +153,48 @@ typedef struct lx_rt_frame {
 /// response's 12 bytes of fixed fields, within the captured frame without its FCS.
 int lx_rt_frame_parse(const uint8_t *buf, size_t len, lx_rt_frame_t *f);
 
+/// lx_rt_frame_parse() with a layout memo for the radiotap header (lx_radiotap_parse_memo).
+int lx_rt_frame_parse_memo(const uint8_t *buf, size_t len, lx_rt_frame_t *f, lx_rt_layout_t *memo);
+
+/// The MAC header bytes that must be captured before a management or data frame's
+/// addresses count (Wireshark adds wlan.sa only then): 24, + 6 for addr4 (data, ToDS and
+/// FromDS), + 2 QoS control (QoS data subtypes); 0 for any other frame: control,
+/// extension, protocol version 1 (S1G, another layout) or reserved. A +HTC field is not
+/// required: Wireshark reports the addresses of a frame cut inside it.
+static inline size_t lx_wlan_addr_len(uint16_t fc)
+{
+    const unsigned type = (fc >> 2) & 3u;
+    if ((fc & 3u) != 0u || (type != LX_WLAN_MGMT && type != LX_WLAN_DATA)) { return 0; }
+    size_t need = 24;
+    if (type == LX_WLAN_DATA && ((fc >> 8) & 3u) == 3u) { need += 6; }
+    if (type == LX_WLAN_DATA && (fc & 0x80u) != 0u) { need += 2; }
+    return need;
+}
+
+/// Offset of the source address in a management or data frame. IEEE 802.11-2020 Table
+/// 9-30: addr2 with FromDS 0, addr3 with FromDS 1 and ToDS 0, addr4 with both; a
+/// management frame's SA is addr2 whatever the DS bits.
+static inline size_t lx_wlan_sa_offset(uint16_t fc)
+{
+    static const uint8_t sa_at[4] = {10, 10, 16, 24};
+    return ((fc >> 2) & 3u) == LX_WLAN_MGMT ? 10u : sa_at[(fc >> 8) & 3u];
+}
+
 /// The source address (wlan.sa) of a captured record, found from the radiotap length
 /// field (bytes 2-3) and the 802.11 header alone, no radiotap field parsed: a filter ahead
 /// of lx_rt_frame_parse(). Its 6 bytes inside buf, or NULL when there is none. For a
 /// record lx_rt_frame_parse() accepts (returns 0) the answer agrees with its wlan.has_sa
 /// and wlan.sa; a record it rejects may still have one here. Never reads outside buf[0, len).
-const uint8_t *lx_rt_frame_sa(const uint8_t *buf, size_t len);
+static inline const uint8_t *lx_rt_frame_sa(const uint8_t *buf, size_t len)
+{
+    /* The same location as lx_rt_frame_parse (a header it accepts has it_len in [8, len])
+     * and lx_wlan_parse's rule for when the SA counts. Inline: it runs on every record. */
+    const size_t it_len = len >= 8u ? (size_t)(buf[2] | (buf[3] << 8)) : 0u;
+    if (it_len < 8u || it_len + 2u > len) { return NULL; }
+    const uint8_t *frame = buf + it_len;
+    const uint16_t fc = (uint16_t)(frame[0] | (frame[1] << 8));
+    const size_t need = lx_wlan_addr_len(fc);
+    return need == 0 || len - it_len < need ? NULL : frame + lx_wlan_sa_offset(fc);
+}
 
 #endif /* LX_RADIOTAP_H */

@@ -373,15 +373,22 @@ extern "C" unsigned hs_box2d_walls_crossed(const hs_box2d_t *w, double x0, doubl
     w->world->RayCast(&rev, b, a);
     // Interval of each fixture along the segment, as fractions from a: entry from the
     // forward cast (0 when a is inside), exit from the reverse cast (1 when b is inside).
+    // A fixture only one cast reports with the far end outside it was grazed (a corner
+    // or an edge touched: the cache points and nodes lie on the map's pixel corners): a
+    // crossing of no length there, not an interval to the end that would merge every
+    // wall beyond into one (docs/RADIO_MODEL.md, "Walls").
     std::vector<std::pair<double, double>> iv;
     iv.reserve(fwd.hits.size() + rev.hits.size());
     for (const auto &h : fwd.hits) {
-        double out = 1.0;
+        double out = -1.0;
         for (const auto &r : rev.hits) {
             if (r.first == h.first) {
                 out = 1.0 - r.second;
                 break;
             }
+        }
+        if (out < 0.0) {
+            out = h.first->TestPoint(b) ? 1.0 : h.second;
         }
         iv.emplace_back(h.second, out);
     }
@@ -394,7 +401,7 @@ extern "C" unsigned hs_box2d_walls_crossed(const hs_box2d_t *w, double x0, doubl
             }
         }
         if (!seen) {
-            iv.emplace_back(0.0, 1.0 - r.second);
+            iv.emplace_back(r.first->TestPoint(a) ? 0.0 : 1.0 - r.second, 1.0 - r.second);
         }
     }
     if (iv.empty()) {

@@ -44,7 +44,7 @@ def field():
 
 
 def reference(cells, best):
-    k_tol, k_clr = int(TOL / STEP + 1e-9), int(CLEAR / STEP + 1e-9)
+    k_clr = int(CLEAR / STEP + 1e-9)  # the clearance disc holds the tolerance disc
     worst, legal = {}, set()
     for (i, j), v in cells.items():
         w, whole = v, True

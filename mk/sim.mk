@@ -64,6 +64,8 @@ $(eval $(call test_script,batch_out,tests/host_sim/batch_out.sh $(SIM),$(SIM)))
 $(eval $(call test_script,placements,$(PYTHON) tests/host_sim/placements.py $(SIM),$(SIM)))
 $(eval $(call test_script,faults,tests/host_sim/faults.sh $(SIM) 3,$(SIM)))
 $(eval $(call test_script,strategy_cli,tests/host_sim/strategy_cli.sh $(SIM),$(SIM)))
+# bridge_bounds.py's tolerance reference against a brute-force walk of the grid.
+$(eval $(call test_script,bridge_bounds,$(PYTHON) tests/host_sim/bridge_bounds_check.py,))
 $(eval $(call test_script,pathloss_out,tests/host_sim/pathloss_out.sh $(SIM),$(SIM)))
 $(eval $(call test_script,rfseek_map,tests/host_sim/test_rfseek_map.sh $(BUILD)/bin/rfseek-map,$(BUILD)/bin/rfseek-map))
 # Map images as map_server reads them: PNG of every colour type and depth, PGM, the three

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Bounds on bridging (docs/STRATEGIES.md, "Bridging: what limits it"): for each seed, one
-meta-path + pathloss run of a bridging scenario with its fields dumped, and where three
+meta-path + pathloss run of a bridging scenario with its fields dumped, and where four
 references would settle against the simulator's best point of the true f:
 
   pathloss  the best point of f on the path-loss fields of the true parameters (the
@@ -10,6 +10,14 @@ references would settle against the simulator's best point of the true f:
             fitted position, P0, n and W; the walls still counted to the true node)
   track     the best true f within 1 m of the robot's track: the best a seeker could
             choose among the places it has been
+  tolerance the legal point, connected to the best one, whose worst true f within 0.15 m
+            (goal tolerance 0.1 m, pose noise about 5 cm) is highest: the best place a
+            robot can be sure to stand on
+
+Each seed's line also gives how far the best point stands above its own worst f within
+0.15 m (*narrow*), the wall counts there to each node and the fewest among those
+neighbours, and the run's end against the tolerance point (distance; shortfall of the
+worst f within 0.15 m).
 
     /usr/bin/python3 scripts/bridge_bounds.py SCENARIO A..B [--sim build/bin/rfseek-sim]
                                               [--jobs 2]
@@ -29,13 +37,41 @@ import tempfile
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
+from scipy import ndimage
 from scipy.spatial import cKDTree
 
 REF_LOSS_DB, EXPONENT = 39.6, 3.0  # docs/SIMULATOR.md, the radio's defaults
+TOL_M, CLEARANCE_M = 0.15, 0.25  # where a settled robot stands; sim.clearance_m
 
 
 def f_of(r1, r2):
     return -np.abs(r1 - r2) - np.abs(r1 + r2)
+
+
+def disc(r, step):
+    """The grid offsets within r (metres) of a grid of this step, as a footprint."""
+    k = int(np.floor(r / step + 1e-9))
+    o = np.arange(-k, k + 1)
+    return np.add.outer(o ** 2, o ** 2) <= (r / step) ** 2 + 1e-9
+
+
+def tolerant(xy, f, best, tol=TOL_M, clearance=CLEARANCE_M):
+    """On a field's points xy (a regular grid) with values f: each point's worst f within
+    tol, and the index of the legal point (its whole clearance disc on the grid), in the
+    4-connected legal part that holds the legal point nearest best, whose worst is highest."""
+    step = np.min(np.diff(np.unique(xy[:, 0])))
+    ix = np.rint((xy[:, 0] - xy[:, 0].min()) / step).astype(int)
+    iy = np.rint((xy[:, 1] - xy[:, 1].min()) / step).astype(int)
+    grid = np.full((iy.max() + 1, ix.max() + 1), np.inf)
+    grid[iy, ix] = f
+    worst = ndimage.minimum_filter(grid, footprint=disc(tol, step), mode="constant",
+                                   cval=np.inf)[iy, ix]
+    legal = ndimage.binary_erosion(np.isfinite(grid), structure=disc(clearance, step))
+    label = ndimage.label(legal)[0][iy, ix]
+    near = np.flatnonzero(label > 0)
+    part = label[near[np.argmin(np.hypot(*(xy[near] - best).T))]]
+    ok = np.flatnonzero(label == part)
+    return worst, int(ok[np.argmax(worst[ok])])
 
 
 def one(sim, scenario, seed, wall_db):
@@ -46,11 +82,16 @@ def one(sim, scenario, seed, wall_db):
                            capture_output=True, text=True)
         if r.returncode != 0:
             sys.exit(f"bridge_bounds: seed {seed}: {r.stderr.strip()}")
-        with open(os.path.join(out, "summary.json")) as fh:
-            s = json.load(fh)
-        a = np.loadtxt(os.path.join(out, "field.tsv"), skiprows=1, usecols=(0, 1, 2, 3))
-        b = np.loadtxt(os.path.join(out, "field1.tsv"), skiprows=1, usecols=(0, 1, 2, 3))
-        track = np.loadtxt(os.path.join(out, "track.tsv"), skiprows=1, usecols=(1, 2))
+        return analyse(out, seed, wall_db)
+
+
+def analyse(out, seed, wall_db):
+    """The references of one run's output directory (summary.json, both fields, track)."""
+    with open(os.path.join(out, "summary.json")) as fh:
+        s = json.load(fh)
+    a = np.loadtxt(os.path.join(out, "field.tsv"), skiprows=1, usecols=(0, 1, 2, 3))
+    b = np.loadtxt(os.path.join(out, "field1.tsv"), skiprows=1, usecols=(0, 1, 2, 3))
+    track = np.loadtxt(os.path.join(out, "track.tsv"), skiprows=1, usecols=(1, 2))
     tx = 20.0  # the bridging scenarios' nodes
     f = f_of(a[:, 3], b[:, 3])
 
@@ -74,6 +115,17 @@ def one(sim, scenario, seed, wall_db):
         res["fits"] = at(np.argmax(g))
     near = cKDTree(track).query(a[:, :2])[0] < 1.0
     res["track"] = at(np.flatnonzero(near)[np.argmax(f[near])])
+    worst, t = tolerant(a[:, :2], f, (bx, by))
+    res["tolerance"] = at(t)
+    tree = cKDTree(a[:, :2])
+    # the field's points are cell centres, the best point's grid the cells' corners
+    cell = tree.query_ball_point((bx, by), 0.75 * (np.min(np.diff(np.unique(a[:, 0])))))
+    b0 = cell[int(np.argmax(f[cell]))] if cell else tree.query((bx, by))[1]
+    ring = [k for k in tree.query_ball_point(a[b0, :2], TOL_M) if k != b0]
+    res["narrow"] = float(f[b0] - worst[b0])
+    res["walls"] = [(int(fl[b0, 2]), int(fl[ring, 2].min())) for fl in (a, b)]
+    e = tree.query((s["final_x_m"], s["final_y_m"]))[1]
+    res["end"] = (float(np.hypot(*(a[e, :2] - a[t, :2]))), float(worst[t] - worst[e]))
     return res
 
 
@@ -97,14 +149,25 @@ def main():
     seeds = range(int(m.group(1)), int(m.group(2)) + 1)
     with ThreadPoolExecutor(max(1, a.jobs)) as ex:
         rows = list(ex.map(lambda sd: one(a.sim, a.scenario, sd, wall_db), seeds))
-    keys = ["run", "pathloss", "fits", "track"]
+    keys = ["run", "pathloss", "fits", "track", "tolerance"]
     for r in rows:
-        print(r["seed"], "  ".join(f"{k} {r[k][0]:.1f} m {r[k][1]:.1f} dB" for k in keys if k in r))
+        print(r["seed"], "  ".join(f"{k} {r[k][0]:.1f} m {r[k][1]:.1f} dB" for k in keys if k in r),
+              f" narrow {r['narrow']:.1f} dB, walls " +
+              ", ".join(f"{w} ({m} near)" for w, m in r["walls"]) +
+              f"; end to tolerance {r['end'][0]:.1f} m {r['end'][1]:.1f} dB")
     for k in keys:
         v = np.array([r[k] for r in rows if k in r])
         if len(v):
             print(f"{k}: within 3 m {int((v[:, 0] <= 3.0).sum())} of {len(v)}, shortfall "
                   f"median {np.median(v[:, 1]):.1f} dB, p90 {np.percentile(v[:, 1], 90):.1f} dB")
+    narrow = np.array([r["narrow"] for r in rows])
+    end = np.array([r["end"] for r in rows])
+    print(f"narrow: the best point above its worst f within {TOL_M} m: median "
+          f"{np.median(narrow):.1f} dB, p90 {np.percentile(narrow, 90):.1f} dB, by over 3 dB "
+          f"in {int((narrow > 3.0).sum())} of {len(rows)}")
+    print(f"end to tolerance: within 3 m {int((end[:, 0] <= 3.0).sum())} of {len(end)}, "
+          f"shortfall (worst within {TOL_M} m) median {np.median(end[:, 1]):.1f} dB, p90 "
+          f"{np.percentile(end[:, 1], 90):.1f} dB")
     return 0
 
 

@@ -51,6 +51,8 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.eps_geodesic = false;                 /* epsilon weights by straight distance */
     c.eps_sample = false;                   /* and epsilon goals at random, not drawn */
     c.refute_r = 0;                         /* and nothing is ruled out */
+    c.local_r = 0;                          /* stand at the estimate */
+    c.leg_max = 0;                          /* and walk the whole leg to it */
     c.silence_floor = INT32_MIN;            /* silence adds no sample */
     c.settle_dist = 0;                      /* epsilon anneals to eps_floor, never 0 */
     c.settle_orbit = 0;
@@ -166,7 +168,7 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         cfg->tumble_better < 0 || cfg->tumble_better > RFS_Q16_ONE || cfg->tumble_worse < 0 ||
         cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0 || cfg->settle_dist < 0 ||
         cfg->settle_orbit < 0 || cfg->settle_end < 0 || cfg->refute_r < 0 ||
-        cfg->src_spacing < 0) {
+        cfg->src_spacing < 0 || cfg->local_r < 0 || cfg->leg_max < 0) {
         return -1;
     }
     if (model.ops == 0 || model.ops->fit == 0 || model.ops->predict == 0 ||

@@ -104,6 +104,16 @@ typedef struct rfs_seek_cfg {
                                 ///< the source is not there): the fit's next best place is
                                 ///< visited next, a local search round a near miss (off in
                                 ///< every preset: docs/STRATEGIES.md, "Stalls")
+    rfs_q16_t local_r;          ///< a greedy goal at a known argmax the robot has been to
+                                ///< (its lattice point, or its reachable stand-in's, is
+                                ///< visited) becomes the unvisited reachable lattice point
+                                ///< within this radius of it nearest to the robot and to it
+                                ///< (least sum of the straight distances): a local search
+                                ///< round an estimate already stood at, metres Q16.16 (0:
+                                ///< off, stand at it)
+    rfs_q16_t leg_max;          ///< a greedy leg to a known argmax ends after this much of
+                                ///< its path (the next decision relearns and may explore),
+                                ///< metres Q16.16 (0: the whole path)
     rfs_q16_t silence_floor;    ///< target rssi: while the receiver reports itself up and
                                 ///< no packet came for a whole averaging window, every pose
                                 ///< adds a sample of this value: the fit learns where the

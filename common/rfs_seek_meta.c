@@ -417,31 +417,32 @@ static bool choose_greedy(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
 }
 
 /* local_r: the goal of a local search round an estimate (mx, my) the robot has stood
- * at (its lattice point, or its reachable stand-in's, is visited), the unvisited
- * reachable lattice point within local_r of it with the least straight distance to the
- * robot plus to the estimate (ties: the first in row order): when the robot is at the
- * estimate the nearest ring round it first, then round the ring; false when the estimate
- * is not yet visited or no point is left. Scaling: offsets Q16 in int64, squared (Q32)
- * against local_r squared; distances by rfs_q16_dist (Q16), their sum in int64. */
+ * at, or round its reachable stand-in when it is unreachable (the centre: its lattice
+ * point is visited), the unvisited reachable lattice point within local_r of the centre
+ * with the least sum of its squared straight distances to the robot and to the centre
+ * (the nearest to their midpoint; ties: the first in row order): when the robot is at
+ * the centre the nearest ring round it first, then on round the ring; false when the
+ * centre is not yet visited or no point is left. No square root: a window of up to
+ * (2 local_r / grid + 3)^2 points stays within a control period on the microcontroller.
+ * Scaling: offsets Q16 (< 2^31 each, map coordinates) in int64, squared Q32 < 2^62;
+ * a sum of two squared distances to the robot and centre saturates at INT64_MAX. */
 static bool local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_t *gx,
                        rfs_q16_t *gy)
 {
     const rfs_map_t *m = s->map;
-    uint16_t ei, ej, vi, vj;
-    rfs_map_lattice_nearest(m, mx, my, &ei, &ej);
-    vi = ei;
-    vj = ej;
-    if (!rfs_reach_bit(s->reach, (uint32_t)ej * m->lw + ei)) {
-        rfs_q16_t nx, ny;
-        if (!rfs_reach_nearest(m, s->reach, mx, my, &nx, &ny)) {
+    uint16_t ci, cj;
+    rfs_q16_t cx = mx, cy = my;
+    rfs_map_lattice_nearest(m, mx, my, &ci, &cj);
+    if (!rfs_reach_bit(s->reach, (uint32_t)cj * m->lw + ci)) {
+        if (!rfs_reach_nearest(m, s->reach, mx, my, &cx, &cy)) {
             return false;
         }
-        rfs_map_lattice_nearest(m, nx, ny, &vi, &vj);
+        rfs_map_lattice_nearest(m, cx, cy, &ci, &cj);
     }
-    if (!rfs_reach_bit(s->visited, (uint32_t)vj * m->lw + vi)) {
+    if (!rfs_reach_bit(s->visited, (uint32_t)cj * m->lw + ci)) {
         return false;
     }
-    const lattice_window_t w = lattice_window(m, ei, ej, s->cfg.local_r / m->cfg.grid + 1);
+    const lattice_window_t w = lattice_window(m, ci, cj, s->cfg.local_r / m->cfg.grid + 1);
     const int64_t r2 = (int64_t)s->cfg.local_r * s->cfg.local_r;
     int64_t best = INT64_MAX;
     for (int32_t j = w.j0; j <= w.j1; ++j) {
@@ -452,12 +453,14 @@ static bool local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_
             }
             rfs_q16_t px, py;
             rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
-            const int64_t dx = (int64_t)px - mx, dy = (int64_t)py - my;
+            const int64_t dx = (int64_t)px - cx, dy = (int64_t)py - cy;
             if (dx * dx + dy * dy > r2) {
                 continue;
             }
-            const int64_t cost = (int64_t)rfs_q16_dist(s->pose.x, s->pose.y, px, py) +
-                                 rfs_q16_dist(mx, my, px, py);
+            const int64_t rx = (int64_t)px - s->pose.x, ry = (int64_t)py - s->pose.y;
+            const uint64_t rr = (uint64_t)(rx * rx) + (uint64_t)(ry * ry);
+            const uint64_t sum = rr + (uint64_t)(dx * dx + dy * dy);
+            const int64_t cost = sum > (uint64_t)INT64_MAX - 1u ? INT64_MAX - 1 : (int64_t)sum;
             if (cost < best) {
                 best = cost;
                 *gx = px;

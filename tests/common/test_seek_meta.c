@@ -527,8 +527,8 @@ static void test_refute_reached_moves_on(void **state)
  * every mean exactly (no relearn, nothing refuted), every decision greedy. The first goes
  * to the estimate; from then on each goal must be, by a double-precision reference, a
  * legal lattice point within local_r (1 m) of the estimate outside the 0.5 m novelty
- * radius of every place the robot stood, with the least distance to the robot plus to the
- * estimate; when none is left the goal is the estimate again. With leg_max 4 m instead,
+ * radius of every place the robot stood, with the least sum of the squared distances to
+ * the robot and to the estimate; when none is left the goal is the estimate again. With leg_max 4 m instead,
  * the first greedy leg ends 4 m along the straight way to an estimate 12 m off. */
 #define LOCAL_EX 10.3
 #define LOCAL_EY 5.2
@@ -545,7 +545,7 @@ static void local_world(world_t *t, rfs_seek_cfg_t *cfg, fixed_model_t *fm)
 }
 
 /* The reference goal after the robot stood at the n places (px, py); false when no
- * lattice point is left. Ties within 1e-6 m are accepted. */
+ * lattice point is left. Ties within 1e-6 m^2 are accepted. */
 static bool local_ref_ok(const world_t *t, const double *px, const double *py, int n,
                          double gx, double gy)
 {
@@ -563,7 +563,8 @@ static bool local_ref_ok(const world_t *t, const double *px, const double *py, i
                 hypot(x - LOCAL_EX, y - LOCAL_EY) > 1.0 + 1e-9) {
                 continue;
             }
-            double c = hypot(x - px[n - 1], y - py[n - 1]) + hypot(x - LOCAL_EX, y - LOCAL_EY);
+            double c = pow(hypot(x - px[n - 1], y - py[n - 1]), 2) +
+                       pow(hypot(x - LOCAL_EX, y - LOCAL_EY), 2);
             best = c < best ? c : best;
             if (fabs(x - gx) < 1e-4 && fabs(y - gy) < 1e-4) {
                 got = c;

@@ -97,6 +97,7 @@ void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg)
     cfg->settle_orbit = RFS_Q16_FRAC(1, 4);
     cfg->settle_end = RFS_Q16_INT(125);
     cfg->refute_r = 0; /* the argmax is the target's best point, not a source */
+    cfg->local_r = 0;  /* and the settle tour measures round it */
     cfg->silence_floor = INT32_MIN; /* each node's store has src_floor */
 }
 
@@ -119,6 +120,8 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
     cfg->refute_r = on ? cfg->step : 0;
     /* Radiotap receivers report down to -100 dBm (docs/STRATEGIES.md, "Stalls"). */
     cfg->silence_floor = on ? RFS_Q16_INT(-100) : INT32_MIN;
+    /* Sweep round an estimate already stood at (docs/STRATEGIES.md, "Stalls"). */
+    cfg->local_r = on ? 4 * cfg->step : 0;
 }
 
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)

@@ -340,13 +340,12 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 /// Choose a strategy with its named preset: sets cfg->strategy and the improvement
 /// fields, on for RFS_SEEK_META_PATH (recheck_dist = cfg->step, eps_by_travel,
 /// recheck_adapt, eps_geodesic, eps_sample, refute_r = cfg->step, silence_floor = -100
-/// dBm), the
-/// paper's (0, false) for every other strategy.
+/// dBm, local_r = 4 cfg->step), the paper's (0, false) for every other strategy.
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 
 /// The settings for a model fitted per source (rfs_fields.h; docs/STRATEGIES.md,
 /// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m, settle_orbit
-/// 0.25 m, settle_end 125 m, refute_r 0, silence_floor none (src_floor instead).
+/// 0.25 m, settle_end 125 m, refute_r 0, local_r 0, silence_floor none (src_floor instead).
 void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg);
 
 /// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array

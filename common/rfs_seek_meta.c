@@ -475,24 +475,22 @@ bool rfs_seek_meta_path_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool kno
                              rfs_rng_t *rng, int64_t now_us)
 {
     (void)rng;
-    if (known && s->cfg.local_r > 0) {
-        /* A point that cannot be planned to (unreachable in practice) is marked visited
-         * and the next tried; a plan waiting for the search tree decides again later. */
-        rfs_q16_t gx, gy;
-        for (int attempt = 0; attempt < GOAL_TRIES && local_goal(s, mx, my, &gx, &gy);
-             ++attempt) {
-            if (rfs_seek_go_to(s, gx, gy, now_us)) {
-                s->decision.goal_x = gx;
-                s->decision.goal_y = gy;
-                return true;
-            }
-            if (s->plan.tree_more) {
-                return false;
-            }
-            uint16_t li, lj;
-            rfs_map_lattice_nearest(s->map, gx, gy, &li, &lj);
-            rfs_reach_bit_set(s->visited, (uint32_t)lj * s->map->lw + li);
+    rfs_q16_t gx, gy;
+    if (known && s->cfg.local_r > 0 && local_goal(s, mx, my, &gx, &gy)) {
+        /* One scan a decision (the period budget); a point that cannot be planned to
+         * (unreachable in practice) is marked visited and this decision goes to the
+         * estimate; a plan waiting for the search tree decides again later. */
+        if (rfs_seek_go_to(s, gx, gy, now_us)) {
+            s->decision.goal_x = gx;
+            s->decision.goal_y = gy;
+            return true;
         }
+        if (s->plan.tree_more) {
+            return false;
+        }
+        uint16_t li, lj;
+        rfs_map_lattice_nearest(s->map, gx, gy, &li, &lj);
+        rfs_reach_bit_set(s->visited, (uint32_t)lj * s->map->lw + li);
     }
     return greedy_along_path(s, mx, my, known ? s->cfg.leg_max : s->cfg.step, now_us);
 }

@@ -403,6 +403,7 @@ static void refute_world(world_t *t, rfs_seek_cfg_t cfg, refute_model_t *m)
     world_make(t, 20.0, 10.0, 0, 0);
     cfg.eps_amp = 0;
     cfg.eps_floor = 0;
+    cfg.local_r = 0; /* the robot stays at each maximum (no sweep round it) */
     seek_make(t, cfg, 5);
     memset(m, 0, sizeof *m);
     rfs_model_t model = { &ops, m };

@@ -51,6 +51,8 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.eps_geodesic = false;                 /* epsilon weights by straight distance */
     c.eps_sample = false;                   /* and epsilon goals at random, not drawn */
     c.refute_r = 0;                         /* and nothing is ruled out */
+    c.local_r = 0;                          /* stand at the estimate */
+    c.leg_max = 0;                          /* and walk the whole leg to it */
     c.silence_floor = INT32_MIN;            /* silence adds no sample */
     c.settle_dist = 0;                      /* epsilon anneals to eps_floor, never 0 */
     c.settle_orbit = 0;
@@ -95,6 +97,7 @@ void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg)
     cfg->settle_orbit = RFS_Q16_FRAC(1, 4);
     cfg->settle_end = RFS_Q16_INT(125);
     cfg->refute_r = 0; /* the argmax is the target's best point, not a source */
+    cfg->local_r = 0;  /* and the settle tour measures round it */
     cfg->silence_floor = INT32_MIN; /* each node's store has src_floor */
 }
 
@@ -117,6 +120,8 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
     cfg->refute_r = on ? cfg->step : 0;
     /* Radiotap receivers report down to -100 dBm (docs/STRATEGIES.md, "Stalls"). */
     cfg->silence_floor = on ? RFS_Q16_INT(-100) : INT32_MIN;
+    /* Sweep round an estimate already stood at (docs/STRATEGIES.md, "Stalls"). */
+    cfg->local_r = on ? 4 * cfg->step : 0;
 }
 
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)
@@ -166,7 +171,7 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         cfg->tumble_better < 0 || cfg->tumble_better > RFS_Q16_ONE || cfg->tumble_worse < 0 ||
         cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0 || cfg->settle_dist < 0 ||
         cfg->settle_orbit < 0 || cfg->settle_end < 0 || cfg->refute_r < 0 ||
-        cfg->src_spacing < 0) {
+        cfg->src_spacing < 0 || cfg->local_r < 0 || cfg->leg_max < 0) {
         return -1;
     }
     if (model.ops == 0 || model.ops->fit == 0 || model.ops->predict == 0 ||

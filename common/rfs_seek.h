@@ -104,6 +104,16 @@ typedef struct rfs_seek_cfg {
                                 ///< the source is not there): the fit's next best place is
                                 ///< visited next, a local search round a near miss (off in
                                 ///< every preset: docs/STRATEGIES.md, "Stalls")
+    rfs_q16_t local_r;          ///< a greedy goal at a known argmax the robot has been to
+                                ///< (its lattice point, or its reachable stand-in's, is
+                                ///< visited) becomes the unvisited reachable lattice point
+                                ///< within this radius of it nearest to the robot and to it
+                                ///< (least sum of the straight distances): a local search
+                                ///< round an estimate already stood at, metres Q16.16 (0:
+                                ///< off, stand at it)
+    rfs_q16_t leg_max;          ///< a greedy leg to a known argmax ends after this much of
+                                ///< its path (the next decision relearns and may explore),
+                                ///< metres Q16.16 (0: the whole path)
     rfs_q16_t silence_floor;    ///< target rssi: while the receiver reports itself up and
                                 ///< no packet came for a whole averaging window, every pose
                                 ///< adds a sample of this value: the fit learns where the
@@ -330,13 +340,12 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 /// Choose a strategy with its named preset: sets cfg->strategy and the improvement
 /// fields, on for RFS_SEEK_META_PATH (recheck_dist = cfg->step, eps_by_travel,
 /// recheck_adapt, eps_geodesic, eps_sample, refute_r = cfg->step, silence_floor = -100
-/// dBm), the
-/// paper's (0, false) for every other strategy.
+/// dBm, local_r = 4 cfg->step), the paper's (0, false) for every other strategy.
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 
 /// The settings for a model fitted per source (rfs_fields.h; docs/STRATEGIES.md,
 /// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m, settle_orbit
-/// 0.25 m, settle_end 125 m, refute_r 0, silence_floor none (src_floor instead).
+/// 0.25 m, settle_end 125 m, refute_r 0, local_r 0, silence_floor none (src_floor instead).
 void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg);
 
 /// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array

@@ -205,10 +205,11 @@ static bool accept_detour(const rfs_seek_t *s, rfs_rng_t *rng, uint32_t q, rfs_q
  * `step` metres of the path, so a greedy step goes round walls the way the planner does
  * instead of straight at the maximum with a line search; with a model that knows where
  * its maximum is (argmax: the pathloss model's estimated source) the goal is that point
- * itself, reached through the planner. The cut point lies on a legal segment
+ * itself, reached through the planner (leg > 0: the first leg metres of the way; 0: all
+ * of it). The cut point lies on a legal segment
  * of the path. Scaling: waypoint offsets (Q16, < 2^32) times the remaining length
  * (Q16, < 2^16 m) < 2^63; segment lengths by rfs_q16_dist(). */
-static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool whole,
+static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_t leg,
                               int64_t now_us)
 {
     if (!rfs_seek_go_to(s, mx, my, now_us)) {
@@ -228,7 +229,7 @@ static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool wh
     }
     rfs_path_t *p = &s->drive.path;
     int64_t px = s->pose.x, py = s->pose.y;
-    int64_t left = whole ? INT32_MAX : s->cfg.step;
+    int64_t left = leg > 0 ? leg : INT32_MAX;
     for (uint16_t k = 0; k < p->n; ++k) {
         int64_t dx = (int64_t)p->x[k] - px, dy = (int64_t)p->y[k] - py;
         int64_t len = rfs_q16_dist((rfs_q16_t)px, (rfs_q16_t)py, p->x[k], p->y[k]);
@@ -238,7 +239,7 @@ static bool greedy_along_path(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool wh
                 p->y[k] = rfs_sat32(py + rfs_sdiv64_round(dy * left, len));
             }
             p->n = (uint16_t)(k + 1u);
-            p->length = s->cfg.step;
+            p->length = leg;
             break;
         }
         left -= len;
@@ -284,7 +285,7 @@ static bool epsilon_sample(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     }
     /* An unreachable draw's stand-in (the reachable point nearest to it) where the robot
      * stands is a null move: the robot would learn nothing new there, again and again. */
-    if (!greedy_along_path(s, x, y, true, now_us) ||
+    if (!greedy_along_path(s, x, y, 0, now_us) ||
         rfs_q16_dist(s->pose.x, s->pose.y, s->decision.goal_x, s->decision.goal_y) < near) {
         return false;
     }
@@ -415,11 +416,83 @@ static bool choose_greedy(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     return rfs_seek_ops(s)->to_max(s, mx, my, known, rng, now_us);
 }
 
+/* local_r: the goal of a local search round an estimate (mx, my) the robot has stood
+ * at, or round its reachable stand-in when it is unreachable (the centre: its lattice
+ * point is visited), the unvisited reachable lattice point within local_r of the centre
+ * with the least sum of its squared straight distances to the robot and to the centre
+ * (the nearest to their midpoint; ties: the first in row order): when the robot is at
+ * the centre the nearest ring round it first, then on round the ring; false when the
+ * centre is not yet visited or no point is left. No square root: a window of up to
+ * (2 local_r / grid + 3)^2 points stays within a control period on the microcontroller.
+ * Scaling: offsets Q16 (< 2^31 each, map coordinates) in int64, squared Q32 < 2^62;
+ * a sum of two squared distances to the robot and centre saturates at INT64_MAX. */
+static bool local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_t *gx,
+                       rfs_q16_t *gy)
+{
+    const rfs_map_t *m = s->map;
+    uint16_t ci, cj;
+    rfs_q16_t cx = mx, cy = my;
+    rfs_map_lattice_nearest(m, mx, my, &ci, &cj);
+    if (!rfs_reach_bit(s->reach, (uint32_t)cj * m->lw + ci)) {
+        if (!rfs_reach_nearest(m, s->reach, mx, my, &cx, &cy)) {
+            return false;
+        }
+        rfs_map_lattice_nearest(m, cx, cy, &ci, &cj);
+    }
+    if (!rfs_reach_bit(s->visited, (uint32_t)cj * m->lw + ci)) {
+        return false;
+    }
+    const lattice_window_t w = lattice_window(m, ci, cj, s->cfg.local_r / m->cfg.grid + 1);
+    const int64_t r2 = (int64_t)s->cfg.local_r * s->cfg.local_r;
+    int64_t best = INT64_MAX;
+    for (int32_t j = w.j0; j <= w.j1; ++j) {
+        for (int32_t i = w.i0; i <= w.i1; ++i) {
+            const uint32_t idx = (uint32_t)j * m->lw + (uint32_t)i;
+            if (rfs_reach_bit(s->visited, idx) || !rfs_reach_bit(s->reach, idx)) {
+                continue;
+            }
+            rfs_q16_t px, py;
+            rfs_map_lattice_point(m, (uint16_t)i, (uint16_t)j, &px, &py);
+            const int64_t dx = (int64_t)px - cx, dy = (int64_t)py - cy;
+            if (dx * dx + dy * dy > r2) {
+                continue;
+            }
+            const int64_t rx = (int64_t)px - s->pose.x, ry = (int64_t)py - s->pose.y;
+            const uint64_t rr = (uint64_t)(rx * rx) + (uint64_t)(ry * ry);
+            const uint64_t sum = rr + (uint64_t)(dx * dx + dy * dy);
+            const int64_t cost = sum > (uint64_t)INT64_MAX - 1u ? INT64_MAX - 1 : (int64_t)sum;
+            if (cost < best) {
+                best = cost;
+                *gx = px;
+                *gy = py;
+            }
+        }
+    }
+    return best != INT64_MAX;
+}
+
 bool rfs_seek_meta_path_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool known,
                              rfs_rng_t *rng, int64_t now_us)
 {
     (void)rng;
-    return greedy_along_path(s, mx, my, known, now_us);
+    rfs_q16_t gx, gy;
+    if (known && s->cfg.local_r > 0 && local_goal(s, mx, my, &gx, &gy)) {
+        /* One scan a decision (the period budget); a point that cannot be planned to
+         * (unreachable in practice) is marked visited and this decision goes to the
+         * estimate; a plan waiting for the search tree decides again later. */
+        if (rfs_seek_go_to(s, gx, gy, now_us)) {
+            s->decision.goal_x = gx;
+            s->decision.goal_y = gy;
+            return true;
+        }
+        if (s->plan.tree_more) {
+            return false;
+        }
+        uint16_t li, lj;
+        rfs_map_lattice_nearest(s->map, gx, gy, &li, &lj);
+        rfs_reach_bit_set(s->visited, (uint32_t)lj * s->map->lw + li);
+    }
+    return greedy_along_path(s, mx, my, known ? s->cfg.leg_max : s->cfg.step, now_us);
 }
 
 /* The paper's greedy step: move min(distance, step) towards the maximum; when that point

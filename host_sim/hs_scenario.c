@@ -200,6 +200,8 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_refute_m = -1.0;
     sc->seek_silence_floor = -1;
     sc->seek_refute_reached = -1;
+    sc->seek_local_m = -1.0;
+    sc->seek_leg_m = -1.0;
     sc->seek_eps_by_travel = -1;
     sc->seek_eps_geodesic = -1;
     sc->seek_recheck_adapt = -1;
@@ -423,10 +425,12 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
         static const char *const k[] = {"recheck_m", "eps_by_travel", "eps_rate",
                                         "eps_geodesic", "recheck_adapt", "p0_min_dbm",
                                         "eps_sample", "refute_m", "silence_floor",
-                                        "refute_reached", NULL};
+                                        "refute_reached", "local_m", "leg_m", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "refute_m", 0, 100, &sc->seek_refute_m) ||
+            num(p, n, "seek", "local_m", 0, 100, &sc->seek_local_m) ||
+            num(p, n, "seek", "leg_m", 0, 1000, &sc->seek_leg_m) ||
             num(p, n, "seek", "eps_rate", 0, 100, &sc->seek_eps_rate) ||
             num(p, n, "seek", "p0_min_dbm", -200, 100, &sc->seek_p0_min_dbm) ||
             preset_bool(p, n, "eps_by_travel", &sc->seek_eps_by_travel) ||

@@ -10,7 +10,7 @@
  *   seek: {recheck_m: 1.0, eps_by_travel: true, eps_rate: 0.162, eps_geodesic: true,
  *                                  #       recheck_adapt: true, eps_sample: true, refute_m: 1,
  *                                  #       silence_floor: true, refute_reached: false,
- *                                  #       p0_min_dbm: -32}
+ *                                  #       p0_min_dbm: -32, local_m: 0, leg_m: 0}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2
@@ -72,6 +72,10 @@ typedef struct hs_scenario {
                                   ///< of a greedy leg (-1 = the strategy's preset)
     double seek_refute_m;         ///< seek.refute_m: radius ruled out round a refuted argmax
                                   ///< (rfs_seek_cfg_t.refute_r; 0: off; -1 = the preset)
+    double seek_local_m;          ///< seek.local_m: local search radius round an estimate
+                                  ///< stood at (rfs_seek_cfg_t.local_r; 0: off; -1 = preset)
+    double seek_leg_m;            ///< seek.leg_m: longest greedy leg to a known argmax
+                                  ///< (rfs_seek_cfg_t.leg_max; 0: whole; -1 = the preset)
     int seek_refute_reached;      ///< seek.refute_reached: 0 / 1 (rfs_seek_cfg_t; -1 = the
                                   ///< strategy's preset)
     int seek_silence_floor;       ///< seek.silence_floor: 0 / 1, floor samples (-100 dBm) in

@@ -181,7 +181,7 @@ def section(cmd, at, minutes, nruns, seeds, held, floors, results):
     L = [BEGIN, "## Generalisation: random placements", "",
          f"Written by `{cmd}` at commit {at} ({nruns} runs, {minutes:.0f} min): held-out "
          f"placements {held} (1..50 tune) of every shipped floor "
-         "(`rfseek-sim --placements`, docs/SIMULATOR.md), seeds "
+         "(docs/SIMULATOR.md, \"Placements\"), seeds "
          f"{seeds}; `p` meta-path + pathloss, `r` meta + ridge (the "
          "paper). Ratio: travel / shortest path, successful runs. Failures (first match; "
          "defined in scripts/bench_general.py): near miss / blocked / wrong belief / exploring "

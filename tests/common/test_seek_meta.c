@@ -403,6 +403,7 @@ static void refute_world(world_t *t, rfs_seek_cfg_t cfg, refute_model_t *m)
     world_make(t, 20.0, 10.0, 0, 0);
     cfg.eps_amp = 0;
     cfg.eps_floor = 0;
+    cfg.local_r = 0; /* the robot stays at each maximum (no sweep round it) */
     seek_make(t, cfg, 5);
     memset(m, 0, sizeof *m);
     rfs_model_t model = { &ops, m };
@@ -521,6 +522,126 @@ static void test_refute_reached_moves_on(void **state)
     assert_int_equal(refuted, 0);
     assert_int_equal(m.nexcl, 0);
     assert_true(m.fits <= 2); /* the first fit and nothing after: a parked robot */
+}
+
+/* local_r (docs/STRATEGIES.md, "Stalls"): a model whose estimate (10.3, 5.2) predicts
+ * every mean exactly (no relearn, nothing refuted), every decision greedy. The first goes
+ * to the estimate; from then on each goal must be, by a double-precision reference, a
+ * legal lattice point within local_r (1 m) of the estimate outside the 0.5 m novelty
+ * radius of every place the robot stood, with the least sum of the squared distances to
+ * the robot and to the estimate; when none is left the goal is the estimate again. With leg_max 4 m instead,
+ * the first greedy leg ends 4 m along the straight way to an estimate 12 m off. */
+#define LOCAL_EX 10.3
+#define LOCAL_EY 5.2
+
+static void local_world(world_t *t, rfs_seek_cfg_t *cfg, fixed_model_t *fm)
+{
+    world_make(t, 20.0, 10.0, 0.0, 0.0);
+    *cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(cfg, RFS_SEEK_META_PATH);
+    cfg->eps_amp = 0;
+    cfg->eps_floor = 0;
+    seek_make(t, *cfg, 5);
+    *fm = (fixed_model_t){ false, Q(LOCAL_EX), Q(LOCAL_EY) };
+}
+
+/* The reference goal after the robot stood at the n places (px, py); false when no
+ * lattice point is left. Ties within 1e-6 m^2 are accepted. */
+static bool local_ref_ok(const world_t *t, const double *px, const double *py, int n,
+                         double gx, double gy)
+{
+    double best = INFINITY, got = INFINITY;
+    for (uint16_t j = 0; j < t->map.lh; ++j) {
+        for (uint16_t i = 0; i < t->map.lw; ++i) {
+            rfs_q16_t qx, qy;
+            rfs_map_lattice_point(&t->map, i, j, &qx, &qy);
+            double x = D(qx), y = D(qy);
+            bool seen = false;
+            for (int k = 0; k < n && !seen; ++k) {
+                seen = hypot(x - px[k], y - py[k]) <= 0.5 + 1e-9;
+            }
+            if (seen || !rfs_map_lattice_legal(&t->map, i, j) ||
+                hypot(x - LOCAL_EX, y - LOCAL_EY) > 1.0 + 1e-9) {
+                continue;
+            }
+            double c = pow(hypot(x - px[n - 1], y - py[n - 1]), 2) +
+                       pow(hypot(x - LOCAL_EX, y - LOCAL_EY), 2);
+            best = c < best ? c : best;
+            if (fabs(x - gx) < 1e-4 && fabs(y - gy) < 1e-4) {
+                got = c;
+            }
+        }
+    }
+    if (best == INFINITY) {
+        return fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4;
+    }
+    return got < best + 1e-6;
+}
+
+static void test_local_search_round_the_estimate(void **state)
+{
+    (void)state;
+    world_t t;
+    rfs_seek_cfg_t cfg;
+    fixed_model_t fm;
+    local_world(&t, &cfg, &fm);
+    cfg.local_r = Q(1.0);
+    rfs_model_t model = { fixed_ops(), &fm };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.0, .y = 5.0 };
+    double px[64] = { 4.0 }, py[64] = { 5.0 };
+    int n = 1, local = 0;
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.kind, RFS_SEEK_INITIAL);
+    px[n] = D(out.decision.goal_x);
+    py[n++] = D(out.decision.goal_y);
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_true(fabs(D(out.decision.goal_x) - LOCAL_EX) < 1e-4); /* not yet stood at */
+    px[n] = LOCAL_EX;
+    py[n++] = LOCAL_EY;
+    while (n < 40) {
+        assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+        assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
+        double gx = D(out.decision.goal_x), gy = D(out.decision.goal_y);
+        assert_true(local_ref_ok(&t, px, py, n, gx, gy));
+        if (fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4) {
+            break; /* every point round the estimate stood near: back at it */
+        }
+        assert_true(hypot(gx - LOCAL_EX, gy - LOCAL_EY) <= 1.0 + 1e-9);
+        px[n] = gx;
+        py[n++] = gy;
+        local++;
+    }
+    assert_true(local >= 4 && n < 40);
+    world_free(&t);
+}
+
+static void test_leg_max_cuts_the_leg(void **state)
+{
+    (void)state;
+    world_t t;
+    rfs_seek_cfg_t cfg;
+    fixed_model_t fm;
+    local_world(&t, &cfg, &fm);
+    cfg.leg_max = Q(4.0);
+    fm.mx = Q(16.3);
+    rfs_model_t model = { fixed_ops(), &fm };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.0, .y = 5.0 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    double x0 = D(out.decision.goal_x), y0 = D(out.decision.goal_y);
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
+    double d = hypot(16.3 - x0, LOCAL_EY - y0);
+    double ex = x0 + 4.0 * (16.3 - x0) / d, ey = y0 + 4.0 * (LOCAL_EY - y0) / d;
+    assert_true(fabs(D(out.decision.goal_x) - ex) < 1e-3);
+    assert_true(fabs(D(out.decision.goal_y) - ey) < 1e-3);
+    assert_true(fabs(D(out.decision.path_len) - 4.0) < 1e-3);
+    world_free(&t);
 }
 
 /* The geodesic epsilon step (cfg.eps_geodesic, docs/STRATEGIES.md) against a double-
@@ -838,6 +959,8 @@ int main(void)
         cmocka_unit_test(test_eps_sample_goes_to_the_draw),
         cmocka_unit_test(test_refute_rules_out_the_argmax),
         cmocka_unit_test(test_refute_reached_moves_on),
+        cmocka_unit_test(test_local_search_round_the_estimate),
+        cmocka_unit_test(test_leg_max_cuts_the_leg),
         cmocka_unit_test(test_eps_geodesic_distribution),
         cmocka_unit_test(test_plan_slices_on_the_leg),
     };

@@ -241,6 +241,7 @@ static void run_orbit(rfs_q16_t orbit, rfs_q16_t end, int *ring, int *held, int 
     world_make(&t, 10.0, 10.0, 0, 0);
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    cfg.local_r = 0; /* as rfs_seek_cfg_per_source */
     cfg.settle_dist = RFS_Q16_INT(2);
     cfg.settle_orbit = orbit;
     cfg.settle_end = end;

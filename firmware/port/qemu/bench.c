@@ -883,6 +883,64 @@ static void __attribute__((noinline)) measure_behind_wall(const rfs_app_map_t *m
     rfs_bc_report("tree_second_goal_path_cm", 0, (uint32_t)((path->length * 100) >> 16));
 }
 
+/* local_r (docs/STRATEGIES.md, "Stalls"): a meta-path greedy decision at an estimate the
+ * robot stands at, on the open south half of the map: a model whose argmax is the robot's
+ * position and whose prediction is the measured -60 dBm, so the decision scans the
+ * 35 x 35 lattice points round it (every one within 4 m unvisited and reachable but those
+ * the robot's own poses marked: the scan's worst case) and plans to the nearest ring. */
+static rfs_q16_t s_local_x, s_local_y;
+static void local_reset(void *self)
+{
+    (void)self;
+}
+static rfs_fit_result_t local_fit(void *self, const rfs_model_fit_in_t *in, uint32_t budget,
+                                  rfs_rng_t *rng)
+{
+    (void)self;
+    (void)in;
+    (void)budget;
+    (void)rng;
+    return RFS_FIT_DONE;
+}
+static bool local_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *v)
+{
+    (void)self;
+    (void)x;
+    (void)y;
+    *v = RFS_Q16_INT(-60);
+    return true;
+}
+static bool local_argmax(const void *self, rfs_q16_t *x, rfs_q16_t *y)
+{
+    (void)self;
+    *x = s_local_x;
+    *y = s_local_y;
+    return true;
+}
+static void __attribute__((noinline)) measure_local_scan(const rfs_app_map_t *map)
+{
+    static const rfs_model_ops_t ops = {.name = "local", .reset = local_reset, .fit = local_fit,
+                                        .predict = local_predict, .argmax = local_argmax};
+    rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.samples = s_samples;
+    rfs_seek_cfg_use_strategy(&cfg.seek, RFS_SEEK_META_PATH);
+    cfg.seek.eps_amp = 0; /* epsilon = 0: every decision greedy */
+    cfg.seek.eps_floor = 0;
+    if (rfs_app_init(&s_app, &cfg, map) != 0) {
+        rfs_sh_puts("bench: rfs_app_init failed for the local scan\n");
+        rfs_sh_exit(1);
+    }
+    s_local_x = RFS_Q16_INT(30);
+    s_local_y = RFS_Q16_INT(5);
+    s_app.seek.model.ops = &ops;
+    rfs_app_out_t out;
+    rfs_rng_t rng0;
+    measure_decision(s_local_x, s_local_y, NULL, "local_scan", false, &out, &rng0);
+    const rfs_q16_t d = rfs_q16_dist(s_local_x, s_local_y, out.decision.goal_x, out.decision.goal_y);
+    rfs_bc_report("local_scan_greedy", 0, (uint32_t)(out.decided && out.decision.kind == RFS_SEEK_GREEDY));
+    rfs_bc_report("local_scan_goal_cm", 0, (uint32_t)((d * 100) >> 16));
+}
+
 int main(void)
 {
     rfs_bc_start(); /* SysTick, and the calibration lines */
@@ -908,5 +966,6 @@ int main(void)
     measure_sliced(&map, &cfg, rx, ry, &out);
     measure_behind_wall(&map, &path);
     ls_measure(&map);
+    measure_local_scan(&map);
     rfs_sh_exit(0);
 }

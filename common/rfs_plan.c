@@ -516,6 +516,7 @@ void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0)
     p->tree = 1;
     p->tree_done = false;
     p->tree_sliced = false;
+    p->lead = false;
 }
 
 static void set_dir(uint8_t *w, uint32_t u, uint32_t k)
@@ -594,32 +595,36 @@ bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget)
     return p->tree != 2 || p->tree_done;
 }
 
-bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0)
+bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t max_hop)
 {
     if (p->tree != 2) {
         return false;
     }
     uint32_t idx;
     bool ok = connect(p->map, x0, y0, true, &idx) && idx == p->tree_root;
+    bool lead = false;
     if (!ok && rfs_map_point_legal(p->map, x0, y0)) {
-        /* Another join point of the start's 3 x 3: the root, when a legal segment
-         * reaches it, serves as well (a robot stopped within the goal tolerance). */
-        uint16_t ci;
-        uint16_t cj;
-        rfs_map_lattice_nearest(p->map, x0, y0, &ci, &cj);
-        const int32_t di = (int32_t)(p->tree_root % p->map->lw) - ci;
-        const int32_t dj = (int32_t)(p->tree_root / p->map->lw) - cj;
+        /* The root within max_hop by a legal segment serves as well (a robot stopped
+         * near it, or braked past it): paths from (x0, y0) hop to it first. Else the
+         * tree's start (joined to the root when the tree was seeded) by way of it. */
         rfs_q16_t rx;
         rfs_q16_t ry;
         point_of(p->map, p->tree_root, &rx, &ry);
-        ok = di >= -1 && di <= 1 && dj >= -1 && dj <= 1 &&
+        ok = rfs_q16_dist(x0, y0, rx, ry) <= max_hop &&
              rfs_map_segment_legal(p->map, x0, y0, rx, ry);
+        lead = !ok && rfs_q16_dist(x0, y0, p->tree_x, p->tree_y) <= max_hop &&
+               rfs_map_segment_legal(p->map, x0, y0, p->tree_x, p->tree_y);
     }
     if (ok) {
         p->tree_x = x0;
         p->tree_y = y0;
+        p->lead = false;
+    } else if (lead) {
+        p->lead = true;
+        p->lead_x = x0;
+        p->lead_y = y0;
     }
-    return ok;
+    return ok || lead;
 }
 
 /* The goal (x1, y1) on the tree: -1 no path (illegal, unreachable, not closed yet on a
@@ -660,6 +665,42 @@ static int tree_goal(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, uint32_t *g_idx)
     return 0;
 }
 
+/* A tree moved by way of its start (lead): the path from the start, `out`, preceded by
+ * the hop from the lead point, whose segment to the start is legal (rfs_plan_tree_move);
+ * the start is skipped when the lead sees the first waypoint. false when that needs more
+ * than RFS_PLAN_MAX_WAYPOINTS waypoints. Scaling: lengths Q16.16, the sum saturated. */
+static bool lead_hop(const rfs_plan_t *p, rfs_path_t *out)
+{
+    const rfs_q16_t lx = p->lead_x, ly = p->lead_y;
+    int64_t len = (int64_t)out->length - rfs_q16_dist(out->x0, out->y0, out->x[0], out->y[0]);
+    if (rfs_map_segment_legal(p->map, lx, ly, out->x[0], out->y[0])) {
+        len += rfs_q16_dist(lx, ly, out->x[0], out->y[0]);
+    } else if (out->n < RFS_PLAN_MAX_WAYPOINTS) {
+        memmove(&out->x[1], &out->x[0], (size_t)out->n * sizeof out->x[0]);
+        memmove(&out->y[1], &out->y[0], (size_t)out->n * sizeof out->y[0]);
+        out->x[0] = out->x0;
+        out->y[0] = out->y0;
+        out->n++;
+        len += rfs_q16_dist(lx, ly, out->x0, out->y0) +
+               rfs_q16_dist(out->x0, out->y0, out->x[1], out->y[1]);
+    } else {
+        out->n = 0;
+        out->length = 0;
+        return false;
+    }
+    out->length = len > INT32_MAX ? INT32_MAX : (rfs_q16_t)len;
+    out->x0 = lx;
+    out->y0 = ly;
+    return true;
+}
+
+/* A tree moved by way of its start: the goal (x1, y1) in line of sight from the lead. */
+static bool lead_sees(const rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1)
+{
+    return p->tree != 0 && p->lead && rfs_map_point_legal(p->map, x1, y1) &&
+           rfs_map_segment_legal(p->map, p->lead_x, p->lead_y, x1, y1);
+}
+
 bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out)
 {
     out->n = 0;
@@ -667,6 +708,17 @@ bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *o
     out->x0 = p->tree_x;
     out->y0 = p->tree_y;
     out->has_start = true;
+    if (lead_sees(p, x1, y1)) {
+        p->expanded = 0;
+        p->pulled = 0;
+        out->x0 = p->lead_x;
+        out->y0 = p->lead_y;
+        out->x[0] = x1;
+        out->y[0] = y1;
+        out->n = 1;
+        out->length = rfs_q16_dist(p->lead_x, p->lead_y, x1, y1);
+        return true;
+    }
     uint32_t g_idx = 0;
     const int at = tree_goal(p, x1, y1, &g_idx);
     if (at > 0) {
@@ -675,16 +727,26 @@ bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *o
         out->n = 1;
         out->length = rfs_q16_dist(p->tree_x, p->tree_y, x1, y1);
     }
-    return at == 0 ? tree_extract(p, g_idx, x1, y1, out) : at > 0;
+    const bool ok = at == 0 ? tree_extract(p, g_idx, x1, y1, out) : at > 0;
+    return ok && (!p->lead || lead_hop(p, out));
 }
 
 bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *len)
 {
     const rfs_map_t *m = p->map;
+    if (lead_sees(p, x1, y1)) {
+        p->expanded = 0;
+        p->pulled = 0;
+        *len = rfs_q16_dist(p->lead_x, p->lead_y, x1, y1);
+        return true;
+    }
+    /* A lead hops to the start first. Scaling: a hop of at most the map's diagonal. */
+    const uint64_t hop = p->lead ? (uint64_t)rfs_q16_dist(p->lead_x, p->lead_y, p->tree_x, p->tree_y) : 0u;
     uint32_t g_idx = 0;
     const int at = tree_goal(p, x1, y1, &g_idx);
     if (at != 0) {
-        *len = at > 0 ? rfs_q16_dist(p->tree_x, p->tree_y, x1, y1) : 0;
+        const uint64_t l = hop + (uint64_t)rfs_q16_dist(p->tree_x, p->tree_y, x1, y1);
+        *len = at > 0 ? (l > (uint64_t)INT32_MAX ? INT32_MAX : (rfs_q16_t)l) : 0;
         return at > 0;
     }
     /* Scaling and overflow: at most lw * lh < 2^32 steps of grid < 2^31 (Q16) each, the
@@ -704,7 +766,7 @@ bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *
     point_of(m, p->tree_root, &rx, &ry);
     point_of(m, g_idx, &gx, &gy);
     const uint64_t g = (uint64_t)m->cfg.grid;
-    uint64_t l = (uint64_t)rfs_q16_dist(p->tree_x, p->tree_y, rx, ry) +
+    uint64_t l = hop + (uint64_t)rfs_q16_dist(p->tree_x, p->tree_y, rx, ry) +
                  (uint64_t)rfs_q16_dist(gx, gy, x1, y1) + straight * g +
                  ((diagonal * g * 92682u) >> 16);
     *len = l > (uint64_t)INT32_MAX ? INT32_MAX : (rfs_q16_t)l;

@@ -68,6 +68,10 @@ typedef struct rfs_plan {
     bool tree_sliced;       ///< grown by rfs_plan_tree_grow: plans do not search
     bool tree_more;         ///< set (never cleared here) when a plan on a sliced tree asked
                             ///< for a point it has not closed yet: grow it, ask again
+    bool lead;              ///< moved by way of tree_x, tree_y (rfs_plan_tree_move): paths
+                            ///< start at lead_x, lead_y and hop to it first
+    rfs_q16_t lead_x;       ///< metres Q16.16
+    rfs_q16_t lead_y;       ///< metres Q16.16
 } rfs_plan_t;
 
 /// A planned path: waypoints in order, the last one the goal itself.
@@ -127,11 +131,14 @@ bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *
 bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget);
 
 /// Let a seeded tree (rooted at a lattice point) serve plans from (x0, y0), e.g. a
-/// robot stopped near the point the tree was begun at: true, and later paths start at
-/// (x0, y0), when it joins the lattice at the tree's root, or it is legal and the root
-/// is one of the 3 x 3 lattice points round it and a legal segment reaches it; false
+/// robot stopped near the point the tree was begun at, or cut short before or braked past
+/// it: true when (x0, y0) joins the lattice at the tree's root, or it is legal and a legal
+/// segment of at most max_hop (metres, Q16.16) reaches the root's lattice point (later
+/// paths start at (x0, y0)) or the tree's start (paths then start at (x0, y0) and hop to
+/// the start first, unless the goal or the first waypoint is in line of sight): at most
+/// 2 max_hop longer than from a tree rooted at (x0, y0), before string pulling. false
 /// (the tree unchanged) otherwise.
-bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0);
+bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t max_hop);
 
 /// Tell the planner which lattice points are known to be connected: `bits` (NULL: none)
 /// holds one bit per lattice point and must be a union of whole components of the lattice

@@ -465,7 +465,7 @@ static bool plan_begin(rfs_seek_t *s)
     if (!rfs_seek_plan_start(s, &sx, &sy)) {
         return false;
     }
-    if (!rfs_plan_tree_move(&s->plan, sx, sy)) {
+    if (!rfs_plan_tree_move(&s->plan, sx, sy, s->cfg.step)) {
         rfs_plan_tree_begin(&s->plan, sx, sy);
     }
     return true;
@@ -717,11 +717,13 @@ static void resume_goal(rfs_seek_t *s, int64_t now_us)
     s->state = RFS_SEEK_DRIVING;
 }
 
-/* plan_budget: one slice of the next decision's search tree (begun by end_decision). */
+/* plan_budget: one slice of the next decision's search tree (begun by end_decision). A
+ * period that drives or stands without choosing has the room of the choice: its slice
+ * is 5/4 plan_budget (docs/PERFORMANCE.md, "Planning in slices"). */
 static void grow_next(rfs_seek_t *s)
 {
     if (s->cfg.plan_budget != 0u) {
-        (void)rfs_plan_tree_grow(&s->plan, s->cfg.plan_budget);
+        (void)rfs_plan_tree_grow(&s->plan, RFS_SEEK_DRIVE_SLICE(s->cfg.plan_budget));
     }
 }
 

@@ -1001,7 +1001,7 @@ static void test_tree_sliced(void **state)
             /* A robot stopped 0.07 m from the root, or a lattice step away. */
             const rfs_q16_t mx = x0 + RFS_Q16_FRAC(7, 100), my = y0 - RFS_Q16_FRAC(3, 100);
             if (rfs_map_point_legal(&wd.m, mx, my) && ref_seg(mx, my, x0, y0)) {
-                assert_true(rfs_plan_tree_move(&t, mx, my));
+                assert_true(rfs_plan_tree_move(&t, mx, my, RFS_Q16_ONE));
                 moved++;
                 int gi, gj;
                 random_legal(&rs, lw, lh, &gi, &gj);
@@ -1016,7 +1016,7 @@ static void test_tree_sliced(void **state)
                     }
                 }
             }
-            assert_false(rfs_plan_tree_move(&t, x0 + (rfs_q16_t)(3 * g), y0));
+            assert_false(rfs_plan_tree_move(&t, x0 + (rfs_q16_t)(3 * g), y0, (rfs_q16_t)(2 * g)));
         }
     }
     print_message("sliced trees: %d plans before done, %d of them asked for more; %d moved\n",

@@ -226,7 +226,7 @@ static uint32_t geo_replay(rfs_seek_t *s, rfs_rng_t rng, bool geodesic, rfs_q16_
 
 /* The planner's search tree for the next decision grown while the last leg was driven
  * (rfs_seek.c, plan_budget): begun where the leg ends, here the robot's pose, and grown by
- * plan_budget points a period as drive_on does, each slice measured; the worst as
+ * RFS_SEEK_DRIVE_SLICE(plan_budget) points a period as drive_on does, each slice measured; the worst as
  * `base`_slice, the number as `base`_slices. */
 static void grow_on_leg(const char *base, rfs_q16_t rx, rfs_q16_t ry)
 {
@@ -236,8 +236,12 @@ static void grow_on_leg(const char *base, rfs_q16_t rx, rfs_q16_t ry)
     uint32_t slices = 0;
     bool done = false;
     while (!done && slices < 1000u) {
+        /* Start just after a SysTick wrap: a slice (under 2^24 ticks) then contains none,
+         * and its count stays exact (tests/firmware/bench.sh). */
+        while ((rfs_bc_ticks() & 0xFFFFFFu) > 0x1000u) {
+        }
         const uint64_t a = rfs_bc_ticks();
-        done = rfs_plan_tree_grow(p, s_app.seek.cfg.plan_budget);
+        done = rfs_plan_tree_grow(p, RFS_SEEK_DRIVE_SLICE(s_app.seek.cfg.plan_budget));
         const uint64_t d = rfs_bc_ticks() - a;
         worst = d > worst ? d : worst;
         slices++;

@@ -68,10 +68,8 @@ typedef struct rfs_plan {
     bool tree_sliced;       ///< grown by rfs_plan_tree_grow: plans do not search
     bool tree_more;         ///< set (never cleared here) when a plan on a sliced tree asked
                             ///< for a point it has not closed yet: grow it, ask again
-    bool lead;              ///< moved by way of tree_x, tree_y (rfs_plan_tree_move): paths
-                            ///< start at lead_x, lead_y and hop to it first
-    rfs_q16_t lead_x;       ///< metres Q16.16
-    rfs_q16_t lead_y;       ///< metres Q16.16
+    uint32_t tree_from;     ///< the lattice point paths leave tree_x, tree_y by: the root,
+                            ///< or the join point of a start moved (rfs_plan_tree_move)
 } rfs_plan_t;
 
 /// A planned path: waypoints in order, the last one the goal itself.
@@ -130,14 +128,14 @@ bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *
 /// when no tree was begun.
 bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget);
 
-/// Let a seeded tree (rooted at a lattice point) serve plans from (x0, y0), e.g. a
-/// robot stopped near the point the tree was begun at, or cut short before or braked past
-/// it: true when (x0, y0) joins the lattice at the tree's root, or it is legal and a legal
-/// segment of at most max_hop (metres, Q16.16) reaches the root's lattice point (later
-/// paths start at (x0, y0)) or the tree's start (paths then start at (x0, y0) and hop to
-/// the start first, unless the goal or the first waypoint is in line of sight): at most
-/// 2 max_hop longer than from a tree rooted at (x0, y0), before string pulling. false
-/// (the tree unchanged) otherwise.
+/// Let a seeded tree serve plans from (x0, y0), e.g. a robot stopped near the point the
+/// tree was begun at, braked past it or cut short before it: true, and later paths start
+/// at (x0, y0), when the lattice point it joins (as rfs_plan_path joins a start) is
+/// closed and the hop to it plus its tree path to the root (straight steps grid,
+/// diagonal ones grid sqrt 2) is at most max_hop (metres, Q16.16). Paths then go from
+/// that point up its branch to the goal's and along it: at most 2 max_hop longer than
+/// from a tree rooted at (x0, y0), before string pulling. false (the tree unchanged)
+/// otherwise.
 bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t max_hop);
 
 /// Tell the planner which lattice points are known to be connected: `bits` (NULL: none)

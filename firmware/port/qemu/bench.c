@@ -884,6 +884,21 @@ static void __attribute__((noinline)) measure_behind_wall(const rfs_app_map_t *m
     rfs_bc_report("walk_behind_wall_ok", 0, geo_ok ? 1u : 0u);
     rfs_bc_report("walk_behind_wall_pulled", 0, s_app.seek.plan.pulled);
     rfs_bc_report("walk_behind_wall_path_cm", 0, (uint32_t)((path->length * 100) >> 16));
+    rfs_q16_t len = 0;
+    RFS_BC_MEASURE("phase_length_behind_wall", 1,
+                   geo_ok = rfs_plan_tree_length(&s_app.seek.plan, gx, gy, &len));
+    /* The same tree serving a robot 0.5 m off its root (braked past it): joined at its
+     * own lattice point, paths up its branch (rfs_plan_tree_move). */
+    RFS_BC_MEASURE("phase_tree_move", 1,
+                   geo_ok = rfs_plan_tree_move(&s_app.seek.plan, RFS_Q16_FRAC(13, 8),
+                                               RFS_Q16_FRAC(69, 8), s_app.seek.cfg.step));
+    rfs_bc_report("tree_move_ok", 0, geo_ok ? 1u : 0u);
+    RFS_BC_MEASURE("phase_walk_moved", 1,
+                   geo_ok = rfs_plan_tree_path(&s_app.seek.plan, gx, gy, path));
+    rfs_bc_report("walk_moved_ok", 0, geo_ok ? 1u : 0u);
+    rfs_bc_report("walk_moved_path_cm", 0, (uint32_t)((path->length * 100) >> 16));
+    RFS_BC_MEASURE("phase_length_moved", 1,
+                   geo_ok = rfs_plan_tree_length(&s_app.seek.plan, gx, gy, &len));
     rfs_bc_report("tree_second_goal_path_cm", 0, (uint32_t)((path->length * 100) >> 16));
 }
 

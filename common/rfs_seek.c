@@ -411,7 +411,11 @@ static void begin_next_tree(rfs_seek_t *s)
             py = p->y[k];
         }
     }
-    rfs_plan_tree_begin(&s->plan, x, y);
+    /* A short leg (a line search's few centimetres) ends within half a step of the tree
+     * the robot decided on: that tree, further grown, serves the next decision. */
+    if (!rfs_plan_tree_move(&s->plan, x, y, s->cfg.step / 2)) {
+        rfs_plan_tree_begin(&s->plan, x, y);
+    }
 }
 
 /* Count the decision, report it, and start driving (or flag that there is no goal). */

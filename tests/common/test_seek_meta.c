@@ -909,6 +909,57 @@ static void test_plan_leg_cut_short(void **state)
     world_free(&t);
 }
 
+/* plan_budget, short legs: the paper's meta stepping 0.3 m at a time (the maximum just
+ * ahead, moved on after each step) keeps the tree it decided on, moved to the leg's end
+ * and grown on, while that end is within half a step of its root (every other step
+ * here), else begins one there; no decision waits beyond its relearn period. */
+static void test_plan_short_leg_keeps_tree(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 24.0, 16.0, 12.0, 12.0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    cfg.eps_floor = 0;
+    cfg.eps_amp = 0;
+    seek_make(&t, cfg, 11);
+    fixed_model_t fm = { false, Q(6.0), Q(4.125) };
+    rfs_model_t model = { fixed_ops(), &fm };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 6.0, .y = 4.125 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out)); /* the initial move */
+    int kept = 0, begun = 0;
+    for (int k = 0; k < 8; k++) {
+        fm.mx = Q((r.pending ? r.gx : r.x) + 0.3); /* just ahead of where it decides */
+        fm.my = Q(r.pending ? r.gy : r.y);
+        assert_true(next_decision(&t, &r, &f, 1000000, 20000000, &out));
+        const rfs_seek_decision_t *d = &out.decision;
+        if (d->kind != RFS_SEEK_GREEDY) {
+            continue;
+        }
+        assert_true(d->plan_wait <= (d->relearned ? 1u : 0u));
+        assert_int_equal(d->goal_x, fm.mx);
+        /* The next tree serves the leg's end: kept (seeded, its root within half a step)
+         * or begun there (seeded at the next slice). */
+        assert_int_equal(t.seek.plan.tree_x, d->goal_x);
+        assert_int_equal(t.seek.plan.tree_y, d->goal_y);
+        if (t.seek.plan.tree == 2) {
+            const uint32_t root = t.seek.plan.tree_root, lw = t.map.lw;
+            const double gx = D(t.map.cfg.grid) * ((root % lw) + 0.5);
+            const double gy = D(t.map.cfg.grid) * ((root / lw) + 0.5);
+            assert_true(hypot(gx - D(d->goal_x), gy - D(d->goal_y)) <= 0.5 + 1e-6);
+            kept++;
+        } else {
+            assert_int_equal(t.seek.plan.tree, 1);
+            begun++;
+        }
+    }
+    print_message("short legs: %d decisions kept the tree, %d began one\n", kept, begun);
+    assert_true(kept >= 3 && begun >= 2);
+    world_free(&t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -923,6 +974,7 @@ int main(void)
         cmocka_unit_test(test_eps_geodesic_distribution),
         cmocka_unit_test(test_plan_slices_on_the_leg),
         cmocka_unit_test(test_plan_leg_cut_short),
+        cmocka_unit_test(test_plan_short_leg_keeps_tree),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

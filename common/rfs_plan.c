@@ -734,18 +734,14 @@ bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *
         *len = at > 0 ? rfs_q16_dist(p->tree_x, p->tree_y, x1, y1) : 0;
         return at > 0;
     }
-    /* From the root a walk from the goal up its chain; from another start the chain
-     * turned round and walked from the start (tree_extract's lattice path). */
+    /* The goal's chain up to the root, and a moved start's (short: within the move's
+     * hop) also up to the root, not to where they meet: one walk, an upper bound of
+     * tree_extract's lattice path by at most twice the start's. */
     uint64_t straight = 0;
     uint64_t diagonal = 0;
-    bool ok;
-    if (p->tree_from == p->tree_root) {
-        ok = walk_steps(p, g_idx, p->tree_root, &straight, &diagonal);
-    } else {
-        uint32_t root_dir;
-        ok = turn_chain(p, g_idx, &root_dir) != 0u &&
-             walk_steps(p, p->tree_from, g_idx, &straight, &diagonal);
-        turn_back(p, g_idx, root_dir);
+    bool ok = walk_steps(p, g_idx, p->tree_root, &straight, &diagonal);
+    if (ok && p->tree_from != p->tree_root) {
+        ok = walk_steps(p, p->tree_from, p->tree_root, &straight, &diagonal);
     }
     rfs_q16_t fx, fy, gx, gy;
     point_of(m, p->tree_from, &fx, &fy);

@@ -111,12 +111,14 @@ void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0);
 /// rfs_plan_path call ended it.
 bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out);
 
-/// The length of the path from the tree's root to the legal point (x1, y1) before string
-/// pulling, metres Q16.16 (saturated): the root's position to its lattice point, the
+/// The length of the path from the tree's start to the legal point (x1, y1) before string
+/// pulling, metres Q16.16 (saturated): the start's position to its lattice point, the
 /// lattice path (straight steps grid, diagonal ones grid sqrt 2), the goal's lattice
-/// point to the goal; the straight distance in line of sight. At least the pulled
-/// path's length; its lattice part at most 6.1 % above the shortest lattice path (octile
-/// costs 1.5 for sqrt 2); a walk, no pull.
+/// point to the goal; the straight distance in line of sight. From a moved start
+/// (rfs_plan_tree_move) the lattice part runs by the root: at most twice the start's
+/// tree path over rfs_plan_tree_path's. At least the pulled path's length; from the
+/// root its lattice part at most 6.1 % above the shortest lattice path (octile costs 1.5
+/// for sqrt 2); a walk, no pull.
 /// rfs_plan_tree_path's result cases (false, *len 0, when it would fail).
 bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *len);
 

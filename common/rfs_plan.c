@@ -523,25 +523,46 @@ static void set_dir(uint8_t *w, uint32_t u, uint32_t k)
     w[u] = (uint8_t)((w[u] & (uint8_t)~W_DIR) | k);
 }
 
-/* The path from the tree's root to the closed point g_idx, pulled, into out.
- *
- * The back-pointers lead from the goal to the root. Turn those of the path round (each
- * point then points at its successor towards the goal), pull the path from the root
- * forwards as rfs_plan_path does, and turn them back, so the tree is unchanged for the
- * next goal: no memory beyond the work byte. The walks are bounded by the points (a
- * closed point's pointers always reach the root). */
-static bool tree_extract(rfs_plan_t *p, uint32_t g_idx, rfs_q16_t x1, rfs_q16_t y1,
-                         rfs_path_t *out)
+/* Walk the direction bits from u until `end` (at most the lattice's points), counting
+ * straight and diagonal steps; false when it does not get there. */
+static bool walk_steps(const rfs_plan_t *p, uint32_t u, uint32_t end, uint64_t *straight,
+                       uint64_t *diagonal)
 {
-    const rfs_map_t *m = p->map;
+    const uint32_t lw = p->map->lw;
+    const uint32_t n = lw * p->map->lh;
+    for (uint32_t k = 0; u != end && k <= n; k++) {
+        const uint32_t dir = p->work[u] & W_DIR;
+        *straight += (dir & 1u) == 0u;
+        *diagonal += dir & 1u;
+        u = step_from(u, dir, lw);
+    }
+    return u == end;
+}
+
+/* Metres Q16.16 (saturated) of a walk's steps: straight ones grid, diagonal ones grid
+ * sqrt 2. Scaling: at most lw * lh < 2^32 steps of grid < 2^31 (Q16) each in uint64;
+ * sqrt 2 in Q16 (92682) times that stays below 2^64 for any lattice whose path
+ * saturates the result (32 km) long before. */
+static uint64_t steps_length(const rfs_map_t *m, uint64_t straight, uint64_t diagonal)
+{
+    const uint64_t g = (uint64_t)m->cfg.grid;
+    return straight * g + ((diagonal * g * 92682u) >> 16);
+}
+
+/* Turn the back-pointers of the chain from the closed point g_idx to the root round,
+ * each then pointing at its child: a walk by the direction bits from any closed point
+ * then reaches g_idx (up its own branch to the chain, then along it). *root_dir keeps
+ * the root's own bits for turn_back. The chain's points (both ends), 0 when it does not
+ * reach the root (cannot happen: a closed point's pointers lead to the root). */
+static uint32_t turn_chain(rfs_plan_t *p, uint32_t g_idx, uint32_t *root_dir)
+{
     uint8_t *w = p->work;
-    const uint32_t root = p->tree_root;
-    const uint32_t lw = m->lw;
-    const uint32_t n = lw * m->lh;
+    const uint32_t lw = p->map->lw;
+    const uint32_t n = lw * p->map->lh;
     uint32_t u = g_idx;
     uint32_t k = w[u] & W_DIR; /* from u to its parent */
     uint32_t pts = 1;
-    while (u != root && pts <= n) {
+    while (u != p->tree_root && pts <= n) {
         uint32_t v = step_from(u, k, lw);
         uint32_t kv = w[v] & W_DIR;
         set_dir(w, v, (k + 4u) & 7u); /* v now points at its child u */
@@ -549,19 +570,47 @@ static bool tree_extract(rfs_plan_t *p, uint32_t g_idx, rfs_q16_t x1, rfs_q16_t 
         k = kv;
         pts++;
     }
-    if (u != root) {
-        return false; /* unreachable: a closed point's pointers lead to the root */
-    }
-    const bool ok = pull_path(m, w, root, pts, p->tree_x, p->tree_y, x1, y1, out, &p->pulled);
-    /* Turn the pointers back: each point's parent is the one before it. */
-    uint32_t back = k; /* the root's own direction bits, restored as they were */
-    for (u = root; u != g_idx;) {
+    *root_dir = k;
+    return u == p->tree_root ? pts : 0u;
+}
+
+/* Undo turn_chain: each chain point's parent is the one before it again. */
+static void turn_back(rfs_plan_t *p, uint32_t g_idx, uint32_t root_dir)
+{
+    uint8_t *w = p->work;
+    const uint32_t lw = p->map->lw;
+    uint32_t back = root_dir;
+    for (uint32_t u = p->tree_root; u != g_idx;) {
         const uint32_t fwd = w[u] & W_DIR;
         set_dir(w, u, back);
         back = (fwd + 4u) & 7u;
         u = step_from(u, fwd, lw);
     }
     set_dir(w, g_idx, back);
+}
+
+/* The path from the tree's start (tree_from: the root, or a moved start's join point) to
+ * the closed point g_idx, pulled, into out.
+ *
+ * The back-pointers lead from the goal to the root. Turn those of the chain round
+ * (turn_chain), pull the path from the start forwards as rfs_plan_path does (from the
+ * root: the chain; from another start: up its branch to the chain, then along it), and
+ * turn them back, so the tree is unchanged for the next goal: no memory beyond the work
+ * byte. */
+static bool tree_extract(rfs_plan_t *p, uint32_t g_idx, rfs_q16_t x1, rfs_q16_t y1,
+                         rfs_path_t *out)
+{
+    uint32_t root_dir;
+    uint32_t pts = turn_chain(p, g_idx, &root_dir);
+    if (pts == 0u) {
+        return false;
+    }
+    if (p->tree_from != p->tree_root) {
+        pts = path_points(p, p->tree_from, g_idx);
+    }
+    const bool ok = pts != 0u && pull_path(p->map, p->work, p->tree_from, pts, p->tree_x,
+                                           p->tree_y, x1, y1, out, &p->pulled);
+    turn_back(p, g_idx, root_dir);
     return ok;
 }
 
@@ -575,6 +624,7 @@ static void tree_seed(rfs_plan_t *p)
         p->tree = 3;
         return;
     }
+    p->tree_from = p->tree_root;
     p->queue_peak = 0;
     seed(p, p->tree_root);
     p->tree = 2;
@@ -594,32 +644,29 @@ bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget)
     return p->tree != 2 || p->tree_done;
 }
 
-bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0)
+bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t max_hop)
 {
-    if (p->tree != 2) {
+    uint32_t idx;
+    if (p->tree != 2 || !connect(p->map, x0, y0, true, &idx) ||
+        !(p->work[idx] & W_CLOSED)) {
         return false;
     }
-    uint32_t idx;
-    bool ok = connect(p->map, x0, y0, true, &idx) && idx == p->tree_root;
-    if (!ok && rfs_map_point_legal(p->map, x0, y0)) {
-        /* Another join point of the start's 3 x 3: the root, when a legal segment
-         * reaches it, serves as well (a robot stopped within the goal tolerance). */
-        uint16_t ci;
-        uint16_t cj;
-        rfs_map_lattice_nearest(p->map, x0, y0, &ci, &cj);
-        const int32_t di = (int32_t)(p->tree_root % p->map->lw) - ci;
-        const int32_t dj = (int32_t)(p->tree_root / p->map->lw) - cj;
-        rfs_q16_t rx;
-        rfs_q16_t ry;
-        point_of(p->map, p->tree_root, &rx, &ry);
-        ok = di >= -1 && di <= 1 && dj >= -1 && dj <= 1 &&
-             rfs_map_segment_legal(p->map, x0, y0, rx, ry);
+    uint64_t straight = 0;
+    uint64_t diagonal = 0;
+    if (!walk_steps(p, idx, p->tree_root, &straight, &diagonal)) {
+        return false;
     }
-    if (ok) {
-        p->tree_x = x0;
-        p->tree_y = y0;
+    rfs_q16_t jx;
+    rfs_q16_t jy;
+    point_of(p->map, idx, &jx, &jy);
+    if ((uint64_t)rfs_q16_dist(x0, y0, jx, jy) + steps_length(p->map, straight, diagonal) >
+        (uint64_t)(max_hop < 0 ? 0 : max_hop)) {
+        return false;
     }
-    return ok;
+    p->tree_x = x0;
+    p->tree_y = y0;
+    p->tree_from = idx;
+    return true;
 }
 
 /* The goal (x1, y1) on the tree: -1 no path (illegal, unreachable, not closed yet on a
@@ -687,26 +734,20 @@ bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *
         *len = at > 0 ? rfs_q16_dist(p->tree_x, p->tree_y, x1, y1) : 0;
         return at > 0;
     }
-    /* Scaling and overflow: at most lw * lh < 2^32 steps of grid < 2^31 (Q16) each, the
-     * sums in uint64; sqrt 2 in Q16 (92682) times that stays below 2^64 for any lattice
-     * whose path saturates the result (32 km) long before. */
+    /* The goal's chain up to the root, and a moved start's (short: within the move's
+     * hop) also up to the root, not to where they meet: one walk, an upper bound of
+     * tree_extract's lattice path by at most twice the start's. */
     uint64_t straight = 0;
     uint64_t diagonal = 0;
-    const uint32_t n = (uint32_t)m->lw * m->lh;
-    uint32_t u = g_idx;
-    for (uint32_t k = 0; u != p->tree_root && k <= n; k++) {
-        const uint32_t dir = p->work[u] & W_DIR;
-        straight += (dir & 1u) == 0u;
-        diagonal += dir & 1u;
-        u = step_from(u, dir, m->lw);
+    bool ok = walk_steps(p, g_idx, p->tree_root, &straight, &diagonal);
+    if (ok && p->tree_from != p->tree_root) {
+        ok = walk_steps(p, p->tree_from, p->tree_root, &straight, &diagonal);
     }
-    rfs_q16_t rx, ry, gx, gy;
-    point_of(m, p->tree_root, &rx, &ry);
+    rfs_q16_t fx, fy, gx, gy;
+    point_of(m, p->tree_from, &fx, &fy);
     point_of(m, g_idx, &gx, &gy);
-    const uint64_t g = (uint64_t)m->cfg.grid;
-    uint64_t l = (uint64_t)rfs_q16_dist(p->tree_x, p->tree_y, rx, ry) +
-                 (uint64_t)rfs_q16_dist(gx, gy, x1, y1) + straight * g +
-                 ((diagonal * g * 92682u) >> 16);
+    uint64_t l = (uint64_t)rfs_q16_dist(p->tree_x, p->tree_y, fx, fy) +
+                 (uint64_t)rfs_q16_dist(gx, gy, x1, y1) + steps_length(m, straight, diagonal);
     *len = l > (uint64_t)INT32_MAX ? INT32_MAX : (rfs_q16_t)l;
-    return u == p->tree_root;
+    return ok;
 }

@@ -68,6 +68,8 @@ typedef struct rfs_plan {
     bool tree_sliced;       ///< grown by rfs_plan_tree_grow: plans do not search
     bool tree_more;         ///< set (never cleared here) when a plan on a sliced tree asked
                             ///< for a point it has not closed yet: grow it, ask again
+    uint32_t tree_from;     ///< the lattice point paths leave tree_x, tree_y by: the root,
+                            ///< or the join point of a start moved (rfs_plan_tree_move)
 } rfs_plan_t;
 
 /// A planned path: waypoints in order, the last one the goal itself.
@@ -109,12 +111,14 @@ void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0);
 /// rfs_plan_path call ended it.
 bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *out);
 
-/// The length of the path from the tree's root to the legal point (x1, y1) before string
-/// pulling, metres Q16.16 (saturated): the root's position to its lattice point, the
+/// The length of the path from the tree's start to the legal point (x1, y1) before string
+/// pulling, metres Q16.16 (saturated): the start's position to its lattice point, the
 /// lattice path (straight steps grid, diagonal ones grid sqrt 2), the goal's lattice
-/// point to the goal; the straight distance in line of sight. At least the pulled
-/// path's length; its lattice part at most 6.1 % above the shortest lattice path (octile
-/// costs 1.5 for sqrt 2); a walk, no pull.
+/// point to the goal; the straight distance in line of sight. From a moved start
+/// (rfs_plan_tree_move) the lattice part runs by the root: at most twice the start's
+/// tree path over rfs_plan_tree_path's. At least the pulled path's length; from the
+/// root its lattice part at most 6.1 % above the shortest lattice path (octile costs 1.5
+/// for sqrt 2); a walk, no pull.
 /// rfs_plan_tree_path's result cases (false, *len 0, when it would fail).
 bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *len);
 
@@ -126,12 +130,15 @@ bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *
 /// when no tree was begun.
 bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget);
 
-/// Let a seeded tree (rooted at a lattice point) serve plans from (x0, y0), e.g. a
-/// robot stopped near the point the tree was begun at: true, and later paths start at
-/// (x0, y0), when it joins the lattice at the tree's root, or it is legal and the root
-/// is one of the 3 x 3 lattice points round it and a legal segment reaches it; false
-/// (the tree unchanged) otherwise.
-bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0);
+/// Let a seeded tree serve plans from (x0, y0), e.g. a robot stopped near the point the
+/// tree was begun at, braked past it or cut short before it: true, and later paths start
+/// at (x0, y0), when the lattice point it joins (as rfs_plan_path joins a start) is
+/// closed and the hop to it plus its tree path to the root (straight steps grid,
+/// diagonal ones grid sqrt 2) is at most max_hop (metres, Q16.16). Paths then go from
+/// that point up its branch to the goal's and along it: at most 2 max_hop longer than
+/// from a tree rooted at (x0, y0), before string pulling. false (the tree unchanged)
+/// otherwise.
+bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t max_hop);
 
 /// Tell the planner which lattice points are known to be connected: `bits` (NULL: none)
 /// holds one bit per lattice point and must be a union of whole components of the lattice

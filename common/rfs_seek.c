@@ -416,7 +416,11 @@ static void begin_next_tree(rfs_seek_t *s)
             py = p->y[k];
         }
     }
-    rfs_plan_tree_begin(&s->plan, x, y);
+    /* A short leg (a line search's few centimetres) ends within half a step of the tree
+     * the robot decided on: that tree, further grown, serves the next decision. */
+    if (!rfs_plan_tree_move(&s->plan, x, y, s->cfg.step / 2)) {
+        rfs_plan_tree_begin(&s->plan, x, y);
+    }
 }
 
 /* Count the decision, report it, and start driving (or flag that there is no goal). */
@@ -470,7 +474,7 @@ static bool plan_begin(rfs_seek_t *s)
     if (!rfs_seek_plan_start(s, &sx, &sy)) {
         return false;
     }
-    if (!rfs_plan_tree_move(&s->plan, sx, sy)) {
+    if (!rfs_plan_tree_move(&s->plan, sx, sy, s->cfg.step)) {
         rfs_plan_tree_begin(&s->plan, sx, sy);
     }
     return true;
@@ -722,11 +726,13 @@ static void resume_goal(rfs_seek_t *s, int64_t now_us)
     s->state = RFS_SEEK_DRIVING;
 }
 
-/* plan_budget: one slice of the next decision's search tree (begun by end_decision). */
+/* plan_budget: one slice of the next decision's search tree (begun by end_decision). A
+ * period that drives or stands without choosing has the room of the choice: its slice
+ * is 5/4 plan_budget (docs/PERFORMANCE.md, "Planning in slices"). */
 static void grow_next(rfs_seek_t *s)
 {
     if (s->cfg.plan_budget != 0u) {
-        (void)rfs_plan_tree_grow(&s->plan, s->cfg.plan_budget);
+        (void)rfs_plan_tree_grow(&s->plan, RFS_SEEK_DRIVE_SLICE(s->cfg.plan_budget));
     }
 }
 

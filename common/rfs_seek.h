@@ -247,6 +247,10 @@ typedef struct rfs_seek_out {
 /// Cortex-M4), the 12,800-point lattice of a 40 x 20 m map in 20 periods (1 s).
 #define RFS_SEEK_PLAN_BUDGET 640u
 
+/// Search-tree points a control period that drives (or stands) without choosing adds:
+/// 5/4 plan_budget, the choice's room (800 by default, about 440,000 instructions).
+#define RFS_SEEK_DRIVE_SLICE(budget) ((budget) + (budget) / 4u)
+
 /// reach_budget for the microcontroller: 1,000 lattice points a period (docs/PERFORMANCE.md,
 /// "Firmware"); rfs_seek_cfg_default() keeps 0, the whole flood in one period.
 #define RFS_SEEK_REACH_BUDGET 1000u

@@ -10,9 +10,11 @@ Per scenario and configuration (meta + ridge, meta-path + pathloss): success (re
 the source within the run's limits) of each build with its 95 % Wilson interval, the
 discordant pairs (seeds only one build reached) with McNemar's exact two-sided p, the
 median travel ratio (distance travelled / shortest path) of each over the seeds both
-reached and the mean change of its log over those seeds (+- one standard error); from the new build's summaries the
-decisions that waited two or more control periods for their search tree (over 100 ms at
-20 Hz; summary.json slow_decisions) as a share of all decisions, and the longest wait.
+reached and the mean change of its log over those seeds (+- one standard error); from each
+build's summaries (base / new) the decisions that waited two or more control periods for
+their search tree (over 100 ms at 20 Hz; summary.json slow_decisions) as a share of all
+decisions (the new build's count), and the longest decision latency (a leg's end to the
+wheel command: a period per wait and the deciding one).
 """
 import argparse
 import json
@@ -80,7 +82,7 @@ def main():
     ap.add_argument("--work", default="build/compare_plan")
     a = ap.parse_args()
     print("| scenario, configuration | success base | success new | only base / new (p) | "
-          "ratio base / new | paired | decisions > 100 ms | longest wait |")
+          "ratio base / new | paired | decisions > 100 ms | longest latency |")
     print("|---|---|---|---|---|---|---|---|")
     for scen in SCENARIOS:
         for strat, model in CONFIGS:
@@ -110,14 +112,18 @@ def main():
                 logs = []
             mlog = statistics.mean(logs) if logs else float("nan")
             se = statistics.stdev(logs) / math.sqrt(len(logs)) if len(logs) > 1 else float("nan")
-            sm = summaries(os.path.join(a.work, "new", "%s-%s-%s" % (scen, strat, model)), seeds)
-            dec = sum(int(s["iterations"]) for s in sm.values())
-            slow = sum(int(s.get("slow_decisions", 0)) for s in sm.values())
-            wait = max([int(s.get("plan_wait_max", 0)) for s in sm.values()] or [0])
+            waits = []
+            for t in ("base", "new"):
+                sm = summaries(os.path.join(a.work, t, "%s-%s-%s" % (scen, strat, model)), seeds)
+                dec = sum(int(s["iterations"]) for s in sm.values())
+                slow = sum(int(s.get("slow_decisions", 0)) for s in sm.values())
+                wait = max([int(s.get("plan_wait_max", 0)) for s in sm.values()] or [0])
+                waits.append((100.0 * slow / max(dec, 1), dec, 50 * (wait + 1)))
             print("| %s, %s + %s | %s | %s | %d / %d (%.2f) | %.2f / %.2f | %+.3f +- %.3f | "
-                  "%.2f %% of %d | %d ms |" % (scen, strat, model, cell[0], cell[1], b, c,
-                                              mcnemar(b, c), med(rb), med(rn), mlog, se,
-                                              100.0 * slow / max(dec, 1), dec, 50 * (wait + 1)))
+                  "%.2f / %.2f %% of %d | %d / %d ms |" % (
+                      scen, strat, model, cell[0], cell[1], b, c, mcnemar(b, c), med(rb),
+                      med(rn), mlog, se, waits[0][0], waits[1][0], waits[1][1], waits[0][2],
+                      waits[1][2]))
             sys.stdout.flush()
 
 

@@ -1001,7 +1001,7 @@ static void test_tree_sliced(void **state)
             /* A robot stopped 0.07 m from the root, or a lattice step away. */
             const rfs_q16_t mx = x0 + RFS_Q16_FRAC(7, 100), my = y0 - RFS_Q16_FRAC(3, 100);
             if (rfs_map_point_legal(&wd.m, mx, my) && ref_seg(mx, my, x0, y0)) {
-                assert_true(rfs_plan_tree_move(&t, mx, my));
+                assert_true(rfs_plan_tree_move(&t, mx, my, RFS_Q16_ONE));
                 moved++;
                 int gi, gj;
                 random_legal(&rs, lw, lh, &gi, &gj);
@@ -1016,7 +1016,7 @@ static void test_tree_sliced(void **state)
                     }
                 }
             }
-            assert_false(rfs_plan_tree_move(&t, x0 + (rfs_q16_t)(3 * g), y0));
+            assert_false(rfs_plan_tree_move(&t, x0 + (rfs_q16_t)(3 * g), y0, (rfs_q16_t)(2 * g)));
         }
     }
     print_message("sliced trees: %d plans before done, %d of them asked for more; %d moved\n",
@@ -1074,6 +1074,103 @@ static void test_tree_length(void **state)
     assert_true(checked >= 100 && searched >= 40);
 }
 
+/* A done tree moved to a robot near its start (rfs_plan_tree_move: a leg cut short or a
+ * base braked past the point the tree was begun at; docs/PERFORMANCE.md, "Planning in
+ * slices"): starts off the lattice, robots up to 1.2 m away, hop 1 m (160 trees a map).
+ * Moved, the robot sees its join point by a legal segment (the reference geometry) and
+ * the hop plus the reference's lattice distance from there to the root is at most 1 m;
+ * every path starts at the robot, is legal hop by hop, its length the double-precision
+ * sum of its hops, at least the straight distance and at most the hop plus 1.0607 times
+ * the reference's lattice distance from the root; the tree length bounds it from above;
+ * reachability is the reference's; the tree is unchanged by them. Refused, the tree is
+ * unchanged. */
+static void test_tree_hop(void **state)
+{
+    (void)state;
+    int moved = 0, off_root = 0, paths = 0, refused = 0;
+    for (int kind = 0; kind <= 4; kind++) {
+        build_kind(kind, 5);
+        const int lw = wd.m.lw, lh = wd.m.lh;
+        const double g = (double)wd.m.cfg.grid;
+        rfs_plan_t t;
+        assert_int_equal(rfs_plan_init(&t, &wd.m, work, sizeof(work), queue, 1024), 0);
+        uint32_t rs = 4242u + (uint32_t)kind;
+        for (int k = 0; k < 160; k++) {
+            int si, sj;
+            random_legal(&rs, lw, lh, &si, &sj);
+            const rfs_q16_t ex = (rfs_q16_t)(g / 2 + si * g + ((int)(lcg(&rs) % 1001u) - 500) * g / 1000);
+            const rfs_q16_t ey = (rfs_q16_t)(g / 2 + sj * g + ((int)(lcg(&rs) % 1001u) - 500) * g / 1000);
+            const rfs_q16_t qx = ex + (rfs_q16_t)(((int)(lcg(&rs) % 2401u) - 1200) * 65536.0 / 1000);
+            const rfs_q16_t qy = ey + (rfs_q16_t)(((int)(lcg(&rs) % 2401u) - 1200) * 65536.0 / 1000);
+            if (!rfs_map_point_legal(&wd.m, ex, ey) || qx < 0 || qy < 0 ||
+                !rfs_map_point_legal(&wd.m, qx, qy)) {
+                continue;
+            }
+            rfs_plan_tree_begin(&t, ex, ey);
+            for (int slice = 0; !rfs_plan_tree_grow(&t, 640u); slice++) {
+                assert_true(slice < 100);
+            }
+            assert_int_equal(t.tree, 2);
+            const int ri = (int)(t.tree_root % (uint32_t)lw), rj = (int)(t.tree_root / (uint32_t)lw);
+            (void)ref_dijkstra(lw, lh, ri, rj, -1, -1);
+            if (!rfs_plan_tree_move(&t, qx, qy, RFS_Q16_ONE)) {
+                assert_int_equal(t.tree_x, ex);
+                assert_int_equal(t.tree_y, ey);
+                assert_int_equal(t.tree_from, t.tree_root);
+                refused++;
+                continue;
+            }
+            moved++;
+            off_root += t.tree_from != t.tree_root;
+            const double jx = g / 2 + (t.tree_from % (uint32_t)lw) * g;
+            const double jy = g / 2 + (t.tree_from / (uint32_t)lw) * g;
+            assert_int_equal(t.tree_x, qx);
+            assert_int_equal(t.tree_y, qy);
+            assert_true(ref_seg(qx, qy, jx, jy));
+            assert_true((hypot(qx - jx, qy - jy) + dist_ref[t.tree_from]) / 65536.0 <= 1.0 + 1e-4);
+            static uint8_t before[LMAX];
+            memcpy(before, work, (size_t)(lw * lh));
+            for (int q = 0; q < 6; q++) {
+                int gi, gj;
+                random_legal(&rs, lw, lh, &gi, &gj);
+                const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi * g), y1 = (rfs_q16_t)(g / 2 + gj * g);
+                rfs_path_t pt;
+                const bool ok = rfs_plan_tree_path(&t, x1, y1, &pt);
+                rfs_q16_t len = -1;
+                assert_int_equal(rfs_plan_tree_length(&t, x1, y1, &len), ok);
+                const double d = dist_ref[gj * lw + gi];
+                assert_int_equal(ok, !isinf(d) || ref_seg(qx, qy, x1, y1));
+                if (!ok) {
+                    continue;
+                }
+                paths++;
+                assert_int_equal(pt.x0, qx);
+                assert_int_equal(pt.y0, qy);
+                double sum = 0, px = qx, py = qy;
+                for (int w = 0; w < pt.n; w++) {
+                    assert_true(ref_seg(px, py, pt.x[w], pt.y[w]));
+                    sum += hypot(pt.x[w] - px, pt.y[w] - py) / 65536.0;
+                    px = pt.x[w];
+                    py = pt.y[w];
+                }
+                assert_int_equal(pt.x[pt.n - 1], x1);
+                assert_int_equal(pt.y[pt.n - 1], y1);
+                const double l = pt.length / 65536.0;
+                assert_true(fabs(l - sum) < 1e-4 * pt.n + 1e-4);
+                assert_true(l >= hypot(x1 - qx, y1 - qy) / 65536.0 - 1e-4);
+                if (!isinf(d)) {
+                    assert_true(l <= 1.0 + d / 65536.0 * 1.0607 + 1e-3);
+                }
+                assert_true(len / 65536.0 >= l - 1e-3);
+            }
+            assert_memory_equal(before, work, (size_t)(lw * lh)); /* the walks left the tree as it was */
+        }
+    }
+    print_message("tree hops: %d moved (%d off the root), %d refused, %d paths\n", moved,
+                  off_root, refused, paths);
+    assert_true(moved >= 150 && off_root >= 100 && refused >= 40 && paths >= 800);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1088,6 +1185,7 @@ int main(void)
         cmocka_unit_test(test_pull_linear),
         cmocka_unit_test(test_tree_sliced),
         cmocka_unit_test(test_tree_length),
+        cmocka_unit_test(test_tree_hop),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -948,6 +948,139 @@ static void test_plan_slices_on_the_leg(void **state)
     }
 }
 
+/* plan_budget, a leg cut short (docs/PERFORMANCE.md, "Planning in slices"): meta-path
+ * round a wall on a 24 x 16 m map (6,144 lattice points, 10 slices of 640), every leg
+ * stopped 0.6 m along its first segment until the drive calls it blocked. After the
+ * initial move (whose tree grew from its end, not its check point) the next
+ * decision's tree, grown from the check point 1 m along, serves the robot 0.4 m short of
+ * it: no decision waits beyond its relearn period, where a tree begun at the robot
+ * (counted here on a second planner) needs several slices. The path starts at the robot,
+ * its length is the double-precision sum of its hops and at most twice the hop longer
+ * than that tree's path. */
+static void test_plan_leg_cut_short(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 24.0, 16.0, 12.0, 12.0); /* wall x = 12, y in [0, 12) */
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    cfg.eps_sample = false;
+    cfg.eps_floor = 0;
+    cfg.eps_amp = 0;
+    seek_make(&t, cfg, 7);
+    fixed_model_t fm = { false, Q(18.125), Q(4.125) };
+    rfs_model_t model = { fixed_ops(), &fm };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    const uint32_t lpts = (uint32_t)t.map.lw * t.map.lh;
+    uint8_t *work = calloc(lpts, 1);
+    uint32_t *queue = calloc(lpts, sizeof *queue);
+    rfs_plan_t fresh;
+    assert_int_equal(rfs_plan_init(&fresh, &t.map, work, lpts, queue, lpts), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 6.0, .y = 4.125 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    int cut = 0, slow_fresh = 0;
+    for (int k = 0; k < 7; k++) {
+        const rfs_path_t *p = &t.seek.drive.path;
+        const double px = r.x, py = r.y;
+        const double sx = D(p->x[0]) - px, sy = D(p->y[0]) - py, len0 = hypot(sx, sy);
+        if (len0 < 1.0) {
+            break; /* past the wall's end: the rest is in line of sight */
+        }
+        r.pending = false; /* the robot stops 0.6 m along, short of the check point */
+        r.x = px + 0.6 * sx / len0;
+        r.y = py + 0.6 * sy / len0;
+        assert_true(next_decision(&t, &r, &f, 1000000, 20000000, &out));
+        const rfs_seek_decision_t *d = &out.decision;
+        assert_int_equal(d->prev, RFS_DRIVE_BLOCKED);
+        if (k == 0) {
+            continue; /* the initial move's tree grew from its end, 5 m on */
+        }
+        assert_true(d->plan_wait <= (d->relearned ? 1u : 0u));
+        assert_int_equal(p->x0, Q(r.x));
+        assert_int_equal(p->y0, Q(r.y));
+        double sum = 0, hx = r.x, hy = r.y;
+        for (uint16_t w = 0; w < p->n; w++) {
+            sum += hypot(D(p->x[w]) - hx, D(p->y[w]) - hy);
+            hx = D(p->x[w]);
+            hy = D(p->y[w]);
+        }
+        assert_true(fabs(sum - D(p->length)) < 1e-3 * p->n);
+        /* The same goal from a tree begun at the robot: slices until it is closed. */
+        rfs_plan_tree_begin(&fresh, Q(r.x), Q(r.y));
+        rfs_path_t fp;
+        int slices = 0;
+        bool done = rfs_plan_tree_grow(&fresh, 0u); /* seeded, sliced: never searched on demand */
+        while (!rfs_plan_tree_path(&fresh, d->goal_x, d->goal_y, &fp) && !done) {
+            done = rfs_plan_tree_grow(&fresh, cfg.plan_budget);
+            slices++;
+        }
+        slow_fresh += slices >= 3;
+        /* The hop (0.4 m) lengthens it by at most twice its length. */
+        assert_true(fp.n > 0 && D(p->length) <= D(fp.length) + 0.8 + 1e-3);
+        cut++;
+        r.pending = false;
+    }
+    print_message("leg cut short: %d decisions without waiting for the tree, %d of them "
+                  "would wait 3 or more slices for a tree begun at the robot\n", cut, slow_fresh);
+    assert_true(cut >= 5 && slow_fresh >= 5);
+    free(work);
+    free(queue);
+    world_free(&t);
+}
+
+/* plan_budget, short legs: the paper's meta stepping 0.3 m at a time (the maximum just
+ * ahead, moved on after each step) keeps the tree it decided on, moved to the leg's end
+ * and grown on, while that end is within half a step of its root (every other step
+ * here), else begins one there; no decision waits beyond its relearn period. */
+static void test_plan_short_leg_keeps_tree(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 24.0, 16.0, 12.0, 12.0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    cfg.eps_floor = 0;
+    cfg.eps_amp = 0;
+    seek_make(&t, cfg, 11);
+    fixed_model_t fm = { false, Q(6.0), Q(4.125) };
+    rfs_model_t model = { fixed_ops(), &fm };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 6.0, .y = 4.125 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out)); /* the initial move */
+    int kept = 0, begun = 0;
+    for (int k = 0; k < 8; k++) {
+        fm.mx = Q((r.pending ? r.gx : r.x) + 0.3); /* just ahead of where it decides */
+        fm.my = Q(r.pending ? r.gy : r.y);
+        assert_true(next_decision(&t, &r, &f, 1000000, 20000000, &out));
+        const rfs_seek_decision_t *d = &out.decision;
+        if (d->kind != RFS_SEEK_GREEDY) {
+            continue;
+        }
+        assert_true(d->plan_wait <= (d->relearned ? 1u : 0u));
+        assert_int_equal(d->goal_x, fm.mx);
+        /* The next tree serves the leg's end: kept (seeded, its root within half a step)
+         * or begun there (seeded at the next slice). */
+        assert_int_equal(t.seek.plan.tree_x, d->goal_x);
+        assert_int_equal(t.seek.plan.tree_y, d->goal_y);
+        if (t.seek.plan.tree == 2) {
+            const uint32_t root = t.seek.plan.tree_root, lw = t.map.lw;
+            const double gx = D(t.map.cfg.grid) * ((root % lw) + 0.5);
+            const double gy = D(t.map.cfg.grid) * ((root / lw) + 0.5);
+            assert_true(hypot(gx - D(d->goal_x), gy - D(d->goal_y)) <= 0.5 + 1e-6);
+            kept++;
+        } else {
+            assert_int_equal(t.seek.plan.tree, 1);
+            begun++;
+        }
+    }
+    print_message("short legs: %d decisions kept the tree, %d began one\n", kept, begun);
+    assert_true(kept >= 3 && begun >= 2);
+    world_free(&t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -963,6 +1096,8 @@ int main(void)
         cmocka_unit_test(test_leg_max_cuts_the_leg),
         cmocka_unit_test(test_eps_geodesic_distribution),
         cmocka_unit_test(test_plan_slices_on_the_leg),
+        cmocka_unit_test(test_plan_leg_cut_short),
+        cmocka_unit_test(test_plan_short_leg_keeps_tree),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -226,7 +226,7 @@ static uint32_t geo_replay(rfs_seek_t *s, rfs_rng_t rng, bool geodesic, rfs_q16_
 
 /* The planner's search tree for the next decision grown while the last leg was driven
  * (rfs_seek.c, plan_budget): begun where the leg ends, here the robot's pose, and grown by
- * plan_budget points a period as drive_on does, each slice measured; the worst as
+ * RFS_SEEK_DRIVE_SLICE(plan_budget) points a period as drive_on does, each slice measured; the worst as
  * `base`_slice, the number as `base`_slices. */
 static void grow_on_leg(const char *base, rfs_q16_t rx, rfs_q16_t ry)
 {
@@ -236,8 +236,12 @@ static void grow_on_leg(const char *base, rfs_q16_t rx, rfs_q16_t ry)
     uint32_t slices = 0;
     bool done = false;
     while (!done && slices < 1000u) {
+        /* Start just after a SysTick wrap: a slice (under 2^24 ticks) then contains none,
+         * and its count stays exact (tests/firmware/bench.sh). */
+        while ((rfs_bc_ticks() & 0xFFFFFFu) > 0x1000u) {
+        }
         const uint64_t a = rfs_bc_ticks();
-        done = rfs_plan_tree_grow(p, s_app.seek.cfg.plan_budget);
+        done = rfs_plan_tree_grow(p, RFS_SEEK_DRIVE_SLICE(s_app.seek.cfg.plan_budget));
         const uint64_t d = rfs_bc_ticks() - a;
         worst = d > worst ? d : worst;
         slices++;
@@ -880,6 +884,21 @@ static void __attribute__((noinline)) measure_behind_wall(const rfs_app_map_t *m
     rfs_bc_report("walk_behind_wall_ok", 0, geo_ok ? 1u : 0u);
     rfs_bc_report("walk_behind_wall_pulled", 0, s_app.seek.plan.pulled);
     rfs_bc_report("walk_behind_wall_path_cm", 0, (uint32_t)((path->length * 100) >> 16));
+    rfs_q16_t len = 0;
+    RFS_BC_MEASURE("phase_length_behind_wall", 1,
+                   geo_ok = rfs_plan_tree_length(&s_app.seek.plan, gx, gy, &len));
+    /* The same tree serving a robot 0.5 m off its root (braked past it): joined at its
+     * own lattice point, paths up its branch (rfs_plan_tree_move). */
+    RFS_BC_MEASURE("phase_tree_move", 1,
+                   geo_ok = rfs_plan_tree_move(&s_app.seek.plan, RFS_Q16_FRAC(13, 8),
+                                               RFS_Q16_FRAC(69, 8), s_app.seek.cfg.step));
+    rfs_bc_report("tree_move_ok", 0, geo_ok ? 1u : 0u);
+    RFS_BC_MEASURE("phase_walk_moved", 1,
+                   geo_ok = rfs_plan_tree_path(&s_app.seek.plan, gx, gy, path));
+    rfs_bc_report("walk_moved_ok", 0, geo_ok ? 1u : 0u);
+    rfs_bc_report("walk_moved_path_cm", 0, (uint32_t)((path->length * 100) >> 16));
+    RFS_BC_MEASURE("phase_length_moved", 1,
+                   geo_ok = rfs_plan_tree_length(&s_app.seek.plan, gx, gy, &len));
     rfs_bc_report("tree_second_goal_path_cm", 0, (uint32_t)((path->length * 100) >> 16));
 }
 

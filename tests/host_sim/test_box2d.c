@@ -222,6 +222,52 @@ static void test_walls_crossed(void **state)
     free(m.cell);
 }
 
+/// xorshift64: the test's own segments, the same on every run.
+static double uniform(uint64_t *s, double lo, double hi)
+{
+    *s ^= *s << 13;
+    *s ^= *s >> 7;
+    *s ^= *s << 17;
+    return lo + (hi - lo) * (double)(*s >> 11) / 9007199254740992.0;
+}
+
+/// The radio-fixture index answers as Box2D's own tree (b2World::RayCast both ways) on
+/// the shipped SLAM map (thousands of small walls) for random segments, segments along
+/// cell edges and through corners, vertical and horizontal ones, and ends off the map.
+static void test_walls_crossed_index_matches_tree(void **state)
+{
+    (void)state;
+    lx_map_t m;
+    char err[256];
+    assert_int_equal(lx_map_load("scenarios/maps/intel.yaml", &m, err, sizeof err), 0);
+    hs_box2d_t *w = hs_box2d_create(&m, NULL, err, sizeof err);
+    assert_non_null(w);
+    const double x1 = m.origin_x + m.w * m.res, y1 = m.origin_y + m.h * m.res;
+    uint64_t s = 0x9E3779B97F4A7C15u;
+    unsigned walls = 0, differ = 0;
+    for (int k = 0; k < 3000; k++) {
+        double a = uniform(&s, m.origin_x - 1.0, x1 + 1.0), b = uniform(&s, m.origin_y - 1.0, y1 + 1.0);
+        double c = uniform(&s, m.origin_x - 1.0, x1 + 1.0), d = uniform(&s, m.origin_y - 1.0, y1 + 1.0);
+        if (k % 4 == 1) { // on cell edges and corners
+            a = m.origin_x + floor((a - m.origin_x) / m.res) * m.res;
+            b = m.origin_y + floor((b - m.origin_y) / m.res) * m.res;
+            c = m.origin_x + floor((c - m.origin_x) / m.res) * m.res;
+            d = m.origin_y + floor((d - m.origin_y) / m.res) * m.res;
+        } else if (k % 4 == 2) {
+            c = a; // vertical
+        } else if (k % 4 == 3) {
+            d = b; // horizontal
+        }
+        unsigned n = hs_box2d_walls_crossed(w, a, b, c, d);
+        walls += n;
+        differ += n != hs_box2d_walls_crossed_tree(w, a, b, c, d) ? 1u : 0u;
+    }
+    assert_int_equal(differ, 0);
+    assert_true(walls > 3000u * 5u); // the segments do cross the lab's walls
+    hs_box2d_destroy(w);
+    lx_map_free(&m);
+}
+
 static unsigned walls_cb(void *ctx, double x0, double y0, double x1, double y1)
 {
     return hs_box2d_walls_crossed(ctx, x0, y0, x1, y1);
@@ -265,6 +311,7 @@ int main(void)
         cmocka_unit_test(test_walls_stop_the_robot),
         cmocka_unit_test(test_wall_contacts),
         cmocka_unit_test(test_walls_crossed),
+        cmocka_unit_test(test_walls_crossed_index_matches_tree),
         cmocka_unit_test(test_one_wall_costs_its_attenuation),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -10,7 +10,8 @@
 #    (another build's rfseek-sim) side by side, the two runs alternating:
 #   scripts/bench_sim.sh build/bin/rfseek-sim [BASE]
 # 4. With BENCH_SIM_ALL=1 instead: the same factors for every strategy x {ridge, pathloss}
-#    on every shipped floor (FLOORS narrows them), one table row each, then stop.
+#    on every shipped floor (FLOORS narrows them), one table row each, then stop
+#    (BENCH_SIM_REPS=1: one run each instead of the median of three).
 set -euo pipefail
 SIM=${1:?usage: bench_sim.sh path/to/rfseek-sim [BASE]}
 BASE=${2:-}
@@ -18,11 +19,11 @@ echo "bench-sim: load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 # cpu-time factor of one run: SIM SCENARIO STRATEGY MODEL
 rtf() { "$1" "scenarios/$2.yaml" --strategy "$3" --model "$4" --seeds 1..5 --bench |
         sed -nE 's/.*by cpu time: ([0-9]+)x.*/\1/p'; }
-med3() { printf '%s\n' "$@" | sort -n | sed -n 2p; }
+med3() { printf '%s\n' "$@" | sort -n | sed -n "$((($# + 1) / 2))p"; }
 # The factors of SCENARIO STRATEGY MODEL, median of three, with BASE's alternating.
 compare() {
     local new=() old=() line
-    for rep in 1 2 3; do
+    for rep in $(seq "${BENCH_SIM_REPS:-3}"); do
         new+=("$(rtf "$SIM" "$1" "$2" "$3")")
         if [ -n "$BASE" ]; then old+=("$(rtf "$BASE" "$1" "$2" "$3")"); fi
     done

@@ -20,6 +20,29 @@ extern "C" {
 }
 
 namespace {
+struct ForgetWallMoves {}; // UpdatePairs' tag below
+}
+
+/* The walls' proxies need no pair search: Box2D buffers every new proxy as moved and its
+ * first Step queries each against the tree, to find pairs of two static bodies that it
+ * then drops (b2ContactManager::AddPair: not dynamic), all the robot's pairs coming from
+ * the robot's own query (a proxy skips moved ones above its id). Forgetting the walls'
+ * moves once they are built, their moved flags cleared as that Step would, leaves the
+ * robot's pairs, their order and so every contact as they were, without the O(walls)
+ * queries (most of the first Step on a large floor). An explicit specialisation of the
+ * public member template, so a member of b2BroadPhase. */
+template <>
+void b2BroadPhase::UpdatePairs<ForgetWallMoves>(ForgetWallMoves *)
+{
+    for (int32 i = 0; i < m_moveCount; ++i) {
+        if (m_moveBuffer[i] != e_nullProxy) {
+            m_tree.ClearMoved(m_moveBuffer[i]);
+        }
+    }
+    m_moveCount = 0;
+}
+
+namespace {
 
 constexpr uint16 CAT_COLLIDE = 0x0001; // walls the robot collides with
 constexpr uint16 CAT_RADIO = 0x0002;   // walls the radio counts; never collide
@@ -294,6 +317,8 @@ extern "C" hs_box2d_t *hs_box2d_create(const lx_map_t *m, const hs_box2d_cfg_t *
             throw std::bad_alloc();
         }
         index_radio(w, radio);
+        ForgetWallMoves tag;
+        const_cast<b2ContactManager &>(w->world->GetContactManager()).m_broadPhase.UpdatePairs(&tag);
         b2BodyDef bd;
         bd.type = b2_dynamicBody;
         bd.position.Set((float)m->origin_x, (float)m->origin_y);

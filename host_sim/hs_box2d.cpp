@@ -130,6 +130,7 @@ extern "C" hs_box2d_cfg_t hs_box2d_cfg_default(void)
     c.velocity_iters = 8;     // Box2D manual's recommendation
     c.position_iters = 3;
     c.wall_merge_gap_m = 0.1;
+    c.wall_pairs = false;
     return c;
 }
 
@@ -189,10 +190,9 @@ extern "C" long hs_box2d_merge_rects(const lx_map_t *m, hs_box2d_kind_t kind, hs
     return (long)done.size();
 }
 
-static long add_walls(const lx_map_t *m, b2Body *body, hs_box2d_kind_t kind)
+static long add_walls(const lx_map_t *m, b2Body *body, hs_box2d_kind_t kind,
+                      const hs_rect_t *rects, long n)
 {
-    hs_rect_t *rects = nullptr;
-    long n = hs_box2d_merge_rects(m, kind, &rects);
     for (long i = 0; i < n; i++) {
         const hs_rect_t &r = rects[i];
         float hx = (float)(0.5 * r.w * m->res);
@@ -214,8 +214,29 @@ static long add_walls(const lx_map_t *m, b2Body *body, hs_box2d_kind_t kind)
         }
         body->CreateFixture(&fd);
     }
-    free(rects);
     return n;
+}
+
+extern "C" int hs_box2d_walls_make(const lx_map_t *m, hs_box2d_walls_t *w)
+{
+    for (int k = 0; k < 2; k++) {
+        w->rect[k] = nullptr;
+        w->n[k] = hs_box2d_merge_rects(m, (hs_box2d_kind_t)k, &w->rect[k]);
+        if (w->n[k] < 0) {
+            hs_box2d_walls_free(w);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+extern "C" void hs_box2d_walls_free(hs_box2d_walls_t *w)
+{
+    for (int k = 0; k < 2; k++) {
+        free(w->rect[k]);
+        w->rect[k] = nullptr;
+        w->n[k] = 0;
+    }
 }
 
 /* Cells of the radio index the box [x0, x1] x [y0, y1] (metres) touches, clamped. */
@@ -276,6 +297,22 @@ static void index_radio(hs_box2d_t *w, b2Body *radio)
 extern "C" hs_box2d_t *hs_box2d_create(const lx_map_t *m, const hs_box2d_cfg_t *cfg, char *err,
                                        size_t errlen)
 {
+    // An unusable map gets no walls: hs_box2d_create_walls() rejects it.
+    const bool usable = m && m->cell && m->w > 0 && m->h > 0 && m->res > 0.0;
+    hs_box2d_walls_t walls = {{nullptr, nullptr}, {0, 0}};
+    if (usable && hs_box2d_walls_make(m, &walls) != 0) {
+        snprintf(err, errlen, "world: out of memory");
+        return nullptr;
+    }
+    hs_box2d_t *w = hs_box2d_create_walls(m, cfg, &walls, err, errlen);
+    hs_box2d_walls_free(&walls);
+    return w;
+}
+
+extern "C" hs_box2d_t *hs_box2d_create_walls(const lx_map_t *m, const hs_box2d_cfg_t *cfg,
+                                             const hs_box2d_walls_t *walls, char *err,
+                                             size_t errlen)
+{
     hs_box2d_cfg_t c = cfg ? *cfg : hs_box2d_cfg_default();
     if (!(c.robot_radius_m > 0.0) || !(c.robot_mass_kg > 0.0) || c.velocity_iters < 1 ||
         c.position_iters < 1 || !(c.wall_merge_gap_m >= 0.0)) {
@@ -311,14 +348,16 @@ extern "C" hs_box2d_t *hs_box2d_create(const lx_map_t *m, const hs_box2d_cfg_t *
         sd.type = b2_staticBody;
         b2Body *collide = w->world->CreateBody(&sd);
         b2Body *radio = w->world->CreateBody(&sd);
-        w->n_collide = add_walls(m, collide, HS_BOX2D_COLLIDE);
-        w->n_radio = add_walls(m, radio, HS_BOX2D_RADIO);
-        if (w->n_collide < 0 || w->n_radio < 0) {
-            throw std::bad_alloc();
-        }
+        w->n_collide = add_walls(m, collide, HS_BOX2D_COLLIDE, walls->rect[HS_BOX2D_COLLIDE],
+                                 walls->n[HS_BOX2D_COLLIDE]);
+        w->n_radio = add_walls(m, radio, HS_BOX2D_RADIO, walls->rect[HS_BOX2D_RADIO],
+                               walls->n[HS_BOX2D_RADIO]);
         index_radio(w, radio);
-        ForgetWallMoves tag;
-        const_cast<b2ContactManager &>(w->world->GetContactManager()).m_broadPhase.UpdatePairs(&tag);
+        if (!c.wall_pairs) {
+            ForgetWallMoves tag;
+            const_cast<b2ContactManager &>(w->world->GetContactManager())
+                .m_broadPhase.UpdatePairs(&tag);
+        }
         b2BodyDef bd;
         bd.type = b2_dynamicBody;
         bd.position.Set((float)m->origin_x, (float)m->origin_y);

@@ -222,6 +222,56 @@ static void test_walls_crossed(void **state)
     free(m.cell);
 }
 
+/// One world with the shared merged walls and the walls' pair search skipped, one as
+/// Box2D builds it (hs_box2d_create, wall_pairs): the robot driving into, along and away
+/// from the Intel lab's cluttered walls for 60 s ends every step at the same pose, bit for
+/// bit, with the same contacts; the rectangles and ray counts agree too.
+static void test_shared_walls_same_world(void **state)
+{
+    (void)state;
+    lx_map_t m;
+    char err[256];
+    assert_int_equal(lx_map_load("scenarios/maps/intel.yaml", &m, err, sizeof err), 0);
+    hs_box2d_walls_t walls;
+    assert_int_equal(hs_box2d_walls_make(&m, &walls), 0);
+    hs_box2d_cfg_t ref_cfg = hs_box2d_cfg_default();
+    ref_cfg.wall_pairs = true;
+    hs_box2d_t *a = hs_box2d_create_walls(&m, NULL, &walls, err, sizeof err);
+    hs_box2d_t *b = hs_box2d_create(&m, &ref_cfg, err, sizeof err);
+    assert_non_null(a);
+    assert_non_null(b);
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(hs_box2d_rect_count(a, (hs_box2d_kind_t)k), walls.n[k]);
+        assert_int_equal(hs_box2d_rect_count(b, (hs_box2d_kind_t)k), walls.n[k]);
+    }
+    assert_true(walls.n[HS_BOX2D_RADIO] > 1000);
+    hs_box2d_place_robot(a, 26.0, 9.0, 3.14159);
+    hs_box2d_place_robot(b, 26.0, 9.0, 3.14159);
+    int touching = 0;
+    for (int i = 0; i < 3000; i++) { // 60 s: forward, turning now and then, backing off
+        double v = (i / 400) % 3 == 2 ? -0.3 : 0.6, om = (i / 150) % 4 == 1 ? 0.9 : -0.2;
+        hs_box2d_step(a, v, om, 0.02);
+        hs_box2d_step(b, v, om, 0.02);
+        double xa, ya, ta, xb, yb, tb;
+        hs_box2d_robot_pose(a, &xa, &ya, &ta);
+        hs_box2d_robot_pose(b, &xb, &yb, &tb);
+        assert_memory_equal(&xa, &xb, sizeof xa);
+        assert_memory_equal(&ya, &yb, sizeof ya);
+        assert_memory_equal(&ta, &tb, sizeof ta);
+        assert_int_equal(hs_box2d_robot_touching(a), hs_box2d_robot_touching(b));
+        touching += hs_box2d_robot_touching(a);
+    }
+    assert_int_equal(hs_box2d_wall_contacts(a), hs_box2d_wall_contacts(b));
+    assert_true(hs_box2d_wall_contacts(a) >= 2);
+    assert_true(touching > 100);
+    assert_int_equal(hs_box2d_walls_crossed(a, 1.0, 1.0, 30.0, 25.0),
+                     hs_box2d_walls_crossed(b, 1.0, 1.0, 30.0, 25.0));
+    hs_box2d_destroy(a);
+    hs_box2d_destroy(b);
+    hs_box2d_walls_free(&walls);
+    lx_map_free(&m);
+}
+
 /// xorshift64: the test's own segments, the same on every run.
 static double uniform(uint64_t *s, double lo, double hi)
 {
@@ -312,6 +362,7 @@ int main(void)
         cmocka_unit_test(test_wall_contacts),
         cmocka_unit_test(test_walls_crossed),
         cmocka_unit_test(test_walls_crossed_index_matches_tree),
+        cmocka_unit_test(test_shared_walls_same_world),
         cmocka_unit_test(test_one_wall_costs_its_attenuation),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -70,6 +70,8 @@ typedef struct rfs_map {
     uint8_t step_n;        ///< cells per lattice step (grid / res); 0 = no patterns
     uint8_t step_c0;       ///< cells: the cell of lattice point 0 along an axis, (grid/2) / res
     uint16_t *memo;        ///< lattice memo (rfs_map_memo_attach()); NULL (init): none
+    const uint8_t *wall_dist; ///< cells to the nearest wall cell (rfs_map_wall_dist_attach());
+                              ///< NULL (init): none
 } rfs_map_t;
 
 /// Defaults: 0.25 m clearance, 0.25 m lattice.
@@ -164,5 +166,16 @@ uint32_t rfs_map_memo_entries(const rfs_map_t *m);
 /// every edge of every search). rfs_map_init() detaches it. -1 when buf is NULL or too
 /// small.
 int rfs_map_memo_attach(rfs_map_t *m, uint16_t *buf, uint32_t entries);
+
+/// Bytes of a wall-distance grid for m (rfs_map_wall_dist_attach()): one per cell.
+uint32_t rfs_map_wall_dist_bytes(const rfs_map_t *m);
+
+/// Fill buf with each cell's Chebyshev distance in cells to the nearest wall cell (0 on a
+/// wall, saturated at 255; cells off the map are not walls) and attach it (it stays the
+/// caller's, outliving m): rfs_map_walls_crossed() then passes over the free squares a
+/// distance promises instead of reading their cells (the same counts; a host index, about
+/// 1 byte a cell, docs/PATHLOSS.md, "Work, the wall-count cache and slicing").
+/// rfs_map_init() detaches it. -1 when the map has no wall grid or buf is NULL or too small.
+int rfs_map_wall_dist_attach(rfs_map_t *m, uint8_t *buf, uint32_t bytes);
 
 #endif /* RFS_MAP_H */

@@ -20,6 +20,29 @@ extern "C" {
 }
 
 namespace {
+struct ForgetWallMoves {}; // UpdatePairs' tag below
+}
+
+/* The walls' proxies need no pair search: Box2D buffers every new proxy as moved and its
+ * first Step queries each against the tree, to find pairs of two static bodies that it
+ * then drops (b2ContactManager::AddPair: not dynamic), all the robot's pairs coming from
+ * the robot's own query (a proxy skips moved ones above its id). Forgetting the walls'
+ * moves once they are built, their moved flags cleared as that Step would, leaves the
+ * robot's pairs, their order and so every contact as they were, without the O(walls)
+ * queries (most of the first Step on a large floor). An explicit specialisation of the
+ * public member template, so a member of b2BroadPhase. */
+template <>
+void b2BroadPhase::UpdatePairs<ForgetWallMoves>(ForgetWallMoves *)
+{
+    for (int32 i = 0; i < m_moveCount; ++i) {
+        if (m_moveBuffer[i] != e_nullProxy) {
+            m_tree.ClearMoved(m_moveBuffer[i]);
+        }
+    }
+    m_moveCount = 0;
+}
+
+namespace {
 
 constexpr uint16 CAT_COLLIDE = 0x0001; // walls the robot collides with
 constexpr uint16 CAT_RADIO = 0x0002;   // walls the radio counts; never collide
@@ -83,11 +106,20 @@ struct hs_box2d {
     // -1 not yet known.
     mutable std::vector<int8_t> clear;
     uint32_t cw, ch;
+    // Radio fixtures by RAY_CELL_M cell of the map (every cell their box, widened by
+    // RAY_MARGIN_M, touches): first[c] .. first[c + 1] - 1 index into fx_of.
+    std::vector<b2Fixture *> radio_fx;
+    std::vector<uint32_t> first, fx_of;
+    uint32_t rw, rh;
+    mutable std::vector<uint32_t> seen; // per radio fixture: the last cast that tested it
+    mutable uint32_t casts;
 };
 
 namespace {
 constexpr double CLEAR_M = 0.1;       // cache cell, metres
 constexpr double CLEAR_MARGIN = 0.05; // > one step of travel (0.7 m/s x 20 ms) plus Box2D's skin
+constexpr double RAY_CELL_M = 0.5;    // cell of the radio fixtures' index, metres
+constexpr double RAY_MARGIN_M = 0.05; // far above float rounding: no hit is left out
 }
 
 extern "C" hs_box2d_cfg_t hs_box2d_cfg_default(void)
@@ -98,6 +130,7 @@ extern "C" hs_box2d_cfg_t hs_box2d_cfg_default(void)
     c.velocity_iters = 8;     // Box2D manual's recommendation
     c.position_iters = 3;
     c.wall_merge_gap_m = 0.1;
+    c.wall_pairs = false;
     return c;
 }
 
@@ -157,10 +190,9 @@ extern "C" long hs_box2d_merge_rects(const lx_map_t *m, hs_box2d_kind_t kind, hs
     return (long)done.size();
 }
 
-static long add_walls(const lx_map_t *m, b2Body *body, hs_box2d_kind_t kind)
+static long add_walls(const lx_map_t *m, b2Body *body, hs_box2d_kind_t kind,
+                      const hs_rect_t *rects, long n)
 {
-    hs_rect_t *rects = nullptr;
-    long n = hs_box2d_merge_rects(m, kind, &rects);
     for (long i = 0; i < n; i++) {
         const hs_rect_t &r = rects[i];
         float hx = (float)(0.5 * r.w * m->res);
@@ -182,12 +214,104 @@ static long add_walls(const lx_map_t *m, b2Body *body, hs_box2d_kind_t kind)
         }
         body->CreateFixture(&fd);
     }
-    free(rects);
     return n;
+}
+
+extern "C" int hs_box2d_walls_make(const lx_map_t *m, hs_box2d_walls_t *w)
+{
+    for (int k = 0; k < 2; k++) {
+        w->rect[k] = nullptr;
+        w->n[k] = hs_box2d_merge_rects(m, (hs_box2d_kind_t)k, &w->rect[k]);
+        if (w->n[k] < 0) {
+            hs_box2d_walls_free(w);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+extern "C" void hs_box2d_walls_free(hs_box2d_walls_t *w)
+{
+    for (int k = 0; k < 2; k++) {
+        free(w->rect[k]);
+        w->rect[k] = nullptr;
+        w->n[k] = 0;
+    }
+}
+
+/* Cells of the radio index the box [x0, x1] x [y0, y1] (metres) touches, clamped. */
+static void ray_cells(const hs_box2d_t *w, double x0, double y0, double x1, double y1,
+                      uint32_t *i0, uint32_t *j0, uint32_t *i1, uint32_t *j1)
+{
+    auto cell = [](double v, uint32_t n) {
+        double c = std::floor(v / RAY_CELL_M);
+        return c < 0.0 ? 0u : (c >= (double)n ? n - 1u : (uint32_t)c);
+    };
+    *i0 = cell(x0 - w->ox, w->rw);
+    *i1 = cell(x1 - w->ox, w->rw);
+    *j0 = cell(y0 - w->oy, w->rh);
+    *j1 = cell(y1 - w->oy, w->rh);
+}
+
+/* The radio fixtures by cell (hs_box2d_walls_crossed tests only those of the cells along
+ * its segment instead of walking Box2D's tree, twice). */
+static void index_radio(hs_box2d_t *w, b2Body *radio)
+{
+    w->rw = (uint32_t)std::ceil(w->w * w->res / RAY_CELL_M);
+    w->rh = (uint32_t)std::ceil(w->h * w->res / RAY_CELL_M);
+    for (b2Fixture *f = radio->GetFixtureList(); f; f = f->GetNext()) {
+        w->radio_fx.push_back(f);
+    }
+    std::vector<uint32_t> count((size_t)w->rw * w->rh + 1u, 0u);
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t k = 0; k < w->radio_fx.size(); k++) {
+            b2AABB bb;
+            w->radio_fx[k]->GetShape()->ComputeAABB(&bb, radio->GetTransform(), 0);
+            uint32_t i0, j0, i1, j1;
+            ray_cells(w, bb.lowerBound.x - RAY_MARGIN_M, bb.lowerBound.y - RAY_MARGIN_M,
+                      bb.upperBound.x + RAY_MARGIN_M, bb.upperBound.y + RAY_MARGIN_M, &i0, &j0,
+                      &i1, &j1);
+            for (uint32_t j = j0; j <= j1; j++) {
+                for (uint32_t i = i0; i <= i1; i++) {
+                    size_t c = (size_t)j * w->rw + i;
+                    if (pass == 0) {
+                        count[c + 1u]++;
+                    } else {
+                        w->fx_of[count[c]++] = (uint32_t)k;
+                    }
+                }
+            }
+        }
+        if (pass == 0) {
+            for (size_t c = 1; c < count.size(); c++) {
+                count[c] += count[c - 1u];
+            }
+            w->first = count;
+            w->fx_of.assign(count.back(), 0u);
+        }
+    }
+    w->seen.assign(w->radio_fx.size(), 0u);
+    w->casts = 0u;
 }
 
 extern "C" hs_box2d_t *hs_box2d_create(const lx_map_t *m, const hs_box2d_cfg_t *cfg, char *err,
                                        size_t errlen)
+{
+    // An unusable map gets no walls: hs_box2d_create_walls() rejects it.
+    const bool usable = m && m->cell && m->w > 0 && m->h > 0 && m->res > 0.0;
+    hs_box2d_walls_t walls = {{nullptr, nullptr}, {0, 0}};
+    if (usable && hs_box2d_walls_make(m, &walls) != 0) {
+        snprintf(err, errlen, "world: out of memory");
+        return nullptr;
+    }
+    hs_box2d_t *w = hs_box2d_create_walls(m, cfg, &walls, err, errlen);
+    hs_box2d_walls_free(&walls);
+    return w;
+}
+
+extern "C" hs_box2d_t *hs_box2d_create_walls(const lx_map_t *m, const hs_box2d_cfg_t *cfg,
+                                             const hs_box2d_walls_t *walls, char *err,
+                                             size_t errlen)
 {
     hs_box2d_cfg_t c = cfg ? *cfg : hs_box2d_cfg_default();
     if (!(c.robot_radius_m > 0.0) || !(c.robot_mass_kg > 0.0) || c.velocity_iters < 1 ||
@@ -224,10 +348,15 @@ extern "C" hs_box2d_t *hs_box2d_create(const lx_map_t *m, const hs_box2d_cfg_t *
         sd.type = b2_staticBody;
         b2Body *collide = w->world->CreateBody(&sd);
         b2Body *radio = w->world->CreateBody(&sd);
-        w->n_collide = add_walls(m, collide, HS_BOX2D_COLLIDE);
-        w->n_radio = add_walls(m, radio, HS_BOX2D_RADIO);
-        if (w->n_collide < 0 || w->n_radio < 0) {
-            throw std::bad_alloc();
+        w->n_collide = add_walls(m, collide, HS_BOX2D_COLLIDE, walls->rect[HS_BOX2D_COLLIDE],
+                                 walls->n[HS_BOX2D_COLLIDE]);
+        w->n_radio = add_walls(m, radio, HS_BOX2D_RADIO, walls->rect[HS_BOX2D_RADIO],
+                               walls->n[HS_BOX2D_RADIO]);
+        index_radio(w, radio);
+        if (!c.wall_pairs) {
+            ForgetWallMoves tag;
+            const_cast<b2ContactManager &>(w->world->GetContactManager())
+                .m_broadPhase.UpdatePairs(&tag);
         }
         b2BodyDef bd;
         bd.type = b2_dynamicBody;
@@ -357,8 +486,9 @@ extern "C" long hs_box2d_wall_contacts(const hs_box2d_t *w)
     return w->contacts.contacts;
 }
 
-extern "C" unsigned hs_box2d_walls_crossed(const hs_box2d_t *w, double x0, double y0, double x1,
-                                           double y1)
+/* hs_box2d_walls_crossed(), its fixtures from the radio index or (tree) Box2D's tree. */
+static unsigned walls_crossed(const hs_box2d_t *w, double x0, double y0, double x1, double y1,
+                              bool tree)
 {
     double len = std::hypot(x1 - x0, y1 - y0);
     if (len <= 0.0) {
@@ -369,8 +499,55 @@ extern "C" unsigned hs_box2d_walls_crossed(const hs_box2d_t *w, double x0, doubl
         return 0; // Box2D asserts on a zero-length ray (equal after rounding to float)
     }
     HitCollector fwd, rev;
-    w->world->RayCast(&fwd, a, b);
-    w->world->RayCast(&rev, b, a);
+    if (!tree) {
+        // Box2D's ray cast without its tree: every radio fixture in a cell the segment
+        // (widened by RAY_MARGIN_M) passes, cast at once with the same input b2World::RayCast
+        // gives it (maxFraction 1: the collector never clips), so the same hits.
+        if (++w->casts == 0u) {
+            std::fill(w->seen.begin(), w->seen.end(), 0u);
+            w->casts = 1u;
+        }
+        b2RayCastInput in_f = {a, b, 1.0f}, in_r = {b, a, 1.0f};
+        const double xlo = std::min(x0, x1) - RAY_MARGIN_M, xhi = std::max(x0, x1) + RAY_MARGIN_M;
+        const double ylo = std::min(y0, y1) - RAY_MARGIN_M, yhi = std::max(y0, y1) + RAY_MARGIN_M;
+        uint32_t i0, j0, i1, j1;
+        ray_cells(w, xlo, ylo, xhi, yhi, &i0, &j0, &i1, &j1);
+        for (uint32_t i = i0; i <= i1; i++) {
+            // The segment's y over this column of cells (all of it for a vertical one).
+            double ca = std::max(xlo, w->ox + i * RAY_CELL_M);
+            double cb = std::min(xhi, w->ox + (i + 1) * RAY_CELL_M);
+            double ya = ylo + RAY_MARGIN_M, yb = yhi - RAY_MARGIN_M;
+            if (x1 != x0) {
+                double t = (y1 - y0) / (x1 - x0);
+                ya = y0 + (std::max(ca, std::min(x0, x1)) - x0) * t;
+                yb = y0 + (std::min(cb, std::max(x0, x1)) - x0) * t;
+            }
+            uint32_t u0, v0, u1, v1;
+            ray_cells(w, ca, std::min(ya, yb) - RAY_MARGIN_M, cb, std::max(ya, yb) + RAY_MARGIN_M,
+                      &u0, &v0, &u1, &v1);
+            for (uint32_t j = v0; j <= v1; j++) {
+                const size_t c = (size_t)j * w->rw + i;
+                for (uint32_t k = w->first[c]; k < w->first[c + 1u]; k++) {
+                    const uint32_t fi = w->fx_of[k];
+                    if (w->seen[fi] == w->casts) {
+                        continue;
+                    }
+                    w->seen[fi] = w->casts;
+                    b2Fixture *f = w->radio_fx[fi];
+                    b2RayCastOutput out;
+                    if (f->RayCast(&out, in_f, 0)) {
+                        fwd.hits.emplace_back(f, out.fraction);
+                    }
+                    if (f->RayCast(&out, in_r, 0)) {
+                        rev.hits.emplace_back(f, out.fraction);
+                    }
+                }
+            }
+        }
+    } else {
+        w->world->RayCast(&fwd, a, b);
+        w->world->RayCast(&rev, b, a);
+    }
     // Interval of each fixture along the segment, as fractions from a: entry from the
     // forward cast (0 when a is inside), exit from the reverse cast (1 when b is inside).
     // A fixture only one cast reports with the far end outside it was grazed (a corner
@@ -418,6 +595,18 @@ extern "C" unsigned hs_box2d_walls_crossed(const hs_box2d_t *w, double x0, doubl
         end = std::max(end, iv[i].second);
     }
     return n;
+}
+
+extern "C" unsigned hs_box2d_walls_crossed(const hs_box2d_t *w, double x0, double y0, double x1,
+                                           double y1)
+{
+    return walls_crossed(w, x0, y0, x1, y1, false);
+}
+
+extern "C" unsigned hs_box2d_walls_crossed_tree(const hs_box2d_t *w, double x0, double y0,
+                                                double x1, double y1)
+{
+    return walls_crossed(w, x0, y0, x1, y1, true);
 }
 
 extern "C" bool hs_box2d_disc_blocked(const hs_box2d_t *w, double x, double y)

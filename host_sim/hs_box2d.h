@@ -47,6 +47,8 @@ typedef struct hs_box2d_cfg {
     int velocity_iters;     ///< Box2D velocity iterations (8)
     int position_iters;     ///< Box2D position iterations (3)
     double wall_merge_gap_m; ///< ray cast hits closer than this count as one wall (0.1 m)
+    bool wall_pairs;        ///< let Box2D's first step search pairs among the walls too (the
+                            ///< same world, slower; false: tests compare against it)
 } hs_box2d_cfg_t;
 
 /// Opaque world (owns the Box2D world).
@@ -63,6 +65,24 @@ long hs_box2d_merge_rects(const lx_map_t *m, hs_box2d_kind_t kind, hs_rect_t **o
 /// Build the world from a map. Returns NULL with err = "reason" on failure.
 hs_box2d_t *hs_box2d_create(const lx_map_t *m, const hs_box2d_cfg_t *cfg, char *err,
                             size_t errlen);
+
+/// A map's wall rectangles of both kinds, merged once for every world built from it.
+typedef struct hs_box2d_walls {
+    hs_rect_t *rect[2]; ///< by hs_box2d_kind_t, malloc'd (NULL when none)
+    long n[2];          ///< rectangles of each kind
+} hs_box2d_walls_t;
+
+/// Merge m's walls of both kinds into *w (hs_box2d_merge_rects). 0, or -1 when out of
+/// memory (*w then holds nothing).
+int hs_box2d_walls_make(const lx_map_t *m, hs_box2d_walls_t *w);
+
+/// Free what hs_box2d_walls_make() allocated.
+void hs_box2d_walls_free(hs_box2d_walls_t *w);
+
+/// hs_box2d_create() with m's walls merged already (w from hs_box2d_walls_make(m)): the
+/// same world.
+hs_box2d_t *hs_box2d_create_walls(const lx_map_t *m, const hs_box2d_cfg_t *cfg,
+                                  const hs_box2d_walls_t *w, char *err, size_t errlen);
 
 /// Destroy the world (NULL is fine).
 void hs_box2d_destroy(hs_box2d_t *w);
@@ -92,6 +112,11 @@ long hs_box2d_wall_contacts(const hs_box2d_t *w);
 /// wall_merge_gap_m merged). Ends inside a wall count that wall.
 unsigned hs_box2d_walls_crossed(const hs_box2d_t *w, double x0, double y0, double x1,
                                 double y1);
+
+/// hs_box2d_walls_crossed() through Box2D's own tree (b2World::RayCast): the same count,
+/// slower; the reference its radio-fixture index is tested against.
+unsigned hs_box2d_walls_crossed_tree(const hs_box2d_t *w, double x0, double y0, double x1,
+                                     double y1);
 
 /// true when a disc of the robot's radius at (x, y) overlaps a collision wall or lies
 /// (partly) off the map.

@@ -18,7 +18,9 @@ typedef struct fading_wave {
 
 typedef struct radio_src {
     hs_radio_src_t s;
-    float *shadow;         ///< gw * gh values, dB
+    float *shadow;         ///< gw * gh values, dB; NaN until first read (shadow_at)
+    double *shadow_x;      ///< per grid column, every wave's cos and sin of kx x + phase
+    double *shadow_y;      ///< per grid row, every wave's cos and sin of ky y
     fading_wave_t *waves;  ///< fading_waves plane waves
     int8_t *walls;         ///< cw * ch cached wall counts, -1 = not yet known
     bool walls_owned;      ///< walls was allocated here (not lent by the caller)
@@ -130,12 +132,15 @@ static int make_shadow(hs_radio_t *r, radio_src_t *rs, uint64_t seed, unsigned s
 {
     const hs_radio_cfg_t *c = &r->cfg;
     size_t n = (size_t)r->gw * r->gh;
-    rs->shadow = calloc(n, sizeof(float));
-    double *acc = calloc(n, sizeof(double));
-    double *cxr = malloc(sizeof(double) * r->gw * 2), *cyr = malloc(sizeof(double) * r->gh * 2);
-    if (!rs->shadow || !acc || !cxr || !cyr) {
-        free(acc); free(cxr); free(cyr);
-        return -1;
+    const size_t nw = c->shadow_waves;
+    rs->shadow = malloc(n * sizeof(float));
+    rs->shadow_x = malloc(sizeof(double) * r->gw * 2 * nw);
+    rs->shadow_y = malloc(sizeof(double) * r->gh * 2 * nw);
+    if (!rs->shadow || !rs->shadow_x || !rs->shadow_y) {
+        return -1; // hs_radio_destroy frees them
+    }
+    for (size_t i = 0; i < n; i++) {
+        rs->shadow[i] = NAN;
     }
     rfs_rng_t rng;
     field_rng(&rng, seed, 1, s);
@@ -147,28 +152,34 @@ static int make_shadow(hs_radio_t *r, radio_src_t *rs, uint64_t seed, unsigned s
         double kx = k * cos(a), ky = k * sin(a);
         for (uint32_t gx = 0; gx < r->gw; gx++) {
             double p = kx * (gx * c->shadow_grid_m) + ph;
-            cxr[2 * gx] = cos(p);
-            cxr[2 * gx + 1] = sin(p);
+            rs->shadow_x[((size_t)gx * nw + i) * 2] = cos(p);
+            rs->shadow_x[((size_t)gx * nw + i) * 2 + 1] = sin(p);
         }
         for (uint32_t gy = 0; gy < r->gh; gy++) {
             double p = ky * (gy * c->shadow_grid_m);
-            cyr[2 * gy] = cos(p);
-            cyr[2 * gy + 1] = sin(p);
-        }
-        for (uint32_t gy = 0; gy < r->gh; gy++) {
-            double yc = cyr[2 * gy], ys = cyr[2 * gy + 1];
-            double *row = acc + (size_t)gy * r->gw;
-            for (uint32_t gx = 0; gx < r->gw; gx++) {
-                row[gx] += cxr[2 * gx] * yc - cxr[2 * gx + 1] * ys; // cos(px + py)
-            }
+            rs->shadow_y[((size_t)gy * nw + i) * 2] = cos(p);
+            rs->shadow_y[((size_t)gy * nw + i) * 2 + 1] = sin(p);
         }
     }
-    double scale = c->shadow_sigma_db * sqrt(2.0 / c->shadow_waves);
-    for (size_t i = 0; i < n; i++) {
-        rs->shadow[i] = (float)(acc[i] * scale);
-    }
-    free(acc); free(cxr); free(cyr);
     return 0;
+}
+
+/* Grid point (gx, gy) of source rs's shadowing, summed over the waves on its first read
+ * (a run reads a few hundred of the grid's points): the sum in wave order, each term
+ * cos(px + py) = cos px cos py - sin px sin py, so the value of summing the whole grid. */
+static float shadow_at(const hs_radio_t *r, const radio_src_t *rs, uint32_t gx, uint32_t gy)
+{
+    float *v = &rs->shadow[(size_t)gy * r->gw + gx];
+    if (isnan(*v)) {
+        const size_t nw = r->cfg.shadow_waves;
+        const double *cx = rs->shadow_x + (size_t)gx * nw * 2, *cy = rs->shadow_y + (size_t)gy * nw * 2;
+        double acc = 0.0;
+        for (size_t i = 0; i < nw; i++) {
+            acc += cx[2 * i] * cy[2 * i] - cx[2 * i + 1] * cy[2 * i + 1];
+        }
+        *v = (float)(acc * (r->cfg.shadow_sigma_db * sqrt(2.0 / r->cfg.shadow_waves)));
+    }
+    return *v;
 }
 
 static int make_fading(hs_radio_t *r, radio_src_t *rs, uint64_t seed, unsigned s)
@@ -263,6 +274,8 @@ void hs_radio_destroy(hs_radio_t *r)
     }
     for (unsigned s = 0; s < r->nsrc; s++) {
         free(r->src[s].shadow);
+        free(r->src[s].shadow_x);
+        free(r->src[s].shadow_y);
         free(r->src[s].waves);
         if (r->src[s].walls_owned) {
             free(r->src[s].walls);
@@ -325,9 +338,10 @@ double hs_radio_shadow_db(const hs_radio_t *r, unsigned s, double x, double y)
     fy = fy < 0.0 ? 0.0 : (fy > maxy ? maxy : fy);
     uint32_t ix = (uint32_t)fx, iy = (uint32_t)fy;
     double ax = fx - ix, ay = fy - iy;
-    const float *p = rs->shadow + (size_t)iy * r->gw + ix;
-    double a = p[0] + ax * (p[1] - p[0]);
-    double b = p[r->gw] + ax * (p[r->gw + 1] - p[r->gw]);
+    const double p00 = shadow_at(r, rs, ix, iy), p10 = shadow_at(r, rs, ix + 1, iy);
+    const double p01 = shadow_at(r, rs, ix, iy + 1), p11 = shadow_at(r, rs, ix + 1, iy + 1);
+    double a = p00 + ax * (p10 - p00);
+    double b = p01 + ax * (p11 - p01);
     return a + ay * (b - a);
 }
 

@@ -182,6 +182,22 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
         hs_sim_env_close(e);
         return -1;
     }
+    /* Every run's world from the same merged walls. */
+    if (hs_box2d_walls_make(&e->map, &e->walls) != 0) {
+        snprintf(err, errlen, "%s: map: out of memory", sc->path);
+        hs_sim_env_close(e);
+        return -1;
+    }
+    /* The path-loss model's wall counts pass over free squares (rfs_map_wall_dist_attach). */
+    if (e->core.map.wall != NULL) {
+        const uint32_t nd = rfs_map_wall_dist_bytes(&e->core.map);
+        e->wall_dist = malloc(nd);
+        if (e->wall_dist == NULL || rfs_map_wall_dist_attach(&e->core.map, e->wall_dist, nd) != 0) {
+            snprintf(err, errlen, "%s: map: out of memory", sc->path);
+            hs_sim_env_close(e);
+            return -1;
+        }
+    }
     if (env_prepare(e, err, errlen) != 0) {
         hs_sim_env_close(e);
         return -1;
@@ -219,6 +235,9 @@ void hs_sim_env_close(hs_sim_env_t *e)
     lx_core_map_free(&e->core);
     free(e->lattice_memo);
     e->lattice_memo = NULL;
+    free(e->wall_dist);
+    e->wall_dist = NULL;
+    hs_box2d_walls_free(&e->walls);
     lx_map_free(&e->map);
 }
 
@@ -355,7 +374,7 @@ static hs_radio_t *world_radio_open(const hs_sim_env_t *e, uint64_t seed, bool p
 {
     const hs_scenario_t *sc = &e->sc;
     char werr[256];
-    hs_box2d_t *world = hs_box2d_create(&e->map, NULL, werr, sizeof werr);
+    hs_box2d_t *world = hs_box2d_create_walls(&e->map, NULL, &e->walls, werr, sizeof werr);
     if (!world) {
         snprintf(err, errlen, "%s: %s", sc->path, werr);
         return NULL;

@@ -472,8 +472,10 @@ def main():
         # 3. internal models under meta
         mtab = {}
         t0 = time.time()
+        t_model = {m: 0.0 for m in MODELS}
         for sc in scenarios:
             for m in MODELS:
+                t1 = time.time()
                 n = args.slow_model_seeds if m in SLOW_MODELS else ms
                 if n == 0:
                     mtab[(sc, m)] = None
@@ -484,6 +486,7 @@ def main():
                 log("models: %s on %s, %d seeds" % (m, sc, n))
                 mtab[(sc, m)] = summarise(run_batch(args, tmp, scenario_path(sc), "meta", m, n,
                                                     "model-%s-%s" % (sc, m), set()))
+                t_model[m] += time.time() - t1
         t_models = time.time() - t0
         # 4. figures
         figs = fig_trajectories(figdir, tmp, tags, "default", args.seeds)
@@ -498,7 +501,8 @@ def main():
                 walls[sc] = walls_lookup(os.path.join(d, "field.tsv"))
         t_total = time.time() - t_all
         write_results(args, results, scenarios, table, sweep, mtab, walls, figs,
-                      dict(sweep=t_sweep, noise=t_noise, models=t_models, total=t_total), ns,
+                      dict(sweep=t_sweep, noise=t_noise, models=t_models, total=t_total,
+                           model=t_model), ns,
                       ms)
     except BaseException:
         if smoke_dir:
@@ -661,9 +665,11 @@ def write_results(args, path, scenarios, table, sweep, mtab, walls, figs, times,
     A("## Wall time of the benchmark\n")
     A("On this machine (2 cores, shared with other builds while it ran), `--jobs %d`: "
       "strategy sweep (%d scenarios x %d strategies x %d seeds) %.0f s; noise sweep %.0f s; "
-      "models %.0f s; whole benchmark including figures %.0f s (%.1f min)."
+      "models %.0f s (%s); whole benchmark including figures %.0f s (%.1f min)."
       % (args.jobs, len(scenarios), len(STRATEGIES), args.seeds, times["sweep"],
-         times["noise"], times["models"], times["total"], times["total"] / 60))
+         times["noise"], times["models"],
+         ", ".join("%s %.0f" % (m, t) for m, t in times["model"].items() if t >= 0.5),
+         times["total"], times["total"] / 60))
     A("")
     # Sections other benches write (scripts/bench_drive.py, scripts/bench_general.py), kept.
     for name in re.findall(r"<!-- ([\w-]+): begin -->", old):

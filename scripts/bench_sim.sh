@@ -9,10 +9,37 @@
 #    office and the Intel lab (seeds 1..5, one process each, median of three), with BASE
 #    (another build's rfseek-sim) side by side, the two runs alternating:
 #   scripts/bench_sim.sh build/bin/rfseek-sim [BASE]
+# 4. With BENCH_SIM_ALL=1 instead: the same factors for every strategy x {ridge, pathloss}
+#    on every shipped floor (FLOORS narrows them), one table row each, then stop
+#    (BENCH_SIM_REPS=1: one run each instead of the median of three).
 set -euo pipefail
 SIM=${1:?usage: bench_sim.sh path/to/rfseek-sim [BASE]}
 BASE=${2:-}
 echo "bench-sim: load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
+# cpu-time factor of one run: SIM SCENARIO STRATEGY MODEL
+rtf() { "$1" "scenarios/$2.yaml" --strategy "$3" --model "$4" --seeds 1..5 --bench |
+        sed -nE 's/.*by cpu time: ([0-9]+)x.*/\1/p'; }
+med3() { printf '%s\n' "$@" | sort -n | sed -n "$((($# + 1) / 2))p"; }
+# The factors of SCENARIO STRATEGY MODEL, median of three, with BASE's alternating.
+compare() {
+    local new=() old=() line
+    for rep in $(seq "${BENCH_SIM_REPS:-3}"); do
+        new+=("$(rtf "$SIM" "$1" "$2" "$3")")
+        if [ -n "$BASE" ]; then old+=("$(rtf "$BASE" "$1" "$2" "$3")"); fi
+    done
+    line="bench-sim: $1, $2 + $3, seeds 1..5, by cpu time: median ${new[*]} -> $(med3 "${new[@]}")x"
+    if [ -n "$BASE" ]; then line="$line; base ${old[*]} -> $(med3 "${old[@]}")x"; fi
+    echo "$line"
+}
+if [ -n "${BENCH_SIM_ALL:-}" ]; then
+    for sc in ${FLOORS:-default intel willow 3ne gdc2 gdc4 house lshape open}; do
+        for st in meta meta-global fd-gradient plane-gradient chemotaxis meta-path; do
+            for model in ridge pathloss; do compare "$sc" "$st" "$model"; done
+        done
+    done
+    echo "bench-sim: load average at the end: $(cut -d' ' -f1-3 /proc/loadavg)"
+    exit 0
+fi
 rtfs=() cpus=()
 for rep in 1 2 3; do
     out=$("$SIM" scenarios/default.yaml --seeds 1..20 --bench)
@@ -28,21 +55,10 @@ start=$(date +%s.%N)
 end=$(date +%s.%N)
 echo "bench-sim: 200-seed batch of the default scenario on 2 cores: $(awk "BEGIN{printf \"%.1f\", $end - $start}") s wall"
 echo "bench-sim: load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
-# cpu-time factor of one run: SIM SCENARIO STRATEGY MODEL
-rtf() { "$1" "scenarios/$2.yaml" --strategy "$3" --model "$4" --seeds 1..5 --bench |
-        sed -nE 's/.*by cpu time: ([0-9]+)x.*/\1/p'; }
-med3() { printf '%s\n' "$@" | sort -n | sed -n 2p; }
 for sc in default intel; do
     for sm in "meta ridge" "meta-path pathloss"; do
         set -- $sm
-        new=() old=()
-        for rep in 1 2 3; do
-            new+=("$(rtf "$SIM" "$sc" "$1" "$2")")
-            if [ -n "$BASE" ]; then old+=("$(rtf "$BASE" "$sc" "$1" "$2")"); fi
-        done
-        line="bench-sim: $sc, $1 + $2, seeds 1..5, by cpu time: median ${new[*]} -> $(med3 "${new[@]}")x"
-        if [ -n "$BASE" ]; then line="$line; base ${old[*]} -> $(med3 "${old[@]}")x"; fi
-        echo "$line"
+        compare "$sc" "$1" "$2"
     done
 done
 echo "bench-sim: load average at the end: $(cut -d' ' -f1-3 /proc/loadavg)"

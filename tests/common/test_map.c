@@ -562,6 +562,87 @@ static void test_walls_crossed_blocks(void **state)
     assert_int_equal(rfs_map_wall_blocks(&nowall, buf, sizeof buf, &b), -1);
 }
 
+/* A wall-distance grid (rfs_map_wall_dist_attach) holds each cell's Chebyshev distance to
+ * the nearest wall cell (brute force here), and wall counts passing over the free squares
+ * it promises equal ref_walls_in_order, with or without blocks passed in: on maps with
+ * walls scattered, thinned to a few, and none, for random segments, segments between cell
+ * corners (along rows, columns and diagonals of them) and ends off the map. */
+static void test_walls_crossed_wall_dist(void **state)
+{
+    (void)state;
+    uint32_t s = 11;
+    int nonzero = 0;
+    static uint8_t dist[H * W];
+    for (int mapk = 0; mapk < 6; mapk++) {
+        make_map(&fx, 500u + (uint32_t)mapk, RFS_Q16_FRAC(1, 10), RFS_Q16_FRAC(1, 4));
+        uint16_t stride = (W + 7) / 8;
+        for (int y = 0; y < H; y++) {
+            for (int x = 0; x < W; x++) {
+                /* 0, 1: as drawn; 2, 3: every seventh wall cell; 4: one cell; 5: none */
+                int keep = mapk < 2 || (mapk < 4 && (x * 5 + y * 3) % 7 == 0) ||
+                           (mapk == 4 && x == W / 2 && y == H / 3);
+                fx.wall_c[y][x] = fx.wall_c[y][x] && keep;
+                if (mapk == 4) {
+                    fx.wall_c[y][x] = keep;
+                }
+                rfs_map_bit_set(fx.wall_bits, stride, (uint16_t)x, (uint16_t)y, fx.wall_c[y][x]);
+            }
+        }
+        rfs_map_cfg_t cfg = rfs_map_cfg_default();
+        assert_int_equal(rfs_map_init(&fx.m, &cfg, W, H, fx.res, fx.ox, fx.oy, fx.free_bits,
+                                      fx.wall_bits, fx.legal_bits), 0);
+        assert_int_equal(rfs_map_wall_dist_bytes(&fx.m), W * H);
+        assert_int_equal(rfs_map_wall_dist_attach(&fx.m, dist, W * H - 1), -1);
+        assert_null(fx.m.wall_dist);
+        assert_int_equal(rfs_map_wall_dist_attach(&fx.m, dist, W * H), 0);
+        for (int y = 0; y < H; y++) {
+            for (int x = 0; x < W; x++) {
+                int best = 255;
+                for (int v = 0; v < H; v++) {
+                    for (int u = 0; u < W; u++) {
+                        int d = abs(u - x) > abs(v - y) ? abs(u - x) : abs(v - y);
+                        best = fx.wall_c[v][u] && d < best ? d : best;
+                    }
+                }
+                assert_int_equal(dist[y * W + x], best);
+            }
+        }
+        uint8_t buf[64];
+        rfs_map_wall_blocks_t b;
+        assert_int_equal(rfs_map_wall_blocks(&fx.m, buf, sizeof buf, &b), 0);
+        for (int k = 0; k < 1500; k++) {
+            rfs_q16_t x0, y0, x1, y1;
+            if (k % 3 == 0) {
+                x0 = rand_coord(&s, fx.ox, W, fx.res);
+                y0 = rand_coord(&s, fx.oy, H, fx.res);
+                x1 = rand_coord(&s, fx.ox, W, fx.res);
+                y1 = rand_coord(&s, fx.oy, H, fx.res);
+            } else {
+                int i0 = (int)(lcg(&s) % (W + 5)) - 2, j0 = (int)(lcg(&s) % (H + 5)) - 2;
+                int i1 = (int)(lcg(&s) % (W + 5)) - 2, j1 = (int)(lcg(&s) % (H + 5)) - 2;
+                if (k % 9 == 1) {
+                    j1 = j0 + (i1 - i0) * ((k & 2) ? 1 : -1);
+                } else if (k % 3 == 1) {
+                    if (k & 4) { i1 = i0; } else { j1 = j0; }
+                }
+                x0 = fx.ox + i0 * fx.res;
+                y0 = fx.oy + j0 * fx.res;
+                x1 = fx.ox + i1 * fx.res;
+                y1 = fx.oy + j1 * fx.res;
+            }
+            int want = ref_walls_in_order(&fx, x0, y0, x1, y1);
+            assert_int_equal(rfs_map_walls_crossed(&fx.m, x0, y0, x1, y1), want);
+            assert_int_equal(rfs_map_walls_crossed_blocks(&fx.m, &b, x0, y0, x1, y1), want);
+            nonzero += want > 0;
+        }
+    }
+    assert_true(nonzero > 1000);
+    rfs_map_t nowall = fx.m;
+    nowall.wall = NULL;
+    assert_int_equal(rfs_map_wall_dist_attach(&nowall, dist, sizeof dist), -1);
+    assert_int_equal(rfs_map_wall_dist_attach(&fx.m, NULL, sizeof dist), -1);
+}
+
 /* Along one axis, lattice lines at o + g/2 + k g (k < n; o Q16.16, g metres): is line idx
  * as near to p (Q16.16) as the nearest of all n, by brute force in double? */
 static int nearest_on_axis(rfs_q16_t p, rfs_q16_t o, double g, int n, int idx)
@@ -655,6 +736,7 @@ int main(void)
         cmocka_unit_test(test_segment_grazing_corner),
         cmocka_unit_test(test_walls_crossed),
         cmocka_unit_test(test_walls_crossed_blocks),
+        cmocka_unit_test(test_walls_crossed_wall_dist),
         cmocka_unit_test(test_lattice),
         cmocka_unit_test(test_init_rejects),
     };

@@ -277,6 +277,101 @@ static void test_grazed_corner_keeps_walls_beyond(void **state)
         hs_box2d_destroy(w);
         lx_map_free(&m);
     }
+
+/// One world with the shared merged walls and the walls' pair search skipped, one as
+/// Box2D builds it (hs_box2d_create, wall_pairs): the robot driving into, along and away
+/// from the Intel lab's cluttered walls for 60 s ends every step at the same pose, bit for
+/// bit, with the same contacts; the rectangles and ray counts agree too.
+static void test_shared_walls_same_world(void **state)
+{
+    (void)state;
+    lx_map_t m;
+    char err[256];
+    assert_int_equal(lx_map_load("scenarios/maps/intel.yaml", &m, err, sizeof err), 0);
+    hs_box2d_walls_t walls;
+    assert_int_equal(hs_box2d_walls_make(&m, &walls), 0);
+    hs_box2d_cfg_t ref_cfg = hs_box2d_cfg_default();
+    ref_cfg.wall_pairs = true;
+    hs_box2d_t *a = hs_box2d_create_walls(&m, NULL, &walls, err, sizeof err);
+    hs_box2d_t *b = hs_box2d_create(&m, &ref_cfg, err, sizeof err);
+    assert_non_null(a);
+    assert_non_null(b);
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(hs_box2d_rect_count(a, (hs_box2d_kind_t)k), walls.n[k]);
+        assert_int_equal(hs_box2d_rect_count(b, (hs_box2d_kind_t)k), walls.n[k]);
+    }
+    assert_true(walls.n[HS_BOX2D_RADIO] > 1000);
+    hs_box2d_place_robot(a, 26.0, 9.0, 3.14159);
+    hs_box2d_place_robot(b, 26.0, 9.0, 3.14159);
+    int touching = 0;
+    for (int i = 0; i < 3000; i++) { // 60 s: forward, turning now and then, backing off
+        double v = (i / 400) % 3 == 2 ? -0.3 : 0.6, om = (i / 150) % 4 == 1 ? 0.9 : -0.2;
+        hs_box2d_step(a, v, om, 0.02);
+        hs_box2d_step(b, v, om, 0.02);
+        double xa, ya, ta, xb, yb, tb;
+        hs_box2d_robot_pose(a, &xa, &ya, &ta);
+        hs_box2d_robot_pose(b, &xb, &yb, &tb);
+        assert_memory_equal(&xa, &xb, sizeof xa);
+        assert_memory_equal(&ya, &yb, sizeof ya);
+        assert_memory_equal(&ta, &tb, sizeof ta);
+        assert_int_equal(hs_box2d_robot_touching(a), hs_box2d_robot_touching(b));
+        touching += hs_box2d_robot_touching(a);
+    }
+    assert_int_equal(hs_box2d_wall_contacts(a), hs_box2d_wall_contacts(b));
+    assert_true(hs_box2d_wall_contacts(a) >= 2);
+    assert_true(touching > 100);
+    assert_int_equal(hs_box2d_walls_crossed(a, 1.0, 1.0, 30.0, 25.0),
+                     hs_box2d_walls_crossed(b, 1.0, 1.0, 30.0, 25.0));
+    hs_box2d_destroy(a);
+    hs_box2d_destroy(b);
+    hs_box2d_walls_free(&walls);
+    lx_map_free(&m);
+}
+
+/// xorshift64: the test's own segments, the same on every run.
+static double uniform(uint64_t *s, double lo, double hi)
+{
+    *s ^= *s << 13;
+    *s ^= *s >> 7;
+    *s ^= *s << 17;
+    return lo + (hi - lo) * (double)(*s >> 11) / 9007199254740992.0;
+}
+
+/// The radio-fixture index answers as Box2D's own tree (b2World::RayCast both ways) on
+/// the shipped SLAM map (thousands of small walls) for random segments, segments along
+/// cell edges and through corners, vertical and horizontal ones, and ends off the map.
+static void test_walls_crossed_index_matches_tree(void **state)
+{
+    (void)state;
+    lx_map_t m;
+    char err[256];
+    assert_int_equal(lx_map_load("scenarios/maps/intel.yaml", &m, err, sizeof err), 0);
+    hs_box2d_t *w = hs_box2d_create(&m, NULL, err, sizeof err);
+    assert_non_null(w);
+    const double x1 = m.origin_x + m.w * m.res, y1 = m.origin_y + m.h * m.res;
+    uint64_t s = 0x9E3779B97F4A7C15u;
+    unsigned walls = 0, differ = 0;
+    for (int k = 0; k < 3000; k++) {
+        double a = uniform(&s, m.origin_x - 1.0, x1 + 1.0), b = uniform(&s, m.origin_y - 1.0, y1 + 1.0);
+        double c = uniform(&s, m.origin_x - 1.0, x1 + 1.0), d = uniform(&s, m.origin_y - 1.0, y1 + 1.0);
+        if (k % 4 == 1) { // on cell edges and corners
+            a = m.origin_x + floor((a - m.origin_x) / m.res) * m.res;
+            b = m.origin_y + floor((b - m.origin_y) / m.res) * m.res;
+            c = m.origin_x + floor((c - m.origin_x) / m.res) * m.res;
+            d = m.origin_y + floor((d - m.origin_y) / m.res) * m.res;
+        } else if (k % 4 == 2) {
+            c = a; // vertical
+        } else if (k % 4 == 3) {
+            d = b; // horizontal
+        }
+        unsigned n = hs_box2d_walls_crossed(w, a, b, c, d);
+        walls += n;
+        differ += n != hs_box2d_walls_crossed_tree(w, a, b, c, d) ? 1u : 0u;
+    }
+    assert_int_equal(differ, 0);
+    assert_true(walls > 3000u * 5u); // the segments do cross the lab's walls
+    hs_box2d_destroy(w);
+    lx_map_free(&m);
 }
 
 static unsigned walls_cb(void *ctx, double x0, double y0, double x1, double y1)
@@ -323,6 +418,8 @@ int main(void)
         cmocka_unit_test(test_wall_contacts),
         cmocka_unit_test(test_walls_crossed),
         cmocka_unit_test(test_grazed_corner_keeps_walls_beyond),
+        cmocka_unit_test(test_walls_crossed_index_matches_tree),
+        cmocka_unit_test(test_shared_walls_same_world),
         cmocka_unit_test(test_one_wall_costs_its_attenuation),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -129,6 +129,31 @@ static void test_shadowing_sigma_and_correlation(void **state)
     assert_true(fabs(dcorr - 5.0) < 0.75);
 }
 
+/// Shadowing grid points are summed on first read: two radios of one seed read in
+/// opposite orders (one from the far corner back, one point by point forward) agree bit
+/// for bit everywhere, so a value does not depend on what was read before.
+static void test_shadowing_lazy_order_free(void **state)
+{
+    (void)state;
+    hs_radio_cfg_t c = cfg_none();
+    c.shadowing = true;
+    hs_radio_t *a = make(&c, 30, 20, 7), *b = make(&c, 30, 20, 7);
+    const int n = 61, m = 41; // 0.5 m grid points over the 30 x 20 m area
+    for (int k = n * m - 1; k >= 0; k--) {
+        (void)hs_radio_shadow_db(a, 0, -15.0 + 0.5 * (k % n), -10.0 + 0.5 * (k / n));
+    }
+    int nonzero = 0;
+    for (int k = 0; k < n * m; k++) {
+        double x = -15.0 + 0.5 * (k % n) + 0.13, y = -10.0 + 0.5 * (k / n) + 0.31;
+        double va = hs_radio_shadow_db(a, 0, x, y), vb = hs_radio_shadow_db(b, 0, x, y);
+        assert_memory_equal(&va, &vb, sizeof va);
+        nonzero += va != 0.0;
+    }
+    assert_true(nonzero > n * m / 2);
+    hs_radio_destroy(a);
+    hs_radio_destroy(b);
+}
+
 /// The shadowing field is fixed per seed (returning gives the same value) and differs
 /// between seeds.
 static void test_fields_fixed_per_seed(void **state)
@@ -351,6 +376,7 @@ int main(void)
         cmocka_unit_test(test_pathloss_slope),
         cmocka_unit_test(test_shadowing_sigma_and_correlation),
         cmocka_unit_test(test_fields_fixed_per_seed),
+        cmocka_unit_test(test_shadowing_lazy_order_free),
         cmocka_unit_test(test_fading_distribution),
         cmocka_unit_test(test_fading_spatial_scale),
         cmocka_unit_test(test_loss_curve),

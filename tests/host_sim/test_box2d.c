@@ -277,6 +277,7 @@ static void test_grazed_corner_keeps_walls_beyond(void **state)
         hs_box2d_destroy(w);
         lx_map_free(&m);
     }
+}
 
 /// One world with the shared merged walls and the walls' pair search skipped, one as
 /// Box2D builds it (hs_box2d_create, wall_pairs): the robot driving into, along and away

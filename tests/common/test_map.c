@@ -216,6 +216,32 @@ static rfs_q16_t rand_coord(uint32_t *s, rfs_q16_t o, int cells, rfs_q16_t res)
 
 static fixture_t fx;
 
+/* Segment k of a wall-count sweep on fixture f: one in three random, the others between
+ * cell corners (one in three of those along a row or column of them, one in nine on a
+ * diagonal through corners, some off the map). */
+static void draw_segment(uint32_t *s, const fixture_t *f, int k, rfs_q16_t *x0, rfs_q16_t *y0,
+                         rfs_q16_t *x1, rfs_q16_t *y1)
+{
+    if (k % 3 == 0) {
+        *x0 = rand_coord(s, f->ox, W, f->res);
+        *y0 = rand_coord(s, f->oy, H, f->res);
+        *x1 = rand_coord(s, f->ox, W, f->res);
+        *y1 = rand_coord(s, f->oy, H, f->res);
+        return;
+    }
+    int i0 = (int)(lcg(s) % (W + 5)) - 2, j0 = (int)(lcg(s) % (H + 5)) - 2;
+    int i1 = (int)(lcg(s) % (W + 5)) - 2, j1 = (int)(lcg(s) % (H + 5)) - 2;
+    if (k % 9 == 1) {
+        j1 = j0 + (i1 - i0) * ((k & 2) ? 1 : -1);
+    } else if (k % 3 == 1) {
+        if (k & 4) { i1 = i0; } else { j1 = j0; }
+    }
+    *x0 = f->ox + i0 * f->res;
+    *y0 = f->oy + j0 * f->res;
+    *x1 = f->ox + i1 * f->res;
+    *y1 = f->oy + j1 * f->res;
+}
+
 /* The derived legal grid equals the brute-force reference, for three resolutions. */
 static void test_legal_grid_matches_reference(void **state)
 {
@@ -526,26 +552,7 @@ static void test_walls_crossed_blocks(void **state)
             }
             for (int k = 0; k < 900; k++) {
                 rfs_q16_t x0, y0, x1, y1;
-                if (k % 3 == 0) {
-                    x0 = rand_coord(&s, fx.ox, W, fx.res);
-                    y0 = rand_coord(&s, fx.oy, H, fx.res);
-                    x1 = rand_coord(&s, fx.ox, W, fx.res);
-                    y1 = rand_coord(&s, fx.oy, H, fx.res);
-                } else {
-                    /* cell corners, one in three segments along a row or column of them,
-                     * one in nine on a diagonal through corners, some off the map */
-                    int i0 = (int)(lcg(&s) % (W + 5)) - 2, j0 = (int)(lcg(&s) % (H + 5)) - 2;
-                    int i1 = (int)(lcg(&s) % (W + 5)) - 2, j1 = (int)(lcg(&s) % (H + 5)) - 2;
-                    if (k % 9 == 1) {
-                        j1 = j0 + (i1 - i0) * ((k & 2) ? 1 : -1);
-                    } else if (k % 3 == 1) {
-                        if (k & 4) { i1 = i0; } else { j1 = j0; }
-                    }
-                    x0 = fx.ox + i0 * fx.res;
-                    y0 = fx.oy + j0 * fx.res;
-                    x1 = fx.ox + i1 * fx.res;
-                    y1 = fx.oy + j1 * fx.res;
-                }
+                draw_segment(&s, &fx, k, &x0, &y0, &x1, &y1);
                 int want = ref_walls_in_order(&fx, x0, y0, x1, y1);
                 assert_int_equal(rfs_map_walls_crossed_blocks(&fx.m, &b, x0, y0, x1, y1), want);
                 assert_int_equal(rfs_map_walls_crossed(&fx.m, x0, y0, x1, y1), want);
@@ -612,24 +619,7 @@ static void test_walls_crossed_wall_dist(void **state)
         assert_int_equal(rfs_map_wall_blocks(&fx.m, buf, sizeof buf, &b), 0);
         for (int k = 0; k < 1500; k++) {
             rfs_q16_t x0, y0, x1, y1;
-            if (k % 3 == 0) {
-                x0 = rand_coord(&s, fx.ox, W, fx.res);
-                y0 = rand_coord(&s, fx.oy, H, fx.res);
-                x1 = rand_coord(&s, fx.ox, W, fx.res);
-                y1 = rand_coord(&s, fx.oy, H, fx.res);
-            } else {
-                int i0 = (int)(lcg(&s) % (W + 5)) - 2, j0 = (int)(lcg(&s) % (H + 5)) - 2;
-                int i1 = (int)(lcg(&s) % (W + 5)) - 2, j1 = (int)(lcg(&s) % (H + 5)) - 2;
-                if (k % 9 == 1) {
-                    j1 = j0 + (i1 - i0) * ((k & 2) ? 1 : -1);
-                } else if (k % 3 == 1) {
-                    if (k & 4) { i1 = i0; } else { j1 = j0; }
-                }
-                x0 = fx.ox + i0 * fx.res;
-                y0 = fx.oy + j0 * fx.res;
-                x1 = fx.ox + i1 * fx.res;
-                y1 = fx.oy + j1 * fx.res;
-            }
+            draw_segment(&s, &fx, k, &x0, &y0, &x1, &y1);
             int want = ref_walls_in_order(&fx, x0, y0, x1, y1);
             assert_int_equal(rfs_map_walls_crossed(&fx.m, x0, y0, x1, y1), want);
             assert_int_equal(rfs_map_walls_crossed_blocks(&fx.m, &b, x0, y0, x1, y1), want);

@@ -184,7 +184,8 @@ void rfs_can_pack_status(const rfs_can_status_t *s, uint8_t counter, rfs_can_fra
 {
     frame_begin(f, RFS_CAN_ID_STATUS, RFS_CAN_DLC_STATUS, counter, (uint8_t)(s->state & 0x3u));
     f->data[1] = (uint8_t)((s->kind & 0x3u) | ((s->relearned ? 1u : 0u) << 2) |
-                           ((s->line_search ? 1u : 0u) << 3) | ((s->prev & 0x7u) << 4));
+                           ((s->line_search ? 1u : 0u) << 3) | ((s->prev & 0x7u) << 4) |
+                           ((s->configured ? 1u : 0u) << 7));
     f->data[2] = s->faults;
     put_u32(&f->data[3], s->iteration);
     frame_seal(f);
@@ -306,7 +307,7 @@ rfs_can_err_t rfs_can_unpack_status(const rfs_can_frame_t *f, rfs_can_status_t *
         return e;
     }
     uint8_t prev = (uint8_t)((f->data[1] >> 4) & 0x7u);
-    if ((f->data[0] >> 6) || (f->data[1] & 0x80u) || prev > RFS_DRIVE_BLOCKED) {
+    if ((f->data[0] >> 6) || prev > RFS_DRIVE_BLOCKED) {
         return RFS_CAN_E_RANGE;
     }
     s->state = (uint8_t)((f->data[0] >> 4) & 0x3u);
@@ -316,6 +317,7 @@ rfs_can_err_t rfs_can_unpack_status(const rfs_can_frame_t *f, rfs_can_status_t *
     s->prev = prev;
     s->faults = f->data[2];
     s->iteration = get_u32(&f->data[3]);
+    s->configured = (f->data[1] & 0x80u) != 0;
     *counter = f->data[0] & 0x0Fu;
     return RFS_CAN_OK;
 }

@@ -169,6 +169,7 @@ typedef struct rfs_can_status {
     bool line_search;    ///< the latest greedy goal came from the line search
     uint8_t faults;      ///< RFS_SEEK_FAULT_* bits (low 8)
     uint32_t iteration;  ///< iteration number of the latest decision
+    bool configured;     ///< a CONFIG frame was applied (false: the controller's own, as after a reset)
 } rfs_can_status_t;
 
 /// CRC-8/SAE-J1850 of n bytes (poly 0x1D, init 0xFF, xorout 0xFF). Check value:

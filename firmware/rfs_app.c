@@ -383,6 +383,8 @@ uint8_t rfs_app_frames(rfs_app_t *a, const rfs_app_out_t *out, rfs_can_frame_t f
     }
     st.faults = faults;
     st.iteration = out->decision.iteration;
+    /* An operator who sent a CONFIG and reads false sends it again (a reset forgets it). */
+    st.configured = a->stats.configs != 0u;
 
     rfs_can_tx_wheel(&a->can_tx, &wheel, &frames[0]);
     rfs_can_tx_status(&a->can_tx, &st, &frames[1]);

@@ -86,7 +86,7 @@ static void rssi_and_status_bytes_match_python_reference(void **state)
 {
     (void)state;
     rfs_can_rssi_t r = {1, -67, 200, 1000000u};
-    rfs_can_status_t s = {3, 2, 2, true, false, 5, 300};
+    rfs_can_status_t s = {3, 2, 2, true, false, 5, 300, false};
     const uint8_t want_r[] = {0x17, 0xBD, 0xC8, 0x40, 0x42, 0x0F, 0x00, 0x62};
     const uint8_t want_s[] = {0x32, 0x26, 0x05, 0x2C, 0x01, 0x00, 0x00, 0xD6};
     rfs_can_frame_t fr, fs;
@@ -96,6 +96,12 @@ static void rssi_and_status_bytes_match_python_reference(void **state)
 
     assert_memory_equal(fr.data, want_r, 8);
     assert_memory_equal(fs.data, want_s, 8);
+
+    /* Configured is bit 15 (byte 1 bit 7); the checksum from the Python reference too. */
+    const uint8_t want_c[] = {0x32, 0xA6, 0x05, 0x2C, 0x01, 0x00, 0x00, 0x76};
+    s.configured = true;
+    rfs_can_pack_status(&s, 2, &fs);
+    assert_memory_equal(fs.data, want_c, 8);
 }
 
 static void wheel_every_speed_round_trips(void **state)
@@ -155,7 +161,7 @@ static void rssi_and_status_every_field_value_round_trips(void **state)
     for (int v = 0; v < 256; v++) {
         rfs_can_rssi_t r = {(uint8_t)(v & 15), (int8_t)(v - 128), (uint8_t)(255 - v), 0x9E3779B9u * (uint32_t)v}, ro;
         rfs_can_status_t s = {(uint8_t)(v & 3), (uint8_t)((v >> 2) & 3), (uint8_t)(v % 5), (v & 16) != 0,
-                              (v & 32) != 0, (uint8_t)v, 0x01000193u * (uint32_t)v}, so;
+                              (v & 32) != 0, (uint8_t)v, 0x01000193u * (uint32_t)v, (v & 64) != 0}, so;
         rfs_can_frame_t fr, fs;
         uint8_t c;
 
@@ -175,6 +181,7 @@ static void rssi_and_status_every_field_value_round_trips(void **state)
         assert_int_equal(so.line_search, (v & 32) != 0);
         assert_int_equal(so.faults, v);
         assert_int_equal(so.iteration, 0x01000193u * (uint32_t)v);
+        assert_int_equal(so.configured, (v & 64) != 0);
     }
 }
 

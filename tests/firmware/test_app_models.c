@@ -203,6 +203,10 @@ static void test_config_frame_chooses_before_the_first_decision(void **state)
     rfs_app_out_t o;
     rfs_app_step(&s_app, 0, &o);
     rfs_app_frames(&s_app, &o, out); /* STATUS counter 0 */
+    rfs_can_status_t st;
+    uint8_t ctr;
+    assert_int_equal(rfs_can_unpack_status(&out[1], &st, &ctr), RFS_CAN_OK);
+    assert_false(st.configured); /* the image's own configuration */
 
     /* knn: not offered; bridge + pathloss: one fit per node, no room; meta-global and a
      * baseline (chemotaxis: its decision kinds have no code on the wire). */
@@ -237,6 +241,8 @@ static void test_config_frame_chooses_before_the_first_decision(void **state)
     rfs_app_step(&s_app, 50000, &o);
     rfs_app_frames(&s_app, &o, out);
     assert_int_equal(out[1].data[0] & 0x0Fu, 1u); /* the STATUS counter runs on */
+    assert_int_equal(rfs_can_unpack_status(&out[1], &st, &ctr), RFS_CAN_OK);
+    assert_true(st.configured);
     assert_false(o.faults & RFS_APP_FAULT_RESET);
 
     /* The mission starts: a decision (after the boot's flood fill in slices), then a

@@ -67,7 +67,7 @@ static int do_send(const char *ifname, const char *expect)
     }
     for (int i = 0; i < 2; i++) {
         rfs_can_status_t s = {(uint8_t)(3 - i), (uint8_t)(2 + i), (uint8_t)(2 + 2 * i), i == 0, i == 1,
-                              (uint8_t)(i ? 0x0F : 0), i ? 0xFFFFFFFFu : 7u};
+                              (uint8_t)(i ? 0x0F : 0), i ? 0xFFFFFFFFu : 7u, i == 1};
         rfs_can_tx_status(&tx, &s, &fr[n++]);
     }
     for (int i = 0; i < 2; i++) { /* receiver heartbeats, across the wrap */
@@ -148,9 +148,9 @@ static int do_recv(const char *ifname, int64_t now_us)
             printf("RECEIVER t=%" PRId64 "\n", m.receiver_t_us);
             break;
         case RFS_CAN_MSG_STATUS:
-            printf("STATUS state=%u kind=%u prev=%u relearned=%u line=%u faults=%u iter=%" PRIu32 "\n", m.status.state,
-                   m.status.kind, m.status.prev, m.status.relearned, m.status.line_search, m.status.faults,
-                   m.status.iteration);
+            printf("STATUS state=%u kind=%u prev=%u relearned=%u line=%u configured=%u faults=%u iter=%" PRIu32 "\n",
+                   m.status.state, m.status.kind, m.status.prev, m.status.relearned, m.status.line_search,
+                   m.status.configured, m.status.faults, m.status.iteration);
             break;
         case RFS_CAN_MSG_CONFIG:
             printf("CONFIG target=%u strategy=%u model=%u p0=%d seed=%" PRIu32 "\n", m.config.target,

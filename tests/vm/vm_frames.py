@@ -65,9 +65,10 @@ def main(argv):
     # 8. wheel command, stop flag
     send.append(frame(0x100, struct.pack("<Bhh", 0x15, -700, 700)))
     want.append("WHEEL left=-700 right=700 flags=1")
-    # 9. status: counter 9, state 3, kind 2, relearned, prev 2, faults 5, iteration 300
-    send.append(frame(0x180, struct.pack("<BBBI", 0x39, 2 | 4 | (2 << 4), 5, 300)))
-    want.append("STATUS state=3 kind=2 prev=2 relearned=1 line=0 faults=5 iter=300")
+    # 9. status: counter 9, state 3, kind 2, relearned, prev 2, configured, faults 5,
+    #    iteration 300
+    send.append(frame(0x180, struct.pack("<BBBI", 0x39, 2 | 4 | (2 << 4) | 0x80, 5, 300)))
+    want.append("STATUS state=3 kind=2 prev=2 relearned=1 line=0 configured=1 faults=5 iter=300")
     # 10. RSSI counter 3 (last accepted 0: a jump), seq 202 (201 missing)
     send.append(frame(0x120, struct.pack("<BbBI", 0x13, -70, 202, t32(NOW - 500))))
     want.append("RSSI src=1 dbm=-70 seq=202 t=%d" % (NOW - 500))

@@ -46,7 +46,7 @@ __attribute__((noinline)) static void bench_rssi(rfs_can_tx_t *tx, rfs_can_rx_t 
 __attribute__((noinline)) static void bench_status(rfs_can_tx_t *tx, rfs_can_rx_t *rx)
 {
     for (int i = 0; i < REPS; i++) {
-        rfs_can_status_t s = {3, 2, 2, true, false, 0, (uint32_t)i};
+        rfs_can_status_t s = {3, 2, 2, true, false, 0, (uint32_t)i, false};
         rfs_can_frame_t f;
         rfs_can_msg_t m;
         rfs_can_tx_status(tx, &s, &f);

@@ -76,12 +76,13 @@ int main(int argc, char **argv)
     const uint32_t iters[] = {0, 0xFFFFFFFFu, 1, 0x12345678u, 5, 65536};
     for (unsigned i = 0; i < sizeof iters / sizeof iters[0]; i++) {
         rfs_can_status_t s = {(uint8_t)(i % 4u), (uint8_t)((i + 1u) % 4u), (uint8_t)(i % 5u), (i & 1u) != 0,
-                              (i & 2u) != 0, (uint8_t)(i == 1 ? 255u : i * 3u), iters[i]};
+                              (i & 2u) != 0, (uint8_t)(i == 1 ? 255u : i * 3u), iters[i], (i & 4u) != 0};
         uint8_t c = (uint8_t)(i + 9u) % 16u;
         rfs_can_pack_status(&s, c, &f);
         print_frame(&f);
-        printf(" Counter=%u State=%u Kind=%u Relearned=%u LineSearch=%u PrevGoal=%u Faults=%u Iteration=%" PRIu32 "\n", c,
-               s.state, s.kind, s.relearned, s.line_search, s.prev, s.faults, s.iteration);
+        printf(" Counter=%u State=%u Kind=%u Relearned=%u LineSearch=%u PrevGoal=%u Configured=%u Faults=%u "
+               "Iteration=%" PRIu32 "\n",
+               c, s.state, s.kind, s.relearned, s.line_search, s.prev, s.configured, s.faults, s.iteration);
     }
     return 0;
 }

@@ -104,14 +104,17 @@ typedef struct rings {
 
 /* Scaling and overflow: costs are half lattice steps (straight 2, diagonal 3), below
  * 3 * lw * lh < 2^32 for any lattice the uint16_t sizes allow; only cost mod 4 is stored. */
-static void ring_push(rings_t *r, uint32_t cost, uint32_t v)
+static inline void ring_push(rings_t *r, uint32_t cost, uint32_t v)
 {
     uint32_t b = cost & 3u;
     if (r->st.count[b] == r->cap) {
         r->st.overflow = true;
         return;
     }
-    r->q[b * r->cap + (r->st.head[b] + r->st.count[b]) % r->cap] = v;
+    /* head < cap and count < cap: one wrap at most (no division in the hot loop). */
+    uint32_t at = r->st.head[b] + r->st.count[b];
+    at = at >= r->cap ? at - r->cap : at;
+    r->q[b * r->cap + at] = v;
     r->st.count[b]++;
     if (r->st.count[b] > r->st.peak) {
         r->st.peak = r->st.count[b];
@@ -198,6 +201,37 @@ static bool relax(const rfs_map_t *m, uint8_t *w, bool steps, rings_t *r, uint32
     return true;
 }
 
+/* relax() with the map's edge table (rfs_map_edges_attach): u's legal edges in one load,
+ * the same answers as relax()'s lattice tests (which only skip the tests a closed or
+ * cheaper neighbour makes moot), pushed in the same direction order. off[k]: the index
+ * step towards direction k (unsigned wrap-around for the negative ones). */
+static inline bool relax_edges(const rfs_map_t *m, uint8_t *w, const uint32_t *off, rings_t *r,
+                               uint32_t u, uint32_t d)
+{
+    uint32_t e = m->edges[u];
+    if ((e & RFS_MAP_EDGES_KNOWN) == 0u) {
+        e = rfs_map_lattice_edges(m, (uint16_t)(u % m->lw), (uint16_t)(u / m->lw));
+    }
+    for (e &= 0xFFu; e != 0u; e &= e - 1u) {
+        const uint32_t k = (uint32_t)__builtin_ctz(e);
+        const uint32_t v = u + off[k];
+        const uint8_t wv = w[v];
+        if (wv & W_CLOSED) {
+            continue;
+        }
+        const uint32_t nc = d + 2u + (k & 1u);
+        if ((wv & W_OPEN) && nc >= d + ((((wv & W_TMOD) >> W_TMOD_SHIFT) - d) & 3u)) {
+            continue;
+        }
+        w[v] = (uint8_t)(W_OPEN | ((nc & 3u) << W_TMOD_SHIFT) | ((k + 4u) & 7u));
+        ring_push(r, nc, v);
+        if (r->st.overflow) {
+            return false;
+        }
+    }
+    return true;
+}
+
 /* What search_until stopped at. */
 typedef enum search_end {
     SEARCH_FOUND,    /* the target is closed */
@@ -222,15 +256,19 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
     const rfs_map_t *m = p->map;
     /* The memo's answers are the traversal's (rfs_map_memo_attach). */
     const bool steps = m->step_n != 0 ? !p->exact_edges : m->memo != 0;
+    const bool edges = steps && m->edges != 0 && !p->exact_edges;
+    const uint32_t lw = m->lw;
+    const uint32_t off[8] = {1u, lw + 1u, lw, lw - 1u, 0u - 1u, 0u - lw - 1u, 0u - lw, 1u - lw};
     uint32_t d = r.st.cost;
     uint32_t u = r.st.pending; /* closed, neighbours not yet relaxed */
     uint32_t empty_run = 0;
     uint32_t closed = 0;
+    uint32_t peak = 0; /* the rings' peak at the last point closed */
     search_end_t end = SEARCH_EMPTY;
     bool ok = !r.st.overflow;
     while (ok) {
         if (u != NO_POINT) {
-            ok = relax(m, w, steps, &r, u, d);
+            ok = edges ? relax_edges(m, w, off, &r, u, d) : relax(m, w, steps, &r, u, d);
             u = NO_POINT;
             continue;
         }
@@ -248,21 +286,24 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
         }
         empty_run = 0;
         const uint32_t v = r.q[b * r.cap + r.st.head[b]];
-        r.st.head[b] = (r.st.head[b] + 1u) % r.cap;
+        r.st.head[b] = r.st.head[b] + 1u == r.cap ? 0u : r.st.head[b] + 1u;
         r.st.count[b]--;
         const uint8_t wv = w[v];
         if ((wv & W_CLOSED) || ((wv & W_TMOD) >> W_TMOD_SHIFT) != b) {
             continue; /* stale entry */
         }
         w[v] = (uint8_t)((wv & W_DIR) | W_CLOSED);
-        p->expanded++;
         closed++;
-        p->queue_peak = r.st.peak;
+        peak = r.st.peak;
         u = v;
         if (v == target) {
             end = SEARCH_FOUND;
             break;
         }
+    }
+    if (closed != 0u) {
+        p->expanded += closed;
+        p->queue_peak = peak;
     }
     r.st.cost = d;
     r.st.pending = end == SEARCH_EMPTY ? NO_POINT : u;

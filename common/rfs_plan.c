@@ -201,35 +201,40 @@ static bool relax(const rfs_map_t *m, uint8_t *w, bool steps, rings_t *r, uint32
     return true;
 }
 
+/* One edge of relax_edges: the push to v at cost nc (parent direction back, towards
+ * u closed at cost d) unless v is closed or holds nc or less. false on overflow. */
+static inline bool edge_to(uint8_t *w, rings_t *r, uint32_t v, uint32_t d, uint32_t nc,
+                           uint32_t back)
+{
+    const uint8_t wv = w[v];
+    if ((wv & W_CLOSED) ||
+        ((wv & W_OPEN) && nc >= d + ((((wv & W_TMOD) >> W_TMOD_SHIFT) - d) & 3u))) {
+        return true;
+    }
+    w[v] = (uint8_t)(W_OPEN | ((nc & 3u) << W_TMOD_SHIFT) | back);
+    ring_push(r, nc, v);
+    return !r->st.overflow;
+}
+
 /* relax() with the map's edge table (rfs_map_edges_attach): u's legal edges in one load,
  * the same answers as relax()'s lattice tests (which only skip the tests a closed or
- * cheaper neighbour makes moot), pushed in the same direction order. off[k]: the index
- * step towards direction k (unsigned wrap-around for the negative ones). */
-static inline bool relax_edges(const rfs_map_t *m, uint8_t *w, const uint32_t *off, rings_t *r,
-                               uint32_t u, uint32_t d)
+ * cheaper neighbour makes moot), pushed in the same direction order (DIR_X, DIR_Y). */
+static inline bool relax_edges(const rfs_map_t *m, uint8_t *w, rings_t *r, uint32_t u,
+                               uint32_t d)
 {
+    const uint32_t lw = m->lw;
     uint32_t e = m->edges[u];
     if ((e & RFS_MAP_EDGES_KNOWN) == 0u) {
-        e = rfs_map_lattice_edges(m, (uint16_t)(u % m->lw), (uint16_t)(u / m->lw));
+        e = rfs_map_lattice_edges(m, (uint16_t)(u % lw), (uint16_t)(u / lw));
     }
-    for (e &= 0xFFu; e != 0u; e &= e - 1u) {
-        const uint32_t k = (uint32_t)__builtin_ctz(e);
-        const uint32_t v = u + off[k];
-        const uint8_t wv = w[v];
-        if (wv & W_CLOSED) {
-            continue;
-        }
-        const uint32_t nc = d + 2u + (k & 1u);
-        if ((wv & W_OPEN) && nc >= d + ((((wv & W_TMOD) >> W_TMOD_SHIFT) - d) & 3u)) {
-            continue;
-        }
-        w[v] = (uint8_t)(W_OPEN | ((nc & 3u) << W_TMOD_SHIFT) | ((k + 4u) & 7u));
-        ring_push(r, nc, v);
-        if (r->st.overflow) {
-            return false;
-        }
-    }
-    return true;
+    return (!(e & 0x01u) || edge_to(w, r, u + 1u, d, d + 2u, 4u)) &&
+           (!(e & 0x02u) || edge_to(w, r, u + lw + 1u, d, d + 3u, 5u)) &&
+           (!(e & 0x04u) || edge_to(w, r, u + lw, d, d + 2u, 6u)) &&
+           (!(e & 0x08u) || edge_to(w, r, u + lw - 1u, d, d + 3u, 7u)) &&
+           (!(e & 0x10u) || edge_to(w, r, u - 1u, d, d + 2u, 0u)) &&
+           (!(e & 0x20u) || edge_to(w, r, u - lw - 1u, d, d + 3u, 1u)) &&
+           (!(e & 0x40u) || edge_to(w, r, u - lw, d, d + 2u, 2u)) &&
+           (!(e & 0x80u) || edge_to(w, r, u - lw + 1u, d, d + 3u, 3u));
 }
 
 /* What search_until stopped at. */
@@ -257,8 +262,6 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
     /* The memo's answers are the traversal's (rfs_map_memo_attach). */
     const bool steps = m->step_n != 0 ? !p->exact_edges : m->memo != 0;
     const bool edges = steps && m->edges != 0 && !p->exact_edges;
-    const uint32_t lw = m->lw;
-    const uint32_t off[8] = {1u, lw + 1u, lw, lw - 1u, 0u - 1u, 0u - lw - 1u, 0u - lw, 1u - lw};
     uint32_t d = r.st.cost;
     uint32_t u = r.st.pending; /* closed, neighbours not yet relaxed */
     uint32_t empty_run = 0;
@@ -268,7 +271,7 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
     bool ok = !r.st.overflow;
     while (ok) {
         if (u != NO_POINT) {
-            ok = edges ? relax_edges(m, w, off, &r, u, d) : relax(m, w, steps, &r, u, d);
+            ok = edges ? relax_edges(m, w, &r, u, d) : relax(m, w, steps, &r, u, d);
             u = NO_POINT;
             continue;
         }

@@ -219,7 +219,7 @@ static inline bool edge_to(uint8_t *w, rings_t *r, uint32_t v, uint32_t d, uint3
 /* relax() with the map's edge table (rfs_map_edges_attach): u's legal edges in one load,
  * the same answers as relax()'s lattice tests (which only skip the tests a closed or
  * cheaper neighbour makes moot), pushed in the same direction order (DIR_X, DIR_Y). */
-static inline bool relax_edges(const rfs_map_t *m, uint8_t *w, rings_t *r, uint32_t u,
+__attribute__((always_inline)) static inline bool relax_edges(const rfs_map_t *m, uint8_t *w, rings_t *r, uint32_t u,
                                uint32_t d)
 {
     const uint32_t lw = m->lw;
@@ -269,18 +269,18 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
     uint32_t peak = 0; /* the rings' peak at the last point closed */
     search_end_t end = SEARCH_EMPTY;
     bool ok = !r.st.overflow;
-    while (ok) {
-        if (u != NO_POINT) {
-            ok = edges ? relax_edges(m, w, &r, u, d) : relax(m, w, steps, &r, u, d);
-            u = NO_POINT;
-            continue;
-        }
+    if (ok && u != NO_POINT) {
+        ok = edges ? relax_edges(m, w, &r, u, d) : relax(m, w, steps, &r, u, d);
+        u = NO_POINT;
+    }
+    while (ok && end == SEARCH_EMPTY) {
         if (closed == budget) {
             end = SEARCH_BUDGET;
             break;
         }
         const uint32_t b = d & 3u;
-        if (r.st.count[b] == 0) {
+        uint32_t n = r.st.count[b];
+        if (n == 0u) {
             if (++empty_run == 4u) {
                 break;
             }
@@ -288,21 +288,37 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
             continue;
         }
         empty_run = 0;
-        const uint32_t v = r.q[b * r.cap + r.st.head[b]];
-        r.st.head[b] = r.st.head[b] + 1u == r.cap ? 0u : r.st.head[b] + 1u;
-        r.st.count[b]--;
-        const uint8_t wv = w[v];
-        if ((wv & W_CLOSED) || ((wv & W_TMOD) >> W_TMOD_SHIFT) != b) {
-            continue; /* stale entry */
+        /* Drain ring b: relaxing pushes to d + 2 and d + 3 only, never to it, so its head
+         * and count stay local until it is empty or the search stops. */
+        const uint32_t *ring = r.q + b * r.cap;
+        uint32_t head = r.st.head[b];
+        while (n != 0u) {
+            const uint32_t v = ring[head];
+            head = head + 1u == r.cap ? 0u : head + 1u;
+            n--;
+            const uint8_t wv = w[v];
+            if ((wv & W_CLOSED) || ((wv & W_TMOD) >> W_TMOD_SHIFT) != b) {
+                continue; /* stale entry */
+            }
+            w[v] = (uint8_t)((wv & W_DIR) | W_CLOSED);
+            closed++;
+            peak = r.st.peak;
+            if (v == target) {
+                end = SEARCH_FOUND;
+                u = v;
+                break;
+            }
+            ok = edges ? relax_edges(m, w, &r, v, d) : relax(m, w, steps, &r, v, d);
+            if (!ok) {
+                break;
+            }
+            if (closed == budget) {
+                end = SEARCH_BUDGET;
+                break;
+            }
         }
-        w[v] = (uint8_t)((wv & W_DIR) | W_CLOSED);
-        closed++;
-        peak = r.st.peak;
-        u = v;
-        if (v == target) {
-            end = SEARCH_FOUND;
-            break;
-        }
+        r.st.head[b] = head;
+        r.st.count[b] = n;
     }
     if (closed != 0u) {
         p->expanded += closed;
@@ -560,6 +576,32 @@ void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0)
     p->tree = 1;
     p->tree_done = false;
     p->tree_sliced = false;
+    p->tree_owed = 0;
+}
+
+void rfs_plan_tree_defer(rfs_plan_t *p, bool on)
+{
+    p->tree_defer = on;
+}
+
+/* Pay the deferred grows' debt until lattice point `idx` is closed (rfs_plan_tree_defer):
+ * the search the grows would have run, stopped early at idx. A grow that closes fewer
+ * points than its budget finds the tree done, as the search stopping short of the debt
+ * does (all the grows' budgets, S, exceed the points the root reaches, R, in both). When
+ * idx is the debt's last point, its neighbours are relaxed as that grow would have (an
+ * overflow there ends the search). */
+static void tree_settle(rfs_plan_t *p, uint32_t idx)
+{
+    if (p->tree != 2 || p->tree_done || p->tree_owed == 0u || (p->work[idx] & W_CLOSED)) {
+        return;
+    }
+    const uint32_t before = p->expanded;
+    search_end_t end = search_until(p, idx, p->tree_owed);
+    p->tree_owed -= p->expanded - before;
+    if (end == SEARCH_FOUND && p->tree_owed == 0u) {
+        end = search_until(p, NO_POINT, 0u);
+    }
+    p->tree_done = end == SEARCH_EMPTY;
 }
 
 static void set_dir(uint8_t *w, uint32_t u, uint32_t k)
@@ -683,7 +725,11 @@ bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget)
     tree_seed(p);
     p->tree_sliced = true;
     if (p->tree == 2 && !p->tree_done) {
-        p->tree_done = search_until(p, NO_POINT, budget) == SEARCH_EMPTY;
+        if (p->tree_defer) {
+            p->tree_owed = budget > UINT32_MAX - p->tree_owed ? UINT32_MAX : p->tree_owed + budget;
+        } else {
+            p->tree_done = search_until(p, NO_POINT, budget) == SEARCH_EMPTY;
+        }
     }
     return p->tree != 2 || p->tree_done;
 }
@@ -691,8 +737,11 @@ bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget)
 bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t max_hop)
 {
     uint32_t idx;
-    if (p->tree != 2 || !connect(p->map, x0, y0, true, &idx) ||
-        !(p->work[idx] & W_CLOSED)) {
+    if (p->tree != 2 || !connect(p->map, x0, y0, true, &idx)) {
+        return false;
+    }
+    tree_settle(p, idx);
+    if (!(p->work[idx] & W_CLOSED)) {
         return false;
     }
     uint64_t straight = 0;
@@ -739,6 +788,7 @@ static int tree_goal(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, uint32_t *g_idx)
         component_bit(p->component, p->tree_root) != component_bit(p->component, *g_idx)) {
         return -1; /* different components: the search cannot succeed */
     }
+    tree_settle(p, *g_idx);
     if (!(p->work[*g_idx] & W_CLOSED)) {
         if (p->tree_sliced) {
             p->tree_more = p->tree_more || !p->tree_done;

@@ -219,11 +219,12 @@ static inline bool edge_to(uint8_t *w, rings_t *r, uint32_t v, uint32_t d, uint3
 /* relax() with the map's edge table (rfs_map_edges_attach): u's legal edges in one load,
  * the same answers as relax()'s lattice tests (which only skip the tests a closed or
  * cheaper neighbour makes moot), pushed in the same direction order (DIR_X, DIR_Y). */
-__attribute__((always_inline)) static inline bool relax_edges(const rfs_map_t *m, uint8_t *w, rings_t *r, uint32_t u,
-                               uint32_t d)
+__attribute__((always_inline)) static inline bool relax_edges(const rfs_map_t *m,
+                                                             const uint16_t *edges,
+                                                             uint32_t lw, uint8_t *w,
+                                                             rings_t *r, uint32_t u, uint32_t d)
 {
-    const uint32_t lw = m->lw;
-    uint32_t e = m->edges[u];
+    uint32_t e = edges[u];
     if ((e & RFS_MAP_EDGES_KNOWN) == 0u) {
         e = rfs_map_lattice_edges(m, (uint16_t)(u % lw), (uint16_t)(u / lw));
     }
@@ -261,7 +262,9 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
     const rfs_map_t *m = p->map;
     /* The memo's answers are the traversal's (rfs_map_memo_attach). */
     const bool steps = m->step_n != 0 ? !p->exact_edges : m->memo != 0;
-    const bool edges = steps && m->edges != 0 && !p->exact_edges;
+    /* The edge table and lattice width in locals: stores to the work bytes may alias m. */
+    const uint16_t *const edges = steps && !p->exact_edges ? m->edges : 0;
+    const uint32_t lw = m->lw;
     uint32_t d = r.st.cost;
     uint32_t u = r.st.pending; /* closed, neighbours not yet relaxed */
     uint32_t empty_run = 0;
@@ -270,7 +273,7 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
     search_end_t end = SEARCH_EMPTY;
     bool ok = !r.st.overflow;
     if (ok && u != NO_POINT) {
-        ok = edges ? relax_edges(m, w, &r, u, d) : relax(m, w, steps, &r, u, d);
+        ok = edges ? relax_edges(m, edges, lw, w, &r, u, d) : relax(m, w, steps, &r, u, d);
         u = NO_POINT;
     }
     while (ok && end == SEARCH_EMPTY) {
@@ -308,7 +311,7 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
                 u = v;
                 break;
             }
-            ok = edges ? relax_edges(m, w, &r, v, d) : relax(m, w, steps, &r, v, d);
+            ok = edges ? relax_edges(m, edges, lw, w, &r, v, d) : relax(m, w, steps, &r, v, d);
             if (!ok) {
                 break;
             }

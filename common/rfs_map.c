@@ -535,6 +535,45 @@ __attribute__((noinline)) static bool step_by_traversal(const rfs_map_t *m, uint
     return ok;
 }
 
+/* --- lattice edge table ------------------------------------------------------------ */
+
+static const int8_t EDGE_DX[8] = {1, 1, 0, -1, -1, -1, 0, 1};
+static const int8_t EDGE_DY[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+
+int rfs_map_edges_attach(rfs_map_t *m, uint16_t *buf, uint32_t entries)
+{
+    if (buf == 0 || entries < rfs_map_memo_entries(m)) {
+        return -1;
+    }
+    memset(buf, 0, (size_t)rfs_map_memo_entries(m) * sizeof(buf[0]));
+    m->edges = buf;
+    return 0;
+}
+
+uint8_t rfs_map_lattice_edges(const rfs_map_t *m, uint16_t i, uint16_t j)
+{
+    if (i >= m->lw || j >= m->lh) {
+        return 0;
+    }
+    uint16_t *e = m->edges != 0 ? &m->edges[(uint32_t)j * m->lw + i] : 0;
+    if (e != 0 && (*e & RFS_MAP_EDGES_KNOWN) != 0u) {
+        return (uint8_t)*e;
+    }
+    uint32_t bits = 0;
+    for (uint32_t k = 0; k < 8u; k++) {
+        const int32_t ti = (int32_t)i + EDGE_DX[k];
+        const int32_t tj = (int32_t)j + EDGE_DY[k];
+        if (ti >= 0 && tj >= 0 && rfs_map_lattice_legal(m, (uint16_t)ti, (uint16_t)tj) &&
+            rfs_map_lattice_step_legal(m, i, j, EDGE_DX[k], EDGE_DY[k])) {
+            bits |= 1u << k;
+        }
+    }
+    if (e != 0) {
+        *e = (uint16_t)(bits | RFS_MAP_EDGES_KNOWN);
+    }
+    return (uint8_t)bits;
+}
+
 /* Lattice point (i, j)'s legality by its position; remembered in the memo when one is
  * attached. Out of line, as step_by_traversal. */
 __attribute__((noinline)) static bool legal_by_position(const rfs_map_t *m, uint16_t i,

@@ -72,6 +72,7 @@ typedef struct rfs_map {
     uint16_t *memo;        ///< lattice memo (rfs_map_memo_attach()); NULL (init): none
     const uint8_t *wall_dist; ///< cells to the nearest wall cell (rfs_map_wall_dist_attach());
                               ///< NULL (init): none
+    uint16_t *edges;       ///< lattice edge table (rfs_map_edges_attach()); NULL (init): none
 } rfs_map_t;
 
 /// Defaults: 0.25 m clearance, 0.25 m lattice.
@@ -166,6 +167,22 @@ uint32_t rfs_map_memo_entries(const rfs_map_t *m);
 /// every edge of every search). rfs_map_init() detaches it. -1 when buf is NULL or too
 /// small.
 int rfs_map_memo_attach(rfs_map_t *m, uint16_t *buf, uint32_t entries);
+
+/// Bit 8 of an edge table entry: bits 0..7 hold the point's rfs_map_lattice_edges().
+#define RFS_MAP_EDGES_KNOWN 0x100u
+
+/// Legal edges of lattice point (i, j): bit k set when the neighbour towards direction k
+/// ((1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)) is on the
+/// lattice and legal (rfs_map_lattice_legal) and the step to it is legal
+/// (rfs_map_lattice_step_legal). Remembered in the edge table when one is attached.
+uint8_t rfs_map_lattice_edges(const rfs_map_t *m, uint16_t i, uint16_t j);
+
+/// Attach an edge table (rfs_map_memo_entries(m) entries or more, cleared here; it stays
+/// the caller's): rfs_map_lattice_edges() then computes each point's answer once per map,
+/// and the planner reads a point's edges in one load instead of sixteen tests (a host
+/// index, 2 bytes a lattice point). rfs_map_init() detaches it. -1 when buf is NULL or
+/// too small.
+int rfs_map_edges_attach(rfs_map_t *m, uint16_t *buf, uint32_t entries);
 
 /// Bytes of a wall-distance grid for m (rfs_map_wall_dist_attach()): one per cell.
 uint32_t rfs_map_wall_dist_bytes(const rfs_map_t *m);

@@ -104,14 +104,17 @@ typedef struct rings {
 
 /* Scaling and overflow: costs are half lattice steps (straight 2, diagonal 3), below
  * 3 * lw * lh < 2^32 for any lattice the uint16_t sizes allow; only cost mod 4 is stored. */
-static void ring_push(rings_t *r, uint32_t cost, uint32_t v)
+static inline void ring_push(rings_t *r, uint32_t cost, uint32_t v)
 {
     uint32_t b = cost & 3u;
     if (r->st.count[b] == r->cap) {
         r->st.overflow = true;
         return;
     }
-    r->q[b * r->cap + (r->st.head[b] + r->st.count[b]) % r->cap] = v;
+    /* head < cap and count < cap: one wrap at most (no division in the hot loop). */
+    uint32_t at = r->st.head[b] + r->st.count[b];
+    at = at >= r->cap ? at - r->cap : at;
+    r->q[b * r->cap + at] = v;
     r->st.count[b]++;
     if (r->st.count[b] > r->st.peak) {
         r->st.peak = r->st.count[b];
@@ -198,6 +201,43 @@ static bool relax(const rfs_map_t *m, uint8_t *w, bool steps, rings_t *r, uint32
     return true;
 }
 
+/* One edge of relax_edges: the push to v at cost nc (parent direction back, towards
+ * u closed at cost d) unless v is closed or holds nc or less. false on overflow. */
+static inline bool edge_to(uint8_t *w, rings_t *r, uint32_t v, uint32_t d, uint32_t nc,
+                           uint32_t back)
+{
+    const uint8_t wv = w[v];
+    if ((wv & W_CLOSED) ||
+        ((wv & W_OPEN) && nc >= d + ((((wv & W_TMOD) >> W_TMOD_SHIFT) - d) & 3u))) {
+        return true;
+    }
+    w[v] = (uint8_t)(W_OPEN | ((nc & 3u) << W_TMOD_SHIFT) | back);
+    ring_push(r, nc, v);
+    return !r->st.overflow;
+}
+
+/* relax() with the map's edge table (rfs_map_edges_attach): u's legal edges in one load,
+ * the same answers as relax()'s lattice tests (which only skip the tests a closed or
+ * cheaper neighbour makes moot), pushed in the same direction order (DIR_X, DIR_Y). */
+__attribute__((always_inline)) static inline bool relax_edges(const rfs_map_t *m,
+                                                             const uint16_t *edges,
+                                                             uint32_t lw, uint8_t *w,
+                                                             rings_t *r, uint32_t u, uint32_t d)
+{
+    uint32_t e = edges[u];
+    if ((e & RFS_MAP_EDGES_KNOWN) == 0u) {
+        e = rfs_map_lattice_edges(m, (uint16_t)(u % lw), (uint16_t)(u / lw));
+    }
+    return (!(e & 0x01u) || edge_to(w, r, u + 1u, d, d + 2u, 4u)) &&
+           (!(e & 0x02u) || edge_to(w, r, u + lw + 1u, d, d + 3u, 5u)) &&
+           (!(e & 0x04u) || edge_to(w, r, u + lw, d, d + 2u, 6u)) &&
+           (!(e & 0x08u) || edge_to(w, r, u + lw - 1u, d, d + 3u, 7u)) &&
+           (!(e & 0x10u) || edge_to(w, r, u - 1u, d, d + 2u, 0u)) &&
+           (!(e & 0x20u) || edge_to(w, r, u - lw - 1u, d, d + 3u, 1u)) &&
+           (!(e & 0x40u) || edge_to(w, r, u - lw, d, d + 2u, 2u)) &&
+           (!(e & 0x80u) || edge_to(w, r, u - lw + 1u, d, d + 3u, 3u));
+}
+
 /* What search_until stopped at. */
 typedef enum search_end {
     SEARCH_FOUND,    /* the target is closed */
@@ -222,24 +262,28 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
     const rfs_map_t *m = p->map;
     /* The memo's answers are the traversal's (rfs_map_memo_attach). */
     const bool steps = m->step_n != 0 ? !p->exact_edges : m->memo != 0;
+    /* The edge table and lattice width in locals: stores to the work bytes may alias m. */
+    const uint16_t *const edges = steps && !p->exact_edges ? m->edges : 0;
+    const uint32_t lw = m->lw;
     uint32_t d = r.st.cost;
     uint32_t u = r.st.pending; /* closed, neighbours not yet relaxed */
     uint32_t empty_run = 0;
     uint32_t closed = 0;
+    uint32_t peak = 0; /* the rings' peak at the last point closed */
     search_end_t end = SEARCH_EMPTY;
     bool ok = !r.st.overflow;
-    while (ok) {
-        if (u != NO_POINT) {
-            ok = relax(m, w, steps, &r, u, d);
-            u = NO_POINT;
-            continue;
-        }
+    if (ok && u != NO_POINT) {
+        ok = edges ? relax_edges(m, edges, lw, w, &r, u, d) : relax(m, w, steps, &r, u, d);
+        u = NO_POINT;
+    }
+    while (ok && end == SEARCH_EMPTY) {
         if (closed == budget) {
             end = SEARCH_BUDGET;
             break;
         }
         const uint32_t b = d & 3u;
-        if (r.st.count[b] == 0) {
+        uint32_t n = r.st.count[b];
+        if (n == 0u) {
             if (++empty_run == 4u) {
                 break;
             }
@@ -247,22 +291,41 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
             continue;
         }
         empty_run = 0;
-        const uint32_t v = r.q[b * r.cap + r.st.head[b]];
-        r.st.head[b] = (r.st.head[b] + 1u) % r.cap;
-        r.st.count[b]--;
-        const uint8_t wv = w[v];
-        if ((wv & W_CLOSED) || ((wv & W_TMOD) >> W_TMOD_SHIFT) != b) {
-            continue; /* stale entry */
+        /* Drain ring b: relaxing pushes to d + 2 and d + 3 only, never to it, so its head
+         * and count stay local until it is empty or the search stops. */
+        const uint32_t *ring = r.q + b * r.cap;
+        uint32_t head = r.st.head[b];
+        while (n != 0u) {
+            const uint32_t v = ring[head];
+            head = head + 1u == r.cap ? 0u : head + 1u;
+            n--;
+            const uint8_t wv = w[v];
+            if ((wv & W_CLOSED) || ((wv & W_TMOD) >> W_TMOD_SHIFT) != b) {
+                continue; /* stale entry */
+            }
+            w[v] = (uint8_t)((wv & W_DIR) | W_CLOSED);
+            closed++;
+            peak = r.st.peak;
+            if (v == target) {
+                end = SEARCH_FOUND;
+                u = v;
+                break;
+            }
+            ok = edges ? relax_edges(m, edges, lw, w, &r, v, d) : relax(m, w, steps, &r, v, d);
+            if (!ok) {
+                break;
+            }
+            if (closed == budget) {
+                end = SEARCH_BUDGET;
+                break;
+            }
         }
-        w[v] = (uint8_t)((wv & W_DIR) | W_CLOSED);
-        p->expanded++;
-        closed++;
-        p->queue_peak = r.st.peak;
-        u = v;
-        if (v == target) {
-            end = SEARCH_FOUND;
-            break;
-        }
+        r.st.head[b] = head;
+        r.st.count[b] = n;
+    }
+    if (closed != 0u) {
+        p->expanded += closed;
+        p->queue_peak = peak;
     }
     r.st.cost = d;
     r.st.pending = end == SEARCH_EMPTY ? NO_POINT : u;
@@ -516,6 +579,32 @@ void rfs_plan_tree_begin(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0)
     p->tree = 1;
     p->tree_done = false;
     p->tree_sliced = false;
+    p->tree_owed = 0;
+}
+
+void rfs_plan_tree_defer(rfs_plan_t *p, bool on)
+{
+    p->tree_defer = on;
+}
+
+/* Pay the deferred grows' debt until lattice point `idx` is closed (rfs_plan_tree_defer):
+ * the search the grows would have run, stopped early at idx. A grow that closes fewer
+ * points than its budget finds the tree done, as the search stopping short of the debt
+ * does (all the grows' budgets, S, exceed the points the root reaches, R, in both). When
+ * idx is the debt's last point, its neighbours are relaxed as that grow would have (an
+ * overflow there ends the search). */
+static void tree_settle(rfs_plan_t *p, uint32_t idx)
+{
+    if (p->tree != 2 || p->tree_done || p->tree_owed == 0u || (p->work[idx] & W_CLOSED)) {
+        return;
+    }
+    const uint32_t before = p->expanded;
+    search_end_t end = search_until(p, idx, p->tree_owed);
+    p->tree_owed -= p->expanded - before;
+    if (end == SEARCH_FOUND && p->tree_owed == 0u) {
+        end = search_until(p, NO_POINT, 0u);
+    }
+    p->tree_done = end == SEARCH_EMPTY;
 }
 
 static void set_dir(uint8_t *w, uint32_t u, uint32_t k)
@@ -639,7 +728,11 @@ bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget)
     tree_seed(p);
     p->tree_sliced = true;
     if (p->tree == 2 && !p->tree_done) {
-        p->tree_done = search_until(p, NO_POINT, budget) == SEARCH_EMPTY;
+        if (p->tree_defer) {
+            p->tree_owed = budget > UINT32_MAX - p->tree_owed ? UINT32_MAX : p->tree_owed + budget;
+        } else {
+            p->tree_done = search_until(p, NO_POINT, budget) == SEARCH_EMPTY;
+        }
     }
     return p->tree != 2 || p->tree_done;
 }
@@ -647,8 +740,11 @@ bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget)
 bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t max_hop)
 {
     uint32_t idx;
-    if (p->tree != 2 || !connect(p->map, x0, y0, true, &idx) ||
-        !(p->work[idx] & W_CLOSED)) {
+    if (p->tree != 2 || !connect(p->map, x0, y0, true, &idx)) {
+        return false;
+    }
+    tree_settle(p, idx);
+    if (!(p->work[idx] & W_CLOSED)) {
         return false;
     }
     uint64_t straight = 0;
@@ -695,6 +791,7 @@ static int tree_goal(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, uint32_t *g_idx)
         component_bit(p->component, p->tree_root) != component_bit(p->component, *g_idx)) {
         return -1; /* different components: the search cannot succeed */
     }
+    tree_settle(p, *g_idx);
     if (!(p->work[*g_idx] & W_CLOSED)) {
         if (p->tree_sliced) {
             p->tree_more = p->tree_more || !p->tree_done;

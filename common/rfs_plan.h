@@ -70,6 +70,8 @@ typedef struct rfs_plan {
                             ///< for a point it has not closed yet: grow it, ask again
     uint32_t tree_from;     ///< the lattice point paths leave tree_x, tree_y by: the root,
                             ///< or the join point of a start moved (rfs_plan_tree_move)
+    bool tree_defer;        ///< false (init); true (rfs_plan_tree_defer): grows only owe
+    uint32_t tree_owed;     ///< points the tree's grows granted and no search closed yet
 } rfs_plan_t;
 
 /// A planned path: waypoints in order, the last one the goal itself.
@@ -139,6 +141,15 @@ bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget);
 /// from a tree rooted at (x0, y0), before string pulling. false (the tree unchanged)
 /// otherwise.
 bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t max_hop);
+
+/// Defer the searches of rfs_plan_tree_grow (a host option: the simulator has no period
+/// budget to keep). Each grow then only adds its budget to the points owed; a plan or a
+/// move asking for a point not closed yet first continues the search until that point
+/// is closed, the debt is paid or the tree is done. The tree closes points in one order
+/// however its search is sliced, so every answer is the undeferred one; only `expanded`
+/// counts the points where they are closed, and a grow's result is true only once a
+/// plan found the tree done.
+void rfs_plan_tree_defer(rfs_plan_t *p, bool on);
 
 /// Tell the planner which lattice points are known to be connected: `bits` (NULL: none)
 /// holds one bit per lattice point and must be a union of whole components of the lattice

@@ -182,6 +182,14 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
         hs_sim_env_close(e);
         return -1;
     }
+    /* Each lattice point's legal edges once per map: a search reads them in one load. */
+    e->lattice_edges = malloc((size_t)ne * sizeof(e->lattice_edges[0]));
+    if (e->lattice_edges == NULL ||
+        rfs_map_edges_attach(&e->core.map, e->lattice_edges, ne) != 0) {
+        snprintf(err, errlen, "%s: map: out of memory", sc->path);
+        hs_sim_env_close(e);
+        return -1;
+    }
     /* Every run's world from the same merged walls. */
     if (hs_box2d_walls_make(&e->map, &e->walls) != 0) {
         snprintf(err, errlen, "%s: map: out of memory", sc->path);
@@ -235,6 +243,8 @@ void hs_sim_env_close(hs_sim_env_t *e)
     lx_core_map_free(&e->core);
     free(e->lattice_memo);
     e->lattice_memo = NULL;
+    free(e->lattice_edges);
+    e->lattice_edges = NULL;
     free(e->wall_dist);
     e->wall_dist = NULL;
     hs_box2d_walls_free(&e->walls);

@@ -36,6 +36,7 @@ typedef struct hs_sim_env {
     double x0, y0, x1, y1;     ///< the map's extent, metres
     int8_t *wall_cache[HS_SCN_MAX_SOURCES]; ///< wall counts per receiver cell, shared by runs
     uint16_t *lattice_memo;    ///< the core map's lattice memo (rfs_map_memo_attach), shared by runs
+    uint16_t *lattice_edges;   ///< the core map's edge table (rfs_map_edges_attach), shared by runs
     uint8_t *wall_dist;        ///< the core map's wall distances (rfs_map_wall_dist_attach), or NULL
     hs_box2d_walls_t walls;    ///< the map's merged wall rectangles, shared by runs' worlds
     uint64_t placement;        ///< the drawn placement the start and source are (hs_place.h;

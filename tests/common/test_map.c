@@ -691,6 +691,67 @@ static void test_lattice(void **state)
     assert_false(rfs_map_lattice_legal(&m, (uint16_t)lw, 0));
 }
 
+/* rfs_map_lattice_edges against the brute-force geometry: bit k set exactly when the
+ * neighbour towards k is on the lattice, its point's cell legal and the segment to it
+ * legal; the same with an edge table attached (filled, then read back), with the lattice
+ * memo, with step patterns (0.0625 m and 0.125 m cells) and without (0.1 m). */
+static void test_lattice_edges(void **state)
+{
+    (void)state;
+    static const int dx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
+    static const int dy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+    const rfs_q16_t resolutions[3] = {RFS_Q16_FRAC(1, 10), RFS_Q16_FRAC(1, 16), RFS_Q16_FRAC(1, 8)};
+    static uint16_t table[W * H];
+    static uint16_t memo[W * H];
+    int set = 0, clear = 0;
+    for (int k = 0; k < 3; k++) {
+        make_map(&fx, 41u + (uint32_t)k, resolutions[k], RFS_Q16_FRAC(1, 4));
+        fill_cache(&fx);
+        const int lw = fx.m.lw, lh = fx.m.lh;
+        const int64_t g = fx.m.cfg.grid;
+        assert_true(lw * lh <= W * H);
+        assert_int_equal(fx.m.step_n, k == 0 ? 0 : 4 / k);
+        assert_int_equal(rfs_map_edges_attach(&fx.m, NULL, W * H), -1);
+        assert_int_equal(rfs_map_edges_attach(&fx.m, table, (uint32_t)(lw * lh - 1)), -1);
+        for (int pass = 0; pass < 4; pass++) {
+            if (pass == 1) {
+                assert_int_equal(rfs_map_edges_attach(&fx.m, table, W * H), 0);
+            } else if (pass == 3) {
+                assert_int_equal(rfs_map_memo_attach(&fx.m, memo, W * H), 0);
+                assert_int_equal(rfs_map_edges_attach(&fx.m, table, W * H), 0);
+            }
+            for (int j = 0; j < lh; j++) {
+                for (int i = 0; i < lw; i++) {
+                    const rfs_q16_t x0 = (rfs_q16_t)(fx.ox + g / 2 + i * g);
+                    const rfs_q16_t y0 = (rfs_q16_t)(fx.oy + g / 2 + j * g);
+                    int want = 0;
+                    for (int d = 0; d < 8; d++) {
+                        const int ti = i + dx[d], tj = j + dy[d];
+                        if (ti < 0 || tj < 0 || ti >= lw || tj >= lh) {
+                            continue;
+                        }
+                        const int64_t ux = g / 2 + ti * g, uy = g / 2 + tj * g;
+                        const rfs_q16_t x1 = (rfs_q16_t)(fx.ox + ux), y1 = (rfs_q16_t)(fx.oy + uy);
+                        if (legal_cache[uy / fx.res][ux / fx.res] &&
+                            ref_segment_legal(&fx, x0, y0, x1, y1)) {
+                            want |= 1 << d;
+                        }
+                    }
+                    assert_int_equal(rfs_map_lattice_edges(&fx.m, (uint16_t)i, (uint16_t)j), want);
+                    if (pass == 0) {
+                        set += __builtin_popcount((unsigned)want);
+                        clear += 8 - __builtin_popcount((unsigned)want);
+                    }
+                }
+            }
+        }
+        assert_int_equal(rfs_map_lattice_edges(&fx.m, (uint16_t)lw, 0), 0);
+        assert_int_equal(rfs_map_lattice_edges(&fx.m, 0, (uint16_t)lh), 0);
+    }
+    print_message("lattice edges: %d legal, %d not\n", set, clear);
+    assert_true(set > 1000 && clear > 500);
+}
+
 /* init rejects bad configurations. */
 static void test_init_rejects(void **state)
 {
@@ -728,6 +789,7 @@ int main(void)
         cmocka_unit_test(test_walls_crossed_blocks),
         cmocka_unit_test(test_walls_crossed_wall_dist),
         cmocka_unit_test(test_lattice),
+        cmocka_unit_test(test_lattice_edges),
         cmocka_unit_test(test_init_rejects),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1171,6 +1171,193 @@ static void test_tree_hop(void **state)
     assert_true(moved >= 150 && off_root >= 100 && refused >= 40 && paths >= 800);
 }
 
+/* The map's edge table (rfs_map_edges_attach, with the lattice memo as the simulator
+ * attaches both) against exact_edges, which tests positions and rfs_map_segment_legal
+ * for every edge: on the five kinds of map, plans and trees give the same paths bit for
+ * bit after the same number of expansions, reachability as the reference's octile
+ * Dijkstra, and a queue too small overflows both alike. */
+static void test_edge_table(void **state)
+{
+    (void)state;
+    static uint8_t work_e[LMAX];
+    static uint32_t queue_e[1024];
+    static uint16_t memo[LMAX];
+    static uint16_t table[LMAX];
+    int reached = 0, unreached = 0;
+    for (int kind = 0; kind <= 4; kind++) {
+        build_kind(kind, 3);
+        const int lw = wd.m.lw, lh = wd.m.lh;
+        const double g = (double)wd.m.cfg.grid;
+        assert_int_equal(rfs_map_memo_attach(&wd.m, memo, LMAX), 0);
+        assert_int_equal(rfs_map_edges_attach(&wd.m, table, LMAX), 0);
+        rfs_plan_t f, e;
+        assert_int_equal(rfs_plan_init(&f, &wd.m, work, sizeof(work), queue, 1024), 0);
+        assert_int_equal(rfs_plan_init(&e, &wd.m, work_e, sizeof(work_e), queue_e, 1024), 0);
+        e.exact_edges = true;
+        uint32_t rs = 901u + (uint32_t)kind;
+        for (int k = 0; k < 12; k++) {
+            int si, sj;
+            random_legal(&rs, lw, lh, &si, &sj);
+            ref_octile(lw, lh, si, sj);
+            const rfs_q16_t x0 = (rfs_q16_t)(g / 2 + si * g), y0 = (rfs_q16_t)(g / 2 + sj * g);
+            rfs_plan_tree_begin(&f, x0, y0);
+            rfs_plan_tree_begin(&e, x0, y0);
+            for (int q = 0; q < 4; q++) {
+                int gi, gj;
+                random_legal(&rs, lw, lh, &gi, &gj);
+                const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi * g), y1 = (rfs_q16_t)(g / 2 + gj * g);
+                rfs_path_t pf, pe;
+                const bool ok = rfs_plan_tree_path(&f, x1, y1, &pf);
+                assert_int_equal(ok, rfs_plan_tree_path(&e, x1, y1, &pe));
+                assert_int_equal(f.expanded, e.expanded);
+                assert_int_equal(ok, oct_ref[gj * lw + gi] < INT32_MAX || ref_seg(x0, y0, x1, y1));
+                if (ok) {
+                    assert_same_path(&pf, &pe);
+                }
+            }
+            int gi, gj;
+            random_legal(&rs, lw, lh, &gi, &gj);
+            const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi * g), y1 = (rfs_q16_t)(g / 2 + gj * g);
+            rfs_path_t pf, pe;
+            const bool ok = rfs_plan_path(&f, x0, y0, x1, y1, &pf);
+            assert_int_equal(ok, rfs_plan_path(&e, x0, y0, x1, y1, &pe));
+            assert_int_equal(f.expanded, e.expanded);
+            assert_int_equal(ok, oct_ref[gj * lw + gi] < INT32_MAX || ref_seg(x0, y0, x1, y1));
+            reached += ok;
+            unreached += !ok;
+            if (ok) {
+                assert_same_path(&pf, &pe);
+            }
+        }
+        if (kind == 1) { /* into the closed room from outside: both fail */
+            rfs_path_t pf, pe;
+            const rfs_q16_t m1 = RFS_Q16_INT(1);
+            assert_false(rfs_plan_path(&f, 2 * m1, 2 * m1, 9 * m1, 3 * m1, &pf));
+            assert_false(rfs_plan_path(&e, 2 * m1, 2 * m1, 9 * m1, 3 * m1, &pe));
+            assert_int_equal(f.expanded, e.expanded);
+            unreached++;
+        }
+        if (kind == 4) { /* round the wall: an 8-entry queue (two a ring) overflows on both */
+            rfs_path_t pf, pe;
+            const rfs_q16_t m1 = RFS_Q16_INT(1);
+            assert_true(rfs_plan_path(&f, 2 * m1, 2 * m1, 2 * m1, 6 * m1, &pf));
+            assert_int_equal(rfs_plan_init(&f, &wd.m, work, sizeof(work), queue, 8), 0);
+            assert_int_equal(rfs_plan_init(&e, &wd.m, work_e, sizeof(work_e), queue_e, 8), 0);
+            e.exact_edges = true;
+            assert_false(rfs_plan_path(&f, 2 * m1, 2 * m1, 2 * m1, 6 * m1, &pf));
+            assert_false(rfs_plan_path(&e, 2 * m1, 2 * m1, 2 * m1, 6 * m1, &pe));
+            assert_int_equal(f.expanded, e.expanded);
+        }
+    }
+    print_message("edge table: %d plans reached, %d not\n", reached, unreached);
+    assert_true(reached >= 40 && unreached >= 1);
+}
+
+/* One step of test_tree_deferred: the same goal on the tree grown at once (t) and the
+ * deferred one (d): path, length and tree_more alike. */
+static void check_deferred_goal(rfs_plan_t *t, rfs_plan_t *d, rfs_q16_t x1, rfs_q16_t y1)
+{
+    rfs_path_t pt, pd;
+    t->tree_more = d->tree_more = false;
+    const bool ok = rfs_plan_tree_path(t, x1, y1, &pt);
+    assert_int_equal(ok, rfs_plan_tree_path(d, x1, y1, &pd));
+    assert_int_equal(t->tree_more, d->tree_more);
+    if (ok) {
+        assert_same_path(&pt, &pd);
+    }
+    rfs_q16_t lt = -1, ld = -2;
+    t->tree_more = d->tree_more = false;
+    assert_int_equal(rfs_plan_tree_length(t, x1, y1, &lt), rfs_plan_tree_length(d, x1, y1, &ld));
+    assert_int_equal(lt, ld);
+    assert_int_equal(t->tree_more, d->tree_more);
+}
+
+/* rfs_plan_tree_defer: grows of random budgets (0 to 300 points) on a tree searched at
+ * once and on a deferred one, each followed by plans, lengths and a move near the root:
+ * the same answers and tree_more flags all along, on the five kinds of map; the deferred
+ * grows themselves expand nothing. Then the edge of "done": grows summing to exactly the
+ * points the root reaches (the reference's count) leave both not done (a goal in the
+ * closed room asks for more), one more point makes both done. */
+static void test_tree_deferred(void **state)
+{
+    (void)state;
+    static uint8_t work_d[LMAX];
+    static uint32_t queue_d[1024];
+    const uint32_t budgets[5] = {0, 1, 5, 37, 300};
+    int more = 0, moved = 0, grows = 0;
+    for (int kind = 0; kind <= 4; kind++) {
+        build_kind(kind, 4);
+        const int lw = wd.m.lw, lh = wd.m.lh;
+        const double g = (double)wd.m.cfg.grid;
+        rfs_plan_t t, d;
+        assert_int_equal(rfs_plan_init(&t, &wd.m, work, sizeof(work), queue, 1024), 0);
+        assert_int_equal(rfs_plan_init(&d, &wd.m, work_d, sizeof(work_d), queue_d, 1024), 0);
+        rfs_plan_tree_defer(&d, true);
+        uint32_t rs = 313u + (uint32_t)kind;
+        for (int k = 0; k < 3; k++) {
+            int si, sj;
+            random_legal(&rs, lw, lh, &si, &sj);
+            const rfs_q16_t x0 = (rfs_q16_t)(g / 2 + si * g), y0 = (rfs_q16_t)(g / 2 + sj * g);
+            rfs_plan_tree_begin(&t, x0, y0);
+            rfs_plan_tree_begin(&d, x0, y0);
+            int after = 0;
+            for (int slice = 0; after < 3; slice++) {
+                assert_true(slice < 5000);
+                const uint32_t b = budgets[lcg(&rs) % 5u];
+                after += rfs_plan_tree_grow(&t, b);
+                (void)rfs_plan_tree_grow(&d, b);
+                assert_int_equal(d.expanded, 0);
+                grows++;
+                for (int q = 0; q < 2; q++) {
+                    int gi, gj;
+                    random_legal(&rs, lw, lh, &gi, &gj);
+                    check_deferred_goal(&t, &d, (rfs_q16_t)(g / 2 + gi * g), (rfs_q16_t)(g / 2 + gj * g));
+                    more += t.tree_more;
+                }
+                if (lcg(&rs) % 8u == 0u) {
+                    const rfs_q16_t mx = x0 + (rfs_q16_t)(lcg(&rs) % 20000u) - 10000;
+                    const rfs_q16_t my = y0 + (rfs_q16_t)(lcg(&rs) % 20000u) - 10000;
+                    const bool ok = rfs_plan_tree_move(&t, mx, my, RFS_Q16_ONE);
+                    assert_int_equal(ok, rfs_plan_tree_move(&d, mx, my, RFS_Q16_ONE));
+                    assert_int_equal(t.tree_from, d.tree_from);
+                    moved += ok;
+                }
+            }
+        }
+    }
+    /* The closed room (kind 1): a root outside reaches `upto` points, none inside. */
+    build_kind(1, 4);
+    const int lw = wd.m.lw, lh = wd.m.lh;
+    const rfs_q16_t m1 = RFS_Q16_INT(1);
+    uint16_t si, sj;
+    rfs_map_lattice_nearest(&wd.m, 2 * m1, 2 * m1, &si, &sj);
+    ref_octile(lw, lh, si, sj);
+    int below, upto;
+    oct_count(lw * lh, INT32_MAX, &below, &upto);
+    rfs_plan_t t, d;
+    assert_int_equal(rfs_plan_init(&t, &wd.m, work, sizeof(work), queue, 1024), 0);
+    assert_int_equal(rfs_plan_init(&d, &wd.m, work_d, sizeof(work_d), queue_d, 1024), 0);
+    rfs_plan_tree_defer(&d, true);
+    rfs_q16_t x0, y0;
+    rfs_map_lattice_point(&wd.m, si, sj, &x0, &y0);
+    rfs_plan_tree_begin(&t, x0, y0);
+    rfs_plan_tree_begin(&d, x0, y0);
+    assert_false(rfs_plan_tree_grow(&t, (uint32_t)upto - 100u));
+    assert_false(rfs_plan_tree_grow(&d, (uint32_t)upto - 100u));
+    assert_false(rfs_plan_tree_grow(&t, 100u));
+    assert_false(rfs_plan_tree_grow(&d, 100u));
+    check_deferred_goal(&t, &d, 9 * m1, 3 * m1);
+    assert_true(t.tree_more);
+    assert_false(rfs_plan_tree_grow(&t, 1u) == false);
+    (void)rfs_plan_tree_grow(&d, 1u);
+    check_deferred_goal(&t, &d, 9 * m1, 3 * m1);
+    assert_false(t.tree_more);
+    assert_true(rfs_plan_tree_grow(&d, 0u)); /* the plan found it done */
+    print_message("deferred trees: %d grows, %d plans asked for more, %d moves\n", grows, more,
+                  moved);
+    assert_true(grows > 250 && more > 50 && moved > 10);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1186,6 +1373,8 @@ int main(void)
         cmocka_unit_test(test_tree_sliced),
         cmocka_unit_test(test_tree_length),
         cmocka_unit_test(test_tree_hop),
+        cmocka_unit_test(test_edge_table),
+        cmocka_unit_test(test_tree_deferred),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -26,6 +26,7 @@ rfs_fields_cfg_t rfs_fields_cfg_default(void)
 {
     rfs_fields_cfg_t c;
     c.pathloss = rfs_pathloss_cfg_default();
+    c.pathloss.p0_max = INT32_MAX; /* a node's f, not a source: no ceiling */
     /* Tuned on seeds 1..30 of scenarios/bridge.yaml (docs/STRATEGIES.md, "Bridging"): the
      * true f changes by a wall's 5 dB across the edge of a doorway's line of sight, so a
      * cell and kernel much larger than the lattice blur the best point away. */

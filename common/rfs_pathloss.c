@@ -64,9 +64,10 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
      * runs behind docs/STRATEGIES.md, estimates within 5 m of the source had P0 >= -45 dBm
      * in all but 1 of 3,479 fits, estimates farther away had it below in 1,176 of 5,553. */
     c.p0_min = RFS_Q16_INT(-45);
-    /* No ceiling: -10 dBm (30 dBm EIRP) did not help held-out placements (docs/PATHLOSS.md,
-     * "The P0 floor"). */
-    c.p0_max = INT32_MAX;
+    /* 30 dBm EIRP (the most any 2.4 GHz rule allows indoors) less those 40 dB: a fit that
+     * explains a flat stretch of data by a source tens of metres off needs P0 far above
+     * it (docs/PATHLOSS.md, "The P0 floor"). */
+    c.p0_max = RFS_Q16_INT(-10);
     c.hold_k = RFS_Q16_INT(6);
     /* The spread region's and hold_k's likelihood-ratio reading of the surface, untempered
      * (docs/PATHLOSS.md, "Epsilon steps that draw the source"). */

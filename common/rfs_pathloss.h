@@ -113,7 +113,7 @@ typedef struct rfs_pathloss_cfg {
                             ///< INT32_MIN: no floor). A candidate whose fit needs a weaker
                             ///< P0 adds total weight x Huber(p0_min - P0) to its loss
     rfs_q16_t p0_max;       ///< target units Q16.16: strongest plausible signal at 1 m
-                            ///< (INT32_MAX: no ceiling, the default). A candidate whose fit
+                            ///< (-10 dBm; INT32_MAX: no ceiling). A candidate whose fit
                             ///< needs a stronger P0 adds total weight x Huber(P0 - p0_max)
     rfs_q16_t footprint;    ///< metres Q16.16: a bin's wall counts start this far either
                             ///< side of its cell's centre, along x and y (0.25 m; 0: from

@@ -54,6 +54,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.local_r = 0;                          /* stand at the estimate */
     c.leg_max = 0;                          /* and walk the whole leg to it */
     c.silence_floor = INT32_MIN;            /* silence adds no sample */
+    c.recheck_silent = false;               /* and a silent check passes */
     c.settle_dist = 0;                      /* epsilon anneals to eps_floor, never 0 */
     c.settle_orbit = 0;
     c.settle_end = 0;
@@ -120,6 +121,7 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
     cfg->refute_r = on ? cfg->step : 0;
     /* Radiotap receivers report down to -100 dBm (docs/STRATEGIES.md, "Stalls"). */
     cfg->silence_floor = on ? RFS_Q16_INT(-100) : INT32_MIN;
+    cfg->recheck_silent = on; /* docs/STRATEGIES.md, "Stalls" */
     /* Sweep round an estimate already stood at (docs/STRATEGIES.md, "Stalls"). */
     cfg->local_r = on ? 4 * cfg->step : 0;
 }
@@ -219,6 +221,15 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
     return 0;
 }
 
+/* silence_floor: a source heard before, silent for a window at t_us, the receiver up. */
+static bool silent(const rfs_seek_t *s, int64_t t_us)
+{
+    return s->cfg.silence_floor != INT32_MIN && s->target == &rfs_target_rssi && s->have_meas &&
+           s->have_rx && !apart(t_us, s->last_rx_us, s->cfg.rssi_timeout_us) &&
+           t_us > s->last_meas_us &&
+           apart(t_us, s->last_meas_us, (int64_t)s->cfg.rssi.window_us);
+}
+
 bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
 {
     if (s->have_pose && pose->t_us <= s->pose.t_us) {
@@ -229,11 +240,7 @@ bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng)
     if (s->src != 0) {
         rfs_seek_src_on_pose(s, pose, rng);
     }
-    /* silence_floor: a source heard before, silent for a window, the receiver up. */
-    if (s->cfg.silence_floor != INT32_MIN && s->target == &rfs_target_rssi && s->have_meas &&
-        s->have_rx && !apart(pose->t_us, s->last_rx_us, s->cfg.rssi_timeout_us) &&
-        pose->t_us > s->last_meas_us &&
-        apart(pose->t_us, s->last_meas_us, (int64_t)s->cfg.rssi.window_us)) {
+    if (silent(s, pose->t_us)) {
         rfs_store_add_value(&s->store, pose->t_us, s->cfg.silence_floor, rng);
     }
     s->pose = *pose;
@@ -379,11 +386,19 @@ static bool recheck_fails(rfs_seek_t *s, int64_t now_us)
     }
     count_travel(s);
     rfs_q16_t mean, pred;
-    if (!rfs_seek_src_mean(s, now_us, &mean) ||
-        !s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &pred)) {
+    const bool have_mean = rfs_seek_src_mean(s, now_us, &mean);
+    if (!s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &pred)) {
         return false;
     }
-    return rfs_seek_recheck_miss(&s->cfg, &s->miss_ms, rfs_q16_abs(rfs_q16_sub(mean, pred)));
+    if (have_mean) {
+        return rfs_seek_recheck_miss(&s->cfg, &s->miss_ms, rfs_q16_abs(rfs_q16_sub(mean, pred)));
+    }
+    /* recheck_silent: silence says the signal is below the floor, not how far below. */
+    if (!s->cfg.recheck_silent || !silent(s, now_us)) {
+        return false;
+    }
+    rfs_q16_t above = rfs_q16_sub(pred, s->cfg.silence_floor);
+    return rfs_seek_recheck_miss(&s->cfg, &s->miss_ms, above > 0 ? above : 0);
 }
 
 /* plan_budget: begin the search tree of the next decision where it will be made, to be

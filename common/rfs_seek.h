@@ -120,6 +120,11 @@ typedef struct rfs_seek_cfg {
                                 ///< source is below the receiver's floor (a dead zone)
                                 ///< instead of never seeing the place, dBm Q16.16
                                 ///< (INT32_MIN: none, the paper's)
+    bool recheck_silent;        ///< with recheck_dist and silence_floor: an in-leg check
+                                ///< in a silent window (as for silence_floor) takes the
+                                ///< floor as its mean and misses by how far the prediction
+                                ///< lies above it: a leg planned from a dead zone is not
+                                ///< driven blind
     rfs_q16_t settle_dist;      ///< after this much travel every choice is greedy (epsilon
                                 ///< 0): the robot goes to the model's best point and stays
                                 ///< there, metres Q16.16 (0: never, the paper's)
@@ -344,7 +349,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 /// Choose a strategy with its named preset: sets cfg->strategy and the improvement
 /// fields, on for RFS_SEEK_META_PATH (recheck_dist = cfg->step, eps_by_travel,
 /// recheck_adapt, eps_geodesic, eps_sample, refute_r = cfg->step, silence_floor = -100
-/// dBm, local_r = 4 cfg->step), the paper's (0, false) for every other strategy.
+/// dBm, recheck_silent, local_r = 4 cfg->step), the paper's (0, false) for every other strategy.
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 
 /// The settings for a model fitted per source (rfs_fields.h; docs/STRATEGIES.md,

@@ -200,6 +200,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_refute_m = -1.0;
     sc->seek_silence_floor = -1;
     sc->seek_refute_reached = -1;
+    sc->seek_recheck_silent = -1;
     sc->seek_local_m = -1.0;
     sc->seek_leg_m = -1.0;
     sc->seek_eps_by_travel = -1;
@@ -425,7 +426,8 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
         static const char *const k[] = {"recheck_m", "eps_by_travel", "eps_rate",
                                         "eps_geodesic", "recheck_adapt", "p0_min_dbm",
                                         "eps_sample", "refute_m", "silence_floor",
-                                        "refute_reached", "local_m", "leg_m", NULL};
+                                        "refute_reached", "local_m", "leg_m", "recheck_silent",
+                                        NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "refute_m", 0, 100, &sc->seek_refute_m) ||
@@ -438,7 +440,8 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             preset_bool(p, n, "recheck_adapt", &sc->seek_recheck_adapt) ||
             preset_bool(p, n, "eps_sample", &sc->seek_eps_sample) ||
             preset_bool(p, n, "silence_floor", &sc->seek_silence_floor) ||
-            preset_bool(p, n, "refute_reached", &sc->seek_refute_reached)) {
+            preset_bool(p, n, "refute_reached", &sc->seek_refute_reached) ||
+            preset_bool(p, n, "recheck_silent", &sc->seek_recheck_silent)) {
             return -1;
         }
     }

@@ -10,6 +10,7 @@
  *   seek: {recheck_m: 1.0, eps_by_travel: true, eps_rate: 0.162, eps_geodesic: true,
  *                                  #       recheck_adapt: true, eps_sample: true, refute_m: 1,
  *                                  #       silence_floor: true, refute_reached: false,
+ *                                  #       recheck_silent: true,
  *                                  #       p0_min_dbm: -32, local_m: 0, leg_m: 0}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
@@ -80,6 +81,7 @@ typedef struct hs_scenario {
                                   ///< strategy's preset)
     int seek_silence_floor;       ///< seek.silence_floor: 0 / 1, floor samples (-100 dBm) in
                                   ///< silence (rfs_seek_cfg_t; -1 = the strategy's preset)
+    int seek_recheck_silent;      ///< seek.recheck_silent: 0 / 1 (-1 = the strategy's preset)
     int seek_eps_by_travel;       ///< seek.eps_by_travel: 0 / 1 (-1 = the strategy's preset)
     int seek_eps_geodesic;        ///< seek.eps_geodesic: 0 / 1 (-1 = the strategy's preset)
     int seek_recheck_adapt;       ///< seek.recheck_adapt: 0 / 1 (-1 = the strategy's preset)

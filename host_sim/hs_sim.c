@@ -1031,6 +1031,9 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     if (e->sc.seek_refute_reached >= 0) {
         cc.seek.refute_reached = e->sc.seek_refute_reached != 0;
     }
+    if (e->sc.seek_recheck_silent >= 0) {
+        cc.seek.recheck_silent = e->sc.seek_recheck_silent != 0;
+    }
     cc.seed = seed ^ 0x5A17C0FFEE000003ull;
     hs_ctrl_t ctrl;
     char cerr[256];

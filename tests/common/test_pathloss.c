@@ -486,6 +486,27 @@ static void p0_ceiling_same_as_reference(void **state)
     assert_true(on.p0 / 65536.0 < off.p0 / 65536.0 - 2.0);
 }
 
+/* The default ceiling, -10 dBm (docs/PATHLOSS.md, "The P0 floor"): a node 15 dB above it
+ * (P0 +5 dBm) is fitted as the double reference with the same ceiling fits it, with P0
+ * pulled below the truth; without the ceiling the fit recovers the truth's P0. */
+static void p0_default_ceiling_same_as_reference(void **state)
+{
+    fixture_t *f = *state;
+    truth_t strong = k_office;
+    strong.p0 = 5.0;
+    make_samples(f->s, NS, &f->map, &strong, 11);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+    assert_int_equal(c.p0_max, RFS_Q16_INT(-10));
+    expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
+    rfs_pathloss_est_t on;
+    assert_true(rfs_pathloss_estimate(&f->pl, &on));
+    c.p0_max = INT32_MAX;
+    rfs_pathloss_est_t off = fit_with(f, &c, NS, &f->map, 0, NULL);
+    assert_true(fabs(off.p0 / 65536.0 - strong.p0) < 1.5);
+    assert_true(on.p0 / 65536.0 < off.p0 / 65536.0 - 2.0);
+}
+
 /* footprint 0 (each bin's walls counted from its cell's centre alone, the model before
  * the footprint) equals the double reference too, and differs from the default: the
  * test's office has bins whose footprint straddles a wall's end. */
@@ -1051,6 +1072,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(footprint_off_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_floor_off_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_ceiling_same_as_reference, setup, teardown),
+        cmocka_unit_test_setup_teardown(p0_default_ceiling_same_as_reference, setup, teardown),
         cmocka_unit_test(registered_as_pathloss),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -470,6 +470,7 @@ static void test_meta_path_preset(void **state)
     assert_true(cfg.eps_sample);
     assert_int_equal(cfg.refute_r, cfg.step);
     assert_int_equal(cfg.silence_floor, RFS_Q16_INT(-100));
+    assert_true(cfg.recheck_silent);
     rfs_seek_cfg_t per = cfg;
     rfs_seek_cfg_per_source(&per); /* a fit per node: its own floor, no source to rule out */
     assert_int_equal(per.refute_r, 0);
@@ -481,6 +482,7 @@ static void test_meta_path_preset(void **state)
     assert_false(cfg.eps_sample);
     assert_int_equal(cfg.refute_r, 0);
     assert_int_equal(cfg.silence_floor, INT32_MIN);
+    assert_false(cfg.recheck_silent);
     cfg.refute_r = -1;
     assert_int_equal(init_result(cfg), -1);
     cfg.refute_r = 0;

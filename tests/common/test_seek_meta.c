@@ -644,6 +644,93 @@ static void test_leg_max_cuts_the_leg(void **state)
     world_free(&t);
 }
 
+/* recheck_silent (docs/STRATEGIES.md, "Stalls"): the estimate 12 m off, (16.3, 5.2), the
+ * model predicting `level` dBm everywhere. The robot hears -60 dBm until the greedy leg
+ * to the estimate begins, then nothing, the receiver reporting itself up every period;
+ * it walks the leg at 1 m/s. With the option, the first check (every metre) more than
+ * a window (1 s) into the silence takes the -100 dBm floor as its mean: a -60 dBm
+ * prediction misses by 40 dB, above both 3 dB and the running RMS (40 / sqrt(8) dB), and
+ * the leg is abandoned (prev = running) 2 m along; a -110 dBm prediction (below the
+ * floor) passes, as does every check without the option: the leg ends reached. Returns
+ * the next decision's prev and where the robot stood. */
+typedef struct level_model {
+    fixed_model_t f; /* first: the fixed model's reset, fit and argmax serve */
+    rfs_q16_t level;
+} level_model_t;
+
+static bool level_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *value)
+{
+    const level_model_t *m = self;
+    (void)x;
+    (void)y;
+    *value = m->level;
+    return m->f.valid;
+}
+
+static rfs_drive_status_t silent_leg(bool on, double level, double *at_x)
+{
+    static const rfs_model_ops_t ops = { .name = "level", .reset = fixed_reset,
+                                         .fit = fixed_fit, .predict = level_predict,
+                                         .argmax = fixed_argmax };
+    world_t t;
+    rfs_seek_cfg_t cfg;
+    level_model_t m;
+    local_world(&t, &cfg, &m.f);
+    cfg.recheck_silent = on;
+    m.f.mx = Q(16.3);
+    m.level = Q(level);
+    rfs_model_t model = { &ops, &m };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    double x = 4.0, y = LOCAL_EY, gx = x, gy = y;
+    int decisions = 0;
+    bool silence = false;
+    rfs_seek_out_t out;
+    for (int64_t now = 10000; now < 60000000; now += 10000) {
+        if (!silence) {
+            assert_true(rfs_seek_on_rssi(&t.seek, 0, now, -60, &t.rng));
+        }
+        if (now % 50000 != 0) {
+            continue;
+        }
+        double dx = gx - x, dy = gy - y, d = hypot(dx, dy);
+        x = d <= 0.05 ? gx : x + 0.05 * dx / d;
+        y = d <= 0.05 ? gy : y + 0.05 * dy / d;
+        rfs_pose_t p = pose_at(now, x, y, 0);
+        assert_true(rfs_seek_on_pose(&t.seek, &p, &t.rng));
+        assert_true(rfs_seek_on_receiver(&t.seek, now));
+        rfs_seek_step(&t.seek, now, &t.rng, &out);
+        if (!out.decided) {
+            continue;
+        }
+        if (++decisions == 3) {
+            break;
+        }
+        gx = D(out.decision.goal_x);
+        gy = D(out.decision.goal_y);
+        if (decisions == 2) {
+            assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
+            assert_true(fabs(gx - 16.3) < 1e-3);
+            silence = true;
+        }
+    }
+    assert_int_equal(decisions, 3);
+    *at_x = x;
+    world_free(&t);
+    return out.decision.prev;
+}
+
+static void test_recheck_silent_abandons_a_blind_leg(void **state)
+{
+    (void)state;
+    double at;
+    assert_int_equal(silent_leg(true, -60.0, &at), RFS_DRIVE_RUNNING);
+    assert_true(at < 7.5); /* about 2 m along (the base brakes a little past it) */
+    assert_int_equal(silent_leg(true, -110.0, &at), RFS_DRIVE_REACHED);
+    assert_true(at > 16.0);
+    assert_int_equal(silent_leg(false, -60.0, &at), RFS_DRIVE_REACHED);
+    assert_true(at > 16.0);
+}
+
 /* The geodesic epsilon step (cfg.eps_geodesic, docs/STRATEGIES.md) against a double-
  * precision reference. The map: 10 m x 8 m with a one-cell wall at x in [5.2, 5.3)
  * from the floor to y = 5.0; the only way to its far side is the gap above it. The robot
@@ -1094,6 +1181,7 @@ int main(void)
         cmocka_unit_test(test_refute_reached_moves_on),
         cmocka_unit_test(test_local_search_round_the_estimate),
         cmocka_unit_test(test_leg_max_cuts_the_leg),
+        cmocka_unit_test(test_recheck_silent_abandons_a_blind_leg),
         cmocka_unit_test(test_eps_geodesic_distribution),
         cmocka_unit_test(test_plan_slices_on_the_leg),
         cmocka_unit_test(test_plan_leg_cut_short),

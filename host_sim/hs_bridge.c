@@ -111,7 +111,7 @@ bool hs_bridge_best(hs_radio_t *radio, const rfs_map_t *m, double sx, double sy,
     for (size_t k = 0; found && k < npts; k++) {
         double x = x0 + (double)(k % (size_t)(nx + 1)) * GRID_M;
         double y = y0 + (double)(k / (size_t)(nx + 1)) * GRID_M;
-        if (!isnan(fv[k]) && hypot(x - *bx, y - *by) > HS_BRIDGE_FAR_M &&
+        if (!isnan(fv[k]) && hypot(x - *bx, y - *by) > HS_BRIDGE_FAR_M + 1e-9 &&
             (isnan(*far_f) || fv[k] > *far_f)) {
             *far_f = fv[k];
         }

@@ -50,7 +50,8 @@ double hs_bridge_f(hs_radio_t *radio, double x, double y);
 /// The best point of the true f over the points the robot can stand on, reachable from
 /// (sx, sy) on core map m, on a 0.1 m grid from (x0, y0) to (x1, y1): its position and f,
 /// and in *far_f the runner-up, the highest f of those points more than HS_BRIDGE_FAR_M
-/// from it (NaN when there is none). false when there is no such point (or out of memory).
+/// from it, by 1 nm so that a grid point at that distance stays near (NaN when there is
+/// none). false when there is no such point (or out of memory).
 bool hs_bridge_best(hs_radio_t *radio, const rfs_map_t *m, double sx, double sy, double x0,
                     double y0, double x1, double y1, double *bx, double *by, double *bf,
                     double *far_f);

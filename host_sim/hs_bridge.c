@@ -108,12 +108,14 @@ bool hs_bridge_best(hs_radio_t *radio, const rfs_map_t *m, double sx, double sy,
         }
     }
     *far_f = NAN;
-    for (size_t k = 0; found && k < npts; k++) {
-        double x = x0 + (double)(k % (size_t)(nx + 1)) * GRID_M;
-        double y = y0 + (double)(k / (size_t)(nx + 1)) * GRID_M;
-        if (!isnan(fv[k]) && hypot(x - *bx, y - *by) > HS_BRIDGE_FAR_M + 1e-9 &&
-            (isnan(*far_f) || fv[k] > *far_f)) {
-            *far_f = fv[k];
+    for (long j = 0; found && j <= ny; j++) {
+        for (long i = 0; i <= nx; i++) {
+            double v = fv[(size_t)j * (size_t)(nx + 1) + (size_t)i];
+            if (!isnan(v) && hypot(x0 + i * GRID_M - *bx, y0 + j * GRID_M - *by) >
+                                 HS_BRIDGE_FAR_M + 1e-9 &&
+                (isnan(*far_f) || v > *far_f)) {
+                *far_f = v;
+            }
         }
     }
     free(reach);

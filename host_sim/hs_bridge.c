@@ -76,33 +76,50 @@ static rfs_q16_t q16(double v)
 }
 
 bool hs_bridge_best(hs_radio_t *radio, const rfs_map_t *m, double sx, double sy, double x0,
-                    double y0, double x1, double y1, double *bx, double *by, double *bf)
+                    double y0, double x1, double y1, double *bx, double *by, double *bf,
+                    double *far_f)
 {
+    long nx = lround(floor((x1 - x0) / GRID_M)), ny = lround(floor((y1 - y0) / GRID_M));
+    size_t npts = (size_t)(nx + 1) * (size_t)(ny + 1);
     uint32_t nbytes = rfs_reach_bytes(m), cap = (uint32_t)m->lw * m->lh;
     uint8_t *reach = calloc(nbytes ? nbytes : 1, 1);
     uint32_t *queue = calloc(cap ? cap : 1, sizeof *queue);
+    double *fv = malloc(npts * sizeof *fv); /* f at every standing point, NaN elsewhere */
     bool found = false;
-    if (reach && queue && rfs_reach_fill(m, q16(sx), q16(sy), reach, queue, cap)) {
-        long nx = lround(floor((x1 - x0) / GRID_M)), ny = lround(floor((y1 - y0) / GRID_M));
+    if (reach && queue && fv && rfs_reach_fill(m, q16(sx), q16(sy), reach, queue, cap)) {
         for (long j = 0; j <= ny; j++) {
             for (long i = 0; i <= nx; i++) {
                 double x = x0 + i * GRID_M, y = y0 + j * GRID_M;
                 uint16_t li, lj;
+                double *v = &fv[(size_t)j * (size_t)(nx + 1) + (size_t)i];
+                *v = NAN;
                 rfs_map_lattice_nearest(m, q16(x), q16(y), &li, &lj);
                 if (!rfs_map_point_legal(m, q16(x), q16(y)) || !rfs_reach_at(m, reach, li, lj)) {
                     continue;
                 }
-                double f = hs_bridge_f(radio, x, y);
-                if (!found || f > *bf) {
+                *v = hs_bridge_f(radio, x, y);
+                if (!found || *v > *bf) {
                     *bx = x;
                     *by = y;
-                    *bf = f;
+                    *bf = *v;
                     found = true;
                 }
             }
         }
     }
+    *far_f = NAN;
+    for (long j = 0; found && j <= ny; j++) {
+        for (long i = 0; i <= nx; i++) {
+            double v = fv[(size_t)j * (size_t)(nx + 1) + (size_t)i];
+            if (!isnan(v) && hypot(x0 + i * GRID_M - *bx, y0 + j * GRID_M - *by) >
+                                 HS_BRIDGE_FAR_M + 1e-9 &&
+                (isnan(*far_f) || v > *far_f)) {
+                *far_f = v;
+            }
+        }
+    }
     free(reach);
     free(queue);
+    free(fv);
     return found;
 }

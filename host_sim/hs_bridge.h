@@ -20,6 +20,9 @@
 
 /// Radius of the circle a settled robot stays in, metres.
 #define HS_BRIDGE_SETTLE_M 1.0
+/// A run ending within this of the best point is "within 3 m" (scripts/bench_bridge.py);
+/// the runner-up is the best point further away, metres.
+#define HS_BRIDGE_FAR_M 3.0
 
 /// The robot's positions along its travel, one every few centimetres.
 typedef struct hs_bridge_track {
@@ -45,9 +48,12 @@ double hs_bridge_settle_travel(const hs_bridge_track_t *t, double fx, double fy)
 double hs_bridge_f(hs_radio_t *radio, double x, double y);
 
 /// The best point of the true f over the points the robot can stand on, reachable from
-/// (sx, sy) on core map m, on a 0.1 m grid from (x0, y0) to (x1, y1): its position and f.
-/// false when there is no such point (or out of memory).
+/// (sx, sy) on core map m, on a 0.1 m grid from (x0, y0) to (x1, y1): its position and f,
+/// and in *far_f the runner-up, the highest f of those points more than HS_BRIDGE_FAR_M
+/// from it, by 1 nm so that a grid point at that distance stays near (NaN when there is
+/// none). false when there is no such point (or out of memory).
 bool hs_bridge_best(hs_radio_t *radio, const rfs_map_t *m, double sx, double sy, double x0,
-                    double y0, double x1, double y1, double *bx, double *by, double *bf);
+                    double y0, double x1, double y1, double *bx, double *by, double *bf,
+                    double *far_f);
 
 #endif /* HS_BRIDGE_H */

@@ -865,8 +865,9 @@ static void bridge_result(sim_run_t *r)
     hs_sim_result_t *res = r->res;
     const hs_sim_env_t *e = r->e;
     if (!hs_bridge_best(r->radio, &e->core.map, r->sc->start_x, r->sc->start_y, e->x0, e->y0,
-                        e->x1, e->y1, &res->best_x, &res->best_y, &res->best_f_db)) {
-        res->best_x = res->best_y = res->best_f_db = NAN;
+                        e->x1, e->y1, &res->best_x, &res->best_y, &res->best_f_db,
+                        &res->far_f_db)) {
+        res->best_x = res->best_y = res->best_f_db = res->far_f_db = NAN;
     }
     res->settle_f_db = hs_bridge_f(r->radio, r->px, r->py);
     res->settle_error_m = hypot(r->px - res->best_x, r->py - res->best_y);
@@ -1163,6 +1164,7 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
         json_num(f, "settle_f_db", r->settle_f_db, false);
         json_num(f, "settle_error_m", r->settle_error_m, false);
         json_num(f, "settle_travel_m", r->settle_travel_m, false);
+        json_num(f, "far_f_db", r->far_f_db, false);
         json_num(f, "pred_x_m", r->pred_valid ? r->pred_x : NAN, false);
         json_num(f, "pred_y_m", r->pred_valid ? r->pred_y : NAN, false);
         json_num(f, "pred_f_db", r->pred_valid ? r->pred_f_db : NAN, false);
@@ -1242,7 +1244,7 @@ void hs_sim_table_row(FILE *f, const hs_sim_result_t *r, bool placed)
                             r->pred_valid ? r->pred_x : NAN, r->pred_valid ? r->pred_y : NAN,
                             r->pred_valid ? r->pred_f_db : NAN,
                             r->pred_valid ? r->pred_sigma_db : NAN,
-                            r->pred_valid ? r->pred_area_m2 : NAN};
+                            r->pred_valid ? r->pred_area_m2 : NAN, r->far_f_db};
         for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) {
             tsv_num(f, v[i]);
         }

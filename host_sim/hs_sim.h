@@ -111,6 +111,7 @@ typedef struct hs_sim_result {
     double settle_f_db;          ///< the true f at the final position, dB
     double settle_error_m;       ///< final position to the best point, metres
     double settle_travel_m;      ///< travel to settle (hs_bridge_settle_travel), metres
+    double far_f_db;             ///< the runner-up's true f (hs_bridge_best), dB (NaN: none)
     /// The model's predicted best point (rfs_fields_estimate); false for other models.
     bool pred_valid;
     double pred_x, pred_y;       ///< predicted best point, metres
@@ -190,7 +191,7 @@ void hs_sim_table_row(FILE *f, const hs_sim_result_t *r, bool placed);
 
 /// The batch table's columns of a bridging run, after the others.
 #define HS_SIM_BRIDGE_COLUMNS "best_x_m\tbest_y_m\tbest_f_db\tsettle_f_db\tsettle_error_m\t" \
-    "settle_travel_m\tpred_x_m\tpred_y_m\tpred_f_db\tpred_sigma_db\tpred_area_m2"
+    "settle_travel_m\tpred_x_m\tpred_y_m\tpred_f_db\tpred_sigma_db\tpred_area_m2\tfar_f_db"
 
 
 #endif /* HS_SIM_H */

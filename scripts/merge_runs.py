@@ -32,7 +32,7 @@ FLOATS = set(COLS[3:10]) | {"turn_time_s"}
 # The columns a bridging run adds (hs_sim.h, HS_SIM_BRIDGE_COLUMNS).
 BRIDGE = ["best_x_m", "best_y_m", "best_f_db", "settle_f_db", "settle_error_m",
           "settle_travel_m", "pred_x_m", "pred_y_m", "pred_f_db", "pred_sigma_db",
-          "pred_area_m2"]
+          "pred_area_m2", "far_f_db"]
 FLOATS |= set(BRIDGE)
 # A placed batch's table: the placement first, then COLS, then these.
 PLACED = ["start_x_m", "start_y_m", "start_theta_rad", "source_x_m", "source_y_m",

@@ -4,6 +4,8 @@
 #include <string.h>
 
 #include "rfs_assert.h"
+#include "rfs_knn_index.h"
+#include "rfs_knn_internal.h"
 
 /* Fit phases, in order. */
 enum {
@@ -72,97 +74,6 @@ static void size_grid(rfs_knn_t *s)
     s->cell_cm = (uint16_t)cell;
     s->gw = (uint8_t)(ex / cell + 1u);
     s->gh = (uint8_t)(ey / cell + 1u);
-}
-
-/* Sub-cell of a sample along one axis, from its offset to the grid origin (cm):
- * floor(rel F / c), so that sub-cell f lies in grid cell floor(f / F). */
-static uint32_t sub_axis_cm(int32_t rel_cm, uint16_t cell_cm)
-{
-    return (uint32_t)rel_cm * RFS_KNN_FINE / cell_cm;
-}
-
-static uint32_t sub_of(const rfs_knn_t *s, const rfs_sample_t *p)
-{
-    return sub_axis_cm(p->y_cm - s->min_y_cm, s->cell_cm) * ((uint32_t)s->gw * RFS_KNN_FINE) +
-           sub_axis_cm(p->x_cm - s->min_x_cm, s->cell_cm);
-}
-
-/* Sort key of a position inside a sub-cell: x, then y. */
-static uint32_t pos_key(const rfs_sample_t *p)
-{
-    return (uint32_t)(uint16_t)p->x_cm << 16 | (uint16_t)p->y_cm;
-}
-
-/* Stable bottom-up merge sort of entries [a, a + n) by pos_key() (so rank ascending
- * among equal positions), through the scratch arrays. */
-static void index_sort(rfs_knn_index_t *ix, uint32_t a, uint32_t n)
-{
-    for (uint32_t w = 1u; w < n; w *= 2u) {
-        for (uint32_t lo = 0u; lo < n; lo += 2u * w) {
-            uint32_t mid = lo + w < n ? lo + w : n, hi = lo + 2u * w < n ? lo + 2u * w : n;
-            uint32_t i = lo, j = mid, o = lo;
-            while (i < mid || j < hi) {
-                uint32_t from = (j >= hi || (i < mid && pos_key(&ix->pts[a + i]) <=
-                                                            pos_key(&ix->pts[a + j])))
-                                    ? i++
-                                    : j++;
-                ix->tmp_pts[a + o] = ix->pts[a + from];
-                ix->tmp_rank[a + o] = ix->rank[a + from];
-                o++;
-            }
-        }
-        memcpy(&ix->pts[a], &ix->tmp_pts[a], n * sizeof(ix->pts[0]));
-        memcpy(&ix->rank[a], &ix->tmp_rank[a], n * sizeof(ix->rank[0]));
-    }
-}
-
-/* The attached index of a complete grid: a counting sort of the samples by sub-cell
- * (ascending place in pts within a sub-cell), each sub-cell sorted by position, the
- * position runs and the prefix sums of the targets.
- * Scaling and overflow: sums of <= 10,000 Q9.6 targets fit int32. */
-static void index_build(rfs_knn_t *s)
-{
-    rfs_knn_index_t *ix = s->index;
-    if (ix == NULL) {
-        return;
-    }
-    uint32_t cells = (uint32_t)s->gw * s->gh * RFS_KNN_FINE * RFS_KNN_FINE;
-    memset(ix->start, 0, (cells + 1u) * sizeof(ix->start[0]));
-    for (uint32_t p = 0u; p < s->n; ++p) {
-        ix->start[sub_of(s, &s->pts[p])]++;
-    }
-    uint32_t run = 0u;
-    for (uint32_t c = 0u; c <= cells; ++c) {
-        run += ix->start[c];
-        ix->start[c] = (uint16_t)run; /* end of sub-cell c for now */
-    }
-    for (uint32_t p = s->n; p-- > 0u;) {
-        uint32_t at = --ix->start[sub_of(s, &s->pts[p])];
-        ix->pts[at] = s->pts[p];
-        ix->rank[at] = (uint16_t)p;
-    }
-    for (uint32_t c = 0u; c < cells; ++c) {
-        index_sort(ix, ix->start[c], (uint32_t)ix->start[c + 1u] - ix->start[c]);
-    }
-    for (uint32_t c = 0u; c < cells; ++c) {
-        for (uint32_t k = ix->start[c + 1u]; k-- > ix->start[c];) {
-            bool more = k + 1u < ix->start[c + 1u] && pos_key(&ix->pts[k]) == pos_key(&ix->pts[k + 1u]);
-            ix->same[k] = (uint16_t)(more ? ix->same[k + 1u] + 1u : 1u);
-        }
-    }
-    ix->psum_q6[0] = 0;
-    for (uint32_t k = 0u; k < s->n; ++k) {
-        ix->psum_q6[k + 1u] = ix->psum_q6[k] + ix->pts[k].v_q6;
-    }
-}
-
-void rfs_knn_index_attach(rfs_knn_t *s, rfs_knn_index_t *ix)
-{
-    RFS_ASSERT(s != NULL);
-    s->index = ix;
-    if (s->valid) {
-        index_build(s);
-    }
 }
 
 static void knn_reset(void *self)
@@ -244,7 +155,9 @@ static rfs_fit_result_t knn_fit(void *self, const rfs_model_fit_in_t *in, uint32
                 if (++s->pos == cells) {
                     s->fitting = false;
                     s->valid = true;
-                    index_build(s);
+                    if (s->index != NULL) {
+                        s->index->build(s);
+                    }
                     return RFS_FIT_DONE;
                 }
                 break;
@@ -273,32 +186,8 @@ static int32_t query_q8(rfs_q16_t v)
     return (int32_t)q;
 }
 
-/* Cell index along one axis of a query coordinate relative to the grid origin (cm Q8),
- * clamped to the grid. */
-static int32_t axis_cell(int32_t rel_q8, int32_t cell_q8, uint8_t cells)
-{
-    if (rel_q8 < 0) {
-        return 0;
-    }
-    int32_t c = rel_q8 / cell_q8;
-    return c >= cells ? cells - 1 : c;
-}
 
-/* Mean of target values (Q9.6 sum over count) in Q16.16, rounded.
- * Scaling and overflow: the sum of <= 10,000 int16 fits int32; << 10 in int64. */
-static rfs_q16_t mean_q16(int32_t sum_q6, uint32_t count)
-{
-    return rfs_sat32(rfs_sdiv64_round((int64_t)sum_q6 * 1024, (int64_t)count));
-}
 
-/* Squared distance from the query (cm Q8) to a sample, (cm Q8)^2: each difference is
- * below 2^27, the sum of squares below 2^55. */
-static int64_t dist2(const rfs_sample_t *p, int32_t qx, int32_t qy)
-{
-    int64_t dx = (int64_t)p->x_cm * 256 - qx;
-    int64_t dy = (int64_t)p->y_cm * 256 - qy;
-    return dx * dx + dy * dy;
-}
 
 typedef struct knn_best {
     int64_t d2[RFS_KNN_MAX_K]; /* ascending, (cm Q8)^2 */
@@ -307,32 +196,20 @@ typedef struct knn_best {
     uint32_t k;                /* entries wanted */
 } knn_best_t;
 
-/* Squared distance from the query (cm Q8) to the smallest rectangle holding every sample
- * of cell (i, j): samples are whole centimetres in [i c, (i+1) c - 1] from the origin.
- * Scaling and overflow: as dist2(). */
-static int64_t cell_near2(const rfs_knn_t *s, int32_t i, int32_t j, int32_t qx, int32_t qy)
-{
-    int64_t c8 = (int64_t)s->cell_cm * 256;
-    int64_t x0 = (int64_t)s->min_x_cm * 256 + i * c8, y0 = (int64_t)s->min_y_cm * 256 + j * c8;
-    int64_t x1 = x0 + c8 - 256, y1 = y0 + c8 - 256;
-    int64_t dx = qx < x0 ? x0 - qx : (qx > x1 ? qx - x1 : 0);
-    int64_t dy = qy < y0 ? y0 - qy : (qy > y1 ? qy - y1 : 0);
-    return dx * dx + dy * dy;
-}
 
 /* A cell none of whose samples can enter the k best is skipped: each would be rejected
  * (d2 >= the k-th), so the result, ties included, is the full ring scan's. */
 static void scan_cell_k(const rfs_knn_t *s, uint32_t cell, int32_t qx, int32_t qy, knn_best_t *b)
 {
     if (b->m == b->k && s->start[cell] != s->start[cell + 1u]) {
-        int64_t near2 = cell_near2(s, (int32_t)(cell % s->gw), (int32_t)(cell / s->gw), qx, qy);
+        int64_t near2 = rfs_knn_cell_near2(s, (int32_t)(cell % s->gw), (int32_t)(cell / s->gw), qx, qy);
         // NOLINTNEXTLINE(clang-analyzer-core.UndefinedBinaryOperatorResult): valid needs n >= 1, so k >= 1
         if (near2 >= b->d2[b->m - 1u]) {
             return;
         }
     }
     for (uint32_t i = s->start[cell]; i < s->start[cell + 1u]; ++i) {
-        int64_t d2 = dist2(&s->pts[i], qx, qy);
+        int64_t d2 = rfs_knn_dist2(&s->pts[i], qx, qy);
         // NOLINTNEXTLINE(clang-analyzer-core.UndefinedBinaryOperatorResult): valid needs n >= 1, so k >= 1
         if (b->m == b->k && d2 >= b->d2[b->m - 1u]) {
             continue;
@@ -400,8 +277,8 @@ static bool predict_k(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t *val
     b.k = s->cfg.k < s->n ? s->cfg.k : s->n;
     int32_t c8 = (int32_t)s->cell_cm * 256;
     knn_ring_t ring;
-    ring.cx = axis_cell(qx - (int32_t)s->min_x_cm * 256, c8, s->gw);
-    ring.cy = axis_cell(qy - (int32_t)s->min_y_cm * 256, c8, s->gh);
+    ring.cx = rfs_knn_axis_cell(qx - (int32_t)s->min_x_cm * 256, c8, s->gw);
+    ring.cy = rfs_knn_axis_cell(qy - (int32_t)s->min_y_cm * 256, c8, s->gh);
     for (int32_t r = 0; ring_start(s, &ring, r); ++r) {
         int32_t i, j;
         while (ring_next(s, &ring, &i, &j)) {
@@ -417,7 +294,7 @@ static bool predict_k(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t *val
     for (uint32_t i = 0u; i < b.m; ++i) {
         sum += b.v[i];
     }
-    *value = mean_q16(sum, b.m);
+    *value = rfs_knn_mean_q16(sum, b.m);
     return true;
 }
 
@@ -432,15 +309,15 @@ static bool predict_radius(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t
         ry - r8 >= (int32_t)s->gh * c8) {
         return false;
     }
-    int32_t i0 = axis_cell(rx - r8, c8, s->gw), i1 = axis_cell(rx + r8, c8, s->gw);
-    int32_t j0 = axis_cell(ry - r8, c8, s->gh), j1 = axis_cell(ry + r8, c8, s->gh);
+    int32_t i0 = rfs_knn_axis_cell(rx - r8, c8, s->gw), i1 = rfs_knn_axis_cell(rx + r8, c8, s->gw);
+    int32_t j0 = rfs_knn_axis_cell(ry - r8, c8, s->gh), j1 = rfs_knn_axis_cell(ry + r8, c8, s->gh);
     int32_t sum = 0;
     uint32_t count = 0u;
     for (int32_t j = j0; j <= j1; ++j) {
         for (int32_t i = i0; i <= i1; ++i) {
             uint32_t cell = (uint32_t)(j * s->gw + i);
             for (uint32_t k = s->start[cell]; k < s->start[cell + 1u]; ++k) {
-                if (dist2(&s->pts[k], qx, qy) <= r2) {
+                if (rfs_knn_dist2(&s->pts[k], qx, qy) <= r2) {
                     sum += s->pts[k].v_q6;
                     count++;
                 }
@@ -450,243 +327,7 @@ static bool predict_radius(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t
     if (count == 0u) {
         return false;
     }
-    *value = mean_q16(sum, count);
-    return true;
-}
-
-/* --- Predictions through the attached index: the same answers, fewer samples read --- */
-
-/* The whole centimetres of sub-cell f along one axis, as cm Q8 from the origin o (cm):
- * [*lo, *hi], those rel with floor(rel F / c) == f. */
-static void sub_span(int16_t o, uint16_t cell_cm, int32_t f, int64_t *lo, int64_t *hi)
-{
-    int64_t a = ((int64_t)f * cell_cm + RFS_KNN_FINE - 1u) / RFS_KNN_FINE;
-    int64_t b = ((int64_t)(f + 1) * cell_cm + RFS_KNN_FINE - 1u) / RFS_KNN_FINE - 1;
-    *lo = ((int64_t)o + a) * 256;
-    *hi = ((int64_t)o + b) * 256;
-}
-
-/* Distance from q to [lo, hi] (near) and to its farther end (far), cm Q8. */
-static void span_d(int64_t q, int64_t lo, int64_t hi, int64_t *near, int64_t *far)
-{
-    *near = q < lo ? lo - q : (q > hi ? q - hi : 0);
-    *far = q - lo > hi - q ? q - lo : hi - q;
-}
-
-/* The k best by (squared distance, key), key = ring << 16 | place in pts: the order in
- * which the plain ring scan meets the samples, so ties at the k-th distance go the same
- * way. Keys are unique. */
-typedef struct knn_kbest {
-    int64_t d2[RFS_KNN_MAX_K]; /* ascending with key, (cm Q8)^2 */
-    uint32_t key[RFS_KNN_MAX_K];
-    int16_t v[RFS_KNN_MAX_K]; /* target, Q9.6 */
-    uint32_t m;               /* entries held */
-    uint32_t k;               /* entries wanted */
-} knn_kbest_t;
-
-static bool kbest_before(int64_t d2a, uint32_t ka, int64_t d2b, uint32_t kb)
-{
-    return d2a < d2b || (d2a == d2b && ka < kb);
-}
-
-/* false: refused (not before the k-th held). */
-static bool kbest_offer(knn_kbest_t *b, int64_t d2, uint32_t key, int16_t v)
-{
-    if (b->m == b->k && !kbest_before(d2, key, b->d2[b->m - 1u], b->key[b->m - 1u])) {
-        return false;
-    }
-    uint32_t at = b->m < b->k ? b->m++ : b->m - 1u;
-    while (at > 0u && kbest_before(d2, key, b->d2[at - 1u], b->key[at - 1u])) {
-        b->d2[at] = b->d2[at - 1u];
-        b->key[at] = b->key[at - 1u];
-        b->v[at] = b->v[at - 1u];
-        --at;
-    }
-    b->d2[at] = d2;
-    b->key[at] = key;
-    b->v[at] = v;
-    return true;
-}
-
-/* Squared distance from the query (cm Q8) to sub-cell (fi, fj)'s whole centimetres. */
-static int64_t sub_near2(const rfs_knn_t *s, int32_t fi, int32_t fj, int32_t qx, int32_t qy)
-{
-    int64_t lo, hi, nx, ny, far;
-    sub_span(s->min_x_cm, s->cell_cm, fi, &lo, &hi);
-    span_d(qx, lo, hi, &nx, &far);
-    sub_span(s->min_y_cm, s->cell_cm, fj, &lo, &hi);
-    span_d(qy, lo, hi, &ny, &far);
-    return nx * nx + ny * ny;
-}
-
-/* Cells (or sub-cells) to visit, nearest first. */
-typedef struct knn_visit {
-    int64_t near2;
-    uint32_t cell;
-} knn_visit_t;
-
-/* Insert into v[0, *n), ascending near2. */
-static void visit_push(knn_visit_t *v, uint32_t *n, int64_t near2, uint32_t cell)
-{
-    uint32_t at = (*n)++;
-    while (at > 0u && v[at - 1u].near2 > near2) {
-        v[at] = v[at - 1u];
-        --at;
-    }
-    v[at].near2 = near2;
-    v[at].cell = cell;
-}
-
-/* A sub-cell's samples: a position's samples come in rank order, so once one is refused,
- * so are the rest (same distance, later keys). */
-static void offer_sub(const rfs_knn_index_t *ix, uint32_t sc, uint32_t ring, int32_t qx,
-                      int32_t qy, knn_kbest_t *b)
-{
-    for (uint32_t k = ix->start[sc]; k < ix->start[sc + 1u];) {
-        uint32_t end = k + ix->same[k];
-        int64_t d2 = dist2(&ix->pts[k], qx, qy);
-        while (k < end && kbest_offer(b, d2, ring << 16 | ix->rank[k], ix->pts[k].v_q6)) {
-            ++k;
-        }
-        k = end;
-    }
-}
-
-/* predict_k()'s rings of grid cells and its stop rule, but each ring's cells, and each
- * cell's sub-cells, nearest first, and any whose nearest point is beyond the k-th
- * distance skipped. The k best are by (distance, key), so the order of the visits does
- * not change them. */
-static bool predict_k_index(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t *value)
-{
-    const rfs_knn_index_t *ix = s->index;
-    knn_kbest_t b;
-    b.m = 0u;
-    b.k = s->cfg.k < s->n ? s->cfg.k : s->n;
-    int32_t c8 = (int32_t)s->cell_cm * 256;
-    uint32_t fw = (uint32_t)s->gw * RFS_KNN_FINE;
-    knn_visit_t cells[8u * RFS_KNN_GRID], subs[RFS_KNN_FINE * RFS_KNN_FINE];
-    int32_t cx = axis_cell(qx - (int32_t)s->min_x_cm * 256, c8, s->gw);
-    int32_t cy = axis_cell(qy - (int32_t)s->min_y_cm * 256, c8, s->gh);
-    int32_t rmax = s->gw > s->gh ? s->gw : s->gh;
-    for (int32_t r = 0; r <= rmax; ++r) {
-        int32_t i, j;
-        uint32_t nc = 0u;
-        int32_t j0 = cy - r < 0 ? 0 : cy - r, j1 = cy + r >= s->gh ? s->gh - 1 : cy + r;
-        for (j = j0; j <= j1; ++j) {
-            bool edge = j == cy - r || j == cy + r;
-            int32_t step = edge || r == 0 ? 1 : 2 * r;
-            for (i = cx - r; i <= cx + r; i += step) {
-                if (i < 0 || i >= s->gw) {
-                    continue;
-                }
-                uint32_t cell = (uint32_t)(j * s->gw + i);
-                if (s->start[cell] == s->start[cell + 1u]) {
-                    continue;
-                }
-                int64_t near2 = cell_near2(s, i, j, qx, qy);
-                if (b.m < b.k || near2 <= b.d2[b.m - 1u]) {
-                    visit_push(cells, &nc, near2, cell);
-                }
-            }
-        }
-        for (uint32_t c = 0u; c < nc; ++c) {
-            if (b.m == b.k && cells[c].near2 > b.d2[b.m - 1u]) {
-                break;
-            }
-            i = (int32_t)(cells[c].cell % s->gw);
-            j = (int32_t)(cells[c].cell / s->gw);
-            uint32_t ns = 0u;
-            for (int32_t fj = j * (int32_t)RFS_KNN_FINE; fj < (j + 1) * (int32_t)RFS_KNN_FINE; ++fj) {
-                for (int32_t fi = i * (int32_t)RFS_KNN_FINE; fi < (i + 1) * (int32_t)RFS_KNN_FINE; ++fi) {
-                    uint32_t sc = (uint32_t)fj * fw + (uint32_t)fi;
-                    if (ix->start[sc] != ix->start[sc + 1u]) {
-                        visit_push(subs, &ns, sub_near2(s, fi, fj, qx, qy), sc);
-                    }
-                }
-            }
-            for (uint32_t k = 0u; k < ns; ++k) {
-                if (b.m == b.k && subs[k].near2 > b.d2[b.m - 1u]) {
-                    break;
-                }
-                offer_sub(ix, subs[k].cell, (uint32_t)r, qx, qy, &b);
-            }
-        }
-        int64_t reach = (int64_t)r * c8;
-        if (b.m == b.k && reach * reach >= b.d2[b.m - 1u]) {
-            break;
-        }
-    }
-    int32_t sum = 0;
-    for (uint32_t i = 0u; i < b.m; ++i) {
-        sum += b.v[i];
-    }
-    *value = mean_q16(sum, b.m);
-    return true;
-}
-
-/* Sub-cell along one axis of a query offset (cm Q8) to the grid origin, clamped. */
-static int32_t sub_axis_q8(int64_t rel_q8, int32_t c8, uint8_t cells)
-{
-    int64_t last = (int64_t)cells * RFS_KNN_FINE - 1;
-    int64_t f = rel_q8 < 0 ? 0 : rel_q8 * RFS_KNN_FINE / c8;
-    return (int32_t)(f > last ? last : f);
-}
-
-/* predict_radius() over sub-cells: none of a sub-cell's samples can be within r (skipped),
- * all are (its prefix sums), or each is tested. Sums are exact, so the order is free. */
-static bool predict_radius_index(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t *value)
-{
-    const rfs_knn_index_t *ix = s->index;
-    int32_t r8 = (int32_t)(((int64_t)s->cfg.radius * 100 + 128) >> 8);
-    int64_t r2 = (int64_t)r8 * r8;
-    int32_t c8 = (int32_t)s->cell_cm * 256;
-    int32_t rx = qx - (int32_t)s->min_x_cm * 256;
-    int32_t ry = qy - (int32_t)s->min_y_cm * 256;
-    if (rx + r8 < 0 || ry + r8 < 0 || rx - r8 >= (int32_t)s->gw * c8 ||
-        ry - r8 >= (int32_t)s->gh * c8) {
-        return false;
-    }
-    int32_t i0 = sub_axis_q8((int64_t)rx - r8, c8, s->gw), i1 = sub_axis_q8((int64_t)rx + r8, c8, s->gw);
-    int32_t j0 = sub_axis_q8((int64_t)ry - r8, c8, s->gh), j1 = sub_axis_q8((int64_t)ry + r8, c8, s->gh);
-    uint32_t fw = (uint32_t)s->gw * RFS_KNN_FINE;
-    int32_t sum = 0;
-    uint32_t count = 0u;
-    for (int32_t fj = j0; fj <= j1; ++fj) {
-        int64_t ylo, yhi, ny, fy;
-        sub_span(s->min_y_cm, s->cell_cm, fj, &ylo, &yhi);
-        span_d(qy, ylo, yhi, &ny, &fy);
-        if (ny * ny > r2) {
-            continue;
-        }
-        for (int32_t fi = i0; fi <= i1; ++fi) {
-            uint32_t sc = (uint32_t)fj * fw + (uint32_t)fi;
-            if (ix->start[sc] == ix->start[sc + 1u]) {
-                continue;
-            }
-            int64_t xlo, xhi, nx, fx;
-            sub_span(s->min_x_cm, s->cell_cm, fi, &xlo, &xhi);
-            span_d(qx, xlo, xhi, &nx, &fx);
-            if (nx * nx + ny * ny > r2) {
-                continue;
-            }
-            uint32_t a = ix->start[sc], e = ix->start[sc + 1u];
-            if (fx * fx + fy * fy <= r2) {
-                sum += ix->psum_q6[e] - ix->psum_q6[a];
-                count += e - a;
-                continue;
-            }
-            for (uint32_t k = a; k < e; k += ix->same[k]) {
-                if (dist2(&ix->pts[k], qx, qy) <= r2) {
-                    sum += ix->psum_q6[k + ix->same[k]] - ix->psum_q6[k];
-                    count += ix->same[k];
-                }
-            }
-        }
-    }
-    if (count == 0u) {
-        return false;
-    }
-    *value = mean_q16(sum, count);
+    *value = rfs_knn_mean_q16(sum, count);
     return true;
 }
 
@@ -699,8 +340,7 @@ static bool knn_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *v
     }
     int32_t qx = query_q8(x), qy = query_q8(y);
     if (s->index != NULL) {
-        return s->cfg.mode == RFS_KNN_RADIUS ? predict_radius_index(s, qx, qy, value)
-                                             : predict_k_index(s, qx, qy, value);
+        return s->index->predict(s, qx, qy, value);
     }
     return s->cfg.mode == RFS_KNN_RADIUS ? predict_radius(s, qx, qy, value)
                                          : predict_k(s, qx, qy, value);
@@ -784,8 +424,8 @@ static int64_t kth_far2(const rfs_knn_t *s, const knn_box_t *b, uint32_t kk)
     int32_t ox = (int32_t)s->min_x_cm * 256, oy = (int32_t)s->min_y_cm * 256;
     int64_t hx = ((int64_t)b->x1 - b->x0) / 2, hy = ((int64_t)b->y1 - b->y0) / 2;
     knn_ring_t ring;
-    ring.cx = axis_cell((int32_t)(b->x0 + hx) - ox, c8, s->gw);
-    ring.cy = axis_cell((int32_t)(b->y0 + hy) - oy, c8, s->gh);
+    ring.cx = rfs_knn_axis_cell((int32_t)(b->x0 + hx) - ox, c8, s->gw);
+    ring.cy = rfs_knn_axis_cell((int32_t)(b->y0 + hy) - oy, c8, s->gh);
     for (int32_t r = 0; ring_start(s, &ring, r); ++r) {
         int32_t i, j;
         while (ring_next(s, &ring, &i, &j)) {
@@ -831,7 +471,7 @@ static void top_insert(int16_t *top, uint32_t *m, uint32_t cap, int16_t v)
 /* k-neighbours: a query q of the box has its kk nearest samples within kth(q) of it, and
  * kth(q) <= U, the kk-th smallest far distance (those kk samples are all within U of q);
  * so each of them has its near distance <= U. Their mean is at most the mean of the kk
- * largest targets among the samples with near distance <= U; mean_q16() is monotone in
+ * largest targets among the samples with near distance <= U; rfs_knn_mean_q16() is monotone in
  * the sum, so the bound holds after rounding, bit for bit. */
 static bool bound_k(const rfs_knn_t *s, const knn_box_t *b, rfs_q16_t *ub)
 {
@@ -872,7 +512,7 @@ static bool bound_k(const rfs_knn_t *s, const knn_box_t *b, rfs_q16_t *ub)
     for (uint32_t i = 0u; i < m; ++i) {
         sum += top[i];
     }
-    *ub = mean_q16(sum, m);
+    *ub = rfs_knn_mean_q16(sum, m);
     return true;
 }
 
@@ -883,7 +523,7 @@ static bool bound_k(const rfs_knn_t *s, const knn_box_t *b, rfs_q16_t *ub)
  * RFS_KNN_MAX_K largest others held, any dropped one is <= the smallest held, which then
  * bounds the rest (a mean of two parts is at most the larger part's mean). Means are
  * compared exactly (cross products: sums below 2^29, counts below 2^14) and rounded once
- * by mean_q16(), which is monotone. */
+ * by rfs_knn_mean_q16(), which is monotone. */
 static bool bound_radius(const rfs_knn_t *s, const knn_box_t *b, rfs_q16_t *ub)
 {
     int32_t r8 = (int32_t)(((int64_t)s->cfg.radius * 100 + 128) >> 8);
@@ -945,7 +585,7 @@ static bool bound_radius(const rfs_knn_t *s, const knn_box_t *b, rfs_q16_t *ub)
         best_sum = top[m - 1u];
         best_n = 1u;
     }
-    *ub = mean_q16(best_sum, best_n);
+    *ub = rfs_knn_mean_q16(best_sum, best_n);
     return true;
 }
 

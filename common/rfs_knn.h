@@ -22,12 +22,7 @@
  * be a neighbour of some point of the box; radius: only when one sample covers the whole
  * box, else false), for the seeker's branch-and-bound grid search (docs/MODELS.md).
  *
- * A host may attach a finer index (rfs_knn_index_attach(), about 270 KB): RFS_KNN_FINE^2
- * sub-cells per grid cell, the samples of each grouped by position, rebuilt when a fit
- * completes. predict() then reads only the sub-cells that can hold a neighbour, one
- * distance per position (k-neighbours: ties still go to the sample the plain ring scan
- * meets first; radius: whole sub-cells and positions summed from prefix sums), so the
- * predictions are bit for bit the plain ones; no work unit changes.
+ * A host may attach a finer index (rfs_knn_index.h): the same predictions, faster.
  *
  * Sliced learning: one work unit is one sample copied, counted or placed, or one grid
  * cell visited (exactly 3 n + 3 cells + 1 units per fit); fit(budget) does at most
@@ -48,22 +43,6 @@
 #define RFS_KNN_MAX_K 32u
 /// Grid cells per side at most.
 #define RFS_KNN_GRID 64u
-
-/// Sub-cells per grid cell side in an attached index.
-#define RFS_KNN_FINE 4u
-/// Sub-cells of an attached index at most.
-#define RFS_KNN_FINE_CELLS (RFS_KNN_GRID * RFS_KNN_FINE * RFS_KNN_GRID * RFS_KNN_FINE)
-
-/// A finer index over a fitted model's samples (rfs_knn_index_attach()), caller-owned.
-typedef struct rfs_knn_index {
-    uint16_t start[RFS_KNN_FINE_CELLS + 1u]; ///< first entry of each sub-cell (row-major)
-    rfs_sample_t pts[RFS_KNN_MAX_SAMPLES];   ///< the samples by sub-cell, x, y, rank
-    uint16_t rank[RFS_KNN_MAX_SAMPLES];      ///< each one's place in rfs_knn_t.pts
-    uint16_t same[RFS_KNN_MAX_SAMPLES];      ///< entries from this one on at its position
-    int32_t psum_q6[RFS_KNN_MAX_SAMPLES + 1u]; ///< targets of the entries before each, Q9.6
-    rfs_sample_t tmp_pts[RFS_KNN_MAX_SAMPLES]; ///< build scratch
-    uint16_t tmp_rank[RFS_KNN_MAX_SAMPLES];    ///< build scratch
-} rfs_knn_index_t;
 
 /// Which regressor.
 typedef enum rfs_knn_mode {
@@ -99,7 +78,7 @@ typedef struct rfs_knn {
     rfs_sample_t pts[RFS_KNN_MAX_SAMPLES];          ///< the samples, sorted by cell
     uint16_t start[RFS_KNN_GRID * RFS_KNN_GRID + 1u]; ///< first sample of each cell (row-major)
     uint16_t cursor[RFS_KNN_GRID * RFS_KNN_GRID];   ///< fit scratch: next free slot per cell
-    rfs_knn_index_t *index;                         ///< attached finer index; NULL: none
+    struct rfs_knn_index *index;                    ///< attached finer index (rfs_knn_index.h)
 } rfs_knn_t;
 
 /// Defaults for k-neighbours: k = 5, 1 m cells (scikit-learn's defaults).
@@ -110,10 +89,6 @@ rfs_knn_cfg_t rfs_knn_cfg_radius_default(void);
 
 /// Initialise without a model. Returns 0, or -1 when a field is outside the ranges above.
 int rfs_knn_init(rfs_knn_t *s, const rfs_knn_cfg_t *cfg);
-
-/// Attach a finer index to an initialised state (NULL detaches); it is built at once when
-/// a model exists, then again at the end of every fit. Predictions do not change.
-void rfs_knn_index_attach(rfs_knn_t *s, rfs_knn_index_t *ix);
 
 /// The model interface of a state (rfs_knn_ops or rfs_radius_ops by the configured mode).
 rfs_model_t rfs_knn_model(rfs_knn_t *s);

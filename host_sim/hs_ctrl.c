@@ -9,6 +9,7 @@
 
 #include "rfs_cellsum.h"
 #include "rfs_knn.h"
+#include "rfs_knn_index.h"
 #include "rfs_models.h"
 #include "rfs_pathloss.h"
 #include "rfs_pdr.h"
@@ -289,7 +290,7 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
         }
     }
     if (me->ops == &rfs_knn_ops || me->ops == &rfs_radius_ops) {
-        // predictions read fewer samples through it, the same answers (rfs_knn.h)
+        // predictions read fewer samples through it, the same answers (rfs_knn_index.h)
         p->knn_index = malloc(sizeof *p->knn_index);
         if (!p->knn_index) {
             ip_close(p);

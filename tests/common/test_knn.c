@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "rfs_knn.h"
+#include "rfs_knn_index.h"
 
 #define MAXS 10000u
 #define MAXQ 600u

@@ -165,6 +165,32 @@ def read_batch(out, keep):
     return res
 
 
+def plan_batches(args, tmp, scenarios, ns, ms):
+    """The batches of the three sections, as dicts: (scenario, strategy) -> the strategy
+    sweep's; (strategy, shadowing, noise) -> the noise sweep's; (scenario, model) -> the
+    internal models'. Rows that are another section's runs have no batch of their own."""
+    sweep_b, var_b, model_b = {}, {}, {}
+    # 1. every strategy on every scenario
+    for sc in scenarios:
+        for st in STRATEGIES:
+            keep = range(1, 6) if sc == "default" else ()
+            sweep_b[(sc, st)] = Batch("sweep", "%s-%s" % (sc, st), sc, scenario_path(sc), st,
+                                      model_of(st), args.seeds, keep)
+    # 2. shadowing and noise on the default scenario (4/4 is the default itself)
+    for st in STRATEGIES:
+        for sh, no in [(0, 4), (8, 4), (4, 2), (4, 8)] + ([] if ns == args.seeds else [(4, 4)]):
+            var_b[(st, sh, no)] = Batch("noise", "var-%s-%g-%g" % (st, sh, no), "default",
+                                        make_variant(tmp, sh, no), st, model_of(st), ns)
+    # 3. internal models under meta
+    for sc in scenarios:
+        for m in MODELS:
+            n = args.slow_model_seeds if m in SLOW_MODELS else ms
+            if n > 0 and not (m == "ridge" and n == args.seeds):
+                model_b[(sc, m)] = Batch(m, "model-%s-%s" % (sc, m), sc, scenario_path(sc),
+                                         "meta", m, n)
+    return sweep_b, var_b, model_b
+
+
 def run_all(args, tmp, batches):
     """Every batch, one single-process rfseek-sim each, args.jobs at a time, the longest
     (by estimate) first: a core frees only when a batch ends, and the last to start are
@@ -484,29 +510,9 @@ def main():
     os.makedirs(figdir, exist_ok=True)
     t_all = time.time()
     try:
-        # Every batch of the three sections in one pool (run_all()).
-        # 1. every strategy on every scenario
-        batches, sweep_b, var_b, model_b = [], {}, {}, {}
-        for sc in scenarios:
-            for st in STRATEGIES:
-                keep = range(1, 6) if sc == "default" else ()
-                sweep_b[(sc, st)] = Batch("sweep", "%s-%s" % (sc, st), sc, scenario_path(sc), st,
-                                          model_of(st), args.seeds, keep)
+        sweep_b, var_b, model_b = plan_batches(args, tmp, scenarios, ns, ms)
         tags = {k: b.tag for k, b in sweep_b.items()}
-        # 2. shadowing and noise on the default scenario (4/4 is the default itself)
         variants = [(0, 4), (8, 4), (4, 2), (4, 8)]
-        for st in STRATEGIES:
-            for sh, no in [(4, 4)] + variants:
-                if (sh, no) != (4, 4) or ns != args.seeds:
-                    var_b[(st, sh, no)] = Batch("noise", "var-%s-%g-%g" % (st, sh, no), "default",
-                                                make_variant(tmp, sh, no), st, model_of(st), ns)
-        # 3. internal models under meta
-        for sc in scenarios:
-            for m in MODELS:
-                n = args.slow_model_seeds if m in SLOW_MODELS else ms
-                if n > 0 and not (m == "ridge" and n == args.seeds):
-                    model_b[(sc, m)] = Batch(m, "model-%s-%s" % (sc, m), sc, scenario_path(sc),
-                                             "meta", m, n)
         batches = list(sweep_b.values()) + list(var_b.values()) + list(model_b.values())
         log("%d batches, %d runs, %d at a time" % (len(batches), sum(b.seeds for b in batches),
                                                    args.jobs))

@@ -213,6 +213,7 @@ static bool predict_k_index(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_
                     continue;
                 }
                 int64_t near2 = rfs_knn_cell_near2(s, i, j, qx, qy);
+                // NOLINTNEXTLINE(clang-analyzer-core.UndefinedBinaryOperatorResult): valid needs n >= 1, so k >= 1
                 if (b.m < b.k || near2 <= b.d2[b.m - 1u]) {
                     visit_push(cells, &nc, near2, cell);
                 }
@@ -241,6 +242,7 @@ static bool predict_k_index(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_
             }
         }
         int64_t reach = (int64_t)r * c8;
+        // NOLINTNEXTLINE(clang-analyzer-core.UndefinedBinaryOperatorResult): valid needs n >= 1, so k >= 1
         if (b.m == b.k && reach * reach >= b.d2[b.m - 1u]) {
             break;
         }

@@ -89,8 +89,9 @@ static void index_build(rfs_knn_t *s)
  * [*lo, *hi], those rel with floor(rel F / c) == f. */
 static void sub_span(int16_t o, uint16_t cell_cm, int32_t f, int64_t *lo, int64_t *hi)
 {
-    int64_t a = ((int64_t)f * cell_cm + RFS_KNN_FINE - 1u) / RFS_KNN_FINE;
-    int64_t b = ((int64_t)(f + 1) * cell_cm + RFS_KNN_FINE - 1u) / RFS_KNN_FINE - 1;
+    /* f <= 256 and cell_cm < 2^15: 32-bit arithmetic (no libgcc on -m32) */
+    int64_t a = ((uint32_t)f * cell_cm + RFS_KNN_FINE - 1u) / RFS_KNN_FINE;
+    int64_t b = (int64_t)((((uint32_t)f + 1u) * cell_cm + RFS_KNN_FINE - 1u) / RFS_KNN_FINE) - 1;
     *lo = ((int64_t)o + a) * 256;
     *hi = ((int64_t)o + b) * 256;
 }
@@ -258,9 +259,14 @@ static bool predict_k_index(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_
 /* Sub-cell along one axis of a query offset (cm Q8) to the grid origin, clamped. */
 static int32_t sub_axis_q8(int64_t rel_q8, int32_t c8, uint8_t cells)
 {
-    int64_t last = (int64_t)cells * RFS_KNN_FINE - 1;
-    int64_t f = rel_q8 < 0 ? 0 : rel_q8 * RFS_KNN_FINE / c8;
-    return (int32_t)(f > last ? last : f);
+    if (rel_q8 < 0) {
+        return 0;
+    }
+    if (rel_q8 >= (int64_t)cells * c8) {
+        return (int32_t)(cells * RFS_KNN_FINE - 1u);
+    }
+    /* below cells * c8 < 2^29, times RFS_KNN_FINE below 2^31: 32-bit division */
+    return (int32_t)((uint32_t)rel_q8 * RFS_KNN_FINE / (uint32_t)c8);
 }
 
 /* predict_radius() over sub-cells: none of a sub-cell's samples can be within r (skipped),

@@ -426,8 +426,8 @@ static uint32_t index_equals_plain(const rfs_knn_cfg_t *c, uint32_t n, uint32_t 
         const rfs_sample_t *on = &g_s[rfs_rng_below(&rq, n)];
         rfs_q16_t x = query_at(&rq, lo_x, hi_x), y = query_at(&rq, lo_y, hi_y);
         if (rfs_rng_below(&rq, 4) == 0u) { /* one in four exactly on a sample */
-            x = (rfs_q16_t)(((int64_t)on->x_cm << 16) / 100);
-            y = (rfs_q16_t)(((int64_t)on->y_cm << 16) / 100);
+            x = (rfs_q16_t)((int64_t)on->x_cm * 65536 / 100);
+            y = (rfs_q16_t)((int64_t)on->y_cm * 65536 / 100);
         }
         rfs_q16_t a = 12345, b = 12345;
         bool oka = rfs_knn_ops.predict(&g_knn, x, y, &a);

@@ -4,6 +4,8 @@
 #include <string.h>
 
 #include "rfs_assert.h"
+#include "rfs_knn_index.h"
+#include "rfs_knn_internal.h"
 
 /* Fit phases, in order. */
 enum {
@@ -153,6 +155,9 @@ static rfs_fit_result_t knn_fit(void *self, const rfs_model_fit_in_t *in, uint32
                 if (++s->pos == cells) {
                     s->fitting = false;
                     s->valid = true;
+                    if (s->index != NULL) {
+                        s->index->build(s);
+                    }
                     return RFS_FIT_DONE;
                 }
                 break;
@@ -181,32 +186,8 @@ static int32_t query_q8(rfs_q16_t v)
     return (int32_t)q;
 }
 
-/* Cell index along one axis of a query coordinate relative to the grid origin (cm Q8),
- * clamped to the grid. */
-static int32_t axis_cell(int32_t rel_q8, int32_t cell_q8, uint8_t cells)
-{
-    if (rel_q8 < 0) {
-        return 0;
-    }
-    int32_t c = rel_q8 / cell_q8;
-    return c >= cells ? cells - 1 : c;
-}
 
-/* Mean of target values (Q9.6 sum over count) in Q16.16, rounded.
- * Scaling and overflow: the sum of <= 10,000 int16 fits int32; << 10 in int64. */
-static rfs_q16_t mean_q16(int32_t sum_q6, uint32_t count)
-{
-    return rfs_sat32(rfs_sdiv64_round((int64_t)sum_q6 * 1024, (int64_t)count));
-}
 
-/* Squared distance from the query (cm Q8) to a sample, (cm Q8)^2: each difference is
- * below 2^27, the sum of squares below 2^55. */
-static int64_t dist2(const rfs_sample_t *p, int32_t qx, int32_t qy)
-{
-    int64_t dx = (int64_t)p->x_cm * 256 - qx;
-    int64_t dy = (int64_t)p->y_cm * 256 - qy;
-    return dx * dx + dy * dy;
-}
 
 typedef struct knn_best {
     int64_t d2[RFS_KNN_MAX_K]; /* ascending, (cm Q8)^2 */
@@ -215,32 +196,20 @@ typedef struct knn_best {
     uint32_t k;                /* entries wanted */
 } knn_best_t;
 
-/* Squared distance from the query (cm Q8) to the smallest rectangle holding every sample
- * of cell (i, j): samples are whole centimetres in [i c, (i+1) c - 1] from the origin.
- * Scaling and overflow: as dist2(). */
-static int64_t cell_near2(const rfs_knn_t *s, int32_t i, int32_t j, int32_t qx, int32_t qy)
-{
-    int64_t c8 = (int64_t)s->cell_cm * 256;
-    int64_t x0 = (int64_t)s->min_x_cm * 256 + i * c8, y0 = (int64_t)s->min_y_cm * 256 + j * c8;
-    int64_t x1 = x0 + c8 - 256, y1 = y0 + c8 - 256;
-    int64_t dx = qx < x0 ? x0 - qx : (qx > x1 ? qx - x1 : 0);
-    int64_t dy = qy < y0 ? y0 - qy : (qy > y1 ? qy - y1 : 0);
-    return dx * dx + dy * dy;
-}
 
 /* A cell none of whose samples can enter the k best is skipped: each would be rejected
  * (d2 >= the k-th), so the result, ties included, is the full ring scan's. */
 static void scan_cell_k(const rfs_knn_t *s, uint32_t cell, int32_t qx, int32_t qy, knn_best_t *b)
 {
     if (b->m == b->k && s->start[cell] != s->start[cell + 1u]) {
-        int64_t near2 = cell_near2(s, (int32_t)(cell % s->gw), (int32_t)(cell / s->gw), qx, qy);
+        int64_t near2 = rfs_knn_cell_near2(s, (int32_t)(cell % s->gw), (int32_t)(cell / s->gw), qx, qy);
         // NOLINTNEXTLINE(clang-analyzer-core.UndefinedBinaryOperatorResult): valid needs n >= 1, so k >= 1
         if (near2 >= b->d2[b->m - 1u]) {
             return;
         }
     }
     for (uint32_t i = s->start[cell]; i < s->start[cell + 1u]; ++i) {
-        int64_t d2 = dist2(&s->pts[i], qx, qy);
+        int64_t d2 = rfs_knn_dist2(&s->pts[i], qx, qy);
         // NOLINTNEXTLINE(clang-analyzer-core.UndefinedBinaryOperatorResult): valid needs n >= 1, so k >= 1
         if (b->m == b->k && d2 >= b->d2[b->m - 1u]) {
             continue;
@@ -308,8 +277,8 @@ static bool predict_k(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t *val
     b.k = s->cfg.k < s->n ? s->cfg.k : s->n;
     int32_t c8 = (int32_t)s->cell_cm * 256;
     knn_ring_t ring;
-    ring.cx = axis_cell(qx - (int32_t)s->min_x_cm * 256, c8, s->gw);
-    ring.cy = axis_cell(qy - (int32_t)s->min_y_cm * 256, c8, s->gh);
+    ring.cx = rfs_knn_axis_cell(qx - (int32_t)s->min_x_cm * 256, c8, s->gw);
+    ring.cy = rfs_knn_axis_cell(qy - (int32_t)s->min_y_cm * 256, c8, s->gh);
     for (int32_t r = 0; ring_start(s, &ring, r); ++r) {
         int32_t i, j;
         while (ring_next(s, &ring, &i, &j)) {
@@ -325,7 +294,7 @@ static bool predict_k(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t *val
     for (uint32_t i = 0u; i < b.m; ++i) {
         sum += b.v[i];
     }
-    *value = mean_q16(sum, b.m);
+    *value = rfs_knn_mean_q16(sum, b.m);
     return true;
 }
 
@@ -340,15 +309,15 @@ static bool predict_radius(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t
         ry - r8 >= (int32_t)s->gh * c8) {
         return false;
     }
-    int32_t i0 = axis_cell(rx - r8, c8, s->gw), i1 = axis_cell(rx + r8, c8, s->gw);
-    int32_t j0 = axis_cell(ry - r8, c8, s->gh), j1 = axis_cell(ry + r8, c8, s->gh);
+    int32_t i0 = rfs_knn_axis_cell(rx - r8, c8, s->gw), i1 = rfs_knn_axis_cell(rx + r8, c8, s->gw);
+    int32_t j0 = rfs_knn_axis_cell(ry - r8, c8, s->gh), j1 = rfs_knn_axis_cell(ry + r8, c8, s->gh);
     int32_t sum = 0;
     uint32_t count = 0u;
     for (int32_t j = j0; j <= j1; ++j) {
         for (int32_t i = i0; i <= i1; ++i) {
             uint32_t cell = (uint32_t)(j * s->gw + i);
             for (uint32_t k = s->start[cell]; k < s->start[cell + 1u]; ++k) {
-                if (dist2(&s->pts[k], qx, qy) <= r2) {
+                if (rfs_knn_dist2(&s->pts[k], qx, qy) <= r2) {
                     sum += s->pts[k].v_q6;
                     count++;
                 }
@@ -358,7 +327,7 @@ static bool predict_radius(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t
     if (count == 0u) {
         return false;
     }
-    *value = mean_q16(sum, count);
+    *value = rfs_knn_mean_q16(sum, count);
     return true;
 }
 
@@ -370,6 +339,9 @@ static bool knn_predict(const void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *v
         return false;
     }
     int32_t qx = query_q8(x), qy = query_q8(y);
+    if (s->index != NULL) {
+        return s->index->predict(s, qx, qy, value);
+    }
     return s->cfg.mode == RFS_KNN_RADIUS ? predict_radius(s, qx, qy, value)
                                          : predict_k(s, qx, qy, value);
 }
@@ -452,8 +424,8 @@ static int64_t kth_far2(const rfs_knn_t *s, const knn_box_t *b, uint32_t kk)
     int32_t ox = (int32_t)s->min_x_cm * 256, oy = (int32_t)s->min_y_cm * 256;
     int64_t hx = ((int64_t)b->x1 - b->x0) / 2, hy = ((int64_t)b->y1 - b->y0) / 2;
     knn_ring_t ring;
-    ring.cx = axis_cell((int32_t)(b->x0 + hx) - ox, c8, s->gw);
-    ring.cy = axis_cell((int32_t)(b->y0 + hy) - oy, c8, s->gh);
+    ring.cx = rfs_knn_axis_cell((int32_t)(b->x0 + hx) - ox, c8, s->gw);
+    ring.cy = rfs_knn_axis_cell((int32_t)(b->y0 + hy) - oy, c8, s->gh);
     for (int32_t r = 0; ring_start(s, &ring, r); ++r) {
         int32_t i, j;
         while (ring_next(s, &ring, &i, &j)) {
@@ -499,7 +471,7 @@ static void top_insert(int16_t *top, uint32_t *m, uint32_t cap, int16_t v)
 /* k-neighbours: a query q of the box has its kk nearest samples within kth(q) of it, and
  * kth(q) <= U, the kk-th smallest far distance (those kk samples are all within U of q);
  * so each of them has its near distance <= U. Their mean is at most the mean of the kk
- * largest targets among the samples with near distance <= U; mean_q16() is monotone in
+ * largest targets among the samples with near distance <= U; rfs_knn_mean_q16() is monotone in
  * the sum, so the bound holds after rounding, bit for bit. */
 static bool bound_k(const rfs_knn_t *s, const knn_box_t *b, rfs_q16_t *ub)
 {
@@ -540,7 +512,7 @@ static bool bound_k(const rfs_knn_t *s, const knn_box_t *b, rfs_q16_t *ub)
     for (uint32_t i = 0u; i < m; ++i) {
         sum += top[i];
     }
-    *ub = mean_q16(sum, m);
+    *ub = rfs_knn_mean_q16(sum, m);
     return true;
 }
 
@@ -551,7 +523,7 @@ static bool bound_k(const rfs_knn_t *s, const knn_box_t *b, rfs_q16_t *ub)
  * RFS_KNN_MAX_K largest others held, any dropped one is <= the smallest held, which then
  * bounds the rest (a mean of two parts is at most the larger part's mean). Means are
  * compared exactly (cross products: sums below 2^29, counts below 2^14) and rounded once
- * by mean_q16(), which is monotone. */
+ * by rfs_knn_mean_q16(), which is monotone. */
 static bool bound_radius(const rfs_knn_t *s, const knn_box_t *b, rfs_q16_t *ub)
 {
     int32_t r8 = (int32_t)(((int64_t)s->cfg.radius * 100 + 128) >> 8);
@@ -613,7 +585,7 @@ static bool bound_radius(const rfs_knn_t *s, const knn_box_t *b, rfs_q16_t *ub)
         best_sum = top[m - 1u];
         best_n = 1u;
     }
-    *ub = mean_q16(best_sum, best_n);
+    *ub = rfs_knn_mean_q16(best_sum, best_n);
     return true;
 }
 

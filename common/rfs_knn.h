@@ -22,6 +22,8 @@
  * be a neighbour of some point of the box; radius: only when one sample covers the whole
  * box, else false), for the seeker's branch-and-bound grid search (docs/MODELS.md).
  *
+ * A host may attach a finer index (rfs_knn_index.h): the same predictions, faster.
+ *
  * Sliced learning: one work unit is one sample copied, counted or placed, or one grid
  * cell visited (exactly 3 n + 3 cells + 1 units per fit); fit(budget) does at most
  * `budget` units per call and returns RFS_FIT_MORE until the index is complete.
@@ -76,6 +78,7 @@ typedef struct rfs_knn {
     rfs_sample_t pts[RFS_KNN_MAX_SAMPLES];          ///< the samples, sorted by cell
     uint16_t start[RFS_KNN_GRID * RFS_KNN_GRID + 1u]; ///< first sample of each cell (row-major)
     uint16_t cursor[RFS_KNN_GRID * RFS_KNN_GRID];   ///< fit scratch: next free slot per cell
+    struct rfs_knn_index *index;                    ///< attached finer index (rfs_knn_index.h)
 } rfs_knn_t;
 
 /// Defaults for k-neighbours: k = 5, 1 m cells (scikit-learn's defaults).

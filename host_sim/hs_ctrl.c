@@ -8,6 +8,8 @@
 #include <math.h>
 
 #include "rfs_cellsum.h"
+#include "rfs_knn.h"
+#include "rfs_knn_index.h"
 #include "rfs_models.h"
 #include "rfs_pathloss.h"
 #include "rfs_pdr.h"
@@ -22,6 +24,7 @@ typedef struct inproc {
     rfs_seek_t seek;
     void *model_state; // rfs_models_max_state_bytes(), aligned to RFS_MODELS_STATE_ALIGN
     void *wall_cache;  // the path-loss model's attached wall-count cache, or NULL
+    rfs_knn_index_t *knn_index; // knn and radius: the attached finer index, or NULL
     rfs_fields_t *fields; // one fit per source (rfs_models_per_source()), else NULL
     rfs_fields_mem_t fmem;
     rfs_rng_t rng;
@@ -117,6 +120,7 @@ static void ip_close(void *self)
     free(p->mem.reach);
     free(p->model_state);
     free(p->wall_cache);
+    free(p->knn_index);
     free(p->cells);
     free(p->cell_links);
     free(p);
@@ -284,6 +288,16 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
             snprintf(err, errlen, "model: ridge: map-wide radius rejected");
             return -1;
         }
+    }
+    if (me->ops == &rfs_knn_ops || me->ops == &rfs_radius_ops) {
+        // predictions read fewer samples through it, the same answers (rfs_knn_index.h)
+        p->knn_index = malloc(sizeof *p->knn_index);
+        if (!p->knn_index) {
+            ip_close(p);
+            snprintf(err, errlen, "controller: out of memory");
+            return -1;
+        }
+        rfs_knn_index_attach(p->model_state, p->knn_index);
     }
     if (me->ops == &rfs_pathloss_ops && open_pathloss(p, cfg, err, errlen) != 0) {
         ip_close(p);

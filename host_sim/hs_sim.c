@@ -7,11 +7,23 @@
 #include <time.h>
 
 #include "hs_bridge.h"
+#include "hs_fmt.h"
 #include "hs_motor.h"
 #include "hs_radio.h"
 #include "hs_box2d.h"
 #include "hs_paths.h"
 #include "rfs_pdr.h"
+
+/* Append v[0..n) to line at n, each as printf("%.*f", prec[i]) and followed by a tab,
+ * through hs_fmt_fixed() (a run log's rows; its text is printf's). Returns the length. */
+static size_t put_fields(char *line, size_t n, const double *v, const int *prec, int count)
+{
+    for (int i = 0; i < count; i++) {
+        n += hs_fmt_fixed(line + n, v[i], prec[i]);
+        line[n++] = '\t';
+    }
+    return n;
+}
 
 // --- environment ------------------------------------------------------------------------
 
@@ -621,8 +633,12 @@ static void packet_event(sim_run_t *r, const event_t *ev, unsigned s)
             r->ctrl->on_rssi(r->ctrl->self, r->fm[k].src, r->fm[k].t_us, r->fm[k].dbm);
         }
         if (io && io->samples) {
-            fprintf(io->samples, "%.6f\t%u\t%.3f\t%.3f\t%.3f\t%d\n", ev->te * 1e-6, s, ev->ex,
-                    ev->ey, ev->etr, dbm);
+            char line[6 * HS_FMT_MAX];
+            size_t n = hs_fmt_fixed(line, ev->te * 1e-6, 6);
+            n += (size_t)snprintf(line + n, sizeof line - n, "\t%u\t", s);
+            n = put_fields(line, n, (const double[]){ev->ex, ev->ey, ev->etr}, (const int[]){3, 3, 3}, 3);
+            n += (size_t)snprintf(line + n, sizeof line - n, "%d\n", dbm);
+            fwrite(line, 1, n, io->samples);
         }
     }
 }
@@ -676,8 +692,12 @@ static void pose_event(sim_run_t *r, const event_t *ev, const tick_t *k)
         r->ctrl->on_pose(r->ctrl->self, &r->fm[i].pose);
     }
     if (r->io && r->io->track) {
-        fprintf(r->io->track, "%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%.4f\t%d\n", ev->te * 1e-6,
-                ev->ex, ev->ey, eth, mx, my, mth, hs_box2d_robot_touching(r->world) ? 1 : 0);
+        char line[8 * HS_FMT_MAX];
+        size_t n = put_fields(line, 0, (const double[]){ev->te * 1e-6, ev->ex, ev->ey, eth, mx, my, mth},
+                              (const int[]){3, 3, 3, 4, 3, 3, 4}, 7);
+        line[n++] = hs_box2d_robot_touching(r->world) ? '1' : '0';
+        line[n++] = '\n';
+        fwrite(line, 1, n, r->io->track);
     }
 }
 

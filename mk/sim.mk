@@ -50,6 +50,7 @@ ALL_TARGETS += $(SIM_LIB) $(SIM_PROGS)
 $(eval $(call cmocka_test,test_radio,tests/host_sim/test_radio.c,sim))
 $(eval $(call cmocka_test,test_box2d,tests/host_sim/test_box2d.c,sim))
 $(eval $(call cmocka_test,test_sim,tests/host_sim/test_sim.c,sim))
+$(eval $(call cmocka_test,test_fmt,tests/host_sim/test_fmt.c,sim))
 # The fault hooks alone and whole runs of the open-hall fault scenarios, log read back.
 $(eval $(call cmocka_test,test_faults,tests/host_sim/test_faults.c,sim))
 

@@ -126,14 +126,25 @@ def leg_stats(logrows, total):
     return eps, path, detour
 
 
-def run_batch(args, tmp, scen_file, strategy, model, seeds, tag, keep):
-    """One rfseek-sim batch; returns a list of per-run dicts. keep: seeds whose logs stay."""
-    out = os.path.join(tmp, tag)
-    cmd = [args.bin, scen_file, "--seeds", "1..%d" % seeds, "--jobs", str(args.jobs),
-           "--out", out, "--strategy", strategy, "--model", model]
-    if args.quiet:
-        cmd.append("--quiet")
-    subprocess.run(cmd, check=True)
+# CPU seconds per run, a model's on the default office, and a scenario's factor (measured
+# with make bench-seek; docs/PERFORMANCE.md, "Seek benchmark"): only for the order in which
+# run_all() starts the batches, so a stale value costs time, never a figure.
+RUN_CPU = {"ridge": 0.08, "pathloss": 0.25, "radius": 0.2, "knn": 0.5, "mlp": 0.6}
+SCEN_CPU = {"default": 1.0, "open": 0.6, "lshape": 1.0, "willow": 2.5, "3ne": 2.0, "intel": 3.0}
+
+
+class Batch:
+    """One rfseek-sim --seeds batch: a strategy with a model on a scenario file."""
+
+    def __init__(self, section, tag, scen, scen_file, strategy, model, seeds, keep=()):
+        self.section, self.tag, self.scen_file = section, tag, scen_file
+        self.strategy, self.model, self.seeds, self.keep = strategy, model, seeds, set(keep)
+        self.est = seeds * RUN_CPU.get(model, 1.0) * SCEN_CPU.get(scen, 1.0)
+        self.res, self.cpu = None, 0.0
+
+
+def read_batch(out, keep):
+    """The per-run dicts of a finished batch in out; seed logs not in keep are removed."""
     runs = read_tsv(os.path.join(out, "runs.tsv"))
     res = []
     for r in runs:
@@ -152,6 +163,68 @@ def run_batch(args, tmp, scen_file, strategy, model, seeds, tag, keep):
         if seed not in keep:
             shutil.rmtree(sd)
     return res
+
+
+def plan_batches(args, tmp, scenarios, ns, ms):
+    """The batches of the three sections, as dicts: (scenario, strategy) -> the strategy
+    sweep's; (strategy, shadowing, noise) -> the noise sweep's; (scenario, model) -> the
+    internal models'. Rows that are another section's runs have no batch of their own."""
+    sweep_b, var_b, model_b = {}, {}, {}
+    # 1. every strategy on every scenario
+    for sc in scenarios:
+        for st in STRATEGIES:
+            keep = range(1, 6) if sc == "default" else ()
+            sweep_b[(sc, st)] = Batch("sweep", "%s-%s" % (sc, st), sc, scenario_path(sc), st,
+                                      model_of(st), args.seeds, keep)
+    # 2. shadowing and noise on the default scenario (4/4 is the default itself)
+    for st in STRATEGIES:
+        for sh, no in [(0, 4), (8, 4), (4, 2), (4, 8)] + ([] if ns == args.seeds else [(4, 4)]):
+            var_b[(st, sh, no)] = Batch("noise", "var-%s-%g-%g" % (st, sh, no), "default",
+                                        make_variant(tmp, sh, no), st, model_of(st), ns)
+    # 3. internal models under meta
+    for sc in scenarios:
+        for m in MODELS:
+            n = args.slow_model_seeds if m in SLOW_MODELS else ms
+            if n > 0 and not (m == "ridge" and n == args.seeds):
+                model_b[(sc, m)] = Batch(m, "model-%s-%s" % (sc, m), sc, scenario_path(sc),
+                                         "meta", m, n)
+    return sweep_b, var_b, model_b
+
+
+def run_all(args, tmp, batches):
+    """Every batch, one single-process rfseek-sim each, args.jobs at a time, the longest
+    (by estimate) first: a core frees only when a batch ends, and the last to start are
+    the shortest, so no core waits for a section to finish. Fills each batch's res and
+    cpu (its process's user + system seconds)."""
+    todo = sorted(batches, key=lambda b: -b.est)
+    running, finished, t0 = {}, [], time.time()
+    while todo or running or finished:
+        while todo and len(running) < args.jobs:
+            b = todo.pop(0)
+            cmd = [args.bin, b.scen_file, "--seeds", "1..%d" % b.seeds, "--jobs", "1",
+                   "--quiet", "--out", os.path.join(tmp, b.tag), "--strategy", b.strategy,
+                   "--model", b.model]
+            p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL)
+            running[p.pid] = (p, b)
+        if finished:
+            b = finished.pop(0)
+            b.res = read_batch(os.path.join(tmp, b.tag), b.keep)
+            if not args.quiet:
+                log("[%d/%d] %s: %d seeds, %.1f s CPU (%.0f s so far)" % (
+                    len(batches) - len(todo) - len(running) - len(finished), len(batches),
+                    b.tag, b.seeds, b.cpu, time.time() - t0))
+            continue
+        pid, status, ru = os.wait4(-1, 0)
+        if pid not in running:
+            continue
+        p, b = running.pop(pid)
+        p.returncode = os.waitstatus_to_exitcode(status)
+        if p.returncode != 0:
+            for q, _ in running.values():
+                q.kill()
+            raise subprocess.CalledProcessError(p.returncode, p.args)
+        b.cpu = ru.ru_utime + ru.ru_stime
+        finished.append(b)
 
 
 def summarise(res):
@@ -437,57 +510,33 @@ def main():
     os.makedirs(figdir, exist_ok=True)
     t_all = time.time()
     try:
-        # 1. every strategy on every scenario
-        tags, table = {}, {}
-        jobs = [(sc, st) for sc in scenarios for st in STRATEGIES]
-        t0 = time.time()
-        for i, (sc, st) in enumerate(jobs):
-            log("[%d/%d] %s on %s, %d seeds (%.0f s so far)" % (i + 1, len(jobs), st, sc,
-                                                                 args.seeds, time.time() - t0))
-            tag = "%s-%s" % (sc, st)
-            tags[(sc, st)] = tag
-            keep = set(range(1, 6)) if sc == "default" else set()
-            table[(sc, st)] = run_batch(args, tmp, scenario_path(sc), st, model_of(st),
-                                        args.seeds, tag, keep)
-        t_sweep = time.time() - t0
-        # 2. shadowing and noise on the default scenario (4/4 is the default itself)
-        sweep = {"shadow": {st: {} for st in STRATEGIES}, "noise": {st: {} for st in STRATEGIES}}
+        sweep_b, var_b, model_b = plan_batches(args, tmp, scenarios, ns, ms)
+        tags = {k: b.tag for k, b in sweep_b.items()}
         variants = [(0, 4), (8, 4), (4, 2), (4, 8)]
-        t0 = time.time()
+        batches = list(sweep_b.values()) + list(var_b.values()) + list(model_b.values())
+        log("%d batches, %d runs, %d at a time" % (len(batches), sum(b.seeds for b in batches),
+                                                   args.jobs))
+        run_all(args, tmp, batches)
+        table = {k: b.res for k, b in sweep_b.items()}
+        sweep = {"shadow": {st: {} for st in STRATEGIES}, "noise": {st: {} for st in STRATEGIES}}
         for st in STRATEGIES:
-            base = summarise(table[("default", st)]) if ns == args.seeds else None
             for sh, no in [(4, 4)] + variants:
-                if (sh, no) == (4, 4) and base is not None:
-                    s = base
-                else:
-                    log("noise sweep: %s at shadowing %g dB, noise %g dB" % (st, sh, no))
-                    sf = make_variant(tmp, sh, no)
-                    tag = "var-%s-%g-%g" % (st, sh, no)
-                    s = summarise(run_batch(args, tmp, sf, st, model_of(st), ns, tag, set()))
+                b = var_b.get((st, sh, no))
+                s = summarise(b.res if b else table[("default", st)])
                 if no == 4:
                     sweep["shadow"][st][sh] = s
                 if sh == 4:
                     sweep["noise"][st][no] = s
-        t_noise = time.time() - t0
-        # 3. internal models under meta
         mtab = {}
-        t0 = time.time()
-        t_model = {m: 0.0 for m in MODELS}
         for sc in scenarios:
             for m in MODELS:
-                t1 = time.time()
+                b = model_b.get((sc, m))
                 n = args.slow_model_seeds if m in SLOW_MODELS else ms
-                if n == 0:
-                    mtab[(sc, m)] = None
-                    continue
-                if m == "ridge" and n == args.seeds:
-                    mtab[(sc, m)] = summarise(table[(sc, "meta")])
-                    continue
-                log("models: %s on %s, %d seeds" % (m, sc, n))
-                mtab[(sc, m)] = summarise(run_batch(args, tmp, scenario_path(sc), "meta", m, n,
-                                                    "model-%s-%s" % (sc, m), set()))
-                t_model[m] += time.time() - t1
-        t_models = time.time() - t0
+                mtab[(sc, m)] = (summarise(b.res) if b else
+                                 summarise(table[(sc, "meta")]) if n > 0 else None)
+        cpu = {sec: sum(b.cpu for b in batches if b.section == sec) for sec in ("sweep", "noise")}
+        t_model = {m: sum(b.cpu for b in model_b.values() if b.model == m) for m in MODELS}
+        t_run = time.time() - t_all
         # 4. figures
         figs = fig_trajectories(figdir, tmp, tags, "default", args.seeds)
         figs.append(fig_rssi(figdir, tmp, args, "default"))
@@ -500,10 +549,13 @@ def main():
                 single_run(args, scenario_path(sc), 1, d, "meta", field=True)
                 walls[sc] = walls_lookup(os.path.join(d, "field.tsv"))
         t_total = time.time() - t_all
-        write_results(args, results, scenarios, table, sweep, mtab, walls, figs,
-                      dict(sweep=t_sweep, noise=t_noise, models=t_models, total=t_total,
-                           model=t_model), ns,
-                      ms)
+        times = dict(sweep=cpu["sweep"], noise=cpu["noise"], models=sum(t_model.values()),
+                     model=t_model, runs=t_run, total=t_total)
+        log("CPU s: strategy sweep %.0f, noise sweep %.0f, models %.0f (%s); wall s: batches "
+            "%.0f, whole %.0f" % (times["sweep"], times["noise"], times["models"],
+                                  ", ".join("%s %.0f" % kv for kv in t_model.items()), t_run,
+                                  t_total))
+        write_results(args, results, scenarios, table, sweep, mtab, walls, figs, times, ns, ms)
     except BaseException:
         if smoke_dir:
             shutil.rmtree(smoke_dir, ignore_errors=True)
@@ -663,13 +715,13 @@ def write_results(args, path, scenarios, table, sweep, mtab, walls, figs, times,
         A("![%s](figures/seek_traj_%s.png)" % (st, st))
     A("![rssi](figures/seek_rssi_vs_distance.png)\n")
     A("## Wall time of the benchmark\n")
-    A("On this machine (2 cores, shared with other builds while it ran), `--jobs %d`: "
-      "strategy sweep (%d scenarios x %d strategies x %d seeds) %.0f s; noise sweep %.0f s; "
-      "models %.0f s (%s); whole benchmark including figures %.0f s (%.1f min)."
+    A("On this machine (2 cores), `--jobs %d` (every batch in one pool, longest first), CPU "
+      "time: strategy sweep (%d scenarios x %d strategies x %d seeds) %.0f s; noise sweep "
+      "%.0f s; models %.0f s (%s). Wall: batches %.0f s, whole benchmark with figures %.0f s."
       % (args.jobs, len(scenarios), len(STRATEGIES), args.seeds, times["sweep"],
          times["noise"], times["models"],
          ", ".join("%s %.0f" % (m, t) for m, t in times["model"].items() if t >= 0.5),
-         times["total"], times["total"] / 60))
+         times["runs"], times["total"]))
     A("")
     # Sections other benches write (scripts/bench_drive.py, scripts/bench_general.py), kept.
     for name in re.findall(r"<!-- ([\w-]+): begin -->", old):

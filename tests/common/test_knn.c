@@ -5,7 +5,8 @@
  * tests/common/ref_knn.py, with the same samples and queries written to a temporary file.
  * Queries whose answer depends on tie-breaking (k-th and (k+1)-th distances within
  * 1e-5 m, or a distance within 1e-5 m of the radius) are skipped; the script says which.
- * Run from the repository root (as `make test` does).
+ * The attached index (rfs_knn_index_attach()) is checked against the plain scan, ties at
+ * the k-th distance included. Run from the repository root (as `make test` does).
  */
 #include "rfs_test.h"
 
@@ -16,6 +17,7 @@
 #include <unistd.h>
 
 #include "rfs_knn.h"
+#include "rfs_knn_index.h"
 
 #define MAXS 10000u
 #define MAXQ 600u
@@ -325,6 +327,159 @@ static void no_samples_fails_and_reset_discards(void **state)
     assert_false(m.ops->predict(m.self, 0, 0, &v));
 }
 
+/* --- The attached finer index (rfs_knn_index_attach()) against the plain scan ---------- */
+
+static rfs_knn_index_t g_ix;
+
+/* Samples in n / 40 clusters on a 10 cm lattice, many at one position (a robot that
+ * stands still), the rest scattered: exact ties at the k-th distance are common. */
+static void make_clustered(uint32_t n, uint32_t w_cm, uint32_t h_cm, uint64_t seed)
+{
+    rfs_rng_t r;
+    rfs_rng_seed(&r, seed);
+    uint32_t nc = n / 40u + 1u;
+    for (uint32_t i = 0; i < n; ++i) {
+        uint32_t c = rfs_rng_below(&r, nc);
+        rfs_rng_t rc;
+        rfs_rng_seed(&rc, seed * 1000u + c);
+        int32_t cx = (int32_t)rfs_rng_below(&rc, w_cm / 10u + 1u) * 10;
+        int32_t cy = (int32_t)rfs_rng_below(&rc, h_cm / 10u + 1u) * 10;
+        uint32_t spread = rfs_rng_below(&r, 3) * 10u; /* 0: the cluster's own position */
+        g_s[i].x_cm = (int16_t)(cx + (int32_t)rfs_rng_below(&r, 2u * spread + 1u) - (int32_t)spread);
+        g_s[i].y_cm = (int16_t)(cy + (int32_t)rfs_rng_below(&r, 2u * spread + 1u) - (int32_t)spread);
+        g_s[i].v_q6 = (int16_t)(-80 * 64 + (int32_t)rfs_rng_below(&r, 50 * 64));
+    }
+}
+
+/* A query coordinate in Q16.16 anywhere around the samples' span [lo, hi] (cm) and
+ * beyond it (clamped rings). */
+static rfs_q16_t query_at(rfs_rng_t *r, int32_t lo_cm, int32_t hi_cm)
+{
+    int32_t span = hi_cm - lo_cm + 2000;
+    int64_t cm_q8 = ((int64_t)lo_cm - 1000) * 256 + (int64_t)rfs_rng_below(r, (uint32_t)span * 256u);
+    return (rfs_q16_t)(cm_q8 * 65536 / 25600);
+}
+
+static int cmp_i64(const void *a, const void *b)
+{
+    int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Whether the mean of the k nearest (brute force, exact integer distances) depends on
+ * which of the samples tied at the k-th distance are taken. */
+static bool tie_matters(uint32_t n, uint32_t k, rfs_q16_t x, rfs_q16_t y)
+{
+    int64_t qx = ((int64_t)x * 100 + 128) >> 8, qy = ((int64_t)y * 100 + 128) >> 8;
+    static int64_t d2[MAXS];
+    for (uint32_t i = 0; i < n; ++i) {
+        int64_t dx = (int64_t)g_s[i].x_cm * 256 - qx, dy = (int64_t)g_s[i].y_cm * 256 - qy;
+        d2[i] = dx * dx + dy * dy;
+    }
+    if (k >= n) {
+        return false;
+    }
+    static int64_t sorted[MAXS];
+    memcpy(sorted, d2, n * sizeof d2[0]);
+    qsort(sorted, n, sizeof sorted[0], cmp_i64);
+    int64_t kth = sorted[k - 1u];
+    uint32_t less = 0, tied = 0;
+    int16_t vmin = INT16_MAX, vmax = INT16_MIN;
+    for (uint32_t i = 0; i < n; ++i) {
+        less += d2[i] < kth ? 1u : 0u;
+        if (d2[i] == kth) {
+            tied++;
+            vmin = g_s[i].v_q6 < vmin ? g_s[i].v_q6 : vmin;
+            vmax = g_s[i].v_q6 > vmax ? g_s[i].v_q6 : vmax;
+        }
+    }
+    return less + tied > k && vmin != vmax;
+}
+
+/* Both states fitted from g_s[0, n); g_knn2 with the index (attached before the fit, or
+ * after it). Every query: same answer, same value. Returns the tie-dependent queries
+ * among the first `ties_checked`. */
+static uint32_t index_equals_plain(const rfs_knn_cfg_t *c, uint32_t n, uint32_t nq,
+                                   uint32_t ties_checked, bool attach_first, uint64_t seed)
+{
+    rfs_rng_t rng, rq;
+    rfs_rng_seed(&rng, 1);
+    rfs_rng_seed(&rq, seed);
+    rfs_model_fit_in_t in = {.samples = g_s, .n = (uint16_t)n};
+    assert_int_equal(rfs_knn_init(&g_knn, c), 0);
+    assert_int_equal(rfs_knn_init(&g_knn2, c), 0);
+    if (attach_first) {
+        rfs_knn_index_attach(&g_knn2, &g_ix);
+    }
+    assert_int_equal(rfs_knn_ops.fit(&g_knn, &in, 0, &rng), RFS_FIT_DONE);
+    rfs_fit_result_t r;
+    do {
+        r = rfs_knn_ops.fit(&g_knn2, &in, 301, &rng);
+    } while (r == RFS_FIT_MORE);
+    assert_int_equal(r, RFS_FIT_DONE);
+    if (!attach_first) {
+        rfs_knn_index_attach(&g_knn2, &g_ix);
+    }
+    int32_t lo_x = g_knn.min_x_cm, hi_x = g_knn.max_x_cm, lo_y = g_knn.min_y_cm, hi_y = g_knn.max_y_cm;
+    uint32_t ties = 0;
+    for (uint32_t q = 0; q < nq; ++q) {
+        const rfs_sample_t *on = &g_s[rfs_rng_below(&rq, n)];
+        rfs_q16_t x = query_at(&rq, lo_x, hi_x), y = query_at(&rq, lo_y, hi_y);
+        if (rfs_rng_below(&rq, 4) == 0u) { /* one in four exactly on a sample */
+            x = (rfs_q16_t)((int64_t)on->x_cm * 65536 / 100);
+            y = (rfs_q16_t)((int64_t)on->y_cm * 65536 / 100);
+        }
+        rfs_q16_t a = 12345, b = 12345;
+        bool oka = rfs_knn_ops.predict(&g_knn, x, y, &a);
+        bool okb = rfs_knn_ops.predict(&g_knn2, x, y, &b);
+        if (oka != okb || a != b) {
+            fail_msg("query %u (%d, %d) Q16: plain %d %d, indexed %d %d", q, x, y, oka, a, okb, b);
+        }
+        if (q < ties_checked && c->mode == RFS_KNN_KNEIGHBORS && tie_matters(n, c->k, x, y)) {
+            ties++;
+        }
+    }
+    return ties;
+}
+
+static void index_predicts_as_plain_knn(void **state)
+{
+    (void)state;
+    const uint8_t ks[] = {1, 5, 32};
+    const int32_t cells_cm[] = {5, 30, 100, 300};
+    uint32_t ties = 0;
+    for (uint32_t t = 0; t < 12; ++t) {
+        rfs_knn_cfg_t c = rfs_knn_cfg_default();
+        c.k = ks[t % 3u];
+        c.cell = RFS_Q16_FRAC(cells_cm[t / 3u], 100);
+        make_clustered(4000, 3000, 1200, 60 + t);
+        ties += index_equals_plain(&c, 4000, 1500, t < 3 ? 200 : 0, t % 2u == 0u, 70 + t);
+        make_path(MAXS, 80 + t);
+        (void)index_equals_plain(&c, MAXS, 800, 0, t % 2u == 1u, 90 + t);
+        make_uniform(1 + t * 7, 30000, 500, 100 + t); /* fewer samples than k; wide cells */
+        (void)index_equals_plain(&c, 1 + t * 7, 300, 0, true, 110 + t);
+    }
+    /* the k-th distance was tied between different targets, so the order mattered */
+    print_message("tie-dependent queries: %u of 600\n", ties);
+    assert_true(ties >= 20);
+}
+
+static void index_predicts_as_plain_radius(void **state)
+{
+    (void)state;
+    const int32_t radii_cm[] = {10, 100, 250};
+    const int32_t cells_cm[] = {5, 100, 300};
+    for (uint32_t t = 0; t < 9; ++t) {
+        rfs_knn_cfg_t c = rfs_knn_cfg_radius_default();
+        c.radius = RFS_Q16_FRAC(radii_cm[t % 3u], 100);
+        c.cell = RFS_Q16_FRAC(cells_cm[t / 3u], 100);
+        make_clustered(4000, 3000, 1200, 120 + t);
+        (void)index_equals_plain(&c, 4000, 2000, 0, t % 2u == 0u, 130 + t);
+        make_path(MAXS, 140 + t);
+        (void)index_equals_plain(&c, MAXS, 1000, 0, t % 2u == 1u, 150 + t);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -336,6 +491,8 @@ int main(void)
         cmocka_unit_test(sliced_fit_respects_budget_and_equals_whole),
         cmocka_unit_test(init_rejects_bad_configuration_and_defaults_are_sklearns),
         cmocka_unit_test(no_samples_fails_and_reset_discards),
+        cmocka_unit_test(index_predicts_as_plain_knn),
+        cmocka_unit_test(index_predicts_as_plain_radius),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

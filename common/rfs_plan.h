@@ -7,7 +7,7 @@
  * (octile, diagonal 1.5 instead of 1.414) so the priority queue is Dial's: four ring
  * buffers, one per cost mod 4. Edges are tested by rfs_map_lattice_step_legal (the
  * traversal's cells recorded once per direction; same answers, a few byte loads), or
- * read from the map's edge table when the host attached one (rfs_map_edges_attach). The
+ * read from the map's edge table (rfs_map_edges_attach, rfs_plan_use_edges). The
  * start and the goal join the lattice through the closest legal lattice point of their
  * 3 x 3 neighbourhood that a legal segment reaches (a start inside the clearance zone:
  * the closest legal one of its 5 x 5, unchecked, so the robot can get out). The lattice
@@ -73,6 +73,9 @@ typedef struct rfs_plan {
                             ///< or the join point of a start moved (rfs_plan_tree_move)
     bool tree_defer;        ///< false (init); true (rfs_plan_tree_defer): grows only owe
     uint32_t tree_owed;     ///< points the tree's grows granted and no search closed yet
+    uint8_t (*search)(struct rfs_plan *p, uint32_t target, uint32_t budget);
+                            ///< the search loop: NULL (init) the lattice tests',
+                            ///< rfs_plan_use_edges the edge table's
 } rfs_plan_t;
 
 /// A planned path: waypoints in order, the last one the goal itself.
@@ -143,6 +146,11 @@ bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget);
 /// from a tree rooted at (x0, y0), before string pulling. false (the tree unchanged)
 /// otherwise.
 bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t max_hop);
+
+/// Search with the map's edge table when it has one (rfs_map_edges_attach; a host
+/// option: the code for it is linked only into programs that call this). The same
+/// plans and trees, point for point.
+void rfs_plan_use_edges(rfs_plan_t *p);
 
 /// Defer the searches of rfs_plan_tree_grow (a host option: the simulator has no period
 /// budget to keep). Each grow then only adds its budget to the points owed; a plan or a

@@ -252,7 +252,10 @@ typedef enum search_end {
  * uninterrupted search would, whatever targets or budgets it stopped at. Buckets are
  * drained in cost order; four empty rings in a row are an empty queue (pushes go to
  * d + 2 and d + 3, never to the ring being drained). */
-static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget)
+__attribute__((always_inline)) static inline search_end_t search_loop(rfs_plan_t *p,
+                                                                      uint32_t target,
+                                                                      uint32_t budget,
+                                                                      bool table)
 {
     rings_t r;
     r.q = p->queue;
@@ -263,7 +266,7 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
     /* The memo's answers are the traversal's (rfs_map_memo_attach). */
     const bool steps = m->step_n != 0 ? !p->exact_edges : m->memo != 0;
     /* The edge table and lattice width in locals: stores to the work bytes may alias m. */
-    const uint16_t *const edges = steps && !p->exact_edges ? m->edges : 0;
+    const uint16_t *const edges = table && steps && !p->exact_edges ? m->edges : 0;
     const uint32_t lw = m->lw;
     uint32_t d = r.st.cost;
     uint32_t u = r.st.pending; /* closed, neighbours not yet relaxed */
@@ -331,6 +334,30 @@ static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget
     r.st.pending = end == SEARCH_EMPTY ? NO_POINT : u;
     p->dial = r.st;
     return end;
+}
+
+/* search_loop with the lattice tests, and with the map's edge table: the second is
+ * reached only through rfs_plan_use_edges, so an image that never calls it links none
+ * of its code (-ffunction-sections, --gc-sections). */
+static search_end_t search_plain(rfs_plan_t *p, uint32_t target, uint32_t budget)
+{
+    return search_loop(p, target, budget, false);
+}
+
+static uint8_t search_table(rfs_plan_t *p, uint32_t target, uint32_t budget)
+{
+    return (uint8_t)search_loop(p, target, budget, true);
+}
+
+static search_end_t search_until(rfs_plan_t *p, uint32_t target, uint32_t budget)
+{
+    return p->search != 0 ? (search_end_t)p->search(p, target, budget)
+                          : search_plain(p, target, budget);
+}
+
+void rfs_plan_use_edges(rfs_plan_t *p)
+{
+    p->search = search_table;
 }
 
 void rfs_plan_set_component(rfs_plan_t *p, const uint8_t *bits)

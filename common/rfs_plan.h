@@ -6,7 +6,8 @@
  * the start's is closed, with integer costs 2 for a straight and 3 for a diagonal step
  * (octile, diagonal 1.5 instead of 1.414) so the priority queue is Dial's: four ring
  * buffers, one per cost mod 4. Edges are tested by rfs_map_lattice_step_legal (the
- * traversal's cells recorded once per direction; same answers, a few byte loads). The
+ * traversal's cells recorded once per direction; same answers, a few byte loads), or
+ * read from the map's edge table (rfs_map_edges_attach, rfs_plan_use_edges). The
  * start and the goal join the lattice through the closest legal lattice point of their
  * 3 x 3 neighbourhood that a legal segment reaches (a start inside the clearance zone:
  * the closest legal one of its 5 x 5, unchecked, so the robot can get out). The lattice
@@ -72,6 +73,9 @@ typedef struct rfs_plan {
                             ///< or the join point of a start moved (rfs_plan_tree_move)
     bool tree_defer;        ///< false (init); true (rfs_plan_tree_defer): grows only owe
     uint32_t tree_owed;     ///< points the tree's grows granted and no search closed yet
+    uint8_t (*search)(struct rfs_plan *p, uint32_t target, uint32_t budget);
+                            ///< the search loop: NULL (init) the lattice tests',
+                            ///< rfs_plan_use_edges the edge table's
 } rfs_plan_t;
 
 /// A planned path: waypoints in order, the last one the goal itself.
@@ -125,7 +129,8 @@ bool rfs_plan_tree_path(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_path_t *o
 bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *len);
 
 /// Continue the begun tree's search by at most `budget` closed lattice points (a
-/// control period's slice; the first call also clears the work, lw * lh bytes). true
+/// control period's slice, or owed: rfs_plan_tree_defer; the first call also clears the
+/// work, lw * lh bytes). true
 /// when it is done: every point the root reaches is closed (then each rfs_plan_tree_path
 /// is a walk along the back-pointers and a pull), or the root joins no lattice point, or
 /// the queue overflowed (plans to points not closed fail); false while more is left, or
@@ -141,6 +146,11 @@ bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget);
 /// from a tree rooted at (x0, y0), before string pulling. false (the tree unchanged)
 /// otherwise.
 bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t max_hop);
+
+/// Search with the map's edge table when it has one (rfs_map_edges_attach; a host
+/// option: the code for it is linked only into programs that call this). The same
+/// plans and trees, point for point.
+void rfs_plan_use_edges(rfs_plan_t *p);
 
 /// Defer the searches of rfs_plan_tree_grow (a host option: the simulator has no period
 /// budget to keep). Each grow then only adds its budget to the points owed; a plan or a

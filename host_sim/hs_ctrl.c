@@ -323,6 +323,7 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
     }
     /* No period budget to keep here: the tree's search runs when a plan needs it. */
     rfs_plan_tree_defer(&p->seek.plan, true);
+    rfs_plan_use_edges(&p->seek.plan); /* the edge table hs_sim_env_open attached */
     rfs_rng_seed(&p->rng, cfg->seed);
     c->name = rfs_seek_strategy_name(cfg->seek.strategy);
     c->self = p;

@@ -25,6 +25,7 @@ int hs_paths_lattice_reaches(const rfs_map_t *m, double sx, double sy, double gx
     int found = -1;
     if (work && queue && reach && path && rfs_plan_init(&plan, m, work, n, queue, n) == 0) {
         found = 0;
+        rfs_plan_use_edges(&plan); /* the map's edge table, if the caller attached one */
         // The queue is the flood's work memory before it is the planner's.
         if (rfs_reach_fill(m, (rfs_q16_t)lround(sx * 65536.0), (rfs_q16_t)lround(sy * 65536.0),
                            reach, queue, n ? n : 1)) {

@@ -1171,11 +1171,12 @@ static void test_tree_hop(void **state)
     assert_true(moved >= 150 && off_root >= 100 && refused >= 40 && paths >= 800);
 }
 
-/* The map's edge table (rfs_map_edges_attach, with the lattice memo as the simulator
- * attaches both) against exact_edges, which tests positions and rfs_map_segment_legal
- * for every edge: on the five kinds of map, plans and trees give the same paths bit for
- * bit after the same number of expansions, reachability as the reference's octile
- * Dijkstra, and a queue too small overflows both alike. */
+/* The map's edge table (rfs_map_edges_attach and rfs_plan_use_edges, with the lattice
+ * memo as the simulator attaches both; the table filled as the searches read it) against
+ * exact_edges, which tests positions and rfs_map_segment_legal for every edge: on the
+ * five kinds of map, plans and trees give the same paths bit for bit after the same
+ * number of expansions, reachability as the reference's octile Dijkstra, and a queue
+ * too small overflows both alike. */
 static void test_edge_table(void **state)
 {
     (void)state;
@@ -1193,6 +1194,7 @@ static void test_edge_table(void **state)
         rfs_plan_t f, e;
         assert_int_equal(rfs_plan_init(&f, &wd.m, work, sizeof(work), queue, 1024), 0);
         assert_int_equal(rfs_plan_init(&e, &wd.m, work_e, sizeof(work_e), queue_e, 1024), 0);
+        rfs_plan_use_edges(&f);
         e.exact_edges = true;
         uint32_t rs = 901u + (uint32_t)kind;
         for (int k = 0; k < 12; k++) {
@@ -1229,6 +1231,11 @@ static void test_edge_table(void **state)
                 assert_same_path(&pf, &pe);
             }
         }
+        int known = 0;
+        for (int k = 0; k < lw * lh; k++) {
+            known += (table[k] & RFS_MAP_EDGES_KNOWN) != 0u;
+        }
+        assert_true(known > lw * lh / 4);
         if (kind == 1) { /* into the closed room from outside: both fail */
             rfs_path_t pf, pe;
             const rfs_q16_t m1 = RFS_Q16_INT(1);
@@ -1242,6 +1249,7 @@ static void test_edge_table(void **state)
             const rfs_q16_t m1 = RFS_Q16_INT(1);
             assert_true(rfs_plan_path(&f, 2 * m1, 2 * m1, 2 * m1, 6 * m1, &pf));
             assert_int_equal(rfs_plan_init(&f, &wd.m, work, sizeof(work), queue, 8), 0);
+            rfs_plan_use_edges(&f);
             assert_int_equal(rfs_plan_init(&e, &wd.m, work_e, sizeof(work_e), queue_e, 8), 0);
             e.exact_edges = true;
             assert_false(rfs_plan_path(&f, 2 * m1, 2 * m1, 2 * m1, 6 * m1, &pf));

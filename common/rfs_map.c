@@ -500,14 +500,20 @@ uint32_t rfs_map_memo_entries(const rfs_map_t *m)
     return (uint32_t)m->lw * m->lh;
 }
 
-int rfs_map_memo_attach(rfs_map_t *m, uint16_t *buf, uint32_t entries)
+/* Clear a caller's per-lattice-point buffer and attach it at *slot (memo, edge table). */
+static int attach_lattice_buf(rfs_map_t *m, uint16_t *buf, uint32_t entries, uint16_t **slot)
 {
     if (buf == 0 || entries < rfs_map_memo_entries(m)) {
         return -1;
     }
     memset(buf, 0, (size_t)rfs_map_memo_entries(m) * sizeof(buf[0]));
-    m->memo = buf;
+    *slot = buf;
     return 0;
+}
+
+int rfs_map_memo_attach(rfs_map_t *m, uint16_t *buf, uint32_t entries)
+{
+    return attach_lattice_buf(m, buf, entries, &m->memo);
 }
 
 /* The step from lattice point (si, sj) towards (di, dj) of the upper half ((1, 0), (1, 1),
@@ -542,12 +548,7 @@ static const int8_t EDGE_DY[8] = {0, 1, 1, 1, 0, -1, -1, -1};
 
 int rfs_map_edges_attach(rfs_map_t *m, uint16_t *buf, uint32_t entries)
 {
-    if (buf == 0 || entries < rfs_map_memo_entries(m)) {
-        return -1;
-    }
-    memset(buf, 0, (size_t)rfs_map_memo_entries(m) * sizeof(buf[0]));
-    m->edges = buf;
-    return 0;
+    return attach_lattice_buf(m, buf, entries, &m->edges);
 }
 
 uint8_t rfs_map_lattice_edges(const rfs_map_t *m, uint16_t i, uint16_t j)

@@ -110,15 +110,15 @@ def section(seeds, wall, at, jobs, table):
          f"`/usr/bin/python3 scripts/bench_bridge.py --seeds {seeds}"
          f"{f' --jobs {jobs}' if jobs else ''}` at {at} "
          f"({'kept tables' if wall is None else f'{wall:.0f} s'}); runs end at 150 m or "
-         "600 s. *Best point*: of the true f (mean field, no fading; reachable standing "
-         "points, 0.1 m grid; hs_bridge.h). *Distance*, *shortfall* f(best) - f(end): where "
+         "600 s. *Best point*: the true f's (mean field, no fading; reachable points, 0.1 m "
+         "grid; hs_bridge.h). *Distance*, *shortfall* f(best) - f(end): where "
          "a run ends; *travel to settle*: after which it stayed within 1 m. Per node: ends "
          f"{np.nanmedian(gap):.2f} m from the predicted point; fitted nodes "
          f"{np.nanmedian(fit_err):.1f} m off (p90 {np.nanpercentile(fit_err, 90):.1f}), W "
          f"{', '.join(fit_w)} dB (true 5, 5, 3, 3). Cells: median (p90). *paper*: meta + ridge on f; *per node*: meta-path + "
          "pathloss.", "",
          "| scenario | configuration | within 3 m | distance, m | shortfall, dB | "
-         "travel to settle, m | runner-up over 3 m off within 3 dB |",
+         "travel to settle, m | runner-up (over 3 m off) within 3 dB |",
          "|---|---|---|---|---|---|---|"]
     for sc, cfgs in table:
         for (_, _, label), s in cfgs:

@@ -284,17 +284,12 @@ static bool predict_k(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t *val
         while (ring_next(s, &ring, &i, &j)) {
             scan_cell_k(s, (uint32_t)(j * s->gw + i), qx, qy, &b);
         }
-        int64_t reach = (int64_t)r * c8;
         // NOLINTNEXTLINE(clang-analyzer-core.UndefinedBinaryOperatorResult): valid needs n >= 1, so k >= 1
-        if (b.m == b.k && reach * reach >= b.d2[b.m - 1u]) {
+        if (b.m != 0u && rfs_knn_ring_done(b.m, b.k, b.d2[b.m - 1u], r, c8)) {
             break;
         }
     }
-    int32_t sum = 0;
-    for (uint32_t i = 0u; i < b.m; ++i) {
-        sum += b.v[i];
-    }
-    *value = rfs_knn_mean_q16(sum, b.m);
+    *value = rfs_knn_mean_of(b.v, b.m);
     return true;
 }
 

@@ -27,6 +27,25 @@ static inline rfs_q16_t rfs_knn_mean_q16(int32_t sum_q6, uint32_t count)
     return rfs_sat32(rfs_sdiv64_round((int64_t)sum_q6 * 1024, (int64_t)count));
 }
 
+/* The k values found (Q9.6), their mean in Q16.16 (rfs_knn_mean_q16). */
+static inline rfs_q16_t rfs_knn_mean_of(const int16_t *v, uint32_t m)
+{
+    int32_t sum = 0;
+    for (uint32_t i = 0u; i < m; ++i) {
+        sum += v[i];
+    }
+    return rfs_knn_mean_q16(sum, m);
+}
+
+/* A ring search may stop after ring r: k found (m == k >= 1) and every cell of ring r + 1
+ * lies at least r cells of c8 (cm Q8) away, beyond the k-th distance d2_k.
+ * Scaling and overflow: r * c8 below 2^31, its square below 2^62. */
+static inline bool rfs_knn_ring_done(uint32_t m, uint32_t k, int64_t d2_k, int32_t r, int32_t c8)
+{
+    const int64_t reach = (int64_t)r * c8;
+    return m == k && reach * reach >= d2_k;
+}
+
 /* Squared distance from the query (cm Q8) to a sample, (cm Q8)^2: each difference is
  * below 2^27, the sum of squares below 2^55. */
 static inline int64_t rfs_knn_dist2(const rfs_sample_t *p, int32_t qx, int32_t qy)

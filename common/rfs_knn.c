@@ -295,15 +295,12 @@ static bool predict_k(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t *val
 
 static bool predict_radius(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t *value)
 {
-    int32_t r8 = (int32_t)(((int64_t)s->cfg.radius * 100 + 128) >> 8);
-    int64_t r2 = (int64_t)r8 * r8;
-    int32_t c8 = (int32_t)s->cell_cm * 256;
-    int32_t rx = qx - (int32_t)s->min_x_cm * 256;
-    int32_t ry = qy - (int32_t)s->min_y_cm * 256;
-    if (rx + r8 < 0 || ry + r8 < 0 || rx - r8 >= (int32_t)s->gw * c8 ||
-        ry - r8 >= (int32_t)s->gh * c8) {
+    rfs_knn_rq_t q;
+    if (!rfs_knn_radius_query(s, qx, qy, &q)) {
         return false;
     }
+    const int32_t r8 = q.r8, c8 = q.c8, rx = q.rx, ry = q.ry;
+    const int64_t r2 = q.r2;
     int32_t i0 = rfs_knn_axis_cell(rx - r8, c8, s->gw), i1 = rfs_knn_axis_cell(rx + r8, c8, s->gw);
     int32_t j0 = rfs_knn_axis_cell(ry - r8, c8, s->gh), j1 = rfs_knn_axis_cell(ry + r8, c8, s->gh);
     int32_t sum = 0;

@@ -269,15 +269,12 @@ static int32_t sub_axis_q8(int64_t rel_q8, int32_t c8, uint8_t cells)
 static bool predict_radius_index(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_q16_t *value)
 {
     const rfs_knn_index_t *ix = s->index;
-    int32_t r8 = (int32_t)(((int64_t)s->cfg.radius * 100 + 128) >> 8);
-    int64_t r2 = (int64_t)r8 * r8;
-    int32_t c8 = (int32_t)s->cell_cm * 256;
-    int32_t rx = qx - (int32_t)s->min_x_cm * 256;
-    int32_t ry = qy - (int32_t)s->min_y_cm * 256;
-    if (rx + r8 < 0 || ry + r8 < 0 || rx - r8 >= (int32_t)s->gw * c8 ||
-        ry - r8 >= (int32_t)s->gh * c8) {
+    rfs_knn_rq_t q;
+    if (!rfs_knn_radius_query(s, qx, qy, &q)) {
         return false;
     }
+    const int32_t r8 = q.r8, c8 = q.c8, rx = q.rx, ry = q.ry;
+    const int64_t r2 = q.r2;
     int32_t i0 = sub_axis_q8((int64_t)rx - r8, c8, s->gw), i1 = sub_axis_q8((int64_t)rx + r8, c8, s->gw);
     int32_t j0 = sub_axis_q8((int64_t)ry - r8, c8, s->gh), j1 = sub_axis_q8((int64_t)ry + r8, c8, s->gh);
     uint32_t fw = (uint32_t)s->gw * RFS_KNN_FINE;

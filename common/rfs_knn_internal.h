@@ -27,6 +27,30 @@ static inline rfs_q16_t rfs_knn_mean_q16(int32_t sum_q6, uint32_t count)
     return rfs_sat32(rfs_sdiv64_round((int64_t)sum_q6 * 1024, (int64_t)count));
 }
 
+/* A radius query in grid terms: the radius r8 (cm Q8) and its square, the cell side c8
+ * (cm Q8), the query relative to the grid's origin (rx, ry, cm Q8). */
+typedef struct rfs_knn_rq {
+    int32_t r8;
+    int64_t r2;
+    int32_t c8;
+    int32_t rx;
+    int32_t ry;
+} rfs_knn_rq_t;
+
+/* Fill *q for the query (qx, qy) (cm Q8); false when the radius's box misses the grid.
+ * Scaling and overflow: the radius (Q16 m, <= 2^31) in cm Q8 below 2^31, its square in
+ * int64; the grid (at most RFS_KNN_GRID cells of cell_cm a side) in cm Q8 below 2^31. */
+static inline bool rfs_knn_radius_query(const rfs_knn_t *s, int32_t qx, int32_t qy, rfs_knn_rq_t *q)
+{
+    q->r8 = (int32_t)(((int64_t)s->cfg.radius * 100 + 128) >> 8);
+    q->r2 = (int64_t)q->r8 * q->r8;
+    q->c8 = (int32_t)s->cell_cm * 256;
+    q->rx = qx - (int32_t)s->min_x_cm * 256;
+    q->ry = qy - (int32_t)s->min_y_cm * 256;
+    return !(q->rx + q->r8 < 0 || q->ry + q->r8 < 0 || q->rx - q->r8 >= (int32_t)s->gw * q->c8 ||
+             q->ry - q->r8 >= (int32_t)s->gh * q->c8);
+}
+
 /* The k values found (Q9.6), their mean in Q16.16 (rfs_knn_mean_q16). */
 static inline rfs_q16_t rfs_knn_mean_of(const int16_t *v, uint32_t m)
 {

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/types.h>
@@ -175,9 +176,10 @@ static void progress(uint64_t done, uint64_t total, uint64_t reached, bool place
     fflush(stderr);
 }
 
-/* One --seeds batch: its runs not yet done shared among jobs worker processes, each
- * result sent to the parent through a pipe. Without placements run i is seed a + i; with
- * them, seed a + i % nseeds at placement places[i / nseeds]. */
+/* One --seeds batch: its runs not yet done shared among jobs worker processes (each takes
+ * the next one not taken when it is free), each result sent to the parent through a pipe.
+ * Without placements run i is seed a + i; with them, seed a + i % nseeds at placement
+ * places[i / nseeds]. */
 typedef struct batch {
     hs_sim_env_t *env;    /* each worker's copy is placed as its runs need */
     uint64_t a, nseeds;   /* seeds a .. a + nseeds - 1 */
@@ -185,6 +187,7 @@ typedef struct batch {
     uint64_t nplaces;     /* their count (0 without) */
     uint64_t total;       /* runs: nseeds, or nseeds x nplaces */
     uint64_t *todo, ntodo; /* the runs to do (indices) */
+    uint64_t *next;       /* shared by the workers (MAP_SHARED): the next todo to take */
     int jobs;
     const char *dir;      /* per-run directories and runs.tsv in it, or NULL: stdout */
     bool samples, quiet;
@@ -233,9 +236,9 @@ static int run_place(const batch_t *bt, uint64_t i, char *msg, size_t msglen)
                             pl->start_theta, pl->source_x, pl->source_y, msg, msglen);
 }
 
-/* Worker j: its runs (todo[j], todo[j + jobs], ...), each run and its result written to
- * the pipe; exits 1 after the first failure. */
-static _Noreturn void batch_worker(const batch_t *bt, int j)
+/* A worker: the runs not yet taken, one at a time, each run and its result written to the
+ * pipe; exits 1 after the first failure. */
+static _Noreturn void batch_worker(const batch_t *bt)
 {
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);
@@ -245,7 +248,7 @@ static _Noreturn void batch_worker(const batch_t *bt, int j)
         _exit(1);
     }
     close(bt->fds[0]);
-    for (uint64_t k = (uint64_t)j; k < bt->ntodo; k += (uint64_t)bt->jobs) {
+    for (uint64_t k; (k = __atomic_fetch_add(bt->next, 1, __ATOMIC_RELAXED)) < bt->ntodo;) {
         const uint64_t i = bt->todo[k], s = bt->a + i % bt->nseeds;
         wire_res_t w;
         memset(&w, 0, sizeof w);
@@ -298,7 +301,7 @@ static int batch_fork(batch_t *bt)
             return 1;
         }
         if (pid == 0) {
-            batch_worker(bt, j);
+            batch_worker(bt);
         }
         bt->pids[j] = pid;
     }
@@ -565,7 +568,10 @@ int hs_batch_run(hs_sim_env_t *env, const char *header, uint64_t a, uint64_t b,
     }
     bt.jobs = (uint64_t)jobs > bt.ntodo ? (int)(bt.ntodo > 0 ? bt.ntodo : 1) : jobs;
     bt.pids = calloc((size_t)bt.jobs, sizeof *bt.pids);
-    if (rc == 0 && (!bt.pids || pipe(bt.fds) != 0)) {
+    void *shared = mmap(NULL, sizeof *bt.next, PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS,
+                        -1, 0);
+    bt.next = shared == MAP_FAILED ? NULL : shared;
+    if (rc == 0 && (!bt.pids || !bt.next || pipe(bt.fds) != 0)) {
         fprintf(stderr, "%s: out of memory\n", prog);
         rc = 1;
     }
@@ -599,5 +605,8 @@ int hs_batch_run(hs_sim_env_t *env, const char *header, uint64_t a, uint64_t b,
         free(bt.rows[i]);
     }
     free(bt.rows); free(bt.todo); free(bt.pids);
+    if (bt.next) {
+        munmap(bt.next, sizeof *bt.next);
+    }
     return rc;
 }

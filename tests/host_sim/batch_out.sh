@@ -3,8 +3,8 @@
 # seed, no wrap) and one too large (refused), stdout on /dev/full (single and batch), a
 # full disk (a 200 KB tmpfs: one error line, nothing left), and a batch interrupted by
 # SIGINT / SIGTERM / SIGKILL then continued with --resume to the very table an
-# uninterrupted batch writes; scripts/merge_runs.py on an interrupted directory names the
-# missing seeds.
+# uninterrupted batch writes (and one, two or three workers the same table);
+# scripts/merge_runs.py on an interrupted directory names the missing seeds.
 #   tests/host_sim/batch_out.sh build/bin/rfseek-sim        (from the repository root)
 set -uo pipefail
 SIM=${1:?usage: batch_out.sh path/to/rfseek-sim}
@@ -84,6 +84,10 @@ interrupt() {
     wait $pid
 }
 "$SIM" $SCN --seeds 1..40 --jobs 2 --quiet --out "$T/whole" 2>/dev/null
+# Workers take runs as they come free: any number of them writes the single process's table.
+"$SIM" $SCN --seeds 1..40 --quiet --out "$T/one" 2>/dev/null
+"$SIM" $SCN --seeds 1..40 --jobs 3 --quiet --out "$T/three" 2>/dev/null
+check "jobs-same-table" 'cmp "$T/one/runs.tsv" "$T/whole/runs.tsv" && cmp "$T/one/runs.tsv" "$T/three/runs.tsv"'
 for sig in INT TERM; do
     d=$T/cut$sig
     interrupt $sig "$d"

@@ -118,6 +118,10 @@ typedef struct rfs_pathloss_cfg {
     rfs_q16_t footprint;    ///< metres Q16.16: a bin's wall counts start this far either
                             ///< side of its cell's centre, along x and y (0.25 m; 0: from
                             ///< the centre alone), 0..bin / 2
+    rfs_q16_t coarse_footprint; ///< metres Q16.16: the footprint of the coarse candidates'
+                            ///< counts (0: one count a bin). Unless equal to footprint the
+                            ///< coarse pass only ranks: the refinement re-evaluates the
+                            ///< top points with footprint (docs/PATHLOSS.md, "Fit")
     rfs_q16_t hold_k;       ///< a relearn keeps the previous fit's source when its loss is
                             ///< within best (1 + hold_k / bins) (6.0; 0: off, always the
                             ///< least loss): no jumping between sources the data cannot
@@ -200,6 +204,7 @@ typedef struct rfs_pathloss_ev {
     rfs_q16_t sx;    ///< its position, metres Q16.16
     rfs_q16_t sy;
     int32_t col;     ///< its wall-count cache column, -1 when none
+    rfs_q16_t fp;    ///< its counts' footprint (cfg footprint or coarse_footprint), m Q16.16
     uint32_t c;      ///< its coarse surface index (coarse candidates)
     uint32_t b;      ///< next bin to gather
 } rfs_pathloss_ev_t;

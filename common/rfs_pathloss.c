@@ -480,7 +480,7 @@ static void ev_start(rfs_pathloss_t *p, uint16_t li, uint16_t lj, uint8_t kind, 
  * "Fit", step 4): its top points are evaluated again in the refinement. */
 static bool coarse_ranks(const rfs_pathloss_t *p)
 {
-    return p->cfg.coarse_footprint != p->cfg.footprint;
+    return p->map != 0 && p->cfg.coarse_footprint != p->cfg.footprint;
 }
 
 static void consider(rfs_pathloss_t *p, const rfs_pathloss_cand_t *cd)

@@ -510,8 +510,9 @@ static void keep_top(rfs_pathloss_t *p, const rfs_pathloss_cand_t *cd)
     }
 }
 
-/* True when lattice point (i, j) was evaluated in this fit: a coarse point, or one of the
- * remembered refinement points (remembered here when it was not). */
+/* True when lattice point (i, j) was evaluated in this fit with the footprint: a coarse
+ * point (unless the coarse pass only ranked), or one of the remembered refinement points
+ * (remembered here when it was not). */
 static bool seen_before(rfs_pathloss_t *p, int32_t i, int32_t j)
 {
     const rfs_pathloss_lat_t *l = &p->lat;

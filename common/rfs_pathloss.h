@@ -23,7 +23,10 @@
  * the number of samples. Candidates are legal lattice points, searched coarse to fine:
  * every `coarse` (2 m), then the 8 neighbours of each of the best `top` (3) at half that
  * spacing (1 m), then the 8 neighbours of the best so far at half the spacing again,
- * down to the lattice spacing (0.5 m, 0.25 m). A point is evaluated once per fit.
+ * down to the lattice spacing (0.5 m, 0.25 m). A point is evaluated once per fit, but
+ * for the top points when the coarse pass counted walls with its own footprint
+ * (`coarse_footprint`, one count a bin by default): its losses then only rank, and the
+ * refinement evaluates the top points again with `footprint`.
  * Without a map (fit_in.map NULL) the candidates cover the samples' extent plus
  * `margin` on a 0.25 m lattice, and there are no walls.
  *
@@ -37,8 +40,8 @@
  * centroid, along x and y (a point that is not legal counts as the centre), in quarter
  * walls. A bin's mean is an average over where its samples were taken, and on a
  * cluttered map one line's count jumps by several walls within centimetres of where it
- * starts (footprint 0: the centre's count alone). The counts are cached across fits,
- * RFS_PATHLOSS_CACHE_ROWS origins x the first candidates evaluated (a byte each; a count
+ * starts (footprint 0: the centre's count alone; the coarse pass's: coarse_footprint,
+ * cached apart). The counts are cached across fits, RFS_PATHLOSS_CACHE_ROWS origins x the first candidates evaluated (a byte each; a count
  * saturates at 15 walls): RFS_PATHLOSS_CACHE_COLS of them built in (the first legal
  * coarse candidates), or as many as a caller's buffer holds
  * (rfs_pathloss_cache_attach(): every coarse, refinement and hold candidate of a run).

@@ -76,6 +76,9 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
     /* A quarter of the 1 m bin: the four points sit at the centres of the bin's quarters
      * when its centroid is central (docs/PATHLOSS.md, "A bin's walls"). */
     c.footprint = RFS_Q16_FRAC(1, 4);
+    /* The coarse pass counts as the refinement does (0: one count a bin, the coarse points
+     * then only rank: a quarter of their counts, docs/PATHLOSS.md, "A bin's walls"). */
+    c.coarse_footprint = c.footprint;
     return c;
 }
 
@@ -97,6 +100,7 @@ int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg)
               c->huber <= RFS_Q16_INT(100) && c->spread_k >= 0 &&
               c->spread_k <= RFS_Q16_INT(1000) && c->margin >= 0 && c->hold_k >= 0 &&
               c->hold_k <= RFS_Q16_INT(64) && c->footprint >= 0 && c->footprint <= c->bin / 2 &&
+              c->coarse_footprint >= 0 && c->coarse_footprint <= c->bin / 2 &&
               c->margin <= RFS_Q16_INT(100) && c->sample_t >= RFS_Q16_FRAC(1, 16) &&
               c->sample_t <= RFS_Q16_INT(64);
     if (!ok) {
@@ -466,9 +470,17 @@ static void ev_start(rfs_pathloss_t *p, uint16_t li, uint16_t lj, uint8_t kind, 
     p->ev.li = li;
     p->ev.lj = lj;
     rfs_pathloss_lattice_xy(&p->lat, li, lj, &p->ev.sx, &p->ev.sy);
-    p->ev.col = rfs_pathloss_walls_col(p, li, lj);
+    p->ev.col = rfs_pathloss_walls_col(p, li, lj, kind == EV_COARSE);
+    p->ev.fp = kind == EV_COARSE ? p->cfg.coarse_footprint : p->cfg.footprint;
     p->ev.c = c;
     p->ev.b = 0u;
+}
+
+/* The coarse pass counts with its own footprint, so it only ranks (docs/PATHLOSS.md,
+ * "Fit", step 4): its top points are evaluated again in the refinement. */
+static bool coarse_ranks(const rfs_pathloss_t *p)
+{
+    return p->map != 0 && p->cfg.coarse_footprint != p->cfg.footprint;
 }
 
 static void consider(rfs_pathloss_t *p, const rfs_pathloss_cand_t *cd)
@@ -498,13 +510,14 @@ static void keep_top(rfs_pathloss_t *p, const rfs_pathloss_cand_t *cd)
     }
 }
 
-/* True when lattice point (i, j) was evaluated in this fit: a coarse point, or one of the
- * remembered refinement points (remembered here when it was not). */
+/* True when lattice point (i, j) was evaluated in this fit with the footprint: a coarse
+ * point (unless the coarse pass only ranked), or one of the remembered refinement points
+ * (remembered here when it was not). */
 static bool seen_before(rfs_pathloss_t *p, int32_t i, int32_t j)
 {
     const rfs_pathloss_lat_t *l = &p->lat;
     int32_t ci = i - l->c0i, cj = j - l->c0j;
-    if (ci >= 0 && cj >= 0 && ci % l->cs == 0 && cj % l->cs == 0) {
+    if (!coarse_ranks(p) && ci >= 0 && cj >= 0 && ci % l->cs == 0 && cj % l->cs == 0) {
         return true;
     }
     for (uint32_t k = 0u; k < p->nvis; ++k) {
@@ -696,6 +709,9 @@ static bool ev_run(rfs_pathloss_t *p, uint32_t budget, uint32_t *used)
     if (p->ev.kind == EV_COARSE) {
         p->surface[p->ev.c] = rfs_pathloss_mean_loss(p, cd.loss);
         keep_top(p, &cd);
+        if (coarse_ranks(p)) {
+            return true;
+        }
     }
     consider(p, &cd);
     return true;
@@ -785,7 +801,9 @@ static bool refine_next(rfs_pathloss_t *p, rfs_fit_result_t *res)
     int32_t cj = p->phase == RFS_PATHLOSS_REFINE ? p->top[k].lj : p->fc_j;
     int32_t i, j;
     neighbour(ci, cj, rem, p->step, &i, &j);
-    if (rem != 4u && cand_legal(p, i, j) && !seen_before(p, i, j)) {
+    /* A top point itself (rem 4) when the coarse pass only ranked it. */
+    const bool centre = rem == 4u && !(p->phase == RFS_PATHLOSS_REFINE && coarse_ranks(p));
+    if (!centre && cand_legal(p, i, j) && !seen_before(p, i, j)) {
         ev_start(p, (uint16_t)i, (uint16_t)j, EV_REFINE, 0u);
     }
     return false;

@@ -23,7 +23,10 @@
  * the number of samples. Candidates are legal lattice points, searched coarse to fine:
  * every `coarse` (2 m), then the 8 neighbours of each of the best `top` (3) at half that
  * spacing (1 m), then the 8 neighbours of the best so far at half the spacing again,
- * down to the lattice spacing (0.5 m, 0.25 m). A point is evaluated once per fit.
+ * down to the lattice spacing (0.5 m, 0.25 m). A point is evaluated once per fit, but
+ * for the top points when the coarse pass counted walls with its own footprint
+ * (`coarse_footprint`, the footprint by default; 0: one count a bin): its losses then only
+ * rank, and the refinement evaluates the top points again with `footprint`.
  * Without a map (fit_in.map NULL) the candidates cover the samples' extent plus
  * `margin` on a 0.25 m lattice, and there are no walls.
  *
@@ -37,8 +40,8 @@
  * centroid, along x and y (a point that is not legal counts as the centre), in quarter
  * walls. A bin's mean is an average over where its samples were taken, and on a
  * cluttered map one line's count jumps by several walls within centimetres of where it
- * starts (footprint 0: the centre's count alone). The counts are cached across fits,
- * RFS_PATHLOSS_CACHE_ROWS origins x the first candidates evaluated (a byte each; a count
+ * starts (footprint 0: the centre's count alone; the coarse pass's: coarse_footprint,
+ * cached apart). The counts are cached across fits, RFS_PATHLOSS_CACHE_ROWS origins x the first candidates evaluated (a byte each; a count
  * saturates at 15 walls): RFS_PATHLOSS_CACHE_COLS of them built in (the first legal
  * coarse candidates), or as many as a caller's buffer holds
  * (rfs_pathloss_cache_attach(): every coarse, refinement and hold candidate of a run).
@@ -118,6 +121,11 @@ typedef struct rfs_pathloss_cfg {
     rfs_q16_t footprint;    ///< metres Q16.16: a bin's wall counts start this far either
                             ///< side of its cell's centre, along x and y (0.25 m; 0: from
                             ///< the centre alone), 0..bin / 2
+    rfs_q16_t coarse_footprint; ///< metres Q16.16: the footprint of the coarse candidates'
+                            ///< counts (0.25 m, as footprint; 0: one count a bin, about
+                            ///< half the counts of a fit). Unless equal to footprint the
+                            ///< coarse pass only ranks: the refinement re-evaluates the
+                            ///< top points with footprint (docs/PATHLOSS.md, "Fit")
     rfs_q16_t hold_k;       ///< a relearn keeps the previous fit's source when its loss is
                             ///< within best (1 + hold_k / bins) (6.0; 0: off, always the
                             ///< least loss): no jumping between sources the data cannot
@@ -200,6 +208,7 @@ typedef struct rfs_pathloss_ev {
     rfs_q16_t sx;    ///< its position, metres Q16.16
     rfs_q16_t sy;
     int32_t col;     ///< its wall-count cache column, -1 when none
+    rfs_q16_t fp;    ///< its counts' footprint (cfg footprint or coarse_footprint), m Q16.16
     uint32_t c;      ///< its coarse surface index (coarse candidates)
     uint32_t b;      ///< next bin to gather
 } rfs_pathloss_ev_t;

@@ -48,9 +48,11 @@ void rfs_pathloss_walls_assign(rfs_pathloss_t *p);
 uint32_t rfs_pathloss_walls_line(const rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,
                                  rfs_q16_t sy);
 
-/* The cache column of lattice point (li, lj): found, or the next free one; -1 when the
- * cache is full (its counts are then not kept) or there is no map. */
-int32_t rfs_pathloss_walls_col(rfs_pathloss_t *p, uint16_t li, uint16_t lj);
+/* The cache column of lattice point (li, lj) counted with footprint `coarse` ? the
+ * coarse candidates' : cfg footprint (one column when both are equal): found, or the next
+ * free one; -1 when the cache is full (its counts are then not kept), lj >= 2^15 with two
+ * footprints, or there is no map. */
+int32_t rfs_pathloss_walls_col(rfs_pathloss_t *p, uint16_t li, uint16_t lj, bool coarse);
 
 /* Bin bb's walls to the candidate in p->ev, in quarter walls (0..4 x WALLS_MAX): from
  * the cache when counted before, else counted (and cached when the bin has a row and the

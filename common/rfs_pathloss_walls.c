@@ -131,15 +131,17 @@ void rfs_pathloss_walls_assign(rfs_pathloss_t *p)
     }
 }
 
-int32_t rfs_pathloss_walls_col(rfs_pathloss_t *p, uint16_t li, uint16_t lj)
+int32_t rfs_pathloss_walls_col(rfs_pathloss_t *p, uint16_t li, uint16_t lj, bool coarse)
 {
-    if (p->map == 0) {
+    const bool two = p->cfg.coarse_footprint != p->cfg.footprint;
+    if (p->map == 0 || (two && lj >= 0x8000u)) {
         return -1;
     }
     rfs_pathloss_xcache_t c = cache_of(p);
-    const uint32_t key = (uint32_t)li | (uint32_t)lj << 16;
+    /* The coarse footprint's column of a point is keyed apart (bit 31). */
+    const uint32_t key = (uint32_t)li | (uint32_t)lj << 16 | (two && coarse ? 1u << 31 : 0u);
     const uint32_t mask = (1u << c.hash_bits) - 1u;
-    uint32_t h = ((uint32_t)li * 0x9E3779B1u + (uint32_t)lj * 0x85EBCA77u) >> (32u - c.hash_bits);
+    uint32_t h = ((uint32_t)li * 0x9E3779B1u + (key >> 16) * 0x85EBCA77u) >> (32u - c.hash_bits);
     while (c.col_hash[h] != 0u) {
         if (c.col_key[c.col_hash[h] - 1u] == key) {
             return (int32_t)c.col_hash[h] - 1;
@@ -178,7 +180,7 @@ static uint32_t walls_to(rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t 
 static uint32_t footprint_walls(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb, rfs_q16_t sx,
                                 rfs_q16_t sy)
 {
-    const rfs_q16_t f = p->cfg.footprint;
+    const rfs_q16_t f = p->ev.fp;
     if (f == 0) {
         return RFS_PATHLOSS_FOOTPRINT_RAYS * walls_to(p, bb->wx, bb->wy, sx, sy);
     }

@@ -44,6 +44,7 @@ hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void)
     c.seed = 1;
     c.period_us = 50000;
     c.p0_min_dbm = NAN;
+    c.coarse_footprint_m = NAN;
     return c;
 }
 
@@ -150,16 +151,29 @@ static void open_cellsum(inproc_t *p, const rfs_map_t *map, uint16_t capacity)
     }
 }
 
-/* The path-loss model's options: P0 bounded by the node's transmit power when known
- * (docs/PATHLOSS.md, "The P0 floor"), and the simulator's large wall-count cache. 0, or
- * -1 with the reason in err. */
-static int open_pathloss(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, char *err, size_t errlen)
+/* The scenario's path-loss settings into pc: P0 bounded by the node's transmit power when
+ * known (docs/PATHLOSS.md, "The P0 floor") and the coarse pass's footprint ("Fit"). */
+static void pathloss_options(const hs_ctrl_inproc_cfg_t *cfg, rfs_pathloss_cfg_t *pc)
 {
     if (!isnan(cfg->p0_min_dbm)) {
+        pc->p0_min = (rfs_q16_t)lround(fmax(-200.0, fmin(100.0, cfg->p0_min_dbm)) * 65536.0);
+    }
+    if (!isnan(cfg->coarse_footprint_m)) {
+        pc->coarse_footprint =
+            (rfs_q16_t)lround(fmax(0.0, fmin(0.5, cfg->coarse_footprint_m)) * 65536.0);
+    }
+}
+
+/* The path-loss model's options (pathloss_options) and the simulator's large wall-count
+ * cache. 0, or -1 with the reason in err. */
+static int open_pathloss(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, char *err, size_t errlen)
+{
+    if (!isnan(cfg->p0_min_dbm) || !isnan(cfg->coarse_footprint_m)) {
         rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
-        pc.p0_min = (rfs_q16_t)lround(fmax(-200.0, fmin(100.0, cfg->p0_min_dbm)) * 65536.0);
+        pathloss_options(cfg, &pc);
         if (rfs_pathloss_init(p->model_state, &pc) != 0) {
-            snprintf(err, errlen, "model: pathloss: p0_min_dbm %g rejected", cfg->p0_min_dbm);
+            snprintf(err, errlen, "model: pathloss: p0_min_dbm %g or coarse_footprint_m %g rejected",
+                     cfg->p0_min_dbm, cfg->coarse_footprint_m);
             return -1;
         }
     }
@@ -178,9 +192,7 @@ static int open_fields(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, const rfs_m
                        const rfs_target_ops_t *target)
 {
     rfs_fields_cfg_t fc = rfs_fields_cfg_default();
-    if (!isnan(cfg->p0_min_dbm)) {
-        fc.pathloss.p0_min = (rfs_q16_t)lround(fmax(-200.0, fmin(100.0, cfg->p0_min_dbm)) * 65536.0);
-    }
+    pathloss_options(cfg, &fc.pathloss);
     uint32_t points, cells;
     rfs_fields_mem_size(map, &fc, &points, &cells);
     p->fmem.points = points;

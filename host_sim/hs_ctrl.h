@@ -66,6 +66,8 @@ typedef struct hs_ctrl_inproc_cfg {
     int64_t period_us;      ///< control period, microseconds (50,000)
     double p0_min_dbm;      ///< pathloss model only: floor on the signal at 1 m, dBm, in
                             ///< [-200, 100] (NAN: the model's default, -45)
+    double coarse_footprint_m; ///< pathloss model only: its coarse pass's footprint,
+                            ///< metres, in [0, 0.5] (NAN: the model's default, 0)
 } hs_ctrl_inproc_cfg_t;
 
 /// Defaults: the paper's seeker, local ridge, RSSI of one source, 20 Hz.

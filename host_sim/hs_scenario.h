@@ -11,7 +11,8 @@
  *                                  #       recheck_adapt: true, eps_sample: true, refute_m: 1,
  *                                  #       silence_floor: true, refute_reached: false,
  *                                  #       recheck_silent: true,
- *                                  #       p0_min_dbm: -32, local_m: 0, leg_m: 0}
+ *                                  #       p0_min_dbm: -32, local_m: 0, leg_m: 0,
+ *                                  #       coarse_footprint_m: 0.25}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2
@@ -91,6 +92,9 @@ typedef struct hs_scenario {
     double seek_p0_min_dbm;       ///< seek.p0_min_dbm: the pathloss model's floor on the
                                   ///< signal at 1 m, dBm (NAN = its default, -45; other
                                   ///< models ignore it; docs/PATHLOSS.md "The P0 floor")
+    double seek_coarse_footprint_m; ///< seek.coarse_footprint_m: the pathloss model's
+                                  ///< coarse-pass footprint, metres (NAN = its default, 0;
+                                  ///< 0.25: every count with the footprint, docs/PATHLOSS.md)
     unsigned nsources;            ///< sources
     hs_scn_source_t src[HS_SCN_MAX_SOURCES]; ///< the sources
     double start_x, start_y;      ///< robot start, metres

@@ -10,8 +10,10 @@
  * test_map.c), because they are the model's definition of a wall: a bin's walls are the
  * mean of the counts (each saturated at 15) from the four points `footprint` either side
  * of the centre of the core cell holding its centroid, along x and y, a point that is not
- * legal (rfs_map_point_legal) counting from the centre. A candidate within excl_r of a
- * place ruled out is not legal. No cache.
+ * legal (rfs_map_point_legal) counting from the centre. The coarse points count with
+ * `coarse_footprint` instead; when that differs from `footprint` (and there is a map) they
+ * only choose the top points, all of which the refinement evaluates afresh. A candidate
+ * within excl_r of a place ruled out is not legal. No cache.
  */
 #ifndef REF_PATHLOSS_H
 #define REF_PATHLOSS_H
@@ -38,6 +40,7 @@ typedef struct ref_pl_cfg {
     int nexcl;        /* places ruled out: no candidate within excl_r of (ex[e], ey[e]) */
     double ex[8], ey[8], excl_r;
     double p0_max; /* strongest plausible P0; a fit above adds total x Huber(P0 - p0_max) */
+    double coarse_footprint; /* m: the footprint of the coarse points' counts */
 } ref_pl_cfg_t;
 
 typedef struct ref_pl_bin {
@@ -65,6 +68,7 @@ typedef struct ref_pl {
     double surface[REF_PL_MAX_COARSE]; /* sqrt(2 mean loss), dB; NAN: no candidate */
     int candidates;
     unsigned char *seen; /* lattice points evaluated */
+    double fp;           /* m: the footprint of the counts being made */
     double L[REF_PL_MAX_BINS];
     double K[REF_PL_MAX_BINS];
 } ref_pl_t;
@@ -72,7 +76,7 @@ typedef struct ref_pl {
 static inline ref_pl_cfg_t ref_pl_cfg_default(void)
 {
     ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5, 30.0, -45.0,
-                      0.25, 0, {0}, {0}, 0.0, -10.0};
+                      0.25, 0, {0}, {0}, 0.0, -10.0, 0.25};
     return c;
 }
 
@@ -218,7 +222,7 @@ static inline double ref_pl_eval(ref_pl_t *r, int i, int j, double *pn, double *
             }
             int c0 = rfs_map_walls_crossed(r->map, bx, by, qx, qy);
             c0 = c0 > 15 ? 15 : c0;
-            rfs_q16_t f = (rfs_q16_t)lround(r->cfg.footprint * 65536.0);
+            rfs_q16_t f = (rfs_q16_t)lround(r->fp * 65536.0);
             for (int q = 0; q < 4; ++q) {
                 rfs_q16_t px = bx + ((q & 1) ? f : -f), py = by + ((q & 2) ? f : -f);
                 int c = c0;
@@ -336,6 +340,7 @@ static inline bool ref_pl_fit(ref_pl_t *r, const rfs_sample_t *s, int n, const r
     ref_pl_bin_samples(r, s, n);
     ref_pl_lattice(r);
     r->seen = calloc((size_t)r->lw * r->lh, 1);
+    r->fp = cfg->coarse_footprint;
     int ti[8], tj[8];
     double tl[8];
     int nt = 0;
@@ -369,6 +374,12 @@ static inline bool ref_pl_fit(ref_pl_t *r, const rfs_sample_t *s, int n, const r
     /* 8 neighbours of each top candidate at half the coarse spacing, then of the best so
      * far at half the spacing again, down to one lattice step */
     int h = r->cs / 2 < 1 ? 1 : r->cs / 2;
+    if (map != NULL && cfg->coarse_footprint != cfg->footprint) {
+        /* The coarse losses only ranked: start afresh (the top points included). */
+        memset(r->seen, 0, (size_t)r->lw * r->lh);
+        r->loss = INFINITY;
+    }
+    r->fp = cfg->footprint;
     for (int k = 0; k < nt; ++k) {
         for (int b = -1; b <= 1; ++b) {
             for (int a = -1; a <= 1; ++a) {
@@ -397,6 +408,7 @@ static inline bool ref_pl_fit(ref_pl_t *r, const rfs_sample_t *s, int n, const r
 static inline double ref_pl_hold(ref_pl_t *r, int i, int j, bool local, int *bi, int *bj)
 {
     r->seen = calloc((size_t)r->lw * r->lh, 1);
+    r->fp = r->cfg.footprint;
     double n, w, p0;
     double best = ref_pl_eval(r, i, j, &n, &w, &p0);
     *bi = i;

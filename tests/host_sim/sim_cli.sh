@@ -65,6 +65,19 @@ if [ -s "$T/p0cli.json" ] && cmp -s <(same "$T/p0cli.json") <(same "$T/p0key.jso
 else
     fail p0_min_cli_equals_key "$(head -c 300 "$T/p0cli.json") / $(head -c 300 "$T/p0key.json")"
 fi
+# seek.coarse_footprint_m reaches the model: on the office (walls), 0 (the coarse pass at one
+# count a bin) changes the run; 0.25, the default, does not (docs/PATHLOSS.md).
+for cf in def 0 0.25; do
+    { sed "s|^map: .*|map: $(realpath scenarios/maps/office.yaml)|" scenarios/default.yaml
+      [ "$cf" = def ] || echo "seek: {coarse_footprint_m: $cf}"; } >"$T/cf$cf.yaml"
+    "$SIM" "$T/cf$cf.yaml" --model pathloss --strategy meta-path --seed 3 >"$T/cf$cf.json" 2>/dev/null
+done
+if [ -s "$T/cfdef.json" ] && cmp -s <(same "$T/cfdef.json") <(same "$T/cf0.25.json") \
+    && ! cmp -s <(same "$T/cfdef.json") <(same "$T/cf0.json"); then
+    pass coarse_footprint_key
+else
+    fail coarse_footprint_key "$(head -c 300 "$T/cf0.25.json")"
+fi
 scn unknown.yaml "${BASE}colour: red
 "
 bad unknown_key "unknown.yaml:5: scenario: unknown key 'colour'" "$T/unknown.yaml" --out "$T/out"

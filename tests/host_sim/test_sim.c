@@ -102,6 +102,7 @@ static void test_scenario_good(void **state)
     assert_int_equal(sc.seek_recheck_silent, -1);
     assert_true(sc.seek_local_m == -1.0 && sc.seek_leg_m == -1.0);
     assert_true(isnan(sc.seek_p0_min_dbm)); // the pathloss model's own default
+    assert_true(isnan(sc.seek_coarse_footprint_m));
     assert_true(sc.rx_heartbeat); // on unless the scenario turns it off
     // seek: overrides of the strategy's preset.
     char text[2048];
@@ -129,6 +130,9 @@ static void test_scenario_good(void **state)
     assert_int_equal(hs_scenario_load(scn("seek_p0.yaml", text), &sc, err, sizeof err), 0);
     assert_true(sc.seek_p0_min_dbm == -32.5);
     assert_true(isnan(sc.seek_p0_min_dbm) == false && sc.seek_recheck_m == -1.0);
+    snprintf(text, sizeof text, "%sseek: {coarse_footprint_m: 0.25}\n", GOOD);
+    assert_int_equal(hs_scenario_load(scn("seek_cf.yaml", text), &sc, err, sizeof err), 0);
+    assert_true(sc.seek_coarse_footprint_m == 0.25 && isnan(sc.seek_p0_min_dbm));
 }
 
 /// Each bad scenario: -1 and one line naming the file, the line and the field.
@@ -222,6 +226,10 @@ static void test_scenario_bad(void **state)
                "map: @MAP@\nseek: {p0_min_dbm: -300}\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",
                "seek_p0_range.yaml:2: seek.p0_min_dbm: -300 is out of range");
+    expect_bad("seek_cf_range.yaml",
+               "map: @MAP@\nseek: {coarse_footprint_m: 0.6}\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "seek_cf_range.yaml:2: seek.coarse_footprint_m: 0.6 is out of range");
     expect_bad("seek_p0_num.yaml",
                "map: @MAP@\nseek: {p0_min_dbm: loud}\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",

@@ -66,7 +66,7 @@ $(FEED)/fuzz_radiotap: tests/fuzz/fuzz_radiotap.c $(FUZZ_LX)/lx_radiotap.c $(FUZ
 # not input bytes; built without comparison tracing (edges still counted) a control period
 # costs a third (CHANGELOG.md, "Fuzzing speed").
 FUZZ_FW_SRCS := firmware/rfs_app.c firmware/rfs_replay.c
-FUZZ_NOCMP := common/rfs_map.c common/rfs_reach.c
+FUZZ_NOCMP := common/rfs_map.c common/rfs_map_walls.c common/rfs_reach.c
 FUZZ_NOCMP_OBJS := $(FUZZ_NOCMP:common/%.c=$(FW)/fuzz-nocmp/%.o)
 $(FW)/fuzz-nocmp/%.o: common/%.c $(FUZZ_HDRS)
 	@mkdir -p $(@D)

@@ -175,8 +175,8 @@ static void init_rejects_bad_configurations(void **state)
 {
     fixture_t *f = *state;
     rfs_pathloss_cfg_t good = rfs_pathloss_cfg_default();
-    rfs_pathloss_cfg_t bad[18];
-    for (int i = 0; i < 18; ++i) {
+    rfs_pathloss_cfg_t bad[20];
+    for (int i = 0; i < 20; ++i) {
         bad[i] = good;
     }
     bad[0].bin = RFS_Q16_FRAC(1, 20);
@@ -197,9 +197,11 @@ static void init_rejects_bad_configurations(void **state)
     bad[15].footprint = good.bin / 2 + 1;      /* beyond the bin */
     bad[16].sample_t = RFS_Q16_FRAC(1, 16) - 1;
     bad[17].sample_t = RFS_Q16_INT(64) + 1;
+    bad[18].p0_max_wall = -1;
+    bad[19].p0_max_wall = RFS_Q16_INT(60) + 1;
 
     assert_int_equal(rfs_pathloss_init(&f->pl, &good), 0);
-    for (int i = 0; i < 18; ++i) {
+    for (int i = 0; i < 20; ++i) {
         if (rfs_pathloss_init(&f->pl, &bad[i]) != -1) {
             fail_msg("bad configuration %d accepted", i);
         }
@@ -468,8 +470,8 @@ static void p0_floor_off_same_as_reference(void **state)
     expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
 }
 
-/* p0_max below the truth's -35 dBm: the fixed-point search equals the double reference
- * with the ceiling biting, and the ceiling pulls the fitted P0 down. */
+/* p0_max below the truth's -35 dBm, every wall charged the fit's W: the fixed-point search
+ * equals the double reference with the ceiling biting, and the ceiling pulls P0 down. */
 static void p0_ceiling_same_as_reference(void **state)
 {
     fixture_t *f = *state;
@@ -477,7 +479,9 @@ static void p0_ceiling_same_as_reference(void **state)
     rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
     ref_pl_cfg_t rc = ref_pl_cfg_default();
     c.p0_max = RFS_Q16_INT(-41);
+    c.p0_max_wall = c.w_max;
     rc.p0_max = -41.0;
+    rc.p0_max_wall = 15.0;
     expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
     rfs_pathloss_est_t on;
     assert_true(rfs_pathloss_estimate(&f->pl, &on));
@@ -505,6 +509,33 @@ static void p0_default_ceiling_same_as_reference(void **state)
     rfs_pathloss_est_t off = fit_with(f, &c, NS, &f->map, 0, NULL);
     assert_true(fabs(off.p0 / 65536.0 - strong.p0) < 1.5);
     assert_true(on.p0 / 65536.0 < off.p0 / 65536.0 - 2.0);
+}
+
+/* The ceiling holds the P0 with each wall at 3 dB at most (p0_max_wall) against -10 dBm: a
+ * node at -4 dBm behind 8 dB walls is fitted with its P0 as the double reference fits it,
+ * while charging the fit's W (p0_max_wall at w_max) pulls P0 down, as the reference too. */
+static void p0_ceiling_credits_walls(void **state)
+{
+    fixture_t *f = *state;
+    truth_t t = k_office;
+    t.p0 = -4.0;
+    t.w = 8.0;
+    make_samples(f->s, NS, &f->map, &t, 11);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+    assert_int_equal(c.p0_max_wall, RFS_Q16_INT(3));
+    expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
+    rfs_pathloss_est_t credited;
+    assert_true(rfs_pathloss_estimate(&f->pl, &credited));
+    c.p0_max_wall = c.w_max;
+    rc.p0_max_wall = 15.0;
+    expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
+    rfs_pathloss_est_t charged;
+    assert_true(rfs_pathloss_estimate(&f->pl, &charged));
+    print_message("P0 credited %.2f charged %.2f, W %.2f %.2f\n", credited.p0 / 65536.0,
+                  charged.p0 / 65536.0, credited.w / 65536.0, charged.w / 65536.0);
+    assert_true(fabs(credited.p0 / 65536.0 - t.p0) < 1.5);
+    assert_true(charged.p0 / 65536.0 < t.p0 - 2.0);
 }
 
 /* footprint 0 (each bin's walls counted from its cell's centre alone, the model before
@@ -1073,6 +1104,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(p0_floor_off_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_ceiling_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_default_ceiling_same_as_reference, setup, teardown),
+        cmocka_unit_test_setup_teardown(p0_ceiling_credits_walls, setup, teardown),
         cmocka_unit_test(registered_as_pathloss),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -68,11 +68,11 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
      * explains a flat stretch of data by a source tens of metres off needs P0 far above
      * it (docs/PATHLOSS.md, "The P0 floor"). */
     c.p0_max = RFS_Q16_INT(-10);
-    /* The fit's W stays near its 5 dB prior until the data set it, and a SLAM map's "walls"
-     * (furniture, laser artefacts) cost 3 dB in the simulator: through 10-15 of them the
-     * true source's fit needs P0 20-30 dB above the node's. The ceiling tests the P0 with
-     * each wall at drywall's 3 dB at most (docs/PATHLOSS.md, "The P0 floor"). */
-    c.p0_max_wall = RFS_Q16_INT(3);
+    /* Off: the ceiling charges each wall the fit's W. The fit's W stays near its 5 dB prior
+     * until the data set it, so behind 10-15 SLAM-map "walls" (3 dB in the simulator) the
+     * true source's fit needs P0 20-30 dB above the node's; 3 dB (drywall) lets it pass
+     * but cost held-out placements (docs/PATHLOSS.md, "The P0 floor"). */
+    c.p0_max_wall = INT32_MAX;
     c.hold_k = RFS_Q16_INT(6);
     /* The spread region's and hold_k's likelihood-ratio reading of the surface, untempered
      * (docs/PATHLOSS.md, "Epsilon steps that draw the source"). */
@@ -102,9 +102,10 @@ int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg)
               c->huber <= RFS_Q16_INT(100) && c->spread_k >= 0 &&
               c->spread_k <= RFS_Q16_INT(1000) && c->margin >= 0 && c->hold_k >= 0 &&
               c->hold_k <= RFS_Q16_INT(64) && c->footprint >= 0 && c->footprint <= c->bin / 2 &&
-              c->margin <= RFS_Q16_INT(100) && c->p0_max_wall >= 0 &&
-              c->p0_max_wall <= RFS_Q16_INT(60) && c->sample_t >= RFS_Q16_FRAC(1, 16) &&
-              c->sample_t <= RFS_Q16_INT(64);
+              c->margin <= RFS_Q16_INT(100) && c->sample_t >= RFS_Q16_FRAC(1, 16) &&
+              c->sample_t <= RFS_Q16_INT(64) &&
+              ((c->p0_max_wall >= 0 && c->p0_max_wall <= RFS_Q16_INT(60)) ||
+               c->p0_max_wall == INT32_MAX);
     if (!ok) {
         return -1;
     }

@@ -44,6 +44,7 @@ hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void)
     c.seed = 1;
     c.period_us = 50000;
     c.p0_min_dbm = NAN;
+    c.p0_max_wall_db = NAN;
     return c;
 }
 
@@ -150,16 +151,23 @@ static void open_cellsum(inproc_t *p, const rfs_map_t *map, uint16_t capacity)
     }
 }
 
-/* The path-loss model's options: P0 bounded by the node's transmit power when known
- * (docs/PATHLOSS.md, "The P0 floor"), and the simulator's large wall-count cache. 0, or
+/* The path-loss model's options: P0 bounded by the node's transmit power when known and
+ * the ceiling's charge per wall (docs/PATHLOSS.md, "The P0 floor"), and the simulator's
+ * large wall-count cache. 0, or
  * -1 with the reason in err. */
 static int open_pathloss(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, char *err, size_t errlen)
 {
-    if (!isnan(cfg->p0_min_dbm)) {
+    if (!isnan(cfg->p0_min_dbm) || !isnan(cfg->p0_max_wall_db)) {
         rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
-        pc.p0_min = (rfs_q16_t)lround(fmax(-200.0, fmin(100.0, cfg->p0_min_dbm)) * 65536.0);
+        if (!isnan(cfg->p0_min_dbm)) {
+            pc.p0_min = (rfs_q16_t)lround(fmax(-200.0, fmin(100.0, cfg->p0_min_dbm)) * 65536.0);
+        }
+        if (!isnan(cfg->p0_max_wall_db)) {
+            pc.p0_max_wall = (rfs_q16_t)lround(fmax(0.0, fmin(60.0, cfg->p0_max_wall_db)) * 65536.0);
+        }
         if (rfs_pathloss_init(p->model_state, &pc) != 0) {
-            snprintf(err, errlen, "model: pathloss: p0_min_dbm %g rejected", cfg->p0_min_dbm);
+            snprintf(err, errlen, "model: pathloss: p0_min_dbm %g, p0_max_wall_db %g rejected",
+                     cfg->p0_min_dbm, cfg->p0_max_wall_db);
             return -1;
         }
     }

@@ -66,6 +66,8 @@ typedef struct hs_ctrl_inproc_cfg {
     int64_t period_us;      ///< control period, microseconds (50,000)
     double p0_min_dbm;      ///< pathloss model only: floor on the signal at 1 m, dBm, in
                             ///< [-200, 100] (NAN: the model's default, -45)
+    double p0_max_wall_db;  ///< pathloss model only: the most a wall costs in the P0 held
+                            ///< against the ceiling, dB, in [0, 60] (NAN: off)
 } hs_ctrl_inproc_cfg_t;
 
 /// Defaults: the paper's seeker, local ridge, RSSI of one source, 20 Hz.

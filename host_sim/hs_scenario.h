@@ -91,6 +91,9 @@ typedef struct hs_scenario {
     double seek_p0_min_dbm;       ///< seek.p0_min_dbm: the pathloss model's floor on the
                                   ///< signal at 1 m, dBm (NAN = its default, -45; other
                                   ///< models ignore it; docs/PATHLOSS.md "The P0 floor")
+    double seek_p0_max_wall_db;   ///< seek.p0_max_wall_db: the most a wall costs in the P0 the
+                                  ///< pathloss model holds against its ceiling, dB (NAN = off;
+                                  ///< docs/PATHLOSS.md "The P0 floor")
     unsigned nsources;            ///< sources
     hs_scn_source_t src[HS_SCN_MAX_SOURCES]; ///< the sources
     double start_x, start_y;      ///< robot start, metres

@@ -38,7 +38,7 @@ typedef struct ref_pl_cfg {
     int nexcl;        /* places ruled out: no candidate within excl_r of (ex[e], ey[e]) */
     double ex[8], ey[8], excl_r;
     double p0_max; /* strongest plausible P0; a fit above adds total x Huber(P0 - p0_max) */
-    double p0_max_wall; /* dB: the most a wall costs in the P0 held against p0_max */
+    double p0_max_wall; /* dB: the most a wall costs in the P0 held against p0_max (inf: W) */
 } ref_pl_cfg_t;
 
 typedef struct ref_pl_bin {
@@ -73,7 +73,7 @@ typedef struct ref_pl {
 static inline ref_pl_cfg_t ref_pl_cfg_default(void)
 {
     ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5, 30.0, -45.0,
-                      0.25, 0, {0}, {0}, 0.0, -10.0, 3.0};
+                      0.25, 0, {0}, {0}, 0.0, -10.0, INFINITY};
     return c;
 }
 

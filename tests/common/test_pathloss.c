@@ -470,8 +470,8 @@ static void p0_floor_off_same_as_reference(void **state)
     expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
 }
 
-/* p0_max below the truth's -35 dBm, every wall charged the fit's W: the fixed-point search
- * equals the double reference with the ceiling biting, and the ceiling pulls P0 down. */
+/* p0_max below the truth's -35 dBm: the fixed-point search equals the double reference
+ * with the ceiling biting, and the ceiling pulls the fitted P0 down. */
 static void p0_ceiling_same_as_reference(void **state)
 {
     fixture_t *f = *state;
@@ -479,9 +479,7 @@ static void p0_ceiling_same_as_reference(void **state)
     rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
     ref_pl_cfg_t rc = ref_pl_cfg_default();
     c.p0_max = RFS_Q16_INT(-41);
-    c.p0_max_wall = c.w_max;
     rc.p0_max = -41.0;
-    rc.p0_max_wall = 15.0;
     expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
     rfs_pathloss_est_t on;
     assert_true(rfs_pathloss_estimate(&f->pl, &on));
@@ -511,9 +509,10 @@ static void p0_default_ceiling_same_as_reference(void **state)
     assert_true(on.p0 / 65536.0 < off.p0 / 65536.0 - 2.0);
 }
 
-/* The ceiling holds the P0 with each wall at 3 dB at most (p0_max_wall) against -10 dBm: a
- * node at -4 dBm behind 8 dB walls is fitted with its P0 as the double reference fits it,
- * while charging the fit's W (p0_max_wall at w_max) pulls P0 down, as the reference too. */
+/* p0_max_wall 3 dB: the ceiling holds the P0 with each wall at 3 dB at most against -10
+ * dBm, so a node at -4 dBm behind 8 dB walls is fitted with its P0, as the double reference
+ * fits it; by default (each wall at the fit's W) the ceiling pulls P0 down, as in the
+ * reference too. */
 static void p0_ceiling_credits_walls(void **state)
 {
     fixture_t *f = *state;
@@ -523,12 +522,14 @@ static void p0_ceiling_credits_walls(void **state)
     make_samples(f->s, NS, &f->map, &t, 11);
     rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
     ref_pl_cfg_t rc = ref_pl_cfg_default();
-    assert_int_equal(c.p0_max_wall, RFS_Q16_INT(3));
+    assert_int_equal(c.p0_max_wall, INT32_MAX);
+    c.p0_max_wall = RFS_Q16_INT(3);
+    rc.p0_max_wall = 3.0;
     expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
     rfs_pathloss_est_t credited;
     assert_true(rfs_pathloss_estimate(&f->pl, &credited));
-    c.p0_max_wall = c.w_max;
-    rc.p0_max_wall = 15.0;
+    c.p0_max_wall = INT32_MAX;
+    rc.p0_max_wall = INFINITY;
     expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
     rfs_pathloss_est_t charged;
     assert_true(rfs_pathloss_estimate(&f->pl, &charged));

@@ -129,6 +129,10 @@ static void test_scenario_good(void **state)
     assert_int_equal(hs_scenario_load(scn("seek_p0.yaml", text), &sc, err, sizeof err), 0);
     assert_true(sc.seek_p0_min_dbm == -32.5);
     assert_true(isnan(sc.seek_p0_min_dbm) == false && sc.seek_recheck_m == -1.0);
+    assert_true(isnan(sc.seek_p0_max_wall_db)); // off: each wall costs the fit's W
+    snprintf(text, sizeof text, "%sseek: {p0_max_wall_db: 3}\n", GOOD);
+    assert_int_equal(hs_scenario_load(scn("seek_p0w.yaml", text), &sc, err, sizeof err), 0);
+    assert_true(sc.seek_p0_max_wall_db == 3.0);
 }
 
 /// Each bad scenario: -1 and one line naming the file, the line and the field.
@@ -222,6 +226,10 @@ static void test_scenario_bad(void **state)
                "map: @MAP@\nseek: {p0_min_dbm: -300}\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",
                "seek_p0_range.yaml:2: seek.p0_min_dbm: -300 is out of range");
+    expect_bad("seek_p0w_range.yaml",
+               "map: @MAP@\nseek: {p0_max_wall_db: 61}\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "seek_p0w_range.yaml:2: seek.p0_max_wall_db: 61 is out of range");
     expect_bad("seek_p0_num.yaml",
                "map: @MAP@\nseek: {p0_min_dbm: loud}\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",

@@ -70,8 +70,8 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
     c.p0_max = RFS_Q16_INT(-10);
     /* Off: the ceiling charges each wall the fit's W. The fit's W stays near its 5 dB prior
      * until the data set it, so behind 10-15 SLAM-map "walls" (3 dB in the simulator) the
-     * true source's fit needs P0 20-30 dB above the node's; 3 dB (drywall) lets it pass
-     * but cost held-out placements (docs/PATHLOSS.md, "The P0 floor"). */
+     * true source's fit needs P0 20-30 dB above the node's; 3 dB (drywall) lets it pass,
+     * but the held-out placements' table fell (docs/PATHLOSS.md, "The P0 floor"). */
     c.p0_max_wall = INT32_MAX;
     c.hold_k = RFS_Q16_INT(6);
     /* The spread region's and hold_k's likelihood-ratio reading of the surface, untempered

@@ -68,6 +68,11 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
      * explains a flat stretch of data by a source tens of metres off needs P0 far above
      * it (docs/PATHLOSS.md, "The P0 floor"). */
     c.p0_max = RFS_Q16_INT(-10);
+    /* Off: the ceiling charges each wall the fit's W. The fit's W stays near its 5 dB prior
+     * until the data set it, so behind 10-15 SLAM-map "walls" (3 dB in the simulator) the
+     * true source's fit needs P0 20-30 dB above the node's; 3 dB (drywall) lets it pass,
+     * but the held-out placements' table fell (docs/PATHLOSS.md, "The P0 floor"). */
+    c.p0_max_wall = INT32_MAX;
     c.hold_k = RFS_Q16_INT(6);
     /* The spread region's and hold_k's likelihood-ratio reading of the surface, untempered
      * (docs/PATHLOSS.md, "Epsilon steps that draw the source"). */
@@ -102,7 +107,9 @@ int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg)
               c->hold_k <= RFS_Q16_INT(64) && c->footprint >= 0 && c->footprint <= c->bin / 2 &&
               c->coarse_footprint >= 0 && c->coarse_footprint <= c->bin / 2 &&
               c->margin <= RFS_Q16_INT(100) && c->sample_t >= RFS_Q16_FRAC(1, 16) &&
-              c->sample_t <= RFS_Q16_INT(64);
+              c->sample_t <= RFS_Q16_INT(64) &&
+              ((c->p0_max_wall >= 0 && c->p0_max_wall <= RFS_Q16_INT(60)) ||
+               c->p0_max_wall == INT32_MAX);
     if (!ok) {
         return -1;
     }
@@ -442,9 +449,14 @@ static void solve(rfs_pathloss_t *p, rfs_pathloss_cand_t *out)
     int64_t p0 = (int64_t)p->mz_q16 + (((int64_t)n * ml + (int64_t)w * mk + 32768) >> 16);
     /* Scaling: the shortfall or excess in Q8 saturates at 2^24 like a residual; total <=
      * 2^16 times the Huber value < 2^35 stays below 2^51. */
+    /* The ceiling's P0: walls charged at most p0_max_wall each; (W - p0_max_wall) < 2^22
+     * (Q16 dB <= 60) times mk < 2^20 (Q16 walls <= 15) stays below 2^42. */
+    const int64_t p0c = w > c->p0_max_wall
+                            ? p0 - ((((int64_t)w - c->p0_max_wall) * mk + 32768) >> 16)
+                            : p0;
     int64_t a = p0 < c->p0_min ? (((int64_t)c->p0_min - p0) + 128) >> 8
-              : c->p0_max != INT32_MAX && p0 > c->p0_max ? ((p0 - (int64_t)c->p0_max) + 128) >> 8
-                                                         : 0;
+              : c->p0_max != INT32_MAX && p0c > c->p0_max ? ((p0c - (int64_t)c->p0_max) + 128) >> 8
+                                                          : 0;
     if (a > 0) {
         a = a > ((int64_t)1 << 24) ? ((int64_t)1 << 24) : a;
         int64_t h = a <= d8 ? (a * a) >> 1 : d8 * a - ((d8 * d8) >> 1);

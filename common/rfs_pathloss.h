@@ -118,6 +118,9 @@ typedef struct rfs_pathloss_cfg {
     rfs_q16_t p0_max;       ///< target units Q16.16: strongest plausible signal at 1 m
                             ///< (-10 dBm; INT32_MAX: no ceiling). A candidate whose fit
                             ///< needs a stronger P0 adds total weight x Huber(P0 - p0_max)
+    rfs_q16_t p0_max_wall;  ///< dB Q16.16: the ceiling tests the P0 the fit would need with
+                            ///< each wall costing at most this (3 dB: drywall), 0..60 dB
+                            ///< (INT32_MAX: off, each wall costs the fit's W)
     rfs_q16_t footprint;    ///< metres Q16.16: a bin's wall counts start this far either
                             ///< side of its cell's centre, along x and y (0.25 m; 0: from
                             ///< the centre alone), 0..bin / 2

@@ -45,6 +45,7 @@ hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void)
     c.period_us = 50000;
     c.p0_min_dbm = NAN;
     c.coarse_footprint_m = NAN;
+    c.p0_max_wall_db = NAN;
     return c;
 }
 
@@ -152,11 +153,15 @@ static void open_cellsum(inproc_t *p, const rfs_map_t *map, uint16_t capacity)
 }
 
 /* The scenario's path-loss settings into pc: P0 bounded by the node's transmit power when
- * known (docs/PATHLOSS.md, "The P0 floor") and the coarse pass's footprint ("Fit"). */
+ * known, the ceiling's charge per wall (docs/PATHLOSS.md, "The P0 floor") and the coarse
+ * pass's footprint ("A bin's walls"). */
 static void pathloss_options(const hs_ctrl_inproc_cfg_t *cfg, rfs_pathloss_cfg_t *pc)
 {
     if (!isnan(cfg->p0_min_dbm)) {
         pc->p0_min = (rfs_q16_t)lround(fmax(-200.0, fmin(100.0, cfg->p0_min_dbm)) * 65536.0);
+    }
+    if (!isnan(cfg->p0_max_wall_db)) {
+        pc->p0_max_wall = (rfs_q16_t)lround(fmax(0.0, fmin(60.0, cfg->p0_max_wall_db)) * 65536.0);
     }
     if (!isnan(cfg->coarse_footprint_m)) {
         pc->coarse_footprint =
@@ -168,12 +173,13 @@ static void pathloss_options(const hs_ctrl_inproc_cfg_t *cfg, rfs_pathloss_cfg_t
  * cache. 0, or -1 with the reason in err. */
 static int open_pathloss(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, char *err, size_t errlen)
 {
-    if (!isnan(cfg->p0_min_dbm) || !isnan(cfg->coarse_footprint_m)) {
+    if (!isnan(cfg->p0_min_dbm) || !isnan(cfg->p0_max_wall_db) || !isnan(cfg->coarse_footprint_m)) {
         rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
         pathloss_options(cfg, &pc);
         if (rfs_pathloss_init(p->model_state, &pc) != 0) {
-            snprintf(err, errlen, "model: pathloss: p0_min_dbm %g or coarse_footprint_m %g rejected",
-                     cfg->p0_min_dbm, cfg->coarse_footprint_m);
+            snprintf(err, errlen,
+                     "model: pathloss: p0_min_dbm %g, p0_max_wall_db %g or coarse_footprint_m %g rejected",
+                     cfg->p0_min_dbm, cfg->p0_max_wall_db, cfg->coarse_footprint_m);
             return -1;
         }
     }

@@ -67,7 +67,9 @@ typedef struct hs_ctrl_inproc_cfg {
     double p0_min_dbm;      ///< pathloss model only: floor on the signal at 1 m, dBm, in
                             ///< [-200, 100] (NAN: the model's default, -45)
     double coarse_footprint_m; ///< pathloss model only: its coarse pass's footprint,
-                            ///< metres, in [0, 0.5] (NAN: the model's default, 0)
+                            ///< metres, in [0, 0.5] (NAN: the model's default, 0.25)
+    double p0_max_wall_db;  ///< pathloss model only: the most a wall costs in the P0 held
+                            ///< against the ceiling, dB, in [0, 60] (NAN: off)
 } hs_ctrl_inproc_cfg_t;
 
 /// Defaults: the paper's seeker, local ridge, RSSI of one source, 20 Hz.

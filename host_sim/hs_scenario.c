@@ -209,6 +209,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_eps_sample = -1;
     sc->seek_p0_min_dbm = NAN;
     sc->seek_coarse_footprint_m = NAN;
+    sc->seek_p0_max_wall_db = NAN;
     sc->seek_eps_rate = -1.0;
     snprintf(sc->model, sizeof sc->model, "ridge");
     snprintf(sc->target, sizeof sc->target, "rssi");
@@ -428,7 +429,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
                                         "eps_geodesic", "recheck_adapt", "p0_min_dbm",
                                         "eps_sample", "refute_m", "silence_floor",
                                         "refute_reached", "local_m", "leg_m", "recheck_silent",
-                                        "coarse_footprint_m", NULL};
+                                        "coarse_footprint_m", "p0_max_wall_db", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "refute_m", 0, 100, &sc->seek_refute_m) ||
@@ -437,6 +438,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             num(p, n, "seek", "eps_rate", 0, 100, &sc->seek_eps_rate) ||
             num(p, n, "seek", "p0_min_dbm", -200, 100, &sc->seek_p0_min_dbm) ||
             num(p, n, "seek", "coarse_footprint_m", 0, 0.5, &sc->seek_coarse_footprint_m) ||
+            num(p, n, "seek", "p0_max_wall_db", 0, 60, &sc->seek_p0_max_wall_db) ||
             preset_bool(p, n, "eps_by_travel", &sc->seek_eps_by_travel) ||
             preset_bool(p, n, "eps_geodesic", &sc->seek_eps_geodesic) ||
             preset_bool(p, n, "recheck_adapt", &sc->seek_recheck_adapt) ||

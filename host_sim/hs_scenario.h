@@ -12,7 +12,8 @@
  *                                  #       silence_floor: true, refute_reached: false,
  *                                  #       recheck_silent: true,
  *                                  #       p0_min_dbm: -32, local_m: 0, leg_m: 0,
- *                                  #       coarse_footprint_m: 0.25}
+ *                                  #       coarse_footprint_m: 0.25,
+ *                                  #       p0_max_wall_db: 3}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2
@@ -93,8 +94,11 @@ typedef struct hs_scenario {
                                   ///< signal at 1 m, dBm (NAN = its default, -45; other
                                   ///< models ignore it; docs/PATHLOSS.md "The P0 floor")
     double seek_coarse_footprint_m; ///< seek.coarse_footprint_m: the pathloss model's
-                                  ///< coarse-pass footprint, metres (NAN = its default, 0;
-                                  ///< 0.25: every count with the footprint, docs/PATHLOSS.md)
+                                  ///< coarse-pass footprint, metres (NAN = its default, 0.25;
+                                  ///< 0: one count a coarse bin, docs/PATHLOSS.md)
+    double seek_p0_max_wall_db;   ///< seek.p0_max_wall_db: the most a wall costs in the P0 the
+                                  ///< pathloss model holds against its ceiling, dB (NAN = off;
+                                  ///< docs/PATHLOSS.md "The P0 floor")
     unsigned nsources;            ///< sources
     hs_scn_source_t src[HS_SCN_MAX_SOURCES]; ///< the sources
     double start_x, start_y;      ///< robot start, metres

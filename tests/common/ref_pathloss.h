@@ -41,6 +41,7 @@ typedef struct ref_pl_cfg {
     double ex[8], ey[8], excl_r;
     double p0_max; /* strongest plausible P0; a fit above adds total x Huber(P0 - p0_max) */
     double coarse_footprint; /* m: the footprint of the coarse points' counts */
+    double p0_max_wall; /* dB: the most a wall costs in the P0 held against p0_max (inf: W) */
 } ref_pl_cfg_t;
 
 typedef struct ref_pl_bin {
@@ -76,7 +77,7 @@ typedef struct ref_pl {
 static inline ref_pl_cfg_t ref_pl_cfg_default(void)
 {
     ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5, 30.0, -45.0,
-                      0.25, 0, {0}, {0}, 0.0, -10.0, 0.25};
+                      0.25, 0, {0}, {0}, 0.0, -10.0, 0.25, INFINITY};
     return c;
 }
 
@@ -295,7 +296,9 @@ static inline double ref_pl_eval(ref_pl_t *r, int i, int j, double *pn, double *
         double h = res <= cf->huber ? 0.5 * res * res : cf->huber * (res - 0.5 * cf->huber);
         loss += r->bins[b].count * h;
     }
-    double a = p0 < cf->p0_min ? cf->p0_min - p0 : p0 > cf->p0_max ? p0 - cf->p0_max : 0.0;
+    /* The ceiling holds the P0 with each wall at p0_max_wall at most against p0_max. */
+    double p0c = p0 - fmax(w - cf->p0_max_wall, 0.0) * mk;
+    double a = p0 < cf->p0_min ? cf->p0_min - p0 : p0c > cf->p0_max ? p0c - cf->p0_max : 0.0;
     loss += (double)r->total * (a <= cf->huber ? 0.5 * a * a : cf->huber * (a - 0.5 * cf->huber));
     *pn = n;
     *pw = w;

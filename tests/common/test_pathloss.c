@@ -175,8 +175,8 @@ static void init_rejects_bad_configurations(void **state)
 {
     fixture_t *f = *state;
     rfs_pathloss_cfg_t good = rfs_pathloss_cfg_default();
-    rfs_pathloss_cfg_t bad[20];
-    for (int i = 0; i < 20; ++i) {
+    rfs_pathloss_cfg_t bad[22];
+    for (int i = 0; i < 22; ++i) {
         bad[i] = good;
     }
     bad[0].bin = RFS_Q16_FRAC(1, 20);
@@ -199,9 +199,11 @@ static void init_rejects_bad_configurations(void **state)
     bad[17].sample_t = RFS_Q16_INT(64) + 1;
     bad[18].coarse_footprint = -1;
     bad[19].coarse_footprint = good.bin / 2 + 1;
+    bad[20].p0_max_wall = -1;
+    bad[21].p0_max_wall = RFS_Q16_INT(60) + 1;
 
     assert_int_equal(rfs_pathloss_init(&f->pl, &good), 0);
-    for (int i = 0; i < 20; ++i) {
+    for (int i = 0; i < 22; ++i) {
         if (rfs_pathloss_init(&f->pl, &bad[i]) != -1) {
             fail_msg("bad configuration %d accepted", i);
         }
@@ -509,6 +511,36 @@ static void p0_default_ceiling_same_as_reference(void **state)
     rfs_pathloss_est_t off = fit_with(f, &c, NS, &f->map, 0, NULL);
     assert_true(fabs(off.p0 / 65536.0 - strong.p0) < 1.5);
     assert_true(on.p0 / 65536.0 < off.p0 / 65536.0 - 2.0);
+}
+
+/* p0_max_wall 3 dB: the ceiling holds the P0 with each wall at 3 dB at most against -10
+ * dBm, so a node at -4 dBm behind 8 dB walls is fitted with its P0, as the double reference
+ * fits it; by default (each wall at the fit's W) the ceiling pulls P0 down, as in the
+ * reference too. */
+static void p0_ceiling_credits_walls(void **state)
+{
+    fixture_t *f = *state;
+    truth_t t = k_office;
+    t.p0 = -4.0;
+    t.w = 8.0;
+    make_samples(f->s, NS, &f->map, &t, 11);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+    assert_int_equal(c.p0_max_wall, INT32_MAX);
+    c.p0_max_wall = RFS_Q16_INT(3);
+    rc.p0_max_wall = 3.0;
+    expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
+    rfs_pathloss_est_t credited;
+    assert_true(rfs_pathloss_estimate(&f->pl, &credited));
+    c.p0_max_wall = INT32_MAX;
+    rc.p0_max_wall = INFINITY;
+    expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
+    rfs_pathloss_est_t charged;
+    assert_true(rfs_pathloss_estimate(&f->pl, &charged));
+    print_message("P0 credited %.2f charged %.2f, W %.2f %.2f\n", credited.p0 / 65536.0,
+                  charged.p0 / 65536.0, credited.w / 65536.0, charged.w / 65536.0);
+    assert_true(fabs(credited.p0 / 65536.0 - t.p0) < 1.5);
+    assert_true(charged.p0 / 65536.0 < t.p0 - 2.0);
 }
 
 /* footprint 0 (each bin's walls counted from its cell's centre alone, the model before
@@ -1099,6 +1131,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(p0_ceiling_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(coarse_footprint_one_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_default_ceiling_same_as_reference, setup, teardown),
+        cmocka_unit_test_setup_teardown(p0_ceiling_credits_walls, setup, teardown),
         cmocka_unit_test(registered_as_pathloss),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -133,6 +133,10 @@ static void test_scenario_good(void **state)
     snprintf(text, sizeof text, "%sseek: {coarse_footprint_m: 0.25}\n", GOOD);
     assert_int_equal(hs_scenario_load(scn("seek_cf.yaml", text), &sc, err, sizeof err), 0);
     assert_true(sc.seek_coarse_footprint_m == 0.25 && isnan(sc.seek_p0_min_dbm));
+    assert_true(isnan(sc.seek_p0_max_wall_db)); // off: each wall costs the fit's W
+    snprintf(text, sizeof text, "%sseek: {p0_max_wall_db: 3}\n", GOOD);
+    assert_int_equal(hs_scenario_load(scn("seek_p0w.yaml", text), &sc, err, sizeof err), 0);
+    assert_true(sc.seek_p0_max_wall_db == 3.0);
 }
 
 /// Each bad scenario: -1 and one line naming the file, the line and the field.
@@ -230,6 +234,10 @@ static void test_scenario_bad(void **state)
                "map: @MAP@\nseek: {coarse_footprint_m: 0.6}\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",
                "seek_cf_range.yaml:2: seek.coarse_footprint_m: 0.6 is out of range");
+    expect_bad("seek_p0w_range.yaml",
+               "map: @MAP@\nseek: {p0_max_wall_db: 61}\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "seek_p0w_range.yaml:2: seek.p0_max_wall_db: 61 is out of range");
     expect_bad("seek_p0_num.yaml",
                "map: @MAP@\nseek: {p0_min_dbm: loud}\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",

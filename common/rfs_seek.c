@@ -52,6 +52,8 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.eps_sample = false;                   /* and epsilon goals at random, not drawn */
     c.refute_r = 0;                         /* and nothing is ruled out */
     c.local_r = 0;                          /* stand at the estimate */
+    c.local_gap = 0;
+    c.at_tol = 0;                           /* the drive's goal tolerance for every goal */
     c.leg_max = 0;                          /* and walk the whole leg to it */
     c.silence_floor = INT32_MIN;            /* silence adds no sample */
     c.recheck_silent = false;               /* and a silent check passes */
@@ -124,6 +126,11 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
     cfg->recheck_silent = on; /* docs/STRATEGIES.md, "Stalls" */
     /* Sweep round an estimate already stood at (docs/STRATEGIES.md, "Stalls"). */
     cfg->local_r = on ? 4 * cfg->step : 0;
+    /* Its sweeps 1 m apart: a source within local_r passes within the 1.5 m "at source"
+     * radius; and the robot stands on the estimate, not 5 cm short (docs/STRATEGIES.md,
+     * "Stalls"). */
+    cfg->local_gap = on ? cfg->step / 2 : 0;
+    cfg->at_tol = on ? RFS_Q16_FRAC(3, 100) : 0;
 }
 
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)
@@ -173,7 +180,8 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         cfg->tumble_better < 0 || cfg->tumble_better > RFS_Q16_ONE || cfg->tumble_worse < 0 ||
         cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0 || cfg->settle_dist < 0 ||
         cfg->settle_orbit < 0 || cfg->settle_end < 0 || cfg->refute_r < 0 ||
-        cfg->src_spacing < 0 || cfg->local_r < 0 || cfg->leg_max < 0) {
+        cfg->src_spacing < 0 || cfg->local_r < 0 || cfg->leg_max < 0 ||
+        cfg->local_gap < 0 || cfg->at_tol < 0) {
         return -1;
     }
     if (model.ops == 0 || model.ops->fit == 0 || model.ops->predict == 0 ||

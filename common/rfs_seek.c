@@ -349,6 +349,23 @@ static void stop_wheels(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     out->right_mm_s = 0;
 }
 
+/* at_tol: a goal driven with the tighter tolerance that stalls (blocked) within the
+ * drive's own goal_tol of its end counts as reached: under 20 cm pose noise the filtered
+ * pose cannot settle within 3 cm (docs/STRATEGIES.md, "Stalls"). Other statuses, and
+ * every goal at the drive's own tolerance, pass unchanged. */
+static rfs_drive_status_t goal_end(const rfs_seek_t *s, rfs_drive_status_t st)
+{
+    const rfs_path_t *p = &s->drive.path;
+    rfs_pose_t est;
+    if (st != RFS_DRIVE_BLOCKED || s->drive.cfg.goal_tol >= s->cfg.drive.goal_tol ||
+        p->n == 0u || !rfs_drive_estimate(&s->drive, &est)) {
+        return st;
+    }
+    return rfs_q16_dist(est.x, est.y, p->x[p->n - 1u], p->y[p->n - 1u]) <= s->cfg.drive.goal_tol
+               ? RFS_DRIVE_REACHED
+               : st;
+}
+
 /* Add the straight distance from the last check point to the pose to the travel and
  * make the pose the check point. Scaling: each leg < 2^16 m in Q16.16 (rfs_q16_dist),
  * the sum saturates far beyond any mission (2^47 m). */
@@ -468,8 +485,8 @@ static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t 
     }
     s->state = RFS_SEEK_DRIVING;
     begin_next_tree(s);
-    rfs_drive_status_t st = rfs_drive_update(&s->drive, &s->pose, now_us, &out->left_mm_s,
-                                             &out->right_mm_s);
+    rfs_drive_status_t st = goal_end(s, rfs_drive_update(&s->drive, &s->pose, now_us,
+                                                         &out->left_mm_s, &out->right_mm_s));
     if (st != RFS_DRIVE_RUNNING) {
         s->prev_status = st;
     }
@@ -772,8 +789,8 @@ static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     if (s->drive.status != RFS_DRIVE_RUNNING) {
         return false;
     }
-    rfs_drive_status_t st = rfs_drive_update(&s->drive, &s->pose, now_us, &out->left_mm_s,
-                                             &out->right_mm_s);
+    rfs_drive_status_t st = goal_end(s, rfs_drive_update(&s->drive, &s->pose, now_us,
+                                                         &out->left_mm_s, &out->right_mm_s));
     if (st == RFS_DRIVE_RUNNING) {
         s->state = RFS_SEEK_DRIVING;
         if (s->chk_x != chk_x || s->chk_y != chk_y) {

@@ -775,6 +775,40 @@ static void test_at_tol_at_the_estimate(void **state)
     }
 }
 
+/* at_tol's stall: the robot teleported `off` metres short of the greedy goal at the
+ * estimate and held there; the drive's estimate creeps but the poses do not, so the goal
+ * ends blocked (no progress in 5 s) unless within at_tol. The next decision's prev: reached
+ * within the drive's own 10 cm (9 cm short: blocked without the rule), blocked beyond
+ * (30 cm short). */
+static rfs_drive_status_t stall_short_of_goal(double off)
+{
+    world_t t;
+    rfs_seek_cfg_t cfg;
+    fixed_model_t fm;
+    local_world(&t, &cfg, &fm);
+    rfs_model_t model = { fixed_ops(), &fm };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.0, .y = 5.0 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out)); /* the initial move */
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
+    assert_true(fabs(D(out.decision.goal_x) - LOCAL_EX) < 1e-4);
+    r.gx = LOCAL_EX - off; /* arrives short of the goal, on the way from the west */
+    r.gy = LOCAL_EY;
+    assert_true(next_decision(&t, &r, &f, 1000000, 20000000, &out));
+    world_free(&t);
+    return out.decision.prev;
+}
+
+static void test_at_tol_stall_counts_as_reached(void **state)
+{
+    (void)state;
+    assert_int_equal(stall_short_of_goal(0.09), RFS_DRIVE_REACHED);
+    assert_int_equal(stall_short_of_goal(0.30), RFS_DRIVE_BLOCKED);
+}
+
 static void test_leg_max_cuts_the_leg(void **state)
 {
     (void)state;
@@ -1339,6 +1373,7 @@ int main(void)
         cmocka_unit_test(test_local_search_round_the_estimate),
         cmocka_unit_test(test_local_gap_spaces_the_sweep),
         cmocka_unit_test(test_at_tol_at_the_estimate),
+        cmocka_unit_test(test_at_tol_stall_counts_as_reached),
         cmocka_unit_test(test_leg_max_cuts_the_leg),
         cmocka_unit_test(test_recheck_silent_abandons_a_blind_leg),
         cmocka_unit_test(test_eps_geodesic_distribution),

@@ -101,6 +101,7 @@ void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg)
     cfg->settle_end = RFS_Q16_INT(125);
     cfg->refute_r = 0; /* the argmax is the target's best point, not a source */
     cfg->local_r = 0;  /* and the settle tour measures round it */
+    cfg->at_tol = 0;   /* with the drive's own tolerance (bridging as measured) */
     cfg->silence_floor = INT32_MIN; /* each node's store has src_floor */
 }
 

@@ -364,7 +364,8 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
 
 /// The settings for a model fitted per source (rfs_fields.h; docs/STRATEGIES.md,
 /// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m, settle_orbit
-/// 0.25 m, settle_end 125 m, refute_r 0, local_r 0, silence_floor none (src_floor instead).
+/// 0.25 m, settle_end 125 m, refute_r 0, local_r 0, at_tol 0, silence_floor none (src_floor
+/// instead).
 void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg);
 
 /// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array

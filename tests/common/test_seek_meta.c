@@ -736,7 +736,8 @@ static void test_local_gap_spaces_the_sweep(void **state)
 
 /* at_tol (docs/STRATEGIES.md, "Stalls"): the drive's goal tolerance is at_tol (3 cm in
  * the preset) on a greedy leg to the model's known argmax and on a local search's goal,
- * and the drive's own (10 cm) on an epsilon goal, and under the paper's meta (at_tol 0). */
+ * and the drive's own (10 cm) on an epsilon goal, under the paper's meta (at_tol 0) and
+ * for a fit per source (bridging). */
 static void test_at_tol_at_the_estimate(void **state)
 {
     (void)state;
@@ -773,6 +774,10 @@ static void test_at_tol_at_the_estimate(void **state)
         assert_true(greedy >= 4 && eps >= 4);
         world_free(&t);
     }
+    rfs_seek_cfg_t src = rfs_seek_cfg_default(); /* bridging: the drive's own tolerance */
+    rfs_seek_cfg_use_strategy(&src, RFS_SEEK_META_PATH);
+    rfs_seek_cfg_per_source(&src);
+    assert_int_equal(src.at_tol, 0);
 }
 
 /* at_tol's stall: the robot teleported `off` metres short of the greedy goal at the

@@ -52,6 +52,8 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.eps_sample = false;                   /* and epsilon goals at random, not drawn */
     c.refute_r = 0;                         /* and nothing is ruled out */
     c.local_r = 0;                          /* stand at the estimate */
+    c.local_gap = 0;
+    c.at_tol = 0;                           /* the drive's goal tolerance for every goal */
     c.leg_max = 0;                          /* and walk the whole leg to it */
     c.silence_floor = INT32_MIN;            /* silence adds no sample */
     c.recheck_silent = false;               /* and a silent check passes */
@@ -99,6 +101,7 @@ void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg)
     cfg->settle_end = RFS_Q16_INT(125);
     cfg->refute_r = 0; /* the argmax is the target's best point, not a source */
     cfg->local_r = 0;  /* and the settle tour measures round it */
+    cfg->at_tol = 0;   /* with the drive's own tolerance (bridging as measured) */
     cfg->silence_floor = INT32_MIN; /* each node's store has src_floor */
 }
 
@@ -124,6 +127,11 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
     cfg->recheck_silent = on; /* docs/STRATEGIES.md, "Stalls" */
     /* Sweep round an estimate already stood at (docs/STRATEGIES.md, "Stalls"). */
     cfg->local_r = on ? 4 * cfg->step : 0;
+    /* Its sweeps 1 m apart: a source within local_r passes within the 1.5 m "at source"
+     * radius; and the robot stands on the estimate, not 5 cm short (docs/STRATEGIES.md,
+     * "Stalls"). */
+    cfg->local_gap = on ? cfg->step / 2 : 0;
+    cfg->at_tol = on ? RFS_Q16_FRAC(3, 100) : 0;
 }
 
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)
@@ -173,7 +181,8 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         cfg->tumble_better < 0 || cfg->tumble_better > RFS_Q16_ONE || cfg->tumble_worse < 0 ||
         cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0 || cfg->settle_dist < 0 ||
         cfg->settle_orbit < 0 || cfg->settle_end < 0 || cfg->refute_r < 0 ||
-        cfg->src_spacing < 0 || cfg->local_r < 0 || cfg->leg_max < 0) {
+        cfg->src_spacing < 0 || cfg->local_r < 0 || cfg->leg_max < 0 ||
+        cfg->local_gap < 0 || cfg->at_tol < 0) {
         return -1;
     }
     if (model.ops == 0 || model.ops->fit == 0 || model.ops->predict == 0 ||
@@ -341,6 +350,23 @@ static void stop_wheels(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     out->right_mm_s = 0;
 }
 
+/* at_tol: a goal driven with the tighter tolerance that stalls (blocked) within the
+ * drive's own goal_tol of its end counts as reached: under 20 cm pose noise the filtered
+ * pose cannot settle within 3 cm (docs/STRATEGIES.md, "Stalls"). Other statuses, and
+ * every goal at the drive's own tolerance, pass unchanged. */
+static rfs_drive_status_t goal_end(const rfs_seek_t *s, rfs_drive_status_t st)
+{
+    const rfs_path_t *p = &s->drive.path;
+    rfs_pose_t est;
+    if (st != RFS_DRIVE_BLOCKED || s->drive.cfg.goal_tol >= s->cfg.drive.goal_tol ||
+        p->n == 0u || !rfs_drive_estimate(&s->drive, &est)) {
+        return st;
+    }
+    return rfs_q16_dist(est.x, est.y, p->x[p->n - 1u], p->y[p->n - 1u]) <= s->cfg.drive.goal_tol
+               ? RFS_DRIVE_REACHED
+               : st;
+}
+
 /* Add the straight distance from the last check point to the pose to the travel and
  * make the pose the check point. Scaling: each leg < 2^16 m in Q16.16 (rfs_q16_dist),
  * the sum saturates far beyond any mission (2^47 m). */
@@ -460,8 +486,8 @@ static void end_decision(rfs_seek_t *s, bool ok, int64_t now_us, rfs_seek_out_t 
     }
     s->state = RFS_SEEK_DRIVING;
     begin_next_tree(s);
-    rfs_drive_status_t st = rfs_drive_update(&s->drive, &s->pose, now_us, &out->left_mm_s,
-                                             &out->right_mm_s);
+    rfs_drive_status_t st = goal_end(s, rfs_drive_update(&s->drive, &s->pose, now_us,
+                                                         &out->left_mm_s, &out->right_mm_s));
     if (st != RFS_DRIVE_RUNNING) {
         s->prev_status = st;
     }
@@ -764,8 +790,8 @@ static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     if (s->drive.status != RFS_DRIVE_RUNNING) {
         return false;
     }
-    rfs_drive_status_t st = rfs_drive_update(&s->drive, &s->pose, now_us, &out->left_mm_s,
-                                             &out->right_mm_s);
+    rfs_drive_status_t st = goal_end(s, rfs_drive_update(&s->drive, &s->pose, now_us,
+                                                         &out->left_mm_s, &out->right_mm_s));
     if (st == RFS_DRIVE_RUNNING) {
         s->state = RFS_SEEK_DRIVING;
         if (s->chk_x != chk_x || s->chk_y != chk_y) {

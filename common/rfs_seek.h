@@ -111,6 +111,15 @@ typedef struct rfs_seek_cfg {
                                 ///< (least sum of the straight distances): a local search
                                 ///< round an estimate already stood at, metres Q16.16 (0:
                                 ///< off, stand at it)
+    rfs_q16_t local_gap;        ///< with local_r: a local search's goal also keeps this far
+                                ///< from every visited lattice point (within the novelty
+                                ///< radius of a past position), so its sweeps lie about
+                                ///< novelty_radius + local_gap apart, metres Q16.16 (0: any
+                                ///< unvisited point)
+    rfs_q16_t at_tol;           ///< the drive's goal tolerance (drive.goal_tol otherwise) on
+                                ///< a whole greedy leg to a known argmax and on a local
+                                ///< search's goal: the robot stands at the estimate, not
+                                ///< half drive.goal_tol short of it, metres Q16.16 (0: off)
     rfs_q16_t leg_max;          ///< a greedy leg to a known argmax ends after this much of
                                 ///< its path (the next decision relearns and may explore),
                                 ///< metres Q16.16 (0: the whole path)
@@ -349,12 +358,14 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 /// Choose a strategy with its named preset: sets cfg->strategy and the improvement
 /// fields, on for RFS_SEEK_META_PATH (recheck_dist = cfg->step, eps_by_travel,
 /// recheck_adapt, eps_geodesic, eps_sample, refute_r = cfg->step, silence_floor = -100
-/// dBm, recheck_silent, local_r = 4 cfg->step), the paper's (0, false) for every other strategy.
+/// dBm, recheck_silent, local_r = 4 cfg->step, local_gap = cfg->step / 2, at_tol = 3 cm),
+/// the paper's (0, false) for every other strategy.
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 
 /// The settings for a model fitted per source (rfs_fields.h; docs/STRATEGIES.md,
 /// "Bridging"): src_spacing 4 cm, src_floor -100 dBm, settle_dist 100 m, settle_orbit
-/// 0.25 m, settle_end 125 m, refute_r 0, local_r 0, silence_floor none (src_floor instead).
+/// 0.25 m, settle_end 125 m, refute_r 0, local_r 0, at_tol 0, silence_floor none (src_floor
+/// instead).
 void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg);
 
 /// Initialise. Returns 0, or -1 when the configuration is out of range, a memory array

@@ -416,14 +416,37 @@ static bool choose_greedy(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     return rfs_seek_ops(s)->to_max(s, mx, my, known, rng, now_us);
 }
 
+/* local_gap: a visited lattice point within local_gap of lattice point (i, j) (a window
+ * of (2 local_gap / grid + 1)^2 points). Scaling: lattice offsets squared times grid^2
+ * (Q16 squared: Q32) in int64 against local_gap^2 (Q32). */
+static bool near_visited(const rfs_seek_t *s, int32_t i, int32_t j)
+{
+    const rfs_map_t *m = s->map;
+    const lattice_window_t w = lattice_window(m, (uint16_t)i, (uint16_t)j,
+                                              s->cfg.local_gap / m->cfg.grid);
+    const int64_t r2 = (int64_t)s->cfg.local_gap * s->cfg.local_gap;
+    const int64_t g2 = (int64_t)m->cfg.grid * m->cfg.grid;
+    for (int32_t b = w.j0; b <= w.j1; ++b) {
+        for (int32_t a = w.i0; a <= w.i1; ++a) {
+            const int64_t q = (int64_t)(a - i) * (a - i) + (int64_t)(b - j) * (b - j);
+            if (q * g2 <= r2 && rfs_reach_bit(s->visited, (uint32_t)b * m->lw + (uint32_t)a)) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
 /* local_r: the goal of a local search round an estimate (mx, my) the robot has stood
  * at, or round its reachable stand-in when it is unreachable (the centre: its lattice
  * point is visited), the unvisited reachable lattice point within local_r of the centre
+ * (and, with local_gap, no visited point within local_gap of it)
  * with the least sum of its squared straight distances to the robot and to the centre
  * (the nearest to their midpoint; ties: the first in row order): when the robot is at
  * the centre the nearest ring round it first, then on round the ring; false when the
  * centre is not yet visited or no point is left. No square root: a window of up to
- * (2 local_r / grid + 3)^2 points stays within a control period on the microcontroller.
+ * (2 local_r / grid + 3)^2 points stays within a control period on the microcontroller;
+ * the local_gap test runs only for a point that would be the best so far.
  * Scaling: offsets Q16 (< 2^31 each, map coordinates) in int64, squared Q32 < 2^62;
  * a sum of two squared distances to the robot and centre saturates at INT64_MAX. */
 static bool local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_t *gx,
@@ -461,7 +484,7 @@ static bool local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_
             const uint64_t rr = (uint64_t)(rx * rx) + (uint64_t)(ry * ry);
             const uint64_t sum = rr + (uint64_t)(dx * dx + dy * dy);
             const int64_t cost = sum > (uint64_t)INT64_MAX - 1u ? INT64_MAX - 1 : (int64_t)sum;
-            if (cost < best) {
+            if (cost < best && (s->cfg.local_gap <= 0 || !near_visited(s, i, j))) {
                 best = cost;
                 *gx = px;
                 *gy = py;
@@ -476,6 +499,11 @@ bool rfs_seek_meta_path_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool kno
 {
     (void)rng;
     rfs_q16_t gx, gy;
+    if (known && s->cfg.at_tol > 0) {
+        /* Read at every drive update: this goal's, until the next decision resets it
+         * (rfs_seek_meta_choose). */
+        s->drive.cfg.goal_tol = s->cfg.at_tol;
+    }
     if (known && s->cfg.local_r > 0 && local_goal(s, mx, my, &gx, &gy)) {
         /* One scan a decision (the period budget); a point that cannot be planned to
          * (unreachable in practice) is marked visited and this decision goes to the
@@ -559,6 +587,7 @@ bool rfs_seek_meta_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool known,
 bool rfs_seek_meta_choose(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t now_us)
 {
     rfs_seek_decision_t *d = &s->decision;
+    s->drive.cfg.goal_tol = s->cfg.drive.goal_tol; /* at_tol: only a goal at the estimate */
     d->epsilon = rfs_seek_epsilon(&s->cfg, epsilon_index(s));
     /* settle_dist: exploration is over, the robot holds the model's best point. No draw is
      * taken then, so the paper's configuration (0: never) draws as it always did. */

@@ -1027,6 +1027,12 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     if (e->sc.seek_local_m >= 0.0) {
         cc.seek.local_r = (rfs_q16_t)lround(e->sc.seek_local_m * 65536.0);
     }
+    if (e->sc.seek_local_gap_m >= 0.0) {
+        cc.seek.local_gap = (rfs_q16_t)lround(e->sc.seek_local_gap_m * 65536.0);
+    }
+    if (e->sc.seek_at_tol_m >= 0.0) {
+        cc.seek.at_tol = (rfs_q16_t)lround(e->sc.seek_at_tol_m * 65536.0);
+    }
     if (e->sc.seek_leg_m >= 0.0) {
         cc.seek.leg_max = (rfs_q16_t)lround(e->sc.seek_leg_m * 65536.0);
     }

@@ -586,6 +586,7 @@ static void test_local_search_round_the_estimate(void **state)
     fixed_model_t fm;
     local_world(&t, &cfg, &fm);
     cfg.local_r = Q(1.0);
+    cfg.local_gap = 0;
     rfs_model_t model = { fixed_ops(), &fm };
     assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
     field_t f = { .kind = 2, .scripted = -60.0 };
@@ -616,6 +617,201 @@ static void test_local_search_round_the_estimate(void **state)
     }
     assert_true(local >= 4 && n < 40);
     world_free(&t);
+}
+
+/* local_gap (docs/STRATEGIES.md, "Stalls"), local_r 2 m: every local goal must be, by a
+ * double-precision reference, the legal lattice point within local_r of the estimate
+ * with no lattice point within the 0.5 m novelty radius of a place stood at lying within
+ * local_gap of it, nearest the robot-estimate midpoint. When the search ends (back at
+ * the estimate) every legal lattice point within local_r lies within novelty radius +
+ * local_gap of a place stood at, and the sweep took fewer goals than without the gap.
+ * Returns the local goals taken. */
+static bool gap_ref_ok(const world_t *t, const double *px, const double *py, int n,
+                       double gap, double gx, double gy)
+{
+    double best = INFINITY, got = INFINITY;
+    for (uint16_t j = 0; j < t->map.lh; ++j) {
+        for (uint16_t i = 0; i < t->map.lw; ++i) {
+            rfs_q16_t qx, qy;
+            rfs_map_lattice_point(&t->map, i, j, &qx, &qy);
+            double x = D(qx), y = D(qy);
+            if (!rfs_map_lattice_legal(&t->map, i, j) ||
+                hypot(x - LOCAL_EX, y - LOCAL_EY) > 2.0 + 1e-9) {
+                continue;
+            }
+            bool near = false; /* a visited lattice point within gap */
+            for (uint16_t b = 0; b < t->map.lh && !near; ++b) {
+                for (uint16_t a = 0; a < t->map.lw && !near; ++a) {
+                    rfs_q16_t vx, vy;
+                    rfs_map_lattice_point(&t->map, a, b, &vx, &vy);
+                    if (hypot(D(vx) - x, D(vy) - y) > gap + 1e-9) {
+                        continue;
+                    }
+                    for (int k = 0; k < n && !near; ++k) {
+                        near = hypot(D(vx) - px[k], D(vy) - py[k]) <= 0.5 + 1e-9;
+                    }
+                }
+            }
+            if (near) {
+                continue;
+            }
+            double c = pow(hypot(x - px[n - 1], y - py[n - 1]), 2) +
+                       pow(hypot(x - LOCAL_EX, y - LOCAL_EY), 2);
+            best = c < best ? c : best;
+            if (fabs(x - gx) < 1e-4 && fabs(y - gy) < 1e-4) {
+                got = c;
+            }
+        }
+    }
+    if (best == INFINITY) {
+        return fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4;
+    }
+    return got < best + 1e-6;
+}
+
+static int gap_sweep(double gap)
+{
+    world_t t;
+    rfs_seek_cfg_t cfg;
+    fixed_model_t fm;
+    local_world(&t, &cfg, &fm);
+    cfg.local_r = Q(2.0);
+    cfg.local_gap = Q(gap);
+    rfs_model_t model = { fixed_ops(), &fm };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.0, .y = 5.0 };
+    double px[128] = { 4.0 }, py[128] = { 5.0 };
+    int n = 1, local = 0;
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    px[n] = D(out.decision.goal_x);
+    py[n++] = D(out.decision.goal_y);
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_true(fabs(D(out.decision.goal_x) - LOCAL_EX) < 1e-4);
+    px[n] = LOCAL_EX;
+    py[n++] = LOCAL_EY;
+    bool ended = false;
+    while (n < 128 && !ended) {
+        assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+        assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
+        double gx = D(out.decision.goal_x), gy = D(out.decision.goal_y);
+        assert_true(gap_ref_ok(&t, px, py, n, gap, gx, gy));
+        ended = fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4;
+        if (!ended) {
+            px[n] = gx;
+            py[n++] = gy;
+            local++;
+        }
+    }
+    assert_true(ended);
+    for (uint16_t j = 0; j < t.map.lh; ++j) { /* the sweep's cover */
+        for (uint16_t i = 0; i < t.map.lw; ++i) {
+            rfs_q16_t qx, qy;
+            rfs_map_lattice_point(&t.map, i, j, &qx, &qy);
+            if (!rfs_map_lattice_legal(&t.map, i, j) ||
+                hypot(D(qx) - LOCAL_EX, D(qy) - LOCAL_EY) > 2.0 + 1e-9) {
+                continue;
+            }
+            double dmin = INFINITY;
+            for (int k = 0; k < n; ++k) {
+                double d = hypot(D(qx) - px[k], D(qy) - py[k]);
+                dmin = d < dmin ? d : dmin;
+            }
+            assert_true(dmin <= 0.5 + gap + 1e-9);
+        }
+    }
+    world_free(&t);
+    return local;
+}
+
+static void test_local_gap_spaces_the_sweep(void **state)
+{
+    (void)state;
+    int plain = gap_sweep(0.0), spaced = gap_sweep(0.5);
+    print_message("local_gap 0.5 m: %d local goals sweep 2 m round the estimate, %d without\n",
+                  spaced, plain);
+    assert_true(spaced >= 4 && spaced * 3 < plain * 2);
+}
+
+/* at_tol (docs/STRATEGIES.md, "Stalls"): the drive's goal tolerance is at_tol (3 cm in
+ * the preset) on a greedy leg to the model's known argmax and on a local search's goal,
+ * and the drive's own (10 cm) on an epsilon goal, under the paper's meta (at_tol 0) and
+ * for a fit per source (bridging). */
+static void test_at_tol_at_the_estimate(void **state)
+{
+    (void)state;
+    for (int meta = 0; meta < 2; ++meta) {
+        world_t t;
+        rfs_seek_cfg_t cfg;
+        fixed_model_t fm;
+        local_world(&t, &cfg, &fm);
+        if (meta) {
+            rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META);
+            cfg.eps_amp = 0;
+            cfg.eps_floor = 0;
+        }
+        assert_int_equal(cfg.at_tol, meta ? 0 : Q(0.03));
+        rfs_model_t model = { fixed_ops(), &fm };
+        assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+        field_t f = { .kind = 2, .scripted = -60.0 };
+        run_t r = { .x = 4.0, .y = 5.0 };
+        rfs_seek_out_t out;
+        int greedy = 0, eps = 0;
+        for (int k = 0; k < 16; ++k) {
+            /* Every other decision epsilon: epsilon 1, then 0. */
+            t.seek.cfg.eps_floor = (k % 2) ? RFS_Q16_ONE : 0;
+            assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+            double tol = D(t.seek.drive.cfg.goal_tol);
+            if (out.decision.kind == RFS_SEEK_GREEDY) {
+                greedy++;
+                assert_true(fabs(tol - (meta ? 0.1 : 0.03)) < 1e-4);
+            } else if (out.decision.kind == RFS_SEEK_EPSILON) {
+                eps++;
+                assert_true(fabs(tol - 0.1) < 1e-4);
+            }
+        }
+        assert_true(greedy >= 4 && eps >= 4);
+        world_free(&t);
+    }
+    rfs_seek_cfg_t src = rfs_seek_cfg_default(); /* bridging: the drive's own tolerance */
+    rfs_seek_cfg_use_strategy(&src, RFS_SEEK_META_PATH);
+    rfs_seek_cfg_per_source(&src);
+    assert_int_equal(src.at_tol, 0);
+}
+
+/* at_tol's stall: the robot teleported `off` metres short of the greedy goal at the
+ * estimate and held there; the drive's estimate creeps but the poses do not, so the goal
+ * ends blocked (no progress in 5 s) unless within at_tol. The next decision's prev: reached
+ * within the drive's own 10 cm (9 cm short: blocked without the rule), blocked beyond
+ * (30 cm short). */
+static rfs_drive_status_t stall_short_of_goal(double off)
+{
+    world_t t;
+    rfs_seek_cfg_t cfg;
+    fixed_model_t fm;
+    local_world(&t, &cfg, &fm);
+    rfs_model_t model = { fixed_ops(), &fm };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.0, .y = 5.0 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out)); /* the initial move */
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
+    assert_true(fabs(D(out.decision.goal_x) - LOCAL_EX) < 1e-4);
+    r.gx = LOCAL_EX - off; /* arrives short of the goal, on the way from the west */
+    r.gy = LOCAL_EY;
+    assert_true(next_decision(&t, &r, &f, 1000000, 20000000, &out));
+    world_free(&t);
+    return out.decision.prev;
+}
+
+static void test_at_tol_stall_counts_as_reached(void **state)
+{
+    (void)state;
+    assert_int_equal(stall_short_of_goal(0.09), RFS_DRIVE_REACHED);
+    assert_int_equal(stall_short_of_goal(0.30), RFS_DRIVE_BLOCKED);
 }
 
 static void test_leg_max_cuts_the_leg(void **state)
@@ -1180,6 +1376,9 @@ int main(void)
         cmocka_unit_test(test_refute_rules_out_the_argmax),
         cmocka_unit_test(test_refute_reached_moves_on),
         cmocka_unit_test(test_local_search_round_the_estimate),
+        cmocka_unit_test(test_local_gap_spaces_the_sweep),
+        cmocka_unit_test(test_at_tol_at_the_estimate),
+        cmocka_unit_test(test_at_tol_stall_counts_as_reached),
         cmocka_unit_test(test_leg_max_cuts_the_leg),
         cmocka_unit_test(test_recheck_silent_abandons_a_blind_leg),
         cmocka_unit_test(test_eps_geodesic_distribution),

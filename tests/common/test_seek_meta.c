@@ -545,6 +545,29 @@ static void local_world(world_t *t, rfs_seek_cfg_t *cfg, fixed_model_t *fm)
     *fm = (fixed_model_t){ false, Q(LOCAL_EX), Q(LOCAL_EY) };
 }
 
+/* A candidate (x, y) of the local-search references: its cost, the squared distances to
+ * the robot at (rx, ry) and to the estimate, lowers *best, and is *got when it is the
+ * goal (gx, gy). */
+static void local_score(double x, double y, double rx, double ry, double gx, double gy,
+                        double *best, double *got)
+{
+    double c = pow(hypot(x - rx, y - ry), 2) + pow(hypot(x - LOCAL_EX, y - LOCAL_EY), 2);
+    *best = c < *best ? c : *best;
+    if (fabs(x - gx) < 1e-4 && fabs(y - gy) < 1e-4) {
+        *got = c;
+    }
+}
+
+/* The references' verdict on the goal (gx, gy): the least cost (ties within 1e-6 m^2), or
+ * the estimate itself when no candidate is left. */
+static bool local_verdict(double best, double got, double gx, double gy)
+{
+    if (best == INFINITY) {
+        return fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4;
+    }
+    return got < best + 1e-6;
+}
+
 /* The reference goal after the robot stood at the n places (px, py); false when no
  * lattice point is left. Ties within 1e-6 m^2 are accepted. */
 static bool local_ref_ok(const world_t *t, const double *px, const double *py, int n,
@@ -564,18 +587,10 @@ static bool local_ref_ok(const world_t *t, const double *px, const double *py, i
                 hypot(x - LOCAL_EX, y - LOCAL_EY) > 1.0 + 1e-9) {
                 continue;
             }
-            double c = pow(hypot(x - px[n - 1], y - py[n - 1]), 2) +
-                       pow(hypot(x - LOCAL_EX, y - LOCAL_EY), 2);
-            best = c < best ? c : best;
-            if (fabs(x - gx) < 1e-4 && fabs(y - gy) < 1e-4) {
-                got = c;
-            }
+            local_score(x, y, px[n - 1], py[n - 1], gx, gy, &best, &got);
         }
     }
-    if (best == INFINITY) {
-        return fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4;
-    }
-    return got < best + 1e-6;
+    return local_verdict(best, got, gx, gy);
 }
 
 static void test_local_search_round_the_estimate(void **state)
@@ -655,18 +670,10 @@ static bool gap_ref_ok(const world_t *t, const double *px, const double *py, int
             if (near) {
                 continue;
             }
-            double c = pow(hypot(x - px[n - 1], y - py[n - 1]), 2) +
-                       pow(hypot(x - LOCAL_EX, y - LOCAL_EY), 2);
-            best = c < best ? c : best;
-            if (fabs(x - gx) < 1e-4 && fabs(y - gy) < 1e-4) {
-                got = c;
-            }
+            local_score(x, y, px[n - 1], py[n - 1], gx, gy, &best, &got);
         }
     }
-    if (best == INFINITY) {
-        return fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4;
-    }
-    return got < best + 1e-6;
+    return local_verdict(best, got, gx, gy);
 }
 
 static int gap_sweep(double gap)

@@ -545,6 +545,17 @@ static void local_world(world_t *t, rfs_seek_cfg_t *cfg, fixed_model_t *fm)
     *fm = (fixed_model_t){ false, Q(LOCAL_EX), Q(LOCAL_EY) };
 }
 
+/* local_world's seeker started with local_r and local_gap (metres) on the fixed model. */
+static void local_seek(world_t *t, fixed_model_t *fm, double local_r, double gap)
+{
+    rfs_seek_cfg_t cfg;
+    local_world(t, &cfg, fm);
+    cfg.local_r = Q(local_r);
+    cfg.local_gap = Q(gap);
+    rfs_model_t model = { fixed_ops(), fm };
+    assert_int_equal(rfs_seek_init(&t->seek, &cfg, &t->map, model, &rfs_target_rssi, &t->mem), 0);
+}
+
 /* A candidate (x, y) of the local-search references: its cost, the squared distances to
  * the robot at (rx, ry) and to the estimate, lowers *best, and is *got when it is the
  * goal (gx, gy). */
@@ -597,13 +608,8 @@ static void test_local_search_round_the_estimate(void **state)
 {
     (void)state;
     world_t t;
-    rfs_seek_cfg_t cfg;
     fixed_model_t fm;
-    local_world(&t, &cfg, &fm);
-    cfg.local_r = Q(1.0);
-    cfg.local_gap = 0;
-    rfs_model_t model = { fixed_ops(), &fm };
-    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    local_seek(&t, &fm, 1.0, 0.0);
     field_t f = { .kind = 2, .scripted = -60.0 };
     run_t r = { .x = 4.0, .y = 5.0 };
     double px[64] = { 4.0 }, py[64] = { 5.0 };
@@ -679,13 +685,8 @@ static bool gap_ref_ok(const world_t *t, const double *px, const double *py, int
 static int gap_sweep(double gap)
 {
     world_t t;
-    rfs_seek_cfg_t cfg;
     fixed_model_t fm;
-    local_world(&t, &cfg, &fm);
-    cfg.local_r = Q(2.0);
-    cfg.local_gap = Q(gap);
-    rfs_model_t model = { fixed_ops(), &fm };
-    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    local_seek(&t, &fm, 2.0, gap);
     field_t f = { .kind = 2, .scripted = -60.0 };
     run_t r = { .x = 4.0, .y = 5.0 };
     double px[128] = { 4.0 }, py[128] = { 5.0 };

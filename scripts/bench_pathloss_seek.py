@@ -5,7 +5,8 @@ on (the default) and with the node's transmit power known, on the shipped floors
 where it breaks (8 dB shadowing, a source in the corridor, nodes weaker than believed).
 Writes its section of docs/RESULTS.md, between the markers below, and nothing else.
 
-    /usr/bin/python3 scripts/bench_pathloss_seek.py [--seeds N] [--sim build/bin/rfseek-sim]
+    /usr/bin/python3 scripts/bench_pathloss_seek.py [--seeds N] [--first-seed 1001]
+                                                    [--sim build/bin/rfseek-sim]
                                                     [--results docs/RESULTS.md]
 """
 import argparse
@@ -61,9 +62,10 @@ def wilson(k, n, z=1.96):
     return (max(0.0, c - h), min(1.0, c + h))
 
 
-def run(sim, scenario, strategy, model, seeds):
+def run(sim, scenario, strategy, model, seeds, first=1):
     out = subprocess.run([sim, scenario, "--strategy", strategy, "--model", model,
-                          "--seeds", f"1..{seeds}", "--quiet"], capture_output=True, text=True)
+                          "--seeds", f"{first}..{first + seeds - 1}", "--quiet"],
+                         capture_output=True, text=True)
     if out.returncode != 0:
         sys.exit(f"bench_pathloss_seek: {scenario}: {out.stderr.strip()}")
     lines = out.stdout.strip().split("\n")
@@ -112,14 +114,16 @@ def cell(r):
             f"{r['ratio']:.2f}")
 
 
-def section(seeds, wall, at, table):
+def section(seeds, first, wall, at, table):
     """The section as it goes into RESULTS.md; table: [(title, [(label, [cell])])]."""
     L = [BEGIN, "## The path-loss model's configurations", "",
-         f"Written by `/usr/bin/python3 scripts/bench_pathloss_seek.py --seeds {seeds}` at "
+         f"Written by `/usr/bin/python3 scripts/bench_pathloss_seek.py --seeds {seeds}"
+         f"{'' if first == 1001 else f' --first-seed {first}'}` at "
          f"commit {at} ({wall:.0f} s on two cores). Each cell: success (95 % Wilson "
          "interval), then the median over **all** runs of travel / shortest path (a failed "
          "run counts its 150 m; the tables above take the median over the successful runs). "
-         f"Seeds 1..{seeds}, the scenario's radio settings unless the row says otherwise. "
+         f"Seeds {first}..{first + seeds - 1} (1..500 are the tuning draws), the scenario's "
+         "radio settings unless the row says otherwise. "
          "Columns: `meta + ridge` is the paper; the others are `meta-path + pathloss` "
          "(docs/STRATEGIES.md, docs/PATHLOSS.md) with its preset improvements off (`seek: "
          "{recheck_m: 0, eps_by_travel: false, eps_geodesic: false, recheck_adapt: false, "
@@ -158,12 +162,14 @@ def splice(path, text, begin=BEGIN, end=END):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seeds", type=int, default=200)
+    ap.add_argument("--first-seed", type=int, default=1001,
+                    help="seeds FIRST..FIRST+N-1 (1..500 are the tuning draws: report on others)")
     ap.add_argument("--sim", default="build/bin/rfseek-sim")
     ap.add_argument("--results", default="docs/RESULTS.md",
                     help="the markdown file whose section is replaced")
     a = ap.parse_args()
-    if a.seeds < 1:
-        sys.exit("bench_pathloss_seek: --seeds must be at least 1")
+    if a.seeds < 1 or a.first_seed < 1:
+        sys.exit("bench_pathloss_seek: --seeds and --first-seed must be at least 1")
     tmps = []
     t0 = time.time()
     table = []
@@ -174,14 +180,15 @@ def main():
                 cells = []
                 for strategy, model, name, extra in CONFIGS:
                     scen = scenario_file(path, edits, tmps, extra)
-                    cells.append(cell(run(a.sim, scen, strategy, model, a.seeds)))
+                    cells.append(cell(run(a.sim, scen, strategy, model, a.seeds,
+                                          a.first_seed)))
                     print(f"{label} | {name} | {cells[-1]}", flush=True)
                 out.append((label, cells))
             table.append((title, out))
     finally:
         for t in tmps:
             os.unlink(t)
-    splice(a.results, section(a.seeds, time.time() - t0, commit(), table))
+    splice(a.results, section(a.seeds, a.first_seed, time.time() - t0, commit(), table))
     print(f"wrote {a.results} ({time.time() - t0:.0f} s)")
 
 

@@ -136,9 +136,11 @@ SCEN_CPU = {"default": 1.0, "open": 0.6, "lshape": 1.0, "willow": 2.5, "3ne": 2.
 class Batch:
     """One rfseek-sim --seeds batch: a strategy with a model on a scenario file."""
 
-    def __init__(self, section, tag, scen, scen_file, strategy, model, seeds, keep=()):
+    def __init__(self, section, tag, scen, scen_file, strategy, model, seeds, keep=(),
+                 first=1):
         self.section, self.tag, self.scen_file = section, tag, scen_file
         self.strategy, self.model, self.seeds, self.keep = strategy, model, seeds, set(keep)
+        self.first = first
         self.est = seeds * RUN_CPU.get(model, 1.0) * SCEN_CPU.get(scen, 1.0)
         self.res, self.cpu = None, 0.0
 
@@ -173,21 +175,23 @@ def plan_batches(args, tmp, scenarios, ns, ms):
     # 1. every strategy on every scenario
     for sc in scenarios:
         for st in STRATEGIES:
-            keep = range(1, 6) if sc == "default" else ()
+            f = args.first_seed
+            keep = range(f, f + 5) if sc == "default" else ()
             sweep_b[(sc, st)] = Batch("sweep", "%s-%s" % (sc, st), sc, scenario_path(sc), st,
-                                      model_of(st), args.seeds, keep)
+                                      model_of(st), args.seeds, keep, f)
     # 2. shadowing and noise on the default scenario (4/4 is the default itself)
     for st in STRATEGIES:
         for sh, no in [(0, 4), (8, 4), (4, 2), (4, 8)] + ([] if ns == args.seeds else [(4, 4)]):
             var_b[(st, sh, no)] = Batch("noise", "var-%s-%g-%g" % (st, sh, no), "default",
-                                        make_variant(tmp, sh, no), st, model_of(st), ns)
+                                        make_variant(tmp, sh, no), st, model_of(st), ns,
+                                        first=args.first_seed)
     # 3. internal models under meta
     for sc in scenarios:
         for m in MODELS:
             n = args.slow_model_seeds if m in SLOW_MODELS else ms
             if n > 0 and not (m == "ridge" and n == args.seeds):
                 model_b[(sc, m)] = Batch(m, "model-%s-%s" % (sc, m), sc, scenario_path(sc),
-                                         "meta", m, n)
+                                         "meta", m, n, first=args.first_seed)
     return sweep_b, var_b, model_b
 
 
@@ -201,7 +205,8 @@ def run_all(args, tmp, batches):
     while todo or running or finished:
         while todo and len(running) < args.jobs:
             b = todo.pop(0)
-            cmd = [args.bin, b.scen_file, "--seeds", "1..%d" % b.seeds, "--jobs", "1",
+            cmd = [args.bin, b.scen_file, "--seeds", "%d..%d" % (b.first, b.first + b.seeds - 1),
+                   "--jobs", "1",
                    "--quiet", "--out", os.path.join(tmp, b.tag), "--strategy", b.strategy,
                    "--model", b.model]
             p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL)
@@ -368,7 +373,7 @@ def make_variant(tmp, shadow, noise):
 
 # ---- figures ---------------------------------------------------------------------------
 
-def fig_trajectories(figdir, tmp, tags, scen, nseeds):
+def fig_trajectories(figdir, tmp, tags, scen, nseeds, first):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -380,7 +385,7 @@ def fig_trajectories(figdir, tmp, tags, scen, nseeds):
         npan = min(5, nseeds)
         fig, axs = plt.subplots(npan, 1, figsize=(8, 2.6 * npan), squeeze=False)
         for k, ax in enumerate(axs[:, 0]):
-            sd = os.path.join(d, "seed-%d" % (k + 1))
+            sd = os.path.join(d, "seed-%d" % (first + k))
             ax.imshow(img, cmap="gray", extent=ext, origin="upper", vmin=0, vmax=255)
             tr = np.loadtxt(os.path.join(sd, "track.tsv"), skiprows=1, usecols=(1, 2))
             lg = read_tsv(os.path.join(sd, "log.tsv"))
@@ -400,7 +405,7 @@ def fig_trajectories(figdir, tmp, tags, scen, nseeds):
             ax.plot(start[0], start[1], "s", ms=6, color="tab:green", label="start")
             summ = read_tsv(os.path.join(d, "runs.tsv"))[k]
             ax.set_title("%s, seed %d: %s after %.0f m, %s model updates" %
-                         (st, k + 1, summ["end"], fnum(summ["distance_travelled_m"]),
+                         (st, first + k, summ["end"], fnum(summ["distance_travelled_m"]),
                           summ["model_updates"]), fontsize=9)
             ax.set_xlim(ext[0], ext[1])
             ax.set_ylim(ext[2], ext[3])
@@ -422,7 +427,7 @@ def fig_rssi(figdir, tmp, args, scen):
     fig, axs = plt.subplots(len(STRATEGIES), 1, figsize=(8, 12), sharex=True)
     for ax, st in zip(axs, STRATEGIES):
         d = os.path.join(tmp, "rssi-%s" % st)
-        single_run(args, scenario_path(scen), 1, d, st)
+        single_run(args, scenario_path(scen), args.first_seed, d, st)
         a = np.loadtxt(os.path.join(d, "samples.tsv"), skiprows=1, usecols=(4, 5))
         ax.plot(a[:, 0], a[:, 1], ",", color="0.6", alpha=0.5)
         # Moving average over a sliding 1 m window of distance (odometry is monotonic).
@@ -434,7 +439,7 @@ def fig_rssi(figdir, tmp, args, scen):
         ma = (c[hi[ok]] - c[lo[ok]]) / (hi[ok] - lo[ok])
         ax.plot(xs[ok], ma, "-", color="tab:blue", lw=1.2, label="1 m moving average")
         ax.set_ylabel("RSSI dBm")
-        ax.set_title("%s, %s, seed 1" % (scen, st), fontsize=9)
+        ax.set_title("%s, %s, seed %d" % (scen, st, args.first_seed), fontsize=9)
         ax.legend(fontsize=7, loc="lower right")
     axs[-1].set_xlabel("distance travelled, m")
     fig.tight_layout()
@@ -481,6 +486,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bin", default="build/bin/rfseek-sim", help="rfseek-sim to run")
     ap.add_argument("--seeds", type=int, default=200, help="seeds per strategy x scenario")
+    ap.add_argument("--first-seed", type=int, default=1001,
+                    help="seeds FIRST..FIRST+N-1 (1..500 are the tuning draws: report on others)")
     ap.add_argument("--noise-seeds", type=int, default=None, help="seeds per noise point")
     ap.add_argument("--model-seeds", type=int, default=None, help="seeds per model x scenario")
     ap.add_argument("--slow-model-seeds", type=int, default=30, help="seeds for mlp and knn")
@@ -495,8 +502,8 @@ def main():
     if not os.access(args.bin, os.X_OK):
         sys.stderr.write("bench_seek.py: %s: not an executable (build it first)\n" % args.bin)
         return 1
-    if args.seeds < 1 or args.jobs < 1:
-        sys.stderr.write("bench_seek.py: --seeds and --jobs must be at least 1\n")
+    if args.seeds < 1 or args.jobs < 1 or args.first_seed < 1:
+        sys.stderr.write("bench_seek.py: --seeds, --first-seed and --jobs must be at least 1\n")
         return 1
     scenarios = ["default"] if args.smoke else SCENARIOS
     if args.smoke:
@@ -538,7 +545,7 @@ def main():
         t_model = {m: sum(b.cpu for b in model_b.values() if b.model == m) for m in MODELS}
         t_run = time.time() - t_all
         # 4. figures
-        figs = fig_trajectories(figdir, tmp, tags, "default", args.seeds)
+        figs = fig_trajectories(figdir, tmp, tags, "default", args.seeds, args.first_seed)
         figs.append(fig_rssi(figdir, tmp, args, "default"))
         figs.append(fig_noise(figdir, sweep))
         # failure analysis needs the walls for the unlabelled floors
@@ -546,7 +553,7 @@ def main():
         for sc in scenarios:
             if sc not in REGIONS:
                 d = os.path.join(tmp, "field-%s" % sc)
-                single_run(args, scenario_path(sc), 1, d, "meta", field=True)
+                single_run(args, scenario_path(sc), args.first_seed, d, "meta", field=True)
                 walls[sc] = walls_lookup(os.path.join(d, "field.tsv"))
         t_total = time.time() - t_all
         times = dict(sweep=cpu["sweep"], noise=cpu["noise"], models=sum(t_model.values()),
@@ -625,11 +632,13 @@ def write_results(args, path, scenarios, table, sweep, mtab, walls, figs, times,
     A("# Results\n")
     A("Written by `make bench-seek` (`%s scripts/bench_seek.py --seeds %d --jobs %d "
       "--slow-model-seeds %d%s%s`) at commit %s: `rfseek-sim`, in-process fixed-point "
-      "core. Seeds 1..N of every scenario, the same seeds for every strategy, so rows are "
-      "paired. Do not edit the tables by hand: re-run the benchmark."
+      "core. Seeds %d.. of every scenario (1..500 are the tuning draws), the same seeds for "
+      "every strategy, so rows are paired. Do not edit the tables by hand: re-run the "
+      "benchmark."
       % (sys.executable, args.seeds, args.jobs, args.slow_model_seeds,
          " --noise-seeds %d" % ns if ns != args.seeds else "",
-         " --model-seeds %d" % ms if ms != args.seeds else "", bench_pathloss_seek.commit()))
+         " --model-seeds %d" % ms if ms != args.seeds else "", bench_pathloss_seek.commit(),
+         args.first_seed))
     A("")
     A("**Definitions.** *Success*: within 1.5 m of the source before 150 m of travel (and "
       "900 s). *Travel*: path length of the true robot position. *Ratio*: travel / "

@@ -81,9 +81,10 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
     /* A quarter of the 1 m bin: the four points sit at the centres of the bin's quarters
      * when its centroid is central (docs/PATHLOSS.md, "A bin's walls"). */
     c.footprint = RFS_Q16_FRAC(1, 4);
-    /* The coarse pass counts as the refinement does (0: one count a bin, the coarse points
-     * then only rank: a quarter of their counts, docs/PATHLOSS.md, "A bin's walls"). */
-    c.coarse_footprint = c.footprint;
+    /* The coarse pass counts as the refinement does, whatever footprint a caller sets (0:
+     * one count a bin, the coarse points then only rank: a quarter of their counts,
+     * docs/PATHLOSS.md, "A bin's walls"). */
+    c.coarse_footprint = RFS_PATHLOSS_COARSE_AS_FOOTPRINT;
     return c;
 }
 
@@ -105,7 +106,8 @@ int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg)
               c->huber <= RFS_Q16_INT(100) && c->spread_k >= 0 &&
               c->spread_k <= RFS_Q16_INT(1000) && c->margin >= 0 && c->hold_k >= 0 &&
               c->hold_k <= RFS_Q16_INT(64) && c->footprint >= 0 && c->footprint <= c->bin / 2 &&
-              c->coarse_footprint >= 0 && c->coarse_footprint <= c->bin / 2 &&
+              (c->coarse_footprint == RFS_PATHLOSS_COARSE_AS_FOOTPRINT ||
+               (c->coarse_footprint >= 0 && c->coarse_footprint <= c->bin / 2)) &&
               c->margin <= RFS_Q16_INT(100) && c->sample_t >= RFS_Q16_FRAC(1, 16) &&
               c->sample_t <= RFS_Q16_INT(64) &&
               ((c->p0_max_wall >= 0 && c->p0_max_wall <= RFS_Q16_INT(60)) ||
@@ -115,6 +117,9 @@ int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg)
     }
     memset(p, 0, sizeof(*p));
     p->cfg = *cfg;
+    if (p->cfg.coarse_footprint == RFS_PATHLOSS_COARSE_AS_FOOTPRINT) {
+        p->cfg.coarse_footprint = p->cfg.footprint;
+    }
     return 0;
 }
 

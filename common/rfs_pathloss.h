@@ -95,6 +95,9 @@
 #define RFS_PATHLOSS_NO_LOSS UINT32_MAX
 
 /// Configuration; rfs_pathloss_cfg_default() gives the values in the comments.
+/// rfs_pathloss_cfg_t.coarse_footprint: count the coarse pass with `footprint` (the default).
+#define RFS_PATHLOSS_COARSE_AS_FOOTPRINT (-1)
+
 typedef struct rfs_pathloss_cfg {
     rfs_q16_t bin;          ///< metres Q16.16: side of a sample bin (1 m), 0.1..16 m
     rfs_q16_t coarse;       ///< metres Q16.16: coarse candidate spacing (2 m)
@@ -125,7 +128,8 @@ typedef struct rfs_pathloss_cfg {
                             ///< side of its cell's centre, along x and y (0.25 m; 0: from
                             ///< the centre alone), 0..bin / 2
     rfs_q16_t coarse_footprint; ///< metres Q16.16: the footprint of the coarse candidates'
-                            ///< counts (0.25 m, as footprint; 0: one count a bin, about
+                            ///< counts (RFS_PATHLOSS_COARSE_AS_FOOTPRINT: footprint's,
+                            ///< the default; 0: one count a bin, about
                             ///< half the counts of a fit). Unless equal to footprint the
                             ///< coarse pass only ranks: the refinement re-evaluates the
                             ///< top points with footprint (docs/PATHLOSS.md, "Fit")

@@ -197,7 +197,7 @@ static void init_rejects_bad_configurations(void **state)
     bad[15].footprint = good.bin / 2 + 1;      /* beyond the bin */
     bad[16].sample_t = RFS_Q16_FRAC(1, 16) - 1;
     bad[17].sample_t = RFS_Q16_INT(64) + 1;
-    bad[18].coarse_footprint = -1;
+    bad[18].coarse_footprint = -2;
     bad[19].coarse_footprint = good.bin / 2 + 1;
     bad[20].p0_max_wall = -1;
     bad[21].p0_max_wall = RFS_Q16_INT(60) + 1;
@@ -545,14 +545,15 @@ static void p0_ceiling_credits_walls(void **state)
 
 /* footprint 0 (each bin's walls counted from its cell's centre alone, the model before
  * the footprint) equals the double reference too, and differs from the default: the
- * test's office has bins whose footprint straddles a wall's end. */
+ * test's office has bins whose footprint straddles a wall's end. The coarse pass follows
+ * the footprint set alone (coarse_footprint left at its default). */
 static void footprint_off_same_as_reference(void **state)
 {
     fixture_t *f = *state;
     make_samples(f->s, NS, &f->map, &k_office, 11);
     rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
     ref_pl_cfg_t rc = ref_pl_cfg_default();
-    c.footprint = c.coarse_footprint = 0;
+    c.footprint = 0;
     rc.footprint = rc.coarse_footprint = 0.0;
     expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
     rfs_pathloss_est_t off;
@@ -573,7 +574,7 @@ static void coarse_footprint_one_same_as_reference(void **state)
     make_samples(f->s, NS, &f->map, &k_office, 11);
     rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
     ref_pl_cfg_t rc = ref_pl_cfg_default();
-    assert_int_equal(c.coarse_footprint, c.footprint);
+    assert_int_equal(c.coarse_footprint, RFS_PATHLOSS_COARSE_AS_FOOTPRINT);
     c.coarse_footprint = 0;
     rc.coarse_footprint = 0.0;
     expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);

@@ -63,10 +63,10 @@ static bool start_at(const hs_placer_t *p, uint32_t i, double *x, double *y, lon
     const long ix = (long)(p->starts[i] % cm->w), iy = (long)(p->starts[i] / cm->w);
     *x = round_to(e->x0 + (ix + 0.5) * res, 1000.0);
     *y = round_to(e->y0 + (iy + 0.5) * res, 1000.0);
-    const uint32_t mx = (uint32_t)((*x - e->map.origin_x) / e->map.res);
-    const uint32_t my = (uint32_t)((*y - e->map.origin_y) / e->map.res);
+    uint32_t mx, my;
     return hs_paths_cell(cm, e->x0, e->y0, *x, *y, cx, cy) && *cx == ix && *cy == iy &&
-           mx < e->map.w && my < e->map.h && e->map.cell[(size_t)my * e->map.w + mx] == LX_CELL_FREE &&
+           lx_map_cell_at(&e->map, *x, *y, &mx, &my) &&
+           e->map.cell[(size_t)my * e->map.w + mx] == LX_CELL_FREE &&
            rfs_map_point_legal(cm, (rfs_q16_t)lround(*x * 65536.0), (rfs_q16_t)lround(*y * 65536.0));
 }
 
@@ -78,8 +78,8 @@ static bool source_at(const hs_placer_t *p, uint32_t i, double *x, double *y)
     const uint32_t ix = p->sources[i] % m->w, iy = p->sources[i] / m->w;
     *x = round_to(m->origin_x + (ix + 0.5) * m->res, 1000.0);
     *y = round_to(m->origin_y + (iy + 0.5) * m->res, 1000.0);
-    const double fx = (*x - m->origin_x) / m->res, fy = (*y - m->origin_y) / m->res;
-    return fx >= 0.0 && fy >= 0.0 && (uint32_t)fx == ix && (uint32_t)fy == iy;
+    uint32_t cx, cy;
+    return lx_map_cell_at(m, *x, *y, &cx, &cy) && cx == ix && cy == iy;
 }
 
 /* The sources tried for one start (its distances in p->dist): 1 with *out filled, 0 when

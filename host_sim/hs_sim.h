@@ -1,5 +1,7 @@
 /* hs_sim.h - the simulator's run loop: world, radio, motor and localisation around a
- * controller (hs_ctrl.h), in simulated time (docs/SIMULATOR.md).
+ * controller (hs_ctrl.h), in simulated time (docs/SIMULATOR.md). The loop is hs_sim.c;
+ * what the runs of a scenario share (hs_sim_env_t) hs_sim_env.c; the written results
+ * (summary.json, runs.tsv rows) hs_sim_out.c.
  *
  * Time advances in physics ticks (default 20 ms). Each tick: the motor model turns the
  * commands received so far into a body velocity, Box2D moves the robot, and then every

@@ -12,6 +12,7 @@
 #include "rfs_test.h"
 
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -76,6 +77,35 @@ static void test_real_maps_counts(void **state)
         assert_int_equal(u, t[k].unk);
         lx_map_free(&m);
     }
+}
+
+/* lx_map_cell_at on 3ne (origin (-60.45, -23.4), 0.05 m, 1857 x 573): cells worked out by
+ * hand from the YAML's numbers; points off the map and NaN are refused. */
+static void test_cell_at(void **state)
+{
+    (void)state;
+    lx_map_t m;
+    load_real("3ne.yaml", &m);
+    static const struct {
+        double x, y;
+        bool on;
+        uint32_t cx, cy;
+    } t[] = {
+        {-60.44, -23.39, true, 0, 0},       {-59.925, -23.04, true, 10, 7},
+        {32.375, 5.225, true, 1856, 572},   {0.01, 0.01, true, 1209, 468},
+        {-60.46, -23.0, false, 0, 0},       {-60.0, -23.41, false, 0, 0},
+        {32.5, 0.0, false, 0, 0},           {0.0, 5.3, false, 0, 0},
+        {NAN, 0.0, false, 0, 0},            {0.0, NAN, false, 0, 0},
+    };
+    for (size_t k = 0; k < sizeof t / sizeof t[0]; k++) {
+        uint32_t cx = UINT32_MAX, cy = UINT32_MAX;
+        assert_int_equal(lx_map_cell_at(&m, t[k].x, t[k].y, &cx, &cy), t[k].on);
+        if (t[k].on) {
+            assert_int_equal(cx, t[k].cx);
+            assert_int_equal(cy, t[k].cy);
+        }
+    }
+    lx_map_free(&m);
 }
 
 /* Row 0 of the PGM is the top of the map; thresholds; negate; P2 and P5 agree. */
@@ -483,6 +513,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_real_maps_counts),
         cmocka_unit_test(test_orientation_thresholds_negate),
+        cmocka_unit_test(test_cell_at),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_yaml_node_bound),
         cmocka_unit_test(test_core_same_resolution),

@@ -569,6 +569,17 @@ static uint8_t cell_at(const lx_map_t *m, size_t i)
     return m->cell != NULL ? m->cell[i] : lx_map_cell_of(m->value[i]);
 }
 
+bool lx_map_cell_at(const lx_map_t *m, double x, double y, uint32_t *cx, uint32_t *cy)
+{
+    const double fx = (x - m->origin_x) / m->res, fy = (y - m->origin_y) / m->res;
+    if (!(fx >= 0.0 && fy >= 0.0 && fx < m->w && fy < m->h)) {
+        return false;
+    }
+    *cx = (uint32_t)fx;
+    *cy = (uint32_t)fy;
+    return true;
+}
+
 bool lx_map_known_box(const lx_map_t *m, uint32_t *x0, uint32_t *y0, uint32_t *x1, uint32_t *y1)
 {
     uint32_t bx0 = UINT32_MAX;

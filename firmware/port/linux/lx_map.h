@@ -92,6 +92,10 @@ int lx_map_load_values(const char *yaml_path, lx_map_t *m, char *err, size_t err
 /// Release a loaded map (safe on a zeroed or already freed map).
 void lx_map_free(lx_map_t *m);
 
+/// The cell (cx, cy) holding the world point (x, y) metres (row 0 = bottom): false when the
+/// point is off the map (or not a number).
+bool lx_map_cell_at(const lx_map_t *m, double x, double y, uint32_t *cx, uint32_t *cy);
+
 /// The smallest box holding every cell that is not unknown: columns x0..x1, rows y0..y1
 /// (row 0 = bottom), inclusive. false when every cell is unknown.
 bool lx_map_known_box(const lx_map_t *m, uint32_t *x0, uint32_t *y0, uint32_t *x1, uint32_t *y1);

@@ -326,6 +326,20 @@ static inline void oct_count(int n, int c, int *below, int *upto)
     }
 }
 
+/* The length of path from (x0, y0) (Q16 map units), metres, each segment asserted legal by
+ * the reference geometry. */
+static inline double ref_path_len(double x0, double y0, const rfs_path_t *path)
+{
+    double len = 0, px = x0, py = y0;
+    for (int w = 0; w < path->n; w++) {
+        assert_true(ref_seg(px, py, path->x[w], path->y[w]));
+        len += hypot(path->x[w] - px, path->y[w] - py) / 65536.0;
+        px = path->x[w];
+        py = path->y[w];
+    }
+    return len;
+}
+
 static inline void assert_same_path(const rfs_path_t *a, const rfs_path_t *b)
 {
     assert_int_equal(a->n, b->n);

@@ -30,14 +30,7 @@ static void run_random_pairs(uint32_t seed, int pairs, int *n_reach, int *n_unre
         assert_true(path.n >= 1);
         assert_int_equal(path.x[path.n - 1], x1);
         assert_int_equal(path.y[path.n - 1], y1);
-        double len = 0;
-        double px = x0, py = y0;
-        for (int w = 0; w < path.n; w++) {
-            assert_true(ref_seg(px, py, path.x[w], path.y[w]));
-            len += hypot(path.x[w] - px, path.y[w] - py) / 65536.0;
-            px = path.x[w];
-            py = path.y[w];
-        }
+        double len = ref_path_len(x0, y0, &path);
         double straight = hypot(x1 - x0, y1 - y0) / 65536.0;
         assert_true(len >= straight - 1e-4);
         assert_true(len <= want * 1.06 + 1e-3);
@@ -244,13 +237,7 @@ static void test_pull_linear(void **state)
     const rfs_q16_t x1 = (rfs_q16_t)(g / 2 + gi * g), y1 = (rfs_q16_t)(g / 2 + gj * g);
     rfs_path_t path;
     assert_true(rfs_plan_path(&p, x0, y0, x1, y1, &path));
-    double len = 0, px = x0, py = y0;
-    for (int w = 0; w < path.n; w++) {
-        assert_true(ref_seg(px, py, path.x[w], path.y[w]));
-        len += hypot(path.x[w] - px, path.y[w] - py) / 65536.0;
-        px = path.x[w];
-        py = path.y[w];
-    }
+    double len = ref_path_len(x0, y0, &path);
     const double points = 1.0607 * want * 65536.0 / g + 3.0;
     print_message("serpentine: %.2f m (lattice optimum %.2f m), %d waypoints, tests spanned "
                   "%u points, %.2f per lattice point\n", len, want, path.n, p.pulled,

@@ -563,13 +563,7 @@ static void test_tree_hop(void **state)
                 paths++;
                 assert_int_equal(pt.x0, qx);
                 assert_int_equal(pt.y0, qy);
-                double sum = 0, px = qx, py = qy;
-                for (int w = 0; w < pt.n; w++) {
-                    assert_true(ref_seg(px, py, pt.x[w], pt.y[w]));
-                    sum += hypot(pt.x[w] - px, pt.y[w] - py) / 65536.0;
-                    px = pt.x[w];
-                    py = pt.y[w];
-                }
+                double sum = ref_path_len(qx, qy, &pt);
                 assert_int_equal(pt.x[pt.n - 1], x1);
                 assert_int_equal(pt.y[pt.n - 1], y1);
                 const double l = pt.length / 65536.0;

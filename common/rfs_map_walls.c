@@ -6,6 +6,7 @@
 
 #include <string.h>
 
+#include "rfs_fix.h"
 #include "rfs_map_internal.h"
 
 static int64_t clamp64(int64_t v, int64_t lo, int64_t hi)
@@ -133,6 +134,11 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
     const int32_t step = flip ? -(int32_t)m->stride : (int32_t)m->stride;
     const uint8_t *wd = m->wall_dist;
     const bool shallow = wd != 0 && dy <= dx;
+    const uint8_t *fwd = m->wall_fwd != 0 ? m->wall_fwd + (flip ? (size_t)m->w * m->h : 0u) : 0;
+    /* Columns a free square of side d holds: d, or d dx / dy when steep (Q16 ratio). */
+    const uint32_t fwd_slope = fwd != 0 && dy > dx
+                                   ? (uint32_t)rfs_udiv64((uint64_t)dx << 16, (uint64_t)dy)
+                                   : 65536u;
     const int32_t long_col = b != 0 ? bs : (wd != 0 ? 3 : INT32_MAX); /* rows from which skips pay */
     for (int32_t i = ia; i <= ib; i++, nr += rdy) {
         if (dx != 0) {
@@ -154,10 +160,19 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
              * at once when the rows they span stay within d - 1 of the first cell, d its
              * distance (all inside its free square); ie and je from the same recurrence as
              * below. Steep segments pass over free cells inside a column (walk_column). */
-            const int32_t d = shallow && i < ib && (uint32_t)i < m->w
-                                  ? dist_at(m, i, flip ? -1 - jlo : jlo) : 0;
-            if (d > 2) {
-                const int32_t ie = i + d - 2 > ib ? ib : i + d - 2;
+            /* With a forward grid instead, the free square of side d ahead of (i, jlo):
+             * the columns i .. i + d - 1 when their rows stay below jlo + d, any slope. */
+            const int32_t jr = flip ? -1 - jlo : jlo;
+            int32_t d = 0, cols = 0;
+            if (fwd != 0 && i < ib && (uint32_t)i < m->w && (uint32_t)jr < m->h) {
+                d = fwd[(uint32_t)jr * m->w + (uint32_t)i];
+                cols = (int32_t)(((uint32_t)d * fwd_slope) >> 16);
+            } else if (shallow && i < ib && (uint32_t)i < m->w) {
+                d = dist_at(m, i, jr);
+                cols = d - 1;
+            }
+            if (cols > 1) {
+                const int32_t ie = i + cols - 1 > ib ? ib : i + cols - 1;
                 const int64_t ne = ie == ib ? Y1 * dx : nr + (int64_t)(ie - i) * rdy;
                 int32_t je = jhi;
                 int64_t be = bhi;
@@ -205,6 +220,50 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
         walk_column(m, b, &wk, i, jlo, jhi, flip, step, edge || jhi - jlo >= long_col);
     }
     return (uint16_t)(wk.runs > UINT16_MAX ? UINT16_MAX : wk.runs);
+}
+
+uint32_t rfs_map_wall_fwd_bytes(const rfs_map_t *m)
+{
+    return 2u * (uint32_t)m->w * m->h;
+}
+
+/* Side of the free square with cell (i, j) as its corner towards -x and -dj (dj = +-1):
+ * 0 on a wall, else one more than the least of its three neighbours' ahead (0 off the map). */
+static uint8_t fwd_square(const rfs_map_t *m, const uint8_t *g, int32_t i, int32_t j, int32_t dj)
+{
+    if (rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)j)) {
+        return 0u;
+    }
+    const int32_t w = m->w, h = m->h, jn = j + dj;
+    const bool in_i = i + 1 < w, in_j = jn >= 0 && jn < h;
+    uint32_t a = in_i ? g[(uint32_t)j * (uint32_t)w + (uint32_t)i + 1u] : 0u;
+    uint32_t b = in_j ? g[(uint32_t)jn * (uint32_t)w + (uint32_t)i] : 0u;
+    uint32_t c = in_i && in_j ? g[(uint32_t)jn * (uint32_t)w + (uint32_t)i + 1u] : 0u;
+    uint32_t v = (a < b ? a : b);
+    v = (v < c ? v : c) + 1u;
+    return (uint8_t)(v > 255u ? 255u : v);
+}
+
+int rfs_map_wall_fwd_attach(rfs_map_t *m, uint8_t *buf, uint32_t bytes)
+{
+    if (m->wall == 0 || buf == 0 || bytes < rfs_map_wall_fwd_bytes(m)) {
+        return -1;
+    }
+    /* Squares towards +y first (rows from the top down), then towards -y (bottom up). */
+    const int32_t w = m->w, h = m->h;
+    uint8_t *dn = buf + (uint32_t)w * (uint32_t)h;
+    for (int32_t j = h - 1; j >= 0; --j) {
+        for (int32_t i = w - 1; i >= 0; --i) {
+            buf[(uint32_t)j * (uint32_t)w + (uint32_t)i] = fwd_square(m, buf, i, j, 1);
+        }
+    }
+    for (int32_t j = 0; j < h; ++j) {
+        for (int32_t i = w - 1; i >= 0; --i) {
+            dn[(uint32_t)j * (uint32_t)w + (uint32_t)i] = fwd_square(m, dn, i, j, -1);
+        }
+    }
+    m->wall_fwd = buf;
+    return 0;
 }
 
 uint16_t rfs_map_walls_crossed(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,

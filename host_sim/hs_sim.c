@@ -208,11 +208,16 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
         hs_sim_env_close(e);
         return -1;
     }
-    /* The path-loss model's wall counts pass over free squares (rfs_map_wall_dist_attach). */
+    /* The path-loss model's wall counts pass over free squares (rfs_map_wall_dist_attach)
+     * and the free squares ahead of the walk (rfs_map_wall_fwd_attach). */
     if (e->core.map.wall != NULL) {
         const uint32_t nd = rfs_map_wall_dist_bytes(&e->core.map);
+        const uint32_t nf = rfs_map_wall_fwd_bytes(&e->core.map);
         e->wall_dist = malloc(nd);
-        if (e->wall_dist == NULL || rfs_map_wall_dist_attach(&e->core.map, e->wall_dist, nd) != 0) {
+        e->wall_fwd = malloc(nf);
+        if (e->wall_dist == NULL || e->wall_fwd == NULL ||
+            rfs_map_wall_dist_attach(&e->core.map, e->wall_dist, nd) != 0 ||
+            rfs_map_wall_fwd_attach(&e->core.map, e->wall_fwd, nf) != 0) {
             snprintf(err, errlen, "%s: map: out of memory", sc->path);
             hs_sim_env_close(e);
             return -1;
@@ -259,6 +264,8 @@ void hs_sim_env_close(hs_sim_env_t *e)
     e->lattice_edges = NULL;
     free(e->wall_dist);
     e->wall_dist = NULL;
+    free(e->wall_fwd);
+    e->wall_fwd = NULL;
     hs_box2d_walls_free(&e->walls);
     lx_map_free(&e->map);
 }

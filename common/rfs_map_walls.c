@@ -172,18 +172,24 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
                 cols = d - 1;
             }
             if (cols > 1) {
+                /* Rows up to column ie stay below jlo + d when y(xr) * dx there, ne, is
+                 * below (jlo + d) r dx; then jhi (rows with (j + 1) r dx <= ne) and jlo
+                 * (those < ne, the next column's) step at once. Scaling: ne - bhi and
+                 * ne - blo are below d r dx < 2^54. */
                 const int32_t ie = i + cols - 1 > ib ? ib : i + cols - 1;
                 const int64_t ne = ie == ib ? Y1 * dx : nr + (int64_t)(ie - i) * rdy;
-                int32_t je = jhi;
-                int64_t be = bhi;
-                while (be <= ne && je - jlo < d) {
-                    je++;
-                    be += rdx;
-                }
-                if (je - jlo < d) {
+                if (jhi - jlo < d && ne < blo + (int64_t)(d - 1) * rdx) {
+                    if (bhi <= ne) {
+                        const int64_t k = (int64_t)rfs_udiv64((uint64_t)(ne - bhi), (uint64_t)rdx) + 1;
+                        jhi += (int32_t)k;
+                        bhi += k * rdx;
+                    }
+                    if (blo < ne) {
+                        const int64_t k = (int64_t)rfs_udiv64((uint64_t)(ne - blo - 1), (uint64_t)rdx) + 1;
+                        jlo += (int32_t)k;
+                        blo += k * rdx;
+                    }
                     wk.in_wall = false;
-                    jhi = je;
-                    bhi = be;
                     nl = ne;
                     nr += (int64_t)(ie - i) * rdy;
                     i = ie;

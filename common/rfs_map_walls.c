@@ -174,20 +174,26 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
             if (cols > 1) {
                 /* Rows up to column ie stay below jlo + d when y(xr) * dx there, ne, is
                  * below (jlo + d) r dx; then jhi (rows with (j + 1) r dx <= ne) and jlo
-                 * (those < ne, the next column's) step at once. Scaling: ne - bhi and
-                 * ne - blo are below d r dx < 2^54. */
+                 * (those < ne, the next column's) catch up four rows a step. */
                 const int32_t ie = i + cols - 1 > ib ? ib : i + cols - 1;
                 const int64_t ne = ie == ib ? Y1 * dx : nr + (int64_t)(ie - i) * rdy;
                 if (jhi - jlo < d && ne < blo + (int64_t)(d - 1) * rdx) {
-                    if (bhi <= ne) {
-                        const int64_t k = (int64_t)rfs_udiv64((uint64_t)(ne - bhi), (uint64_t)rdx) + 1;
-                        jhi += (int32_t)k;
-                        bhi += k * rdx;
+                    const int64_t r4 = 4 * rdx;
+                    while (bhi + 3 * rdx <= ne) {
+                        jhi += 4;
+                        bhi += r4;
                     }
-                    if (blo < ne) {
-                        const int64_t k = (int64_t)rfs_udiv64((uint64_t)(ne - blo - 1), (uint64_t)rdx) + 1;
-                        jlo += (int32_t)k;
-                        blo += k * rdx;
+                    while (bhi <= ne) {
+                        jhi++;
+                        bhi += rdx;
+                    }
+                    while (blo + 3 * rdx < ne) {
+                        jlo += 4;
+                        blo += r4;
+                    }
+                    while (blo < ne) {
+                        jlo++;
+                        blo += rdx;
                     }
                     wk.in_wall = false;
                     nl = ne;

@@ -135,10 +135,11 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
     const uint8_t *wd = m->wall_dist;
     const bool shallow = wd != 0 && dy <= dx;
     const uint8_t *fwd = m->wall_fwd != 0 ? m->wall_fwd + (flip ? (size_t)m->w * m->h : 0u) : 0;
-    /* Columns a free square of side d holds: d, or d dx / dy when steep (Q16 ratio). */
-    const uint32_t fwd_slope = fwd != 0 && dy > dx
-                                   ? (uint32_t)rfs_udiv64((uint64_t)dx << 16, (uint64_t)dy)
-                                   : 65536u;
+    /* Columns the segment crosses inside a free square of side d from the bottom of its
+     * first row: d, at most (d - 1) dx / dy (fwd_slope: dx / dy in Q16, at most 256). */
+    const uint64_t fwd_slope = fwd == 0 ? 0u
+                               : dy * 256 <= dx ? (uint64_t)256 << 16
+                                                : rfs_udiv64((uint64_t)dx << 16, (uint64_t)dy);
     const int32_t long_col = b != 0 ? bs : (wd != 0 ? 3 : INT32_MAX); /* rows from which skips pay */
     for (int32_t i = ia; i <= ib; i++, nr += rdy) {
         if (dx != 0) {
@@ -166,7 +167,8 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
             int32_t d = 0, cols = 0;
             if (fwd != 0 && i < ib && (uint32_t)i < m->w && (uint32_t)jr < m->h) {
                 d = fwd[(uint32_t)jr * m->w + (uint32_t)i];
-                cols = (int32_t)(((uint32_t)d * fwd_slope) >> 16);
+                const uint64_t c = ((uint64_t)(d > 0 ? d - 1 : 0) * fwd_slope) >> 16;
+                cols = c < (uint64_t)d ? (int32_t)c : d;
             } else if (shallow && i < ib && (uint32_t)i < m->w) {
                 d = dist_at(m, i, jr);
                 cols = d - 1;

@@ -113,10 +113,10 @@ long hs_box2d_wall_contacts(const hs_box2d_t *w);
 unsigned hs_box2d_walls_crossed(const hs_box2d_t *w, double x0, double y0, double x1,
                                 double y1);
 
-/// hs_box2d_walls_crossed() through Box2D's own tree (b2World::RayCast): the same count,
-/// slower; the reference its radio-fixture index is tested against.
-unsigned hs_box2d_walls_crossed_tree(const hs_box2d_t *w, double x0, double y0, double x1,
-                                     double y1);
+/// hs_box2d_walls_crossed() casting every radio fixture: the same count, slower; the
+/// reference its radio-fixture index is tested against.
+unsigned hs_box2d_walls_crossed_all(const hs_box2d_t *w, double x0, double y0, double x1,
+                                    double y1);
 
 /// true when a disc of the robot's radius at (x, y) overlaps a collision wall or lies
 /// (partly) off the map.

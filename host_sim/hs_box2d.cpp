@@ -340,10 +340,10 @@ extern "C" hs_box2d_t *hs_box2d_create_walls(const lx_map_t *m, const hs_box2d_c
         sd.type = b2_staticBody;
         b2Body *collide = w->world->CreateBody(&sd);
         // The radio walls answer ray casts through their own index (index_radio), never
-        // Box2D's tree or contacts: on a disabled body their fixtures get no broad-phase
-        // proxies, a tree half the size to build every run (the robot's contacts, with the
-        // collision walls only, come in the same order).
-        sd.enabled = false;
+        // Box2D's tree or contacts: on a disabled body (unless wall_pairs) their fixtures
+        // get no broad-phase proxies, a tree half the size to build every run (the robot's
+        // contacts, with the collision walls only, come in the same order).
+        sd.enabled = c.wall_pairs;
         b2Body *radio = w->world->CreateBody(&sd);
         w->n_collide = add_walls(m, collide, HS_BOX2D_COLLIDE, walls->rect[HS_BOX2D_COLLIDE],
                                  walls->n[HS_BOX2D_COLLIDE]);

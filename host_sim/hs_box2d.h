@@ -47,8 +47,9 @@ typedef struct hs_box2d_cfg {
     int velocity_iters;     ///< Box2D velocity iterations (8)
     int position_iters;     ///< Box2D position iterations (3)
     double wall_merge_gap_m; ///< ray cast hits closer than this count as one wall (0.1 m)
-    bool wall_pairs;        ///< let Box2D's first step search pairs among the walls too (the
-                            ///< same world, slower; false: tests compare against it)
+    bool wall_pairs;        ///< the world as Box2D builds it: pairs searched among the walls
+                            ///< too, the radio walls in its tree (the same world, slower;
+                            ///< false: tests compare against it)
 } hs_box2d_cfg_t;
 
 /// Opaque world (owns the Box2D world).

@@ -12,6 +12,7 @@
 #include "hs_radio.h"
 #include "hs_box2d.h"
 #include "hs_paths.h"
+#include "rfs_pathloss.h"
 #include "rfs_pdr.h"
 
 /* Append v[0..n) to line at n, each as printf("%.*f", prec[i]) and followed by a tab,
@@ -223,6 +224,16 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
             return -1;
         }
     }
+    /* The path-loss model's distance terms read their logarithms from one table. */
+    if (strcmp(sc->model, "pathloss") == 0) {
+        e->pathloss_log2 = malloc(RFS_PATHLOSS_LOG2_ENTRIES * sizeof(e->pathloss_log2[0]));
+        if (e->pathloss_log2 == NULL) {
+            snprintf(err, errlen, "%s: map: out of memory", sc->path);
+            hs_sim_env_close(e);
+            return -1;
+        }
+        rfs_pathloss_log2_fill(e->pathloss_log2);
+    }
     if (env_prepare(e, err, errlen) != 0) {
         hs_sim_env_close(e);
         return -1;
@@ -266,6 +277,8 @@ void hs_sim_env_close(hs_sim_env_t *e)
     e->wall_dist = NULL;
     free(e->wall_fwd);
     e->wall_fwd = NULL;
+    free(e->pathloss_log2);
+    e->pathloss_log2 = NULL;
     hs_box2d_walls_free(&e->walls);
     lx_map_free(&e->map);
 }
@@ -1064,6 +1077,7 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     cc.p0_min_dbm = e->sc.seek_p0_min_dbm;
     cc.coarse_footprint_m = e->sc.seek_coarse_footprint_m;
     cc.p0_max_wall_db = e->sc.seek_p0_max_wall_db;
+    cc.pathloss_log2 = e->pathloss_log2;
     if (e->sc.seek_refute_reached >= 0) {
         cc.seek.refute_reached = e->sc.seek_refute_reached != 0;
     }

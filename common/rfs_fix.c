@@ -320,9 +320,9 @@ int64_t rfs_i128_div_shift(rfs_i128_t n, rfs_i128_t d, unsigned shift)
         top_bit -= skip;
     }
     for (int i = top_bit; i >= 0; --i) {
-        uint64_t bit = i >= 128 ? (w2 >> (i - 128)) & 1u
-                     : i >= 64  ? (w1 >> (i - 64)) & 1u
-                                : (w0 >> i) & 1u;
+        uint64_t bit = i >= 128 ? (w2 >> ((unsigned)(i - 128) & 63u)) & 1u
+                     : i >= 64  ? (w1 >> ((unsigned)(i - 64) & 63u)) & 1u
+                                : (w0 >> ((unsigned)i & 63u)) & 1u;
         uint64_t top = rh >> 63;
         rh = (rh << 1) | (rl >> 63);
         rl = (rl << 1) | bit;

@@ -94,6 +94,42 @@ static inline int32_t dist_at(const rfs_map_t *m, int32_t i, int32_t j)
     return (uint32_t)j < m->h ? m->wall_dist[(uint32_t)j * m->w + (uint32_t)i] : 0;
 }
 
+/* Step row j and its bound (j + 1) r dx while the bound is below n, four rows a step. */
+static inline void rows_to(int32_t *j, int64_t *bound, int64_t n, int64_t rdx)
+{
+    while (*bound + 3 * rdx < n) {
+        *j += 4;
+        *bound += 4 * rdx;
+    }
+    while (*bound < n) {
+        (*j)++;
+        *bound += rdx;
+    }
+}
+
+/* The free square ahead of cell (i, jr), i on the map, jr the real row of the column's
+ * first cell in walk order: its side in *d and the columns of it the walk may pass over.
+ * With a forward grid (fwd, for the walk's direction), the square of side d with the
+ * cell as its corner: the columns a segment of slope 1 / slope (Q16) crosses in it from
+ * the bottom of its first row, min(d, (d - 1) slope), any slope. With a wall-distance
+ * grid instead, on a shallow segment (shallow), the square round the cell, d its
+ * distance: d - 1 columns ahead (steep segments pass over free cells inside a column,
+ * walk_column). 0: none. */
+static inline int32_t square_ahead(const rfs_map_t *m, const uint8_t *fwd, uint64_t slope,
+                                   bool shallow, int32_t i, int32_t jr, int32_t *d)
+{
+    if (fwd != 0 && (uint32_t)jr < m->h) {
+        *d = fwd[(uint32_t)jr * m->w + (uint32_t)i];
+        const uint64_t c = ((uint64_t)(*d > 0 ? *d - 1 : 0) * slope) >> 16;
+        return c < (uint64_t)*d ? (int32_t)c : *d;
+    }
+    if (fwd == 0 && shallow) {
+        *d = dist_at(m, i, jr);
+        return *d - 1;
+    }
+    return 0;
+}
+
 /* traverse() with the VISIT_WALLS visitor, specialised: the same cells in the same order
  * (the same endpoint swap, mirror and column recurrences), counting runs of wall cells.
  * Cells off the map are not walls: columns -1 and w (first and last, when an endpoint
@@ -135,9 +171,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
     const uint8_t *wd = m->wall_dist;
     const bool shallow = wd != 0 && dy <= dx;
     const uint8_t *fwd = m->wall_fwd != 0 ? m->wall_fwd + (flip ? (size_t)m->w * m->h : 0u) : 0;
-    /* Columns the segment crosses inside a free square of side d from the bottom of its
-     * first row: d, at most (d - 1) dx / dy (fwd_slope: dx / dy in Q16, at most 256). */
-    const uint64_t fwd_slope = fwd == 0 ? 0u
+    const uint64_t fwd_slope = fwd == 0 ? 0u /* dx / dy, Q16, at most 256 */
                                : dy * 256 <= dx ? (uint64_t)256 << 16
                                                 : rfs_udiv64((uint64_t)dx << 16, (uint64_t)dy);
     const int32_t long_col = b != 0 ? bs : (wd != 0 ? 3 : INT32_MAX); /* rows from which skips pay */
@@ -157,46 +191,18 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
                 bhi += rdx;
             }
             nl = n_r; /* the next column starts where this one ends */
-            /* With a wall-distance grid and a shallow segment, the columns i .. i + d - 2
-             * at once when the rows they span stay within d - 1 of the first cell, d its
-             * distance (all inside its free square); ie and je from the same recurrence as
-             * below. Steep segments pass over free cells inside a column (walk_column). */
-            /* With a forward grid instead, the free square of side d ahead of (i, jlo):
-             * the columns i .. i + d - 1 when their rows stay below jlo + d, any slope. */
-            const int32_t jr = flip ? -1 - jlo : jlo;
-            int32_t d = 0, cols = 0;
-            if (fwd != 0 && i < ib && (uint32_t)i < m->w && (uint32_t)jr < m->h) {
-                d = fwd[(uint32_t)jr * m->w + (uint32_t)i];
-                const uint64_t c = ((uint64_t)(d > 0 ? d - 1 : 0) * fwd_slope) >> 16;
-                cols = c < (uint64_t)d ? (int32_t)c : d;
-            } else if (shallow && i < ib && (uint32_t)i < m->w) {
-                d = dist_at(m, i, jr);
-                cols = d - 1;
-            }
+            /* The columns i .. ie in the free square of side d ahead (square_ahead) when
+             * their rows stay below jlo + d: y(xr) * dx at ie, ne, below (jlo + d) r dx. */
+            int32_t d = 0;
+            const int32_t cols = i < ib && (uint32_t)i < m->w
+                                     ? square_ahead(m, fwd, fwd_slope, shallow, i,
+                                                    flip ? -1 - jlo : jlo, &d) : 0;
             if (cols > 1) {
-                /* Rows up to column ie stay below jlo + d when y(xr) * dx there, ne, is
-                 * below (jlo + d) r dx; then jhi (rows with (j + 1) r dx <= ne) and jlo
-                 * (those < ne, the next column's) catch up four rows a step. */
                 const int32_t ie = i + cols - 1 > ib ? ib : i + cols - 1;
                 const int64_t ne = ie == ib ? Y1 * dx : nr + (int64_t)(ie - i) * rdy;
                 if (jhi - jlo < d && ne < blo + (int64_t)(d - 1) * rdx) {
-                    const int64_t r4 = 4 * rdx;
-                    while (bhi + 3 * rdx <= ne) {
-                        jhi += 4;
-                        bhi += r4;
-                    }
-                    while (bhi <= ne) {
-                        jhi++;
-                        bhi += rdx;
-                    }
-                    while (blo + 3 * rdx < ne) {
-                        jlo += 4;
-                        blo += r4;
-                    }
-                    while (blo < ne) {
-                        jlo++;
-                        blo += rdx;
-                    }
+                    rows_to(&jhi, &bhi, ne + 1, rdx);
+                    rows_to(&jlo, &blo, ne, rdx);
                     wk.in_wall = false;
                     nl = ne;
                     nr += (int64_t)(ie - i) * rdy;

@@ -107,6 +107,20 @@ static inline void rows_to(int32_t *j, int64_t *bound, int64_t n, int64_t rdx)
     }
 }
 
+/* dx / dy in Q16 (0 <= dx, dy < 2^31), at most 256, rounded down after dropping low bits
+ * so that one 32-bit division does (the skips only need a lower bound). */
+static inline uint64_t slope_q16(int64_t dx, int64_t dy)
+{
+    if (dy * 256 <= dx) {
+        return (uint64_t)256 << 16;
+    }
+    uint32_t sh = 0u; /* (dx >> sh) << 16 in 32 bits, dy >> sh below 2^15 */
+    while ((dx >> sh) >= 65536 || (dy >> sh) >= 32768) {
+        sh++;
+    }
+    return (((uint32_t)(dx >> sh) << 16) / (uint32_t)((dy >> sh) + 1));
+}
+
 /* The free square ahead of cell (i, jr), i on the map, jr the real row of the column's
  * first cell in walk order: its side in *d and the columns of it the walk may pass over.
  * With a forward grid (fwd, for the walk's direction), the square of side d with the
@@ -171,9 +185,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
     const uint8_t *wd = m->wall_dist;
     const bool shallow = wd != 0 && dy <= dx;
     const uint8_t *fwd = m->wall_fwd != 0 ? m->wall_fwd + (flip ? (size_t)m->w * m->h : 0u) : 0;
-    const uint64_t fwd_slope = fwd == 0 ? 0u /* dx / dy, Q16, at most 256 */
-                               : dy * 256 <= dx ? (uint64_t)256 << 16
-                                                : rfs_udiv64((uint64_t)dx << 16, (uint64_t)dy);
+    const uint64_t fwd_slope = fwd == 0 ? 0u : slope_q16(dx, dy);
     const int32_t long_col = b != 0 ? bs : (wd != 0 ? 3 : INT32_MAX); /* rows from which skips pay */
     for (int32_t i = ia; i <= ib; i++, nr += rdy) {
         if (dx != 0) {

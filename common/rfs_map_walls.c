@@ -206,7 +206,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
             /* The columns i .. ie in the free square of side d ahead (square_ahead) when
              * their rows stay below jlo + d: y(xr) * dx at ie, ne, below (jlo + d) r dx. */
             int32_t d = 0;
-            const int32_t cols = i < ib && (uint32_t)i < m->w
+            const int32_t cols = (fwd != 0 || shallow) && i < ib && (uint32_t)i < m->w
                                      ? square_ahead(m, fwd, fwd_slope, shallow, i,
                                                     flip ? -1 - jlo : jlo, &d) : 0;
             if (cols > 1) {

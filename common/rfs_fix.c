@@ -269,6 +269,22 @@ static int u128_cmp(uint64_t ah, uint64_t al, uint64_t bh, uint64_t bl)
     return al < bl ? -1 : (al > bl ? 1 : 0);
 }
 
+/* (w2, w1, w0) >> sh for 0 <= sh < 192, when the result fits 128 bits (hi, lo). */
+static void shr192(uint64_t w2, uint64_t w1, uint64_t w0, int sh, uint64_t *hi, uint64_t *lo)
+{
+    if (sh >= 128) {
+        *hi = 0u;
+        *lo = w2 >> (sh - 128);
+    } else if (sh >= 64) {
+        const int t = sh - 64;
+        *hi = w2 >> t;
+        *lo = t ? (w1 >> t) | (w2 << (64 - t)) : w1;
+    } else {
+        *hi = sh ? (w1 >> sh) | (w2 << (64 - sh)) : w1;
+        *lo = sh ? (w0 >> sh) | (w1 << (64 - sh)) : w0;
+    }
+}
+
 int64_t rfs_i128_div_shift(rfs_i128_t n, rfs_i128_t d, unsigned shift)
 {
     RFS_ASSERT(shift <= 62u);
@@ -290,16 +306,23 @@ int64_t rfs_i128_div_shift(rfs_i128_t n, rfs_i128_t d, unsigned shift)
     uint64_t w2 = shift ? nh >> (64u - shift) : 0u;
     uint64_t w1 = shift ? (nh << shift) | (nl >> (64u - shift)) : nh;
     uint64_t w0 = nl << shift;
-    /* Long division, one bit per round over 192 bits; remainder stays < 2 * d. Rounds
-     * above the numerator's top bit would leave remainder and quotient 0: start at it. */
+    /* Long division, one bit per round over 192 bits; remainder stays < 2 * d. The
+     * numerator's top bits shorter than d (db bits) only shift into the remainder with
+     * quotient bits 0: they are taken at once, and the rounds start below them. */
     uint64_t rh = 0u, rl = 0u, qh = 0u, ql = 0u;
     bool overflow = false;
     int top_bit = w2 ? 191 - __builtin_clzll(w2) : w1 ? 127 - __builtin_clzll(w1)
                 : w0 ? 63 - __builtin_clzll(w0) : -1;
+    const int db = dh ? 128 - __builtin_clzll(dh) : 64 - __builtin_clzll(dl);
+    const int skip = top_bit + 1 < db - 1 ? top_bit + 1 : db - 1; /* bits taken at once */
+    if (skip > 0) {
+        shr192(w2, w1, w0, top_bit + 1 - skip, &rh, &rl);
+        top_bit -= skip;
+    }
     for (int i = top_bit; i >= 0; --i) {
-        uint64_t bit = i >= 128 ? (w2 >> (i - 128)) & 1u
-                     : i >= 64  ? (w1 >> (i - 64)) & 1u
-                                : (w0 >> i) & 1u;
+        uint64_t bit = i >= 128 ? (w2 >> ((unsigned)(i - 128) & 63u)) & 1u
+                     : i >= 64  ? (w1 >> ((unsigned)(i - 64) & 63u)) & 1u
+                                : (w0 >> ((unsigned)i & 63u)) & 1u;
         uint64_t top = rh >> 63;
         rh = (rh << 1) | (rl >> 63);
         rl = (rl << 1) | bit;

@@ -73,6 +73,8 @@ typedef struct rfs_map {
     const uint8_t *wall_dist; ///< cells to the nearest wall cell (rfs_map_wall_dist_attach());
                               ///< NULL (init): none
     uint16_t *edges;       ///< lattice edge table (rfs_map_edges_attach()); NULL (init): none
+    const uint8_t *wall_fwd; ///< free squares ahead of each cell (rfs_map_wall_fwd_attach());
+                             ///< NULL (init): none
 } rfs_map_t;
 
 /// Defaults: 0.25 m clearance, 0.25 m lattice.
@@ -194,5 +196,16 @@ uint32_t rfs_map_wall_dist_bytes(const rfs_map_t *m);
 /// 1 byte a cell, docs/PATHLOSS.md, "Work, the wall-count cache and slicing").
 /// rfs_map_init() detaches it. -1 when the map has no wall grid or buf is NULL or too small.
 int rfs_map_wall_dist_attach(rfs_map_t *m, uint8_t *buf, uint32_t bytes);
+
+/// Bytes of a forward free-square grid for m (rfs_map_wall_fwd_attach()): two per cell.
+uint32_t rfs_map_wall_fwd_bytes(const rfs_map_t *m);
+
+/// Fill buf with the side in cells of the largest wall-free square on the map with each
+/// cell as its corner towards -x, once towards -y and once towards +y (saturated at 255),
+/// and attach it (it stays the caller's, outliving m): rfs_map_walls_crossed() then passes
+/// over the free square ahead of the walk, whatever lies behind (the same counts; a host
+/// index, docs/PATHLOSS.md, "Work, the wall-count cache and slicing"). rfs_map_init()
+/// detaches it. -1 when the map has no wall grid or buf is NULL or too small.
+int rfs_map_wall_fwd_attach(rfs_map_t *m, uint8_t *buf, uint32_t bytes);
 
 #endif /* RFS_MAP_H */

@@ -6,6 +6,7 @@
 
 #include <string.h>
 
+#include "rfs_fix.h"
 #include "rfs_map_internal.h"
 
 static int64_t clamp64(int64_t v, int64_t lo, int64_t hi)
@@ -93,6 +94,56 @@ static inline int32_t dist_at(const rfs_map_t *m, int32_t i, int32_t j)
     return (uint32_t)j < m->h ? m->wall_dist[(uint32_t)j * m->w + (uint32_t)i] : 0;
 }
 
+/* Step row j and its bound (j + 1) r dx while the bound is below n, four rows a step. */
+static inline void rows_to(int32_t *j, int64_t *bound, int64_t n, int64_t rdx)
+{
+    while (*bound + 3 * rdx < n) {
+        *j += 4;
+        *bound += 4 * rdx;
+    }
+    while (*bound < n) {
+        (*j)++;
+        *bound += rdx;
+    }
+}
+
+/* dx / dy in Q16 (0 <= dx, dy < 2^31), at most 256, rounded down after dropping low bits
+ * so that one 32-bit division does (the skips only need a lower bound). */
+static inline uint64_t slope_q16(int64_t dx, int64_t dy)
+{
+    if (dy * 256 <= dx) {
+        return (uint64_t)256 << 16;
+    }
+    uint32_t sh = 0u; /* (dx >> sh) << 16 in 32 bits, dy >> sh below 2^15 */
+    while ((dx >> sh) >= 65536 || (dy >> sh) >= 32768) {
+        sh++;
+    }
+    return (((uint32_t)(dx >> sh) << 16) / (uint32_t)((dy >> sh) + 1));
+}
+
+/* The free square ahead of cell (i, jr), i on the map, jr the real row of the column's
+ * first cell in walk order: its side in *d and the columns of it the walk may pass over.
+ * With a forward grid (fwd, for the walk's direction), the square of side d with the
+ * cell as its corner: the columns a segment of slope 1 / slope (Q16) crosses in it from
+ * the bottom of its first row, min(d, (d - 1) slope), any slope. With a wall-distance
+ * grid instead, on a shallow segment (shallow), the square round the cell, d its
+ * distance: d - 1 columns ahead (steep segments pass over free cells inside a column,
+ * walk_column). 0: none. */
+static inline int32_t square_ahead(const rfs_map_t *m, const uint8_t *fwd, uint64_t slope,
+                                   bool shallow, int32_t i, int32_t jr, int32_t *d)
+{
+    if (fwd != 0 && (uint32_t)jr < m->h) {
+        *d = fwd[(uint32_t)jr * m->w + (uint32_t)i];
+        const uint64_t c = ((uint64_t)(*d > 0 ? *d - 1 : 0) * slope) >> 16;
+        return c < (uint64_t)*d ? (int32_t)c : *d;
+    }
+    if (fwd == 0 && shallow) {
+        *d = dist_at(m, i, jr);
+        return *d - 1;
+    }
+    return 0;
+}
+
 /* traverse() with the VISIT_WALLS visitor, specialised: the same cells in the same order
  * (the same endpoint swap, mirror and column recurrences), counting runs of wall cells.
  * Cells off the map are not walls: columns -1 and w (first and last, when an endpoint
@@ -133,6 +184,8 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
     const int32_t step = flip ? -(int32_t)m->stride : (int32_t)m->stride;
     const uint8_t *wd = m->wall_dist;
     const bool shallow = wd != 0 && dy <= dx;
+    const uint8_t *fwd = m->wall_fwd != 0 ? m->wall_fwd + (flip ? (size_t)m->w * m->h : 0u) : 0;
+    const uint64_t fwd_slope = fwd == 0 ? 0u : slope_q16(dx, dy);
     const int32_t long_col = b != 0 ? bs : (wd != 0 ? 3 : INT32_MAX); /* rows from which skips pay */
     for (int32_t i = ia; i <= ib; i++, nr += rdy) {
         if (dx != 0) {
@@ -150,25 +203,19 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
                 bhi += rdx;
             }
             nl = n_r; /* the next column starts where this one ends */
-            /* With a wall-distance grid and a shallow segment, the columns i .. i + d - 2
-             * at once when the rows they span stay within d - 1 of the first cell, d its
-             * distance (all inside its free square); ie and je from the same recurrence as
-             * below. Steep segments pass over free cells inside a column (walk_column). */
-            const int32_t d = shallow && i < ib && (uint32_t)i < m->w
-                                  ? dist_at(m, i, flip ? -1 - jlo : jlo) : 0;
-            if (d > 2) {
-                const int32_t ie = i + d - 2 > ib ? ib : i + d - 2;
+            /* The columns i .. ie in the free square of side d ahead (square_ahead) when
+             * their rows stay below jlo + d: y(xr) * dx at ie, ne, below (jlo + d) r dx. */
+            int32_t d = 0;
+            const int32_t cols = (fwd != 0 || shallow) && i < ib && (uint32_t)i < m->w
+                                     ? square_ahead(m, fwd, fwd_slope, shallow, i,
+                                                    flip ? -1 - jlo : jlo, &d) : 0;
+            if (cols > 1) {
+                const int32_t ie = i + cols - 1 > ib ? ib : i + cols - 1;
                 const int64_t ne = ie == ib ? Y1 * dx : nr + (int64_t)(ie - i) * rdy;
-                int32_t je = jhi;
-                int64_t be = bhi;
-                while (be <= ne && je - jlo < d) {
-                    je++;
-                    be += rdx;
-                }
-                if (je - jlo < d) {
+                if (jhi - jlo < d && ne < blo + (int64_t)(d - 1) * rdx) {
+                    rows_to(&jhi, &bhi, ne + 1, rdx);
+                    rows_to(&jlo, &blo, ne, rdx);
                     wk.in_wall = false;
-                    jhi = je;
-                    bhi = be;
                     nl = ne;
                     nr += (int64_t)(ie - i) * rdy;
                     i = ie;
@@ -205,6 +252,50 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
         walk_column(m, b, &wk, i, jlo, jhi, flip, step, edge || jhi - jlo >= long_col);
     }
     return (uint16_t)(wk.runs > UINT16_MAX ? UINT16_MAX : wk.runs);
+}
+
+uint32_t rfs_map_wall_fwd_bytes(const rfs_map_t *m)
+{
+    return 2u * (uint32_t)m->w * m->h;
+}
+
+/* Side of the free square with cell (i, j) as its corner towards -x and -dj (dj = +-1):
+ * 0 on a wall, else one more than the least of its three neighbours' ahead (0 off the map). */
+static uint8_t fwd_square(const rfs_map_t *m, const uint8_t *g, int32_t i, int32_t j, int32_t dj)
+{
+    if (rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)j)) {
+        return 0u;
+    }
+    const int32_t w = m->w, h = m->h, jn = j + dj;
+    const bool in_i = i + 1 < w, in_j = jn >= 0 && jn < h;
+    uint32_t a = in_i ? g[(uint32_t)j * (uint32_t)w + (uint32_t)i + 1u] : 0u;
+    uint32_t b = in_j ? g[(uint32_t)jn * (uint32_t)w + (uint32_t)i] : 0u;
+    uint32_t c = in_i && in_j ? g[(uint32_t)jn * (uint32_t)w + (uint32_t)i + 1u] : 0u;
+    uint32_t v = (a < b ? a : b);
+    v = (v < c ? v : c) + 1u;
+    return (uint8_t)(v > 255u ? 255u : v);
+}
+
+int rfs_map_wall_fwd_attach(rfs_map_t *m, uint8_t *buf, uint32_t bytes)
+{
+    if (m->wall == 0 || buf == 0 || bytes < rfs_map_wall_fwd_bytes(m)) {
+        return -1;
+    }
+    /* Squares towards +y first (rows from the top down), then towards -y (bottom up). */
+    const int32_t w = m->w, h = m->h;
+    uint8_t *dn = buf + (uint32_t)w * (uint32_t)h;
+    for (int32_t j = h - 1; j >= 0; --j) {
+        for (int32_t i = w - 1; i >= 0; --i) {
+            buf[(uint32_t)j * (uint32_t)w + (uint32_t)i] = fwd_square(m, buf, i, j, 1);
+        }
+    }
+    for (int32_t j = 0; j < h; ++j) {
+        for (int32_t i = w - 1; i >= 0; --i) {
+            dn[(uint32_t)j * (uint32_t)w + (uint32_t)i] = fwd_square(m, dn, i, j, -1);
+        }
+    }
+    m->wall_fwd = buf;
+    return 0;
 }
 
 uint16_t rfs_map_walls_crossed(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1,

@@ -131,7 +131,8 @@ static void pathloss_reset(void *self)
     p->phase = RFS_PATHLOSS_IDLE;
 }
 
-rfs_q16_t rfs_pathloss_db_dist(uint64_t d2_q32)
+/* rfs_pathloss_db_dist() with the mantissa's logarithm from tab (NULL: computed). */
+static rfs_q16_t db_dist(const int32_t *tab, uint64_t d2_q32)
 {
     const uint64_t one = (uint64_t)1 << 32; /* 1 m^2 */
     uint64_t v = d2_q32 < one ? one : d2_q32;
@@ -145,8 +146,31 @@ rfs_q16_t rfs_pathloss_db_dist(uint64_t d2_q32)
         }
     }
     uint32_t m = bl >= 16u ? (uint32_t)(v >> (bl - 16u)) : (uint32_t)(v << (16u - bl));
-    int64_t lg = ((int64_t)bl - 32) * 65536 + rfs_q16_log2((rfs_q16_t)m);
+    int64_t lg = ((int64_t)bl - 32) * 65536 +
+                 (tab != 0 ? tab[m - 65536u] : rfs_q16_log2((rfs_q16_t)m));
     return (rfs_q16_t)((lg * DB_PER_LOG2_SQ_Q30 + ((int64_t)1 << 29)) >> 30);
+}
+
+rfs_q16_t rfs_pathloss_db_dist(uint64_t d2_q32)
+{
+    return db_dist(0, d2_q32);
+}
+
+void rfs_pathloss_log2_fill(int32_t *tab)
+{
+    RFS_ASSERT(tab != 0);
+    for (uint32_t k = 0u; k < RFS_PATHLOSS_LOG2_ENTRIES; ++k) {
+        tab[k] = rfs_q16_log2((rfs_q16_t)(65536u + k));
+    }
+}
+
+int rfs_pathloss_log2_attach(rfs_pathloss_t *p, const int32_t *tab)
+{
+    if (p == 0 || tab == 0) {
+        return -1;
+    }
+    p->log2_tab = tab;
+    return 0;
 }
 
 /* floor(a / b) for b > 0. */
@@ -391,7 +415,7 @@ static uint32_t gather_bin(rfs_pathloss_t *p, uint32_t b)
 {
     const rfs_pathloss_bin_t *bb = &p->bins[b];
     int64_t dx = (int64_t)bb->x - p->ev.sx, dy = (int64_t)bb->y - p->ev.sy;
-    p->l_q16[b] = rfs_pathloss_db_dist(sq_sum(dx, dy));
+    p->l_q16[b] = db_dist(p->log2_tab, sq_sum(dx, dy));
     uint32_t lines = 0u;
     p->k[b] = p->map != 0 ? (uint8_t)rfs_pathloss_walls_bin(p, bb, &lines) : 0u;
     return lines;

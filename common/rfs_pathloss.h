@@ -309,6 +309,7 @@ typedef struct rfs_pathloss {
     rfs_pathloss_row_t rows[RFS_PATHLOSS_CACHE_ROWS]; ///< cached origins
     rfs_pathloss_xcache_t x;                      ///< an attached cache (cells NULL: none;
                                                   ///< then the three built-in arrays below)
+    const int32_t *log2_tab;                      ///< attached log2 table (NULL: none)
     uint16_t col_hash[RFS_PATHLOSS_COL_HASH];     ///< column + 1 by hashed lattice point
     uint32_t col_key[RFS_PATHLOSS_CACHE_COLS];    ///< lattice point of each column
     uint8_t walls[RFS_PATHLOSS_CACHE_ROWS][RFS_PATHLOSS_CACHE_COLS]; ///< footprint wall
@@ -337,6 +338,19 @@ uint32_t rfs_pathloss_cache_bytes(uint16_t cols);
 /// Empties the cache. Returns 0, or -1 on a null p or buf, cols 0 or above
 /// RFS_PATHLOSS_MAX_CACHE_COLS, or too few bytes.
 int rfs_pathloss_cache_attach(rfs_pathloss_t *p, void *buf, uint32_t bytes, uint16_t cols);
+
+/// Entries of a log2 table (rfs_pathloss_log2_fill()): one per 17-bit mantissa.
+#define RFS_PATHLOSS_LOG2_ENTRIES 65536u
+
+/// Fill tab (RFS_PATHLOSS_LOG2_ENTRIES entries) with rfs_q16_log2(65536 + k) at k: the
+/// logarithms of the distance terms' mantissas (rfs_pathloss_db_dist()), once for many
+/// states (a host index, 256 KB).
+void rfs_pathloss_log2_fill(int32_t *tab);
+
+/// Read the distance terms' logarithms from tab (filled by rfs_pathloss_log2_fill(),
+/// outliving p) instead of computing them: the same fits with less work. Returns 0, or -1
+/// on a null p or tab.
+int rfs_pathloss_log2_attach(rfs_pathloss_t *p, const int32_t *tab);
 
 /// The model interface of a path-loss state.
 rfs_model_t rfs_pathloss_model(rfs_pathloss_t *p);

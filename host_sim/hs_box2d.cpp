@@ -54,17 +54,9 @@ bool cell_in(const lx_map_t *m, uint32_t x, uint32_t y, hs_box2d_kind_t kind)
     return kind == HS_BOX2D_RADIO ? c == LX_CELL_OCC : c != LX_CELL_FREE;
 }
 
-// Collects, per radio fixture, the fraction at which a ray enters it.
-class HitCollector : public b2RayCastCallback {
-public:
+// Per radio fixture a ray hits, the fraction at which it enters.
+struct HitCollector {
     std::vector<std::pair<b2Fixture *, float>> hits;
-    float ReportFixture(b2Fixture *f, const b2Vec2 &, const b2Vec2 &, float fraction) override
-    {
-        if (f->GetFilterData().categoryBits == CAT_RADIO) {
-            hits.emplace_back(f, fraction);
-        }
-        return 1.0f; // keep going: every wall on the segment counts
-    }
 };
 
 /// Counts the robot's wall contacts from Box2D's contact events: a contact begins when
@@ -347,6 +339,11 @@ extern "C" hs_box2d_t *hs_box2d_create_walls(const lx_map_t *m, const hs_box2d_c
         b2BodyDef sd;
         sd.type = b2_staticBody;
         b2Body *collide = w->world->CreateBody(&sd);
+        // The radio walls answer ray casts through their own index (index_radio), never
+        // Box2D's tree or contacts: on a disabled body (unless wall_pairs) their fixtures
+        // get no broad-phase proxies, a tree half the size to build every run (the robot's
+        // contacts, with the collision walls only, come in the same order).
+        sd.enabled = c.wall_pairs;
         b2Body *radio = w->world->CreateBody(&sd);
         w->n_collide = add_walls(m, collide, HS_BOX2D_COLLIDE, walls->rect[HS_BOX2D_COLLIDE],
                                  walls->n[HS_BOX2D_COLLIDE]);
@@ -486,9 +483,9 @@ extern "C" long hs_box2d_wall_contacts(const hs_box2d_t *w)
     return w->contacts.contacts;
 }
 
-/* hs_box2d_walls_crossed(), its fixtures from the radio index or (tree) Box2D's tree. */
+/* hs_box2d_walls_crossed(), its fixtures from the radio index or (all) every one. */
 static unsigned walls_crossed(const hs_box2d_t *w, double x0, double y0, double x1, double y1,
-                              bool tree)
+                              bool all)
 {
     double len = std::hypot(x1 - x0, y1 - y0);
     if (len <= 0.0) {
@@ -499,7 +496,8 @@ static unsigned walls_crossed(const hs_box2d_t *w, double x0, double y0, double 
         return 0; // Box2D asserts on a zero-length ray (equal after rounding to float)
     }
     HitCollector fwd, rev;
-    if (!tree) {
+    b2RayCastInput in_f = {a, b, 1.0f}, in_r = {b, a, 1.0f};
+    if (!all) {
         // Box2D's ray cast without its tree: every radio fixture in a cell the segment
         // (widened by RAY_MARGIN_M) passes, cast at once with the same input b2World::RayCast
         // gives it (maxFraction 1: the collector never clips), so the same hits.
@@ -507,7 +505,6 @@ static unsigned walls_crossed(const hs_box2d_t *w, double x0, double y0, double 
             std::fill(w->seen.begin(), w->seen.end(), 0u);
             w->casts = 1u;
         }
-        b2RayCastInput in_f = {a, b, 1.0f}, in_r = {b, a, 1.0f};
         const double xlo = std::min(x0, x1) - RAY_MARGIN_M, xhi = std::max(x0, x1) + RAY_MARGIN_M;
         const double ylo = std::min(y0, y1) - RAY_MARGIN_M, yhi = std::max(y0, y1) + RAY_MARGIN_M;
         uint32_t i0, j0, i1, j1;
@@ -545,8 +542,15 @@ static unsigned walls_crossed(const hs_box2d_t *w, double x0, double y0, double 
             }
         }
     } else {
-        w->world->RayCast(&fwd, a, b);
-        w->world->RayCast(&rev, b, a);
+        for (b2Fixture *f : w->radio_fx) {
+            b2RayCastOutput out;
+            if (f->RayCast(&out, in_f, 0)) {
+                fwd.hits.emplace_back(f, out.fraction);
+            }
+            if (f->RayCast(&out, in_r, 0)) {
+                rev.hits.emplace_back(f, out.fraction);
+            }
+        }
     }
     // Interval of each fixture along the segment, as fractions from a: entry from the
     // forward cast (0 when a is inside), exit from the reverse cast (1 when b is inside).
@@ -603,7 +607,7 @@ extern "C" unsigned hs_box2d_walls_crossed(const hs_box2d_t *w, double x0, doubl
     return walls_crossed(w, x0, y0, x1, y1, false);
 }
 
-extern "C" unsigned hs_box2d_walls_crossed_tree(const hs_box2d_t *w, double x0, double y0,
+extern "C" unsigned hs_box2d_walls_crossed_all(const hs_box2d_t *w, double x0, double y0,
                                                 double x1, double y1)
 {
     return walls_crossed(w, x0, y0, x1, y1, true);

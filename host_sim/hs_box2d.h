@@ -47,8 +47,9 @@ typedef struct hs_box2d_cfg {
     int velocity_iters;     ///< Box2D velocity iterations (8)
     int position_iters;     ///< Box2D position iterations (3)
     double wall_merge_gap_m; ///< ray cast hits closer than this count as one wall (0.1 m)
-    bool wall_pairs;        ///< let Box2D's first step search pairs among the walls too (the
-                            ///< same world, slower; false: tests compare against it)
+    bool wall_pairs;        ///< the world as Box2D builds it: pairs searched among the walls
+                            ///< too, the radio walls in its tree (the same world, slower;
+                            ///< false: tests compare against it)
 } hs_box2d_cfg_t;
 
 /// Opaque world (owns the Box2D world).
@@ -113,10 +114,10 @@ long hs_box2d_wall_contacts(const hs_box2d_t *w);
 unsigned hs_box2d_walls_crossed(const hs_box2d_t *w, double x0, double y0, double x1,
                                 double y1);
 
-/// hs_box2d_walls_crossed() through Box2D's own tree (b2World::RayCast): the same count,
-/// slower; the reference its radio-fixture index is tested against.
-unsigned hs_box2d_walls_crossed_tree(const hs_box2d_t *w, double x0, double y0, double x1,
-                                     double y1);
+/// hs_box2d_walls_crossed() casting every radio fixture: the same count, slower; the
+/// reference its radio-fixture index is tested against.
+unsigned hs_box2d_walls_crossed_all(const hs_box2d_t *w, double x0, double y0, double x1,
+                                    double y1);
 
 /// true when a disc of the robot's radius at (x, y) overlaps a collision wall or lies
 /// (partly) off the map.

@@ -46,6 +46,7 @@ hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void)
     c.p0_min_dbm = NAN;
     c.coarse_footprint_m = NAN;
     c.p0_max_wall_db = NAN;
+    c.pathloss_log2 = NULL;
     return c;
 }
 
@@ -189,6 +190,9 @@ static int open_pathloss(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, char *err
         rfs_pathloss_cache_attach(p->model_state, p->wall_cache, cb, HS_CTRL_PATHLOSS_CACHE_COLS) != 0) {
         snprintf(err, errlen, "model: pathloss: out of memory");
         return -1;
+    }
+    if (cfg->pathloss_log2 != NULL) {
+        (void)rfs_pathloss_log2_attach(p->model_state, cfg->pathloss_log2);
     }
     return 0;
 }

@@ -40,6 +40,8 @@ typedef struct hs_sim_env {
     uint16_t *lattice_memo;    ///< the core map's lattice memo (rfs_map_memo_attach), shared by runs
     uint16_t *lattice_edges;   ///< the core map's edge table (rfs_map_edges_attach), shared by runs
     uint8_t *wall_dist;        ///< the core map's wall distances (rfs_map_wall_dist_attach), or NULL
+    uint8_t *wall_fwd;         ///< the core map's forward free squares (rfs_map_wall_fwd_attach), or NULL
+    int32_t *pathloss_log2;    ///< the path-loss model's log2 table (rfs_pathloss_log2_fill), or NULL
     hs_box2d_walls_t walls;    ///< the map's merged wall rectangles, shared by runs' worlds
     uint64_t placement;        ///< the drawn placement the start and source are (hs_place.h;
                                ///< hs_sim_env_place), 0: the scenario's own

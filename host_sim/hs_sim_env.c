@@ -11,6 +11,7 @@
 #include "hs_faults.h"
 #include "hs_paths.h"
 #include "hs_radio.h"
+#include "rfs_pathloss.h"
 
 
 static int check_point(const hs_sim_env_t *e, const char *field, double x, double y, char *err,
@@ -183,15 +184,30 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
         hs_sim_env_close(e);
         return -1;
     }
-    /* The path-loss model's wall counts pass over free squares (rfs_map_wall_dist_attach). */
+    /* The path-loss model's wall counts pass over free squares (rfs_map_wall_dist_attach)
+     * and the free squares ahead of the walk (rfs_map_wall_fwd_attach). */
     if (e->core.map.wall != NULL) {
         const uint32_t nd = rfs_map_wall_dist_bytes(&e->core.map);
+        const uint32_t nf = rfs_map_wall_fwd_bytes(&e->core.map);
         e->wall_dist = malloc(nd);
-        if (e->wall_dist == NULL || rfs_map_wall_dist_attach(&e->core.map, e->wall_dist, nd) != 0) {
+        e->wall_fwd = malloc(nf);
+        if (e->wall_dist == NULL || e->wall_fwd == NULL ||
+            rfs_map_wall_dist_attach(&e->core.map, e->wall_dist, nd) != 0 ||
+            rfs_map_wall_fwd_attach(&e->core.map, e->wall_fwd, nf) != 0) {
             snprintf(err, errlen, "%s: map: out of memory", sc->path);
             hs_sim_env_close(e);
             return -1;
         }
+    }
+    /* The path-loss model's distance terms read their logarithms from one table. */
+    if (strcmp(sc->model, "pathloss") == 0) {
+        e->pathloss_log2 = malloc(RFS_PATHLOSS_LOG2_ENTRIES * sizeof(e->pathloss_log2[0]));
+        if (e->pathloss_log2 == NULL) {
+            snprintf(err, errlen, "%s: map: out of memory", sc->path);
+            hs_sim_env_close(e);
+            return -1;
+        }
+        rfs_pathloss_log2_fill(e->pathloss_log2);
     }
     if (env_prepare(e, err, errlen) != 0) {
         hs_sim_env_close(e);
@@ -234,6 +250,10 @@ void hs_sim_env_close(hs_sim_env_t *e)
     e->lattice_edges = NULL;
     free(e->wall_dist);
     e->wall_dist = NULL;
+    free(e->wall_fwd);
+    e->wall_fwd = NULL;
+    free(e->pathloss_log2);
+    e->pathloss_log2 = NULL;
     hs_box2d_walls_free(&e->walls);
     lx_map_free(&e->map);
 }

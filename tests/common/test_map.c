@@ -633,6 +633,95 @@ static void test_walls_crossed_wall_dist(void **state)
     assert_int_equal(rfs_map_wall_dist_attach(&fx.m, NULL, sizeof dist), -1);
 }
 
+/* A forward grid (rfs_map_wall_fwd_attach) holds each cell's largest wall-free square
+ * ahead towards +x and +y, and +x and -y (brute force here), and wall counts passing over
+ * those squares equal ref_walls_in_order and the plain walk's, alone and with the
+ * wall-distance grid or blocks beside it: on maps with walls scattered, in rows with gaps,
+ * thinned, one cell and none, for random segments, shallow ones, steep ones through cell
+ * corners, segments between cell corners and ends off the map. */
+static void test_walls_crossed_wall_fwd(void **state)
+{
+    (void)state;
+    uint32_t s = 23;
+    int nonzero = 0;
+    static uint8_t fwd[2 * H * W];
+    static uint8_t dist[H * W];
+    for (int mapk = 0; mapk < 7; mapk++) {
+        make_map(&fx, 700u + (uint32_t)mapk, RFS_Q16_FRAC(1, 10), RFS_Q16_FRAC(1, 4));
+        uint16_t stride = (W + 7) / 8;
+        for (int y = 0; y < H; y++) {
+            for (int x = 0; x < W; x++) {
+                /* 0, 1: as drawn; 2: rows of wall with gaps; 3, 4: every seventh wall cell;
+                 * 5: one cell; 6: none */
+                int keep = mapk < 2 || (mapk < 5 && (x * 5 + y * 3) % 7 == 0) ||
+                           (mapk == 5 && x == W / 2 && y == H / 3);
+                fx.wall_c[y][x] = fx.wall_c[y][x] && keep;
+                if (mapk == 2) {
+                    fx.wall_c[y][x] = y % 4 == 1 && (x * 7 + y) % 11 > 2;
+                }
+                if (mapk == 5) {
+                    fx.wall_c[y][x] = keep;
+                }
+                rfs_map_bit_set(fx.wall_bits, stride, (uint16_t)x, (uint16_t)y, fx.wall_c[y][x]);
+            }
+        }
+        rfs_map_cfg_t cfg = rfs_map_cfg_default();
+        assert_int_equal(rfs_map_init(&fx.m, &cfg, W, H, fx.res, fx.ox, fx.oy, fx.free_bits,
+                                      fx.wall_bits, fx.legal_bits), 0);
+        rfs_map_t plain = fx.m;
+        assert_int_equal(rfs_map_wall_fwd_bytes(&fx.m), 2 * W * H);
+        assert_int_equal(rfs_map_wall_fwd_attach(&fx.m, fwd, 2 * W * H - 1), -1);
+        assert_null(fx.m.wall_fwd);
+        assert_int_equal(rfs_map_wall_fwd_attach(&fx.m, fwd, 2 * W * H), 0);
+        for (int dir = 0; dir < 2; dir++) {
+            for (int y = 0; y < H; y++) {
+                for (int x = 0; x < W; x++) {
+                    int side = 0; /* grow the square while it stays on the map and free */
+                    for (int free = 1; free; ) {
+                        int n = side + 1;
+                        int y1 = dir == 0 ? y + n - 1 : y - n + 1;
+                        free = x + n <= W && y1 >= 0 && y1 < H;
+                        for (int v = 0; free && v < n; v++) {
+                            for (int u = 0; free && u < n; u++) {
+                                free = !fx.wall_c[dir == 0 ? y + v : y - v][x + u];
+                            }
+                        }
+                        side += free;
+                    }
+                    assert_int_equal(fwd[dir * W * H + y * W + x], side);
+                }
+            }
+        }
+        rfs_map_t with_dist = fx.m;
+        assert_int_equal(rfs_map_wall_dist_attach(&with_dist, dist, W * H), 0);
+        uint8_t buf[64];
+        rfs_map_wall_blocks_t b;
+        assert_int_equal(rfs_map_wall_blocks(&fx.m, buf, sizeof buf, &b), 0);
+        for (int k = 0; k < 3000; k++) {
+            rfs_q16_t x0, y0, x1, y1;
+            draw_segment(&s, &fx, k, &x0, &y0, &x1, &y1);
+            if (k % 6 == 5) { /* shallow: within a few rows over the width */
+                y1 = y0 + (rfs_q16_t)((int32_t)(lcg(&s) % 8u) - 4) * fx.res / 3;
+            } else if (k % 6 == 4) { /* steep through cell corners: slope +-2, +-3 */
+                int32_t d = (int32_t)(lcg(&s) % 17u) - 8, sl = 2 + (int32_t)(lcg(&s) % 2u);
+                x1 = x0 + d * fx.res;
+                y1 = y0 + ((k & 8) ? sl : -sl) * d * fx.res;
+            }
+            int want = ref_walls_in_order(&fx, x0, y0, x1, y1);
+            assert_int_equal(rfs_map_walls_crossed(&plain, x0, y0, x1, y1), want);
+            assert_int_equal(rfs_map_walls_crossed(&fx.m, x0, y0, x1, y1), want);
+            assert_int_equal(rfs_map_walls_crossed(&with_dist, x0, y0, x1, y1), want);
+            assert_int_equal(rfs_map_walls_crossed_blocks(&fx.m, &b, x0, y0, x1, y1), want);
+            nonzero += want > 0;
+        }
+    }
+    assert_true(nonzero > 3000);
+    rfs_map_t nowall = fx.m;
+    nowall.wall = NULL;
+    assert_int_equal(rfs_map_wall_fwd_attach(&nowall, fwd, 2 * W * H), -1);
+    assert_int_equal(rfs_map_wall_fwd_attach(&fx.m, NULL, 2 * W * H), -1);
+}
+
 /* Along one axis, lattice lines at o + g/2 + k g (k < n; o Q16.16, g metres): is line idx
  * as near to p (Q16.16) as the nearest of all n, by brute force in double? */
 static int nearest_on_axis(rfs_q16_t p, rfs_q16_t o, double g, int n, int idx)
@@ -788,6 +877,7 @@ int main(void)
         cmocka_unit_test(test_walls_crossed),
         cmocka_unit_test(test_walls_crossed_blocks),
         cmocka_unit_test(test_walls_crossed_wall_dist),
+        cmocka_unit_test(test_walls_crossed_wall_fwd),
         cmocka_unit_test(test_lattice),
         cmocka_unit_test(test_lattice_edges),
         cmocka_unit_test(test_init_rejects),

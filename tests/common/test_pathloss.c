@@ -763,7 +763,9 @@ static void cached_relearn_equals_fresh(void **state)
 /* A caller's wall-count cache (rfs_pathloss_cache_attach): over relearns on a growing
  * walk (so the hold phase runs too) the results equal the built-in cache's and a tiny
  * attached cache's bit for bit; the large one also keeps the refinement's counts, so it
- * counts fewer lines. */
+ * counts fewer lines. The large one reads its distance terms' logarithms from a table
+ * (rfs_pathloss_log2_attach), whose entries are log2 of the mantissas in [1, 2) in double
+ * precision, to the Q16 unit. */
 static void attached_cache_equals_builtin(void **state)
 {
     fixture_t *f = *state;
@@ -785,6 +787,15 @@ static void attached_cache_equals_builtin(void **state)
             assert_int_equal(rfs_pathloss_cache_attach(st[k], buf[k], bytes, cols[k]), 0);
         }
     }
+    int32_t *tab = malloc(RFS_PATHLOSS_LOG2_ENTRIES * sizeof(int32_t));
+    assert_non_null(tab);
+    rfs_pathloss_log2_fill(tab);
+    for (uint32_t k = 0; k < RFS_PATHLOSS_LOG2_ENTRIES; ++k) {
+        assert_true(fabs(tab[k] - 65536.0 * log2(1.0 + k / 65536.0)) <= 1.0);
+    }
+    assert_int_equal(rfs_pathloss_log2_attach(st[1], NULL), -1);
+    assert_int_equal(rfs_pathloss_log2_attach(NULL, tab), -1);
+    assert_int_equal(rfs_pathloss_log2_attach(st[1], tab), 0);
     assert_int_equal(rfs_pathloss_cache_attach(st[1], buf[1], UINT32_MAX, 0), -1);
     assert_int_equal(rfs_pathloss_cache_attach(st[1], NULL, UINT32_MAX, 8), -1);
     assert_int_equal(rfs_pathloss_cache_attach(st[1], buf[1], UINT32_MAX,
@@ -821,6 +832,7 @@ static void attached_cache_equals_builtin(void **state)
         free(st[k]);
         free(buf[k]);
     }
+    free(tab);
 }
 
 static void model_invalid_while_slicing(void **state)

@@ -338,10 +338,10 @@ static double uniform(uint64_t *s, double lo, double hi)
     return lo + (hi - lo) * (double)(*s >> 11) / 9007199254740992.0;
 }
 
-/// The radio-fixture index answers as Box2D's own tree (b2World::RayCast both ways) on
+/// The radio-fixture index answers as casting every radio fixture (both ways) on
 /// the shipped SLAM map (thousands of small walls) for random segments, segments along
 /// cell edges and through corners, vertical and horizontal ones, and ends off the map.
-static void test_walls_crossed_index_matches_tree(void **state)
+static void test_walls_crossed_index_matches_all(void **state)
 {
     (void)state;
     lx_map_t m;
@@ -367,7 +367,7 @@ static void test_walls_crossed_index_matches_tree(void **state)
         }
         unsigned n = hs_box2d_walls_crossed(w, a, b, c, d);
         walls += n;
-        differ += n != hs_box2d_walls_crossed_tree(w, a, b, c, d) ? 1u : 0u;
+        differ += n != hs_box2d_walls_crossed_all(w, a, b, c, d) ? 1u : 0u;
     }
     assert_int_equal(differ, 0);
     assert_true(walls > 3000u * 5u); // the segments do cross the lab's walls
@@ -419,7 +419,7 @@ int main(void)
         cmocka_unit_test(test_wall_contacts),
         cmocka_unit_test(test_walls_crossed),
         cmocka_unit_test(test_grazed_corner_keeps_walls_beyond),
-        cmocka_unit_test(test_walls_crossed_index_matches_tree),
+        cmocka_unit_test(test_walls_crossed_index_matches_all),
         cmocka_unit_test(test_shared_walls_same_world),
         cmocka_unit_test(test_one_wall_costs_its_attenuation),
     };

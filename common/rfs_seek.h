@@ -116,6 +116,10 @@ typedef struct rfs_seek_cfg {
                                 ///< radius of a past position), so its sweeps lie about
                                 ///< novelty_radius + local_gap apart, metres Q16.16 (0: any
                                 ///< unvisited point)
+    rfs_q16_t local_wide;       ///< with local_r: when no local goal is left within local_r
+                                ///< of the estimate, the search goes on out to this radius
+                                ///< by the same rule (a source just beyond the swept disc),
+                                ///< metres Q16.16 (0: off, stand at the estimate)
     rfs_q16_t at_tol;           ///< the drive's goal tolerance (drive.goal_tol otherwise) on
                                 ///< a whole greedy leg to a known argmax and on a local
                                 ///< search's goal: the robot stands at the estimate, not

@@ -439,18 +439,18 @@ static bool near_visited(const rfs_seek_t *s, int32_t i, int32_t j)
 
 /* local_r: the goal of a local search round an estimate (mx, my) the robot has stood
  * at, or round its reachable stand-in when it is unreachable (the centre: its lattice
- * point is visited), the unvisited reachable lattice point within local_r of the centre
+ * point is visited), the unvisited reachable lattice point within radius of the centre
  * (and, with local_gap, no visited point within local_gap of it)
  * with the least sum of its squared straight distances to the robot and to the centre
  * (the nearest to their midpoint; ties: the first in row order): when the robot is at
  * the centre the nearest ring round it first, then on round the ring; false when the
  * centre is not yet visited or no point is left. No square root: a window of up to
- * (2 local_r / grid + 3)^2 points stays within a control period on the microcontroller;
+ * (2 radius / grid + 3)^2 points stays within a control period on the microcontroller;
  * the local_gap test runs only for a point that would be the best so far.
  * Scaling: offsets Q16 (< 2^31 each, map coordinates) in int64, squared Q32 < 2^62;
  * a sum of two squared distances to the robot and centre saturates at INT64_MAX. */
-static bool local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_t *gx,
-                       rfs_q16_t *gy)
+static bool local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_t radius,
+                       rfs_q16_t *gx, rfs_q16_t *gy)
 {
     const rfs_map_t *m = s->map;
     uint16_t ci, cj;
@@ -465,8 +465,8 @@ static bool local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_
     if (!rfs_reach_bit(s->visited, (uint32_t)cj * m->lw + ci)) {
         return false;
     }
-    const lattice_window_t w = lattice_window(m, ci, cj, s->cfg.local_r / m->cfg.grid + 1);
-    const int64_t r2 = (int64_t)s->cfg.local_r * s->cfg.local_r;
+    const lattice_window_t w = lattice_window(m, ci, cj, radius / m->cfg.grid + 1);
+    const int64_t r2 = (int64_t)radius * radius;
     int64_t best = INT64_MAX;
     for (int32_t j = w.j0; j <= w.j1; ++j) {
         for (int32_t i = w.i0; i <= w.i1; ++i) {
@@ -504,7 +504,12 @@ bool rfs_seek_meta_path_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool kno
          * (rfs_seek_meta_choose). */
         s->drive.cfg.goal_tol = s->cfg.at_tol;
     }
-    if (known && s->cfg.local_r > 0 && local_goal(s, mx, my, &gx, &gy)) {
+    /* local_wide: the disc swept, a source just beyond it is likelier than one at the
+     * estimate the robot has stood round (docs/STRATEGIES.md, "Stalls"). */
+    if (known && s->cfg.local_r > 0 &&
+        (local_goal(s, mx, my, s->cfg.local_r, &gx, &gy) ||
+         (s->cfg.local_wide > s->cfg.local_r &&
+          local_goal(s, mx, my, s->cfg.local_wide, &gx, &gy)))) {
         /* One scan a decision (the period budget); a point that cannot be planned to
          * (unreachable in practice) is marked visited and this decision goes to the
          * estimate; a plan waiting for the search tree decides again later. */

@@ -579,10 +579,11 @@ static bool local_verdict(double best, double got, double gx, double gy)
     return got < best + 1e-6;
 }
 
-/* The reference goal after the robot stood at the n places (px, py); false when no
- * lattice point is left. Ties within 1e-6 m^2 are accepted. */
+/* The reference goal after the robot stood at the n places (px, py), the search within
+ * radius of the estimate; false when no lattice point is left. Ties within 1e-6 m^2 are
+ * accepted. */
 static bool local_ref_ok(const world_t *t, const double *px, const double *py, int n,
-                         double gx, double gy)
+                         double radius, double gx, double gy)
 {
     double best = INFINITY, got = INFINITY;
     for (uint16_t j = 0; j < t->map.lh; ++j) {
@@ -595,7 +596,7 @@ static bool local_ref_ok(const world_t *t, const double *px, const double *py, i
                 seen = hypot(x - px[k], y - py[k]) <= 0.5 + 1e-9;
             }
             if (seen || !rfs_map_lattice_legal(&t->map, i, j) ||
-                hypot(x - LOCAL_EX, y - LOCAL_EY) > 1.0 + 1e-9) {
+                hypot(x - LOCAL_EX, y - LOCAL_EY) > radius + 1e-9) {
                 continue;
             }
             local_score(x, y, px[n - 1], py[n - 1], gx, gy, &best, &got);
@@ -627,7 +628,7 @@ static void test_local_search_round_the_estimate(void **state)
         assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
         assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
         double gx = D(out.decision.goal_x), gy = D(out.decision.goal_y);
-        assert_true(local_ref_ok(&t, px, py, n, gx, gy));
+        assert_true(local_ref_ok(&t, px, py, n, 1.0, gx, gy));
         if (fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4) {
             break; /* every point round the estimate stood near: back at it */
         }
@@ -637,6 +638,68 @@ static void test_local_search_round_the_estimate(void **state)
         local++;
     }
     assert_true(local >= 4 && n < 40);
+    world_free(&t);
+}
+
+/* local_wide 2 m (docs/STRATEGIES.md, "Stalls"), local_r 1 m: while a legal lattice
+ * point within 1 m of the estimate lies outside the novelty radius of every place stood
+ * at, the goal is the double reference's within 1 m; then its within 2 m; then the
+ * estimate. The search ends with every legal lattice point within 2 m of the estimate
+ * within 0.5 m of a place stood at, after more goals than the 1 m search alone. */
+static void test_local_wide_after_the_disc(void **state)
+{
+    (void)state;
+    world_t t;
+    fixed_model_t fm;
+    local_seek(&t, &fm, 1.0, 0.0);
+    t.seek.cfg.local_wide = Q(2.0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.0, .y = 5.0 };
+    double px[160] = { 4.0 }, py[160] = { 5.0 };
+    int n = 1, inner = 0, wide = 0;
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    px[n] = D(out.decision.goal_x);
+    py[n++] = D(out.decision.goal_y);
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_true(fabs(D(out.decision.goal_x) - LOCAL_EX) < 1e-4);
+    px[n] = LOCAL_EX;
+    py[n++] = LOCAL_EY;
+    bool ended = false;
+    while (n < 160 && !ended) {
+        assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+        assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
+        double gx = D(out.decision.goal_x), gy = D(out.decision.goal_y);
+        double d = hypot(gx - LOCAL_EX, gy - LOCAL_EY);
+        ended = d < 1e-4;
+        /* The 1 m reference while it has a point, else the 2 m one. */
+        bool in1 = !local_ref_ok(&t, px, py, n, 1.0, LOCAL_EX, LOCAL_EY);
+        assert_true(local_ref_ok(&t, px, py, n, in1 ? 1.0 : 2.0, gx, gy));
+        if (!ended) {
+            assert_true(d <= (in1 ? 1.0 : 2.0) + 1e-9);
+            inner += in1;
+            wide += !in1;
+            px[n] = gx;
+            py[n++] = gy;
+        }
+    }
+    assert_true(ended && inner >= 4 && wide > inner);
+    for (uint16_t j = 0; j < t.map.lh; ++j) { /* the wide sweep's cover */
+        for (uint16_t i = 0; i < t.map.lw; ++i) {
+            rfs_q16_t qx, qy;
+            rfs_map_lattice_point(&t.map, i, j, &qx, &qy);
+            if (!rfs_map_lattice_legal(&t.map, i, j) ||
+                hypot(D(qx) - LOCAL_EX, D(qy) - LOCAL_EY) > 2.0 + 1e-9) {
+                continue;
+            }
+            double dmin = INFINITY;
+            for (int k = 0; k < n; ++k) {
+                double dk = hypot(D(qx) - px[k], D(qy) - py[k]);
+                dmin = dk < dmin ? dk : dmin;
+            }
+            assert_true(dmin <= 0.5 + 1e-9);
+        }
+    }
     world_free(&t);
 }
 
@@ -1385,6 +1448,7 @@ int main(void)
         cmocka_unit_test(test_refute_reached_moves_on),
         cmocka_unit_test(test_local_search_round_the_estimate),
         cmocka_unit_test(test_local_gap_spaces_the_sweep),
+        cmocka_unit_test(test_local_wide_after_the_disc),
         cmocka_unit_test(test_at_tol_at_the_estimate),
         cmocka_unit_test(test_at_tol_stall_counts_as_reached),
         cmocka_unit_test(test_leg_max_cuts_the_leg),

@@ -54,6 +54,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.local_r = 0;                          /* stand at the estimate */
     c.local_gap = 0;
     c.local_wide = 0;
+    c.local_refute = false;
     c.at_tol = 0;                           /* the drive's goal tolerance for every goal */
     c.leg_max = 0;                          /* and walk the whole leg to it */
     c.silence_floor = INT32_MIN;            /* silence adds no sample */

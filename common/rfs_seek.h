@@ -120,6 +120,10 @@ typedef struct rfs_seek_cfg {
                                 ///< of the estimate, the search goes on out to this radius
                                 ///< by the same rule (a source just beyond the swept disc),
                                 ///< metres Q16.16 (0: off, stand at the estimate)
+    bool local_refute;          ///< with local_r and refute_r: a greedy decision whose
+                                ///< local search finds no goal left (nor local_wide's) rules
+                                ///< the estimate out as refute_r does and relearns at the
+                                ///< next decision, instead of standing at it
     rfs_q16_t at_tol;           ///< the drive's goal tolerance (drive.goal_tol otherwise) on
                                 ///< a whole greedy leg to a known argmax and on a local
                                 ///< search's goal: the robot stands at the estimate, not

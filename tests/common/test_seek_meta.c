@@ -703,6 +703,55 @@ static void test_local_wide_after_the_disc(void **state)
     world_free(&t);
 }
 
+/* local_refute (docs/STRATEGIES.md, "Stalls"), local_r 1 m: the local goals follow the
+ * double reference until it has no point left; that decision goes to the estimate and,
+ * with the option, rules it out (one place, at (1030, 520) cm) and the next decision
+ * relearns; without it nothing is ruled out and the next decision keeps the model. */
+static void refute_sweep(bool on)
+{
+    world_t t;
+    fixed_model_t fm;
+    local_seek(&t, &fm, 1.0, 0.0);
+    t.seek.cfg.local_refute = on;
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.0, .y = 5.0 };
+    double px[64] = { 4.0 }, py[64] = { 5.0 };
+    int n = 1;
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    px[n] = D(out.decision.goal_x);
+    py[n++] = D(out.decision.goal_y);
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    px[n] = LOCAL_EX;
+    py[n++] = LOCAL_EY;
+    bool ended = false;
+    while (n < 64 && !ended) {
+        assert_int_equal(t.seek.nexcl, 0);
+        assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+        double gx = D(out.decision.goal_x), gy = D(out.decision.goal_y);
+        assert_true(local_ref_ok(&t, px, py, n, 1.0, gx, gy));
+        ended = fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4;
+        px[n] = gx;
+        py[n++] = gy;
+    }
+    assert_true(ended && n >= 8);
+    assert_int_equal(t.seek.nexcl, on ? 1 : 0);
+    if (on) {
+        assert_int_equal(t.seek.excl_x_cm[0], (int)lround(LOCAL_EX * 100));
+        assert_int_equal(t.seek.excl_y_cm[0], (int)lround(LOCAL_EY * 100));
+    }
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.relearned, on);
+    world_free(&t);
+}
+
+static void test_local_refute_rules_out_the_swept(void **state)
+{
+    (void)state;
+    refute_sweep(true);
+    refute_sweep(false);
+}
+
 /* local_gap (docs/STRATEGIES.md, "Stalls"), local_r 2 m: every local goal must be, by a
  * double-precision reference, the legal lattice point within local_r of the estimate
  * with no lattice point within the 0.5 m novelty radius of a place stood at lying within
@@ -1449,6 +1498,7 @@ int main(void)
         cmocka_unit_test(test_local_search_round_the_estimate),
         cmocka_unit_test(test_local_gap_spaces_the_sweep),
         cmocka_unit_test(test_local_wide_after_the_disc),
+        cmocka_unit_test(test_local_refute_rules_out_the_swept),
         cmocka_unit_test(test_at_tol_at_the_estimate),
         cmocka_unit_test(test_at_tol_stall_counts_as_reached),
         cmocka_unit_test(test_leg_max_cuts_the_leg),

@@ -53,7 +53,6 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.refute_r = 0;                         /* and nothing is ruled out */
     c.local_r = 0;                          /* stand at the estimate */
     c.local_gap = 0;
-    c.local_wide = 0;
     c.local_refute = false;
     c.at_tol = 0;                           /* the drive's goal tolerance for every goal */
     c.leg_max = 0;                          /* and walk the whole leg to it */
@@ -184,7 +183,7 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0 || cfg->settle_dist < 0 ||
         cfg->settle_orbit < 0 || cfg->settle_end < 0 || cfg->refute_r < 0 ||
         cfg->src_spacing < 0 || cfg->local_r < 0 || cfg->leg_max < 0 ||
-        cfg->local_gap < 0 || cfg->local_wide < 0 || cfg->at_tol < 0) {
+        cfg->local_gap < 0 || cfg->at_tol < 0) {
         return -1;
     }
     if (model.ops == 0 || model.ops->fit == 0 || model.ops->predict == 0 ||

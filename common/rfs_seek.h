@@ -116,12 +116,8 @@ typedef struct rfs_seek_cfg {
                                 ///< radius of a past position), so its sweeps lie about
                                 ///< novelty_radius + local_gap apart, metres Q16.16 (0: any
                                 ///< unvisited point)
-    rfs_q16_t local_wide;       ///< with local_r: when no local goal is left within local_r
-                                ///< of the estimate, the search goes on out to this radius
-                                ///< by the same rule (a source just beyond the swept disc),
-                                ///< metres Q16.16 (0: off, stand at the estimate)
     bool local_refute;          ///< with local_r and refute_r: a greedy decision whose
-                                ///< local search finds no goal left (nor local_wide's) rules
+                                ///< local search finds no goal left rules
                                 ///< the estimate out as refute_r does and relearns at the
                                 ///< next decision, instead of standing at it
     rfs_q16_t at_tol;           ///< the drive's goal tolerance (drive.goal_tol otherwise) on

@@ -446,18 +446,18 @@ static bool near_visited(const rfs_seek_t *s, int32_t i, int32_t j)
 
 /* local_r: the goal of a local search round an estimate (mx, my) the robot has stood
  * at, or round its reachable stand-in when it is unreachable (the centre: its lattice
- * point is visited), the unvisited reachable lattice point within radius of the centre
+ * point is visited), the unvisited reachable lattice point within local_r of the centre
  * (and, with local_gap, no visited point within local_gap of it)
  * with the least sum of its squared straight distances to the robot and to the centre
  * (the nearest to their midpoint; ties: the first in row order): when the robot is at
  * the centre the nearest ring round it first, then on round the ring; false when the
  * centre is not yet visited (-1) or no point is left (0; 1: a goal). No square root: a window of up to
- * (2 radius / grid + 3)^2 points stays within a control period on the microcontroller;
+ * (2 local_r / grid + 3)^2 points stays within a control period on the microcontroller;
  * the local_gap test runs only for a point that would be the best so far.
  * Scaling: offsets Q16 (< 2^31 each, map coordinates) in int64, squared Q32 < 2^62;
  * a sum of two squared distances to the robot and centre saturates at INT64_MAX. */
-static int local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_t radius,
-                      rfs_q16_t *gx, rfs_q16_t *gy)
+static int local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_t *gx,
+                      rfs_q16_t *gy)
 {
     const rfs_map_t *m = s->map;
     uint16_t ci, cj;
@@ -472,8 +472,8 @@ static int local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_t
     if (!rfs_reach_bit(s->visited, (uint32_t)cj * m->lw + ci)) {
         return -1;
     }
-    const lattice_window_t w = lattice_window(m, ci, cj, radius / m->cfg.grid + 1);
-    const int64_t r2 = (int64_t)radius * radius;
+    const lattice_window_t w = lattice_window(m, ci, cj, s->cfg.local_r / m->cfg.grid + 1);
+    const int64_t r2 = (int64_t)s->cfg.local_r * s->cfg.local_r;
     int64_t best = INT64_MAX;
     for (int32_t j = w.j0; j <= w.j1; ++j) {
         for (int32_t i = w.i0; i <= w.i1; ++i) {
@@ -511,12 +511,7 @@ bool rfs_seek_meta_path_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool kno
          * (rfs_seek_meta_choose). */
         s->drive.cfg.goal_tol = s->cfg.at_tol;
     }
-    /* local_wide: the disc swept, a source just beyond it is likelier than one at the
-     * estimate the robot has stood round (docs/STRATEGIES.md, "Stalls"). */
-    int local = known && s->cfg.local_r > 0 ? local_goal(s, mx, my, s->cfg.local_r, &gx, &gy) : -1;
-    if (local == 0 && s->cfg.local_wide > s->cfg.local_r) {
-        local = local_goal(s, mx, my, s->cfg.local_wide, &gx, &gy);
-    }
+    const int local = known && s->cfg.local_r > 0 ? local_goal(s, mx, my, &gx, &gy) : -1;
     if (local == 1) {
         /* One scan a decision (the period budget); a point that cannot be planned to
          * (unreachable in practice) is marked visited and this decision goes to the

@@ -1030,9 +1030,6 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     if (e->sc.seek_local_gap_m >= 0.0) {
         cc.seek.local_gap = (rfs_q16_t)lround(e->sc.seek_local_gap_m * 65536.0);
     }
-    if (e->sc.seek_local_wide_m >= 0.0) {
-        cc.seek.local_wide = (rfs_q16_t)lround(e->sc.seek_local_wide_m * 65536.0);
-    }
     if (e->sc.seek_at_tol_m >= 0.0) {
         cc.seek.at_tol = (rfs_q16_t)lround(e->sc.seek_at_tol_m * 65536.0);
     }

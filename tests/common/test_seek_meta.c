@@ -641,68 +641,6 @@ static void test_local_search_round_the_estimate(void **state)
     world_free(&t);
 }
 
-/* local_wide 2 m (docs/STRATEGIES.md, "Stalls"), local_r 1 m: while a legal lattice
- * point within 1 m of the estimate lies outside the novelty radius of every place stood
- * at, the goal is the double reference's within 1 m; then its within 2 m; then the
- * estimate. The search ends with every legal lattice point within 2 m of the estimate
- * within 0.5 m of a place stood at, after more goals than the 1 m search alone. */
-static void test_local_wide_after_the_disc(void **state)
-{
-    (void)state;
-    world_t t;
-    fixed_model_t fm;
-    local_seek(&t, &fm, 1.0, 0.0);
-    t.seek.cfg.local_wide = Q(2.0);
-    field_t f = { .kind = 2, .scripted = -60.0 };
-    run_t r = { .x = 4.0, .y = 5.0 };
-    double px[160] = { 4.0 }, py[160] = { 5.0 };
-    int n = 1, inner = 0, wide = 0;
-    rfs_seek_out_t out;
-    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
-    px[n] = D(out.decision.goal_x);
-    py[n++] = D(out.decision.goal_y);
-    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
-    assert_true(fabs(D(out.decision.goal_x) - LOCAL_EX) < 1e-4);
-    px[n] = LOCAL_EX;
-    py[n++] = LOCAL_EY;
-    bool ended = false;
-    while (n < 160 && !ended) {
-        assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
-        assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
-        double gx = D(out.decision.goal_x), gy = D(out.decision.goal_y);
-        double d = hypot(gx - LOCAL_EX, gy - LOCAL_EY);
-        ended = d < 1e-4;
-        /* The 1 m reference while it has a point, else the 2 m one. */
-        bool in1 = !local_ref_ok(&t, px, py, n, 1.0, LOCAL_EX, LOCAL_EY);
-        assert_true(local_ref_ok(&t, px, py, n, in1 ? 1.0 : 2.0, gx, gy));
-        if (!ended) {
-            assert_true(d <= (in1 ? 1.0 : 2.0) + 1e-9);
-            inner += in1;
-            wide += !in1;
-            px[n] = gx;
-            py[n++] = gy;
-        }
-    }
-    assert_true(ended && inner >= 4 && wide > inner);
-    for (uint16_t j = 0; j < t.map.lh; ++j) { /* the wide sweep's cover */
-        for (uint16_t i = 0; i < t.map.lw; ++i) {
-            rfs_q16_t qx, qy;
-            rfs_map_lattice_point(&t.map, i, j, &qx, &qy);
-            if (!rfs_map_lattice_legal(&t.map, i, j) ||
-                hypot(D(qx) - LOCAL_EX, D(qy) - LOCAL_EY) > 2.0 + 1e-9) {
-                continue;
-            }
-            double dmin = INFINITY;
-            for (int k = 0; k < n; ++k) {
-                double dk = hypot(D(qx) - px[k], D(qy) - py[k]);
-                dmin = dk < dmin ? dk : dmin;
-            }
-            assert_true(dmin <= 0.5 + 1e-9);
-        }
-    }
-    world_free(&t);
-}
-
 /* local_refute (docs/STRATEGIES.md, "Stalls"), local_r 1 m: the local goals follow the
  * double reference until it has no point left; that decision goes to the estimate and,
  * with the option, rules it out (one place, at (1030, 520) cm) and the next decision
@@ -1497,7 +1435,6 @@ int main(void)
         cmocka_unit_test(test_refute_reached_moves_on),
         cmocka_unit_test(test_local_search_round_the_estimate),
         cmocka_unit_test(test_local_gap_spaces_the_sweep),
-        cmocka_unit_test(test_local_wide_after_the_disc),
         cmocka_unit_test(test_local_refute_rules_out_the_swept),
         cmocka_unit_test(test_at_tol_at_the_estimate),
         cmocka_unit_test(test_at_tol_stall_counts_as_reached),

@@ -133,6 +133,7 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
      * "Stalls"). */
     cfg->local_gap = on ? cfg->step / 2 : 0;
     cfg->at_tol = on ? RFS_Q16_FRAC(3, 100) : 0;
+    cfg->local_refute = on; /* no parking at a swept estimate (docs/STRATEGIES.md, "Stalls") */
 }
 
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)

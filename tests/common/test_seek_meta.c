@@ -686,6 +686,10 @@ static void refute_sweep(bool on)
 static void test_local_refute_rules_out_the_swept(void **state)
 {
     (void)state;
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    assert_false(cfg.local_refute); /* the paper's meta */
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    assert_true(cfg.local_refute);
     refute_sweep(true);
     refute_sweep(false);
 }

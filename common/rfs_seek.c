@@ -53,6 +53,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.refute_r = 0;                         /* and nothing is ruled out */
     c.local_r = 0;                          /* stand at the estimate */
     c.local_gap = 0;
+    c.local_refute = false;
     c.at_tol = 0;                           /* the drive's goal tolerance for every goal */
     c.leg_max = 0;                          /* and walk the whole leg to it */
     c.silence_floor = INT32_MIN;            /* silence adds no sample */
@@ -132,6 +133,7 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
      * "Stalls"). */
     cfg->local_gap = on ? cfg->step / 2 : 0;
     cfg->at_tol = on ? RFS_Q16_FRAC(3, 100) : 0;
+    cfg->local_refute = on; /* no parking at a swept estimate (docs/STRATEGIES.md, "Stalls") */
 }
 
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)

@@ -116,6 +116,10 @@ typedef struct rfs_seek_cfg {
                                 ///< radius of a past position), so its sweeps lie about
                                 ///< novelty_radius + local_gap apart, metres Q16.16 (0: any
                                 ///< unvisited point)
+    bool local_refute;          ///< with local_r and refute_r: a greedy decision whose
+                                ///< local search finds no goal left rules
+                                ///< the estimate out as refute_r does and relearns at the
+                                ///< next decision, instead of standing at it
     rfs_q16_t at_tol;           ///< the drive's goal tolerance (drive.goal_tol otherwise) on
                                 ///< a whole greedy leg to a known argmax and on a local
                                 ///< search's goal: the robot stands at the estimate, not
@@ -358,7 +362,8 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 /// Choose a strategy with its named preset: sets cfg->strategy and the improvement
 /// fields, on for RFS_SEEK_META_PATH (recheck_dist = cfg->step, eps_by_travel,
 /// recheck_adapt, eps_geodesic, eps_sample, refute_r = cfg->step, silence_floor = -100
-/// dBm, recheck_silent, local_r = 4 cfg->step, local_gap = cfg->step / 2, at_tol = 3 cm),
+/// dBm, recheck_silent, local_r = 4 cfg->step, local_gap = cfg->step / 2, at_tol = 3 cm,
+/// local_refute),
 /// the paper's (0, false) for every other strategy.
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 

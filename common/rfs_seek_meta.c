@@ -98,6 +98,18 @@ void rfs_seek_meta_visit(rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y)
     }
 }
 
+/* Rule out sources within refute_r of (mx, my) for later fits (the latest
+ * RFS_MODEL_MAX_EXCL places), in centimetres as the store's samples (the
+ * microcontroller's RAM budget). Scaling: x * 100 < 2^39 in int64, rounded, saturated to
+ * +-327.67 m. */
+static void exclude(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my)
+{
+    s->excl_x_cm[s->excl_next] = rfs_sat16(((int64_t)mx * 100 + 32768) >> 16);
+    s->excl_y_cm[s->excl_next] = rfs_sat16(((int64_t)my * 100 + 32768) >> 16);
+    s->excl_next = (uint8_t)((s->excl_next + 1u) % RFS_MODEL_MAX_EXCL);
+    s->nexcl = (uint8_t)(s->nexcl < RFS_MODEL_MAX_EXCL ? s->nexcl + 1u : RFS_MODEL_MAX_EXCL);
+}
+
 bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us)
 {
     rfs_seek_decision_t *d = &s->decision;
@@ -126,12 +138,7 @@ bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us)
     if (!weak && !silent && !(s->cfg.refute_reached && s->parked)) {
         return false;
     }
-    /* Centimetres, as the store's samples (the microcontroller's RAM budget). Scaling:
-     * x * 100 < 2^39 in int64, rounded, saturated to +-327.67 m. */
-    s->excl_x_cm[s->excl_next] = rfs_sat16(((int64_t)mx * 100 + 32768) >> 16);
-    s->excl_y_cm[s->excl_next] = rfs_sat16(((int64_t)my * 100 + 32768) >> 16);
-    s->excl_next = (uint8_t)((s->excl_next + 1u) % RFS_MODEL_MAX_EXCL);
-    s->nexcl = (uint8_t)(s->nexcl < RFS_MODEL_MAX_EXCL ? s->nexcl + 1u : RFS_MODEL_MAX_EXCL);
+    exclude(s, mx, my);
     d->refuted = true;
     return true;
 }
@@ -444,13 +451,13 @@ static bool near_visited(const rfs_seek_t *s, int32_t i, int32_t j)
  * with the least sum of its squared straight distances to the robot and to the centre
  * (the nearest to their midpoint; ties: the first in row order): when the robot is at
  * the centre the nearest ring round it first, then on round the ring; false when the
- * centre is not yet visited or no point is left. No square root: a window of up to
+ * centre is not yet visited (-1) or no point is left (0; 1: a goal). No square root: a window of up to
  * (2 local_r / grid + 3)^2 points stays within a control period on the microcontroller;
  * the local_gap test runs only for a point that would be the best so far.
  * Scaling: offsets Q16 (< 2^31 each, map coordinates) in int64, squared Q32 < 2^62;
  * a sum of two squared distances to the robot and centre saturates at INT64_MAX. */
-static bool local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_t *gx,
-                       rfs_q16_t *gy)
+static int local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_t *gx,
+                      rfs_q16_t *gy)
 {
     const rfs_map_t *m = s->map;
     uint16_t ci, cj;
@@ -458,12 +465,12 @@ static bool local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_
     rfs_map_lattice_nearest(m, mx, my, &ci, &cj);
     if (!rfs_reach_bit(s->reach, (uint32_t)cj * m->lw + ci)) {
         if (!rfs_reach_nearest(m, s->reach, mx, my, &cx, &cy)) {
-            return false;
+            return -1;
         }
         rfs_map_lattice_nearest(m, cx, cy, &ci, &cj);
     }
     if (!rfs_reach_bit(s->visited, (uint32_t)cj * m->lw + ci)) {
-        return false;
+        return -1;
     }
     const lattice_window_t w = lattice_window(m, ci, cj, s->cfg.local_r / m->cfg.grid + 1);
     const int64_t r2 = (int64_t)s->cfg.local_r * s->cfg.local_r;
@@ -491,7 +498,7 @@ static bool local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_
             }
         }
     }
-    return best != INT64_MAX;
+    return best != INT64_MAX ? 1 : 0;
 }
 
 bool rfs_seek_meta_path_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool known,
@@ -504,7 +511,8 @@ bool rfs_seek_meta_path_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool kno
          * (rfs_seek_meta_choose). */
         s->drive.cfg.goal_tol = s->cfg.at_tol;
     }
-    if (known && s->cfg.local_r > 0 && local_goal(s, mx, my, &gx, &gy)) {
+    const int local = known && s->cfg.local_r > 0 ? local_goal(s, mx, my, &gx, &gy) : -1;
+    if (local == 1) {
         /* One scan a decision (the period budget); a point that cannot be planned to
          * (unreachable in practice) is marked visited and this decision goes to the
          * estimate; a plan waiting for the search tree decides again later. */
@@ -520,7 +528,17 @@ bool rfs_seek_meta_path_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool kno
         rfs_map_lattice_nearest(s->map, gx, gy, &li, &lj);
         rfs_reach_bit_set(s->visited, (uint32_t)lj * s->map->lw + li);
     }
-    return greedy_along_path(s, mx, my, known ? s->cfg.leg_max : s->cfg.step, now_us);
+    if (!greedy_along_path(s, mx, my, known ? s->cfg.leg_max : s->cfg.step, now_us)) {
+        return false;
+    }
+    if (local == 0 && s->cfg.local_refute && s->cfg.refute_r > 0) {
+        /* local_refute: the disc round the estimate swept to within the novelty radius
+         * plus local_gap of every reachable point, and no source met: rule the estimate
+         * out and relearn at the next decision (docs/STRATEGIES.md, "Stalls"). */
+        exclude(s, mx, my);
+        s->replan = true;
+    }
+    return true;
 }
 
 /* The paper's greedy step: move min(distance, step) towards the maximum; when that point

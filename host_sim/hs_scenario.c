@@ -204,6 +204,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_local_m = -1.0;
     sc->seek_leg_m = -1.0;
     sc->seek_local_gap_m = -1.0;
+    sc->seek_local_refute = -1;
     sc->seek_at_tol_m = -1.0;
     sc->seek_eps_by_travel = -1;
     sc->seek_eps_geodesic = -1;
@@ -432,7 +433,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
                                         "eps_sample", "refute_m", "silence_floor",
                                         "refute_reached", "local_m", "leg_m", "recheck_silent",
                                         "coarse_footprint_m", "p0_max_wall_db", "local_gap_m",
-                                        "at_tol_m", NULL};
+                                        "at_tol_m", "local_refute", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "refute_m", 0, 100, &sc->seek_refute_m) ||
@@ -450,6 +451,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             preset_bool(p, n, "eps_sample", &sc->seek_eps_sample) ||
             preset_bool(p, n, "silence_floor", &sc->seek_silence_floor) ||
             preset_bool(p, n, "refute_reached", &sc->seek_refute_reached) ||
+            preset_bool(p, n, "local_refute", &sc->seek_local_refute) ||
             preset_bool(p, n, "recheck_silent", &sc->seek_recheck_silent)) {
             return -1;
         }

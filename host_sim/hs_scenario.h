@@ -78,6 +78,7 @@ typedef struct hs_scenario {
                                   ///< (rfs_seek_cfg_t.refute_r; 0: off; -1 = the preset)
     double seek_local_m;          ///< seek.local_m: local search radius round an estimate
                                   ///< stood at (rfs_seek_cfg_t.local_r; 0: off; -1 = preset)
+    int seek_local_refute;        ///< seek.local_refute: 0 / 1 (rfs_seek_cfg_t; -1 = preset)
     double seek_local_gap_m;      ///< seek.local_gap_m: a local search goal's distance from
                                   ///< visited points (rfs_seek_cfg_t.local_gap; -1 = preset)
     double seek_at_tol_m;         ///< seek.at_tol_m: goal tolerance at the estimate

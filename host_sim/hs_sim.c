@@ -819,6 +819,9 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     cc.coarse_footprint_m = e->sc.seek_coarse_footprint_m;
     cc.p0_max_wall_db = e->sc.seek_p0_max_wall_db;
     cc.pathloss_log2 = e->pathloss_log2;
+    if (e->sc.seek_local_refute >= 0) {
+        cc.seek.local_refute = e->sc.seek_local_refute != 0;
+    }
     if (e->sc.seek_refute_reached >= 0) {
         cc.seek.refute_reached = e->sc.seek_refute_reached != 0;
     }

@@ -579,10 +579,11 @@ static bool local_verdict(double best, double got, double gx, double gy)
     return got < best + 1e-6;
 }
 
-/* The reference goal after the robot stood at the n places (px, py); false when no
- * lattice point is left. Ties within 1e-6 m^2 are accepted. */
+/* The reference goal after the robot stood at the n places (px, py), the search within
+ * radius of the estimate; false when no lattice point is left. Ties within 1e-6 m^2 are
+ * accepted. */
 static bool local_ref_ok(const world_t *t, const double *px, const double *py, int n,
-                         double gx, double gy)
+                         double radius, double gx, double gy)
 {
     double best = INFINITY, got = INFINITY;
     for (uint16_t j = 0; j < t->map.lh; ++j) {
@@ -595,7 +596,7 @@ static bool local_ref_ok(const world_t *t, const double *px, const double *py, i
                 seen = hypot(x - px[k], y - py[k]) <= 0.5 + 1e-9;
             }
             if (seen || !rfs_map_lattice_legal(&t->map, i, j) ||
-                hypot(x - LOCAL_EX, y - LOCAL_EY) > 1.0 + 1e-9) {
+                hypot(x - LOCAL_EX, y - LOCAL_EY) > radius + 1e-9) {
                 continue;
             }
             local_score(x, y, px[n - 1], py[n - 1], gx, gy, &best, &got);
@@ -627,7 +628,7 @@ static void test_local_search_round_the_estimate(void **state)
         assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
         assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
         double gx = D(out.decision.goal_x), gy = D(out.decision.goal_y);
-        assert_true(local_ref_ok(&t, px, py, n, gx, gy));
+        assert_true(local_ref_ok(&t, px, py, n, 1.0, gx, gy));
         if (fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4) {
             break; /* every point round the estimate stood near: back at it */
         }
@@ -638,6 +639,59 @@ static void test_local_search_round_the_estimate(void **state)
     }
     assert_true(local >= 4 && n < 40);
     world_free(&t);
+}
+
+/* local_refute (docs/STRATEGIES.md, "Stalls"), local_r 1 m: the local goals follow the
+ * double reference until it has no point left; that decision goes to the estimate and,
+ * with the option, rules it out (one place, at (1030, 520) cm) and the next decision
+ * relearns; without it nothing is ruled out and the next decision keeps the model. */
+static void refute_sweep(bool on)
+{
+    world_t t;
+    fixed_model_t fm;
+    local_seek(&t, &fm, 1.0, 0.0);
+    t.seek.cfg.local_refute = on;
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.0, .y = 5.0 };
+    double px[64] = { 4.0 }, py[64] = { 5.0 };
+    int n = 1;
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    px[n] = D(out.decision.goal_x);
+    py[n++] = D(out.decision.goal_y);
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    px[n] = LOCAL_EX;
+    py[n++] = LOCAL_EY;
+    bool ended = false;
+    while (n < 64 && !ended) {
+        assert_int_equal(t.seek.nexcl, 0);
+        assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+        double gx = D(out.decision.goal_x), gy = D(out.decision.goal_y);
+        assert_true(local_ref_ok(&t, px, py, n, 1.0, gx, gy));
+        ended = fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4;
+        px[n] = gx;
+        py[n++] = gy;
+    }
+    assert_true(ended && n >= 8);
+    assert_int_equal(t.seek.nexcl, on ? 1 : 0);
+    if (on) {
+        assert_int_equal(t.seek.excl_x_cm[0], (int)lround(LOCAL_EX * 100));
+        assert_int_equal(t.seek.excl_y_cm[0], (int)lround(LOCAL_EY * 100));
+    }
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.relearned, on);
+    world_free(&t);
+}
+
+static void test_local_refute_rules_out_the_swept(void **state)
+{
+    (void)state;
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    assert_false(cfg.local_refute); /* the paper's meta */
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    assert_true(cfg.local_refute);
+    refute_sweep(true);
+    refute_sweep(false);
 }
 
 /* local_gap (docs/STRATEGIES.md, "Stalls"), local_r 2 m: every local goal must be, by a
@@ -1385,6 +1439,7 @@ int main(void)
         cmocka_unit_test(test_refute_reached_moves_on),
         cmocka_unit_test(test_local_search_round_the_estimate),
         cmocka_unit_test(test_local_gap_spaces_the_sweep),
+        cmocka_unit_test(test_local_refute_rules_out_the_swept),
         cmocka_unit_test(test_at_tol_at_the_estimate),
         cmocka_unit_test(test_at_tol_stall_counts_as_reached),
         cmocka_unit_test(test_leg_max_cuts_the_leg),

@@ -70,6 +70,22 @@ typedef enum rfs_fit_result {
     RFS_FIT_FAILED,   ///< no model could be learnt (e.g. no samples); the model is invalid
 } rfs_fit_result_t;
 
+/// A question to rfs_model_ops_t.near: of the places where the maximum may be, weighing
+/// w = e^(-chi2 / 2 temp) against the argmax (w = 1), the one with the most weight per
+/// metre, w / (d + d0), d its straight distance from (x, y), when that beats the argmax's
+/// 1 / (d_argmax + d0); places refuse() refuses are passed over.
+typedef struct rfs_model_near {
+    rfs_q16_t x;    ///< from here (the robot), metres Q16.16
+    rfs_q16_t y;    ///< metres Q16.16
+    rfs_q16_t ax;   ///< the argmax, metres Q16.16
+    rfs_q16_t ay;   ///< metres Q16.16
+    rfs_q16_t temp; ///< temperature of the weights, Q16.16 (> 0)
+    rfs_q16_t d0;   ///< added to every distance, metres Q16.16 (> 0)
+    /// true refuses the place (x, y) (NULL: none refused).
+    bool (*refuse)(const void *ctx, rfs_q16_t x, rfs_q16_t y);
+    const void *ctx; ///< passed to refuse
+} rfs_model_near_t;
+
 /// Operations of one kind of internal model.
 typedef struct rfs_model_ops {
     const char *name; ///< short name, as on the command line ("ridge")
@@ -106,6 +122,9 @@ typedef struct rfs_model_ops {
     /// false when there is no model. Epsilon steps go there (rfs_seek_cfg_t.eps_sample):
     /// exploration towards plausible sources rather than at random.
     bool (*sample)(const void *self, rfs_rng_t *rng, rfs_q16_t *x, rfs_q16_t *y);
+    /// Optional (may be NULL): the plausible maximum worth visiting before the argmax
+    /// (rfs_model_near_t); false when none beats the argmax or there is no model.
+    bool (*near)(const void *self, const struct rfs_model_near *q, rfs_q16_t *x, rfs_q16_t *y);
 } rfs_model_ops_t;
 
 /// A model: its operations and its caller-owned state.

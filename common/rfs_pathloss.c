@@ -994,6 +994,50 @@ static bool pathloss_sample(const void *self, rfs_rng_t *rng, rfs_q16_t *x, rfs_
     return false;
 }
 
+/* rfs_model_ops_t.near over the coarse candidates of the last fit: w = e^(-chi2 / 2T),
+ * chi2 = (m / m_best - 1) x bins against the chosen source, as the draws' weights
+ * (draw_consts) at temperature q->temp. One pass; refuse() only for a point that would
+ * lead. Scaling: w (Q16, <= 2^16) times a distance plus d0 (Q16, < 2^32) < 2^48; the
+ * exponent as draw_weight's (cut at 16, where w < 2^-23). */
+static bool pathloss_near(const void *self, const rfs_model_near_t *q, rfs_q16_t *x,
+                          rfs_q16_t *y)
+{
+    const rfs_pathloss_t *p = (const rfs_pathloss_t *)self;
+    RFS_ASSERT(p != 0 && q != 0 && x != 0 && y != 0);
+    if (!p->valid || q->temp <= 0) {
+        return false;
+    }
+    const rfs_pathloss_lat_t *l = &p->lat;
+    const uint32_t nc = (uint32_t)l->ncx * l->ncy;
+    const uint64_t bm = rfs_pathloss_mean_loss(p, p->best.loss);
+    const uint64_t den2 = ((bm > 0u ? bm : 1u) * 2u * (uint64_t)q->temp) >> 16;
+    const uint64_t den = den2 > 0u ? den2 : 1u;
+    int64_t wb = RFS_Q16_ONE; /* the leader: weight wb at distance db (+ d0) */
+    int64_t db = (int64_t)rfs_q16_dist(q->x, q->y, q->ax, q->ay) + q->d0;
+    bool found = false;
+    for (uint32_t c = 0u; c < nc; ++c) {
+        const uint32_t m = p->surface[c];
+        const uint64_t num = m != RFS_PATHLOSS_NO_LOSS && m > bm ? ((uint64_t)m - bm) * p->used_bins
+                                                                 : 0u;
+        if (m == RFS_PATHLOSS_NO_LOSS || num >= 16u * den) {
+            continue;
+        }
+        const int64_t w = rfs_q16_exp_neg((rfs_q16_t)rfs_udiv64(num << 16, den));
+        rfs_q16_t cx, cy;
+        rfs_pathloss_lattice_xy(l, (uint16_t)(l->c0i + (c % l->ncx) * l->cs),
+                                (uint16_t)(l->c0j + (c / l->ncx) * l->cs), &cx, &cy);
+        const int64_t d = (int64_t)rfs_q16_dist(q->x, q->y, cx, cy) + q->d0;
+        if (w * db > wb * d && !(q->refuse != 0 && q->refuse(q->ctx, cx, cy))) {
+            wb = w;
+            db = d;
+            *x = cx;
+            *y = cy;
+            found = true;
+        }
+    }
+    return found;
+}
+
 const rfs_model_ops_t rfs_pathloss_ops = {
     .name = "pathloss",
     .reset = pathloss_reset,
@@ -1002,6 +1046,7 @@ const rfs_model_ops_t rfs_pathloss_ops = {
     .argmax = pathloss_argmax,
     .predict_row = 0,
     .sample = pathloss_sample,
+    .near = pathloss_near,
 };
 
 rfs_model_t rfs_pathloss_model(rfs_pathloss_t *p)

@@ -558,6 +558,7 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
         s->plan.tree_more = false;
         d->line_search = false; /* flags a dropped choice may have set */
         d->sampled = false;
+        d->near = false;
     }
     if (!rfs_seek_ops(s)->learns) {
         ok = rfs_seek_ops(s)->choose(s, false, rng, now_us);

@@ -124,6 +124,15 @@ typedef struct rfs_seek_cfg {
                                 ///< a whole greedy leg to a known argmax and on a local
                                 ///< search's goal: the robot stands at the estimate, not
                                 ///< half drive.goal_tol short of it, metres Q16.16 (0: off)
+    rfs_q16_t near_t;           ///< with a model that answers near (the path-loss model)
+                                ///< and a known argmax at least near_min from the robot: a
+                                ///< greedy goal at the unvisited reachable place more than 4
+                                ///< steps from it with the most weight e^(-chi2 / 2 near_t)
+                                ///< per metre (straight, plus 5 steps) when that beats the
+                                ///< argmax and its path is at most 1.3 x straight + 2 steps:
+                                ///< a nearer plausible source first (docs/STRATEGIES.md,
+                                ///< "Stalls"), Q16.16 (0: off)
+    rfs_q16_t near_min;         ///< see near_t, metres Q16.16
     rfs_q16_t leg_max;          ///< a greedy leg to a known argmax ends after this much of
                                 ///< its path (the next decision relearns and may explore),
                                 ///< metres Q16.16 (0: the whole path)
@@ -243,6 +252,7 @@ typedef struct rfs_seek_decision {
     rfs_q16_t max_x, max_y;    ///< model maximum found by the grid search (greedy), or the
                                ///< model's draw (a sampled epsilon step)
     bool sampled;              ///< epsilon: the goal is the model's draw (cfg.eps_sample)
+    bool near;                 ///< greedy: the goal is a nearer plausible source (cfg.near_t)
     bool refuted;              ///< the argmax was ruled out before this decision's fit
                                ///< (cfg.refute_r)
     rfs_q16_t path_len;        ///< planned path length, metres Q16.16

@@ -501,11 +501,62 @@ static int local_goal(const rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, rfs_q16_t
     return best != INT64_MAX ? 1 : 0;
 }
 
+/* near_t (rfs_seek_cfg_t): a place is the argmax's own within NEAR_OWN steps of it (the
+ * local search's), distances count NEAR_D0 steps more, and a path longer than
+ * NEAR_DETOUR x straight + NEAR_SLACK steps (round walls) sends the robot to the argmax. */
+#define NEAR_OWN 4
+#define NEAR_D0 5
+#define NEAR_DETOUR RFS_Q16_FRAC(13, 10)
+#define NEAR_SLACK 2
+
+/* near: refuse a place visited, unreachable or the argmax's own. */
+static bool near_refuse(const void *ctx, rfs_q16_t x, rfs_q16_t y)
+{
+    const rfs_seek_t *s = (const rfs_seek_t *)ctx;
+    if (rfs_q16_dist(x, y, s->decision.max_x, s->decision.max_y) <= NEAR_OWN * s->cfg.step) {
+        return true;
+    }
+    uint16_t i, j;
+    rfs_map_lattice_nearest(s->map, x, y, &i, &j);
+    const uint32_t idx = (uint32_t)j * s->map->lw + i;
+    return rfs_reach_bit(s->visited, idx) || !rfs_reach_bit(s->reach, idx);
+}
+
+/* near_t: the whole way to a nearer plausible source than the argmax (mx, my), when the
+ * model names one and its path is not much longer than the straight line; false (the
+ * argmax's leg follows, or a plan waits: s->plan.tree_more) otherwise.
+ * Scaling: straight (Q16, < 2^31) x NEAR_DETOUR (Q16) in int64. */
+static bool near_first(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, int64_t now_us)
+{
+    rfs_q16_t gx, gy;
+    rfs_model_near_t q = { s->pose.x, s->pose.y, mx, my, s->cfg.near_t,
+                           NEAR_D0 * s->cfg.step, near_refuse, s };
+    if (s->cfg.near_t <= 0 || s->model.ops->near == 0 ||
+        rfs_q16_dist(s->pose.x, s->pose.y, mx, my) < s->cfg.near_min ||
+        !s->model.ops->near(s->model.self, &q, &gx, &gy) ||
+        !greedy_along_path(s, gx, gy, 0, now_us)) {
+        return false;
+    }
+    const int64_t straight = rfs_q16_dist(s->pose.x, s->pose.y, gx, gy);
+    if ((int64_t)s->drive.path.length >
+        ((straight * NEAR_DETOUR) >> 16) + (int64_t)NEAR_SLACK * s->cfg.step) {
+        return false;
+    }
+    s->decision.near = true;
+    return true;
+}
+
 bool rfs_seek_meta_path_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool known,
                              rfs_rng_t *rng, int64_t now_us)
 {
     (void)rng;
     rfs_q16_t gx, gy;
+    if (known && near_first(s, mx, my, now_us)) {
+        return true;
+    }
+    if (known && s->cfg.near_t > 0 && s->plan.tree_more) {
+        return false; /* near_first's plan waits for the search tree */
+    }
     if (known && s->cfg.at_tol > 0) {
         /* Read at every drive update: this goal's, until the next decision resets it
          * (rfs_seek_meta_choose). */

@@ -14,7 +14,7 @@
  *                                  #       p0_min_dbm: -32, local_m: 0, leg_m: 0,
  *                                  #       coarse_footprint_m: 0.25,
  *                                  #       p0_max_wall_db: 3, local_gap_m: 0.5,
- *                                  #       at_tol_m: 0.03}
+ *                                  #       at_tol_m: 0.03, near_t: 0, near_m: 30}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2
@@ -83,6 +83,9 @@ typedef struct hs_scenario {
                                   ///< visited points (rfs_seek_cfg_t.local_gap; -1 = preset)
     double seek_at_tol_m;         ///< seek.at_tol_m: goal tolerance at the estimate
                                   ///< (rfs_seek_cfg_t.at_tol; 0: off; -1 = the preset)
+    double seek_near_t;           ///< seek.near_t: a nearer plausible source first
+                                  ///< (rfs_seek_cfg_t.near_t; 0: off; -1 = the preset)
+    double seek_near_m;           ///< seek.near_m: rfs_seek_cfg_t.near_min (-1 = the preset)
     double seek_leg_m;            ///< seek.leg_m: longest greedy leg to a known argmax
                                   ///< (rfs_seek_cfg_t.leg_max; 0: whole; -1 = the preset)
     int seek_refute_reached;      ///< seek.refute_reached: 0 / 1 (rfs_seek_cfg_t; -1 = the

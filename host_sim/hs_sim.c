@@ -469,7 +469,7 @@ static void log_decision(FILE *f, const hs_ctrl_t *ctrl, const rfs_seek_decision
     char reason[96];
     snprintf(reason, sizeof reason, "prev=%s%s%s%s%s%s", hs_sim_prev_name(d->prev),
              d->line_search ? ",line_search" : "",
-             d->sampled ? ",sampled" : "", d->refuted ? ",refuted" : "",
+             d->sampled ? ",sampled" : d->near ? ",near" : "", d->refuted ? ",refuted" : "",
              d->model_valid ? "" : ",no_model",
              d->mean_valid ? "" : ",no_mean");
     double pred = d->model_valid ? q16d(d->prediction) : NAN;
@@ -827,6 +827,12 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     }
     if (e->sc.seek_recheck_silent >= 0) {
         cc.seek.recheck_silent = e->sc.seek_recheck_silent != 0;
+    }
+    if (e->sc.seek_near_t >= 0.0) {
+        cc.seek.near_t = (rfs_q16_t)lround(e->sc.seek_near_t * 65536.0);
+    }
+    if (e->sc.seek_near_m >= 0.0) {
+        cc.seek.near_min = (rfs_q16_t)lround(e->sc.seek_near_m * 65536.0);
     }
     cc.seed = seed ^ 0x5A17C0FFEE000003ull;
     hs_ctrl_t ctrl;

@@ -325,6 +325,108 @@ static void test_eps_sample_goes_to_the_draw(void **state)
     eps_sample_case(true, fixed_ops(), 10.5, false, DRAW_AHEAD); /* the model does not draw */
 }
 
+/* A model that also answers near (rfs_model_ops_t.near): the point (nx, ny) unless the
+ * seeker's refuse() does; it keeps the question it was asked. */
+typedef struct near_model {
+    fixed_model_t base; /* first: the fixed_* operations read it */
+    rfs_q16_t nx, ny;
+    rfs_model_near_t q;
+    int asked;
+} near_model_t;
+
+static bool fixed_near(const void *self, const rfs_model_near_t *q, rfs_q16_t *x, rfs_q16_t *y)
+{
+    near_model_t *m = (near_model_t *)(uintptr_t)self;
+    m->q = *q;
+    m->asked++;
+    if (q->refuse != NULL && q->refuse(q->ctx, m->nx, m->ny)) {
+        return false;
+    }
+    *x = m->nx;
+    *y = m->ny;
+    return m->base.valid;
+}
+
+static const rfs_model_ops_t k_near_ops = {
+    .name = "near", .reset = fixed_reset, .fit = fixed_fit, .predict = fixed_predict,
+    .argmax = fixed_argmax, .near = fixed_near,
+};
+
+/* near_t (docs/STRATEGIES.md, "Stalls"): with the estimate at (38.125, 5.125), 34 m from
+ * the robot (within 2 m of its start, (4.125, 5.125)), the greedy goal is the model's nearer place, the whole
+ * straight way (its length in double); the estimate instead when it is nearer than
+ * near_min, when near_t is 0, and when the place is refused: the start (visited), within
+ * 4 steps of the estimate, or behind a wall (x = 7 m, y < 8.5 m) whose way round is longer
+ * than 1.3 x straight + 2 steps (round over the wall's end plus the clearance, in double).
+ * The question: the
+ * robot, the estimate, near_t and 5 steps. */
+enum { NEAR_AHEAD = 0, NEAR_CLOSE_MAX = 1, NEAR_OFF = 2, NEAR_AT_START = 3, NEAR_BY_MAX = 4,
+       NEAR_WALLED = 5 };
+
+static void near_case(int what, double nx, double ny, bool expect)
+{
+    world_t t;
+    world_make(&t, 40.0, 10.0, what == NEAR_WALLED ? 7.0 : 0.0, 8.5);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    assert_int_equal(cfg.near_t, 0); /* an option, off in the preset */
+    cfg.near_t = what == NEAR_OFF ? 0 : Q(8.0);
+    cfg.near_min = Q(30.0);
+    cfg.eps_amp = 0;
+    cfg.eps_floor = 0; /* every decision after the first is greedy */
+    seek_make(&t, cfg, 5);
+    near_model_t nm = { { false, Q(what == NEAR_CLOSE_MAX ? 24.125 : 38.125), Q(5.125) },
+                        Q(nx), Q(ny), { 0 }, 0 };
+    rfs_model_t model = { &k_near_ops, &nm };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.125, .y = 5.125 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 0, 5000000, &out));
+    assert_int_equal(out.decision.kind, RFS_SEEK_INITIAL);
+    r.x = r.gx; /* arrive at once; the start stays visited */
+    r.y = r.gy;
+    r.pending = false;
+    if (!next_decision(&t, &r, &f, 0, 5000000, &out)) {
+        fail_msg("case %d: no decision", what);
+    }
+    const rfs_seek_decision_t *d = &out.decision;
+    assert_int_equal(d->kind, RFS_SEEK_GREEDY);
+    assert_int_equal(d->near, expect);
+    const double gx = expect ? nx : D(nm.base.mx), gy = expect ? ny : D(nm.base.my);
+    if (what == NEAR_WALLED) {
+        const double round = hypot(7.0 - r.x, 8.75 - r.y) + hypot(nx - 7.0, 8.75 - ny);
+        assert_true(round > 1.3 * hypot(nx - r.x, ny - r.y) + 2.0);
+    }
+    if (fabs(D(d->goal_x) - gx) > 1e-4 || fabs(D(d->goal_y) - gy) > 1e-4) {
+        fail_msg("case %d: goal (%.3f, %.3f), expected (%.3f, %.3f)", what, D(d->goal_x),
+                 D(d->goal_y), gx, gy);
+    }
+    if (expect) {
+        assert_true(fabs(D(d->path_len) - hypot(nx - r.x, ny - r.y)) < 0.01);
+    }
+    const bool asked = what != NEAR_OFF && what != NEAR_CLOSE_MAX;
+    assert_int_equal(nm.asked > 0, asked);
+    if (asked) {
+        assert_true(fabs(D(nm.q.x) - r.x) < 0.01 && fabs(D(nm.q.y) - r.y) < 0.01);
+        assert_true(nm.q.ax == nm.base.mx && nm.q.ay == nm.base.my);
+        assert_true(nm.q.temp == Q(8.0) && nm.q.d0 == Q(5.0));
+    }
+    world_free(&t);
+}
+
+static void test_near_goes_to_the_nearer_place(void **state)
+{
+    (void)state;
+    near_case(NEAR_AHEAD, 12.125, 3.125, true);
+    near_case(NEAR_CLOSE_MAX, 12.125, 3.125, false);
+    near_case(NEAR_OFF, 12.125, 3.125, false);
+    near_case(NEAR_AT_START, 4.125, 5.125, false);
+    near_case(NEAR_BY_MAX, 35.125, 3.125, false);
+    near_case(NEAR_WALLED, 9.125, 2.125, false);
+    near_case(NEAR_AHEAD, 9.125, 2.125, true); /* the same place without the wall */
+}
+
 /* refute_r (docs/STRATEGIES.md, "Stalls"): a model that knows its maximum, predicts -60
  * dB everywhere, records the places ruled out that each fit is given, and moves its
  * maximum to the next point of a 1.5 m x 2 m grid at every fit. The robot, teleported
@@ -1440,6 +1542,7 @@ int main(void)
         cmocka_unit_test(test_local_search_round_the_estimate),
         cmocka_unit_test(test_local_gap_spaces_the_sweep),
         cmocka_unit_test(test_local_refute_rules_out_the_swept),
+        cmocka_unit_test(test_near_goes_to_the_nearer_place),
         cmocka_unit_test(test_at_tol_at_the_estimate),
         cmocka_unit_test(test_at_tol_stall_counts_as_reached),
         cmocka_unit_test(test_leg_max_cuts_the_leg),

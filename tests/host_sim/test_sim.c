@@ -103,6 +103,7 @@ static void test_scenario_good(void **state)
     assert_int_equal(sc.seek_local_refute, -1);
     assert_true(sc.seek_local_m == -1.0 && sc.seek_leg_m == -1.0);
     assert_true(sc.seek_local_gap_m == -1.0 && sc.seek_at_tol_m == -1.0);
+    assert_true(sc.seek_near_t == -1.0 && sc.seek_near_m == -1.0);
     assert_true(isnan(sc.seek_p0_min_dbm)); // the pathloss model's own default
     assert_true(isnan(sc.seek_coarse_footprint_m));
     assert_true(sc.rx_heartbeat); // on unless the scenario turns it off
@@ -111,7 +112,8 @@ static void test_scenario_good(void **state)
     snprintf(text, sizeof text, "%sstrategy: meta-path\nseek: {recheck_m: 0.5, eps_by_travel: false, "
              "eps_rate: 0.3, eps_geodesic: false, recheck_adapt: false, eps_sample: false, "
              "refute_m: 0, silence_floor: false, refute_reached: true, local_m: 2.5, leg_m: 12, "
-             "recheck_silent: false, local_gap_m: 0.75, at_tol_m: 0, local_refute: false}\n", GOOD);
+             "recheck_silent: false, local_gap_m: 0.75, at_tol_m: 0, local_refute: false, "
+             "near_t: 8, near_m: 30}\n", GOOD);
     assert_int_equal(hs_scenario_load(scn("seek.yaml", text), &sc, err, sizeof err), 0);
     assert_string_equal(sc.strategy, "meta-path");
     assert_true(sc.seek_recheck_m == 0.5 && sc.seek_eps_by_travel == 0 && sc.seek_eps_rate == 0.3);
@@ -125,6 +127,7 @@ static void test_scenario_good(void **state)
     assert_int_equal(sc.seek_local_refute, 0);
     assert_true(sc.seek_local_m == 2.5 && sc.seek_leg_m == 12.0);
     assert_true(sc.seek_local_gap_m == 0.75 && sc.seek_at_tol_m == 0.0);
+    assert_true(sc.seek_near_t == 8.0 && sc.seek_near_m == 30.0);
     snprintf(text, sizeof text, "%sseek: {eps_geodesic: true}\n", GOOD);
     assert_int_equal(hs_scenario_load(scn("seek_geo.yaml", text), &sc, err, sizeof err), 0);
     assert_int_equal(sc.seek_eps_geodesic, 1);

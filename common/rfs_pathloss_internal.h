@@ -59,4 +59,13 @@ int32_t rfs_pathloss_walls_col(rfs_pathloss_t *p, uint16_t li, uint16_t lj, bool
  * candidate a column). *lines: the wall counts computed (left alone when cached). */
 uint32_t rfs_pathloss_walls_bin(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb, uint32_t *lines);
 
+/* rfs_model_ops_t.sample of the path-loss model (rfs_pathloss_draw.c): a coarse candidate
+ * of the last fit drawn with its tempered likelihood-ratio weight. */
+bool rfs_pathloss_sample_op(const void *self, rfs_rng_t *rng, rfs_q16_t *x, rfs_q16_t *y);
+
+/* rfs_model_ops_t.near of the path-loss model (rfs_pathloss_draw.c): the coarse candidate
+ * with the most weight per metre, when it beats the leader. */
+bool rfs_pathloss_near_op(const void *self, const rfs_model_near_t *q, rfs_q16_t *x,
+                          rfs_q16_t *y);
+
 #endif /* RFS_PATHLOSS_INTERNAL_H */

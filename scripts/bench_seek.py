@@ -6,7 +6,7 @@ Runs every strategy on every shipped scenario with the simulator's batch mode
 levels and the internal models; then writes the tables (docs/RESULTS.md) and figures
 (docs/figures/seek_*.png). Bridging is scripts/bench_bridge.py's.
 
-  scripts/bench_seek.py [--seeds 200] [--model-seeds 200] [--slow-model-seeds 30]
+  scripts/bench_seek.py [--seeds 200] [--first-seed 1001] [--model-seeds 200] [--slow-model-seeds 30]
                         [--jobs 2] [--bin build/bin/rfseek-sim]
   scripts/bench_seek.py --smoke --bin build-x/bin/rfseek-sim    (2 seeds, a self-check)
 

@@ -66,5 +66,7 @@ bench_bridge.py|--sim /nonexistent|/nonexistent: not an executable
 bench_bridge.py|--seeds x|--seeds: expected A..B
 bridge_bounds.py|--sim /nonexistent scenarios/bridge.yaml 1..2|/nonexistent: not an executable
 bridge_bounds.py|scenarios/nope.yaml 1..2|no such scenario file
+bench_seek.py|--bin /bin/true --first-seed 0|--first-seed and --jobs must be at least 1
+bench_pathloss_seek.py|--first-seed 0|--first-seed must be at least 1
 LIST
 [ $fails -eq 0 ]

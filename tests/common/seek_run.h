@@ -1,6 +1,6 @@
 /* seek_run.h - the harness shared by the seeker's decision tests (test_seek.c,
- * test_seek_meta.c, test_seek_baseline.c): a synthetic field in double precision, a
- * "teleporting" robot, and a model that knows its maximum.
+ * test_seek_meta.c, test_seek_stall.c, test_seek_baseline.c): a synthetic field in double
+ * precision, a "teleporting" robot, and a model that knows its maximum.
  *
  * The robot is teleported: when the seeker decides a goal, the harness moves the
  * reported pose onto the goal after a hold time, so the drive reports it reached and the
@@ -128,6 +128,24 @@ static inline const rfs_model_ops_t *fixed_ops(void)
         .argmax = fixed_argmax,
     };
     return &ops;
+}
+
+
+/* The local-search world (test_seek_meta.c, test_seek_stall.c): 20 x 10 m without walls,
+ * the meta-path preset with epsilon off, and a fixed model whose estimate is
+ * (LOCAL_EX, LOCAL_EY). */
+#define LOCAL_EX 10.3
+#define LOCAL_EY 5.2
+
+static inline void local_world(world_t *t, rfs_seek_cfg_t *cfg, fixed_model_t *fm)
+{
+    world_make(t, 20.0, 10.0, 0.0, 0.0);
+    *cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(cfg, RFS_SEEK_META_PATH);
+    cfg->eps_amp = 0;
+    cfg->eps_floor = 0;
+    seek_make(t, *cfg, 5);
+    *fm = (fixed_model_t){ false, Q(LOCAL_EX), Q(LOCAL_EY) };
 }
 
 #endif /* SEEK_RUN_H */

@@ -1,0 +1,481 @@
+/* test_seek_stall.c - meta-path's answers to a stall (common/rfs_seek_meta.c,
+ * docs/STRATEGIES.md "Stalls"): ruling out a refuted or swept estimate (refute_r,
+ * refute_reached, local_refute) and the bounded local search round it (local_r,
+ * local_gap), each against a reference computed here in double precision.
+ */
+#include "rfs_test.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ref_geom.h"
+#include "seek_run.h"
+
+/* refute_r (docs/STRATEGIES.md, "Stalls"): a model that knows its maximum, predicts -60
+ * dB everywhere, records the places ruled out that each fit is given, and moves its
+ * maximum to the next point of a 1.5 m x 2 m grid at every fit. The robot, teleported
+ * onto every goal, stands at the maximum at each decision after the first greedy one.
+ * The places expected are kept here in double: the maximum when the robot stands within
+ * half a step of it and the 1 s mean is weaker than -60 dB by more than 6 dB, the
+ * latest RFS_MODEL_MAX_EXCL of them. */
+typedef struct refute_model {
+    fixed_model_t base; /* first: the fixed_* operations read it */
+    int fits;
+    int nexcl;           /* what the latest fit was given */
+    double ex[RFS_MODEL_MAX_EXCL], ey[RFS_MODEL_MAX_EXCL], r;
+    double want_x[64], want_y[64]; /* every refutation expected so far, oldest first */
+    int nwant;
+    double mean;         /* the scripted 1 s mean */
+    bool silent;         /* no packet at the decisions, the receiver up */
+    bool reached;        /* cfg.refute_reached: every decision at the maximum rules it out */
+    bool mismatch;       /* a fit was given other places than expected */
+} refute_model_t;
+
+static void refute_point(int k, double *x, double *y)
+{
+    *x = 2.125 + 1.5 * (double)(k % 11);
+    *y = 2.125 + 2.0 * (double)((k / 11) % 3);
+}
+
+static rfs_fit_result_t refute_fit(void *self, const rfs_model_fit_in_t *in, uint32_t budget,
+                                   rfs_rng_t *rng)
+{
+    (void)budget;
+    (void)rng;
+    refute_model_t *m = self;
+    /* The double rule at the query point (the robot), against the maximum held (reset
+     * has just invalidated the model: any fit but the first had one). */
+    if (m->fits > 0 &&
+        hypot(D(in->qx) - D(m->base.mx), D(in->qy) - D(m->base.my)) <= 0.5 &&
+        (m->silent || m->reached || -60.0 - m->mean > 6.0) && m->nwant < 64) {
+        m->want_x[m->nwant] = D(m->base.mx);
+        m->want_y[m->nwant] = D(m->base.my);
+        m->nwant++;
+    }
+    int expect = m->nwant < (int)RFS_MODEL_MAX_EXCL ? m->nwant : (int)RFS_MODEL_MAX_EXCL;
+    m->nexcl = in->nexcl;
+    m->r = D(in->excl_r);
+    if (in->nexcl != expect) {
+        m->mismatch = true;
+    }
+    for (int e = 0; e < in->nexcl && e < expect; ++e) {
+        m->ex[e] = in->excl_x_cm[e] / 100.0;
+        m->ey[e] = in->excl_y_cm[e] / 100.0;
+        /* Slots fill in order, then the oldest is overwritten: any order, the latest ones. */
+        bool found = false;
+        for (int w = m->nwant - expect; w < m->nwant; ++w) {
+            found = found || (fabs(m->ex[e] - m->want_x[w]) < 0.0051 &&
+                              fabs(m->ey[e] - m->want_y[w]) < 0.0051); /* to the cm */
+        }
+        m->mismatch = m->mismatch || !found;
+    }
+    m->fits++;
+    double x, y;
+    refute_point(m->fits, &x, &y);
+    m->base.mx = Q(x);
+    m->base.my = Q(y);
+    m->base.valid = true;
+    return RFS_FIT_DONE;
+}
+
+/* The refute worlds: a 20 x 10 m room, meta-path with every decision after the first
+ * greedy, the seeker on model m (cleared) with cfg's refute settings. */
+static void refute_world(world_t *t, rfs_seek_cfg_t cfg, refute_model_t *m)
+{
+    static const rfs_model_ops_t ops = {
+        .name = "refute", .reset = fixed_reset, .fit = refute_fit, .predict = fixed_predict,
+        .argmax = fixed_argmax,
+    };
+    world_make(t, 20.0, 10.0, 0, 0);
+    cfg.eps_amp = 0;
+    cfg.eps_floor = 0;
+    cfg.local_r = 0; /* the robot stays at each maximum (no sweep round it) */
+    seek_make(t, cfg, 5);
+    memset(m, 0, sizeof *m);
+    rfs_model_t model = { &ops, m };
+    assert_int_equal(rfs_seek_init(&t->seek, &cfg, &t->map, model, &rfs_target_rssi, &t->mem), 0);
+}
+
+static int refute_case(double mean, bool on, bool reached, int decisions, refute_model_t *m)
+{
+    world_t t;
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    assert_int_equal(cfg.refute_r, cfg.step); /* the preset's */
+    cfg.refute_r = on ? cfg.refute_r : 0;
+    cfg.refute_reached = reached;
+    refute_world(&t, cfg, m);
+    m->mean = mean;
+    m->reached = reached;
+    field_t f = { .kind = 2, .scripted = mean };
+    run_t r = { .x = 4.125, .y = 5.125 };
+    rfs_seek_out_t out;
+    int refuted = 0;
+    for (int k = 0; k < decisions; ++k) {
+        assert_true(next_decision(&t, &r, &f, 500000, 5000000, &out));
+        refuted += out.decision.refuted ? 1 : 0;
+    }
+    world_free(&t);
+    return refuted;
+}
+
+/* The same model in silence: packets (-60 dBm) for the first 1.5 s only, then the
+ * receiver's reports alone, every 10 ms; the robot teleported onto each goal 0.5 s after
+ * it is decided. Returns the decisions that ruled a place out. */
+static int refute_silent(refute_model_t *m, int decisions)
+{
+    world_t t;
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    refute_world(&t, cfg, m);
+    m->silent = true;
+    double x = 4.125, y = 5.125, gx = x, gy = y;
+    int64_t arrive = -1;
+    int refuted = 0, decided = 0;
+    for (int64_t now = 10000; decided < decisions && now < 600000000; now += 10000) {
+        if (arrive >= 0 && now >= arrive) {
+            x = gx;
+            y = gy;
+            arrive = -1;
+        }
+        if (now < 1500000) {
+            rfs_seek_on_rssi(&t.seek, 0, now, -60, &t.rng);
+        }
+        assert_true(rfs_seek_on_receiver(&t.seek, now));
+        if (now % 50000 == 0) {
+            rfs_seek_out_t out;
+            rfs_pose_t p = { now, Q(x), Q(y), 0 };
+            rfs_seek_on_pose(&t.seek, &p, &t.rng);
+            rfs_seek_step(&t.seek, now, &t.rng, &out);
+            if (out.decided) {
+                decided++;
+                refuted += out.decision.refuted ? 1 : 0;
+                assert_true(!out.decision.refuted || !out.decision.mean_valid);
+                gx = D(out.decision.goal_x);
+                gy = D(out.decision.goal_y);
+                arrive = now + 500000;
+            }
+        }
+    }
+    assert_int_equal(decided, decisions);
+    world_free(&t);
+    return refuted;
+}
+
+static void test_refute_rules_out_the_argmax(void **state)
+{
+    (void)state;
+    refute_model_t m;
+    /* 7 dB weaker at every maximum: ruled out at each decision there, 32 kept. */
+    int refuted = refute_case(-67.0, true, false, 40, &m);
+    assert_false(m.mismatch);
+    assert_true(m.fits >= 39);
+    assert_int_equal(refuted, m.nwant);
+    assert_true(m.nwant >= 37); /* every decision after the initial move and the first leg */
+    assert_int_equal(m.nexcl, (int)RFS_MODEL_MAX_EXCL);
+    assert_true(fabs(m.r - 1.0) < 1e-9);
+    /* 6 dB stronger (relearnt, nothing ruled out), 5 dB weaker (relearnt, within twice the
+     * threshold), or the option off: nothing. */
+    const double means[3] = {-54.0, -65.0, -67.0};
+    for (int c = 0; c < 3; ++c) {
+        refuted = refute_case(means[c], c != 2, false, 12, &m);
+        assert_int_equal(refuted, 0);
+        assert_true(c == 2 || m.nwant == 0);
+        assert_int_equal(m.nexcl, 0);
+        assert_true(m.fits >= 11); /* every miss relearns */
+    }
+    /* Silence at the maximum, the receiver up: ruled out, the model relearnt for it. */
+    refuted = refute_silent(&m, 12);
+    assert_false(m.mismatch);
+    assert_int_equal(refuted, m.nwant);
+    assert_true(m.nwant >= 9);
+    assert_true(m.fits >= m.nwant);
+}
+
+/* refute_reached: the mean exactly as predicted (no relearn of its own) still rules out
+ * every maximum the robot has stood at for a decision (a greedy null move), so every
+ * second decision from the fourth on; without it the robot stays at the first one. */
+static void test_refute_reached_moves_on(void **state)
+{
+    (void)state;
+    refute_model_t m;
+    int refuted = refute_case(-60.0, true, true, 12, &m);
+    assert_false(m.mismatch);
+    assert_int_equal(refuted, m.nwant);
+    assert_int_equal(m.nwant, 5); /* decisions 3, 5, 7, 9, 11 */
+    assert_true(m.fits >= m.nwant);
+    refuted = refute_case(-60.0, true, false, 12, &m);
+    assert_int_equal(refuted, 0);
+    assert_int_equal(m.nexcl, 0);
+    assert_true(m.fits <= 2); /* the first fit and nothing after: a parked robot */
+}
+
+/* local_r (docs/STRATEGIES.md, "Stalls"): a model whose estimate (10.3, 5.2) predicts
+ * every mean exactly (no relearn, nothing refuted), every decision greedy. The first goes
+ * to the estimate; from then on each goal must be, by a double-precision reference, a
+ * legal lattice point within local_r (1 m) of the estimate outside the 0.5 m novelty
+ * radius of every place the robot stood, with the least sum of the squared distances to
+ * the robot and to the estimate; when none is left the goal is the estimate again. */
+/* local_world's seeker started with local_r and local_gap (metres) on the fixed model. */
+static void local_seek(world_t *t, fixed_model_t *fm, double local_r, double gap)
+{
+    rfs_seek_cfg_t cfg;
+    local_world(t, &cfg, fm);
+    cfg.local_r = Q(local_r);
+    cfg.local_gap = Q(gap);
+    rfs_model_t model = { fixed_ops(), fm };
+    assert_int_equal(rfs_seek_init(&t->seek, &cfg, &t->map, model, &rfs_target_rssi, &t->mem), 0);
+}
+
+/* A candidate (x, y) of the local-search references: its cost, the squared distances to
+ * the robot at (rx, ry) and to the estimate, lowers *best, and is *got when it is the
+ * goal (gx, gy). */
+static void local_score(double x, double y, double rx, double ry, double gx, double gy,
+                        double *best, double *got)
+{
+    double c = pow(hypot(x - rx, y - ry), 2) + pow(hypot(x - LOCAL_EX, y - LOCAL_EY), 2);
+    *best = c < *best ? c : *best;
+    if (fabs(x - gx) < 1e-4 && fabs(y - gy) < 1e-4) {
+        *got = c;
+    }
+}
+
+/* The references' verdict on the goal (gx, gy): the least cost (ties within 1e-6 m^2), or
+ * the estimate itself when no candidate is left. */
+static bool local_verdict(double best, double got, double gx, double gy)
+{
+    if (best == INFINITY) {
+        return fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4;
+    }
+    return got < best + 1e-6;
+}
+
+/* The reference goal after the robot stood at the n places (px, py), the search within
+ * radius of the estimate; false when no lattice point is left. Ties within 1e-6 m^2 are
+ * accepted. */
+static bool local_ref_ok(const world_t *t, const double *px, const double *py, int n,
+                         double radius, double gx, double gy)
+{
+    double best = INFINITY, got = INFINITY;
+    for (uint16_t j = 0; j < t->map.lh; ++j) {
+        for (uint16_t i = 0; i < t->map.lw; ++i) {
+            rfs_q16_t qx, qy;
+            rfs_map_lattice_point(&t->map, i, j, &qx, &qy);
+            double x = D(qx), y = D(qy);
+            bool seen = false;
+            for (int k = 0; k < n && !seen; ++k) {
+                seen = hypot(x - px[k], y - py[k]) <= 0.5 + 1e-9;
+            }
+            if (seen || !rfs_map_lattice_legal(&t->map, i, j) ||
+                hypot(x - LOCAL_EX, y - LOCAL_EY) > radius + 1e-9) {
+                continue;
+            }
+            local_score(x, y, px[n - 1], py[n - 1], gx, gy, &best, &got);
+        }
+    }
+    return local_verdict(best, got, gx, gy);
+}
+
+static void test_local_search_round_the_estimate(void **state)
+{
+    (void)state;
+    world_t t;
+    fixed_model_t fm;
+    local_seek(&t, &fm, 1.0, 0.0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.0, .y = 5.0 };
+    double px[64] = { 4.0 }, py[64] = { 5.0 };
+    int n = 1, local = 0;
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.kind, RFS_SEEK_INITIAL);
+    px[n] = D(out.decision.goal_x);
+    py[n++] = D(out.decision.goal_y);
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_true(fabs(D(out.decision.goal_x) - LOCAL_EX) < 1e-4); /* not yet stood at */
+    px[n] = LOCAL_EX;
+    py[n++] = LOCAL_EY;
+    while (n < 40) {
+        assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+        assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
+        double gx = D(out.decision.goal_x), gy = D(out.decision.goal_y);
+        assert_true(local_ref_ok(&t, px, py, n, 1.0, gx, gy));
+        if (fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4) {
+            break; /* every point round the estimate stood near: back at it */
+        }
+        assert_true(hypot(gx - LOCAL_EX, gy - LOCAL_EY) <= 1.0 + 1e-9);
+        px[n] = gx;
+        py[n++] = gy;
+        local++;
+    }
+    assert_true(local >= 4 && n < 40);
+    world_free(&t);
+}
+
+/* local_refute (docs/STRATEGIES.md, "Stalls"), local_r 1 m: the local goals follow the
+ * double reference until it has no point left; that decision goes to the estimate and,
+ * with the option, rules it out (one place, at (1030, 520) cm) and the next decision
+ * relearns; without it nothing is ruled out and the next decision keeps the model. */
+static void refute_sweep(bool on)
+{
+    world_t t;
+    fixed_model_t fm;
+    local_seek(&t, &fm, 1.0, 0.0);
+    t.seek.cfg.local_refute = on;
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.0, .y = 5.0 };
+    double px[64] = { 4.0 }, py[64] = { 5.0 };
+    int n = 1;
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    px[n] = D(out.decision.goal_x);
+    py[n++] = D(out.decision.goal_y);
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    px[n] = LOCAL_EX;
+    py[n++] = LOCAL_EY;
+    bool ended = false;
+    while (n < 64 && !ended) {
+        assert_int_equal(t.seek.nexcl, 0);
+        assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+        double gx = D(out.decision.goal_x), gy = D(out.decision.goal_y);
+        assert_true(local_ref_ok(&t, px, py, n, 1.0, gx, gy));
+        ended = fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4;
+        px[n] = gx;
+        py[n++] = gy;
+    }
+    assert_true(ended && n >= 8);
+    assert_int_equal(t.seek.nexcl, on ? 1 : 0);
+    if (on) {
+        assert_int_equal(t.seek.excl_x_cm[0], (int)lround(LOCAL_EX * 100));
+        assert_int_equal(t.seek.excl_y_cm[0], (int)lround(LOCAL_EY * 100));
+    }
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.relearned, on);
+    world_free(&t);
+}
+
+static void test_local_refute_rules_out_the_swept(void **state)
+{
+    (void)state;
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    assert_false(cfg.local_refute); /* the paper's meta */
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    assert_true(cfg.local_refute);
+    refute_sweep(true);
+    refute_sweep(false);
+}
+
+/* local_gap (docs/STRATEGIES.md, "Stalls"), local_r 2 m: every local goal must be, by a
+ * double-precision reference, the legal lattice point within local_r of the estimate
+ * with no lattice point within the 0.5 m novelty radius of a place stood at lying within
+ * local_gap of it, nearest the robot-estimate midpoint. When the search ends (back at
+ * the estimate) every legal lattice point within local_r lies within novelty radius +
+ * local_gap of a place stood at, and the sweep took fewer goals than without the gap.
+ * Returns the local goals taken. */
+static bool gap_ref_ok(const world_t *t, const double *px, const double *py, int n,
+                       double gap, double gx, double gy)
+{
+    double best = INFINITY, got = INFINITY;
+    for (uint16_t j = 0; j < t->map.lh; ++j) {
+        for (uint16_t i = 0; i < t->map.lw; ++i) {
+            rfs_q16_t qx, qy;
+            rfs_map_lattice_point(&t->map, i, j, &qx, &qy);
+            double x = D(qx), y = D(qy);
+            if (!rfs_map_lattice_legal(&t->map, i, j) ||
+                hypot(x - LOCAL_EX, y - LOCAL_EY) > 2.0 + 1e-9) {
+                continue;
+            }
+            bool near = false; /* a visited lattice point within gap */
+            for (uint16_t b = 0; b < t->map.lh && !near; ++b) {
+                for (uint16_t a = 0; a < t->map.lw && !near; ++a) {
+                    rfs_q16_t vx, vy;
+                    rfs_map_lattice_point(&t->map, a, b, &vx, &vy);
+                    if (hypot(D(vx) - x, D(vy) - y) > gap + 1e-9) {
+                        continue;
+                    }
+                    for (int k = 0; k < n && !near; ++k) {
+                        near = hypot(D(vx) - px[k], D(vy) - py[k]) <= 0.5 + 1e-9;
+                    }
+                }
+            }
+            if (near) {
+                continue;
+            }
+            local_score(x, y, px[n - 1], py[n - 1], gx, gy, &best, &got);
+        }
+    }
+    return local_verdict(best, got, gx, gy);
+}
+
+static int gap_sweep(double gap)
+{
+    world_t t;
+    fixed_model_t fm;
+    local_seek(&t, &fm, 2.0, gap);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.0, .y = 5.0 };
+    double px[128] = { 4.0 }, py[128] = { 5.0 };
+    int n = 1, local = 0;
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    px[n] = D(out.decision.goal_x);
+    py[n++] = D(out.decision.goal_y);
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_true(fabs(D(out.decision.goal_x) - LOCAL_EX) < 1e-4);
+    px[n] = LOCAL_EX;
+    py[n++] = LOCAL_EY;
+    bool ended = false;
+    while (n < 128 && !ended) {
+        assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+        assert_int_equal(out.decision.kind, RFS_SEEK_GREEDY);
+        double gx = D(out.decision.goal_x), gy = D(out.decision.goal_y);
+        assert_true(gap_ref_ok(&t, px, py, n, gap, gx, gy));
+        ended = fabs(gx - LOCAL_EX) < 1e-4 && fabs(gy - LOCAL_EY) < 1e-4;
+        if (!ended) {
+            px[n] = gx;
+            py[n++] = gy;
+            local++;
+        }
+    }
+    assert_true(ended);
+    for (uint16_t j = 0; j < t.map.lh; ++j) { /* the sweep's cover */
+        for (uint16_t i = 0; i < t.map.lw; ++i) {
+            rfs_q16_t qx, qy;
+            rfs_map_lattice_point(&t.map, i, j, &qx, &qy);
+            if (!rfs_map_lattice_legal(&t.map, i, j) ||
+                hypot(D(qx) - LOCAL_EX, D(qy) - LOCAL_EY) > 2.0 + 1e-9) {
+                continue;
+            }
+            double dmin = INFINITY;
+            for (int k = 0; k < n; ++k) {
+                double d = hypot(D(qx) - px[k], D(qy) - py[k]);
+                dmin = d < dmin ? d : dmin;
+            }
+            assert_true(dmin <= 0.5 + gap + 1e-9);
+        }
+    }
+    world_free(&t);
+    return local;
+}
+
+static void test_local_gap_spaces_the_sweep(void **state)
+{
+    (void)state;
+    int plain = gap_sweep(0.0), spaced = gap_sweep(0.5);
+    print_message("local_gap 0.5 m: %d local goals sweep 2 m round the estimate, %d without\n",
+                  spaced, plain);
+    assert_true(spaced >= 4 && spaced * 3 < plain * 2);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_refute_rules_out_the_argmax),
+        cmocka_unit_test(test_refute_reached_moves_on),
+        cmocka_unit_test(test_local_search_round_the_estimate),
+        cmocka_unit_test(test_local_refute_rules_out_the_swept),
+        cmocka_unit_test(test_local_gap_spaces_the_sweep),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -587,6 +587,20 @@ extern "C" long hs_box2d_wall_contacts(const hs_box2d_t *w)
     return w->contacts.contacts;
 }
 
+/* A box (centre x, y, half width, height) farther than RAY_MISS_M from the segment from
+ * (x0, y0), unit direction (ux, uy), length len, across it or beyond either end: neither
+ * cast can hit it. */
+static bool off_segment(const double *box, double x0, double y0, double ux, double uy,
+                        double len)
+{
+    const double dx = box[0] - x0, dy = box[1] - y0;
+    const double across = std::fabs(uy) * box[2] + std::fabs(ux) * box[3];
+    const double along = std::fabs(ux) * box[2] + std::fabs(uy) * box[3];
+    const double t = ux * dx + uy * dy;
+    return std::fabs(ux * dy - uy * dx) > across + RAY_MISS_M || t < -along - RAY_MISS_M ||
+           t > len + along + RAY_MISS_M;
+}
+
 /* hs_box2d_walls_crossed(), its fixtures from the radio index or (all) every one. */
 static unsigned walls_crossed(const hs_box2d_t *w, double x0, double y0, double x1, double y1,
                               bool all)
@@ -638,15 +652,7 @@ static unsigned walls_crossed(const hs_box2d_t *w, double x0, double y0, double 
                         continue;
                     }
                     w->seen[fi] = w->casts;
-                    // A box farther than RAY_MISS_M from the segment's line, or beyond
-                    // either end along it, cannot be hit: no cast.
-                    const double *box = &w->radio_box[4 * fi];
-                    const double dx = box[0] - x0, dy = box[1] - y0;
-                    const double across = std::fabs(uy) * box[2] + std::fabs(ux) * box[3];
-                    const double along = std::fabs(ux) * box[2] + std::fabs(uy) * box[3];
-                    const double t = ux * dx + uy * dy;
-                    if (std::fabs(ux * dy - uy * dx) > across + RAY_MISS_M ||
-                        t < -along - RAY_MISS_M || t > len + along + RAY_MISS_M) {
+                    if (off_segment(&w->radio_box[4 * fi], x0, y0, ux, uy, len)) {
                         continue;
                     }
                     b2Fixture *f = w->radio_fx[fi];

@@ -179,7 +179,7 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
         return -1;
     }
     /* Every run's world from the same merged walls, the first run's reset for the next. */
-    e->world = calloc(1, sizeof *e->world);
+    e->world = calloc(1, sizeof(hs_box2d_t *));
     if (e->world == NULL || hs_box2d_walls_make(&e->map, &e->walls) != 0) {
         snprintf(err, errlen, "%s: map: out of memory", sc->path);
         hs_sim_env_close(e);

@@ -43,6 +43,66 @@ void b2BroadPhase::UpdatePairs<ForgetWallMoves>(ForgetWallMoves *)
 }
 
 namespace {
+/* The broad phase as the walls left it (hs_box2d_reset): its tree's arrays and counts. A
+ * run's robot proxy moves by removal and insertion, whose rotations reshape the walls'
+ * branches; the tree's shape orders the robot's pairs and so its contacts. */
+struct TreeState {
+    std::vector<b2TreeNode> nodes; // the whole node array (free nodes too: the free list)
+    int32 root = b2_nullNode, count = 0, capacity = 0, free_list = b2_nullNode, insertions = 0;
+    int32 proxies = 0; // the broad phase's proxy count
+    bool save = true;  // true: copy the tree into this; false: copy this into the tree
+};
+using InvDt0 = float b2World::*;
+InvDt0 world_inv_dt0();
+/* b2World::m_inv_dt0 (the last step's 1/dt, 0 in a new world) has no accessor: an
+ * explicit instantiation may name a private member ([temp.spec]), and hands it out. */
+template <InvDt0 M> struct InvDt0Of {
+    friend InvDt0 world_inv_dt0() { return M; }
+};
+template struct InvDt0Of<&b2World::m_inv_dt0>;
+} // namespace
+
+/* TreeState's copy, as a member of b2DynamicTree (an explicit specialisation of its public
+ * template, like UpdatePairs below): const only in its signature. */
+template <>
+void b2DynamicTree::Query<TreeState>(TreeState *s, const b2AABB &) const
+{
+    b2DynamicTree *t = const_cast<b2DynamicTree *>(this);
+    if (s->save) {
+        s->nodes.assign(m_nodes, m_nodes + m_nodeCapacity);
+        s->root = m_root;
+        s->count = m_nodeCount;
+        s->capacity = m_nodeCapacity;
+        s->free_list = m_freeList;
+        s->insertions = m_insertionCount;
+        return;
+    }
+    // Capacity only grows: the live array holds the saved one (a smaller capacity only
+    // means the next growth comes sooner, as in the new tree).
+    b2Assert(m_nodeCapacity >= s->capacity);
+    std::copy(s->nodes.begin(), s->nodes.end(), t->m_nodes);
+    t->m_root = s->root;
+    t->m_nodeCount = s->count;
+    t->m_nodeCapacity = s->capacity;
+    t->m_freeList = s->free_list;
+    t->m_insertionCount = s->insertions;
+}
+
+/* TreeState with the broad phase's counts (no moves buffered: the walls' are forgotten). */
+template <>
+void b2BroadPhase::UpdatePairs<TreeState>(TreeState *s)
+{
+    if (s->save) {
+        s->proxies = m_proxyCount;
+    } else {
+        m_proxyCount = s->proxies;
+        m_moveCount = 0;
+        m_pairCount = 0;
+    }
+    m_tree.Query(s, b2AABB());
+}
+
+namespace {
 
 constexpr uint16 CAT_COLLIDE = 0x0001; // walls the robot collides with
 constexpr uint16 CAT_RADIO = 0x0002;   // walls the radio counts; never collide
@@ -105,6 +165,10 @@ struct hs_box2d {
     uint32_t rw, rh;
     mutable std::vector<uint32_t> seen; // per radio fixture: the last cast that tested it
     mutable uint32_t casts;
+    std::vector<double> radio_box; // per radio fixture: its AABB's centre x, y, half width, height
+    mutable HitCollector fwd, rev;  // walls_crossed's hits and intervals, kept for their capacity
+    mutable std::vector<std::pair<double, double>> iv;
+    TreeState built; // the broad phase before the robot (hs_box2d_reset); unused with wall_pairs
 };
 
 namespace {
@@ -112,6 +176,8 @@ constexpr double CLEAR_M = 0.1;       // cache cell, metres
 constexpr double CLEAR_MARGIN = 0.05; // > one step of travel (0.7 m/s x 20 ms) plus Box2D's skin
 constexpr double RAY_CELL_M = 0.5;    // cell of the radio fixtures' index, metres
 constexpr double RAY_MARGIN_M = 0.05; // far above float rounding: no hit is left out
+constexpr double RAY_MISS_M = 1e-3;   // a segment this far from a box (beyond its AABB's
+                                      // polygon radius) misses it in float too
 }
 
 extern "C" hs_box2d_cfg_t hs_box2d_cfg_default(void)
@@ -255,10 +321,16 @@ static void index_radio(hs_box2d_t *w, b2Body *radio)
         w->radio_fx.push_back(f);
     }
     std::vector<uint32_t> count((size_t)w->rw * w->rh + 1u, 0u);
+    w->radio_box.resize(4 * w->radio_fx.size());
     for (int pass = 0; pass < 2; pass++) {
         for (size_t k = 0; k < w->radio_fx.size(); k++) {
             b2AABB bb;
             w->radio_fx[k]->GetShape()->ComputeAABB(&bb, radio->GetTransform(), 0);
+            double *box = &w->radio_box[4 * k];
+            box[0] = 0.5 * ((double)bb.lowerBound.x + bb.upperBound.x);
+            box[1] = 0.5 * ((double)bb.lowerBound.y + bb.upperBound.y);
+            box[2] = 0.5 * ((double)bb.upperBound.x - bb.lowerBound.x);
+            box[3] = 0.5 * ((double)bb.upperBound.y - bb.lowerBound.y);
             uint32_t i0, j0, i1, j1;
             ray_cells(w, bb.lowerBound.x - RAY_MARGIN_M, bb.lowerBound.y - RAY_MARGIN_M,
                       bb.upperBound.x + RAY_MARGIN_M, bb.upperBound.y + RAY_MARGIN_M, &i0, &j0,
@@ -299,6 +371,25 @@ extern "C" hs_box2d_t *hs_box2d_create(const lx_map_t *m, const hs_box2d_cfg_t *
     hs_box2d_t *w = hs_box2d_create_walls(m, cfg, &walls, err, errlen);
     hs_box2d_walls_free(&walls);
     return w;
+}
+
+/* The robot: a dynamic disc at the map origin, colliding with the collision walls only. */
+static void add_robot(hs_box2d_t *w)
+{
+    const hs_box2d_cfg_t &c = w->cfg;
+    b2BodyDef bd;
+    bd.type = b2_dynamicBody;
+    bd.position.Set((float)w->ox, (float)w->oy);
+    w->robot = w->world->CreateBody(&bd);
+    b2CircleShape disc;
+    disc.m_radius = (float)c.robot_radius_m;
+    b2FixtureDef fd;
+    fd.shape = &disc;
+    fd.density = (float)(c.robot_mass_kg / (M_PI * c.robot_radius_m * c.robot_radius_m));
+    fd.friction = 0.0f;
+    fd.filter.categoryBits = CAT_ROBOT;
+    fd.filter.maskBits = CAT_COLLIDE;
+    w->robot->CreateFixture(&fd);
 }
 
 extern "C" hs_box2d_t *hs_box2d_create_walls(const lx_map_t *m, const hs_box2d_cfg_t *cfg,
@@ -352,22 +443,12 @@ extern "C" hs_box2d_t *hs_box2d_create_walls(const lx_map_t *m, const hs_box2d_c
         index_radio(w, radio);
         if (!c.wall_pairs) {
             ForgetWallMoves tag;
-            const_cast<b2ContactManager &>(w->world->GetContactManager())
-                .m_broadPhase.UpdatePairs(&tag);
+            b2BroadPhase &bp =
+                const_cast<b2ContactManager &>(w->world->GetContactManager()).m_broadPhase;
+            bp.UpdatePairs(&tag);
+            bp.UpdatePairs(&w->built);
         }
-        b2BodyDef bd;
-        bd.type = b2_dynamicBody;
-        bd.position.Set((float)m->origin_x, (float)m->origin_y);
-        w->robot = w->world->CreateBody(&bd);
-        b2CircleShape disc;
-        disc.m_radius = (float)c.robot_radius_m;
-        b2FixtureDef fd;
-        fd.shape = &disc;
-        fd.density = (float)(c.robot_mass_kg / (M_PI * c.robot_radius_m * c.robot_radius_m));
-        fd.friction = 0.0f;
-        fd.filter.categoryBits = CAT_ROBOT;
-        fd.filter.maskBits = CAT_COLLIDE;
-        w->robot->CreateFixture(&fd);
+        add_robot(w);
     } catch (const std::bad_alloc &) {
         hs_box2d_destroy(w);
         snprintf(err, errlen, "world: out of memory");
@@ -383,6 +464,29 @@ extern "C" void hs_box2d_destroy(hs_box2d_t *w)
     }
     delete w->world;
     delete w;
+}
+
+/* What a run changes: the robot (body, fixture, proxy, contacts), the tree round its
+ * proxy, the broad phase's counts and move buffer, the world's last 1/dt and the contact
+ * counts. The walls, their fixtures and proxies never move; the free-space cache and the
+ * radio index depend on the walls alone. The robot is made again, as hs_box2d_create_walls
+ * makes it, after the tree is back: the same proxy and node ids, body list and pairs. */
+extern "C" int hs_box2d_reset(hs_box2d_t *w)
+{
+    if (w->cfg.wall_pairs) {
+        return -1; // the walls' moves stay buffered until the first step: not saved
+    }
+    w->world->DestroyBody(w->robot); // its contacts end: EndContact may count down
+    w->robot = nullptr;
+    b2BroadPhase &bp = const_cast<b2ContactManager &>(w->world->GetContactManager()).m_broadPhase;
+    w->built.save = false;
+    bp.UpdatePairs(&w->built);
+    w->built.save = true;
+    w->world->*world_inv_dt0() = 0.0f;
+    w->contacts.touching = 0;
+    w->contacts.contacts = 0;
+    add_robot(w);
+    return 0;
 }
 
 extern "C" long hs_box2d_rect_count(const hs_box2d_t *w, hs_box2d_kind_t kind)
@@ -483,6 +587,20 @@ extern "C" long hs_box2d_wall_contacts(const hs_box2d_t *w)
     return w->contacts.contacts;
 }
 
+/* A box (centre x, y, half width, height) farther than RAY_MISS_M from the segment from
+ * (x0, y0), unit direction (ux, uy), length len, across it or beyond either end: neither
+ * cast can hit it. */
+static bool off_segment(const double *box, double x0, double y0, double ux, double uy,
+                        double len)
+{
+    const double dx = box[0] - x0, dy = box[1] - y0;
+    const double across = std::fabs(uy) * box[2] + std::fabs(ux) * box[3];
+    const double along = std::fabs(ux) * box[2] + std::fabs(uy) * box[3];
+    const double t = ux * dx + uy * dy;
+    return std::fabs(ux * dy - uy * dx) > across + RAY_MISS_M || t < -along - RAY_MISS_M ||
+           t > len + along + RAY_MISS_M;
+}
+
 /* hs_box2d_walls_crossed(), its fixtures from the radio index or (all) every one. */
 static unsigned walls_crossed(const hs_box2d_t *w, double x0, double y0, double x1, double y1,
                               bool all)
@@ -495,8 +613,12 @@ static unsigned walls_crossed(const hs_box2d_t *w, double x0, double y0, double 
     if ((b - a).LengthSquared() <= 0.0f) {
         return 0; // Box2D asserts on a zero-length ray (equal after rounding to float)
     }
-    HitCollector fwd, rev;
+    HitCollector &fwd = w->fwd, &rev = w->rev;
+    fwd.hits.clear();
+    rev.hits.clear();
     b2RayCastInput in_f = {a, b, 1.0f}, in_r = {b, a, 1.0f};
+    // The segment's unit direction (ux, uy) and normal (-uy, ux).
+    const double ux = (x1 - x0) / len, uy = (y1 - y0) / len;
     if (!all) {
         // Box2D's ray cast without its tree: every radio fixture in a cell the segment
         // (widened by RAY_MARGIN_M) passes, cast at once with the same input b2World::RayCast
@@ -530,6 +652,9 @@ static unsigned walls_crossed(const hs_box2d_t *w, double x0, double y0, double 
                         continue;
                     }
                     w->seen[fi] = w->casts;
+                    if (off_segment(&w->radio_box[4 * fi], x0, y0, ux, uy, len)) {
+                        continue;
+                    }
                     b2Fixture *f = w->radio_fx[fi];
                     b2RayCastOutput out;
                     if (f->RayCast(&out, in_f, 0)) {
@@ -558,8 +683,8 @@ static unsigned walls_crossed(const hs_box2d_t *w, double x0, double y0, double 
     // or an edge touched: the cache points and nodes lie on the map's pixel corners): a
     // crossing of no length there, not an interval to the end that would merge every
     // wall beyond into one (docs/RADIO_MODEL.md, "Walls").
-    std::vector<std::pair<double, double>> iv;
-    iv.reserve(fwd.hits.size() + rev.hits.size());
+    std::vector<std::pair<double, double>> &iv = w->iv;
+    iv.clear();
     for (const auto &h : fwd.hits) {
         double out = -1.0;
         for (const auto &r : rev.hits) {

@@ -88,6 +88,12 @@ hs_box2d_t *hs_box2d_create_walls(const lx_map_t *m, const hs_box2d_cfg_t *cfg,
 /// Destroy the world (NULL is fine).
 void hs_box2d_destroy(hs_box2d_t *w);
 
+/// Return the world to the state hs_box2d_create_walls() left it in (a new robot at the
+/// map origin, no contacts, the walls' tree as built), for the next run without building
+/// the walls again: the same steps and contacts after it, bit for bit. 0, or -1 when the
+/// world keeps wall pairs (cfg.wall_pairs; then destroy it and create another).
+int hs_box2d_reset(hs_box2d_t *w);
+
 /// Number of rectangles of each kind in the world.
 long hs_box2d_rect_count(const hs_box2d_t *w, hs_box2d_kind_t kind);
 

@@ -21,6 +21,8 @@ typedef struct radio_src {
     float *shadow;         ///< gw * gh values, dB; NaN until first read (shadow_at)
     double *shadow_x;      ///< per grid column, every wave's cos and sin of kx x + phase
     double *shadow_y;      ///< per grid row, every wave's cos and sin of ky y
+    double *shadow_k;      ///< per wave kx, ky, phase (rad/m, rad/m, rad)
+    uint8_t *shadow_xy;    ///< per column, then per row: 1 once its cos and sin are tabulated
     fading_wave_t *waves;  ///< fading_waves plane waves
     int8_t *walls;         ///< cw * ch cached wall counts, -1 = not yet known
     bool walls_owned;      ///< walls was allocated here (not lent by the caller)
@@ -127,7 +129,8 @@ static void field_rng(rfs_rng_t *rng, uint64_t seed, unsigned tag, unsigned s)
 /// normalised spectrum of sigma^2 exp(-r / d_c) in 2-D, whose radial CDF is
 /// F(k) = 1 - (1 + (k d_c)^2)^-1/2 (inverted in closed form). Covariance of the sum:
 /// sigma^2 E[cos(k . r)] = sigma^2 exp(-|r| / d_c). Rows and columns are separable:
-/// e^{j k.x} = e^{j kx x} e^{j ky y}.
+/// e^{j k.x} = e^{j kx x} e^{j ky y}. Here the waves are drawn; a column's or row's cos
+/// and sin are tabulated on its first read (shadow_line), the same values as all at once.
 static int make_shadow(hs_radio_t *r, radio_src_t *rs, uint64_t seed, unsigned s)
 {
     const hs_radio_cfg_t *c = &r->cfg;
@@ -136,7 +139,9 @@ static int make_shadow(hs_radio_t *r, radio_src_t *rs, uint64_t seed, unsigned s
     rs->shadow = malloc(n * sizeof(float));
     rs->shadow_x = malloc(sizeof(double) * r->gw * 2 * nw);
     rs->shadow_y = malloc(sizeof(double) * r->gh * 2 * nw);
-    if (!rs->shadow || !rs->shadow_x || !rs->shadow_y) {
+    rs->shadow_k = malloc(sizeof(double) * 3 * nw);
+    rs->shadow_xy = calloc((size_t)r->gw + r->gh, 1);
+    if (!rs->shadow || !rs->shadow_x || !rs->shadow_y || !rs->shadow_k || !rs->shadow_xy) {
         return -1; // hs_radio_destroy frees them
     }
     for (size_t i = 0; i < n; i++) {
@@ -149,19 +154,30 @@ static int make_shadow(hs_radio_t *r, radio_src_t *rs, uint64_t seed, unsigned s
         double k = sqrt(1.0 / ((1.0 - u) * (1.0 - u)) - 1.0) / c->shadow_dcorr_m;
         double a = 2.0 * M_PI * hs_radio_uniform(&rng);
         double ph = 2.0 * M_PI * hs_radio_uniform(&rng);
-        double kx = k * cos(a), ky = k * sin(a);
-        for (uint32_t gx = 0; gx < r->gw; gx++) {
-            double p = kx * (gx * c->shadow_grid_m) + ph;
-            rs->shadow_x[((size_t)gx * nw + i) * 2] = cos(p);
-            rs->shadow_x[((size_t)gx * nw + i) * 2 + 1] = sin(p);
-        }
-        for (uint32_t gy = 0; gy < r->gh; gy++) {
-            double p = ky * (gy * c->shadow_grid_m);
-            rs->shadow_y[((size_t)gy * nw + i) * 2] = cos(p);
-            rs->shadow_y[((size_t)gy * nw + i) * 2 + 1] = sin(p);
-        }
+        rs->shadow_k[3 * i] = k * cos(a);
+        rs->shadow_k[3 * i + 1] = k * sin(a);
+        rs->shadow_k[3 * i + 2] = ph;
     }
     return 0;
+}
+
+/* Column gx's (y: row gy's) cos and sin of every wave, tabulated on first use: most of a
+ * grid is never read, a table of all of it costs (gw + gh) x waves sincos a run. */
+static const double *shadow_line(const hs_radio_t *r, const radio_src_t *rs, bool y, uint32_t g)
+{
+    const size_t nw = r->cfg.shadow_waves;
+    double *t = (y ? rs->shadow_y : rs->shadow_x) + (size_t)g * nw * 2;
+    uint8_t *done = &rs->shadow_xy[y ? r->gw + g : g];
+    if (!*done) {
+        for (size_t i = 0; i < nw; i++) {
+            double p = y ? rs->shadow_k[3 * i + 1] * (g * r->cfg.shadow_grid_m)
+                         : rs->shadow_k[3 * i] * (g * r->cfg.shadow_grid_m) + rs->shadow_k[3 * i + 2];
+            t[2 * i] = cos(p);
+            t[2 * i + 1] = sin(p);
+        }
+        *done = 1;
+    }
+    return t;
 }
 
 /* Grid point (gx, gy) of source rs's shadowing, summed over the waves on its first read
@@ -172,7 +188,7 @@ static float shadow_at(const hs_radio_t *r, const radio_src_t *rs, uint32_t gx, 
     float *v = &rs->shadow[(size_t)gy * r->gw + gx];
     if (isnan(*v)) {
         const size_t nw = r->cfg.shadow_waves;
-        const double *cx = rs->shadow_x + (size_t)gx * nw * 2, *cy = rs->shadow_y + (size_t)gy * nw * 2;
+        const double *cx = shadow_line(r, rs, false, gx), *cy = shadow_line(r, rs, true, gy);
         double acc = 0.0;
         for (size_t i = 0; i < nw; i++) {
             acc += cx[2 * i] * cy[2 * i] - cx[2 * i + 1] * cy[2 * i + 1];
@@ -276,6 +292,8 @@ void hs_radio_destroy(hs_radio_t *r)
         free(r->src[s].shadow);
         free(r->src[s].shadow_x);
         free(r->src[s].shadow_y);
+        free(r->src[s].shadow_k);
+        free(r->src[s].shadow_xy);
         free(r->src[s].waves);
         if (r->src[s].walls_owned) {
             free(r->src[s].walls);

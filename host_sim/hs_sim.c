@@ -157,10 +157,17 @@ static hs_radio_t *world_radio_open(const hs_sim_env_t *e, uint64_t seed, bool p
 {
     const hs_scenario_t *sc = &e->sc;
     char werr[256];
-    hs_box2d_t *world = hs_box2d_create_walls(&e->map, NULL, &e->walls, werr, sizeof werr);
-    if (!world) {
-        snprintf(err, errlen, "%s: %s", sc->path, werr);
-        return NULL;
+    // The walls are the map's: the first run builds the world, the next reset it.
+    hs_box2d_t *world = *e->world;
+    if (world == NULL) {
+        world = hs_box2d_create_walls(&e->map, NULL, &e->walls, werr, sizeof werr);
+        if (!world) {
+            snprintf(err, errlen, "%s: %s", sc->path, werr);
+            return NULL;
+        }
+        *e->world = world;
+    } else {
+        (void)hs_box2d_reset(world); // the default configuration: no wall pairs
     }
     if (place_robot) {
         hs_box2d_place_robot(world, sc->start_x, sc->start_y, sc->start_theta);
@@ -171,7 +178,6 @@ static hs_radio_t *world_radio_open(const hs_sim_env_t *e, uint64_t seed, bool p
     hs_radio_t *radio = hs_radio_create(&sc->radio, rs, sc->nsources, e->x0, e->y0, e->x1, e->y1,
                                         seed, walls_cb, world, werr, sizeof werr);
     if (!radio) {
-        hs_box2d_destroy(world);
         snprintf(err, errlen, "%s: %s", sc->path, werr);
         return NULL;
     }
@@ -250,7 +256,6 @@ static void run_close(sim_run_t *r)
     hs_bridge_track_free(&r->track);
     free(r->pdr);
     hs_radio_destroy(r->radio);
-    hs_box2d_destroy(r->world);
 }
 
 /* Set up a run: 0, or -1 with err set (nothing left open). */
@@ -884,7 +889,6 @@ int hs_sim_field(const hs_sim_env_t *e, uint64_t seed, unsigned src, double step
         }
     }
     hs_radio_destroy(radio);
-    hs_box2d_destroy(world);
     return 0;
 }
 

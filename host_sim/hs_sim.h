@@ -43,6 +43,8 @@ typedef struct hs_sim_env {
     uint8_t *wall_fwd;         ///< the core map's forward free squares (rfs_map_wall_fwd_attach), or NULL
     int32_t *pathloss_log2;    ///< the path-loss model's log2 table (rfs_pathloss_log2_fill), or NULL
     hs_box2d_walls_t walls;    ///< the map's merged wall rectangles, shared by runs' worlds
+    hs_box2d_t **world;        ///< the runs' world: made by the first, reset by the next
+                               ///< (hs_box2d_reset); one slot, NULL until then
     uint64_t placement;        ///< the drawn placement the start and source are (hs_place.h;
                                ///< hs_sim_env_place), 0: the scenario's own
     uint64_t placement_seed;   ///< the seed it was drawn from

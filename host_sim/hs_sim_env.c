@@ -178,8 +178,9 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
         hs_sim_env_close(e);
         return -1;
     }
-    /* Every run's world from the same merged walls. */
-    if (hs_box2d_walls_make(&e->map, &e->walls) != 0) {
+    /* Every run's world from the same merged walls, the first run's reset for the next. */
+    e->world = calloc(1, sizeof(hs_box2d_t *));
+    if (e->world == NULL || hs_box2d_walls_make(&e->map, &e->walls) != 0) {
         snprintf(err, errlen, "%s: map: out of memory", sc->path);
         hs_sim_env_close(e);
         return -1;
@@ -255,6 +256,11 @@ void hs_sim_env_close(hs_sim_env_t *e)
     free(e->pathloss_log2);
     e->pathloss_log2 = NULL;
     hs_box2d_walls_free(&e->walls);
+    if (e->world != NULL) {
+        hs_box2d_destroy(*e->world);
+        free(e->world);
+        e->world = NULL;
+    }
     lx_map_free(&e->map);
 }
 

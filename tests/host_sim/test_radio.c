@@ -129,9 +129,10 @@ static void test_shadowing_sigma_and_correlation(void **state)
     assert_true(fabs(dcorr - 5.0) < 0.75);
 }
 
-/// Shadowing grid points are summed on first read: two radios of one seed read in
-/// opposite orders (one from the far corner back, one point by point forward) agree bit
-/// for bit everywhere, so a value does not depend on what was read before.
+/// Shadowing grid points are summed, and their columns and rows tabulated, on first
+/// read: two radios of one seed read in opposite orders (one from the far corner back,
+/// one point by point forward) agree bit for bit everywhere, so a value does not depend
+/// on what was read before.
 static void test_shadowing_lazy_order_free(void **state)
 {
     (void)state;

@@ -1,5 +1,5 @@
 /* ref_pathloss.h - a double-precision reference of the path-loss model's search
- * (common/rfs_pathloss.h), for tests/common/test_pathloss.c.
+ * (common/rfs_pathloss.h), for tests/common/test_pathloss*.c.
  *
  * The same definition computed another way: bins found by a linear search, centroids
  * rounded to the centimetre as the definition says (the store's unit), distances and

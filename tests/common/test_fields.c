@@ -14,12 +14,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "office_map.h"
 #include "rfs_fields.h"
 #include "rfs_models.h"
 
-#define MW 300
-#define MH 160
-#define RES_Q16 6554 /* 0.1 m as the map loader rounds it */
 #define NS 3000
 #define Q(v) ((rfs_q16_t)lround((v) * 65536.0))
 #define D(q) ((double)(q) / 65536.0)
@@ -38,18 +36,6 @@ typedef struct fixture {
     rfs_fields_t fl;
     rfs_fields_t fl2;
 } fixture_t;
-
-static bool is_wall(int i, int j)
-{
-    if (i == 0 || j == 0 || i == MW - 1 || j == MH - 1) {
-        return true;
-    }
-    bool door = (i >= 40 && i < 50) || (i >= 140 && i < 150) || (i >= 240 && i < 250);
-    if ((j == 70 || j == 90) && !door) {
-        return true;
-    }
-    return (i == 100 || i == 200) && (j < 70 || j > 90);
-}
 
 static void alloc_mem(rfs_fields_mem_t *m, const rfs_map_t *map, const rfs_fields_cfg_t *c)
 {
@@ -78,16 +64,7 @@ static int setup(void **state)
 {
     fixture_t *f = calloc(1, sizeof(*f));
     assert_non_null(f);
-    uint16_t stride = (MW + 7) / 8;
-    for (int j = 0; j < MH; ++j) {
-        for (int i = 0; i < MW; ++i) {
-            rfs_map_bit_set(f->wall_bits, stride, (uint16_t)i, (uint16_t)j, is_wall(i, j));
-            rfs_map_bit_set(f->free_bits, stride, (uint16_t)i, (uint16_t)j, !is_wall(i, j));
-        }
-    }
-    rfs_map_cfg_t mc = rfs_map_cfg_default();
-    assert_int_equal(rfs_map_init(&f->map, &mc, MW, MH, RES_Q16, 0, 0, f->free_bits,
-                                  f->wall_bits, f->legal_bits), 0);
+    office_map_init(f->free_bits, f->wall_bits, f->legal_bits, &f->map);
     rfs_fields_cfg_t c = rfs_fields_cfg_default();
     alloc_mem(&f->mem, &f->map, &c);
     *state = f;

@@ -1,0 +1,142 @@
+/* pathloss_office.h - the fixture of the path-loss model's tests (test_pathloss.c,
+ * test_pathloss_use.c): the office (office_map.h), samples valued by the model with a known
+ * source, P0, n and W plus Gaussian noise, and whole or sliced fits from a fresh model.
+ */
+#ifndef PATHLOSS_OFFICE_H
+#define PATHLOSS_OFFICE_H
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "office_map.h"
+#include "ref_pathloss.h"
+#include "rfs_pathloss.h"
+
+#define NS 2000
+
+typedef struct fixture {
+    uint8_t free_bits[MH * ((MW + 7) / 8)];
+    uint8_t wall_bits[MH * ((MW + 7) / 8)];
+    uint8_t legal_bits[MH * ((MW + 7) / 8)];
+    rfs_map_t map;
+    rfs_sample_t s[NS];
+    rfs_pathloss_t pl;
+    ref_pl_t ref;
+} fixture_t;
+
+static inline int setup(void **state)
+{
+    fixture_t *f = calloc(1, sizeof(*f));
+    assert_non_null(f);
+    office_map_init(f->free_bits, f->wall_bits, f->legal_bits, &f->map);
+    *state = f;
+    return 0;
+}
+
+static inline int teardown(void **state)
+{
+    free(*state);
+    return 0;
+}
+
+static inline double gauss(rfs_rng_t *r)
+{
+    double u1 = ((double)rfs_rng_u32(r) + 1.0) / 4294967297.0;
+    double u2 = (double)rfs_rng_u32(r) / 4294967296.0;
+    return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
+}
+
+typedef struct truth {
+    double sx, sy, p0, n, w, noise;
+} truth_t;
+
+/* n samples at random legal points of the map (or anywhere in [0, 30] x [0, 16] m when
+ * map is NULL), valued by the model with the truth's parameters; walls counted from the
+ * sample's exact position to the source. */
+static inline void make_samples(rfs_sample_t *s, int n, const rfs_map_t *map, const truth_t *t,
+                                uint64_t seed)
+{
+    rfs_rng_t r;
+    rfs_rng_seed(&r, seed);
+    rfs_q16_t qsx = (rfs_q16_t)lround(t->sx * 65536.0), qsy = (rfs_q16_t)lround(t->sy * 65536.0);
+    for (int i = 0; i < n;) {
+        int xc = (int)rfs_rng_below(&r, 3001), yc = (int)rfs_rng_below(&r, 1601);
+        rfs_q16_t qx = (rfs_q16_t)lround(xc / 100.0 * 65536.0);
+        rfs_q16_t qy = (rfs_q16_t)lround(yc / 100.0 * 65536.0);
+        if (map != NULL && !rfs_map_point_legal(map, qx, qy)) {
+            continue;
+        }
+        double d = hypot(xc / 100.0 - t->sx, yc / 100.0 - t->sy);
+        int k = map != NULL ? rfs_map_walls_crossed(map, qx, qy, qsx, qsy) : 0;
+        double v = t->p0 - 10.0 * t->n * log10(d < 1.0 ? 1.0 : d) - t->w * k + t->noise * gauss(&r);
+        s[i].x_cm = (int16_t)xc;
+        s[i].y_cm = (int16_t)yc;
+        s[i].v_q6 = (int16_t)lround(v * 64.0);
+        ++i;
+    }
+}
+
+/* The estimator without its strong prior: a prior of weight 1 and every sample counted
+ * (bin_cap at its maximum), for checks against the truth that generated the data. */
+static inline rfs_pathloss_cfg_t weak_cfg(void)
+{
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    c.prior_weight = RFS_Q16_ONE;
+    c.w_prior_weight = RFS_Q16_ONE;
+    c.bin_cap = UINT16_MAX;
+    return c;
+}
+
+static inline ref_pl_cfg_t weak_ref(void)
+{
+    ref_pl_cfg_t c = ref_pl_cfg_default();
+    c.prior_weight = 1.0;
+    c.w_prior_weight = 1.0;
+    c.bin_cap = UINT16_MAX;
+    return c;
+}
+
+static inline rfs_pathloss_est_t fit_in_with(fixture_t *f, const rfs_pathloss_cfg_t *c,
+                                             const rfs_model_fit_in_t *in, uint32_t budget, int *calls);
+
+static inline rfs_pathloss_est_t fit_with(fixture_t *f, const rfs_pathloss_cfg_t *c, int n,
+                                          const rfs_map_t *map, uint32_t budget, int *calls)
+{
+    rfs_model_fit_in_t in = {.samples = f->s, .n = (uint16_t)n, .map = map};
+    return fit_in_with(f, c, &in, budget, calls);
+}
+
+/* A whole (budget 0) or sliced fit of `in` from a fresh model. */
+static inline rfs_pathloss_est_t fit_in_with(fixture_t *f, const rfs_pathloss_cfg_t *c,
+                                             const rfs_model_fit_in_t *in, uint32_t budget, int *calls)
+{
+    assert_int_equal(rfs_pathloss_init(&f->pl, c), 0);
+    rfs_model_t m = rfs_pathloss_model(&f->pl);
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 1);
+    rfs_fit_result_t r;
+    int k = 0;
+    do {
+        r = m.ops->fit(m.self, in, budget, &rng);
+        ++k;
+    } while (r == RFS_FIT_MORE && k < 100000);
+    assert_int_equal(r, RFS_FIT_DONE);
+    if (calls != NULL) {
+        *calls = k;
+    }
+    rfs_pathloss_est_t e;
+    assert_true(rfs_pathloss_estimate(&f->pl, &e));
+    return e;
+}
+
+static inline rfs_pathloss_est_t fit_default(fixture_t *f, int n, const rfs_map_t *map, uint32_t budget,
+                                             int *calls)
+{
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    return fit_with(f, &c, n, map, budget, calls);
+}
+
+/* n and W away from the default prior (3, 5 dB), so that recovering them means something. */
+static const truth_t k_office = {15.125, 3.375, -35.0, 2.6, 6.5, 0.3};
+
+#endif /* PATHLOSS_OFFICE_H */

@@ -63,6 +63,7 @@ $(eval $(call test_script,batch_out,tests/host_sim/batch_out.sh $(SIM),$(SIM)))
 # Drawn placements (--placements) against scipy's Dijkstra over the map image, their
 # batches, job list and resume, bad options.
 $(eval $(call test_script,placements,$(PYTHON) tests/host_sim/placements.py $(SIM),$(SIM)))
+$(eval $(call test_script,greedy_extrap,$(PYTHON) tests/host_sim/greedy_extrap_check.py $(SIM),$(SIM) scripts/greedy_extrap.py))
 $(eval $(call test_script,faults,tests/host_sim/faults.sh $(SIM) 3,$(SIM)))
 $(eval $(call test_script,strategy_cli,tests/host_sim/strategy_cli.sh $(SIM),$(SIM)))
 # bridge_bounds.py's tolerance reference against a brute-force walk of the grid.

@@ -167,7 +167,14 @@ def main(argv):
     i = 1
     while i < len(argv):
         if argv[i] == "--wrong" and i + 1 < len(argv):
-            wrong_m = float(argv[i + 1])
+            try:
+                wrong_m = float(argv[i + 1])
+            except ValueError:
+                wrong_m = float("nan")
+            if not wrong_m > 0.0 or math.isinf(wrong_m):
+                print("greedy_extrap.py: --wrong %s: not a positive distance in metres"
+                      % argv[i + 1], file=sys.stderr)
+                return 1
             i += 2
         elif argv[i] == "--tsv" and i + 1 < len(argv):
             tsv = argv[i + 1]
@@ -199,10 +206,18 @@ def main(argv):
     if tsv:
         keys = ("batch", "run", "reached", "end", "t", "err", "data", "robot", "leg", "total",
                 "shortest", "p0", "n", "w", "area")
-        with open(tsv, "w") as f:
-            f.write("\t".join(keys) + "\n")
-            for r in allrows:
-                f.write("\t".join(str(r[k]) for k in keys) + "\n")
+        tmp = "%s.tmp-%d" % (tsv, os.getpid())
+        try:
+            with open(tmp, "w") as f:
+                f.write("\t".join(keys) + "\n")
+                for r in allrows:
+                    f.write("\t".join(str(r[k]) for k in keys) + "\n")
+            os.replace(tmp, tsv)
+        except OSError as e:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            print("greedy_extrap.py: %s: %s" % (tsv, e.strerror), file=sys.stderr)
+            return 1
     return 0
 
 

@@ -179,6 +179,9 @@ def main(argv):
         elif argv[i] == "--tsv" and i + 1 < len(argv):
             tsv = argv[i + 1]
             i += 2
+        elif argv[i] in ("--wrong", "--tsv"):
+            print("greedy_extrap.py: %s needs a value" % argv[i], file=sys.stderr)
+            return 1
         elif argv[i].startswith("--"):
             print("greedy_extrap.py: unknown option %s" % argv[i], file=sys.stderr)
             return 1

@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include "rfs_map.h"
+#include "rfs_test.h"
 
 #define MW 300
 #define MH 160

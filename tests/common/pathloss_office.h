@@ -11,6 +11,7 @@
 #include "office_map.h"
 #include "ref_pathloss.h"
 #include "rfs_pathloss.h"
+#include "rfs_test.h"
 
 #define NS 2000
 

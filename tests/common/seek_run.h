@@ -130,7 +130,6 @@ static inline const rfs_model_ops_t *fixed_ops(void)
     return &ops;
 }
 
-
 /* The local-search world (test_seek_meta.c, test_seek_stall.c): 20 x 10 m without walls,
  * the meta-path preset with epsilon off, and a fixed model whose estimate is
  * (LOCAL_EX, LOCAL_EY). */

@@ -92,6 +92,7 @@ def main():
         for args, what in ((["--wrong", "x", batch], "--wrong x"),
                            (["--wrong", "-3", batch], "--wrong -3"),
                            (["--bogus", batch], "unknown option"),
+                           ([batch, "--tsv"], "--tsv without a value"),
                            ([os.path.join(tmp, "none")], "missing DIR"),
                            ([tmp + "/rows.tsv"], "a file as DIR"),
                            ([batch, "--tsv", os.path.join(tmp, "no", "x.tsv")], "unwritable TSV")):

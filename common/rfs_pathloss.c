@@ -350,8 +350,9 @@ static bool cand_legal(const rfs_pathloss_t *p, int32_t i, int32_t j)
 
 /* How far the snap search looks from a coarse point, lattice steps (the offsets' 4 bits). */
 #define SNAP_REACH 7
-/* Work units of one snap search. */
-#define SNAP_UNITS 2u
+/* Work units of one snap search (at most (2 SNAP_REACH + 1)^2 legality tests: less than a
+ * wall count). */
+#define SNAP_UNITS 1u
 
 /* Lattice point (i, j) is on the lattice and legal on the map (places ruled out aside). */
 static bool lattice_legal(const rfs_pathloss_t *p, int32_t i, int32_t j)

@@ -211,12 +211,16 @@ def main(argv):
 
 
 def plot_residual(path, s, img, ext, sources, tx, ty, out):
-    """Heat map of residual.tsv (one value per coarse candidate on a regular lattice)."""
+    """Heat map of residual.tsv: one value per coarse candidate, drawn as its cell of the
+    regular coarse grid (cell_x_m, cell_y_m; files without them: the candidates' own x, y)."""
     rh, rr = read_tsv(path)
     if not rr:
         return  # no fit: nothing to draw
     try:
-        rx, ry, rv = col(rh, rr, "x_m"), col(rh, rr, "y_m"), col(rh, rr, "residual_db")
+        cells = "cell_x_m" in rh and "cell_y_m" in rh
+        rx = col(rh, rr, "cell_x_m" if cells else "x_m")
+        ry = col(rh, rr, "cell_y_m" if cells else "y_m")
+        rv = col(rh, rr, "residual_db")
     except (ValueError, IndexError) as e:
         die("%s: %s" % (path, e))
     xs, ys = np.unique(rx), np.unique(ry)

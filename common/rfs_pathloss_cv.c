@@ -77,9 +77,9 @@ void rfs_pathloss_cv_order(rfs_pathloss_t *p)
     }
     /* The first bin of each block is marked in cv_order's top bit (bins < 2^15). */
     uint32_t blocks = 0u;
-    for (uint32_t i = 0u; i < n; ++i) {
+    for (uint32_t i = n; i-- > 0u;) {
         if (i == 0u || key[p->cv_order[i]] != key[p->cv_order[i - 1u]]) {
-            p->cv_order[i] |= CV_FIRST;
+            p->cv_order[i] |= CV_FIRST; /* read no more: the bins before it are unmarked */
             blocks++;
         }
     }

@@ -86,6 +86,7 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
      * docs/PATHLOSS.md, "A bin's walls"). */
     c.coarse_footprint = RFS_PATHLOSS_COARSE_AS_FOOTPRINT;
     c.cv_block = 0;
+    c.cv_hold_only = false;
     return c;
 }
 
@@ -465,15 +466,19 @@ static void solve(rfs_pathloss_t *p, rfs_pathloss_cand_t *out)
     /* Huber loss of the bins' mean residuals z_b - P0 + n L_b + W k_b
      * = dz_b + n (L_b - mean L) + W (k_b - mean k), Q16, then Q8 (saturated to 2^24). */
     const int64_t d8 = ((int64_t)c->huber + 128) >> 8;
-    int64_t loss = 0;
-    if (p->cv_blocks > 1u) {
+    int64_t loss = 0, cvl = 0;
+    const bool cv = p->cv_blocks > 1u;
+    if (cv) {
         /* Cross-validated: each block's bins under the fit to all the others. */
-        loss = rfs_pathloss_cv_loss(p, ml, mk, n, w);
-    } else {
+        cvl = rfs_pathloss_cv_loss(p, ml, mk, n, w);
+    }
+    if (!cv || c->cv_hold_only) {
         for (uint32_t b = 0u; b < p->nbins; ++b) {
             loss += (int64_t)p->bins[b].count *
                     rfs_pathloss_huber(rfs_pathloss_residual(p, b, ml, mk, 0, n, w), d8);
         }
+    } else {
+        loss = cvl;
     }
     int64_t p0 = (int64_t)p->mz_q16 + (((int64_t)n * ml + (int64_t)w * mk + 32768) >> 16);
     /* Scaling: the shortfall or excess in Q8 saturates at 2^24 like a residual; total <=
@@ -486,8 +491,10 @@ static void solve(rfs_pathloss_t *p, rfs_pathloss_cand_t *out)
     int64_t a = p0 < c->p0_min ? (int64_t)c->p0_min - p0
               : c->p0_max != INT32_MAX && p0c > c->p0_max ? p0c - (int64_t)c->p0_max
                                                           : 0;
-    loss += (int64_t)p->total * rfs_pathloss_huber(a, d8);
+    const int64_t p0_term = (int64_t)p->total * rfs_pathloss_huber(a, d8);
+    loss += p0_term;
     out->loss = loss;
+    out->hloss = cv && c->cv_hold_only ? cvl + p0_term : loss;
     out->sx = sx;
     out->sy = sy;
     out->li = p->ev.li;
@@ -636,11 +643,11 @@ static bool hold_next(rfs_pathloss_t *p)
         p->hold_j = p->hold_best.lj;
         p->hold_pos = 0u;
     }
-    uint64_t per = rfs_udiv64((uint64_t)p->cur.loss, p->nbins);
+    uint64_t per = rfs_udiv64((uint64_t)p->cur.hloss, p->nbins);
     uint64_t thr = per >= ((uint64_t)1 << 41)
                        ? UINT64_MAX
-                       : (uint64_t)p->cur.loss + ((per * (uint64_t)p->cfg.hold_k) >> 16);
-    if ((uint64_t)p->hold_best.loss <= thr) {
+                       : (uint64_t)p->cur.hloss + ((per * (uint64_t)p->cfg.hold_k) >> 16);
+    if ((uint64_t)p->hold_best.hloss <= thr) {
         p->cur = p->hold_best;
     }
     return false;
@@ -673,6 +680,7 @@ static bool fit_begin(rfs_pathloss_t *p, const rfs_model_fit_in_t *in)
     p->nvis = 0u;
     p->candidates = 0u;
     p->cur.loss = INT64_MAX;
+    p->cur.hloss = INT64_MAX;
     p->ev.on = false;
     return true;
 }
@@ -743,7 +751,7 @@ static bool ev_run(rfs_pathloss_t *p, uint32_t budget, uint32_t *used)
     solve(p, &cd);
     p->ev.on = false;
     if (p->ev.kind == EV_HOLD) {
-        if (cd.loss < p->hold_best.loss) {
+        if (cd.hloss < p->hold_best.hloss) {
             p->hold_best = cd;
         }
         return true;
@@ -803,6 +811,7 @@ static bool hold_begin(rfs_pathloss_t *p)
     p->hold_step = (uint16_t)(l->cs / 2u < 1u ? 1u : l->cs / 2u);
     p->hold_pos = UINT8_MAX; /* the previous source itself first */
     p->hold_best.loss = INT64_MAX;
+    p->hold_best.hloss = INT64_MAX;
     return true;
 }
 

@@ -148,6 +148,8 @@ typedef struct rfs_pathloss_cfg {
     rfs_q16_t cv_block;     ///< metres Q16.16: side of the squares that cross-validate a
                             ///< candidate's loss (0: off, the default; 1..64 m): each
                             ///< square's bins scored under the fit to all the others
+    bool cv_hold_only;      ///< with cv_block: rank by the ordinary loss, and use the
+                            ///< cross-validated one only in the hold phase (false)
 } rfs_pathloss_cfg_t;
 
 /// One sample bin. Scaling: sums of up to 65,535 samples of int16 fit int32.
@@ -169,6 +171,8 @@ typedef struct rfs_pathloss_bin {
 /// One evaluated candidate source and its fit.
 typedef struct rfs_pathloss_cand {
     int64_t loss;    ///< sum over bins of count x Huber(mean residual), dB^2 Q16 (Q8 x Q8)
+    int64_t hloss;   ///< the loss the hold phase compares (cross-validated with
+                     ///< cv_hold_only, else loss), dB^2 Q16
     rfs_q16_t sx;    ///< source x, metres Q16.16
     rfs_q16_t sy;    ///< source y, metres Q16.16
     uint16_t li;     ///< its lattice index along x

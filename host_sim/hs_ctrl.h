@@ -72,6 +72,8 @@ typedef struct hs_ctrl_inproc_cfg {
                             ///< against the ceiling, dB, in [0, 60] (NAN: off)
     double cv_block_m;      ///< pathloss model only: side of its cross-validation blocks,
                             ///< metres, 0 or [1, 64] (NAN or 0: off)
+    int cv_hold_only;       ///< pathloss model only: cross-validate only the hold decision
+                            ///< (1), or rank every candidate by it (0; -1: the default, 0)
     const int32_t *pathloss_log2; ///< pathloss model only: a log2 table to attach
                             ///< (rfs_pathloss_log2_fill(), outliving the controller) or NULL
 } hs_ctrl_inproc_cfg_t;

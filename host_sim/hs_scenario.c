@@ -216,6 +216,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_coarse_footprint_m = NAN;
     sc->seek_p0_max_wall_db = NAN;
     sc->seek_cv_block_m = NAN;
+    sc->seek_cv_hold_only = -1;
     sc->seek_eps_rate = -1.0;
     snprintf(sc->model, sizeof sc->model, "ridge");
     snprintf(sc->target, sizeof sc->target, "rssi");
@@ -437,7 +438,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
                                         "refute_reached", "local_m", "leg_m", "recheck_silent",
                                         "coarse_footprint_m", "p0_max_wall_db", "local_gap_m",
                                         "at_tol_m", "local_refute", "near_t",
-                                        "near_m", "cv_block_m", NULL};
+                                        "near_m", "cv_block_m", "cv_hold_only", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "refute_m", 0, 100, &sc->seek_refute_m) ||
@@ -459,7 +460,8 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             preset_bool(p, n, "silence_floor", &sc->seek_silence_floor) ||
             preset_bool(p, n, "refute_reached", &sc->seek_refute_reached) ||
             preset_bool(p, n, "local_refute", &sc->seek_local_refute) ||
-            preset_bool(p, n, "recheck_silent", &sc->seek_recheck_silent)) {
+            preset_bool(p, n, "recheck_silent", &sc->seek_recheck_silent) ||
+            preset_bool(p, n, "cv_hold_only", &sc->seek_cv_hold_only)) {
             return -1;
         }
         if (sc->seek_cv_block_m > 0 && sc->seek_cv_block_m < 1) {

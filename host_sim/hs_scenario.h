@@ -109,6 +109,7 @@ typedef struct hs_scenario {
     double seek_p0_max_wall_db;   ///< seek.p0_max_wall_db: the most a wall costs in the P0 the
                                   ///< pathloss model holds against its ceiling, dB (NAN = off;
                                   ///< docs/PATHLOSS.md "The P0 floor")
+    int seek_cv_hold_only;        ///< seek.cv_hold_only: 0 / 1 (-1 = the model's default, 0)
     double seek_cv_block_m;       ///< seek.cv_block_m: side of the pathloss model's
                                   ///< cross-validation blocks, metres, 0 or [1, 64] (NAN = its
                                   ///< default, 0: off; docs/PATHLOSS.md "Fit")

@@ -186,7 +186,6 @@ static void expect_same_as_reference(fixture_t *f, const rfs_pathloss_cfg_t *c, 
             assert_true(fabs(y / 65536.0 - (r->oy + (r->c0j + cj * r->cs) * r->grid)) < 1e-4);
             if (ok) {
                 worst = fmax(worst, fabs(rms / 65536.0 - want));
-                if (fabs(rms / 65536.0 - want) > 0.03) print_message("DBG %d %d %.4f %.4f\n", ci, cj, rms / 65536.0, want);
             }
         }
     }

@@ -85,8 +85,6 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
      * one count a bin, the coarse points then only rank: a quarter of their counts,
      * docs/PATHLOSS.md, "A bin's walls"). */
     c.coarse_footprint = RFS_PATHLOSS_COARSE_AS_FOOTPRINT;
-    c.cv_block = 0;
-    c.cv_hold_only = false;
     return c;
 }
 
@@ -112,7 +110,6 @@ int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg)
                (c->coarse_footprint >= 0 && c->coarse_footprint <= c->bin / 2)) &&
               c->margin <= RFS_Q16_INT(100) && c->sample_t >= RFS_Q16_FRAC(1, 16) &&
               c->sample_t <= RFS_Q16_INT(64) &&
-              (c->cv_block == 0 || (c->cv_block >= RFS_Q16_ONE && c->cv_block <= RFS_Q16_INT(64))) &&
               ((c->p0_max_wall >= 0 && c->p0_max_wall <= RFS_Q16_INT(60)) ||
                c->p0_max_wall == INT32_MAX);
     if (!ok) {
@@ -376,8 +373,8 @@ static int32_t edge_min(int64_t r, int64_t m12, int32_t v, int64_t m, int32_t lo
 
 /* Box-constrained least squares in (n, W); M = {M11, M12, M22}, R = right-hand side,
  * both Q16 (see the file comment). M is positive definite. */
-void rfs_pathloss_solve_nw(const rfs_pathloss_cfg_t *c, const int64_t M[3], const int64_t R[2],
-                           int32_t *n_out, int32_t *w_out)
+static void solve_nw(const rfs_pathloss_cfg_t *c, const int64_t M[3], const int64_t R[2],
+                     int32_t *n_out, int32_t *w_out)
 {
     rfs_i128_t det = rfs_i128_sub(rfs_i128_mul(M[0], M[2]), rfs_i128_mul(M[1], M[1]));
     rfs_i128_t nn = rfs_i128_sub(rfs_i128_mul(R[0], M[2]), rfs_i128_mul(M[1], R[1]));
@@ -462,23 +459,21 @@ static void solve(rfs_pathloss_t *p, rfs_pathloss_cand_t *out)
     const int64_t R[2] = {-bl + ((lam * c->n_prior + 32768) >> 16),
                           -bk + ((lamw * c->w_prior + 32768) >> 16)};
     int32_t n, w;
-    rfs_pathloss_solve_nw(c, M, R, &n, &w);
+    solve_nw(c, M, R, &n, &w);
     /* Huber loss of the bins' mean residuals z_b - P0 + n L_b + W k_b
      * = dz_b + n (L_b - mean L) + W (k_b - mean k), Q16, then Q8 (saturated to 2^24). */
     const int64_t d8 = ((int64_t)c->huber + 128) >> 8;
-    int64_t loss = 0, cvl = 0;
-    const bool cv = p->cv_blocks > 1u;
-    if (cv) {
-        /* Cross-validated: each block's bins under the fit to all the others. */
-        cvl = rfs_pathloss_cv_loss(p, ml, mk, n, w);
-    }
-    if (!cv || c->cv_hold_only) {
-        for (uint32_t b = 0u; b < p->nbins; ++b) {
-            loss += (int64_t)p->bins[b].count *
-                    rfs_pathloss_huber(rfs_pathloss_residual(p, b, ml, mk, 0, n, w), d8);
-        }
-    } else {
-        loss = cvl;
+    int64_t loss = 0;
+    for (uint32_t b = 0u; b < p->nbins; ++b) {
+        const rfs_pathloss_bin_t *bb = &p->bins[b];
+        int64_t r = (int64_t)bb->dz_q16 +
+                    (((int64_t)n * ((int64_t)p->l_q16[b] - ml) +
+                      (int64_t)w * ((int64_t)p->k[b] * 16384 - mk) + 32768) >> 16);
+        int64_t a = (r < 0 ? -r : r);
+        a = (a + 128) >> 8;
+        a = a > ((int64_t)1 << 24) ? ((int64_t)1 << 24) : a;
+        int64_t h = a <= d8 ? (a * a) >> 1 : d8 * a - ((d8 * d8) >> 1);
+        loss += (int64_t)bb->count * h;
     }
     int64_t p0 = (int64_t)p->mz_q16 + (((int64_t)n * ml + (int64_t)w * mk + 32768) >> 16);
     /* Scaling: the shortfall or excess in Q8 saturates at 2^24 like a residual; total <=
@@ -488,13 +483,15 @@ static void solve(rfs_pathloss_t *p, rfs_pathloss_cand_t *out)
     const int64_t p0c = w > c->p0_max_wall
                             ? p0 - ((((int64_t)w - c->p0_max_wall) * mk + 32768) >> 16)
                             : p0;
-    int64_t a = p0 < c->p0_min ? (int64_t)c->p0_min - p0
-              : c->p0_max != INT32_MAX && p0c > c->p0_max ? p0c - (int64_t)c->p0_max
+    int64_t a = p0 < c->p0_min ? (((int64_t)c->p0_min - p0) + 128) >> 8
+              : c->p0_max != INT32_MAX && p0c > c->p0_max ? ((p0c - (int64_t)c->p0_max) + 128) >> 8
                                                           : 0;
-    const int64_t p0_term = (int64_t)p->total * rfs_pathloss_huber(a, d8);
-    loss += p0_term;
+    if (a > 0) {
+        a = a > ((int64_t)1 << 24) ? ((int64_t)1 << 24) : a;
+        int64_t h = a <= d8 ? (a * a) >> 1 : d8 * a - ((d8 * d8) >> 1);
+        loss += (int64_t)p->total * h;
+    }
     out->loss = loss;
-    out->hloss = cv && c->cv_hold_only ? cvl + p0_term : loss;
     out->sx = sx;
     out->sy = sy;
     out->li = p->ev.li;
@@ -643,11 +640,11 @@ static bool hold_next(rfs_pathloss_t *p)
         p->hold_j = p->hold_best.lj;
         p->hold_pos = 0u;
     }
-    uint64_t per = rfs_udiv64((uint64_t)p->cur.hloss, p->nbins);
+    uint64_t per = rfs_udiv64((uint64_t)p->cur.loss, p->nbins);
     uint64_t thr = per >= ((uint64_t)1 << 41)
                        ? UINT64_MAX
-                       : (uint64_t)p->cur.hloss + ((per * (uint64_t)p->cfg.hold_k) >> 16);
-    if ((uint64_t)p->hold_best.hloss <= thr) {
+                       : (uint64_t)p->cur.loss + ((per * (uint64_t)p->cfg.hold_k) >> 16);
+    if ((uint64_t)p->hold_best.loss <= thr) {
         p->cur = p->hold_best;
     }
     return false;
@@ -680,7 +677,6 @@ static bool fit_begin(rfs_pathloss_t *p, const rfs_model_fit_in_t *in)
     p->nvis = 0u;
     p->candidates = 0u;
     p->cur.loss = INT64_MAX;
-    p->cur.hloss = INT64_MAX;
     p->ev.on = false;
     return true;
 }
@@ -706,9 +702,7 @@ static bool bin_run(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t bu
             bin_reset(p, p->bin_cm * 2);
         }
     }
-    /* Cross-validation blocks: a sort of the bins (rfs_pathloss_cv_order()). */
-    const uint32_t finish_units =
-        p->nbins / BINS_PER_UNIT + 1u + (p->cfg.cv_block > 0 ? p->nbins / BINS_PER_UNIT : 0u);
+    const uint32_t finish_units = p->nbins / BINS_PER_UNIT + 1u;
     if (budget != 0u && *used != 0u && *used + finish_units > budget) {
         return true;
     }
@@ -719,7 +713,6 @@ static bool bin_run(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t bu
         return true;
     }
     bin_means(p);
-    rfs_pathloss_cv_order(p);
     setup_lattice(p, in->map);
     rfs_pathloss_walls_assign(p);
     p->phase = RFS_PATHLOSS_COARSE;
@@ -740,9 +733,7 @@ static bool ev_run(rfs_pathloss_t *p, uint32_t budget, uint32_t *used)
         *used += gather_bin(p, p->ev.b++);
         *used += p->ev.b % BINS_PER_UNIT == 0u ? 1u : 0u;
     }
-    /* Cross-validation: a second pass over the bins and a solve per block (a quarter). */
-    const uint32_t solve_units = p->nbins / BINS_PER_UNIT + 1u +
-                                 (p->cv_blocks > 1u ? p->nbins / BINS_PER_UNIT + p->cv_blocks / 4u : 0u);
+    const uint32_t solve_units = p->nbins / BINS_PER_UNIT + 1u;
     if (budget != 0u && *used != 0u && *used + solve_units > budget) {
         return false;
     }
@@ -751,7 +742,7 @@ static bool ev_run(rfs_pathloss_t *p, uint32_t budget, uint32_t *used)
     solve(p, &cd);
     p->ev.on = false;
     if (p->ev.kind == EV_HOLD) {
-        if (cd.hloss < p->hold_best.hloss) {
+        if (cd.loss < p->hold_best.loss) {
             p->hold_best = cd;
         }
         return true;
@@ -811,7 +802,6 @@ static bool hold_begin(rfs_pathloss_t *p)
     p->hold_step = (uint16_t)(l->cs / 2u < 1u ? 1u : l->cs / 2u);
     p->hold_pos = UINT8_MAX; /* the previous source itself first */
     p->hold_best.loss = INT64_MAX;
-    p->hold_best.hloss = INT64_MAX;
     return true;
 }
 

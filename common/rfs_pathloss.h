@@ -15,8 +15,7 @@
  * prior_weight and w_prior_weight, which also keeps W defined when every bin sees the
  * same number of walls.
  * Each bin weighs min(samples, bin_cap). The estimate is the candidate with the least
- * weighted Huber loss of the bins' mean residuals; with cv_block, of each block's bins
- * under the fit to every other block (spatially blocked cross-validation).
+ * weighted Huber loss of the bins' mean residuals.
  *
  * Samples are first aggregated into square bins (1 m; at most RFS_PATHLOSS_MAX_BINS,
  * the bin doubles when there are more): each bin is its sample count, mean value and
@@ -145,11 +144,6 @@ typedef struct rfs_pathloss_cfg {
     rfs_q16_t sample_t;     ///< temperature of the model's draws (rfs_pathloss_ops.sample):
                             ///< coarse candidate c is drawn with weight e^(-chi2_c / 2T),
                             ///< chi2_c = (loss_c / best loss - 1) x bins (1.0), 1/16..64
-    rfs_q16_t cv_block;     ///< metres Q16.16: side of the squares that cross-validate a
-                            ///< candidate's loss (0: off, the default; 1..64 m): each
-                            ///< square's bins scored under the fit to all the others
-    bool cv_hold_only;      ///< with cv_block: rank by the ordinary loss, and use the
-                            ///< cross-validated one only in the hold phase (false)
 } rfs_pathloss_cfg_t;
 
 /// One sample bin. Scaling: sums of up to 65,535 samples of int16 fit int32.
@@ -171,8 +165,6 @@ typedef struct rfs_pathloss_bin {
 /// One evaluated candidate source and its fit.
 typedef struct rfs_pathloss_cand {
     int64_t loss;    ///< sum over bins of count x Huber(mean residual), dB^2 Q16 (Q8 x Q8)
-    int64_t hloss;   ///< the loss the hold phase compares (cross-validated with
-                     ///< cv_hold_only, else loss), dB^2 Q16
     rfs_q16_t sx;    ///< source x, metres Q16.16
     rfs_q16_t sy;    ///< source y, metres Q16.16
     uint16_t li;     ///< its lattice index along x
@@ -300,9 +292,6 @@ typedef struct rfs_pathloss {
     uint16_t vis_j[RFS_PATHLOSS_MAX_VISITED];     ///< their lattice y
     rfs_pathloss_bin_t bins[RFS_PATHLOSS_MAX_BINS]; ///< sample bins
     uint16_t hash[RFS_PATHLOSS_HASH];             ///< bin index + 1 by hashed cell, 0 = empty
-    uint16_t cv_blocks;                           ///< cross-validation blocks (0: off)
-    uint16_t cv_order[RFS_PATHLOSS_MAX_BINS];     ///< bins block by block (cfg cv_block),
-                                                  ///< a block's first with bit 15 set
     int32_t l_q16[RFS_PATHLOSS_MAX_BINS];         ///< scratch: 10 log10(d) per bin, dB Q16.16
     uint8_t k[RFS_PATHLOSS_MAX_BINS];             ///< scratch: walls per bin, quarter walls
     uint32_t walls_counted;                       ///< wall counts (lines) computed by this fit
@@ -337,7 +326,7 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void);
 /// outside (0, 64] m, bin_cap 0, top outside 1..RFS_PATHLOSS_MAX_TOP, n bounds not
 /// 0 < n_min <= n_max <= 10, W bounds not 0 <= w_min <= w_max <= 60 dB, priors outside
 /// their bounds, prior_weight or w_prior_weight outside (0, 10^4], huber outside (0, 100] dB, spread_k
-/// outside [0, 1000], margin outside [0, 100] m, or cv_block neither 0 nor in [1, 64] m.
+/// outside [0, 1000], or margin outside [0, 100] m.
 int rfs_pathloss_init(rfs_pathloss_t *p, const rfs_pathloss_cfg_t *cfg);
 
 /// Bytes of a caller buffer for a wall-count cache of `cols` candidates per origin.

@@ -31,45 +31,6 @@ static inline uint32_t rfs_pathloss_mean_loss(const rfs_pathloss_t *p, int64_t l
     return m >= RFS_PATHLOSS_NO_LOSS ? RFS_PATHLOSS_NO_LOSS - 1u : (uint32_t)m;
 }
 
-/* Huber value of a residual r (target units Q16.16) with threshold d8 (dB Q8): |r|
- * rounded to Q8 and saturated at 2^24, then a^2 / 2 below d8, d8 a - d8^2 / 2 above; dB^2
- * Q16 below 2^48 (Q8 x Q8). */
-static inline int64_t rfs_pathloss_huber(int64_t r, int64_t d8)
-{
-    int64_t a = ((r < 0 ? -r : r) + 128) >> 8;
-    a = a > ((int64_t)1 << 24) ? ((int64_t)1 << 24) : a;
-    return a <= d8 ? (a * a) >> 1 : d8 * a - ((d8 * d8) >> 1);
-}
-
-/* Bin b's mean residual under intercept a (Q16, 0 for the fit to every bin), exponent n
- * and wall loss w (Q16): dz_b - a + n (L_b - ml) + w (k_b - mk), with the candidate's
- * distance terms and walls gathered (l_q16, k) and their weighted means ml (dB Q16) and mk
- * (walls Q16). Scaling: n, w < 2^23 times centred terms < 2^23 in int64. */
-static inline int64_t rfs_pathloss_residual(const rfs_pathloss_t *p, uint32_t b, int32_t ml,
-                                            int32_t mk, int64_t a, int32_t n, int32_t w)
-{
-    return (int64_t)p->bins[b].dz_q16 - a +
-           (((int64_t)n * ((int64_t)p->l_q16[b] - ml) +
-             (int64_t)w * ((int64_t)p->k[b] * 16384 - mk) + 32768) >> 16);
-}
-
-/* Box-constrained least squares in (n, W) with M = {M11, M12, M22} positive definite
- * and right-hand side R, both Q16 (rfs_pathloss.c's file comment); n and W in Q16. */
-void rfs_pathloss_solve_nw(const rfs_pathloss_cfg_t *c, const int64_t M[3], const int64_t R[2],
-                           int32_t *n_out, int32_t *w_out);
-
-/* Group the bins into cross-validation blocks (cfg cv_block squares, aligned like the
- * bins): cv_order lists the bins block by block, cv_blocks counts the blocks (0 when
- * cv_block is 0). After binning. */
-void rfs_pathloss_cv_order(rfs_pathloss_t *p);
-
-/* The cross-validated Huber loss of the candidate whose bins are gathered (rfs_pathloss_cv.c):
- * each block's bins under (P0, n, W) fitted to every other block's, with the priors and
- * bounds of the fit; ml, mk the weighted means of l_q16 and k (dB Q16, walls Q16) and
- * (n, w) the fit to every bin, which scores a block when it holds every bin's weight. */
-int64_t rfs_pathloss_cv_loss(const rfs_pathloss_t *p, int32_t ml, int32_t mk, int32_t n,
-                             int32_t w);
-
 /* Wall counts saturate here (15 walls are 75 dB at 5 dB each; four of them, in quarter
  * walls, fit a byte of the cache). */
 #define RFS_PATHLOSS_WALLS_MAX 15u

@@ -46,8 +46,6 @@ hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void)
     c.p0_min_dbm = NAN;
     c.coarse_footprint_m = NAN;
     c.p0_max_wall_db = NAN;
-    c.cv_block_m = NAN;
-    c.cv_hold_only = -1;
     c.pathloss_log2 = NULL;
     return c;
 }
@@ -170,27 +168,19 @@ static void pathloss_options(const hs_ctrl_inproc_cfg_t *cfg, rfs_pathloss_cfg_t
         pc->coarse_footprint =
             (rfs_q16_t)lround(fmax(0.0, fmin(0.5, cfg->coarse_footprint_m)) * 65536.0);
     }
-    if (!isnan(cfg->cv_block_m)) {
-        pc->cv_block = (rfs_q16_t)lround(fmax(0.0, fmin(64.0, cfg->cv_block_m)) * 65536.0);
-    }
-    if (cfg->cv_hold_only >= 0) {
-        pc->cv_hold_only = cfg->cv_hold_only != 0;
-    }
 }
 
 /* The path-loss model's options (pathloss_options) and the simulator's large wall-count
  * cache. 0, or -1 with the reason in err. */
 static int open_pathloss(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, char *err, size_t errlen)
 {
-    if (!isnan(cfg->p0_min_dbm) || !isnan(cfg->p0_max_wall_db) || !isnan(cfg->coarse_footprint_m) ||
-        !isnan(cfg->cv_block_m) || cfg->cv_hold_only >= 0) {
+    if (!isnan(cfg->p0_min_dbm) || !isnan(cfg->p0_max_wall_db) || !isnan(cfg->coarse_footprint_m)) {
         rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
         pathloss_options(cfg, &pc);
         if (rfs_pathloss_init(p->model_state, &pc) != 0) {
             snprintf(err, errlen,
-                     "model: pathloss: p0_min_dbm %g, p0_max_wall_db %g, coarse_footprint_m %g or "
-                     "cv_block_m %g rejected",
-                     cfg->p0_min_dbm, cfg->p0_max_wall_db, cfg->coarse_footprint_m, cfg->cv_block_m);
+                     "model: pathloss: p0_min_dbm %g, p0_max_wall_db %g or coarse_footprint_m %g rejected",
+                     cfg->p0_min_dbm, cfg->p0_max_wall_db, cfg->coarse_footprint_m);
             return -1;
         }
     }

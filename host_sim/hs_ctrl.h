@@ -70,10 +70,6 @@ typedef struct hs_ctrl_inproc_cfg {
                             ///< metres, in [0, 0.5] (NAN: the model's default, 0.25)
     double p0_max_wall_db;  ///< pathloss model only: the most a wall costs in the P0 held
                             ///< against the ceiling, dB, in [0, 60] (NAN: off)
-    double cv_block_m;      ///< pathloss model only: side of its cross-validation blocks,
-                            ///< metres, 0 or [1, 64] (NAN or 0: off)
-    int cv_hold_only;       ///< pathloss model only: cross-validate only the hold decision
-                            ///< (1), or rank every candidate by it (0; -1: the default, 0)
     const int32_t *pathloss_log2; ///< pathloss model only: a log2 table to attach
                             ///< (rfs_pathloss_log2_fill(), outliving the controller) or NULL
 } hs_ctrl_inproc_cfg_t;

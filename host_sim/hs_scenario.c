@@ -215,8 +215,6 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_p0_min_dbm = NAN;
     sc->seek_coarse_footprint_m = NAN;
     sc->seek_p0_max_wall_db = NAN;
-    sc->seek_cv_block_m = NAN;
-    sc->seek_cv_hold_only = -1;
     sc->seek_eps_rate = -1.0;
     snprintf(sc->model, sizeof sc->model, "ridge");
     snprintf(sc->target, sizeof sc->target, "rssi");
@@ -438,7 +436,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
                                         "refute_reached", "local_m", "leg_m", "recheck_silent",
                                         "coarse_footprint_m", "p0_max_wall_db", "local_gap_m",
                                         "at_tol_m", "local_refute", "near_t",
-                                        "near_m", "cv_block_m", "cv_hold_only", NULL};
+                                        "near_m", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "refute_m", 0, 100, &sc->seek_refute_m) ||
@@ -452,7 +450,6 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             num(p, n, "seek", "p0_min_dbm", -200, 100, &sc->seek_p0_min_dbm) ||
             num(p, n, "seek", "coarse_footprint_m", 0, 0.5, &sc->seek_coarse_footprint_m) ||
             num(p, n, "seek", "p0_max_wall_db", 0, 60, &sc->seek_p0_max_wall_db) ||
-            num(p, n, "seek", "cv_block_m", 0, 64, &sc->seek_cv_block_m) ||
             preset_bool(p, n, "eps_by_travel", &sc->seek_eps_by_travel) ||
             preset_bool(p, n, "eps_geodesic", &sc->seek_eps_geodesic) ||
             preset_bool(p, n, "recheck_adapt", &sc->seek_recheck_adapt) ||
@@ -460,13 +457,8 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             preset_bool(p, n, "silence_floor", &sc->seek_silence_floor) ||
             preset_bool(p, n, "refute_reached", &sc->seek_refute_reached) ||
             preset_bool(p, n, "local_refute", &sc->seek_local_refute) ||
-            preset_bool(p, n, "recheck_silent", &sc->seek_recheck_silent) ||
-            preset_bool(p, n, "cv_hold_only", &sc->seek_cv_hold_only)) {
+            preset_bool(p, n, "recheck_silent", &sc->seek_recheck_silent)) {
             return -1;
-        }
-        if (sc->seek_cv_block_m > 0 && sc->seek_cv_block_m < 1) {
-            return fail(p, lx_yaml_get(n, "cv_block_m"), "seek.cv_block_m: %g is neither 0 nor in [1, 64]",
-                        sc->seek_cv_block_m);
         }
     }
     return 0;

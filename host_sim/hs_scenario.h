@@ -14,8 +14,7 @@
  *                                  #       p0_min_dbm: -32, local_m: 0, leg_m: 0,
  *                                  #       coarse_footprint_m: 0.25,
  *                                  #       p0_max_wall_db: 3, local_gap_m: 0.5,
- *                                  #       at_tol_m: 0.03, near_t: 0, near_m: 30,
- *                                  #       cv_block_m: 0}
+ *                                  #       at_tol_m: 0.03, near_t: 0, near_m: 30}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2
@@ -109,10 +108,6 @@ typedef struct hs_scenario {
     double seek_p0_max_wall_db;   ///< seek.p0_max_wall_db: the most a wall costs in the P0 the
                                   ///< pathloss model holds against its ceiling, dB (NAN = off;
                                   ///< docs/PATHLOSS.md "The P0 floor")
-    int seek_cv_hold_only;        ///< seek.cv_hold_only: 0 / 1 (-1 = the model's default, 0)
-    double seek_cv_block_m;       ///< seek.cv_block_m: side of the pathloss model's
-                                  ///< cross-validation blocks, metres, 0 or [1, 64] (NAN = its
-                                  ///< default, 0: off; docs/PATHLOSS.md "Fit")
     unsigned nsources;            ///< sources
     hs_scn_source_t src[HS_SCN_MAX_SOURCES]; ///< the sources
     double start_x, start_y;      ///< robot start, metres

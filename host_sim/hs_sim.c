@@ -823,8 +823,6 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     cc.p0_min_dbm = e->sc.seek_p0_min_dbm;
     cc.coarse_footprint_m = e->sc.seek_coarse_footprint_m;
     cc.p0_max_wall_db = e->sc.seek_p0_max_wall_db;
-    cc.cv_block_m = e->sc.seek_cv_block_m;
-    cc.cv_hold_only = e->sc.seek_cv_hold_only;
     cc.pathloss_log2 = e->pathloss_log2;
     if (e->sc.seek_local_refute >= 0) {
         cc.seek.local_refute = e->sc.seek_local_refute != 0;

@@ -13,9 +13,7 @@
  * legal (rfs_map_point_legal) counting from the centre. The coarse points count with
  * `coarse_footprint` instead; when that differs from `footprint` (and there is a map) they
  * only choose the top points, all of which the refinement evaluates afresh. A candidate
- * within excl_r of a place ruled out is not legal. With cv_block each bin's residual is
- * taken under the fit to the bins outside its square (squares of cv_block aligned to the
- * origin, by centroid). No cache.
+ * within excl_r of a place ruled out is not legal. No cache.
  */
 #ifndef REF_PATHLOSS_H
 #define REF_PATHLOSS_H
@@ -44,8 +42,6 @@ typedef struct ref_pl_cfg {
     double p0_max; /* strongest plausible P0; a fit above adds total x Huber(P0 - p0_max) */
     double coarse_footprint; /* m: the footprint of the coarse points' counts */
     double p0_max_wall; /* dB: the most a wall costs in the P0 held against p0_max (inf: W) */
-    double cv_block; /* m: cross-validation squares (0: off): each square's bins scored under
-                      * the fit to the other squares' bins (all bins when none is left) */
 } ref_pl_cfg_t;
 
 typedef struct ref_pl_bin {
@@ -81,7 +77,7 @@ typedef struct ref_pl {
 static inline ref_pl_cfg_t ref_pl_cfg_default(void)
 {
     ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5, 30.0, -45.0,
-                      0.25, 0, {0}, {0}, 0.0, -10.0, 0.25, INFINITY, 0.0};
+                      0.25, 0, {0}, {0}, 0.0, -10.0, 0.25, INFINITY};
     return c;
 }
 
@@ -182,24 +178,17 @@ static inline bool ref_pl_legal(const ref_pl_t *r, int i, int j)
     return r->map == NULL || rfs_map_lattice_legal(r->map, (uint16_t)i, (uint16_t)j);
 }
 
-/* Sum of count-weighted squared residuals of the bins in[] plus the prior, at (n, w), P0
- * optimal. */
-static inline double ref_pl_sse(const ref_pl_t *r, const bool *in, double n, double w, double *p0)
+/* Sum of count-weighted squared residuals plus the prior, at (n, w), P0 optimal. */
+static inline double ref_pl_sse(const ref_pl_t *r, double n, double w, double *p0)
 {
     double sc = 0, sr = 0;
     for (int b = 0; b < r->nbins; ++b) {
-        if (!in[b]) {
-            continue;
-        }
         sc += r->bins[b].count;
         sr += r->bins[b].count * (r->bins[b].z + n * r->L[b] + w * r->K[b]);
     }
     double P0 = sr / sc;
     double e = 0;
     for (int b = 0; b < r->nbins; ++b) {
-        if (!in[b]) {
-            continue;
-        }
         double d = r->bins[b].z - (P0 - n * r->L[b] - w * r->K[b]);
         e += r->bins[b].count * d * d;
     }
@@ -212,81 +201,6 @@ static inline double ref_pl_sse(const ref_pl_t *r, const bool *in, double n, dou
 static inline double ref_pl_clamp(double v, double lo, double hi)
 {
     return v < lo ? lo : (v > hi ? hi : v);
-}
-
-/* Square (axis 0: x, 1: y) of bin b's centroid, cv_block squares from the origin. */
-static inline long ref_pl_square(const ref_pl_t *r, int b, int axis)
-{
-    double v = axis == 0 ? r->bins[b].x : r->bins[b].y;
-    return (long)floor(round(v * 100.0) / round(r->cfg.cv_block * 100.0));
-}
-
-/* The constrained least-squares fit (n, w, P0) to the bins in[], L and K set. */
-static inline void ref_pl_solve(const ref_pl_t *r, const bool *in, double *pn, double *pw,
-                                double *pp0)
-{
-    /* Normal equations of the centred problem with the prior, solved directly. */
-    double sc = 0, ml = 0, mk = 0, mz = 0;
-    for (int b = 0; b < r->nbins; ++b) {
-        if (!in[b]) {
-            continue;
-        }
-        double c = r->bins[b].count;
-        sc += c;
-        ml += c * r->L[b];
-        mk += c * r->K[b];
-        mz += c * r->bins[b].z;
-    }
-    ml /= sc;
-    mk /= sc;
-    mz /= sc;
-    double a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0;
-    for (int b = 0; b < r->nbins; ++b) {
-        if (!in[b]) {
-            continue;
-        }
-        double c = r->bins[b].count, l = r->L[b] - ml, k = r->K[b] - mk, z = r->bins[b].z - mz;
-        a11 += c * l * l;
-        a12 += c * l * k;
-        a22 += c * k * k;
-        b1 -= c * l * z;
-        b2 -= c * k * z;
-    }
-    const ref_pl_cfg_t *cf = &r->cfg;
-    a11 += cf->prior_weight;
-    a22 += cf->w_prior_weight;
-    b1 += cf->prior_weight * cf->n_prior;
-    b2 += cf->w_prior_weight * cf->w_prior;
-    double det = a11 * a22 - a12 * a12;
-    double n = (b1 * a22 - a12 * b2) / det, w = (a11 * b2 - a12 * b1) / det;
-    if (!(n >= cf->n_min && n <= cf->n_max && w >= cf->w_min && w <= cf->w_max)) {
-        /* Edges and corners; the least SSE wins. */
-        double cn[8], cw[8];
-        cn[0] = cf->n_min;
-        cw[0] = ref_pl_clamp((b2 - a12 * cn[0]) / a22, cf->w_min, cf->w_max);
-        cn[1] = cf->n_max;
-        cw[1] = ref_pl_clamp((b2 - a12 * cn[1]) / a22, cf->w_min, cf->w_max);
-        cw[2] = cf->w_min;
-        cn[2] = ref_pl_clamp((b1 - a12 * cw[2]) / a11, cf->n_min, cf->n_max);
-        cw[3] = cf->w_max;
-        cn[3] = ref_pl_clamp((b1 - a12 * cw[3]) / a11, cf->n_min, cf->n_max);
-        cn[4] = cf->n_min; cw[4] = cf->w_min;
-        cn[5] = cf->n_min; cw[5] = cf->w_max;
-        cn[6] = cf->n_max; cw[6] = cf->w_min;
-        cn[7] = cf->n_max; cw[7] = cf->w_max;
-        double best = INFINITY, p0;
-        for (int e = 0; e < 8; ++e) {
-            double s = ref_pl_sse(r, in, cn[e], cw[e], &p0);
-            if (s < best) {
-                best = s;
-                n = cn[e];
-                w = cw[e];
-            }
-        }
-    }
-    *pn = n;
-    *pw = w;
-    *pp0 = mz + n * ml + w * mk;
 }
 
 /* Fit and Huber loss of candidate (i, j). */
@@ -322,39 +236,67 @@ static inline double ref_pl_eval(ref_pl_t *r, int i, int j, double *pn, double *
         }
         r->K[b] = k;
     }
-    bool all[REF_PL_MAX_BINS] = {false};
+    /* Normal equations of the centred problem with the prior, solved directly. */
+    double sc = 0, ml = 0, mk = 0, mz = 0;
     for (int b = 0; b < r->nbins; ++b) {
-        all[b] = true;
+        double c = r->bins[b].count;
+        sc += c;
+        ml += c * r->L[b];
+        mk += c * r->K[b];
+        mz += c * r->bins[b].z;
     }
-    double n, w, p0;
-    ref_pl_solve(r, all, &n, &w, &p0);
-    const ref_pl_cfg_t *cf = &r->cfg;
-    double loss = 0;
+    ml /= sc;
+    mk /= sc;
+    mz /= sc;
+    double a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0;
     for (int b = 0; b < r->nbins; ++b) {
-        double bn = n, bw = w, bp0 = p0;
-        if (cf->cv_block > 0) {
-            /* The fit to the bins outside b's square. */
-            bool out[REF_PL_MAX_BINS] = {false};
-            bool any = false;
-            for (int o = 0; o < r->nbins; ++o) {
-                out[o] = ref_pl_square(r, o, 0) != ref_pl_square(r, b, 0) ||
-                         ref_pl_square(r, o, 1) != ref_pl_square(r, b, 1);
-                any = any || out[o];
-            }
-            if (any) {
-                ref_pl_solve(r, out, &bn, &bw, &bp0);
+        double c = r->bins[b].count, l = r->L[b] - ml, k = r->K[b] - mk, z = r->bins[b].z - mz;
+        a11 += c * l * l;
+        a12 += c * l * k;
+        a22 += c * k * k;
+        b1 -= c * l * z;
+        b2 -= c * k * z;
+    }
+    const ref_pl_cfg_t *cf = &r->cfg;
+    a11 += cf->prior_weight;
+    a22 += cf->w_prior_weight;
+    b1 += cf->prior_weight * cf->n_prior;
+    b2 += cf->w_prior_weight * cf->w_prior;
+    double det = a11 * a22 - a12 * a12;
+    double n = (b1 * a22 - a12 * b2) / det, w = (a11 * b2 - a12 * b1) / det;
+    if (!(n >= cf->n_min && n <= cf->n_max && w >= cf->w_min && w <= cf->w_max)) {
+        /* Edges and corners; the least SSE wins. */
+        double cn[8], cw[8];
+        cn[0] = cf->n_min;
+        cw[0] = ref_pl_clamp((b2 - a12 * cn[0]) / a22, cf->w_min, cf->w_max);
+        cn[1] = cf->n_max;
+        cw[1] = ref_pl_clamp((b2 - a12 * cn[1]) / a22, cf->w_min, cf->w_max);
+        cw[2] = cf->w_min;
+        cn[2] = ref_pl_clamp((b1 - a12 * cw[2]) / a11, cf->n_min, cf->n_max);
+        cw[3] = cf->w_max;
+        cn[3] = ref_pl_clamp((b1 - a12 * cw[3]) / a11, cf->n_min, cf->n_max);
+        cn[4] = cf->n_min; cw[4] = cf->w_min;
+        cn[5] = cf->n_min; cw[5] = cf->w_max;
+        cn[6] = cf->n_max; cw[6] = cf->w_min;
+        cn[7] = cf->n_max; cw[7] = cf->w_max;
+        double best = INFINITY, p0;
+        for (int e = 0; e < 8; ++e) {
+            double s = ref_pl_sse(r, cn[e], cw[e], &p0);
+            if (s < best) {
+                best = s;
+                n = cn[e];
+                w = cw[e];
             }
         }
-        double res = fabs(r->bins[b].z - (bp0 - bn * r->L[b] - bw * r->K[b]));
+    }
+    double p0 = mz + n * ml + w * mk;
+    double loss = 0;
+    for (int b = 0; b < r->nbins; ++b) {
+        double res = fabs(r->bins[b].z - (p0 - n * r->L[b] - w * r->K[b]));
         double h = res <= cf->huber ? 0.5 * res * res : cf->huber * (res - 0.5 * cf->huber);
         loss += r->bins[b].count * h;
     }
     /* The ceiling holds the P0 with each wall at p0_max_wall at most against p0_max. */
-    double mk = 0;
-    for (int b = 0; b < r->nbins; ++b) {
-        mk += r->bins[b].count * r->K[b];
-    }
-    mk /= (double)r->total;
     double p0c = p0 - fmax(w - cf->p0_max_wall, 0.0) * mk;
     double a = p0 < cf->p0_min ? cf->p0_min - p0 : p0c > cf->p0_max ? p0c - cf->p0_max : 0.0;
     loss += (double)r->total * (a <= cf->huber ? 0.5 * a * a : cf->huber * (a - 0.5 * cf->huber));

@@ -27,8 +27,8 @@ static void init_rejects_bad_configurations(void **state)
 {
     fixture_t *f = *state;
     rfs_pathloss_cfg_t good = rfs_pathloss_cfg_default();
-    rfs_pathloss_cfg_t bad[24];
-    for (int i = 0; i < 24; ++i) {
+    rfs_pathloss_cfg_t bad[22];
+    for (int i = 0; i < 22; ++i) {
         bad[i] = good;
     }
     bad[0].bin = RFS_Q16_FRAC(1, 20);
@@ -53,11 +53,9 @@ static void init_rejects_bad_configurations(void **state)
     bad[19].coarse_footprint = good.bin / 2 + 1;
     bad[20].p0_max_wall = -1;
     bad[21].p0_max_wall = RFS_Q16_INT(60) + 1;
-    bad[22].cv_block = RFS_Q16_ONE - 1;         /* neither 0 nor 1..64 m */
-    bad[23].cv_block = RFS_Q16_INT(64) + 1;
 
     assert_int_equal(rfs_pathloss_init(&f->pl, &good), 0);
-    for (int i = 0; i < 24; ++i) {
+    for (int i = 0; i < 22; ++i) {
         if (rfs_pathloss_init(&f->pl, &bad[i]) != -1) {
             fail_msg("bad configuration %d accepted", i);
         }
@@ -441,30 +439,6 @@ static void coarse_footprint_one_same_as_reference(void **state)
 
 /* The default configuration on the same data: the prior (3, 5 dB) pulls n and W from
  * the truth (2.6, 6.5 dB) towards itself, the source stays within one lattice cell. */
-/* Cross-validated losses (cv_block 5 m and 16 m: several squares; 64 m: one square,
- * the ordinary loss) against the reference's, which refits without each bin's square; the
- * sparse data make the squares' fits differ. */
-static void cv_block_same_as_reference(void **state)
-{
-    fixture_t *f = *state;
-    make_samples(f->s, NS, &f->map, &k_office, 11);
-    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
-    ref_pl_cfg_t rc = ref_pl_cfg_default();
-    c.cv_block = RFS_Q16_INT(5);
-    rc.cv_block = 5.0;
-    expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
-    c.cv_block = RFS_Q16_INT(16);
-    rc.cv_block = 16.0;
-    expect_same_as_reference(f, &c, 60, &f->map, &rc, 0.01);
-    rfs_pathloss_est_t one, off;
-    c.cv_block = RFS_Q16_INT(64);
-    one = fit_with(f, &c, NS, &f->map, 0, NULL);
-    off = fit_default(f, NS, &f->map, 0, NULL);
-    assert_int_equal(one.sx, off.sx);
-    assert_int_equal(one.sy, off.sy);
-    assert_int_equal(one.rms, off.rms);
-}
-
 static void default_prior_shrinks_towards_physics(void **state)
 {
     fixture_t *f = *state;
@@ -585,7 +559,6 @@ int main(void)
         cmocka_unit_test_setup_teardown(coarse_footprint_one_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_default_ceiling_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_ceiling_credits_walls, setup, teardown),
-        cmocka_unit_test_setup_teardown(cv_block_same_as_reference, setup, teardown),
         cmocka_unit_test(registered_as_pathloss),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

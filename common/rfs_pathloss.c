@@ -85,6 +85,9 @@ rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
      * one count a bin, the coarse points then only rank: a quarter of their counts,
      * docs/PATHLOSS.md, "A bin's walls"). */
     c.coarse_footprint = RFS_PATHLOSS_COARSE_AS_FOOTPRINT;
+    /* A 2 m grid misses corridors whose legal band (about 1 m) lies between two of its
+     * rows (docs/PATHLOSS.md, "Fit", step 4). */
+    c.coarse_snap = true;
     return c;
 }
 
@@ -345,6 +348,101 @@ static bool cand_legal(const rfs_pathloss_t *p, int32_t i, int32_t j)
            !excluded(p, i, j);
 }
 
+/* How far the snap search looks from a coarse point, lattice steps (the offsets' 4 bits). */
+#define SNAP_REACH 7
+/* Work units of one snap search (at most (2 SNAP_REACH + 1)^2 legality tests: less than a
+ * wall count). */
+#define SNAP_UNITS 1u
+
+/* Lattice point (i, j) is on the lattice and legal on the map (places ruled out aside). */
+static bool lattice_legal(const rfs_pathloss_t *p, int32_t i, int32_t j)
+{
+    return i >= 0 && j >= 0 && i < (int32_t)p->lat.lw && j < (int32_t)p->lat.lh &&
+           (p->map == 0 || rfs_map_lattice_legal(p->map, (uint16_t)i, (uint16_t)j));
+}
+
+static uint8_t snap_pack(int32_t di, int32_t dj)
+{
+    return (uint8_t)((uint32_t)(di + SNAP_REACH) | (uint32_t)(dj + SNAP_REACH) << 4);
+}
+
+/* The lowest and highest offset of a coarse point's cell, lattice steps: the cells tile the
+ * lattice (lo + hi + 1 = cs), within SNAP_REACH. */
+static void snap_span(const rfs_pathloss_lat_t *l, int32_t *lo, int32_t *hi)
+{
+    *lo = ((int32_t)l->cs - 1) / 2;
+    *hi = (int32_t)l->cs / 2;
+    *lo = *lo > SNAP_REACH ? SNAP_REACH : *lo;
+    *hi = *hi > SNAP_REACH ? SNAP_REACH : *hi;
+}
+
+/* Coarse point c's grid point, lattice indices. */
+static void coarse_grid(const rfs_pathloss_lat_t *l, uint32_t c, int32_t *i, int32_t *j)
+{
+    *i = (int32_t)l->c0i + (int32_t)(c % l->ncx) * (int32_t)l->cs;
+    *j = (int32_t)l->c0j + (int32_t)(c / l->ncx) * (int32_t)l->cs;
+}
+
+/* Coarse point c's lattice point, packed (rfs_pathloss_t.snap): its grid point when
+ * legal; else, with coarse_snap, the legal point of its cell nearest it (least di^2 +
+ * dj^2, the first in row order on a tie); else SNAP_NONE. *searched: the cell was
+ * searched (at most (2 SNAP_REACH + 1)^2 legality tests). */
+static uint8_t snap_find(const rfs_pathloss_t *p, uint32_t c, bool *searched)
+{
+    int32_t i0, j0;
+    coarse_grid(&p->lat, c, &i0, &j0);
+    *searched = false;
+    if (lattice_legal(p, i0, j0)) {
+        return snap_pack(0, 0);
+    }
+    if (!p->cfg.coarse_snap) {
+        return RFS_PATHLOSS_SNAP_NONE;
+    }
+    *searched = true;
+    int32_t lo, hi;
+    snap_span(&p->lat, &lo, &hi);
+    int32_t best = INT32_MAX;
+    uint8_t found = RFS_PATHLOSS_SNAP_NONE;
+    for (int32_t dj = -lo; dj <= hi; ++dj) {
+        for (int32_t di = -lo; di <= hi; ++di) {
+            const int32_t d2 = di * di + dj * dj;
+            if (d2 < best && lattice_legal(p, i0 + di, j0 + dj)) {
+                best = d2;
+                found = snap_pack(di, dj);
+            }
+        }
+    }
+    return found;
+}
+
+bool rfs_pathloss_coarse_ij(const rfs_pathloss_t *p, uint32_t c, int32_t *i, int32_t *j)
+{
+    const uint8_t s = p->snap[c];
+    RFS_ASSERT(s != RFS_PATHLOSS_SNAP_UNKNOWN);
+    if (s == RFS_PATHLOSS_SNAP_NONE) {
+        return false;
+    }
+    coarse_grid(&p->lat, c, i, j);
+    *i += (int32_t)(s & 15u) - SNAP_REACH;
+    *j += (int32_t)(s >> 4) - SNAP_REACH;
+    return true;
+}
+
+/* The coarse point whose lattice point (i, j) is, if any (its cell's, once looked for). */
+static bool is_coarse(const rfs_pathloss_t *p, int32_t i, int32_t j)
+{
+    const rfs_pathloss_lat_t *l = &p->lat;
+    const int32_t ki = i - (int32_t)l->c0i + ((int32_t)l->cs - 1) / 2;
+    const int32_t kj = j - (int32_t)l->c0j + ((int32_t)l->cs - 1) / 2;
+    if (ki < 0 || kj < 0 || ki / l->cs >= l->ncx || kj / l->cs >= l->ncy) {
+        return false;
+    }
+    const uint32_t c = (uint32_t)(kj / l->cs) * l->ncx + (uint32_t)(ki / l->cs);
+    int32_t ci, cj;
+    return p->snap[c] != RFS_PATHLOSS_SNAP_UNKNOWN && rfs_pathloss_coarse_ij(p, c, &ci, &cj) &&
+           ci == i && cj == j;
+}
+
 static rfs_i128_t i128_of(int64_t v)
 {
     return rfs_i128_mul(v, 1);
@@ -556,9 +654,7 @@ static void keep_top(rfs_pathloss_t *p, const rfs_pathloss_cand_t *cd)
  * (remembered here when it was not). */
 static bool seen_before(rfs_pathloss_t *p, int32_t i, int32_t j)
 {
-    const rfs_pathloss_lat_t *l = &p->lat;
-    int32_t ci = i - l->c0i, cj = j - l->c0j;
-    if (!coarse_ranks(p) && ci >= 0 && cj >= 0 && ci % l->cs == 0 && cj % l->cs == 0) {
+    if (!coarse_ranks(p) && is_coarse(p, i, j)) {
         return true;
     }
     for (uint32_t k = 0u; k < p->nvis; ++k) {
@@ -714,6 +810,11 @@ static bool bin_run(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t bu
     }
     bin_means(p);
     setup_lattice(p, in->map);
+    if (p->map == 0 || p->snap_map != p->map || !rfs_pathloss_same_lattice(&p->snap_lat, &p->lat)) {
+        memset(p->snap, (int)RFS_PATHLOSS_SNAP_UNKNOWN, sizeof(p->snap));
+        p->snap_map = p->map;
+        p->snap_lat = p->lat;
+    }
     rfs_pathloss_walls_assign(p);
     p->phase = RFS_PATHLOSS_COARSE;
     p->pos = 0u;
@@ -759,8 +860,10 @@ static bool ev_run(rfs_pathloss_t *p, uint32_t budget, uint32_t *used)
 }
 
 /* The coarse phase's next point: start it when legal; at the end, on to the refinement.
- * true when the fit is over (no legal candidate on the map: *res FAILED). */
-static bool coarse_next(rfs_pathloss_t *p, rfs_fit_result_t *res)
+ * A point's first snap search (coarse_snap) is a work unit: none when it would overrun the
+ * budget (*res MORE). true when the call must return *res (FAILED: no legal candidate on
+ * the map). */
+static bool coarse_next(rfs_pathloss_t *p, uint32_t budget, uint32_t *used, rfs_fit_result_t *res)
 {
     const rfs_pathloss_lat_t *l = &p->lat;
     uint32_t nc = (uint32_t)l->ncx * l->ncy;
@@ -775,11 +878,20 @@ static bool coarse_next(rfs_pathloss_t *p, rfs_fit_result_t *res)
         p->pos = 0u;
         return false;
     }
-    uint32_t c = p->pos++;
-    int32_t i = l->c0i + (int32_t)(c % l->ncx) * l->cs;
-    int32_t j = l->c0j + (int32_t)(c / l->ncx) * l->cs;
+    const uint32_t c = p->pos;
+    if (p->snap[c] == RFS_PATHLOSS_SNAP_UNKNOWN) {
+        if (budget != 0u && *used != 0u && *used + SNAP_UNITS > budget && p->cfg.coarse_snap) {
+            *res = RFS_FIT_MORE;
+            return true;
+        }
+        bool searched;
+        p->snap[c] = snap_find(p, c, &searched);
+        *used += searched ? SNAP_UNITS : 0u;
+    }
+    p->pos++;
     p->surface[c] = RFS_PATHLOSS_NO_LOSS;
-    if (cand_legal(p, i, j)) {
+    int32_t i, j;
+    if (rfs_pathloss_coarse_ij(p, c, &i, &j) && cand_legal(p, i, j)) {
         ev_start(p, (uint16_t)i, (uint16_t)j, EV_COARSE, c);
     }
     return false;
@@ -870,7 +982,7 @@ static rfs_fit_result_t pathloss_fit(void *self, const rfs_model_fit_in_t *in, u
             if (!ev_run(p, budget, &used)) {
                 return RFS_FIT_MORE;
             }
-        } else if (p->phase == RFS_PATHLOSS_COARSE ? coarse_next(p, &res)
+        } else if (p->phase == RFS_PATHLOSS_COARSE ? coarse_next(p, budget, &used, &res)
                                                    : refine_next(p, &res)) {
             return res;
         }

@@ -93,6 +93,10 @@
 #define RFS_PATHLOSS_NO_ROW UINT16_MAX
 /// Surface value of a coarse point that is not a candidate (illegal).
 #define RFS_PATHLOSS_NO_LOSS UINT32_MAX
+/// rfs_pathloss_t.snap: the coarse point's cell has no legal lattice point.
+#define RFS_PATHLOSS_SNAP_NONE 0xFEu
+/// rfs_pathloss_t.snap: not looked for yet on this lattice.
+#define RFS_PATHLOSS_SNAP_UNKNOWN 0xFFu
 
 /// Configuration; rfs_pathloss_cfg_default() gives the values in the comments.
 /// rfs_pathloss_cfg_t.coarse_footprint: count the coarse pass with `footprint` (the default).
@@ -144,6 +148,10 @@ typedef struct rfs_pathloss_cfg {
     rfs_q16_t sample_t;     ///< temperature of the model's draws (rfs_pathloss_ops.sample):
                             ///< coarse candidate c is drawn with weight e^(-chi2_c / 2T),
                             ///< chi2_c = (loss_c / best loss - 1) x bins (1.0), 1/16..64
+    bool coarse_snap;       ///< a coarse point that is not legal stands for the legal
+                            ///< lattice point of its cell nearest it (true; false: the
+                            ///< grid point or nothing, so a corridor between two coarse
+                            ///< rows has no candidate) (docs/PATHLOSS.md, "Fit")
 } rfs_pathloss_cfg_t;
 
 /// One sample bin. Scaling: sums of up to 65,535 samples of int16 fit int32.
@@ -317,6 +325,12 @@ typedef struct rfs_pathloss {
     uint32_t surface[RFS_PATHLOSS_MAX_COARSE];    ///< mean Huber loss per unit weight of
                                                   ///< each coarse point, dB^2 Q16.16;
                                                   ///< NO_LOSS = no candidate
+    const rfs_map_t *snap_map;                    ///< map of snap[] (NULL: not begun)
+    rfs_pathloss_lat_t snap_lat;                  ///< lattice of snap[]
+    uint8_t snap[RFS_PATHLOSS_MAX_COARSE];        ///< each coarse point's lattice point:
+                                                  ///< offsets (di + 7) | (dj + 7) << 4;
+                                                  ///< RFS_PATHLOSS_SNAP_NONE: no legal
+                                                  ///< point; _UNKNOWN: not looked for
 } rfs_pathloss_t;
 
 /// Defaults (see rfs_pathloss_cfg_t).

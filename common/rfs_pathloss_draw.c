@@ -70,9 +70,11 @@ bool rfs_pathloss_sample_op(const void *self, rfs_rng_t *rng, rfs_q16_t *x, rfs_
     for (uint32_t c = 0u; c < nc; ++c) {
         acc += draw_weight(p, &k, c);
         if (acc > pick) {
-            rfs_pathloss_lattice_xy(l, (uint16_t)(l->c0i + (c % l->ncx) * l->cs),
-                       (uint16_t)(l->c0j + (c / l->ncx) * l->cs), x, y);
-            return true;
+            int32_t i, j;
+            const bool on = rfs_pathloss_coarse_ij(p, c, &i, &j);
+            RFS_ASSERT(on); /* a point with weight was a candidate */
+            rfs_pathloss_lattice_xy(l, (uint16_t)i, (uint16_t)j, x, y);
+            return on;
         }
     }
     RFS_ASSERT(false); /* acc reaches total > pick */
@@ -109,8 +111,11 @@ bool rfs_pathloss_near_op(const void *self, const rfs_model_near_t *q, rfs_q16_t
         }
         const int64_t w = rfs_q16_exp_neg((rfs_q16_t)rfs_udiv64(num << 16, den));
         rfs_q16_t cx, cy;
-        rfs_pathloss_lattice_xy(l, (uint16_t)(l->c0i + (c % l->ncx) * l->cs),
-                                (uint16_t)(l->c0j + (c / l->ncx) * l->cs), &cx, &cy);
+        int32_t i, j;
+        if (!rfs_pathloss_coarse_ij(p, c, &i, &j)) {
+            continue;
+        }
+        rfs_pathloss_lattice_xy(l, (uint16_t)i, (uint16_t)j, &cx, &cy);
         const int64_t d = (int64_t)rfs_q16_dist(q->x, q->y, cx, cy) + q->d0;
         if (w * db > wb * d && !(q->refuse != 0 && q->refuse(q->ctx, cx, cy))) {
             wb = w;

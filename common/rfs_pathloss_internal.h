@@ -24,6 +24,20 @@ static inline void rfs_pathloss_lattice_xy(const rfs_pathloss_lat_t *l, uint16_t
     *y = rfs_sat32((int64_t)l->oy + (int64_t)j * l->grid);
 }
 
+/* Field by field: the core may call no memcmp (only memcpy/memset/memmove). */
+static inline bool rfs_pathloss_same_lattice(const rfs_pathloss_lat_t *a,
+                                             const rfs_pathloss_lat_t *b)
+{
+    return a->ox == b->ox && a->oy == b->oy && a->grid == b->grid && a->lw == b->lw &&
+           a->lh == b->lh && a->cs == b->cs && a->c0i == b->c0i && a->c0j == b->c0j &&
+           a->ncx == b->ncx && a->ncy == b->ncy;
+}
+
+/* Coarse point c's lattice point (i, j) on the last fit's lattice (its grid point, or its
+ * cell's stand-in with coarse_snap: docs/PATHLOSS.md, "Fit", step 4); false when none.
+ * The fit must have reached c. */
+bool rfs_pathloss_coarse_ij(const rfs_pathloss_t *p, uint32_t c, int32_t *i, int32_t *j);
+
 /* Mean Huber loss per unit weight, dB^2 Q16, saturated below NO_LOSS. */
 static inline uint32_t rfs_pathloss_mean_loss(const rfs_pathloss_t *p, int64_t loss)
 {

@@ -44,11 +44,15 @@ bool rfs_pathloss_residual_at(const rfs_pathloss_t *p, uint16_t ci, uint16_t cj,
     if (!p->valid || ci >= l->ncx || cj >= l->ncy) {
         return false;
     }
-    rfs_pathloss_lattice_xy(l, (uint16_t)(l->c0i + ci * l->cs), (uint16_t)(l->c0j + cj * l->cs), x, y);
-    uint32_t m = p->surface[(uint32_t)cj * l->ncx + ci];
-    if (m == RFS_PATHLOSS_NO_LOSS) {
+    const uint32_t c = (uint32_t)cj * l->ncx + ci;
+    const uint32_t m = p->surface[c];
+    int32_t i, j;
+    if (m == RFS_PATHLOSS_NO_LOSS || !rfs_pathloss_coarse_ij(p, c, &i, &j)) {
+        rfs_pathloss_lattice_xy(l, (uint16_t)(l->c0i + ci * l->cs), (uint16_t)(l->c0j + cj * l->cs),
+                                x, y);
         return false;
     }
+    rfs_pathloss_lattice_xy(l, (uint16_t)i, (uint16_t)j, x, y);
     /* sqrt(2 m): 2 m saturated to the Q16 range (181 dB). */
     *rms = rfs_q16_sqrt(m > (uint32_t)INT32_MAX / 2u ? INT32_MAX : (rfs_q16_t)(2u * m));
     return true;

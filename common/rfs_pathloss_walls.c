@@ -13,14 +13,6 @@ static uint32_t cell_hash(uint16_t cx, uint16_t cy)
     return ((uint32_t)cx * 0x9E3779B1u + (uint32_t)cy * 0x85EBCA77u) >> 22; /* 10 bits */
 }
 
-/* Field by field: the core may call no memcmp (only memcpy/memset/memmove). */
-static bool same_lattice(const rfs_pathloss_lat_t *a, const rfs_pathloss_lat_t *b)
-{
-    return a->ox == b->ox && a->oy == b->oy && a->grid == b->grid && a->lw == b->lw &&
-           a->lh == b->lh && a->cs == b->cs && a->c0i == b->c0i && a->c0j == b->c0j &&
-           a->ncx == b->ncx && a->ncy == b->ncy;
-}
-
 /* The cache in use: the attached one, or the built-in arrays. */
 static rfs_pathloss_xcache_t cache_of(rfs_pathloss_t *p)
 {
@@ -93,7 +85,7 @@ void rfs_pathloss_walls_assign(rfs_pathloss_t *p)
         p->blocks_map = rfs_map_wall_blocks(p->map, p->wall_blocks, sizeof(p->wall_blocks),
                                             &p->blocks) == 0 ? p->map : 0;
     }
-    if (p->cache_map != p->map || !same_lattice(&p->cache_lat, &p->lat)) {
+    if (p->cache_map != p->map || !rfs_pathloss_same_lattice(&p->cache_lat, &p->lat)) {
         cache_clear(p);
         p->cache_map = p->map;
         p->cache_lat = p->lat;

@@ -46,6 +46,7 @@ hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void)
     c.p0_min_dbm = NAN;
     c.coarse_footprint_m = NAN;
     c.p0_max_wall_db = NAN;
+    c.coarse_snap = -1;
     c.pathloss_log2 = NULL;
     return c;
 }
@@ -155,7 +156,7 @@ static void open_cellsum(inproc_t *p, const rfs_map_t *map, uint16_t capacity)
 
 /* The scenario's path-loss settings into pc: P0 bounded by the node's transmit power when
  * known, the ceiling's charge per wall (docs/PATHLOSS.md, "The P0 floor") and the coarse
- * pass's footprint ("A bin's walls"). */
+ * pass's footprint ("A bin's walls") and its snap ("Fit"). */
 static void pathloss_options(const hs_ctrl_inproc_cfg_t *cfg, rfs_pathloss_cfg_t *pc)
 {
     if (!isnan(cfg->p0_min_dbm)) {
@@ -168,13 +169,17 @@ static void pathloss_options(const hs_ctrl_inproc_cfg_t *cfg, rfs_pathloss_cfg_t
         pc->coarse_footprint =
             (rfs_q16_t)lround(fmax(0.0, fmin(0.5, cfg->coarse_footprint_m)) * 65536.0);
     }
+    if (cfg->coarse_snap >= 0) {
+        pc->coarse_snap = cfg->coarse_snap != 0;
+    }
 }
 
 /* The path-loss model's options (pathloss_options) and the simulator's large wall-count
  * cache. 0, or -1 with the reason in err. */
 static int open_pathloss(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, char *err, size_t errlen)
 {
-    if (!isnan(cfg->p0_min_dbm) || !isnan(cfg->p0_max_wall_db) || !isnan(cfg->coarse_footprint_m)) {
+    if (!isnan(cfg->p0_min_dbm) || !isnan(cfg->p0_max_wall_db) || !isnan(cfg->coarse_footprint_m) ||
+        cfg->coarse_snap >= 0) {
         rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
         pathloss_options(cfg, &pc);
         if (rfs_pathloss_init(p->model_state, &pc) != 0) {

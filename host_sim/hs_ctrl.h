@@ -68,6 +68,8 @@ typedef struct hs_ctrl_inproc_cfg {
                             ///< [-200, 100] (NAN: the model's default, -45)
     double coarse_footprint_m; ///< pathloss model only: its coarse pass's footprint,
                             ///< metres, in [0, 0.5] (NAN: the model's default, 0.25)
+    int coarse_snap;        ///< pathloss model only: 0 / 1 its coarse points snapped to
+                            ///< legal ones in their cells (-1: the model's default, on)
     double p0_max_wall_db;  ///< pathloss model only: the most a wall costs in the P0 held
                             ///< against the ceiling, dB, in [0, 60] (NAN: off)
     const int32_t *pathloss_log2; ///< pathloss model only: a log2 table to attach

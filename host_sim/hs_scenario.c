@@ -214,6 +214,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_eps_sample = -1;
     sc->seek_p0_min_dbm = NAN;
     sc->seek_coarse_footprint_m = NAN;
+    sc->seek_coarse_snap = -1;
     sc->seek_p0_max_wall_db = NAN;
     sc->seek_eps_rate = -1.0;
     snprintf(sc->model, sizeof sc->model, "ridge");
@@ -436,7 +437,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
                                         "refute_reached", "local_m", "leg_m", "recheck_silent",
                                         "coarse_footprint_m", "p0_max_wall_db", "local_gap_m",
                                         "at_tol_m", "local_refute", "near_t",
-                                        "near_m", NULL};
+                                        "near_m", "coarse_snap", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "refute_m", 0, 100, &sc->seek_refute_m) ||
@@ -457,6 +458,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             preset_bool(p, n, "silence_floor", &sc->seek_silence_floor) ||
             preset_bool(p, n, "refute_reached", &sc->seek_refute_reached) ||
             preset_bool(p, n, "local_refute", &sc->seek_local_refute) ||
+            preset_bool(p, n, "coarse_snap", &sc->seek_coarse_snap) ||
             preset_bool(p, n, "recheck_silent", &sc->seek_recheck_silent)) {
             return -1;
         }

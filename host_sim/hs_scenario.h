@@ -14,7 +14,8 @@
  *                                  #       p0_min_dbm: -32, local_m: 0, leg_m: 0,
  *                                  #       coarse_footprint_m: 0.25,
  *                                  #       p0_max_wall_db: 3, local_gap_m: 0.5,
- *                                  #       at_tol_m: 0.03, near_t: 0, near_m: 30}
+ *                                  #       at_tol_m: 0.03, near_t: 0, near_m: 30,
+ *                                  #       coarse_snap: true}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2
@@ -105,6 +106,9 @@ typedef struct hs_scenario {
     double seek_coarse_footprint_m; ///< seek.coarse_footprint_m: the pathloss model's
                                   ///< coarse-pass footprint, metres (NAN = its default, 0.25;
                                   ///< 0: one count a coarse bin, docs/PATHLOSS.md)
+    int seek_coarse_snap;         ///< seek.coarse_snap: 0 / 1, the pathloss model's coarse
+                                  ///< points in corridors off the 2 m grid (-1 = its
+                                  ///< default, on; docs/PATHLOSS.md "Fit")
     double seek_p0_max_wall_db;   ///< seek.p0_max_wall_db: the most a wall costs in the P0 the
                                   ///< pathloss model holds against its ceiling, dB (NAN = off;
                                   ///< docs/PATHLOSS.md "The P0 floor")

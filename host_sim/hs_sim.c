@@ -128,10 +128,11 @@ void hs_sim_result_estimate(hs_sim_result_t *r, const hs_ctrl_t *ctrl, double sr
 }
 
 /// residual.tsv: every coarse candidate of the last fit with its residual
-/// sqrt(2 x mean Huber loss) in dB (rfs_pathloss_residual_at()); header only without one.
+/// sqrt(2 x mean Huber loss) in dB (rfs_pathloss_residual_at()) and its cell's grid point
+/// (the candidate itself unless snapped, docs/PATHLOSS.md "Fit"); header only without one.
 static void write_residual(FILE *f, const hs_ctrl_t *ctrl)
 {
-    fprintf(f, "x_m\ty_m\tresidual_db\n");
+    fprintf(f, "x_m\ty_m\tresidual_db\tcell_x_m\tcell_y_m\n");
     const rfs_pathloss_t *pl = ctrl->pathloss ? ctrl->pathloss(ctrl->self) : NULL;
     if (!pl) {
         return;
@@ -142,7 +143,10 @@ static void write_residual(FILE *f, const hs_ctrl_t *ctrl)
         for (uint16_t ci = 0; ci < ncx; ci++) {
             rfs_q16_t x, y, r;
             if (rfs_pathloss_residual_at(pl, ci, cj, &x, &y, &r)) {
-                fprintf(f, "%.3f\t%.3f\t%.3f\n", q16d(x), q16d(y), q16d(r));
+                const rfs_pathloss_lat_t *l = &pl->lat;
+                fprintf(f, "%.3f\t%.3f\t%.3f\t%.3f\t%.3f\n", q16d(x), q16d(y), q16d(r),
+                        q16d(l->ox) + (l->c0i + ci * l->cs) * q16d(l->grid),
+                        q16d(l->oy) + (l->c0j + cj * l->cs) * q16d(l->grid));
             }
         }
     }
@@ -823,6 +827,7 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     cc.p0_min_dbm = e->sc.seek_p0_min_dbm;
     cc.coarse_footprint_m = e->sc.seek_coarse_footprint_m;
     cc.p0_max_wall_db = e->sc.seek_p0_max_wall_db;
+    cc.coarse_snap = e->sc.seek_coarse_snap;
     cc.pathloss_log2 = e->pathloss_log2;
     if (e->sc.seek_local_refute >= 0) {
         cc.seek.local_refute = e->sc.seek_local_refute != 0;

@@ -66,6 +66,8 @@ $(eval $(call test_script,placements,$(PYTHON) tests/host_sim/placements.py $(SI
 $(eval $(call test_script,greedy_extrap,$(PYTHON) tests/host_sim/greedy_extrap_check.py $(SIM),$(SIM) scripts/greedy_extrap.py))
 $(eval $(call test_script,faults,tests/host_sim/faults.sh $(SIM) 3,$(SIM)))
 $(eval $(call test_script,strategy_cli,tests/host_sim/strategy_cli.sh $(SIM),$(SIM)))
+# Every program in scripts/ answers --help (exit 0, a usage text, nothing written).
+$(eval $(call test_script,scripts_help,tests/host_sim/scripts_help.sh $(PYTHON),))
 # bridge_bounds.py's tolerance reference against a brute-force walk of the grid.
 $(eval $(call test_script,bridge_bounds,$(PYTHON) tests/host_sim/bridge_bounds_check.py,))
 $(eval $(call test_script,pathloss_out,tests/host_sim/pathloss_out.sh $(SIM),$(SIM)))

@@ -161,12 +161,13 @@ def figure(path, sim, seed, best, finals):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--seeds", default="1001..1200")
-    ap.add_argument("--sim", default="build/bin/rfseek-sim")
-    ap.add_argument("--jobs", type=int, default=0)
-    ap.add_argument("--results", default="docs/RESULTS.md")
-    ap.add_argument("--figure", default="docs/figures/seek_bridge.png")
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0],
+                                 formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    ap.add_argument("--seeds", default="1001..1200", help="seeds A..B (1..500 are the tuning draws)")
+    ap.add_argument("--sim", default="build/bin/rfseek-sim", help="the rfseek-sim to run")
+    ap.add_argument("--jobs", type=int, default=0, help="worker processes (0: one a core)")
+    ap.add_argument("--results", default="docs/RESULTS.md", help="the markdown file whose section is replaced")
+    ap.add_argument("--figure", default="docs/figures/seek_bridge.png", help="the figure written")
     ap.add_argument("--no-write", action="store_true", help="print the table only")
     ap.add_argument("--smoke", action="store_true", help="seed 1, print, check, no files")
     ap.add_argument("--keep", help="also copy every runs.tsv (and the run's commit) here")

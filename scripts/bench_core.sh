@@ -4,6 +4,7 @@
 # 101 iterations then the scikit-learn twin's median of 101, and their ratio per round.
 #   scripts/bench_core.sh [BUILD] [ROUNDS]
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 build=${1:-build}
 rounds=${2:-5}
 bin=$build/bin/bench_core

@@ -2,7 +2,9 @@
 # Instruction counts of the data path (docs/PERFORMANCE.md, "data"): callgrind counts
 # exactly the calls inside CALLGRIND_TOGGLE_COLLECT pairs in bench/bench_ridge.c; per-item figures
 # are marginal (difference of two sizes / difference of counts), so set-up cost cancels.
+#   scripts/bench_data.sh [BUILD]      (default build)
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 build=${1:-build}
 bin=$build/bin/bench_ridge
 tmp=$(mktemp -d)

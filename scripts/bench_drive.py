@@ -136,14 +136,15 @@ def section(seeds, wall, at, floors, rows, every):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--seeds", default="1001..1200")
-    ap.add_argument("--floors", default="default,lshape,willow")
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0],
+                                 formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    ap.add_argument("--seeds", default="1001..1200", help="seeds A..B (1..500 are the tuning draws)")
+    ap.add_argument("--floors", default="default,lshape,willow", help="floors of the pose-noise table")
     ap.add_argument("--all-floors", default="all",
                     help="floors of the every-floor table: all shipped, none, or a list")
-    ap.add_argument("--sim", default="build/bin/rfseek-sim")
-    ap.add_argument("--jobs", type=int, default=0)
-    ap.add_argument("--results", default="docs/RESULTS.md")
+    ap.add_argument("--sim", default="build/bin/rfseek-sim", help="the rfseek-sim to run")
+    ap.add_argument("--jobs", type=int, default=0, help="worker processes (0: one a core)")
+    ap.add_argument("--results", default="docs/RESULTS.md", help="the markdown file whose section is replaced")
     ap.add_argument("--no-write", action="store_true", help="print the tables only")
     ap.add_argument("--keep", metavar="DIR",
                     help="keep each batch's runs table in DIR and reuse the ones there "

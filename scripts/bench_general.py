@@ -193,14 +193,15 @@ def section(cmd, at, minutes, nruns, seeds, held, floors, results):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--placements", type=int, default=100)
-    ap.add_argument("--seeds", default="1..2")
-    ap.add_argument("--floors", default=",".join(REAL + SYNTHETIC))
-    ap.add_argument("--sim", default="build/bin/rfseek-sim")
-    ap.add_argument("--jobs", type=int, default=1)
-    ap.add_argument("--work", default="build/bench_general")
-    ap.add_argument("--results", default="docs/RESULTS.md")
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0],
+                                 formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    ap.add_argument("--placements", type=int, default=100, help="placements a floor (even: the first half tunes, the second is held out)")
+    ap.add_argument("--seeds", default="1..2", help="simulator seeds a placement, A..B")
+    ap.add_argument("--floors", default=",".join(REAL + SYNTHETIC), help="comma-separated floors (scenarios/NAME.yaml)")
+    ap.add_argument("--sim", default="build/bin/rfseek-sim", help="the rfseek-sim to run")
+    ap.add_argument("--jobs", type=int, default=1, help="worker processes a batch")
+    ap.add_argument("--work", default="build/bench_general", help="folder for the batches' runs")
+    ap.add_argument("--results", default="docs/RESULTS.md", help="the markdown file whose section is replaced")
     ap.add_argument("--no-write", action="store_true", help="print the tables only")
     ap.add_argument("--held-out-only", action="store_true",
                     help="run placements 51.. only (the tuning draws are not run)")

@@ -2,6 +2,7 @@
 # Instruction counts of the internal models (docs/PERFORMANCE.md, "Models"): callgrind,
 # host x86-64, exact. Usage: scripts/bench_models.sh BUILD_DIR
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 build=${1:-build}
 bin=$build/bin/bench_models
 tmp=$(mktemp -d)

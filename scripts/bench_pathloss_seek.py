@@ -160,11 +160,12 @@ def splice(path, text, begin=BEGIN, end=END):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--seeds", type=int, default=200)
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0],
+                                 formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    ap.add_argument("--seeds", type=int, default=200, help="seeds a configuration")
     ap.add_argument("--first-seed", type=int, default=1001,
                     help="seeds FIRST..FIRST+N-1 (1..500 are the tuning draws: report on others)")
-    ap.add_argument("--sim", default="build/bin/rfseek-sim")
+    ap.add_argument("--sim", default="build/bin/rfseek-sim", help="the rfseek-sim to run")
     ap.add_argument("--results", default="docs/RESULTS.md",
                     help="the markdown file whose section is replaced")
     a = ap.parse_args()

@@ -13,6 +13,7 @@
 #    on every shipped floor (FLOORS narrows them), one table row each, then stop
 #    (BENCH_SIM_REPS=1: one run each instead of the median of three).
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 SIM=${1:?usage: bench_sim.sh path/to/rfseek-sim [BASE]}
 BASE=${2:-}
 echo "bench-sim: load average before: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -2,7 +2,9 @@
 # Fail when the core library references an external symbol other than
 # memcpy/memset/memmove (the core is freestanding: no libc, no libgcc helpers).
 # Symbols one object uses and another defines are internal to the library.
+#   scripts/check_core_symbols.sh NM LIB      (NM: nm or arm-none-eabi-nm)
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 nm_tool=$1 lib=$2
 undef=$("$nm_tool" -u "$lib" | awk 'NF && $0 !~ /:$/ {print $NF}' | sort -u)
 defined=$("$nm_tool" --defined-only "$lib" | awk 'NF==3 {print $3}' | sort -u)

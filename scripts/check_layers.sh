@@ -4,6 +4,7 @@
 # per offending include (file, header, the rule), a PASS line when there is none.
 #   scripts/check_layers.sh            (from the repository root)
 set -uo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 cd "$(dirname "$0")/.."
 
 # Where each project header lives (names are unique across the tree).

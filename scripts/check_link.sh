@@ -4,6 +4,7 @@
 # program, from its dynamic section (readelf NEEDED).
 #   scripts/check_link.sh PROGRAM...
 set -uo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 [ $# -ge 1 ] || { echo "usage: check_link.sh PROGRAM..." >&2; exit 2; }
 rc=0
 for p in "$@"; do

@@ -74,12 +74,13 @@ def summaries(out, seeds):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--base", required=True)
-    ap.add_argument("--new", default="build/bin/rfseek-sim")
-    ap.add_argument("--seeds", type=int, default=200)
-    ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--work", default="build/compare_plan")
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0],
+                                 formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    ap.add_argument("--base", required=True, help="the rfseek-sim to compare against (required)")
+    ap.add_argument("--new", default="build/bin/rfseek-sim", help="the rfseek-sim under test")
+    ap.add_argument("--seeds", type=int, default=200, help="seeds 1..N a configuration")
+    ap.add_argument("--jobs", type=int, default=2, help="worker processes")
+    ap.add_argument("--work", default="build/compare_plan", help="folder for the runs")
     a = ap.parse_args()
     print("| scenario, configuration | success base | success new | only base / new (p) | "
           "ratio base / new | paired | decisions > 100 ms | longest latency |")

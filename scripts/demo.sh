@@ -5,6 +5,7 @@
 # A second run with the map-aware path-loss model (--model pathloss --strategy
 # meta-path) goes to OUTDIR/pathloss/run, its figures (with residual.png) to OUTDIR/pathloss.
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 OUT=${1:-out/demo}
 SIM=${BUILD:-build}/bin/rfseek-sim
 SEED=${SEED:-1}

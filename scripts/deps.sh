@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Install the Debian packages listed in scripts/deps.txt that are missing: one
 # dpkg-query check, then one apt-get install of exactly the missing ones.
+#   scripts/deps.sh      (make deps; needs root when something is missing)
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 here=$(cd "$(dirname "$0")" && pwd)
 mapfile -t pkgs < <(grep -vE '^\s*(#|$)' "$here/deps.txt")
 missing=()

@@ -3,6 +3,7 @@
 # against the budgets its linker script asserts (stm32f405.ld: _rfs_flash_used,
 # _rfs_ram_used, _rfs_ccm_used).
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 elf=$1
 sym() {
     local hex

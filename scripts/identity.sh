@@ -5,6 +5,7 @@
 #   SCENARIOS="default lshape 3ne" (default), SEEDS 1..50 (default), JOBS=2; MODELS and
 #   STRATEGIES narrow the sweep (default: every model and strategy below)
 set -u
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 sim=${1:?usage: identity.sh SIM OUTDIR [SEEDS]} out=${2:?usage: identity.sh SIM OUTDIR [SEEDS]}
 seeds=${3:-1..50}
 here=$(cd "$(dirname "$0")/.." && pwd)

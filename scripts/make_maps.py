@@ -13,9 +13,9 @@ Maps (0.05 m per pixel, walls 0.1 m thick, doors 1.0 m, a 0.5 m unknown border):
 Pixel values: 254 free, 0 occupied, 205 unknown (map_server's own trinary output).
 The output is deterministic; the files are committed and `make maps` regenerates them.
 """
+import argparse
 import math
 import os
-import sys
 
 RES = 0.05
 FREE, OCC, UNKNOWN = 254, 0, 205
@@ -146,7 +146,10 @@ def lshape():
 
 
 def main():
-    outdir = sys.argv[1] if len(sys.argv) > 1 else "scenarios/maps"
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("outdir", nargs="?", default="scenarios/maps",
+                    help="where the PGM and YAML files go (default scenarios/maps)")
+    outdir = ap.parse_args().outdir
     os.makedirs(outdir, exist_ok=True)
     maps = {
         "office": (office(), "rfseek office floor 35 x 12 m: corridor and rooms"),

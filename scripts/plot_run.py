@@ -5,7 +5,7 @@
     scripts/plot_run.py RUNDIR --animate [--out FILE] [--fps N] [--speed S] [--max-frames N]
 
 RUNDIR is an `rfseek-sim --out` directory (summary.json, track.tsv, log.tsv, samples.tsv,
-and field.tsv when run with --field). Writes into DIR (default RUNDIR):
+and field.tsv when run with --field). Writes into DIR (default RUNDIR; made if missing):
   trajectory.png  the map, the trajectory, the start (red cross), the source (red star)
                   and the model updates (red circles)                  (paper figs. 3, 4 top)
   rssi.png        RSSI of every received packet against the distance travelled, with its
@@ -114,15 +114,29 @@ def main(argv):
     run = argv[1]
     if "--animate" in argv[2:]:
         return animate_main(run, argv[2:])
-    outdir = argv[3] if len(argv) == 4 and argv[2] == "--outdir" else run
+    if len(argv) == 2:
+        outdir = run
+    elif len(argv) == 4 and argv[2] == "--outdir":
+        outdir = argv[3]
+    else:
+        die("expected RUNDIR [--outdir DIR] or RUNDIR --animate [...], got %r (see --help)"
+            % " ".join(argv[2:]))
     try:
         with open(os.path.join(run, "summary.json")) as f:
             s = json.load(f)
     except (OSError, ValueError) as e:
         die("%s: %s" % (run, e))
-    img, ext = read_map(s["map"])
+    try:
+        img, ext = read_map(s["map"])
+    except (OSError, KeyError, ValueError) as e:
+        die("map %s: %s (summary.json's paths are relative to where rfseek-sim ran)"
+            % (s["map"], e.strerror if isinstance(e, OSError) else "bad YAML: %s" % e))
     sources = np.array(s["sources"])
     start = s["start"]
+    try:
+        os.makedirs(outdir, exist_ok=True)
+    except OSError as e:
+        die("--outdir %s: %s" % (outdir, e.strerror))
 
     # Trajectory with start, source and model updates.
     th, tr = read_tsv(os.path.join(run, "track.tsv"))
@@ -197,12 +211,16 @@ def main(argv):
 
 
 def plot_residual(path, s, img, ext, sources, tx, ty, out):
-    """Heat map of residual.tsv (one value per coarse candidate on a regular lattice)."""
+    """Heat map of residual.tsv: one value per coarse candidate, drawn as its cell of the
+    regular coarse grid (cell_x_m, cell_y_m; files without them: the candidates' own x, y)."""
     rh, rr = read_tsv(path)
     if not rr:
         return  # no fit: nothing to draw
     try:
-        rx, ry, rv = col(rh, rr, "x_m"), col(rh, rr, "y_m"), col(rh, rr, "residual_db")
+        cells = "cell_x_m" in rh and "cell_y_m" in rh
+        rx = col(rh, rr, "cell_x_m" if cells else "x_m")
+        ry = col(rh, rr, "cell_y_m" if cells else "y_m")
+        rv = col(rh, rr, "residual_db")
     except (ValueError, IndexError) as e:
         die("%s: %s" % (path, e))
     xs, ys = np.unique(rx), np.unique(ry)

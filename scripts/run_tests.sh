@@ -8,6 +8,7 @@
 # non-zero when anything failed.
 #   scripts/run_tests.sh JOBFILE [--only NAME]    (--only: that job alone, its log shown)
 set -uo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 jobfile=${1:?usage: run_tests.sh JOBFILE [--only NAME]}
 only=
 [ "${2:-}" = --only ] && only=${3:?--only needs a NAME}

@@ -6,9 +6,10 @@
 # that aborts on a report also ends its worker, which rfseek-sim reports. One PASS/FAIL
 # line per scenario, with the seeds run, the seeds that reached the source and the time.
 set -uo pipefail
-if [ $# -lt 3 ] || [ "${1:-}" = --help ]; then
-    echo "usage: san_sweep.sh ASAN_SIM N SCENARIO..." >&2
-    [ "${1:-}" = --help ]; exit $?
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
+if [ $# -lt 3 ]; then
+    echo "usage: san_sweep.sh ASAN_SIM N SCENARIO... (see --help)" >&2
+    exit 2
 fi
 sim=$1 n=$2; shift 2
 [[ $n =~ ^[1-9][0-9]*$ ]] || { echo "san_sweep.sh: N: expected a positive whole number, got '$n'" >&2; exit 2; }

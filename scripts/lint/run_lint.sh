@@ -5,7 +5,7 @@
 #   scripts/lint/run_lint.sh BUILD [cppcheck|clang-tidy]...
 # BUILD must hold the generated LCM headers (BUILD/gen, from `make`).
 set -uo pipefail
-[ "${1:-}" = --help ] && { sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
+case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 build=${1:?usage: run_lint.sh BUILD [cppcheck|clang-tidy]...}
 shift
 tools=("$@")

@@ -42,6 +42,8 @@ typedef struct ref_pl_cfg {
     double p0_max; /* strongest plausible P0; a fit above adds total x Huber(P0 - p0_max) */
     double coarse_footprint; /* m: the footprint of the coarse points' counts */
     double p0_max_wall; /* dB: the most a wall costs in the P0 held against p0_max (inf: W) */
+    bool coarse_snap; /* a coarse grid point off the legal map stands for its cell's nearest
+                         legal lattice point */
 } ref_pl_cfg_t;
 
 typedef struct ref_pl_bin {
@@ -67,6 +69,7 @@ typedef struct ref_pl {
     double sx, sy, p0, n, w, loss;
     int li, lj;
     double surface[REF_PL_MAX_COARSE]; /* sqrt(2 mean loss), dB; NAN: no candidate */
+    int pi[REF_PL_MAX_COARSE], pj[REF_PL_MAX_COARSE]; /* each coarse point's lattice point */
     int candidates;
     unsigned char *seen; /* lattice points evaluated */
     double fp;           /* m: the footprint of the counts being made */
@@ -77,7 +80,7 @@ typedef struct ref_pl {
 static inline ref_pl_cfg_t ref_pl_cfg_default(void)
 {
     ref_pl_cfg_t c = {1.0, 2.0, 3, 1.5, 5.0, 0.0, 15.0, 3.0, 5.0, 3000.0, 6.0, 20.0, 5, 30.0, -45.0,
-                      0.25, 0, {0}, {0}, 0.0, -10.0, 0.25, INFINITY};
+                      0.25, 0, {0}, {0}, 0.0, -10.0, 0.25, INFINITY, true};
     return c;
 }
 
@@ -176,6 +179,40 @@ static inline bool ref_pl_legal(const ref_pl_t *r, int i, int j)
         }
     }
     return r->map == NULL || rfs_map_lattice_legal(r->map, (uint16_t)i, (uint16_t)j);
+}
+
+/* Coarse point c's lattice point: its grid point when that is legal on the map; else,
+ * with coarse_snap, the map-legal lattice point nearest it in its cell (offsets -(cs - 1) /
+ * 2 .. cs / 2 either way, at most 7; the first in row order among the nearest); false
+ * when there is none. Places ruled out are tested after (ref_pl_try). */
+static inline bool ref_pl_snap(const ref_pl_t *r, int c, int *pi, int *pj)
+{
+    const rfs_map_t *m = r->map;
+    int i0 = r->c0i + (c % r->ncx) * r->cs, j0 = r->c0j + (c / r->ncx) * r->cs;
+    *pi = i0;
+    *pj = j0;
+#define REF_PL_ON_MAP(i, j) ((i) >= 0 && (j) >= 0 && (i) < r->lw && (j) < r->lh && \
+                             (m == NULL || rfs_map_lattice_legal(m, (uint16_t)(i), (uint16_t)(j))))
+    if (REF_PL_ON_MAP(i0, j0)) {
+        return true;
+    }
+    if (!r->cfg.coarse_snap) {
+        return false;
+    }
+    int lo = (r->cs - 1) / 2 > 7 ? 7 : (r->cs - 1) / 2, hi = r->cs / 2 > 7 ? 7 : r->cs / 2;
+    double best = INFINITY;
+    for (int dj = -lo; dj <= hi; ++dj) {
+        for (int di = -lo; di <= hi; ++di) {
+            double d = hypot(di, dj);
+            if (d < best && REF_PL_ON_MAP(i0 + di, j0 + dj)) {
+                best = d;
+                *pi = i0 + di;
+                *pj = j0 + dj;
+            }
+        }
+    }
+#undef REF_PL_ON_MAP
+    return !isinf(best);
 }
 
 /* Sum of count-weighted squared residuals plus the prior, at (n, w), P0 optimal. */
@@ -348,8 +385,11 @@ static inline bool ref_pl_fit(ref_pl_t *r, const rfs_sample_t *s, int n, const r
     double tl[8];
     int nt = 0;
     for (int c = 0; c < r->ncx * r->ncy; ++c) {
-        int i = r->c0i + (c % r->ncx) * r->cs, j = r->c0j + (c / r->ncx) * r->cs;
-        double loss = ref_pl_try(r, i, j);
+        int i, j;
+        bool some = ref_pl_snap(r, c, &i, &j);
+        r->pi[c] = i;
+        r->pj[c] = j;
+        double loss = some ? ref_pl_try(r, i, j) : INFINITY;
         r->surface[c] = isinf(loss) ? NAN : sqrt(2.0 * loss / (double)r->total);
         if (isinf(loss)) {
             continue;

@@ -180,8 +180,8 @@ static void expect_same_as_reference(fixture_t *f, const rfs_pathloss_cfg_t *c, 
             if (ok == isnan(want)) {
                 fail_msg("coarse (%d, %d): candidate %d, reference %d", ci, cj, ok, !isnan(want));
             }
-            assert_true(fabs(x / 65536.0 - (r->ox + (r->c0i + ci * r->cs) * r->grid)) < 1e-4);
-            assert_true(fabs(y / 65536.0 - (r->oy + (r->c0j + cj * r->cs) * r->grid)) < 1e-4);
+            assert_true(fabs(x / 65536.0 - (r->ox + r->pi[cj * ncx + ci] * r->grid)) < 1e-4);
+            assert_true(fabs(y / 65536.0 - (r->oy + r->pj[cj * ncx + ci] * r->grid)) < 1e-4);
             if (ok) {
                 worst = fmax(worst, fabs(rms / 65536.0 - want));
             }
@@ -416,6 +416,51 @@ static void footprint_off_same_as_reference(void **state)
     assert_true(on.rms != off.rms);
 }
 
+/* A floor whose corridor lies between two coarse rows (the rows every 2 m fall at y =
+ * 10.875 and 12.875 m, its legal band is about 11.35-12.25 m): a room (y < 6 m), a 5 m block
+ * of wall above it with a 1.5 m passage at its west end, the corridor (y 11-12.6 m) and wall
+ * above. */
+static bool corridor_is_wall(int i, int j)
+{
+    if (i == 0 || j == 0 || i == MW - 1 || j >= 126) {
+        return true;
+    }
+    return j >= 60 && j <= 109 && !(i >= 10 && i < 25);
+}
+
+/* coarse_snap: the coarse point of a cell whose grid point is not legal stands for the
+ * cell's legal lattice point nearest it, so the corridor between two coarse rows has
+ * candidates. A source at its east end, samples all over the floor: with the snap the
+ * estimate lies within 0.5 m of it (and equals the double reference, which snaps the same
+ * way); without it no candidate lies in the corridor's east part, the estimate stays over
+ * 4 m off (the reference agrees there too). */
+static void coarse_snap_finds_corridor_off_the_grid(void **state)
+{
+    fixture_t *f = *state;
+    static uint8_t fb[MH * ((MW + 7) / 8)], wb[MH * ((MW + 7) / 8)], lb[MH * ((MW + 7) / 8)];
+    const uint16_t stride = (MW + 7) / 8;
+    for (int j = 0; j < MH; ++j) {
+        for (int i = 0; i < MW; ++i) {
+            rfs_map_bit_set(wb, stride, (uint16_t)i, (uint16_t)j, corridor_is_wall(i, j));
+            rfs_map_bit_set(fb, stride, (uint16_t)i, (uint16_t)j, !corridor_is_wall(i, j));
+        }
+    }
+    rfs_map_t map;
+    rfs_map_cfg_t mc = rfs_map_cfg_default();
+    assert_int_equal(rfs_map_init(&map, &mc, MW, MH, RES_Q16, 0, 0, fb, wb, lb), 0);
+    const truth_t t = {28.0, 11.8, -30.0, 2.6, 6.5, 0.3};
+    make_samples(f->s, NS, &map, &t, 5);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default(), off = rfs_pathloss_cfg_default();
+    ref_pl_cfg_t rc = ref_pl_cfg_default(), roff = ref_pl_cfg_default();
+    off.coarse_snap = false;
+    roff.coarse_snap = false;
+
+    expect_same_as_reference(f, &c, NS, &map, &rc, 0.01);
+    assert_true(hypot(f->ref.sx - t.sx, f->ref.sy - t.sy) <= 0.5);
+    expect_same_as_reference(f, &off, NS, &map, &roff, 0.01);
+    assert_true(hypot(f->ref.sx - t.sx, f->ref.sy - t.sy) > 4.0);
+}
+
 /* The one-count coarse pass (coarse_footprint 0: the coarse points' losses only rank, the
  * refinement re-evaluates the top points with the footprint) equals the double reference,
  * and counts under half the default's lines (one a coarse footprint, four a refinement's)
@@ -557,6 +602,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(p0_floor_off_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_ceiling_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(coarse_footprint_one_same_as_reference, setup, teardown),
+        cmocka_unit_test_setup_teardown(coarse_snap_finds_corridor_off_the_grid, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_default_ceiling_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_ceiling_credits_walls, setup, teardown),
         cmocka_unit_test(registered_as_pathloss),

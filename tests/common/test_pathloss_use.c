@@ -99,8 +99,11 @@ static void cached_relearn_equals_fresh(void **state)
     assert_memory_equal(warm->surface, f->pl.surface, sizeof(f->pl.surface));
     assert_int_equal(ew.candidates, ef.candidates);
     assert_int_equal(ew.footprints + ew.footprints_cached, ef.footprints + ef.footprints_cached);
-    /* the coarse counts of the west half's bins came from the cache */
-    assert_true(ew.footprints_cached > ef.footprints / 4u);
+    /* the west half's bins (about half of them) took every built-in column's counts
+     * from the cache: a whole number of columns' worth, at least a third of the bins */
+    const uint32_t bins = ef.footprints / ef.candidates;
+    assert_int_equal(ew.footprints_cached % RFS_PATHLOSS_CACHE_COLS, 0);
+    assert_true(ew.footprints_cached >= bins / 3u * RFS_PATHLOSS_CACHE_COLS);
     free(warm);
 }
 
@@ -267,7 +270,20 @@ static void residual_surface_and_spread(void **state)
     /* the least residual of the coarse grid is the coarse point nearest the truth */
     assert_true(fabs(bx - k_office.sx) <= 1.0 && fabs(by - k_office.sy) <= 1.0);
     assert_true(best >= e.rms / 65536.0 - 1e-4);
+    /* every 2 m cell of the office holds a legal lattice point: each coarse point stands
+     * for one (coarse_snap); without the snap, grid points in walls have no candidate */
+    assert_int_equal(walls, 0);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    c.coarse_snap = false;
+    (void)fit_with(f, &c, NS, &f->map, 0, NULL);
+    for (uint16_t cj = 0; cj < ncy; ++cj) {
+        for (uint16_t ci = 0; ci < ncx; ++ci) {
+            walls += !rfs_pathloss_residual_at(&f->pl, ci, cj, &x, &y, &rms) &&
+                     !rfs_map_point_legal(&f->map, x, y);
+        }
+    }
     assert_true(walls > 0);
+    (void)fit_default(f, NS, &f->map, 0, NULL);
     assert_false(rfs_pathloss_residual_at(&f->pl, ncx, 0, &x, &y, &rms));
     /* with 0.3 dB noise the region is one or two coarse cells of 4 m^2 */
     assert_true(e.spread_m2 >= RFS_Q16_INT(4) && e.spread_m2 <= RFS_Q16_INT(8));

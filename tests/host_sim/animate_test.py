@@ -14,7 +14,9 @@ the run's own files and the documented layout, not by the script:
   - the map from a PNG image (the same office converted by Pillow) draws alike;
   - MP4 through ffmpeg when it is installed (ffprobe's frame count), else a one-line error;
   - bad input (missing RUNDIR, bad --fps, unknown option, damaged track.tsv): one stderr
-    line, exit 1, no video left behind.
+    line, exit 1, no video left behind;
+  - the figures' mode: --outdir made when missing; an unknown option, --outdir without a
+    value, a map not found: one stderr line, exit 1, no figures.
 """
 import json
 import math
@@ -198,6 +200,28 @@ def run(tmp):
     env = dict(os.environ, PATH=os.path.join(tmp, "no-such-dir"))
     one_line_error("mp4_without_ffmpeg", run_plot(run_dir, "--animate", "--out", mp4 + "2.mp4",
                                                   env=env), "needs ffmpeg", mp4 + "2.mp4")
+
+    # The figures' mode: --outdir made when missing; bad options and a map not found.
+    figs = os.path.join(tmp, "figs", "new")
+    p = run_plot(run_dir, "--outdir", figs)
+    made = os.path.join(figs, "trajectory.png")
+    check("outdir_made", p.returncode == 0 and os.path.exists(made), p.stderr[:300])
+    if os.path.exists(made):
+        with Image.open(made) as im:
+            check("outdir_trajectory_png", im.format == "PNG" and im.size[0] > 500, str(im.size))
+    left = os.path.join(run_dir, "trajectory.png")
+    one_line_error("figures_unknown_option", run_plot(run_dir, "--bogus"), "--bogus", left)
+    one_line_error("figures_outdir_without_value", run_plot(run_dir, "--outdir"), "--outdir", left)
+    moved = os.path.join(tmp, "moved")
+    shutil.copytree(run_dir, moved)
+    with open(os.path.join(moved, "summary.json")) as f:
+        sm = json.load(f)
+    sm["map"] = "maps/nowhere.yaml"
+    with open(os.path.join(moved, "summary.json"), "w") as f:
+        json.dump(sm, f)
+    one_line_error("figures_map_not_found",
+                   run_plot(moved, "--outdir", os.path.join(tmp, "moved_figs")),
+                   "relative to where rfseek-sim ran", os.path.join(tmp, "moved_figs"))
 
     out = os.path.join(tmp, "bad.gif")
     one_line_error("missing_rundir", run_plot(os.path.join(tmp, "nope"), "--animate", "--out", out),

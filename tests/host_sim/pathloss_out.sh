@@ -35,10 +35,17 @@ import json, math, sys
 d = sys.argv[1]
 s = json.load(open(d + "/summary.json"))
 with open(d + "/residual.tsv") as f:
-    assert f.readline() == "x_m\ty_m\tresidual_db\n", "residual.tsv header"
+    assert f.readline() == "x_m\ty_m\tresidual_db\tcell_x_m\tcell_y_m\n", "residual.tsv header"
     res = [tuple(float(v) for v in line.split("\t")) for line in f]
 assert len(res) >= 10, "residual.tsv: %d rows" % len(res)
 assert all(math.isfinite(r[2]) and r[2] >= 0.0 for r in res), "residual values"
+# each candidate lies in its cell (the grid point or its snap, within a coarse half-step)
+# and the cells are distinct points of one regular grid
+cells = sorted({(r[3], r[4]) for r in res})
+assert len(cells) == len(res), "residual.tsv: a cell twice"
+step = min(abs(a[0] - b[0]) for a in cells for b in cells if a[0] != b[0])
+assert all(abs(r[0] - r[3]) <= step / 2 + 1e-3 and abs(r[1] - r[4]) <= step / 2 + 1e-3
+           for r in res), "residual.tsv: a candidate outside its cell"
 with open(d + "/log.tsv") as f:
     head = f.readline().rstrip("\n").split("\t")
     rows = [line.rstrip("\n").split("\t") for line in f]

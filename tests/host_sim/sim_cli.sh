@@ -78,6 +78,19 @@ if [ -s "$T/cfdef.json" ] && cmp -s <(same "$T/cfdef.json") <(same "$T/cf0.25.js
 else
     fail coarse_footprint_key "$(head -c 300 "$T/cf0.25.json")"
 fi
+# seek.coarse_snap reaches the model: false (coarse grid points in walls have no candidate)
+# changes the run on the office; true, the default, does not (docs/PATHLOSS.md, "Fit").
+for cs in def false true; do
+    { sed "s|^map: .*|map: $(realpath scenarios/maps/office.yaml)|" scenarios/default.yaml
+      [ "$cs" = def ] || echo "seek: {coarse_snap: $cs}"; } >"$T/cs$cs.yaml"
+    "$SIM" "$T/cs$cs.yaml" --model pathloss --strategy meta-path --seed 3 >"$T/cs$cs.json" 2>/dev/null
+done
+if [ -s "$T/csdef.json" ] && cmp -s <(same "$T/csdef.json") <(same "$T/cstrue.json") \
+    && ! cmp -s <(same "$T/csdef.json") <(same "$T/csfalse.json"); then
+    pass coarse_snap_key
+else
+    fail coarse_snap_key "$(head -c 300 "$T/csfalse.json")"
+fi
 scn unknown.yaml "${BASE}colour: red
 "
 bad unknown_key "unknown.yaml:5: scenario: unknown key 'colour'" "$T/unknown.yaml" --out "$T/out"

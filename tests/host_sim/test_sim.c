@@ -106,6 +106,7 @@ static void test_scenario_good(void **state)
     assert_true(sc.seek_near_t == -1.0 && sc.seek_near_m == -1.0);
     assert_true(isnan(sc.seek_p0_min_dbm)); // the pathloss model's own default
     assert_true(isnan(sc.seek_coarse_footprint_m));
+    assert_int_equal(sc.seek_coarse_snap, -1); // the pathloss model's own default (on)
     assert_true(sc.rx_heartbeat); // on unless the scenario turns it off
     // seek: overrides of the strategy's preset.
     char text[2048];
@@ -141,6 +142,9 @@ static void test_scenario_good(void **state)
     assert_int_equal(hs_scenario_load(scn("seek_cf.yaml", text), &sc, err, sizeof err), 0);
     assert_true(sc.seek_coarse_footprint_m == 0.25 && isnan(sc.seek_p0_min_dbm));
     assert_true(isnan(sc.seek_p0_max_wall_db)); // off: each wall costs the fit's W
+    snprintf(text, sizeof text, "%sseek: {coarse_snap: false}\n", GOOD);
+    assert_int_equal(hs_scenario_load(scn("seek_snap.yaml", text), &sc, err, sizeof err), 0);
+    assert_int_equal(sc.seek_coarse_snap, 0);
     snprintf(text, sizeof text, "%sseek: {p0_max_wall_db: 3}\n", GOOD);
     assert_int_equal(hs_scenario_load(scn("seek_p0w.yaml", text), &sc, err, sizeof err), 0);
     assert_true(sc.seek_p0_max_wall_db == 3.0);
@@ -249,6 +253,10 @@ static void test_scenario_bad(void **state)
                "map: @MAP@\nseek: {p0_max_wall_db: 61}\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",
                "seek_p0w_range.yaml:2: seek.p0_max_wall_db: 61 is out of range");
+    expect_bad("seek_snap_bool.yaml",
+               "map: @MAP@\nseek: {coarse_snap: 2}\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "seek_snap_bool.yaml:2: seek.coarse_snap: expected true or false");
     expect_bad("seek_p0_num.yaml",
                "map: @MAP@\nseek: {p0_min_dbm: loud}\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",

@@ -65,32 +65,27 @@ if [ -s "$T/p0cli.json" ] && cmp -s <(same "$T/p0cli.json") <(same "$T/p0key.jso
 else
     fail p0_min_cli_equals_key "$(head -c 300 "$T/p0cli.json") / $(head -c 300 "$T/p0key.json")"
 fi
-# seek.coarse_footprint_m reaches the model: on the office (walls), 0 (the coarse pass at one
-# count a bin) changes the run; 0.25, the default, does not (docs/PATHLOSS.md).
-for cf in def 0 0.25; do
-    { sed "s|^map: .*|map: $(realpath scenarios/maps/office.yaml)|" scenarios/default.yaml
-      [ "$cf" = def ] || echo "seek: {coarse_footprint_m: $cf}"; } >"$T/cf$cf.yaml"
-    "$SIM" "$T/cf$cf.yaml" --model pathloss --strategy meta-path --seed 3 >"$T/cf$cf.json" 2>/dev/null
-done
-if [ -s "$T/cfdef.json" ] && cmp -s <(same "$T/cfdef.json") <(same "$T/cf0.25.json") \
-    && ! cmp -s <(same "$T/cfdef.json") <(same "$T/cf0.json"); then
-    pass coarse_footprint_key
-else
-    fail coarse_footprint_key "$(head -c 300 "$T/cf0.25.json")"
-fi
-# seek.coarse_snap reaches the model: false (coarse grid points in walls have no candidate)
-# changes the run on the office; true, the default, does not (docs/PATHLOSS.md, "Fit").
-for cs in def false true; do
-    { sed "s|^map: .*|map: $(realpath scenarios/maps/office.yaml)|" scenarios/default.yaml
-      [ "$cs" = def ] || echo "seek: {coarse_snap: $cs}"; } >"$T/cs$cs.yaml"
-    "$SIM" "$T/cs$cs.yaml" --model pathloss --strategy meta-path --seed 3 >"$T/cs$cs.json" 2>/dev/null
-done
-if [ -s "$T/csdef.json" ] && cmp -s <(same "$T/csdef.json") <(same "$T/cstrue.json") \
-    && ! cmp -s <(same "$T/csdef.json") <(same "$T/csfalse.json"); then
-    pass coarse_snap_key
-else
-    fail coarse_snap_key "$(head -c 300 "$T/csfalse.json")"
-fi
+# seek.KEY reaches the path-loss model: on the office (walls), OTHER changes the run, SAME
+# (the model's default) does not (docs/PATHLOSS.md): coarse_footprint_m 0 counts the coarse
+# pass at one count a bin; coarse_snap false leaves coarse grid points in walls without a
+# candidate.
+key_reaches() { # NAME KEY SAME OTHER
+    local name=$1 key=$2 sv=$3 ov=$4 v
+    for v in def "$sv" "$ov"; do
+        { sed "s|^map: .*|map: $(realpath scenarios/maps/office.yaml)|" scenarios/default.yaml
+          [ "$v" = def ] || echo "seek: {$key: $v}"; } >"$T/$name$v.yaml"
+        "$SIM" "$T/$name$v.yaml" --model pathloss --strategy meta-path --seed 3 \
+            >"$T/$name$v.json" 2>/dev/null
+    done
+    if [ -s "$T/${name}def.json" ] && cmp -s <(same "$T/${name}def.json") <(same "$T/$name$sv.json") \
+        && ! cmp -s <(same "$T/${name}def.json") <(same "$T/$name$ov.json"); then
+        pass "$name"
+    else
+        fail "$name" "$(head -c 300 "$T/$name$ov.json")"
+    fi
+}
+key_reaches coarse_footprint_key coarse_footprint_m 0.25 0
+key_reaches coarse_snap_key coarse_snap true false
 scn unknown.yaml "${BASE}colour: red
 "
 bad unknown_key "unknown.yaml:5: scenario: unknown key 'colour'" "$T/unknown.yaml" --out "$T/out"

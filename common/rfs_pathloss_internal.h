@@ -33,6 +33,20 @@ static inline bool rfs_pathloss_same_lattice(const rfs_pathloss_lat_t *a,
            a->ncx == b->ncx && a->ncy == b->ncy;
 }
 
+/* The candidate lattice of a fit on map m (NULL: the bins' extent plus the margin, at
+ * 0.25 m), its coarse grid (cfg coarse, wider beyond RFS_PATHLOSS_MAX_COARSE points), and
+ * the snap table emptied when the map or lattice changed (rfs_pathloss_lattice.c). */
+void rfs_pathloss_lattice_setup(rfs_pathloss_t *p, const rfs_map_t *m);
+
+/* Coarse point c's lattice point, packed (rfs_pathloss_t.snap): its grid point when
+ * legal on the map; else, with coarse_snap, the legal point of its cell nearest it (least
+ * di^2 + dj^2, the first in row order on a tie); else RFS_PATHLOSS_SNAP_NONE. *searched:
+ * the cell was searched (at most 225 legality tests). */
+uint8_t rfs_pathloss_snap_find(const rfs_pathloss_t *p, uint32_t c, bool *searched);
+
+/* Lattice point (i, j) is a coarse point's (its cell's, once looked for). */
+bool rfs_pathloss_is_coarse(const rfs_pathloss_t *p, int32_t i, int32_t j);
+
 /* Coarse point c's lattice point (i, j) on the last fit's lattice (its grid point, or its
  * cell's stand-in with coarse_snap: docs/PATHLOSS.md, "Fit", step 4); false when none.
  * The fit must have reached c. */

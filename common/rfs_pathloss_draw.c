@@ -71,10 +71,13 @@ bool rfs_pathloss_sample_op(const void *self, rfs_rng_t *rng, rfs_q16_t *x, rfs_
         acc += draw_weight(p, &k, c);
         if (acc > pick) {
             int32_t i, j;
-            const bool on = rfs_pathloss_coarse_ij(p, c, &i, &j);
-            RFS_ASSERT(on); /* a point with weight was a candidate */
+            /* A point with weight was a candidate, unless a fit on another lattice has
+             * begun since (its snaps not looked for yet): then no draw. */
+            if (!rfs_pathloss_coarse_ij(p, c, &i, &j)) {
+                return false;
+            }
             rfs_pathloss_lattice_xy(l, (uint16_t)i, (uint16_t)j, x, y);
-            return on;
+            return true;
         }
     }
     RFS_ASSERT(false); /* acc reaches total > pick */

@@ -48,8 +48,8 @@ uint8_t rfs_pathloss_snap_find(const rfs_pathloss_t *p, uint32_t c, bool *search
 bool rfs_pathloss_is_coarse(const rfs_pathloss_t *p, int32_t i, int32_t j);
 
 /* Coarse point c's lattice point (i, j) on the last fit's lattice (its grid point, or its
- * cell's stand-in with coarse_snap: docs/PATHLOSS.md, "Fit", step 4); false when none.
- * The fit must have reached c. */
+ * cell's stand-in with coarse_snap: docs/PATHLOSS.md, "Fit", step 4); false when none, or
+ * when not looked for yet (a fit on another lattice in progress). */
 bool rfs_pathloss_coarse_ij(const rfs_pathloss_t *p, uint32_t c, int32_t *i, int32_t *j);
 
 /* Mean Huber loss per unit weight, dB^2 Q16, saturated below NO_LOSS. */

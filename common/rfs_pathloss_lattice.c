@@ -5,8 +5,6 @@
 
 #include <string.h>
 
-#include "rfs_assert.h"
-
 /* Lattice spacing without a map, metres Q16.16 (the map default). */
 #define NOMAP_GRID RFS_Q16_FRAC(1, 4)
 
@@ -117,8 +115,7 @@ uint8_t rfs_pathloss_snap_find(const rfs_pathloss_t *p, uint32_t c, bool *search
 bool rfs_pathloss_coarse_ij(const rfs_pathloss_t *p, uint32_t c, int32_t *i, int32_t *j)
 {
     const uint8_t s = p->snap[c];
-    RFS_ASSERT(s != RFS_PATHLOSS_SNAP_UNKNOWN);
-    if (s == RFS_PATHLOSS_SNAP_NONE) {
+    if (s == RFS_PATHLOSS_SNAP_NONE || s == RFS_PATHLOSS_SNAP_UNKNOWN) {
         return false;
     }
     coarse_grid(&p->lat, c, i, j);

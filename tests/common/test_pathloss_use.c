@@ -449,6 +449,44 @@ static void draws_follow_the_residual_surface(void **state)
     assert_int_equal(rfs_pathloss_draw_weight(&f->pl, 0, 0), 0u);
 }
 
+/* Without a map the lattice follows the samples: a sliced fit on data spread otherwise
+ * moves it and empties the snap table. Between its slices the last model stays valid, and
+ * a draw or a residual read there either reads a coarse point of the new lattice already
+ * looked for or gives none: no trap, every position drawn inside the new lattice's extent
+ * or the old model's candidates'. */
+static void draws_between_slices_of_a_moved_lattice(void **state)
+{
+    fixture_t *f = *state;
+    truth_t t = {21.0, 6.0, -30.0, 2.0, 0.0, 0.3};
+    make_samples(f->s, 800, NULL, &t, 13);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    (void)fit_with(f, &c, 400, NULL, 0, NULL); /* the first 400 samples' lattice */
+    for (int i = 0; i < 800; ++i) {            /* the same places, shifted 7 m east */
+        f->s[i].x_cm = (int16_t)(f->s[i].x_cm + 700);
+    }
+    rfs_model_fit_in_t in = {.samples = f->s, .n = 800, .map = NULL};
+    rfs_rng_t rng, draw;
+    rfs_rng_seed(&rng, 1);
+    rfs_rng_seed(&draw, 2);
+    int calls = 0, drawn = 0, none = 0;
+    rfs_fit_result_t r;
+    do {
+        r = rfs_pathloss_ops.fit(&f->pl, &in, 3, &rng);
+        calls++;
+        rfs_q16_t x, y, rms;
+        if (rfs_pathloss_ops.sample(&f->pl, &draw, &x, &y)) {
+            drawn++;
+            assert_true(x >= -(20 << 16) && x <= (58 << 16) && y >= -(21 << 16) && y <= (37 << 16));
+        } else {
+            none++;
+        }
+        (void)rfs_pathloss_residual_at(&f->pl, 0, 0, &x, &y, &rms);
+    } while (r == RFS_FIT_MORE && calls < 100000);
+    assert_int_equal(r, RFS_FIT_DONE);
+    assert_true(calls > 10 && drawn > 0);
+    print_message("between slices: %d draws, %d without one\n", drawn, none);
+}
+
 /* Closed loop with the paper's meta-algorithm (rfs_seek, paper defaults) and this model:
  * the office of this file, the source in a room, the robot starting in the corridor
  * 17 m away; a double-precision world (unicycle kinematics) with -40 - 30 log10(d)
@@ -552,6 +590,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(residual_surface_and_spread, setup, teardown),
         cmocka_unit_test_setup_teardown(near_weighs_plausibility_per_metre, setup, teardown),
         cmocka_unit_test_setup_teardown(draws_follow_the_residual_surface, setup, teardown),
+        cmocka_unit_test_setup_teardown(draws_between_slices_of_a_moved_lattice, setup, teardown),
         cmocka_unit_test_setup_teardown(closed_loop_finds_the_room, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -135,8 +135,9 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
     cfg->local_gap = on ? cfg->step / 2 : 0;
     cfg->at_tol = on ? RFS_Q16_FRAC(3, 100) : 0;
     cfg->local_refute = on; /* no parking at a swept estimate (docs/STRATEGIES.md, "Stalls") */
-    /* 4 m^2 at the 0.25 m lattice: no pocket to seek in (docs/STRATEGIES.md, "Stalls"). */
-    cfg->reach_min = on ? 64u : 0u;
+    /* 1 m^2 at the 0.25 m lattice, no room for a step; larger sealed components can hold
+     * the source (docs/STRATEGIES.md, "Stalls"). */
+    cfg->reach_min = on ? 16u : 0u;
 }
 
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)

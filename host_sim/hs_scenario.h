@@ -15,7 +15,7 @@
  *                                  #       coarse_footprint_m: 0.25,
  *                                  #       p0_max_wall_db: 3, local_gap_m: 0.5,
  *                                  #       at_tol_m: 0.03, near_t: 0, near_m: 30,
- *                                  #       reach_min: 64}
+ *                                  #       reach_min: 16}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2

@@ -290,6 +290,12 @@ static void pocket_case(uint32_t seed, double res, uint32_t budget, int *left, i
 static void test_reach_min_leaves_a_pocket(void **state)
 {
     (void)state;
+    rfs_seek_cfg_t c = rfs_seek_cfg_default();
+    assert_int_equal(c.reach_min, 0); /* the paper's: the robot's component */
+    rfs_seek_cfg_use_strategy(&c, RFS_SEEK_META_PATH);
+    assert_int_equal(c.reach_min, 16);
+    rfs_seek_cfg_use_strategy(&c, RFS_SEEK_META);
+    assert_int_equal(c.reach_min, 0);
     int left = 0, kept = 0;
     for (uint32_t seed = 1; seed <= 12; seed++) {
         pocket_case(seed, 0.125, 0u, &left, &kept);

@@ -8,8 +8,9 @@ uint32_t rfs_reach_bytes(const rfs_map_t *map)
     return ((uint32_t)map->lw * map->lh + 7u) / 8u;
 }
 
-bool rfs_reach_snap(const rfs_map_t *map, const uint8_t *reach, rfs_q16_t x, rfs_q16_t y,
-                    uint16_t *oi, uint16_t *oj)
+/* The snap's ring search; with `reach`, only points whose bit there is `in`. */
+static bool snap(const rfs_map_t *map, const uint8_t *reach, bool in, rfs_q16_t x, rfs_q16_t y,
+                 uint16_t *oi, uint16_t *oj)
 {
     const rfs_map_t *m = map;
     uint16_t ci, cj;
@@ -28,7 +29,7 @@ bool rfs_reach_snap(const rfs_map_t *map, const uint8_t *reach, rfs_q16_t x, rfs
                 if (!rfs_map_lattice_legal(m, (uint16_t)i, (uint16_t)j)) {
                     continue;
                 }
-                if (reach != 0 && !rfs_reach_at(m, reach, (uint16_t)i, (uint16_t)j)) {
+                if (reach != 0 && rfs_reach_at(m, reach, (uint16_t)i, (uint16_t)j) != in) {
                     continue;
                 }
                 int64_t d = (int64_t)di * di + (int64_t)dj * dj;
@@ -44,6 +45,18 @@ bool rfs_reach_snap(const rfs_map_t *map, const uint8_t *reach, rfs_q16_t x, rfs
         }
     }
     return false;
+}
+
+bool rfs_reach_snap(const rfs_map_t *map, const uint8_t *reach, rfs_q16_t x, rfs_q16_t y,
+                    uint16_t *oi, uint16_t *oj)
+{
+    return snap(map, reach, true, x, y, oi, oj);
+}
+
+bool rfs_reach_snap_outside(const rfs_map_t *map, const uint8_t *reach, rfs_q16_t x,
+                            rfs_q16_t y, uint16_t *oi, uint16_t *oj)
+{
+    return snap(map, reach, false, x, y, oi, oj);
 }
 
 /* Mark every legal lattice point: the answer when the flood's queue is too small for
@@ -66,6 +79,7 @@ bool rfs_reach_flood_begin(rfs_reach_flood_t *f, const rfs_map_t *map, rfs_q16_t
     f->head = 0u;
     f->count = 0u;
     f->overflow = false;
+    f->marked = 0u;
     uint16_t si, sj;
     if (!rfs_reach_snap(map, 0, x, y, &si, &sj)) {
         return false;
@@ -74,6 +88,7 @@ bool rfs_reach_flood_begin(rfs_reach_flood_t *f, const rfs_map_t *map, rfs_q16_t
     rfs_reach_bit_set(reach, start);
     queue[0] = start;
     f->count = 1u;
+    f->marked = 1u;
     return true;
 }
 
@@ -107,6 +122,7 @@ bool rfs_reach_flood_run(rfs_reach_flood_t *f, const rfs_map_t *map, uint8_t *re
                 continue;
             }
             rfs_reach_bit_set(reach, nidx);
+            f->marked++;
             if (f->count == cap) {
                 f->overflow = true; /* marked but not expanded: handled below */
                 continue;
@@ -118,6 +134,7 @@ bool rfs_reach_flood_run(rfs_reach_flood_t *f, const rfs_map_t *map, uint8_t *re
     if (f->overflow) {
         mark_all_legal(m, reach);
         f->overflow = false;
+        f->marked = UINT32_MAX;
     }
     return true;
 }

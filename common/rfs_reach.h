@@ -49,6 +49,10 @@ static inline bool rfs_reach_at(const rfs_map_t *map, const uint8_t *reach, uint
 bool rfs_reach_snap(const rfs_map_t *map, const uint8_t *reach, rfs_q16_t x, rfs_q16_t y,
                     uint16_t *oi, uint16_t *oj);
 
+/// rfs_reach_snap(), but the point must be clear in `reach` (outside that component).
+bool rfs_reach_snap_outside(const rfs_map_t *map, const uint8_t *reach, rfs_q16_t x,
+                            rfs_q16_t y, uint16_t *oi, uint16_t *oj);
+
 /// Fill `reach` (rfs_reach_bytes(map) bytes) with the component of the lattice graph
 /// that holds the legal lattice point nearest to (x, y) (rfs_reach_snap). `queue` (cap
 /// entries, >= 1) is the flood's work memory; when it is too small for the frontier every
@@ -63,6 +67,7 @@ typedef struct rfs_reach_flood {
     uint32_t head;  ///< queue index of the next point to expand
     uint32_t count; ///< points queued, 0 when the flood is over
     bool overflow;  ///< a point was marked but not queued (queue too small)
+    uint32_t marked; ///< points marked so far (UINT32_MAX once every legal point is)
 } rfs_reach_flood_t;
 /// rfs_reach_fill() in slices: clear `reach` and queue the legal lattice point nearest to
 /// (x, y) (rfs_reach_snap). false, and no bit set, when there is none within

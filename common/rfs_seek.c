@@ -56,6 +56,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.local_refute = false;
     c.at_tol = 0;                           /* the drive's goal tolerance for every goal */
     c.leg_max = 0;                          /* and walk the whole leg to it */
+    c.reach_min = 0;                        /* the robot's component, however small */
     c.silence_floor = INT32_MIN;            /* silence adds no sample */
     c.recheck_silent = false;               /* and a silent check passes */
     c.settle_dist = 0;                      /* epsilon anneals to eps_floor, never 0 */
@@ -134,6 +135,9 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
     cfg->local_gap = on ? cfg->step / 2 : 0;
     cfg->at_tol = on ? RFS_Q16_FRAC(3, 100) : 0;
     cfg->local_refute = on; /* no parking at a swept estimate (docs/STRATEGIES.md, "Stalls") */
+    /* 1 m^2 at the 0.25 m lattice, no room for a step; larger sealed components can hold
+     * the source (docs/STRATEGIES.md, "Stalls"). */
+    cfg->reach_min = on ? 16u : 0u;
 }
 
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)
@@ -721,6 +725,31 @@ static bool inputs_stale(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     return true;
 }
 
+/* reach_min, at the end of a flood: a component of fewer than reach_min points is a pocket
+ * (a clutter pocket the snap joined at a tie: the robot would be sealed in it). Flood once
+ * from the nearest legal lattice point outside it; keep that component when larger, else
+ * flood the pocket again. true when a flood began. */
+static bool flood_pocket(rfs_seek_t *s)
+{
+    uint16_t i, j;
+    rfs_q16_t x = s->pose.x, y = s->pose.y;
+    if (s->cfg.reach_min == 0u || s->reach_pocket == 2u ||
+        (s->reach_pocket == 0u && s->flood.marked >= s->cfg.reach_min) ||
+        (s->reach_pocket == 1u && s->flood.marked > s->reach_own)) {
+        return false;
+    }
+    if (s->reach_pocket == 0u) {
+        if (!rfs_reach_snap_outside(s->map, s->reach, x, y, &i, &j)) {
+            return false;
+        }
+        s->reach_own = s->flood.marked;
+        rfs_map_lattice_point(s->map, i, j, &x, &y);
+    }
+    s->reach_pocket++;
+    s->reach_valid = false;
+    return rfs_reach_flood_begin(&s->flood, s->map, x, y, s->reach, s->queue);
+}
+
 /* Keep the reach bits the robot's component: computed at the first fresh period, and
  * again when the robot is somewhere the flood fill did not reach (pushed, relocalised);
  * with reach_budget in slices. true while a sliced flood goes on: the period ends with
@@ -732,11 +761,12 @@ static bool keep_reach(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     if (!s->flooding &&
         (!s->reach_valid || !rfs_reach_snap(s->map, s->reach, s->pose.x, s->pose.y, &si, &sj))) {
         s->reach_valid = false;
+        s->reach_pocket = 0u;
         s->flooding = rfs_reach_flood_begin(&s->flood, s->map, s->pose.x, s->pose.y, s->reach,
                                             s->queue);
         filled = !s->flooding; /* no legal point near: no flood */
     }
-    if (s->flooding) {
+    while (s->flooding) {
         if (!rfs_reach_flood_run(&s->flood, s->map, s->reach, s->queue, s->queue_cap,
                                  s->cfg.reach_budget)) {
             stop_wheels(s, now_us, out);
@@ -745,6 +775,11 @@ static bool keep_reach(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
         s->flooding = false;
         s->reach_valid = true;
         filled = true;
+        s->flooding = flood_pocket(s);
+        if (s->flooding && s->cfg.reach_budget != 0u) {
+            stop_wheels(s, now_us, out); /* sliced: the next flood from the next period */
+            return true;
+        }
     }
     if (filled && s->plan.tree != 0u) {
         /* The fill used the planner's queue: a tree being grown starts again. */

@@ -136,6 +136,11 @@ typedef struct rfs_seek_cfg {
     rfs_q16_t leg_max;          ///< a greedy leg to a known argmax ends after this much of
                                 ///< its path (the next decision relearns and may explore),
                                 ///< metres Q16.16 (0: the whole path)
+    uint32_t reach_min;         ///< the robot's reachable component holding fewer lattice
+                                ///< points than this is a pocket (sealed off in clutter,
+                                ///< joined by a tie in the snap): the component of the
+                                ///< nearest legal lattice point outside it is taken instead
+                                ///< when larger (0: off, the robot's own)
     rfs_q16_t silence_floor;    ///< target rssi: while the receiver reports itself up and
                                 ///< no packet came for a whole averaging window, every pose
                                 ///< adds a sample of this value: the fit learns where the
@@ -311,6 +316,9 @@ typedef struct rfs_seek {
     bool reach_valid;                         ///< reach holds the robot's component
     bool flooding;                            ///< reach_budget: a sliced flood is under way
     rfs_reach_flood_t flood;                  ///< its state
+    uint8_t reach_pocket;                     ///< reach_min: 0 the robot's component, 1 the
+                                              ///< one beside its pocket, 2 the pocket again
+    uint32_t reach_own;                       ///< reach_min: the pocket's lattice points
     uint16_t eps_w[RFS_SEEK_EPS_TABLE];       ///< e^(-d) by squared lattice offset, Q0.16
     rfs_pose_t pose;                          ///< latest pose
     bool have_pose;                           ///< pose is valid
@@ -373,7 +381,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 /// fields, on for RFS_SEEK_META_PATH (recheck_dist = cfg->step, eps_by_travel,
 /// recheck_adapt, eps_geodesic, eps_sample, refute_r = cfg->step, silence_floor = -100
 /// dBm, recheck_silent, local_r = 4 cfg->step, local_gap = cfg->step / 2, at_tol = 3 cm,
-/// local_refute),
+/// local_refute, reach_min = 16),
 /// the paper's (0, false) for every other strategy.
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 

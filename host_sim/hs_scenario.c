@@ -95,6 +95,23 @@ static int num(pctx_t *p, const lx_yaml_node_t *m, const char *where, const char
     return to_num(p, n, w, lo, hi, out);
 }
 
+/// Optional whole number field `key` of mapping m, in [0, hi] (*out untouched when absent).
+static int whole(pctx_t *p, const lx_yaml_node_t *m, const char *where, const char *key, double hi,
+                 double *out)
+{
+    double v = -1.0;
+    if (num(p, m, where, key, 0, hi, &v) != 0) {
+        return -1;
+    }
+    if (v != floor(v)) {
+        return fail(p, lx_yaml_get(m, key), "%s.%s: %g is not a whole number", where, key, v);
+    }
+    if (v >= 0.0) {
+        *out = v;
+    }
+    return 0;
+}
+
 static int boolean(pctx_t *p, const lx_yaml_node_t *m, const char *where, const char *key, bool *out)
 {
     const lx_yaml_node_t *n = lx_yaml_get(m, key);
@@ -208,6 +225,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_at_tol_m = -1.0;
     sc->seek_near_t = -1.0;
     sc->seek_near_m = -1.0;
+    sc->seek_reach_min = -1.0;
     sc->seek_eps_by_travel = -1;
     sc->seek_eps_geodesic = -1;
     sc->seek_recheck_adapt = -1;
@@ -437,7 +455,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
                                         "refute_reached", "local_m", "leg_m", "recheck_silent",
                                         "coarse_footprint_m", "p0_max_wall_db", "local_gap_m",
                                         "at_tol_m", "local_refute", "near_t",
-                                        "near_m", "coarse_snap", NULL};
+                                        "near_m", "coarse_snap", "reach_min", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "refute_m", 0, 100, &sc->seek_refute_m) ||
@@ -447,6 +465,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             num(p, n, "seek", "at_tol_m", 0, 1, &sc->seek_at_tol_m) ||
             num(p, n, "seek", "near_t", 0, 64, &sc->seek_near_t) ||
             num(p, n, "seek", "near_m", 0, 1000, &sc->seek_near_m) ||
+            whole(p, n, "seek", "reach_min", 1e6, &sc->seek_reach_min) ||
             num(p, n, "seek", "eps_rate", 0, 100, &sc->seek_eps_rate) ||
             num(p, n, "seek", "p0_min_dbm", -200, 100, &sc->seek_p0_min_dbm) ||
             num(p, n, "seek", "coarse_footprint_m", 0, 0.5, &sc->seek_coarse_footprint_m) ||

@@ -159,6 +159,152 @@ static void test_reach_is_the_component(void **state)
     reach_case(4, 0.1, true, 0u, &c2, &l2);
 }
 
+/* t's map: 8 x 6 m at cell size res, no clearance, the 0.25 m lattice, 14 rectangular
+ * rings of one-cell walls 0.4 to 2.4 m a side at random (seed), overlapping: closed
+ * pockets of many sizes. Returns the random state after the map. */
+static uint32_t boxed_map(world_t *t, uint32_t seed, double res)
+{
+    memset(t, 0, sizeof *t);
+    t->w = (uint16_t)lround(8.0 / res);
+    t->h = (uint16_t)lround(6.0 / res);
+    uint32_t bytes = rfs_map_bytes(t->w, t->h);
+    uint16_t stride = (uint16_t)((t->w + 7) / 8);
+    t->free_bits = calloc(bytes, 1);
+    t->wall_bits = calloc(bytes, 1);
+    t->legal_bits = calloc(bytes, 1);
+    for (uint16_t y = 0; y < t->h; ++y) {
+        for (uint16_t x = 0; x < t->w; ++x) {
+            rfs_map_bit_set(t->free_bits, stride, x, y, true);
+        }
+    }
+    uint32_t s = seed * 2654435761u;
+    for (int b = 0; b < 14; b++) {
+        int xy[4];
+        for (int k = 0; k < 4; k++) {
+            s = s * 1664525u + 1013904223u;
+            xy[k] = (int)((s >> 8) % 1000u);
+        }
+        int x0 = xy[0] * (t->w - 1) / 1000, y0 = xy[1] * (t->h - 1) / 1000;
+        int x1 = x0 + (int)lround((0.4 + 2.0 * xy[2] / 1000.0) / res);
+        int y1 = y0 + (int)lround((0.4 + 2.0 * xy[3] / 1000.0) / res);
+        for (int y = y0; y <= y1 && y < t->h; y++) {
+            for (int x = x0; x <= x1 && x < t->w; x++) {
+                if (x == x0 || x == x1 || y == y0 || y == y1) {
+                    rfs_map_bit_set(t->free_bits, stride, (uint16_t)x, (uint16_t)y, false);
+                }
+            }
+        }
+    }
+    rfs_map_cfg_t mc = rfs_map_cfg_default();
+    mc.clearance = 0;
+    assert_int_equal(rfs_map_init(&t->map, &mc, t->w, t->h, Q(res), 0, 0, t->free_bits,
+                                  t->wall_bits, t->legal_bits), 0);
+    return s;
+}
+
+/* Points set in a reference flood's bits. */
+static int bits_count(const uint8_t *bits, int n)
+{
+    int c = 0;
+    for (int v = 0; v < n; v++) {
+        c += bit_of(bits, v);
+    }
+    return c;
+}
+
+/* reach_min (rfs_seek_cfg_t): a robot on a legal lattice point of a pocket (a component
+ * of fewer than reach_min points) of a boxed map gets the component of the nearest
+ * legal lattice point outside it (squared lattice offset, rings of up to
+ * RFS_REACH_SNAP_RADIUS, row-major at a tie) when that is larger, else its own: both from
+ * double-precision floods. Counts the pockets left and kept. */
+static void pocket_case(uint32_t seed, double res, uint32_t budget, int *left, int *kept)
+{
+    world_t t;
+    uint32_t s = boxed_map(&t, seed, res);
+    const int lw = t.map.lw, lh = t.map.lh, n = lw * lh;
+    uint8_t *own = calloc(t.map.lw * (size_t)t.map.lh / 8 + 1, 1);
+    uint8_t *other = calloc(t.map.lw * (size_t)t.map.lh / 8 + 1, 1);
+    int si, sj, size, tries = 0;
+    do { /* a random legal lattice point in a pocket (under 64 points) */
+        s = s * 1664525u + 1013904223u;
+        si = (int)((s >> 8) % (uint32_t)lw);
+        s = s * 1664525u + 1013904223u;
+        sj = (int)((s >> 8) % (uint32_t)lh);
+        size = 0;
+        if (ref_lat_legal(&t.map, si, sj)) {
+            ref_flood(lw, lh, si, sj, ref_map_step, &t.map, own);
+            size = bits_count(own, n);
+        }
+    } while ((size < 1 || size >= 64) && ++tries < 5000);
+    assert_true(size >= 1 && size < 64);
+    int oi = -1, oj = -1;
+    for (int r = 1; r <= RFS_REACH_SNAP_RADIUS && oi < 0; r++) {
+        int best = INT32_MAX;
+        for (int dj = -r; dj <= r; dj++) {
+            for (int di = -r; di <= r; di++) {
+                int i = si + di, j = sj + dj;
+                if ((abs(di) != r && abs(dj) != r) || i < 0 || j < 0 || i >= lw || j >= lh ||
+                    !ref_lat_legal(&t.map, i, j) || bit_of(own, j * lw + i) ||
+                    di * di + dj * dj >= best) {
+                    continue;
+                }
+                best = di * di + dj * dj;
+                oi = i;
+                oj = j;
+            }
+        }
+    }
+    const uint8_t *want = own;
+    if (oi >= 0) {
+        ref_flood(lw, lh, oi, oj, ref_map_step, &t.map, other);
+        want = bits_count(other, n) > size ? other : own;
+    }
+    *left += want == other;
+    *kept += want == own;
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    cfg.reach_budget = budget;
+    cfg.reach_min = 64;
+    seek_make(&t, cfg, seed);
+    double g = D(t.map.cfg.grid);
+    rfs_pose_t p = pose_at(100000, g / 2 + si * g, g / 2 + sj * g, 0);
+    rfs_seek_out_t out;
+    rfs_seek_on_pose(&t.seek, &p, &t.rng);
+    rfs_seek_on_rssi(&t.seek, 0, 100000, -50, &t.rng);
+    rfs_seek_step(&t.seek, 100000, &t.rng, &out);
+    while (t.seek.flooding) {
+        assert_int_equal(out.left_mm_s, 0);
+        rfs_seek_step(&t.seek, 100000, &t.rng, &out);
+    }
+    assert_true(t.seek.reach_valid);
+    for (int v = 0; v < n; v++) {
+        if (bit_of(t.mem.reach, v) != bit_of(want, v)) {
+            fail_msg("seed %u, %.3f m cells, pocket of %d at (%d, %d): point (%d, %d) reach %d",
+                     seed, res, size, si, sj, v % lw, v / lw, !bit_of(want, v));
+        }
+    }
+    free(own);
+    free(other);
+    world_free(&t);
+}
+
+static void test_reach_min_leaves_a_pocket(void **state)
+{
+    (void)state;
+    rfs_seek_cfg_t c = rfs_seek_cfg_default();
+    assert_int_equal(c.reach_min, 0); /* the paper's: the robot's component */
+    rfs_seek_cfg_use_strategy(&c, RFS_SEEK_META_PATH);
+    assert_int_equal(c.reach_min, 16);
+    rfs_seek_cfg_use_strategy(&c, RFS_SEEK_META);
+    assert_int_equal(c.reach_min, 0);
+    int left = 0, kept = 0;
+    for (uint32_t seed = 1; seed <= 12; seed++) {
+        pocket_case(seed, 0.125, 0u, &left, &kept);
+        pocket_case(seed, 0.1, seed % 2 ? 0u : 7u, &left, &kept);
+    }
+    print_message("pockets left %d, kept %d\n", left, kept);
+    assert_true(left > 0 && kept > 0);
+}
+
 /* reach_budget: the flood sliced over periods gives the whole flood's bits. */
 static void test_sliced_reach_is_the_component(void **state)
 {
@@ -229,6 +375,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reach_is_the_component),
         cmocka_unit_test(test_sliced_reach_is_the_component),
+        cmocka_unit_test(test_reach_min_leaves_a_pocket),
         cmocka_unit_test(test_memo_matches_reference),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

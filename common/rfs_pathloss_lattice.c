@@ -134,6 +134,5 @@ bool rfs_pathloss_is_coarse(const rfs_pathloss_t *p, int32_t i, int32_t j)
     }
     const uint32_t c = (uint32_t)(kj / l->cs) * l->ncx + (uint32_t)(ki / l->cs);
     int32_t ci, cj;
-    return p->snap[c] != RFS_PATHLOSS_SNAP_UNKNOWN && rfs_pathloss_coarse_ij(p, c, &ci, &cj) &&
-           ci == i && cj == j;
+    return rfs_pathloss_coarse_ij(p, c, &ci, &cj) && ci == i && cj == j;
 }

@@ -50,18 +50,25 @@ static int ref_map_step(void *ctx, int ui, int uj, int vi, int vj)
     return ref_lat_legal(m, vi, vj) && ref_step_legal(m, ui, uj, vi, vj);
 }
 
-/* t's map: 8 x 6 m at cell size res, 2.5 % of the cells occupied at random (seed), no
- * clearance, the 0.25 m lattice. Returns the random state after the map. */
-static uint32_t speckled_map(world_t *t, uint32_t seed, double res)
+/* t emptied, 8 x 6 m at cell size res, its three bit grids allocated and clear; returns
+ * the grids' row stride in bytes. */
+static uint16_t blank_8x6(world_t *t, double res)
 {
     memset(t, 0, sizeof *t);
     t->w = (uint16_t)lround(8.0 / res);
     t->h = (uint16_t)lround(6.0 / res);
     uint32_t bytes = rfs_map_bytes(t->w, t->h);
-    uint16_t stride = (uint16_t)((t->w + 7) / 8);
     t->free_bits = calloc(bytes, 1);
     t->wall_bits = calloc(bytes, 1);
     t->legal_bits = calloc(bytes, 1);
+    return (uint16_t)((t->w + 7) / 8);
+}
+
+/* t's map: 8 x 6 m at cell size res, 2.5 % of the cells occupied at random (seed), no
+ * clearance, the 0.25 m lattice. Returns the random state after the map. */
+static uint32_t speckled_map(world_t *t, uint32_t seed, double res)
+{
+    const uint16_t stride = blank_8x6(t, res);
     uint32_t s = seed * 2654435761u;
     for (uint16_t y = 0; y < t->h; ++y) {
         for (uint16_t x = 0; x < t->w; ++x) {
@@ -164,14 +171,7 @@ static void test_reach_is_the_component(void **state)
  * pockets of many sizes. Returns the random state after the map. */
 static uint32_t boxed_map(world_t *t, uint32_t seed, double res)
 {
-    memset(t, 0, sizeof *t);
-    t->w = (uint16_t)lround(8.0 / res);
-    t->h = (uint16_t)lround(6.0 / res);
-    uint32_t bytes = rfs_map_bytes(t->w, t->h);
-    uint16_t stride = (uint16_t)((t->w + 7) / 8);
-    t->free_bits = calloc(bytes, 1);
-    t->wall_bits = calloc(bytes, 1);
-    t->legal_bits = calloc(bytes, 1);
+    const uint16_t stride = blank_8x6(t, res);
     for (uint16_t y = 0; y < t->h; ++y) {
         for (uint16_t x = 0; x < t->w; ++x) {
             rfs_map_bit_set(t->free_bits, stride, x, y, true);

@@ -64,6 +64,17 @@ static uint16_t blank_8x6(world_t *t, double res)
     return (uint16_t)((t->w + 7) / 8);
 }
 
+/* t's robot at lattice point (si, sj) with one pose and one 1 s mean, and its first
+ * period (the reach flood begins there). */
+static void first_step(world_t *t, int si, int sj, rfs_seek_out_t *out)
+{
+    double g = D(t->map.cfg.grid);
+    rfs_pose_t p = pose_at(100000, g / 2 + si * g, g / 2 + sj * g, 0);
+    rfs_seek_on_pose(&t->seek, &p, &t->rng);
+    rfs_seek_on_rssi(&t->seek, 0, 100000, -50, &t->rng);
+    rfs_seek_step(&t->seek, 100000, &t->rng, out);
+}
+
 /* t's map: 8 x 6 m at cell size res, 2.5 % of the cells occupied at random (seed), no
  * clearance, the 0.25 m lattice. Returns the random state after the map. */
 static uint32_t speckled_map(world_t *t, uint32_t seed, double res)
@@ -111,12 +122,8 @@ static void reach_case(uint32_t seed, double res, bool small_queue, uint32_t bud
         assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, rfs_ridge_model(&t.ridge),
                                        &rfs_target_rssi, &t.mem), 0);
     }
-    double g = D(t.map.cfg.grid);
-    rfs_pose_t p = pose_at(100000, g / 2 + si * g, g / 2 + sj * g, 0);
     rfs_seek_out_t out;
-    rfs_seek_on_pose(&t.seek, &p, &t.rng);
-    rfs_seek_on_rssi(&t.seek, 0, 100000, -50, &t.rng);
-    rfs_seek_step(&t.seek, 100000, &t.rng, &out);
+    first_step(&t, si, sj, &out);
     int waits = 0;
     while (t.seek.flooding) {
         assert_false(t.seek.reach_valid);
@@ -265,12 +272,8 @@ static void pocket_case(uint32_t seed, double res, uint32_t budget, int *left, i
     cfg.reach_budget = budget;
     cfg.reach_min = 64;
     seek_make(&t, cfg, seed);
-    double g = D(t.map.cfg.grid);
-    rfs_pose_t p = pose_at(100000, g / 2 + si * g, g / 2 + sj * g, 0);
     rfs_seek_out_t out;
-    rfs_seek_on_pose(&t.seek, &p, &t.rng);
-    rfs_seek_on_rssi(&t.seek, 0, 100000, -50, &t.rng);
-    rfs_seek_step(&t.seek, 100000, &t.rng, &out);
+    first_step(&t, si, sj, &out);
     while (t.seek.flooding) {
         assert_int_equal(out.left_mm_s, 0);
         rfs_seek_step(&t.seek, 100000, &t.rng, &out);

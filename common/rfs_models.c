@@ -45,8 +45,10 @@ static int pathloss_init_default(void *state)
  * docs/PERFORMANCE.md, "Models on the Cortex-M4"): the largest round budget whose
  * heaviest slice stays under 16,800,000 Cortex-M4 instructions, half the 200 ms deadline
  * at 168 MHz, the other half left for the rest of the period and cycles > instructions.
- * - ridge, knn, radius: 2,500 samples, 74 k / 147 k instructions: also inside the
- *   firmware's 500,000 per period (docs/FIRMWARE.md).
+ * - ridge: 0, a whole fit (10,000 samples: 323,163 instructions, inside a period's
+ *   500,000; the choice waits a period), so a relearn delays a decision by 50 ms.
+ * - knn, radius: 2,500 samples, 147 k instructions: also inside the firmware's 500,000
+ *   per period (docs/FIRMWARE.md).
  * - mlp: 700 sample-updates, 16.3 M (about 23,000 per update; the first slice also
  *   standardises the samples); 800 would be 18.6 M.
  * - pathloss: 30 work units (about a wall count each, rfs_pathloss.h "Work"), 449,119:
@@ -54,7 +56,7 @@ static int pathloss_init_default(void *state)
  *   A call stops before work that could overrun the budget and resumes there. */
 const rfs_models_entry_t rfs_models_ridge = {
     "ridge", &rfs_ridge_ops, (uint32_t)sizeof(rfs_ridge_t), ridge_init_default,
-    "local ridge regression, 5 m radius, alpha 1 (paper 5.2.1)", 2500u, false};
+    "local ridge regression, 5 m radius, alpha 1 (paper 5.2.1)", 0u, false};
 const rfs_models_entry_t rfs_models_mlp = {
     "mlp", &rfs_mlp_ops, (uint32_t)sizeof(rfs_mlp_t), mlp_init_default,
     "MLP 2-100-1, sigmoid, backprop rate 0.01 momentum 0.1, 3 epochs (paper 5.2.2)", 700u, false};

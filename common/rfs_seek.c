@@ -591,11 +591,14 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
 }
 
 /* One slice of learning (all of it when fit_budget is 0). false while the fit needs more
- * periods: the wheels stay stopped meanwhile. */
+ * periods: the wheels stay stopped meanwhile. The query point is where the decision began,
+ * not the latest pose: a pose that moves by its noise between slices would restart a local
+ * fit (ridge) every period, and a fit longer than two periods would never end. */
 static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
 {
     rfs_model_fit_in_t fin = { .samples = s->store.samples, .n = s->store.count,
-                               .index = s->store.index, .qx = s->pose.x, .qy = s->pose.y, .map = s->map,
+                               .index = s->store.index, .qx = s->decision.x,
+                               .qy = s->decision.y, .map = s->map,
                                .reach = s->reach_valid ? s->reach : 0,
                                .excl_x_cm = s->excl_x_cm, .excl_y_cm = s->excl_y_cm,
                                .nexcl = s->nexcl,

@@ -60,11 +60,12 @@
 /// Pending measurements waiting for a bracketing pose (>= 64 required by rfs_seek).
 #define RFS_APP_PENDING 64u
 /// Work units the MCU configuration learns per control period with the built-in local
-/// ridge (the "ridge" registry entry's mcu_fit_budget, tested equal): 2,500 samples, the
-/// 10,000-sample fit spread over four periods keeps every period under 500,000
-/// instructions (docs/PERFORMANCE.md). Other models have their own budget in the registry
-/// (rfs_models_entry_t.mcu_fit_budget; rfs_app_fit_budget()).
-#define RFS_APP_MCU_FIT_BUDGET 2500u
+/// ridge (the "ridge" registry entry's mcu_fit_budget, tested equal): 0, a whole fit: on
+/// 10,000 samples about 323,000 instructions, under the 500,000 of a period, and the
+/// choice comes the period after (rfs_seek_cfg_t.plan_budget), so a decision that relearns
+/// takes two periods, 100 ms (docs/PERFORMANCE.md, "Decision latency"). Other models have
+/// their own budget in the registry (rfs_models_entry_t.mcu_fit_budget; rfs_app_fit_budget()).
+#define RFS_APP_MCU_FIT_BUDGET 0u
 /// Model state built into rfs_app_t, bytes: the local ridge's; any other model's state is
 /// the port's (rfs_app_cfg_t.model_state).
 #define RFS_APP_MODEL_BYTES ((uint32_t)sizeof(rfs_ridge_t))
@@ -201,11 +202,11 @@ typedef struct rfs_app {
 /// rfs_map_cfg_default), RSSI target, seed 1, 150 ms input timeout, node 1.
 rfs_app_cfg_t rfs_app_cfg_default(void);
 
-/// The microcontroller configuration: the defaults with the fit sliced over control
-/// periods so that no period's slice of a relearn comes near the 200 ms safety deadline:
-/// fit_budget_by_model set, and seek.fit_budget = RFS_APP_MCU_FIT_BUDGET
-/// (the ridge's; rfs_app_init() takes another model's from the registry). Decisions are
-/// the same; a ridge relearn keeps the wheels stopped for three more periods (150 ms).
+/// The microcontroller configuration: the defaults with each model's fit sliced over
+/// control periods as the registry says, so that no period comes near the 200 ms safety
+/// deadline: fit_budget_by_model set, and seek.fit_budget = RFS_APP_MCU_FIT_BUDGET (the
+/// ridge's, a whole fit; rfs_app_init() takes another model's from the registry), and the
+/// boot's flood fill in slices. Decisions are the same; the wheels wait while a fit runs.
 rfs_app_cfg_t rfs_app_cfg_mcu(void);
 
 /// The fit budget (work units per control period) rfs_app_init() gives the seeker for

@@ -226,6 +226,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_near_t = -1.0;
     sc->seek_near_m = -1.0;
     sc->seek_reach_min = -1.0;
+    sc->seek_fit_budget = -1.0;
     sc->seek_eps_by_travel = -1;
     sc->seek_eps_geodesic = -1;
     sc->seek_recheck_adapt = -1;
@@ -455,7 +456,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
                                         "refute_reached", "local_m", "leg_m", "recheck_silent",
                                         "coarse_footprint_m", "p0_max_wall_db", "local_gap_m",
                                         "at_tol_m", "local_refute", "near_t",
-                                        "near_m", "coarse_snap", "reach_min", NULL};
+                                        "near_m", "coarse_snap", "reach_min", "fit_budget", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "refute_m", 0, 100, &sc->seek_refute_m) ||
@@ -466,6 +467,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             num(p, n, "seek", "near_t", 0, 64, &sc->seek_near_t) ||
             num(p, n, "seek", "near_m", 0, 1000, &sc->seek_near_m) ||
             whole(p, n, "seek", "reach_min", 1e6, &sc->seek_reach_min) ||
+            whole(p, n, "seek", "fit_budget", 1e6, &sc->seek_fit_budget) ||
             num(p, n, "seek", "eps_rate", 0, 100, &sc->seek_eps_rate) ||
             num(p, n, "seek", "p0_min_dbm", -200, 100, &sc->seek_p0_min_dbm) ||
             num(p, n, "seek", "coarse_footprint_m", 0, 0.5, &sc->seek_coarse_footprint_m) ||

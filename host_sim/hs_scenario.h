@@ -15,7 +15,8 @@
  *                                  #       coarse_footprint_m: 0.25,
  *                                  #       p0_max_wall_db: 3, local_gap_m: 0.5,
  *                                  #       at_tol_m: 0.03, near_t: 0, near_m: 30,
- *                                  #       coarse_snap: true, reach_min: 16}
+ *                                  #       coarse_snap: true, reach_min: 16,
+ *                                  #       fit_budget: 30}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2
@@ -89,6 +90,8 @@ typedef struct hs_scenario {
     double seek_near_m;           ///< seek.near_m: rfs_seek_cfg_t.near_min (-1 = the preset)
     double seek_reach_min;        ///< seek.reach_min: lattice points of the smallest component
                                   ///< kept (rfs_seek_cfg_t.reach_min; 0: off; -1 = preset)
+    double seek_fit_budget;       ///< seek.fit_budget: the model's work units a control period
+                                  ///< (rfs_seek_cfg_t.fit_budget; 0: a whole fit; -1 = 0)
     double seek_leg_m;            ///< seek.leg_m: longest greedy leg to a known argmax
                                   ///< (rfs_seek_cfg_t.leg_max; 0: whole; -1 = the preset)
     int seek_refute_reached;      ///< seek.refute_reached: 0 / 1 (rfs_seek_cfg_t; -1 = the

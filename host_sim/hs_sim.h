@@ -88,6 +88,10 @@ typedef struct hs_sim_result {
                                  ///< their search tree (rfs_seek_decision_t.plan_wait):
                                  ///< over 100 ms from the leg's end at 20 Hz
     uint32_t plan_wait_max;      ///< the longest such wait, control periods
+    uint32_t decisions_over_100ms; ///< decisions whose latency (below) exceeded 100 ms
+    double decision_wait_max_s;  ///< the longest decision latency: from the period a decision
+                                 ///< began (a leg's end) to its wheel command, that period
+                                 ///< included (a sliced fit's and the search tree's waits)
     double turn_time_s;          ///< time turning on the spot (|v| < 2 cm/s, |w| > 0.05 rad/s)
     long wall_contacts;          ///< wall contacts (hs_box2d_wall_contacts)
     double wall_time_s;          ///< host time the run took (not part of determinism)

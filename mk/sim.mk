@@ -88,10 +88,10 @@ $(eval $(call test_script,status_est,tests/host_sim/status_est.sh $(BUILD),$(BUI
 # Every program's model and target options and scenario keys, good and bad values; PDR
 # seeking in the simulator and PDR replay of real captures against tshark; the MLP
 # bit-identical on the emulated Cortex-M4 (docs/MODELS.md, "Choosing a model").
-$(eval $(call test_script,models_cli,tests/host_sim/test_models_cli.sh $(BUILD),$(SIM) $(BUILD)/bin/rfseek-feed $(FEED_ASAN) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-record $(BUILD)/bin/rfseek-replay $(FW_IMAGES)))
+$(eval $(call test_script,models_cli,tests/host_sim/test_models_cli.sh $(BUILD),$(SIM) $(BUILD)/bin/rfseek-feed $(FEED_ASAN) $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-record $(BUILD)/bin/rfseek-replay $(FW_IMAGES) $(WIRE_LCM_TOOL)))
 # The receiver heartbeat through rfseek-record/-replay and the emulator image, and through
 # the pcap feeder's replay (every captured frame proves the receiver alive).
-$(eval $(call test_script,heartbeat_replay,tests/wire/heartbeat_replay.sh $(BUILD),$(BUILD)/bin/rfseek-record $(BUILD)/bin/rfseek-replay $(FW_IMAGES)))
+$(eval $(call test_script,heartbeat_replay,tests/wire/heartbeat_replay.sh $(BUILD),$(BUILD)/bin/rfseek-record $(BUILD)/bin/rfseek-replay $(FW_IMAGES) $(WIRE_LCM_TOOL)))
 $(eval $(call test_script,feed_heartbeat,$(PYTHON) tests/wire/feed_heartbeat.py $(FEED_ASAN),$(FEED_ASAN)))
 # The simulator under ASan+UBSan, 3 seeds of the default and three fault scenarios.
 $(eval $(call test_script,sweep,scripts/san_sweep.sh $(SWEEP_SIM) 3 scenarios/default.yaml scenarios/faults/office-kidnap.yaml scenarios/faults/office-rssi_silence.yaml scenarios/faults/office-bus_off.yaml,$(SWEEP_SIM)))

@@ -24,6 +24,7 @@
 #include "hs_batch.h"
 #include "hs_place.h"
 #include "hs_sim.h"
+#include "rfs_models.h"
 
 static const char *prog = "rfseek-sim";
 
@@ -60,6 +61,10 @@ static void usage(FILE *f)
             "  --p0-min DBM    pathloss only: floor on the fitted signal at 1 m, overriding\n"
             "                  the scenario's seek.p0_min_dbm (default -45; the node's EIRP\n"
             "                  - 52 when its power is known: docs/PATHLOSS.md)\n"
+            "  --fit-budget N|mcu  the model's work units a control period, overriding the\n"
+            "                  scenario's seek.fit_budget (0, the default: each fit whole;\n"
+            "                  mcu: the model's Cortex-M4 budget, docs/PERFORMANCE.md); the\n"
+            "                  wheels wait while a fit runs (summary.json decision_wait_max_s)\n"
             "  --start X,Y[,THETA]  start here (metres, radians), overriding the scenario's\n"
             "  --source X,Y    put the first source here (and the goal, unless the scenario\n"
             "                  names one); both must be legal places on the map\n"
@@ -170,6 +175,7 @@ typedef struct sim_opts {
     uint64_t seed;
     bool has_seed, samples, field, emit, quiet, bench, no_faults, resume;
     double p0_min;                /* --p0-min: NAN keeps the scenario's (or the model's default) */
+    long fit_budget;              /* --fit-budget: -1 keeps the scenario's, FIT_MCU the model's */
     const char *start, *source;   /* --start X,Y[,THETA], --source X,Y: placement overrides */
     const char *placements;       /* --placements N or A..B: drawn pairs pa..pb */
     uint64_t pa, pb;
@@ -182,12 +188,14 @@ typedef struct sim_opts {
 } sim_opts_t;
 
 enum { RUN = -1 }; /* parse_options: go on (else the exit status) */
+enum { FIT_MCU = -2 }; /* --fit-budget mcu */
 
 /* The command line into *o: RUN, or the exit status (--help, a bad option). */
 static int parse_options(int argc, char **argv, sim_opts_t *o)
 {
     memset(o, 0, sizeof *o);
     o->p0_min = NAN;
+    o->fit_budget = -1;
     o->pseed = 1;
     o->jobs = sysconf(_SC_NPROCESSORS_ONLN);
     for (int i = 1; i < argc; i++) {
@@ -239,6 +247,17 @@ static int parse_options(int argc, char **argv, sim_opts_t *o)
             if (!more || !*argv[i + 1] || *end != '\0' || !(o->p0_min >= -200.0 && o->p0_min <= 100.0)) {
                 return die("--p0-min: expected dBm in [-200, 100], got '%s'%s",
                            more ? argv[i + 1] : "", "");
+            }
+            i++;
+        } else if (strcmp(a, "--fit-budget") == 0) {
+            uint64_t v;
+            if (more && strcmp(argv[i + 1], "mcu") == 0) {
+                o->fit_budget = FIT_MCU;
+            } else if (!more || parse_u64(argv[i + 1], &v) != 0 || v > 1000000u) {
+                return die("--fit-budget: expected work units from 0 to 1000000 or 'mcu', got '%s'%s",
+                           more ? argv[i + 1] : "", "");
+            } else {
+                o->fit_budget = (long)v;
             }
             i++;
         } else if (strcmp(a, "--start") == 0 || strcmp(a, "--source") == 0) {
@@ -526,6 +545,11 @@ static int load_scenario(const sim_opts_t *o, hs_scenario_t *sc)
         }
         sc->seek_p0_min_dbm = o->p0_min;
     }
+    if (o->fit_budget != -1) {
+        const rfs_models_entry_t *m = rfs_models_lookup(sc->model);
+        sc->seek_fit_budget = o->fit_budget == FIT_MCU ? (double)(m ? m->mcu_fit_budget : 0u)
+                                                       : (double)o->fit_budget;
+    }
     return placement(o, sc);
 }
 
@@ -542,9 +566,13 @@ static int emit_jobs(const sim_opts_t *o, const hs_scenario_t *sc)
     const uint64_t np = o->placements ? o->pb - o->pa + 1 : 1, ns = o->sb - o->sa + 1;
     for (uint64_t i = 0; i < np * ns; i++) {
         const uint64_t s = o->sa + i % ns, k = o->pa + i / ns; /* a batch's order */
-        char p0[48] = "", place[96] = "", dir[64];
+        char p0[96] = "", place[96] = "", dir[64];
         if (!isnan(o->p0_min)) {
             snprintf(p0, sizeof p0, " --p0-min %.17g", o->p0_min);
+        }
+        if (o->fit_budget != -1) {
+            size_t l = strlen(p0);
+            snprintf(p0 + l, sizeof p0 - l, " --fit-budget %.0f", sc->seek_fit_budget);
         }
         snprintf(dir, sizeof dir, "seed-%llu", (unsigned long long)s);
         if (o->placements) {

@@ -379,6 +379,81 @@ static void test_closed_loop_reaches_source(void **state)
     assert_int_equal(reached, runs);
 }
 
+/* A sliced relearn under pose noise: the robot (teleported to each goal) reports poses
+ * that jitter by +-1 cm at 20 Hz, the relearn takes 500 samples a period. Each fit runs
+ * at the point where its decision began, so it ends after ceil(n / 500) periods whatever
+ * the pose does (a fit restarted at each new pose never ended once it needed three
+ * periods), and the sliced ridge equals a whole fit of the same samples at that point. */
+static void test_sliced_fit_ends_under_pose_noise(void **state)
+{
+    (void)state;
+    world_t t;
+    world_make(&t, 20, 20, 0, 0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    cfg.fit_budget = 500;
+    seek_make(&t, cfg, 5);
+    double x = 5, y = 10, gx = 5, gy = 10;
+    int64_t arrive = 0, begun = -1;
+    uint32_t decisions = 0, relearned = 0, compared = 0, pkt = 0;
+    for (int64_t now = 5000; now <= 120000000; now += 5000) {
+        if (now >= arrive) {
+            x = gx;
+            y = gy;
+        }
+        const double d = fmax(hypot(x - 15.0, y - 10.0), 1.0);
+        const double u = fmod((double)pkt++ * 0.6180339887498949, 1.0);
+        rfs_seek_on_rssi(&t.seek, 0, now, (int8_t)floor(-40 - 30 * log10(d) + u), &t.rng);
+        if (now % 50000 != 0) {
+            continue;
+        }
+        const double jit = (now / 50000) % 2 == 0 ? 0.01 : -0.01;
+        rfs_pose_t p = pose_at(now, x + jit, y - jit, 0);
+        rfs_seek_on_pose(&t.seek, &p, &t.rng);
+        const uint32_t n = t.seek.store.count;
+        rfs_seek_out_t out;
+        rfs_seek_step(&t.seek, now, &t.rng, &out);
+        if (t.seek.state == RFS_SEEK_LEARNING && begun < 0) {
+            begun = now; /* the relearn's first period */
+            assert_true(n > 1500u); /* long enough to need more than three periods */
+        }
+        if (!out.decided) {
+            continue;
+        }
+        decisions++;
+        if (begun >= 0) {
+            relearned++;
+            /* ceil(n / 500) periods, one more for the samples that came meanwhile */
+            const int64_t periods = (now - begun) / 50000 + 1;
+            assert_true(periods <= (int64_t)(n + 499u) / 500 + 1);
+            /* A whole fit of the store at the decision's start point predicts the same
+             * (while the store is not full: a full one replaces samples under the slices). */
+            if (t.seek.store.count < cfg.store.capacity) {
+                rfs_ridge_t whole;
+                rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
+                assert_int_equal(rfs_ridge_init(&whole, &rc), 0);
+                const rfs_model_fit_in_t in = {.samples = t.seek.store.samples,
+                                               .n = t.seek.store.count, .qx = out.decision.x,
+                                               .qy = out.decision.y};
+                const rfs_model_t wm = rfs_ridge_model(&whole);
+                assert_int_equal(wm.ops->fit(wm.self, &in, 0u, &t.rng), RFS_FIT_DONE);
+                rfs_q16_t a, b;
+                assert_true(t.seek.model.ops->predict(t.seek.model.self, Q(8), Q(9), &a));
+                assert_true(wm.ops->predict(wm.self, Q(8), Q(9), &b));
+                assert_int_equal(a, b);
+                compared++;
+            }
+            begun = -1;
+        }
+        gx = D(out.decision.goal_x);
+        gy = D(out.decision.goal_y);
+        arrive = now + 1000000;
+    }
+    assert_true(compared >= 3u);
+    assert_true(relearned >= 10u);
+    assert_true(decisions >= 20u);
+    world_free(&t);
+}
+
 /* A robot with nowhere to go (a 0.8 m box: one legal lattice point) reports NO_GOAL, keeps
  * its wheels stopped and decides again only after a second, not at every period. */
 static void test_no_goal_backs_off(void **state)
@@ -713,6 +788,7 @@ int main(void)
         cmocka_unit_test(test_recheck_adapt),
         cmocka_unit_test(test_abandoned_leg_decides_at_rest),
         cmocka_unit_test(test_closed_loop_reaches_source),
+        cmocka_unit_test(test_sliced_fit_ends_under_pose_noise),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -60,8 +60,8 @@ check)
                    END { if (n == 0) exit 1; for (m in s) if (s[m] != w[m]) exit 1 }' "$tmp/m4.sums"; then
         pass "sliced relearn equals the whole relearn on the Cortex-M4"; else
         bad "a sliced relearn differs from the whole one on the Cortex-M4"; fi
-    # The 200 ms safety deadline at every model's registry budget, from the
-    # exact instruction count of its heaviest slice; every model the host twin runs has one.
+    # The 200 ms safety deadline at every model's registry budget (0: one whole fit), from
+    # the exact instruction count of its heaviest slice; every model the host twin runs has one.
     if awk -F'\t' -v models="$models" '
         $1 == "calib_empty" { e = $2 } $1 == "calib_nop1000" { per = ($2 - e) / 1000 }
         NF == 3 { v[$1] = $2 }
@@ -70,7 +70,7 @@ check)
             if (per <= 0 || k != models) { print "  " k " models with a registry budget of " models; exit 1 }
             for (i = 1; i <= k; i++) {
                 m = order[i]; w = "slice_worst_" m "_" b[m]
-                if (b[m] == 0 || !(w in v)) { print "  " m ": no sliced relearn at budget " b[m]; bad = 1; continue }
+                if (!(w in v)) { print "  " m ": no relearn measured at budget " b[m]; bad = 1; continue }
                 ins = int((v[w] - e) / per + 0.5)
                 printf "  %-9s budget %5d: heaviest slice %10d instructions, %5.1f %% of 33,600,000 (200 ms at 168 MHz)\n", m, b[m], ins, ins / 336000
                 if (ins >= 33600000) bad = 1

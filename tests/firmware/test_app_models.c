@@ -280,8 +280,10 @@ static void test_mcu_fit_budget_is_the_model_s(void **state)
     assert_non_null(mlp);
     /* The ridge's registry budget is the firmware's long-standing one. */
     assert_int_equal(rfs_models_lookup("ridge")->mcu_fit_budget, RFS_APP_MCU_FIT_BUDGET);
+    /* 0 is one whole fit: only the ridge's fits a control period (make bench-firmware). */
     for (uint32_t i = 0; i < rfs_models_count(); i++) {
-        assert_true(rfs_models_at(i)->mcu_fit_budget > 0u); /* 0 would be one whole fit */
+        const rfs_models_entry_t *e = rfs_models_at(i);
+        assert_true((e->mcu_fit_budget == 0u) == (e == &rfs_models_ridge));
     }
 
     /* The MCU defaults, the model chosen afterwards (the ports' order). */
@@ -294,13 +296,14 @@ static void test_mcu_fit_budget_is_the_model_s(void **state)
     assert_int_equal(s_app.seek.cfg.fit_budget, mlp->mcu_fit_budget);
     assert_int_equal(s_app.cfg.seek.fit_budget, mlp->mcu_fit_budget);
 
-    /* The built-in ridge (NULL) and its registry entry: 2,500 samples. */
+    /* The built-in ridge (NULL) and its registry entry: a whole fit. */
     c.model = NULL;
+    c.seek.fit_budget = 77u;
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
-    assert_int_equal(s_app.seek.cfg.fit_budget, 2500u);
+    assert_int_equal(s_app.seek.cfg.fit_budget, 0u);
     c.model = rfs_models_lookup("ridge");
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
-    assert_int_equal(s_app.seek.cfg.fit_budget, 2500u);
+    assert_int_equal(s_app.seek.cfg.fit_budget, 0u);
 
     /* Without fit_budget_by_model the given budget stands (host defaults: 0, whole fit;
      * a replay's recorded budget). */

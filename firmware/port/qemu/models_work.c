@@ -19,7 +19,7 @@ extern const rfs_app_map_t rfs_mw_office_map;
 
 /* Comparison budgets measured beside each model's registry budget (mcu_fit_budget, the
  * firmware's MCU configuration; not in the check run): the single budget every model had
- * before the per-model ones (2,500, RFS_APP_MCU_FIT_BUDGET, now the ridge's), the MLP's
+ * before the per-model ones (2,500; the ridge's until its whole fit, 0), the MLP's
  * earlier budget (10 sample-updates: its heaviest slice near 0.5 M instructions) and
  * 300 wall counts for the pathloss model (a slice of about 50 ms). */
 typedef struct mw_cmp {

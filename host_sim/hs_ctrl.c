@@ -189,10 +189,13 @@ static int open_pathloss(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, char *err
             return -1;
         }
     }
+    /* The host's cache holds every candidate of a run; the built-in one (the Cortex-M4's)
+     * 64 columns: the same fits, more counts. */
     const uint32_t cb = rfs_pathloss_cache_bytes(HS_CTRL_PATHLOSS_CACHE_COLS);
-    p->wall_cache = malloc(cb);
-    if (!p->wall_cache ||
-        rfs_pathloss_cache_attach(p->model_state, p->wall_cache, cb, HS_CTRL_PATHLOSS_CACHE_COLS) != 0) {
+    p->wall_cache = cfg->pathloss_builtin_cache ? NULL : malloc(cb);
+    if (!cfg->pathloss_builtin_cache &&
+        (!p->wall_cache || rfs_pathloss_cache_attach(p->model_state, p->wall_cache, cb,
+                                                     HS_CTRL_PATHLOSS_CACHE_COLS) != 0)) {
         snprintf(err, errlen, "model: pathloss: out of memory");
         return -1;
     }

@@ -74,6 +74,8 @@ typedef struct hs_ctrl_inproc_cfg {
                             ///< against the ceiling, dB, in [0, 60] (NAN: off)
     const int32_t *pathloss_log2; ///< pathloss model only: a log2 table to attach
                             ///< (rfs_pathloss_log2_fill(), outliving the controller) or NULL
+    bool pathloss_builtin_cache; ///< pathloss model only: keep the built-in wall-count cache
+                            ///< (the Cortex-M4's) instead of attaching the host's
 } hs_ctrl_inproc_cfg_t;
 
 /// Defaults: the paper's seeker, local ridge, RSSI of one source, 20 Hz.

@@ -92,6 +92,8 @@ typedef struct hs_scenario {
                                   ///< kept (rfs_seek_cfg_t.reach_min; 0: off; -1 = preset)
     double seek_fit_budget;       ///< seek.fit_budget: the model's work units a control period
                                   ///< (rfs_seek_cfg_t.fit_budget; 0: a whole fit; -1 = 0)
+    bool fit_mcu;                 ///< rfseek-sim --fit-budget mcu: also the path-loss model's
+                                  ///< built-in wall-count cache, as on the Cortex-M4
     double seek_leg_m;            ///< seek.leg_m: longest greedy leg to a known argmax
                                   ///< (rfs_seek_cfg_t.leg_max; 0: whole; -1 = the preset)
     int seek_refute_reached;      ///< seek.refute_reached: 0 / 1 (rfs_seek_cfg_t; -1 = the

@@ -832,6 +832,7 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     cc.p0_max_wall_db = e->sc.seek_p0_max_wall_db;
     cc.coarse_snap = e->sc.seek_coarse_snap;
     cc.pathloss_log2 = e->pathloss_log2;
+    cc.pathloss_builtin_cache = e->sc.fit_mcu;
     if (e->sc.seek_local_refute >= 0) {
         cc.seek.local_refute = e->sc.seek_local_refute != 0;
     }

@@ -63,7 +63,8 @@ static void usage(FILE *f)
             "                  - 52 when its power is known: docs/PATHLOSS.md)\n"
             "  --fit-budget N|mcu  the model's work units a control period, overriding the\n"
             "                  scenario's seek.fit_budget (0, the default: each fit whole;\n"
-            "                  mcu: the model's Cortex-M4 budget, docs/PERFORMANCE.md); the\n"
+            "                  mcu: the model's Cortex-M4 budget and wall-count cache,\n"
+            "                  docs/PERFORMANCE.md); the\n"
             "                  wheels wait while a fit runs (summary.json decision_wait_max_s)\n"
             "  --start X,Y[,THETA]  start here (metres, radians), overriding the scenario's\n"
             "  --source X,Y    put the first source here (and the goal, unless the scenario\n"
@@ -549,6 +550,7 @@ static int load_scenario(const sim_opts_t *o, hs_scenario_t *sc)
         const rfs_models_entry_t *m = rfs_models_lookup(sc->model);
         sc->seek_fit_budget = o->fit_budget == FIT_MCU ? (double)(m ? m->mcu_fit_budget : 0u)
                                                        : (double)o->fit_budget;
+        sc->fit_mcu = o->fit_budget == FIT_MCU;
     }
     return placement(o, sc);
 }
@@ -572,7 +574,11 @@ static int emit_jobs(const sim_opts_t *o, const hs_scenario_t *sc)
         }
         if (o->fit_budget != -1) {
             size_t l = strlen(p0);
-            snprintf(p0 + l, sizeof p0 - l, " --fit-budget %.0f", sc->seek_fit_budget);
+            if (sc->fit_mcu) {
+                snprintf(p0 + l, sizeof p0 - l, " --fit-budget mcu");
+            } else {
+                snprintf(p0 + l, sizeof p0 - l, " --fit-budget %.0f", sc->seek_fit_budget);
+            }
         }
         snprintf(dir, sizeof dir, "seed-%llu", (unsigned long long)s);
         if (o->placements) {

@@ -65,6 +65,28 @@ if [ -s "$T/p0cli.json" ] && cmp -s <(same "$T/p0cli.json") <(same "$T/p0key.jso
 else
     fail p0_min_cli_equals_key "$(head -c 300 "$T/p0cli.json") / $(head -c 300 "$T/p0key.json")"
 fi
+# --fit-budget: bad values; the same setting as seek.fit_budget; a sliced ridge waits
+# periods for its fit (decision latency in summary.json), the ridge's Cortex-M4 budget
+# ("mcu") is a whole fit, the same run as none.
+bad fit_budget_word "--fit-budget: expected work units from 0 to 1000000 or 'mcu', got 'lots'" "$T/p0.yaml" --fit-budget lots --out "$T/out"
+bad fit_budget_range "--fit-budget: expected work units from 0 to 1000000 or 'mcu', got '1000001'" "$T/p0.yaml" --fit-budget 1000001 --out "$T/out"
+scn fbbad.yaml "${BASE}seek: {fit_budget: 2.5}
+"
+bad fit_budget_key "seek.fit_budget: 2.5 is not a whole number" "$T/fbbad.yaml" --out "$T/out"
+scn fbkey.yaml "${BASE}seek: {fit_budget: 100}
+"
+"$SIM" "$T/p0.yaml" --fit-budget 100 --seed 2 >"$T/fbcli.json" 2>/dev/null
+"$SIM" "$T/fbkey.yaml" --seed 2 >"$T/fbkey.json" 2>/dev/null
+"$SIM" "$T/p0.yaml" --fit-budget mcu --seed 2 >"$T/fbmcu.json" 2>/dev/null
+"$SIM" "$T/p0.yaml" --seed 2 >"$T/fbnone.json" 2>/dev/null
+over() { sed -nE 's/.*"decisions_over_100ms": ([0-9]+).*/\1/p' "$1"; }
+if [ -s "$T/fbcli.json" ] && cmp -s <(same "$T/fbcli.json") <(same "$T/fbkey.json") \
+    && [ "$(over "$T/fbcli.json")" -gt 0 ] && [ "$(over "$T/fbnone.json")" -eq 0 ] \
+    && cmp -s <(same "$T/fbmcu.json") <(same "$T/fbnone.json"); then
+    pass fit_budget_cli_key_latency
+else
+    fail fit_budget_cli_key_latency "over $(over "$T/fbcli.json") / $(over "$T/fbnone.json")"
+fi
 # seek.KEY reaches the path-loss model: on the office (walls), OTHER changes the run, SAME
 # (the model's default) does not (docs/PATHLOSS.md): coarse_footprint_m 0 counts the coarse
 # pass at one count a bin; coarse_snap false leaves coarse grid points in walls without a

@@ -137,16 +137,10 @@ static rfs_q16_t db_dist(const int32_t *tab, uint64_t d2_q32)
 {
     const uint64_t one = (uint64_t)1 << 32; /* 1 m^2 */
     uint64_t v = d2_q32 < one ? one : d2_q32;
-    /* floor(log2(v)) without a libgcc helper (no 64-bit clz on the Cortex-M4). */
-    uint32_t bl = 0u;
-    uint64_t t = v;
-    for (uint32_t s = 32u; s != 0u; s >>= 1) {
-        if ((t >> s) != 0u) {
-            t >>= s;
-            bl += s;
-        }
-    }
-    uint32_t m = bl >= 16u ? (uint32_t)(v >> (bl - 16u)) : (uint32_t)(v << (16u - bl));
+    /* floor(log2(v)) >= 32 from the high word's 32-bit clz (one CLZ on the Cortex-M4, no
+     * libgcc helper); m: v's top 17 bits, 1.16. */
+    uint32_t bl = 63u - (uint32_t)__builtin_clz((uint32_t)(v >> 32));
+    uint32_t m = (uint32_t)(v >> (bl - 16u));
     int64_t lg = ((int64_t)bl - 32) * 65536 +
                  (tab != 0 ? tab[m - 65536u] : rfs_q16_log2((rfs_q16_t)m));
     return (rfs_q16_t)((lg * DB_PER_LOG2_SQ_Q30 + ((int64_t)1 << 29)) >> 30);

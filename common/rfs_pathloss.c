@@ -337,13 +337,15 @@ static void solve_nw(const rfs_pathloss_cfg_t *c, const int64_t M[3], const int6
 {
     rfs_i128_t det = rfs_i128_sub(rfs_i128_mul(M[0], M[2]), rfs_i128_mul(M[1], M[1]));
     rfs_i128_t nn = rfs_i128_sub(rfs_i128_mul(R[0], M[2]), rfs_i128_mul(M[1], R[1]));
-    rfs_i128_t nw = rfs_i128_sub(rfs_i128_mul(M[0], R[1]), rfs_i128_mul(M[1], R[0]));
     int64_t n = rfs_i128_div_shift(nn, det, 16u);
-    int64_t w = rfs_i128_div_shift(nw, det, 16u);
-    if (n >= c->n_min && n <= c->n_max && w >= c->w_min && w <= c->w_max) {
-        *n_out = (int32_t)n;
-        *w_out = (int32_t)w;
-        return;
+    if (n >= c->n_min && n <= c->n_max) { /* else W is moot: an edge's */
+        rfs_i128_t nw = rfs_i128_sub(rfs_i128_mul(M[0], R[1]), rfs_i128_mul(M[1], R[0]));
+        int64_t w = rfs_i128_div_shift(nw, det, 16u);
+        if (w >= c->w_min && w <= c->w_max) {
+            *n_out = (int32_t)n;
+            *w_out = (int32_t)w;
+            return;
+        }
     }
     /* The four edges: n at a bound with W free, W at a bound with n free. */
     int32_t en[4], ew[4];

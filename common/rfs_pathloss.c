@@ -370,6 +370,23 @@ static void solve_nw(const rfs_pathloss_cfg_t *c, const int64_t M[3], const int6
     *w_out = ew[best];
 }
 
+/* Bin b's 10 log10(d) to the candidate at (sx, sy) in l_q16[b] and its walls in k[b],
+ * added with its weight to *sl and *sk. Returns the wall counts (lines) computed: 0 when
+ * cached. Scaling: weight < 2^16 times |L| < 2^22 or k <= 60, over <= 512 bins: int64. */
+static inline uint32_t gather_bin(rfs_pathloss_t *p, uint32_t b, rfs_q16_t sx, rfs_q16_t sy,
+                                  int64_t *sl, int64_t *sk)
+{
+    const rfs_pathloss_bin_t *bb = &p->bins[b];
+    const rfs_q16_t l = db_dist(p->log2_tab, sq_sum((int64_t)bb->x - sx, (int64_t)bb->y - sy));
+    uint32_t lines = 0u;
+    const uint32_t k = p->map != 0 ? rfs_pathloss_walls_bin(p, bb, &lines) : 0u;
+    p->l_q16[b] = l;
+    p->k[b] = (uint8_t)k;
+    *sl += (int64_t)bb->count * l;
+    *sk += (int64_t)bb->count * k;
+    return lines;
+}
+
 /* Fit (P0, n, W) for the candidate in p->ev, whose bins gather_bin() has done, and its
  * Huber loss.
  * Scaling and overflow (|L| < 64 dB, so L Q16 < 2^22; counts sum to <= 65,535 = 2^16;
@@ -671,34 +688,27 @@ static bool bin_run(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t bu
  * the work units of this call. */
 static bool ev_run(rfs_pathloss_t *p, uint32_t budget, uint32_t *used)
 {
-    /* Each bin's 10 log10(d) in l_q16[b] and walls in k[b], their weighted sums in ev.sl,
-     * ev.sk. Scaling: weight < 2^16 times |L| < 2^22 or k <= 60, over <= 512 bins: int64. */
-    const rfs_pathloss_bin_t *bins = p->bins;
-    const int32_t *tab = p->log2_tab;
-    const bool walls = p->map != 0;
-    const uint32_t nbins = p->nbins;
     const rfs_q16_t sx = p->ev.sx, sy = p->ev.sy;
-    uint32_t b = p->ev.b, u = *used;
+    const uint32_t nbins = p->nbins;
+    uint32_t b = p->ev.b;
     int64_t sl = p->ev.sl, sk = p->ev.sk;
-    while (b < nbins) {
-        if (budget != 0u && u != 0u && u + RFS_PATHLOSS_FOOTPRINT_RAYS > budget) {
-            break;
+    if (budget == 0u) { /* unsliced: no work to count */
+        for (; b < nbins; ++b) {
+            gather_bin(p, b, sx, sy, &sl, &sk);
         }
-        const rfs_pathloss_bin_t *bb = &bins[b];
-        const rfs_q16_t l = db_dist(tab, sq_sum((int64_t)bb->x - sx, (int64_t)bb->y - sy));
-        uint32_t lines = 0u;
-        const uint32_t k = walls ? rfs_pathloss_walls_bin(p, bb, &lines) : 0u;
-        p->l_q16[b] = l;
-        p->k[b] = (uint8_t)k;
-        sl += (int64_t)bb->count * l;
-        sk += (int64_t)bb->count * k;
-        b++;
-        u += lines + (b % BINS_PER_UNIT == 0u ? 1u : 0u);
+    } else {
+        uint32_t u = *used;
+        for (; b < nbins; ++b) {
+            if (u != 0u && u + RFS_PATHLOSS_FOOTPRINT_RAYS > budget) {
+                break;
+            }
+            u += gather_bin(p, b, sx, sy, &sl, &sk) + ((b + 1u) % BINS_PER_UNIT == 0u ? 1u : 0u);
+        }
+        *used = u;
     }
     p->ev.b = b;
     p->ev.sl = sl;
     p->ev.sk = sk;
-    *used = u;
     if (b < nbins) {
         return false;
     }

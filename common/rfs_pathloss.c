@@ -133,7 +133,8 @@ static void pathloss_reset(void *self)
 }
 
 /* rfs_pathloss_db_dist() with the mantissa's logarithm from tab (NULL: computed). */
-static rfs_q16_t db_dist(const int32_t *tab, uint64_t d2_q32)
+__attribute__((always_inline)) static inline rfs_q16_t db_dist(const int32_t *tab,
+                                                              uint64_t d2_q32)
 {
     const uint64_t one = (uint64_t)1 << 32; /* 1 m^2 */
     uint64_t v = d2_q32 < one ? one : d2_q32;

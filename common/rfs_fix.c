@@ -218,6 +218,48 @@ rfs_q16_t rfs_q16_db10(rfs_q16_t x)
     return (rfs_q16_t)((log2_q20(x) * 808071242 + ((int64_t)1 << 31)) >> 32);
 }
 
+static rfs_i128_t u128_mul(uint64_t a, uint64_t b)
+{
+    uint64_t a0 = (uint32_t)a, a1 = a >> 32;
+    uint64_t b0 = (uint32_t)b, b1 = b >> 32;
+    uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
+    uint64_t mid = (p00 >> 32) + (uint32_t)p01 + (uint32_t)p10;
+    rfs_i128_t r;
+    r.lo = (mid << 32) | (uint32_t)p00;
+    r.hi = (int64_t)(p11 + (p01 >> 32) + (p10 >> 32) + (mid >> 32));
+    return r;
+}
+
+static rfs_i128_t i128_negate(rfs_i128_t a)
+{
+    rfs_i128_t r;
+    r.lo = ~a.lo + 1u;
+    r.hi = (int64_t)(~(uint64_t)a.hi + (r.lo == 0u ? 1u : 0u));
+    return r;
+}
+
+rfs_i128_t rfs_i128_mul(int64_t a, int64_t b)
+{
+    bool neg = (a < 0) != (b < 0);
+    uint64_t ua = a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a;
+    uint64_t ub = b < 0 ? (uint64_t)0 - (uint64_t)b : (uint64_t)b;
+    rfs_i128_t r = u128_mul(ua, ub);
+    return neg ? i128_negate(r) : r;
+}
+
+rfs_i128_t rfs_i128_add(rfs_i128_t a, rfs_i128_t b)
+{
+    rfs_i128_t r;
+    r.lo = a.lo + b.lo;
+    r.hi = (int64_t)((uint64_t)a.hi + (uint64_t)b.hi + (r.lo < a.lo ? 1u : 0u));
+    return r;
+}
+
+rfs_i128_t rfs_i128_sub(rfs_i128_t a, rfs_i128_t b)
+{
+    return rfs_i128_add(a, i128_negate(b));
+}
+
 /* Unsigned 128-bit helpers on (hi, lo) pairs, hi kept as uint64. */
 static int u128_cmp(uint64_t ah, uint64_t al, uint64_t bh, uint64_t bl)
 {
@@ -250,21 +292,20 @@ static void shr192(uint64_t w2, uint64_t w1, uint64_t w0, int sh, uint64_t *hi, 
  * bit, in a few dozen instructions instead of one 128-bit round per quotient bit.
  * Scaling and overflow: N >> s (s = db - 31) has <= nb - db + 31 <= 60 bits; with the
  * estimate q <= N / D, N - q D < 3 D < 2^127, so the remainder is exact from N's and
- * q D's low 128 bits (q D taken modulo 2^128). */
-static int64_t div_small(uint64_t w2, uint64_t w1, uint64_t w0, uint64_t dh, uint64_t dl,
-                         int db, bool neg)
+ * q D's low 128 bits (q D taken modulo 2^128). Not inlined: one copy beside the long
+ * division keeps the Cortex-M4 image small. */
+__attribute__((noinline)) static int64_t div_small(uint64_t w2, uint64_t w1, uint64_t w0,
+                                                   uint64_t dh, uint64_t dl, int db, bool neg)
 {
-    uint64_t q;
-    if (db <= 31) { /* D and N fit one word each: exact */
-        q = rfs_udiv64(w0, dl);
-    } else {
+    uint64_t nt = w0, dt = dl; /* db <= 31: D and N fit one word each, exact */
+    if (db > 31) {
         const int s = db - 31;
-        uint64_t dt = s >= 64 ? dh >> (s - 64) : (dl >> s) | (dh << (64 - s));
-        uint64_t nh, nt;
+        uint64_t nh;
         shr192(w2, w1, w0, s, &nh, &nt);
-        q = rfs_udiv64(nt, dt + 1u);
+        dt = (s >= 64 ? dh >> (s - 64) : (dl >> s) | (dh << (64 - s))) + 1u;
     }
-    rfs_i128_t qd = rfs_u128_mul(q, dl);
+    uint64_t q = rfs_udiv64(nt, dt);
+    rfs_i128_t qd = u128_mul(q, dl);
     uint64_t ph = (uint64_t)qd.hi + q * dh;
     uint64_t rl = w0 - qd.lo;
     uint64_t rh = w1 - ph - (w0 < qd.lo ? 1u : 0u);
@@ -285,10 +326,10 @@ int64_t rfs_i128_div_shift(rfs_i128_t n, rfs_i128_t d, unsigned shift)
     RFS_ASSERT(shift <= 62u);
     bool nneg = rfs_i128_neg(n), dneg = rfs_i128_neg(d);
     if (nneg) {
-        n = rfs_i128_negate(n);
+        n = i128_negate(n);
     }
     if (dneg) {
-        d = rfs_i128_negate(d);
+        d = i128_negate(d);
     }
     uint64_t nh = (uint64_t)n.hi, nl = n.lo, dh = (uint64_t)d.hi, dl = d.lo;
     if (dh == 0u && dl == 0u) {

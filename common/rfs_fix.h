@@ -140,57 +140,14 @@ typedef struct rfs_i128 {
     int64_t hi;  ///< high 64 bits, carries the sign
 } rfs_i128_t;
 
-/* The products, sums and negations below are inline: the path-loss fit's solve takes
- * about twenty of them per candidate. */
-
-/// Exact 64 x 64 -> 128-bit unsigned product (as an rfs_i128_t's two words).
-/// Scaling: four 32 x 32 -> 64-bit partial products; the middle sum of three values below
-/// 2^32 cannot overflow 64 bits.
-static inline rfs_i128_t rfs_u128_mul(uint64_t a, uint64_t b)
-{
-    uint64_t a0 = (uint32_t)a, a1 = a >> 32;
-    uint64_t b0 = (uint32_t)b, b1 = b >> 32;
-    uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
-    uint64_t mid = (p00 >> 32) + (uint32_t)p01 + (uint32_t)p10;
-    rfs_i128_t r;
-    r.lo = (mid << 32) | (uint32_t)p00;
-    r.hi = (int64_t)(p11 + (p01 >> 32) + (p10 >> 32) + (mid >> 32));
-    return r;
-}
-
-/// 128-bit -a (two's complement; wraps for the most negative value).
-static inline rfs_i128_t rfs_i128_negate(rfs_i128_t a)
-{
-    rfs_i128_t r;
-    r.lo = ~a.lo + 1u;
-    r.hi = (int64_t)(~(uint64_t)a.hi + (r.lo == 0u ? 1u : 0u));
-    return r;
-}
-
 /// Exact 64 x 64 -> 128-bit signed product.
-static inline rfs_i128_t rfs_i128_mul(int64_t a, int64_t b)
-{
-    bool neg = (a < 0) != (b < 0);
-    uint64_t ua = a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a;
-    uint64_t ub = b < 0 ? (uint64_t)0 - (uint64_t)b : (uint64_t)b;
-    rfs_i128_t r = rfs_u128_mul(ua, ub);
-    return neg ? rfs_i128_negate(r) : r;
-}
-
-/// 128-bit a + b.
-static inline rfs_i128_t rfs_i128_add(rfs_i128_t a, rfs_i128_t b)
-{
-    rfs_i128_t r;
-    r.lo = a.lo + b.lo;
-    r.hi = (int64_t)((uint64_t)a.hi + (uint64_t)b.hi + (r.lo < a.lo ? 1u : 0u));
-    return r;
-}
+rfs_i128_t rfs_i128_mul(int64_t a, int64_t b);
 
 /// 128-bit a - b (wraps on overflow, which cannot happen for products of int64).
-static inline rfs_i128_t rfs_i128_sub(rfs_i128_t a, rfs_i128_t b)
-{
-    return rfs_i128_add(a, rfs_i128_negate(b));
-}
+rfs_i128_t rfs_i128_sub(rfs_i128_t a, rfs_i128_t b);
+
+/// 128-bit a + b.
+rfs_i128_t rfs_i128_add(rfs_i128_t a, rfs_i128_t b);
 
 /// true when a < 0.
 static inline bool rfs_i128_neg(rfs_i128_t a) { return a.hi < 0; }

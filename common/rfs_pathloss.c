@@ -133,8 +133,7 @@ static void pathloss_reset(void *self)
 }
 
 /* rfs_pathloss_db_dist() with the mantissa's logarithm from tab (NULL: computed). */
-__attribute__((always_inline)) static inline rfs_q16_t db_dist(const int32_t *tab,
-                                                              uint64_t d2_q32)
+static rfs_q16_t db_dist(const int32_t *tab, uint64_t d2_q32)
 {
     const uint64_t one = (uint64_t)1 << 32; /* 1 m^2 */
     uint64_t v = d2_q32 < one ? one : d2_q32;
@@ -307,7 +306,10 @@ static bool cand_legal(const rfs_pathloss_t *p, int32_t i, int32_t j)
 
 static rfs_i128_t i128_of(int64_t v)
 {
-    return rfs_i128_mul(v, 1);
+    rfs_i128_t r;
+    r.lo = (uint64_t)v;
+    r.hi = v < 0 ? -1 : 0;
+    return r;
 }
 
 /* F(n, W) = M11 n^2 + 2 M12 n W + M22 W^2 - 2 (R1 n + R2 W), Q48 in 128 bits: the LS
@@ -369,23 +371,6 @@ static void solve_nw(const rfs_pathloss_cfg_t *c, const int64_t M[3], const int6
     }
     *n_out = en[best];
     *w_out = ew[best];
-}
-
-/* Bin b's 10 log10(d) to the candidate at (sx, sy) in l_q16[b] and its walls in k[b],
- * added with its weight to *sl and *sk. Returns the wall counts (lines) computed: 0 when
- * cached. Scaling: weight < 2^16 times |L| < 2^22 or k <= 60, over <= 512 bins: int64. */
-static inline uint32_t gather_bin(rfs_pathloss_t *p, uint32_t b, rfs_q16_t sx, rfs_q16_t sy,
-                                  int64_t *sl, int64_t *sk)
-{
-    const rfs_pathloss_bin_t *bb = &p->bins[b];
-    const rfs_q16_t l = db_dist(p->log2_tab, sq_sum((int64_t)bb->x - sx, (int64_t)bb->y - sy));
-    uint32_t lines = 0u;
-    const uint32_t k = p->map != 0 ? rfs_pathloss_walls_bin(p, bb, &lines) : 0u;
-    p->l_q16[b] = l;
-    p->k[b] = (uint8_t)k;
-    *sl += (int64_t)bb->count * l;
-    *sk += (int64_t)bb->count * k;
-    return lines;
 }
 
 /* Fit (P0, n, W) for the candidate in p->ev, whose bins gather_bin() has done, and its
@@ -689,27 +674,34 @@ static bool bin_run(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t bu
  * the work units of this call. */
 static bool ev_run(rfs_pathloss_t *p, uint32_t budget, uint32_t *used)
 {
-    const rfs_q16_t sx = p->ev.sx, sy = p->ev.sy;
+    /* Each bin's 10 log10(d) in l_q16[b] and walls in k[b], their weighted sums in ev.sl,
+     * ev.sk. Scaling: weight < 2^16 times |L| < 2^22 or k <= 60, over <= 512 bins: int64. */
+    const rfs_pathloss_bin_t *bins = p->bins;
+    const int32_t *tab = p->log2_tab;
+    const bool walls = p->map != 0;
     const uint32_t nbins = p->nbins;
-    uint32_t b = p->ev.b;
+    const rfs_q16_t sx = p->ev.sx, sy = p->ev.sy;
+    uint32_t b = p->ev.b, u = *used;
     int64_t sl = p->ev.sl, sk = p->ev.sk;
-    if (budget == 0u) { /* unsliced: no work to count */
-        for (; b < nbins; ++b) {
-            gather_bin(p, b, sx, sy, &sl, &sk);
+    while (b < nbins) {
+        if (budget != 0u && u != 0u && u + RFS_PATHLOSS_FOOTPRINT_RAYS > budget) {
+            break;
         }
-    } else {
-        uint32_t u = *used;
-        for (; b < nbins; ++b) {
-            if (u != 0u && u + RFS_PATHLOSS_FOOTPRINT_RAYS > budget) {
-                break;
-            }
-            u += gather_bin(p, b, sx, sy, &sl, &sk) + ((b + 1u) % BINS_PER_UNIT == 0u ? 1u : 0u);
-        }
-        *used = u;
+        const rfs_pathloss_bin_t *bb = &bins[b];
+        const rfs_q16_t l = db_dist(tab, sq_sum((int64_t)bb->x - sx, (int64_t)bb->y - sy));
+        uint32_t lines = 0u;
+        const uint32_t k = walls ? rfs_pathloss_walls_bin(p, bb, &lines) : 0u;
+        p->l_q16[b] = l;
+        p->k[b] = (uint8_t)k;
+        sl += (int64_t)bb->count * l;
+        sk += (int64_t)bb->count * k;
+        b++;
+        u += lines + (b % BINS_PER_UNIT == 0u ? 1u : 0u);
     }
     p->ev.b = b;
     p->ev.sl = sl;
     p->ev.sk = sk;
+    *used = u;
     if (b < nbins) {
         return false;
     }

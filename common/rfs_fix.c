@@ -285,6 +285,42 @@ static void shr192(uint64_t w2, uint64_t w1, uint64_t w0, int sh, uint64_t *hi, 
     }
 }
 
+/* rfs_i128_div_shift() for a quotient below 2^30: numerator N = (w2, w1, w0) of nb bits,
+ * divisor D = (dh, dl) of db bits, db <= 125, nb - db <= 29. The quotient is estimated
+ * from D's top 31 bits with one 64 / 32 division (never above the true one, at most two
+ * below), then corrected and rounded on the remainder: the long division's result bit for
+ * bit, in a few dozen instructions instead of one 128-bit round per quotient bit.
+ * Scaling and overflow: N >> s (s = db - 31) has <= nb - db + 31 <= 60 bits; with the
+ * estimate q <= N / D, N - q D < 3 D < 2^127, so the remainder is exact from N's and
+ * q D's low 128 bits (q D taken modulo 2^128). Not inlined: one copy beside the long
+ * division keeps the Cortex-M4 image small. */
+__attribute__((noinline)) static int64_t div_small(uint64_t w2, uint64_t w1, uint64_t w0,
+                                                   uint64_t dh, uint64_t dl, int db, bool neg)
+{
+    uint64_t nt = w0, dt = dl; /* db <= 31: D and N fit one word each, exact */
+    if (db > 31) {
+        const int s = db - 31;
+        uint64_t nh;
+        shr192(w2, w1, w0, s, &nh, &nt);
+        dt = (s >= 64 ? dh >> (s - 64) : (dl >> s) | (dh << (64 - s))) + 1u;
+    }
+    uint64_t q = rfs_udiv64(nt, dt);
+    rfs_i128_t qd = u128_mul(q, dl);
+    uint64_t ph = (uint64_t)qd.hi + q * dh;
+    uint64_t rl = w0 - qd.lo;
+    uint64_t rh = w1 - ph - (w0 < qd.lo ? 1u : 0u);
+    while (u128_cmp(rh, rl, dh, dl) >= 0) {
+        rh = rh - dh - (rl < dl ? 1u : 0u);
+        rl -= dl;
+        q++;
+    }
+    /* Round to nearest: remainder * 2 >= d (the remainder is below 2^125). */
+    if (u128_cmp((rh << 1) | (rl >> 63), rl << 1, dh, dl) >= 0) {
+        q++;
+    }
+    return neg ? -(int64_t)q : (int64_t)q;
+}
+
 int64_t rfs_i128_div_shift(rfs_i128_t n, rfs_i128_t d, unsigned shift)
 {
     RFS_ASSERT(shift <= 62u);
@@ -314,6 +350,9 @@ int64_t rfs_i128_div_shift(rfs_i128_t n, rfs_i128_t d, unsigned shift)
     int top_bit = w2 ? 191 - __builtin_clzll(w2) : w1 ? 127 - __builtin_clzll(w1)
                 : w0 ? 63 - __builtin_clzll(w0) : -1;
     const int db = dh ? 128 - __builtin_clzll(dh) : 64 - __builtin_clzll(dl);
+    if (db <= 125 && top_bit + 1 - db <= 29) {
+        return div_small(w2, w1, w0, dh, dl, db, nneg != dneg);
+    }
     const int skip = top_bit + 1 < db - 1 ? top_bit + 1 : db - 1; /* bits taken at once */
     if (skip > 0) {
         shr192(w2, w1, w0, top_bit + 1 - skip, &rh, &rl);

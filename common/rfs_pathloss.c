@@ -137,16 +137,10 @@ static rfs_q16_t db_dist(const int32_t *tab, uint64_t d2_q32)
 {
     const uint64_t one = (uint64_t)1 << 32; /* 1 m^2 */
     uint64_t v = d2_q32 < one ? one : d2_q32;
-    /* floor(log2(v)) without a libgcc helper (no 64-bit clz on the Cortex-M4). */
-    uint32_t bl = 0u;
-    uint64_t t = v;
-    for (uint32_t s = 32u; s != 0u; s >>= 1) {
-        if ((t >> s) != 0u) {
-            t >>= s;
-            bl += s;
-        }
-    }
-    uint32_t m = bl >= 16u ? (uint32_t)(v >> (bl - 16u)) : (uint32_t)(v << (16u - bl));
+    /* floor(log2(v)) >= 32 from the high word's 32-bit clz (one CLZ on the Cortex-M4, no
+     * libgcc helper); m: v's top 17 bits, 1.16. */
+    uint32_t bl = 63u - (uint32_t)__builtin_clz((uint32_t)(v >> 32));
+    uint32_t m = (uint32_t)(v >> (bl - 16u));
     int64_t lg = ((int64_t)bl - 32) * 65536 +
                  (tab != 0 ? tab[m - 65536u] : rfs_q16_log2((rfs_q16_t)m));
     return (rfs_q16_t)((lg * DB_PER_LOG2_SQ_Q30 + ((int64_t)1 << 29)) >> 30);
@@ -312,7 +306,10 @@ static bool cand_legal(const rfs_pathloss_t *p, int32_t i, int32_t j)
 
 static rfs_i128_t i128_of(int64_t v)
 {
-    return rfs_i128_mul(v, 1);
+    rfs_i128_t r;
+    r.lo = (uint64_t)v;
+    r.hi = v < 0 ? -1 : 0;
+    return r;
 }
 
 /* F(n, W) = M11 n^2 + 2 M12 n W + M22 W^2 - 2 (R1 n + R2 W), Q48 in 128 bits: the LS
@@ -343,13 +340,15 @@ static void solve_nw(const rfs_pathloss_cfg_t *c, const int64_t M[3], const int6
 {
     rfs_i128_t det = rfs_i128_sub(rfs_i128_mul(M[0], M[2]), rfs_i128_mul(M[1], M[1]));
     rfs_i128_t nn = rfs_i128_sub(rfs_i128_mul(R[0], M[2]), rfs_i128_mul(M[1], R[1]));
-    rfs_i128_t nw = rfs_i128_sub(rfs_i128_mul(M[0], R[1]), rfs_i128_mul(M[1], R[0]));
     int64_t n = rfs_i128_div_shift(nn, det, 16u);
-    int64_t w = rfs_i128_div_shift(nw, det, 16u);
-    if (n >= c->n_min && n <= c->n_max && w >= c->w_min && w <= c->w_max) {
-        *n_out = (int32_t)n;
-        *w_out = (int32_t)w;
-        return;
+    if (n >= c->n_min && n <= c->n_max) { /* else W is moot: an edge's */
+        rfs_i128_t nw = rfs_i128_sub(rfs_i128_mul(M[0], R[1]), rfs_i128_mul(M[1], R[0]));
+        int64_t w = rfs_i128_div_shift(nw, det, 16u);
+        if (w >= c->w_min && w <= c->w_max) {
+            *n_out = (int32_t)n;
+            *w_out = (int32_t)w;
+            return;
+        }
     }
     /* The four edges: n at a bound with W free, W at a bound with n free. */
     int32_t en[4], ew[4];
@@ -374,18 +373,6 @@ static void solve_nw(const rfs_pathloss_cfg_t *c, const int64_t M[3], const int6
     *w_out = ew[best];
 }
 
-/* One bin's distance term and walls for the candidate in p->ev (its 10 log10(d) in
- * l_q16[b], its walls in k[b]). Returns the wall counts (lines) computed: 0 when cached. */
-static uint32_t gather_bin(rfs_pathloss_t *p, uint32_t b)
-{
-    const rfs_pathloss_bin_t *bb = &p->bins[b];
-    int64_t dx = (int64_t)bb->x - p->ev.sx, dy = (int64_t)bb->y - p->ev.sy;
-    p->l_q16[b] = db_dist(p->log2_tab, sq_sum(dx, dy));
-    uint32_t lines = 0u;
-    p->k[b] = p->map != 0 ? (uint8_t)rfs_pathloss_walls_bin(p, bb, &lines) : 0u;
-    return lines;
-}
-
 /* Fit (P0, n, W) for the candidate in p->ev, whose bins gather_bin() has done, and its
  * Huber loss.
  * Scaling and overflow (|L| < 64 dB, so L Q16 < 2^22; counts sum to <= 65,535 = 2^16;
@@ -396,16 +383,12 @@ static void solve(rfs_pathloss_t *p, rfs_pathloss_cand_t *out)
 {
     const rfs_pathloss_cfg_t *c = &p->cfg;
     const rfs_q16_t sx = p->ev.sx, sy = p->ev.sy;
-    int64_t sl = 0, sk = 0;
-    for (uint32_t b = 0u; b < p->nbins; ++b) {
-        sl += (int64_t)p->bins[b].count * p->l_q16[b];
-        sk += (int64_t)p->bins[b].count * (int64_t)p->k[b]; /* quarter walls */
-    }
+    const uint32_t nbins = p->nbins;
     const int64_t tot = (int64_t)p->total;
-    const int32_t ml = (int32_t)rfs_sdiv64_round(sl, tot);
-    const int32_t mk = (int32_t)rfs_sdiv64_round(sk * 16384, tot); /* walls Q16 */
+    const int32_t ml = (int32_t)rfs_sdiv64_round(p->ev.sl, tot);
+    const int32_t mk = (int32_t)rfs_sdiv64_round(p->ev.sk * 16384, tot); /* walls Q16 */
     int64_t all = 0, alk = 0, akk = 0, bl = 0, bk = 0;
-    for (uint32_t b = 0u; b < p->nbins; ++b) {
+    for (uint32_t b = 0u; b < nbins; ++b) {
         const rfs_pathloss_bin_t *bb = &p->bins[b];
         int64_t cnt = bb->count;
         int64_t l8 = ((int64_t)p->l_q16[b] - ml + 128) >> 8;
@@ -429,7 +412,7 @@ static void solve(rfs_pathloss_t *p, rfs_pathloss_cand_t *out)
      * = dz_b + n (L_b - mean L) + W (k_b - mean k), Q16, then Q8 (saturated to 2^24). */
     const int64_t d8 = ((int64_t)c->huber + 128) >> 8;
     int64_t loss = 0;
-    for (uint32_t b = 0u; b < p->nbins; ++b) {
+    for (uint32_t b = 0u; b < nbins; ++b) {
         const rfs_pathloss_bin_t *bb = &p->bins[b];
         int64_t r = (int64_t)bb->dz_q16 +
                     (((int64_t)n * ((int64_t)p->l_q16[b] - ml) +
@@ -480,6 +463,8 @@ static void ev_start(rfs_pathloss_t *p, uint16_t li, uint16_t lj, uint8_t kind, 
     p->ev.fp = kind == EV_COARSE ? p->cfg.coarse_footprint : p->cfg.footprint;
     p->ev.c = c;
     p->ev.b = 0u;
+    p->ev.sl = 0;
+    p->ev.sk = 0;
 }
 
 /* The coarse pass counts with its own footprint, so it only ranks (docs/PATHLOSS.md,
@@ -689,12 +674,36 @@ static bool bin_run(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t bu
  * the work units of this call. */
 static bool ev_run(rfs_pathloss_t *p, uint32_t budget, uint32_t *used)
 {
-    while (p->ev.b < p->nbins) {
-        if (budget != 0u && *used != 0u && *used + RFS_PATHLOSS_FOOTPRINT_RAYS > budget) {
-            return false;
+    /* Each bin's 10 log10(d) in l_q16[b] and walls in k[b], their weighted sums in ev.sl,
+     * ev.sk. Scaling: weight < 2^16 times |L| < 2^22 or k <= 60, over <= 512 bins: int64. */
+    const rfs_pathloss_bin_t *bins = p->bins;
+    const int32_t *tab = p->log2_tab;
+    const bool walls = p->map != 0;
+    const uint32_t nbins = p->nbins;
+    const rfs_q16_t sx = p->ev.sx, sy = p->ev.sy;
+    uint32_t b = p->ev.b, u = *used;
+    int64_t sl = p->ev.sl, sk = p->ev.sk;
+    while (b < nbins) {
+        if (budget != 0u && u != 0u && u + RFS_PATHLOSS_FOOTPRINT_RAYS > budget) {
+            break;
         }
-        *used += gather_bin(p, p->ev.b++);
-        *used += p->ev.b % BINS_PER_UNIT == 0u ? 1u : 0u;
+        const rfs_pathloss_bin_t *bb = &bins[b];
+        const rfs_q16_t l = db_dist(tab, sq_sum((int64_t)bb->x - sx, (int64_t)bb->y - sy));
+        uint32_t lines = 0u;
+        const uint32_t k = walls ? rfs_pathloss_walls_bin(p, bb, &lines) : 0u;
+        p->l_q16[b] = l;
+        p->k[b] = (uint8_t)k;
+        sl += (int64_t)bb->count * l;
+        sk += (int64_t)bb->count * k;
+        b++;
+        u += lines + (b % BINS_PER_UNIT == 0u ? 1u : 0u);
+    }
+    p->ev.b = b;
+    p->ev.sl = sl;
+    p->ev.sk = sk;
+    *used = u;
+    if (b < nbins) {
+        return false;
     }
     const uint32_t solve_units = p->nbins / BINS_PER_UNIT + 1u;
     if (budget != 0u && *used != 0u && *used + solve_units > budget) {

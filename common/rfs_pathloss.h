@@ -226,6 +226,8 @@ typedef struct rfs_pathloss_ev {
     rfs_q16_t fp;    ///< its counts' footprint (cfg footprint or coarse_footprint), m Q16.16
     uint32_t c;      ///< its coarse surface index (coarse candidates)
     uint32_t b;      ///< next bin to gather
+    int64_t sl;      ///< sum over the gathered bins of weight x 10 log10(d), dB Q16.16
+    int64_t sk;      ///< sum of weight x walls, quarter walls
 } rfs_pathloss_ev_t;
 
 /// What the model believes (rfs_pathloss_estimate()).

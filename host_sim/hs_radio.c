@@ -41,7 +41,8 @@ struct hs_radio {
     uint32_t gw, gh;          ///< shadow grid points
     uint32_t cw, ch;          ///< wall cache cells
     double k_steps;           ///< wavenumber 2 pi / lambda in table steps per metre
-    float sin_tab[SIN_N];     ///< sin(2 pi i / SIN_N)
+    double sin_tab[SIN_N];    ///< sin(2 pi i / SIN_N) rounded to float precision, stored as
+                              ///< double (no conversion per wave)
     hs_radio_walls_fn walls_fn;
     void *walls_ctx;
     double los_a, los_b;      ///< Rician amplitudes sqrt(K/(K+1)), sqrt(1/(K+1))
@@ -253,7 +254,7 @@ hs_radio_t *hs_radio_create(const hs_radio_cfg_t *cfg, const hs_radio_src_t *src
     r->los_b = sqrt(1.0 / (k + 1.0));
     r->scat = 1.0 / sqrt((double)cfg->fading_waves);
     for (unsigned i = 0; i < SIN_N; i++) {
-        r->sin_tab[i] = (float)sin(2.0 * M_PI * i / SIN_N);
+        r->sin_tab[i] = (double)(float)sin(2.0 * M_PI * i / SIN_N);
     }
     for (unsigned s = 0; s < nsrc; s++) {
         radio_src_t *rs = &r->src[s];

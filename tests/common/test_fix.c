@@ -399,6 +399,22 @@ static void test_i128(void **state)
         }
         check_div_shift(n, d, shift);
     }
+    /* quotients below 2^31 (the estimated path) and just above it, divisors of every size */
+    for (int i = 0; i < 300000; ++i) {
+        unsigned shift = (unsigned)(mix(&x) % 63u);
+        int dbits = (int)(mix(&x) % 126u) + 1;
+        int nbits = dbits + (int)(mix(&x) % 34u) - 2 - (int)shift;
+        nbits = nbits < 1 ? 1 : (nbits > 126 - (int)shift ? 126 - (int)shift : nbits);
+        i128 n = (i128)(((unsigned __int128)mix(&x) << 64 | mix(&x)) >> (128 - nbits));
+        i128 d = (i128)(((unsigned __int128)mix(&x) << 64 | mix(&x)) >> (128 - dbits));
+        if (mix(&x) & 1u) {
+            d = (i128)((((unsigned __int128)1 << (dbits - 1)) | (unsigned __int128)d) &
+                       ~(unsigned __int128)(mix(&x) & 1u ? 0u : 0xFFFFFFFFu));
+        }
+        check_div_shift(mix(&x) & 1u ? -n : n, mix(&x) & 1u ? -d : d, shift);
+    }
+    check_div_shift(((i128)1 << 120) - 1, ((i128)1 << 91) + 1, 0); /* estimate 2 below */
+    check_div_shift(((i128)3 << 60), 2, 40);
     check_div_shift(7, 2, 0);
     check_div_shift(-7, 2, 0);
     check_div_shift(5, 0, 3);

@@ -736,19 +736,20 @@ static bool flood_pocket(rfs_seek_t *s)
 {
     uint16_t i, j;
     rfs_q16_t x = s->pose.x, y = s->pose.y;
-    if (s->cfg.reach_min == 0u || s->reach_pocket == 2u ||
-        (s->reach_pocket == 0u && s->flood.marked >= s->cfg.reach_min) ||
-        (s->reach_pocket == 1u && s->flood.marked > s->reach_own)) {
+    if (s->cfg.reach_min == 0u || s->reach_pocket == RFS_SEEK_POCKET_AGAIN ||
+        (s->reach_pocket == RFS_SEEK_POCKET_OWN && s->flood.marked >= s->cfg.reach_min) ||
+        (s->reach_pocket == RFS_SEEK_POCKET_BESIDE && s->flood.marked > s->reach_own)) {
         return false;
     }
-    if (s->reach_pocket == 0u) {
+    if (s->reach_pocket == RFS_SEEK_POCKET_OWN) {
         if (!rfs_reach_snap_outside(s->map, s->reach, x, y, &i, &j)) {
             return false;
         }
         s->reach_own = s->flood.marked;
         rfs_map_lattice_point(s->map, i, j, &x, &y);
     }
-    s->reach_pocket++;
+    s->reach_pocket = s->reach_pocket == RFS_SEEK_POCKET_OWN ? RFS_SEEK_POCKET_BESIDE
+                                                             : RFS_SEEK_POCKET_AGAIN;
     s->reach_valid = false;
     return rfs_reach_flood_begin(&s->flood, s->map, x, y, s->reach, s->queue);
 }
@@ -764,7 +765,7 @@ static bool keep_reach(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     if (!s->flooding &&
         (!s->reach_valid || !rfs_reach_snap(s->map, s->reach, s->pose.x, s->pose.y, &si, &sj))) {
         s->reach_valid = false;
-        s->reach_pocket = 0u;
+        s->reach_pocket = RFS_SEEK_POCKET_OWN;
         s->flooding = rfs_reach_flood_begin(&s->flood, s->map, s->pose.x, s->pose.y, s->reach,
                                             s->queue);
         filled = !s->flooding; /* no legal point near: no flood */

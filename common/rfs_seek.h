@@ -230,6 +230,13 @@ typedef enum rfs_seek_state {
     RFS_SEEK_DRIVING,     ///< following the current goal
 } rfs_seek_state_t;
 
+/// reach_min's flood stages (rfs_seek_t.reach_pocket).
+typedef enum rfs_seek_pocket {
+    RFS_SEEK_POCKET_OWN = 0, ///< the flood of the robot's own component
+    RFS_SEEK_POCKET_BESIDE,  ///< it was a pocket: the flood from the nearest point outside it
+    RFS_SEEK_POCKET_AGAIN,   ///< that one was no larger: the pocket flooded again, kept
+} rfs_seek_pocket_t;
+
 /// Fault flags (bits of rfs_seek_out_t.faults).
 enum {
     RFS_SEEK_FAULT_POSE_STALE = 1u << 0, ///< no pose within pose_timeout_us
@@ -316,8 +323,7 @@ typedef struct rfs_seek {
     bool reach_valid;                         ///< reach holds the robot's component
     bool flooding;                            ///< reach_budget: a sliced flood is under way
     rfs_reach_flood_t flood;                  ///< its state
-    uint8_t reach_pocket;                     ///< reach_min: 0 the robot's component, 1 the
-                                              ///< one beside its pocket, 2 the pocket again
+    rfs_seek_pocket_t reach_pocket;           ///< reach_min: the flood stage
     uint32_t reach_own;                       ///< reach_min: the pocket's lattice points
     uint16_t eps_w[RFS_SEEK_EPS_TABLE];       ///< e^(-d) by squared lattice offset, Q0.16
     rfs_pose_t pose;                          ///< latest pose

@@ -6,8 +6,8 @@ where it breaks (8 dB shadowing, a source in the corridor, nodes weaker than bel
 Writes its section of docs/RESULTS.md, between the markers below, and nothing else.
 
     /usr/bin/python3 scripts/bench_pathloss_seek.py [--seeds N] [--first-seed 1001]
-                                                    [--sim build/bin/rfseek-sim]
-                                                    [--results docs/RESULTS.md]
+                                                    [--sim build/bin/rfseek-sim] [--jobs N]
+                                                    [--results docs/RESULTS.md | --no-write]
 """
 import argparse
 import math
@@ -62,9 +62,10 @@ def wilson(k, n, z=1.96):
     return (max(0.0, c - h), min(1.0, c + h))
 
 
-def run(sim, scenario, strategy, model, seeds, first=1):
-    out = subprocess.run([sim, scenario, "--strategy", strategy, "--model", model,
-                          "--seeds", f"{first}..{first + seeds - 1}", "--quiet"],
+def run(sim, scenario, strategy, model, seeds, first=1, jobs=None):
+    cmd = [sim, scenario, "--strategy", strategy, "--model", model,
+           "--seeds", f"{first}..{first + seeds - 1}", "--quiet"]
+    out = subprocess.run(cmd + (["--jobs", str(jobs)] if jobs else []),
                          capture_output=True, text=True)
     if out.returncode != 0:
         sys.exit(f"bench_pathloss_seek: {scenario}: {out.stderr.strip()}")
@@ -166,11 +167,17 @@ def main():
     ap.add_argument("--first-seed", type=int, default=1001,
                     help="seeds FIRST..FIRST+N-1 (1..500 are the tuning draws: report on others)")
     ap.add_argument("--sim", default="build/bin/rfseek-sim", help="the rfseek-sim to run")
+    ap.add_argument("--jobs", type=int, default=0,
+                    help="rfseek-sim worker processes (0: all cores)")
     ap.add_argument("--results", default="docs/RESULTS.md",
                     help="the markdown file whose section is replaced")
+    ap.add_argument("--no-write", action="store_true",
+                    help="print the section instead of writing it into --results")
     a = ap.parse_args()
     if a.seeds < 1 or a.first_seed < 1:
         sys.exit("bench_pathloss_seek: --seeds and --first-seed must be at least 1")
+    if a.jobs < 0:
+        sys.exit("bench_pathloss_seek: --jobs must be 0 (all cores) or more")
     tmps = []
     t0 = time.time()
     table = []
@@ -182,14 +189,18 @@ def main():
                 for strategy, model, name, extra in CONFIGS:
                     scen = scenario_file(path, edits, tmps, extra)
                     cells.append(cell(run(a.sim, scen, strategy, model, a.seeds,
-                                          a.first_seed)))
+                                          a.first_seed, a.jobs)))
                     print(f"{label} | {name} | {cells[-1]}", flush=True)
                 out.append((label, cells))
             table.append((title, out))
     finally:
         for t in tmps:
             os.unlink(t)
-    splice(a.results, section(a.seeds, a.first_seed, time.time() - t0, commit(), table))
+    text = section(a.seeds, a.first_seed, time.time() - t0, commit(), table)
+    if a.no_write:
+        print(text)
+        return
+    splice(a.results, text)
     print(f"wrote {a.results} ({time.time() - t0:.0f} s)")
 
 

@@ -68,5 +68,6 @@ bridge_bounds.py|--sim /nonexistent scenarios/bridge.yaml 1..2|/nonexistent: not
 bridge_bounds.py|scenarios/nope.yaml 1..2|no such scenario file
 bench_seek.py|--bin /bin/true --first-seed 0|--first-seed and --jobs must be at least 1
 bench_pathloss_seek.py|--first-seed 0|--first-seed must be at least 1
+bench_pathloss_seek.py|--jobs -1|--jobs must be 0 (all cores) or more
 LIST
 [ $fails -eq 0 ]

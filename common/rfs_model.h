@@ -125,6 +125,10 @@ typedef struct rfs_model_ops {
     /// Optional (may be NULL): the plausible maximum worth visiting before the argmax
     /// (rfs_model_near_t); false when none beats the argmax or there is no model.
     bool (*near)(const void *self, const struct rfs_model_near *q, rfs_q16_t *x, rfs_q16_t *y);
+    /// Optional (may be NULL): how far the fit's source power lies above the model's floor
+    /// of plausible powers (the path-loss model: P0 - p0_min), dB Q16.16 (negative below
+    /// it); false when there is no model or no floor (rfs_seek_cfg_t.floor_gap).
+    bool (*floor_gap)(const void *self, rfs_q16_t *gap);
 } rfs_model_ops_t;
 
 /// A model: its operations and its caller-owned state.

@@ -905,6 +905,17 @@ static bool pathloss_argmax(const void *self, rfs_q16_t *x, rfs_q16_t *y)
     return true;
 }
 
+/* Scaling: P0 and p0_min Q16.16 dB (|.| < 2^31), the difference in int64, saturated. */
+static bool pathloss_floor_gap(const void *self, rfs_q16_t *gap)
+{
+    const rfs_pathloss_t *p = (const rfs_pathloss_t *)self;
+    if (!p->valid || p->cfg.p0_min == INT32_MIN) {
+        return false;
+    }
+    *gap = rfs_sat32((int64_t)p->best.p0 - p->cfg.p0_min);
+    return true;
+}
+
 const rfs_model_ops_t rfs_pathloss_ops = {
     .name = "pathloss",
     .reset = pathloss_reset,
@@ -914,6 +925,7 @@ const rfs_model_ops_t rfs_pathloss_ops = {
     .predict_row = 0,
     .sample = rfs_pathloss_sample_op,
     .near = rfs_pathloss_near_op,
+    .floor_gap = pathloss_floor_gap,
 };
 
 rfs_model_t rfs_pathloss_model(rfs_pathloss_t *p)

@@ -134,12 +134,12 @@ typedef struct rfs_seek_cfg {
                                 ///< "Stalls"), Q16.16 (0: off)
     rfs_q16_t near_min;         ///< see near_t, metres Q16.16
     rfs_q16_t floor_gap;        ///< with a model that answers floor_gap (the path-loss
-                                ///< model): a greedy decision whose fit's source power
-                                ///< lies less than this above the model's floor (the
-                                ///< floor pins the fit: its estimate is rarely within 5 m)
-                                ///< takes floor_leg, dB Q16.16 (0: off)
-    rfs_q16_t floor_leg;        ///< with floor_gap: the longest greedy leg to a pinned
-                                ///< estimate, metres Q16.16 (0: an epsilon step instead)
+                                ///< model): a fit whose source power lies less than this
+                                ///< above the model's floor (pinned: a weak source near the
+                                ///< robot, seldom within 5 m of the real one) has its
+                                ///< estimate ruled out as refute_r does, the next decision
+                                ///< relearns, and this one explores (epsilon) instead of
+                                ///< going greedy, dB Q16.16 (0: off)
     rfs_q16_t leg_max;          ///< a greedy leg to a known argmax ends after this much of
                                 ///< its path (the next decision relearns and may explore),
                                 ///< metres Q16.16 (0: the whole path)
@@ -272,7 +272,8 @@ typedef struct rfs_seek_decision {
                                ///< model's draw (a sampled epsilon step)
     bool sampled;              ///< epsilon: the goal is the model's draw (cfg.eps_sample)
     bool near;                 ///< greedy: the goal is a nearer plausible source (cfg.near_t)
-    bool pinned;               ///< the fit's power lay within cfg.floor_gap of its floor
+    bool pinned;               ///< greedy drawn, but the fit's power lay within
+                               ///< cfg.floor_gap of its floor: ruled out, epsilon instead
     bool refuted;              ///< the argmax was ruled out before this decision's fit
                                ///< (cfg.refute_r)
     rfs_q16_t path_len;        ///< planned path length, metres Q16.16

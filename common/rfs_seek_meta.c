@@ -579,12 +579,7 @@ bool rfs_seek_meta_path_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool kno
         rfs_map_lattice_nearest(s->map, gx, gy, &li, &lj);
         rfs_reach_bit_set(s->visited, (uint32_t)lj * s->map->lw + li);
     }
-    rfs_q16_t leg = known ? s->cfg.leg_max : s->cfg.step;
-    if (known && s->decision.pinned && s->cfg.floor_leg > 0 &&
-        (leg <= 0 || leg > s->cfg.floor_leg)) {
-        leg = s->cfg.floor_leg; /* floor_gap: a short leg, then a fit on what it saw */
-    }
-    if (!greedy_along_path(s, mx, my, leg, now_us)) {
+    if (!greedy_along_path(s, mx, my, known ? s->cfg.leg_max : s->cfg.step, now_us)) {
         return false;
     }
     if (local == 0 && s->cfg.local_refute && s->cfg.refute_r > 0) {
@@ -655,13 +650,14 @@ bool rfs_seek_meta_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool known,
     return rfs_seek_go_to(s, mx, my, now_us);
 }
 
-/* floor_gap: the fit's source power within cfg.floor_gap of the model's floor (the floor's
- * penalty about to bind): distance traded against power, the estimate seldom within 5 m
- * of the source (docs/STRATEGIES.md, "Stalls"). */
+/* floor_gap: the fit's source power within cfg.floor_gap of the model's floor (its
+ * penalty about to bind): distance traded against power, a weak source placed near the
+ * robot, the real one farther (docs/STRATEGIES.md, "Stalls"). */
 static bool floor_pinned(const rfs_seek_t *s)
 {
     rfs_q16_t gap;
     return s->cfg.floor_gap > 0 && s->model.ops->floor_gap != 0 &&
+           s->model.ops->argmax != 0 &&
            s->model.ops->floor_gap(s->model.self, &gap) && gap < s->cfg.floor_gap;
 }
 
@@ -678,9 +674,13 @@ bool rfs_seek_meta_choose(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t 
     bool settled = rfs_seek_src_settled(s);
     bool greedy = model_ok && (s->replan || settled || rfs_rng_q16(rng) >= d->epsilon);
     s->replan = false;
-    d->pinned = model_ok && floor_pinned(s);
-    if (greedy && !settled && d->pinned && s->cfg.floor_leg <= 0) {
-        greedy = false; /* floor_gap: the pinned estimate is rarely the source: explore */
+    rfs_q16_t ax, ay;
+    d->pinned = greedy && !settled && floor_pinned(s) &&
+                s->model.ops->argmax(s->model.self, &ax, &ay);
+    if (d->pinned) {
+        exclude(s, ax, ay); /* for the relearn the next decision makes */
+        s->replan = true;
+        greedy = false;
     }
     d->kind = greedy ? RFS_SEEK_GREEDY : RFS_SEEK_EPSILON;
     if (greedy && rfs_seek_src_orbit(s, rng, now_us)) {

@@ -812,9 +812,6 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     if (e->sc.seek_floor_db >= 0.0) {
         cc.seek.floor_gap = (rfs_q16_t)lround(e->sc.seek_floor_db * 65536.0);
     }
-    if (e->sc.seek_floor_leg_m >= 0.0) {
-        cc.seek.floor_leg = (rfs_q16_t)lround(e->sc.seek_floor_leg_m * 65536.0);
-    }
     if (e->sc.seek_silence_floor >= 0) {
         cc.seek.silence_floor = e->sc.seek_silence_floor != 0 ? RFS_Q16_INT(-100) : INT32_MIN;
     }

@@ -16,7 +16,7 @@
  *                                  #       p0_max_wall_db: 3, local_gap_m: 0.5,
  *                                  #       at_tol_m: 0.03, near_t: 0, near_m: 30,
  *                                  #       coarse_snap: true, reach_min: 16,
- *                                  #       fit_budget: 30}
+ *                                  #       fit_budget: 30, floor_db: 1}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2

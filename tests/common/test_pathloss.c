@@ -326,6 +326,28 @@ static void p0_floor_off_same_as_reference(void **state)
     expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
 }
 
+/* floor_gap (the seeker's floor_gap rule): the fit's P0 above the -45 dBm floor, the
+ * double reference's P0 + 45 for the office truth (P0 -35 dBm); no answer without a
+ * floor or before a fit. */
+static void floor_gap_is_p0_above_the_floor(void **state)
+{
+    fixture_t *f = *state;
+    rfs_q16_t gap = 0;
+    rfs_pathloss_ops.reset(&f->pl);
+    assert_false(rfs_pathloss_ops.floor_gap(&f->pl, &gap));
+    make_samples(f->s, NS, &f->map, &k_office, 11);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+    assert_int_equal(c.p0_min, RFS_Q16_INT(-45));
+    expect_same_as_reference(f, &c, NS, &f->map, &rc, 0.01);
+    assert_true(rfs_pathloss_ops.floor_gap(&f->pl, &gap));
+    assert_true(fabs(gap / 65536.0 - (f->ref.p0 + 45.0)) < 0.2);
+    assert_true(gap / 65536.0 > 5.0);
+    c.p0_min = INT32_MIN;
+    (void)fit_with(f, &c, NS, &f->map, 0, NULL);
+    assert_false(rfs_pathloss_ops.floor_gap(&f->pl, &gap));
+}
+
 /* p0_max below the truth's -35 dBm: the fixed-point search equals the double reference
  * with the ceiling biting, and the ceiling pulls the fitted P0 down. */
 static void p0_ceiling_same_as_reference(void **state)
@@ -600,6 +622,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(places_ruled_out_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(footprint_off_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_floor_off_same_as_reference, setup, teardown),
+        cmocka_unit_test_setup_teardown(floor_gap_is_p0_above_the_floor, setup, teardown),
         cmocka_unit_test_setup_teardown(p0_ceiling_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(coarse_footprint_one_same_as_reference, setup, teardown),
         cmocka_unit_test_setup_teardown(coarse_snap_finds_corridor_off_the_grid, setup, teardown),

@@ -1,7 +1,7 @@
 /* test_seek_stall.c - meta-path's answers to a stall (common/rfs_seek_meta.c,
  * docs/STRATEGIES.md "Stalls"): ruling out a refuted or swept estimate (refute_r,
- * refute_reached, local_refute) and the bounded local search round it (local_r,
- * local_gap), each against a reference computed here in double precision.
+ * refute_reached, local_refute, floor_gap) and the bounded local search round it
+ * (local_r, local_gap), each against a reference computed here in double precision.
  */
 #include "rfs_test.h"
 
@@ -468,6 +468,82 @@ static void test_local_gap_spaces_the_sweep(void **state)
     assert_true(spaced >= 4 && spaced * 3 < plain * 2);
 }
 
+/* floor_gap (docs/STRATEGIES.md, "Stalls"): a fixed model whose fit reports its source
+ * power `gap` dB above its floor and records the places ruled out it is given. The
+ * greedy decision after the initial move, with the floor_gap rule at 1 dB: a fit 0.5 dB
+ * above the floor explores (epsilon, away from the estimate) and rules the estimate out
+ * (the next decision relearns, given that one place at refute_r); 1.5 dB, or the rule
+ * off, goes greedy to the estimate and rules nothing out. */
+typedef struct floor_model {
+    fixed_model_t base; /* first: the fixed_* operations read it */
+    double gap;         /* dB above the floor */
+    int fits, nexcl;    /* fits, and the places the latest one was given */
+    double ex, ey, r;   /* the latest place ruled out and its radius, metres */
+} floor_model_t;
+
+static rfs_fit_result_t floor_fit(void *self, const rfs_model_fit_in_t *in, uint32_t budget,
+                                  rfs_rng_t *rng)
+{
+    floor_model_t *m = self;
+    m->fits++;
+    m->nexcl = in->nexcl;
+    if (in->nexcl > 0) {
+        m->ex = in->excl_x_cm[in->nexcl - 1] / 100.0;
+        m->ey = in->excl_y_cm[in->nexcl - 1] / 100.0;
+        m->r = D(in->excl_r);
+    }
+    return fixed_fit(self, in, budget, rng);
+}
+
+static bool floor_gap_op(const void *self, rfs_q16_t *gap)
+{
+    const floor_model_t *m = self;
+    *gap = Q(m->gap);
+    return m->base.valid;
+}
+
+static void floor_case(double rule_db, double gap, bool pinned)
+{
+    static const rfs_model_ops_t ops = { .name = "floor", .reset = fixed_reset,
+                                         .fit = floor_fit, .predict = fixed_predict,
+                                         .argmax = fixed_argmax, .floor_gap = floor_gap_op };
+    world_t t;
+    rfs_seek_cfg_t cfg;
+    floor_model_t m = { .gap = gap };
+    local_world(&t, &cfg, &m.base);
+    cfg.floor_gap = Q(rule_db);
+    rfs_model_t model = { &ops, &m };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 }; /* as predicted: no relearn by a miss */
+    run_t r = { .x = 4.0, .y = 5.0 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.kind, RFS_SEEK_INITIAL);
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    double off = hypot(D(out.decision.goal_x) - LOCAL_EX, D(out.decision.goal_y) - LOCAL_EY);
+    assert_int_equal(out.decision.pinned, pinned);
+    assert_int_equal(out.decision.kind, pinned ? RFS_SEEK_EPSILON : RFS_SEEK_GREEDY);
+    assert_true(pinned ? off > 2.0 : off < 1e-3);
+    int fits = m.fits;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.relearned, pinned);
+    assert_int_equal(m.fits, fits + (pinned ? 1 : 0));
+    assert_int_equal(m.nexcl, pinned ? 1 : 0);
+    if (pinned) {
+        assert_true(fabs(m.ex - LOCAL_EX) < 0.006 && fabs(m.ey - LOCAL_EY) < 0.006);
+        assert_true(fabs(m.r - D(cfg.refute_r)) < 1e-9 && m.r > 0.0);
+    }
+    world_free(&t);
+}
+
+static void test_floor_gap_rules_out_a_pinned_fit(void **state)
+{
+    (void)state;
+    floor_case(1.0, 0.5, true);
+    floor_case(1.0, 1.5, false);
+    floor_case(0.0, 0.5, false);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -476,6 +552,7 @@ int main(void)
         cmocka_unit_test(test_local_search_round_the_estimate),
         cmocka_unit_test(test_local_refute_rules_out_the_swept),
         cmocka_unit_test(test_local_gap_spaces_the_sweep),
+        cmocka_unit_test(test_floor_gap_rules_out_a_pinned_fit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -48,6 +48,7 @@ hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void)
     c.p0_max_wall_db = NAN;
     c.coarse_snap = -1;
     c.pathloss_log2 = NULL;
+    c.pathloss_builtin_cache = false;
     return c;
 }
 

@@ -727,6 +727,32 @@ static int load(const char *path, hs_scenario_t *sc, char *err, size_t errlen)
     return rc;
 }
 
+int hs_scenario_seek(hs_scenario_t *sc, const char *text, char *err, size_t errlen)
+{
+    char buf[sizeof sc->seek_cli + 16];
+    const int n = snprintf(buf, sizeof buf, "seek: {%s}\n", text);
+    if (n < 0 || (size_t)n >= sizeof buf || strlen(text) >= sizeof sc->seek_cli) {
+        snprintf(err, errlen, "--seek: longer than %zu characters", sizeof sc->seek_cli - 1);
+        return -1;
+    }
+    pctx_t p = {.file = "--seek", .err = err, .errlen = errlen};
+    lx_yaml_doc_t doc;
+    lx_yaml_error_t ye;
+    int rc = -1;
+    if (lx_yaml_load_string((const uint8_t *)buf, (size_t)n, &doc, &ye) != LX_YAML_OK ||
+        !doc.root || !lx_yaml_get(doc.root, "seek")) {
+        snprintf(err, errlen, "--seek: expected KEY: VALUE[, KEY: VALUE...], got '%s'", text);
+        lx_err_one_line(err);
+    } else {
+        rc = parse_seek(&p, doc.root, sc);
+    }
+    lx_yaml_free(&doc);
+    if (rc == 0) {
+        snprintf(sc->seek_cli, sizeof sc->seek_cli, "%s", text);
+    }
+    return rc;
+}
+
 int hs_scenario_load(const char *path, hs_scenario_t *sc, char *err, size_t errlen)
 {
     const int rc = load(path, sc, err, errlen);

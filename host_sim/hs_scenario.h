@@ -69,6 +69,7 @@ typedef struct hs_scn_source {
 /// A loaded scenario.
 typedef struct hs_scenario {
     char path[1024];              ///< the scenario file
+    char seek_cli[256];           ///< rfseek-sim --seek: the keys overriding seek: ("" none)
     char map_path[1024];          ///< the map YAML, resolved against the scenario's folder
     uint64_t seed;                ///< default seed (1)
     char model[32];               ///< internal model name ("ridge")
@@ -154,6 +155,10 @@ void hs_scenario_defaults(hs_scenario_t *sc);
 
 /// Load and check a scenario file. Returns 0, or -1 with err = "file:line: reason".
 int hs_scenario_load(const char *path, hs_scenario_t *sc, char *err, size_t errlen);
+
+/// Override seek: keys with text "KEY: VALUE[, KEY: VALUE...]" (rfseek-sim --seek), checked
+/// as the file's; kept in sc->seek_cli. Returns 0, or -1 with err = one line.
+int hs_scenario_seek(hs_scenario_t *sc, const char *text, char *err, size_t errlen);
 
 /// Parse "aa:bb:cc:dd:ee:ff"; 0 or -1.
 int hs_scenario_parse_mac(const char *s, uint8_t mac[6]);

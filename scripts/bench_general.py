@@ -126,7 +126,9 @@ def batch(a, floor, strategy, model, first, last, base):
 
 def chunk(a, floor, strategy, model, first, last, base):
     """The runs of one batch, run (or resumed, or read back) in base/..."""
-    d = os.path.join(base, floor, f"{strategy}-{model}-p{first}..{last}-s{a.seeds}")
+    seek = a.seek if strategy == "meta-path" else ""
+    tag = "-seek" + hashlib.sha256(seek.encode()).hexdigest()[:8] if seek else ""
+    d = os.path.join(base, floor, f"{strategy}-{model}-p{first}..{last}-s{a.seeds}{tag}")
     runs = os.path.join(d, "runs.tsv")
     if not os.path.exists(runs):
         t0 = time.time()
@@ -134,6 +136,8 @@ def chunk(a, floor, strategy, model, first, last, base):
         cmd = [a.sim, f"scenarios/{floor}.yaml", "--placements", f"{first}..{last}",
                "--placement-seed", "1", "--seeds", a.seeds, "--strategy", strategy, "--model",
                model, "--jobs", str(a.jobs), "--quiet", "--out", d]
+        if seek:
+            cmd += ["--seek", seek]
         if os.path.exists(d) or glob.glob(d + ".tmp-*"):
             cmd.append("--resume")
         out = subprocess.run(cmd, capture_output=True, text=True)
@@ -203,6 +207,9 @@ def main():
     ap.add_argument("--work", default="build/bench_general", help="folder for the batches' runs")
     ap.add_argument("--results", default="docs/RESULTS.md", help="the markdown file whose section is replaced")
     ap.add_argument("--no-write", action="store_true", help="print the tables only")
+    ap.add_argument("--seek", default="",
+                    help="rfseek-sim --seek for meta-path + pathloss ('KEY: VALUE, ...'; a variant "
+                         "beside the preset, the paper's runs unchanged)")
     ap.add_argument("--held-out-only", action="store_true",
                     help="run placements 51.. only (the tuning draws are not run)")
     a = ap.parse_args()
@@ -217,6 +224,11 @@ def main():
                      f"(known: {', '.join(REAL + SYNTHETIC)})")
     if not os.access(a.sim, os.X_OK):
         sys.exit(f"bench_general: {a.sim}: not an executable (make all)")
+    if a.seek:  # checked once, before any batch
+        chk = subprocess.run([a.sim, "scenarios/open.yaml", "--seek", a.seek, "--placements", "1",
+                              "--list-placements"], capture_output=True, text=True)
+        if chk.returncode != 0:
+            sys.exit(f"bench_general: {chk.stderr.strip()}")
     with open(a.sim, "rb") as f:
         base = os.path.join(a.work, hashlib.sha256(f.read()).hexdigest()[:12])
     half = a.placements // 2

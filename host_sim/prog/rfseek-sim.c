@@ -61,6 +61,8 @@ static void usage(FILE *f)
             "  --p0-min DBM    pathloss only: floor on the fitted signal at 1 m, overriding\n"
             "                  the scenario's seek.p0_min_dbm (default -45; the node's EIRP\n"
             "                  - 52 when its power is known: docs/PATHLOSS.md)\n"
+            "  --seek 'KEY: VALUE, ...'  override the scenario's seek: keys (docs/SIMULATOR.md),\n"
+            "                  checked as in the file\n"
             "  --fit-budget N|mcu  the model's work units a control period, overriding the\n"
             "                  scenario's seek.fit_budget (0, the default: each fit whole;\n"
             "                  mcu: the model's Cortex-M4 budget and wall-count cache,\n"
@@ -177,6 +179,7 @@ typedef struct sim_opts {
     bool has_seed, samples, field, emit, quiet, bench, no_faults, resume;
     double p0_min;                /* --p0-min: NAN keeps the scenario's (or the model's default) */
     long fit_budget;              /* --fit-budget: -1 keeps the scenario's, FIT_MCU the model's */
+    const char *seek;             /* --seek KEY: VALUE, ...: seek: keys overridden, or NULL */
     const char *start, *source;   /* --start X,Y[,THETA], --source X,Y: placement overrides */
     const char *placements;       /* --placements N or A..B: drawn pairs pa..pb */
     uint64_t pa, pb;
@@ -250,6 +253,11 @@ static int parse_options(int argc, char **argv, sim_opts_t *o)
                            more ? argv[i + 1] : "", "");
             }
             i++;
+        } else if (strcmp(a, "--seek") == 0) {
+            if (!more || !*argv[i + 1] || strchr(argv[i + 1], '\'') != NULL) {
+                return die("--seek: expected KEY: VALUE[, KEY: VALUE...] (no quote)%s%s", "", "");
+            }
+            o->seek = argv[++i];
         } else if (strcmp(a, "--fit-budget") == 0) {
             uint64_t v;
             if (more && strcmp(argv[i + 1], "mcu") == 0) {
@@ -546,6 +554,12 @@ static int load_scenario(const sim_opts_t *o, hs_scenario_t *sc)
         }
         sc->seek_p0_min_dbm = o->p0_min;
     }
+    if (o->seek) {
+        char err[512];
+        if (hs_scenario_seek(sc, o->seek, err, sizeof err) != 0) {
+            return die("%s%s", err, "");
+        }
+    }
     if (o->fit_budget != -1) {
         const rfs_models_entry_t *m = rfs_models_lookup(sc->model);
         sc->seek_fit_budget = o->fit_budget == FIT_MCU ? (double)(m ? m->mcu_fit_budget : 0u)
@@ -568,9 +582,13 @@ static int emit_jobs(const sim_opts_t *o, const hs_scenario_t *sc)
     const uint64_t np = o->placements ? o->pb - o->pa + 1 : 1, ns = o->sb - o->sa + 1;
     for (uint64_t i = 0; i < np * ns; i++) {
         const uint64_t s = o->sa + i % ns, k = o->pa + i / ns; /* a batch's order */
-        char p0[96] = "", place[96] = "", dir[64];
+        char p0[96 + sizeof sc->seek_cli] = "", place[96] = "", dir[64];
         if (!isnan(o->p0_min)) {
             snprintf(p0, sizeof p0, " --p0-min %.17g", o->p0_min);
+        }
+        if (o->seek) {
+            size_t l = strlen(p0);
+            snprintf(p0 + l, sizeof p0 - l, " --seek '%s'", o->seek);
         }
         if (o->fit_budget != -1) {
             size_t l = strlen(p0);

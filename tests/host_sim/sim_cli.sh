@@ -87,6 +87,24 @@ if [ -s "$T/fbcli.json" ] && cmp -s <(same "$T/fbcli.json") <(same "$T/fbkey.jso
 else
     fail fit_budget_cli_key_latency "over $(over "$T/fbcli.json") / $(over "$T/fbnone.json")"
 fi
+# --seek: the scenario's seek: keys from the command line, checked as the file's; the same
+# run as the key in the file, another run than without it.
+bad seek_unknown "--seek:1: seek: unknown key 'bogus'" "$T/p0.yaml" --seek 'bogus: 1' --out "$T/out"
+bad seek_value "--seek:1: seek.leg_m: 'far' is not a number" "$T/p0.yaml" --seek 'leg_m: far' --out "$T/out"
+bad seek_syntax "--seek: expected KEY: VALUE[, KEY: VALUE...], got '[1, 2'" "$T/p0.yaml" --seek '[1, 2' --out "$T/out"
+scn legkey.yaml "${BASE}model: pathloss
+strategy: meta-path
+seek: {leg_m: 2}
+"
+"$SIM" "$T/p0.yaml" --model pathloss --strategy meta-path --seek 'leg_m: 2' --seed 3 >"$T/legcli.json" 2>/dev/null
+"$SIM" "$T/legkey.yaml" --seed 3 >"$T/legkey.json" 2>/dev/null
+"$SIM" "$T/p0.yaml" --model pathloss --strategy meta-path --seed 3 >"$T/legnone.json" 2>/dev/null
+if [ -s "$T/legcli.json" ] && cmp -s <(same "$T/legcli.json") <(same "$T/legkey.json") \
+    && ! cmp -s <(same "$T/legcli.json") <(same "$T/legnone.json"); then
+    pass seek_cli_equals_key
+else
+    fail seek_cli_equals_key "$(head -c 300 "$T/legcli.json")"
+fi
 # seek.KEY reaches the path-loss model: on the office (walls), OTHER changes the run, SAME
 # (the model's default) does not (docs/PATHLOSS.md): coarse_footprint_m 0 counts the coarse
 # pass at one count a bin; coarse_snap false leaves coarse grid points in walls without a

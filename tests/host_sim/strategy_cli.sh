@@ -62,6 +62,7 @@ mlp_steps.py|--seeds 5..1|'5..1' is not A..B
 mlp_steps.py|--sim /nonexistent|/nonexistent: not an executable
 bench_general.py|--placements 0|--placements: expected an even number
 bench_general.py|--sim /nonexistent|/nonexistent: not an executable
+bench_general.py|--seek bogus:1|unknown key 'bogus:1'
 bench_bridge.py|--sim /nonexistent|/nonexistent: not an executable
 bench_bridge.py|--seeds x|--seeds: expected A..B
 bridge_bounds.py|--sim /nonexistent scenarios/bridge.yaml 1..2|/nonexistent: not an executable

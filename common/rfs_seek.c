@@ -139,9 +139,8 @@ void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy
     /* 1 m^2 at the 0.25 m lattice, no room for a step; larger sealed components can hold
      * the source (docs/STRATEGIES.md, "Stalls"). */
     cfg->reach_min = on ? 16u : 0u;
-    /* A fit within 3 dB of the P0 floor places a weak source near the robot, the real one
-     * farther (docs/STRATEGIES.md, "Stalls"). */
-    cfg->floor_gap = on ? RFS_Q16_INT(3) : 0;
+    /* floor_gap stays off: 3 dB shortens the real floors' tails but loses weak nodes,
+     * whose true P0 sits at the floor (docs/STRATEGIES.md, "Stalls"). */
 }
 
 const char *rfs_seek_strategy_name(rfs_seek_strategy_t st)

@@ -396,7 +396,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void);
 /// fields, on for RFS_SEEK_META_PATH (recheck_dist = cfg->step, eps_by_travel,
 /// recheck_adapt, eps_geodesic, eps_sample, refute_r = cfg->step, silence_floor = -100
 /// dBm, recheck_silent, local_r = 4 cfg->step, local_gap = cfg->step / 2, at_tol = 3 cm,
-/// local_refute, reach_min = 16, floor_gap = 3 dB),
+/// local_refute, reach_min = 16; floor_gap stays 0),
 /// the paper's (0, false) for every other strategy.
 void rfs_seek_cfg_use_strategy(rfs_seek_cfg_t *cfg, rfs_seek_strategy_t strategy);
 

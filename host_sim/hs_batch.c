@@ -446,9 +446,11 @@ void hs_batch_state_header(char *buf, size_t n, const char *scenario, const hs_s
                  (unsigned long long)pa, (unsigned long long)pb, (unsigned long long)ps);
     }
     snprintf(buf, n, "# rfseek-sim batch\tscenario=%s\tseeds=%llu..%llu\tstrategy=%s\tmodel=%s"
-             "\tfaults=%u\tp0_min=%.17g\tfit_budget=%.0f%s\tseek=%s\tsamples=%d\tstart=%.17g,%.17g,%.17g\tsource=%.17g,%.17g%s\n",
+             "\tfaults=%u\tp0_min=%.17g\tfit_budget=%.0f%s\tseek=%s\tsamples=%d"
+             "\tstart=%.17g,%.17g,%.17g\tsource=%.17g,%.17g%s\n",
              realpath(scenario, abs) ? abs : scenario, (unsigned long long)a, (unsigned long long)b,
-             sc->strategy, sc->model, sc->faults.n, sc->seek_p0_min_dbm, sc->seek_fit_budget, sc->fit_mcu ? " (mcu)" : "", sc->seek_cli, samples ? 1 : 0,
+             sc->strategy, sc->model, sc->faults.n, sc->seek_p0_min_dbm, sc->seek_fit_budget,
+             sc->fit_mcu ? " (mcu)" : "", sc->seek_cli, samples ? 1 : 0,
              sc->start_x, sc->start_y, sc->start_theta, sc->src[0].x, sc->src[0].y, places);
 }
 

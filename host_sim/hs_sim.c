@@ -525,9 +525,9 @@ static void ctrl_event(sim_run_t *r, const event_t *ev, const tick_t *k)
         res->goal_blocked += d->prev == RFS_DRIVE_BLOCKED ? 1u : 0u;
         res->slow_decisions += d->plan_wait >= 2u ? 1u : 0u;
         res->plan_wait_max = d->plan_wait > res->plan_wait_max ? d->plan_wait : res->plan_wait_max;
-        const double wait_s = (double)(ev->te - d->t_us + ctrl->period_us) * 1e-6;
-        res->decisions_over_100ms += wait_s > 0.1 + 1e-9 ? 1u : 0u;
-        res->decision_wait_max_s = fmax(res->decision_wait_max_s, wait_s);
+        const int64_t wait_us = ev->te - d->t_us + ctrl->period_us; /* the deciding period too */
+        res->decisions_over_100ms += wait_us > 100000 ? 1u : 0u;
+        res->decision_wait_max_s = fmax(res->decision_wait_max_s, (double)wait_us * 1e-6);
         if (d->kind == RFS_SEEK_GREEDY && d->model_valid) {
             r->belief_x = q16d(d->max_x);
             r->belief_y = q16d(d->max_y);

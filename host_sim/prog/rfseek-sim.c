@@ -66,8 +66,8 @@ static void usage(FILE *f)
             "  --fit-budget N|mcu  the model's work units a control period, overriding the\n"
             "                  scenario's seek.fit_budget (0, the default: each fit whole;\n"
             "                  mcu: the model's Cortex-M4 budget and wall-count cache,\n"
-            "                  docs/PERFORMANCE.md); the\n"
-            "                  wheels wait while a fit runs (summary.json decision_wait_max_s)\n"
+            "                  docs/PERFORMANCE.md); the wheels wait while a fit runs\n"
+            "                  (summary.json decision_wait_max_s)\n"
             "  --start X,Y[,THETA]  start here (metres, radians), overriding the scenario's\n"
             "  --source X,Y    put the first source here (and the goal, unless the scenario\n"
             "                  names one); both must be legal places on the map\n"
@@ -254,8 +254,9 @@ static int parse_options(int argc, char **argv, sim_opts_t *o)
             }
             i++;
         } else if (strcmp(a, "--seek") == 0) {
-            if (!more || !*argv[i + 1] || strchr(argv[i + 1], '\'') != NULL) {
-                return die("--seek: expected KEY: VALUE[, KEY: VALUE...] (no quote)%s%s", "", "");
+            if (!more || !*argv[i + 1] || strpbrk(argv[i + 1], "'{}\t\n") != NULL) {
+                return die("--seek: expected KEY: VALUE[, KEY: VALUE...] (no quote, brace, tab "
+                           "or line break)%s%s", "", "");
             }
             o->seek = argv[++i];
         } else if (strcmp(a, "--fit-budget") == 0) {

@@ -4,14 +4,16 @@
 paper's meta + ridge on the same placements and seeds. Prints success, travel / shortest
 path and a failure taxonomy for the tuning draws (placements 1..50) and the held-out
 draws (51..100), and writes only the held-out half to its section of docs/RESULTS.md
-(between the markers below).
+(between the markers below). --placement-seed S (not 1) draws other pairs, all of them
+fair tuning draws (nothing written); --only p or r runs one configuration.
 
     /usr/bin/python3 scripts/bench_general.py [--placements 100] [--seeds 1..2]
         [--floors willow,3ne,...] [--sim build/bin/rfseek-sim] [--jobs 1]
         [--work build/bench_general] [--results docs/RESULTS.md | --no-write] [--held-out-only]
+        [--placement-seed S] [--only p|r]
 
 --placements P (even, 2..100) runs placements 1..P/2 and 51..50+P/2, so a smaller bench
-keeps the same held-out draws. Batches of up to CHUNK placements go to WORK/<binary
+keeps the same held-out draws (with another placement seed: 1..P). Batches of up to CHUNK placements go to WORK/<binary
 hash>/...: a finished one is read back and an interrupted one resumed (rfseek-sim
 --resume), so an interrupted bench continues where it stopped and a larger one reuses a
 smaller one's runs; a rebuilt simulator starts afresh. --held-out-only skips the tuning
@@ -128,13 +130,14 @@ def chunk(a, floor, strategy, model, first, last, base):
     """The runs of one batch, run (or resumed, or read back) in base/..."""
     seek = a.seek if strategy == "meta-path" else ""
     tag = "-seek" + hashlib.sha256(seek.encode()).hexdigest()[:8] if seek else ""
-    d = os.path.join(base, floor, f"{strategy}-{model}-p{first}..{last}-s{a.seeds}{tag}")
+    ps = f"-ps{a.placement_seed}" if a.placement_seed != 1 else ""
+    d = os.path.join(base, floor, f"{strategy}-{model}-p{first}..{last}{ps}-s{a.seeds}{tag}")
     runs = os.path.join(d, "runs.tsv")
     if not os.path.exists(runs):
         t0 = time.time()
         os.makedirs(os.path.dirname(d), exist_ok=True)
         cmd = [a.sim, f"scenarios/{floor}.yaml", "--placements", f"{first}..{last}",
-               "--placement-seed", "1", "--seeds", a.seeds, "--strategy", strategy, "--model",
+               "--placement-seed", str(a.placement_seed), "--seeds", a.seeds, "--strategy", strategy, "--model",
                model, "--jobs", str(a.jobs), "--quiet", "--out", d]
         if seek:
             cmd += ["--seek", seek]
@@ -160,8 +163,9 @@ def cells(s, parked):
 def table(results, floors, parked=True):
     """One row per floor, both configurations side by side, then the real floors pooled;
     the parked columns unless parked is False."""
+    configs = [x for x in CONFIGS if any(k[1] == x[2] for k in results)]
     head = ["floor (runs)"]
-    for _, _, _, c in CONFIGS:
+    for _, _, _, c in configs:
         head += [f"{c} success %", f"{c} ratio median / p90", f"{c} failures"] + \
             ([f"{c} parked"] if parked else [])
     L = ["| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
@@ -169,7 +173,7 @@ def table(results, floors, parked=True):
     if len([f for f in floors if f in REAL]) > 1:
         rows.append(("**all real**", [f for f in floors if f in REAL]))
     for label, group in rows:
-        st = [stats([r for f in group for r in results[(f, cfg)]]) for _, _, cfg, _ in CONFIGS]
+        st = [stats([r for f in group for r in results[(f, cfg)]]) for _, _, cfg, _ in configs]
         L.append(f"| {label} ({st[0]['n']}) | " + " | ".join(cells(x, parked) for x in st) + " |")
     return L
 
@@ -212,7 +216,22 @@ def main():
                          "beside the preset, the paper's runs unchanged)")
     ap.add_argument("--held-out-only", action="store_true",
                     help="run placements 51.. only (the tuning draws are not run)")
+    ap.add_argument("--placement-seed", type=int, default=1,
+                    help="the seed the pairs are drawn from; any but 1 gives tuning draws only "
+                         "(needs --no-write)")
+    ap.add_argument("--only", default="",
+                    help="run only this configuration (p: meta-path + pathloss, r: meta + ridge; "
+                         "needs --no-write)")
     a = ap.parse_args()
+    if a.only not in ("", "p", "r"):
+        sys.exit(f"bench_general: --only: expected p or r, not {a.only!r}")
+    if a.placement_seed < 1:
+        sys.exit("bench_general: --placement-seed: expected a positive integer")
+    if (a.placement_seed != 1 or a.only) and not a.no_write:
+        sys.exit("bench_general: --placement-seed and --only need --no-write "
+                 "(RESULTS.md holds the held-out draws of placement seed 1, both configurations)")
+    if a.placement_seed != 1 and a.held_out_only:
+        sys.exit("bench_general: --held-out-only: only placement seed 1 has held-out draws")
     if not (2 <= a.placements <= 100 and a.placements % 2 == 0):
         sys.exit("bench_general: --placements: expected an even number from 2 to 100")
     if not re.fullmatch(r"\d+\.\.\d+", a.seeds):
@@ -233,12 +252,16 @@ def main():
         base = os.path.join(a.work, hashlib.sha256(f.read()).hexdigest()[:12])
     half = a.placements // 2
     halves = [("tuning", 1, half), ("held-out", HELD_OUT_FIRST, HELD_OUT_FIRST + half - 1)]
+    if a.placement_seed != 1:  # every pair of another seed is a tuning draw
+        halves = [(f"tuning (placement seed {a.placement_seed})", 1, a.placements)]
     if a.held_out_only:
         halves = halves[1:]
     t0, spent = time.time(), 0.0
     results = {h: {} for h, _, _ in halves}
     for f in floors:
-        for strategy, model, cfg, _ in CONFIGS:
+        for strategy, model, cfg, c in CONFIGS:
+            if a.only and c != a.only:
+                continue
             for h, first, last in halves:
                 results[h][(f, cfg)], el = batch(a, f, strategy, model, first, last, base)
                 spent += el

@@ -63,6 +63,10 @@ mlp_steps.py|--sim /nonexistent|/nonexistent: not an executable
 bench_general.py|--placements 0|--placements: expected an even number
 bench_general.py|--sim /nonexistent|/nonexistent: not an executable
 bench_general.py|--seek bogus:1|unknown key 'bogus:1'
+bench_general.py|--only x --no-write|--only: expected p or r
+bench_general.py|--placement-seed 0 --no-write|--placement-seed: expected a positive integer
+bench_general.py|--placement-seed 2|--placement-seed and --only need --no-write
+bench_general.py|--placement-seed 2 --no-write --held-out-only|only placement seed 1 has held-out draws
 bench_bridge.py|--sim /nonexistent|/nonexistent: not an executable
 bench_bridge.py|--seeds x|--seeds: expected A..B
 bridge_bounds.py|--sim /nonexistent scenarios/bridge.yaml 1..2|/nonexistent: not an executable

@@ -528,6 +528,7 @@ static void ctrl_event(sim_run_t *r, const event_t *ev, const tick_t *k)
         const int64_t wait_us = ev->te - d->t_us + ctrl->period_us; /* the deciding period too */
         res->decisions_over_100ms += wait_us > 100000 ? 1u : 0u;
         res->decision_wait_max_s = fmax(res->decision_wait_max_s, (double)wait_us * 1e-6);
+        res->decision_wait_sum_s += (double)wait_us * 1e-6;
         if (d->kind == RFS_SEEK_GREEDY && d->model_valid) {
             r->belief_x = q16d(d->max_x);
             r->belief_y = q16d(d->max_y);

@@ -92,6 +92,7 @@ typedef struct hs_sim_result {
     double decision_wait_max_s;  ///< the longest decision latency: from the period a decision
                                  ///< began (a leg's end) to its wheel command, that period
                                  ///< included (a sliced fit's and the search tree's waits)
+    double decision_wait_sum_s;  ///< the decisions' latencies summed (summary.json: their mean)
     double turn_time_s;          ///< time turning on the spot (|v| < 2 cm/s, |w| > 0.05 rad/s)
     long wall_contacts;          ///< wall contacts (hs_box2d_wall_contacts)
     double wall_time_s;          ///< host time the run took (not part of determinism)

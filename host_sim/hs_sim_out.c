@@ -57,6 +57,8 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
     fprintf(f, "  \"plan_wait_max\": %u,\n", r->plan_wait_max);
     fprintf(f, "  \"decisions_over_100ms\": %u,\n", r->decisions_over_100ms);
     json_num(f, "decision_wait_max_s", r->decision_wait_max_s, false);
+    json_num(f, "decision_wait_mean_s",
+             r->iterations > 0u ? r->decision_wait_sum_s / r->iterations : NAN, false);
     json_num(f, "turn_time_s", r->turn_time_s, false);
     fprintf(f, "  \"wall_contacts\": %ld,\n", r->wall_contacts);
     // The path-loss model's final estimate (null for other models).

@@ -87,6 +87,15 @@ if [ -s "$T/fbcli.json" ] && cmp -s <(same "$T/fbcli.json") <(same "$T/fbkey.jso
 else
     fail fit_budget_cli_key_latency "over $(over "$T/fbcli.json") / $(over "$T/fbnone.json")"
 fi
+# The mean latency: above the whole fits' (at most two periods each), at most the longest.
+num() { sed -nE "s/.*\"$2\": ([0-9.]+).*/\1/p" "$1"; }
+if awk -v sm="$(num "$T/fbcli.json" decision_wait_mean_s)" -v sx="$(num "$T/fbcli.json" decision_wait_max_s)" \
+       -v wm="$(num "$T/fbnone.json" decision_wait_mean_s)" -v wx="$(num "$T/fbnone.json" decision_wait_max_s)" \
+       'BEGIN { exit !(sm != "" && wm != "" && sm > wm && sm <= sx && wm > 0 && wm <= wx && wx <= 0.1) }'; then
+    pass fit_budget_mean_latency
+else
+    fail fit_budget_mean_latency "mean $(num "$T/fbcli.json" decision_wait_mean_s) / $(num "$T/fbnone.json" decision_wait_mean_s)"
+fi
 # --seek: the scenario's seek: keys from the command line, checked as the file's; the same
 # run as the key in the file, another run than without it.
 bad seek_unknown "--seek:1: seek: unknown key 'bogus'" "$T/p0.yaml" --seek 'bogus: 1' --out "$T/out"

@@ -735,6 +735,15 @@ int hs_scenario_seek(hs_scenario_t *sc, const char *text, char *err, size_t errl
         snprintf(err, errlen, "--seek: longer than %zu characters", sizeof sc->seek_cli - 1);
         return -1;
     }
+    const char *colon = strchr(text, ':');
+    while (colon && colon[1] == ' ') {
+        colon = strchr(colon + 1, ':');
+    }
+    if (colon) { /* YAML would read "key:1" as one key: say what is wrong instead */
+        snprintf(err, errlen, "--seek: a space after each colon ('KEY: VALUE'), got '%s'", text);
+        lx_err_one_line(err);
+        return -1;
+    }
     pctx_t p = {.file = "--seek", .err = err, .errlen = errlen};
     lx_yaml_doc_t doc;
     lx_yaml_error_t ye;

@@ -101,6 +101,7 @@ fi
 bad seek_unknown "--seek:1: seek: unknown key 'bogus'" "$T/p0.yaml" --seek 'bogus: 1' --out "$T/out"
 bad seek_value "--seek:1: seek.leg_m: 'far' is not a number" "$T/p0.yaml" --seek 'leg_m: far' --out "$T/out"
 bad seek_syntax "--seek: expected KEY: VALUE[, KEY: VALUE...], got '[1, 2'" "$T/p0.yaml" --seek '[1, 2' --out "$T/out"
+bad seek_colon "--seek: a space after each colon ('KEY: VALUE'), got 'leg_m: 2, local_m:3'" "$T/p0.yaml" --seek 'leg_m: 2, local_m:3' --out "$T/out"
 bad seek_brace "no quote, brace, tab or line break" "$T/p0.yaml" --seek 'leg_m: 2}, model: {x: 1' --out "$T/out"
 bad seek_long "--seek: longer than 255 characters" "$T/p0.yaml" --seek "leg_m: 2$(printf ', leg_m: 2%.0s' $(seq 30))" --out "$T/out"
 scn legkey.yaml "${BASE}model: pathloss

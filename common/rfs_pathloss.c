@@ -30,6 +30,9 @@ enum { EV_COARSE = 0, EV_REFINE = 1, EV_HOLD = 2 };
 #define BINS_PER_UNIT 32u
 /// Samples binned per work unit.
 #define SAMPLES_PER_UNIT 64u
+/// Work units of tidying the built-in cache when its rows or columns run out (at most
+/// 32 KB set and about 35,000 cells cleared).
+#define TIDY_UNITS 10u
 
 rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
 {
@@ -650,7 +653,8 @@ static bool bin_run(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t bu
             bin_reset(p, p->bin_cm * 2);
         }
     }
-    const uint32_t finish_units = p->nbins / BINS_PER_UNIT + 1u;
+    /* With the built-in cache, the rows' and columns' tidying too (rfs_pathloss_walls.c). */
+    const uint32_t finish_units = p->nbins / BINS_PER_UNIT + 1u + (p->x.cells == 0 ? TIDY_UNITS : 0u);
     if (budget != 0u && *used != 0u && *used + finish_units > budget) {
         return true;
     }

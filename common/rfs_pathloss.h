@@ -41,13 +41,15 @@
  * walls. A bin's mean is an average over where its samples were taken, and on a
  * cluttered map one line's count jumps by several walls within centimetres of where it
  * starts (footprint 0: the centre's count alone; the coarse pass's: coarse_footprint,
- * cached apart). The counts are cached across fits, RFS_PATHLOSS_CACHE_ROWS origins x the first candidates evaluated (a byte each; a count
- * saturates at 15 walls): RFS_PATHLOSS_CACHE_COLS of them built in (the first legal
- * coarse candidates), or as many as a caller's buffer holds
- * (rfs_pathloss_cache_attach(): every coarse, refinement and hold candidate of a run).
- * Bins are fixed cells, so a relearn counts walls only for bins that are new or whose
- * centroid moved to another core cell, and for candidates without a column. The cache is
- * cleared when the map or the lattice changes, or when its origins are all used.
+ * cached apart). The counts are cached across fits, a byte per origin (row) and candidate
+ * (column, as first evaluated; a count saturates at 15 walls): built in
+ * RFS_PATHLOSS_BUILTIN_ROWS x RFS_PATHLOSS_CACHE_COLS, or RFS_PATHLOSS_CACHE_ROWS x as
+ * many columns as a caller's buffer holds (rfs_pathloss_cache_attach(): every coarse,
+ * refinement and hold candidate of a run). Bins are fixed cells, so a relearn counts
+ * walls only for bins that are new or whose centroid moved to another core cell, and for
+ * candidates without a column. The cache is emptied when the map or the lattice changes;
+ * when its rows run out, those no bin of the fit holds are emptied and reused, and so
+ * are the built-in columns the last fit did not use.
  *
  * Work: one unit is one computed wall count, 32 bins gathered from the cache, solved or
  * set up, or 64 samples binned. fit() with budget 0 does everything; with budget > 0 it
@@ -80,7 +82,9 @@
 /// Wall-count origins cached (rows) and candidates per origin in the built-in cache
 /// (columns).
 #define RFS_PATHLOSS_CACHE_ROWS 512u
-#define RFS_PATHLOSS_CACHE_COLS 64u
+#define RFS_PATHLOSS_CACHE_COLS 256u
+/// Origins (rows) of the built-in wall-count cache (an attached one: RFS_PATHLOSS_CACHE_ROWS).
+#define RFS_PATHLOSS_BUILTIN_ROWS 120u
 /// Slots of the cache's hash tables (powers of two, twice the rows; twice the columns).
 #define RFS_PATHLOSS_CACHE_HASH (2u * RFS_PATHLOSS_CACHE_ROWS)
 #define RFS_PATHLOSS_COL_HASH (2u * RFS_PATHLOSS_CACHE_COLS)
@@ -317,12 +321,16 @@ typedef struct rfs_pathloss {
     uint16_t ncols;                               ///< cache columns in use
     uint16_t row_hash[RFS_PATHLOSS_CACHE_HASH];   ///< row + 1 by hashed core cell, 0 = empty
     rfs_pathloss_row_t rows[RFS_PATHLOSS_CACHE_ROWS]; ///< cached origins
+    uint8_t row_used[RFS_PATHLOSS_CACHE_ROWS / 8u]; ///< scratch: rows a bin of this fit holds
+    uint8_t col_used[RFS_PATHLOSS_CACHE_COLS / 8u]; ///< built-in columns looked up since the
+                                                  ///< fit began (kept when the cache is full)
+    uint8_t col_live[RFS_PATHLOSS_CACHE_COLS / 8u]; ///< built-in columns holding a point
     rfs_pathloss_xcache_t x;                      ///< an attached cache (cells NULL: none;
                                                   ///< then the three built-in arrays below)
     const int32_t *log2_tab;                      ///< attached log2 table (NULL: none)
     uint16_t col_hash[RFS_PATHLOSS_COL_HASH];     ///< column + 1 by hashed lattice point
     uint32_t col_key[RFS_PATHLOSS_CACHE_COLS];    ///< lattice point of each column
-    uint8_t walls[RFS_PATHLOSS_CACHE_ROWS][RFS_PATHLOSS_CACHE_COLS]; ///< footprint wall
+    uint8_t walls[RFS_PATHLOSS_BUILTIN_ROWS][RFS_PATHLOSS_CACHE_COLS]; ///< footprint wall
                                                   ///< counts, quarter walls; 255: not counted
     uint32_t surface[RFS_PATHLOSS_MAX_COARSE];    ///< mean Huber loss per unit weight of
                                                   ///< each coarse point, dB^2 Q16.16;

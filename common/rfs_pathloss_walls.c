@@ -19,10 +19,16 @@ static rfs_pathloss_xcache_t cache_of(rfs_pathloss_t *p)
     if (p->x.cells != 0) {
         return p->x;
     }
-    _Static_assert(RFS_PATHLOSS_COL_HASH == 128u, "7 hash bits");
-    rfs_pathloss_xcache_t c = {RFS_PATHLOSS_CACHE_COLS, 7u, p->col_hash, p->col_key,
+    _Static_assert(RFS_PATHLOSS_COL_HASH == 512u, "9 hash bits");
+    rfs_pathloss_xcache_t c = {RFS_PATHLOSS_CACHE_COLS, 9u, p->col_hash, p->col_key,
                                (uint8_t *)(void *)p->walls};
     return c;
+}
+
+/* Rows the cache in use holds. */
+static uint16_t cache_rows(const rfs_pathloss_t *p)
+{
+    return p->x.cells != 0 ? (uint16_t)RFS_PATHLOSS_CACHE_ROWS : (uint16_t)RFS_PATHLOSS_BUILTIN_ROWS;
 }
 
 /* The cache byte of (row, col). */
@@ -34,14 +40,26 @@ static uint8_t *cache_cell(rfs_pathloss_t *p, uint16_t row, uint32_t col)
     return &p->walls[row][col];
 }
 
+static bool bit(const uint8_t *b, uint32_t i)
+{
+    return (b[i >> 3] & (1u << (i & 7u))) != 0u;
+}
+
+static void bit_set(uint8_t *b, uint32_t i, bool v)
+{
+    b[i >> 3] = (uint8_t)(v ? b[i >> 3] | (1u << (i & 7u)) : b[i >> 3] & ~(1u << (i & 7u)));
+}
+
 static void cache_clear(rfs_pathloss_t *p)
 {
     rfs_pathloss_xcache_t c = cache_of(p);
     p->nrows = 0u;
     p->ncols = 0u;
     memset(p->row_hash, 0, sizeof(p->row_hash));
+    memset(p->col_used, 0, sizeof(p->col_used));
+    memset(p->col_live, 0, sizeof(p->col_live));
     memset(c.col_hash, 0, ((size_t)1 << c.hash_bits) * sizeof(c.col_hash[0]));
-    memset(c.cells, (int)NOT_COUNTED, (size_t)RFS_PATHLOSS_CACHE_ROWS * c.cols);
+    memset(c.cells, (int)NOT_COUNTED, (size_t)cache_rows(p) * c.cols);
 }
 
 uint32_t rfs_pathloss_cache_bytes(uint16_t cols)
@@ -74,10 +92,78 @@ int rfs_pathloss_cache_attach(rfs_pathloss_t *p, void *buf, uint32_t bytes, uint
     return 0;
 }
 
+/* The hash slot of origin (cx, cy): its row's, or the empty one where it would go. */
+static uint32_t row_slot(const rfs_pathloss_t *p, uint16_t cx, uint16_t cy)
+{
+    uint32_t h = cell_hash(cx, cy);
+    while (p->row_hash[h] != 0u) {
+        const rfs_pathloss_row_t *r = &p->rows[p->row_hash[h] - 1u];
+        if (r->cx == cx && r->cy == cy) {
+            break;
+        }
+        h = (h + 1u) & (RFS_PATHLOSS_CACHE_HASH - 1u);
+    }
+    return h;
+}
+
+/* The cache is full of origins: keep those a bin of this fit holds (row_used), empty
+ * the others' counts and drop them from the hash. */
+static void rows_tidy(rfs_pathloss_t *p)
+{
+    rfs_pathloss_xcache_t c = cache_of(p);
+    memset(p->row_hash, 0, sizeof(p->row_hash));
+    for (uint16_t r = 0u; r < p->nrows; ++r) {
+        if (bit(p->row_used, r)) {
+            p->row_hash[row_slot(p, p->rows[r].cx, p->rows[r].cy)] = (uint16_t)(r + 1u);
+        } else {
+            memset(cache_cell(p, r, 0u), (int)NOT_COUNTED, c.cols);
+        }
+    }
+}
+
+/* The built-in columns are all taken: keep those the last fit looked up (col_used), empty
+ * the others (a row at a time, skipping bytes of the bitmap with none: at most 32,768
+ * cells), drop
+ * them from the hash; col_used starts again for this fit. */
+static void cols_tidy(rfs_pathloss_t *p)
+{
+    _Static_assert(RFS_PATHLOSS_CACHE_COLS % 8u == 0u, "whole bitmap bytes");
+    rfs_pathloss_xcache_t c = cache_of(p);
+    const uint32_t mask = (1u << c.hash_bits) - 1u;
+    memset(c.col_hash, 0, ((size_t)1 << c.hash_bits) * sizeof(c.col_hash[0]));
+    for (uint32_t k = 0u; k < RFS_PATHLOSS_CACHE_COLS; ++k) {
+        if (!bit(p->col_live, k) || !bit(p->col_used, k)) {
+            continue;
+        }
+        const uint32_t key = c.col_key[k];
+        uint32_t h = ((key & 0xFFFFu) * 0x9E3779B1u + (key >> 16) * 0x85EBCA77u) >> (32u - c.hash_bits);
+        while (c.col_hash[h] != 0u) {
+            h = (h + 1u) & mask;
+        }
+        c.col_hash[h] = (uint16_t)(k + 1u);
+    }
+    /* col_used becomes the columns dropped (live, not used); live keeps the used ones */
+    for (uint32_t b = 0u; b < sizeof(p->col_used); ++b) {
+        const uint8_t used = p->col_used[b];
+        p->col_used[b] = (uint8_t)(p->col_live[b] & ~used);
+        p->col_live[b] &= used;
+    }
+    for (uint32_t r = 0u; r < RFS_PATHLOSS_BUILTIN_ROWS; ++r) {
+        uint8_t *row = p->walls[r];
+        for (uint32_t b = 0u; b < sizeof(p->col_used); ++b) {
+            for (uint32_t d = p->col_used[b]; d != 0u; d &= d - 1u) {
+                row[8u * b + (uint32_t)__builtin_ctz(d)] = NOT_COUNTED;
+            }
+        }
+    }
+    memset(p->col_used, 0, sizeof(p->col_used));
+}
+
 void rfs_pathloss_walls_assign(rfs_pathloss_t *p)
 {
     _Static_assert(RFS_PATHLOSS_CACHE_HASH == 1024u, "cell_hash yields 10 bits");
-    _Static_assert(RFS_PATHLOSS_CACHE_ROWS >= RFS_PATHLOSS_MAX_BINS, "a row for every bin");
+    _Static_assert(RFS_PATHLOSS_CACHE_ROWS <= 0xFFFFu && RFS_PATHLOSS_CACHE_COLS <= 0xFFFFu,
+                   "uint16 row and column numbers");
     if (p->map == 0) {
         return;
     }
@@ -89,37 +175,56 @@ void rfs_pathloss_walls_assign(rfs_pathloss_t *p)
         cache_clear(p);
         p->cache_map = p->map;
         p->cache_lat = p->lat;
+    } else if (p->x.cells == 0 && p->ncols == RFS_PATHLOSS_CACHE_COLS) {
+        cols_tidy(p);
+    } else if (p->x.cells == 0) {
+        memset(p->col_used, 0, sizeof(p->col_used));
     }
+    /* The bins' origins cached already, then the others in rows free or freed (a bin
+     * beyond the rows counts uncached). */
+    memset(p->row_used, 0, sizeof(p->row_used));
     for (uint32_t b = 0u; b < p->nbins; ++b) {
         rfs_pathloss_bin_t *bb = &p->bins[b];
         uint16_t cx, cy;
-        if (!rfs_map_cell(p->map, bb->x, bb->y, &cx, &cy)) {
+        bb->row = RFS_PATHLOSS_NO_ROW;
+        if (rfs_map_cell(p->map, bb->x, bb->y, &cx, &cy)) {
+            const uint32_t h = row_slot(p, cx, cy);
+            if (p->row_hash[h] != 0u) {
+                bb->row = (uint16_t)(p->row_hash[h] - 1u);
+                bit_set(p->row_used, bb->row, true);
+            }
+        }
+    }
+    const uint16_t nrows_max = cache_rows(p);
+    bool tidied = false;
+    uint16_t free_from = 0u;
+    for (uint32_t b = 0u; b < p->nbins; ++b) {
+        rfs_pathloss_bin_t *bb = &p->bins[b];
+        uint16_t cx, cy;
+        if (bb->row != RFS_PATHLOSS_NO_ROW || !rfs_map_cell(p->map, bb->x, bb->y, &cx, &cy)) {
             continue;
         }
-        uint32_t h = cell_hash(cx, cy);
-        while (p->row_hash[h] != 0u) {
-            const rfs_pathloss_row_t *r = &p->rows[p->row_hash[h] - 1u];
-            if (r->cx == cx && r->cy == cy) {
-                break;
+        uint16_t r;
+        if (p->nrows < nrows_max) {
+            r = p->nrows++;
+        } else {
+            if (!tidied) {
+                rows_tidy(p);
+                tidied = true;
             }
-            h = (h + 1u) & (RFS_PATHLOSS_CACHE_HASH - 1u);
-        }
-        if (p->row_hash[h] == 0u) {
-            if (p->nrows == RFS_PATHLOSS_CACHE_ROWS) {
-                /* Full of origins no bin uses any more: start again (rows >= bins). */
-                cache_clear(p);
-                for (uint32_t c = 0u; c < b; ++c) {
-                    p->bins[c].row = RFS_PATHLOSS_NO_ROW;
-                }
-                b = UINT32_MAX; /* the loop's ++ restarts it at 0 */
-                continue;
+            while (free_from < p->nrows && bit(p->row_used, free_from)) {
+                free_from++;
             }
-            rfs_pathloss_row_t *r = &p->rows[p->nrows];
-            r->cx = cx;
-            r->cy = cy;
-            p->row_hash[h] = (uint16_t)(++p->nrows);
+            if (free_from == p->nrows) {
+                continue; /* every row holds a bin of this fit */
+            }
+            r = free_from;
         }
-        bb->row = (uint16_t)(p->row_hash[h] - 1u);
+        p->rows[r].cx = cx;
+        p->rows[r].cy = cy;
+        p->row_hash[row_slot(p, cx, cy)] = (uint16_t)(r + 1u);
+        bit_set(p->row_used, r, true);
+        bb->row = r;
     }
 }
 
@@ -130,22 +235,41 @@ int32_t rfs_pathloss_walls_col(rfs_pathloss_t *p, uint16_t li, uint16_t lj, bool
         return -1;
     }
     rfs_pathloss_xcache_t c = cache_of(p);
+    const bool builtin = p->x.cells == 0;
     /* The coarse footprint's column of a point is keyed apart (bit 31). */
     const uint32_t key = (uint32_t)li | (uint32_t)lj << 16 | (two && coarse ? 1u << 31 : 0u);
     const uint32_t mask = (1u << c.hash_bits) - 1u;
     uint32_t h = ((uint32_t)li * 0x9E3779B1u + (key >> 16) * 0x85EBCA77u) >> (32u - c.hash_bits);
     while (c.col_hash[h] != 0u) {
-        if (c.col_key[c.col_hash[h] - 1u] == key) {
-            return (int32_t)c.col_hash[h] - 1;
+        const uint32_t k = c.col_hash[h] - 1u;
+        if (c.col_key[k] == key) {
+            if (builtin) {
+                bit_set(p->col_used, k, true);
+            }
+            return (int32_t)k;
         }
         h = (h + 1u) & mask;
     }
-    if (p->ncols == c.cols) {
-        return -1; /* full: the first candidates keep their columns until a clear */
+    uint32_t k = p->ncols;
+    if (k == c.cols) {
+        if (!builtin) {
+            return -1; /* full: the first candidates keep their columns until a clear */
+        }
+        for (k = 0u; k < c.cols && bit(p->col_live, k); ++k) {
+        }
+        if (k == c.cols) {
+            return -1; /* every column live: this point is counted uncached */
+        }
+    } else {
+        p->ncols++;
     }
-    c.col_key[p->ncols] = key;
-    c.col_hash[h] = (uint16_t)(++p->ncols);
-    return (int32_t)p->ncols - 1;
+    c.col_key[k] = key;
+    c.col_hash[h] = (uint16_t)(k + 1u);
+    if (builtin) {
+        bit_set(p->col_live, k, true);
+        bit_set(p->col_used, k, true);
+    }
+    return (int32_t)k;
 }
 
 uint32_t rfs_pathloss_walls_line(const rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx,

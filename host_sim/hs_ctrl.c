@@ -191,7 +191,7 @@ static int open_pathloss(inproc_t *p, const hs_ctrl_inproc_cfg_t *cfg, char *err
         }
     }
     /* The host's cache holds every candidate of a run; the built-in one (the Cortex-M4's)
-     * 64 columns: the same fits, more counts. */
+     * 120 origins by 256 candidates: the same fits, more counts. */
     const uint32_t cb = rfs_pathloss_cache_bytes(HS_CTRL_PATHLOSS_CACHE_COLS);
     p->wall_cache = cfg->pathloss_builtin_cache ? NULL : malloc(cb);
     if (!cfg->pathloss_builtin_cache &&

@@ -99,11 +99,12 @@ static void cached_relearn_equals_fresh(void **state)
     assert_memory_equal(warm->surface, f->pl.surface, sizeof(f->pl.surface));
     assert_int_equal(ew.candidates, ef.candidates);
     assert_int_equal(ew.footprints + ew.footprints_cached, ef.footprints + ef.footprints_cached);
-    /* the west half's bins (about half of them) took every built-in column's counts
-     * from the cache: a whole number of columns' worth, at least a third of the bins */
-    const uint32_t bins = ef.footprints / ef.candidates;
-    assert_int_equal(ew.footprints_cached % RFS_PATHLOSS_CACHE_COLS, 0);
-    assert_true(ew.footprints_cached >= bins / 3u * RFS_PATHLOSS_CACHE_COLS);
+    /* the warm fit's bins (the west half's, more than the built-in cache's rows) filled
+     * every row, and each kept its origin: each row read the same columns (the points
+     * both fits evaluate) from the cache, at least half the candidates */
+    assert_int_equal(warm->nrows, RFS_PATHLOSS_BUILTIN_ROWS);
+    assert_int_equal(ew.footprints_cached % RFS_PATHLOSS_BUILTIN_ROWS, 0);
+    assert_true(ew.footprints_cached >= RFS_PATHLOSS_BUILTIN_ROWS * (ef.candidates / 2u));
     free(warm);
 }
 
@@ -180,6 +181,65 @@ static void attached_cache_equals_builtin(void **state)
         free(buf[k]);
     }
     free(tab);
+}
+
+/* The built-in cache when its rows (origins) and columns (candidates) run out: each
+ * relearn has samples at the same places and at new ones (other origins) of a source
+ * elsewhere in the office (so other refinement points); rows holding no bin of a fit and columns the last
+ * fit did not use are emptied and reused. Every relearn equals that of a state with a
+ * large attached cache (which keeps everything) bit for bit, and relearns after both ran
+ * out still read counts from the cache. */
+static void builtin_cache_reuses_rows_and_columns(void **state)
+{
+    fixture_t *f = *state;
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    rfs_pathloss_t *kept = malloc(sizeof(rfs_pathloss_t));
+    rfs_pathloss_t *large = malloc(sizeof(rfs_pathloss_t));
+    const uint32_t bytes = rfs_pathloss_cache_bytes(4096);
+    void *buf = malloc(bytes);
+    assert_true(kept != NULL && large != NULL && buf != NULL);
+    assert_int_equal(rfs_pathloss_init(kept, &c), 0);
+    assert_int_equal(rfs_pathloss_init(large, &c), 0);
+    assert_int_equal(rfs_pathloss_cache_attach(large, buf, bytes, 4096), 0);
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 1);
+    bool rows_full = false, cols_full = false;
+    uint32_t cached_after = 0u, fits_after = 0u;
+    for (int k = 0; k < 12; ++k) {
+        truth_t t = k_office;
+        t.sx = 4.0 + 2.5 * (k % 10);
+        t.sy = k % 2 == 0 ? 3.375 : 11.0;
+        make_samples(f->s, NS / 6, &f->map, &t, 100u);                      /* places kept */
+        make_samples(f->s + NS / 6, NS / 6, &f->map, &t, 200u + (uint64_t)k); /* and new ones */
+        rfs_model_fit_in_t in = {.samples = f->s, .n = (uint16_t)(NS / 3), .map = &f->map};
+        const bool both = rows_full && cols_full; /* before this fit */
+        assert_int_equal(rfs_pathloss_ops.fit(kept, &in, 0, &rng), RFS_FIT_DONE);
+        assert_int_equal(rfs_pathloss_ops.fit(large, &in, 0, &rng), RFS_FIT_DONE);
+        assert_memory_equal(&kept->best, &large->best, sizeof(large->best));
+        assert_memory_equal(kept->surface, large->surface, sizeof(large->surface));
+        rfs_pathloss_est_t ek, el;
+        assert_true(rfs_pathloss_estimate(kept, &ek));
+        assert_true(rfs_pathloss_estimate(large, &el));
+        assert_int_equal(ek.footprints + ek.footprints_cached, el.footprints + el.footprints_cached);
+        assert_true(kept->nrows <= RFS_PATHLOSS_BUILTIN_ROWS);
+        assert_true(large->ncols < 4096u); /* the reference kept every candidate */
+        assert_true(k == 0 || ek.footprints_cached > 0u);
+        rows_full = rows_full || kept->nrows == RFS_PATHLOSS_BUILTIN_ROWS;
+        cols_full = cols_full || kept->ncols == RFS_PATHLOSS_CACHE_COLS;
+        if (both) {
+            cached_after += ek.footprints_cached;
+            fits_after++;
+        }
+    }
+    assert_true(rows_full && cols_full);
+    assert_true(fits_after >= 3u);
+    /* the large cache held more points than the built-in columns: these were reused */
+    assert_true(large->ncols > 2u * RFS_PATHLOSS_CACHE_COLS);
+    /* each relearn after both ran out read at least twenty kept origins' coarse counts */
+    assert_true(cached_after >= fits_after * 20u * 100u);
+    free(kept);
+    free(large);
+    free(buf);
 }
 
 static void model_invalid_while_slicing(void **state)
@@ -585,6 +645,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(sliced_fit_equals_whole_fit, setup, teardown),
         cmocka_unit_test_setup_teardown(cached_relearn_equals_fresh, setup, teardown),
         cmocka_unit_test_setup_teardown(attached_cache_equals_builtin, setup, teardown),
+        cmocka_unit_test_setup_teardown(builtin_cache_reuses_rows_and_columns, setup, teardown),
         cmocka_unit_test_setup_teardown(model_invalid_while_slicing, setup, teardown),
         cmocka_unit_test_setup_teardown(predict_is_the_fitted_formula, setup, teardown),
         cmocka_unit_test_setup_teardown(residual_surface_and_spread, setup, teardown),

@@ -62,7 +62,7 @@ mlp_steps.py|--seeds 5..1|'5..1' is not A..B
 mlp_steps.py|--sim /nonexistent|/nonexistent: not an executable
 bench_general.py|--placements 0|--placements: expected an even number
 bench_general.py|--sim /nonexistent|/nonexistent: not an executable
-bench_general.py|--seek bogus:1|unknown key 'bogus:1'
+bench_general.py|--seek bogus:1|a space after each colon
 bench_general.py|--only x --no-write|--only: expected p or r
 bench_general.py|--placement-seed 0 --no-write|--placement-seed: expected a positive integer
 bench_general.py|--placement-seed 2|--placement-seed and --only need --no-write

@@ -325,6 +325,7 @@ typedef struct rfs_pathloss {
     uint8_t col_used[RFS_PATHLOSS_CACHE_COLS / 8u]; ///< built-in columns looked up since the
                                                   ///< fit began (kept when the cache is full)
     uint8_t col_live[RFS_PATHLOSS_CACHE_COLS / 8u]; ///< built-in columns holding a point
+    uint16_t cols_free;                           ///< built-in columns below ncols not live
     rfs_pathloss_xcache_t x;                      ///< an attached cache (cells NULL: none;
                                                   ///< then the three built-in arrays below)
     const int32_t *log2_tab;                      ///< attached log2 table (NULL: none)

@@ -1,9 +1,11 @@
 /* rfs_pathloss_walls.c - the path-loss model's wall counts (docs/PATHLOSS.md, "A bin's
  * walls: the footprint" and "Work, the wall-count cache and slicing"): a bin's footprint
- * counts and the cache that keeps the coarse candidates' counts across fits. */
+ * counts and the cache that keeps them across fits. */
 #include "rfs_pathloss_internal.h"
 
 #include <string.h>
+
+#include "rfs_assert.h"
 
 /// A cache cell not counted yet (counts are at most 4 x RFS_PATHLOSS_WALLS_MAX).
 #define NOT_COUNTED 255u
@@ -55,6 +57,7 @@ static void cache_clear(rfs_pathloss_t *p)
     rfs_pathloss_xcache_t c = cache_of(p);
     p->nrows = 0u;
     p->ncols = 0u;
+    p->cols_free = 0u;
     memset(p->row_hash, 0, sizeof(p->row_hash));
     memset(p->col_used, 0, sizeof(p->col_used));
     memset(p->col_live, 0, sizeof(p->col_live));
@@ -147,6 +150,7 @@ static void cols_tidy(rfs_pathloss_t *p)
         const uint8_t used = p->col_used[b];
         p->col_used[b] = (uint8_t)(p->col_live[b] & ~used);
         p->col_live[b] &= used;
+        p->cols_free = (uint16_t)(p->cols_free + (uint32_t)__builtin_popcount(p->col_used[b]));
     }
     for (uint32_t r = 0u; r < RFS_PATHLOSS_BUILTIN_ROWS; ++r) {
         uint8_t *row = p->walls[r];
@@ -255,11 +259,16 @@ int32_t rfs_pathloss_walls_col(rfs_pathloss_t *p, uint16_t li, uint16_t lj, bool
         if (!builtin) {
             return -1; /* full: the first candidates keep their columns until a clear */
         }
-        for (k = 0u; k < c.cols && bit(p->col_live, k); ++k) {
-        }
-        if (k == c.cols) {
+        if (p->cols_free == 0u) {
             return -1; /* every column live: this point is counted uncached */
         }
+        uint32_t b = 0u;
+        while (b < sizeof(p->col_live) && p->col_live[b] == 0xFFu) {
+            b++;
+        }
+        RFS_ASSERT(b < sizeof(p->col_live)); /* cols_free counts the columns not live */
+        k = 8u * b + (uint32_t)__builtin_ctz(~(uint32_t)p->col_live[b]);
+        p->cols_free--;
     } else {
         p->ncols++;
     }

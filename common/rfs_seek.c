@@ -57,6 +57,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.at_tol = 0;                           /* the drive's goal tolerance for every goal */
     c.leg_max = 0;                          /* and walk the whole leg to it */
     c.floor_gap = 0;                        /* whatever the fit's power */
+    c.floor_max = 0;                        /* and however often */
     c.reach_min = 0;                        /* the robot's component, however small */
     c.silence_floor = INT32_MIN;            /* silence adds no sample */
     c.recheck_silent = false;               /* and a silent check passes */

@@ -140,6 +140,10 @@ typedef struct rfs_seek_cfg {
                                 ///< estimate ruled out as refute_r does, the next decision
                                 ///< relearns, and this one explores (epsilon) instead of
                                 ///< going greedy, dB Q16.16 (0: off)
+    uint8_t floor_max;          ///< with floor_gap: at most this many estimates ruled out
+                                ///< for the floor a mission, later pinned fits believed (a
+                                ///< weak node's fit stays pinned, a wrong one seldom pins
+                                ///< more than twice; docs/STRATEGIES.md, "Stalls"), 0: no limit
     rfs_q16_t leg_max;          ///< a greedy leg to a known argmax ends after this much of
                                 ///< its path (the next decision relearns and may explore),
                                 ///< metres Q16.16 (0: the whole path)
@@ -384,6 +388,8 @@ typedef struct rfs_seek {
     uint8_t excl_next;                        ///< refute_r: the slot the next one takes
     int16_t excl_x_cm[RFS_MODEL_MAX_EXCL];    ///< refute_r: their x, centimetres
     int16_t excl_y_cm[RFS_MODEL_MAX_EXCL];    ///< refute_r: their y, centimetres
+    uint8_t nfloor;                           ///< floor_gap: estimates ruled out for the
+                                              ///< floor so far (saturates at 255)
     bool have_sub;                            ///< sub_* hold the latest unreachable maximum
     rfs_q16_t sub_mx, sub_my;                 ///< an unreachable greedy maximum, metres Q16.16
     rfs_q16_t sub_x, sub_y;                   ///< the reachable point driven to instead

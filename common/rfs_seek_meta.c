@@ -652,11 +652,13 @@ bool rfs_seek_meta_step(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my, bool known,
 
 /* floor_gap: the fit's source power within cfg.floor_gap of the model's floor (its
  * penalty about to bind): distance traded against power, a weak source placed near the
- * robot, the real one farther (docs/STRATEGIES.md, "Stalls"). */
+ * robot, the real one farther. floor_max: a fit still pinned after that many rule-outs
+ * is a weak node the data keep pointing at (docs/STRATEGIES.md, "Stalls"). */
 static bool floor_pinned(const rfs_seek_t *s)
 {
     rfs_q16_t gap;
     return s->cfg.floor_gap > 0 && s->model.ops->floor_gap != 0 &&
+           (s->cfg.floor_max == 0u || s->nfloor < s->cfg.floor_max) &&
            s->model.ops->argmax != 0 &&
            s->model.ops->floor_gap(s->model.self, &gap) && gap < s->cfg.floor_gap;
 }
@@ -678,6 +680,7 @@ bool rfs_seek_meta_choose(rfs_seek_t *s, bool model_ok, rfs_rng_t *rng, int64_t 
     d->pinned = greedy && !settled && floor_pinned(s) &&
                 s->model.ops->argmax(s->model.self, &ax, &ay);
     if (d->pinned) {
+        s->nfloor = (uint8_t)(s->nfloor < UINT8_MAX ? s->nfloor + 1u : UINT8_MAX);
         exclude(s, ax, ay); /* for the relearn the next decision makes */
         s->replan = true;
         greedy = false;

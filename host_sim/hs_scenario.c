@@ -221,6 +221,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_local_m = -1.0;
     sc->seek_leg_m = -1.0;
     sc->seek_floor_db = -1.0;
+    sc->seek_floor_max = -1.0;
     sc->seek_local_gap_m = -1.0;
     sc->seek_local_refute = -1;
     sc->seek_at_tol_m = -1.0;
@@ -458,7 +459,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
                                         "coarse_footprint_m", "p0_max_wall_db", "local_gap_m",
                                         "at_tol_m", "local_refute", "near_t",
                                         "near_m", "coarse_snap", "reach_min", "fit_budget",
-                                        "floor_db", NULL};
+                                        "floor_db", "floor_max", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "refute_m", 0, 100, &sc->seek_refute_m) ||
@@ -470,6 +471,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             num(p, n, "seek", "near_t", 0, 64, &sc->seek_near_t) ||
             num(p, n, "seek", "near_m", 0, 1000, &sc->seek_near_m) ||
             whole(p, n, "seek", "reach_min", 1e6, &sc->seek_reach_min) ||
+            whole(p, n, "seek", "floor_max", 255, &sc->seek_floor_max) ||
             whole(p, n, "seek", "fit_budget", 1e6, &sc->seek_fit_budget) ||
             num(p, n, "seek", "eps_rate", 0, 100, &sc->seek_eps_rate) ||
             num(p, n, "seek", "p0_min_dbm", -200, 100, &sc->seek_p0_min_dbm) ||

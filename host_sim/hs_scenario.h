@@ -16,7 +16,7 @@
  *                                  #       p0_max_wall_db: 3, local_gap_m: 0.5,
  *                                  #       at_tol_m: 0.03, near_t: 0, near_m: 30,
  *                                  #       coarse_snap: true, reach_min: 16,
- *                                  #       fit_budget: 30, floor_db: 1}
+ *                                  #       fit_budget: 30, floor_db: 1, floor_max: 2}
  *                                  # optional: override the strategy's
  *                                  # preset improvements (docs/STRATEGIES.md)
  *   sources:                       # required, 1 or 2
@@ -99,6 +99,8 @@ typedef struct hs_scenario {
                                   ///< (rfs_seek_cfg_t.leg_max; 0: whole; -1 = the preset)
     double seek_floor_db;         ///< seek.floor_db: rfs_seek_cfg_t.floor_gap, dB (0: off;
                                   ///< -1 = the preset)
+    double seek_floor_max;        ///< seek.floor_max: rfs_seek_cfg_t.floor_max, 0..255 (0: no
+                                  ///< limit; -1 = the preset)
     int seek_refute_reached;      ///< seek.refute_reached: 0 / 1 (rfs_seek_cfg_t; -1 = the
                                   ///< strategy's preset)
     int seek_silence_floor;       ///< seek.silence_floor: 0 / 1, floor samples (-100 dBm) in

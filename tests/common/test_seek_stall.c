@@ -502,17 +502,18 @@ static bool floor_gap_op(const void *self, rfs_q16_t *gap)
     return m->base.valid;
 }
 
+static const rfs_model_ops_t floor_ops = { .name = "floor", .reset = fixed_reset,
+                                           .fit = floor_fit, .predict = fixed_predict,
+                                           .argmax = fixed_argmax, .floor_gap = floor_gap_op };
+
 static void floor_case(double rule_db, double gap, bool pinned)
 {
-    static const rfs_model_ops_t ops = { .name = "floor", .reset = fixed_reset,
-                                         .fit = floor_fit, .predict = fixed_predict,
-                                         .argmax = fixed_argmax, .floor_gap = floor_gap_op };
     world_t t;
     rfs_seek_cfg_t cfg;
     floor_model_t m = { .gap = gap };
     local_world(&t, &cfg, &m.base);
     cfg.floor_gap = Q(rule_db);
-    rfs_model_t model = { &ops, &m };
+    rfs_model_t model = { &floor_ops, &m };
     assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
     field_t f = { .kind = 2, .scripted = -60.0 }; /* as predicted: no relearn by a miss */
     run_t r = { .x = 4.0, .y = 5.0 };
@@ -544,6 +545,44 @@ static void test_floor_gap_rules_out_a_pinned_fit(void **state)
     floor_case(0.0, 0.5, false);
 }
 
+/* floor_max (docs/STRATEGIES.md, "Stalls"): the same fit, pinned at every decision (0.5 dB
+ * above the floor, the rule at 1 dB). Each rule-out makes the next decision greedy (it
+ * relearns), so the three decisions after the initial move all draw greedy: with
+ * floor_max 2 the first two rule the estimate out and explore, the third believes it and
+ * goes to it, the fit given the two places; with no limit all three rule it out. */
+static void floor_max_case(uint8_t floor_max, const bool pinned[3], int places)
+{
+    world_t t;
+    rfs_seek_cfg_t cfg;
+    floor_model_t m = { .gap = 0.5 };
+    local_world(&t, &cfg, &m.base);
+    cfg.floor_gap = Q(1.0);
+    cfg.floor_max = floor_max;
+    rfs_model_t model = { &floor_ops, &m };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    run_t r = { .x = 4.0, .y = 5.0 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.kind, RFS_SEEK_INITIAL);
+    for (int i = 0; i < 3; ++i) {
+        assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+        double off = hypot(D(out.decision.goal_x) - LOCAL_EX, D(out.decision.goal_y) - LOCAL_EY);
+        assert_int_equal(out.decision.pinned, pinned[i]);
+        assert_int_equal(out.decision.kind, pinned[i] ? RFS_SEEK_EPSILON : RFS_SEEK_GREEDY);
+        assert_true(pinned[i] ? off > 2.0 : off < 1e-3);
+    }
+    assert_int_equal(m.nexcl, places);
+    world_free(&t);
+}
+
+static void test_floor_max_believes_a_fit_pinned_again(void **state)
+{
+    (void)state;
+    floor_max_case(2u, (const bool[3]){true, true, false}, 2);
+    floor_max_case(0u, (const bool[3]){true, true, true}, 2);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -553,6 +592,7 @@ int main(void)
         cmocka_unit_test(test_local_refute_rules_out_the_swept),
         cmocka_unit_test(test_local_gap_spaces_the_sweep),
         cmocka_unit_test(test_floor_gap_rules_out_a_pinned_fit),
+        cmocka_unit_test(test_floor_max_believes_a_fit_pinned_again),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -150,7 +150,9 @@ static void cols_tidy(rfs_pathloss_t *p)
         const uint8_t used = p->col_used[b];
         p->col_used[b] = (uint8_t)(p->col_live[b] & ~used);
         p->col_live[b] &= used;
-        p->cols_free = (uint16_t)(p->cols_free + (uint32_t)__builtin_popcount(p->col_used[b]));
+        for (uint32_t d = p->col_used[b]; d != 0u; d &= d - 1u) {
+            p->cols_free++; /* no __builtin_popcount: the core links no library */
+        }
     }
     for (uint32_t r = 0u; r < RFS_PATHLOSS_BUILTIN_ROWS; ++r) {
         uint8_t *row = p->walls[r];

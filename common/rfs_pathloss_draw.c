@@ -130,3 +130,39 @@ bool rfs_pathloss_near_op(const void *self, const rfs_model_near_t *q, rfs_q16_t
     }
     return found;
 }
+
+/* rfs_model_ops_t.mean: the coarse candidates' mean position, each weighted as the draws
+ * (draw_weight), and the spread region's area. One pass, no table. Scaling: weights <=
+ * 2^16 times coordinates (Q16, |.| < 2^31) < 2^47, summed over at most
+ * RFS_PATHLOSS_MAX_COARSE (2^10) points < 2^57; the weights sum below 2^26. */
+bool rfs_pathloss_mean_op(const void *self, rfs_q16_t *x, rfs_q16_t *y, rfs_q16_t *area)
+{
+    const rfs_pathloss_t *p = (const rfs_pathloss_t *)self;
+    RFS_ASSERT(p != 0 && x != 0 && y != 0 && area != 0);
+    if (!p->valid) {
+        return false;
+    }
+    const rfs_pathloss_lat_t *l = &p->lat;
+    const uint32_t nc = (uint32_t)l->ncx * l->ncy;
+    const draw_k_t k = draw_consts(p);
+    int64_t sw = 0, sx = 0, sy = 0;
+    for (uint32_t c = 0u; c < nc; ++c) {
+        const uint32_t w = draw_weight(p, &k, c);
+        int32_t i, j;
+        if (w == 0u || !rfs_pathloss_coarse_ij(p, c, &i, &j)) {
+            continue;
+        }
+        rfs_q16_t cx, cy;
+        rfs_pathloss_lattice_xy(l, (uint16_t)i, (uint16_t)j, &cx, &cy);
+        sw += w;
+        sx += (int64_t)w * cx;
+        sy += (int64_t)w * cy;
+    }
+    if (sw == 0) {
+        return false; /* a fit on another lattice has begun since (as the draws) */
+    }
+    *x = (rfs_q16_t)rfs_sdiv64_round(sx, sw);
+    *y = (rfs_q16_t)rfs_sdiv64_round(sy, sw);
+    *area = p->spread_m2;
+    return true;
+}

@@ -97,6 +97,6 @@ bool rfs_pathloss_near_op(const void *self, const rfs_model_near_t *q, rfs_q16_t
                           rfs_q16_t *y);
 
 /// rfs_model_ops_t.mean (rfs_pathloss_draw.c).
-bool rfs_pathloss_mean_op(const void *self, rfs_q16_t *x, rfs_q16_t *y, rfs_q16_t *area);
+bool rfs_pathloss_mean_op(const void *self, rfs_q16_t temp, rfs_q16_t *x, rfs_q16_t *y);
 
 #endif /* RFS_PATHLOSS_INTERNAL_H */

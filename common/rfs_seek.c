@@ -57,7 +57,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.at_tol = 0;                           /* the drive's goal tolerance for every goal */
     c.leg_max = 0;                          /* and walk the whole leg to it */
     c.floor_gap = 0;                        /* whatever the fit's power */
-    c.mean_area = 0;                        /* greedy goes to the argmax */
+    c.mean_t = 0;                           /* greedy goes to the argmax */
     c.reach_min = 0;                        /* the robot's component, however small */
     c.silence_floor = INT32_MIN;            /* silence adds no sample */
     c.recheck_silent = false;               /* and a silent check passes */
@@ -192,7 +192,7 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0 || cfg->settle_dist < 0 ||
         cfg->settle_orbit < 0 || cfg->settle_end < 0 || cfg->refute_r < 0 ||
         cfg->src_spacing < 0 || cfg->local_r < 0 || cfg->leg_max < 0 ||
-        cfg->floor_gap < 0 || cfg->mean_area < 0 ||
+        cfg->floor_gap < 0 || cfg->mean_t < 0 || cfg->mean_t > RFS_Q16_INT(64) ||
         cfg->local_gap < 0 || cfg->at_tol < 0) {
         return -1;
     }

@@ -400,7 +400,7 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     return false;
 }
 
-/* mean_area: while the belief is wide, the greedy goal is its mean, where the way from
+/* mean_t: the greedy goal is the belief's mean, where the way from
  * the robot and on to the argmax is open (docs/STRATEGIES.md, "Stalls"): a mirror image
  * across the line of the first samples, or a weaker source nearer the robot, fits the
  * early data as well as the argmax, which flips between them; heading for their mean
@@ -408,9 +408,9 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
  * The whole planned leg, rechecked as any (no local search: the mean is no estimate). */
 static bool hedge(rfs_seek_t *s, rfs_q16_t ax, rfs_q16_t ay, int64_t now_us)
 {
-    rfs_q16_t x, y, area;
-    if (s->cfg.mean_area <= 0 || s->model.ops->mean == 0 ||
-        !s->model.ops->mean(s->model.self, &x, &y, &area) || area < s->cfg.mean_area ||
+    rfs_q16_t x, y;
+    if (s->cfg.mean_t <= 0 || s->model.ops->mean == 0 ||
+        !s->model.ops->mean(s->model.self, s->cfg.mean_t, &x, &y) ||
         rfs_q16_dist(s->pose.x, s->pose.y, x, y) < rfs_q16_add(s->cfg.step, s->cfg.step / 2) ||
         rfs_map_walls_crossed(s->map, s->pose.x, s->pose.y, x, y) != 0u ||
         rfs_map_walls_crossed(s->map, x, y, ax, ay) != 0u ||

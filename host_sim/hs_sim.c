@@ -810,8 +810,8 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     if (e->sc.seek_leg_m >= 0.0) {
         cc.seek.leg_max = (rfs_q16_t)lround(e->sc.seek_leg_m * 65536.0);
     }
-    if (e->sc.seek_mean_m2 >= 0.0) {
-        cc.seek.mean_area = (rfs_q16_t)lround(e->sc.seek_mean_m2 * 65536.0);
+    if (e->sc.seek_mean_t >= 0.0) {
+        cc.seek.mean_t = (rfs_q16_t)lround(e->sc.seek_mean_t * 65536.0);
     }
     if (e->sc.seek_floor_db >= 0.0) {
         cc.seek.floor_gap = (rfs_q16_t)lround(e->sc.seek_floor_db * 65536.0);

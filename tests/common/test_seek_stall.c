@@ -544,29 +544,27 @@ static void test_floor_gap_rules_out_a_pinned_fit(void **state)
     floor_case(0.0, 0.5, false);
 }
 
-/* mean_area (docs/STRATEGIES.md, "Stalls"): a fixed model whose belief has its mean at
- * (mx, my), spread over `area` m^2. The greedy decision after the initial move, with the
- * rule at 16 m^2: a belief of 20 m^2 sends the robot to its mean (the goal, hedged);
- * 10 m^2, the rule off, a mean within 1.5 steps of the robot, or a wall on the line from
- * the robot to the mean or from the mean to the estimate (a wall at x = 7 m up to y = 7 m,
- * its door above) send it to the estimate. */
+/* mean_t (docs/STRATEGIES.md, "Stalls"): a fixed model whose belief has its mean at
+ * (mx, my) at temperature 2 (none at another). The greedy decision after the initial
+ * move, with mean_t 2: the robot goes to the mean (the goal, hedged); mean_t 1 (no mean
+ * answered), the rule off, a mean within 1.5 steps of the robot, or a wall on the line
+ * from the robot to the mean or from the mean to the estimate (a wall at x = 7 m up to
+ * y = 7 m, its door above) send it to the estimate. */
 typedef struct mean_model {
     fixed_model_t base; /* first: the fixed_* operations read it */
     double mx, my;      /* the belief's mean, metres (NAN: 0.5 m east of the robot) */
-    double area;        /* m^2 */
     const run_t *r;     /* the robot */
 } mean_model_t;
 
-static bool mean_op(const void *self, rfs_q16_t *x, rfs_q16_t *y, rfs_q16_t *area)
+static bool mean_op(const void *self, rfs_q16_t temp, rfs_q16_t *x, rfs_q16_t *y)
 {
     const mean_model_t *m = self;
     *x = Q(isnan(m->mx) ? m->r->x + 0.5 : m->mx);
     *y = Q(isnan(m->mx) ? m->r->y : m->my);
-    *area = Q(m->area);
-    return m->base.valid;
+    return m->base.valid && temp == RFS_Q16_INT(2);
 }
 
-static void mean_case(double rule_m2, double area, double mx, double my, bool wall, bool hedged)
+static void mean_case(double rule_t, double mx, double my, bool wall, bool hedged)
 {
     static const rfs_model_ops_t ops = { .name = "mean", .reset = fixed_reset,
                                          .fit = fixed_fit, .predict = fixed_predict,
@@ -574,14 +572,14 @@ static void mean_case(double rule_m2, double area, double mx, double my, bool wa
     world_t t;
     rfs_seek_cfg_t cfg;
     run_t r = { .x = 4.0, .y = 5.0 };
-    mean_model_t m = { .mx = mx, .my = my, .area = area, .r = &r };
+    mean_model_t m = { .mx = mx, .my = my, .r = &r };
     local_world(&t, &cfg, &m.base);
     if (wall) {
         world_free(&t);
         world_make(&t, 20.0, 10.0, 7.0, 7.0);
         seek_make(&t, cfg, 5);
     }
-    cfg.mean_area = Q(rule_m2);
+    cfg.mean_t = Q(rule_t);
     rfs_model_t model = { &ops, &m };
     assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
     field_t f = { .kind = 2, .scripted = -60.0 };
@@ -601,16 +599,16 @@ static void mean_case(double rule_m2, double area, double mx, double my, bool wa
     world_free(&t);
 }
 
-static void test_mean_area_hedges_a_wide_belief(void **state)
+static void test_mean_t_hedges_between_guesses(void **state)
 {
     (void)state;
-    mean_case(16.0, 20.0, 8.5, 5.0, false, true);
-    mean_case(16.0, 10.0, 8.5, 5.0, false, false);
-    mean_case(0.0, 20.0, 8.5, 5.0, false, false);
-    mean_case(16.0, 20.0, NAN, NAN, false, false);
-    mean_case(16.0, 20.0, 8.5, 5.0, true, false);  /* robot to mean through the wall */
-    mean_case(16.0, 20.0, 5.0, 2.5, false, true);
-    mean_case(16.0, 20.0, 5.0, 2.5, true, false);  /* mean to estimate through it */
+    mean_case(2.0, 8.5, 5.0, false, true);
+    mean_case(1.0, 8.5, 5.0, false, false);
+    mean_case(0.0, 8.5, 5.0, false, false);
+    mean_case(2.0, NAN, NAN, false, false);
+    mean_case(2.0, 8.5, 5.0, true, false); /* robot to mean through the wall */
+    mean_case(2.0, 5.0, 2.5, false, true);
+    mean_case(2.0, 5.0, 2.5, true, false); /* mean to estimate through it */
 }
 
 int main(void)
@@ -622,7 +620,7 @@ int main(void)
         cmocka_unit_test(test_local_refute_rules_out_the_swept),
         cmocka_unit_test(test_local_gap_spaces_the_sweep),
         cmocka_unit_test(test_floor_gap_rules_out_a_pinned_fit),
-        cmocka_unit_test(test_mean_area_hedges_a_wide_belief),
+        cmocka_unit_test(test_mean_t_hedges_between_guesses),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

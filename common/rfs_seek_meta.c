@@ -404,14 +404,21 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
  * the robot and on to the argmax is open (docs/STRATEGIES.md, "Stalls"): a mirror image
  * across the line of the first samples, or a weaker source nearer the robot, fits the
  * early data as well as the argmax, which flips between them; heading for their mean
- * loses little whichever holds. Behind a wall the mean is no way to either: the argmax.
- * The whole planned leg, rechecked as any (no local search: the mean is no estimate). */
+ * loses little whichever holds. With a wall between any two of robot, mean and argmax
+ * the mean is no way to either (a corridor ring's two ways round): the argmax.
+ * Nor where the robot has been: between two modes the mean stays put, and the robot
+ * shuttled between it and a wrong argmax. The whole planned leg, rechecked as any (no
+ * local search: the mean is no estimate). */
 static bool hedge(rfs_seek_t *s, rfs_q16_t ax, rfs_q16_t ay, int64_t now_us)
 {
     rfs_q16_t x, y;
+    uint16_t li, lj;
     if (s->cfg.mean_t <= 0 || s->model.ops->mean == 0 ||
         !s->model.ops->mean(s->model.self, s->cfg.mean_t, &x, &y) ||
         rfs_q16_dist(s->pose.x, s->pose.y, x, y) < rfs_q16_add(s->cfg.step, s->cfg.step / 2) ||
+        (rfs_map_lattice_nearest(s->map, x, y, &li, &lj),
+         rfs_reach_bit(s->visited, (uint32_t)lj * s->map->lw + li)) ||
+        rfs_map_walls_crossed(s->map, s->pose.x, s->pose.y, ax, ay) != 0u ||
         rfs_map_walls_crossed(s->map, s->pose.x, s->pose.y, x, y) != 0u ||
         rfs_map_walls_crossed(s->map, x, y, ax, ay) != 0u ||
         !greedy_along_path(s, x, y, s->cfg.leg_max, now_us)) {

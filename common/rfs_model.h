@@ -129,6 +129,11 @@ typedef struct rfs_model_ops {
     /// of plausible powers (the path-loss model: P0 - p0_min), dB Q16.16 (negative below
     /// it); false when there is no model or no floor (rfs_seek_cfg_t.floor_gap).
     bool (*floor_gap)(const void *self, rfs_q16_t *gap);
+    /// Optional (may be NULL): the mean of the model's belief where the maximum is, at
+    /// temperature temp (Q16.16, > 0; the path-loss model: its candidates' positions
+    /// weighted e^(-chi2 / 2 temp), as sample() draws them at its own); false when there is
+    /// no model (rfs_seek_cfg_t.mean_t).
+    bool (*mean)(const void *self, rfs_q16_t temp, rfs_q16_t *x, rfs_q16_t *y);
 } rfs_model_ops_t;
 
 /// A model: its operations and its caller-owned state.

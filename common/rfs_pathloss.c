@@ -930,6 +930,7 @@ const rfs_model_ops_t rfs_pathloss_ops = {
     .sample = rfs_pathloss_sample_op,
     .near = rfs_pathloss_near_op,
     .floor_gap = pathloss_floor_gap,
+    .mean = rfs_pathloss_mean_op,
 };
 
 rfs_model_t rfs_pathloss_model(rfs_pathloss_t *p)

@@ -15,11 +15,11 @@ typedef struct draw_k {
     uint64_t den; /* 2 T bm, dB^2 Q16, >= 1 */
 } draw_k_t;
 
-static draw_k_t draw_consts(const rfs_pathloss_t *p)
+static draw_k_t draw_consts(const rfs_pathloss_t *p, rfs_q16_t temp)
 {
     uint64_t bm = rfs_pathloss_mean_loss(p, p->best.loss);
     bm = bm > 0u ? bm : 1u;
-    uint64_t den = (bm * 2u * (uint64_t)p->cfg.sample_t) >> 16;
+    uint64_t den = (bm * 2u * (uint64_t)temp) >> 16;
     draw_k_t k = {rfs_pathloss_mean_loss(p, p->top[0].loss), den > 0u ? den : 1u};
     return k;
 }
@@ -44,7 +44,7 @@ uint32_t rfs_pathloss_draw_weight(const rfs_pathloss_t *p, uint16_t ci, uint16_t
     if (!p->valid || ci >= p->lat.ncx || cj >= p->lat.ncy) {
         return 0u;
     }
-    draw_k_t k = draw_consts(p);
+    draw_k_t k = draw_consts(p, p->cfg.sample_t);
     return draw_weight(p, &k, (uint32_t)cj * p->lat.ncx + ci);
 }
 
@@ -60,7 +60,7 @@ bool rfs_pathloss_sample_op(const void *self, rfs_rng_t *rng, rfs_q16_t *x, rfs_
     }
     const rfs_pathloss_lat_t *l = &p->lat;
     const uint32_t nc = (uint32_t)l->ncx * l->ncy;
-    const draw_k_t k = draw_consts(p);
+    const draw_k_t k = draw_consts(p, p->cfg.sample_t);
     uint32_t total = 0u;
     for (uint32_t c = 0u; c < nc; ++c) {
         total += draw_weight(p, &k, c);
@@ -129,4 +129,39 @@ bool rfs_pathloss_near_op(const void *self, const rfs_model_near_t *q, rfs_q16_t
         }
     }
     return found;
+}
+
+/* rfs_model_ops_t.mean: the coarse candidates' mean position, each weighted as the draws
+ * (draw_weight) at temperature temp. One pass, no table. Scaling: weights <=
+ * 2^16 times coordinates (Q16, |.| < 2^31) < 2^47, summed over at most
+ * RFS_PATHLOSS_MAX_COARSE (2^10) points < 2^57; the weights sum below 2^26. */
+bool rfs_pathloss_mean_op(const void *self, rfs_q16_t temp, rfs_q16_t *x, rfs_q16_t *y)
+{
+    const rfs_pathloss_t *p = (const rfs_pathloss_t *)self;
+    RFS_ASSERT(p != 0 && temp > 0 && x != 0 && y != 0);
+    if (!p->valid) {
+        return false;
+    }
+    const rfs_pathloss_lat_t *l = &p->lat;
+    const uint32_t nc = (uint32_t)l->ncx * l->ncy;
+    const draw_k_t k = draw_consts(p, temp);
+    int64_t sw = 0, sx = 0, sy = 0;
+    for (uint32_t c = 0u; c < nc; ++c) {
+        const uint32_t w = draw_weight(p, &k, c);
+        int32_t i, j;
+        if (w == 0u || !rfs_pathloss_coarse_ij(p, c, &i, &j)) {
+            continue;
+        }
+        rfs_q16_t cx, cy;
+        rfs_pathloss_lattice_xy(l, (uint16_t)i, (uint16_t)j, &cx, &cy);
+        sw += w;
+        sx += (int64_t)w * cx;
+        sy += (int64_t)w * cy;
+    }
+    if (sw == 0) {
+        return false; /* a fit on another lattice has begun since (as the draws) */
+    }
+    *x = (rfs_q16_t)rfs_sdiv64_round(sx, sw);
+    *y = (rfs_q16_t)rfs_sdiv64_round(sy, sw);
+    return true;
 }

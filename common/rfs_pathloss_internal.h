@@ -96,4 +96,7 @@ bool rfs_pathloss_sample_op(const void *self, rfs_rng_t *rng, rfs_q16_t *x, rfs_
 bool rfs_pathloss_near_op(const void *self, const rfs_model_near_t *q, rfs_q16_t *x,
                           rfs_q16_t *y);
 
+/// rfs_model_ops_t.mean (rfs_pathloss_draw.c).
+bool rfs_pathloss_mean_op(const void *self, rfs_q16_t temp, rfs_q16_t *x, rfs_q16_t *y);
+
 #endif /* RFS_PATHLOSS_INTERNAL_H */

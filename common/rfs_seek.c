@@ -58,6 +58,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.leg_max = 0;                          /* and walk the whole leg to it */
     c.floor_gap = 0;                        /* whatever the fit's power */
     c.floor_max = 0;                        /* and however often */
+    c.mean_t = 0;                           /* greedy goes to the argmax */
     c.reach_min = 0;                        /* the robot's component, however small */
     c.silence_floor = INT32_MIN;            /* silence adds no sample */
     c.recheck_silent = false;               /* and a silent check passes */
@@ -192,7 +193,7 @@ int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map
         cfg->tumble_worse > RFS_Q16_ONE || cfg->recheck_dist < 0 || cfg->settle_dist < 0 ||
         cfg->settle_orbit < 0 || cfg->settle_end < 0 || cfg->refute_r < 0 ||
         cfg->src_spacing < 0 || cfg->local_r < 0 || cfg->leg_max < 0 ||
-        cfg->floor_gap < 0 ||
+        cfg->floor_gap < 0 || cfg->mean_t < 0 || cfg->mean_t > RFS_Q16_INT(64) ||
         cfg->local_gap < 0 || cfg->at_tol < 0) {
         return -1;
     }
@@ -569,6 +570,7 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
         d->sampled = false;
         d->near = false;
         d->pinned = false;
+        d->hedged = false;
     }
     if (!rfs_seek_ops(s)->learns) {
         ok = rfs_seek_ops(s)->choose(s, false, rng, now_us);

@@ -144,6 +144,14 @@ typedef struct rfs_seek_cfg {
                                 ///< for the floor a mission, later pinned fits believed (a
                                 ///< weak node's fit stays pinned, a wrong one seldom pins
                                 ///< more than twice; docs/STRATEGIES.md, "Stalls"), 0: no limit
+    rfs_q16_t mean_t;           ///< with a model that answers mean (the path-loss model): a
+                                ///< greedy goal is the belief's mean at this temperature,
+                                ///< not its argmax, when the mean lies 1.5 steps or more
+                                ///< from the robot and no wall crosses the lines robot-mean
+                                ///< and mean-argmax: early data leave bearing and distance
+                                ///< open and the argmax flips between far guesses; in the
+                                ///< open the mean hedges between them (a tight belief's
+                                ///< mean is its argmax), Q16.16 (0: off)
     rfs_q16_t leg_max;          ///< a greedy leg to a known argmax ends after this much of
                                 ///< its path (the next decision relearns and may explore),
                                 ///< metres Q16.16 (0: the whole path)
@@ -276,6 +284,7 @@ typedef struct rfs_seek_decision {
                                ///< model's draw (a sampled epsilon step)
     bool sampled;              ///< epsilon: the goal is the model's draw (cfg.eps_sample)
     bool near;                 ///< greedy: the goal is a nearer plausible source (cfg.near_t)
+    bool hedged;               ///< greedy: the goal is the belief's mean (cfg.mean_t)
     bool pinned;               ///< greedy drawn, but the fit's power lay within
                                ///< cfg.floor_gap of its floor: ruled out, epsilon instead
     bool refuted;              ///< the argmax was ruled out before this decision's fit

@@ -400,6 +400,36 @@ static bool choose_epsilon(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     return false;
 }
 
+/* mean_t: the greedy goal is the belief's mean, where the way from
+ * the robot and on to the argmax is open (docs/STRATEGIES.md, "Stalls"): a mirror image
+ * across the line of the first samples, or a weaker source nearer the robot, fits the
+ * early data as well as the argmax, which flips between them; heading for their mean
+ * loses little whichever holds. With a wall between any two of robot, mean and argmax
+ * the mean is no way to either (a corridor ring's two ways round): the argmax.
+ * Nor where the robot has been: between two modes the mean stays put, and the robot
+ * shuttled between it and a wrong argmax. The whole planned leg, rechecked as any (no
+ * local search: the mean is no estimate). */
+static bool hedge(rfs_seek_t *s, rfs_q16_t ax, rfs_q16_t ay, int64_t now_us)
+{
+    rfs_q16_t x, y;
+    uint16_t li, lj;
+    if (s->cfg.mean_t <= 0 || s->model.ops->mean == 0 ||
+        !s->model.ops->mean(s->model.self, s->cfg.mean_t, &x, &y) ||
+        rfs_q16_dist(s->pose.x, s->pose.y, x, y) < rfs_q16_add(s->cfg.step, s->cfg.step / 2) ||
+        (rfs_map_lattice_nearest(s->map, x, y, &li, &lj),
+         rfs_reach_bit(s->visited, (uint32_t)lj * s->map->lw + li)) ||
+        rfs_map_walls_crossed(s->map, s->pose.x, s->pose.y, ax, ay) != 0u ||
+        rfs_map_walls_crossed(s->map, s->pose.x, s->pose.y, x, y) != 0u ||
+        rfs_map_walls_crossed(s->map, x, y, ax, ay) != 0u ||
+        !greedy_along_path(s, x, y, s->cfg.leg_max, now_us)) {
+        return false;
+    }
+    s->decision.max_x = x;
+    s->decision.max_y = y;
+    s->decision.hedged = true;
+    return true;
+}
+
 /* Greedy step (paper section 2): the model's maximum, from the model itself when it
  * knows where it is (argmax: the pathloss model's estimated source, docs/PATHLOSS.md,
  * "Model"), else by the grid search over every reachable legal lattice point; then
@@ -410,6 +440,9 @@ static bool choose_greedy(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us)
     bool found = false;
     bool known = false;
     if (s->model.ops->argmax != 0 && s->model.ops->argmax(s->model.self, &mx, &my)) {
+        if (hedge(s, mx, my, now_us)) {
+            return true;
+        }
         found = true;
         known = true;
     } else {

@@ -222,6 +222,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_leg_m = -1.0;
     sc->seek_floor_db = -1.0;
     sc->seek_floor_max = -1.0;
+    sc->seek_mean_t = -1.0;
     sc->seek_local_gap_m = -1.0;
     sc->seek_local_refute = -1;
     sc->seek_at_tol_m = -1.0;
@@ -459,13 +460,14 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
                                         "coarse_footprint_m", "p0_max_wall_db", "local_gap_m",
                                         "at_tol_m", "local_refute", "near_t",
                                         "near_m", "coarse_snap", "reach_min", "fit_budget",
-                                        "floor_db", "floor_max", NULL};
+                                        "floor_db", "floor_max", "mean_t", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
             num(p, n, "seek", "refute_m", 0, 100, &sc->seek_refute_m) ||
             num(p, n, "seek", "local_m", 0, 100, &sc->seek_local_m) ||
             num(p, n, "seek", "leg_m", 0, 1000, &sc->seek_leg_m) ||
             num(p, n, "seek", "floor_db", 0, 60, &sc->seek_floor_db) ||
+            num(p, n, "seek", "mean_t", 0, 64, &sc->seek_mean_t) ||
             num(p, n, "seek", "local_gap_m", 0, 100, &sc->seek_local_gap_m) ||
             num(p, n, "seek", "at_tol_m", 0, 1, &sc->seek_at_tol_m) ||
             num(p, n, "seek", "near_t", 0, 64, &sc->seek_near_t) ||

@@ -101,6 +101,8 @@ typedef struct hs_scenario {
                                   ///< -1 = the preset)
     double seek_floor_max;        ///< seek.floor_max: rfs_seek_cfg_t.floor_max, 0..255 (0: no
                                   ///< limit; -1 = the preset)
+    double seek_mean_t;           ///< seek.mean_t: rfs_seek_cfg_t.mean_t (0: off; -1 = the
+                                  ///< preset)
     int seek_refute_reached;      ///< seek.refute_reached: 0 / 1 (rfs_seek_cfg_t; -1 = the
                                   ///< strategy's preset)
     int seek_silence_floor;       ///< seek.silence_floor: 0 / 1, floor samples (-100 dBm) in

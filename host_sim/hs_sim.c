@@ -478,7 +478,8 @@ static void log_decision(FILE *f, const hs_ctrl_t *ctrl, const rfs_seek_decision
     char reason[96];
     snprintf(reason, sizeof reason, "prev=%s%s%s%s%s%s%s", hs_sim_prev_name(d->prev),
              d->line_search ? ",line_search" : "",
-             d->sampled ? ",sampled" : d->near ? ",near" : "", d->refuted ? ",refuted" : "",
+             d->sampled ? ",sampled" : d->near ? ",near" : d->hedged ? ",hedged" : "",
+             d->refuted ? ",refuted" : "",
              d->pinned ? ",pinned" : "", d->model_valid ? "" : ",no_model",
              d->mean_valid ? "" : ",no_mean");
     double pred = d->model_valid ? q16d(d->prediction) : NAN;
@@ -809,6 +810,9 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     }
     if (e->sc.seek_leg_m >= 0.0) {
         cc.seek.leg_max = (rfs_q16_t)lround(e->sc.seek_leg_m * 65536.0);
+    }
+    if (e->sc.seek_mean_t >= 0.0) {
+        cc.seek.mean_t = (rfs_q16_t)lround(e->sc.seek_mean_t * 65536.0);
     }
     if (e->sc.seek_floor_db >= 0.0) {
         cc.seek.floor_gap = (rfs_q16_t)lround(e->sc.seek_floor_db * 65536.0);

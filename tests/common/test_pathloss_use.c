@@ -430,7 +430,9 @@ static void near_weighs_plausibility_per_metre(void **state)
  * probability proportional to e^(-chi2_c / 2T), chi2_c = (m_c / m_best - 1) x bins, m
  * the mean loss per unit weight (rms^2 / 2 of the reported surface). Weights recomputed
  * in double from the reported surface and estimate; draw frequencies within 4.5
- * binomial sigma of them over 40,000 draws. Few, noisy samples: a broad belief. */
+ * binomial sigma of them over 40,000 draws; the belief's mean at T (rfs_pathloss_ops.mean,
+ * mean_t) the points' mean position so weighted, within 2 cm. Few, noisy samples: a broad
+ * belief. */
 static void draws_follow_the_residual_surface(void **state)
 {
     fixture_t *f = *state;
@@ -450,7 +452,7 @@ static void draws_follow_the_residual_surface(void **state)
         double *m = calloc((size_t)nc, sizeof *m), *want = calloc((size_t)nc, sizeof *want);
         int *count = calloc((size_t)nc, sizeof *count);
         assert_true(m != NULL && want != NULL && count != NULL);
-        double m0 = INFINITY, bm = pow(e.rms / 65536.0, 2) / 2.0, sum = 0;
+        double m0 = INFINITY, bm = pow(e.rms / 65536.0, 2) / 2.0, sum = 0, sx = 0, sy = 0;
         for (int ci = 0; ci < nc; ++ci) {
             rfs_q16_t x, y, rms;
             m[ci] = rfs_pathloss_residual_at(&f->pl, (uint16_t)(ci % ncx), (uint16_t)(ci / ncx),
@@ -469,7 +471,18 @@ static void draws_follow_the_residual_surface(void **state)
                          want[ci]);
             }
             sum += want[ci];
+            rfs_q16_t px, py, rms;
+            if (rfs_pathloss_residual_at(&f->pl, (uint16_t)(ci % ncx), (uint16_t)(ci / ncx), &px,
+                                         &py, &rms)) {
+                sx += want[ci] * px / 65536.0;
+                sy += want[ci] * py / 65536.0;
+            }
         }
+        rfs_q16_t mx, my;
+        assert_true(rfs_pathloss_ops.mean(&f->pl, c.sample_t, &mx, &my));
+        print_message("belief mean at T %.0f: (%.3f, %.3f) m, double (%.3f, %.3f) m\n", temps[k],
+                      mx / 65536.0, my / 65536.0, sx / sum, sy / sum);
+        assert_true(hypot(mx / 65536.0 - sx / sum, my / 65536.0 - sy / sum) < 0.02);
         rfs_rng_t rng;
         rfs_rng_seed(&rng, 5 + (uint64_t)k);
         for (int d = 0; d < ndraw; ++d) {
@@ -507,6 +520,7 @@ static void draws_follow_the_residual_surface(void **state)
     rfs_pathloss_ops.reset(&f->pl);
     assert_false(rfs_pathloss_ops.sample(&f->pl, &rng, &x, &y));
     assert_int_equal(rfs_pathloss_draw_weight(&f->pl, 0, 0), 0u);
+    assert_false(rfs_pathloss_ops.mean(&f->pl, RFS_Q16_ONE, &x, &y));
 }
 
 /* Without a map the lattice follows the samples: a sliced fit on data spread otherwise

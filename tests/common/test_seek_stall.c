@@ -581,6 +581,85 @@ static void test_floor_max_believes_a_fit_pinned_again(void **state)
     (void)state;
     floor_max_case(2u, (const bool[3]){true, true, false}, 2);
     floor_max_case(0u, (const bool[3]){true, true, true}, 2);
+/* mean_t (docs/STRATEGIES.md, "Stalls"): a fixed model whose belief has its mean at
+ * (mx, my) at temperature 2 (none at another). The greedy decision after the initial
+ * move, with mean_t 2: the robot goes to the mean (the goal, hedged), and at the next
+ * decision, the mean moved to the start, to the estimate (visited); mean_t 1 (no mean
+ * answered), the rule off, a mean within 1.5 steps of the robot, or a wall between any two
+ * of robot, mean and estimate (a wall at x = 7 m up to y = 3 or 7 m, a door above) send it
+ * to the estimate. */
+typedef struct mean_model {
+    fixed_model_t base; /* first: the fixed_* operations read it */
+    double mx, my;      /* the belief's mean, metres (NAN: 0.5 m east of the robot) */
+    const run_t *r;     /* the robot */
+} mean_model_t;
+
+static bool mean_op(const void *self, rfs_q16_t temp, rfs_q16_t *x, rfs_q16_t *y)
+{
+    const mean_model_t *m = self;
+    *x = Q(isnan(m->mx) ? m->r->x + 0.5 : m->mx);
+    *y = Q(isnan(m->mx) ? m->r->y : m->my);
+    return m->base.valid && temp == RFS_Q16_INT(2);
+}
+
+static void mean_case(double rule_t, double mx, double my, double wall_top, bool hedged)
+{
+    static const rfs_model_ops_t ops = { .name = "mean", .reset = fixed_reset,
+                                         .fit = fixed_fit, .predict = fixed_predict,
+                                         .argmax = fixed_argmax, .mean = mean_op };
+    world_t t;
+    rfs_seek_cfg_t cfg;
+    run_t r = { .x = 4.0, .y = 5.0 };
+    mean_model_t m = { .mx = mx, .my = my, .r = &r };
+    local_world(&t, &cfg, &m.base);
+    if (wall_top > 0.0) {
+        world_free(&t);
+        world_make(&t, 20.0, 10.0, 7.0, wall_top);
+        seek_make(&t, cfg, 5);
+    }
+    cfg.mean_t = Q(rule_t);
+    rfs_model_t model = { &ops, &m };
+    assert_int_equal(rfs_seek_init(&t.seek, &cfg, &t.map, model, &rfs_target_rssi, &t.mem), 0);
+    field_t f = { .kind = 2, .scripted = -60.0 };
+    rfs_seek_out_t out;
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    assert_int_equal(out.decision.kind, RFS_SEEK_INITIAL);
+    assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+    const rfs_seek_decision_t *d = &out.decision;
+    assert_int_equal(d->kind, RFS_SEEK_GREEDY);
+    assert_int_equal(d->hedged, hedged);
+    const double gx = hedged ? mx : LOCAL_EX, gy = hedged ? my : LOCAL_EY;
+    assert_true(hypot(D(d->goal_x) - gx, D(d->goal_y) - gy) < 1e-3);
+    assert_true(hypot(D(d->max_x) - gx, D(d->max_y) - gy) < 1e-3);
+    if (!isnan(mx)) {
+        assert_true(hypot(D(d->x) - mx, D(d->y) - my) > 1.5); /* not the near rule's case */
+    }
+    if (hedged && wall_top == 0.0) {
+        /* Then the mean at the start, 1.5 steps or more away but visited: the estimate. */
+        m.mx = 4.0;
+        m.my = 5.0;
+        assert_true(next_decision(&t, &r, &f, 1000000, 5000000, &out));
+        assert_int_equal(d->kind, RFS_SEEK_GREEDY);
+        assert_false(d->hedged);
+        assert_true(hypot(D(d->x) - 4.0, D(d->y) - 5.0) > 1.5);
+        assert_true(hypot(D(d->goal_x) - LOCAL_EX, D(d->goal_y) - LOCAL_EY) < 1e-3);
+    }
+    world_free(&t);
+}
+
+static void test_mean_t_hedges_between_guesses(void **state)
+{
+    (void)state;
+    mean_case(2.0, 8.5, 5.0, 0.0, true);
+    mean_case(1.0, 8.5, 5.0, 0.0, false);
+    mean_case(0.0, 8.5, 5.0, 0.0, false);
+    mean_case(2.0, NAN, NAN, 0.0, false);
+    mean_case(2.0, 8.5, 1.0, 0.0, true);
+    mean_case(2.0, 8.5, 1.0, 3.0, false); /* robot to mean through the wall */
+    mean_case(2.0, 5.0, 0.8, 0.0, true);
+    mean_case(2.0, 5.0, 0.8, 3.0, false); /* mean to estimate through it */
+    mean_case(2.0, 8.5, 8.5, 0.0, true);
+    mean_case(2.0, 8.5, 8.5, 7.0, false); /* robot to estimate through it */
 }
 
 int main(void)
@@ -593,6 +672,7 @@ int main(void)
         cmocka_unit_test(test_local_gap_spaces_the_sweep),
         cmocka_unit_test(test_floor_gap_rules_out_a_pinned_fit),
         cmocka_unit_test(test_floor_max_believes_a_fit_pinned_again),
+        cmocka_unit_test(test_mean_t_hedges_between_guesses),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -106,6 +106,7 @@ static void test_scenario_good(void **state)
     assert_true(sc.seek_near_t == -1.0 && sc.seek_near_m == -1.0);
     assert_true(sc.seek_reach_min == -1.0 && sc.seek_floor_db == -1.0);
     assert_true(sc.seek_floor_max == -1.0);
+    assert_true(sc.seek_mean_t == -1.0);
     assert_true(isnan(sc.seek_p0_min_dbm)); // the pathloss model's own default
     assert_true(isnan(sc.seek_coarse_footprint_m));
     assert_int_equal(sc.seek_coarse_snap, -1); // the pathloss model's own default (on)
@@ -117,6 +118,7 @@ static void test_scenario_good(void **state)
              "refute_m: 0, silence_floor: false, refute_reached: true, local_m: 2.5, leg_m: 12, "
              "recheck_silent: false, local_gap_m: 0.75, at_tol_m: 0, local_refute: false, "
              "near_t: 8, near_m: 30, reach_min: 16, floor_db: 1.5, floor_max: 2}\n", GOOD);
+             "near_t: 8, near_m: 30, reach_min: 16, floor_db: 1.5, mean_t: 2}\n", GOOD);
     assert_int_equal(hs_scenario_load(scn("seek.yaml", text), &sc, err, sizeof err), 0);
     assert_string_equal(sc.strategy, "meta-path");
     assert_true(sc.seek_recheck_m == 0.5 && sc.seek_eps_by_travel == 0 && sc.seek_eps_rate == 0.3);
@@ -133,6 +135,7 @@ static void test_scenario_good(void **state)
     assert_true(sc.seek_near_t == 8.0 && sc.seek_near_m == 30.0);
     assert_true(sc.seek_reach_min == 16.0 && sc.seek_floor_db == 1.5);
     assert_true(sc.seek_floor_max == 2.0);
+    assert_true(sc.seek_mean_t == 2.0);
     snprintf(text, sizeof text, "%sseek: {eps_geodesic: true}\n", GOOD);
     assert_int_equal(hs_scenario_load(scn("seek_geo.yaml", text), &sc, err, sizeof err), 0);
     assert_int_equal(sc.seek_eps_geodesic, 1);
@@ -233,6 +236,10 @@ static void test_scenario_bad(void **state)
                "map: @MAP@\nseek: {floor_max: 256}\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",
                "seek.floor_max: 256 is out of range");
+    expect_bad("seek_mean.yaml",
+               "map: @MAP@\nseek: {mean_t: 65}\nsources:\n  - position: [15, 10]\n"
+               "start: {position: [5, 10]}\n",
+               "seek.mean_t: 65 is out of range");
     expect_bad("seek_reach_min.yaml",
                "map: @MAP@\nseek: {reach_min: 2.5}\nsources:\n  - position: [15, 10]\n"
                "start: {position: [5, 10]}\n",

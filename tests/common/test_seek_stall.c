@@ -581,6 +581,8 @@ static void test_floor_max_believes_a_fit_pinned_again(void **state)
     (void)state;
     floor_max_case(2u, (const bool[3]){true, true, false}, 2);
     floor_max_case(0u, (const bool[3]){true, true, true}, 2);
+}
+
 /* mean_t (docs/STRATEGIES.md, "Stalls"): a fixed model whose belief has its mean at
  * (mx, my) at temperature 2 (none at another). The greedy decision after the initial
  * move, with mean_t 2: the robot goes to the mean (the goal, hedged), and at the next

@@ -117,8 +117,8 @@ static void test_scenario_good(void **state)
              "eps_rate: 0.3, eps_geodesic: false, recheck_adapt: false, eps_sample: false, "
              "refute_m: 0, silence_floor: false, refute_reached: true, local_m: 2.5, leg_m: 12, "
              "recheck_silent: false, local_gap_m: 0.75, at_tol_m: 0, local_refute: false, "
-             "near_t: 8, near_m: 30, reach_min: 16, floor_db: 1.5, floor_max: 2}\n", GOOD);
-             "near_t: 8, near_m: 30, reach_min: 16, floor_db: 1.5, mean_t: 2}\n", GOOD);
+             "near_t: 8, near_m: 30, reach_min: 16, floor_db: 1.5, floor_max: 2, mean_t: 2}\n",
+             GOOD);
     assert_int_equal(hs_scenario_load(scn("seek.yaml", text), &sc, err, sizeof err), 0);
     assert_string_equal(sc.strategy, "meta-path");
     assert_true(sc.seek_recheck_m == 0.5 && sc.seek_eps_by_travel == 0 && sc.seek_eps_rate == 0.3);

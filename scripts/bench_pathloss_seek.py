@@ -8,6 +8,10 @@ Writes its section of docs/RESULTS.md, between the markers below, and nothing el
     /usr/bin/python3 scripts/bench_pathloss_seek.py [--seeds N] [--first-seed 1001]
                                                     [--sim build/bin/rfseek-sim] [--jobs N]
                                                     [--results docs/RESULTS.md | --no-write]
+                                                    [--seek 'KEY: VALUE, ...'] [--only-pathloss]
+
+--seek runs the meta-path + pathloss column with rfseek-sim --seek (a variant beside the
+presets); --only-pathloss runs that column alone. Both print only (--no-write).
 """
 import argparse
 import math
@@ -62,9 +66,9 @@ def wilson(k, n, z=1.96):
     return (max(0.0, c - h), min(1.0, c + h))
 
 
-def run(sim, scenario, strategy, model, seeds, first=1, jobs=None):
+def run(sim, scenario, strategy, model, seeds, first=1, jobs=None, seek=""):
     cmd = [sim, scenario, "--strategy", strategy, "--model", model,
-           "--seeds", f"{first}..{first + seeds - 1}", "--quiet"]
+           "--seeds", f"{first}..{first + seeds - 1}", "--quiet"] + (["--seek", seek] if seek else [])
     out = subprocess.run(cmd + (["--jobs", str(jobs)] if jobs else []),
                          capture_output=True, text=True)
     if out.returncode != 0:
@@ -173,7 +177,20 @@ def main():
                     help="the markdown file whose section is replaced")
     ap.add_argument("--no-write", action="store_true",
                     help="print the section instead of writing it into --results")
+    ap.add_argument("--seek", default="",
+                    help="rfseek-sim --seek for the meta-path + pathloss column ('KEY: VALUE, "
+                         "...'; needs --no-write)")
+    ap.add_argument("--only-pathloss", action="store_true",
+                    help="run only the meta-path + pathloss column, a line a row (needs --no-write)")
     a = ap.parse_args()
+    if (a.seek or a.only_pathloss) and not a.no_write:
+        sys.exit("bench_pathloss_seek: --seek and --only-pathloss need --no-write "
+                 "(RESULTS.md holds the presets)")
+    if a.seek:  # checked once, before any run
+        chk = subprocess.run([a.sim, "scenarios/open.yaml", "--seek", a.seek, "--placements", "1",
+                              "--list-placements"], capture_output=True, text=True)
+        if chk.returncode != 0:
+            sys.exit(f"bench_pathloss_seek: {chk.stderr.strip()}")
     if a.seeds < 1 or a.first_seed < 1:
         sys.exit("bench_pathloss_seek: --seeds and --first-seed must be at least 1")
     if a.jobs < 0:
@@ -187,15 +204,20 @@ def main():
             for label, path, edits in rows:
                 cells = []
                 for strategy, model, name, extra in CONFIGS:
+                    main_col = name == "meta-path + pathloss"
+                    if a.only_pathloss and not main_col:
+                        continue
                     scen = scenario_file(path, edits, tmps, extra)
                     cells.append(cell(run(a.sim, scen, strategy, model, a.seeds,
-                                          a.first_seed, a.jobs)))
+                                          a.first_seed, a.jobs, a.seek if main_col else "")))
                     print(f"{label} | {name} | {cells[-1]}", flush=True)
                 out.append((label, cells))
             table.append((title, out))
     finally:
         for t in tmps:
             os.unlink(t)
+    if a.only_pathloss:
+        return  # one column: the lines above are the result
     text = section(a.seeds, a.first_seed, time.time() - t0, commit(), table)
     if a.no_write:
         print(text)

@@ -74,5 +74,17 @@ bridge_bounds.py|scenarios/nope.yaml 1..2|no such scenario file
 bench_seek.py|--bin /bin/true --first-seed 0|--first-seed and --jobs must be at least 1
 bench_pathloss_seek.py|--first-seed 0|--first-seed must be at least 1
 bench_pathloss_seek.py|--jobs -1|--jobs must be 0 (all cores) or more
+bench_pathloss_seek.py|--seek leg_m:2 --no-write|a space after each colon
+bench_pathloss_seek.py|--only-pathloss|--seek and --only-pathloss need --no-write
 LIST
+
+# bench_pathloss_seek.py --only-pathloss --seek: one line a row, the meta-path + pathloss
+# column run with the variant: its default-office ratio is rfseek-sim's own for that seed.
+/usr/bin/python3 scripts/bench_pathloss_seek.py --sim "$sim" --seeds 1 --first-seed 7 --jobs 2 \
+    --only-pathloss --no-write --seek 'leg_m: 6' >"$tmp/pls" 2>"$tmp/e"
+rc=$?
+"$sim" scenarios/default.yaml --strategy meta-path --model pathloss --seed 7 --seek 'leg_m: 6' \
+    >"$tmp/pls.json" 2>/dev/null
+want=$(/usr/bin/python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); print("%.2f" % (r["distance_travelled_m"] / r["shortest_path_m"]))' "$tmp/pls.json")
+check pathloss-seek-only '[ $rc -eq 0 ] && [ "$(grep -c " | meta-path + pathloss | " "$tmp/pls")" -eq 9 ] && grep -q "^default office | meta-path + pathloss | .*, $want\$" "$tmp/pls"'
 [ $fails -eq 0 ]

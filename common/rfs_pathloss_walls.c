@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "rfs_assert.h"
+#include "rfs_reach.h"
 
 /// A cache cell not counted yet (counts are at most 4 x RFS_PATHLOSS_WALLS_MAX).
 #define NOT_COUNTED 255u
@@ -42,14 +43,10 @@ static uint8_t *cache_cell(rfs_pathloss_t *p, uint16_t row, uint32_t col)
     return &p->walls[row][col];
 }
 
-static bool bit(const uint8_t *b, uint32_t i)
+/* The hash slot a column key starts its probe at (bits: log2 of the slots). */
+static uint32_t col_hash_of(uint32_t key, uint8_t bits)
 {
-    return (b[i >> 3] & (1u << (i & 7u))) != 0u;
-}
-
-static void bit_set(uint8_t *b, uint32_t i, bool v)
-{
-    b[i >> 3] = (uint8_t)(v ? b[i >> 3] | (1u << (i & 7u)) : b[i >> 3] & ~(1u << (i & 7u)));
+    return ((key & 0xFFFFu) * 0x9E3779B1u + (key >> 16) * 0x85EBCA77u) >> (32u - bits);
 }
 
 static void cache_clear(rfs_pathloss_t *p)
@@ -116,7 +113,7 @@ static void rows_tidy(rfs_pathloss_t *p)
     rfs_pathloss_xcache_t c = cache_of(p);
     memset(p->row_hash, 0, sizeof(p->row_hash));
     for (uint16_t r = 0u; r < p->nrows; ++r) {
-        if (bit(p->row_used, r)) {
+        if (rfs_reach_bit(p->row_used, r)) {
             p->row_hash[row_slot(p, p->rows[r].cx, p->rows[r].cy)] = (uint16_t)(r + 1u);
         } else {
             memset(cache_cell(p, r, 0u), (int)NOT_COUNTED, c.cols);
@@ -135,11 +132,10 @@ static void cols_tidy(rfs_pathloss_t *p)
     const uint32_t mask = (1u << c.hash_bits) - 1u;
     memset(c.col_hash, 0, ((size_t)1 << c.hash_bits) * sizeof(c.col_hash[0]));
     for (uint32_t k = 0u; k < RFS_PATHLOSS_CACHE_COLS; ++k) {
-        if (!bit(p->col_live, k) || !bit(p->col_used, k)) {
+        if (!rfs_reach_bit(p->col_live, k) || !rfs_reach_bit(p->col_used, k)) {
             continue;
         }
-        const uint32_t key = c.col_key[k];
-        uint32_t h = ((key & 0xFFFFu) * 0x9E3779B1u + (key >> 16) * 0x85EBCA77u) >> (32u - c.hash_bits);
+        uint32_t h = col_hash_of(c.col_key[k], c.hash_bits);
         while (c.col_hash[h] != 0u) {
             h = (h + 1u) & mask;
         }
@@ -197,7 +193,7 @@ void rfs_pathloss_walls_assign(rfs_pathloss_t *p)
             const uint32_t h = row_slot(p, cx, cy);
             if (p->row_hash[h] != 0u) {
                 bb->row = (uint16_t)(p->row_hash[h] - 1u);
-                bit_set(p->row_used, bb->row, true);
+                rfs_reach_bit_set(p->row_used, bb->row);
             }
         }
     }
@@ -218,7 +214,7 @@ void rfs_pathloss_walls_assign(rfs_pathloss_t *p)
                 rows_tidy(p);
                 tidied = true;
             }
-            while (free_from < p->nrows && bit(p->row_used, free_from)) {
+            while (free_from < p->nrows && rfs_reach_bit(p->row_used, free_from)) {
                 free_from++;
             }
             if (free_from == p->nrows) {
@@ -229,7 +225,7 @@ void rfs_pathloss_walls_assign(rfs_pathloss_t *p)
         p->rows[r].cx = cx;
         p->rows[r].cy = cy;
         p->row_hash[row_slot(p, cx, cy)] = (uint16_t)(r + 1u);
-        bit_set(p->row_used, r, true);
+        rfs_reach_bit_set(p->row_used, r);
         bb->row = r;
     }
 }
@@ -245,12 +241,12 @@ int32_t rfs_pathloss_walls_col(rfs_pathloss_t *p, uint16_t li, uint16_t lj, bool
     /* The coarse footprint's column of a point is keyed apart (bit 31). */
     const uint32_t key = (uint32_t)li | (uint32_t)lj << 16 | (two && coarse ? 1u << 31 : 0u);
     const uint32_t mask = (1u << c.hash_bits) - 1u;
-    uint32_t h = ((uint32_t)li * 0x9E3779B1u + (key >> 16) * 0x85EBCA77u) >> (32u - c.hash_bits);
+    uint32_t h = col_hash_of(key, c.hash_bits);
     while (c.col_hash[h] != 0u) {
         const uint32_t k = c.col_hash[h] - 1u;
         if (c.col_key[k] == key) {
             if (builtin) {
-                bit_set(p->col_used, k, true);
+                rfs_reach_bit_set(p->col_used, k);
             }
             return (int32_t)k;
         }
@@ -277,8 +273,8 @@ int32_t rfs_pathloss_walls_col(rfs_pathloss_t *p, uint16_t li, uint16_t lj, bool
     c.col_key[k] = key;
     c.col_hash[h] = (uint16_t)(k + 1u);
     if (builtin) {
-        bit_set(p->col_live, k, true);
-        bit_set(p->col_used, k, true);
+        rfs_reach_bit_set(p->col_live, k);
+        rfs_reach_bit_set(p->col_used, k);
     }
     return (int32_t)k;
 }

@@ -153,9 +153,13 @@ static const char *get_cfg(const uint8_t *p, uint8_t n, rfs_replay_rec_t *rec)
     if (i == n) {
         return NULL;
     }
-    /* The choice: the NUL, strategy, p0_min, the CONFIG frame's ranges. */
+    /* The choice: the NUL, strategy, p0_min, the CONFIG frame's ranges (its length first:
+     * a NUL near the end leaves no p0_min to read). */
+    if (n - i != RFS_REPLAY_CHOICE_LEN) {
+        return "CFG choice malformed or out of range";
+    }
     const int16_t p0 = (int16_t)rd16(p + i + 2u);
-    if (n - i != RFS_REPLAY_CHOICE_LEN || p[i + 1u] >= (uint8_t)RFS_SEEK_STRATEGY_COUNT ||
+    if (p[i + 1u] >= (uint8_t)RFS_SEEK_STRATEGY_COUNT ||
         (p0 != RFS_CAN_P0_NONE && (p0 < RFS_CAN_P0_MIN || p0 > RFS_CAN_P0_MAX))) {
         return "CFG choice malformed or out of range";
     }

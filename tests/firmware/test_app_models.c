@@ -6,6 +6,7 @@
  * Cortex-M4 by tests/firmware/bench_models.sh). */
 #include "rfs_test.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 #include "app_fixture.h"
@@ -145,6 +146,15 @@ static void test_cfg_model_name_bytes(void **state)
     assert_int_equal(rfs_replay_parse(bad, sizeof bad, &used, &back), RFS_REPLAY_BAD);
     bad[26] = 0x00; /* 12800: 100 dBm, the limit */
     assert_int_equal(rfs_replay_parse(bad, sizeof bad, &used, &back), RFS_REPLAY_OK);
+    /* The NUL the record's last byte (a choice of one byte), the record the buffer's end:
+     * refused without reading past it (a heap copy of exactly its size, for ASan). */
+    uint8_t *end = malloc(sizeof ch - 3u);
+    assert_non_null(end);
+    memcpy(end, ch, sizeof ch - 3u);
+    end[1] = 23;
+    assert_int_equal(rfs_replay_parse(end, sizeof ch - 3u, &used, &back), RFS_REPLAY_BAD);
+    assert_string_equal(back.error, "CFG choice malformed or out of range");
+    free(end);
 }
 
 static void sink(void *ctx, const uint8_t *p, uint32_t n)

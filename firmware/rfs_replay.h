@@ -103,7 +103,7 @@ typedef struct rfs_replay_rec {
             uint64_t seed;    ///< random seed
             uint8_t target;   ///< rfs_app_target_t
             uint8_t node;     ///< node id
-            uint32_t fit_budget; ///< samples learnt per control period (0 = all at once)
+            uint32_t fit_budget; ///< the model's work units a control period (0 = all at once)
             /// internal model by registry name, NUL-terminated; "" = the player's base
             /// configuration (the local ridge)
             char model[RFS_REPLAY_MODEL_NAME_MAX + 1u];

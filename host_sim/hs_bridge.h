@@ -1,5 +1,5 @@
 /* hs_bridge.h - the bridging figures of a run (target bridge, paper section 6;
- * docs/SIMULATOR.md, "Bridging"): where the true f = -|R1 - R2| - |R1 + R2| is best, f
+ * docs/STRATEGIES.md, "Bridging"): where the true f = -|R1 - R2| - |R1 + R2| is best, f
  * where the robot settled, and when it settled.
  *
  * The true f is the mean field's (path loss, walls and the seed's shadowing; no fading,

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Bounds on bridging (docs/STRATEGIES.md, "Bridging: what limits it"): for each seed, one
+"""Bounds on bridging (docs/STRATEGIES.md, "Bridging: one fit per node"): for each seed, one
 meta-path + pathloss run of a bridging scenario with its fields dumped, and where four
 references would settle against the simulator's best point of the true f:
 

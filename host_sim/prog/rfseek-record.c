@@ -290,7 +290,7 @@ static void usage(FILE *f)
             "  --heartbeat MODE     the receiver heartbeat (when the scenario has it):\n"
             "                       can (RX_STATUS frames, default), record (RECEIVER\n"
             "                       records) or off (packets only)\n"
-            "  --fit-budget N       samples learnt per control period (0: all; the MCU\n"
+            "  --fit-budget N       the model's work units a control period (0: all; the MCU\n"
             "                       configuration uses each model's, 0 for the ridge)\n"
             "  --model NAME         internal model, overriding the scenario's: ridge, mlp, knn,\n"
             "                       radius, pathloss (recorded in the CFG record; the emulator\n"

@@ -183,7 +183,7 @@ static void usage(FILE *f)
                "  --seed N         seed of the controller's random source (default 1)\n"
                "  --target NAME    rssi (default) or bridge\n"
                "  --model NAME     ridge (default), mlp, knn, radius, pathloss\n"
-               "  --fit-budget N   samples learnt per control period (default 0: all)\n"
+               "  --fit-budget N   the model's work units a control period (default 0: all)\n"
                "  -h, --help       this text\n");
 }
 

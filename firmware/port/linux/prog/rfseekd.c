@@ -51,7 +51,7 @@ static const char usage_text[] =
     "  --target NAME     rssi (default) or bridge\n"
     "  --model NAME      internal model: ridge (default, the paper's), mlp, knn, radius,\n"
     "                    pathloss (docs/MODELS.md; one fit per node under --target bridge,\n"
-    "                    docs/STRATEGIES.md; the STM32 image holds the ridge only)\n"
+    "                    docs/STRATEGIES.md; the STM32 image holds ridge and pathloss)\n"
     "  --strategy NAME   meta (default, the paper's Algorithm 1) or meta-path (greedy legs\n"
     "                    along the planned path, with its preset improvements; with\n"
     "                    --model pathloss: docs/STRATEGIES.md); also fd-gradient,\n"

@@ -58,6 +58,11 @@
  * the search is done. The model is invalid while a fit is in progress; a sliced fit bins
  * the samples its first call saw (samples added meanwhile wait for the next relearn;
  * ones a full store replaces meanwhile may be binned new).
+ *
+ * Warming (rfs_pathloss_ops.warm, rfs_pathloss_warm.c): between fits, in the same units,
+ * the counts the next fit will read from the cache: bins with a new wall origin (but the
+ * robot's) against the last fit's columns, then every bin against the first points of
+ * the next hold search. The model and the next fit's results are unchanged, bit for bit.
  */
 #ifndef RFS_PATHLOSS_H
 #define RFS_PATHLOSS_H

@@ -257,6 +257,120 @@ static void warm_resumes_at_budget_one(void **state)
     free(whole);
 }
 
+/* Rows the last fit's bins hold are never taken: with more bins than rows (the whole
+ * office) warming finds none free for the bins whose centroids moved, stops, and leaves
+ * every origin and count as it was (it may only add counts); the relearn equals one
+ * without warming. */
+static void warm_keeps_the_last_fits_rows(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS / 2, &f->map, &k_office, 11);
+    make_samples(f->s + NS / 2, NS / 2, &f->map, &k_office, 12); /* centroids move */
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    rfs_pathloss_t *cold = malloc(sizeof(rfs_pathloss_t));
+    rfs_pathloss_t *before = malloc(sizeof(rfs_pathloss_t));
+    assert_true(cold != NULL && before != NULL);
+    assert_int_equal(rfs_pathloss_init(&f->pl, &c), 0);
+    rfs_model_fit_in_t in1 = input(f, NS / 2), in2 = input(f, NS);
+    (void)fit(&f->pl, &in1, 0);
+    assert_true(f->pl.nbins > RFS_PATHLOSS_BUILTIN_ROWS);
+    assert_int_equal(f->pl.nrows, RFS_PATHLOSS_BUILTIN_ROWS);
+    memcpy(cold, &f->pl, sizeof(*cold));
+    memcpy(before, &f->pl, sizeof(*before));
+
+    (void)warm_all(&f->pl, &in2, 1);
+    assert_true(f->pl.warm.stopped);
+    assert_memory_equal(f->pl.rows, before->rows, sizeof(before->rows));
+    uint32_t kept = 0u;
+    for (uint32_t r = 0u; r < RFS_PATHLOSS_BUILTIN_ROWS; ++r) {
+        for (uint32_t k = 0u; k < RFS_PATHLOSS_CACHE_COLS; ++k) {
+            if (before->walls[r][k] != 255u) {
+                assert_int_equal(f->pl.walls[r][k], before->walls[r][k]);
+                kept++;
+            }
+        }
+    }
+    assert_true(kept > 10000u);
+    (void)fit(&f->pl, &in2, 0);
+    (void)fit(cold, &in2, 0);
+    same_fit(&f->pl, cold);
+    free(cold);
+    free(before);
+}
+
+/* Samples in every bin (bx, by), bx0 <= bx < bx1, by0 <= by < by1, from s; returns the
+ * count. */
+static int block(fixture_t *f, int at, int bx0, int bx1, int by0, int by1)
+{
+    for (int bx = bx0; bx < bx1; ++bx) {
+        for (int by = by0; by < by1; ++by) {
+            bin_samples(f->s + at, 8, &f->map, &k_office, bx, by, (uint64_t)(bx * 100 + by));
+            at += 8;
+        }
+    }
+    return at;
+}
+
+/* A full cache whose rows partly hold no bin of the last fit (an earlier fit's, emptied by
+ * the last fit's tidy): warming takes those for the bins the robot left and keeps every
+ * origin the last fit's bins hold, with its counts. */
+static void warm_takes_rows_no_bin_holds(void **state)
+{
+    fixture_t *f = *state;
+    const int a = block(f, 0, 1, 11, 1, 7);          /* 60 bins west */
+    const int a2 = block(f, a, 1, 11, 10, 14);       /* 40 more */
+    const int b = block(f, a2, 16, 26, 1, 7);        /* then 60 bins east */
+    const int b2 = block(f, b, 16, 26, 10, 14);      /* 40 more */
+    int n = b2;
+    for (int bx = 16; bx < 19; ++bx) {               /* the leg, the robot in (18, 7) */
+        bin_samples(f->s + n, PER_BIN, &f->map, &k_office, bx, 7, (uint64_t)(900 + bx));
+        n += PER_BIN;
+    }
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    rfs_pathloss_t *cold = malloc(sizeof(rfs_pathloss_t));
+    rfs_pathloss_t *before = malloc(sizeof(rfs_pathloss_t));
+    assert_true(cold != NULL && before != NULL);
+    assert_int_equal(rfs_pathloss_init(&f->pl, &c), 0);
+    rfs_model_fit_in_t west = input(f, a2), east = {.samples = f->s + a2, .n = (uint16_t)(b2 - a2),
+                                                    .map = &f->map};
+    rfs_model_fit_in_t leg = {.samples = f->s + a2, .n = (uint16_t)(n - a2), .map = &f->map,
+                              .qx = 18 * 65536 + 32768, .qy = 7 * 65536 + 39322};
+    (void)fit(&f->pl, &west, 0);
+    (void)fit(&f->pl, &east, 0);
+    assert_int_equal(f->pl.nrows, RFS_PATHLOSS_BUILTIN_ROWS);
+    assert_true(f->pl.nbins < RFS_PATHLOSS_BUILTIN_ROWS);
+    memcpy(cold, &f->pl, sizeof(*cold));
+    memcpy(before, &f->pl, sizeof(*before));
+
+    (void)warm_all(&f->pl, &leg, 0);
+    assert_false(f->pl.warm.stopped);
+    uint32_t held = 0u, taken = 0u;
+    for (uint32_t r = 0u; r < RFS_PATHLOSS_BUILTIN_ROWS; ++r) {
+        bool counted = false;
+        for (uint32_t k = 0u; k < RFS_PATHLOSS_CACHE_COLS; ++k) {
+            if (before->walls[r][k] != 255u) {
+                assert_int_equal(f->pl.walls[r][k], before->walls[r][k]);
+                counted = true;
+            }
+        }
+        if (counted) { /* a row the last fit filled keeps its origin */
+            assert_int_equal(f->pl.rows[r].cx, before->rows[r].cx);
+            assert_int_equal(f->pl.rows[r].cy, before->rows[r].cy);
+            held++;
+        } else if (f->pl.walls[r][0] != 255u || f->pl.rows[r].cx != before->rows[r].cx ||
+                   f->pl.rows[r].cy != before->rows[r].cy) {
+            taken++;
+        }
+    }
+    assert_int_equal(held, before->nbins);
+    assert_int_equal(taken, 2u); /* the two bins left */
+    rfs_pathloss_est_t ew = fit(&f->pl, &leg, 0), ec = fit(cold, &leg, 0);
+    same_fit(&f->pl, cold);
+    assert_true(ew.footprints < ec.footprints);
+    free(cold);
+    free(before);
+}
+
 static void only_pathloss_warms(void **state)
 {
     (void)state;
@@ -276,6 +390,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(relearn_after_warm_equals_relearn_without, setup, teardown),
         cmocka_unit_test_setup_teardown(warm_leaves_the_model_unchanged, setup, teardown),
         cmocka_unit_test_setup_teardown(warm_resumes_at_budget_one, setup, teardown),
+        cmocka_unit_test_setup_teardown(warm_keeps_the_last_fits_rows, setup, teardown),
+        cmocka_unit_test_setup_teardown(warm_takes_rows_no_bin_holds, setup, teardown),
         cmocka_unit_test(only_pathloss_warms),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

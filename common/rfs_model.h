@@ -134,6 +134,12 @@ typedef struct rfs_model_ops {
     /// weighted e^(-chi2 / 2 temp), as sample() draws them at its own); false when there is
     /// no model (rfs_seek_cfg_t.mean_t).
     bool (*mean)(const void *self, rfs_q16_t temp, rfs_q16_t *x, rfs_q16_t *y);
+    /// Optional (may be NULL): between fits (the robot driving a leg), do work the next
+    /// fit would do, in fit()'s work units (budget > 0; 0 = no limit): the path-loss
+    /// model counts walls of the bins the robot has left (in->qx, qy: the robot). The
+    /// model, its predictions and the next fit's results stay bit for bit the same; the
+    /// next fit only has less to do. true while more is left.
+    bool (*warm)(void *self, const rfs_model_fit_in_t *in, uint32_t budget);
 } rfs_model_ops_t;
 
 /// A model: its operations and its caller-owned state.

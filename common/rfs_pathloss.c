@@ -171,21 +171,13 @@ int rfs_pathloss_log2_attach(rfs_pathloss_t *p, const int32_t *tab)
     return 0;
 }
 
-/* floor(a / b) for b > 0. */
-static int32_t floor_div(int32_t a, int32_t b)
-{
-    int32_t q = a / b;
-    return (a % b != 0 && a < 0) ? q - 1 : q;
-}
-
 static uint32_t bin_hash(int16_t kx, int16_t ky)
 {
     uint32_t h = (uint32_t)(uint16_t)kx * 0x9E3779B1u + (uint32_t)(uint16_t)ky * 0x85EBCA77u;
     return h >> 22; /* 10 bits: RFS_PATHLOSS_HASH = 1024 */
 }
 
-/* Binning (re)starts with bins of bin_cm and none used. */
-static void bin_reset(rfs_pathloss_t *p, int32_t bin_cm)
+void rfs_pathloss_bin_reset(rfs_pathloss_t *p, int32_t bin_cm)
 {
     memset(p->hash, 0, sizeof(p->hash));
     p->nbins = 0u;
@@ -193,16 +185,14 @@ static void bin_reset(rfs_pathloss_t *p, int32_t bin_cm)
     p->pos = 0u;
 }
 
-/* Bin samples p->pos..end - 1 into bins of p->bin_cm; false (binning must restart with
- * bins twice as wide) when they need more than MAX_BINS. */
-static bool bin_add(rfs_pathloss_t *p, const rfs_sample_t *smp, uint32_t end)
+bool rfs_pathloss_bin_add(rfs_pathloss_t *p, const rfs_sample_t *smp, uint32_t end)
 {
     _Static_assert(RFS_PATHLOSS_HASH == 1024u, "bin_hash yields 10 bits");
     const int32_t bin_cm = p->bin_cm;
     for (; p->pos < end; ++p->pos) {
         const rfs_sample_t *sm = &smp[p->pos];
-        int16_t kx = (int16_t)floor_div(sm->x_cm, bin_cm);
-        int16_t ky = (int16_t)floor_div(sm->y_cm, bin_cm);
+        int16_t kx = (int16_t)rfs_pathloss_floor_div(sm->x_cm, bin_cm);
+        int16_t ky = (int16_t)rfs_pathloss_floor_div(sm->y_cm, bin_cm);
         uint32_t h = bin_hash(kx, ky);
         while (p->hash[h] != 0u) {
             const rfs_pathloss_bin_t *b = &p->bins[p->hash[h] - 1u];
@@ -294,7 +284,7 @@ static bool excluded(const rfs_pathloss_t *p, int32_t i, int32_t j)
     return false;
 }
 
-static bool cand_legal(const rfs_pathloss_t *p, int32_t i, int32_t j)
+bool rfs_pathloss_cand_legal(const rfs_pathloss_t *p, int32_t i, int32_t j)
 {
     if (i < 0 || j < 0 || i >= (int32_t)p->lat.lw || j >= (int32_t)p->lat.lh) {
         return false;
@@ -578,7 +568,7 @@ static bool hold_next(rfs_pathloss_t *p)
             uint32_t rem = p->hold_pos++;
             int32_t i, j;
             neighbour(p->hold_i, p->hold_j, rem, p->hold_step, &i, &j);
-            if (rem != 4u && cand_legal(p, i, j)) {
+            if (rem != 4u && rfs_pathloss_cand_legal(p, i, j)) {
                 ev_start(p, (uint16_t)i, (uint16_t)j, EV_HOLD, 0u);
                 return true;
             }
@@ -618,11 +608,13 @@ static bool fit_begin(rfs_pathloss_t *p, const rfs_model_fit_in_t *in)
         p->excl_x[e] = rfs_pathloss_cm_to_q16(in->excl_x_cm[e]); /* once a fit, not per candidate */
         p->excl_y[e] = rfs_pathloss_cm_to_q16(in->excl_y_cm[e]);
     }
-    bin_reset(p, (int32_t)(((int64_t)p->cfg.bin * 100 + 32768) >> 16));
+    rfs_pathloss_bin_reset(p, (int32_t)(((int64_t)p->cfg.bin * 100 + 32768) >> 16));
     p->bin_n = in->n;
     p->walls_counted = 0u;
     p->footprints = 0u;
     p->footprints_cached = 0u;
+    p->walls_warmed = p->warm.lines;
+    memset(&p->warm, 0, sizeof(p->warm)); /* the bins warming used are the fit's now */
     p->phase = RFS_PATHLOSS_BIN;
     p->ntop = 0u;
     p->nvis = 0u;
@@ -649,8 +641,8 @@ static bool bin_run(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t bu
         }
         const uint32_t end = n - p->pos > SAMPLES_PER_UNIT ? p->pos + SAMPLES_PER_UNIT : n;
         (*used)++;
-        if (!bin_add(p, in->samples, end)) {
-            bin_reset(p, p->bin_cm * 2);
+        if (!rfs_pathloss_bin_add(p, in->samples, end)) {
+            rfs_pathloss_bin_reset(p, p->bin_cm * 2);
         }
     }
     /* With the built-in cache, the rows' and columns' tidying too (rfs_pathloss_walls.c). */
@@ -766,7 +758,7 @@ static bool coarse_next(rfs_pathloss_t *p, uint32_t budget, uint32_t *used, rfs_
     p->pos++;
     p->surface[c] = RFS_PATHLOSS_NO_LOSS;
     int32_t i, j;
-    if (rfs_pathloss_coarse_ij(p, c, &i, &j) && cand_legal(p, i, j)) {
+    if (rfs_pathloss_coarse_ij(p, c, &i, &j) && rfs_pathloss_cand_legal(p, i, j)) {
         ev_start(p, (uint16_t)i, (uint16_t)j, EV_COARSE, c);
     }
     return false;
@@ -779,7 +771,7 @@ static bool hold_begin(rfs_pathloss_t *p)
 {
     if (p->cfg.hold_k <= 0 || !p->have_prev || p->map == 0 || p->prev_map != p->map ||
         (p->best.li == p->cur.li && p->best.lj == p->cur.lj) ||
-        !cand_legal(p, p->best.li, p->best.lj)) {
+        !rfs_pathloss_cand_legal(p, p->best.li, p->best.lj)) {
         return false;
     }
     const rfs_pathloss_lat_t *l = &p->lat;
@@ -831,7 +823,7 @@ static bool refine_next(rfs_pathloss_t *p, rfs_fit_result_t *res)
     neighbour(ci, cj, rem, p->step, &i, &j);
     /* A top point itself (rem 4) when the coarse pass only ranked it. */
     const bool centre = rem == 4u && !(p->phase == RFS_PATHLOSS_REFINE && coarse_ranks(p));
-    if (!centre && cand_legal(p, i, j) && !seen_before(p, i, j)) {
+    if (!centre && rfs_pathloss_cand_legal(p, i, j) && !seen_before(p, i, j)) {
         ev_start(p, (uint16_t)i, (uint16_t)j, EV_REFINE, 0u);
     }
     return false;
@@ -931,6 +923,7 @@ const rfs_model_ops_t rfs_pathloss_ops = {
     .near = rfs_pathloss_near_op,
     .floor_gap = pathloss_floor_gap,
     .mean = rfs_pathloss_mean_op,
+    .warm = rfs_pathloss_warm_op,
 };
 
 rfs_model_t rfs_pathloss_model(rfs_pathloss_t *p)

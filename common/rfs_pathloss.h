@@ -58,6 +58,11 @@
  * the search is done. The model is invalid while a fit is in progress; a sliced fit bins
  * the samples its first call saw (samples added meanwhile wait for the next relearn;
  * ones a full store replaces meanwhile may be binned new).
+ *
+ * Warming (rfs_pathloss_ops.warm, rfs_pathloss_warm.c): between fits, in the same units,
+ * the counts the next fit will read from the cache: bins with a new wall origin (but the
+ * robot's) against the last fit's columns, then every bin against the first points of
+ * the next hold search. The model and the next fit's results are unchanged, bit for bit.
  */
 #ifndef RFS_PATHLOSS_H
 #define RFS_PATHLOSS_H
@@ -234,6 +239,32 @@ typedef struct rfs_pathloss_ev {
     int64_t sk;      ///< sum of weight x walls, quarter walls
 } rfs_pathloss_ev_t;
 
+/// Warming (rfs_pathloss_ops.warm) between fits: a pass bins the samples as a fit would
+/// (in the fit's bin arrays, free between fits), counts the walls of each bin whose wall
+/// origin has no cache row (but the robot's bin) against the columns the last fit
+/// evaluated, then every bin's against the points round the last fit's source that the
+/// next fit's hold search evaluates first. Emptied when a fit begins.
+typedef struct rfs_pathloss_warm {
+    uint8_t phase;     ///< 0: a pass may begin, 1 binning, 2 finding origins, 3 counting,
+                       ///< 4 every bin against the hold search's first points
+    bool tidied;       ///< the cache's rows were tidied for warming since the last fit
+    bool passed;       ///< a pass was made since the last fit
+    bool stopped;      ///< every row holds a bin: nothing more until the next fit
+    int16_t rkx;       ///< bin the robot was in when the last pass began (x index, cfg bin)
+    int16_t rky;       ///< its y index
+    uint16_t b;        ///< next bin to look at
+    uint16_t row;      ///< the cache row being counted
+    uint16_t free_from; ///< rows below this hold an origin (after tidying)
+    rfs_q16_t wx;      ///< its wall origin, metres Q16.16
+    rfs_q16_t wy;      ///< metres Q16.16
+    uint32_t col;      ///< next column: coarse point, then refinement points, then the best
+    uint32_t seen;     ///< columns looked at (a work unit each RFS_PATHLOSS_WARM_PER_UNIT)
+    int16_t hold_col[8]; ///< columns of the next hold search's first points (-1: none)
+    uint8_t warmed[RFS_PATHLOSS_CACHE_ROWS / 8u]; ///< rows this pass gave an origin
+    uint32_t lines;    ///< wall counts computed by warming since the last fit
+    uint32_t footprints; ///< bin footprints it counted
+} rfs_pathloss_warm_t;
+
 /// What the model believes (rfs_pathloss_estimate()).
 typedef struct rfs_pathloss_est {
     rfs_q16_t sx;         ///< estimated source x, metres Q16.16
@@ -250,6 +281,7 @@ typedef struct rfs_pathloss_est {
     uint32_t walls_counted;     ///< wall counts (lines) computed by the last fit
     uint32_t footprints;        ///< bin footprints it counted (up to four lines each)
     uint32_t footprints_cached; ///< bin footprints it read from the cache
+    uint32_t walls_warmed;      ///< wall counts warming computed before it began
 } rfs_pathloss_est_t;
 
 /// A wall-count cache in a caller's buffer (rfs_pathloss_cache_attach()).
@@ -311,6 +343,9 @@ typedef struct rfs_pathloss {
     uint32_t walls_counted;                       ///< wall counts (lines) computed by this fit
     uint32_t footprints;                          ///< bin footprints counted by this fit
     uint32_t footprints_cached;                   ///< bin footprints read from the cache
+    rfs_pathloss_warm_t warm;                     ///< warming between fits
+    uint32_t walls_warmed;                        ///< wall counts warming computed before
+                                                  ///< this fit began
     const rfs_map_t *blocks_map;                  ///< map of wall_blocks (NULL: none)
     rfs_map_wall_blocks_t blocks;                 ///< its wall-free blocks, skipped by counts
                                                   ///< (bits: wall_blocks, even in a copy)

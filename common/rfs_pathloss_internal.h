@@ -52,6 +52,25 @@ bool rfs_pathloss_is_coarse(const rfs_pathloss_t *p, int32_t i, int32_t j);
  * when not looked for yet (a fit on another lattice in progress). */
 bool rfs_pathloss_coarse_ij(const rfs_pathloss_t *p, uint32_t c, int32_t *i, int32_t *j);
 
+/* floor(a / b) for b > 0. */
+static inline int32_t rfs_pathloss_floor_div(int32_t a, int32_t b)
+{
+    int32_t q = a / b;
+    return (a % b != 0 && a < 0) ? q - 1 : q;
+}
+
+/* Binning (re)starts with bins of bin_cm and none used. */
+void rfs_pathloss_bin_reset(rfs_pathloss_t *p, int32_t bin_cm);
+
+/* Bin samples p->pos..end - 1 into bins of p->bin_cm (sums of position and value, and
+ * counts); false (binning must restart with bins twice as wide) when they need more than
+ * RFS_PATHLOSS_MAX_BINS. */
+bool rfs_pathloss_bin_add(rfs_pathloss_t *p, const rfs_sample_t *smp, uint32_t end);
+
+/* Lattice point (i, j) is a candidate of the fit: on the lattice, legal on the map and
+ * not within excl_r of a place ruled out. */
+bool rfs_pathloss_cand_legal(const rfs_pathloss_t *p, int32_t i, int32_t j);
+
 /* Mean Huber loss per unit weight, dB^2 Q16, saturated below NO_LOSS. */
 static inline uint32_t rfs_pathloss_mean_loss(const rfs_pathloss_t *p, int64_t loss)
 {
@@ -95,6 +114,29 @@ bool rfs_pathloss_sample_op(const void *self, rfs_rng_t *rng, rfs_q16_t *x, rfs_
  * with the most weight per metre, when it beats the leader. */
 bool rfs_pathloss_near_op(const void *self, const rfs_model_near_t *q, rfs_q16_t *x,
                           rfs_q16_t *y);
+
+/* The cache row of wall origin (cx, cy), RFS_PATHLOSS_NO_ROW when none. */
+uint16_t rfs_pathloss_walls_row_find(const rfs_pathloss_t *p, uint16_t cx, uint16_t cy);
+
+/* A cache row for origin (cx, cy), which has none, kept from the next fit's tidying only
+ * when a bin of it has that origin: a row never used, else (after one tidy since the last
+ * fit, *tidied set: rows no bin of the last fit holds emptied, rfs_pathloss_walls.c) one
+ * no bin of the last fit holds; RFS_PATHLOSS_NO_ROW when every row holds one. */
+uint16_t rfs_pathloss_walls_row_warm(rfs_pathloss_t *p, uint16_t cx, uint16_t cy, bool *tidied);
+
+/* The cache column of lattice point (li, lj) as rfs_pathloss_walls_col() finds it, or -1
+ * when it has none; never a new one. */
+int32_t rfs_pathloss_walls_col_find(const rfs_pathloss_t *p, uint16_t li, uint16_t lj,
+                                    bool coarse);
+
+/* Count the walls of origin row `row` (wall origin wx, wy) to column `col`, lattice point
+ * (li, lj) counted with footprint fp, into the cache unless counted; the lines computed
+ * (0 when it was). */
+uint32_t rfs_pathloss_walls_warm(rfs_pathloss_t *p, uint16_t row, rfs_q16_t wx, rfs_q16_t wy,
+                                 int32_t col, uint16_t li, uint16_t lj, rfs_q16_t fp);
+
+/* rfs_model_ops_t.warm of the path-loss model (rfs_pathloss_warm.c). */
+bool rfs_pathloss_warm_op(void *self, const rfs_model_fit_in_t *in, uint32_t budget);
 
 /// rfs_model_ops_t.mean (rfs_pathloss_draw.c).
 bool rfs_pathloss_mean_op(const void *self, rfs_q16_t temp, rfs_q16_t *x, rfs_q16_t *y);

@@ -26,6 +26,7 @@ bool rfs_pathloss_estimate(const rfs_pathloss_t *p, rfs_pathloss_est_t *est)
     est->walls_counted = p->walls_counted;
     est->footprints = p->footprints;
     est->footprints_cached = p->footprints_cached;
+    est->walls_warmed = p->walls_warmed;
     return true;
 }
 

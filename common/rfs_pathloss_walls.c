@@ -289,33 +289,29 @@ uint32_t rfs_pathloss_walls_line(const rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t
     return k > RFS_PATHLOSS_WALLS_MAX ? RFS_PATHLOSS_WALLS_MAX : k;
 }
 
-/* rfs_pathloss_walls_line(), counted as a fit's work. */
-static uint32_t walls_to(rfs_pathloss_t *p, rfs_q16_t x, rfs_q16_t y, rfs_q16_t sx, rfs_q16_t sy)
+/* A wall origin's walls to the candidate (sx, sy) in quarter walls (0..4 x
+ * RFS_PATHLOSS_WALLS_MAX): the sum of the counts from its footprint's four points
+ * (wx +- f, wy +- f), a point that is not legal counting as the centre (wx, wy); with
+ * footprint 0, four times the centre's. At most four counts (added to *lines): the centre
+ * is counted only in place of an illegal point. */
+static uint32_t footprint_walls(const rfs_pathloss_t *p, rfs_q16_t wx, rfs_q16_t wy, rfs_q16_t f,
+                                rfs_q16_t sx, rfs_q16_t sy, uint32_t *lines)
 {
-    p->walls_counted++;
-    return rfs_pathloss_walls_line(p, x, y, sx, sy);
-}
-
-/* A bin's walls to the candidate (sx, sy) in quarter walls (0..4 x RFS_PATHLOSS_WALLS_MAX): the sum of
- * the counts from its footprint's four points (wx +- f, wy +- f), a point that is not
- * legal counting as the centre (wx, wy); with footprint 0, four times the centre's.
- * At most four counts: the centre is counted only in place of an illegal point. */
-static uint32_t footprint_walls(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb, rfs_q16_t sx,
-                                rfs_q16_t sy)
-{
-    const rfs_q16_t f = p->ev.fp;
     if (f == 0) {
-        return RFS_PATHLOSS_FOOTPRINT_RAYS * walls_to(p, bb->wx, bb->wy, sx, sy);
+        (*lines)++;
+        return RFS_PATHLOSS_FOOTPRINT_RAYS * rfs_pathloss_walls_line(p, wx, wy, sx, sy);
     }
     uint32_t sum = 0u, centre = UINT32_MAX;
     for (uint32_t q = 0u; q < RFS_PATHLOSS_FOOTPRINT_RAYS; ++q) {
-        rfs_q16_t x = rfs_sat32((int64_t)bb->wx + ((q & 1u) != 0u ? f : -f));
-        rfs_q16_t y = rfs_sat32((int64_t)bb->wy + ((q & 2u) != 0u ? f : -f));
+        rfs_q16_t x = rfs_sat32((int64_t)wx + ((q & 1u) != 0u ? f : -f));
+        rfs_q16_t y = rfs_sat32((int64_t)wy + ((q & 2u) != 0u ? f : -f));
         if (rfs_map_point_legal(p->map, x, y)) {
-            sum += walls_to(p, x, y, sx, sy);
+            (*lines)++;
+            sum += rfs_pathloss_walls_line(p, x, y, sx, sy);
         } else {
             if (centre == UINT32_MAX) {
-                centre = walls_to(p, bb->wx, bb->wy, sx, sy);
+                (*lines)++;
+                centre = rfs_pathloss_walls_line(p, wx, wy, sx, sy);
             }
             sum += centre;
         }
@@ -332,12 +328,82 @@ uint32_t rfs_pathloss_walls_bin(rfs_pathloss_t *p, const rfs_pathloss_bin_t *bb,
         p->footprints_cached++;
         return *cell;
     }
-    uint32_t before = p->walls_counted;
-    uint32_t k = footprint_walls(p, bb, p->ev.sx, p->ev.sy);
-    *lines = p->walls_counted - before;
+    uint32_t n = 0u;
+    uint32_t k = footprint_walls(p, bb->wx, bb->wy, p->ev.fp, p->ev.sx, p->ev.sy, &n);
+    *lines = n;
+    p->walls_counted += n;
     p->footprints++;
     if (cell != 0) {
         *cell = (uint8_t)k;
     }
     return k;
+}
+
+uint16_t rfs_pathloss_walls_row_find(const rfs_pathloss_t *p, uint16_t cx, uint16_t cy)
+{
+    const uint32_t h = row_slot(p, cx, cy);
+    return p->row_hash[h] != 0u ? (uint16_t)(p->row_hash[h] - 1u) : RFS_PATHLOSS_NO_ROW;
+}
+
+uint16_t rfs_pathloss_walls_row_warm(rfs_pathloss_t *p, uint16_t cx, uint16_t cy, bool *tidied)
+{
+    uint16_t r;
+    if (p->nrows < cache_rows(p)) {
+        r = p->nrows++;
+    } else {
+        /* row_used: the rows the last fit's bins hold (rfs_pathloss_walls_assign), and the
+         * ones warming gave origins since */
+        if (!p->warm.tidied) {
+            rows_tidy(p);
+            p->warm.tidied = true;
+            p->warm.free_from = 0u;
+            *tidied = true;
+        }
+        while (p->warm.free_from < p->nrows && rfs_reach_bit(p->row_used, p->warm.free_from)) {
+            p->warm.free_from++;
+        }
+        if (p->warm.free_from == p->nrows) {
+            return RFS_PATHLOSS_NO_ROW;
+        }
+        r = p->warm.free_from;
+    }
+    p->rows[r].cx = cx;
+    p->rows[r].cy = cy;
+    p->row_hash[row_slot(p, cx, cy)] = (uint16_t)(r + 1u);
+    rfs_reach_bit_set(p->row_used, r);
+    return r;
+}
+
+int32_t rfs_pathloss_walls_col_find(const rfs_pathloss_t *p, uint16_t li, uint16_t lj, bool coarse)
+{
+    const bool two = p->cfg.coarse_footprint != p->cfg.footprint;
+    if (p->map == 0 || (two && lj >= 0x8000u)) {
+        return -1;
+    }
+    const bool builtin = p->x.cells == 0;
+    const uint8_t bits = builtin ? 9u : p->x.hash_bits;
+    const uint16_t *hash = builtin ? p->col_hash : p->x.col_hash;
+    const uint32_t *keys = builtin ? p->col_key : p->x.col_key;
+    const uint32_t key = (uint32_t)li | (uint32_t)lj << 16 | (two && coarse ? 1u << 31 : 0u);
+    const uint32_t mask = (1u << bits) - 1u;
+    for (uint32_t h = col_hash_of(key, bits); hash[h] != 0u; h = (h + 1u) & mask) {
+        if (keys[hash[h] - 1u] == key) {
+            return (int32_t)(hash[h] - 1u);
+        }
+    }
+    return -1;
+}
+
+uint32_t rfs_pathloss_walls_warm(rfs_pathloss_t *p, uint16_t row, rfs_q16_t wx, rfs_q16_t wy,
+                                 int32_t col, uint16_t li, uint16_t lj, rfs_q16_t fp)
+{
+    uint8_t *cell = cache_cell(p, row, (uint32_t)col);
+    if (*cell != NOT_COUNTED) {
+        return 0u;
+    }
+    rfs_q16_t sx, sy;
+    rfs_pathloss_lattice_xy(&p->lat, li, lj, &sx, &sy);
+    uint32_t n = 0u;
+    *cell = (uint8_t)footprint_walls(p, wx, wy, fp, sx, sy, &n);
+    return n;
 }

@@ -764,6 +764,20 @@ bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget)
     return p->tree != 2 || p->tree_done;
 }
 
+bool rfs_plan_tree_grown(rfs_plan_t *p)
+{
+    if (p->tree != 2) {
+        return p->tree != 1;
+    }
+    if (!p->tree_done && p->tree_defer && p->tree_owed != 0u) {
+        const uint32_t before = p->expanded;
+        const search_end_t end = search_until(p, NO_POINT, p->tree_owed);
+        p->tree_owed -= p->expanded - before;
+        p->tree_done = end == SEARCH_EMPTY;
+    }
+    return p->tree_done;
+}
+
 bool rfs_plan_tree_move(rfs_plan_t *p, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t max_hop)
 {
     uint32_t idx;

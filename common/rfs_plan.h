@@ -137,6 +137,12 @@ bool rfs_plan_tree_length(rfs_plan_t *p, rfs_q16_t x1, rfs_q16_t y1, rfs_q16_t *
 /// when no tree was begun.
 bool rfs_plan_tree_grow(rfs_plan_t *p, uint32_t budget);
 
+/// The tree's search has no work left for a grow: it is done, or its root joins no lattice
+/// point, or none is begun (a begun tree not seeded yet has). A deferred tree's debt is
+/// paid first (rfs_plan_tree_defer: the search its grows would have run), so the answer is
+/// the undeferred one's.
+bool rfs_plan_tree_grown(rfs_plan_t *p);
+
 /// Let a seeded tree serve plans from (x0, y0), e.g. a robot stopped near the point the
 /// tree was begun at, braked past it or cut short before it: true, and later paths start
 /// at (x0, y0), when the lattice point it joins (as rfs_plan_path joins a start) is

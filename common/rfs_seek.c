@@ -598,28 +598,35 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
     end_decision(s, ok, now_us, out);
 }
 
+/* The model's input: the samples, map, reach bits, places ruled out and each source's
+ * samples, queried at (qx, qy). */
+static void fit_input(const rfs_seek_t *s, rfs_q16_t qx, rfs_q16_t qy, rfs_model_fit_in_t *fin)
+{
+    *fin = (rfs_model_fit_in_t){ .samples = s->store.samples, .n = s->store.count,
+                                 .index = s->store.index, .qx = qx, .qy = qy, .map = s->map,
+                                 .reach = s->reach_valid ? s->reach : 0,
+                                 .excl_x_cm = s->excl_x_cm, .excl_y_cm = s->excl_y_cm,
+                                 .nexcl = s->nexcl,
+                                 .excl_r = s->cfg.refute_r,
+                                 .settle = !rfs_seek_src_settled(s) ? RFS_MODEL_EXPLORE
+                                           : rfs_seek_src_orbiting(s) ? RFS_MODEL_TOUR
+                                                                      : RFS_MODEL_HOLD };
+    for (uint8_t i = 0; s->src != 0 && i < s->target->nsources; ++i) {
+        fin->src_samples[i] = s->src[i].store.samples;
+        fin->src_n[i] = s->src[i].store.count;
+        fin->src_seen[i] = s->src[i].store.seen;
+        fin->nsources = (uint8_t)(i + 1u);
+    }
+}
+
 /* One slice of learning (all of it when fit_budget is 0). false while the fit needs more
  * periods: the wheels stay stopped meanwhile. The query point is where the decision began,
  * not the latest pose: a pose that moves by its noise between slices would restart a local
  * fit (ridge) every period, and a fit longer than two periods would never end. */
 static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
 {
-    rfs_model_fit_in_t fin = { .samples = s->store.samples, .n = s->store.count,
-                               .index = s->store.index, .qx = s->decision.x,
-                               .qy = s->decision.y, .map = s->map,
-                               .reach = s->reach_valid ? s->reach : 0,
-                               .excl_x_cm = s->excl_x_cm, .excl_y_cm = s->excl_y_cm,
-                               .nexcl = s->nexcl,
-                               .excl_r = s->cfg.refute_r,
-                               .settle = !rfs_seek_src_settled(s) ? RFS_MODEL_EXPLORE
-                                         : rfs_seek_src_orbiting(s) ? RFS_MODEL_TOUR
-                                                                    : RFS_MODEL_HOLD };
-    for (uint8_t i = 0; s->src != 0 && i < s->target->nsources; ++i) {
-        fin.src_samples[i] = s->src[i].store.samples;
-        fin.src_n[i] = s->src[i].store.count;
-        fin.src_seen[i] = s->src[i].store.seen;
-        fin.nsources = (uint8_t)(i + 1u);
-    }
+    rfs_model_fit_in_t fin;
+    fit_input(s, s->decision.x, s->decision.y, &fin);
     rfs_fit_result_t r = s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng);
     if (r == RFS_FIT_MORE) {
         s->state = RFS_SEEK_LEARNING;
@@ -817,14 +824,39 @@ static void resume_goal(rfs_seek_t *s, int64_t now_us)
     s->state = RFS_SEEK_DRIVING;
 }
 
+/* The model warms between fits (rfs_model_ops_t.warm): it has the operation and its fits
+ * are sliced (a whole fit does the work in one period anyway). */
+static bool warms(const rfs_seek_t *s)
+{
+    return s->cfg.fit_budget != 0u && s->model.ops != 0 && s->model.ops->warm != 0 &&
+           rfs_seek_ops(s)->learns;
+}
+
 /* plan_budget: one slice of the next decision's search tree (begun by end_decision). A
  * period that drives or stands without choosing has the room of the choice: its slice
- * is 5/4 plan_budget (docs/PERFORMANCE.md, "Planning in slices"). */
-static void grow_next(rfs_seek_t *s)
+ * is 5/4 plan_budget (docs/PERFORMANCE.md, "Planning in slices"). true when the tree had
+ * no work left for it (none is grown, or it is done: asked only of a model that warms). */
+static bool grow_next(rfs_seek_t *s)
 {
-    if (s->cfg.plan_budget != 0u) {
-        (void)rfs_plan_tree_grow(&s->plan, RFS_SEEK_DRIVE_SLICE(s->cfg.plan_budget));
+    if (s->cfg.plan_budget == 0u) {
+        return true;
     }
+    const bool grown = warms(s) && rfs_plan_tree_grown(&s->plan);
+    (void)rfs_plan_tree_grow(&s->plan, RFS_SEEK_DRIVE_SLICE(s->cfg.plan_budget));
+    return grown;
+}
+
+/* A driving period the tree left free: the model warms for the next relearn, at most
+ * RFS_SEEK_WARM_SLICE of its fit budget beside the drive's work (docs/PERFORMANCE.md,
+ * "Decision latency"). The model and its next fit's results are unchanged. */
+static void warm_next(rfs_seek_t *s)
+{
+    if (!warms(s)) {
+        return;
+    }
+    rfs_model_fit_in_t fin;
+    fit_input(s, s->pose.x, s->pose.y, &fin);
+    (void)s->model.ops->warm(s->model.self, &fin, RFS_SEEK_WARM_SLICE(s->cfg.fit_budget));
 }
 
 /* Drive the current goal. true while it is still being driven; when it ends (reached,
@@ -847,7 +879,9 @@ static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
         if (s->chk_x != chk_x || s->chk_y != chk_y) {
             begin_next_tree(s); /* a check passed: the next one is further on */
         }
-        grow_next(s); /* the next decision's search tree */
+        if (grow_next(s)) { /* the next decision's search tree */
+            warm_next(s);
+        }
         return true;
     }
     s->prev_status = st;
@@ -863,13 +897,17 @@ static bool hold_still(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     if (!rfs_drive_at_rest(&s->drive)) {
         stop_wheels(s, now_us, out);
         s->state = RFS_SEEK_DRIVING;
-        grow_next(s);
+        if (grow_next(s)) {
+            warm_next(s);
+        }
         return true;
     }
     if (now_us < s->retry_after_us) {
         out->faults |= s->retry_no_goal ? RFS_SEEK_FAULT_NO_GOAL : 0u;
         stop_wheels(s, now_us, out);
-        grow_next(s);
+        if (grow_next(s)) {
+            warm_next(s);
+        }
         return true;
     }
     if (!rfs_seek_ops(s)->dwell) {

@@ -3,7 +3,8 @@
 # change behaviour-preserving (docs/ARCHITECTURE.md, "Bit-identical runs"): run it with the
 # old and the new rfseek-sim into two folders, then `diff -r` them.
 #   SCENARIOS="default lshape 3ne" (default), SEEDS 1..50 (default), JOBS=2; MODELS and
-#   STRATEGIES narrow the sweep (default: every model and strategy below)
+#   STRATEGIES narrow the sweep (default: every model and strategy below); ARGS adds
+#   rfseek-sim options to every run (e.g. ARGS="--fit-budget mcu")
 set -u
 case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 sim=${1:?usage: identity.sh SIM OUTDIR [SEEDS]} out=${2:?usage: identity.sh SIM OUTDIR [SEEDS]}
@@ -17,7 +18,7 @@ for st in ${STRATEGIES:-meta meta-global fd-gradient plane-gradient chemotaxis m
     [ -s "$f" ] && continue
     d=$(mktemp -d)
     if "$sim" "$here/scenarios/$sc.yaml" --strategy "$st" --model "$model" --seeds "$seeds" \
-           --jobs "${JOBS:-2}" --quiet --out "$d/o" > "$d/log" 2>&1; then
+           --jobs "${JOBS:-2}" --quiet --out "$d/o" ${ARGS:-} > "$d/log" 2>&1; then
         cp "$d/o/runs.tsv" "$f"
     else
         { echo "ERROR"; cat "$d/log"; } > "$f"

@@ -776,6 +776,51 @@ static void test_tree_deferred(void **state)
                   moved);
     assert_true(grows > 250 && more > 50 && moved > 10);
 }
+/* rfs_plan_tree_grown: true with no tree, false for a tree begun and while its search has
+ * points left; a deferred tree pays its debt and answers as the undeferred one, at the edge
+ * of "done" (the closed room of test_tree_deferred: grows summing to the points the root
+ * reaches are not done, one more point is). */
+static void test_tree_grown(void **state)
+{
+    (void)state;
+    static uint8_t work_d[LMAX];
+    static uint32_t queue_d[1024];
+    build_kind(1, 4);
+    const int lw = wd.m.lw, lh = wd.m.lh;
+    const rfs_q16_t m1 = RFS_Q16_INT(1);
+    uint16_t si, sj;
+    rfs_map_lattice_nearest(&wd.m, 2 * m1, 2 * m1, &si, &sj);
+    ref_octile(lw, lh, si, sj);
+    int below, upto;
+    oct_count(lw * lh, INT32_MAX, &below, &upto);
+    rfs_plan_t t, d;
+    assert_int_equal(rfs_plan_init(&t, &wd.m, work, sizeof(work), queue, 1024), 0);
+    assert_int_equal(rfs_plan_init(&d, &wd.m, work_d, sizeof(work_d), queue_d, 1024), 0);
+    rfs_plan_tree_defer(&d, true);
+    assert_true(rfs_plan_tree_grown(&t));
+    rfs_q16_t x0, y0;
+    rfs_map_lattice_point(&wd.m, si, sj, &x0, &y0);
+    rfs_plan_tree_begin(&t, x0, y0);
+    rfs_plan_tree_begin(&d, x0, y0);
+    assert_false(rfs_plan_tree_grown(&t));
+    assert_false(rfs_plan_tree_grown(&d));
+    (void)rfs_plan_tree_grow(&t, (uint32_t)upto - 100u);
+    (void)rfs_plan_tree_grow(&d, (uint32_t)upto - 100u);
+    assert_false(rfs_plan_tree_grown(&t));
+    assert_false(rfs_plan_tree_grown(&d));
+    assert_int_equal(d.expanded, upto - 100); /* the debt paid here */
+    (void)rfs_plan_tree_grow(&t, 100u);
+    (void)rfs_plan_tree_grow(&d, 100u);
+    assert_false(rfs_plan_tree_grown(&t));
+    assert_false(rfs_plan_tree_grown(&d));
+    (void)rfs_plan_tree_grow(&t, 1u);
+    (void)rfs_plan_tree_grow(&d, 1u);
+    assert_true(rfs_plan_tree_grown(&t));
+    assert_true(rfs_plan_tree_grown(&d));
+    check_deferred_goal(&t, &d, 9 * m1, 3 * m1);
+    assert_false(t.tree_more);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -786,6 +831,7 @@ int main(void)
         cmocka_unit_test(test_tree_hop),
         cmocka_unit_test(test_edge_table),
         cmocka_unit_test(test_tree_deferred),
+        cmocka_unit_test(test_tree_grown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

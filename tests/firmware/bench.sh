@@ -50,6 +50,13 @@ printf '%s\n%s\n' "$out" "$models" | awk -F'\t' '
             pl = int((m[ms] - me) / mper + 0.5)
             printf "path-loss relearn slice at its registry budget (%d work units, 1,000 samples): %s; %d units a slice would meet it\n", mb, verdict(pl), int(500000 * mb / pl)
         } else { printf "path-loss relearn slice: not measured\n"; bad = bad " models_image" }
+        # A driving period with the tree grown warms the path-loss model (RFS_SEEK_WARM_SLICE):
+        # the drive period, the model warm slice and its recheck prediction together.
+        wb = mb - int(mb / 8); ws = "warm_worst_pathloss_" wb; dg = "driving_grown_iteration"
+        if (mper > 0 && (ws in m) && (dg in ins) && ("predict_pathloss" in m) && v["driving_grown_running"] == 1) {
+            wl = int((m[ws] - me) / mper + 0.5); pp = int((m["predict_pathloss"] - me) / mper + 0.5)
+            printf "driving period with a path-loss warm slice (%d units, 1,000 samples: %d) + the drive, tree grown (%d) + a prediction (%d): %s\n", wb, wl, ins[dg], pp, verdict(wl + ins[dg] + pp)
+        } else { printf "path-loss warm slice: not measured\n"; bad = bad " models_warm" }
         printf "boot periods (reachability flood fill in slices of %d points, then the first fit, first_iteration, %d periods): %s\n", 1000, v["first_iteration_periods"], verdict(ins["first_iteration"])
         # The scenario checks: each decision relearnt and decided as described, and the
         # replay of its draws kept the same goal (else the counts describe another one).

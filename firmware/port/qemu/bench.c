@@ -960,6 +960,53 @@ static void __attribute__((noinline)) measure_local_scan(const rfs_app_map_t *ma
     rfs_bc_report("local_scan_goal_cm", 0, (uint32_t)((d * 100) >> 16));
 }
 
+/* A driving period whose next-decision tree is grown (rfs_plan_tree_grown): the drive's
+ * own work, beside which a model's warming slice runs (docs/PERFORMANCE.md, "Decision
+ * latency"; bench.sh adds the path-loss slice and prediction from the models image). */
+static void __attribute__((noinline)) measure_drive_grown(const rfs_app_map_t *map,
+                                                          rfs_app_cfg_t *cfg, rfs_q16_t rx,
+                                                          rfs_q16_t ry, rfs_app_out_t *out)
+{
+    cfg->seek.fit_budget = 0u;
+    if (rfs_app_init(&s_app, cfg, map) != 0) {
+        rfs_sh_exit(1);
+    }
+    fill_store(&s_app.seek.store, 42u);
+    int64_t t = 1000000 - RFS_APP_PERIOD_US;
+    rfs_rng_t rng0;
+    run_until_decided("grown_boot", rx, ry, &t, out, &rng0);
+    rfs_drive_stop(&s_app.seek.drive, t);
+    s_app.seek.model.ops->reset(s_app.seek.model.self);
+    run_until_decided("grown_decision", rx, ry, &t, out, &rng0);
+    /* A goal 3 m on, driven from here; the next decision's tree begun at it and grown. */
+    rfs_path_t leg;
+    memset(&leg, 0, sizeof leg);
+    leg.x[0] = rx + RFS_Q16_INT(3);
+    leg.y[0] = ry;
+    leg.n = 1;
+    leg.length = RFS_Q16_INT(3);
+    rfs_drive_set_path(&s_app.seek.drive, &leg, t);
+    s_app.seek.state = RFS_SEEK_DRIVING;
+    rfs_plan_tree_begin(&s_app.seek.plan, leg.x[0], leg.y[0]);
+    uint32_t k = 0;
+    for (; k < 200u && !rfs_plan_tree_grown(&s_app.seek.plan); k++) {
+        t += RFS_APP_PERIOD_US;
+        const rfs_pose_t pk = {.t_us = t, .x = rx + (rfs_q16_t)k * 1000, .y = ry, .theta = 0};
+        rfs_app_on_pose(&s_app, &pk, t);
+        rfs_app_on_rssi(&s_app, 0, t, -60, t);
+        rfs_app_step(&s_app, t, out);
+    }
+    t += RFS_APP_PERIOD_US;
+    const rfs_pose_t pg = {.t_us = t, .x = rx + (rfs_q16_t)k * 1000, .y = ry, .theta = 0};
+    rfs_app_on_pose(&s_app, &pg, t);
+    rfs_app_on_rssi(&s_app, 0, t, -60, t);
+    RFS_BC_MEASURE("driving_grown_iteration", 1, rfs_app_step(&s_app, t, out));
+    rfs_bc_report("driving_grown_periods", 0, k);
+    rfs_bc_report("driving_grown_running", 0,
+                  (uint32_t)(s_app.seek.state == RFS_SEEK_DRIVING &&
+                             s_app.seek.drive.status == RFS_DRIVE_RUNNING));
+}
+
 int main(void)
 {
     rfs_bc_start(); /* SysTick, and the calibration lines */
@@ -986,5 +1033,6 @@ int main(void)
     measure_behind_wall(&map, &path);
     ls_measure(&map);
     measure_local_scan(&map);
+    measure_drive_grown(&map, &cfg, rx, ry, &out);
     rfs_sh_exit(0);
 }

@@ -10,6 +10,7 @@
 #include "rfs_app.h"
 #include "rfs_gridmax.h"
 #include "rfs_models.h"
+#include "rfs_seek.h"
 #include "rfs_target.h"
 
 /* The maps, baked by scripts/map2c.py (mk/firmware_m4.mk): the firmware's 40 x 20 m box
@@ -239,6 +240,41 @@ static void sliced(const rfs_models_entry_t *e, void *st, const rfs_model_fit_in
                   r == RFS_FIT_DONE ? sum_predictions(e, st, floor) : 0u);
 }
 
+/* Warming (rfs_model_ops_t.warm) at the seeker's slice of the registry budget
+ * (RFS_SEEK_WARM_SLICE): a finished fit on the first tenth of the samples, then warming
+ * for all of them (the robot at in's query point) until it has nothing left, every call
+ * timed; then the relearn, whose predictions' sum the host twin must print too. */
+static void warmed(const rfs_models_entry_t *e, void *st, const rfs_model_fit_in_t *in,
+                   const rfs_rng_t *rng0, bool floor)
+{
+    char nb[64];
+    const uint32_t budget = RFS_SEEK_WARM_SLICE(e->mcu_fit_budget);
+    rfs_rng_t rng = *rng0;
+    rfs_model_fit_in_t part = *in;
+    part.n = (uint16_t)(in->n / 10u > 0u ? in->n / 10u : 1u);
+    (void)e->init_default(st);
+    if (e->ops->fit(st, &part, 0u, &rng) != RFS_FIT_DONE) {
+        error("error_warm_fit");
+        return;
+    }
+    uint64_t worst = 0, total = 0;
+    uint32_t calls = 0;
+    bool more = true;
+    while (more && calls < 1000000u) {
+        const uint64_t t0 = rfs_bc_ticks();
+        more = e->ops->warm(st, in, budget);
+        const uint64_t t1 = rfs_bc_ticks();
+        worst = t1 - t0 > worst ? t1 - t0 : worst;
+        total += t1 - t0;
+        calls++;
+    }
+    rfs_bc_report(name3(nb, sizeof nb, "warm_worst", e->name, budget), worst, 1);
+    rfs_bc_report(name3(nb, sizeof nb, "warm_total", e->name, budget), total, calls);
+    rfs_fit_result_t r = e->ops->fit(st, in, 0u, &rng);
+    rfs_bc_report(name2(nb, sizeof nb, "sum_warmed", e->name), 0,
+                  r == RFS_FIT_DONE ? sum_predictions(e, st, floor) : 0u);
+}
+
 /* The 160 x 80 predictions of bench/bench_models.c's grid mode (no map, no reachability):
  * the figure to set beside the host's callgrind count. */
 static void predict_loop(const rfs_models_entry_t *e, const void *st)
@@ -339,6 +375,9 @@ static int run_model(rfs_mw_mem_t *mem, const rfs_models_entry_t *e, uint32_t n,
      * the port's extra ones. */
     rfs_bc_report(name2(nb, sizeof nb, "mcu_budget", e->name), 0, e->mcu_fit_budget);
     sliced(e, st, &in, e->mcu_fit_budget, &rng0, floor);
+    if (e->ops->warm != 0 && e->mcu_fit_budget != 0u) {
+        warmed(e, st, &in, &rng0, floor);
+    }
     for (uint32_t k = 0; (flags & RFS_MW_QUICK) == 0u && k < sizeof k_cmp / sizeof k_cmp[0]; ++k) {
         const char *a = k_cmp[k].model, *b = e->name;
         while (*a != '\0' && *a == *b) {

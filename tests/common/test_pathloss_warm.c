@@ -1,0 +1,398 @@
+/* test_pathloss_warm.c - the path-loss model's warming (rfs_pathloss_ops.warm): a relearn
+ * after warming equals one without, bit for bit, and counts fewer walls; warming leaves the
+ * model as it was; sliced at budget 1 it warms as a whole.
+ *
+ * The robot walks the test office's corridor: a first fit on 20 bins of it, then three new
+ * bins along it (the robot in the last, whose samples are not complete), warmed, relearnt.
+ */
+#include <string.h>
+
+#include "pathloss_office.h"
+#include "rfs_fields.h"
+#include "rfs_models.h"
+
+/* Samples per bin. */
+#define PER_BIN 40
+
+/* n samples at random legal points of the 1 m bin (bx, by), valued as make_samples does. */
+static void bin_samples(rfs_sample_t *s, int n, const rfs_map_t *map, const truth_t *t, int bx,
+                        int by, uint64_t seed)
+{
+    rfs_rng_t r;
+    rfs_rng_seed(&r, seed);
+    rfs_q16_t qsx = (rfs_q16_t)lround(t->sx * 65536.0), qsy = (rfs_q16_t)lround(t->sy * 65536.0);
+    int tries = 0;
+    for (int i = 0; i < n; ++tries) {
+        assert_true(tries < 100000);
+        int xc = bx * 100 + (int)rfs_rng_below(&r, 100), yc = by * 100 + (int)rfs_rng_below(&r, 100);
+        rfs_q16_t qx = (rfs_q16_t)lround(xc / 100.0 * 65536.0);
+        rfs_q16_t qy = (rfs_q16_t)lround(yc / 100.0 * 65536.0);
+        if (!rfs_map_point_legal(map, qx, qy)) {
+            continue;
+        }
+        double d = hypot(xc / 100.0 - t->sx, yc / 100.0 - t->sy);
+        int k = rfs_map_walls_crossed(map, qx, qy, qsx, qsy);
+        double v = t->p0 - 10.0 * t->n * log10(d < 1.0 ? 1.0 : d) - t->w * k + t->noise * gauss(&r);
+        s[i].x_cm = (int16_t)xc;
+        s[i].y_cm = (int16_t)yc;
+        s[i].v_q6 = (int16_t)lround(v * 64.0);
+        ++i;
+    }
+}
+
+/* The walk: bins x = 2..11 at y = 7, 8 m (the corridor), then the leg's x = 12, 13, 14 at
+ * y = 7 m. Returns the samples of the first fit; *all: with the leg's. */
+static int walk(fixture_t *f, int *all)
+{
+    int n = 0;
+    for (int bx = 2; bx < 12; ++bx) {
+        for (int by = 7; by < 9; ++by) {
+            bin_samples(f->s + n, PER_BIN, &f->map, &k_office, bx, by, (uint64_t)(100 + bx * 10 + by));
+            n += PER_BIN;
+        }
+    }
+    const int first = n;
+    for (int bx = 12; bx < 15; ++bx) {
+        bin_samples(f->s + n, PER_BIN, &f->map, &k_office, bx, 7, (uint64_t)(500 + bx));
+        n += PER_BIN;
+    }
+    *all = n;
+    return first;
+}
+
+/* The robot, in the leg's last bin. */
+static const rfs_q16_t k_robot_x = 14 * 65536 + 32768, k_robot_y = 7 * 65536 + 39322;
+
+static rfs_model_fit_in_t input(fixture_t *f, int n)
+{
+    rfs_model_fit_in_t in = {.samples = f->s, .n = (uint16_t)n, .map = &f->map, .qx = k_robot_x,
+                             .qy = k_robot_y};
+    return in;
+}
+
+/* A whole fit (budget 0) or a sliced one; the estimate. */
+static rfs_pathloss_est_t fit(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t budget)
+{
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 1);
+    rfs_fit_result_t r;
+    int k = 0;
+    do {
+        r = rfs_pathloss_ops.fit(p, in, budget, &rng);
+    } while (r == RFS_FIT_MORE && ++k < 100000);
+    assert_int_equal(r, RFS_FIT_DONE);
+    rfs_pathloss_est_t e;
+    assert_true(rfs_pathloss_estimate(p, &e));
+    return e;
+}
+
+/* Warm until there is nothing left; the calls it took. */
+static int warm_all(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t budget)
+{
+    int calls = 1;
+    while (rfs_pathloss_ops.warm(p, in, budget)) {
+        assert_true(++calls < 1000000);
+    }
+    return calls;
+}
+
+/* Cache cells counted, by a scan of the built-in cache (not the model's counters). */
+static uint32_t cells_counted(const rfs_pathloss_t *p)
+{
+    uint32_t n = 0u;
+    for (uint32_t r = 0u; r < RFS_PATHLOSS_BUILTIN_ROWS; ++r) {
+        for (uint32_t c = 0u; c < RFS_PATHLOSS_CACHE_COLS; ++c) {
+            n += p->walls[r][c] != 255u ? 1u : 0u;
+        }
+    }
+    return n;
+}
+
+static void same_fit(const rfs_pathloss_t *a, const rfs_pathloss_t *b)
+{
+    assert_memory_equal(&a->best, &b->best, sizeof(a->best));
+    assert_memory_equal(a->top, b->top, sizeof(a->top));
+    assert_memory_equal(a->surface, b->surface, sizeof(a->surface));
+    assert_int_equal(a->spread_m2, b->spread_m2);
+    assert_int_equal(a->candidates, b->candidates);
+}
+
+/* Relearn after warming (whole and sliced at the MCU budget) equals one without, bit for
+ * bit, and counts fewer walls: at least the two bins the robot left times every coarse
+ * candidate (the double reference's count), at most what warming counted. */
+static void relearn_after_warm_equals_relearn_without(void **state)
+{
+    fixture_t *f = *state;
+    int all;
+    const int first = walk(f, &all);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    rfs_pathloss_t *warmed = malloc(sizeof(rfs_pathloss_t));
+    rfs_pathloss_t *sliced = malloc(sizeof(rfs_pathloss_t));
+    rfs_pathloss_t *cold = malloc(sizeof(rfs_pathloss_t));
+    assert_true(warmed != NULL && sliced != NULL && cold != NULL);
+    assert_int_equal(rfs_pathloss_init(cold, &c), 0);
+    rfs_model_fit_in_t in1 = input(f, first), in2 = input(f, all);
+    (void)fit(cold, &in1, 0);
+    memcpy(warmed, cold, sizeof(*cold));
+    memcpy(sliced, cold, sizeof(*cold));
+
+    const uint32_t before = cells_counted(warmed);
+    (void)warm_all(warmed, &in2, 0);
+    (void)warm_all(sliced, &in2, 26);
+    const uint32_t filled = cells_counted(warmed) - before;
+    rfs_pathloss_est_t ew = fit(warmed, &in2, 0), es = fit(sliced, &in2, 30), ec = fit(cold, &in2, 0);
+
+    same_fit(warmed, cold);
+    same_fit(sliced, cold);
+    ref_pl_t *ref = malloc(sizeof(ref_pl_t));
+    assert_non_null(ref);
+    ref_pl_cfg_t rc = ref_pl_cfg_default();
+    assert_true(ref_pl_fit(ref, f->s, all, &f->map, &rc));
+    uint32_t coarse = 0u;
+    for (int k = 0; k < ref->ncx * ref->ncy; ++k) {
+        coarse += isnan(ref->surface[k]) ? 0u : 1u;
+    }
+    free(ref->seen);
+    free(ref);
+    assert_true(coarse > 50u);
+    assert_int_equal(ew.footprints + ew.footprints_cached, ec.footprints + ec.footprints_cached);
+    assert_int_equal(es.footprints, ew.footprints);
+    assert_true(ec.footprints - ew.footprints >= 2u * coarse);
+    assert_true(ec.footprints - ew.footprints <= filled);
+    assert_int_equal(warmed->walls_warmed, ew.walls_warmed);
+    assert_true(ew.walls_warmed >= 2u * coarse && ec.walls_warmed == 0u);
+    free(warmed);
+    free(sliced);
+    free(cold);
+}
+
+/* Warming changes nothing the model publishes: predictions, the argmax, draws, the
+ * estimate. */
+static void warm_leaves_the_model_unchanged(void **state)
+{
+    fixture_t *f = *state;
+    int all;
+    const int first = walk(f, &all);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    assert_int_equal(rfs_pathloss_init(&f->pl, &c), 0);
+    rfs_model_fit_in_t in1 = input(f, first), in2 = input(f, all);
+    rfs_pathloss_est_t e0 = fit(&f->pl, &in1, 0);
+    rfs_q16_t v0[30][16], x0, y0, dx0[8], dy0[8];
+    for (int i = 0; i < 30; ++i) {
+        for (int j = 0; j < 16; ++j) {
+            assert_true(rfs_pathloss_ops.predict(&f->pl, i * 65536 + 32768, j * 65536 + 32768,
+                                                 &v0[i][j]));
+        }
+    }
+    assert_true(rfs_pathloss_ops.argmax(&f->pl, &x0, &y0));
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 7);
+    for (int k = 0; k < 8; ++k) {
+        assert_true(rfs_pathloss_ops.sample(&f->pl, &rng, &dx0[k], &dy0[k]));
+    }
+
+    assert_true(warm_all(&f->pl, &in2, 0) >= 1);
+    assert_true(f->pl.warm.lines > 0u);
+
+    for (int i = 0; i < 30; ++i) {
+        for (int j = 0; j < 16; ++j) {
+            rfs_q16_t v;
+            assert_true(rfs_pathloss_ops.predict(&f->pl, i * 65536 + 32768, j * 65536 + 32768, &v));
+            assert_int_equal(v, v0[i][j]);
+        }
+    }
+    rfs_q16_t x, y;
+    assert_true(rfs_pathloss_ops.argmax(&f->pl, &x, &y));
+    assert_int_equal(x, x0);
+    assert_int_equal(y, y0);
+    rfs_rng_seed(&rng, 7);
+    for (int k = 0; k < 8; ++k) {
+        assert_true(rfs_pathloss_ops.sample(&f->pl, &rng, &x, &y));
+        assert_int_equal(x, dx0[k]);
+        assert_int_equal(y, dy0[k]);
+    }
+    rfs_pathloss_est_t e;
+    assert_true(rfs_pathloss_estimate(&f->pl, &e));
+    assert_memory_equal(&e, &e0, sizeof(e));
+}
+
+/* Budget 1 (at least a piece a call) warms what one unbounded call does, over many calls;
+ * nothing is warmed without a finished fit, on another map, or while a fit is sliced. */
+static void warm_resumes_at_budget_one(void **state)
+{
+    fixture_t *f = *state;
+    int all;
+    const int first = walk(f, &all);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    rfs_pathloss_t *whole = malloc(sizeof(rfs_pathloss_t));
+    assert_non_null(whole);
+    assert_int_equal(rfs_pathloss_init(&f->pl, &c), 0);
+    rfs_model_fit_in_t in1 = input(f, first), in2 = input(f, all);
+    assert_false(rfs_pathloss_ops.warm(&f->pl, &in2, 0)); /* no fit yet */
+    (void)fit(&f->pl, &in1, 0);
+    rfs_model_fit_in_t other = in2;
+    other.map = NULL;
+    assert_false(rfs_pathloss_ops.warm(&f->pl, &other, 0));
+    assert_int_equal(f->pl.warm.lines, 0u);
+    memcpy(whole, &f->pl, sizeof(*whole));
+
+    assert_int_equal(warm_all(whole, &in2, 0), 1);
+    const int calls = warm_all(&f->pl, &in2, 1);
+    /* a footprint (up to four units) a call at most */
+    assert_true(whole->warm.footprints > 300u && (uint32_t)calls > whole->warm.footprints);
+    assert_int_equal(f->pl.warm.lines, whole->warm.lines);
+    assert_int_equal(f->pl.nrows, whole->nrows);
+    assert_int_equal(f->pl.ncols, whole->ncols);
+    assert_memory_equal(f->pl.walls, whole->walls, sizeof(whole->walls));
+    assert_memory_equal(f->pl.rows, whole->rows, sizeof(whole->rows));
+    /* the robot in the same bin: no second pass */
+    assert_false(rfs_pathloss_ops.warm(&f->pl, &in2, 1));
+    assert_int_equal(f->pl.warm.lines, whole->warm.lines);
+
+    /* a sliced fit in progress is not warmed */
+    rfs_rng_t rng;
+    rfs_rng_seed(&rng, 1);
+    assert_int_equal(rfs_pathloss_ops.fit(&f->pl, &in2, 30, &rng), RFS_FIT_MORE);
+    assert_false(rfs_pathloss_ops.warm(&f->pl, &in2, 0));
+    free(whole);
+}
+
+/* Rows the last fit's bins hold are never taken: with more bins than rows (the whole
+ * office) warming finds none free for the bins whose centroids moved, stops, and leaves
+ * every origin and count as it was (it may only add counts); the relearn equals one
+ * without warming. */
+static void warm_keeps_the_last_fits_rows(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS / 2, &f->map, &k_office, 11);
+    make_samples(f->s + NS / 2, NS / 2, &f->map, &k_office, 12); /* centroids move */
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    rfs_pathloss_t *cold = malloc(sizeof(rfs_pathloss_t));
+    rfs_pathloss_t *before = malloc(sizeof(rfs_pathloss_t));
+    assert_true(cold != NULL && before != NULL);
+    assert_int_equal(rfs_pathloss_init(&f->pl, &c), 0);
+    rfs_model_fit_in_t in1 = input(f, NS / 2), in2 = input(f, NS);
+    (void)fit(&f->pl, &in1, 0);
+    assert_true(f->pl.nbins > RFS_PATHLOSS_BUILTIN_ROWS);
+    assert_int_equal(f->pl.nrows, RFS_PATHLOSS_BUILTIN_ROWS);
+    memcpy(cold, &f->pl, sizeof(*cold));
+    memcpy(before, &f->pl, sizeof(*before));
+
+    (void)warm_all(&f->pl, &in2, 1);
+    assert_true(f->pl.warm.stopped);
+    assert_memory_equal(f->pl.rows, before->rows, sizeof(before->rows));
+    uint32_t kept = 0u;
+    for (uint32_t r = 0u; r < RFS_PATHLOSS_BUILTIN_ROWS; ++r) {
+        for (uint32_t k = 0u; k < RFS_PATHLOSS_CACHE_COLS; ++k) {
+            if (before->walls[r][k] != 255u) {
+                assert_int_equal(f->pl.walls[r][k], before->walls[r][k]);
+                kept++;
+            }
+        }
+    }
+    assert_true(kept > 10000u);
+    (void)fit(&f->pl, &in2, 0);
+    (void)fit(cold, &in2, 0);
+    same_fit(&f->pl, cold);
+    free(cold);
+    free(before);
+}
+
+/* Samples in every bin (bx, by), bx0 <= bx < bx1, by0 <= by < by1, from s; returns the
+ * count. */
+static int block(fixture_t *f, int at, int bx0, int bx1, int by0, int by1)
+{
+    for (int bx = bx0; bx < bx1; ++bx) {
+        for (int by = by0; by < by1; ++by) {
+            bin_samples(f->s + at, 8, &f->map, &k_office, bx, by, (uint64_t)(bx * 100 + by));
+            at += 8;
+        }
+    }
+    return at;
+}
+
+/* A full cache whose rows partly hold no bin of the last fit (an earlier fit's, emptied by
+ * the last fit's tidy): warming takes those for the bins the robot left and keeps every
+ * origin the last fit's bins hold, with its counts. */
+static void warm_takes_rows_no_bin_holds(void **state)
+{
+    fixture_t *f = *state;
+    const int a = block(f, 0, 1, 11, 1, 7);          /* 60 bins west */
+    const int a2 = block(f, a, 1, 11, 10, 14);       /* 40 more */
+    const int b = block(f, a2, 16, 26, 1, 7);        /* then 60 bins east */
+    const int b2 = block(f, b, 16, 26, 10, 14);      /* 40 more */
+    int n = b2;
+    for (int bx = 16; bx < 19; ++bx) {               /* the leg, the robot in (18, 7) */
+        bin_samples(f->s + n, PER_BIN, &f->map, &k_office, bx, 7, (uint64_t)(900 + bx));
+        n += PER_BIN;
+    }
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    rfs_pathloss_t *cold = malloc(sizeof(rfs_pathloss_t));
+    rfs_pathloss_t *before = malloc(sizeof(rfs_pathloss_t));
+    assert_true(cold != NULL && before != NULL);
+    assert_int_equal(rfs_pathloss_init(&f->pl, &c), 0);
+    rfs_model_fit_in_t west = input(f, a2), east = {.samples = f->s + a2, .n = (uint16_t)(b2 - a2),
+                                                    .map = &f->map};
+    rfs_model_fit_in_t leg = {.samples = f->s + a2, .n = (uint16_t)(n - a2), .map = &f->map,
+                              .qx = 18 * 65536 + 32768, .qy = 7 * 65536 + 39322};
+    (void)fit(&f->pl, &west, 0);
+    (void)fit(&f->pl, &east, 0);
+    assert_int_equal(f->pl.nrows, RFS_PATHLOSS_BUILTIN_ROWS);
+    assert_true(f->pl.nbins < RFS_PATHLOSS_BUILTIN_ROWS);
+    memcpy(cold, &f->pl, sizeof(*cold));
+    memcpy(before, &f->pl, sizeof(*before));
+
+    (void)warm_all(&f->pl, &leg, 0);
+    assert_false(f->pl.warm.stopped);
+    uint32_t held = 0u, taken = 0u;
+    for (uint32_t r = 0u; r < RFS_PATHLOSS_BUILTIN_ROWS; ++r) {
+        bool counted = false;
+        for (uint32_t k = 0u; k < RFS_PATHLOSS_CACHE_COLS; ++k) {
+            if (before->walls[r][k] != 255u) {
+                assert_int_equal(f->pl.walls[r][k], before->walls[r][k]);
+                counted = true;
+            }
+        }
+        if (counted) { /* a row the last fit filled keeps its origin */
+            assert_int_equal(f->pl.rows[r].cx, before->rows[r].cx);
+            assert_int_equal(f->pl.rows[r].cy, before->rows[r].cy);
+            held++;
+        } else if (f->pl.walls[r][0] != 255u || f->pl.rows[r].cx != before->rows[r].cx ||
+                   f->pl.rows[r].cy != before->rows[r].cy) {
+            taken++;
+        }
+    }
+    assert_int_equal(held, before->nbins);
+    assert_int_equal(taken, 2u); /* the two bins left */
+    rfs_pathloss_est_t ew = fit(&f->pl, &leg, 0), ec = fit(cold, &leg, 0);
+    same_fit(&f->pl, cold);
+    assert_true(ew.footprints < ec.footprints);
+    free(cold);
+    free(before);
+}
+
+static void only_pathloss_warms(void **state)
+{
+    (void)state;
+    assert_true(rfs_models_find("pathloss")->warm == rfs_pathloss_ops.warm);
+    assert_non_null(rfs_pathloss_ops.warm);
+    assert_null(rfs_fields_ops.warm);
+    const char *others[] = {"ridge", "mlp", "knn", "radius"};
+    for (int k = 0; k < 4; ++k) {
+        assert_non_null(rfs_models_find(others[k]));
+        assert_null(rfs_models_find(others[k])->warm);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(relearn_after_warm_equals_relearn_without, setup, teardown),
+        cmocka_unit_test_setup_teardown(warm_leaves_the_model_unchanged, setup, teardown),
+        cmocka_unit_test_setup_teardown(warm_resumes_at_budget_one, setup, teardown),
+        cmocka_unit_test_setup_teardown(warm_keeps_the_last_fits_rows, setup, teardown),
+        cmocka_unit_test_setup_teardown(warm_takes_rows_no_bin_holds, setup, teardown),
+        cmocka_unit_test(only_pathloss_warms),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -14,147 +14,193 @@ static int64_t clamp64(int64_t v, int64_t lo, int64_t hi)
     return v < lo ? lo : (v > hi ? hi : v);
 }
 
-/* Whether the block column holding column i (on the map) has a wall block among the rows
- * ra..rb (real rows, ra <= rb; the parts off the map have none). */
-static bool blocks_hold_wall(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, int32_t i,
-                             int32_t ra, int32_t rb)
+/* floor(n / d) for d > 0 and a quotient below 2^32: two 32-bit divisions when d < 2^16
+ * and n < 2^48, else bit by bit (the core links no 64-bit division helper).
+ * Scaling and overflow: the high digit qh = floor(n / 2^16 / d) < 2^16 as the quotient
+ * is below 2^32; the low dividend (remainder < d < 2^16, shifted 16) stays in 32 bits. */
+static uint32_t div_q32(uint64_t n, uint32_t d)
 {
-    ra = ra < 0 ? 0 : ra;
-    rb = rb >= (int32_t)m->h ? (int32_t)m->h - 1 : rb;
-    const uint16_t bi = (uint16_t)((uint32_t)i >> b->shift);
-    for (int32_t bj = ra >> b->shift; bj <= (rb >> b->shift) && ra <= rb; ++bj) {
-        if (rfs_map_bit(b->bits, b->stride, bi, (uint16_t)bj)) {
-            return true;
+    if (d < 65536u && n < ((uint64_t)1 << 48)) {
+        const uint32_t hi = (uint32_t)(n >> 16);
+        const uint32_t qh = hi / d;
+        const uint32_t lo = ((hi - qh * d) << 16) | (uint32_t)(n & 0xFFFFu);
+        return (qh << 16) + lo / d;
+    }
+    uint32_t q = 0u;
+    for (int32_t k = 31; k >= 0; --k) {
+        if (((uint64_t)d << k) <= n) {
+            n -= (uint64_t)d << k;
+            q |= 1u << k;
         }
     }
-    return false;
+    return q;
 }
 
-/* The state of a wall walk: runs of wall cells so far, and whether the last cell visited
- * was a wall. */
-typedef struct walk {
-    uint32_t runs;
-    bool in_wall;
-} walk_t;
+/* The bands a segment's cells fall into across one axis (the along axis p: its columns,
+ * or its rows), in the mirrored frame (both extents >= 0): band k holds the cells lo..hi
+ * of the other axis q, hi the cell where the segment leaves the band at p = (k + 1) r,
+ * q_c there. Exactly: q_c / r = hi + (r u + v) / (r dp), 0 <= u < dp, 0 <= v < r. From
+ * one crossing to the next q_c grows by r dq / dp, a = floor(dq / dp) cells and s / dp
+ * of one (s = dq mod dp), so u steps in 32 bits (v, a multiple of r apart, never moves):
+ * a carry when u + s >= dp. A crossing lies on a cell corner when u == 0 and v == 0
+ * (then the next band starts a cell before hi). */
+typedef struct bands {
+    int32_t hi;   /* cells: the band's last cell along q, at the crossing */
+    uint32_t u;   /* the crossing's remainder, 0 .. dp - 1 */
+    uint32_t dp;  /* the segment's extent along p, Q16 (> 0) */
+    uint32_t s;   /* dq mod dp */
+    int32_t a;    /* floor(dq / dp) */
+    bool on_edge; /* v == 0: a crossing with u == 0 lies on a cell corner */
+} bands_t;
 
-/* Visit rows jlo..jhi (walk order) of column i (on the map). step: bytes from one row to
- * the next in walk order, flip: walk rows run down the map, slow: the column needs the
- * careful walk (edge: rows -1 and h, which are not walls, may be among its rows; or with
- * blocks b it is long enough that a wall-free block's cells are passed over at once). */
-static inline void walk_column(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, walk_t *wk,
-                               int32_t i, int32_t jlo, int32_t jhi, bool flip, int32_t step,
-                               bool slow)
+/* The first crossing, at p = (k0 + 1) r, k0 = rfs_map_low_cell(p0): t0 = (k0 + 1) r - p0
+ * in [0, r); q_c dp = q0 dp + t0 dq. With g = floor(q0 / r), f = q0 - g r:
+ * n = f dp + t0 dq < r (dp + dq), q_c / r = g + n / (r dp).
+ * Scaling and overflow: |p0|, |q0| <= 2^30 and dp, dq <= 2^30 (the map's extent), so
+ * n < 2^61 and floor(n / r) < dp + dq <= 2^31 (div_q32). */
+static void bands_init(bands_t *bd, int32_t r, int64_t p0, int64_t q0, int64_t dp, int64_t dq)
 {
-    const uint8_t mask = (uint8_t)(1u << (i & 7));
-    if (slow) {
-        const int32_t bs = b != 0 ? (int32_t)1 << b->shift : 0;
-        const uint8_t *wd = m->wall_dist;
-        for (int32_t j = jlo; j <= jhi; j++) {
-            const int32_t jr = flip ? -1 - j : j;
-            if (jr < 0 || jr >= (int32_t)m->h) {
-                wk->in_wall = false;
-                continue;
+    const int32_t k0 = rfs_map_low_cell(p0, r);
+    const uint32_t t0 = (uint32_t)(((int64_t)k0 + 1) * r - p0);
+    const int32_t g = rfs_map_fdiv(q0, r);
+    const uint32_t f = (uint32_t)(q0 - (int64_t)g * r);
+    const uint64_t n = (uint64_t)f * (uint64_t)dp + (uint64_t)t0 * (uint64_t)dq;
+    const uint32_t nr = div_q32(n, (uint32_t)r); /* floor(n / r) */
+    bd->dp = (uint32_t)dp;
+    bd->hi = g + (int32_t)(nr / bd->dp);
+    bd->u = nr % bd->dp;
+    bd->on_edge = n == (uint64_t)nr * (uint32_t)r;
+    bd->a = (int32_t)((uint32_t)dq / bd->dp);
+    bd->s = (uint32_t)dq % bd->dp;
+}
+
+/* Whether the crossing now lies on a cell corner. */
+static inline bool bands_corner(const bands_t *bd)
+{
+    return bd->on_edge && bd->u == 0u;
+}
+
+/* To the next crossing. */
+static inline void bands_step(bands_t *bd)
+{
+    bd->u += bd->s; /* both below dp <= 2^30 */
+    const uint32_t c = bd->u >= bd->dp ? 1u : 0u;
+    bd->u -= c != 0u ? bd->dp : 0u;
+    bd->hi += bd->a + (int32_t)c;
+}
+
+/* The state of a wall walk in one word: bit 0, whether the last cell visited was a wall;
+ * the bits above, the runs of wall cells so far (a segment has below 2^18 cells). */
+#define WALK_RUN 2u
+
+/* One cell of the walk. */
+static inline uint32_t walk_one(uint32_t ws, bool wall)
+{
+    return ((ws + ((wall && (ws & 1u) == 0u) ? WALK_RUN : 0u)) & ~1u) | (wall ? 1u : 0u);
+}
+
+/* Cell (i, jr), real row jr; off the map it is not a wall. */
+static inline uint32_t walk_cell(const rfs_map_t *m, uint32_t ws, int32_t i, int32_t jr)
+{
+    return walk_one(ws, (uint32_t)i < m->w && (uint32_t)jr < m->h &&
+                            rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)jr));
+}
+
+/* Bits lo .. lo + n - 1 (n >= 1) of a row of the wall grid, in order, up to 24 at a time:
+ * a run starts at each wall bit whose predecessor is free. lim: the grid's last byte
+ * minus 3 (four bytes load at once up to there, the last ones one by one). */
+static inline uint32_t walk_bits(const uint8_t *row, const uint8_t *lim, uint32_t ws, uint32_t lo,
+                                 uint32_t n)
+{
+    for (;;) {
+        const uint8_t *p = row + (lo >> 3);
+        uint32_t w = 0u;
+        if (p <= lim) {
+            w = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+        } else {
+            for (uint32_t k = 0u; p + k <= lim + 3; k++) {
+                w |= (uint32_t)p[k] << (8u * k);
             }
-            if (wd != 0) {
-                /* The next d - 1 cells of the column either way are free too. */
-                const int32_t d = wd[(uint32_t)jr * m->w + (uint32_t)i];
-                wk->runs += (d == 0 && !wk->in_wall) ? 1u : 0u;
-                wk->in_wall = d == 0;
-                j += d > 1 ? d - 1 : 0;
-                continue;
-            }
-            if (b != 0 && !rfs_map_bit(b->bits, b->stride, (uint16_t)((uint32_t)i >> b->shift),
-                                       (uint16_t)((uint32_t)jr >> b->shift))) {
-                wk->in_wall = false;
-                j = flip ? -1 - (jr & -bs) : (jr | (bs - 1)); /* the rest of the block */
-                continue;
-            }
-            const bool wall = (m->wall[(uint32_t)jr * m->stride + ((uint32_t)i >> 3)] & mask) != 0u;
-            wk->runs += (wall && !wk->in_wall) ? 1u : 0u;
-            wk->in_wall = wall;
         }
-        return;
+        w >>= lo & 7u; /* 25 bits or more left: the ones wanted */
+        const uint32_t t = n <= 25u ? n : 24u;
+        w &= 0xFFFFFFFFu >> (32u - t);
+        for (uint32_t st = w & ~((w << 1) | (ws & 1u)); st != 0u; st &= st - 1u) {
+            ws += WALK_RUN;
+        }
+        ws = (ws & ~1u) | ((w >> (t - 1u)) & 1u);
+        if (n == t) {
+            return ws;
+        }
+        n -= t;
+        lo += t;
     }
-    const int32_t jr0 = flip ? -1 - jlo : jlo;
-    const uint8_t *p = m->wall + (uint32_t)jr0 * m->stride + ((uint32_t)i >> 3);
-    uint32_t runs = wk->runs;
-    uint32_t in = wk->in_wall ? 1u : 0u;
-    for (int32_t j = jlo; j <= jhi; j++, p += step) {
-        const uint32_t wall = (*p & mask) != 0u ? 1u : 0u;
-        runs += wall & (in ^ 1u);
-        in = wall;
-    }
-    wk->runs = runs;
-    wk->in_wall = in != 0u;
 }
 
-/* The wall distance of cell (i, j), i on the map: 0 off the map's rows (no promise). */
-static inline int32_t dist_at(const rfs_map_t *m, int32_t i, int32_t j)
+/* Columns lo..hi (lo <= hi) of real row jr, any of them off the map (not walls). */
+static uint32_t walk_row(const rfs_map_t *m, uint32_t ws, int32_t jr, int32_t lo, int32_t hi)
 {
-    return (uint32_t)j < m->h ? m->wall_dist[(uint32_t)j * m->w + (uint32_t)i] : 0;
+    if ((uint32_t)jr >= m->h || hi < 0 || lo >= (int32_t)m->w) {
+        return ws & ~1u;
+    }
+    const bool after = hi >= (int32_t)m->w; /* column w last */
+    if (lo < 0) {
+        ws &= ~1u; /* column -1 first */
+        lo = 0;
+    }
+    hi = after ? (int32_t)m->w - 1 : hi;
+    ws = walk_bits(m->wall + (uint32_t)jr * m->stride, m->wall + (uint32_t)m->h * m->stride - 4,
+                   ws, (uint32_t)lo, (uint32_t)(hi - lo + 1));
+    return after ? ws & ~1u : ws;
 }
 
-/* Step row j and its bound (j + 1) r dx while the bound is below n, four rows a step. */
-static inline void rows_to(int32_t *j, int64_t *bound, int64_t n, int64_t rdx)
+/* Mirrored rows jlo..jhi of column i, any of them off the map (not walls), passing over
+ * wall-free blocks (b) or the free cells a wall-distance grid promises. */
+static uint32_t walk_col(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uint32_t ws,
+                         int32_t i, int32_t jlo, int32_t jhi, bool flip)
 {
-    while (*bound + 3 * rdx < n) {
-        *j += 4;
-        *bound += 4 * rdx;
+    if ((uint32_t)i >= m->w) {
+        return ws & ~1u; /* column -1 or w */
     }
-    while (*bound < n) {
-        (*j)++;
-        *bound += rdx;
+    const int32_t bs = b != 0 ? (int32_t)1 << b->shift : 0;
+    const uint8_t *wd = m->wall_dist;
+    for (int32_t j = jlo; j <= jhi; j++) {
+        const int32_t jr = flip ? -1 - j : j;
+        if ((uint32_t)jr >= m->h) {
+            ws &= ~1u;
+            continue;
+        }
+        if (wd != 0) {
+            /* The next d - 1 cells of the column either way are free too. */
+            const int32_t d = wd[(uint32_t)jr * m->w + (uint32_t)i];
+            ws = walk_one(ws, d == 0);
+            j += d > 1 ? d - 1 : 0;
+            continue;
+        }
+        if (b != 0 && !rfs_map_bit(b->bits, b->stride, (uint16_t)((uint32_t)i >> b->shift),
+                                   (uint16_t)((uint32_t)jr >> b->shift))) {
+            ws &= ~1u;
+            j = flip ? -1 - (jr & -bs) : (jr | (bs - 1)); /* the rest of the block */
+            continue;
+        }
+        ws = walk_one(ws, rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)jr));
     }
+    return ws;
 }
 
-/* dx / dy in Q16 (0 <= dx, dy < 2^31), at most 256, rounded down after dropping low bits
- * so that one 32-bit division does (the skips only need a lower bound). */
-static inline uint64_t slope_q16(int64_t dx, int64_t dy)
-{
-    if (dy * 256 <= dx) {
-        return (uint64_t)256 << 16;
-    }
-    uint32_t sh = 0u; /* (dx >> sh) << 16 in 32 bits, dy >> sh below 2^15 */
-    while ((dx >> sh) >= 65536 || (dy >> sh) >= 32768) {
-        sh++;
-    }
-    return (((uint32_t)(dx >> sh) << 16) / (uint32_t)((dy >> sh) + 1));
-}
-
-/* The free square ahead of cell (i, jr), i on the map, jr the real row of the column's
- * first cell in walk order: its side in *d and the columns of it the walk may pass over.
- * With a forward grid (fwd, for the walk's direction), the square of side d with the
- * cell as its corner: the columns a segment of slope 1 / slope (Q16) crosses in it from
- * the bottom of its first row, min(d, (d - 1) slope), any slope. With a wall-distance
- * grid instead, on a shallow segment (shallow), the square round the cell, d its
- * distance: d - 1 columns ahead (steep segments pass over free cells inside a column,
- * walk_column). 0: none. */
-static inline int32_t square_ahead(const rfs_map_t *m, const uint8_t *fwd, uint64_t slope,
-                                   bool shallow, int32_t i, int32_t jr, int32_t *d)
-{
-    if (fwd != 0 && (uint32_t)jr < m->h) {
-        *d = fwd[(uint32_t)jr * m->w + (uint32_t)i];
-        const uint64_t c = ((uint64_t)(*d > 0 ? *d - 1 : 0) * slope) >> 16;
-        return c < (uint64_t)*d ? (int32_t)c : *d;
-    }
-    if (fwd == 0 && shallow) {
-        *d = dist_at(m, i, jr);
-        return *d - 1;
-    }
-    return 0;
-}
-
-/* traverse() with the VISIT_WALLS visitor, specialised: the same cells in the same order
- * (the same endpoint swap, mirror and column recurrences), counting runs of wall cells.
- * Cells off the map are not walls: columns -1 and w (first and last, when an endpoint
- * lies on the map's edge) and rows -1 and h (a segment touching the bottom or top edge).
- * With blocks b, cells in wall-free blocks are passed over (they end a run, as a free cell
- * does): inside a column by whole blocks, and from the first column of a block column to
- * its last at once when the rows the segment spans there hold no wall block. With a
- * wall-distance grid (rfs_map_wall_dist_attach) instead of blocks, free cells are passed
- * over by the free squares their distances promise.
- * Scaling and overflow: as traverse() (y * dx below 2^61; r * dy, the step of y(x) * dx
- * per column, below 2^46); the count saturates at UINT16_MAX. */
+/* The cells of traverse() (rfs_map.c) with the VISIT_WALLS visitor, in the same order
+ * (the same endpoint swap and mirror; columns left to right, each column's rows in the
+ * segment's y direction), counting runs of wall cells. Cells off the map are not walls:
+ * columns -1 and w (first and last, when an endpoint lies on the map's edge) and rows -1
+ * and h (a segment touching the bottom or top edge). The bands (bands_t) come from exact
+ * 32-bit remainders, not traverse()'s 64-bit bounds. A shallow segment (0 < |dy| < |dx|)
+ * is walked row by row over the row-major wall bits (a row's cells are a range of
+ * columns, consecutive in traverse()'s order too); where it crosses a row at a cell
+ * corner, traverse() takes the four cells round it column by column, and so does this
+ * walk. Steeper ones go column by column, passing over wall-free blocks (b) or the free
+ * cells a wall-distance grid promises in long columns. careful: cells off the map may
+ * be on the walk (an endpoint on the map's edge).
+ * Scaling and overflow: bands_init's; the count saturates at UINT16_MAX. */
 static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, int64_t X0,
                            int64_t Y0, int64_t X1, int64_t Y1)
 {
@@ -164,94 +210,80 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
         t = Y0; Y0 = Y1; Y1 = t;
     }
     const bool flip = Y1 < Y0;
-    const bool edge = (flip ? Y1 : Y0) <= 0 || (flip ? Y0 : Y1) >= (int64_t)m->h * r;
+    const bool careful = (flip ? Y1 : Y0) <= 0 || (flip ? Y0 : Y1) >= (int64_t)m->h * r ||
+                         X0 <= 0 || X1 >= (int64_t)m->w * r;
     if (flip) {
         Y0 = -Y0;
         Y1 = -Y1;
     }
     const int64_t dx = X1 - X0;
     const int64_t dy = Y1 - Y0;
-    const int32_t ia = rfs_map_low_cell(X0, r);
-    const int32_t ib = rfs_map_fdiv(X1, r);
-    const int32_t bs = b != 0 ? (int32_t)1 << b->shift : 1; /* block side, cells */
-    walk_t wk = {0u, false};
-    int32_t jlo = rfs_map_low_cell(Y0, r), jhi = dx == 0 ? rfs_map_fdiv(Y1, r) : jlo;
-    const int64_t rdx = (int64_t)r * dx, rdy = (int64_t)r * dy;
-    int64_t blo = ((int64_t)jlo + 1) * rdx; /* (jlo + 1) * r * dx */
-    int64_t bhi = blo;                      /* (jhi + 1) * r * dx */
-    int64_t nl = Y0 * dx;                   /* y(xl) * dx, xl the column's left end */
-    int64_t nr = Y0 * dx + ((int64_t)(ia + 1) * r - X0) * dy; /* y(xr) * dx before clamping */
-    const int32_t step = flip ? -(int32_t)m->stride : (int32_t)m->stride;
-    const uint8_t *wd = m->wall_dist;
-    const bool shallow = wd != 0 && dy <= dx;
-    const uint8_t *fwd = m->wall_fwd != 0 ? m->wall_fwd + (flip ? (size_t)m->w * m->h : 0u) : 0;
-    const uint64_t fwd_slope = fwd == 0 ? 0u : slope_q16(dx, dy);
-    const int32_t long_col = b != 0 ? bs : (wd != 0 ? 3 : INT32_MAX); /* rows from which skips pay */
-    for (int32_t i = ia; i <= ib; i++, nr += rdy) {
+    const int32_t rstep = flip ? -(int32_t)m->stride : (int32_t)m->stride;
+    uint32_t ws = 0u;
+    bands_t bd;
+    if (dy != 0 && dy < dx) {
+        const int32_t kb = rfs_map_fdiv(Y1, r), ie = rfs_map_fdiv(X1, r);
+        int32_t k = rfs_map_low_cell(Y0, r), from = rfs_map_low_cell(X0, r);
+        const uint8_t *lim = m->wall + (uint32_t)m->h * m->stride - 4;
+        const uint8_t *row = m->wall + (int32_t)(flip ? -1 - k : k) * (int32_t)m->stride;
+        bands_init(&bd, r, Y0, X0, dy, dx);
+        for (;; k++, row += rstep) {
+            const bool last = k == kb;
+            const bool corner = !last && bands_corner(&bd);
+            const int32_t hi = last ? ie : bd.hi;
+            const int32_t end = corner ? hi - 2 : hi;
+            if (from <= end) {
+                ws = careful ? walk_row(m, ws, flip ? -1 - k : k, from, end)
+                             : walk_bits(row, lim, ws, (uint32_t)from, (uint32_t)(end - from + 1));
+            }
+            if (last) {
+                break;
+            }
+            from = hi;
+            if (corner) {
+                /* Through the corner between columns hi - 1 and hi: both rows of one
+                 * column, then of the next (a shallow segment meets the next row again
+                 * only past column hi). */
+                const int32_t jr = flip ? -1 - k : k, jn = flip ? jr - 1 : jr + 1;
+                ws = walk_cell(m, ws, hi - 1, jr);
+                ws = walk_cell(m, ws, hi - 1, jn);
+                ws = walk_cell(m, ws, hi, jr);
+                ws = walk_cell(m, ws, hi, jn);
+                from = hi + 1;
+            }
+            bands_step(&bd);
+        }
+    } else {
+        const int32_t long_col = b != 0 ? (int32_t)1 << b->shift : (m->wall_dist != 0 ? 3 : INT32_MAX);
+        const int32_t ib = rfs_map_fdiv(X1, r), je = rfs_map_fdiv(Y1, r);
+        int32_t i = rfs_map_low_cell(X0, r), jlo = rfs_map_low_cell(Y0, r);
         if (dx != 0) {
-            const int64_t n_r = i == ib ? Y1 * dx : nr; /* y(min(xr, X1)) * dx */
-            while (blo < nl) {
-                jlo++;
-                blo += rdx;
-            }
-            if (jhi < jlo) {
-                jhi = jlo;
-                bhi = blo;
-            }
-            while (bhi <= n_r) {
-                jhi++;
-                bhi += rdx;
-            }
-            nl = n_r; /* the next column starts where this one ends */
-            /* The columns i .. ie in the free square of side d ahead (square_ahead) when
-             * their rows stay below jlo + d: y(xr) * dx at ie, ne, below (jlo + d) r dx. */
-            int32_t d = 0;
-            const int32_t cols = (fwd != 0 || shallow) && i < ib && (uint32_t)i < m->w
-                                     ? square_ahead(m, fwd, fwd_slope, shallow, i,
-                                                    flip ? -1 - jlo : jlo, &d) : 0;
-            if (cols > 1) {
-                const int32_t ie = i + cols - 1 > ib ? ib : i + cols - 1;
-                const int64_t ne = ie == ib ? Y1 * dx : nr + (int64_t)(ie - i) * rdy;
-                if (jhi - jlo < d && ne < blo + (int64_t)(d - 1) * rdx) {
-                    rows_to(&jhi, &bhi, ne + 1, rdx);
-                    rows_to(&jlo, &blo, ne, rdx);
-                    wk.in_wall = false;
-                    nl = ne;
-                    nr += (int64_t)(ie - i) * rdy;
-                    i = ie;
-                    continue;
+            bands_init(&bd, r, X0, Y0, dx, dy);
+        }
+        for (;; i++) {
+            const bool last = i >= ib;
+            const int32_t hi = dx == 0 || last ? je : bd.hi;
+            if (careful || hi - jlo >= long_col) {
+                ws = walk_col(m, b, ws, i, jlo, hi, flip);
+            } else {
+                const uint8_t *p = m->wall + (int32_t)(flip ? -1 - jlo : jlo) * (int32_t)m->stride +
+                                   ((uint32_t)i >> 3);
+                const uint32_t sh = (uint32_t)i & 7u;
+                for (int32_t n = hi - jlo; n >= 0; n--, p += rstep) {
+                    ws = walk_one(ws, ((*p >> sh) & 1u) != 0u);
                 }
             }
-            /* A block column at once, from its first column, when the rows the segment
-             * spans in it hold no wall block: those of its last column ie from the same
-             * recurrence (jlo catches up in the next column's loop). */
-            if (b != 0 && (i & (bs - 1)) == 0 && i < ib && (uint32_t)i < m->w) {
-                const int32_t ie = i + bs - 1 > ib ? ib : i + bs - 1;
-                const int64_t ne = ie == ib ? Y1 * dx : nr + (int64_t)(ie - i) * rdy;
-                int32_t je = jhi;
-                int64_t be = bhi;
-                while (be <= ne) {
-                    je++;
-                    be += rdx;
-                }
-                if (!blocks_hold_wall(m, b, i, flip ? -1 - je : jlo, flip ? -1 - jlo : je)) {
-                    wk.in_wall = false;
-                    jhi = je;
-                    bhi = be;
-                    nl = ne;
-                    nr += (int64_t)(ie - i) * rdy;
-                    i = ie;
-                    continue;
-                }
+            if (last) {
+                break;
+            }
+            if (dx != 0) {
+                jlo = bd.hi - (bands_corner(&bd) ? 1 : 0);
+                bands_step(&bd);
             }
         }
-        if ((uint32_t)i >= m->w) {
-            wk.in_wall = false; /* column -1 or w */
-            continue;
-        }
-        walk_column(m, b, &wk, i, jlo, jhi, flip, step, edge || jhi - jlo >= long_col);
     }
-    return (uint16_t)(wk.runs > UINT16_MAX ? UINT16_MAX : wk.runs);
+    ws >>= 1;
+    return (uint16_t)(ws > UINT16_MAX ? UINT16_MAX : ws);
 }
 
 uint32_t rfs_map_wall_fwd_bytes(const rfs_map_t *m)

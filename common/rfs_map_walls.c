@@ -93,17 +93,17 @@ static inline void bands_step(bands_t *bd)
  * the bits above, the runs of wall cells so far (a segment has below 2^18 cells). */
 #define WALK_RUN 2u
 
-/* One cell of the walk. */
-static inline uint32_t walk_one(uint32_t ws, bool wall)
+/* One cell of the walk, wall 1 or 0. */
+static inline uint32_t walk_one(uint32_t ws, uint32_t wall)
 {
-    return ((ws + ((wall && (ws & 1u) == 0u) ? WALK_RUN : 0u)) & ~1u) | (wall ? 1u : 0u);
+    return ((ws + ((wall & ~ws) << 1)) & ~1u) | wall;
 }
 
 /* Cell (i, jr), real row jr; off the map it is not a wall. */
 static inline uint32_t walk_cell(const rfs_map_t *m, uint32_t ws, int32_t i, int32_t jr)
 {
     return walk_one(ws, (uint32_t)i < m->w && (uint32_t)jr < m->h &&
-                            rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)jr));
+                                rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)jr) ? 1u : 0u);
 }
 
 /* Bits lo .. lo + n - 1 (n >= 1) of a row of the wall grid, in order, up to 24 at a time:
@@ -173,7 +173,7 @@ static uint32_t walk_col(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uin
         if (wd != 0) {
             /* The next d - 1 cells of the column either way are free too. */
             const int32_t d = wd[(uint32_t)jr * m->w + (uint32_t)i];
-            ws = walk_one(ws, d == 0);
+            ws = walk_one(ws, d == 0 ? 1u : 0u);
             j += d > 1 ? d - 1 : 0;
             continue;
         }
@@ -183,9 +183,80 @@ static uint32_t walk_col(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uin
             j = flip ? -1 - (jr & -bs) : (jr | (bs - 1)); /* the rest of the block */
             continue;
         }
-        ws = walk_one(ws, rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)jr));
+        ws = walk_one(ws, rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)jr) ? 1u : 0u);
     }
     return ws;
+}
+
+/* A shallow walk on the map whose crossings miss every cell corner, from row pointer row
+ * (rstep bytes a band) and column from: nb crossings (bands_t bd), then the last band to
+ * column ie. Every four-byte load from a row's cells stays in the grid (lim: as
+ * walk_bits). */
+static uint32_t walk_rows_fast(const uint8_t *row, const uint8_t *lim, int32_t rstep, uint32_t ws,
+                               int32_t from, bands_t bd, int32_t nb, int32_t ie)
+{
+    int32_t hi = bd.hi;
+    uint32_t u = bd.u;
+    for (;; row += rstep) {
+        const int32_t end = nb == 0 ? ie : hi;
+        const uint32_t n = (uint32_t)(end - from); /* bits - 1 */
+        if (n > 24u) {
+            ws = walk_bits(row, lim, ws, (uint32_t)from, n + 1u);
+        } else {
+            const uint8_t *p = row + ((uint32_t)from >> 3);
+            uint32_t w = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 |
+                         (uint32_t)p[3] << 24;
+            w = (w >> ((uint32_t)from & 7u)) & (0xFFFFFFFFu >> (31u - n));
+            for (uint32_t st = w & ~((w << 1) | (ws & 1u)); st != 0u; st &= st - 1u) {
+                ws += WALK_RUN;
+            }
+            ws = (ws & ~1u) | (w >> n);
+        }
+        if (nb-- == 0) {
+            return ws;
+        }
+        from = hi;
+        u += bd.s;
+        if (u >= bd.dp) {
+            u -= bd.dp;
+            hi++;
+        }
+        hi += bd.a;
+    }
+}
+
+/* A steep walk on the map whose crossings miss every cell corner, from column i, mirrored
+ * row jlo: nb crossings (bands_t bd), then the last column to row je; columns of long_col
+ * rows or more through walk_col (blocks b, the wall-distance grid). */
+static uint32_t walk_cols_fast(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uint32_t ws,
+                               int32_t i, int32_t jlo, bands_t bd, int32_t nb, int32_t je,
+                               bool flip, int32_t long_col)
+{
+    const int32_t stride = (int32_t)m->stride, rstep = flip ? -stride : stride;
+    int32_t hi = bd.hi;
+    uint32_t u = bd.u;
+    for (;; i++) {
+        const int32_t end = nb == 0 ? je : hi;
+        if (end - jlo >= long_col) {
+            ws = walk_col(m, b, ws, i, jlo, end, flip);
+        } else {
+            const uint8_t *p = m->wall + (flip ? -1 - jlo : jlo) * stride + ((uint32_t)i >> 3);
+            const uint32_t sh = (uint32_t)i & 7u;
+            for (int32_t n = end - jlo; n >= 0; n--, p += rstep) {
+                ws = walk_one(ws, (*p >> sh) & 1u);
+            }
+        }
+        if (nb-- == 0) {
+            return ws;
+        }
+        jlo = hi;
+        u += bd.s;
+        if (u >= bd.dp) {
+            u -= bd.dp;
+            hi++;
+        }
+        hi += bd.a;
+    }
 }
 
 /* The cells of traverse() (rfs_map.c) with the VISIT_WALLS visitor, in the same order
@@ -220,13 +291,19 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
     const int64_t dy = Y1 - Y0;
     const int32_t rstep = flip ? -(int32_t)m->stride : (int32_t)m->stride;
     uint32_t ws = 0u;
-    bands_t bd;
+    bands_t bd = {0, 0u, 1u, 0u, 0, false};
     if (dy != 0 && dy < dx) {
         const int32_t kb = rfs_map_fdiv(Y1, r), ie = rfs_map_fdiv(X1, r);
         int32_t k = rfs_map_low_cell(Y0, r), from = rfs_map_low_cell(X0, r);
         const uint8_t *lim = m->wall + (uint32_t)m->h * m->stride - 4;
         const uint8_t *row = m->wall + (int32_t)(flip ? -1 - k : k) * (int32_t)m->stride;
         bands_init(&bd, r, Y0, X0, dy, dx);
+        const int32_t jtop = flip ? -1 - k : kb; /* the highest real row */
+        if (!careful && !bd.on_edge &&
+            (uint32_t)(jtop + 1) * m->stride + 3u <= (uint32_t)m->h * m->stride) {
+            ws = walk_rows_fast(row, lim, rstep, ws, from, bd, kb - k, ie);
+            return (uint16_t)((ws >> 1) > UINT16_MAX ? UINT16_MAX : (ws >> 1));
+        }
         for (;; k++, row += rstep) {
             const bool last = k == kb;
             const bool corner = !last && bands_corner(&bd);
@@ -259,6 +336,10 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
         int32_t i = rfs_map_low_cell(X0, r), jlo = rfs_map_low_cell(Y0, r);
         if (dx != 0) {
             bands_init(&bd, r, X0, Y0, dx, dy);
+            if (!careful && !bd.on_edge) {
+                ws = walk_cols_fast(m, b, ws, i, jlo, bd, ib - i, je, flip, long_col);
+                return (uint16_t)((ws >> 1) > UINT16_MAX ? UINT16_MAX : (ws >> 1));
+            }
         }
         for (;; i++) {
             const bool last = i >= ib;
@@ -270,7 +351,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
                                    ((uint32_t)i >> 3);
                 const uint32_t sh = (uint32_t)i & 7u;
                 for (int32_t n = hi - jlo; n >= 0; n--, p += rstep) {
-                    ws = walk_one(ws, ((*p >> sh) & 1u) != 0u);
+                    ws = walk_one(ws, (*p >> sh) & 1u);
                 }
             }
             if (last) {

@@ -188,17 +188,84 @@ static uint32_t walk_col(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uin
     return ws;
 }
 
-/* A shallow walk on the map whose crossings miss every cell corner, from row pointer row
- * (rstep bytes a band) and column from: nb crossings (bands_t bd), then the last band to
- * column ie. Every four-byte load from a row's cells stays in the grid (lim: as
- * walk_bits). */
-static uint32_t walk_rows_fast(const uint8_t *row, const uint8_t *lim, int32_t rstep, uint32_t ws,
-                               int32_t from, bands_t bd, int32_t nb, int32_t ie)
+/* What an attached grid promises about cell (i, j) on the map (mirrored row j) and the
+ * cells ahead of it, towards +x and the walk's rows: true when the rectangle up to
+ * column *x1 and mirrored row *y1 is free; false when the rectangle up to there (the cell
+ * alone, or a block) may hold a wall. The forward grid (fwd, for the walk's direction):
+ * the square of side d with the cell as its corner; the wall-distance grid: the square
+ * round the cell, d - 1 cells either way; blocks b: the cell's block. No grid: false for
+ * the cell. */
+static inline bool free_ahead(const rfs_map_t *m, const rfs_map_wall_blocks_t *b,
+                              const uint8_t *fwd, int32_t i, int32_t j, bool flip, int32_t *x1,
+                              int32_t *y1)
 {
-    int32_t hi = bd.hi;
+    const int32_t jr = flip ? -1 - j : j;
+    const uint8_t *g = fwd != 0 ? fwd : m->wall_dist;
+    if (g != 0 || b == 0) {
+        const int32_t d = g != 0 ? g[(uint32_t)jr * m->w + (uint32_t)i] : 0;
+        *x1 = i + (d > 1 ? d - 1 : 0);
+        *y1 = j + (d > 1 ? d - 1 : 0);
+        return d != 0;
+    }
+    const int32_t bs = (int32_t)1 << b->shift;
+    *x1 = i | (bs - 1);
+    *y1 = flip ? -1 - (jr & -bs) : (jr | (bs - 1));
+    return !rfs_map_bit(b->bits, b->stride, (uint16_t)((uint32_t)i >> b->shift),
+                        (uint16_t)((uint32_t)jr >> b->shift));
+}
+
+/* The bands' next crossing (bands_step() on copies kept in registers). */
+#define BANDS_NEXT(hi, u, bd)  \
+    do {                       \
+        (u) += (bd).s;         \
+        if ((u) >= (bd).dp) {  \
+            (u) -= (bd).dp;    \
+            (hi)++;            \
+        }                      \
+        (hi) += (bd).a;        \
+    } while (0)
+
+/* A shallow walk on the map whose crossings miss every cell corner, from band k (row
+ * pointer row) and column from: nb crossings (bands_t bd), then the last band to column
+ * ie. With a forward or wall-distance grid, a band's cells inside the free rectangle last
+ * found (free_ahead, looked up again when a band starts outside it) are passed over, and
+ * the bands wholly inside it in a tight loop; the others are read from the row's bits
+ * (blocks would not pay: a band of a few cells crosses into another block every band or
+ * two). Every four-byte load from a row's cells stays in the grid (lim: as walk_bits). */
+static inline uint32_t walk_rows_fast(const rfs_map_t *m, const uint8_t *fwd,
+                                      const uint8_t *row, const uint8_t *lim, uint32_t ws,
+                                      int32_t k, int32_t from, bands_t bd, int32_t nb,
+                                      int32_t ie, bool flip, bool look)
+{
+    const int32_t rstep = flip ? -(int32_t)m->stride : (int32_t)m->stride;
+    int32_t hi = bd.hi, fx1 = INT32_MIN, fy1 = INT32_MIN;
+    bool free = false;
     uint32_t u = bd.u;
-    for (;; row += rstep) {
-        const int32_t end = nb == 0 ? ie : hi;
+    for (;;) {
+        int32_t end = nb == 0 ? ie : hi;
+        if (look) {
+            if (k > fy1 || from > fx1) {
+                free = free_ahead(m, 0, fwd, from, k, flip, &fx1, &fy1);
+            }
+            if (free && end <= fx1) {
+                ws &= ~1u;
+                do {
+                    if (nb-- == 0) {
+                        return ws;
+                    }
+                    from = hi;
+                    BANDS_NEXT(hi, u, bd);
+                    k++;
+                    row += rstep;
+                    end = nb == 0 ? ie : hi;
+                } while (k <= fy1 && end <= fx1);
+                continue;
+            }
+            if (free) {
+                ws &= ~1u;
+                from = fx1 + 1;
+            }
+        }
         const uint32_t n = (uint32_t)(end - from); /* bits - 1 */
         if (n > 24u) {
             ws = walk_bits(row, lim, ws, (uint32_t)from, n + 1u);
@@ -216,33 +283,57 @@ static uint32_t walk_rows_fast(const uint8_t *row, const uint8_t *lim, int32_t r
             return ws;
         }
         from = hi;
-        u += bd.s;
-        if (u >= bd.dp) {
-            u -= bd.dp;
-            hi++;
-        }
-        hi += bd.a;
+        BANDS_NEXT(hi, u, bd);
+        k++;
+        row += rstep;
     }
 }
 
 /* A steep walk on the map whose crossings miss every cell corner, from column i, mirrored
- * row jlo: nb crossings (bands_t bd), then the last column to row je; columns of long_col
- * rows or more through walk_col (blocks b, the wall-distance grid). */
-static uint32_t walk_cols_fast(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uint32_t ws,
-                               int32_t i, int32_t jlo, bands_t bd, int32_t nb, int32_t je,
-                               bool flip, int32_t long_col)
+ * row jlo: nb crossings (bands_t bd), then the last column to row je. With a forward or
+ * wall-distance grid, a column's cells inside the free rectangle last found (free_ahead)
+ * are passed over, and the columns wholly inside it in a tight loop. Of the rest, runs of
+ * long_col rows or more go through walk_col (blocks b, the wall-distance grid), the
+ * others a byte a cell. */
+static inline uint32_t walk_cols_fast(const rfs_map_t *m, const rfs_map_wall_blocks_t *b,
+                                      const uint8_t *fwd, uint32_t ws, int32_t i, int32_t jlo,
+                                      bands_t bd, int32_t nb, int32_t je, bool flip,
+                                      int32_t long_col, bool look)
 {
     const int32_t stride = (int32_t)m->stride, rstep = flip ? -stride : stride;
-    int32_t hi = bd.hi;
+    int32_t hi = bd.hi, fx1 = INT32_MIN, fy1 = INT32_MIN;
+    bool free = false;
     uint32_t u = bd.u;
-    for (;; i++) {
-        const int32_t end = nb == 0 ? je : hi;
-        if (end - jlo >= long_col) {
-            ws = walk_col(m, b, ws, i, jlo, end, flip);
+    for (;;) {
+        int32_t end = nb == 0 ? je : hi, j = jlo;
+        if (look) {
+            if (i > fx1 || j > fy1) {
+                free = free_ahead(m, 0, fwd, i, j, flip, &fx1, &fy1);
+            }
+            if (free && end <= fy1) {
+                ws &= ~1u;
+                do {
+                    if (nb-- == 0) {
+                        return ws;
+                    }
+                    jlo = hi;
+                    BANDS_NEXT(hi, u, bd);
+                    i++;
+                    end = nb == 0 ? je : hi;
+                } while (i <= fx1 && end <= fy1);
+                continue;
+            }
+            if (free) {
+                ws &= ~1u;
+                j = fy1 + 1;
+            }
+        }
+        if (end - j >= long_col) {
+            ws = walk_col(m, b, ws, i, j, end, flip);
         } else {
-            const uint8_t *p = m->wall + (flip ? -1 - jlo : jlo) * stride + ((uint32_t)i >> 3);
+            const uint8_t *p = m->wall + (flip ? -1 - j : j) * stride + ((uint32_t)i >> 3);
             const uint32_t sh = (uint32_t)i & 7u;
-            for (int32_t n = end - jlo; n >= 0; n--, p += rstep) {
+            for (int32_t n = end - j; n >= 0; n--, p += rstep) {
                 ws = walk_one(ws, (*p >> sh) & 1u);
             }
         }
@@ -250,13 +341,40 @@ static uint32_t walk_cols_fast(const rfs_map_t *m, const rfs_map_wall_blocks_t *
             return ws;
         }
         jlo = hi;
-        u += bd.s;
-        if (u >= bd.dp) {
-            u -= bd.dp;
-            hi++;
-        }
-        hi += bd.a;
+        BANDS_NEXT(hi, u, bd);
+        i++;
     }
+}
+
+/* walk_rows_fast() and walk_cols_fast() compiled apart without and with a grid to look
+ * free rectangles up in (look: the forward or wall-distance grid, the host's), so the
+ * loops without one (the Cortex-M4's) carry none of its work. */
+static uint32_t walk_rows_plain(const rfs_map_t *m, const uint8_t *row, const uint8_t *lim,
+                                uint32_t ws, int32_t k, int32_t from, bands_t bd, int32_t nb,
+                                int32_t ie, bool flip)
+{
+    return walk_rows_fast(m, 0, row, lim, ws, k, from, bd, nb, ie, flip, false);
+}
+
+static uint32_t walk_rows_look(const rfs_map_t *m, const uint8_t *fwd, const uint8_t *row,
+                               const uint8_t *lim, uint32_t ws, int32_t k, int32_t from,
+                               bands_t bd, int32_t nb, int32_t ie, bool flip)
+{
+    return walk_rows_fast(m, fwd, row, lim, ws, k, from, bd, nb, ie, flip, true);
+}
+
+static uint32_t walk_cols_plain(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uint32_t ws,
+                                int32_t i, int32_t jlo, bands_t bd, int32_t nb, int32_t je,
+                                bool flip, int32_t long_col)
+{
+    return walk_cols_fast(m, b, 0, ws, i, jlo, bd, nb, je, flip, long_col, false);
+}
+
+static uint32_t walk_cols_look(const rfs_map_t *m, const uint8_t *fwd, uint32_t ws, int32_t i,
+                               int32_t jlo, bands_t bd, int32_t nb, int32_t je, bool flip,
+                               int32_t long_col)
+{
+    return walk_cols_fast(m, 0, fwd, ws, i, jlo, bd, nb, je, flip, long_col, true);
 }
 
 /* The cells of traverse() (rfs_map.c) with the VISIT_WALLS visitor, in the same order
@@ -290,6 +408,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
     const int64_t dx = X1 - X0;
     const int64_t dy = Y1 - Y0;
     const int32_t rstep = flip ? -(int32_t)m->stride : (int32_t)m->stride;
+    const uint8_t *fwd = m->wall_fwd != 0 ? m->wall_fwd + (flip ? (size_t)m->w * m->h : 0u) : 0;
     uint32_t ws = 0u;
     bands_t bd = {0, 0u, 1u, 0u, 0, false};
     if (dy != 0 && dy < dx) {
@@ -301,7 +420,9 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
         const int32_t jtop = flip ? -1 - k : kb; /* the highest real row */
         if (!careful && !bd.on_edge &&
             (uint32_t)(jtop + 1) * m->stride + 3u <= (uint32_t)m->h * m->stride) {
-            ws = walk_rows_fast(row, lim, rstep, ws, from, bd, kb - k, ie);
+            ws = fwd != 0 || m->wall_dist != 0
+                     ? walk_rows_look(m, fwd, row, lim, ws, k, from, bd, kb - k, ie, flip)
+                     : walk_rows_plain(m, row, lim, ws, k, from, bd, kb - k, ie, flip);
             return (uint16_t)((ws >> 1) > UINT16_MAX ? UINT16_MAX : (ws >> 1));
         }
         for (;; k++, row += rstep) {
@@ -337,7 +458,9 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
         if (dx != 0) {
             bands_init(&bd, r, X0, Y0, dx, dy);
             if (!careful && !bd.on_edge) {
-                ws = walk_cols_fast(m, b, ws, i, jlo, bd, ib - i, je, flip, long_col);
+                ws = fwd != 0 || m->wall_dist != 0
+                         ? walk_cols_look(m, fwd, ws, i, jlo, bd, ib - i, je, flip, long_col)
+                         : walk_cols_plain(m, b, ws, i, jlo, bd, ib - i, je, flip, long_col);
                 return (uint16_t)((ws >> 1) > UINT16_MAX ? UINT16_MAX : (ws >> 1));
             }
         }

@@ -177,10 +177,22 @@ static uint32_t walk_col(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uin
             j += d > 1 ? d - 1 : 0;
             continue;
         }
-        if (b != 0 && !rfs_map_bit(b->bits, b->stride, (uint16_t)((uint32_t)i >> b->shift),
-                                   (uint16_t)((uint32_t)jr >> b->shift))) {
-            ws &= ~1u;
-            j = flip ? -1 - (jr & -bs) : (jr | (bs - 1)); /* the rest of the block */
+        if (b != 0) {
+            /* The rest of the cell's block (on the map): passed over, or read. */
+            const int32_t ky = flip ? -1 - (jr & -bs) : (jr | (bs - 1));
+            const int32_t top = flip ? -1 : (int32_t)m->h - 1;
+            const int32_t e = ky < jhi ? (ky < top ? ky : top) : (jhi < top ? jhi : top);
+            if (!rfs_map_bit(b->bits, b->stride, (uint16_t)((uint32_t)i >> b->shift),
+                             (uint16_t)((uint32_t)jr >> b->shift))) {
+                ws &= ~1u;
+            } else {
+                const int32_t rstep = flip ? -(int32_t)m->stride : (int32_t)m->stride;
+                const uint8_t *p = m->wall + (uint32_t)jr * m->stride + ((uint32_t)i >> 3);
+                for (int32_t n = e - j; n >= 0; n--, p += rstep) {
+                    ws = walk_one(ws, (*p >> ((uint32_t)i & 7u)) & 1u);
+                }
+            }
+            j = e;
             continue;
         }
         ws = walk_one(ws, rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)jr) ? 1u : 0u);
@@ -232,7 +244,7 @@ static inline bool free_ahead(const rfs_map_t *m, const rfs_map_wall_blocks_t *b
  * the bands wholly inside it in a tight loop; the others are read from the row's bits
  * (blocks would not pay: a band of a few cells crosses into another block every band or
  * two). Every four-byte load from a row's cells stays in the grid (lim: as walk_bits). */
-static inline uint32_t walk_rows_fast(const rfs_map_t *m, const uint8_t *fwd,
+__attribute__((always_inline)) static inline uint32_t walk_rows_fast(const rfs_map_t *m, const uint8_t *fwd,
                                       const uint8_t *row, const uint8_t *lim, uint32_t ws,
                                       int32_t k, int32_t from, bands_t bd, int32_t nb,
                                       int32_t ie, bool flip, bool look)
@@ -295,7 +307,7 @@ static inline uint32_t walk_rows_fast(const rfs_map_t *m, const uint8_t *fwd,
  * are passed over, and the columns wholly inside it in a tight loop. Of the rest, runs of
  * long_col rows or more go through walk_col (blocks b, the wall-distance grid), the
  * others a byte a cell. */
-static inline uint32_t walk_cols_fast(const rfs_map_t *m, const rfs_map_wall_blocks_t *b,
+__attribute__((always_inline)) static inline uint32_t walk_cols_fast(const rfs_map_t *m, const rfs_map_wall_blocks_t *b,
                                       const uint8_t *fwd, uint32_t ws, int32_t i, int32_t jlo,
                                       bands_t bd, int32_t nb, int32_t je, bool flip,
                                       int32_t long_col, bool look)
@@ -346,33 +358,93 @@ static inline uint32_t walk_cols_fast(const rfs_map_t *m, const rfs_map_wall_blo
     }
 }
 
-/* walk_rows_fast() and walk_cols_fast() compiled apart without and with a grid to look
- * free rectangles up in (look: the forward or wall-distance grid, the host's), so the
- * loops without one (the Cortex-M4's) carry none of its work. */
-static uint32_t walk_rows_plain(const rfs_map_t *m, const uint8_t *row, const uint8_t *lim,
-                                uint32_t ws, int32_t k, int32_t from, bands_t bd, int32_t nb,
-                                int32_t ie, bool flip)
+/* Bits from..from + n (n > 24) of a row, every four-byte load from its cells inside the
+ * grid: as walk_bits. */
+__attribute__((noinline)) static uint32_t row_bits_long(const uint8_t *row, uint32_t ws,
+                                                        uint32_t from, uint32_t n)
 {
-    return walk_rows_fast(m, 0, row, lim, ws, k, from, bd, nb, ie, flip, false);
+    return walk_bits(row, (const uint8_t *)UINTPTR_MAX, ws, from, n + 1u);
 }
 
-static uint32_t walk_rows_look(const rfs_map_t *m, const uint8_t *fwd, const uint8_t *row,
-                               const uint8_t *lim, uint32_t ws, int32_t k, int32_t from,
-                               bands_t bd, int32_t nb, int32_t ie, bool flip)
+/* Bits from..end of a row (from <= end), every four-byte load from its cells inside the
+ * grid. */
+static inline uint32_t row_bits(const uint8_t *row, uint32_t ws, int32_t from, int32_t end)
+{
+    const uint32_t n = (uint32_t)(end - from); /* bits - 1 */
+    if (n > 24u) {
+        return row_bits_long(row, ws, (uint32_t)from, n);
+    }
+    const uint8_t *p = row + ((uint32_t)from >> 3);
+    uint32_t w = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+    w = (w << (31u - ((uint32_t)from & 7u) - n)) >> (31u - n);
+    for (uint32_t st = w & ~((w << 1) | (ws & 1u)); st != 0u; st &= st - 1u) {
+        ws += WALK_RUN;
+    }
+    return (ws & ~1u) | (w >> n);
+}
+
+/* walk_rows_fast() without a grid (the Cortex-M4's walk): the same cells, each band's
+ * bits read at once, few live values. */
+__attribute__((noinline)) static uint32_t walk_rows_plain(const uint8_t *row, int32_t rstep,
+                                                          uint32_t ws, int32_t from, bands_t bd,
+                                                          int32_t nb, int32_t ie)
+{
+    int32_t hi = bd.hi;
+    uint32_t u = bd.u;
+    for (const uint8_t *last = row + nb * rstep; row != last; row += rstep) {
+        ws = row_bits(row, ws, from, hi);
+        from = hi;
+        BANDS_NEXT(hi, u, bd);
+    }
+    return row_bits(row, ws, from, ie);
+}
+
+/* walk_cols_fast() without a grid (the Cortex-M4's walk): the same cells, the byte of a
+ * column's first cell carried over from the last cell of the one before. */
+__attribute__((noinline)) static uint32_t walk_cols_plain(const rfs_map_t *m,
+                                                          const rfs_map_wall_blocks_t *b,
+                                                          uint32_t ws, int32_t i, int32_t jlo,
+                                                          bands_t bd, int32_t nb, int32_t je,
+                                                          bool flip, int32_t long_col)
+{
+    const int32_t rstep = flip ? -(int32_t)m->stride : (int32_t)m->stride;
+    int32_t hi = bd.hi;
+    uint32_t u = bd.u;
+    for (;; i++) {
+        const int32_t end = nb == 0 ? je : hi;
+        if (end - jlo >= long_col) {
+            ws = walk_col(m, b, ws, i, jlo, end, flip);
+        } else {
+            const uint8_t *p = m->wall + (flip ? -1 - jlo : jlo) * (int32_t)m->stride +
+                               ((uint32_t)i >> 3);
+            const uint32_t sh = (uint32_t)i & 7u;
+            for (int32_t n = end - jlo; n >= 0; n--, p += rstep) {
+                ws = walk_one(ws, (*p >> sh) & 1u);
+            }
+        }
+        if (nb-- == 0) {
+            return ws;
+        }
+        jlo = hi;
+        BANDS_NEXT(hi, u, bd);
+    }
+}
+
+/* walk_rows_fast() and walk_cols_fast() with a grid to look free rectangles up in (the
+ * forward or wall-distance grid, the host's). */
+__attribute__((noinline)) static uint32_t walk_rows_look(const rfs_map_t *m, const uint8_t *fwd,
+                                                         const uint8_t *row, const uint8_t *lim,
+                                                         uint32_t ws, int32_t k, int32_t from,
+                                                         bands_t bd, int32_t nb, int32_t ie,
+                                                         bool flip)
 {
     return walk_rows_fast(m, fwd, row, lim, ws, k, from, bd, nb, ie, flip, true);
 }
 
-static uint32_t walk_cols_plain(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uint32_t ws,
-                                int32_t i, int32_t jlo, bands_t bd, int32_t nb, int32_t je,
-                                bool flip, int32_t long_col)
-{
-    return walk_cols_fast(m, b, 0, ws, i, jlo, bd, nb, je, flip, long_col, false);
-}
-
-static uint32_t walk_cols_look(const rfs_map_t *m, const uint8_t *fwd, uint32_t ws, int32_t i,
-                               int32_t jlo, bands_t bd, int32_t nb, int32_t je, bool flip,
-                               int32_t long_col)
+__attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m, const uint8_t *fwd,
+                                                         uint32_t ws, int32_t i, int32_t jlo,
+                                                         bands_t bd, int32_t nb, int32_t je,
+                                                         bool flip, int32_t long_col)
 {
     return walk_cols_fast(m, 0, fwd, ws, i, jlo, bd, nb, je, flip, long_col, true);
 }
@@ -422,7 +494,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
             (uint32_t)(jtop + 1) * m->stride + 3u <= (uint32_t)m->h * m->stride) {
             ws = fwd != 0 || m->wall_dist != 0
                      ? walk_rows_look(m, fwd, row, lim, ws, k, from, bd, kb - k, ie, flip)
-                     : walk_rows_plain(m, row, lim, ws, k, from, bd, kb - k, ie, flip);
+                     : walk_rows_plain(row, rstep, ws, from, bd, kb - k, ie);
             return (uint16_t)((ws >> 1) > UINT16_MAX ? UINT16_MAX : (ws >> 1));
         }
         for (;; k++, row += rstep) {

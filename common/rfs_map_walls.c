@@ -1,6 +1,7 @@
 /* rfs_map_walls.c - walls crossed by a segment: runs of wall cells along the exact
- * supercover traversal of rfs_map.c, with the two accelerations a caller may attach, the
- * wall-block grid and the wall-distance grid (docs/MAPS.md, "The core's grids").
+ * supercover traversal of rfs_map.c, with the accelerations a caller may attach, the
+ * wall-block grid and the host's wall-distance and forward grids (docs/MAPS.md, "The
+ * core's grids").
  */
 #include "rfs_map.h"
 
@@ -200,30 +201,19 @@ static uint32_t walk_col(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uin
     return ws;
 }
 
-/* What an attached grid promises about cell (i, j) on the map (mirrored row j) and the
- * cells ahead of it, towards +x and the walk's rows: true when the rectangle up to
- * column *x1 and mirrored row *y1 is free; false when the rectangle up to there (the cell
- * alone, or a block) may hold a wall. The forward grid (fwd, for the walk's direction):
- * the square of side d with the cell as its corner; the wall-distance grid: the square
- * round the cell, d - 1 cells either way; blocks b: the cell's block. No grid: false for
- * the cell. */
-static inline bool free_ahead(const rfs_map_t *m, const rfs_map_wall_blocks_t *b,
-                              const uint8_t *fwd, int32_t i, int32_t j, bool flip, int32_t *x1,
-                              int32_t *y1)
+/* The free square ahead of cell (i, j) on the map (mirrored row j) that a host grid
+ * promises, towards +x and the walk's rows: its last column *x1 and mirrored row *y1,
+ * false when the cell is a wall. The forward grid (fwd, for the walk's direction): the
+ * square of side d with the cell as its corner; else the wall-distance grid: the square
+ * round the cell, d - 1 cells either way. */
+static inline bool free_ahead(const rfs_map_t *m, const uint8_t *fwd, int32_t i, int32_t j,
+                              bool flip, int32_t *x1, int32_t *y1)
 {
-    const int32_t jr = flip ? -1 - j : j;
     const uint8_t *g = fwd != 0 ? fwd : m->wall_dist;
-    if (g != 0 || b == 0) {
-        const int32_t d = g != 0 ? g[(uint32_t)jr * m->w + (uint32_t)i] : 0;
-        *x1 = i + (d > 1 ? d - 1 : 0);
-        *y1 = j + (d > 1 ? d - 1 : 0);
-        return d != 0;
-    }
-    const int32_t bs = (int32_t)1 << b->shift;
-    *x1 = i | (bs - 1);
-    *y1 = flip ? -1 - (jr & -bs) : (jr | (bs - 1));
-    return !rfs_map_bit(b->bits, b->stride, (uint16_t)((uint32_t)i >> b->shift),
-                        (uint16_t)((uint32_t)jr >> b->shift));
+    const int32_t d = g[(uint32_t)(flip ? -1 - j : j) * m->w + (uint32_t)i];
+    *x1 = i + (d > 1 ? d - 1 : 0);
+    *y1 = j + (d > 1 ? d - 1 : 0);
+    return d != 0;
 }
 
 /* The bands' next crossing (bands_step() on copies kept in registers). */
@@ -237,17 +227,58 @@ static inline bool free_ahead(const rfs_map_t *m, const rfs_map_wall_blocks_t *b
         (hi) += (bd).a;        \
     } while (0)
 
-/* A shallow walk on the map whose crossings miss every cell corner, from band k (row
- * pointer row) and column from: nb crossings (bands_t bd), then the last band to column
- * ie. With a forward or wall-distance grid, a band's cells inside the free rectangle last
- * found (free_ahead, looked up again when a band starts outside it) are passed over, and
- * the bands wholly inside it in a tight loop; the others are read from the row's bits
- * (blocks would not pay: a band of a few cells crosses into another block every band or
- * two). Every four-byte load from a row's cells stays in the grid (lim: as walk_bits). */
-__attribute__((always_inline)) static inline uint32_t walk_rows_fast(const rfs_map_t *m, const uint8_t *fwd,
-                                      const uint8_t *row, const uint8_t *lim, uint32_t ws,
-                                      int32_t k, int32_t from, bands_t bd, int32_t nb,
-                                      int32_t ie, bool flip, bool look)
+/* Bits from..from + n (n > 24) of a row: as walk_bits, every four-byte load from the
+ * row's cells inside the grid. */
+__attribute__((noinline)) static uint32_t row_bits_long(const uint8_t *row, uint32_t ws,
+                                                        uint32_t from, uint32_t n)
+{
+    return walk_bits(row, (const uint8_t *)UINTPTR_MAX, ws, from, n + 1u);
+}
+
+/* Bits from..end of a row (from <= end), every four-byte load from the row's cells inside
+ * the grid: the band's bits shifted down to bit 0, a run starting at each wall bit whose
+ * predecessor is free. */
+static inline uint32_t row_bits(const uint8_t *row, uint32_t ws, int32_t from, int32_t end)
+{
+    const uint32_t n = (uint32_t)(end - from); /* bits - 1 */
+    if (n > 24u) {
+        return row_bits_long(row, ws, (uint32_t)from, n);
+    }
+    const uint8_t *p = row + ((uint32_t)from >> 3);
+    uint32_t w = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+    w = (w << (31u - ((uint32_t)from & 7u) - n)) >> (31u - n);
+    for (uint32_t st = w & ~((w << 1) | (ws & 1u)); st != 0u; st &= st - 1u) {
+        ws += WALK_RUN;
+    }
+    return (ws & ~1u) | (w >> n);
+}
+
+/* A shallow walk on the map whose crossings miss every cell corner, every four-byte load
+ * from a row's cells inside the grid: from row pointer row (rstep bytes a band) and
+ * column from, nb crossings (bands_t bd), then the last band to column ie; each band's
+ * bits read at once (the Cortex-M4's walk: few live values; blocks would not pay, a band
+ * of a few cells enters another block every band or two). */
+__attribute__((noinline)) static uint32_t walk_rows(const uint8_t *row, int32_t rstep,
+                                                    uint32_t ws, int32_t from, bands_t bd,
+                                                    int32_t nb, int32_t ie)
+{
+    int32_t hi = bd.hi;
+    uint32_t u = bd.u;
+    for (const uint8_t *last = row + nb * rstep; row != last; row += rstep) {
+        ws = row_bits(row, ws, from, hi);
+        from = hi;
+        BANDS_NEXT(hi, u, bd);
+    }
+    return row_bits(row, ws, from, ie);
+}
+
+/* walk_rows() with a host grid (fwd, or the wall-distance grid), k the first band: a
+ * band's cells inside the free square last found (free_ahead, looked up again when a band
+ * starts outside it) are passed over, the bands wholly inside it in a tight loop. */
+__attribute__((noinline)) static uint32_t walk_rows_look(const rfs_map_t *m, const uint8_t *fwd,
+                                                         const uint8_t *row, uint32_t ws,
+                                                         int32_t k, int32_t from, bands_t bd,
+                                                         int32_t nb, int32_t ie, bool flip)
 {
     const int32_t rstep = flip ? -(int32_t)m->stride : (int32_t)m->stride;
     int32_t hi = bd.hi, fx1 = INT32_MIN, fy1 = INT32_MIN;
@@ -255,42 +286,28 @@ __attribute__((always_inline)) static inline uint32_t walk_rows_fast(const rfs_m
     uint32_t u = bd.u;
     for (;;) {
         int32_t end = nb == 0 ? ie : hi;
-        if (look) {
-            if (k > fy1 || from > fx1) {
-                free = free_ahead(m, 0, fwd, from, k, flip, &fx1, &fy1);
-            }
-            if (free && end <= fx1) {
-                ws &= ~1u;
-                do {
-                    if (nb-- == 0) {
-                        return ws;
-                    }
-                    from = hi;
-                    BANDS_NEXT(hi, u, bd);
-                    k++;
-                    row += rstep;
-                    end = nb == 0 ? ie : hi;
-                } while (k <= fy1 && end <= fx1);
-                continue;
-            }
-            if (free) {
-                ws &= ~1u;
-                from = fx1 + 1;
-            }
+        if (k > fy1 || from > fx1) {
+            free = free_ahead(m, fwd, from, k, flip, &fx1, &fy1);
         }
-        const uint32_t n = (uint32_t)(end - from); /* bits - 1 */
-        if (n > 24u) {
-            ws = walk_bits(row, lim, ws, (uint32_t)from, n + 1u);
-        } else {
-            const uint8_t *p = row + ((uint32_t)from >> 3);
-            uint32_t w = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 |
-                         (uint32_t)p[3] << 24;
-            w = (w >> ((uint32_t)from & 7u)) & (0xFFFFFFFFu >> (31u - n));
-            for (uint32_t st = w & ~((w << 1) | (ws & 1u)); st != 0u; st &= st - 1u) {
-                ws += WALK_RUN;
-            }
-            ws = (ws & ~1u) | (w >> n);
+        if (free && end <= fx1) {
+            ws &= ~1u;
+            do {
+                if (nb-- == 0) {
+                    return ws;
+                }
+                from = hi;
+                BANDS_NEXT(hi, u, bd);
+                k++;
+                row += rstep;
+                end = nb == 0 ? ie : hi;
+            } while (k <= fy1 && end <= fx1);
+            continue;
         }
+        if (free) {
+            ws &= ~1u;
+            from = fx1 + 1;
+        }
+        ws = row_bits(row, ws, from, end);
         if (nb-- == 0) {
             return ws;
         }
@@ -301,16 +318,48 @@ __attribute__((always_inline)) static inline uint32_t walk_rows_fast(const rfs_m
     }
 }
 
-/* A steep walk on the map whose crossings miss every cell corner, from column i, mirrored
- * row jlo: nb crossings (bands_t bd), then the last column to row je. With a forward or
- * wall-distance grid, a column's cells inside the free rectangle last found (free_ahead)
- * are passed over, and the columns wholly inside it in a tight loop. Of the rest, runs of
- * long_col rows or more go through walk_col (blocks b, the wall-distance grid), the
- * others a byte a cell. */
-__attribute__((always_inline)) static inline uint32_t walk_cols_fast(const rfs_map_t *m, const rfs_map_wall_blocks_t *b,
-                                      const uint8_t *fwd, uint32_t ws, int32_t i, int32_t jlo,
-                                      bands_t bd, int32_t nb, int32_t je, bool flip,
-                                      int32_t long_col, bool look)
+/* A steep walk on the map whose crossings miss every cell corner: from column i, mirrored
+ * row jlo, nb crossings (bands_t bd), then the last column to row je; columns of long_col
+ * rows or more through walk_col (blocks b), the others a byte a cell (the Cortex-M4's
+ * walk). */
+__attribute__((noinline)) static uint32_t walk_cols(const rfs_map_t *m,
+                                                    const rfs_map_wall_blocks_t *b, uint32_t ws,
+                                                    int32_t i, int32_t jlo, bands_t bd,
+                                                    int32_t nb, int32_t je, bool flip,
+                                                    int32_t long_col)
+{
+    const uint8_t *wall = m->wall;
+    const int32_t stride = (int32_t)m->stride, rstep = flip ? -stride : stride;
+    int32_t hi = bd.hi;
+    uint32_t u = bd.u;
+    for (;; i++) {
+        const int32_t end = nb == 0 ? je : hi;
+        if (end - jlo >= long_col) {
+            ws = walk_col(m, b, ws, i, jlo, end, flip);
+        } else {
+            const uint8_t *p = wall + (flip ? -1 - jlo : jlo) * stride + ((uint32_t)i >> 3);
+            const uint32_t sh = (uint32_t)i & 7u;
+            for (int32_t n = end - jlo; n >= 0; n--, p += rstep) {
+                ws = walk_one(ws, (*p >> sh) & 1u);
+            }
+        }
+        if (nb-- == 0) {
+            return ws;
+        }
+        jlo = hi;
+        BANDS_NEXT(hi, u, bd);
+    }
+}
+
+/* walk_cols() with a host grid (fwd, or the wall-distance grid): a column's cells inside
+ * the free square last found (free_ahead) are passed over, the columns wholly inside it
+ * in a tight loop; long columns through walk_col (the wall-distance grid, blocks b). */
+__attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m,
+                                                         const rfs_map_wall_blocks_t *b,
+                                                         const uint8_t *fwd, uint32_t ws,
+                                                         int32_t i, int32_t jlo, bands_t bd,
+                                                         int32_t nb, int32_t je, bool flip,
+                                                         int32_t long_col)
 {
     const int32_t stride = (int32_t)m->stride, rstep = flip ? -stride : stride;
     int32_t hi = bd.hi, fx1 = INT32_MIN, fy1 = INT32_MIN;
@@ -318,27 +367,25 @@ __attribute__((always_inline)) static inline uint32_t walk_cols_fast(const rfs_m
     uint32_t u = bd.u;
     for (;;) {
         int32_t end = nb == 0 ? je : hi, j = jlo;
-        if (look) {
-            if (i > fx1 || j > fy1) {
-                free = free_ahead(m, 0, fwd, i, j, flip, &fx1, &fy1);
-            }
-            if (free && end <= fy1) {
-                ws &= ~1u;
-                do {
-                    if (nb-- == 0) {
-                        return ws;
-                    }
-                    jlo = hi;
-                    BANDS_NEXT(hi, u, bd);
-                    i++;
-                    end = nb == 0 ? je : hi;
-                } while (i <= fx1 && end <= fy1);
-                continue;
-            }
-            if (free) {
-                ws &= ~1u;
-                j = fy1 + 1;
-            }
+        if (i > fx1 || j > fy1) {
+            free = free_ahead(m, fwd, i, j, flip, &fx1, &fy1);
+        }
+        if (free && end <= fy1) {
+            ws &= ~1u;
+            do {
+                if (nb-- == 0) {
+                    return ws;
+                }
+                jlo = hi;
+                BANDS_NEXT(hi, u, bd);
+                i++;
+                end = nb == 0 ? je : hi;
+            } while (i <= fx1 && end <= fy1);
+            continue;
+        }
+        if (free) {
+            ws &= ~1u;
+            j = fy1 + 1;
         }
         if (end - j >= long_col) {
             ws = walk_col(m, b, ws, i, j, end, flip);
@@ -358,109 +405,18 @@ __attribute__((always_inline)) static inline uint32_t walk_cols_fast(const rfs_m
     }
 }
 
-/* Bits from..from + n (n > 24) of a row, every four-byte load from its cells inside the
- * grid: as walk_bits. */
-__attribute__((noinline)) static uint32_t row_bits_long(const uint8_t *row, uint32_t ws,
-                                                        uint32_t from, uint32_t n)
-{
-    return walk_bits(row, (const uint8_t *)UINTPTR_MAX, ws, from, n + 1u);
-}
-
-/* Bits from..end of a row (from <= end), every four-byte load from its cells inside the
- * grid. */
-static inline uint32_t row_bits(const uint8_t *row, uint32_t ws, int32_t from, int32_t end)
-{
-    const uint32_t n = (uint32_t)(end - from); /* bits - 1 */
-    if (n > 24u) {
-        return row_bits_long(row, ws, (uint32_t)from, n);
-    }
-    const uint8_t *p = row + ((uint32_t)from >> 3);
-    uint32_t w = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-    w = (w << (31u - ((uint32_t)from & 7u) - n)) >> (31u - n);
-    for (uint32_t st = w & ~((w << 1) | (ws & 1u)); st != 0u; st &= st - 1u) {
-        ws += WALK_RUN;
-    }
-    return (ws & ~1u) | (w >> n);
-}
-
-/* walk_rows_fast() without a grid (the Cortex-M4's walk): the same cells, each band's
- * bits read at once, few live values. */
-__attribute__((noinline)) static uint32_t walk_rows_plain(const uint8_t *row, int32_t rstep,
-                                                          uint32_t ws, int32_t from, bands_t bd,
-                                                          int32_t nb, int32_t ie)
-{
-    int32_t hi = bd.hi;
-    uint32_t u = bd.u;
-    for (const uint8_t *last = row + nb * rstep; row != last; row += rstep) {
-        ws = row_bits(row, ws, from, hi);
-        from = hi;
-        BANDS_NEXT(hi, u, bd);
-    }
-    return row_bits(row, ws, from, ie);
-}
-
-/* walk_cols_fast() without a grid (the Cortex-M4's walk): the same cells, the byte of a
- * column's first cell carried over from the last cell of the one before. */
-__attribute__((noinline)) static uint32_t walk_cols_plain(const rfs_map_t *m,
-                                                          const rfs_map_wall_blocks_t *b,
-                                                          uint32_t ws, int32_t i, int32_t jlo,
-                                                          bands_t bd, int32_t nb, int32_t je,
-                                                          bool flip, int32_t long_col)
-{
-    const int32_t rstep = flip ? -(int32_t)m->stride : (int32_t)m->stride;
-    int32_t hi = bd.hi;
-    uint32_t u = bd.u;
-    for (;; i++) {
-        const int32_t end = nb == 0 ? je : hi;
-        if (end - jlo >= long_col) {
-            ws = walk_col(m, b, ws, i, jlo, end, flip);
-        } else {
-            const uint8_t *p = m->wall + (flip ? -1 - jlo : jlo) * (int32_t)m->stride +
-                               ((uint32_t)i >> 3);
-            const uint32_t sh = (uint32_t)i & 7u;
-            for (int32_t n = end - jlo; n >= 0; n--, p += rstep) {
-                ws = walk_one(ws, (*p >> sh) & 1u);
-            }
-        }
-        if (nb-- == 0) {
-            return ws;
-        }
-        jlo = hi;
-        BANDS_NEXT(hi, u, bd);
-    }
-}
-
-/* walk_rows_fast() and walk_cols_fast() with a grid to look free rectangles up in (the
- * forward or wall-distance grid, the host's). */
-__attribute__((noinline)) static uint32_t walk_rows_look(const rfs_map_t *m, const uint8_t *fwd,
-                                                         const uint8_t *row, const uint8_t *lim,
-                                                         uint32_t ws, int32_t k, int32_t from,
-                                                         bands_t bd, int32_t nb, int32_t ie,
-                                                         bool flip)
-{
-    return walk_rows_fast(m, fwd, row, lim, ws, k, from, bd, nb, ie, flip, true);
-}
-
-__attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m, const uint8_t *fwd,
-                                                         uint32_t ws, int32_t i, int32_t jlo,
-                                                         bands_t bd, int32_t nb, int32_t je,
-                                                         bool flip, int32_t long_col)
-{
-    return walk_cols_fast(m, 0, fwd, ws, i, jlo, bd, nb, je, flip, long_col, true);
-}
-
 /* The cells of traverse() (rfs_map.c) with the VISIT_WALLS visitor, in the same order
  * (the same endpoint swap and mirror; columns left to right, each column's rows in the
  * segment's y direction), counting runs of wall cells. Cells off the map are not walls:
  * columns -1 and w (first and last, when an endpoint lies on the map's edge) and rows -1
- * and h (a segment touching the bottom or top edge). The bands (bands_t) come from exact
- * 32-bit remainders, not traverse()'s 64-bit bounds. A shallow segment (0 < |dy| < |dx|)
- * is walked row by row over the row-major wall bits (a row's cells are a range of
- * columns, consecutive in traverse()'s order too); where it crosses a row at a cell
- * corner, traverse() takes the four cells round it column by column, and so does this
- * walk. Steeper ones go column by column, passing over wall-free blocks (b) or the free
- * cells a wall-distance grid promises in long columns. careful: cells off the map may
- * be on the walk (an endpoint on the map's edge).
+ * and h (a segment touching the bottom or top edge). The bands (bands_t) step in exact
+ * 32-bit remainders where traverse() compares 64-bit bounds. A shallow segment
+ * (0 < |dy| < |dx|) is walked row by row over the row-major wall bits: a row's cells are
+ * a range of columns, consecutive in traverse()'s order too, except where the segment
+ * crosses a row at a cell corner: traverse() takes the four cells round it column by
+ * column, and so does this walk. Steeper ones go column by column. careful: cells off
+ * the map may be on the walk (an endpoint on the map's edge); then, or when a crossing
+ * may meet a corner, the general loops below run, else the fast ones above.
  * Scaling and overflow: bands_init's; the count saturates at UINT16_MAX. */
 static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, int64_t X0,
                            int64_t Y0, int64_t X1, int64_t Y1)
@@ -493,8 +449,8 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
         if (!careful && !bd.on_edge &&
             (uint32_t)(jtop + 1) * m->stride + 3u <= (uint32_t)m->h * m->stride) {
             ws = fwd != 0 || m->wall_dist != 0
-                     ? walk_rows_look(m, fwd, row, lim, ws, k, from, bd, kb - k, ie, flip)
-                     : walk_rows_plain(row, rstep, ws, from, bd, kb - k, ie);
+                     ? walk_rows_look(m, fwd, row, ws, k, from, bd, kb - k, ie, flip)
+                     : walk_rows(row, rstep, ws, from, bd, kb - k, ie);
             return (uint16_t)((ws >> 1) > UINT16_MAX ? UINT16_MAX : (ws >> 1));
         }
         for (;; k++, row += rstep) {
@@ -531,8 +487,8 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
             bands_init(&bd, r, X0, Y0, dx, dy);
             if (!careful && !bd.on_edge) {
                 ws = fwd != 0 || m->wall_dist != 0
-                         ? walk_cols_look(m, fwd, ws, i, jlo, bd, ib - i, je, flip, long_col)
-                         : walk_cols_plain(m, b, ws, i, jlo, bd, ib - i, je, flip, long_col);
+                         ? walk_cols_look(m, b, fwd, ws, i, jlo, bd, ib - i, je, flip, long_col)
+                         : walk_cols(m, b, ws, i, jlo, bd, ib - i, je, flip, long_col);
                 return (uint16_t)((ws >> 1) > UINT16_MAX ? UINT16_MAX : (ws >> 1));
             }
         }

@@ -8,7 +8,6 @@
 #include <string.h>
 
 #include "rfs_fix.h"
-#include "rfs_map_internal.h"
 
 static int64_t clamp64(int64_t v, int64_t lo, int64_t hi)
 {
@@ -54,25 +53,47 @@ typedef struct bands {
     bool on_edge; /* v == 0: a crossing with u == 0 lies on a cell corner */
 } bands_t;
 
-/* The first crossing, at p = (k0 + 1) r, k0 = rfs_map_low_cell(p0): t0 = (k0 + 1) r - p0
- * in [0, r); q_c dp = q0 dp + t0 dq. With g = floor(q0 / r), f = q0 - g r:
- * n = f dp + t0 dq < r (dp + dq), q_c / r = g + n / (r dp).
- * Scaling and overflow: |p0|, |q0| <= 2^30 and dp, dq <= 2^30 (the map's extent), so
- * n < 2^61 and floor(n / r) < dp + dq <= 2^31 (div_q32). */
-static void bands_init(bands_t *bd, int32_t r, int64_t p0, int64_t q0, int64_t dp, int64_t dq)
+/* A coordinate of the mirrored frame, v = c r + f: its cell c = floor(v / r) and offset
+ * f in [0, r); its lowest touching cell (rfs_map_low_cell) is c - 1 when f == 0. */
+typedef struct pos {
+    int32_t c; /* cells */
+    uint32_t f; /* Q16, 0 .. r - 1 */
+} pos_t;
+
+/* The position of v = V or -V (neg), V < 2^31: one 32-bit division. */
+static inline pos_t pos_of(uint32_t v, bool neg, uint32_t r)
 {
-    const int32_t k0 = rfs_map_low_cell(p0, r);
-    const uint32_t t0 = (uint32_t)(((int64_t)k0 + 1) * r - p0);
-    const int32_t g = rfs_map_fdiv(q0, r);
-    const uint32_t f = (uint32_t)(q0 - (int64_t)g * r);
-    const uint64_t n = (uint64_t)f * (uint64_t)dp + (uint64_t)t0 * (uint64_t)dq;
-    const uint32_t nr = div_q32(n, (uint32_t)r); /* floor(n / r) */
-    bd->dp = (uint32_t)dp;
-    bd->hi = g + (int32_t)(nr / bd->dp);
-    bd->u = nr % bd->dp;
-    bd->on_edge = n == (uint64_t)nr * (uint32_t)r;
-    bd->a = (int32_t)((uint32_t)dq / bd->dp);
-    bd->s = (uint32_t)dq % bd->dp;
+    const uint32_t q = v / r, f = v - q * r;
+    pos_t p = {(int32_t)q, f};
+    if (neg) {
+        p.c = -(int32_t)q - (f != 0u ? 1 : 0);
+        p.f = f != 0u ? r - f : 0u;
+    }
+    return p;
+}
+
+/* The lowest cell touching v. */
+static inline int32_t pos_low(pos_t p)
+{
+    return p.c - (p.f == 0u ? 1 : 0);
+}
+
+/* The first crossing, at p = (k0 + 1) r, k0 = pos_low(p0): t0 = (k0 + 1) r - p0 in
+ * [0, r) (r - f, or 0 on a cell edge); q_c dp = q0 dp + t0 dq, so with q0 = g r + f:
+ * n = f dp + t0 dq < r (dp + dq), q_c / r = g + n / (r dp).
+ * Scaling and overflow: dp, dq <= 2^30 (the map's extent), so n < 2^61 and
+ * floor(n / r) < dp + dq <= 2^31 (div_q32). */
+static void bands_init(bands_t *bd, uint32_t r, pos_t p0, pos_t q0, uint32_t dp, uint32_t dq)
+{
+    const uint32_t t0 = p0.f != 0u ? r - p0.f : 0u;
+    const uint64_t n = (uint64_t)q0.f * dp + (uint64_t)t0 * dq;
+    const uint32_t nr = div_q32(n, r); /* floor(n / r) */
+    bd->dp = dp;
+    bd->hi = q0.c + (int32_t)(nr / dp);
+    bd->u = nr % dp;
+    bd->on_edge = n == (uint64_t)nr * r;
+    bd->a = (int32_t)(dq / dp);
+    bd->s = dq % dp;
 }
 
 /* Whether the crossing now lies on a cell corner. */
@@ -418,33 +439,30 @@ __attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m,
  * the map may be on the walk (an endpoint on the map's edge); then, or when a crossing
  * may meet a corner, the general loops below run, else the fast ones above.
  * Scaling and overflow: bands_init's; the count saturates at UINT16_MAX. */
-static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, int64_t X0,
-                           int64_t Y0, int64_t X1, int64_t Y1)
+static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uint32_t X0,
+                           uint32_t Y0, uint32_t X1, uint32_t Y1)
 {
-    const int32_t r = m->res;
+    const uint32_t r = (uint32_t)m->res;
     if (X1 < X0 || (X1 == X0 && Y1 < Y0)) {
-        int64_t t = X0; X0 = X1; X1 = t;
+        uint32_t t = X0; X0 = X1; X1 = t;
         t = Y0; Y0 = Y1; Y1 = t;
     }
     const bool flip = Y1 < Y0;
-    const bool careful = (flip ? Y1 : Y0) <= 0 || (flip ? Y0 : Y1) >= (int64_t)m->h * r ||
-                         X0 <= 0 || X1 >= (int64_t)m->w * r;
-    if (flip) {
-        Y0 = -Y0;
-        Y1 = -Y1;
-    }
-    const int64_t dx = X1 - X0;
-    const int64_t dy = Y1 - Y0;
+    const bool careful = (flip ? Y1 : Y0) == 0u || (flip ? Y0 : Y1) == m->h * r || X0 == 0u ||
+                         X1 == m->w * r;
+    const uint32_t dx = X1 - X0, dy = flip ? Y0 - Y1 : Y1 - Y0;
+    const pos_t x0 = pos_of(X0, false, r), x1 = pos_of(X1, false, r);
+    const pos_t y0 = pos_of(Y0, flip, r), y1 = pos_of(Y1, flip, r); /* mirrored */
     const int32_t rstep = flip ? -(int32_t)m->stride : (int32_t)m->stride;
     const uint8_t *fwd = m->wall_fwd != 0 ? m->wall_fwd + (flip ? (size_t)m->w * m->h : 0u) : 0;
     uint32_t ws = 0u;
     bands_t bd = {0, 0u, 1u, 0u, 0, false};
-    if (dy != 0 && dy < dx) {
-        const int32_t kb = rfs_map_fdiv(Y1, r), ie = rfs_map_fdiv(X1, r);
-        int32_t k = rfs_map_low_cell(Y0, r), from = rfs_map_low_cell(X0, r);
+    if (dy != 0u && dy < dx) {
+        const int32_t kb = y1.c, ie = x1.c;
+        int32_t k = pos_low(y0), from = pos_low(x0);
         const uint8_t *lim = m->wall + (uint32_t)m->h * m->stride - 4;
         const uint8_t *row = m->wall + (int32_t)(flip ? -1 - k : k) * (int32_t)m->stride;
-        bands_init(&bd, r, Y0, X0, dy, dx);
+        bands_init(&bd, r, y0, x0, dy, dx);
         const int32_t jtop = flip ? -1 - k : kb; /* the highest real row */
         if (!careful && !bd.on_edge &&
             (uint32_t)(jtop + 1) * m->stride + 3u <= (uint32_t)m->h * m->stride) {
@@ -481,10 +499,10 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
         }
     } else {
         const int32_t long_col = b != 0 ? (int32_t)1 << b->shift : (m->wall_dist != 0 ? 3 : INT32_MAX);
-        const int32_t ib = rfs_map_fdiv(X1, r), je = rfs_map_fdiv(Y1, r);
-        int32_t i = rfs_map_low_cell(X0, r), jlo = rfs_map_low_cell(Y0, r);
-        if (dx != 0) {
-            bands_init(&bd, r, X0, Y0, dx, dy);
+        const int32_t ib = x1.c, je = y1.c;
+        int32_t i = pos_low(x0), jlo = pos_low(y0);
+        if (dx != 0u) {
+            bands_init(&bd, r, x0, y0, dx, dy);
             if (!careful && !bd.on_edge) {
                 ws = fwd != 0 || m->wall_dist != 0
                          ? walk_cols_look(m, b, fwd, ws, i, jlo, bd, ib - i, je, flip, long_col)
@@ -494,7 +512,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
         }
         for (;; i++) {
             const bool last = i >= ib;
-            const int32_t hi = dx == 0 || last ? je : bd.hi;
+            const int32_t hi = dx == 0u || last ? je : bd.hi;
             if (careful || hi - jlo >= long_col) {
                 ws = walk_col(m, b, ws, i, jlo, hi, flip);
             } else {
@@ -508,7 +526,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, i
             if (last) {
                 break;
             }
-            if (dx != 0) {
+            if (dx != 0u) {
                 jlo = bd.hi - (bands_corner(&bd) ? 1 : 0);
                 bands_step(&bd);
             }
@@ -578,10 +596,11 @@ uint16_t rfs_map_walls_crossed_blocks(const rfs_map_t *m, const rfs_map_wall_blo
      * the clamp moves them along the axes, an approximation documented in MAPS.md). */
     int64_t we = (int64_t)m->w * m->res;
     int64_t he = (int64_t)m->h * m->res;
-    return walls_walk(m, m->wall_dist != 0 ? 0 : b, clamp64((int64_t)x0 - m->origin_x, 0, we),
-                      clamp64((int64_t)y0 - m->origin_y, 0, he),
-                      clamp64((int64_t)x1 - m->origin_x, 0, we),
-                      clamp64((int64_t)y1 - m->origin_y, 0, he));
+    return walls_walk(m, m->wall_dist != 0 ? 0 : b,
+                      (uint32_t)clamp64((int64_t)x0 - m->origin_x, 0, we),
+                      (uint32_t)clamp64((int64_t)y0 - m->origin_y, 0, he),
+                      (uint32_t)clamp64((int64_t)x1 - m->origin_x, 0, we),
+                      (uint32_t)clamp64((int64_t)y1 - m->origin_y, 0, he));
 }
 
 int rfs_map_wall_blocks(const rfs_map_t *m, uint8_t *buf, uint32_t bytes,

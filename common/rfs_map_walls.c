@@ -102,6 +102,51 @@ static inline bool bands_corner(const bands_t *bd)
     return bd->on_edge && bd->u == 0u;
 }
 
+/* (a b) mod m for a, b < m < 2^31. Scaling and overflow: the product is below 2^62 and its
+ * quotient by m below 2^31 (div_q32). */
+static uint32_t mul_mod(uint32_t a, uint32_t b, uint32_t m)
+{
+    const uint64_t p = (uint64_t)a * b;
+    return (uint32_t)(p - (uint64_t)div_q32(p, m) * m);
+}
+
+/* Whether one of the first nb crossings lies on a cell corner (v == 0): u + k s = 0
+ * (mod dp) for some 0 <= k < nb. With g = gcd(s, dp) dividing dp - u, the least such k is
+ * ((dp - u) / g) (s / g)^-1 mod (dp / g) (extended Euclid). Scaling and overflow: the
+ * Bezout coefficients stay within dp < 2^31 in magnitude. */
+static bool meet_corner(const bands_t *bd, int32_t nb)
+{
+    if (nb <= 0) {
+        return false;
+    }
+    if (bd->u == 0u) {
+        return true;
+    }
+    int64_t r0 = bd->s, r1 = bd->dp, x0 = 1, x1 = 0; /* r0 = x0 s (mod dp) */
+    while (r1 != 0) {
+        const int64_t q = (int64_t)((uint32_t)r0 / (uint32_t)r1);
+        const int64_t r2 = r0 - q * r1, x2 = x0 - q * x1;
+        r0 = r1;
+        r1 = r2;
+        x0 = x1;
+        x1 = x2;
+    }
+    const uint32_t g = (uint32_t)r0, need = bd->dp - bd->u;
+    if (g == 0u || need % g != 0u) {
+        return false; /* s == 0: u never moves from its nonzero start */
+    }
+    const uint32_t mg = bd->dp / g;
+    const int64_t inv = x0 % (int64_t)mg;
+    const uint32_t k = mul_mod((need / g) % mg, (uint32_t)(inv < 0 ? inv + (int64_t)mg : inv), mg);
+    return k < (uint32_t)nb;
+}
+
+/* meet_corner() when a crossing may lie on a corner at all (v == 0). */
+static inline bool bands_meet_corner(const bands_t *bd, int32_t nb)
+{
+    return bd->on_edge && meet_corner(bd, nb);
+}
+
 /* To the next crossing. */
 static inline void bands_step(bands_t *bd)
 {
@@ -464,7 +509,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, u
         const uint8_t *row = m->wall + (int32_t)(flip ? -1 - k : k) * (int32_t)m->stride;
         bands_init(&bd, r, y0, x0, dy, dx);
         const int32_t jtop = flip ? -1 - k : kb; /* the highest real row */
-        if (!careful && !bd.on_edge &&
+        if (!careful && !bands_meet_corner(&bd, kb - k) &&
             (uint32_t)(jtop + 1) * m->stride + 3u <= (uint32_t)m->h * m->stride) {
             ws = fwd != 0 || m->wall_dist != 0
                      ? walk_rows_look(m, fwd, row, ws, k, from, bd, kb - k, ie, flip)
@@ -503,7 +548,7 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, u
         int32_t i = pos_low(x0), jlo = pos_low(y0);
         if (dx != 0u) {
             bands_init(&bd, r, x0, y0, dx, dy);
-            if (!careful && !bd.on_edge) {
+            if (!careful && !bands_meet_corner(&bd, ib - i)) {
                 ws = fwd != 0 || m->wall_dist != 0
                          ? walk_cols_look(m, b, fwd, ws, i, jlo, bd, ib - i, je, flip, long_col)
                          : walk_cols(m, b, ws, i, jlo, bd, ib - i, je, flip, long_col);

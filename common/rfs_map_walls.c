@@ -112,8 +112,8 @@ static uint32_t mul_mod(uint32_t a, uint32_t b, uint32_t m)
 
 /* Whether one of the first nb crossings lies on a cell corner (v == 0): u + k s = 0
  * (mod dp) for some 0 <= k < nb. With g = gcd(s, dp) dividing dp - u, the least such k is
- * ((dp - u) / g) (s / g)^-1 mod (dp / g) (extended Euclid). Scaling and overflow: the
- * Bezout coefficients stay within dp < 2^31 in magnitude. */
+ * ((dp - u) / g) (s / g)^-1 mod (dp / g) (extended Euclid, 32-bit divisions). Scaling and
+ * overflow: the Bezout coefficients stay within dp / g < 2^31 in magnitude. */
 static bool meet_corner(const bands_t *bd, int32_t nb)
 {
     if (nb <= 0) {
@@ -135,9 +135,9 @@ static bool meet_corner(const bands_t *bd, int32_t nb)
     if (g == 0u || need % g != 0u) {
         return false; /* s == 0: u never moves from its nonzero start */
     }
-    const uint32_t mg = bd->dp / g;
-    const int64_t inv = x0 % (int64_t)mg;
-    const uint32_t k = mul_mod((need / g) % mg, (uint32_t)(inv < 0 ? inv + (int64_t)mg : inv), mg);
+    const uint32_t mg = bd->dp / g; /* |x0| <= mg: one step into 0 .. mg - 1 */
+    const int64_t inv = x0 < 0 ? x0 + (int64_t)mg : (x0 >= (int64_t)mg ? x0 - (int64_t)mg : x0);
+    const uint32_t k = mul_mod((need / g) % mg, (uint32_t)inv, mg);
     return k < (uint32_t)nb;
 }
 

@@ -132,10 +132,10 @@ static bool meet_corner(const bands_t *bd, int32_t nb)
         x1 = x2;
     }
     const uint32_t g = (uint32_t)r0, need = bd->dp - bd->u;
-    if (g == 0u || need % g != 0u) {
+    const uint32_t mg = g != 0u ? bd->dp / g : 0u; /* |x0| <= mg: one step into 0 .. mg - 1 */
+    if (mg == 0u || need % g != 0u) {
         return false; /* s == 0: u never moves from its nonzero start */
     }
-    const uint32_t mg = bd->dp / g; /* |x0| <= mg: one step into 0 .. mg - 1 */
     const int64_t inv = x0 < 0 ? x0 + (int64_t)mg : (x0 >= (int64_t)mg ? x0 - (int64_t)mg : x0);
     const uint32_t k = mul_mod((need / g) % mg, (uint32_t)inv, mg);
     return k < (uint32_t)nb;
@@ -179,7 +179,7 @@ static inline uint32_t walk_cell(const rfs_map_t *m, uint32_t ws, int32_t i, int
 static inline uint32_t walk_bits(const uint8_t *row, const uint8_t *lim, uint32_t ws, uint32_t lo,
                                  uint32_t n)
 {
-    for (;;) {
+    while (n != 0u) {
         const uint8_t *p = row + (lo >> 3);
         uint32_t w = 0u;
         if (p <= lim) {
@@ -190,18 +190,16 @@ static inline uint32_t walk_bits(const uint8_t *row, const uint8_t *lim, uint32_
             }
         }
         w >>= lo & 7u; /* 25 bits or more left: the ones wanted */
-        const uint32_t t = n <= 25u ? n : 24u;
-        w &= 0xFFFFFFFFu >> (32u - t);
+        const uint32_t t = n <= 25u ? n : 24u; /* bits taken, 1 .. 25 */
+        w &= 0x1FFFFFFu >> (25u - t);
         for (uint32_t st = w & ~((w << 1) | (ws & 1u)); st != 0u; st &= st - 1u) {
             ws += WALK_RUN;
         }
-        ws = (ws & ~1u) | ((w >> (t - 1u)) & 1u);
-        if (n == t) {
-            return ws;
-        }
+        ws = (ws & ~1u) | (((w << 1) >> t) & 1u); /* bit t - 1 */
         n -= t;
         lo += t;
     }
+    return ws;
 }
 
 /* Columns lo..hi (lo <= hi) of real row jr, any of them off the map (not walls). */

@@ -174,18 +174,19 @@ static inline uint32_t walk_cell(const rfs_map_t *m, uint32_t ws, int32_t i, int
 }
 
 /* Bits lo .. lo + n - 1 (n >= 1) of a row of the wall grid, in order, up to 24 at a time:
- * a run starts at each wall bit whose predecessor is free. lim: the grid's last byte
- * minus 3 (four bytes load at once up to there, the last ones one by one). */
-static inline uint32_t walk_bits(const uint8_t *row, const uint8_t *lim, uint32_t ws, uint32_t lo,
+ * a run starts at each wall bit whose predecessor is free. avail: the grid's bytes from
+ * the row's first on (four load at once while there, the last ones one by one). */
+static inline uint32_t walk_bits(const uint8_t *row, uint32_t avail, uint32_t ws, uint32_t lo,
                                  uint32_t n)
 {
     while (n != 0u) {
-        const uint8_t *p = row + (lo >> 3);
+        const uint32_t b = lo >> 3;
+        const uint8_t *p = row + b;
         uint32_t w = 0u;
-        if (p <= lim) {
+        if (avail >= 4u && b <= avail - 4u) {
             w = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
         } else {
-            for (uint32_t k = 0u; p + k <= lim + 3; k++) {
+            for (uint32_t k = 0u; b + k < avail && k < 4u; k++) {
                 w |= (uint32_t)p[k] << (8u * k);
             }
         }
@@ -214,7 +215,7 @@ static uint32_t walk_row(const rfs_map_t *m, uint32_t ws, int32_t jr, int32_t lo
         lo = 0;
     }
     hi = after ? (int32_t)m->w - 1 : hi;
-    ws = walk_bits(m->wall + (uint32_t)jr * m->stride, m->wall + (uint32_t)m->h * m->stride - 4,
+    ws = walk_bits(m->wall + (uint32_t)jr * m->stride, ((uint32_t)m->h - (uint32_t)jr) * m->stride,
                    ws, (uint32_t)lo, (uint32_t)(hi - lo + 1));
     return after ? ws & ~1u : ws;
 }
@@ -296,7 +297,7 @@ static inline bool free_ahead(const rfs_map_t *m, const uint8_t *fwd, int32_t i,
 __attribute__((noinline)) static uint32_t row_bits_long(const uint8_t *row, uint32_t ws,
                                                         uint32_t from, uint32_t n)
 {
-    return walk_bits(row, (const uint8_t *)UINTPTR_MAX, ws, from, n + 1u);
+    return walk_bits(row, UINT32_MAX, ws, from, n + 1u);
 }
 
 /* Bits from..end of a row (from <= end), every four-byte load from the row's cells inside
@@ -503,25 +504,23 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, u
     if (dy != 0u && dy < dx) {
         const int32_t kb = y1.c, ie = x1.c;
         int32_t k = pos_low(y0), from = pos_low(x0);
-        const uint8_t *lim = m->wall + (uint32_t)m->h * m->stride - 4;
-        const uint8_t *row = m->wall + (int32_t)(flip ? -1 - k : k) * (int32_t)m->stride;
         bands_init(&bd, r, y0, x0, dy, dx);
         const int32_t jtop = flip ? -1 - k : kb; /* the highest real row */
         if (!careful && !bands_meet_corner(&bd, kb - k) &&
             (uint32_t)(jtop + 1) * m->stride + 3u <= (uint32_t)m->h * m->stride) {
+            const uint8_t *row = m->wall + (uint32_t)(flip ? -1 - k : k) * m->stride;
             ws = fwd != 0 || m->wall_dist != 0
                      ? walk_rows_look(m, fwd, row, ws, k, from, bd, kb - k, ie, flip)
                      : walk_rows(row, rstep, ws, from, bd, kb - k, ie);
             return (uint16_t)((ws >> 1) > UINT16_MAX ? UINT16_MAX : (ws >> 1));
         }
-        for (;; k++, row += rstep) {
+        for (;; k++) {
             const bool last = k == kb;
             const bool corner = !last && bands_corner(&bd);
             const int32_t hi = last ? ie : bd.hi;
             const int32_t end = corner ? hi - 2 : hi;
             if (from <= end) {
-                ws = careful ? walk_row(m, ws, flip ? -1 - k : k, from, end)
-                             : walk_bits(row, lim, ws, (uint32_t)from, (uint32_t)(end - from + 1));
+                ws = walk_row(m, ws, flip ? -1 - k : k, from, end);
             }
             if (last) {
                 break;

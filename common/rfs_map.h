@@ -129,7 +129,7 @@ uint16_t rfs_map_walls_crossed(const rfs_map_t *m, rfs_q16_t x0, rfs_q16_t y0, r
 
 /// Which blocks of 2^shift x 2^shift cells of a map hold a wall cell, one bit each (bit
 /// (bi, bj) as rfs_map_bit): lets rfs_map_walls_crossed_blocks() pass over wall-free
-/// blocks without reading their cells.
+/// blocks in long columns without reading their cells.
 typedef struct rfs_map_wall_blocks {
     uint8_t shift;       ///< log2 of the block side, cells (>= 3: a block is whole bytes)
     uint16_t bw;         ///< blocks along x
@@ -144,8 +144,8 @@ typedef struct rfs_map_wall_blocks {
 int rfs_map_wall_blocks(const rfs_map_t *m, uint8_t *buf, uint32_t bytes,
                         rfs_map_wall_blocks_t *b);
 
-/// rfs_map_walls_crossed() of the same map, equal for every segment, reading only the
-/// cells of blocks that hold a wall (b from rfs_map_wall_blocks() of that map).
+/// rfs_map_walls_crossed() of the same map, equal for every segment, passing over
+/// wall-free blocks in long columns (b from rfs_map_wall_blocks() of that map).
 uint16_t rfs_map_walls_crossed_blocks(const rfs_map_t *m, const rfs_map_wall_blocks_t *b,
                                       rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1);
 

@@ -1,257 +1,581 @@
 /* rfs_map_walls.c - walls crossed by a segment: runs of wall cells along the exact
- * supercover traversal of rfs_map.c, with the two accelerations a caller may attach, the
- * wall-block grid and the wall-distance grid (docs/MAPS.md, "The core's grids").
+ * supercover traversal of rfs_map.c, with the accelerations a caller may attach, the
+ * wall-block grid and the host's wall-distance and forward grids (docs/MAPS.md, "The
+ * core's grids").
  */
 #include "rfs_map.h"
 
 #include <string.h>
 
 #include "rfs_fix.h"
-#include "rfs_map_internal.h"
 
 static int64_t clamp64(int64_t v, int64_t lo, int64_t hi)
 {
     return v < lo ? lo : (v > hi ? hi : v);
 }
 
-/* Whether the block column holding column i (on the map) has a wall block among the rows
- * ra..rb (real rows, ra <= rb; the parts off the map have none). */
-static bool blocks_hold_wall(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, int32_t i,
-                             int32_t ra, int32_t rb)
+/* floor(n / d) for d > 0 and a quotient below 2^32: two 32-bit divisions when d < 2^16
+ * and n < 2^48, else bit by bit (the core links no 64-bit division helper).
+ * Scaling and overflow: the high digit qh = floor(n / 2^16 / d) < 2^16 as the quotient
+ * is below 2^32; the low dividend (remainder < d < 2^16, shifted 16) stays in 32 bits. */
+static uint32_t div_q32(uint64_t n, uint32_t d)
 {
-    ra = ra < 0 ? 0 : ra;
-    rb = rb >= (int32_t)m->h ? (int32_t)m->h - 1 : rb;
-    const uint16_t bi = (uint16_t)((uint32_t)i >> b->shift);
-    for (int32_t bj = ra >> b->shift; bj <= (rb >> b->shift) && ra <= rb; ++bj) {
-        if (rfs_map_bit(b->bits, b->stride, bi, (uint16_t)bj)) {
-            return true;
+    if (d < 65536u && n < ((uint64_t)1 << 48)) {
+        const uint32_t hi = (uint32_t)(n >> 16);
+        const uint32_t qh = hi / d;
+        const uint32_t lo = ((hi - qh * d) << 16) | (uint32_t)(n & 0xFFFFu);
+        return (qh << 16) + lo / d;
+    }
+    uint32_t q = 0u;
+    for (int32_t k = 31; k >= 0; --k) {
+        if (((uint64_t)d << k) <= n) {
+            n -= (uint64_t)d << k;
+            q |= 1u << k;
         }
     }
-    return false;
+    return q;
 }
 
-/* The state of a wall walk: runs of wall cells so far, and whether the last cell visited
- * was a wall. */
-typedef struct walk {
-    uint32_t runs;
-    bool in_wall;
-} walk_t;
+/* The bands a segment's cells fall into across one axis (the along axis p: its columns,
+ * or its rows), in the mirrored frame (both extents >= 0): band k holds the cells lo..hi
+ * of the other axis q, hi the cell where the segment leaves the band at p = (k + 1) r,
+ * q_c there. Exactly: q_c / r = hi + (r u + v) / (r dp), 0 <= u < dp, 0 <= v < r. From
+ * one crossing to the next q_c grows by r dq / dp, a = floor(dq / dp) cells and s / dp
+ * of one (s = dq mod dp), so u steps in 32 bits (v, a multiple of r apart, never moves):
+ * a carry when u + s >= dp. A crossing lies on a cell corner when u == 0 and v == 0
+ * (then the next band starts a cell before hi). */
+typedef struct bands {
+    int32_t hi;   /* cells: the band's last cell along q, at the crossing */
+    uint32_t u;   /* the crossing's remainder, 0 .. dp - 1 */
+    uint32_t dp;  /* the segment's extent along p, Q16 (> 0) */
+    uint32_t s;   /* dq mod dp */
+    int32_t a;    /* floor(dq / dp) */
+    bool on_edge; /* v == 0: a crossing with u == 0 lies on a cell corner */
+} bands_t;
 
-/* Visit rows jlo..jhi (walk order) of column i (on the map). step: bytes from one row to
- * the next in walk order, flip: walk rows run down the map, slow: the column needs the
- * careful walk (edge: rows -1 and h, which are not walls, may be among its rows; or with
- * blocks b it is long enough that a wall-free block's cells are passed over at once). */
-static inline void walk_column(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, walk_t *wk,
-                               int32_t i, int32_t jlo, int32_t jhi, bool flip, int32_t step,
-                               bool slow)
+/* A coordinate of the mirrored frame, v = c r + f: its cell c = floor(v / r) and offset
+ * f in [0, r); its lowest touching cell (rfs_map_low_cell) is c - 1 when f == 0. */
+typedef struct pos {
+    int32_t c; /* cells */
+    uint32_t f; /* Q16, 0 .. r - 1 */
+} pos_t;
+
+/* The position of v = V or -V (neg), V < 2^31: one 32-bit division. */
+static inline pos_t pos_of(uint32_t v, bool neg, uint32_t r)
 {
-    const uint8_t mask = (uint8_t)(1u << (i & 7));
-    if (slow) {
-        const int32_t bs = b != 0 ? (int32_t)1 << b->shift : 0;
-        const uint8_t *wd = m->wall_dist;
-        for (int32_t j = jlo; j <= jhi; j++) {
-            const int32_t jr = flip ? -1 - j : j;
-            if (jr < 0 || jr >= (int32_t)m->h) {
-                wk->in_wall = false;
-                continue;
+    const uint32_t q = v / r, f = v - q * r;
+    pos_t p = {(int32_t)q, f};
+    if (neg) {
+        p.c = -(int32_t)q - (f != 0u ? 1 : 0);
+        p.f = f != 0u ? r - f : 0u;
+    }
+    return p;
+}
+
+/* The lowest cell touching v. */
+static inline int32_t pos_low(pos_t p)
+{
+    return p.c - (p.f == 0u ? 1 : 0);
+}
+
+/* The first crossing, at p = (k0 + 1) r, k0 = pos_low(p0): t0 = (k0 + 1) r - p0 in
+ * [0, r) (r - f, or 0 on a cell edge); q_c dp = q0 dp + t0 dq, so with q0 = g r + f:
+ * n = f dp + t0 dq < r (dp + dq), q_c / r = g + n / (r dp).
+ * Scaling and overflow: dp, dq <= 2^30 (the map's extent), so n < 2^61 and
+ * floor(n / r) < dp + dq <= 2^31 (div_q32). */
+static void bands_init(bands_t *bd, uint32_t r, pos_t p0, pos_t q0, uint32_t dp, uint32_t dq)
+{
+    const uint32_t t0 = p0.f != 0u ? r - p0.f : 0u;
+    const uint64_t n = (uint64_t)q0.f * dp + (uint64_t)t0 * dq;
+    const uint32_t nr = div_q32(n, r); /* floor(n / r) */
+    bd->dp = dp;
+    bd->hi = q0.c + (int32_t)(nr / dp);
+    bd->u = nr % dp;
+    bd->on_edge = n == (uint64_t)nr * r;
+    bd->a = (int32_t)(dq / dp);
+    bd->s = dq % dp;
+}
+
+/* Whether the crossing now lies on a cell corner. */
+static inline bool bands_corner(const bands_t *bd)
+{
+    return bd->on_edge && bd->u == 0u;
+}
+
+/* (a b) mod m for a, b < m < 2^31. Scaling and overflow: the product is below 2^62 and its
+ * quotient by m below 2^31 (div_q32). */
+static uint32_t mul_mod(uint32_t a, uint32_t b, uint32_t m)
+{
+    const uint64_t p = (uint64_t)a * b;
+    return (uint32_t)(p - (uint64_t)div_q32(p, m) * m);
+}
+
+/* Whether one of the first nb crossings lies on a cell corner (v == 0): u + k s = 0
+ * (mod dp) for some 0 <= k < nb. With g = gcd(s, dp) dividing dp - u, the least such k is
+ * ((dp - u) / g) (s / g)^-1 mod (dp / g) (extended Euclid, 32-bit divisions). Scaling and
+ * overflow: the Bezout coefficients stay within dp / g < 2^31 in magnitude. */
+static bool meet_corner(const bands_t *bd, int32_t nb)
+{
+    if (nb <= 0) {
+        return false;
+    }
+    if (bd->u == 0u) {
+        return true;
+    }
+    int64_t r0 = bd->s, r1 = bd->dp, x0 = 1, x1 = 0; /* r0 = x0 s (mod dp) */
+    while (r1 != 0) {
+        const int64_t q = (int64_t)((uint32_t)r0 / (uint32_t)r1);
+        const int64_t r2 = r0 - q * r1, x2 = x0 - q * x1;
+        r0 = r1;
+        r1 = r2;
+        x0 = x1;
+        x1 = x2;
+    }
+    const uint32_t g = (uint32_t)r0, need = bd->dp - bd->u;
+    const uint32_t mg = g != 0u ? bd->dp / g : 0u; /* |x0| <= mg: one step into 0 .. mg - 1 */
+    if (mg == 0u || need % g != 0u) {
+        return false; /* s == 0: u never moves from its nonzero start */
+    }
+    const int64_t inv = x0 < 0 ? x0 + (int64_t)mg : (x0 >= (int64_t)mg ? x0 - (int64_t)mg : x0);
+    const uint32_t k = mul_mod((need / g) % mg, (uint32_t)inv, mg);
+    return k < (uint32_t)nb;
+}
+
+/* meet_corner() when a crossing may lie on a corner at all (v == 0). */
+static inline bool bands_meet_corner(const bands_t *bd, int32_t nb)
+{
+    return bd->on_edge && meet_corner(bd, nb);
+}
+
+/* To the next crossing. */
+static inline void bands_step(bands_t *bd)
+{
+    bd->u += bd->s; /* both below dp <= 2^30 */
+    const uint32_t c = bd->u >= bd->dp ? 1u : 0u;
+    bd->u -= c != 0u ? bd->dp : 0u;
+    bd->hi += bd->a + (int32_t)c;
+}
+
+/* The state of a wall walk in one word: bit 0, whether the last cell visited was a wall;
+ * the bits above, the runs of wall cells so far (a segment has below 2^18 cells). */
+#define WALK_RUN 2u
+
+/* One cell of the walk, wall 1 or 0. */
+static inline uint32_t walk_one(uint32_t ws, uint32_t wall)
+{
+    return ((ws + ((wall & ~ws) << 1)) & ~1u) | wall;
+}
+
+/* Cell (i, jr), real row jr; off the map it is not a wall. */
+static inline uint32_t walk_cell(const rfs_map_t *m, uint32_t ws, int32_t i, int32_t jr)
+{
+    return walk_one(ws, (uint32_t)i < m->w && (uint32_t)jr < m->h &&
+                                rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)jr) ? 1u : 0u);
+}
+
+/* Bits lo .. lo + n - 1 (n >= 1) of a row of the wall grid, in order, up to 24 at a time:
+ * a run starts at each wall bit whose predecessor is free. avail: the grid's bytes from
+ * the row's first on (four load at once while there, the last ones one by one). */
+static inline uint32_t walk_bits(const uint8_t *row, uint32_t avail, uint32_t ws, uint32_t lo,
+                                 uint32_t n)
+{
+    while (n != 0u) {
+        const uint32_t b = lo >> 3;
+        const uint8_t *p = row + b;
+        uint32_t w = 0u;
+        if (avail >= 4u && b <= avail - 4u) {
+            w = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+        } else {
+            for (uint32_t k = 0u; b + k < avail && k < 4u; k++) {
+                w |= (uint32_t)p[k] << (8u * k);
             }
-            if (wd != 0) {
-                /* The next d - 1 cells of the column either way are free too. */
-                const int32_t d = wd[(uint32_t)jr * m->w + (uint32_t)i];
-                wk->runs += (d == 0 && !wk->in_wall) ? 1u : 0u;
-                wk->in_wall = d == 0;
-                j += d > 1 ? d - 1 : 0;
-                continue;
-            }
-            if (b != 0 && !rfs_map_bit(b->bits, b->stride, (uint16_t)((uint32_t)i >> b->shift),
-                                       (uint16_t)((uint32_t)jr >> b->shift))) {
-                wk->in_wall = false;
-                j = flip ? -1 - (jr & -bs) : (jr | (bs - 1)); /* the rest of the block */
-                continue;
-            }
-            const bool wall = (m->wall[(uint32_t)jr * m->stride + ((uint32_t)i >> 3)] & mask) != 0u;
-            wk->runs += (wall && !wk->in_wall) ? 1u : 0u;
-            wk->in_wall = wall;
         }
-        return;
+        w >>= lo & 7u; /* 25 bits or more left: the ones wanted */
+        const uint32_t t = n <= 25u ? n : 24u; /* bits taken, 1 .. 25 */
+        w &= 0x1FFFFFFu >> (25u - t);
+        for (uint32_t st = w & ~((w << 1) | (ws & 1u)); st != 0u; st &= st - 1u) {
+            ws += WALK_RUN;
+        }
+        ws = (ws & ~1u) | (((w << 1) >> t) & 1u); /* bit t - 1 */
+        n -= t;
+        lo += t;
     }
-    const int32_t jr0 = flip ? -1 - jlo : jlo;
-    const uint8_t *p = m->wall + (uint32_t)jr0 * m->stride + ((uint32_t)i >> 3);
-    uint32_t runs = wk->runs;
-    uint32_t in = wk->in_wall ? 1u : 0u;
-    for (int32_t j = jlo; j <= jhi; j++, p += step) {
-        const uint32_t wall = (*p & mask) != 0u ? 1u : 0u;
-        runs += wall & (in ^ 1u);
-        in = wall;
-    }
-    wk->runs = runs;
-    wk->in_wall = in != 0u;
+    return ws;
 }
 
-/* The wall distance of cell (i, j), i on the map: 0 off the map's rows (no promise). */
-static inline int32_t dist_at(const rfs_map_t *m, int32_t i, int32_t j)
+/* Columns lo..hi (lo <= hi) of real row jr, any of them off the map (not walls). */
+static uint32_t walk_row(const rfs_map_t *m, uint32_t ws, int32_t jr, int32_t lo, int32_t hi)
 {
-    return (uint32_t)j < m->h ? m->wall_dist[(uint32_t)j * m->w + (uint32_t)i] : 0;
+    if ((uint32_t)jr >= m->h || hi < 0 || lo >= (int32_t)m->w) {
+        return ws & ~1u;
+    }
+    const bool after = hi >= (int32_t)m->w; /* column w last */
+    if (lo < 0) {
+        ws &= ~1u; /* column -1 first */
+        lo = 0;
+    }
+    hi = after ? (int32_t)m->w - 1 : hi;
+    ws = walk_bits(m->wall + (uint32_t)jr * m->stride, ((uint32_t)m->h - (uint32_t)jr) * m->stride,
+                   ws, (uint32_t)lo, (uint32_t)(hi - lo + 1));
+    return after ? ws & ~1u : ws;
 }
 
-/* Step row j and its bound (j + 1) r dx while the bound is below n, four rows a step. */
-static inline void rows_to(int32_t *j, int64_t *bound, int64_t n, int64_t rdx)
+/* Mirrored rows jlo..jhi of column i, any of them off the map (not walls), passing over
+ * wall-free blocks (b) or the free cells a wall-distance grid promises. */
+static uint32_t walk_col(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uint32_t ws,
+                         int32_t i, int32_t jlo, int32_t jhi, bool flip)
 {
-    while (*bound + 3 * rdx < n) {
-        *j += 4;
-        *bound += 4 * rdx;
+    if ((uint32_t)i >= m->w) {
+        return ws & ~1u; /* column -1 or w */
     }
-    while (*bound < n) {
-        (*j)++;
-        *bound += rdx;
+    const int32_t bs = b != 0 ? (int32_t)1 << b->shift : 0;
+    const uint8_t *wd = m->wall_dist;
+    for (int32_t j = jlo; j <= jhi; j++) {
+        const int32_t jr = flip ? -1 - j : j;
+        if ((uint32_t)jr >= m->h) {
+            ws &= ~1u;
+            continue;
+        }
+        if (wd != 0) {
+            /* The next d - 1 cells of the column either way are free too. */
+            const int32_t d = wd[(uint32_t)jr * m->w + (uint32_t)i];
+            ws = walk_one(ws, d == 0 ? 1u : 0u);
+            j += d > 1 ? d - 1 : 0;
+            continue;
+        }
+        if (b != 0) {
+            /* The rest of the cell's block (on the map): passed over, or read. */
+            const int32_t ky = flip ? -1 - (jr & -bs) : (jr | (bs - 1));
+            const int32_t top = flip ? -1 : (int32_t)m->h - 1;
+            const int32_t e = ky < jhi ? (ky < top ? ky : top) : (jhi < top ? jhi : top);
+            if (!rfs_map_bit(b->bits, b->stride, (uint16_t)((uint32_t)i >> b->shift),
+                             (uint16_t)((uint32_t)jr >> b->shift))) {
+                ws &= ~1u;
+            } else {
+                const int32_t rstep = flip ? -(int32_t)m->stride : (int32_t)m->stride;
+                const uint8_t *p = m->wall + (uint32_t)jr * m->stride + ((uint32_t)i >> 3);
+                for (int32_t n = e - j; n >= 0; n--, p += rstep) {
+                    ws = walk_one(ws, (*p >> ((uint32_t)i & 7u)) & 1u);
+                }
+            }
+            j = e;
+            continue;
+        }
+        ws = walk_one(ws, rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)jr) ? 1u : 0u);
+    }
+    return ws;
+}
+
+/* The free square ahead of cell (i, j) on the map (mirrored row j) that a host grid
+ * promises, towards +x and the walk's rows: its last column *x1 and mirrored row *y1,
+ * false when the cell is a wall. The forward grid (fwd, for the walk's direction): the
+ * square of side d with the cell as its corner; else the wall-distance grid: the square
+ * round the cell, d - 1 cells either way. */
+static inline bool free_ahead(const rfs_map_t *m, const uint8_t *fwd, int32_t i, int32_t j,
+                              bool flip, int32_t *x1, int32_t *y1)
+{
+    const uint8_t *g = fwd != 0 ? fwd : m->wall_dist;
+    const int32_t d = g[(uint32_t)(flip ? -1 - j : j) * m->w + (uint32_t)i];
+    *x1 = i + (d > 1 ? d - 1 : 0);
+    *y1 = j + (d > 1 ? d - 1 : 0);
+    return d != 0;
+}
+
+/* The bands' next crossing (bands_step() on copies kept in registers). */
+#define BANDS_NEXT(hi, u, bd)  \
+    do {                       \
+        (u) += (bd).s;         \
+        if ((u) >= (bd).dp) {  \
+            (u) -= (bd).dp;    \
+            (hi)++;            \
+        }                      \
+        (hi) += (bd).a;        \
+    } while (0)
+
+/* Bits from..from + n (n > 24) of a row: as walk_bits, every four-byte load from the
+ * row's cells inside the grid. */
+__attribute__((noinline)) static uint32_t row_bits_long(const uint8_t *row, uint32_t ws,
+                                                        uint32_t from, uint32_t n)
+{
+    return walk_bits(row, UINT32_MAX, ws, from, n + 1u);
+}
+
+/* Bits from..end of a row (from <= end), every four-byte load from the row's cells inside
+ * the grid: the band's bits shifted down to bit 0, a run starting at each wall bit whose
+ * predecessor is free. */
+static inline uint32_t row_bits(const uint8_t *row, uint32_t ws, int32_t from, int32_t end)
+{
+    const uint32_t n = (uint32_t)(end - from); /* bits - 1 */
+    if (n > 24u) {
+        return row_bits_long(row, ws, (uint32_t)from, n);
+    }
+    const uint8_t *p = row + ((uint32_t)from >> 3);
+    uint32_t w = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+    w = (w << (31u - ((uint32_t)from & 7u) - n)) >> (31u - n);
+    for (uint32_t st = w & ~((w << 1) | (ws & 1u)); st != 0u; st &= st - 1u) {
+        ws += WALK_RUN;
+    }
+    return (ws & ~1u) | (w >> n);
+}
+
+/* A shallow walk on the map whose crossings miss every cell corner, every four-byte load
+ * from a row's cells inside the grid: from row pointer row (rstep bytes a band) and
+ * column from, nb crossings (bands_t bd), then the last band to column ie; each band's
+ * bits read at once (the Cortex-M4's walk: few live values; blocks would not pay, a band
+ * of a few cells enters another block every band or two). */
+__attribute__((noinline)) static uint32_t walk_rows(const uint8_t *row, int32_t rstep,
+                                                    uint32_t ws, int32_t from, bands_t bd,
+                                                    int32_t nb, int32_t ie)
+{
+    int32_t hi = bd.hi;
+    uint32_t u = bd.u;
+    for (const uint8_t *last = row + nb * rstep; row != last; row += rstep) {
+        ws = row_bits(row, ws, from, hi);
+        from = hi;
+        BANDS_NEXT(hi, u, bd);
+    }
+    return row_bits(row, ws, from, ie);
+}
+
+/* walk_rows() with a host grid (fwd, or the wall-distance grid), k the first band: a
+ * band's cells inside the free square last found (free_ahead, looked up again when a band
+ * starts outside it) are passed over, the bands wholly inside it in a tight loop. */
+__attribute__((noinline)) static uint32_t walk_rows_look(const rfs_map_t *m, const uint8_t *fwd,
+                                                         const uint8_t *row, uint32_t ws,
+                                                         int32_t k, int32_t from, bands_t bd,
+                                                         int32_t nb, int32_t ie, bool flip)
+{
+    const int32_t rstep = flip ? -(int32_t)m->stride : (int32_t)m->stride;
+    int32_t hi = bd.hi, fx1 = INT32_MIN, fy1 = INT32_MIN;
+    bool free = false;
+    uint32_t u = bd.u;
+    for (;;) {
+        int32_t end = nb == 0 ? ie : hi;
+        if (k > fy1 || from > fx1) {
+            free = free_ahead(m, fwd, from, k, flip, &fx1, &fy1);
+        }
+        if (free && end <= fx1) {
+            ws &= ~1u;
+            do {
+                if (nb-- == 0) {
+                    return ws;
+                }
+                from = hi;
+                BANDS_NEXT(hi, u, bd);
+                k++;
+                row += rstep;
+                end = nb == 0 ? ie : hi;
+            } while (k <= fy1 && end <= fx1);
+            continue;
+        }
+        if (free) {
+            ws &= ~1u;
+            from = fx1 + 1;
+        }
+        ws = row_bits(row, ws, from, end);
+        if (nb-- == 0) {
+            return ws;
+        }
+        from = hi;
+        BANDS_NEXT(hi, u, bd);
+        k++;
+        row += rstep;
     }
 }
 
-/* dx / dy in Q16 (0 <= dx, dy < 2^31), at most 256, rounded down after dropping low bits
- * so that one 32-bit division does (the skips only need a lower bound). */
-static inline uint64_t slope_q16(int64_t dx, int64_t dy)
+/* A steep walk on the map whose crossings miss every cell corner: from column i, mirrored
+ * row jlo, nb crossings (bands_t bd), then the last column to row je; columns of long_col
+ * rows or more through walk_col (blocks b), the others a byte a cell (the Cortex-M4's
+ * walk). */
+__attribute__((noinline)) static uint32_t walk_cols(const rfs_map_t *m,
+                                                    const rfs_map_wall_blocks_t *b, uint32_t ws,
+                                                    int32_t i, int32_t jlo, bands_t bd,
+                                                    int32_t nb, int32_t je, bool flip,
+                                                    int32_t long_col)
 {
-    if (dy * 256 <= dx) {
-        return (uint64_t)256 << 16;
+    const uint8_t *wall = m->wall;
+    const int32_t stride = (int32_t)m->stride, rstep = flip ? -stride : stride;
+    int32_t hi = bd.hi;
+    uint32_t u = bd.u;
+    for (;; i++) {
+        const int32_t end = nb == 0 ? je : hi;
+        if (end - jlo >= long_col) {
+            ws = walk_col(m, b, ws, i, jlo, end, flip);
+        } else {
+            const uint8_t *p = wall + (flip ? -1 - jlo : jlo) * stride + ((uint32_t)i >> 3);
+            const uint32_t sh = (uint32_t)i & 7u;
+            for (int32_t n = end - jlo; n >= 0; n--, p += rstep) {
+                ws = walk_one(ws, (*p >> sh) & 1u);
+            }
+        }
+        if (nb-- == 0) {
+            return ws;
+        }
+        jlo = hi;
+        BANDS_NEXT(hi, u, bd);
     }
-    uint32_t sh = 0u; /* (dx >> sh) << 16 in 32 bits, dy >> sh below 2^15 */
-    while ((dx >> sh) >= 65536 || (dy >> sh) >= 32768) {
-        sh++;
-    }
-    return (((uint32_t)(dx >> sh) << 16) / (uint32_t)((dy >> sh) + 1));
 }
 
-/* The free square ahead of cell (i, jr), i on the map, jr the real row of the column's
- * first cell in walk order: its side in *d and the columns of it the walk may pass over.
- * With a forward grid (fwd, for the walk's direction), the square of side d with the
- * cell as its corner: the columns a segment of slope 1 / slope (Q16) crosses in it from
- * the bottom of its first row, min(d, (d - 1) slope), any slope. With a wall-distance
- * grid instead, on a shallow segment (shallow), the square round the cell, d its
- * distance: d - 1 columns ahead (steep segments pass over free cells inside a column,
- * walk_column). 0: none. */
-static inline int32_t square_ahead(const rfs_map_t *m, const uint8_t *fwd, uint64_t slope,
-                                   bool shallow, int32_t i, int32_t jr, int32_t *d)
+/* walk_cols() with a host grid (fwd, or the wall-distance grid): a column's cells inside
+ * the free square last found (free_ahead) are passed over, the columns wholly inside it
+ * in a tight loop; long columns through walk_col (the wall-distance grid, blocks b). */
+__attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m,
+                                                         const rfs_map_wall_blocks_t *b,
+                                                         const uint8_t *fwd, uint32_t ws,
+                                                         int32_t i, int32_t jlo, bands_t bd,
+                                                         int32_t nb, int32_t je, bool flip,
+                                                         int32_t long_col)
 {
-    if (fwd != 0 && (uint32_t)jr < m->h) {
-        *d = fwd[(uint32_t)jr * m->w + (uint32_t)i];
-        const uint64_t c = ((uint64_t)(*d > 0 ? *d - 1 : 0) * slope) >> 16;
-        return c < (uint64_t)*d ? (int32_t)c : *d;
+    const int32_t stride = (int32_t)m->stride, rstep = flip ? -stride : stride;
+    int32_t hi = bd.hi, fx1 = INT32_MIN, fy1 = INT32_MIN;
+    bool free = false;
+    uint32_t u = bd.u;
+    for (;;) {
+        int32_t end = nb == 0 ? je : hi, j = jlo;
+        if (i > fx1 || j > fy1) {
+            free = free_ahead(m, fwd, i, j, flip, &fx1, &fy1);
+        }
+        if (free && end <= fy1) {
+            ws &= ~1u;
+            do {
+                if (nb-- == 0) {
+                    return ws;
+                }
+                jlo = hi;
+                BANDS_NEXT(hi, u, bd);
+                i++;
+                end = nb == 0 ? je : hi;
+            } while (i <= fx1 && end <= fy1);
+            continue;
+        }
+        if (free) {
+            ws &= ~1u;
+            j = fy1 + 1;
+        }
+        if (end - j >= long_col) {
+            ws = walk_col(m, b, ws, i, j, end, flip);
+        } else {
+            const uint8_t *p = m->wall + (flip ? -1 - j : j) * stride + ((uint32_t)i >> 3);
+            const uint32_t sh = (uint32_t)i & 7u;
+            for (int32_t n = end - j; n >= 0; n--, p += rstep) {
+                ws = walk_one(ws, (*p >> sh) & 1u);
+            }
+        }
+        if (nb-- == 0) {
+            return ws;
+        }
+        jlo = hi;
+        BANDS_NEXT(hi, u, bd);
+        i++;
     }
-    if (fwd == 0 && shallow) {
-        *d = dist_at(m, i, jr);
-        return *d - 1;
-    }
-    return 0;
 }
 
-/* traverse() with the VISIT_WALLS visitor, specialised: the same cells in the same order
- * (the same endpoint swap, mirror and column recurrences), counting runs of wall cells.
- * Cells off the map are not walls: columns -1 and w (first and last, when an endpoint
- * lies on the map's edge) and rows -1 and h (a segment touching the bottom or top edge).
- * With blocks b, cells in wall-free blocks are passed over (they end a run, as a free cell
- * does): inside a column by whole blocks, and from the first column of a block column to
- * its last at once when the rows the segment spans there hold no wall block. With a
- * wall-distance grid (rfs_map_wall_dist_attach) instead of blocks, free cells are passed
- * over by the free squares their distances promise.
- * Scaling and overflow: as traverse() (y * dx below 2^61; r * dy, the step of y(x) * dx
- * per column, below 2^46); the count saturates at UINT16_MAX. */
-static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, int64_t X0,
-                           int64_t Y0, int64_t X1, int64_t Y1)
+/* The cells of traverse() (rfs_map.c) with the VISIT_WALLS visitor, in the same order
+ * (the same endpoint swap and mirror; columns left to right, each column's rows in the
+ * segment's y direction), counting runs of wall cells. Cells off the map are not walls:
+ * columns -1 and w (first and last, when an endpoint lies on the map's edge) and rows -1
+ * and h (a segment touching the bottom or top edge). The bands (bands_t) step in exact
+ * 32-bit remainders where traverse() compares 64-bit bounds. A shallow segment
+ * (0 < |dy| < |dx|) is walked row by row over the row-major wall bits: a row's cells are
+ * a range of columns, consecutive in traverse()'s order too, except where the segment
+ * crosses a row at a cell corner: traverse() takes the four cells round it column by
+ * column, and so does this walk. Steeper ones go column by column. careful: cells off
+ * the map may be on the walk (an endpoint on the map's edge); then, or when a crossing
+ * may meet a corner, the general loops below run, else the fast ones above.
+ * Scaling and overflow: bands_init's; the count saturates at UINT16_MAX. */
+static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uint32_t X0,
+                           uint32_t Y0, uint32_t X1, uint32_t Y1)
 {
-    const int32_t r = m->res;
+    const uint32_t r = (uint32_t)m->res;
     if (X1 < X0 || (X1 == X0 && Y1 < Y0)) {
-        int64_t t = X0; X0 = X1; X1 = t;
+        uint32_t t = X0; X0 = X1; X1 = t;
         t = Y0; Y0 = Y1; Y1 = t;
     }
     const bool flip = Y1 < Y0;
-    const bool edge = (flip ? Y1 : Y0) <= 0 || (flip ? Y0 : Y1) >= (int64_t)m->h * r;
-    if (flip) {
-        Y0 = -Y0;
-        Y1 = -Y1;
-    }
-    const int64_t dx = X1 - X0;
-    const int64_t dy = Y1 - Y0;
-    const int32_t ia = rfs_map_low_cell(X0, r);
-    const int32_t ib = rfs_map_fdiv(X1, r);
-    const int32_t bs = b != 0 ? (int32_t)1 << b->shift : 1; /* block side, cells */
-    walk_t wk = {0u, false};
-    int32_t jlo = rfs_map_low_cell(Y0, r), jhi = dx == 0 ? rfs_map_fdiv(Y1, r) : jlo;
-    const int64_t rdx = (int64_t)r * dx, rdy = (int64_t)r * dy;
-    int64_t blo = ((int64_t)jlo + 1) * rdx; /* (jlo + 1) * r * dx */
-    int64_t bhi = blo;                      /* (jhi + 1) * r * dx */
-    int64_t nl = Y0 * dx;                   /* y(xl) * dx, xl the column's left end */
-    int64_t nr = Y0 * dx + ((int64_t)(ia + 1) * r - X0) * dy; /* y(xr) * dx before clamping */
-    const int32_t step = flip ? -(int32_t)m->stride : (int32_t)m->stride;
-    const uint8_t *wd = m->wall_dist;
-    const bool shallow = wd != 0 && dy <= dx;
+    const bool careful = (flip ? Y1 : Y0) == 0u || (flip ? Y0 : Y1) == m->h * r || X0 == 0u ||
+                         X1 == m->w * r;
+    const uint32_t dx = X1 - X0, dy = flip ? Y0 - Y1 : Y1 - Y0;
+    const pos_t x0 = pos_of(X0, false, r), x1 = pos_of(X1, false, r);
+    const pos_t y0 = pos_of(Y0, flip, r), y1 = pos_of(Y1, flip, r); /* mirrored */
+    const int32_t rstep = flip ? -(int32_t)m->stride : (int32_t)m->stride;
     const uint8_t *fwd = m->wall_fwd != 0 ? m->wall_fwd + (flip ? (size_t)m->w * m->h : 0u) : 0;
-    const uint64_t fwd_slope = fwd == 0 ? 0u : slope_q16(dx, dy);
-    const int32_t long_col = b != 0 ? bs : (wd != 0 ? 3 : INT32_MAX); /* rows from which skips pay */
-    for (int32_t i = ia; i <= ib; i++, nr += rdy) {
-        if (dx != 0) {
-            const int64_t n_r = i == ib ? Y1 * dx : nr; /* y(min(xr, X1)) * dx */
-            while (blo < nl) {
-                jlo++;
-                blo += rdx;
+    uint32_t ws = 0u;
+    bands_t bd = {0, 0u, 1u, 0u, 0, false};
+    if (dy != 0u && dy < dx) {
+        const int32_t kb = y1.c, ie = x1.c;
+        int32_t k = pos_low(y0), from = pos_low(x0);
+        bands_init(&bd, r, y0, x0, dy, dx);
+        const int32_t jtop = flip ? -1 - k : kb; /* the highest real row */
+        if (!careful && !bands_meet_corner(&bd, kb - k) &&
+            (uint32_t)(jtop + 1) * m->stride + 3u <= (uint32_t)m->h * m->stride) {
+            const uint8_t *row = m->wall + (uint32_t)(flip ? -1 - k : k) * m->stride;
+            ws = fwd != 0 || m->wall_dist != 0
+                     ? walk_rows_look(m, fwd, row, ws, k, from, bd, kb - k, ie, flip)
+                     : walk_rows(row, rstep, ws, from, bd, kb - k, ie);
+            return (uint16_t)((ws >> 1) > UINT16_MAX ? UINT16_MAX : (ws >> 1));
+        }
+        for (;; k++) {
+            const bool last = k == kb;
+            const bool corner = !last && bands_corner(&bd);
+            const int32_t hi = last ? ie : bd.hi;
+            const int32_t end = corner ? hi - 2 : hi;
+            if (from <= end) {
+                ws = walk_row(m, ws, flip ? -1 - k : k, from, end);
             }
-            if (jhi < jlo) {
-                jhi = jlo;
-                bhi = blo;
+            if (last) {
+                break;
             }
-            while (bhi <= n_r) {
-                jhi++;
-                bhi += rdx;
+            from = hi;
+            if (corner) {
+                /* Through the corner between columns hi - 1 and hi: both rows of one
+                 * column, then of the next (a shallow segment meets the next row again
+                 * only past column hi). */
+                const int32_t jr = flip ? -1 - k : k, jn = flip ? jr - 1 : jr + 1;
+                ws = walk_cell(m, ws, hi - 1, jr);
+                ws = walk_cell(m, ws, hi - 1, jn);
+                ws = walk_cell(m, ws, hi, jr);
+                ws = walk_cell(m, ws, hi, jn);
+                from = hi + 1;
             }
-            nl = n_r; /* the next column starts where this one ends */
-            /* The columns i .. ie in the free square of side d ahead (square_ahead) when
-             * their rows stay below jlo + d: y(xr) * dx at ie, ne, below (jlo + d) r dx. */
-            int32_t d = 0;
-            const int32_t cols = (fwd != 0 || shallow) && i < ib && (uint32_t)i < m->w
-                                     ? square_ahead(m, fwd, fwd_slope, shallow, i,
-                                                    flip ? -1 - jlo : jlo, &d) : 0;
-            if (cols > 1) {
-                const int32_t ie = i + cols - 1 > ib ? ib : i + cols - 1;
-                const int64_t ne = ie == ib ? Y1 * dx : nr + (int64_t)(ie - i) * rdy;
-                if (jhi - jlo < d && ne < blo + (int64_t)(d - 1) * rdx) {
-                    rows_to(&jhi, &bhi, ne + 1, rdx);
-                    rows_to(&jlo, &blo, ne, rdx);
-                    wk.in_wall = false;
-                    nl = ne;
-                    nr += (int64_t)(ie - i) * rdy;
-                    i = ie;
-                    continue;
-                }
-            }
-            /* A block column at once, from its first column, when the rows the segment
-             * spans in it hold no wall block: those of its last column ie from the same
-             * recurrence (jlo catches up in the next column's loop). */
-            if (b != 0 && (i & (bs - 1)) == 0 && i < ib && (uint32_t)i < m->w) {
-                const int32_t ie = i + bs - 1 > ib ? ib : i + bs - 1;
-                const int64_t ne = ie == ib ? Y1 * dx : nr + (int64_t)(ie - i) * rdy;
-                int32_t je = jhi;
-                int64_t be = bhi;
-                while (be <= ne) {
-                    je++;
-                    be += rdx;
-                }
-                if (!blocks_hold_wall(m, b, i, flip ? -1 - je : jlo, flip ? -1 - jlo : je)) {
-                    wk.in_wall = false;
-                    jhi = je;
-                    bhi = be;
-                    nl = ne;
-                    nr += (int64_t)(ie - i) * rdy;
-                    i = ie;
-                    continue;
-                }
+            bands_step(&bd);
+        }
+    } else {
+        const int32_t long_col = b != 0 ? (int32_t)1 << b->shift : (m->wall_dist != 0 ? 3 : INT32_MAX);
+        const int32_t ib = x1.c, je = y1.c;
+        int32_t i = pos_low(x0), jlo = pos_low(y0);
+        if (dx != 0u) {
+            bands_init(&bd, r, x0, y0, dx, dy);
+            if (!careful && !bands_meet_corner(&bd, ib - i)) {
+                ws = fwd != 0 || m->wall_dist != 0
+                         ? walk_cols_look(m, b, fwd, ws, i, jlo, bd, ib - i, je, flip, long_col)
+                         : walk_cols(m, b, ws, i, jlo, bd, ib - i, je, flip, long_col);
+                return (uint16_t)((ws >> 1) > UINT16_MAX ? UINT16_MAX : (ws >> 1));
             }
         }
-        if ((uint32_t)i >= m->w) {
-            wk.in_wall = false; /* column -1 or w */
-            continue;
+        for (;; i++) {
+            const bool last = i >= ib;
+            const int32_t hi = dx == 0u || last ? je : bd.hi;
+            if (careful || hi - jlo >= long_col) {
+                ws = walk_col(m, b, ws, i, jlo, hi, flip);
+            } else {
+                const uint8_t *p = m->wall + (int32_t)(flip ? -1 - jlo : jlo) * (int32_t)m->stride +
+                                   ((uint32_t)i >> 3);
+                const uint32_t sh = (uint32_t)i & 7u;
+                for (int32_t n = hi - jlo; n >= 0; n--, p += rstep) {
+                    ws = walk_one(ws, (*p >> sh) & 1u);
+                }
+            }
+            if (last) {
+                break;
+            }
+            if (dx != 0u) {
+                jlo = bd.hi - (bands_corner(&bd) ? 1 : 0);
+                bands_step(&bd);
+            }
         }
-        walk_column(m, b, &wk, i, jlo, jhi, flip, step, edge || jhi - jlo >= long_col);
     }
-    return (uint16_t)(wk.runs > UINT16_MAX ? UINT16_MAX : wk.runs);
+    ws >>= 1;
+    return (uint16_t)(ws > UINT16_MAX ? UINT16_MAX : ws);
 }
 
 uint32_t rfs_map_wall_fwd_bytes(const rfs_map_t *m)
@@ -314,10 +638,11 @@ uint16_t rfs_map_walls_crossed_blocks(const rfs_map_t *m, const rfs_map_wall_blo
      * the clamp moves them along the axes, an approximation documented in MAPS.md). */
     int64_t we = (int64_t)m->w * m->res;
     int64_t he = (int64_t)m->h * m->res;
-    return walls_walk(m, m->wall_dist != 0 ? 0 : b, clamp64((int64_t)x0 - m->origin_x, 0, we),
-                      clamp64((int64_t)y0 - m->origin_y, 0, he),
-                      clamp64((int64_t)x1 - m->origin_x, 0, we),
-                      clamp64((int64_t)y1 - m->origin_y, 0, he));
+    return walls_walk(m, m->wall_dist != 0 ? 0 : b,
+                      (uint32_t)clamp64((int64_t)x0 - m->origin_x, 0, we),
+                      (uint32_t)clamp64((int64_t)y0 - m->origin_y, 0, he),
+                      (uint32_t)clamp64((int64_t)x1 - m->origin_x, 0, we),
+                      (uint32_t)clamp64((int64_t)y1 - m->origin_y, 0, he));
 }
 
 int rfs_map_wall_blocks(const rfs_map_t *m, uint8_t *buf, uint32_t bytes,

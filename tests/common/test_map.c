@@ -722,6 +722,172 @@ static void test_walls_crossed_wall_fwd(void **state)
     assert_int_equal(rfs_map_wall_fwd_attach(&fx.m, NULL, 2 * W * H), -1);
 }
 
+/* floor(a / r), r > 0. */
+static int64_t floor_div(int64_t a, int64_t r)
+{
+    return a >= 0 ? a / r : -((-a + r - 1) / r);
+}
+
+/* traverse() of rfs_map.c with a run counter, written out again: the 64-bit column walk
+ * (y(x) dx against row bounds) the wall count used to run, for more segments than
+ * ref_walls_in_order's brute force affords. Endpoints clamped onto the map's edge; cells
+ * off the map are not walls. */
+static int ref_walk64(const fixture_t *f, rfs_q16_t x0, rfs_q16_t y0, rfs_q16_t x1, rfs_q16_t y1)
+{
+    const int64_t r = f->res;
+    int64_t X0 = (int64_t)x0 - f->ox, Y0 = (int64_t)y0 - f->oy;
+    int64_t X1 = (int64_t)x1 - f->ox, Y1 = (int64_t)y1 - f->oy;
+    X0 = X0 < 0 ? 0 : (X0 > W * r ? W * r : X0);
+    X1 = X1 < 0 ? 0 : (X1 > W * r ? W * r : X1);
+    Y0 = Y0 < 0 ? 0 : (Y0 > H * r ? H * r : Y0);
+    Y1 = Y1 < 0 ? 0 : (Y1 > H * r ? H * r : Y1);
+    if (X1 < X0 || (X1 == X0 && Y1 < Y0)) {
+        int64_t t = X0; X0 = X1; X1 = t;
+        t = Y0; Y0 = Y1; Y1 = t;
+    }
+    const int flip = Y1 < Y0;
+    if (flip) {
+        Y0 = -Y0;
+        Y1 = -Y1;
+    }
+    const int64_t dx = X1 - X0, dy = Y1 - Y0;
+    const int64_t ia = -floor_div(-X0, r) - 1, ib = floor_div(X1, r);
+    int64_t jlo = -floor_div(-Y0, r) - 1, jhi = jlo;
+    int64_t blo = (jlo + 1) * r * dx, bhi = blo;
+    int runs = 0, in = 0;
+    for (int64_t i = ia; i <= ib; i++) {
+        if (dx == 0) {
+            jhi = floor_div(Y1, r);
+        } else {
+            const int64_t xl = i * r < X0 ? X0 : i * r, xr = (i + 1) * r > X1 ? X1 : (i + 1) * r;
+            const int64_t nl = Y0 * dx + (xl - X0) * dy, nr = Y0 * dx + (xr - X0) * dy;
+            for (; blo < nl; blo += r * dx) {
+                jlo++;
+            }
+            if (jhi < jlo) {
+                jhi = jlo;
+                bhi = blo;
+            }
+            for (; bhi <= nr; bhi += r * dx) {
+                jhi++;
+            }
+        }
+        for (int64_t j = jlo; j <= jhi; j++) {
+            const int64_t jr = flip ? -1 - j : j;
+            const int wall = i >= 0 && i < W && jr >= 0 && jr < H && f->wall_c[jr][i];
+            runs += wall && !in;
+            in = wall;
+        }
+    }
+    return runs;
+}
+
+/* The map of f again at resolution res (lattice spacing res, no clearance): resolutions
+ * far from the core's 0.1 m. */
+static void remap(fixture_t *f, rfs_q16_t res)
+{
+    rfs_map_cfg_t cfg = rfs_map_cfg_default();
+    cfg.clearance = 0;
+    cfg.grid = res;
+    f->res = res;
+    assert_int_equal(rfs_map_init(&f->m, &cfg, W, H, res, f->ox, f->oy, f->free_bits,
+                                  f->wall_bits, f->legal_bits), 0);
+}
+
+/* Wall counts in every octant and both directions equal the 64-bit column walk
+ * (ref_walk64, itself checked against ref_walls_in_order on every tenth segment), with no
+ * grid, blocks, the wall-distance grid, the forward grid, both, and forward grid with
+ * blocks: at 0.1 m, 1.5 m (above 2^16 Q16 units a cell) and 7 Q16 units a cell; on maps
+ * of rectangles and of scattered cells; for random segments, segments between cell
+ * corners at slopes p / q (p, q <= 7: through corners every q columns), along cell edges
+ * (rows and columns of corners), nearly flat ones (dy of a few Q16 units: long rows of
+ * bits), ones ending on the map's edge and ones far off it. */
+static void test_walls_crossed_octants(void **state)
+{
+    (void)state;
+    static uint8_t dist[H * W], fwd[2 * H * W];
+    const rfs_q16_t res[3] = {RFS_Q16_FRAC(1, 10), RFS_Q16_FRAC(3, 2), 7};
+    uint32_t s = 29;
+    int checked = 0, nonzero = 0;
+    for (int mapk = 0; mapk < 6; mapk++) {
+        make_map(&fx, 900u + (uint32_t)mapk, RFS_Q16_FRAC(1, 10), RFS_Q16_FRAC(1, 4));
+        if (mapk % 2 == 1) { /* scattered: every cell a wall with odds 3 in 10 */
+            for (int y = 0; y < H; y++) {
+                for (int x = 0; x < W; x++) {
+                    fx.wall_c[y][x] = lcg(&s) % 10u < 3u;
+                    rfs_map_bit_set(fx.wall_bits, (W + 7) / 8, (uint16_t)x, (uint16_t)y,
+                                    fx.wall_c[y][x]);
+                }
+            }
+        }
+        remap(&fx, res[mapk / 2]);
+        const rfs_q16_t r = fx.res;
+        rfs_map_t m[5] = {fx.m, fx.m, fx.m, fx.m, fx.m}; /* none, dist, fwd, both, fwd */
+        assert_int_equal(rfs_map_wall_dist_attach(&m[1], dist, sizeof dist), 0);
+        assert_int_equal(rfs_map_wall_fwd_attach(&m[2], fwd, sizeof fwd), 0);
+        m[3] = m[2];
+        m[3].wall_dist = m[1].wall_dist;
+        m[4] = m[2];
+        uint8_t buf[64];
+        rfs_map_wall_blocks_t b;
+        assert_int_equal(rfs_map_wall_blocks(&fx.m, buf, sizeof buf, &b), 0);
+        for (int k = 0; k < 3000; k++) {
+            const int kind = k % 6;
+            int32_t i0 = (int32_t)(lcg(&s) % (W + 7)) - 3, j0 = (int32_t)(lcg(&s) % (H + 7)) - 3;
+            int64_t X0 = (int64_t)i0 * r, Y0 = (int64_t)j0 * r, X1, Y1;
+            if (kind == 0) { /* anywhere, ends up to 3 cells off the map */
+                X0 += lcg(&s) % (uint32_t)r;
+                Y0 += lcg(&s) % (uint32_t)r;
+                X1 = (int64_t)(lcg(&s) % (uint32_t)((W + 6) * r)) - 3 * r;
+                Y1 = (int64_t)(lcg(&s) % (uint32_t)((H + 6) * r)) - 3 * r;
+            } else if (kind <= 2) { /* corner to corner at slope +-p / q or +-q / p */
+                const int32_t p = 1 + (int32_t)(lcg(&s) % 7u), q = 1 + (int32_t)(lcg(&s) % 7u);
+                const int32_t t = 1 + (int32_t)(lcg(&s) % 12u), sx = (k & 8) ? -1 : 1;
+                const int32_t sy = (k & 16) ? -1 : 1;
+                X1 = X0 + (int64_t)sx * (kind == 1 ? q : p) * t * r;
+                Y1 = Y0 + (int64_t)sy * (kind == 1 ? p : q) * t * r;
+                if (k & 32) { /* from inside a cell, through corners all the same */
+                    X0 -= (k & 64) ? r / 3 * sx * (kind == 1 ? q : p) : 0;
+                    Y0 -= (k & 64) ? r / 3 * sy * (kind == 1 ? p : q) : 0;
+                }
+            } else if (kind == 3) { /* along a row or column of cell edges */
+                X1 = (int64_t)((int32_t)(lcg(&s) % (W + 7)) - 3) * r;
+                Y1 = (int64_t)((int32_t)(lcg(&s) % (H + 7)) - 3) * r;
+                if (k & 8) { X1 = X0; } else { Y1 = Y0; }
+            } else if (kind == 4) { /* nearly flat or nearly upright: dy or dx a few units */
+                X0 += lcg(&s) % (uint32_t)r;
+                Y0 += lcg(&s) % (uint32_t)r;
+                const int64_t d = (int64_t)(lcg(&s) % 9u) - 4, len = (int64_t)(lcg(&s) % (W + 6)) * r;
+                X1 = (k & 8) ? X0 + d : X0 + ((k & 16) ? len : -len);
+                Y1 = (k & 8) ? Y0 + ((k & 16) ? len : -len) : Y0 + d;
+            } else { /* from the map's edge, or far off it */
+                X1 = (int64_t)(lcg(&s) % (uint32_t)(W * r));
+                Y1 = (int64_t)(lcg(&s) % (uint32_t)(H * r));
+                X0 = (k & 8) ? ((k & 16) ? W * r : 0) : ((k & 16) ? 1000 * r : -1000 * r);
+                Y0 = (k & 32) ? (int64_t)(lcg(&s) % (uint32_t)(H * r)) : ((k & 16) ? H * r : 0);
+            }
+            const rfs_q16_t x0 = (rfs_q16_t)(fx.ox + X0), y0 = (rfs_q16_t)(fx.oy + Y0);
+            const rfs_q16_t x1 = (rfs_q16_t)(fx.ox + X1), y1 = (rfs_q16_t)(fx.oy + Y1);
+            const int want = ref_walk64(&fx, x0, y0, x1, y1);
+            if (k % 10 == 0) {
+                assert_int_equal(ref_walls_in_order(&fx, x0, y0, x1, y1), want);
+                checked++;
+            }
+            for (int dir = 0; dir < 2; dir++) {
+                const rfs_q16_t a = dir ? x1 : x0, c = dir ? y1 : y0;
+                const rfs_q16_t e = dir ? x0 : x1, g = dir ? y0 : y1;
+                for (int v = 0; v < 4; v++) {
+                    assert_int_equal(rfs_map_walls_crossed(&m[v], a, c, e, g), want);
+                }
+                assert_int_equal(rfs_map_walls_crossed_blocks(&fx.m, &b, a, c, e, g), want);
+                assert_int_equal(rfs_map_walls_crossed_blocks(&m[4], &b, a, c, e, g), want);
+            }
+            nonzero += want > 0;
+        }
+    }
+    assert_true(checked == 1800 && nonzero > 6000);
+}
+
 /* Along one axis, lattice lines at o + g/2 + k g (k < n; o Q16.16, g metres): is line idx
  * as near to p (Q16.16) as the nearest of all n, by brute force in double? */
 static int nearest_on_axis(rfs_q16_t p, rfs_q16_t o, double g, int n, int idx)
@@ -878,6 +1044,7 @@ int main(void)
         cmocka_unit_test(test_walls_crossed_blocks),
         cmocka_unit_test(test_walls_crossed_wall_dist),
         cmocka_unit_test(test_walls_crossed_wall_fwd),
+        cmocka_unit_test(test_walls_crossed_octants),
         cmocka_unit_test(test_lattice),
         cmocka_unit_test(test_lattice_edges),
         cmocka_unit_test(test_init_rejects),

@@ -145,6 +145,7 @@ bench)
             n = "predict12800_" model[k]
             if (n in v) printf "  %-9s %14.0f %8.0f\n", model[k], ins(n), ins(n) / 12800
         }
+        if ("walls_pathloss" in v) printf "pathloss wall counts (office, wall blocks; models_work.c walls_bench): %d counts, %.0f instructions, %.0f a count\n", c["walls_pathloss"], ins("walls_pathloss"), ins("walls_pathloss") / c["walls_pathloss"]
         printf "stack (painted): "
         for (k = 1; k <= nm; k++) printf "%s relearn %d B grid %d B; ", model[k], val["stack_relearn_" model[k]], val["stack_grid_" model[k]]
         printf "\nstate union %d B (rfs_models_max_state_bytes); counts over 780,190 instructions include the 5 instructions of each SysTick wrap interrupt\n", val["state_bytes_max"]

@@ -146,6 +146,38 @@ static void floor_samples(rfs_sample_t *s, uint32_t n, const rfs_map_t *m, rfs_r
     }
 }
 
+/* Wall counts as the pathloss fit makes them on the floor (over the map's wall-block grid,
+ * RFS_PATHLOSS_WALL_BLOCK_BYTES, as on the Cortex-M4): from the first (up to) 1,000
+ * samples' points to 7 x 3 points every 5 m and 4.5 m from (2.5, 1.5) m; the counts' sum is
+ * a cross-check line. */
+#define WALLS_PTS 1000u
+#define WALLS_NX 7
+#define WALLS_NY 3
+static void walls_bench(const rfs_map_t *m, const rfs_sample_t *s, uint32_t n)
+{
+    static uint8_t bits[RFS_PATHLOSS_WALL_BLOCK_BYTES];
+    rfs_map_wall_blocks_t b;
+    n = n < WALLS_PTS ? n : WALLS_PTS;
+    if (rfs_map_wall_blocks(m, bits, sizeof bits, &b) != 0) {
+        error("error_walls");
+        return;
+    }
+    uint32_t sum = 0u;
+    RFS_BC_MEASURE("walls_pathloss", n * WALLS_NX * WALLS_NY,
+        for (uint32_t i = 0; i < n; ++i) {
+            const rfs_q16_t x = (rfs_q16_t)s[i].x_cm * 65536 / 100;
+            const rfs_q16_t y = (rfs_q16_t)s[i].y_cm * 65536 / 100;
+            for (int32_t gy = 0; gy < WALLS_NY; ++gy) {
+                for (int32_t gx = 0; gx < WALLS_NX; ++gx) {
+                    sum += rfs_map_walls_crossed_blocks(m, &b, x, y,
+                                                          RFS_Q16_INT(5 * gx) + RFS_Q16_FRAC(5, 2),
+                                                          RFS_Q16_FRAC(9 * gy + 3, 2));
+                }
+            }
+        });
+    rfs_bc_report("sum_walls_pathloss", 0, sum);
+}
+
 static int map_init(rfs_mw_mem_t *mem, const rfs_app_map_t *am)
 {
     const rfs_map_cfg_t mc = rfs_map_cfg_default();
@@ -314,6 +346,9 @@ static int run_model(rfs_mw_mem_t *mem, const rfs_models_entry_t *e, uint32_t n,
         field_samples(mem->samples, n);
     }
     rfs_bc_report(name2(nb, sizeof nb, "sum_samples", e->name), 0, sum_samples(mem->samples, n));
+    if (floor) {
+        walls_bench(&mem->map, mem->samples, n);
+    }
     const rfs_model_fit_in_t in = {
         .samples = mem->samples, .n = (uint16_t)n,
         .qx = floor ? 0 : RFS_Q16_INT(20), .qy = floor ? 0 : RFS_Q16_INT(10),

@@ -51,9 +51,9 @@ static int pathloss_init_default(void *state)
  *   per period (docs/FIRMWARE.md).
  * - mlp: 700 sample-updates, 16.3 M (about 23,000 per update; the first slice also
  *   standardises the samples); 800 would be 18.6 M.
- * - pathloss: 80 work units (about a wall count each, rfs_pathloss.h "Work"), 431,469:
+ * - pathloss: 150 work units (about a wall count each, rfs_pathloss.h "Work"), 422,370:
  *   inside the 500,000 of a control period, the rule for this model (the firmware
- *   bench's 1,000-sample slice: 465,343, at most 85 units); 90 would be 465,353 here.
+ *   bench's 1,000-sample slice: 426,495, at most 175 units); 175 would be 495,323 here.
  *   A call stops before work that could overrun the budget and resumes there. */
 const rfs_models_entry_t rfs_models_ridge = {
     "ridge", &rfs_ridge_ops, (uint32_t)sizeof(rfs_ridge_t), ridge_init_default,
@@ -70,7 +70,7 @@ const rfs_models_entry_t rfs_models_radius = {
 const rfs_models_entry_t rfs_models_pathloss = {
     "pathloss", &rfs_pathloss_ops, (uint32_t)sizeof(rfs_pathloss_t), pathloss_init_default,
     "map-aware log-distance + walls fit, source search; one per source under bridge "
-    "(beyond the paper)", 80u, true};
+    "(beyond the paper)", 150u, true};
 
 static const rfs_models_entry_t *const k_models[] = {
     &rfs_models_ridge, &rfs_models_mlp, &rfs_models_knn, &rfs_models_radius, &rfs_models_pathloss,

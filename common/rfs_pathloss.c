@@ -26,13 +26,14 @@
 #define DB_PER_LOG2_SQ_Q30 1616142483LL
 /// What an evaluated candidate is for (rfs_pathloss_ev_t.kind).
 enum { EV_COARSE = 0, EV_REFINE = 1, EV_HOLD = 2 };
-/// Bins gathered, solved or set up per work unit (a unit: about one wall count's work).
-#define BINS_PER_UNIT 32u
+/// Bins gathered, solved or set up per work unit (a unit: about one wall count, 1,600 to
+/// 2,700 Cortex-M4 instructions with its footprint point's legality test).
+#define BINS_PER_UNIT 8u
 /// Samples binned per work unit.
-#define SAMPLES_PER_UNIT 64u
+#define SAMPLES_PER_UNIT 16u
 /// Work units of tidying the built-in cache when its rows or columns run out (at most
 /// 32 KB set and about 35,000 cells cleared).
-#define TIDY_UNITS 10u
+#define TIDY_UNITS 40u
 
 rfs_pathloss_cfg_t rfs_pathloss_cfg_default(void)
 {
@@ -293,9 +294,8 @@ bool rfs_pathloss_cand_legal(const rfs_pathloss_t *p, int32_t i, int32_t j)
            !excluded(p, i, j);
 }
 
-/* Work units of one snap search (at most (2 SNAP_REACH + 1)^2 legality tests: less than a
- * wall count). */
-#define SNAP_UNITS 1u
+/* Work units of one snap search (at most (2 SNAP_REACH + 1)^2 legality tests). */
+#define SNAP_UNITS 4u
 
 static rfs_i128_t i128_of(int64_t v)
 {

@@ -26,12 +26,12 @@
 
 /// Warming's phases (rfs_pathloss_warm_t.phase).
 enum { WARM_START = 0, WARM_BIN, WARM_SCAN, WARM_COUNT, WARM_HOLD, WARM_REFINE };
-/// Bins or columns looked at per work unit (as a fit gathers bins).
-#define PER_UNIT 32u
+/// Bins or columns looked at per work unit (as a fit gathers bins, rfs_pathloss.c).
+#define PER_UNIT 8u
 /// Samples binned per work unit (as a fit bins them).
-#define SAMPLES_PER_UNIT 64u
+#define SAMPLES_PER_UNIT 16u
 /// Work units of tidying the rows (as a fit's, rfs_pathloss.c TIDY_UNITS).
-#define TIDY_UNITS 10u
+#define TIDY_UNITS 40u
 
 /* Metres Q16.16 to centimetres, rounded. Scaling: |v| < 2^31 times 100 in int64. */
 static int32_t q16_to_cm(rfs_q16_t v)

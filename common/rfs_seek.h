@@ -313,10 +313,10 @@ typedef struct rfs_seek_out {
 /// 5/4 plan_budget, the choice's room (800 by default, about 440,000 instructions).
 #define RFS_SEEK_DRIVE_SLICE(budget) ((budget) + (budget) / 4u)
 
-/// Work units a driving period the search tree leaves free gives the model's warming
+/// Work units (3/4 of the fit budget) a driving period the search tree leaves free gives the model's warming
 /// (rfs_model_ops_t.warm), of its fit budget: a leg's drive work beside it keeps the
 /// period within the fit slice's (docs/PERFORMANCE.md, "Decision latency").
-#define RFS_SEEK_WARM_SLICE(budget) ((budget) - (budget) / 8u)
+#define RFS_SEEK_WARM_SLICE(budget) ((budget) - (budget) / 4u)
 
 /// reach_budget for the microcontroller: 1,000 lattice points a period (docs/PERFORMANCE.md,
 /// "Firmware"); rfs_seek_cfg_default() keeps 0, the whole flood in one period.

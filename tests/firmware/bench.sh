@@ -52,7 +52,8 @@ printf '%s\n%s\n' "$out" "$models" | awk -F'\t' '
         } else { printf "path-loss relearn slice: not measured\n"; bad = bad " models_image" }
         # A driving period with the tree grown warms the path-loss model (RFS_SEEK_WARM_SLICE):
         # the drive period, the model warm slice and its recheck prediction together.
-        wb = mb - int(mb / 8); ws = "warm_worst_pathloss_" wb; dg = "driving_grown_iteration"
+        ws = ""; for (k in m) if (k ~ /^warm_worst_pathloss_[0-9]+$/) ws = k
+        wb = substr(ws, 21); dg = "driving_grown_iteration"
         if (mper > 0 && (ws in m) && (dg in ins) && ("predict_pathloss" in m) && v["driving_grown_running"] == 1) {
             wl = int((m[ws] - me) / mper + 0.5); pp = int((m["predict_pathloss"] - me) / mper + 0.5)
             printf "driving period with a path-loss warm slice (%d units, 1,000 samples: %d) + the drive, tree grown (%d) + a prediction (%d): %s\n", wb, wl, ins[dg], pp, verdict(wl + ins[dg] + pp)

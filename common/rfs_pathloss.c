@@ -26,11 +26,8 @@
 #define DB_PER_LOG2_SQ_Q30 1616142483LL
 /// What an evaluated candidate is for (rfs_pathloss_ev_t.kind).
 enum { EV_COARSE = 0, EV_REFINE = 1, EV_HOLD = 2 };
-/// Bins gathered, solved or set up per work unit (a unit: about one wall count, 1,600 to
-/// 2,700 Cortex-M4 instructions with its footprint point's legality test).
-#define BINS_PER_UNIT 8u
-/// Samples binned per work unit.
-#define SAMPLES_PER_UNIT 16u
+#define BINS_PER_UNIT RFS_PATHLOSS_BINS_PER_UNIT
+#define SAMPLES_PER_UNIT RFS_PATHLOSS_SAMPLES_PER_UNIT
 /// Work units of tidying the built-in cache when its rows or columns run out (at most
 /// 32 KB set and about 35,000 cells cleared).
 #define TIDY_UNITS 40u

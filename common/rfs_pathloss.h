@@ -111,6 +111,12 @@
 /// rfs_pathloss_cfg_t.coarse_footprint: count the coarse pass with `footprint` (the default).
 #define RFS_PATHLOSS_COARSE_AS_FOOTPRINT (-1)
 
+/// A work unit of fit() and warm() budgets: one wall count, or this many bins gathered,
+/// solved or set up, or samples binned (each about a count's instructions on the
+/// Cortex-M4; docs/PATHLOSS.md, "Work, the wall-count cache and slicing").
+#define RFS_PATHLOSS_BINS_PER_UNIT 8u
+#define RFS_PATHLOSS_SAMPLES_PER_UNIT 16u
+
 typedef struct rfs_pathloss_cfg {
     rfs_q16_t bin;          ///< metres Q16.16: side of a sample bin (1 m), 0.1..16 m
     rfs_q16_t coarse;       ///< metres Q16.16: coarse candidate spacing (2 m)
@@ -258,7 +264,7 @@ typedef struct rfs_pathloss_warm {
     rfs_q16_t wx;      ///< its wall origin, metres Q16.16
     rfs_q16_t wy;      ///< metres Q16.16
     uint32_t col;      ///< next column: coarse point, then refinement points, then the best
-    uint32_t seen;     ///< columns looked at (a work unit each RFS_PATHLOSS_WARM_PER_UNIT)
+    uint32_t seen;     ///< columns looked at (a work unit each RFS_PATHLOSS_BINS_PER_UNIT)
     int16_t hold_col[8]; ///< columns of the next hold search's first points (-1: none)
     uint8_t warmed[RFS_PATHLOSS_CACHE_ROWS / 8u]; ///< rows this pass gave an origin
     uint32_t lines;    ///< wall counts computed by warming since the last fit

@@ -26,10 +26,10 @@
 
 /// Warming's phases (rfs_pathloss_warm_t.phase).
 enum { WARM_START = 0, WARM_BIN, WARM_SCAN, WARM_COUNT, WARM_HOLD, WARM_REFINE };
-/// Bins or columns looked at per work unit (as a fit gathers bins, rfs_pathloss.c).
-#define PER_UNIT 8u
+/// Bins or columns looked at per work unit (as a fit gathers bins).
+#define PER_UNIT RFS_PATHLOSS_BINS_PER_UNIT
 /// Samples binned per work unit (as a fit bins them).
-#define SAMPLES_PER_UNIT 16u
+#define SAMPLES_PER_UNIT RFS_PATHLOSS_SAMPLES_PER_UNIT
 /// Work units of tidying the rows (as a fit's, rfs_pathloss.c TIDY_UNITS).
 #define TIDY_UNITS 40u
 

@@ -33,22 +33,24 @@ static void sliced_fit_equals_whole_fit(void **state)
     assert_int_equal(sliced.spread_m2, whole.spread_m2);
     assert_int_equal(sliced.candidates, whole.candidates);
     /* a fresh state: no cached wall counts, one footprint per (bin, candidate) pair of
-     * one to four lines. Units (rfs_pathloss.h, "Work"): a line each; per candidate one
-     * per 32 bins gathered and bins / 32 + 1 to solve; 64 samples binned each, and
-     * bins / 32 + 1 to set them up */
+     * one to four lines. Units (rfs_pathloss.h, RFS_PATHLOSS_BINS_PER_UNIT): a line each;
+     * per candidate one per BINS_PER_UNIT bins gathered and bins / BINS_PER_UNIT + 1 to
+     * solve; SAMPLES_PER_UNIT samples binned each, and bins / BINS_PER_UNIT + 1 to set
+     * them up */
     assert_int_equal(sliced.footprints_cached, 0);
     assert_int_equal(sliced.footprints, sliced.candidates * sliced.bins);
     assert_true(sliced.walls_counted >= sliced.footprints);
     assert_true(sliced.walls_counted <= 4u * sliced.footprints);
     assert_int_equal(sliced.walls_counted, whole.walls_counted);
-    const uint32_t per32 = sliced.bins / 32u;
-    const uint32_t units = sliced.walls_counted + sliced.candidates * (2u * per32 + 1u) +
-                           (NS + 63u) / 64u + per32 + 1u;
+    const uint32_t bu = RFS_PATHLOSS_BINS_PER_UNIT, su = RFS_PATHLOSS_SAMPLES_PER_UNIT;
+    const uint32_t perb = sliced.bins / bu;
+    const uint32_t units = sliced.walls_counted + sliced.candidates * (2u * perb + 1u) +
+                           (NS + su - 1u) / su + perb + 1u;
     /* a call overruns 2000 by at most one unit (a footprint's four lines when at most
-     * four are left, and a 32nd bin), and stops at worst when a solve (per32 + 1) or
-     * a footprint (four lines and a 32nd bin) would overrun */
+     * four are left, and a unit's last bin), and stops at worst when a solve (perb + 1)
+     * or a footprint (four lines and a unit's last bin) would overrun */
     assert_true((uint32_t)calls >= units / 2001u);
-    assert_true((uint32_t)calls <= units / (2000u - (per32 + 1u > 5u ? per32 + 1u : 5u)) + 1u);
+    assert_true((uint32_t)calls <= units / (2000u - (perb + 1u > 5u ? perb + 1u : 5u)) + 1u);
 
     /* The smallest budget: one piece of work a call, the same fit. */
     int tiny_calls = 0;
@@ -57,7 +59,9 @@ static void sliced_fit_equals_whole_fit(void **state)
     assert_int_equal(tiny.spread_m2, whole.spread_m2);
     assert_int_equal(tiny.walls_counted, whole.walls_counted);
     /* each binning unit, set-up, footprint and solve in a call of its own */
-    assert_true((uint32_t)tiny_calls >= (NS + 63u) / 64u + 1u + tiny.footprints + tiny.candidates);
+    assert_true((uint32_t)tiny_calls >= (NS + RFS_PATHLOSS_SAMPLES_PER_UNIT - 1u) /
+                                            RFS_PATHLOSS_SAMPLES_PER_UNIT +
+                                        1u + tiny.footprints + tiny.candidates);
 
     /* A budget of one bin a call: candidates are resumed within their bins. */
     rfs_pathloss_est_t fine = fit_default(f, NS, &f->map, 4, &calls);

@@ -691,6 +691,26 @@ static void check_deferred_goal(rfs_plan_t *t, rfs_plan_t *d, rfs_q16_t x1, rfs_
     assert_int_equal(t->tree_more, d->tree_more);
 }
 
+/* The closed room (kind 1) of test_tree_deferred: planners t (on work, queue) and d
+ * (deferred, on work_d, queue_d), no tree begun; *x0, *y0 the lattice point nearest (2, 2)
+ * m. Returns the points a root there reaches (the double reference's count). */
+static int closed_room_trees(rfs_plan_t *t, rfs_plan_t *d, uint8_t *work_d, size_t nwork_d,
+                             uint32_t *queue_d, rfs_q16_t *x0, rfs_q16_t *y0)
+{
+    build_kind(1, 4);
+    const int lw = wd.m.lw, lh = wd.m.lh;
+    uint16_t si, sj;
+    rfs_map_lattice_nearest(&wd.m, RFS_Q16_INT(2), RFS_Q16_INT(2), &si, &sj);
+    ref_octile(lw, lh, si, sj);
+    int below, upto;
+    oct_count(lw * lh, INT32_MAX, &below, &upto);
+    assert_int_equal(rfs_plan_init(t, &wd.m, work, sizeof(work), queue, 1024), 0);
+    assert_int_equal(rfs_plan_init(d, &wd.m, work_d, (uint32_t)nwork_d, queue_d, 1024), 0);
+    rfs_plan_tree_defer(d, true);
+    rfs_map_lattice_point(&wd.m, si, sj, x0, y0);
+    return upto;
+}
+
 /* rfs_plan_tree_defer: grows of random budgets (0 to 300 points) on a tree searched at
  * once and on a deferred one, each followed by plans, lengths and a move near the root:
  * the same answers and tree_more flags all along, on the five kinds of map; the deferred
@@ -745,20 +765,10 @@ static void test_tree_deferred(void **state)
         }
     }
     /* The closed room (kind 1): a root outside reaches `upto` points, none inside. */
-    build_kind(1, 4);
-    const int lw = wd.m.lw, lh = wd.m.lh;
     const rfs_q16_t m1 = RFS_Q16_INT(1);
-    uint16_t si, sj;
-    rfs_map_lattice_nearest(&wd.m, 2 * m1, 2 * m1, &si, &sj);
-    ref_octile(lw, lh, si, sj);
-    int below, upto;
-    oct_count(lw * lh, INT32_MAX, &below, &upto);
     rfs_plan_t t, d;
-    assert_int_equal(rfs_plan_init(&t, &wd.m, work, sizeof(work), queue, 1024), 0);
-    assert_int_equal(rfs_plan_init(&d, &wd.m, work_d, sizeof(work_d), queue_d, 1024), 0);
-    rfs_plan_tree_defer(&d, true);
     rfs_q16_t x0, y0;
-    rfs_map_lattice_point(&wd.m, si, sj, &x0, &y0);
+    const int upto = closed_room_trees(&t, &d, work_d, sizeof(work_d), queue_d, &x0, &y0);
     rfs_plan_tree_begin(&t, x0, y0);
     rfs_plan_tree_begin(&d, x0, y0);
     assert_false(rfs_plan_tree_grow(&t, (uint32_t)upto - 100u));
@@ -785,21 +795,11 @@ static void test_tree_grown(void **state)
     (void)state;
     static uint8_t work_d[LMAX];
     static uint32_t queue_d[1024];
-    build_kind(1, 4);
-    const int lw = wd.m.lw, lh = wd.m.lh;
     const rfs_q16_t m1 = RFS_Q16_INT(1);
-    uint16_t si, sj;
-    rfs_map_lattice_nearest(&wd.m, 2 * m1, 2 * m1, &si, &sj);
-    ref_octile(lw, lh, si, sj);
-    int below, upto;
-    oct_count(lw * lh, INT32_MAX, &below, &upto);
     rfs_plan_t t, d;
-    assert_int_equal(rfs_plan_init(&t, &wd.m, work, sizeof(work), queue, 1024), 0);
-    assert_int_equal(rfs_plan_init(&d, &wd.m, work_d, sizeof(work_d), queue_d, 1024), 0);
-    rfs_plan_tree_defer(&d, true);
-    assert_true(rfs_plan_tree_grown(&t));
     rfs_q16_t x0, y0;
-    rfs_map_lattice_point(&wd.m, si, sj, &x0, &y0);
+    const int upto = closed_room_trees(&t, &d, work_d, sizeof(work_d), queue_d, &x0, &y0);
+    assert_true(rfs_plan_tree_grown(&t));
     rfs_plan_tree_begin(&t, x0, y0);
     rfs_plan_tree_begin(&d, x0, y0);
     assert_false(rfs_plan_tree_grown(&t));

@@ -7,7 +7,7 @@
  * of squared residuals over the interior solution, the four edges and the four corners
  * of the (n, W) box, the Huber loss in double, and a bitmap of evaluated points. Only
  * the wall counts come from the core (rfs_map_walls_crossed and rfs_map_cell, tested in
- * test_map.c), because they are the model's definition of a wall: a bin's walls are the
+ * test_map_walls.c), because they are the model's definition of a wall: a bin's walls are the
  * mean of the counts (each saturated at 15) from the four points `footprint` either side
  * of the centre of the core cell holding its centroid, along x and y, a point that is not
  * legal (rfs_map_point_legal) counting from the centre. The coarse points count with

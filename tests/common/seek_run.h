@@ -1,6 +1,7 @@
 /* seek_run.h - the harness shared by the seeker's decision tests (test_seek.c,
- * test_seek_meta.c, test_seek_stall.c, test_seek_baseline.c): a synthetic field in double
- * precision, a "teleporting" robot, and a model that knows its maximum.
+ * test_seek_meta.c, test_seek_geodesic.c, test_seek_stall.c, test_seek_baseline.c): a
+ * synthetic field in double precision, a "teleporting" robot, and a model that knows its
+ * maximum.
  *
  * The robot is teleported: when the seeker decides a goal, the harness moves the
  * reported pose onto the goal after a hold time, so the drive reports it reached and the

@@ -197,7 +197,8 @@ uint32_t rfs_map_wall_dist_bytes(const rfs_map_t *m);
 /// rfs_map_init() detaches it. -1 when the map has no wall grid or buf is NULL or too small.
 int rfs_map_wall_dist_attach(rfs_map_t *m, uint8_t *buf, uint32_t bytes);
 
-/// Bytes of a forward free-square grid for m (rfs_map_wall_fwd_attach()): two per cell.
+/// Bytes of a forward free-square grid for m (rfs_map_wall_fwd_attach()): two per cell,
+/// saturated at UINT32_MAX (a map of 2^31 cells or more cannot take the grid).
 uint32_t rfs_map_wall_fwd_bytes(const rfs_map_t *m);
 
 /// Fill buf with the side in cells of the largest wall-free square on the map with each

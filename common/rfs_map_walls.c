@@ -254,8 +254,8 @@ static uint32_t walk_col(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, uin
             } else {
                 const int32_t rstep = flip ? -(int32_t)m->stride : (int32_t)m->stride;
                 const uint8_t *p = m->wall + (uint32_t)jr * m->stride + ((uint32_t)i >> 3);
-                for (int32_t n = e - j; n >= 0; n--, p += rstep) {
-                    ws = walk_one(ws, (*p >> ((uint32_t)i & 7u)) & 1u);
+                for (int32_t n = e - j, o = 0; n >= 0; n--, o += rstep) {
+                    ws = walk_one(ws, (p[o] >> ((uint32_t)i & 7u)) & 1u);
                 }
             }
             j = e;
@@ -404,8 +404,8 @@ __attribute__((noinline)) static uint32_t walk_cols(const rfs_map_t *m,
         } else {
             const uint8_t *p = wall + (flip ? -1 - jlo : jlo) * stride + ((uint32_t)i >> 3);
             const uint32_t sh = (uint32_t)i & 7u;
-            for (int32_t n = end - jlo; n >= 0; n--, p += rstep) {
-                ws = walk_one(ws, (*p >> sh) & 1u);
+            for (int32_t n = end - jlo, o = 0; n >= 0; n--, o += rstep) {
+                ws = walk_one(ws, (p[o] >> sh) & 1u);
             }
         }
         if (nb-- == 0) {
@@ -457,8 +457,8 @@ __attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m,
         } else {
             const uint8_t *p = m->wall + (flip ? -1 - j : j) * stride + ((uint32_t)i >> 3);
             const uint32_t sh = (uint32_t)i & 7u;
-            for (int32_t n = end - j; n >= 0; n--, p += rstep) {
-                ws = walk_one(ws, (*p >> sh) & 1u);
+            for (int32_t n = end - j, o = 0; n >= 0; n--, o += rstep) {
+                ws = walk_one(ws, (p[o] >> sh) & 1u);
             }
         }
         if (nb-- == 0) {
@@ -561,8 +561,8 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, u
                 const uint8_t *p = m->wall + (int32_t)(flip ? -1 - jlo : jlo) * (int32_t)m->stride +
                                    ((uint32_t)i >> 3);
                 const uint32_t sh = (uint32_t)i & 7u;
-                for (int32_t n = hi - jlo; n >= 0; n--, p += rstep) {
-                    ws = walk_one(ws, (*p >> sh) & 1u);
+                for (int32_t n = hi - jlo, o = 0; n >= 0; n--, o += rstep) {
+                    ws = walk_one(ws, (p[o] >> sh) & 1u);
                 }
             }
             if (last) {
@@ -578,9 +578,16 @@ static uint16_t walls_walk(const rfs_map_t *m, const rfs_map_wall_blocks_t *b, u
     return (uint16_t)(ws > UINT16_MAX ? UINT16_MAX : ws);
 }
 
+/* Two bytes a cell, in 64 bits: w * h < 2^32, twice that need not be. */
+static uint64_t fwd_bytes64(const rfs_map_t *m)
+{
+    return 2u * (uint64_t)m->w * m->h;
+}
+
 uint32_t rfs_map_wall_fwd_bytes(const rfs_map_t *m)
 {
-    return 2u * (uint32_t)m->w * m->h;
+    const uint64_t n = fwd_bytes64(m);
+    return n > UINT32_MAX ? UINT32_MAX : (uint32_t)n;
 }
 
 /* Side of the free square with cell (i, j) as its corner towards -x and -dj (dj = +-1):
@@ -602,7 +609,7 @@ static uint8_t fwd_square(const rfs_map_t *m, const uint8_t *g, int32_t i, int32
 
 int rfs_map_wall_fwd_attach(rfs_map_t *m, uint8_t *buf, uint32_t bytes)
 {
-    if (m->wall == 0 || buf == 0 || bytes < rfs_map_wall_fwd_bytes(m)) {
+    if (m->wall == 0 || buf == 0 || bytes < fwd_bytes64(m)) {
         return -1;
     }
     /* Squares towards +y first (rows from the top down), then towards -y (bottom up). */

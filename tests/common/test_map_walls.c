@@ -400,6 +400,15 @@ static void test_walls_crossed_wall_fwd(void **state)
     nowall.wall = NULL;
     assert_int_equal(rfs_map_wall_fwd_attach(&nowall, fwd, 2 * W * H), -1);
     assert_int_equal(rfs_map_wall_fwd_attach(&fx.m, NULL, 2 * W * H), -1);
+    /* A map of 2^31 cells or more: two bytes a cell exceed 32 bits; the size saturates and
+     * no 32-bit buffer size is enough (the check runs before the grid is touched). */
+    rfs_map_t big = fx.m;
+    big.w = 65535u;
+    big.h = 32769u;
+    big.wall_fwd = NULL;
+    assert_int_equal(rfs_map_wall_fwd_bytes(&big), UINT32_MAX);
+    assert_int_equal(rfs_map_wall_fwd_attach(&big, fwd, UINT32_MAX), -1);
+    assert_null(big.wall_fwd);
 }
 
 /* floor(a / r), r > 0. */

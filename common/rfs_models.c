@@ -51,9 +51,9 @@ static int pathloss_init_default(void *state)
  *   per period (docs/FIRMWARE.md).
  * - mlp: 700 sample-updates, 16.3 M (about 23,000 per update; the first slice also
  *   standardises the samples); 800 would be 18.6 M.
- * - pathloss: 150 work units (about a wall count each, rfs_pathloss.h "Work"), 422,370:
+ * - pathloss: 150 work units (about a wall count each, rfs_pathloss.h "Work"), 425,333:
  *   inside the 500,000 of a control period, the rule for this model (the firmware
- *   bench's 1,000-sample slice: 426,495, at most 175 units); 175 would be 495,323 here.
+ *   bench's 1,000-sample slice: 429,409, at most 174 units); 175 would be 495,709 here.
  *   A call stops before work that could overrun the budget and resumes there. */
 const rfs_models_entry_t rfs_models_ridge = {
     "ridge", &rfs_ridge_ops, (uint32_t)sizeof(rfs_ridge_t), ridge_init_default,

@@ -371,6 +371,227 @@ static void warm_takes_rows_no_bin_holds(void **state)
     free(before);
 }
 
+/* Review (rv1). The work units a warm call charged itself, at least: the wall counts it
+ * computed (warm.lines) and a unit every RFS_PATHLOSS_BINS_PER_UNIT columns or bins looked
+ * at (warm.seen); binning and tidying aside. */
+static uint32_t rv_units(const rfs_pathloss_t *p, uint32_t lines0, uint32_t seen0)
+{
+    return (p->warm.lines - lines0) +
+           (p->warm.seen / RFS_PATHLOSS_BINS_PER_UNIT - seen0 / RFS_PATHLOSS_BINS_PER_UNIT);
+}
+
+/* The first fit on the corridor's bins x = 2..11 (y = 7, 8 m), then `leg` more: x = 12 ..
+ * 12 + leg - 1 at y = 7 m, and with `both` at y = 8 m too; the robot in the last. Coarse
+ * spacing 1 m: 480 coarse points, more than the built-in cache's 256 columns, so most of
+ * the last fit's coarse and every refinement point have no column. Warmed to the end at
+ * `budget` a call; the most units a call charged. */
+static uint32_t rv_worst_call(fixture_t *f, int leg, bool both, uint32_t budget)
+{
+    int n = 0;
+    for (int bx = 2; bx < 12; ++bx) {
+        for (int by = 7; by < 9; ++by) {
+            bin_samples(f->s + n, PER_BIN, &f->map, &k_office, bx, by, (uint64_t)(100 + bx * 10 + by));
+            n += PER_BIN;
+        }
+    }
+    const int first = n;
+    for (int bx = 12; bx < 12 + leg; ++bx) {
+        for (int by = 7; by < (both ? 9 : 8); ++by) {
+            bin_samples(f->s + n, PER_BIN, &f->map, &k_office, bx, by, (uint64_t)(700 + bx * 10 + by));
+            n += PER_BIN;
+        }
+    }
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    c.coarse = RFS_Q16_INT(1);
+    assert_int_equal(rfs_pathloss_init(&f->pl, &c), 0);
+    rfs_model_fit_in_t in1 = input(f, first), in2 = input(f, n);
+    in1.qx = in2.qx = (11 + leg) * 65536 + 32768;
+    (void)fit(&f->pl, &in1, 0);
+    assert_int_equal(f->pl.ncols, RFS_PATHLOSS_CACHE_COLS);
+    uint32_t worst = 0u, calls = 0u;
+    bool more = true;
+    while (more && calls < 100000u) {
+        const uint32_t l0 = f->pl.warm.lines, s0 = f->pl.warm.seen;
+        more = rfs_pathloss_ops.warm(&f->pl, &in2, budget);
+        const uint32_t u = rv_units(&f->pl, l0, s0);
+        worst = u > worst ? u : worst;
+        calls++;
+    }
+    print_message("rv: leg %d%s, budget %u: %u calls, worst call charged >= %u units\n", leg,
+                  both ? " x 2" : "", budget, calls, worst);
+    return worst;
+}
+
+/* Every call within its budget (the first piece aside, at most 40 units): looks at columns
+ * without a cache column are charged but not checked against the budget (warm_count), nor
+ * are the rows of the refinement pass (WARM_REFINE). */
+static void rv_warm_call_within_budget(void **state)
+{
+    fixture_t *f = *state;
+    const uint32_t w1 = rv_worst_call(f, 16, false, 113u); /* RFS_SEEK_WARM_SLICE(150) */
+    const uint32_t w2 = rv_worst_call(f, 16, false, 40u);
+    const uint32_t w3 = rv_worst_call(f, 17, true, 113u);
+    assert_true(w1 <= 113u);
+    assert_true(w2 <= 40u);
+    assert_true(w3 <= 113u);
+}
+
+/* A randomised differential run: model A warms between fits (random budgets, the robot
+ * moving between calls, samples added and, the store full, replaced), model B never does.
+ * After every fit (A's sliced at a random budget, B's whole) their results are equal, and
+ * warming never changes what A publishes. Variants: coarse spacing, one-count coarse pass,
+ * hold off or without search, footprint 0, 0.5 m bins, places ruled out, an attached
+ * cache, a fit without the map in between. */
+#define RV_CAP 900
+
+static void rv_sample(fixture_t *f, rfs_rng_t *r, int *x, int *y, rfs_sample_t *s)
+{
+    for (int tries = 0; tries < 1000; ++tries) {
+        const int nx = *x + (int)rfs_rng_below(r, 81) - 40, ny = *y + (int)rfs_rng_below(r, 81) - 40;
+        if (nx >= 10 && ny >= 10 && nx <= 2990 && ny <= 1590 &&
+            rfs_map_point_legal(&f->map, (rfs_q16_t)lround(nx / 100.0 * 65536.0),
+                                (rfs_q16_t)lround(ny / 100.0 * 65536.0))) {
+            *x = nx;
+            *y = ny;
+            break;
+        }
+    }
+    const truth_t *t = &k_office;
+    const rfs_q16_t qx = (rfs_q16_t)lround(*x / 100.0 * 65536.0), qy = (rfs_q16_t)lround(*y / 100.0 * 65536.0);
+    const rfs_q16_t qsx = (rfs_q16_t)lround(t->sx * 65536.0), qsy = (rfs_q16_t)lround(t->sy * 65536.0);
+    const double d = hypot(*x / 100.0 - t->sx, *y / 100.0 - t->sy);
+    const int k = rfs_map_walls_crossed(&f->map, qx, qy, qsx, qsy);
+    const double v = t->p0 - 10.0 * t->n * log10(d < 1.0 ? 1.0 : d) - t->w * k + 3.0 * gauss(r);
+    s->x_cm = (int16_t)*x;
+    s->y_cm = (int16_t)*y;
+    s->v_q6 = (int16_t)lround(v * 64.0);
+}
+
+typedef struct rv_pub {
+    rfs_q16_t v[60];
+    rfs_q16_t ax, ay;
+    rfs_pathloss_est_t e;
+    uint32_t surface[RFS_PATHLOSS_MAX_COARSE];
+} rv_pub_t;
+
+static void rv_publish(const rfs_pathloss_t *a, rv_pub_t *o)
+{
+    memset(o, 0, sizeof(*o));
+    int q = 0;
+    for (int i = 0; i < 30; i += 3) {
+        for (int j = 0; j < 16; j += 3) {
+            assert_true(rfs_pathloss_ops.predict(a, i * 65536 + 32768, j * 65536 + 32768, &o->v[q++]));
+        }
+    }
+    assert_true(rfs_pathloss_ops.argmax(a, &o->ax, &o->ay));
+    assert_true(rfs_pathloss_estimate(a, &o->e));
+    memcpy(o->surface, a->surface, sizeof(o->surface));
+}
+
+static void rv_run(fixture_t *f, const rfs_pathloss_cfg_t *c, bool attach, bool excl, uint64_t seed)
+{
+    rfs_pathloss_t *a = malloc(sizeof(*a)), *b = malloc(sizeof(*b));
+    rfs_sample_t *s = malloc(sizeof(rfs_sample_t) * RV_CAP);
+    rv_pub_t *p0 = malloc(sizeof(*p0)), *p1 = malloc(sizeof(*p1));
+    const uint32_t bytes = rfs_pathloss_cache_bytes(300);
+    void *bufa = attach ? malloc(bytes) : NULL, *bufb = attach ? malloc(bytes) : NULL;
+    assert_true(a != NULL && b != NULL && s != NULL && p0 != NULL && p1 != NULL);
+    assert_int_equal(rfs_pathloss_init(a, c), 0);
+    assert_int_equal(rfs_pathloss_init(b, c), 0);
+    if (attach) {
+        assert_int_equal(rfs_pathloss_cache_attach(a, bufa, bytes, 300), 0);
+        assert_int_equal(rfs_pathloss_cache_attach(b, bufb, bytes, 300), 0);
+    }
+    rfs_rng_t r;
+    rfs_rng_seed(&r, seed);
+    int x = 300, y = 800, n = 0;
+    uint32_t seen = 0u;
+    int16_t ex[4] = {0}, ey[4] = {0};
+    uint8_t nexcl = 0u;
+    for (int fitno = 0; fitno < 14; ++fitno) {
+        rfs_model_fit_in_t in = {.samples = s, .n = (uint16_t)n, .map = fitno == 7 ? NULL : &f->map,
+                                 .qx = (rfs_q16_t)(x * 65536 / 100), .qy = (rfs_q16_t)(y * 65536 / 100),
+                                 .excl_x_cm = ex, .excl_y_cm = ey, .nexcl = nexcl,
+                                 .excl_r = excl ? RFS_Q16_INT(2) : 0};
+        if (n > 0) {
+            rfs_pathloss_ops.reset(a);
+            rfs_pathloss_ops.reset(b);
+            (void)fit(a, &in, 1u + rfs_rng_below(&r, 200));
+            (void)fit(b, &in, 0);
+            assert_memory_equal(&a->best, &b->best, sizeof(a->best));
+            assert_memory_equal(a->top, b->top, sizeof(a->top));
+            assert_memory_equal(a->surface, b->surface, sizeof(a->surface));
+            assert_int_equal(a->spread_m2, b->spread_m2);
+            assert_int_equal(a->candidates, b->candidates);
+            assert_int_equal(a->used_bins, b->used_bins);
+        }
+        if (excl && rfs_rng_below(&r, 2) == 0u && nexcl < 4u) {
+            ex[nexcl] = (int16_t)x;
+            ey[nexcl] = (int16_t)y;
+            nexcl++;
+        }
+        const bool valid = a->valid;
+        if (valid) {
+            rv_publish(a, p0);
+        }
+        const int steps = 20 + (int)rfs_rng_below(&r, 120);
+        for (int t = 0; t < steps; ++t) {
+            for (int k = 0; k < 3; ++k) {
+                rfs_sample_t sm;
+                rv_sample(f, &r, &x, &y, &sm);
+                seen++;
+                if (n < RV_CAP) {
+                    s[n++] = sm;
+                } else if (rfs_rng_below(&r, seen) < RV_CAP) {
+                    s[rfs_rng_below(&r, RV_CAP)] = sm;
+                }
+            }
+            rfs_model_fit_in_t wi = in;
+            wi.n = (uint16_t)n;
+            wi.map = &f->map;
+            wi.qx = (rfs_q16_t)(x * 65536 / 100);
+            wi.qy = (rfs_q16_t)(y * 65536 / 100);
+            wi.nexcl = nexcl;
+            (void)rfs_pathloss_ops.warm(a, &wi, 1u + rfs_rng_below(&r, 150));
+            if (valid) {
+                rv_publish(a, p1);
+                assert_memory_equal(p1, p0, sizeof(*p0));
+            }
+        }
+    }
+    free(a);
+    free(b);
+    free(s);
+    free(p0);
+    free(p1);
+    free(bufa);
+    free(bufb);
+}
+
+static void rv_differential(void **state)
+{
+    fixture_t *f = *state;
+    for (uint64_t seed = 1; seed <= 4; ++seed) {
+        rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+        rv_run(f, &c, false, false, seed);
+        c.coarse = RFS_Q16_INT(1);
+        rv_run(f, &c, false, true, seed + 100);
+        c.coarse_footprint = 0;
+        rv_run(f, &c, false, true, seed + 200);
+        c = rfs_pathloss_cfg_default();
+        c.coarse_footprint = 0;
+        c.hold_search = false;
+        rv_run(f, &c, true, true, seed + 300);
+        c = rfs_pathloss_cfg_default();
+        c.footprint = 0;
+        c.hold_k = 0;
+        rv_run(f, &c, false, false, seed + 400);
+        c = rfs_pathloss_cfg_default();
+        c.bin = RFS_Q16_FRAC(1, 2);
+        rv_run(f, &c, true, true, seed + 500);
+    }
+}
+
 static void only_pathloss_warms(void **state)
 {
     (void)state;
@@ -392,6 +613,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(warm_resumes_at_budget_one, setup, teardown),
         cmocka_unit_test_setup_teardown(warm_keeps_the_last_fits_rows, setup, teardown),
         cmocka_unit_test_setup_teardown(warm_takes_rows_no_bin_holds, setup, teardown),
+        cmocka_unit_test_setup_teardown(rv_warm_call_within_budget, setup, teardown),
+        cmocka_unit_test_setup_teardown(rv_differential, setup, teardown),
         cmocka_unit_test(only_pathloss_warms),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

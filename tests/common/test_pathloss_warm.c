@@ -436,6 +436,35 @@ static void rv_warm_call_within_budget(void **state)
     assert_true(w3 <= 113u);
 }
 
+/* The whole office (more bins than rows), 40 units a call: warming finds no row, stops,
+ * then looks at every bin for the hold search's first points (which have no column,
+ * coarse 1 m) and at every row for the refinement pass: those looks are charged but never
+ * checked against the budget (warm_hold, WARM_REFINE), and bins with a row are not even
+ * charged. */
+static void rv_hold_pass_within_budget(void **state)
+{
+    fixture_t *f = *state;
+    make_samples(f->s, NS / 2, &f->map, &k_office, 11);
+    make_samples(f->s + NS / 2, NS / 2, &f->map, &k_office, 12);
+    rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
+    c.coarse = RFS_Q16_INT(1);
+    assert_int_equal(rfs_pathloss_init(&f->pl, &c), 0);
+    rfs_model_fit_in_t in1 = input(f, NS / 2), in2 = input(f, NS);
+    (void)fit(&f->pl, &in1, 0);
+    uint32_t worst = 0u, calls = 0u;
+    bool more = true;
+    while (more && calls < 100000u) {
+        const uint32_t l0 = f->pl.warm.lines, s0 = f->pl.warm.seen;
+        more = rfs_pathloss_ops.warm(&f->pl, &in2, 40u);
+        const uint32_t u = rv_units(&f->pl, l0, s0);
+        worst = u > worst ? u : worst;
+        calls++;
+    }
+    print_message("rv: office, %u bins, %u rows, stopped %d: %u calls, worst call charged >= %u "
+                  "units\n", f->pl.nbins, f->pl.nrows, f->pl.warm.stopped, calls, worst);
+    assert_true(worst <= 40u);
+}
+
 /* A randomised differential run: model A warms between fits (random budgets, the robot
  * moving between calls, samples added and, the store full, replaced), model B never does.
  * After every fit (A's sliced at a random budget, B's whole) their results are equal, and
@@ -614,6 +643,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(warm_keeps_the_last_fits_rows, setup, teardown),
         cmocka_unit_test_setup_teardown(warm_takes_rows_no_bin_holds, setup, teardown),
         cmocka_unit_test_setup_teardown(rv_warm_call_within_budget, setup, teardown),
+        cmocka_unit_test_setup_teardown(rv_hold_pass_within_budget, setup, teardown),
         cmocka_unit_test_setup_teardown(rv_differential, setup, teardown),
         cmocka_unit_test(only_pathloss_warms),
     };

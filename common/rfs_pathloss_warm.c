@@ -137,6 +137,9 @@ static bool warm_count(rfs_pathloss_t *p, uint32_t end, uint32_t budget, uint32_
     const uint32_t nc = (uint32_t)p->lat.ncx * p->lat.ncy;
     const bool ranks = p->cfg.coarse_footprint != p->cfg.footprint;
     while (w->col < end) {
+        if (full(budget, *used, 1u)) {
+            return false; /* a look is work too */
+        }
         int32_t i = p->best.li, j = p->best.lj;
         const bool coarse = w->col < nc;
         if (coarse) {
@@ -197,6 +200,12 @@ static bool warm_hold(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t 
     const int16_t rky = (int16_t)rfs_pathloss_floor_div(q16_to_cm(in->qy), p->bin_cm);
     const int32_t step = p->lat.cs / 2u < 1u ? 1 : (int32_t)(p->lat.cs / 2u);
     for (; w->b < p->nbins; w->b++, w->col = 0u) {
+        if (w->col == 0u) {
+            if (full(budget, *used, 1u)) {
+                return false;
+            }
+            *used += look(w); /* every bin, with a row or not */
+        }
         const rfs_pathloss_bin_t *bb = &p->bins[w->b];
         const int32_t xcm = (int32_t)rfs_sdiv64_round(bb->sx_cm, bb->count);
         const int32_t ycm = (int32_t)rfs_sdiv64_round(bb->sy_cm, bb->count);
@@ -204,7 +213,6 @@ static bool warm_hold(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t 
         if ((bb->kx == rkx && bb->ky == rky) ||
             !rfs_map_cell(m, rfs_pathloss_cm_to_q16(xcm), rfs_pathloss_cm_to_q16(ycm), &cx, &cy) ||
             (row = rfs_pathloss_walls_row_find(p, cx, cy)) == RFS_PATHLOSS_NO_ROW) {
-            *used += look(w);
             continue;
         }
         rfs_q16_t wx, wy;
@@ -293,6 +301,9 @@ bool rfs_pathloss_warm_op(void *self, const rfs_model_fit_in_t *in, uint32_t bud
         } else {
             /* the rows this pass counted against the last fit's refinement points */
             for (; w->b < p->nrows; w->b++, w->col = nc) {
+                if (w->col == nc && full(budget, used, 1u)) {
+                    return true;
+                }
                 if (!rfs_reach_bit(w->warmed, w->b)) {
                     used += look(w);
                     continue;

@@ -10,6 +10,11 @@
 #include "pathloss_office.h"
 #include "rfs_fields.h"
 #include "rfs_models.h"
+#include "rfs_reach.h"
+#include "rfs_seek.h"
+#include "rfs_target.h"
+
+#define Q16(v) ((rfs_q16_t)((v) * 65536 + 32768))
 
 /* Samples per bin. */
 #define PER_BIN 40
@@ -621,6 +626,189 @@ static void rv_differential(void **state)
     }
 }
 
+/* Review (rv1): the seeker's warming (rfs_seek.c warm_next) in a closed loop. The
+ * path-loss model's operations are wrapped: warm is asserted to run only between fits
+ * (no fit or decision in progress) and to leave predictions, argmax and estimate as they
+ * were; every fit call is repeated on a shadow model that never warms (the same inputs and
+ * budget: binning, the only part that reads the samples, is sliced alike), and when both are
+ * done their results must be equal. meta-path, the MCU budget (150 units) and a sliced
+ * search tree, the office and its double world of closed_loop_run. */
+typedef struct rv_loop {
+    rfs_seek_t *sk;
+    rfs_pathloss_t *a;      /* the seeker's model */
+    rfs_pathloss_t *b;      /* the shadow */
+    bool b_done;
+    uint32_t warms, warmed_lines, fits, compared;
+} rv_loop_t;
+
+static rv_loop_t rv_lp;
+static rfs_model_ops_t rv_ops;
+
+static void rv_snap(const rfs_pathloss_t *p, rfs_q16_t v[40], rfs_q16_t *ax, rfs_q16_t *ay)
+{
+    memset(v, 0, 40 * sizeof(v[0]));
+    int q = 0;
+    for (int i = 1; i < 30; i += 4) {
+        for (int j = 1; j < 16; j += 4) {
+            v[q] = 0;
+            (void)rfs_pathloss_ops.predict(p, Q16(i), Q16(j), &v[q]);
+            q++;
+        }
+    }
+    *ax = *ay = 0;
+    (void)rfs_pathloss_ops.argmax(p, ax, ay);
+}
+
+static bool rv_warm(void *self, const rfs_model_fit_in_t *in, uint32_t budget)
+{
+    assert_ptr_equal(self, rv_lp.a);
+    assert_false(rv_lp.sk->fitting);
+    assert_false(rv_lp.sk->planning);
+    rfs_q16_t v0[40], v1[40], x0, y0, x1, y1;
+    rfs_pathloss_est_t e0, e1;
+    memset(&e0, 0, sizeof(e0)); /* the padding after .bins */
+    memset(&e1, 0, sizeof(e1));
+    const bool ok0 = rfs_pathloss_estimate(rv_lp.a, &e0);
+    rv_snap(rv_lp.a, v0, &x0, &y0);
+    const uint32_t l0 = rv_lp.a->warm.lines;
+    const bool more = rfs_pathloss_ops.warm(self, in, budget);
+    rv_lp.warms++;
+    rv_lp.warmed_lines += rv_lp.a->warm.lines - l0;
+    rv_snap(rv_lp.a, v1, &x1, &y1);
+    assert_memory_equal(v0, v1, sizeof(v0));
+    assert_int_equal(x0, x1);
+    assert_int_equal(y0, y1);
+    assert_int_equal(rfs_pathloss_estimate(rv_lp.a, &e1), ok0);
+    if (ok0) {
+        assert_memory_equal(&e0, &e1, sizeof(e0));
+    }
+    return more;
+}
+
+static void rv_reset(void *self)
+{
+    rfs_pathloss_ops.reset(self);
+    rfs_pathloss_ops.reset(rv_lp.b);
+    rv_lp.b_done = false;
+}
+
+static rfs_fit_result_t rv_fit(void *self, const rfs_model_fit_in_t *in, uint32_t budget,
+                               rfs_rng_t *rng)
+{
+    const rfs_fit_result_t r = rfs_pathloss_ops.fit(self, in, budget, rng);
+    rfs_fit_result_t rb = RFS_FIT_DONE;
+    if (!rv_lp.b_done) {
+        rb = rfs_pathloss_ops.fit(rv_lp.b, in, budget, rng);
+        rv_lp.b_done = rb != RFS_FIT_MORE;
+    }
+    if (r != RFS_FIT_MORE) {
+        for (int k = 0; !rv_lp.b_done && k < 100000; ++k) {
+            rb = rfs_pathloss_ops.fit(rv_lp.b, in, budget, rng);
+            rv_lp.b_done = rb != RFS_FIT_MORE;
+        }
+        assert_true(rv_lp.b_done);
+        assert_int_equal(rv_lp.a->valid, rv_lp.b->valid);
+        if (r == RFS_FIT_DONE) {
+            assert_memory_equal(&rv_lp.a->best, &rv_lp.b->best, sizeof(rv_lp.a->best));
+            assert_memory_equal(rv_lp.a->surface, rv_lp.b->surface, sizeof(rv_lp.a->surface));
+            assert_int_equal(rv_lp.a->spread_m2, rv_lp.b->spread_m2);
+            rv_lp.compared++;
+        }
+        rv_lp.fits++;
+    }
+    return r;
+}
+
+static void rv_seek_run(fixture_t *f, uint64_t seed, uint32_t plan_budget)
+{
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    cfg.fit_budget = 150u;
+    cfg.plan_budget = plan_budget;
+    uint32_t lpts = (uint32_t)f->map.lw * f->map.lh;
+    rfs_seek_mem_t mem;
+    memset(&mem, 0, sizeof(mem));
+    mem.samples = calloc(cfg.store.capacity, sizeof(rfs_sample_t));
+    mem.pending = calloc(256, sizeof(rfs_pending_t));
+    mem.pending_cap = 256;
+    mem.plan_work = calloc(lpts, 1);
+    mem.plan_work_bytes = lpts;
+    mem.plan_queue_cap = lpts;
+    mem.plan_queue = calloc(lpts, sizeof(uint32_t));
+    mem.visited_bytes = rfs_reach_bytes(&f->map);
+    mem.visited = calloc(mem.visited_bytes, 1);
+    mem.reach_bytes = mem.visited_bytes;
+    mem.reach = calloc(mem.reach_bytes, 1);
+    rfs_seek_t *sk = calloc(1, sizeof(*sk));
+    rfs_pathloss_t *shadow = malloc(sizeof(*shadow));
+    assert_true(sk != NULL && shadow != NULL);
+    rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
+    assert_int_equal(rfs_pathloss_init(&f->pl, &pc), 0);
+    assert_int_equal(rfs_pathloss_init(shadow, &pc), 0);
+    memset(&rv_lp, 0, sizeof(rv_lp));
+    rv_lp.sk = sk;
+    rv_lp.a = &f->pl;
+    rv_lp.b = shadow;
+    rv_ops = rfs_pathloss_ops;
+    rv_ops.warm = rv_warm;
+    rv_ops.fit = rv_fit;
+    rv_ops.reset = rv_reset;
+    rfs_model_t model = {&rv_ops, &f->pl};
+    assert_int_equal(rfs_seek_init(sk, &cfg, &f->map, model, &rfs_target_rssi, &mem), 0);
+    rfs_rng_t rng, noise;
+    rfs_rng_seed(&rng, seed);
+    rfs_rng_seed(&noise, 1000u + seed);
+    const double sx = 15.125, sy = 3.375;
+    const rfs_q16_t qsx = (rfs_q16_t)lround(sx * 65536.0), qsy = (rfs_q16_t)lround(sy * 65536.0);
+    double x = 2.0, y = 8.0, th = 0, vl = 0, vr = 0;
+    bool reached = false;
+    for (int ms = 0; ms < 600000 && !reached; ms += 5) {
+        int64_t now = (int64_t)ms * 1000;
+        double v = (vl + vr) / 2e3, w = (vr - vl) / 1e3 / 0.23;
+        x += v * cos(th) * 0.005;
+        y += v * sin(th) * 0.005;
+        th = atan2(sin(th + w * 0.005), cos(th + w * 0.005));
+        double d = fmax(hypot(x - sx, y - sy), 1.0);
+        int k = rfs_map_walls_crossed(&f->map, (rfs_q16_t)lround(x * 65536.0),
+                                      (rfs_q16_t)lround(y * 65536.0), qsx, qsy);
+        double dbm = -40 - 30 * log10(d) - 5.0 * k + 4 * gauss(&noise);
+        rfs_seek_on_rssi(sk, 0, now, (int8_t)lround(fmax(dbm, -127)), &rng);
+        if (ms % 100 == 0) {
+            rfs_pose_t p = {now, (rfs_q16_t)lround(x * 65536.0), (rfs_q16_t)lround(y * 65536.0),
+                            (rfs_q16_t)lround(th * 65536.0)};
+            rfs_seek_on_pose(sk, &p, &rng);
+        }
+        if (ms % 50 == 0) {
+            rfs_seek_out_t out;
+            rfs_seek_step(sk, now, &rng, &out);
+            vl = out.left_mm_s;
+            vr = out.right_mm_s;
+        }
+        reached = hypot(x - sx, y - sy) < 1.5;
+    }
+    print_message("rv seek seed %u plan %u: %s, %u warm calls (%u counts), %u fits, %u compared\n",
+                  (unsigned)seed, plan_budget, reached ? "reached" : "not reached", rv_lp.warms,
+                  rv_lp.warmed_lines, rv_lp.fits, rv_lp.compared);
+    assert_true(rv_lp.warms > 0u && rv_lp.warmed_lines > 0u && rv_lp.compared > 1u);
+    free(sk);
+    free(shadow);
+    free(mem.samples);
+    free(mem.pending);
+    free(mem.plan_work);
+    free(mem.plan_queue);
+    free(mem.visited);
+    free(mem.reach);
+}
+
+static void rv_seek_warms_between_fits_only(void **state)
+{
+    fixture_t *f = *state;
+    for (uint64_t seed = 1; seed <= 3; ++seed) {
+        rv_seek_run(f, seed, 0u);
+        rv_seek_run(f, seed, RFS_SEEK_PLAN_BUDGET);
+    }
+}
+
 static void only_pathloss_warms(void **state)
 {
     (void)state;
@@ -645,6 +833,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(rv_warm_call_within_budget, setup, teardown),
         cmocka_unit_test_setup_teardown(rv_hold_pass_within_budget, setup, teardown),
         cmocka_unit_test_setup_teardown(rv_differential, setup, teardown),
+        cmocka_unit_test_setup_teardown(rv_seek_warms_between_fits_only, setup, teardown),
         cmocka_unit_test(only_pathloss_warms),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -200,11 +200,8 @@ static bool warm_hold(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t 
     const int16_t rky = (int16_t)rfs_pathloss_floor_div(q16_to_cm(in->qy), p->bin_cm);
     const int32_t step = p->lat.cs / 2u < 1u ? 1 : (int32_t)(p->lat.cs / 2u);
     for (; w->b < p->nbins; w->b++, w->col = 0u) {
-        if (w->col == 0u) {
-            if (full(budget, *used, 1u)) {
-                return false;
-            }
-            *used += look(w); /* every bin, with a row or not */
+        if (w->col == 0u && full(budget, *used, 1u)) {
+            return false; /* a look is work too */
         }
         const rfs_pathloss_bin_t *bb = &p->bins[w->b];
         const int32_t xcm = (int32_t)rfs_sdiv64_round(bb->sx_cm, bb->count);
@@ -213,6 +210,7 @@ static bool warm_hold(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t 
         if ((bb->kx == rkx && bb->ky == rky) ||
             !rfs_map_cell(m, rfs_pathloss_cm_to_q16(xcm), rfs_pathloss_cm_to_q16(ycm), &cx, &cy) ||
             (row = rfs_pathloss_walls_row_find(p, cx, cy)) == RFS_PATHLOSS_NO_ROW) {
+            *used += look(w);
             continue;
         }
         rfs_q16_t wx, wy;
@@ -234,6 +232,7 @@ static bool warm_hold(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t 
             w->lines += lines;
             w->footprints += lines != 0u ? 1u : 0u;
         }
+        *used += look(w); /* a bin with a row is a look too */
     }
     return true;
 }

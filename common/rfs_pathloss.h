@@ -51,11 +51,11 @@
  * when its rows run out, those no bin of the fit holds are emptied and reused, and so
  * are the built-in columns the last fit did not use.
  *
- * Work: one unit is one computed wall count, 32 bins gathered from the cache, solved or
- * set up, or 64 samples binned. fit() with budget 0 does everything; with budget > 0 it
- * stops before work that could overrun the budget (a footprint: four units; at least
- * one piece per call), resumes there on the next call, and returns RFS_FIT_MORE until
- * the search is done. The model is invalid while a fit is in progress; a sliced fit bins
+ * Work: one unit is one computed wall count, RFS_PATHLOSS_BINS_PER_UNIT (8) bins gathered
+ * from the cache, solved or set up, or RFS_PATHLOSS_SAMPLES_PER_UNIT (16) samples binned.
+ * fit() with budget 0 does everything; with budget > 0 it stops before work that could
+ * overrun the budget (a footprint: four units; at least one piece per call), resumes
+ * there on the next call, and returns RFS_FIT_MORE until the search is done. The model is invalid while a fit is in progress; a sliced fit bins
  * the samples its first call saw (samples added meanwhile wait for the next relearn;
  * ones a full store replaces meanwhile may be binned new).
  *

@@ -91,6 +91,25 @@ static rfs_pathloss_est_t fit(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, u
     return e;
 }
 
+/* Two estimates equal field by field (a struct's padding is not part of it). */
+static void est_equal(const rfs_pathloss_est_t *a, const rfs_pathloss_est_t *b)
+{
+    assert_int_equal(a->sx, b->sx);
+    assert_int_equal(a->sy, b->sy);
+    assert_int_equal(a->p0, b->p0);
+    assert_int_equal(a->n, b->n);
+    assert_int_equal(a->w, b->w);
+    assert_int_equal(a->rms, b->rms);
+    assert_int_equal(a->spread_m2, b->spread_m2);
+    assert_int_equal(a->bins, b->bins);
+    assert_int_equal(a->bin, b->bin);
+    assert_int_equal(a->candidates, b->candidates);
+    assert_int_equal(a->walls_counted, b->walls_counted);
+    assert_int_equal(a->footprints, b->footprints);
+    assert_int_equal(a->footprints_cached, b->footprints_cached);
+    assert_int_equal(a->walls_warmed, b->walls_warmed);
+}
+
 /* Warm until there is nothing left; the calls it took. */
 static int warm_all(rfs_pathloss_t *p, const rfs_model_fit_in_t *in, uint32_t budget)
 {
@@ -218,7 +237,7 @@ static void warm_leaves_the_model_unchanged(void **state)
     }
     rfs_pathloss_est_t e;
     assert_true(rfs_pathloss_estimate(&f->pl, &e));
-    assert_memory_equal(&e, &e0, sizeof(e));
+    est_equal(&e, &e0);
 }
 
 /* Budget 1 (at least a piece a call) warms what one unbounded call does, over many calls;
@@ -376,10 +395,10 @@ static void warm_takes_rows_no_bin_holds(void **state)
     free(before);
 }
 
-/* Review (rv1). The work units a warm call charged itself, at least: the wall counts it
+/* The work units a warm call charged itself, at least: the wall counts it
  * computed (warm.lines) and a unit every RFS_PATHLOSS_BINS_PER_UNIT columns or bins looked
  * at (warm.seen); binning and tidying aside. */
-static uint32_t rv_units(const rfs_pathloss_t *p, uint32_t lines0, uint32_t seen0)
+static uint32_t wm_units(const rfs_pathloss_t *p, uint32_t lines0, uint32_t seen0)
 {
     return (p->warm.lines - lines0) +
            (p->warm.seen / RFS_PATHLOSS_BINS_PER_UNIT - seen0 / RFS_PATHLOSS_BINS_PER_UNIT);
@@ -390,7 +409,7 @@ static uint32_t rv_units(const rfs_pathloss_t *p, uint32_t lines0, uint32_t seen
  * spacing 1 m: 480 coarse points, more than the built-in cache's 256 columns, so most of
  * the last fit's coarse and every refinement point have no column. Warmed to the end at
  * `budget` a call; the most units a call charged. */
-static uint32_t rv_worst_call(fixture_t *f, int leg, bool both, uint32_t budget)
+static uint32_t wm_worst_call(fixture_t *f, int leg, bool both, uint32_t budget)
 {
     int n = 0;
     for (int bx = 2; bx < 12; ++bx) {
@@ -418,7 +437,7 @@ static uint32_t rv_worst_call(fixture_t *f, int leg, bool both, uint32_t budget)
     while (more && calls < 100000u) {
         const uint32_t l0 = f->pl.warm.lines, s0 = f->pl.warm.seen;
         more = rfs_pathloss_ops.warm(&f->pl, &in2, budget);
-        const uint32_t u = rv_units(&f->pl, l0, s0);
+        const uint32_t u = wm_units(&f->pl, l0, s0);
         worst = u > worst ? u : worst;
         calls++;
     }
@@ -430,12 +449,12 @@ static uint32_t rv_worst_call(fixture_t *f, int leg, bool both, uint32_t budget)
 /* Every call within its budget (the first piece aside, at most 40 units): looks at columns
  * without a cache column are charged but not checked against the budget (warm_count), nor
  * are the rows of the refinement pass (WARM_REFINE). */
-static void rv_warm_call_within_budget(void **state)
+static void wm_warm_call_within_budget(void **state)
 {
     fixture_t *f = *state;
-    const uint32_t w1 = rv_worst_call(f, 16, false, 113u); /* RFS_SEEK_WARM_SLICE(150) */
-    const uint32_t w2 = rv_worst_call(f, 16, false, 40u);
-    const uint32_t w3 = rv_worst_call(f, 17, true, 113u);
+    const uint32_t w1 = wm_worst_call(f, 16, false, 113u); /* RFS_SEEK_WARM_SLICE(150) */
+    const uint32_t w2 = wm_worst_call(f, 16, false, 40u);
+    const uint32_t w3 = wm_worst_call(f, 17, true, 113u);
     assert_true(w1 <= 113u);
     assert_true(w2 <= 40u);
     assert_true(w3 <= 113u);
@@ -446,7 +465,7 @@ static void rv_warm_call_within_budget(void **state)
  * coarse 1 m) and at every row for the refinement pass: those looks are charged but never
  * checked against the budget (warm_hold, WARM_REFINE), and bins with a row are not even
  * charged. */
-static void rv_hold_pass_within_budget(void **state)
+static void wm_hold_pass_within_budget(void **state)
 {
     fixture_t *f = *state;
     make_samples(f->s, NS / 2, &f->map, &k_office, 11);
@@ -461,7 +480,7 @@ static void rv_hold_pass_within_budget(void **state)
     while (more && calls < 100000u) {
         const uint32_t l0 = f->pl.warm.lines, s0 = f->pl.warm.seen;
         more = rfs_pathloss_ops.warm(&f->pl, &in2, 40u);
-        const uint32_t u = rv_units(&f->pl, l0, s0);
+        const uint32_t u = wm_units(&f->pl, l0, s0);
         worst = u > worst ? u : worst;
         calls++;
     }
@@ -478,7 +497,7 @@ static void rv_hold_pass_within_budget(void **state)
  * cache, a fit without the map in between. */
 #define RV_CAP 900
 
-static void rv_sample(fixture_t *f, rfs_rng_t *r, int *x, int *y, rfs_sample_t *s)
+static void wm_sample(fixture_t *f, rfs_rng_t *r, int *x, int *y, rfs_sample_t *s)
 {
     for (int tries = 0; tries < 1000; ++tries) {
         const int nx = *x + (int)rfs_rng_below(r, 81) - 40, ny = *y + (int)rfs_rng_below(r, 81) - 40;
@@ -501,14 +520,14 @@ static void rv_sample(fixture_t *f, rfs_rng_t *r, int *x, int *y, rfs_sample_t *
     s->v_q6 = (int16_t)lround(v * 64.0);
 }
 
-typedef struct rv_pub {
+typedef struct wm_pub {
     rfs_q16_t v[60];
     rfs_q16_t ax, ay;
     rfs_pathloss_est_t e;
     uint32_t surface[RFS_PATHLOSS_MAX_COARSE];
-} rv_pub_t;
+} wm_pub_t;
 
-static void rv_publish(const rfs_pathloss_t *a, rv_pub_t *o)
+static void wm_publish(const rfs_pathloss_t *a, wm_pub_t *o)
 {
     memset(o, 0, sizeof(*o));
     int q = 0;
@@ -522,11 +541,11 @@ static void rv_publish(const rfs_pathloss_t *a, rv_pub_t *o)
     memcpy(o->surface, a->surface, sizeof(o->surface));
 }
 
-static void rv_run(fixture_t *f, const rfs_pathloss_cfg_t *c, bool attach, bool excl, uint64_t seed)
+static void wm_run(fixture_t *f, const rfs_pathloss_cfg_t *c, bool attach, bool excl, uint64_t seed)
 {
     rfs_pathloss_t *a = malloc(sizeof(*a)), *b = malloc(sizeof(*b));
     rfs_sample_t *s = malloc(sizeof(rfs_sample_t) * RV_CAP);
-    rv_pub_t *p0 = malloc(sizeof(*p0)), *p1 = malloc(sizeof(*p1));
+    wm_pub_t *p0 = malloc(sizeof(*p0)), *p1 = malloc(sizeof(*p1));
     const uint32_t bytes = rfs_pathloss_cache_bytes(300);
     void *bufa = attach ? malloc(bytes) : NULL, *bufb = attach ? malloc(bytes) : NULL;
     assert_true(a != NULL && b != NULL && s != NULL && p0 != NULL && p1 != NULL);
@@ -566,13 +585,13 @@ static void rv_run(fixture_t *f, const rfs_pathloss_cfg_t *c, bool attach, bool 
         }
         const bool valid = a->valid;
         if (valid) {
-            rv_publish(a, p0);
+            wm_publish(a, p0);
         }
         const int steps = 20 + (int)rfs_rng_below(&r, 120);
         for (int t = 0; t < steps; ++t) {
             for (int k = 0; k < 3; ++k) {
                 rfs_sample_t sm;
-                rv_sample(f, &r, &x, &y, &sm);
+                wm_sample(f, &r, &x, &y, &sm);
                 seen++;
                 if (n < RV_CAP) {
                     s[n++] = sm;
@@ -588,7 +607,7 @@ static void rv_run(fixture_t *f, const rfs_pathloss_cfg_t *c, bool attach, bool 
             wi.nexcl = nexcl;
             (void)rfs_pathloss_ops.warm(a, &wi, 1u + rfs_rng_below(&r, 150));
             if (valid) {
-                rv_publish(a, p1);
+                wm_publish(a, p1);
                 assert_memory_equal(p1, p0, sizeof(*p0));
             }
         }
@@ -602,49 +621,49 @@ static void rv_run(fixture_t *f, const rfs_pathloss_cfg_t *c, bool attach, bool 
     free(bufb);
 }
 
-static void rv_differential(void **state)
+static void wm_differential(void **state)
 {
     fixture_t *f = *state;
     for (uint64_t seed = 1; seed <= 4; ++seed) {
         rfs_pathloss_cfg_t c = rfs_pathloss_cfg_default();
-        rv_run(f, &c, false, false, seed);
+        wm_run(f, &c, false, false, seed);
         c.coarse = RFS_Q16_INT(1);
-        rv_run(f, &c, false, true, seed + 100);
+        wm_run(f, &c, false, true, seed + 100);
         c.coarse_footprint = 0;
-        rv_run(f, &c, false, true, seed + 200);
+        wm_run(f, &c, false, true, seed + 200);
         c = rfs_pathloss_cfg_default();
         c.coarse_footprint = 0;
         c.hold_search = false;
-        rv_run(f, &c, true, true, seed + 300);
+        wm_run(f, &c, true, true, seed + 300);
         c = rfs_pathloss_cfg_default();
         c.footprint = 0;
         c.hold_k = 0;
-        rv_run(f, &c, false, false, seed + 400);
+        wm_run(f, &c, false, false, seed + 400);
         c = rfs_pathloss_cfg_default();
         c.bin = RFS_Q16_FRAC(1, 2);
-        rv_run(f, &c, true, true, seed + 500);
+        wm_run(f, &c, true, true, seed + 500);
     }
 }
 
-/* Review (rv1): the seeker's warming (rfs_seek.c warm_next) in a closed loop. The
+/* The seeker's warming (rfs_seek.c warm_next) in a closed loop. The
  * path-loss model's operations are wrapped: warm is asserted to run only between fits
  * (no fit or decision in progress) and to leave predictions, argmax and estimate as they
  * were; every fit call is repeated on a shadow model that never warms (the same inputs and
  * budget: binning, the only part that reads the samples, is sliced alike), and when both are
  * done their results must be equal. meta-path, the MCU budget (150 units) and a sliced
  * search tree, the office and its double world of closed_loop_run. */
-typedef struct rv_loop {
+typedef struct wm_loop {
     rfs_seek_t *sk;
     rfs_pathloss_t *a;      /* the seeker's model */
     rfs_pathloss_t *b;      /* the shadow */
     bool b_done;
     uint32_t warms, warmed_lines, fits, compared;
-} rv_loop_t;
+} wm_loop_t;
 
-static rv_loop_t rv_lp;
-static rfs_model_ops_t rv_ops;
+static wm_loop_t wm_lp;
+static rfs_model_ops_t wm_ops;
 
-static void rv_snap(const rfs_pathloss_t *p, rfs_q16_t v[40], rfs_q16_t *ax, rfs_q16_t *ay)
+static void wm_snap(const rfs_pathloss_t *p, rfs_q16_t v[40], rfs_q16_t *ax, rfs_q16_t *ay)
 {
     memset(v, 0, 40 * sizeof(v[0]));
     int q = 0;
@@ -659,67 +678,67 @@ static void rv_snap(const rfs_pathloss_t *p, rfs_q16_t v[40], rfs_q16_t *ax, rfs
     (void)rfs_pathloss_ops.argmax(p, ax, ay);
 }
 
-static bool rv_warm(void *self, const rfs_model_fit_in_t *in, uint32_t budget)
+static bool wm_warm(void *self, const rfs_model_fit_in_t *in, uint32_t budget)
 {
-    assert_ptr_equal(self, rv_lp.a);
-    assert_false(rv_lp.sk->fitting);
-    assert_false(rv_lp.sk->planning);
+    assert_ptr_equal(self, wm_lp.a);
+    assert_false(wm_lp.sk->fitting);
+    assert_false(wm_lp.sk->planning);
     rfs_q16_t v0[40], v1[40], x0, y0, x1, y1;
     rfs_pathloss_est_t e0, e1;
     memset(&e0, 0, sizeof(e0)); /* the padding after .bins */
     memset(&e1, 0, sizeof(e1));
-    const bool ok0 = rfs_pathloss_estimate(rv_lp.a, &e0);
-    rv_snap(rv_lp.a, v0, &x0, &y0);
-    const uint32_t l0 = rv_lp.a->warm.lines;
+    const bool ok0 = rfs_pathloss_estimate(wm_lp.a, &e0);
+    wm_snap(wm_lp.a, v0, &x0, &y0);
+    const uint32_t l0 = wm_lp.a->warm.lines;
     const bool more = rfs_pathloss_ops.warm(self, in, budget);
-    rv_lp.warms++;
-    rv_lp.warmed_lines += rv_lp.a->warm.lines - l0;
-    rv_snap(rv_lp.a, v1, &x1, &y1);
+    wm_lp.warms++;
+    wm_lp.warmed_lines += wm_lp.a->warm.lines - l0;
+    wm_snap(wm_lp.a, v1, &x1, &y1);
     assert_memory_equal(v0, v1, sizeof(v0));
     assert_int_equal(x0, x1);
     assert_int_equal(y0, y1);
-    assert_int_equal(rfs_pathloss_estimate(rv_lp.a, &e1), ok0);
+    assert_int_equal(rfs_pathloss_estimate(wm_lp.a, &e1), ok0);
     if (ok0) {
-        assert_memory_equal(&e0, &e1, sizeof(e0));
+        est_equal(&e0, &e1);
     }
     return more;
 }
 
-static void rv_reset(void *self)
+static void wm_reset(void *self)
 {
     rfs_pathloss_ops.reset(self);
-    rfs_pathloss_ops.reset(rv_lp.b);
-    rv_lp.b_done = false;
+    rfs_pathloss_ops.reset(wm_lp.b);
+    wm_lp.b_done = false;
 }
 
-static rfs_fit_result_t rv_fit(void *self, const rfs_model_fit_in_t *in, uint32_t budget,
+static rfs_fit_result_t wm_fit(void *self, const rfs_model_fit_in_t *in, uint32_t budget,
                                rfs_rng_t *rng)
 {
     const rfs_fit_result_t r = rfs_pathloss_ops.fit(self, in, budget, rng);
     rfs_fit_result_t rb = RFS_FIT_DONE;
-    if (!rv_lp.b_done) {
-        rb = rfs_pathloss_ops.fit(rv_lp.b, in, budget, rng);
-        rv_lp.b_done = rb != RFS_FIT_MORE;
+    if (!wm_lp.b_done) {
+        rb = rfs_pathloss_ops.fit(wm_lp.b, in, budget, rng);
+        wm_lp.b_done = rb != RFS_FIT_MORE;
     }
     if (r != RFS_FIT_MORE) {
-        for (int k = 0; !rv_lp.b_done && k < 100000; ++k) {
-            rb = rfs_pathloss_ops.fit(rv_lp.b, in, budget, rng);
-            rv_lp.b_done = rb != RFS_FIT_MORE;
+        for (int k = 0; !wm_lp.b_done && k < 100000; ++k) {
+            rb = rfs_pathloss_ops.fit(wm_lp.b, in, budget, rng);
+            wm_lp.b_done = rb != RFS_FIT_MORE;
         }
-        assert_true(rv_lp.b_done);
-        assert_int_equal(rv_lp.a->valid, rv_lp.b->valid);
+        assert_true(wm_lp.b_done);
+        assert_int_equal(wm_lp.a->valid, wm_lp.b->valid);
         if (r == RFS_FIT_DONE) {
-            assert_memory_equal(&rv_lp.a->best, &rv_lp.b->best, sizeof(rv_lp.a->best));
-            assert_memory_equal(rv_lp.a->surface, rv_lp.b->surface, sizeof(rv_lp.a->surface));
-            assert_int_equal(rv_lp.a->spread_m2, rv_lp.b->spread_m2);
-            rv_lp.compared++;
+            assert_memory_equal(&wm_lp.a->best, &wm_lp.b->best, sizeof(wm_lp.a->best));
+            assert_memory_equal(wm_lp.a->surface, wm_lp.b->surface, sizeof(wm_lp.a->surface));
+            assert_int_equal(wm_lp.a->spread_m2, wm_lp.b->spread_m2);
+            wm_lp.compared++;
         }
-        rv_lp.fits++;
+        wm_lp.fits++;
     }
     return r;
 }
 
-static void rv_seek_run(fixture_t *f, uint64_t seed, uint32_t plan_budget)
+static void wm_seek_run(fixture_t *f, uint64_t seed, uint32_t plan_budget)
 {
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
@@ -745,15 +764,15 @@ static void rv_seek_run(fixture_t *f, uint64_t seed, uint32_t plan_budget)
     rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
     assert_int_equal(rfs_pathloss_init(&f->pl, &pc), 0);
     assert_int_equal(rfs_pathloss_init(shadow, &pc), 0);
-    memset(&rv_lp, 0, sizeof(rv_lp));
-    rv_lp.sk = sk;
-    rv_lp.a = &f->pl;
-    rv_lp.b = shadow;
-    rv_ops = rfs_pathloss_ops;
-    rv_ops.warm = rv_warm;
-    rv_ops.fit = rv_fit;
-    rv_ops.reset = rv_reset;
-    rfs_model_t model = {&rv_ops, &f->pl};
+    memset(&wm_lp, 0, sizeof(wm_lp));
+    wm_lp.sk = sk;
+    wm_lp.a = &f->pl;
+    wm_lp.b = shadow;
+    wm_ops = rfs_pathloss_ops;
+    wm_ops.warm = wm_warm;
+    wm_ops.fit = wm_fit;
+    wm_ops.reset = wm_reset;
+    rfs_model_t model = {&wm_ops, &f->pl};
     assert_int_equal(rfs_seek_init(sk, &cfg, &f->map, model, &rfs_target_rssi, &mem), 0);
     rfs_rng_t rng, noise;
     rfs_rng_seed(&rng, seed);
@@ -787,9 +806,9 @@ static void rv_seek_run(fixture_t *f, uint64_t seed, uint32_t plan_budget)
         reached = hypot(x - sx, y - sy) < 1.5;
     }
     print_message("rv seek seed %u plan %u: %s, %u warm calls (%u counts), %u fits, %u compared\n",
-                  (unsigned)seed, plan_budget, reached ? "reached" : "not reached", rv_lp.warms,
-                  rv_lp.warmed_lines, rv_lp.fits, rv_lp.compared);
-    assert_true(rv_lp.warms > 0u && rv_lp.warmed_lines > 0u && rv_lp.compared > 1u);
+                  (unsigned)seed, plan_budget, reached ? "reached" : "not reached", wm_lp.warms,
+                  wm_lp.warmed_lines, wm_lp.fits, wm_lp.compared);
+    assert_true(wm_lp.warms > 0u && wm_lp.warmed_lines > 0u && wm_lp.compared > 1u);
     free(sk);
     free(shadow);
     free(mem.samples);
@@ -800,12 +819,12 @@ static void rv_seek_run(fixture_t *f, uint64_t seed, uint32_t plan_budget)
     free(mem.reach);
 }
 
-static void rv_seek_warms_between_fits_only(void **state)
+static void wm_seek_warms_between_fits_only(void **state)
 {
     fixture_t *f = *state;
     for (uint64_t seed = 1; seed <= 3; ++seed) {
-        rv_seek_run(f, seed, 0u);
-        rv_seek_run(f, seed, RFS_SEEK_PLAN_BUDGET);
+        wm_seek_run(f, seed, 0u);
+        wm_seek_run(f, seed, RFS_SEEK_PLAN_BUDGET);
     }
 }
 
@@ -830,10 +849,10 @@ int main(void)
         cmocka_unit_test_setup_teardown(warm_resumes_at_budget_one, setup, teardown),
         cmocka_unit_test_setup_teardown(warm_keeps_the_last_fits_rows, setup, teardown),
         cmocka_unit_test_setup_teardown(warm_takes_rows_no_bin_holds, setup, teardown),
-        cmocka_unit_test_setup_teardown(rv_warm_call_within_budget, setup, teardown),
-        cmocka_unit_test_setup_teardown(rv_hold_pass_within_budget, setup, teardown),
-        cmocka_unit_test_setup_teardown(rv_differential, setup, teardown),
-        cmocka_unit_test_setup_teardown(rv_seek_warms_between_fits_only, setup, teardown),
+        cmocka_unit_test_setup_teardown(wm_warm_call_within_budget, setup, teardown),
+        cmocka_unit_test_setup_teardown(wm_hold_pass_within_budget, setup, teardown),
+        cmocka_unit_test_setup_teardown(wm_differential, setup, teardown),
+        cmocka_unit_test_setup_teardown(wm_seek_warms_between_fits_only, setup, teardown),
         cmocka_unit_test(only_pathloss_warms),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

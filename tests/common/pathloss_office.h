@@ -1,6 +1,7 @@
 /* pathloss_office.h - the fixture of the path-loss model's tests (test_pathloss.c,
- * test_pathloss_use.c): the office (office_map.h), samples valued by the model with a known
- * source, P0, n and W plus Gaussian noise, and whole or sliced fits from a fresh model.
+ * test_pathloss_use.c, test_pathloss_warm.c): the office (office_map.h), samples valued by
+ * the model with a known source, P0, n and W plus Gaussian noise, whole or sliced fits from
+ * a fresh model, and a seeker driven in a double world on it.
  */
 #ifndef PATHLOSS_OFFICE_H
 #define PATHLOSS_OFFICE_H
@@ -11,6 +12,7 @@
 #include "office_map.h"
 #include "ref_pathloss.h"
 #include "rfs_pathloss.h"
+#include "rfs_seek.h"
 #include "rfs_test.h"
 
 #define NS 2000
@@ -139,5 +141,53 @@ static inline rfs_pathloss_est_t fit_default(fixture_t *f, int n, const rfs_map_
 
 /* n and W away from the default prior (3, 5 dB), so that recovering them means something. */
 static const truth_t k_office = {15.125, 3.375, -35.0, 2.6, 6.5, 0.3};
+
+/* The seeker sk in a double world on the office: a differential-drive robot (0.23 m track,
+ * 5 ms steps) from (2, 8) m; every 5 ms an RSSI of -40 - 30 log10(d) - 5 dB a wall + 4 dB
+ * noise (noise rng) from the source at (15.125, 3.375) m, a pose every 100 ms and a
+ * control period every 50 ms, until the robot is within 1.5 m of the source or 600 s
+ * pass. Returns that distance, or -1 when not reached; *travel (if not NULL) the metres
+ * driven. */
+static inline double office_seek_run(const rfs_map_t *map, rfs_seek_t *sk, rfs_rng_t *rng,
+                                     rfs_rng_t *noise, double *travel)
+{
+    const double sx = 15.125, sy = 3.375;
+    const rfs_q16_t qsx = (rfs_q16_t)lround(sx * 65536.0), qsy = (rfs_q16_t)lround(sy * 65536.0);
+    double x = 2.0, y = 8.0, th = 0, vl = 0, vr = 0, moved = 0;
+    for (int ms = 0; ms < 600000; ms += 5) {
+        int64_t now = (int64_t)ms * 1000;
+        double v = (vl + vr) / 2e3, w = (vr - vl) / 1e3 / 0.23;
+        x += v * cos(th) * 0.005;
+        y += v * sin(th) * 0.005;
+        moved += fabs(v) * 0.005;
+        th = atan2(sin(th + w * 0.005), cos(th + w * 0.005));
+        double d = fmax(hypot(x - sx, y - sy), 1.0);
+        int k = rfs_map_walls_crossed(map, (rfs_q16_t)lround(x * 65536.0),
+                                      (rfs_q16_t)lround(y * 65536.0), qsx, qsy);
+        double dbm = -40 - 30 * log10(d) - 5.0 * k + 4 * gauss(noise);
+        rfs_seek_on_rssi(sk, 0, now, (int8_t)lround(fmax(dbm, -127)), rng);
+        if (ms % 100 == 0) {
+            rfs_pose_t p = {now, (rfs_q16_t)lround(x * 65536.0), (rfs_q16_t)lround(y * 65536.0),
+                            (rfs_q16_t)lround(th * 65536.0)};
+            rfs_seek_on_pose(sk, &p, rng);
+        }
+        if (ms % 50 == 0) {
+            rfs_seek_out_t out;
+            rfs_seek_step(sk, now, rng, &out);
+            vl = out.left_mm_s;
+            vr = out.right_mm_s;
+        }
+        if (hypot(x - sx, y - sy) < 1.5) {
+            if (travel != NULL) {
+                *travel = moved;
+            }
+            return hypot(x - sx, y - sy);
+        }
+    }
+    if (travel != NULL) {
+        *travel = moved;
+    }
+    return -1.0;
+}
 
 #endif /* PATHLOSS_OFFICE_H */

@@ -597,38 +597,7 @@ static double closed_loop_run(fixture_t *f, uint64_t seed, double *travel)
     rfs_rng_t rng, noise;
     rfs_rng_seed(&rng, seed);
     rfs_rng_seed(&noise, 1000u + seed);
-    const double sx = 15.125, sy = 3.375;
-    const rfs_q16_t qsx = (rfs_q16_t)lround(sx * 65536.0), qsy = (rfs_q16_t)lround(sy * 65536.0);
-    double x = 2.0, y = 8.0, th = 0, vl = 0, vr = 0, dist = -1.0;
-    *travel = 0;
-    for (int ms = 0; ms < 600000; ms += 5) {
-        int64_t now = (int64_t)ms * 1000;
-        double v = (vl + vr) / 2e3, w = (vr - vl) / 1e3 / 0.23;
-        x += v * cos(th) * 0.005;
-        y += v * sin(th) * 0.005;
-        *travel += fabs(v) * 0.005;
-        th = atan2(sin(th + w * 0.005), cos(th + w * 0.005));
-        double d = fmax(hypot(x - sx, y - sy), 1.0);
-        int k = rfs_map_walls_crossed(&f->map, (rfs_q16_t)lround(x * 65536.0),
-                                      (rfs_q16_t)lround(y * 65536.0), qsx, qsy);
-        double dbm = -40 - 30 * log10(d) - 5.0 * k + 4 * gauss(&noise);
-        rfs_seek_on_rssi(sk, 0, now, (int8_t)lround(fmax(dbm, -127)), &rng);
-        if (ms % 100 == 0) {
-            rfs_pose_t p = {now, (rfs_q16_t)lround(x * 65536.0), (rfs_q16_t)lround(y * 65536.0),
-                            (rfs_q16_t)lround(th * 65536.0)};
-            rfs_seek_on_pose(sk, &p, &rng);
-        }
-        if (ms % 50 == 0) {
-            rfs_seek_out_t out;
-            rfs_seek_step(sk, now, &rng, &out);
-            vl = out.left_mm_s;
-            vr = out.right_mm_s;
-        }
-        if (hypot(x - sx, y - sy) < 1.5) {
-            dist = hypot(x - sx, y - sy);
-            break;
-        }
-    }
+    const double dist = office_seek_run(&f->map, sk, &rng, &noise, travel);
     free(sk);
     free(mem.samples);
     free(mem.pending);

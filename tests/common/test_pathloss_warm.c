@@ -777,35 +777,8 @@ static void wm_seek_run(fixture_t *f, uint64_t seed, uint32_t plan_budget)
     rfs_rng_t rng, noise;
     rfs_rng_seed(&rng, seed);
     rfs_rng_seed(&noise, 1000u + seed);
-    const double sx = 15.125, sy = 3.375;
-    const rfs_q16_t qsx = (rfs_q16_t)lround(sx * 65536.0), qsy = (rfs_q16_t)lround(sy * 65536.0);
-    double x = 2.0, y = 8.0, th = 0, vl = 0, vr = 0;
-    bool reached = false;
-    for (int ms = 0; ms < 600000 && !reached; ms += 5) {
-        int64_t now = (int64_t)ms * 1000;
-        double v = (vl + vr) / 2e3, w = (vr - vl) / 1e3 / 0.23;
-        x += v * cos(th) * 0.005;
-        y += v * sin(th) * 0.005;
-        th = atan2(sin(th + w * 0.005), cos(th + w * 0.005));
-        double d = fmax(hypot(x - sx, y - sy), 1.0);
-        int k = rfs_map_walls_crossed(&f->map, (rfs_q16_t)lround(x * 65536.0),
-                                      (rfs_q16_t)lround(y * 65536.0), qsx, qsy);
-        double dbm = -40 - 30 * log10(d) - 5.0 * k + 4 * gauss(&noise);
-        rfs_seek_on_rssi(sk, 0, now, (int8_t)lround(fmax(dbm, -127)), &rng);
-        if (ms % 100 == 0) {
-            rfs_pose_t p = {now, (rfs_q16_t)lround(x * 65536.0), (rfs_q16_t)lround(y * 65536.0),
-                            (rfs_q16_t)lround(th * 65536.0)};
-            rfs_seek_on_pose(sk, &p, &rng);
-        }
-        if (ms % 50 == 0) {
-            rfs_seek_out_t out;
-            rfs_seek_step(sk, now, &rng, &out);
-            vl = out.left_mm_s;
-            vr = out.right_mm_s;
-        }
-        reached = hypot(x - sx, y - sy) < 1.5;
-    }
-    print_message("rv seek seed %u plan %u: %s, %u warm calls (%u counts), %u fits, %u compared\n",
+    const bool reached = office_seek_run(&f->map, sk, &rng, &noise, NULL) >= 0.0;
+    print_message("warming seeker seed %u plan %u: %s, %u warm calls (%u counts), %u fits, %u compared\n",
                   (unsigned)seed, plan_budget, reached ? "reached" : "not reached", wm_lp.warms,
                   wm_lp.warmed_lines, wm_lp.fits, wm_lp.compared);
     assert_true(wm_lp.warms > 0u && wm_lp.warmed_lines > 0u && wm_lp.compared > 1u);

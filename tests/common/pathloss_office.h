@@ -8,10 +8,12 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "office_map.h"
 #include "ref_pathloss.h"
 #include "rfs_pathloss.h"
+#include "rfs_reach.h"
 #include "rfs_seek.h"
 #include "rfs_test.h"
 
@@ -53,6 +55,24 @@ typedef struct truth {
     double sx, sy, p0, n, w, noise;
 } truth_t;
 
+/* Sample s at (xc, yc) cm valued by the truth t: P0 - 10 n log10(max(d, 1 m)) - W walls
+ * (rfs_map_walls_crossed to the source; none without a map) plus Gaussian noise of sd
+ * sigma dB drawn from r. */
+static inline void truth_sample(const rfs_map_t *map, const truth_t *t, int xc, int yc,
+                                double sigma, rfs_rng_t *r, rfs_sample_t *s)
+{
+    const rfs_q16_t qx = (rfs_q16_t)lround(xc / 100.0 * 65536.0);
+    const rfs_q16_t qy = (rfs_q16_t)lround(yc / 100.0 * 65536.0);
+    const rfs_q16_t qsx = (rfs_q16_t)lround(t->sx * 65536.0);
+    const rfs_q16_t qsy = (rfs_q16_t)lround(t->sy * 65536.0);
+    const double d = hypot(xc / 100.0 - t->sx, yc / 100.0 - t->sy);
+    const int k = map != NULL ? rfs_map_walls_crossed(map, qx, qy, qsx, qsy) : 0;
+    const double v = t->p0 - 10.0 * t->n * log10(d < 1.0 ? 1.0 : d) - t->w * k + sigma * gauss(r);
+    s->x_cm = (int16_t)xc;
+    s->y_cm = (int16_t)yc;
+    s->v_q6 = (int16_t)lround(v * 64.0);
+}
+
 /* n samples at random legal points of the map (or anywhere in [0, 30] x [0, 16] m when
  * map is NULL), valued by the model with the truth's parameters; walls counted from the
  * sample's exact position to the source. */
@@ -61,7 +81,6 @@ static inline void make_samples(rfs_sample_t *s, int n, const rfs_map_t *map, co
 {
     rfs_rng_t r;
     rfs_rng_seed(&r, seed);
-    rfs_q16_t qsx = (rfs_q16_t)lround(t->sx * 65536.0), qsy = (rfs_q16_t)lround(t->sy * 65536.0);
     for (int i = 0; i < n;) {
         int xc = (int)rfs_rng_below(&r, 3001), yc = (int)rfs_rng_below(&r, 1601);
         rfs_q16_t qx = (rfs_q16_t)lround(xc / 100.0 * 65536.0);
@@ -69,12 +88,7 @@ static inline void make_samples(rfs_sample_t *s, int n, const rfs_map_t *map, co
         if (map != NULL && !rfs_map_point_legal(map, qx, qy)) {
             continue;
         }
-        double d = hypot(xc / 100.0 - t->sx, yc / 100.0 - t->sy);
-        int k = map != NULL ? rfs_map_walls_crossed(map, qx, qy, qsx, qsy) : 0;
-        double v = t->p0 - 10.0 * t->n * log10(d < 1.0 ? 1.0 : d) - t->w * k + t->noise * gauss(&r);
-        s[i].x_cm = (int16_t)xc;
-        s[i].y_cm = (int16_t)yc;
-        s[i].v_q6 = (int16_t)lround(v * 64.0);
+        truth_sample(map, t, xc, yc, t->noise, &r, &s[i]);
         ++i;
     }
 }
@@ -141,6 +155,37 @@ static inline rfs_pathloss_est_t fit_default(fixture_t *f, int n, const rfs_map_
 
 /* n and W away from the default prior (3, 5 dB), so that recovering them means something. */
 static const truth_t k_office = {15.125, 3.375, -35.0, 2.6, 6.5, 0.3};
+
+/* The seeker's working memory on map (a store of capacity samples, 256 pending, the
+ * planner's lattice-sized buffers, the reachability bits), from the heap. */
+static inline void office_seek_mem(const rfs_map_t *map, uint16_t capacity, rfs_seek_mem_t *mem)
+{
+    const uint32_t lpts = (uint32_t)map->lw * map->lh;
+    memset(mem, 0, sizeof(*mem));
+    mem->samples = calloc(capacity, sizeof(rfs_sample_t));
+    mem->pending = calloc(256, sizeof(rfs_pending_t));
+    mem->pending_cap = 256;
+    mem->plan_work = calloc(lpts, 1);
+    mem->plan_work_bytes = lpts;
+    mem->plan_queue_cap = lpts;
+    mem->plan_queue = calloc(lpts, sizeof(uint32_t));
+    mem->visited_bytes = rfs_reach_bytes(map);
+    mem->visited = calloc(mem->visited_bytes, 1);
+    mem->reach_bytes = mem->visited_bytes;
+    mem->reach = calloc(mem->reach_bytes, 1);
+    assert_true(mem->samples != NULL && mem->pending != NULL && mem->plan_work != NULL &&
+                mem->plan_queue != NULL && mem->visited != NULL && mem->reach != NULL);
+}
+
+static inline void office_seek_mem_free(rfs_seek_mem_t *mem)
+{
+    free(mem->samples);
+    free(mem->pending);
+    free(mem->plan_work);
+    free(mem->plan_queue);
+    free(mem->visited);
+    free(mem->reach);
+}
 
 /* The seeker sk in a double world on the office: a differential-drive robot (0.23 m track,
  * 5 ms steps) from (2, 8) m; every 5 ms an RSSI of -40 - 30 log10(d) - 5 dB a wall + 4 dB

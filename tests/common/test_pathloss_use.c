@@ -574,20 +574,8 @@ static void draws_between_slices_of_a_moved_lattice(void **state)
 static double closed_loop_run(fixture_t *f, uint64_t seed, double *travel)
 {
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
-    uint32_t lpts = (uint32_t)f->map.lw * f->map.lh;
     rfs_seek_mem_t mem;
-    memset(&mem, 0, sizeof(mem));
-    mem.samples = calloc(cfg.store.capacity, sizeof(rfs_sample_t));
-    mem.pending = calloc(256, sizeof(rfs_pending_t));
-    mem.pending_cap = 256;
-    mem.plan_work = calloc(lpts, 1);
-    mem.plan_work_bytes = lpts;
-    mem.plan_queue_cap = lpts;
-    mem.plan_queue = calloc(lpts, sizeof(uint32_t));
-    mem.visited_bytes = rfs_reach_bytes(&f->map);
-    mem.visited = calloc(mem.visited_bytes, 1);
-    mem.reach_bytes = mem.visited_bytes;
-    mem.reach = calloc(mem.reach_bytes, 1);
+    office_seek_mem(&f->map, cfg.store.capacity, &mem);
     rfs_seek_t *sk = calloc(1, sizeof(*sk));
     assert_non_null(sk);
     rfs_pathloss_cfg_t pc = rfs_pathloss_cfg_default();
@@ -599,12 +587,7 @@ static double closed_loop_run(fixture_t *f, uint64_t seed, double *travel)
     rfs_rng_seed(&noise, 1000u + seed);
     const double dist = office_seek_run(&f->map, sk, &rng, &noise, travel);
     free(sk);
-    free(mem.samples);
-    free(mem.pending);
-    free(mem.plan_work);
-    free(mem.plan_queue);
-    free(mem.visited);
-    free(mem.reach);
+    office_seek_mem_free(&mem);
     return dist;
 }
 

@@ -25,7 +25,6 @@ static void bin_samples(rfs_sample_t *s, int n, const rfs_map_t *map, const trut
 {
     rfs_rng_t r;
     rfs_rng_seed(&r, seed);
-    rfs_q16_t qsx = (rfs_q16_t)lround(t->sx * 65536.0), qsy = (rfs_q16_t)lround(t->sy * 65536.0);
     int tries = 0;
     for (int i = 0; i < n; ++tries) {
         assert_true(tries < 100000);
@@ -35,12 +34,7 @@ static void bin_samples(rfs_sample_t *s, int n, const rfs_map_t *map, const trut
         if (!rfs_map_point_legal(map, qx, qy)) {
             continue;
         }
-        double d = hypot(xc / 100.0 - t->sx, yc / 100.0 - t->sy);
-        int k = rfs_map_walls_crossed(map, qx, qy, qsx, qsy);
-        double v = t->p0 - 10.0 * t->n * log10(d < 1.0 ? 1.0 : d) - t->w * k + t->noise * gauss(&r);
-        s[i].x_cm = (int16_t)xc;
-        s[i].y_cm = (int16_t)yc;
-        s[i].v_q6 = (int16_t)lround(v * 64.0);
+        truth_sample(map, t, xc, yc, t->noise, &r, &s[i]);
         ++i;
     }
 }
@@ -495,7 +489,7 @@ static void wm_hold_pass_within_budget(void **state)
  * warming never changes what A publishes. Variants: coarse spacing, one-count coarse pass,
  * hold off or without search, footprint 0, 0.5 m bins, places ruled out, an attached
  * cache, a fit without the map in between. */
-#define RV_CAP 900
+#define WM_CAP 900
 
 static void wm_sample(fixture_t *f, rfs_rng_t *r, int *x, int *y, rfs_sample_t *s)
 {
@@ -509,15 +503,7 @@ static void wm_sample(fixture_t *f, rfs_rng_t *r, int *x, int *y, rfs_sample_t *
             break;
         }
     }
-    const truth_t *t = &k_office;
-    const rfs_q16_t qx = (rfs_q16_t)lround(*x / 100.0 * 65536.0), qy = (rfs_q16_t)lround(*y / 100.0 * 65536.0);
-    const rfs_q16_t qsx = (rfs_q16_t)lround(t->sx * 65536.0), qsy = (rfs_q16_t)lround(t->sy * 65536.0);
-    const double d = hypot(*x / 100.0 - t->sx, *y / 100.0 - t->sy);
-    const int k = rfs_map_walls_crossed(&f->map, qx, qy, qsx, qsy);
-    const double v = t->p0 - 10.0 * t->n * log10(d < 1.0 ? 1.0 : d) - t->w * k + 3.0 * gauss(r);
-    s->x_cm = (int16_t)*x;
-    s->y_cm = (int16_t)*y;
-    s->v_q6 = (int16_t)lround(v * 64.0);
+    truth_sample(&f->map, &k_office, *x, *y, 3.0, r, s);
 }
 
 typedef struct wm_pub {
@@ -544,7 +530,7 @@ static void wm_publish(const rfs_pathloss_t *a, wm_pub_t *o)
 static void wm_run(fixture_t *f, const rfs_pathloss_cfg_t *c, bool attach, bool excl, uint64_t seed)
 {
     rfs_pathloss_t *a = malloc(sizeof(*a)), *b = malloc(sizeof(*b));
-    rfs_sample_t *s = malloc(sizeof(rfs_sample_t) * RV_CAP);
+    rfs_sample_t *s = malloc(sizeof(rfs_sample_t) * WM_CAP);
     wm_pub_t *p0 = malloc(sizeof(*p0)), *p1 = malloc(sizeof(*p1));
     const uint32_t bytes = rfs_pathloss_cache_bytes(300);
     void *bufa = attach ? malloc(bytes) : NULL, *bufb = attach ? malloc(bytes) : NULL;
@@ -593,10 +579,10 @@ static void wm_run(fixture_t *f, const rfs_pathloss_cfg_t *c, bool attach, bool 
                 rfs_sample_t sm;
                 wm_sample(f, &r, &x, &y, &sm);
                 seen++;
-                if (n < RV_CAP) {
+                if (n < WM_CAP) {
                     s[n++] = sm;
-                } else if (rfs_rng_below(&r, seen) < RV_CAP) {
-                    s[rfs_rng_below(&r, RV_CAP)] = sm;
+                } else if (rfs_rng_below(&r, seen) < WM_CAP) {
+                    s[rfs_rng_below(&r, WM_CAP)] = sm;
                 }
             }
             rfs_model_fit_in_t wi = in;
@@ -744,20 +730,8 @@ static void wm_seek_run(fixture_t *f, uint64_t seed, uint32_t plan_budget)
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
     cfg.fit_budget = 150u;
     cfg.plan_budget = plan_budget;
-    uint32_t lpts = (uint32_t)f->map.lw * f->map.lh;
     rfs_seek_mem_t mem;
-    memset(&mem, 0, sizeof(mem));
-    mem.samples = calloc(cfg.store.capacity, sizeof(rfs_sample_t));
-    mem.pending = calloc(256, sizeof(rfs_pending_t));
-    mem.pending_cap = 256;
-    mem.plan_work = calloc(lpts, 1);
-    mem.plan_work_bytes = lpts;
-    mem.plan_queue_cap = lpts;
-    mem.plan_queue = calloc(lpts, sizeof(uint32_t));
-    mem.visited_bytes = rfs_reach_bytes(&f->map);
-    mem.visited = calloc(mem.visited_bytes, 1);
-    mem.reach_bytes = mem.visited_bytes;
-    mem.reach = calloc(mem.reach_bytes, 1);
+    office_seek_mem(&f->map, cfg.store.capacity, &mem);
     rfs_seek_t *sk = calloc(1, sizeof(*sk));
     rfs_pathloss_t *shadow = malloc(sizeof(*shadow));
     assert_true(sk != NULL && shadow != NULL);
@@ -784,12 +758,7 @@ static void wm_seek_run(fixture_t *f, uint64_t seed, uint32_t plan_budget)
     assert_true(wm_lp.warms > 0u && wm_lp.warmed_lines > 0u && wm_lp.compared > 1u);
     free(sk);
     free(shadow);
-    free(mem.samples);
-    free(mem.pending);
-    free(mem.plan_work);
-    free(mem.plan_queue);
-    free(mem.visited);
-    free(mem.reach);
+    office_seek_mem_free(&mem);
 }
 
 static void wm_seek_warms_between_fits_only(void **state)

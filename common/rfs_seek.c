@@ -938,8 +938,11 @@ static void control(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_
         resume_goal(s, now_us);
     }
     if (s->fitting) {
-        /* A sliced fit continues; the decision finishes when it is done. */
-        if (fit_slice(s, now_us, rng, out)) {
+        /* A sliced fit continues (or ended between periods); the decision finishes when it
+         * is done. */
+        if (s->fit_ended || fit_slice(s, now_us, rng, out)) {
+            s->fitting = false;
+            s->fit_ended = false;
             finish_decision(s, now_us, rng, out, false);
         }
         return;
@@ -953,6 +956,21 @@ static void control(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_
         return;
     }
     decide(s, now_us, rng, out);
+}
+
+bool rfs_seek_background(rfs_seek_t *s, rfs_rng_t *rng)
+{
+    RFS_ASSERT(s != 0 && rng != 0);
+    if (!s->fitting || s->fit_ended || s->cfg.fit_budget == 0u) {
+        return false;
+    }
+    rfs_model_fit_in_t fin;
+    fit_input(s, s->decision.x, s->decision.y, &fin);
+    if (s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng) == RFS_FIT_MORE) {
+        return true;
+    }
+    s->fit_ended = true;
+    return false;
 }
 
 void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)

@@ -363,6 +363,8 @@ typedef struct rfs_seek {
     rfs_seek_state_t state;                   ///< controller state
     uint32_t iteration;                       ///< next iteration number
     bool fitting;                             ///< a sliced fit is in progress
+    bool fit_ended;                           ///< rfs_seek_background() ended it: the next
+                                              ///< period finishes the decision
     bool planning;                            ///< plan_budget: a decision waits for its
                                               ///< search tree (grown from the robot)
     bool plan_ready;                          ///< the decision's plans walk that tree
@@ -450,6 +452,12 @@ bool rfs_seek_on_receiver(rfs_seek_t *s, int64_t t_us);
 /// One control period at now_us: decide when the current goal has ended, drive, and
 /// report. Cannot fail.
 void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out);
+
+/// Spare time after a control period (docs/FIRMWARE.md, "Learning between periods"): one
+/// more fit_budget slice of a fit the wheels wait for, so that the decision it holds up is
+/// made at the next period. Touches nothing else (no wheel command, no decision). true
+/// when another call would do more; false with no such fit (fit_budget 0, or none running).
+bool rfs_seek_background(rfs_seek_t *s, rfs_rng_t *rng);
 
 /// The in-leg relearn check on one miss |1 s mean - prediction| (target units Q16.16, >= 0):
 /// true when it fails, i.e. the miss exceeds error_threshold, or with recheck_adapt the

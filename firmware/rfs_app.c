@@ -284,6 +284,11 @@ void rfs_app_set_bus_off(rfs_app_t *a, bool off)
     a->bus_off = off;
 }
 
+bool rfs_app_background(rfs_app_t *a)
+{
+    return rfs_seek_background(&a->seek, &a->rng);
+}
+
 void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out)
 {
     rfs_seek_out_t so;

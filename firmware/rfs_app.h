@@ -71,6 +71,12 @@
 #define RFS_APP_MODEL_BYTES ((uint32_t)sizeof(rfs_ridge_t))
 /// Control period, microseconds (20 Hz).
 #define RFS_APP_PERIOD_US 50000
+/// Fit slices (rfs_app_background()) a port runs in a control period's spare time, after
+/// the period's step: a period at 168 MHz is 8.4 M cycles; the step's worst 480,115
+/// instructions and ten path-loss slices of at most 429,409 use 4.8 M, leaving 40 % for
+/// cycles per instruction above one and the CAN polls between slices (docs/FIRMWARE.md,
+/// "Learning between periods").
+#define RFS_APP_BACKGROUND_SLICES 10u
 
 /// Application fault bits, in the high byte of rfs_app_out_t.faults (the low byte holds
 /// the seeker's RFS_SEEK_FAULT_* bits).
@@ -264,6 +270,11 @@ void rfs_app_set_bus_off(rfs_app_t *a, bool off);
 
 /// One control period at local time now_us. Cannot fail.
 void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out);
+
+/// After a step, in the period's spare time: one more slice of a fit the wheels wait for
+/// (rfs_seek_background()); true when another call would do more. Ports call it up to
+/// RFS_APP_BACKGROUND_SLICES times a period (none when the next step is due).
+bool rfs_app_background(rfs_app_t *a);
 
 /// A raw CAN frame arrived at local time rx_us: decoded with rfs_can (pose pairs, RSSI,
 /// receiver heartbeat, CONFIG; other ids counted as unknown) and fed to the seeker. Returns

@@ -33,6 +33,7 @@ typedef struct inproc {
     rfs_store_index_t cellsum_index; // the store's view of them
     rfs_cellsum_cell_t *cells;
     uint16_t *cell_links;
+    uint32_t fit_slices; // rfs_seek_background() calls after each period
 } inproc_t;
 
 hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void)
@@ -49,6 +50,7 @@ hs_ctrl_inproc_cfg_t hs_ctrl_inproc_cfg_default(void)
     c.coarse_snap = -1;
     c.pathloss_log2 = NULL;
     c.pathloss_builtin_cache = false;
+    c.fit_slices = 0u;
     return c;
 }
 
@@ -79,6 +81,8 @@ static void ip_step(void *self, int64_t now_us, hs_ctrl_out_t *out)
 {
     inproc_t *p = self;
     rfs_seek_step(&p->seek, now_us, &p->rng, out);
+    for (uint32_t k = 0u; k < p->fit_slices && rfs_seek_background(&p->seek, &p->rng); ++k) {
+    }
 }
 
 static bool ip_predict(void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *v)
@@ -356,6 +360,7 @@ int hs_ctrl_inproc_open(hs_ctrl_t *c, const hs_ctrl_inproc_cfg_t *cfg, const rfs
     rfs_plan_tree_defer(&p->seek.plan, true);
     rfs_plan_use_edges(&p->seek.plan); /* the edge table hs_sim_env_open attached */
     rfs_rng_seed(&p->rng, cfg->seed);
+    p->fit_slices = cfg->fit_slices;
     c->name = rfs_seek_strategy_name(cfg->seek.strategy);
     c->self = p;
     c->period_us = cfg->period_us;

@@ -76,6 +76,8 @@ typedef struct hs_ctrl_inproc_cfg {
                             ///< (rfs_pathloss_log2_fill(), outliving the controller) or NULL
     bool pathloss_builtin_cache; ///< pathloss model only: keep the built-in wall-count cache
                             ///< (the Cortex-M4's) instead of attaching the host's
+    uint32_t fit_slices;    ///< rfs_seek_background() calls after each period (the
+                            ///< firmware's spare time; 0: none)
 } hs_ctrl_inproc_cfg_t;
 
 /// Defaults: the paper's seeker, local ridge, RSSI of one source, 20 Hz.

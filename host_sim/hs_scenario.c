@@ -229,6 +229,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_near_t = -1.0;
     sc->seek_near_m = -1.0;
     sc->seek_reach_min = -1.0;
+    sc->seek_fit_slices = -1.0;
     sc->seek_fit_budget = -1.0;
     sc->seek_eps_by_travel = -1;
     sc->seek_eps_geodesic = -1;
@@ -459,7 +460,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
                                         "refute_reached", "local_m", "leg_m", "recheck_silent",
                                         "coarse_footprint_m", "p0_max_wall_db", "local_gap_m",
                                         "at_tol_m", "local_refute", "near_t",
-                                        "near_m", "coarse_snap", "reach_min", "fit_budget",
+                                        "near_m", "coarse_snap", "reach_min", "fit_budget", "fit_slices",
                                         "floor_db", "floor_max", "mean_t", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
@@ -473,6 +474,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             num(p, n, "seek", "near_t", 0, 64, &sc->seek_near_t) ||
             num(p, n, "seek", "near_m", 0, 1000, &sc->seek_near_m) ||
             whole(p, n, "seek", "reach_min", 1e6, &sc->seek_reach_min) ||
+            whole(p, n, "seek", "fit_slices", 1000, &sc->seek_fit_slices) ||
             whole(p, n, "seek", "floor_max", 255, &sc->seek_floor_max) ||
             whole(p, n, "seek", "fit_budget", 1e6, &sc->seek_fit_budget) ||
             num(p, n, "seek", "eps_rate", 0, 100, &sc->seek_eps_rate) ||

@@ -24,6 +24,7 @@
 #include "hs_batch.h"
 #include "hs_place.h"
 #include "hs_sim.h"
+#include "rfs_app.h"
 #include "rfs_models.h"
 
 static const char *prog = "rfseek-sim";
@@ -66,6 +67,7 @@ static void usage(FILE *f)
             "  --fit-budget N|mcu  the model's work units a control period, overriding the\n"
             "                  scenario's seek.fit_budget (0, the default: each fit whole;\n"
             "                  mcu: the model's Cortex-M4 budget and wall-count cache,\n"
+            "                  and 10 more slices in each period's spare time (seek.fit_slices),\n"
             "                  docs/PERFORMANCE.md); the wheels wait while a fit runs\n"
             "                  (summary.json decision_wait_max_s)\n"
             "  --start X,Y[,THETA]  start here (metres, radians), overriding the scenario's\n"
@@ -566,6 +568,9 @@ static int load_scenario(const sim_opts_t *o, hs_scenario_t *sc)
         sc->seek_fit_budget = o->fit_budget == FIT_MCU ? (double)(m ? m->mcu_fit_budget : 0u)
                                                        : (double)o->fit_budget;
         sc->fit_mcu = o->fit_budget == FIT_MCU;
+        if (sc->fit_mcu && sc->seek_fit_slices < 0.0) {
+            sc->seek_fit_slices = (double)RFS_APP_BACKGROUND_SLICES;
+        }
     }
     return placement(o, sc);
 }

@@ -380,21 +380,24 @@ static void test_closed_loop_reaches_source(void **state)
 }
 
 /* A sliced relearn under pose noise: the robot (teleported to each goal) reports poses
- * that jitter by +-1 cm at 20 Hz, the relearn takes 500 samples a period. Each fit runs
- * at the point where its decision began, so it ends after ceil(n / 500) periods whatever
+ * that jitter by +-1 cm at 20 Hz, the relearn takes 500 samples a slice, one a period and
+ * bg more in each period's spare time (rfs_seek_background). Each fit runs at the point
+ * where its decision began, so it ends after ceil(n / (500 (bg + 1))) periods whatever
  * the pose does (a fit restarted at each new pose never ended once it needed three
- * periods), and the sliced ridge equals a whole fit of the same samples at that point. */
-static void test_sliced_fit_ends_under_pose_noise(void **state)
+ * periods), and the sliced ridge equals a whole fit of the same samples at that point.
+ * Background calls with no fit waiting do nothing and say so. */
+static void sliced_fit_run(uint32_t bg)
 {
-    (void)state;
     world_t t;
     world_make(&t, 20, 20, 0, 0);
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     cfg.fit_budget = 500;
     seek_make(&t, cfg, 5);
+    assert_false(rfs_seek_background(&t.seek, &t.rng)); /* before any fit */
     double x = 5, y = 10, gx = 5, gy = 10;
     int64_t arrive = 0, begun = -1;
-    uint32_t decisions = 0, relearned = 0, compared = 0, pkt = 0;
+    uint32_t decisions = 0, relearned = 0, compared = 0, pkt = 0, bg_slices = 0, sooner = 0;
+    uint16_t n_fit = 0u; /* store.count when a fit ended in the spare time */
     for (int64_t now = 5000; now <= 120000000; now += 5000) {
         if (now >= arrive) {
             x = gx;
@@ -412,9 +415,22 @@ static void test_sliced_fit_ends_under_pose_noise(void **state)
         const uint32_t n = t.seek.store.count;
         rfs_seek_out_t out;
         rfs_seek_step(&t.seek, now, &t.rng, &out);
-        if (t.seek.state == RFS_SEEK_LEARNING && begun < 0) {
+        const bool waits = t.seek.state == RFS_SEEK_LEARNING;
+        if (waits && begun < 0) {
             begun = now; /* the relearn's first period */
-            assert_true(n > 1500u); /* long enough to need more than three periods */
+            assert_true(n > 1500u); /* long enough to need more than three slices */
+        }
+        for (uint32_t k = 0u; k < bg; ++k) {
+            const rfs_seek_state_t st = t.seek.state;
+            const bool more = rfs_seek_background(&t.seek, &t.rng);
+            assert_int_equal(t.seek.state, st); /* no decision, no wheel command */
+            if (!waits) {
+                assert_false(more);
+            }
+            bg_slices += more ? 1u : 0u;
+        }
+        if (t.seek.fit_ended && n_fit == 0u) {
+            n_fit = t.seek.store.count; /* ended in the spare time: what it fitted */
         }
         if (!out.decided) {
             continue;
@@ -422,9 +438,12 @@ static void test_sliced_fit_ends_under_pose_noise(void **state)
         decisions++;
         if (begun >= 0) {
             relearned++;
-            /* ceil(n / 500) periods, one more for the samples that came meanwhile */
+            /* ceil(n / 500 (bg + 1)) periods, one more for the samples that came meanwhile
+             * and one for the decision after a fit that ended in the spare time */
             const int64_t periods = (now - begun) / 50000 + 1;
-            assert_true(periods <= (int64_t)(n + 499u) / 500 + 1);
+            const uint32_t per = 500u * (bg + 1u);
+            assert_true(periods <= (int64_t)((n + per - 1u) / per) + 1 + (bg > 0u));
+            sooner += periods < (int64_t)(n + 499u) / 500 ? 1u : 0u; /* slices < periods */
             /* A whole fit of the store at the decision's start point predicts the same
              * (while the store is not full: a full one replaces samples under the slices). */
             if (t.seek.store.count < cfg.store.capacity) {
@@ -432,7 +451,8 @@ static void test_sliced_fit_ends_under_pose_noise(void **state)
                 rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
                 assert_int_equal(rfs_ridge_init(&whole, &rc), 0);
                 const rfs_model_fit_in_t in = {.samples = t.seek.store.samples,
-                                               .n = t.seek.store.count, .qx = out.decision.x,
+                                               .n = n_fit != 0u ? n_fit : t.seek.store.count,
+                                               .qx = out.decision.x,
                                                .qy = out.decision.y};
                 const rfs_model_t wm = rfs_ridge_model(&whole);
                 assert_int_equal(wm.ops->fit(wm.self, &in, 0u, &t.rng), RFS_FIT_DONE);
@@ -444,6 +464,7 @@ static void test_sliced_fit_ends_under_pose_noise(void **state)
             }
             begun = -1;
         }
+        n_fit = 0u;
         gx = D(out.decision.goal_x);
         gy = D(out.decision.goal_y);
         arrive = now + 1000000;
@@ -451,7 +472,20 @@ static void test_sliced_fit_ends_under_pose_noise(void **state)
     assert_true(compared >= 3u);
     assert_true(relearned >= 10u);
     assert_true(decisions >= 20u);
+    assert_true(bg == 0u || (bg_slices >= 10u && sooner >= 5u));
     world_free(&t);
+}
+
+static void test_sliced_fit_ends_under_pose_noise(void **state)
+{
+    (void)state;
+    sliced_fit_run(0u);
+}
+
+static void test_background_slices_end_fits_sooner(void **state)
+{
+    (void)state;
+    sliced_fit_run(3u);
 }
 
 /* A robot with nowhere to go (a 0.8 m box: one legal lattice point) reports NO_GOAL, keeps
@@ -789,6 +823,7 @@ int main(void)
         cmocka_unit_test(test_abandoned_leg_decides_at_rest),
         cmocka_unit_test(test_closed_loop_reaches_source),
         cmocka_unit_test(test_sliced_fit_ends_under_pose_noise),
+        cmocka_unit_test(test_background_slices_end_fits_sooner),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

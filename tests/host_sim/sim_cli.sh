@@ -96,6 +96,16 @@ if awk -v sm="$(num "$T/fbcli.json" decision_wait_mean_s)" -v sx="$(num "$T/fbcl
 else
     fail fit_budget_mean_latency "mean $(num "$T/fbcli.json" decision_wait_mean_s) / $(num "$T/fbnone.json" decision_wait_mean_s)"
 fi
+# seek.fit_slices: more slices in each period's spare time: shorter waits, mean and longest.
+bad fit_slices_key "seek.fit_slices: 2.5 is not a whole number" "$T/p0.yaml" --seek 'fit_slices: 2.5' --out "$T/out"
+"$SIM" "$T/p0.yaml" --fit-budget 100 --seek 'fit_slices: 3' --seed 2 >"$T/fbbg.json" 2>/dev/null
+if awk -v bm="$(num "$T/fbbg.json" decision_wait_mean_s)" -v sm="$(num "$T/fbcli.json" decision_wait_mean_s)" \
+       -v bx="$(num "$T/fbbg.json" decision_wait_max_s)" -v sx="$(num "$T/fbcli.json" decision_wait_max_s)" \
+       'BEGIN { exit !(bm != "" && sm != "" && bm < sm && bx < sx) }'; then
+    pass fit_slices_sooner
+else
+    fail fit_slices_sooner "mean $(num "$T/fbbg.json" decision_wait_mean_s) / $(num "$T/fbcli.json" decision_wait_mean_s)"
+fi
 # --seek: the scenario's seek: keys from the command line, checked as the file's; the same
 # run as the key in the file, another run than without it.
 bad seek_unknown "--seek:1: seek: unknown key 'bogus'" "$T/p0.yaml" --seek 'bogus: 1' --out "$T/out"

@@ -356,16 +356,21 @@ __attribute__((noinline)) static uint32_t walk_rows_look(const rfs_map_t *m, con
         }
         if (free && end <= fx1) {
             ws &= ~1u;
+            if (nb == 0) {
+                return ws;
+            }
+            /* Step over the bands ending inside the square (the last band, or the first
+             * past its rows, back through the loop's checks above). */
+            const int32_t lim = fy1 - k < nb - 1 ? fy1 - k : nb - 1;
+            int32_t t = 0;
             do {
-                if (nb-- == 0) {
-                    return ws;
-                }
                 from = hi;
                 BANDS_NEXT(hi, u, bd);
-                k++;
-                row += rstep;
-                end = nb == 0 ? ie : hi;
-            } while (k <= fy1 && end <= fx1);
+                t++;
+            } while (t <= lim && hi <= fx1);
+            nb -= t;
+            k += t;
+            row += t * rstep;
             continue;
         }
         if (free) {
@@ -437,15 +442,19 @@ __attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m,
         }
         if (free && end <= fy1) {
             ws &= ~1u;
+            if (nb == 0) {
+                return ws;
+            }
+            /* Step over the columns ending inside the square (as walk_rows_look()). */
+            const int32_t lim = fx1 - i < nb - 1 ? fx1 - i : nb - 1;
+            int32_t t = 0;
             do {
-                if (nb-- == 0) {
-                    return ws;
-                }
                 jlo = hi;
                 BANDS_NEXT(hi, u, bd);
-                i++;
-                end = nb == 0 ? je : hi;
-            } while (i <= fx1 && end <= fy1);
+                t++;
+            } while (t <= lim && hi <= fy1);
+            nb -= t;
+            i += t;
             continue;
         }
         if (free) {

@@ -421,9 +421,18 @@ __attribute__((noinline)) static uint32_t walk_cols(const rfs_map_t *m,
     }
 }
 
+/* Bytes a column of the column grid (rfs_map_wall_cols_attach()): row_bits() loads four
+ * bytes from any bit's byte. */
+static uint32_t cols_stride(const rfs_map_t *m)
+{
+    return ((uint32_t)m->h + 7u) / 8u + 4u;
+}
+
 /* walk_cols() with a host grid (fwd, or the wall-distance grid): a column's cells inside
  * the free square last found (free_ahead) are passed over, the columns wholly inside it
- * in a tight loop; long columns through walk_col (the wall-distance grid, blocks b). */
+ * in a tight loop; the others' cells read from the column grid when attached (its
+ * top-down half for a mirrored walk: mirrored row j is its row h + j), else long columns
+ * through walk_col (the wall-distance grid, blocks b). */
 __attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m,
                                                          const rfs_map_wall_blocks_t *b,
                                                          const uint8_t *fwd, uint32_t ws,
@@ -432,6 +441,9 @@ __attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m,
                                                          int32_t long_col)
 {
     const int32_t stride = (int32_t)m->stride, rstep = flip ? -stride : stride;
+    const uint32_t cstride = cols_stride(m);
+    const int32_t coff = flip ? (int32_t)m->h : 0;
+    const uint8_t *cols = m->wall_cols != 0 ? m->wall_cols + (flip ? (uint32_t)m->w * cstride : 0u) : 0;
     int32_t hi = bd.hi, fx1 = INT32_MIN, fy1 = INT32_MIN;
     bool free = false;
     uint32_t u = bd.u;
@@ -461,7 +473,11 @@ __attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m,
             ws &= ~1u;
             j = fy1 + 1;
         }
-        if (end - j >= long_col) {
+        if (cols != 0) {
+            if (j <= end) {
+                ws = row_bits(cols + (uint32_t)i * cstride, ws, coff + j, coff + end);
+            }
+        } else if (end - j >= long_col) {
             ws = walk_col(m, b, ws, i, j, end, flip);
         } else {
             const uint8_t *p = m->wall + (flip ? -1 - j : j) * stride + ((uint32_t)i >> 3);
@@ -635,6 +651,31 @@ int rfs_map_wall_fwd_attach(rfs_map_t *m, uint8_t *buf, uint32_t bytes)
         }
     }
     m->wall_fwd = buf;
+    return 0;
+}
+
+uint32_t rfs_map_wall_cols_bytes(const rfs_map_t *m)
+{
+    return 2u * (uint32_t)m->w * cols_stride(m); /* w, h < 2^16: below 2^31 */
+}
+
+int rfs_map_wall_cols_attach(rfs_map_t *m, uint8_t *buf, uint32_t bytes)
+{
+    if (m->wall == 0 || buf == 0 || bytes < rfs_map_wall_cols_bytes(m)) {
+        return -1;
+    }
+    const uint32_t cs = cols_stride(m), h = m->h;
+    uint8_t *dn = buf + (uint32_t)m->w * cs;
+    memset(buf, 0, rfs_map_wall_cols_bytes(m));
+    for (uint32_t j = 0u; j < h; ++j) {
+        for (uint32_t i = 0u; i < m->w; ++i) {
+            if (rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)j)) {
+                buf[i * cs + (j >> 3)] |= (uint8_t)(1u << (j & 7u));
+                dn[i * cs + ((h - 1u - j) >> 3)] |= (uint8_t)(1u << ((h - 1u - j) & 7u));
+            }
+        }
+    }
+    m->wall_cols = buf;
     return 0;
 }
 

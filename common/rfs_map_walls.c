@@ -1,7 +1,7 @@
 /* rfs_map_walls.c - walls crossed by a segment: runs of wall cells along the exact
  * supercover traversal of rfs_map.c, with the accelerations a caller may attach, the
- * wall-block grid and the host's wall-distance and forward grids (docs/MAPS.md, "The
- * core's grids").
+ * wall-block grid and the host's wall-distance, forward and column grids (docs/MAPS.md,
+ * "The core's grids").
  */
 #include "rfs_map.h"
 

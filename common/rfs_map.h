@@ -75,6 +75,8 @@ typedef struct rfs_map {
     uint16_t *edges;       ///< lattice edge table (rfs_map_edges_attach()); NULL (init): none
     const uint8_t *wall_fwd; ///< free squares ahead of each cell (rfs_map_wall_fwd_attach());
                              ///< NULL (init): none
+    const uint8_t *wall_cols; ///< the wall grid column by column (rfs_map_wall_cols_attach());
+                              ///< NULL (init): none
 } rfs_map_t;
 
 /// Defaults: 0.25 m clearance, 0.25 m lattice.
@@ -208,5 +210,15 @@ uint32_t rfs_map_wall_fwd_bytes(const rfs_map_t *m);
 /// index, docs/PATHLOSS.md, "Work, the wall-count cache and slicing"). rfs_map_init()
 /// detaches it. -1 when the map has no wall grid or buf is NULL or too small.
 int rfs_map_wall_fwd_attach(rfs_map_t *m, uint8_t *buf, uint32_t bytes);
+
+/// Bytes of a column grid for m (rfs_map_wall_cols_attach()): twice w x ((h + 7) / 8 + 4).
+uint32_t rfs_map_wall_cols_bytes(const rfs_map_t *m);
+
+/// Fill buf with the wall grid column by column, once bottom up and once top down, and
+/// attach it (it stays the caller's, outliving m): rfs_map_walls_crossed() with a forward
+/// or wall-distance grid then reads a steep walk's column a word at a time, as a shallow
+/// walk reads its rows (the same counts; a host index). rfs_map_init() detaches it. -1
+/// when the map has no wall grid or buf is NULL or too small.
+int rfs_map_wall_cols_attach(rfs_map_t *m, uint8_t *buf, uint32_t bytes);
 
 #endif /* RFS_MAP_H */

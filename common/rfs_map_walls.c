@@ -1,7 +1,7 @@
 /* rfs_map_walls.c - walls crossed by a segment: runs of wall cells along the exact
  * supercover traversal of rfs_map.c, with the accelerations a caller may attach, the
- * wall-block grid and the host's wall-distance and forward grids (docs/MAPS.md, "The
- * core's grids").
+ * wall-block grid and the host's wall-distance, forward and column grids (docs/MAPS.md,
+ * "The core's grids").
  */
 #include "rfs_map.h"
 
@@ -292,6 +292,16 @@ static inline bool free_ahead(const rfs_map_t *m, const uint8_t *fwd, int32_t i,
         (hi) += (bd).a;        \
     } while (0)
 
+/* BANDS_NEXT() without a branch: the host's walks (*_look), whose carries a branch
+ * predictor cannot guess (the Cortex-M4's walks keep the branch, which costs it less). */
+#define BANDS_NEXT_FLAT(hi, u, bd)                            \
+    do {                                                      \
+        (u) += (bd).s;                                        \
+        const uint32_t carry_ = (u) >= (bd).dp ? 1u : 0u;     \
+        (u) -= (bd).dp & (0u - carry_);                       \
+        (hi) += (bd).a + (int32_t)carry_;                     \
+    } while (0)
+
 /* Bits from..from + n (n > 24) of a row: as walk_bits, every four-byte load from the
  * row's cells inside the grid. */
 __attribute__((noinline)) static uint32_t row_bits_long(const uint8_t *row, uint32_t ws,
@@ -356,16 +366,21 @@ __attribute__((noinline)) static uint32_t walk_rows_look(const rfs_map_t *m, con
         }
         if (free && end <= fx1) {
             ws &= ~1u;
+            if (nb == 0) {
+                return ws;
+            }
+            /* Step over the bands ending inside the square (the last band, or the first
+             * past its rows, back through the loop's checks above). */
+            const int32_t lim = fy1 - k < nb - 1 ? fy1 - k : nb - 1;
+            int32_t t = 0;
             do {
-                if (nb-- == 0) {
-                    return ws;
-                }
                 from = hi;
-                BANDS_NEXT(hi, u, bd);
-                k++;
-                row += rstep;
-                end = nb == 0 ? ie : hi;
-            } while (k <= fy1 && end <= fx1);
+                BANDS_NEXT_FLAT(hi, u, bd);
+                t++;
+            } while (t <= lim && hi <= fx1);
+            nb -= t;
+            k += t;
+            row += t * rstep;
             continue;
         }
         if (free) {
@@ -377,7 +392,7 @@ __attribute__((noinline)) static uint32_t walk_rows_look(const rfs_map_t *m, con
             return ws;
         }
         from = hi;
-        BANDS_NEXT(hi, u, bd);
+        BANDS_NEXT_FLAT(hi, u, bd);
         k++;
         row += rstep;
     }
@@ -416,9 +431,18 @@ __attribute__((noinline)) static uint32_t walk_cols(const rfs_map_t *m,
     }
 }
 
+/* Bytes a column of the column grid (rfs_map_wall_cols_attach()): row_bits() loads four
+ * bytes from any bit's byte. */
+static uint32_t cols_stride(const rfs_map_t *m)
+{
+    return ((uint32_t)m->h + 7u) / 8u + 4u;
+}
+
 /* walk_cols() with a host grid (fwd, or the wall-distance grid): a column's cells inside
  * the free square last found (free_ahead) are passed over, the columns wholly inside it
- * in a tight loop; long columns through walk_col (the wall-distance grid, blocks b). */
+ * in a tight loop; the others' cells read from the column grid when attached (its
+ * top-down half for a mirrored walk: mirrored row j is its row h + j), else long columns
+ * through walk_col (the wall-distance grid, blocks b). */
 __attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m,
                                                          const rfs_map_wall_blocks_t *b,
                                                          const uint8_t *fwd, uint32_t ws,
@@ -427,6 +451,9 @@ __attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m,
                                                          int32_t long_col)
 {
     const int32_t stride = (int32_t)m->stride, rstep = flip ? -stride : stride;
+    const uint32_t cstride = cols_stride(m);
+    const int32_t coff = flip ? (int32_t)m->h : 0;
+    const uint8_t *cols = m->wall_cols != 0 ? m->wall_cols + (flip ? (uint32_t)m->w * cstride : 0u) : 0;
     int32_t hi = bd.hi, fx1 = INT32_MIN, fy1 = INT32_MIN;
     bool free = false;
     uint32_t u = bd.u;
@@ -437,22 +464,30 @@ __attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m,
         }
         if (free && end <= fy1) {
             ws &= ~1u;
+            if (nb == 0) {
+                return ws;
+            }
+            /* Step over the columns ending inside the square (as walk_rows_look()). */
+            const int32_t lim = fx1 - i < nb - 1 ? fx1 - i : nb - 1;
+            int32_t t = 0;
             do {
-                if (nb-- == 0) {
-                    return ws;
-                }
                 jlo = hi;
-                BANDS_NEXT(hi, u, bd);
-                i++;
-                end = nb == 0 ? je : hi;
-            } while (i <= fx1 && end <= fy1);
+                BANDS_NEXT_FLAT(hi, u, bd);
+                t++;
+            } while (t <= lim && hi <= fy1);
+            nb -= t;
+            i += t;
             continue;
         }
         if (free) {
             ws &= ~1u;
             j = fy1 + 1;
         }
-        if (end - j >= long_col) {
+        if (cols != 0) {
+            if (j <= end) {
+                ws = row_bits(cols + (uint32_t)i * cstride, ws, coff + j, coff + end);
+            }
+        } else if (end - j >= long_col) {
             ws = walk_col(m, b, ws, i, j, end, flip);
         } else {
             const uint8_t *p = m->wall + (flip ? -1 - j : j) * stride + ((uint32_t)i >> 3);
@@ -465,7 +500,7 @@ __attribute__((noinline)) static uint32_t walk_cols_look(const rfs_map_t *m,
             return ws;
         }
         jlo = hi;
-        BANDS_NEXT(hi, u, bd);
+        BANDS_NEXT_FLAT(hi, u, bd);
         i++;
     }
 }
@@ -626,6 +661,31 @@ int rfs_map_wall_fwd_attach(rfs_map_t *m, uint8_t *buf, uint32_t bytes)
         }
     }
     m->wall_fwd = buf;
+    return 0;
+}
+
+uint32_t rfs_map_wall_cols_bytes(const rfs_map_t *m)
+{
+    return 2u * (uint32_t)m->w * cols_stride(m); /* w, h < 2^16: below 2^31 */
+}
+
+int rfs_map_wall_cols_attach(rfs_map_t *m, uint8_t *buf, uint32_t bytes)
+{
+    if (m->wall == 0 || buf == 0 || bytes < rfs_map_wall_cols_bytes(m)) {
+        return -1;
+    }
+    const uint32_t cs = cols_stride(m), h = m->h;
+    uint8_t *dn = buf + (uint32_t)m->w * cs;
+    memset(buf, 0, rfs_map_wall_cols_bytes(m));
+    for (uint32_t j = 0u; j < h; ++j) {
+        for (uint32_t i = 0u; i < m->w; ++i) {
+            if (rfs_map_bit(m->wall, m->stride, (uint16_t)i, (uint16_t)j)) {
+                buf[i * cs + (j >> 3)] |= (uint8_t)(1u << (j & 7u));
+                dn[i * cs + ((h - 1u - j) >> 3)] |= (uint8_t)(1u << ((h - 1u - j) & 7u));
+            }
+        }
+    }
+    m->wall_cols = buf;
     return 0;
 }
 

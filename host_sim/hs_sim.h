@@ -41,6 +41,7 @@ typedef struct hs_sim_env {
     uint16_t *lattice_edges;   ///< the core map's edge table (rfs_map_edges_attach), shared by runs
     uint8_t *wall_dist;        ///< the core map's wall distances (rfs_map_wall_dist_attach), or NULL
     uint8_t *wall_fwd;         ///< the core map's forward free squares (rfs_map_wall_fwd_attach), or NULL
+    uint8_t *wall_cols;        ///< the core map's walls by columns (rfs_map_wall_cols_attach), or NULL
     int32_t *pathloss_log2;    ///< the path-loss model's log2 table (rfs_pathloss_log2_fill), or NULL
     hs_box2d_walls_t walls;    ///< the map's merged wall rectangles, shared by runs' worlds
     hs_box2d_t **world;        ///< the runs' world: made by the first, reset by the next

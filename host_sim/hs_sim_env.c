@@ -186,15 +186,19 @@ int hs_sim_env_open(hs_sim_env_t *e, const hs_scenario_t *sc, char *err, size_t 
         return -1;
     }
     /* The path-loss model's wall counts pass over free squares (rfs_map_wall_dist_attach)
-     * and the free squares ahead of the walk (rfs_map_wall_fwd_attach). */
+     * and the free squares ahead of the walk (rfs_map_wall_fwd_attach), and read steep
+     * walks' columns a word at a time (rfs_map_wall_cols_attach). */
     if (e->core.map.wall != NULL) {
         const uint32_t nd = rfs_map_wall_dist_bytes(&e->core.map);
         const uint32_t nf = rfs_map_wall_fwd_bytes(&e->core.map);
+        const uint32_t nc = rfs_map_wall_cols_bytes(&e->core.map);
         e->wall_dist = malloc(nd);
         e->wall_fwd = malloc(nf);
-        if (e->wall_dist == NULL || e->wall_fwd == NULL ||
+        e->wall_cols = malloc(nc);
+        if (e->wall_dist == NULL || e->wall_fwd == NULL || e->wall_cols == NULL ||
             rfs_map_wall_dist_attach(&e->core.map, e->wall_dist, nd) != 0 ||
-            rfs_map_wall_fwd_attach(&e->core.map, e->wall_fwd, nf) != 0) {
+            rfs_map_wall_fwd_attach(&e->core.map, e->wall_fwd, nf) != 0 ||
+            rfs_map_wall_cols_attach(&e->core.map, e->wall_cols, nc) != 0) {
             snprintf(err, errlen, "%s: map: out of memory", sc->path);
             hs_sim_env_close(e);
             return -1;
@@ -253,6 +257,8 @@ void hs_sim_env_close(hs_sim_env_t *e)
     e->wall_dist = NULL;
     free(e->wall_fwd);
     e->wall_fwd = NULL;
+    free(e->wall_cols);
+    e->wall_cols = NULL;
     free(e->pathloss_log2);
     e->pathloss_log2 = NULL;
     hs_box2d_walls_free(&e->walls);

@@ -316,9 +316,10 @@ static void test_walls_crossed_wall_dist(void **state)
 /* A forward grid (rfs_map_wall_fwd_attach) holds each cell's largest wall-free square
  * ahead towards +x and +y, and +x and -y (brute force here), and wall counts passing over
  * those squares equal ref_walls_in_order and the plain walk's, alone and with the
- * wall-distance grid or blocks beside it: on maps with walls scattered, in rows with gaps,
- * thinned, one cell and none, for random segments, shallow ones, steep ones through cell
- * corners, segments between cell corners and ends off the map. */
+ * wall-distance grid, the column grid (rfs_map_wall_cols_attach) or blocks beside it: on
+ * maps with walls scattered, in rows with gaps, thinned, one cell and none, for random
+ * segments, shallow ones, steep ones through cell corners, segments between cell corners
+ * and ends off the map. */
 static void test_walls_crossed_wall_fwd(void **state)
 {
     (void)state;
@@ -326,6 +327,7 @@ static void test_walls_crossed_wall_fwd(void **state)
     int nonzero = 0;
     static uint8_t fwd[2 * H * W];
     static uint8_t dist[H * W];
+    static uint8_t cols[2 * W * ((H + 7) / 8 + 4)];
     for (int mapk = 0; mapk < 7; mapk++) {
         make_map(&fx, 700u + (uint32_t)mapk, RFS_Q16_FRAC(1, 10), RFS_Q16_FRAC(1, 4));
         uint16_t stride = (W + 7) / 8;
@@ -374,6 +376,22 @@ static void test_walls_crossed_wall_fwd(void **state)
         }
         rfs_map_t with_dist = fx.m;
         assert_int_equal(rfs_map_wall_dist_attach(&with_dist, dist, W * H), 0);
+        /* The column grid beside the forward grid, and beside the wall-distance grid: bit
+         * j of column i is cell (i, j), and of the top-down half cell (i, H - 1 - j). */
+        rfs_map_t with_cols = fx.m, dist_cols = with_dist;
+        const uint32_t cs = (H + 7) / 8 + 4;
+        assert_int_equal(rfs_map_wall_cols_bytes(&fx.m), 2 * W * cs);
+        assert_int_equal(rfs_map_wall_cols_attach(&with_cols, cols, 2 * W * cs - 1), -1);
+        assert_null(with_cols.wall_cols);
+        assert_int_equal(rfs_map_wall_cols_attach(&with_cols, cols, 2 * W * cs), 0);
+        assert_int_equal(rfs_map_wall_cols_attach(&dist_cols, cols, 2 * W * cs), 0);
+        for (int x = 0; x < W; x++) {
+            for (int y = 0; y < H; y++) {
+                assert_int_equal((cols[x * cs + y / 8] >> (y % 8)) & 1, fx.wall_c[y][x]);
+                assert_int_equal((cols[(W + x) * cs + y / 8] >> (y % 8)) & 1,
+                                 fx.wall_c[H - 1 - y][x]);
+            }
+        }
         uint8_t buf[64];
         rfs_map_wall_blocks_t b;
         assert_int_equal(rfs_map_wall_blocks(&fx.m, buf, sizeof buf, &b), 0);
@@ -391,6 +409,8 @@ static void test_walls_crossed_wall_fwd(void **state)
             assert_int_equal(rfs_map_walls_crossed(&plain, x0, y0, x1, y1), want);
             assert_int_equal(rfs_map_walls_crossed(&fx.m, x0, y0, x1, y1), want);
             assert_int_equal(rfs_map_walls_crossed(&with_dist, x0, y0, x1, y1), want);
+            assert_int_equal(rfs_map_walls_crossed(&with_cols, x0, y0, x1, y1), want);
+            assert_int_equal(rfs_map_walls_crossed(&dist_cols, x0, y0, x1, y1), want);
             assert_int_equal(rfs_map_walls_crossed_blocks(&fx.m, &b, x0, y0, x1, y1), want);
             nonzero += want > 0;
         }
@@ -400,6 +420,8 @@ static void test_walls_crossed_wall_fwd(void **state)
     nowall.wall = NULL;
     assert_int_equal(rfs_map_wall_fwd_attach(&nowall, fwd, 2 * W * H), -1);
     assert_int_equal(rfs_map_wall_fwd_attach(&fx.m, NULL, 2 * W * H), -1);
+    assert_int_equal(rfs_map_wall_cols_attach(&nowall, cols, sizeof cols), -1);
+    assert_int_equal(rfs_map_wall_cols_attach(&fx.m, NULL, sizeof cols), -1);
     /* A map of 2^31 cells or more: two bytes a cell exceed 32 bits; the size saturates and
      * no 32-bit buffer size is enough (the check runs before the grid is touched). */
     rfs_map_t big = fx.m;

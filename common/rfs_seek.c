@@ -38,6 +38,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.pose_timeout_us = 150000;             /* + one 50 ms period: stopped within 200 ms */
     c.rssi_timeout_us = 150000;
     c.fit_budget = 0;
+    c.fit_early = false;
     c.plan_budget = RFS_SEEK_PLAN_BUDGET;   /* how the paths are computed, not which */
     c.rssi = rfs_rssi_cfg_default();
     c.store = rfs_store_cfg_default();      /* 10,000 samples (section 5.2) */
@@ -626,7 +627,7 @@ static void fit_input(const rfs_seek_t *s, rfs_q16_t qx, rfs_q16_t qy, rfs_model
 static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
 {
     rfs_model_fit_in_t fin;
-    fit_input(s, s->decision.x, s->decision.y, &fin);
+    fit_input(s, s->fit_qx, s->fit_qy, &fin);
     rfs_fit_result_t r = s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng);
     if (r == RFS_FIT_MORE) {
         s->state = RFS_SEEK_LEARNING;
@@ -635,6 +636,37 @@ static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_ou
     }
     s->fitting = false;
     return true;
+}
+
+/* fit_early (docs/STRATEGIES.md, "Relearning early"): a failed recheck makes the next
+ * decision relearn, so with sliced fits the relearn begins now, as the base brakes, on the
+ * samples so far (the braking's come with the next relearn). */
+static void begin_early(rfs_seek_t *s)
+{
+    if (!s->cfg.fit_early || s->cfg.fit_budget == 0u || !rfs_seek_ops(s)->learns ||
+        s->store.count == 0u || s->fitting) {
+        return;
+    }
+    rfs_model_fit_in_t fin;
+    fit_input(s, s->pose.x, s->pose.y, &fin);
+    s->model.ops->reset(s->model.self);
+    s->fitting = true;
+    s->early = true;
+    s->fit_qx = s->pose.x;
+    s->fit_qy = s->pose.y;
+    s->early_nexcl = s->nexcl;
+    s->early_excl_next = s->excl_next;
+    s->early_settle = fin.settle;
+}
+
+/* fit_early: the fit begun as the base braked learns what the decision's would: no place
+ * ruled out since, the same settle phase. */
+static bool early_holds(const rfs_seek_t *s)
+{
+    rfs_model_fit_in_t fin;
+    fit_input(s, s->fit_qx, s->fit_qy, &fin);
+    return s->nexcl == s->early_nexcl && s->excl_next == s->early_excl_next &&
+           fin.settle == s->early_settle;
 }
 
 /* Start an iteration: the relearn check, then (after learning) the step choice. */
@@ -670,12 +702,26 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
      * orbit, and sees the tour end (docs/STRATEGIES.md, "Bridging"). */
     relearn = relearn || (s->cfg.settle_orbit > 0 && rfs_seek_src_settled(s));
 
-    if (relearn && s->store.count > 0u) {
+    if (s->early && !early_holds(s)) {
+        s->early = false; /* a place ruled out or a phase changed since: begin again */
+        s->fitting = false;
+        s->fit_ended = false;
+    }
+    if ((relearn && s->store.count > 0u) || s->early) {
         d->relearned = true;
-        s->model.ops->reset(s->model.self);
-        s->fitting = true;
+        if (!s->early) {
+            s->model.ops->reset(s->model.self);
+            s->fitting = true;
+            s->fit_qx = d->x;
+            s->fit_qy = d->y;
+        }
+        s->early = false;
     }
     const bool whole_fit = s->fitting && s->cfg.fit_budget == 0u;
+    if (s->fitting && s->fit_ended) {
+        s->fitting = false; /* ended between periods */
+        s->fit_ended = false;
+    }
     if (s->fitting && !fit_slice(s, now_us, rng, out)) {
         return;
     }
@@ -868,6 +914,7 @@ static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
         rfs_drive_stop(&s->drive, now_us);
         s->prev_status = RFS_DRIVE_RUNNING; /* abandoned while running: the model failed */
         s->replan = true;
+        begin_early(s);
     }
     if (s->drive.status != RFS_DRIVE_RUNNING) {
         return false;
@@ -937,7 +984,7 @@ static void control(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_
     if (s->resume) {
         resume_goal(s, now_us);
     }
-    if (s->fitting) {
+    if (s->fitting && !s->early) {
         /* A sliced fit continues (or ended between periods); the decision finishes when it
          * is done. */
         if (s->fit_ended || fit_slice(s, now_us, rng, out)) {
@@ -965,7 +1012,7 @@ bool rfs_seek_background(rfs_seek_t *s, rfs_rng_t *rng)
         return false;
     }
     rfs_model_fit_in_t fin;
-    fit_input(s, s->decision.x, s->decision.y, &fin);
+    fit_input(s, s->fit_qx, s->fit_qy, &fin);
     if (s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng) == RFS_FIT_MORE) {
         return true;
     }

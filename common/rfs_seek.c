@@ -599,27 +599,6 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
     end_decision(s, ok, now_us, out);
 }
 
-/* The model's input: the samples, map, reach bits, places ruled out and each source's
- * samples, queried at (qx, qy). */
-static void fit_input(const rfs_seek_t *s, rfs_q16_t qx, rfs_q16_t qy, rfs_model_fit_in_t *fin)
-{
-    *fin = (rfs_model_fit_in_t){ .samples = s->store.samples, .n = s->store.count,
-                                 .index = s->store.index, .qx = qx, .qy = qy, .map = s->map,
-                                 .reach = s->reach_valid ? s->reach : 0,
-                                 .excl_x_cm = s->excl_x_cm, .excl_y_cm = s->excl_y_cm,
-                                 .nexcl = s->nexcl,
-                                 .excl_r = s->cfg.refute_r,
-                                 .settle = !rfs_seek_src_settled(s) ? RFS_MODEL_EXPLORE
-                                           : rfs_seek_src_orbiting(s) ? RFS_MODEL_TOUR
-                                                                      : RFS_MODEL_HOLD };
-    for (uint8_t i = 0; s->src != 0 && i < s->target->nsources; ++i) {
-        fin->src_samples[i] = s->src[i].store.samples;
-        fin->src_n[i] = s->src[i].store.count;
-        fin->src_seen[i] = s->src[i].store.seen;
-        fin->nsources = (uint8_t)(i + 1u);
-    }
-}
-
 /* One slice of learning (all of it when fit_budget is 0). false while the fit needs more
  * periods: the wheels stay stopped meanwhile. The query point is where the decision began,
  * not the latest pose: a pose that moves by its noise between slices would restart a local
@@ -627,7 +606,7 @@ static void fit_input(const rfs_seek_t *s, rfs_q16_t qx, rfs_q16_t qy, rfs_model
 static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
 {
     rfs_model_fit_in_t fin;
-    fit_input(s, s->fit_qx, s->fit_qy, &fin);
+    rfs_seek_fit_input(s, s->fit_qx, s->fit_qy, &fin);
     rfs_fit_result_t r = s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng);
     if (r == RFS_FIT_MORE) {
         s->state = RFS_SEEK_LEARNING;
@@ -636,37 +615,6 @@ static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_ou
     }
     s->fitting = false;
     return true;
-}
-
-/* fit_early (docs/STRATEGIES.md, "Relearning early"): a failed recheck makes the next
- * decision relearn, so with sliced fits the relearn begins now, as the base brakes, on the
- * samples so far (the braking's come with the next relearn). */
-static void begin_early(rfs_seek_t *s)
-{
-    if (!s->cfg.fit_early || s->cfg.fit_budget == 0u || !rfs_seek_ops(s)->learns ||
-        s->store.count == 0u || s->fitting) {
-        return;
-    }
-    rfs_model_fit_in_t fin;
-    fit_input(s, s->pose.x, s->pose.y, &fin);
-    s->model.ops->reset(s->model.self);
-    s->fitting = true;
-    s->early = true;
-    s->fit_qx = s->pose.x;
-    s->fit_qy = s->pose.y;
-    s->early_nexcl = s->nexcl;
-    s->early_excl_next = s->excl_next;
-    s->early_settle = fin.settle;
-}
-
-/* fit_early: the fit begun as the base braked learns what the decision's would: no place
- * ruled out since, the same settle phase. */
-static bool early_holds(const rfs_seek_t *s)
-{
-    rfs_model_fit_in_t fin;
-    fit_input(s, s->fit_qx, s->fit_qy, &fin);
-    return s->nexcl == s->early_nexcl && s->excl_next == s->early_excl_next &&
-           fin.settle == s->early_settle;
 }
 
 /* Start an iteration: the relearn check, then (after learning) the step choice. */
@@ -702,7 +650,7 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
      * orbit, and sees the tour end (docs/STRATEGIES.md, "Bridging"). */
     relearn = relearn || (s->cfg.settle_orbit > 0 && rfs_seek_src_settled(s));
 
-    if (s->early && !early_holds(s)) {
+    if (s->early && !rfs_seek_fit_early_holds(s)) {
         s->early = false; /* a place ruled out or a phase changed since: begin again */
         s->fitting = false;
         s->fit_ended = false;
@@ -901,7 +849,7 @@ static void warm_next(rfs_seek_t *s)
         return;
     }
     rfs_model_fit_in_t fin;
-    fit_input(s, s->pose.x, s->pose.y, &fin);
+    rfs_seek_fit_input(s, s->pose.x, s->pose.y, &fin);
     (void)s->model.ops->warm(s->model.self, &fin, RFS_SEEK_WARM_SLICE(s->cfg.fit_budget));
 }
 
@@ -914,7 +862,7 @@ static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
         rfs_drive_stop(&s->drive, now_us);
         s->prev_status = RFS_DRIVE_RUNNING; /* abandoned while running: the model failed */
         s->replan = true;
-        begin_early(s);
+        rfs_seek_fit_early_begin(s);
     }
     if (s->drive.status != RFS_DRIVE_RUNNING) {
         return false;
@@ -1003,21 +951,6 @@ static void control(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_
         return;
     }
     decide(s, now_us, rng, out);
-}
-
-bool rfs_seek_background(rfs_seek_t *s, rfs_rng_t *rng)
-{
-    RFS_ASSERT(s != 0 && rng != 0);
-    if (!s->fitting || s->fit_ended || s->cfg.fit_budget == 0u) {
-        return false;
-    }
-    rfs_model_fit_in_t fin;
-    fit_input(s, s->fit_qx, s->fit_qy, &fin);
-    if (s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng) == RFS_FIT_MORE) {
-        return true;
-    }
-    s->fit_ended = true;
-    return false;
 }
 
 void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)

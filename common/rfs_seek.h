@@ -60,8 +60,9 @@ typedef struct rfs_seek_cfg {
                                 ///< stale: wheels stop (150 ms)
     uint32_t fit_budget;        ///< work units per control period for model learning (0 = all)
     bool fit_early;             ///< with fit_budget: the relearn a failed recheck makes
-                                ///< certain begins as the base brakes, on the samples so far
-                                ///< (docs/STRATEGIES.md, "Relearning early"); false: at rest
+                                ///< certain begins as the base brakes, on the samples so
+                                ///< far (docs/FIRMWARE.md, "Learning between periods");
+                                ///< false: at rest
     uint32_t plan_budget;       ///< lattice points a control period adds to the search tree
                                 ///< of the next decision (docs/PERFORMANCE.md, "Planning in
                                 ///< slices"; RFS_SEEK_PLAN_BUDGET); 0: every plan searches

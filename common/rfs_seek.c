@@ -38,6 +38,7 @@ rfs_seek_cfg_t rfs_seek_cfg_default(void)
     c.pose_timeout_us = 150000;             /* + one 50 ms period: stopped within 200 ms */
     c.rssi_timeout_us = 150000;
     c.fit_budget = 0;
+    c.fit_early = false;
     c.plan_budget = RFS_SEEK_PLAN_BUDGET;   /* how the paths are computed, not which */
     c.rssi = rfs_rssi_cfg_default();
     c.store = rfs_store_cfg_default();      /* 10,000 samples (section 5.2) */
@@ -598,27 +599,6 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
     end_decision(s, ok, now_us, out);
 }
 
-/* The model's input: the samples, map, reach bits, places ruled out and each source's
- * samples, queried at (qx, qy). */
-static void fit_input(const rfs_seek_t *s, rfs_q16_t qx, rfs_q16_t qy, rfs_model_fit_in_t *fin)
-{
-    *fin = (rfs_model_fit_in_t){ .samples = s->store.samples, .n = s->store.count,
-                                 .index = s->store.index, .qx = qx, .qy = qy, .map = s->map,
-                                 .reach = s->reach_valid ? s->reach : 0,
-                                 .excl_x_cm = s->excl_x_cm, .excl_y_cm = s->excl_y_cm,
-                                 .nexcl = s->nexcl,
-                                 .excl_r = s->cfg.refute_r,
-                                 .settle = !rfs_seek_src_settled(s) ? RFS_MODEL_EXPLORE
-                                           : rfs_seek_src_orbiting(s) ? RFS_MODEL_TOUR
-                                                                      : RFS_MODEL_HOLD };
-    for (uint8_t i = 0; s->src != 0 && i < s->target->nsources; ++i) {
-        fin->src_samples[i] = s->src[i].store.samples;
-        fin->src_n[i] = s->src[i].store.count;
-        fin->src_seen[i] = s->src[i].store.seen;
-        fin->nsources = (uint8_t)(i + 1u);
-    }
-}
-
 /* One slice of learning (all of it when fit_budget is 0). false while the fit needs more
  * periods: the wheels stay stopped meanwhile. The query point is where the decision began,
  * not the latest pose: a pose that moves by its noise between slices would restart a local
@@ -626,7 +606,7 @@ static void fit_input(const rfs_seek_t *s, rfs_q16_t qx, rfs_q16_t qy, rfs_model
 static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
 {
     rfs_model_fit_in_t fin;
-    fit_input(s, s->decision.x, s->decision.y, &fin);
+    rfs_seek_fit_input(s, s->fit_qx, s->fit_qy, &fin);
     rfs_fit_result_t r = s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng);
     if (r == RFS_FIT_MORE) {
         s->state = RFS_SEEK_LEARNING;
@@ -670,12 +650,26 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
      * orbit, and sees the tour end (docs/STRATEGIES.md, "Bridging"). */
     relearn = relearn || (s->cfg.settle_orbit > 0 && rfs_seek_src_settled(s));
 
-    if (relearn && s->store.count > 0u) {
+    if (s->early && !rfs_seek_fit_early_holds(s)) {
+        s->early = false; /* a place ruled out or a phase changed since: begin again */
+        s->fitting = false;
+        s->fit_ended = false;
+    }
+    if ((relearn && s->store.count > 0u) || s->early) {
         d->relearned = true;
-        s->model.ops->reset(s->model.self);
-        s->fitting = true;
+        if (!s->early) {
+            s->model.ops->reset(s->model.self);
+            s->fitting = true;
+            s->fit_qx = d->x;
+            s->fit_qy = d->y;
+        }
+        s->early = false;
     }
     const bool whole_fit = s->fitting && s->cfg.fit_budget == 0u;
+    if (s->fitting && s->fit_ended) {
+        s->fitting = false; /* ended between periods */
+        s->fit_ended = false;
+    }
     if (s->fitting && !fit_slice(s, now_us, rng, out)) {
         return;
     }
@@ -855,7 +849,7 @@ static void warm_next(rfs_seek_t *s)
         return;
     }
     rfs_model_fit_in_t fin;
-    fit_input(s, s->pose.x, s->pose.y, &fin);
+    rfs_seek_fit_input(s, s->pose.x, s->pose.y, &fin);
     (void)s->model.ops->warm(s->model.self, &fin, RFS_SEEK_WARM_SLICE(s->cfg.fit_budget));
 }
 
@@ -868,6 +862,7 @@ static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
         rfs_drive_stop(&s->drive, now_us);
         s->prev_status = RFS_DRIVE_RUNNING; /* abandoned while running: the model failed */
         s->replan = true;
+        rfs_seek_fit_early_begin(s);
     }
     if (s->drive.status != RFS_DRIVE_RUNNING) {
         return false;
@@ -937,7 +932,7 @@ static void control(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_
     if (s->resume) {
         resume_goal(s, now_us);
     }
-    if (s->fitting) {
+    if (s->fitting && !s->early) {
         /* A sliced fit continues (or ended between periods); the decision finishes when it
          * is done. */
         if (s->fit_ended || fit_slice(s, now_us, rng, out)) {
@@ -956,21 +951,6 @@ static void control(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_
         return;
     }
     decide(s, now_us, rng, out);
-}
-
-bool rfs_seek_background(rfs_seek_t *s, rfs_rng_t *rng)
-{
-    RFS_ASSERT(s != 0 && rng != 0);
-    if (!s->fitting || s->fit_ended || s->cfg.fit_budget == 0u) {
-        return false;
-    }
-    rfs_model_fit_in_t fin;
-    fit_input(s, s->decision.x, s->decision.y, &fin);
-    if (s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng) == RFS_FIT_MORE) {
-        return true;
-    }
-    s->fit_ended = true;
-    return false;
 }
 
 void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)

@@ -59,6 +59,10 @@ typedef struct rfs_seek_cfg {
     int64_t rssi_timeout_us;    ///< no measurement and no receiver report for this long is
                                 ///< stale: wheels stop (150 ms)
     uint32_t fit_budget;        ///< work units per control period for model learning (0 = all)
+    bool fit_early;             ///< with fit_budget: the relearn a failed recheck makes
+                                ///< certain begins as the base brakes, on the samples so
+                                ///< far (docs/FIRMWARE.md, "Learning between periods");
+                                ///< false: at rest
     uint32_t plan_budget;       ///< lattice points a control period adds to the search tree
                                 ///< of the next decision (docs/PERFORMANCE.md, "Planning in
                                 ///< slices"; RFS_SEEK_PLAN_BUDGET); 0: every plan searches
@@ -365,6 +369,10 @@ typedef struct rfs_seek {
     bool fitting;                             ///< a sliced fit is in progress
     bool fit_ended;                           ///< rfs_seek_background() ended it: the next
                                               ///< period finishes the decision
+    bool early;                               ///< fit_early: the fit began as the base braked
+    rfs_q16_t fit_qx, fit_qy;                 ///< the fit's query point, metres Q16.16
+    uint8_t early_nexcl, early_excl_next;     ///< fit_early: places ruled out as it began
+    rfs_model_settle_t early_settle;          ///< fit_early: the settle phase as it began
     bool planning;                            ///< plan_budget: a decision waits for its
                                               ///< search tree (grown from the robot)
     bool plan_ready;                          ///< the decision's plans walk that tree

@@ -49,6 +49,19 @@ bool rfs_seek_plan_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, bool tree);
 /* Plan to (gx, gy) and drive the path. */
 bool rfs_seek_go_to(rfs_seek_t *s, rfs_q16_t gx, rfs_q16_t gy, int64_t now_us);
 
+/* ---- rfs_seek_fit.c: learning ------------------------------------------------------ */
+
+/* What a fit learns from (the store, the map, the places ruled out, each source's
+ * samples), asked about (qx, qy). */
+void rfs_seek_fit_input(const rfs_seek_t *s, rfs_q16_t qx, rfs_q16_t qy,
+                        rfs_model_fit_in_t *fin);
+
+/* fit_early: a failed recheck's relearn begins now (s->early), unless off or one runs. */
+void rfs_seek_fit_early_begin(rfs_seek_t *s);
+
+/* fit_early: the fit begun as the base braked still learns what the decision's would. */
+bool rfs_seek_fit_early_holds(const rfs_seek_t *s);
+
 /* ---- rfs_seek_meta.c: the paper's choices (section 2) and their variants ----------- */
 
 /* Tabulate the epsilon weights e^(-d) by squared lattice offset (s->eps_w). */

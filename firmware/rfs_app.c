@@ -26,6 +26,7 @@ rfs_app_cfg_t rfs_app_cfg_mcu(void)
     rfs_app_cfg_t c = rfs_app_cfg_default();
     c.seek.fit_budget = RFS_APP_MCU_FIT_BUDGET;
     c.seek.reach_budget = RFS_SEEK_REACH_BUDGET; /* the boot's flood fill in slices */
+    c.seek.fit_early = true; /* docs/FIRMWARE.md, "Learning between periods" */
     c.fit_budget_by_model = true;
     return c;
 }

@@ -230,6 +230,7 @@ void hs_scenario_defaults(hs_scenario_t *sc)
     sc->seek_near_m = -1.0;
     sc->seek_reach_min = -1.0;
     sc->seek_fit_slices = -1.0;
+    sc->seek_fit_early = -1;
     sc->seek_fit_budget = -1.0;
     sc->seek_eps_by_travel = -1;
     sc->seek_eps_geodesic = -1;
@@ -460,7 +461,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
                                         "refute_reached", "local_m", "leg_m", "recheck_silent",
                                         "coarse_footprint_m", "p0_max_wall_db", "local_gap_m",
                                         "at_tol_m", "local_refute", "near_t",
-                                        "near_m", "coarse_snap", "reach_min", "fit_budget", "fit_slices",
+                                        "near_m", "coarse_snap", "reach_min", "fit_budget", "fit_slices", "fit_early",
                                         "floor_db", "floor_max", "mean_t", NULL};
         if (check_keys(p, n, "seek", k) ||
             num(p, n, "seek", "recheck_m", 0, 100, &sc->seek_recheck_m) ||
@@ -489,6 +490,7 @@ static int parse_seek(pctx_t *p, const lx_yaml_node_t *root, hs_scenario_t *sc)
             preset_bool(p, n, "refute_reached", &sc->seek_refute_reached) ||
             preset_bool(p, n, "local_refute", &sc->seek_local_refute) ||
             preset_bool(p, n, "coarse_snap", &sc->seek_coarse_snap) ||
+            preset_bool(p, n, "fit_early", &sc->seek_fit_early) ||
             preset_bool(p, n, "recheck_silent", &sc->seek_recheck_silent)) {
             return -1;
         }

@@ -91,6 +91,8 @@ typedef struct hs_scenario {
     double seek_near_m;           ///< seek.near_m: rfs_seek_cfg_t.near_min (-1 = the preset)
     double seek_fit_slices;       ///< seek.fit_slices: fit slices in each period's spare time
                                   ///< (hs_ctrl_inproc_cfg_t.fit_slices; -1 = 0)
+    int seek_fit_early;           ///< seek.fit_early: 0 / 1, a failed recheck's relearn
+                                  ///< begins as the base brakes (-1 = off)
     double seek_reach_min;        ///< seek.reach_min: lattice points of the smallest component
                                   ///< kept (rfs_seek_cfg_t.reach_min; 0: off; -1 = preset)
     double seek_fit_budget;       ///< seek.fit_budget: the model's work units a control period

@@ -859,6 +859,9 @@ int hs_sim_run_inproc(const hs_sim_env_t *e, uint64_t seed, const hs_sim_io_t *i
     if (e->sc.seek_floor_max >= 0.0) {
         cc.seek.floor_max = (uint8_t)e->sc.seek_floor_max;
     }
+    if (e->sc.seek_fit_early >= 0) {
+        cc.seek.fit_early = e->sc.seek_fit_early != 0;
+    }
     if (e->sc.seek_fit_slices >= 0.0) {
         cc.fit_slices = (uint32_t)e->sc.seek_fit_slices;
     }

@@ -67,7 +67,8 @@ static void usage(FILE *f)
             "  --fit-budget N|mcu  the model's work units a control period, overriding the\n"
             "                  scenario's seek.fit_budget (0, the default: each fit whole;\n"
             "                  mcu: the model's Cortex-M4 budget and wall-count cache,\n"
-            "                  and 10 more slices in each period's spare time (seek.fit_slices),\n"
+            "                  10 more slices after each period and relearns begun while\n"
+            "                  braking (seek.fit_slices, fit_early),\n"
             "                  docs/PERFORMANCE.md); the wheels wait while a fit runs\n"
             "                  (summary.json decision_wait_max_s)\n"
             "  --start X,Y[,THETA]  start here (metres, radians), overriding the scenario's\n"
@@ -570,6 +571,9 @@ static int load_scenario(const sim_opts_t *o, hs_scenario_t *sc)
         sc->fit_mcu = o->fit_budget == FIT_MCU;
         if (sc->fit_mcu && sc->seek_fit_slices < 0.0) {
             sc->seek_fit_slices = (double)RFS_APP_BACKGROUND_SLICES;
+        }
+        if (sc->fit_mcu && sc->seek_fit_early < 0) {
+            sc->seek_fit_early = rfs_app_cfg_mcu().seek.fit_early ? 1 : 0;
         }
     }
     return placement(o, sc);

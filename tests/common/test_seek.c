@@ -655,6 +655,114 @@ static void test_recheck_abandons_leg(void **state)
     assert_int_equal(ab, 0);     /* the paper's rule runs every leg to its end */
 }
 
+/* fit_early: legs driven through a 12 dB jump fail their recheck (as run_recheck) and the
+ * relearn, a sliced ridge (300 samples a slice, three more slices after each period),
+ * begins as the base brakes. Each such decision waits fewer periods at rest than
+ * without fit_early, and its model is a whole fit of the samples the slices saw, at the
+ * pose where the check failed. */
+typedef struct early_run {
+    int abandoned;        /* decisions after a failed recheck */
+    int began_moving;     /* relearns begun while the base still rolled */
+    int waited;           /* periods those decisions stood at rest */
+    int compared;         /* models checked against a whole fit */
+} early_run_t;
+
+static early_run_t run_early(bool early)
+{
+    world_t t;
+    world_make(&t, 30.0, 30.0, 0, 0);
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    cfg.recheck_dist = Q(0.5);
+    cfg.recheck_adapt = false;
+    cfg.eps_by_travel = false;
+    cfg.eps_amp = 0;
+    cfg.eps_floor = RFS_Q16_HALF;
+    cfg.fit_budget = 300;
+    cfg.fit_early = early;
+    seek_make(&t, cfg, 9);
+    field_t f = { .kind = 1, .a = -80.0, .bx = 0.5, .by = 0.5 };
+    run_t r = { .x = 5.0, .y = 5.0 };
+    early_run_t e = { 0 };
+    bool began = false;
+    int rest = 0;
+    uint16_t n_fit = 0u;
+    for (int k = 0; k < 60; ++k) {
+        rfs_seek_out_t out = { 0 };
+        while (!out.decided) {
+            assert_true(r.t_us < 600000000);
+            r.t_us += 10000;
+            if (r.pending && r.t_us >= r.arrive_us) {
+                r.x = r.gx;
+                r.y = r.gy;
+                r.pending = false;
+            }
+            const double u = fmod((double)r.pkt++ * 0.6180339887498949, 1.0);
+            rfs_seek_on_rssi(&t.seek, 0, r.t_us, (int8_t)floor(field_at(&f, r.x, r.y) + u),
+                             &t.rng);
+            if (r.t_us % 50000 != 0) {
+                continue;
+            }
+            rfs_pose_t p = { r.t_us, Q(r.x), Q(r.y), 0 };
+            rfs_seek_on_pose(&t.seek, &p, &t.rng);
+            rest += rfs_drive_at_rest(&t.seek.drive) && !r.pending ? 1 : 0;
+            rfs_seek_step(&t.seek, r.t_us, &t.rng, &out);
+            began = began || (t.seek.early && !rfs_drive_at_rest(&t.seek.drive));
+            assert_true(early || !t.seek.early);
+            for (int s = 0; s < 3 && rfs_seek_background(&t.seek, &t.rng); ++s) {
+            }
+            if (t.seek.fit_ended && n_fit == 0u) {
+                n_fit = t.seek.store.count;
+            }
+        }
+        const rfs_seek_decision_t *d = &out.decision;
+        if (d->prev == RFS_DRIVE_RUNNING) {
+            assert_true(d->relearned);
+            e.abandoned++;
+            e.began_moving += began;
+            e.waited += rest;
+            if (began && t.seek.store.count < cfg.store.capacity) {
+                rfs_ridge_t whole;
+                rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
+                assert_int_equal(rfs_ridge_init(&whole, &rc), 0);
+                const rfs_model_fit_in_t in = {.samples = t.seek.store.samples,
+                                               .n = n_fit != 0u ? n_fit : t.seek.store.count,
+                                               .qx = t.seek.fit_qx, .qy = t.seek.fit_qy};
+                const rfs_model_t wm = rfs_ridge_model(&whole);
+                assert_int_equal(wm.ops->fit(wm.self, &in, 0u, &t.rng), RFS_FIT_DONE);
+                rfs_q16_t a, b;
+                assert_true(t.seek.model.ops->predict(t.seek.model.self, Q(8), Q(9), &a));
+                assert_true(wm.ops->predict(wm.self, Q(8), Q(9), &b));
+                assert_int_equal(a, b);
+                e.compared++;
+            }
+        }
+        began = false;
+        rest = 0;
+        n_fit = 0u;
+        r.pending = true;
+        r.gx = D(d->goal_x);
+        r.gy = D(d->goal_y);
+        r.arrive_us = r.t_us + 1500000;
+        const bool jumped = d->kind == RFS_SEEK_GREEDY && k % 3 == 0 && d->prev != RFS_DRIVE_RUNNING;
+        f.a = jumped ? -68.0 : -80.0;
+    }
+    world_free(&t);
+    return e;
+}
+
+static void test_fit_early_relearns_while_braking(void **state)
+{
+    (void)state;
+    const early_run_t on = run_early(true), off = run_early(false);
+    assert_true(on.abandoned >= 5 && off.abandoned >= 5);
+    assert_int_equal(off.began_moving, 0);
+    assert_true(on.began_moving >= on.abandoned - 1); /* all but one seen while rolling */
+    assert_true(on.compared >= 3);
+    /* waits at rest per abandoned leg: fewer periods than without */
+    assert_true(on.waited * off.abandoned < off.waited * on.abandoned);
+}
+
 /* recheck_adapt's rule against double precision: a running mean of the squared misses
  * moved 1/8 of the way at each check, and a check fails beyond max(3 dB, its root). Misses
  * from a seeded generator: long quiet stretches (model good to 1-2 dB), bursts of 4-8 dB
@@ -819,6 +927,7 @@ int main(void)
         cmocka_unit_test(test_no_goal_backs_off),
         cmocka_unit_test(test_null_move_backs_off),
         cmocka_unit_test(test_recheck_abandons_leg),
+        cmocka_unit_test(test_fit_early_relearns_while_braking),
         cmocka_unit_test(test_recheck_adapt),
         cmocka_unit_test(test_abandoned_leg_decides_at_rest),
         cmocka_unit_test(test_closed_loop_reaches_source),

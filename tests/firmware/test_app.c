@@ -144,6 +144,9 @@ static void test_init_checks_configuration_and_map(void **state)
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
     assert_int_equal(rfs_app_cfg_mcu().seek.fit_budget, 0u); /* the ridge's: a whole fit */
     assert_int_equal(rfs_app_cfg_default().seek.fit_budget, 0u);
+    /* sliced relearns begin as the base brakes on the MCU; replays follow their CFG */
+    assert_true(rfs_app_cfg_mcu().seek.fit_early);
+    assert_false(rfs_app_cfg_default().seek.fit_early);
 }
 
 static void test_first_step_after_reset_is_zero_and_flagged(void **state)

@@ -106,6 +106,18 @@ if awk -v bm="$(num "$T/fbbg.json" decision_wait_mean_s)" -v sm="$(num "$T/fbcli
 else
     fail fit_slices_sooner "mean $(num "$T/fbbg.json" decision_wait_mean_s) / $(num "$T/fbcli.json" decision_wait_mean_s)"
 fi
+# seek.fit_early: on with --fit-budget mcu (relearns begun while the base brakes: shorter
+# mean wait than with it off); a bad value is refused.
+bad fit_early_value "seek.fit_early: expected true or false" "$T/p0.yaml" --seek 'fit_early: maybe' --out "$T/out"
+"$SIM" "$T/p0.yaml" --strategy meta-path --model pathloss --fit-budget mcu --seed 2 >"$T/feon.json" 2>/dev/null
+"$SIM" "$T/p0.yaml" --strategy meta-path --model pathloss --fit-budget mcu --seek 'fit_early: false' \
+    --seed 2 >"$T/feoff.json" 2>/dev/null
+if awk -v on="$(num "$T/feon.json" decision_wait_mean_s)" -v off="$(num "$T/feoff.json" decision_wait_mean_s)" \
+       'BEGIN { exit !(on != "" && off != "" && on < off) }'; then
+    pass fit_early_mcu
+else
+    fail fit_early_mcu "mean wait $(num "$T/feon.json" decision_wait_mean_s) / $(num "$T/feoff.json" decision_wait_mean_s)"
+fi
 # --seek: the scenario's seek: keys from the command line, checked as the file's; the same
 # run as the key in the file, another run than without it.
 bad seek_unknown "--seek:1: seek: unknown key 'bogus'" "$T/p0.yaml" --seek 'bogus: 1' --out "$T/out"

@@ -1,0 +1,73 @@
+/* rfs_seek_fit.c - the model's learning for the loop in rfs_seek.c: what a fit learns
+ * from, a relearn begun as the base brakes (fit_early) and the slices a port runs between
+ * control periods (docs/FIRMWARE.md, "Learning between periods"). */
+#include "rfs_assert.h"
+#include "rfs_seek_internal.h"
+
+/* The model's input: the samples, map, reach bits, places ruled out and each source's
+ * samples, queried at (qx, qy). */
+void rfs_seek_fit_input(const rfs_seek_t *s, rfs_q16_t qx, rfs_q16_t qy,
+                        rfs_model_fit_in_t *fin)
+{
+    *fin = (rfs_model_fit_in_t){ .samples = s->store.samples, .n = s->store.count,
+                                 .index = s->store.index, .qx = qx, .qy = qy, .map = s->map,
+                                 .reach = s->reach_valid ? s->reach : 0,
+                                 .excl_x_cm = s->excl_x_cm, .excl_y_cm = s->excl_y_cm,
+                                 .nexcl = s->nexcl,
+                                 .excl_r = s->cfg.refute_r,
+                                 .settle = !rfs_seek_src_settled(s) ? RFS_MODEL_EXPLORE
+                                           : rfs_seek_src_orbiting(s) ? RFS_MODEL_TOUR
+                                                                      : RFS_MODEL_HOLD };
+    for (uint8_t i = 0; s->src != 0 && i < s->target->nsources; ++i) {
+        fin->src_samples[i] = s->src[i].store.samples;
+        fin->src_n[i] = s->src[i].store.count;
+        fin->src_seen[i] = s->src[i].store.seen;
+        fin->nsources = (uint8_t)(i + 1u);
+    }
+}
+
+/* fit_early (docs/FIRMWARE.md, "Learning between periods"): a failed recheck makes the next
+ * decision relearn, so with sliced fits the relearn begins now, as the base brakes, on the
+ * samples so far (the braking's come with the next relearn). */
+void rfs_seek_fit_early_begin(rfs_seek_t *s)
+{
+    if (!s->cfg.fit_early || s->cfg.fit_budget == 0u || !rfs_seek_ops(s)->learns ||
+        s->store.count == 0u || s->fitting) {
+        return;
+    }
+    rfs_model_fit_in_t fin;
+    rfs_seek_fit_input(s, s->pose.x, s->pose.y, &fin);
+    s->model.ops->reset(s->model.self);
+    s->fitting = true;
+    s->early = true;
+    s->fit_qx = s->pose.x;
+    s->fit_qy = s->pose.y;
+    s->early_nexcl = s->nexcl;
+    s->early_excl_next = s->excl_next;
+    s->early_settle = fin.settle;
+}
+
+/* fit_early: the fit begun as the base braked learns what the decision's would: no place
+ * ruled out since, the same settle phase. */
+bool rfs_seek_fit_early_holds(const rfs_seek_t *s)
+{
+    rfs_model_fit_in_t fin;
+    rfs_seek_fit_input(s, s->fit_qx, s->fit_qy, &fin);
+    return s->nexcl == s->early_nexcl && s->excl_next == s->early_excl_next &&
+           fin.settle == s->early_settle;
+}
+
+bool rfs_seek_background(rfs_seek_t *s, rfs_rng_t *rng)
+{
+    RFS_ASSERT(s != 0 && rng != 0);
+    if (!s->fitting || s->fit_ended || s->cfg.fit_budget == 0u) {
+        return false;
+    }
+    rfs_model_fit_in_t fin;
+    rfs_seek_fit_input(s, s->fit_qx, s->fit_qy, &fin);
+    if (s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng) == RFS_FIT_MORE) {
+        return true;
+    }
+    s->fit_ended = true;
+    return false;
+}

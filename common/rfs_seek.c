@@ -874,6 +874,12 @@ static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
         if (s->chk_x != chk_x || s->chk_y != chk_y) {
             begin_next_tree(s); /* a check passed: the next one is further on */
         }
+        if (s->cfg.fit_early && !s->fitting &&
+            rfs_q16_dist(s->pose.x, s->pose.y, s->decision.goal_x, s->decision.goal_y) <=
+                RFS_SEEK_EARLY_GOAL &&
+            rfs_seek_fit_early_asks(s, now_us)) {
+            rfs_seek_fit_early_begin(s); /* the decision at the goal will relearn */
+        }
         if (grow_next(s)) { /* the next decision's search tree */
             warm_next(s);
         }

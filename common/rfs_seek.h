@@ -59,10 +59,11 @@ typedef struct rfs_seek_cfg {
     int64_t rssi_timeout_us;    ///< no measurement and no receiver report for this long is
                                 ///< stale: wheels stop (150 ms)
     uint32_t fit_budget;        ///< work units per control period for model learning (0 = all)
-    bool fit_early;             ///< with fit_budget: the relearn a failed recheck makes
-                                ///< certain begins as the base brakes, on the samples so
-                                ///< far (docs/FIRMWARE.md, "Learning between periods");
-                                ///< false: at rest
+    bool fit_early;             ///< with fit_budget: the next decision's relearn begins as
+                                ///< the base brakes, on the samples so far: after a failed
+                                ///< recheck, or within RFS_SEEK_EARLY_GOAL of the goal
+                                ///< (docs/FIRMWARE.md, "Learning between periods"); false:
+                                ///< relearns at rest, when the check asks
     uint32_t plan_budget;       ///< lattice points a control period adds to the search tree
                                 ///< of the next decision (docs/PERFORMANCE.md, "Planning in
                                 ///< slices"; RFS_SEEK_PLAN_BUDGET); 0: every plan searches
@@ -309,6 +310,9 @@ typedef struct rfs_seek_out {
     rfs_seek_decision_t decision; ///< the latest decision (new when `decided`)
 } rfs_seek_out_t;
 
+/// fit_early: the relearn begins within this distance of the goal, metres Q16.16 (0.3 m:
+/// about 0.7 s before rest; 0.6 m cost more travel, docs/FIRMWARE.md).
+#define RFS_SEEK_EARLY_GOAL ((rfs_q16_t)19661)
 /// Default plan_budget: 640 lattice points a period (about 330,000 instructions on the
 /// Cortex-M4), the 12,800-point lattice of a 40 x 20 m map in 20 periods (1 s).
 #define RFS_SEEK_PLAN_BUDGET 640u

@@ -47,6 +47,16 @@ void rfs_seek_fit_early_begin(rfs_seek_t *s)
     s->early_settle = fin.settle;
 }
 
+bool rfs_seek_fit_early_asks(rfs_seek_t *s, int64_t now_us)
+{
+    rfs_q16_t mean, pred;
+    if (!s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &pred)) {
+        return true;
+    }
+    return rfs_seek_src_mean(s, now_us, &mean) &&
+           rfs_q16_abs(rfs_q16_sub(mean, pred)) > s->cfg.error_threshold;
+}
+
 /* fit_early: the fit begun as the base braked learns what the decision's would: no place
  * ruled out since, the same settle phase. */
 bool rfs_seek_fit_early_holds(const rfs_seek_t *s)

@@ -59,6 +59,10 @@ void rfs_seek_fit_input(const rfs_seek_t *s, rfs_q16_t qx, rfs_q16_t qy,
 /* fit_early: a failed recheck's relearn begins now (s->early), unless off or one runs. */
 void rfs_seek_fit_early_begin(rfs_seek_t *s);
 
+/* fit_early near a goal: the decision's relearn check (Algorithm 1) fails already, on
+ * the 1 s mean here (or there is no model). */
+bool rfs_seek_fit_early_asks(rfs_seek_t *s, int64_t now_us);
+
 /* fit_early: the fit begun as the base braked still learns what the decision's would. */
 bool rfs_seek_fit_early_holds(const rfs_seek_t *s);
 

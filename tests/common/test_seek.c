@@ -657,23 +657,27 @@ static void test_recheck_abandons_leg(void **state)
 
 /* fit_early: legs driven through a 12 dB jump fail their recheck (as run_recheck) and the
  * relearn, a sliced ridge (300 samples a slice, three more slices after each period),
- * begins as the base brakes. Each such decision waits fewer periods at rest than
- * without fit_early, and its model is a whole fit of the samples the slices saw, at the
- * pose where the check failed. */
+ * begins as the base brakes; without rechecks the jump fails the check within
+ * RFS_SEEK_EARLY_GOAL of the goal and the relearn begins there. Each such decision waits
+ * fewer periods at rest than without fit_early, and after a failed recheck its model is a
+ * whole fit of the samples the slices saw, at the pose where the check failed. */
 typedef struct early_run {
     int abandoned;        /* decisions after a failed recheck */
     int began_moving;     /* relearns begun while the base still rolled */
     int waited;           /* periods those decisions stood at rest */
     int compared;         /* models checked against a whole fit */
+    int at_goal;          /* relearning decisions at a goal reached */
+    int goal_began;       /* of them, begun before the goal was reached */
+    int goal_waited;      /* periods they stood at rest */
 } early_run_t;
 
-static early_run_t run_early(bool early)
+static early_run_t run_early(bool early, double recheck_m)
 {
     world_t t;
     world_make(&t, 30.0, 30.0, 0, 0);
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
-    cfg.recheck_dist = Q(0.5);
+    cfg.recheck_dist = Q(recheck_m);
     cfg.recheck_adapt = false;
     cfg.eps_by_travel = false;
     cfg.eps_amp = 0;
@@ -708,6 +712,7 @@ static early_run_t run_early(bool early)
             rest += rfs_drive_at_rest(&t.seek.drive) && !r.pending ? 1 : 0;
             rfs_seek_step(&t.seek, r.t_us, &t.rng, &out);
             began = began || (t.seek.early && !rfs_drive_at_rest(&t.seek.drive));
+            began = began || (t.seek.early && t.seek.drive.status == RFS_DRIVE_RUNNING);
             assert_true(early || !t.seek.early);
             for (int s = 0; s < 3 && rfs_seek_background(&t.seek, &t.rng); ++s) {
             }
@@ -716,6 +721,11 @@ static early_run_t run_early(bool early)
             }
         }
         const rfs_seek_decision_t *d = &out.decision;
+        if (d->prev == RFS_DRIVE_REACHED && d->relearned && k > 0) {
+            e.at_goal++;
+            e.goal_began += began;
+            e.goal_waited += rest;
+        }
         if (d->prev == RFS_DRIVE_RUNNING) {
             assert_true(d->relearned);
             e.abandoned++;
@@ -754,13 +764,21 @@ static early_run_t run_early(bool early)
 static void test_fit_early_relearns_while_braking(void **state)
 {
     (void)state;
-    const early_run_t on = run_early(true), off = run_early(false);
+    early_run_t on = run_early(true, 0.5), off = run_early(false, 0.5);
     assert_true(on.abandoned >= 5 && off.abandoned >= 5);
     assert_int_equal(off.began_moving, 0);
     assert_true(on.began_moving >= on.abandoned - 1); /* all but one seen while rolling */
     assert_true(on.compared >= 3);
     /* waits at rest per abandoned leg: fewer periods than without */
     assert_true(on.waited * off.abandoned < off.waited * on.abandoned);
+    /* without rechecks the jumps are met at the goals: every relearn there begun on the
+     * way (none without fit_early), shorter waits */
+    on = run_early(true, 0.0);
+    off = run_early(false, 0.0);
+    assert_true(on.at_goal >= 5 && off.at_goal >= 5);
+    assert_int_equal(on.goal_began, on.at_goal);
+    assert_int_equal(off.goal_began, 0);
+    assert_true(on.goal_waited * off.at_goal < off.goal_waited * on.at_goal);
 }
 
 /* recheck_adapt's rule against double precision: a running mean of the squared misses

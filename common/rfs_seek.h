@@ -310,9 +310,9 @@ typedef struct rfs_seek_out {
     rfs_seek_decision_t decision; ///< the latest decision (new when `decided`)
 } rfs_seek_out_t;
 
-/// fit_early: the relearn begins within this distance of the goal, metres Q16.16 (0.3 m:
-/// about 0.7 s before rest; 0.6 m cost more travel, docs/FIRMWARE.md).
-#define RFS_SEEK_EARLY_GOAL ((rfs_q16_t)19661)
+/// fit_early: the relearn begins within this distance of the goal, metres Q16.16 (0.15 m,
+/// about 0.5 s before rest on the Kobuki; farther costs more travel, docs/FIRMWARE.md).
+#define RFS_SEEK_EARLY_GOAL ((rfs_q16_t)9830)
 /// Default plan_budget: 640 lattice points a period (about 330,000 instructions on the
 /// Cortex-M4), the 12,800-point lattice of a 40 x 20 m map in 20 periods (1 s).
 #define RFS_SEEK_PLAN_BUDGET 640u

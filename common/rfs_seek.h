@@ -59,11 +59,11 @@ typedef struct rfs_seek_cfg {
     int64_t rssi_timeout_us;    ///< no measurement and no receiver report for this long is
                                 ///< stale: wheels stop (150 ms)
     uint32_t fit_budget;        ///< work units per control period for model learning (0 = all)
-    bool fit_early;             ///< with fit_budget: the next decision's relearn begins as
-                                ///< the base brakes, on the samples so far: after a failed
-                                ///< recheck, or within RFS_SEEK_EARLY_GOAL of the goal
-                                ///< (docs/FIRMWARE.md, "Learning between periods"); false:
-                                ///< relearns at rest, when the check asks
+    bool fit_early;             ///< with fit_budget: the next decision's relearn begins on
+                                ///< the samples so far, after a failed recheck (the base
+                                ///< braking) or within RFS_SEEK_EARLY_GOAL of the goal once
+                                ///< the 1 s mean fails the check (docs/FIRMWARE.md, "Learning
+                                ///< between periods"); false: relearns at rest
     uint32_t plan_budget;       ///< lattice points a control period adds to the search tree
                                 ///< of the next decision (docs/PERFORMANCE.md, "Planning in
                                 ///< slices"; RFS_SEEK_PLAN_BUDGET); 0: every plan searches

@@ -72,7 +72,7 @@
 /// Control period, microseconds (20 Hz).
 #define RFS_APP_PERIOD_US 50000
 /// Fit slices (rfs_app_background()) a port runs in a control period's spare time, after
-/// the period's step: a period at 168 MHz is 8.4 M cycles; the step's worst 480,115
+/// the period's step: a period at 168 MHz is 8.4 M cycles; the step's worst about 480,000
 /// instructions and ten path-loss slices of at most 429,409 use 4.8 M, leaving 40 % for
 /// cycles per instruction above one and the CAN polls between slices (docs/FIRMWARE.md,
 /// "Learning between periods").

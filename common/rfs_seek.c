@@ -654,6 +654,7 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
         s->early = false; /* a place ruled out or a phase changed since: begin again */
         s->fitting = false;
         s->fit_ended = false;
+        relearn = true;
     }
     if ((relearn && s->store.count > 0u) || s->early) {
         d->relearned = true;

@@ -87,7 +87,9 @@ bool rfs_seek_fit_early_holds(const rfs_seek_t *s)
 bool rfs_seek_background(rfs_seek_t *s, rfs_rng_t *rng)
 {
     RFS_ASSERT(s != 0 && rng != 0);
-    if (!s->fitting || s->fit_ended || s->cfg.fit_budget == 0u) {
+    /* Not while a sliced flood rewrites the reach bits (reach_valid false): a fit reading
+     * them (rfs_fields.c) waits for the flood, as the periods' slices do (control()). */
+    if (!s->fitting || s->fit_ended || s->cfg.fit_budget == 0u || s->flooding) {
         return false;
     }
     rfs_model_fit_in_t fin;

@@ -34,8 +34,8 @@ static uint32_t speed_abs(int32_t v)
 
 /* How far the base rolls on from its modelled wheel speeds (rfs_drive_t.base_*), braking
  * at the drive's acceleration limit, plus its goal tolerance (pose lag and noise), metres
- * Q16.16. Scaling: v^2 / 2a, v < 2^31 mm/s, in uint64 (v^2 < 2^62), times 2^16 / 1000
- * after one division by 2a (>= 2), saturated. */
+ * Q16.16. Scaling: v <= 2^31 mm/s, v^2 <= 2^62 in uint64, divided by 2a (a > 0, drive
+ * init) and clamped to 2^40 mm, times 2^16 (< 2^56) / 1000, saturated. */
 static rfs_q16_t braking(const rfs_seek_t *s)
 {
     const uint32_t l = speed_abs(s->drive.base_left), r = speed_abs(s->drive.base_right);

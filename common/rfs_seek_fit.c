@@ -26,6 +26,26 @@ void rfs_seek_fit_input(const rfs_seek_t *s, rfs_q16_t qx, rfs_q16_t qy,
     }
 }
 
+/* |v| of a modelled wheel speed, mm/s. */
+static uint32_t speed_abs(int32_t v)
+{
+    return v >= 0 ? (uint32_t)v : 0u - (uint32_t)v;
+}
+
+/* How far the base rolls on from its modelled wheel speeds (rfs_drive_t.base_*), braking
+ * at the drive's acceleration limit, plus its goal tolerance (pose lag and noise), metres
+ * Q16.16. Scaling: v <= 2^31 mm/s, v^2 <= 2^62 in uint64, divided by 2a (a > 0, drive
+ * init) and clamped to 2^40 mm, times 2^16 (< 2^56) / 1000, saturated. */
+static rfs_q16_t braking(const rfs_seek_t *s)
+{
+    const uint32_t l = speed_abs(s->drive.base_left), r = speed_abs(s->drive.base_right);
+    const uint64_t v = l > r ? l : r;
+    const uint64_t a2 = 2u * (uint64_t)(uint32_t)s->drive.cfg.accel_mm_s2;
+    const uint64_t mm = rfs_udiv64(v * v, a2 != 0u ? a2 : 1u);
+    const uint64_t q16 = mm > ((uint64_t)1 << 40) ? ((uint64_t)1 << 40) : mm;
+    return rfs_sat32((int64_t)rfs_udiv64(q16 << 16, 1000u) + s->drive.cfg.goal_tol);
+}
+
 /* fit_early (docs/FIRMWARE.md, "Learning between periods"): a failed recheck makes the next
  * decision relearn, so with sliced fits the relearn begins now, as the base brakes, on the
  * samples so far (the braking's come with the next relearn). */
@@ -33,6 +53,13 @@ void rfs_seek_fit_early_begin(rfs_seek_t *s)
 {
     if (!s->cfg.fit_early || s->cfg.fit_budget == 0u || !rfs_seek_ops(s)->learns ||
         s->store.count == 0u || s->fitting) {
+        return;
+    }
+    /* A refutation at rest (rfs_seek_meta_refute) asks the model this leg was driven on:
+     * where the base may stop within the rule's half step of that model's maximum, the
+     * model stays until the decision and the relearn waits for rest. */
+    rfs_q16_t mx, my;
+    if (rfs_seek_meta_refute_near(s, braking(s), &mx, &my)) {
         return;
     }
     rfs_model_fit_in_t fin;
@@ -70,7 +97,9 @@ bool rfs_seek_fit_early_holds(const rfs_seek_t *s)
 bool rfs_seek_background(rfs_seek_t *s, rfs_rng_t *rng)
 {
     RFS_ASSERT(s != 0 && rng != 0);
-    if (!s->fitting || s->fit_ended || s->cfg.fit_budget == 0u) {
+    /* Not while a sliced flood rewrites the reach bits (reach_valid false): a fit reading
+     * them (rfs_fields.c) waits for the flood, as the periods' slices do (control()). */
+    if (!s->fitting || s->fit_ended || s->cfg.fit_budget == 0u || s->flooding) {
         return false;
     }
     rfs_model_fit_in_t fin;

@@ -81,6 +81,12 @@ bool rfs_seek_meta_initial(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us);
  * up (a dead zone). true when it did: the model must be relearnt. */
 bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us);
 
+/* refute_r: the robot within half a step and margin (metres Q16.16, >= 0) of the model's
+ * argmax (*mx, *my), or of the reachable point driven to instead: where a refutation
+ * may rule it out. false without refute_r or an argmax. */
+bool rfs_seek_meta_refute_near(const rfs_seek_t *s, rfs_q16_t margin, rfs_q16_t *mx,
+                               rfs_q16_t *my);
+
 /* Mark the lattice points within the novelty radius of (x, y) as visited. */
 void rfs_seek_meta_visit(rfs_seek_t *s, rfs_q16_t x, rfs_q16_t y);
 

@@ -110,19 +110,26 @@ static void exclude(rfs_seek_t *s, rfs_q16_t mx, rfs_q16_t my)
     s->nexcl = (uint8_t)(s->nexcl < RFS_MODEL_MAX_EXCL ? s->nexcl + 1u : RFS_MODEL_MAX_EXCL);
 }
 
-bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us)
+bool rfs_seek_meta_refute_near(const rfs_seek_t *s, rfs_q16_t margin, rfs_q16_t *mx,
+                               rfs_q16_t *my)
 {
-    rfs_seek_decision_t *d = &s->decision;
-    rfs_q16_t mx, my;
-    if (s->cfg.refute_r <= 0 || !d->model_valid || s->model.ops->argmax == 0 ||
-        !s->model.ops->argmax(s->model.self, &mx, &my)) {
+    if (s->cfg.refute_r <= 0 || s->model.ops->argmax == 0 ||
+        !s->model.ops->argmax(s->model.self, mx, my)) {
         return false;
     }
     /* At the maximum, or, when it is unreachable, at the reachable point driven to instead
      * (greedy_along_path): as close as the robot can come. */
-    const bool sub = s->have_sub && s->sub_mx == mx && s->sub_my == my;
-    const rfs_q16_t ax = sub ? s->sub_x : mx, ay = sub ? s->sub_y : my;
-    if (rfs_q16_dist(s->pose.x, s->pose.y, ax, ay) > s->cfg.step / 2) {
+    const bool sub = s->have_sub && s->sub_mx == *mx && s->sub_my == *my;
+    const rfs_q16_t ax = sub ? s->sub_x : *mx, ay = sub ? s->sub_y : *my;
+    return (int64_t)rfs_q16_dist(s->pose.x, s->pose.y, ax, ay) <=
+           (int64_t)(s->cfg.step / 2) + margin;
+}
+
+bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us)
+{
+    rfs_seek_decision_t *d = &s->decision;
+    rfs_q16_t mx, my;
+    if (!d->model_valid || !rfs_seek_meta_refute_near(s, 0, &mx, &my)) {
         return false;
     }
     /* Weaker than the model says by twice the relearn threshold (a robot standing still

@@ -433,6 +433,102 @@ static void test_walls_crossed_wall_fwd(void **state)
     assert_null(big.wall_fwd);
 }
 
+/* The host grids (forward, wall-distance, column grid, alone and together) on maps of
+ * every shape, widths and heights not multiples of 8 among them (partial last bytes of
+ * rows and of the column grid's columns), 1 to 70 cells a side, each grid in a heap
+ * buffer of exactly its size (ASan: no read past any): every count equals the plain
+ * walk's, the Cortex-M4's, for random segments, segments between cell corners, steep and
+ * shallow ones, ends on and off the map. */
+static void test_walls_crossed_host_grids_any_size(void **state)
+{
+    (void)state;
+    uint32_t s = 91;
+    int nonzero = 0;
+    for (int mapk = 0; mapk < 60; mapk++) {
+        const uint32_t w = 1u + lcg(&s) % 70u, h = 1u + lcg(&s) % 70u;
+        const uint32_t stride = (w + 7u) / 8u, cells = h * stride;
+        const rfs_q16_t res = mapk % 2 ? RFS_Q16_FRAC(1, 10) : RFS_Q16_FRAC(1, 20);
+        uint8_t *fr = malloc(cells), *wl = malloc(cells), *lg = malloc(cells);
+        assert_non_null(fr);
+        assert_non_null(wl);
+        assert_non_null(lg);
+        memset(wl, 0, cells);
+        memset(fr, 0xFF, cells);
+        const uint32_t dens = (uint32_t)mapk % 5u; /* none, sparse .. half the cells */
+        for (uint32_t j = 0; j < h; j++) {
+            for (uint32_t i = 0; i < w; i++) {
+                const bool wall = dens != 0u && lcg(&s) % (12u - 2u * dens) == 0u;
+                rfs_map_bit_set(wl, (uint16_t)stride, (uint16_t)i, (uint16_t)j, wall);
+                rfs_map_bit_set(fr, (uint16_t)stride, (uint16_t)i, (uint16_t)j, !wall);
+            }
+        }
+        rfs_map_cfg_t cfg = rfs_map_cfg_default();
+        cfg.clearance = 0;
+        cfg.grid = res;
+        rfs_map_t plain;
+        const rfs_q16_t ox = RFS_Q16_INT(3), oy = -RFS_Q16_INT(2);
+        assert_int_equal(rfs_map_init(&plain, &cfg, (uint16_t)w, (uint16_t)h, res, ox, oy, fr,
+                                      wl, lg), 0);
+        const uint32_t nf = rfs_map_wall_fwd_bytes(&plain), nd = rfs_map_wall_dist_bytes(&plain);
+        const uint32_t nc = rfs_map_wall_cols_bytes(&plain);
+        uint8_t *fwd = malloc(nf), *dist = malloc(nd), *cols = malloc(nc);
+        assert_non_null(fwd);
+        assert_non_null(dist);
+        assert_non_null(cols);
+        rfs_map_t v[6] = {plain, plain, plain, plain, plain, plain};
+        assert_int_equal(rfs_map_wall_fwd_attach(&v[0], fwd, nf), 0);  /* fwd */
+        assert_int_equal(rfs_map_wall_dist_attach(&v[1], dist, nd), 0); /* dist */
+        v[2] = v[0];
+        assert_int_equal(rfs_map_wall_cols_attach(&v[2], cols, nc), 0); /* fwd + cols */
+        v[3] = v[1];
+        v[3].wall_cols = v[2].wall_cols;                                 /* dist + cols */
+        v[4] = v[0];
+        v[4].wall_dist = v[1].wall_dist;                                 /* fwd + dist */
+        v[5] = v[4];
+        v[5].wall_cols = v[2].wall_cols;                                 /* all three */
+        const int64_t we = (int64_t)w * res, he = (int64_t)h * res;
+        for (int k = 0; k < 400; k++) {
+            int64_t x0, y0, x1, y1;
+            const int kind = k % 4;
+            if (kind == 0) { /* anywhere, ends up to a map's size off it */
+                x0 = (int64_t)(lcg(&s) % (uint32_t)(3 * we + 1)) - we;
+                y0 = (int64_t)(lcg(&s) % (uint32_t)(3 * he + 1)) - he;
+                x1 = (int64_t)(lcg(&s) % (uint32_t)(3 * we + 1)) - we;
+                y1 = (int64_t)(lcg(&s) % (uint32_t)(3 * he + 1)) - he;
+            } else if (kind == 1) { /* cell corners, the map's edges among them */
+                x0 = (int64_t)(lcg(&s) % (w + 1u)) * res;
+                y0 = (int64_t)(lcg(&s) % (h + 1u)) * res;
+                x1 = (int64_t)(lcg(&s) % (w + 1u)) * res;
+                y1 = (int64_t)(lcg(&s) % (h + 1u)) * res;
+            } else { /* inside: steep (kind 2) or shallow (kind 3), a few cells across */
+                x0 = 1 + (int64_t)(lcg(&s) % (uint32_t)(we - 1 > 0 ? we - 1 : 1));
+                y0 = 1 + (int64_t)(lcg(&s) % (uint32_t)(he - 1 > 0 ? he - 1 : 1));
+                x1 = 1 + (int64_t)(lcg(&s) % (uint32_t)(we - 1 > 0 ? we - 1 : 1));
+                y1 = 1 + (int64_t)(lcg(&s) % (uint32_t)(he - 1 > 0 ? he - 1 : 1));
+                if (kind == 2) {
+                    x1 = x0 + (int64_t)(lcg(&s) % (uint32_t)(3 * res)) - res;
+                } else {
+                    y1 = y0 + (int64_t)(lcg(&s) % (uint32_t)(3 * res)) - res;
+                }
+            }
+            const rfs_q16_t X0 = (rfs_q16_t)(x0 + ox), Y0 = (rfs_q16_t)(y0 + oy);
+            const rfs_q16_t X1 = (rfs_q16_t)(x1 + ox), Y1 = (rfs_q16_t)(y1 + oy);
+            const uint16_t want = rfs_map_walls_crossed(&plain, X0, Y0, X1, Y1);
+            for (int q = 0; q < 6; q++) {
+                assert_int_equal(rfs_map_walls_crossed(&v[q], X0, Y0, X1, Y1), want);
+            }
+            nonzero += want > 0u;
+        }
+        free(fwd);
+        free(dist);
+        free(cols);
+        free(fr);
+        free(wl);
+        free(lg);
+    }
+    assert_true(nonzero > 4000);
+}
+
 /* floor(a / r), r > 0. */
 static int64_t floor_div(int64_t a, int64_t r)
 {
@@ -606,6 +702,7 @@ int main(void)
         cmocka_unit_test(test_walls_crossed_blocks),
         cmocka_unit_test(test_walls_crossed_wall_dist),
         cmocka_unit_test(test_walls_crossed_wall_fwd),
+        cmocka_unit_test(test_walls_crossed_host_grids_any_size),
         cmocka_unit_test(test_walls_crossed_octants),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

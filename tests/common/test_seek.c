@@ -385,7 +385,8 @@ static void test_closed_loop_reaches_source(void **state)
  * where its decision began, so it ends after ceil(n / (500 (bg + 1))) periods whatever
  * the pose does (a fit restarted at each new pose never ended once it needed three
  * periods), and the sliced ridge equals a whole fit of the same samples at that point.
- * Background calls with no fit waiting do nothing and say so. */
+ * Background calls with no fit waiting, or while a sliced flood rewrites the reach bits,
+ * do nothing and say so. */
 static void sliced_fit_run(uint32_t bg)
 {
     world_t t;
@@ -419,6 +420,13 @@ static void sliced_fit_run(uint32_t bg)
         if (waits && begun < 0) {
             begun = now; /* the relearn's first period */
             assert_true(n > 1500u); /* long enough to need more than three slices */
+        }
+        if (waits && bg > 0u && !t.seek.fit_ended) {
+            /* A sliced flood under way (reach bits rewritten): no slice until it ends. */
+            t.seek.flooding = true;
+            assert_false(rfs_seek_background(&t.seek, &t.rng));
+            assert_true(t.seek.fitting && !t.seek.fit_ended);
+            t.seek.flooding = false;
         }
         for (uint32_t k = 0u; k < bg; ++k) {
             const rfs_seek_state_t st = t.seek.state;

@@ -193,6 +193,74 @@ static void test_refute_rules_out_the_argmax(void **state)
     assert_true(m.fits >= m.nwant);
 }
 
+/* refute_r after a failed recheck, with sliced fits (fit_budget) and up to ten
+ * background slices after each period (rfs_seek_background): the robot, teleported onto
+ * each maximum, fails the leg's recheck there (7 dB weaker) and brakes; the decision at
+ * rest rules out the maximum the leg was driven to. fit_early must not change that: the
+ * relearn it begins while the base brakes would otherwise replace the model the rule
+ * asks (its maximum moved on) before the decision. Returns the refuted decisions after
+ * an abandoned leg; *abandoned counts those legs. */
+static int refute_abandoned(bool early, int *abandoned)
+{
+    world_t t;
+    refute_model_t m;
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    cfg.recheck_adapt = false;
+    cfg.fit_budget = 100u;
+    cfg.fit_early = early;
+    refute_world(&t, cfg, &m);
+    m.mean = -67.0;
+    field_t f = { .kind = 2, .scripted = -67.0 };
+    run_t r = { .x = 4.125, .y = 5.125 };
+    int refuted = 0, decided = 0;
+    *abandoned = 0;
+    while (decided < 24) {
+        assert_true(r.t_us < 600000000);
+        r.t_us += 10000;
+        if (r.pending && r.t_us >= r.arrive_us) {
+            r.x = r.gx;
+            r.y = r.gy;
+            r.pending = false;
+        }
+        const double u = fmod((double)r.pkt++ * 0.6180339887498949, 1.0);
+        rfs_seek_on_rssi(&t.seek, 0, r.t_us, (int8_t)floor(field_at(&f, r.x, r.y) + u), &t.rng);
+        if (r.t_us % 50000 != 0) {
+            continue;
+        }
+        rfs_pose_t p = { r.t_us, Q(r.x), Q(r.y), 0 };
+        rfs_seek_on_pose(&t.seek, &p, &t.rng);
+        rfs_seek_out_t out;
+        rfs_seek_step(&t.seek, r.t_us, &t.rng, &out);
+        for (int k = 0; k < 10 && rfs_seek_background(&t.seek, &t.rng); ++k) {
+        }
+        if (!out.decided) {
+            continue;
+        }
+        decided++;
+        if (out.decision.prev == RFS_DRIVE_RUNNING) {
+            (*abandoned)++;
+            refuted += out.decision.refuted ? 1 : 0;
+        }
+        r.pending = true;
+        r.gx = D(out.decision.goal_x);
+        r.gy = D(out.decision.goal_y);
+        r.arrive_us = r.t_us + 500000;
+    }
+    world_free(&t);
+    return refuted;
+}
+
+static void test_refute_after_early_relearn(void **state)
+{
+    (void)state;
+    int ab_off, ab_on;
+    const int off = refute_abandoned(false, &ab_off), on = refute_abandoned(true, &ab_on);
+    assert_true(ab_off >= 15 && ab_on >= 15);
+    assert_true(off >= ab_off - 2); /* every abandoned leg at its maximum rules it out */
+    assert_true(on >= ab_on - 2);
+}
+
 /* refute_reached: the mean exactly as predicted (no relearn of its own) still rules out
  * every maximum the robot has stood at for a decision (a greedy null move), so every
  * second decision from the fourth on; without it the robot stays at the first one. */
@@ -669,6 +737,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_refute_rules_out_the_argmax),
         cmocka_unit_test(test_refute_reached_moves_on),
+        cmocka_unit_test(test_refute_after_early_relearn),
         cmocka_unit_test(test_local_search_round_the_estimate),
         cmocka_unit_test(test_local_refute_rules_out_the_swept),
         cmocka_unit_test(test_local_gap_spaces_the_sweep),

@@ -644,7 +644,12 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
     }
     /* A leg abandoned by a failed recheck relearns (the check failed on this model), even
      * when the mean has moved back within the threshold while the base braked. */
-    relearn = rfs_seek_meta_refute(s, now_us) || relearn;
+    if (s->early) {
+        d->refuted = s->early_refuted; /* made as the early relearn began */
+        relearn = relearn || s->early_refuted;
+    } else {
+        relearn = rfs_seek_meta_refute(s, now_us) || relearn;
+    }
     relearn = relearn || ops->refit || s->replan;
     /* settle_orbit: every decision ranks the candidates with the samples of the last
      * orbit, and sees the tour end (docs/STRATEGIES.md, "Bridging"). */
@@ -863,7 +868,7 @@ static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
         rfs_drive_stop(&s->drive, now_us);
         s->prev_status = RFS_DRIVE_RUNNING; /* abandoned while running: the model failed */
         s->replan = true;
-        rfs_seek_fit_early_begin(s);
+        rfs_seek_fit_early_begin(s, now_us);
     }
     if (s->drive.status != RFS_DRIVE_RUNNING) {
         return false;
@@ -879,7 +884,7 @@ static bool drive_on(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
             rfs_q16_dist(s->pose.x, s->pose.y, s->decision.goal_x, s->decision.goal_y) <=
                 RFS_SEEK_EARLY_GOAL &&
             rfs_seek_fit_early_asks(s, now_us)) {
-            rfs_seek_fit_early_begin(s); /* the decision at the goal will relearn */
+            rfs_seek_fit_early_begin(s, now_us); /* the decision at the goal will relearn */
         }
         if (grow_next(s)) { /* the next decision's search tree */
             warm_next(s);

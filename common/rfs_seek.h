@@ -377,6 +377,8 @@ typedef struct rfs_seek {
     rfs_q16_t fit_qx, fit_qy;                 ///< the fit's query point, metres Q16.16
     uint8_t early_nexcl, early_excl_next;     ///< fit_early: places ruled out as it began
     rfs_model_settle_t early_settle;          ///< fit_early: the settle phase as it began
+    bool early_refuted;                       ///< fit_early: the leg's maximum ruled out as
+                                              ///< it began (refute_r)
     bool planning;                            ///< plan_budget: a decision waits for its
                                               ///< search tree (grown from the robot)
     bool plan_ready;                          ///< the decision's plans walk that tree

@@ -49,18 +49,22 @@ static rfs_q16_t braking(const rfs_seek_t *s)
 /* fit_early (docs/FIRMWARE.md, "Learning between periods"): a failed recheck makes the next
  * decision relearn, so with sliced fits the relearn begins now, as the base brakes, on the
  * samples so far (the braking's come with the next relearn). */
-void rfs_seek_fit_early_begin(rfs_seek_t *s)
+void rfs_seek_fit_early_begin(rfs_seek_t *s, int64_t now_us)
 {
     if (!s->cfg.fit_early || s->cfg.fit_budget == 0u || !rfs_seek_ops(s)->learns ||
         s->store.count == 0u || s->fitting) {
         return;
     }
-    /* A refutation at rest (rfs_seek_meta_refute) asks the model this leg was driven on:
-     * where the base may stop within the rule's half step of that model's maximum, the
-     * model stays until the decision and the relearn waits for rest. */
-    rfs_q16_t mx, my;
-    if (rfs_seek_meta_refute_near(s, braking(s), &mx, &my)) {
-        return;
+    /* The refutation (rfs_seek_meta_refute) asks the model this leg was driven on, so it
+     * is made now, where the base may stop within the rule's half step of that model's
+     * maximum: on the mean and the prediction here, not at rest. */
+    const rfs_q16_t margin = braking(s);
+    rfs_q16_t mx, my, pred, mean;
+    bool refuted = false;
+    if (rfs_seek_meta_refute_near(s, margin, &mx, &my)) {
+        const bool have_pred = s->model.ops->predict(s->model.self, s->pose.x, s->pose.y, &pred);
+        const bool mean_valid = rfs_seek_src_mean(s, now_us, &mean);
+        refuted = rfs_seek_meta_refute_with(s, now_us, margin, have_pred, pred, mean_valid, mean);
     }
     rfs_model_fit_in_t fin;
     rfs_seek_fit_input(s, s->pose.x, s->pose.y, &fin);
@@ -72,6 +76,7 @@ void rfs_seek_fit_early_begin(rfs_seek_t *s)
     s->early_nexcl = s->nexcl;
     s->early_excl_next = s->excl_next;
     s->early_settle = fin.settle;
+    s->early_refuted = refuted;
 }
 
 bool rfs_seek_fit_early_asks(rfs_seek_t *s, int64_t now_us)

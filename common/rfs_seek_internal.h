@@ -57,7 +57,7 @@ void rfs_seek_fit_input(const rfs_seek_t *s, rfs_q16_t qx, rfs_q16_t qy,
                         rfs_model_fit_in_t *fin);
 
 /* fit_early: a failed recheck's relearn begins now (s->early), unless off or one runs. */
-void rfs_seek_fit_early_begin(rfs_seek_t *s);
+void rfs_seek_fit_early_begin(rfs_seek_t *s, int64_t now_us);
 
 /* fit_early near a goal: the decision's relearn check (Algorithm 1) fails already, on
  * the 1 s mean here (or there is no model). */
@@ -80,6 +80,12 @@ bool rfs_seek_meta_initial(rfs_seek_t *s, rfs_rng_t *rng, int64_t now_us);
  * the prediction by more than 2 error_threshold, or there is no mean while the receiver is
  * up (a dead zone). true when it did: the model must be relearnt. */
 bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us);
+
+/* The refutation rule on given values: the model's prediction at the robot (have_pred),
+ * the 1 s mean (mean_valid), the robot within half a step and margin of the maximum
+ * (rfs_seek_meta_refute_near). true when it ruled the maximum out. */
+bool rfs_seek_meta_refute_with(rfs_seek_t *s, int64_t now_us, rfs_q16_t margin, bool have_pred,
+                               rfs_q16_t pred, bool mean_valid, rfs_q16_t mean);
 
 /* refute_r: the robot within half a step and margin (metres Q16.16, >= 0) of the model's
  * argmax (*mx, *my), or of the reachable point driven to instead: where a refutation

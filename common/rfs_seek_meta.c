@@ -128,8 +128,16 @@ bool rfs_seek_meta_refute_near(const rfs_seek_t *s, rfs_q16_t margin, rfs_q16_t 
 bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us)
 {
     rfs_seek_decision_t *d = &s->decision;
+    d->refuted = rfs_seek_meta_refute_with(s, now_us, 0, d->model_valid, d->prediction,
+                                           d->mean_valid, d->mean);
+    return d->refuted;
+}
+
+bool rfs_seek_meta_refute_with(rfs_seek_t *s, int64_t now_us, rfs_q16_t margin, bool have_pred,
+                               rfs_q16_t pred, bool mean_valid, rfs_q16_t mean)
+{
     rfs_q16_t mx, my;
-    if (!d->model_valid || !rfs_seek_meta_refute_near(s, 0, &mx, &my)) {
+    if (!have_pred || !rfs_seek_meta_refute_near(s, margin, &mx, &my)) {
         return false;
     }
     /* Weaker than the model says by twice the relearn threshold (a robot standing still
@@ -138,15 +146,13 @@ bool rfs_seek_meta_refute(rfs_seek_t *s, int64_t now_us)
      * itself up (a dead zone, where no source within a metre could be). Scaling: the
      * doubled threshold (<= 2^31 - 1 in Q16 for any sane threshold) in int64; |now - last
      * report| as in rfs_seek_on_receiver's freshness (clock microseconds). */
-    bool weak = d->mean_valid && (int64_t)rfs_q16_sub(d->prediction, d->mean) >
-                                     2 * (int64_t)s->cfg.error_threshold;
-    bool silent = !d->mean_valid && s->have_meas && s->have_rx && now_us >= s->last_rx_us &&
+    bool weak = mean_valid && (int64_t)rfs_q16_sub(pred, mean) > 2 * (int64_t)s->cfg.error_threshold;
+    bool silent = !mean_valid && s->have_meas && s->have_rx && now_us >= s->last_rx_us &&
                   now_us - s->last_rx_us <= s->cfg.rssi_timeout_us;
     if (!weak && !silent && !(s->cfg.refute_reached && s->parked)) {
         return false;
     }
     exclude(s, mx, my);
-    d->refuted = true;
     return true;
 }
 

@@ -108,6 +108,9 @@ static void print_rec(const rfs_replay_rec_t *r)
     case RFS_REPLAY_CFG:
         printf("\tseed=%" PRIu64 "\ttarget=%u\tnode=%u", r->u.cfg.seed, r->u.cfg.target,
                r->u.cfg.node);
+        if (r->u.cfg.fit_early) {
+            printf("\tfit_early=1");
+        }
         if (r->u.cfg.model[0] != '\0') {
             printf("\tmodel=%s", r->u.cfg.model);
         }

@@ -319,7 +319,7 @@ uint32_t rfs_replay_encode(const rfs_replay_rec_t *rec, uint8_t *buf, uint32_t c
     switch (rec->type) {
     case RFS_REPLAY_CFG:
         if (rec->u.cfg.target > (uint8_t)RFS_APP_TARGET_BRIDGE) {
-            return 0; /* its bits would read as flags */
+            return 0; /* out of range, or its high bits would read as flags */
         }
         p = wr64(p, rec->u.cfg.seed);
         *p++ = (uint8_t)(rec->u.cfg.target | (rec->u.cfg.fit_early ? RFS_REPLAY_CFG_FIT_EARLY : 0u));

@@ -137,9 +137,14 @@ static const char *check_length(uint8_t type, uint8_t n)
 static const char *get_cfg(const uint8_t *p, uint8_t n, rfs_replay_rec_t *rec)
 {
     rec->u.cfg.seed = rd64(p);
-    rec->u.cfg.target = p[8];
+    /* The target byte: the target in bits 0-1, flags above (bits 2-6 unused so far). */
+    rec->u.cfg.target = (uint8_t)(p[8] & 0x03u);
+    rec->u.cfg.fit_early = (p[8] & RFS_REPLAY_CFG_FIT_EARLY) != 0u;
     rec->u.cfg.node = p[9];
     rec->u.cfg.fit_budget = rd32(p + 10);
+    if ((p[8] & (uint8_t)~(0x03u | RFS_REPLAY_CFG_FIT_EARLY)) != 0u) {
+        return "CFG target byte has an unknown flag bit";
+    }
     if (rec->u.cfg.target > (uint8_t)RFS_APP_TARGET_BRIDGE) {
         return "CFG target out of range";
     }
@@ -313,8 +318,11 @@ uint32_t rfs_replay_encode(const rfs_replay_rec_t *rec, uint8_t *buf, uint32_t c
     uint8_t *p = tmp + 2;
     switch (rec->type) {
     case RFS_REPLAY_CFG:
+        if (rec->u.cfg.target > (uint8_t)RFS_APP_TARGET_BRIDGE) {
+            return 0; /* out of range, or its high bits would read as flags */
+        }
         p = wr64(p, rec->u.cfg.seed);
-        *p++ = rec->u.cfg.target;
+        *p++ = (uint8_t)(rec->u.cfg.target | (rec->u.cfg.fit_early ? RFS_REPLAY_CFG_FIT_EARLY : 0u));
         *p++ = rec->u.cfg.node;
         p = wr32(p, rec->u.cfg.fit_budget);
         for (uint32_t i = 0; i < RFS_REPLAY_MODEL_NAME_MAX && rec->u.cfg.model[i] != '\0'; i++) {
@@ -532,6 +540,7 @@ bool rfs_replay_play(rfs_replay_player_t *p, const rfs_replay_rec_t *rec)
         p->cfg.target = (rfs_app_target_t)rec->u.cfg.target;
         p->cfg.node_id = rec->u.cfg.node;
         p->cfg.seek.fit_budget = rec->u.cfg.fit_budget;
+        p->cfg.seek.fit_early = rec->u.cfg.fit_early;
         if (rec->u.cfg.model[0] != '\0') {
             p->cfg.model = rfs_models_lookup(rec->u.cfg.model);
             if (p->cfg.model == NULL) {

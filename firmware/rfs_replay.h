@@ -8,7 +8,7 @@
  *   record  = u8 type, u8 len, len bytes of payload                (all little-endian)
  *
  * Input records (times are the controller's clock, int64 microseconds):
- *   CFG      seed u64, target u8, node u8, fit_budget u32,
+ *   CFG      seed u64, target u8 (| 0x80: seek.fit_early), node u8, fit_budget u32,
  *            [model name, 1..15 bytes, no NUL: rfs_models.h],
  *            [0 u8, strategy u8, p0_min i16: a CONFIG frame's choice]   14..33
  *   MAP      w u16, h u16, res q16, origin_x q16, origin_y q16,
@@ -33,7 +33,8 @@
  *
  * Version 1 streams written before RECEIVER existed hold no such record and load unchanged;
  * a player fed none keeps the packets-only rule. A CFG without the choice after its NUL
- * (written before it existed) keeps the player's strategy and path-loss floor.
+ * (written before it existed) keeps the player's strategy and path-loss floor; one without
+ * the fit_early bit (all before it) plays with fit_early off. Other target bits are refused.
  *
  * The parser is portable C (no libc but memcpy/memset), works on a caller buffer that
  * may end anywhere, checks every length, enum and range, and never reads past `len`.
@@ -58,6 +59,8 @@
 #define RFS_REPLAY_MODEL_NAME_MAX 15u
 /// Bytes of a CFG's choice: the NUL, strategy, p0_min.
 #define RFS_REPLAY_CHOICE_LEN 4u
+/// The CFG target byte's flag: seek.fit_early on (docs/FIRMWARE.md, "Learning between periods").
+#define RFS_REPLAY_CFG_FIT_EARLY 0x80u
 /// Longest encoded record (type, len, 255 bytes of payload).
 #define RFS_REPLAY_MAX_RECORD 257u
 
@@ -104,6 +107,7 @@ typedef struct rfs_replay_rec {
             uint8_t target;   ///< rfs_app_target_t
             uint8_t node;     ///< node id
             uint32_t fit_budget; ///< the model's work units a control period (0 = all at once)
+            bool fit_early;   ///< seek.fit_early (the target byte's RFS_REPLAY_CFG_FIT_EARLY)
             /// internal model by registry name, NUL-terminated; "" = the player's base
             /// configuration (the local ridge)
             char model[RFS_REPLAY_MODEL_NAME_MAX + 1u];
@@ -184,7 +188,7 @@ typedef enum rfs_replay_err {
 typedef struct rfs_replay_player {
     rfs_app_t *app;                           ///< the application driven
     rfs_app_cfg_t cfg;                        ///< configuration (CFG overrides seed, target, node,
-                                              ///< fit budget, model, strategy, p0_min)
+                                              ///< fit budget, fit_early, model, strategy, p0_min)
     rfs_app_map_t map;                        ///< map header (MAP), grids below
     bool have_map;                            ///< MAP seen
     bool started;                             ///< rfs_app_init() done
@@ -198,7 +202,7 @@ typedef struct rfs_replay_player {
 } rfs_replay_player_t;
 
 /// Start a player on `app` with the base configuration (CFG records override seed,
-/// target, node id, fit budget and, when they name one, the model: its state goes into
+/// target, node id, fit budget, fit_early and, when they name one, the model: its state goes into
 /// the base configuration's model_state buffer, or the application's built-in one; a
 /// CFG's choice goes through rfs_app_cfg_choose(), as a CONFIG frame's). CONFIG frames may
 /// choose every registered model (cfg.models), those whose state fits the buffer.

@@ -292,6 +292,9 @@ static void usage(FILE *f)
             "                       records) or off (packets only)\n"
             "  --fit-budget N       the model's work units a control period (0: all; the MCU\n"
             "                       configuration uses each model's, 0 for the ridge)\n"
+            "  --fit-early on|off   with a fit budget, relearns begun while the base brakes\n"
+            "                       (the MCU configuration's; default: the scenario's\n"
+            "                       seek.fit_early, off; recorded in the CFG record)\n"
             "  --model NAME         internal model, overriding the scenario's: ridge, mlp, knn,\n"
             "                       radius, pathloss (recorded in the CFG record; the emulator\n"
             "                       image holds ridge, mlp and pathloss)\n"
@@ -319,6 +322,7 @@ typedef struct options {
     unsigned long long seed;
     double max_time;       /* seconds; <= 0: the scenario's */
     uint32_t fit_budget;
+    int fit_early;          /* --fit-early: 0 / 1, -1: the scenario's */
     const char *model_name; /* NULL: the scenario's */
     const char *strategy;   /* NULL: the scenario's */
     double p0_min;          /* dBm; NAN: the scenario's */
@@ -415,6 +419,12 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
         }
         break;
     case 'C': o->config_frame = true; break;
+    case 'E':
+        if (strcmp(optarg, "on") != 0 && strcmp(optarg, "off") != 0) {
+            die_opt("--fit-early (on or off)", optarg);
+        }
+        o->fit_early = strcmp(optarg, "on") == 0;
+        break;
     case 'H':
         if (strcmp(optarg, "can") == 0) {
             rec->heartbeat = HB_CAN;
@@ -454,10 +464,11 @@ static int parse_options(int argc, char **argv, options_t *o, recorder_t *rec)
         {"fit-budget", required_argument, 0, 'f'}, {"model", required_argument, 0, 'm'},
         {"heartbeat", required_argument, 0, 'H'},  {"candump", required_argument, 0, 'c'},
         {"strategy", required_argument, 0, 'S'},   {"p0-min", required_argument, 0, 'p'},
-        {"config-frame", no_argument, 0, 'C'},
+        {"config-frame", no_argument, 0, 'C'},     {"fit-early", required_argument, 0, 'E'},
         {0, 0, 0, 0}};
     memset(o, 0, sizeof *o);
     o->max_time = -1;
+    o->fit_early = -1;
     o->p0_min = NAN;
     /* getopt's own messages would echo a bad option raw (and the usage follows on stderr):
      * it stays quiet and the one line is ours. A leading ':' tells a missing value (':')
@@ -525,6 +536,9 @@ static int open_scenario(recording_t *s, options_t *o)
     }
     if (isnan(o->p0_min)) {
         o->p0_min = s->sc.seek_p0_min_dbm;
+    }
+    if (o->fit_early < 0) {
+        o->fit_early = s->sc.seek_fit_early > 0;
     }
     if (hs_sim_env_open(&s->env, &s->sc, err, sizeof err) != 0) {
         lx_err_print(PROG, "%s", err);
@@ -616,6 +630,7 @@ static void record_config(recording_t *s, const options_t *o, uint64_t run_seed)
     r.u.cfg.target = s->sc.nsources == 2u ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
     r.u.cfg.node = 1u;
     r.u.cfg.fit_budget = o->fit_budget;
+    r.u.cfg.fit_early = o->fit_early > 0;
     rfs_seek_strategy_t st = RFS_SEEK_META;
     (void)rfs_seek_strategy_parse(o->strategy, &st);
     const int16_t p0 = isnan(o->p0_min) ? (int16_t)(rfs_pathloss_cfg_default().p0_min / 512)

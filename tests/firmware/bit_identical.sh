@@ -4,7 +4,8 @@
 # streams, byte for byte. The stream is a simulated mission (scenarios/default.yaml, the
 # firmware loop as the controller, inputs as CAN frames) with injected faults: inputs
 # stopping, bus-off and a watchdog reset; then a whole mission, and one of meta-path +
-# pathloss (the improvement the image holds beside the paper's). Also: the live closed-loop outputs equal the
+# pathloss (the improvement the image holds beside the paper's), also with the STM32
+# configuration's fit_early. Also: the live closed-loop outputs equal the
 # replay, the outputs are not trivial, and malformed streams fail cleanly on both sides.
 set -uo pipefail
 B=${1:-build}
@@ -62,6 +63,30 @@ if grep -q $'model=pathloss\tstrategy=meta-path\tp0_min=-5120' "$tmp/mp_cfg.txt"
 else
     fail "the mission ran meta-path + pathloss" "$(cat "$tmp/mp_cfg.txt"); $nrel relearns, $nl learning periods"
 fi
+# The STM32 configuration's fit_early (docs/FIRMWARE.md, "Learning between periods") in the
+# CFG record: the same mission with it on is live, host and image alike; `--fit-early off`
+# records mp.rfsr's very bytes; with it on the relearns begin while the base brakes, so
+# the decisions differ and fewer periods wait for a fit.
+fea=(scenarios/default.yaml --seed 3 --model pathloss --strategy meta-path --p0-min -40 --fit-budget 600 --drop 20:21 --reset 30)
+if "$bin/rfseek-record" "${fea[@]}" --fit-early on -o "$tmp/fe.rfsr" --live-out "$tmp/fe.rfso" >"$tmp/fe.txt" \
+        && "$bin/rfseek-record" "${fea[@]}" --fit-early off -o "$tmp/fe0.rfsr" >/dev/null && cmp "$tmp/mp.rfsr" "$tmp/fe0.rfsr" \
+        && "$bin/rfseek-replay" "$tmp/fe.rfsr" -o "$tmp/fe_host.rfso" && cmp "$tmp/fe.rfso" "$tmp/fe_host.rfso" \
+        && qemu fe.rfsr fe_qemu.rfso && cmp "$tmp/fe_host.rfso" "$tmp/fe_qemu.rfso"; then
+    pass "bit-identical on a meta-path + pathloss mission with fit_early, seed 3 ($(cat "$tmp/fe.txt"))"
+else
+    fail "bit-identical on a meta-path + pathloss mission with fit_early, seed 3"
+fi
+"$bin/rfseek-replay" --print "$tmp/fe_qemu.rfso" >"$tmp/fe_qemu.txt"
+fl=$(awk '$1 == "OUT" && $5 == "state=2"' "$tmp/fe_qemu.txt" | wc -l)
+frel=$(grep '^DECISION' "$tmp/fe_qemu.txt" | grep -c 'relearned=1')
+"$bin/rfseek-replay" --print "$tmp/fe.rfsr" | head -1 >"$tmp/fe_cfg.txt"
+if grep -q $'node=1\tfit_early=1\tmodel=pathloss' "$tmp/fe_cfg.txt" && [ "$frel" -ge 3 ] && [ "$fl" -lt "$nl" ] \
+        && ! cmp -s <(grep '^DECISION' "$tmp/fe_qemu.txt") <(grep '^DECISION' "$tmp/mp_qemu.txt"); then
+    pass "fit_early relearns early: decisions differ, $frel relearns, $fl learning periods (off: $nl)"
+else
+    fail "fit_early relearns early" "$(cat "$tmp/fe_cfg.txt"); $frel relearns, $fl learning periods (off: $nl)"
+fi
+
 # The same choice as a CONFIG frame on the bus before any input (the operator's, docs/CAN.md):
 # the outputs equal the CFG choice's but for STATUS's Configured bit (bit 15, set in every
 # STATUS of the CONFIG run, and so its checksum; no reset here: a reset returns to the
@@ -165,6 +190,8 @@ one_err record-newline-option rfseek-record 2 "unknown option '--x?y'" $scn -o "
 one_err record-newline-missing-value rfseek-record 2 "missing value for '--drop'" $scn -o "$tmp/nl.rfsr" --drop
 one_err record-newline-max-time rfseek-record 2 "--max-time: bad value '1?2'" $scn -o "$tmp/nl.rfsr" --max-time "1${nl}2"
 one_err record-newline-drop rfseek-record 2 "--drop: bad value '1:2?'" $scn -o "$tmp/nl.rfsr" --drop "1:2${nl}"
+"$bin/rfseek-record" --help | grep -q -- '--fit-early on|off' && pass record-help-fit-early || fail record-help-fit-early
+one_err record-fit-early-value rfseek-record 2 "--fit-early (on or off): bad value 'yes'" $scn -o "$tmp/nl.rfsr" --fit-early yes
 one_err record-newline-model rfseek-record 2 "--model: unknown 'a?b'" $scn -o "$tmp/nl.rfsr" --model "a${nl}b"
 one_err record-newline-scenario rfseek-record 1 "nl?s.yaml" "$tmp/nl${nl}s.yaml" -o "$tmp/nl.rfsr"
 one_err record-newline-out rfseek-record 1 "nl/a?b.rfsr" $scn -o "$tmp/nl/a${nl}b.rfsr" --max-time 1

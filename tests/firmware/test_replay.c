@@ -243,6 +243,59 @@ static void test_malformed_records_are_rejected(void **state)
     expect_bad(cfg, 16);
 }
 
+/* The CFG target byte's flag: bit 7 is seek.fit_early, the target in bits 0-1, bits 2-6
+ * refused (rfs_replay.h). Bytes worked out by hand. */
+static void test_cfg_fit_early_flag(void **state)
+{
+    (void)state;
+    rfs_replay_rec_t r = rec_at(RFS_REPLAY_CFG, 0);
+    r.u.cfg.seed = 0x0102030405060708ULL;
+    r.u.cfg.target = 1;
+    r.u.cfg.node = 9;
+    r.u.cfg.fit_budget = 600;
+    r.u.cfg.fit_early = true;
+    const uint8_t want[16] = {0x01, 14, 0x08, 0x07, 0x06, 0x05, 0x04, 0x03, 0x02, 0x01,
+                              0x81, 9, 0x58, 0x02, 0x00, 0x00};
+    rfs_replay_rec_t back;
+
+    expect_exact_bytes(&r, want, 16, &back);
+
+    assert_true(back.u.cfg.fit_early);
+    assert_int_equal(back.u.cfg.target, 1);
+    assert_int_equal(back.u.cfg.node, 9);
+    assert_int_equal(back.u.cfg.fit_budget, 600);
+
+    /* A CFG written before the flag (target byte 0 or 1) reads with fit_early off. */
+    uint8_t old[16];
+    memcpy(old, want, sizeof old);
+    old[2 + 8] = 0x01;
+    uint32_t used = 0;
+    assert_int_equal(rfs_replay_parse(old, 16, &used, &back), RFS_REPLAY_OK);
+    assert_false(back.u.cfg.fit_early);
+    assert_int_equal(back.u.cfg.target, 1);
+    r.u.cfg.fit_early = false;
+    uint8_t buf[RFS_REPLAY_MAX_RECORD];
+    assert_int_equal(rfs_replay_encode(&r, buf, sizeof buf), 16);
+    assert_memory_equal(buf, old, 16);
+
+    /* Any of bits 2-6 set, with or without the flag: refused, one reason. */
+    const uint8_t unknown[] = {0x04, 0x08, 0x10, 0x20, 0x40, 0x84, 0xC0, 0xFF};
+    for (unsigned i = 0; i < sizeof unknown; i++) {
+        old[2 + 8] = unknown[i];
+        assert_int_equal(rfs_replay_parse(old, 16, &used, &back), RFS_REPLAY_BAD);
+        assert_string_equal(back.error, "CFG target byte has an unknown flag bit");
+    }
+    const uint8_t range[] = {0x02, 0x03, 0x82}; /* targets 2, 3; 2 with the flag */
+    for (unsigned i = 0; i < sizeof range; i++) {
+        old[2 + 8] = range[i];
+        assert_int_equal(rfs_replay_parse(old, 16, &used, &back), RFS_REPLAY_BAD);
+        assert_string_equal(back.error, "CFG target out of range");
+    }
+    /* A target whose bits would read as the flag is not encoded. */
+    r.u.cfg.target = 0x80;
+    assert_int_equal(rfs_replay_encode(&r, buf, sizeof buf), 0);
+}
+
 static void test_random_bytes_never_overrun(void **state)
 {
     (void)state;
@@ -361,6 +414,47 @@ static void test_player_errors(void **state)
     r.type = RFS_REPLAY_OUT;
     assert_false(rfs_replay_play(&p, &r));
     assert_int_equal(p.error, RFS_REPLAY_E_ORDER);
+}
+
+/* The player sets cfg.seek.fit_early from every CFG: on with the flag, off without it
+ * (a recording from before the flag, played over a base configuration with it on). */
+static void test_player_applies_fit_early(void **state)
+{
+    (void)state;
+    static rfs_app_t app;
+    static rfs_replay_player_t p;
+    static buf_sink_t out;
+    rfs_app_cfg_t cfg = store_cfg();
+    rfs_replay_rec_t c = rec_at(RFS_REPLAY_CFG, 0);
+    c.u.cfg.fit_budget = 600;
+    c.u.cfg.fit_early = true;
+    rfs_replay_rec_t m = rec_at(RFS_REPLAY_MAP, 0);
+    m.u.map.w = 80;
+    m.u.map.h = 40;
+    m.u.map.res = 6554;
+    rfs_replay_rec_t f = rec_at(RFS_REPLAY_MAP_FREE, 0);
+    f.u.chunk.n = 200;
+    memset(f.u.chunk.bytes, 0xFF, 200);
+    const rfs_replay_rec_t step = rec_at(RFS_REPLAY_STEP, 50000);
+
+    rfs_replay_player_init(&p, &app, &cfg, sink, &out);
+    assert_true(rfs_replay_play(&p, &c));
+    assert_true(rfs_replay_play(&p, &m));
+    assert_true(rfs_replay_play(&p, &f));
+    f.u.chunk.offset = 200;
+    assert_true(rfs_replay_play(&p, &f));
+    assert_true(rfs_replay_play(&p, &step));
+
+    assert_true(p.started);
+    assert_true(app.cfg.seek.fit_early);
+    assert_int_equal(app.cfg.seek.fit_budget, 600);
+
+    cfg.seek.fit_early = true;
+    c.u.cfg.fit_early = false;
+    rfs_replay_player_init(&p, &app, &cfg, sink, &out);
+    assert_true(p.cfg.seek.fit_early);
+    assert_true(rfs_replay_play(&p, &c));
+    assert_false(p.cfg.seek.fit_early);
 }
 
 /* RECEIVER: type 0x13, length 16, rx then the capture time, both i64 LE. */
@@ -494,8 +588,10 @@ int main(void)
         cmocka_unit_test(test_out_and_can_exact_bytes),
         cmocka_unit_test(test_every_type_round_trips),
         cmocka_unit_test(test_malformed_records_are_rejected),
+        cmocka_unit_test(test_cfg_fit_early_flag),
         cmocka_unit_test(test_random_bytes_never_overrun),
         cmocka_unit_test(test_player_errors),
+        cmocka_unit_test(test_player_applies_fit_early),
         cmocka_unit_test(test_receiver_record_exact_bytes_and_lengths),
         cmocka_unit_test(test_receiver_records_drive_through_a_dead_zone),
     };

@@ -48,6 +48,20 @@ sed -n 's/^(\([0-9]*\)\.\([0-9]*\)) can0 \(100\|180\)#\(.*\)/\1 \2 \3 \4/p' "$w/
     | awk -v s=$shift_us '{print $1 * 1000000 + $2 - s, $3, $4}' >"$w/tx_log.txt"
 check candump-tx-equals-can-tx '[ -s "$w/tx_log.txt" ] && cmp -s "$w/tx_out.txt" "$w/tx_log.txt"'
 
+# A robot's log of the STM32 configuration (meta-path + pathloss chosen by a CONFIG frame,
+# fit budget 600, fit_early on): the log with `--fit-early on` replays to the stream's
+# output; with it off the decisions part.
+"$bin/rfseek-record" scenarios/default.yaml -o "$w/fe.rfsr" --candump "$w/fe.log" --seed 3 --max-time 60 \
+    --model pathloss --strategy meta-path --p0-min -40 --fit-budget 600 --fit-early on --config-frame >/dev/null \
+    && "$bin/rfseek-replay" "$w/fe.rfsr" -o "$w/fe_s.rfso" || fail record-fit-early
+for fe in on off; do
+    "$bin/rfseek-replay" "$w/fe.log" --map $map --seed 3 --fit-budget 600 --fit-early $fe -o "$w/fe_$fe.rfso" \
+        || fail "replay-candump-fit-early-$fe"
+    "$bin/rfseek-replay" --print "$w/fe_$fe.rfso" | unshift >"$w/fe_$fe.txt"
+done
+"$bin/rfseek-replay" --print "$w/fe_s.rfso" >"$w/fe_s.txt"
+check replay-log-fit-early-equals-stream '[ "$(grep -c ^DECISION "$w/fe_s.txt")" -ge 3 ] && cmp -s "$w/fe_s.txt" "$w/fe_on.txt" && ! cmp -s "$w/fe_s.txt" "$w/fe_off.txt"'
+
 # --- can-utils' own writer: asc2log's lines read as ours -------------------------------------
 asc2log -I "$w/m.asc" -O "$w/a2l.log" 2>/dev/null
 cut -d' ' -f2,3 "$w/a2l.log" >"$w/a2l.frames"; cut -d' ' -f2- "$w/m.log" >"$w/m.frames"
@@ -81,6 +95,7 @@ err() {
     elif compgen -G "$w/x.rfso*" >/dev/null; then fail "$name" "an output was left"
     else pass "$name"; fi
 }
+err candump-fit-early-value 2 "--fit-early: expected on or off, got 'yes'" "$w/m.log" --map $map --fit-early yes -o "$w/x.rfso"
 head -3 "$w/m.log" >"$w/ok3"
 bad_line() { # NAME TEXT LINE: LINE as the 4th line of a log
     { cat "$w/ok3"; printf '%s\n' "$3"; tail -n +4 "$w/m.log"; } >"$w/b.log"

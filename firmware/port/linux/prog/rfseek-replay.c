@@ -108,6 +108,9 @@ static void print_rec(const rfs_replay_rec_t *r)
     case RFS_REPLAY_CFG:
         printf("\tseed=%" PRIu64 "\ttarget=%u\tnode=%u", r->u.cfg.seed, r->u.cfg.target,
                r->u.cfg.node);
+        if (r->u.cfg.fit_early) {
+            printf("\tfit_early=1");
+        }
         if (r->u.cfg.model[0] != '\0') {
             printf("\tmodel=%s", r->u.cfg.model);
         }
@@ -184,6 +187,8 @@ static void usage(FILE *f)
                "  --target NAME    rssi (default) or bridge\n"
                "  --model NAME     ridge (default), mlp, knn, radius, pathloss\n"
                "  --fit-budget N   the model's work units a control period (default 0: all)\n"
+               "  --fit-early on|off  relearns begun while the base brakes (the STM32\n"
+               "                   configuration's; default off)\n"
                "  -h, --help       this text\n");
 }
 
@@ -210,6 +215,7 @@ typedef struct options {
     uint8_t target;         /* --target: rfs_app_target_t */
     const char *model;      /* --model, NULL: the ridge */
     uint32_t fit_budget;    /* --fit-budget */
+    bool fit_early;         /* --fit-early */
     const char *ctl_opt;    /* the first of these options given, or NULL */
 } options_t;
 
@@ -249,6 +255,12 @@ static int parse_ctl(options_t *o, const char *a, const char *v)
             return 2;
         }
         o->model = strcmp(v, "ridge") == 0 ? NULL : v;
+    } else if (strcmp(a, "--fit-early") == 0) {
+        if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0) {
+            lx_err_print(PROG, "--fit-early: expected on or off, got '%s'", v);
+            return 2;
+        }
+        o->fit_early = strcmp(v, "on") == 0;
     } else {
         const unsigned long n = strtoul(v, &end, 10);
         if (*v == '\0' || *v == '-' || *end != '\0' || errno != 0 || n > 100000ul) {
@@ -263,7 +275,8 @@ static int parse_ctl(options_t *o, const char *a, const char *v)
 /* The command line into *o: RUN, or the exit status (--help, a bad option). */
 static int parse_options(int argc, char **argv, options_t *o)
 {
-    static const char *const ctl[] = {"--map", "--res", "--seed", "--target", "--model", "--fit-budget"};
+    static const char *const ctl[] = {"--map", "--res", "--seed", "--target", "--model", "--fit-budget",
+                                      "--fit-early"};
     memset(o, 0, sizeof *o);
     o->res = 0.1;
     o->seed = 1;
@@ -382,6 +395,7 @@ static int candump_config(const options_t *o, run_t *r)
         cfg.u.cfg.target = o->target;
         cfg.u.cfg.node = 1u; /* the default node id, as rfseek-record's */
         cfg.u.cfg.fit_budget = o->fit_budget;
+        cfg.u.cfg.fit_early = o->fit_early;
         if (o->model != NULL) {
             memcpy(cfg.u.cfg.model, o->model, strlen(o->model)); /* <= 15 bytes: checked */
         }

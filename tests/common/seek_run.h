@@ -48,6 +48,22 @@ typedef struct run {
     uint32_t pkt;          /* packets sent (dither phase) */
 } run_t;
 
+/* 10 ms on: the robot appears at a pending goal when due, and one packet arrives from the
+ * field, dithered by a golden-ratio sequence so that 100 packets average to it. true when
+ * a control period (20 Hz) falls here. */
+static inline bool run_tick(world_t *t, run_t *r, const field_t *f)
+{
+    r->t_us += 10000;
+    if (r->pending && r->t_us >= r->arrive_us) {
+        r->x = r->gx;
+        r->y = r->gy;
+        r->pending = false;
+    }
+    const double u = fmod((double)r->pkt++ * 0.6180339887498949, 1.0);
+    rfs_seek_on_rssi(&t->seek, 0, r->t_us, (int8_t)floor(field_at(f, r->x, r->y) + u), &t->rng);
+    return r->t_us % 50000 == 0;
+}
+
 /* Advance until the next decision (or max_us); packets at 100 Hz, poses and control at
  * 20 Hz; a decided goal is reached hold_us later. Returns false on timeout. */
 static inline bool next_decision(world_t *t, run_t *r, const field_t *f, int64_t hold_us,
@@ -55,18 +71,7 @@ static inline bool next_decision(world_t *t, run_t *r, const field_t *f, int64_t
 {
     int64_t end = r->t_us + max_us;
     while (r->t_us < end) {
-        r->t_us += 10000;
-        if (r->pending && r->t_us >= r->arrive_us) {
-            r->x = r->gx;
-            r->y = r->gy;
-            r->pending = false;
-        }
-        /* Dither: a golden-ratio sequence, so 100 packets average to the field. */
-        double v = field_at(f, r->x, r->y);
-        double u = fmod((double)r->pkt++ * 0.6180339887498949, 1.0);
-        int8_t dbm = (int8_t)floor(v + u);
-        rfs_seek_on_rssi(&t->seek, 0, r->t_us, dbm, &t->rng);
-        if (r->t_us % 50000 == 0) {
+        if (run_tick(t, r, f)) {
             rfs_pose_t p = { r->t_us, Q(r->x), Q(r->y), 0 };
             rfs_seek_on_pose(&t->seek, &p, &t->rng);
             rfs_seek_step(&t->seek, r->t_us, &t->rng, out);

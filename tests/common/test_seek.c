@@ -612,10 +612,8 @@ static void test_meta_path_preset(void **state)
  * decision relearns and goes greedy again without an epsilon draw; with recheck_dist 0
  * (the paper) the same leg runs to its end. epsilon is fixed at 0.5 so that an
  * unforced decision is greedy only about half the time. */
-static void run_recheck(double recheck_m, int *jumps, int *jumps_abandoned, int *normal_eps)
+static rfs_seek_cfg_t recheck_cfg(double recheck_m)
 {
-    world_t t;
-    world_make(&t, 30.0, 30.0, 0, 0);
     rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
     rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
     cfg.recheck_dist = Q(recheck_m);
@@ -623,7 +621,14 @@ static void run_recheck(double recheck_m, int *jumps, int *jumps_abandoned, int 
     cfg.eps_by_travel = false;
     cfg.eps_amp = 0;
     cfg.eps_floor = RFS_Q16_HALF;
-    seek_make(&t, cfg, 9);
+    return cfg;
+}
+
+static void run_recheck(double recheck_m, int *jumps, int *jumps_abandoned, int *normal_eps)
+{
+    world_t t;
+    world_make(&t, 30.0, 30.0, 0, 0);
+    seek_make(&t, recheck_cfg(recheck_m), 9);
     field_t f = { .kind = 1, .a = -80.0, .bx = 0.5, .by = 0.5 };
     run_t r = { .x = 5.0, .y = 5.0 };
     rfs_seek_out_t out;
@@ -683,13 +688,7 @@ static early_run_t run_early(bool early, double recheck_m)
 {
     world_t t;
     world_make(&t, 30.0, 30.0, 0, 0);
-    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
-    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
-    cfg.recheck_dist = Q(recheck_m);
-    cfg.recheck_adapt = false;
-    cfg.eps_by_travel = false;
-    cfg.eps_amp = 0;
-    cfg.eps_floor = RFS_Q16_HALF;
+    rfs_seek_cfg_t cfg = recheck_cfg(recheck_m);
     cfg.fit_budget = 300;
     cfg.fit_early = early;
     seek_make(&t, cfg, 9);
@@ -703,16 +702,7 @@ static early_run_t run_early(bool early, double recheck_m)
         rfs_seek_out_t out = { 0 };
         while (!out.decided) {
             assert_true(r.t_us < 600000000);
-            r.t_us += 10000;
-            if (r.pending && r.t_us >= r.arrive_us) {
-                r.x = r.gx;
-                r.y = r.gy;
-                r.pending = false;
-            }
-            const double u = fmod((double)r.pkt++ * 0.6180339887498949, 1.0);
-            rfs_seek_on_rssi(&t.seek, 0, r.t_us, (int8_t)floor(field_at(&f, r.x, r.y) + u),
-                             &t.rng);
-            if (r.t_us % 50000 != 0) {
+            if (!run_tick(&t, &r, &f)) {
                 continue;
             }
             rfs_pose_t p = { r.t_us, Q(r.x), Q(r.y), 0 };

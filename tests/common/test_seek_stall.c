@@ -217,15 +217,7 @@ static int refute_abandoned(bool early, int *abandoned)
     *abandoned = 0;
     while (decided < 24) {
         assert_true(r.t_us < 600000000);
-        r.t_us += 10000;
-        if (r.pending && r.t_us >= r.arrive_us) {
-            r.x = r.gx;
-            r.y = r.gy;
-            r.pending = false;
-        }
-        const double u = fmod((double)r.pkt++ * 0.6180339887498949, 1.0);
-        rfs_seek_on_rssi(&t.seek, 0, r.t_us, (int8_t)floor(field_at(&f, r.x, r.y) + u), &t.rng);
-        if (r.t_us % 50000 != 0) {
+        if (!run_tick(&t, &r, &f)) {
             continue;
         }
         rfs_pose_t p = { r.t_us, Q(r.x), Q(r.y), 0 };

@@ -379,6 +379,23 @@ static void test_closed_loop_reaches_source(void **state)
     assert_int_equal(reached, runs);
 }
 
+/* The seeker's ridge predicts at (8, 9) m what a whole fit of its first n samples (0: all
+ * it holds) at (qx, qy) does. */
+static void assert_whole_ridge(world_t *t, uint16_t n, rfs_q16_t qx, rfs_q16_t qy)
+{
+    rfs_ridge_t whole;
+    rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
+    assert_int_equal(rfs_ridge_init(&whole, &rc), 0);
+    const rfs_model_fit_in_t in = {.samples = t->seek.store.samples,
+                                   .n = n != 0u ? n : t->seek.store.count, .qx = qx, .qy = qy};
+    const rfs_model_t wm = rfs_ridge_model(&whole);
+    assert_int_equal(wm.ops->fit(wm.self, &in, 0u, &t->rng), RFS_FIT_DONE);
+    rfs_q16_t a, b;
+    assert_true(t->seek.model.ops->predict(t->seek.model.self, Q(8), Q(9), &a));
+    assert_true(wm.ops->predict(wm.self, Q(8), Q(9), &b));
+    assert_int_equal(a, b);
+}
+
 /* A sliced relearn under pose noise: the robot (teleported to each goal) reports poses
  * that jitter by +-1 cm at 20 Hz, the relearn takes 500 samples a slice, one a period and
  * bg more in each period's spare time (rfs_seek_background). Each fit runs at the point
@@ -455,19 +472,7 @@ static void sliced_fit_run(uint32_t bg)
             /* A whole fit of the store at the decision's start point predicts the same
              * (while the store is not full: a full one replaces samples under the slices). */
             if (t.seek.store.count < cfg.store.capacity) {
-                rfs_ridge_t whole;
-                rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
-                assert_int_equal(rfs_ridge_init(&whole, &rc), 0);
-                const rfs_model_fit_in_t in = {.samples = t.seek.store.samples,
-                                               .n = n_fit != 0u ? n_fit : t.seek.store.count,
-                                               .qx = out.decision.x,
-                                               .qy = out.decision.y};
-                const rfs_model_t wm = rfs_ridge_model(&whole);
-                assert_int_equal(wm.ops->fit(wm.self, &in, 0u, &t.rng), RFS_FIT_DONE);
-                rfs_q16_t a, b;
-                assert_true(t.seek.model.ops->predict(t.seek.model.self, Q(8), Q(9), &a));
-                assert_true(wm.ops->predict(wm.self, Q(8), Q(9), &b));
-                assert_int_equal(a, b);
+                assert_whole_ridge(&t, n_fit, out.decision.x, out.decision.y);
                 compared++;
             }
             begun = -1;
@@ -730,18 +735,7 @@ static early_run_t run_early(bool early, double recheck_m)
             e.began_moving += began;
             e.waited += rest;
             if (began && t.seek.store.count < cfg.store.capacity) {
-                rfs_ridge_t whole;
-                rfs_ridge_cfg_t rc = rfs_ridge_cfg_default();
-                assert_int_equal(rfs_ridge_init(&whole, &rc), 0);
-                const rfs_model_fit_in_t in = {.samples = t.seek.store.samples,
-                                               .n = n_fit != 0u ? n_fit : t.seek.store.count,
-                                               .qx = t.seek.fit_qx, .qy = t.seek.fit_qy};
-                const rfs_model_t wm = rfs_ridge_model(&whole);
-                assert_int_equal(wm.ops->fit(wm.self, &in, 0u, &t.rng), RFS_FIT_DONE);
-                rfs_q16_t a, b;
-                assert_true(t.seek.model.ops->predict(t.seek.model.self, Q(8), Q(9), &a));
-                assert_true(wm.ops->predict(wm.self, Q(8), Q(9), &b));
-                assert_int_equal(a, b);
+                assert_whole_ridge(&t, n_fit, t.seek.fit_qx, t.seek.fit_qy);
                 e.compared++;
             }
         }

@@ -605,15 +605,17 @@ static void finish_decision(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_s
  * fit (ridge) every period, and a fit longer than two periods would never end. */
 static bool fit_slice(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out)
 {
-    rfs_model_fit_in_t fin;
-    rfs_seek_fit_input(s, s->fit_qx, s->fit_qy, &fin);
-    rfs_fit_result_t r = s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng);
-    if (r == RFS_FIT_MORE) {
-        s->state = RFS_SEEK_LEARNING;
-        stop_wheels(s, now_us, out);
-        return false;
+    if (!s->fit_ended) { /* else it ended between periods (rfs_seek_background) */
+        rfs_model_fit_in_t fin;
+        rfs_seek_fit_input(s, s->fit_qx, s->fit_qy, &fin);
+        if (s->model.ops->fit(s->model.self, &fin, s->cfg.fit_budget, rng) == RFS_FIT_MORE) {
+            s->state = RFS_SEEK_LEARNING;
+            stop_wheels(s, now_us, out);
+            return false;
+        }
     }
     s->fitting = false;
+    s->fit_ended = false;
     return true;
 }
 
@@ -672,10 +674,6 @@ static void decide(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
         s->early = false;
     }
     const bool whole_fit = s->fitting && s->cfg.fit_budget == 0u;
-    if (s->fitting && s->fit_ended) {
-        s->fitting = false; /* ended between periods */
-        s->fit_ended = false;
-    }
     if (s->fitting && !fit_slice(s, now_us, rng, out)) {
         return;
     }
@@ -947,9 +945,7 @@ static void control(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_
     if (s->fitting && !s->early) {
         /* A sliced fit continues (or ended between periods); the decision finishes when it
          * is done. */
-        if (s->fit_ended || fit_slice(s, now_us, rng, out)) {
-            s->fitting = false;
-            s->fit_ended = false;
+        if (fit_slice(s, now_us, rng, out)) {
             finish_decision(s, now_us, rng, out, false);
         }
         return;

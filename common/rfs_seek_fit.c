@@ -6,6 +6,14 @@
 
 /* The model's input: the samples, map, reach bits, places ruled out and each source's
  * samples, queried at (qx, qy). */
+/* The settle phase a fit learns in (rfs_model_fit_in_t.settle). */
+static rfs_model_settle_t settle_phase(const rfs_seek_t *s)
+{
+    return !rfs_seek_src_settled(s) ? RFS_MODEL_EXPLORE
+           : rfs_seek_src_orbiting(s) ? RFS_MODEL_TOUR
+                                      : RFS_MODEL_HOLD;
+}
+
 void rfs_seek_fit_input(const rfs_seek_t *s, rfs_q16_t qx, rfs_q16_t qy,
                         rfs_model_fit_in_t *fin)
 {
@@ -15,9 +23,7 @@ void rfs_seek_fit_input(const rfs_seek_t *s, rfs_q16_t qx, rfs_q16_t qy,
                                  .excl_x_cm = s->excl_x_cm, .excl_y_cm = s->excl_y_cm,
                                  .nexcl = s->nexcl,
                                  .excl_r = s->cfg.refute_r,
-                                 .settle = !rfs_seek_src_settled(s) ? RFS_MODEL_EXPLORE
-                                           : rfs_seek_src_orbiting(s) ? RFS_MODEL_TOUR
-                                                                      : RFS_MODEL_HOLD };
+                                 .settle = settle_phase(s) };
     for (uint8_t i = 0; s->src != 0 && i < s->target->nsources; ++i) {
         fin->src_samples[i] = s->src[i].store.samples;
         fin->src_n[i] = s->src[i].store.count;
@@ -66,8 +72,6 @@ void rfs_seek_fit_early_begin(rfs_seek_t *s, int64_t now_us)
         const bool mean_valid = rfs_seek_src_mean(s, now_us, &mean);
         refuted = rfs_seek_meta_refute_with(s, now_us, margin, have_pred, pred, mean_valid, mean);
     }
-    rfs_model_fit_in_t fin;
-    rfs_seek_fit_input(s, s->pose.x, s->pose.y, &fin);
     s->model.ops->reset(s->model.self);
     s->fitting = true;
     s->early = true;
@@ -75,7 +79,7 @@ void rfs_seek_fit_early_begin(rfs_seek_t *s, int64_t now_us)
     s->fit_qy = s->pose.y;
     s->early_nexcl = s->nexcl;
     s->early_excl_next = s->excl_next;
-    s->early_settle = fin.settle;
+    s->early_settle = settle_phase(s);
     s->early_refuted = refuted;
 }
 
@@ -93,10 +97,8 @@ bool rfs_seek_fit_early_asks(rfs_seek_t *s, int64_t now_us)
  * ruled out since, the same settle phase. */
 bool rfs_seek_fit_early_holds(const rfs_seek_t *s)
 {
-    rfs_model_fit_in_t fin;
-    rfs_seek_fit_input(s, s->fit_qx, s->fit_qy, &fin);
     return s->nexcl == s->early_nexcl && s->excl_next == s->early_excl_next &&
-           fin.settle == s->early_settle;
+           settle_phase(s) == s->early_settle;
 }
 
 bool rfs_seek_background(rfs_seek_t *s, rfs_rng_t *rng)

@@ -39,9 +39,9 @@ static void bin_samples(rfs_sample_t *s, int n, const rfs_map_t *map, const trut
     }
 }
 
-/* The walk: bins x = 2..11 at y = 7, 8 m (the corridor), then the leg's x = 12, 13, 14 at
- * y = 7 m. Returns the samples of the first fit; *all: with the leg's. */
-static int walk(fixture_t *f, int *all)
+/* The corridor's bins x = 2..11 at y = 7, 8 m, PER_BIN samples each from the start of
+ * f->s; returns their count. */
+static int corridor(fixture_t *f)
 {
     int n = 0;
     for (int bx = 2; bx < 12; ++bx) {
@@ -50,6 +50,14 @@ static int walk(fixture_t *f, int *all)
             n += PER_BIN;
         }
     }
+    return n;
+}
+
+/* The walk: bins x = 2..11 at y = 7, 8 m (the corridor), then the leg's x = 12, 13, 14 at
+ * y = 7 m. Returns the samples of the first fit; *all: with the leg's. */
+static int walk(fixture_t *f, int *all)
+{
+    int n = corridor(f);
     const int first = n;
     for (int bx = 12; bx < 15; ++bx) {
         bin_samples(f->s + n, PER_BIN, &f->map, &k_office, bx, 7, (uint64_t)(500 + bx));
@@ -405,13 +413,7 @@ static uint32_t wm_units(const rfs_pathloss_t *p, uint32_t lines0, uint32_t seen
  * `budget` a call; the most units a call charged. */
 static uint32_t wm_worst_call(fixture_t *f, int leg, bool both, uint32_t budget)
 {
-    int n = 0;
-    for (int bx = 2; bx < 12; ++bx) {
-        for (int by = 7; by < 9; ++by) {
-            bin_samples(f->s + n, PER_BIN, &f->map, &k_office, bx, by, (uint64_t)(100 + bx * 10 + by));
-            n += PER_BIN;
-        }
-    }
+    int n = corridor(f);
     const int first = n;
     for (int bx = 12; bx < 12 + leg; ++bx) {
         for (int by = 7; by < (both ? 9 : 8); ++by) {

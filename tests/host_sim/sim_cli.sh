@@ -98,6 +98,7 @@ else
 fi
 # seek.fit_slices: more slices in each period's spare time: shorter waits, mean and longest.
 bad fit_slices_key "seek.fit_slices: 2.5 is not a whole number" "$T/p0.yaml" --seek 'fit_slices: 2.5' --out "$T/out"
+bad fit_slices_range "seek.fit_slices: 1001 is out of range [0, 1000]" "$T/p0.yaml" --seek 'fit_slices: 1001' --out "$T/out"
 "$SIM" "$T/p0.yaml" --fit-budget 100 --seek 'fit_slices: 3' --seed 2 >"$T/fbbg.json" 2>/dev/null
 if awk -v bm="$(num "$T/fbbg.json" decision_wait_mean_s)" -v sm="$(num "$T/fbcli.json" decision_wait_mean_s)" \
        -v bx="$(num "$T/fbbg.json" decision_wait_max_s)" -v sx="$(num "$T/fbcli.json" decision_wait_max_s)" \

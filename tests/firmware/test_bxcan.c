@@ -23,6 +23,8 @@ typedef struct fake_hw {
     uint32_t rfr_last[2]; /* what the fake last put in RF0R / RF1R */
     bool fovr[2];         /* overrun flag (rc_w1) */
     unsigned released[2]; /* RFOM releases seen */
+    unsigned release_ticks; /* polls a mailbox release takes, RFOM reading 1 meanwhile */
+    unsigned releasing[2];  /* polls left of a release under way */
     bool ack_modes;       /* false: a dead controller that never acknowledges */
     unsigned hook_calls;
 } fake_hw_t;
@@ -60,13 +62,23 @@ static void fake_tick(void *ctx)
     for (unsigned f = 0; f < 2; f++) {
         volatile uint32_t *rfr = f == 0 ? &hw->r.rf0r : &hw->r.rf1r;
         const uint32_t w = *rfr;
-        if (w == hw->rfr_last[f]) {
+        if (hw->releasing[f] > 0 && --hw->releasing[f] > 0) {
+            continue; /* still releasing: FMP and the mailbox unchanged, RFOM set */
+        }
+        if (w == hw->rfr_last[f] && (w & RFS_BXCAN_RFR_RFOM) == 0u) {
             continue;
         }
         if ((w & RFS_BXCAN_RFR_FOVR) != 0u) {
             hw->fovr[f] = false;
         }
         if ((w & RFS_BXCAN_RFR_RFOM) != 0u && hw->nq[f] > 0) {
+            if (w != hw->rfr_last[f] && hw->release_ticks > 0) {
+                /* The write left RFOM set; FMP (read-only) keeps its count meanwhile. */
+                hw->releasing[f] = hw->release_ticks;
+                *rfr = hw->rfr_last[f] | RFS_BXCAN_RFR_RFOM;
+                hw->rfr_last[f] = *rfr;
+                continue;
+            }
             memmove(&hw->q[f][0], &hw->q[f][1], sizeof hw->q[f][0] * 7);
             hw->nq[f]--;
             hw->released[f]++;
@@ -271,6 +283,119 @@ static void test_bus_off_aborts_pending_mailboxes_and_refuses_sends(void **state
     assert_int_equal(rfs_bxcan_send(d, &f), 0);
 }
 
+/* A frame whose identifier and first data word carry k. */
+static void push_k(fake_hw_t *hw, unsigned f, uint32_t k)
+{
+    push_rx(hw, f, (0x100u + k) << 21, 8u, k, ~k);
+}
+
+static void test_rx_irq_enables_the_fifo_interrupts(void **state)
+{
+    fake_hw_t *hw = ((void **)*state)[0];
+    rfs_bxcan_t *d = ((void **)*state)[1];
+    rfs_bxcan_cfg_t c = rfs_bxcan_cfg_default();
+    hw->r.ier = 0xFFFFFFFFu;
+    assert_int_equal(rfs_bxcan_init(d, &hw->r, &c, fake_tick, hw), 0);
+    assert_int_equal(hw->r.ier, 0u); /* polled: no interrupt */
+    c.rx_irq = true;
+    assert_int_equal(rfs_bxcan_init(d, &hw->r, &c, fake_tick, hw), 0);
+    /* FMPIE0 (bit 1) | FMPIE1 (bit 4) = 0x12 (RM0090 32.9.5, CAN_IER). */
+    assert_int_equal(hw->r.ier, 0x12u);
+}
+
+static void test_isr_queues_frames_in_arrival_order_beyond_the_fifos(void **state)
+{
+    fake_hw_t *hw = ((void **)*state)[0];
+    rfs_bxcan_t *d = ((void **)*state)[1];
+    rfs_bxcan_cfg_t c = rfs_bxcan_cfg_default();
+    c.rx_irq = true;
+    assert_int_equal(rfs_bxcan_init(d, &hw->r, &c, fake_tick, hw), 0);
+    hw->release_ticks = 2u; /* RFOM reads 1 for two polls after each release */
+    rfs_can_frame_t f;
+    /* While the main loop is away: 7 bursts of 3 frames, FIFO 1 then FIFO 0 in turn, each
+     * taken by its interrupt: 21 frames, 7 times what one FIFO holds. */
+    for (uint32_t b = 0; b < 7u; b++) {
+        const unsigned fifo = (b % 2u == 0u) ? 1u : 0u;
+        for (uint32_t i = 0; i < 3u; i++) {
+            push_k(hw, fifo, 3u * b + i);
+        }
+        rfs_bxcan_isr(d, fifo);
+        assert_int_equal(hw->nq[fifo], 0u);
+    }
+    assert_int_equal(hw->released[0] + hw->released[1], 21u);
+    for (uint32_t k = 0; k < 21u; k++) {
+        assert_true(rfs_bxcan_recv(d, &f));
+        assert_int_equal(f.id, 0x100u + k);
+        assert_int_equal(f.dlc, 8u);
+        assert_int_equal(f.data[0], k);
+        assert_int_equal(f.data[4], 0xFFu - k);
+    }
+    assert_false(rfs_bxcan_recv(d, &f));
+    assert_int_equal(d->rx_frames, 21u);
+    assert_int_equal(d->rx_queue_full, 0u);
+
+    /* The main loop never reads the FIFOs itself: a frame no interrupt took stays. */
+    push_k(hw, 0, 99u);
+    assert_false(rfs_bxcan_recv(d, &f));
+    assert_int_equal(hw->nq[0], 1u);
+}
+
+static void test_isr_counts_and_releases_frames_a_full_queue_drops(void **state)
+{
+    fake_hw_t *hw = ((void **)*state)[0];
+    rfs_bxcan_t *d = ((void **)*state)[1];
+    rfs_bxcan_cfg_t c = rfs_bxcan_cfg_default();
+    c.rx_irq = true;
+    assert_int_equal(rfs_bxcan_init(d, &hw->r, &c, fake_tick, hw), 0);
+    rfs_can_frame_t f;
+    uint32_t k = 0;
+    /* 36 frames, 12 interrupts: the queue keeps the first 32, drops 4, frees every
+     * mailbox (else the interrupt would stay pending). */
+    for (uint32_t b = 0; b < 12u; b++) {
+        for (uint32_t i = 0; i < 3u; i++) {
+            push_k(hw, 1, k++);
+        }
+        rfs_bxcan_isr(d, 1);
+    }
+    assert_int_equal(RFS_BXCAN_RXQ, 32u);
+    assert_int_equal(hw->released[1], 36u);
+    assert_int_equal(hw->nq[1], 0u);
+    assert_int_equal(d->rx_queue_full, 4u);
+    for (uint32_t j = 0; j < 32u; j++) {
+        assert_true(rfs_bxcan_recv(d, &f));
+        assert_int_equal(f.id, 0x100u + j);
+    }
+    assert_false(rfs_bxcan_recv(d, &f));
+    /* Past the wrap of the slots: 40 more, taken as they come. */
+    for (uint32_t j = 0; j < 40u; j++) {
+        push_k(hw, 0, 40u + j);
+        rfs_bxcan_isr(d, 0);
+        assert_true(rfs_bxcan_recv(d, &f));
+        assert_int_equal(f.id, 0x100u + 40u + j);
+        assert_int_equal(f.data[0], 40u + j);
+    }
+    assert_int_equal(d->rx_queue_full, 4u);
+    assert_int_equal(d->rxq_head, 72u);
+}
+
+static void test_polled_recv_waits_for_each_release(void **state)
+{
+    fake_hw_t *hw = ((void **)*state)[0];
+    rfs_bxcan_t *d = ((void **)*state)[1];
+    const rfs_bxcan_cfg_t c = rfs_bxcan_cfg_default();
+    assert_int_equal(rfs_bxcan_init(d, &hw->r, &c, fake_tick, hw), 0);
+    hw->release_ticks = 3u;
+    push_k(hw, 0, 1u);
+    push_k(hw, 0, 2u);
+    rfs_can_frame_t f;
+    assert_true(rfs_bxcan_recv(d, &f));
+    assert_int_equal(f.id, 0x101u);
+    assert_true(rfs_bxcan_recv(d, &f)); /* the next frame, not the first again */
+    assert_int_equal(f.id, 0x102u);
+    assert_false(rfs_bxcan_recv(d, &f));
+    assert_int_equal(hw->released[0], 2u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -282,6 +407,10 @@ int main(void)
         cmocka_unit_test_setup(test_recv_drops_extended_and_remote_frames_and_counts_overruns,
                                setup),
         cmocka_unit_test_setup(test_bus_off_aborts_pending_mailboxes_and_refuses_sends, setup),
+        cmocka_unit_test_setup(test_rx_irq_enables_the_fifo_interrupts, setup),
+        cmocka_unit_test_setup(test_isr_queues_frames_in_arrival_order_beyond_the_fifos, setup),
+        cmocka_unit_test_setup(test_isr_counts_and_releases_frames_a_full_queue_drops, setup),
+        cmocka_unit_test_setup(test_polled_recv_waits_for_each_release, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,6 +1,7 @@
 /* rfs_bxcan.c - bxCAN driver (see rfs_bxcan.h; RM0090 chapter 32). */
 #include "rfs_bxcan.h"
 
+#include <stdatomic.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -140,7 +141,8 @@ int rfs_bxcan_init(rfs_bxcan_t *d, rfs_bxcan_regs_t *regs, const rfs_bxcan_cfg_t
     regs->mcr = RFS_BXCAN_MCR_INRQ | RFS_BXCAN_MCR_ABOM | RFS_BXCAN_MCR_TXFP |
                 RFS_BXCAN_MCR_DBF;
     regs->btr = btr;
-    regs->ier = 0u;
+    /* Interrupts on a pending frame in either FIFO (RM0090 32.9.2, CAN_IER), or none. */
+    regs->ier = cfg->rx_irq ? (RFS_BXCAN_IER_FMPIE0 | RFS_BXCAN_IER_FMPIE1) : 0u;
 
     /* RM0090 32.7.4: filters are written in filter initialisation mode. */
     regs->fmr |= RFS_BXCAN_FMR_FINIT;
@@ -199,45 +201,80 @@ static void hw_sync(rfs_bxcan_t *d)
     }
 }
 
-bool rfs_bxcan_recv(rfs_bxcan_t *d, rfs_can_frame_t *f)
+/* Take the next frame FIFO q holds into *f, releasing its mailbox (counting an overrun
+ * first, and dropping frames the driver cannot represent); false when it holds none. */
+static bool fifo_take(rfs_bxcan_t *d, unsigned q, rfs_can_frame_t *f)
 {
     rfs_bxcan_regs_t *r = d->r;
-    volatile uint32_t *rfr[2] = {&r->rf0r, &r->rf1r};
-    for (unsigned q = 0; q < 2u; q++) {
-        const uint32_t st = *rfr[q];
-        if ((st & RFS_BXCAN_RFR_FOVR) != 0u) {
-            d->rx_overruns++;
-            *rfr[q] = RFS_BXCAN_RFR_FOVR; /* rc_w1: write 1 to clear */
-            hw_sync(d);
+    volatile uint32_t *rfr = q == 0u ? &r->rf0r : &r->rf1r;
+    if ((*rfr & RFS_BXCAN_RFR_FOVR) != 0u) {
+        d->rx_overruns++;
+        *rfr = RFS_BXCAN_RFR_FOVR; /* rc_w1: write 1 to clear */
+        hw_sync(d);
+    }
+    while ((*rfr & RFS_BXCAN_RFR_FMP_MASK) != 0u) {
+        const rfs_bxcan_rxmb_t *m = &r->rx[q];
+        const uint32_t rir = m->rir;
+        const uint32_t rdtr = m->rdtr;
+        const uint32_t lo = m->rdlr;
+        const uint32_t hi = m->rdhr;
+        *rfr = RFS_BXCAN_RFR_RFOM; /* release the output mailbox */
+        hw_sync(d);
+        /* RFOM reads 1 until the hardware has moved the next frame in (RM0090 32.9.4):
+         * read FMP again only then, or the same frame is read twice. */
+        (void)wait_bits(d, rfr, RFS_BXCAN_RFR_RFOM, 0u);
+        const uint8_t dlc = (uint8_t)(rdtr & 0xFu);
+        if ((rir & (RFS_BXCAN_TIR_IDE | RFS_BXCAN_TIR_RTR)) != 0u || dlc > 8u) {
+            d->rx_bad++;
+            continue;
         }
-        while ((*rfr[q] & RFS_BXCAN_RFR_FMP_MASK) != 0u) {
-            const rfs_bxcan_rxmb_t *m = &r->rx[q];
-            const uint32_t rir = m->rir;
-            const uint32_t rdtr = m->rdtr;
-            const uint32_t lo = m->rdlr;
-            const uint32_t hi = m->rdhr;
-            *rfr[q] = RFS_BXCAN_RFR_RFOM; /* release the output mailbox */
-            hw_sync(d);
-            const uint8_t dlc = (uint8_t)(rdtr & 0xFu);
-            if ((rir & (RFS_BXCAN_TIR_IDE | RFS_BXCAN_TIR_RTR)) != 0u || dlc > 8u) {
-                d->rx_bad++;
-                continue;
-            }
-            memset(f, 0, sizeof *f);
-            f->id = rir >> RFS_BXCAN_STID_SHIFT;
-            f->dlc = dlc;
-            for (unsigned i = 0; i < 4u; i++) {
-                f->data[i] = (uint8_t)(lo >> (8u * i));
-                f->data[4u + i] = (uint8_t)(hi >> (8u * i));
-            }
-            for (unsigned i = dlc; i < 8u; i++) {
-                f->data[i] = 0u;
-            }
-            d->rx_frames++;
-            return true;
+        memset(f, 0, sizeof *f);
+        f->id = rir >> RFS_BXCAN_STID_SHIFT;
+        f->dlc = dlc;
+        for (unsigned i = 0; i < 4u; i++) {
+            f->data[i] = (uint8_t)(lo >> (8u * i));
+            f->data[4u + i] = (uint8_t)(hi >> (8u * i));
         }
+        for (unsigned i = dlc; i < 8u; i++) {
+            f->data[i] = 0u;
+        }
+        d->rx_frames++;
+        return true;
     }
     return false;
+}
+
+bool rfs_bxcan_recv(rfs_bxcan_t *d, rfs_can_frame_t *f)
+{
+    if (d->cfg.rx_irq) {
+        const uint32_t tail = d->rxq_tail;
+        if (d->rxq_head == tail) {
+            return false;
+        }
+        /* The frame was written before the interrupt published head. */
+        atomic_signal_fence(memory_order_acquire);
+        *f = d->rxq[tail % RFS_BXCAN_RXQ];
+        atomic_signal_fence(memory_order_release); /* read before its slot is freed */
+        d->rxq_tail = tail + 1u;
+        return true;
+    }
+    return fifo_take(d, 0u, f) || fifo_take(d, 1u, f);
+}
+
+void rfs_bxcan_isr(rfs_bxcan_t *d, unsigned fifo)
+{
+    rfs_can_frame_t f;
+    while (fifo_take(d, fifo != 0u ? 1u : 0u, &f)) {
+        const uint32_t head = d->rxq_head;
+        if (head - d->rxq_tail >= RFS_BXCAN_RXQ) {
+            d->rx_queue_full++; /* released all the same: the interrupt must not stay pending */
+            continue;
+        }
+        atomic_signal_fence(memory_order_acquire); /* the slot was read before it was freed */
+        d->rxq[head % RFS_BXCAN_RXQ] = f;
+        atomic_signal_fence(memory_order_release); /* the frame before head moves */
+        d->rxq_head = head + 1u;
+    }
 }
 
 bool rfs_bxcan_poll(rfs_bxcan_t *d)

@@ -17,8 +17,11 @@ void UsageFault_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void SVC_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void PendSV_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void SysTick_Handler(void) __attribute__((weak, alias("Default_Handler")));
+void CAN1_RX0_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
+void CAN1_RX1_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
 
-/* 16 system exceptions + 82 STM32F405 interrupts, all unused: polled peripherals. */
+/* 16 system exceptions + 82 STM32F405 interrupts: bxCAN's receive FIFOs (the hardware
+ * image enables them), the rest unused (polled peripherals). */
 __attribute__((section(".isr_vector"), used)) void (*const g_vectors[16 + 82])(void) = {
     (void (*)(void))(uintptr_t)&_estack,
     Reset_Handler,
@@ -32,7 +35,9 @@ __attribute__((section(".isr_vector"), used)) void (*const g_vectors[16 + 82])(v
     0, 0,
     PendSV_Handler,
     SysTick_Handler,
-    /* The remaining 82 device interrupts default to 0 (never enabled). */
+    [16 + 20] = CAN1_RX0_IRQHandler,
+    [16 + 21] = CAN1_RX1_IRQHandler,
+    /* The other device interrupts default to 0 (never enabled). */
 };
 
 void Reset_Handler(void)

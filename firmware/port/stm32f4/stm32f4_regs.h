@@ -52,6 +52,12 @@
 #define SYST_CSR_CLKSOURCE (1u << 2)
 #define SYST_CSR_COUNTFLAG (1u << 16)
 
+/* NVIC interrupt set-enable (ARMv7-M B3.4.4); CAN1_RX0 is interrupt 20, CAN1_RX1 21
+ * (RM0090 table 61). */
+#define NVIC_ISER0 RFS_REG(0xE000E100u)
+#define IRQ_CAN1_RX0 20u
+#define IRQ_CAN1_RX1 21u
+
 /* SCB application interrupt and reset control (system reset request). */
 #define SCB_AIRCR RFS_REG(0xE000ED0Cu)
 

@@ -104,7 +104,7 @@ int main(void)
             }
             slices = 0u;
         }
-        /* The period's spare time: slices of a fit the wheels wait for, CAN polled
+        /* The period's spare time: slices of a fit the wheels wait for, the CAN queue read
          * between them, none within a slice's time of the next step (docs/FIRMWARE.md,
          * "Learning between periods"). */
         if (slices < RFS_APP_BACKGROUND_SLICES && rfs_board_now_us() + SLICE_US < next_step) {

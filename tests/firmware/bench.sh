@@ -57,6 +57,11 @@ printf '%s\n%s\n' "$out" "$models" | awk -F'\t' '
         if (mper > 0 && (ws in m) && (dg in ins) && ("predict_pathloss" in m) && v["driving_grown_running"] == 1) {
             wl = int((m[ws] - me) / mper + 0.5); pp = int((m["predict_pathloss"] - me) / mper + 0.5)
             printf "driving period with a path-loss warm slice (%d units, 1,000 samples: %d) + the drive, tree grown (%d) + a prediction (%d): %s\n", wb, wl, ins[dg], pp, verdict(wl + ins[dg] + pp)
+            # fit_early near a goal: every driving period also asks a prediction and the 1 s
+            # mean (rfs_seek_fit_early_asks), and the recheck a mean beside its prediction; each
+            # mean at its worst, scanning the window.
+            am = ins["phase_averaging_mean_scan"]; if (ins["phase_averaging_mean"] > am) am = ins["phase_averaging_mean"]
+            printf "the same near a goal with fit_early: + a second prediction and two 1 s means (%d each): %s\n", am, verdict(wl + ins[dg] + 2 * pp + 2 * am)
         } else { printf "path-loss warm slice: not measured\n"; bad = bad " models_warm" }
         printf "boot periods (reachability flood fill in slices of %d points, then the first fit, first_iteration, %d periods): %s\n", 1000, v["first_iteration_periods"], verdict(ins["first_iteration"])
         # The scenario checks: each decision relearnt and decided as described, and the

@@ -193,7 +193,8 @@ void rfs_can_pack_status(const rfs_can_status_t *s, uint8_t counter, rfs_can_fra
 
 void rfs_can_pack_config(const rfs_can_config_t *c, uint8_t counter, rfs_can_frame_t *f)
 {
-    frame_begin(f, RFS_CAN_ID_CONFIG, RFS_CAN_DLC_CONFIG, counter, (uint8_t)(c->target & 0x3u));
+    frame_begin(f, RFS_CAN_ID_CONFIG, RFS_CAN_DLC_CONFIG, counter,
+                (uint8_t)((c->target & 0x3u) | ((c->fit_early & 0x3u) << 2)));
     f->data[1] = (uint8_t)((c->strategy & 0xFu) | ((c->model & 0xFu) << 4));
     put_u16(&f->data[2], (uint16_t)c->p0_min);
     put_u24(&f->data[4], c->seed & 0xFFFFFFu);
@@ -283,10 +284,11 @@ rfs_can_err_t rfs_can_unpack_config(const rfs_can_frame_t *f, rfs_can_config_t *
         return e;
     }
     const uint8_t target = (uint8_t)((f->data[0] >> 4) & 0x3u);
+    const uint8_t fit_early = (uint8_t)(f->data[0] >> 6);
     const uint8_t strategy = (uint8_t)(f->data[1] & 0xFu);
     const uint8_t model = (uint8_t)(f->data[1] >> 4);
     const int16_t p0 = (int16_t)get_u16(&f->data[2]);
-    if ((f->data[0] >> 6) || target > 1u || strategy >= (uint8_t)RFS_SEEK_STRATEGY_COUNT ||
+    if (target > 1u || fit_early > (uint8_t)RFS_CAN_FIT_EARLY_ON || strategy >= (uint8_t)RFS_SEEK_STRATEGY_COUNT ||
         model >= (uint8_t)RFS_CAN_NMODELS ||
         (p0 != RFS_CAN_P0_NONE && (p0 < RFS_CAN_P0_MIN || p0 > RFS_CAN_P0_MAX))) {
         return RFS_CAN_E_RANGE;
@@ -296,6 +298,7 @@ rfs_can_err_t rfs_can_unpack_config(const rfs_can_frame_t *f, rfs_can_config_t *
     c->model = model;
     c->p0_min = p0;
     c->seed = (uint32_t)f->data[4] | ((uint32_t)f->data[5] << 8) | ((uint32_t)f->data[6] << 16);
+    c->fit_early = fit_early;
     *counter = f->data[0] & 0x0Fu;
     return RFS_CAN_OK;
 }

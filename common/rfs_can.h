@@ -30,7 +30,8 @@
  *   0x120 RSSI       radio module -> controller, 8: source, dBm, sequence, time
  *   0x121 RX_STATUS  radio module -> controller, 6: capture time: the receiver was
  *                    listening up to then, packet or not (docs/FAULTS.md)
- *   0x130 CONFIG     operator -> controller, 8: target, strategy, model, P0 floor, seed
+ *   0x130 CONFIG     operator -> controller, 8: target, fit_early, strategy, model, P0
+ *                    floor, seed
  *                    (applied only before the mission's first decision)
  *   0x180 STATUS     controller -> anyone, 8: heartbeat with state, decision, faults
  * Lower ids win arbitration: wheel commands first, then inputs, then the heartbeat.
@@ -150,6 +151,15 @@ typedef enum rfs_can_model {
 #define RFS_CAN_P0_MIN (-200 * 128)
 #define RFS_CAN_P0_MAX (100 * 128)
 
+/// CONFIG FitEarly values (docs/CAN.md, "0x130 CONFIG"): seek.fit_early as the controller
+/// had it (so a frame without the field means what it always meant), off or on; 3 is
+/// reserved (refused).
+typedef enum rfs_can_fit_early {
+    RFS_CAN_FIT_EARLY_KEEP = 0, ///< the controller's own setting
+    RFS_CAN_FIT_EARLY_OFF = 1,  ///< seek.fit_early false
+    RFS_CAN_FIT_EARLY_ON = 2    ///< seek.fit_early true
+} rfs_can_fit_early_t;
+
 /// Mission configuration (docs/CAN.md, "0x130 CONFIG"): what the controller runs.
 typedef struct rfs_can_config {
     uint8_t target;     ///< rfs_app target: 0 rssi, 1 bridge
@@ -158,6 +168,7 @@ typedef struct rfs_can_config {
     int16_t p0_min;     ///< path-loss floor on the signal at 1 m, dBm / 128, in
                         ///< [RFS_CAN_P0_MIN, RFS_CAN_P0_MAX] or RFS_CAN_P0_NONE
     uint32_t seed;      ///< seed of the controller's random source, 24 bits
+    uint8_t fit_early;  ///< rfs_can_fit_early_t, 0..2
 } rfs_can_config_t;
 
 /// Controller heartbeat.
@@ -196,7 +207,8 @@ void rfs_can_pack_pose_th(const rfs_can_pose_t *p, uint8_t counter, rfs_can_fram
 void rfs_can_pack_rssi(const rfs_can_rssi_t *r, uint8_t counter, rfs_can_frame_t *f);
 /// Encode RX_STATUS.
 void rfs_can_pack_receiver(const rfs_can_receiver_t *r, uint8_t counter, rfs_can_frame_t *f);
-/// Encode CONFIG (target, strategy and model masked to their fields, seed to 24 bits).
+/// Encode CONFIG (target, fit_early, strategy and model masked to their fields, seed to
+/// 24 bits).
 void rfs_can_pack_config(const rfs_can_config_t *c, uint8_t counter, rfs_can_frame_t *f);
 /// Encode STATUS.
 void rfs_can_pack_status(const rfs_can_status_t *s, uint8_t counter, rfs_can_frame_t *f);
@@ -212,8 +224,8 @@ rfs_can_err_t rfs_can_unpack_pose_th(const rfs_can_frame_t *f, rfs_can_pose_t *p
 rfs_can_err_t rfs_can_unpack_rssi(const rfs_can_frame_t *f, rfs_can_rssi_t *r, uint8_t *counter);
 /// Decode RX_STATUS (data[0] bits 4..7 are reserved, zero).
 rfs_can_err_t rfs_can_unpack_receiver(const rfs_can_frame_t *f, rfs_can_receiver_t *r, uint8_t *counter);
-/// Decode CONFIG: target above 1, strategy or model without a value, P0Min outside its
-/// limits (and not RFS_CAN_P0_NONE) or set reserved bits are RFS_CAN_E_RANGE.
+/// Decode CONFIG: target above 1, FitEarly 3, strategy or model without a value, P0Min
+/// outside its limits (and not RFS_CAN_P0_NONE) are RFS_CAN_E_RANGE.
 rfs_can_err_t rfs_can_unpack_config(const rfs_can_frame_t *f, rfs_can_config_t *c, uint8_t *counter);
 /// Decode STATUS.
 rfs_can_err_t rfs_can_unpack_status(const rfs_can_frame_t *f, rfs_can_status_t *s, uint8_t *counter);

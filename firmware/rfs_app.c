@@ -263,6 +263,9 @@ bool rfs_app_on_config(rfs_app_t *a, const rfs_can_config_t *c)
         a->stats.configs_rejected++;
         return false;
     }
+    if (c->fit_early != (uint8_t)RFS_CAN_FIT_EARLY_KEEP) {
+        n.seek.fit_early = c->fit_early == (uint8_t)RFS_CAN_FIT_EARLY_ON;
+    }
     app_kept_t k;
     app_keep(a, &k);
     const rfs_app_cfg_t old = a->cfg;

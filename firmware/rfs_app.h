@@ -259,8 +259,9 @@ bool rfs_app_on_rssi(rfs_app_t *a, uint8_t src, int64_t t_us, int8_t dbm, int64_
 bool rfs_app_on_receiver(rfs_app_t *a, int64_t t_us, int64_t rx_us);
 
 /// A CONFIG frame (docs/CAN.md, "0x130 CONFIG"): while no decision has been made since
-/// init, re-initialises with its seed and rfs_app_cfg_choose() of its target, strategy,
-/// model (cfg.models[code]) and p0_min, keeping the counters and the CAN state. false,
+/// init, re-initialises with its seed, its fit_early (RFS_CAN_FIT_EARLY_KEEP: the one in
+/// force) and rfs_app_cfg_choose() of its target, strategy, model (cfg.models[code]) and
+/// p0_min, keeping the counters and the CAN state. false,
 /// counted in stats.configs_rejected, when a decision was made or the image does not
 /// hold the choice; the configuration in force is unchanged then.
 bool rfs_app_on_config(rfs_app_t *a, const rfs_can_config_t *c);

@@ -4,7 +4,8 @@
 Loads the DBC with canmatrix (an independent implementation of the format), reads
 "ID#HEX Field=raw ..." lines produced by build/.../can_vectors, decodes each frame's
 bytes with the DBC and compares every signal's raw value with the value the C side
-encoded. The checksum is recomputed here with an independent CRC-8/SAE-J1850 and the
+encoded; a DBC signal a vector does not name is a failure too (a field the codec
+gained without the DBC, or the reverse). The checksum is recomputed here with an independent CRC-8/SAE-J1850 and the
 DLC compared with the DBC's frame size. Prints PASS/FAIL lines; exit 1 on any failure.
 
 usage: check_dbc.py DBC VECTORS_FILE
@@ -62,6 +63,9 @@ def main(argv):
             if len(data) != fr.size:
                 errs.append("dlc %d != DBC size %d" % (len(data), fr.size))
             dec = fr.decode(bytearray(data))
+            unnamed = sorted(s.name for s in fr.signals if s.name != "Checksum" and s.name not in want)
+            if unnamed:
+                errs.append("DBC signals without an encoded value: %s" % ", ".join(unnamed))
             for name, value in want.items():
                 if name not in dec:
                     errs.append("%s missing in DBC" % name)

@@ -651,7 +651,10 @@ static void record_config(recording_t *s, const options_t *o, uint64_t run_seed)
                               s->env.core.wall_bits};
     (void)rfs_replay_map_records(&am, feed_rec, rec);
     if (o->config_frame) {
-        rfs_can_config_t k = {r.u.cfg.target, (uint8_t)st, 0, p0, (uint32_t)(run_seed & 0xFFFFFFu)};
+        // fit_early: the CFG record's, kept (a frame with the field would not change the stream's
+        // meaning but would its bytes).
+        rfs_can_config_t k = {r.u.cfg.target, (uint8_t)st, 0, p0, (uint32_t)(run_seed & 0xFFFFFFu),
+                              RFS_CAN_FIT_EARLY_KEEP};
         for (uint8_t c = 0; c < (uint8_t)RFS_CAN_NMODELS; c++) {
             k.model = strcmp(rfs_can_model_name(c), o->model_name) == 0 ? c : k.model;
         }

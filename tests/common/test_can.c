@@ -623,6 +623,74 @@ static void receiver_frame_bytes_round_trip_and_rejects(void **state)
     assert_int_equal(rfs_can_unpack_receiver(&g, &out, &c), RFS_CAN_E_RANGE);
 }
 
+/* CONFIG FitEarly (bits 6..7 of data[0], docs/CAN.md): bytes worked out by hand from the
+ * layout (counter | target << 4 | fit_early << 6) with the CRC-8 from the Python reference
+ * (poly 0x1D over 30 01 and the payload); 0 is the frame without the field; every value
+ * round trips; 3 is refused and counted by the receiver. */
+static void config_fit_early_bits(void **state)
+{
+    (void)state;
+    /* meta-path, pathloss, -40 dBm, seed 0x123456, counter 5, on: 0x05 | 2 << 6 = 0x85. */
+    const uint8_t on[] = {0x85, 0x45, 0x00, 0xEC, 0x56, 0x34, 0x12, 0xD8};
+    /* bridge, meta, ridge, no floor, seed 0xFFFFFF, counter 15, off: 0x1F | 1 << 6 = 0x5F. */
+    const uint8_t off[] = {0x5F, 0x00, 0x00, 0x80, 0xFF, 0xFF, 0xFF, 0x84};
+    /* on's frame with FitEarly 3 (0xC5), sealed. */
+    const uint8_t reserved[] = {0xC5, 0x45, 0x00, 0xEC, 0x56, 0x34, 0x12, 0x06};
+    rfs_can_config_t a = {.target = 0, .strategy = 5, .model = RFS_CAN_MODEL_PATHLOSS, .p0_min = -5120,
+                          .seed = 0x123456u, .fit_early = RFS_CAN_FIT_EARLY_ON};
+    rfs_can_config_t b = {.target = 1, .strategy = 0, .model = RFS_CAN_MODEL_RIDGE,
+                          .p0_min = RFS_CAN_P0_NONE, .seed = 0xFFFFFFu, .fit_early = RFS_CAN_FIT_EARLY_OFF};
+    rfs_can_config_t out;
+    rfs_can_frame_t f, g;
+    uint8_t c = 99;
+
+    rfs_can_pack_config(&a, 5, &f);
+    rfs_can_pack_config(&b, 15, &g);
+
+    assert_memory_equal(f.data, on, 8);
+    assert_memory_equal(g.data, off, 8);
+    assert_int_equal(rfs_can_unpack_config(&f, &out, &c), RFS_CAN_OK);
+    assert_int_equal(out.fit_early, RFS_CAN_FIT_EARLY_ON);
+    assert_int_equal(out.target, 0);
+    assert_int_equal(out.strategy, 5);
+    assert_int_equal(c, 5);
+    assert_int_equal(rfs_can_unpack_config(&g, &out, &c), RFS_CAN_OK);
+    assert_int_equal(out.fit_early, RFS_CAN_FIT_EARLY_OFF);
+    assert_int_equal(out.target, 1);
+    assert_int_equal(out.seed, 0xFFFFFFu);
+    /* Round trip of every value with every target. */
+    for (uint8_t fe = 0; fe <= (uint8_t)RFS_CAN_FIT_EARLY_ON; fe++) {
+        for (uint8_t t = 0; t <= 1u; t++) {
+            rfs_can_config_t x = {.target = t, .strategy = 5, .model = RFS_CAN_MODEL_KNN, .p0_min = 0,
+                                  .seed = 42u, .fit_early = fe};
+            rfs_can_pack_config(&x, fe, &g);
+            memset(&out, 0xA5, sizeof out);
+            assert_int_equal(rfs_can_unpack_config(&g, &out, &c), RFS_CAN_OK);
+            assert_int_equal(out.fit_early, fe);
+            assert_int_equal(out.target, t);
+            assert_int_equal(out.model, RFS_CAN_MODEL_KNN);
+        }
+    }
+    /* The reserved value: refused, outputs untouched; the receiver drops and counts it. */
+    memcpy(g.data, reserved, 8);
+    assert_int_equal(g.data[7], rfs_can_checksum(g.id, g.dlc, g.data));
+    memset(&out, 0, sizeof out);
+    c = 99;
+    assert_int_equal(rfs_can_unpack_config(&g, &out, &c), RFS_CAN_E_RANGE);
+    assert_int_equal(c, 99);
+    assert_int_equal(out.fit_early, 0);
+    rfs_can_rx_t rx;
+    const rfs_can_rx_cfg_t rc = rfs_can_rx_cfg_default();
+    assert_int_equal(rfs_can_rx_init(&rx, &rc), 0);
+    rfs_can_msg_t m;
+    assert_int_equal(rfs_can_rx_frame(&rx, &g, 0, &m), RFS_CAN_E_RANGE);
+    assert_int_equal(m.kind, RFS_CAN_MSG_NONE);
+    assert_int_equal(rx.dropped[RFS_CAN_E_RANGE], 1u);
+    assert_int_equal(rfs_can_rx_frame(&rx, &f, 0, &m), RFS_CAN_OK);
+    assert_int_equal(m.kind, RFS_CAN_MSG_CONFIG);
+    assert_int_equal(m.config.fit_early, RFS_CAN_FIT_EARLY_ON);
+}
+
 /* CONFIG (0x130, docs/CAN.md): bytes from the Python reference (bit fields, struct '<h' for
  * P0Min, the seed's three low bytes, CRC-8 over 30 01 and the payload); every field's
  * limits; values outside them, reserved bits, a wrong DLC and flipped bits rejected; the
@@ -678,12 +746,13 @@ static void config_frame_bytes_ranges_and_receiver(void **state)
         {0, 0, 0, 12801, RFS_CAN_E_RANGE},  {0, 0, 0, -32767, RFS_CAN_E_RANGE},
     };
     for (unsigned i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        rfs_can_config_t x = {cases[i].target, cases[i].strategy, cases[i].model, cases[i].p0, 7u};
+        rfs_can_config_t x = {cases[i].target, cases[i].strategy, cases[i].model, cases[i].p0, 7u,
+                              RFS_CAN_FIT_EARLY_KEEP};
         rfs_can_pack_config(&x, 1, &g);
         assert_int_equal(rfs_can_unpack_config(&g, &out, &c), cases[i].want);
     }
     g = f;
-    g.data[0] |= 0x40u; /* reserved bits 6..7 */
+    g.data[0] |= 0xC0u; /* FitEarly 3, reserved */
     g.data[7] = rfs_can_checksum(g.id, g.dlc, g.data);
     assert_int_equal(rfs_can_unpack_config(&g, &out, &c), RFS_CAN_E_RANGE);
     g = f;
@@ -787,6 +856,7 @@ int main(void)
         cmocka_unit_test(receiver_frame_bytes_round_trip_and_rejects),
         cmocka_unit_test(rx_receiver_unwraps_and_applies_the_packet_time_window),
         cmocka_unit_test(config_frame_bytes_ranges_and_receiver),
+        cmocka_unit_test(config_fit_early_bits),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

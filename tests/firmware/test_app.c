@@ -149,6 +149,61 @@ static void test_init_checks_configuration_and_map(void **state)
     assert_false(rfs_app_cfg_default().seek.fit_early);
 }
 
+/* A CONFIG frame's FitEarly (docs/CAN.md, "0x130 CONFIG"): 1 turns seek.fit_early off, 2
+ * on, 0 keeps the one in force (the frames sent before the field existed); 3 is refused by
+ * the decoder and counted, the configuration unchanged. */
+static void test_config_frame_sets_fit_early(void **state)
+{
+    (void)state;
+    const rfs_app_map_t m = room();
+    const rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_mcu()); /* fit_early on */
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    rfs_can_tx_t op;
+    rfs_can_tx_init(&op);
+    rfs_can_frame_t f;
+    rfs_can_config_t k = {.target = 0, .strategy = RFS_SEEK_META, .model = RFS_CAN_MODEL_RIDGE,
+                          .p0_min = RFS_CAN_P0_NONE, .seed = 7u, .fit_early = RFS_CAN_FIT_EARLY_KEEP};
+    const struct {
+        uint8_t fit_early;
+        bool want;
+    } steps[] = {
+        {RFS_CAN_FIT_EARLY_KEEP, true}, /* the MCU's own */
+        {RFS_CAN_FIT_EARLY_OFF, false}, {RFS_CAN_FIT_EARLY_KEEP, false},
+        {RFS_CAN_FIT_EARLY_ON, true},   {RFS_CAN_FIT_EARLY_KEEP, true},
+        {RFS_CAN_FIT_EARLY_OFF, false},
+    };
+    for (unsigned i = 0; i < sizeof steps / sizeof steps[0]; i++) {
+        k.fit_early = steps[i].fit_early;
+        k.seed = 7u + i;
+        rfs_can_tx_config(&op, &k, &f);
+        assert_int_equal(rfs_app_on_can(&s_app, &f, 1000 * (int64_t)(i + 1u)), RFS_CAN_OK);
+        assert_int_equal(s_app.stats.configs, i + 1u);
+        assert_int_equal(s_app.cfg.seed, 7u + i);
+        assert_int_equal(s_app.seek.cfg.fit_early, steps[i].want);
+        assert_int_equal(s_app.cfg.seek.fit_early, steps[i].want);
+    }
+    /* Reserved: the decoder drops it (counted), nothing applied. */
+    k.fit_early = 3u;
+    k.seed = 99u;
+    rfs_can_tx_config(&op, &k, &f);
+    assert_int_equal(f.data[0] >> 6, 3);
+    const uint32_t dropped = s_app.can_rx.dropped[RFS_CAN_E_RANGE];
+    assert_int_equal(rfs_app_on_can(&s_app, &f, 10000), RFS_CAN_E_RANGE);
+    assert_int_equal(s_app.can_rx.dropped[RFS_CAN_E_RANGE], dropped + 1u);
+    assert_int_equal(s_app.stats.configs, 6u);
+    assert_int_equal(s_app.cfg.seed, 12u);
+    assert_false(s_app.seek.cfg.fit_early);
+
+    /* The host's default (off) switched on. */
+    const rfs_app_cfg_t d = fx_cfg(rfs_app_cfg_default());
+    assert_int_equal(rfs_app_init(&s_app, &d, &m), 0);
+    assert_false(s_app.seek.cfg.fit_early);
+    k.fit_early = RFS_CAN_FIT_EARLY_ON;
+    rfs_can_tx_config(&op, &k, &f);
+    assert_int_equal(rfs_app_on_can(&s_app, &f, 20000), RFS_CAN_OK);
+    assert_true(s_app.seek.cfg.fit_early);
+}
+
 static void test_first_step_after_reset_is_zero_and_flagged(void **state)
 {
     (void)state;
@@ -319,6 +374,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_init_checks_configuration_and_map),
+        cmocka_unit_test(test_config_frame_sets_fit_early),
         cmocka_unit_test(test_first_step_after_reset_is_zero_and_flagged),
         cmocka_unit_test(test_wheels_stop_within_200_ms_of_lost_inputs_and_resume),
         cmocka_unit_test(test_bus_off_stops_at_once_and_recovers),

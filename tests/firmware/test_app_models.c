@@ -221,10 +221,10 @@ static void test_config_frame_chooses_before_the_first_decision(void **state)
     /* knn: not offered; bridge + pathloss: one fit per node, no room; meta-global and a
      * baseline (chemotaxis: its decision kinds have no code on the wire). */
     const rfs_can_config_t refused[4] = {
-        {0, RFS_SEEK_META, RFS_CAN_MODEL_KNN, -5760, 3u},
-        {1, RFS_SEEK_META_PATH, RFS_CAN_MODEL_PATHLOSS, -5760, 3u},
-        {0, RFS_SEEK_META_GLOBAL, RFS_CAN_MODEL_RIDGE, -5760, 3u},
-        {0, RFS_SEEK_CHEMOTAXIS, RFS_CAN_MODEL_RIDGE, -5760, 3u},
+        {0, RFS_SEEK_META, RFS_CAN_MODEL_KNN, -5760, 3u, 0},
+        {1, RFS_SEEK_META_PATH, RFS_CAN_MODEL_PATHLOSS, -5760, 3u, 0},
+        {0, RFS_SEEK_META_GLOBAL, RFS_CAN_MODEL_RIDGE, -5760, 3u, 0},
+        {0, RFS_SEEK_CHEMOTAXIS, RFS_CAN_MODEL_RIDGE, -5760, 3u, 0},
     };
     for (int i = 0; i < 4; i++) {
         rfs_can_tx_config(&op, &refused[i], &f);
@@ -235,7 +235,7 @@ static void test_config_frame_chooses_before_the_first_decision(void **state)
     assert_ptr_equal(s_app.seek.model.ops, &rfs_ridge_ops);
     assert_int_equal(s_app.cfg.seed, 1u);
 
-    const rfs_can_config_t mp = {0, RFS_SEEK_META_PATH, RFS_CAN_MODEL_PATHLOSS, -5120, 0x123456u};
+    const rfs_can_config_t mp = {0, RFS_SEEK_META_PATH, RFS_CAN_MODEL_PATHLOSS, -5120, 0x123456u, 0};
     rfs_can_tx_config(&op, &mp, &f);
     assert_int_equal(rfs_app_on_can(&s_app, &f, 2000), RFS_CAN_OK);
 
@@ -266,7 +266,7 @@ static void test_config_frame_chooses_before_the_first_decision(void **state)
         rfs_app_step(&s_app, t, &o);
     }
     assert_true(s_app.seek.iteration > 0u);
-    const rfs_can_config_t back = {0, RFS_SEEK_META, RFS_CAN_MODEL_RIDGE, -5760, 1u};
+    const rfs_can_config_t back = {0, RFS_SEEK_META, RFS_CAN_MODEL_RIDGE, -5760, 1u, 0};
     rfs_can_tx_config(&op, &back, &f);
     assert_int_equal(rfs_app_on_can(&s_app, &f, t_end + 10000), RFS_CAN_OK);
     assert_int_equal(s_app.stats.configs_rejected, 5u);

@@ -78,11 +78,14 @@ put("can", "repeat_unpaired", pose(3, 1, 2, 3, T0 + 100_000) + pose(3, 1, 2, 3, 
 put("can", "bad_dlc_crc", rec(3, 1, 7, [0], fix=True) + rec(3, 1, 8, [0] * 8, fix=False) +
     rec(7, 1, 8, [0xff, 0x07, 0, 0, 0, 0, 0, 0]) + rec(7, 1, 15, [0x11, 0x01]))
 # CONFIG: meta-path + pathloss at -40 dBm, then a repeat, bridge + ridge without a floor,
-# every limit past by one (target 2, strategy 6, model 5, P0Min 100 dBm + 1/128).
+# every limit past by one (target 2, strategy 6, model 5, P0Min 100 dBm + 1/128), then
+# FitEarly (data[0] bits 6..7) on, off and the reserved 3.
 put("can", "config", rec(6, 1, 8, [0x05, 0x45, 0x00, 0xEC, 0x56, 0x34, 0x12]) +
     rec(6, 1, 8, [0x05, 0x45, 0x00, 0xEC, 0x56, 0x34, 0x12]) +
     rec(6, 1, 8, [0x1F, 0x00, 0x00, 0x80, 0xFF, 0xFF, 0xFF]) + rec(6, 1, 8, [0x20]) +
-    rec(6, 1, 8, [0x01, 0x06]) + rec(6, 1, 8, [0x02, 0x50]) + rec(6, 1, 8, [0x03, 0, 0x01, 0x32]))
+    rec(6, 1, 8, [0x01, 0x06]) + rec(6, 1, 8, [0x02, 0x50]) + rec(6, 1, 8, [0x03, 0, 0x01, 0x32]) +
+    rec(6, 1, 8, [0x86, 0x45, 0x00, 0xEC, 0x56, 0x34, 0x12]) +
+    rec(6, 1, 8, [0x57, 0x00, 0x00, 0x80, 0x01, 0x00, 0x00]) + rec(6, 1, 8, [0xC8]))
 
 
 def receiver(counter, t_us, dt_ms=50):

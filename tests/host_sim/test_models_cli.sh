@@ -156,12 +156,12 @@ if [ -x "$tool" ] && "$tool" mklog "$tmp/in.lcmlog"; then
     for m in ridge mlp knn; do
         "$d" --map scenarios/maps/office.yaml --replay "$tmp/in.lcmlog" --clock-lcm --model "$m" \
             >"$tmp/d-$m.txt" 2>"$tmp/d-$m.err"
-        check "rfseekd-model-$m" '[ $? -eq 0 ] && grep -q "^rfseekd: 81 steps.*(strategy meta, model $m)\$" "$tmp/d-$m.err" && [ -s "$tmp/d-$m.txt" ]'
+        check "rfseekd-model-$m" '[ $? -eq 0 ] && grep -q "^rfseekd: 81 steps.*(strategy meta, model $m, fit budget 0, fit_early off)\$" "$tmp/d-$m.err" && [ -s "$tmp/d-$m.txt" ]'
     done
     for st in meta-path chemotaxis; do
         "$d" --map scenarios/maps/office.yaml --replay "$tmp/in.lcmlog" --clock-lcm --model pathloss \
             --strategy "$st" >"$tmp/s-$st.txt" 2>"$tmp/s-$st.err"
-        check "rfseekd-strategy-$st" '[ $? -eq 0 ] && grep -q "^rfseekd: 81 steps.*(strategy $st, model pathloss)\$" "$tmp/s-$st.err"'
+        check "rfseekd-strategy-$st" '[ $? -eq 0 ] && grep -q "^rfseekd: 81 steps.*(strategy $st, model pathloss, fit budget 0, fit_early off)\$" "$tmp/s-$st.err"'
     done
 else
     echo "FAIL rfseekd-model-replay: $tool mklog unavailable"; fails=$((fails + 1))

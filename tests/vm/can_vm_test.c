@@ -153,8 +153,8 @@ static int do_recv(const char *ifname, int64_t now_us)
                    m.status.configured, m.status.faults, m.status.iteration);
             break;
         case RFS_CAN_MSG_CONFIG:
-            printf("CONFIG target=%u strategy=%u model=%u p0=%d seed=%" PRIu32 "\n", m.config.target,
-                   m.config.strategy, m.config.model, m.config.p0_min, m.config.seed);
+            printf("CONFIG target=%u fit_early=%u strategy=%u model=%u p0=%d seed=%" PRIu32 "\n", m.config.target,
+                   m.config.fit_early, m.config.strategy, m.config.model, m.config.p0_min, m.config.seed);
             break;
         }
     }

@@ -85,11 +85,17 @@ def main(argv):
     want.append("DROP future")
     # 15. CONFIG: meta-path (5), pathloss (4), -40 dBm (-5120 / 128), seed 0x123456
     send.append(frame(0x130, struct.pack("<BBh", 0x00, 5 | (4 << 4), -5120) + (0x123456).to_bytes(3, "little")))
-    want.append("CONFIG target=0 strategy=5 model=4 p0=-5120 seed=%d" % 0x123456)
-    # 16. CONFIG with strategy 6: no such strategy
-    send.append(frame(0x130, struct.pack("<BBh", 0x01, 6, 0) + bytes(3)))
+    want.append("CONFIG target=0 fit_early=0 strategy=5 model=4 p0=-5120 seed=%d" % 0x123456)
+    # 16. CONFIG: bridge (1 << 4), FitEarly on (2 << 6), meta, ridge, no floor, seed 7
+    send.append(frame(0x130, struct.pack("<BBh", 0x01 | (1 << 4) | (2 << 6), 0, -32768) + (7).to_bytes(3, "little")))
+    want.append("CONFIG target=1 fit_early=2 strategy=0 model=0 p0=-32768 seed=7")
+    # 17. CONFIG with strategy 6: no such strategy
+    send.append(frame(0x130, struct.pack("<BBh", 0x02, 6, 0) + bytes(3)))
     want.append("DROP range")
-    want.append("STATS delivered=14 foreign=0 dropped=6 checksum=1 rssi_jumps=1 seq_gaps=1")
+    # 18. CONFIG with FitEarly 3: reserved
+    send.append(frame(0x130, struct.pack("<BBh", 0x03 | (3 << 6), 0, 0) + bytes(3)))
+    want.append("DROP range")
+    want.append("STATS delivered=16 foreign=0 dropped=7 checksum=1 rssi_jumps=1 seq_gaps=1")
     with open(os.path.join(out, "cansend.txt"), "w") as f:
         f.write("\n".join(send) + "\n")
     with open(os.path.join(out, "expect_recv.txt"), "w") as f:

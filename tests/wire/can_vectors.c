@@ -61,17 +61,18 @@ int main(int argc, char **argv)
         print_frame(&f);
         printf(" Counter=%u Time=%" PRIu32 "\n", c, r.t_us32);
     }
-    /* CONFIG: every field's limits (P0Min -200 and 100 dBm, no floor; seed 0 and 2^24 - 1). */
+    /* CONFIG: every field's limits (P0Min -200 and 100 dBm, no floor; seed 0 and 2^24 - 1;
+     * FitEarly keep, off, on). */
     const int16_t p0[] = {RFS_CAN_P0_MIN, RFS_CAN_P0_MAX, RFS_CAN_P0_NONE, -5760};
     const uint32_t seeds[] = {0u, 0xFFFFFFu, 0x123456u, 1u};
     for (unsigned i = 0; i < sizeof p0 / sizeof p0[0]; i++) {
         rfs_can_config_t k = {(uint8_t)(i & 1u), (uint8_t)(i == 1 ? 5u : i), (uint8_t)(i == 0 ? 4u : i),
-                              p0[i], seeds[i]};
+                              p0[i], seeds[i], (uint8_t)(i % 3u)};
         uint8_t c = (uint8_t)(i * 5u % 16u);
         rfs_can_pack_config(&k, c, &f);
         print_frame(&f);
-        printf(" Counter=%u Target=%u Strategy=%u Model=%u P0Min=%d Seed=%" PRIu32 "\n", c, k.target,
-               k.strategy, k.model, k.p0_min, k.seed);
+        printf(" Counter=%u Target=%u FitEarly=%u Strategy=%u Model=%u P0Min=%d Seed=%" PRIu32 "\n", c,
+               k.target, k.fit_early, k.strategy, k.model, k.p0_min, k.seed);
     }
     const uint32_t iters[] = {0, 0xFFFFFFFFu, 1, 0x12345678u, 5, 65536};
     for (unsigned i = 0; i < sizeof iters / sizeof iters[0]; i++) {

@@ -61,6 +61,24 @@ for fe in on off; do
 done
 "$bin/rfseek-replay" --print "$w/fe_s.rfso" >"$w/fe_s.txt"
 check replay-log-fit-early-equals-stream '[ "$(grep -c ^DECISION "$w/fe_s.txt")" -ge 3 ] && cmp -s "$w/fe_s.txt" "$w/fe_on.txt" && ! cmp -s "$w/fe_s.txt" "$w/fe_off.txt"'
+# The CONFIG frame's FitEarly (bits 6..7, docs/CAN.md; re-sealed with scripts/check_dbc.py's
+# CRC) outranks the replay's own setting: 2 (on) plays as --fit-early on, 1 (off) as off.
+fe_config() { # LOG_IN FIT_EARLY LOG_OUT: the log with its CONFIG frame's FitEarly set
+    /usr/bin/python3 -c 'import re, sys; sys.path.insert(0, "scripts"); from check_dbc import crc8_j1850
+def fix(m):
+    d = bytearray.fromhex(m.group(2)); d[0] = (d[0] & 0x3F) | (int(sys.argv[2]) << 6)
+    d[7] = crc8_j1850(bytes([0x30, 0x01]) + bytes(d[:7])); return m.group(1) + d.hex().upper()
+out = [re.sub(r"^(.* 130#)([0-9A-F]{16})$", fix, l) for l in open(sys.argv[1]).read().splitlines()]
+open(sys.argv[3], "w").write("\n".join(out) + "\n")' "$@"
+}
+fe_config "$w/fe.log" 2 "$w/fe_c2.log" && fe_config "$w/fe.log" 1 "$w/fe_c1.log" || fail fe-config-log
+grep -q ' can0 130#8' "$w/fe_c2.log" && grep -q ' can0 130#4' "$w/fe_c1.log" || fail fe-config-log-rewritten
+for c in 1 2; do
+    "$bin/rfseek-replay" "$w/fe_c$c.log" --map $map --seed 3 --fit-budget 600 --fit-early $([ $c = 2 ] && echo off || echo on) \
+        -o "$w/fe_c$c.rfso" && "$bin/rfseek-replay" --print "$w/fe_c$c.rfso" | unshift >"$w/fe_c$c.txt" \
+        || fail "replay-candump-config-fit-early-$c"
+done
+check replay-config-frame-fit-early '[ -s "$w/fe_c2.txt" ] && cmp -s "$w/fe_c2.txt" "$w/fe_on.txt" && cmp -s "$w/fe_c1.txt" "$w/fe_off.txt"'
 
 # --- can-utils' own writer: asc2log's lines read as ours -------------------------------------
 asc2log -I "$w/m.asc" -O "$w/a2l.log" 2>/dev/null

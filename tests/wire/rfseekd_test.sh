@@ -20,7 +20,11 @@ expect_err_of() {
 }
 expect_err() { expect_err_of "$d" "$@"; }
 
-"$d" --help > "$w/help" && grep -q -- '--can-over-lcm' "$w/help" && pass rfseekd-help || fail rfseekd-help
+"$d" --help > "$w/help" && grep -q -- '--can-over-lcm' "$w/help" && grep -q -- '--fit-early on|off' "$w/help" \
+    && grep -q 'whole fits ignore it' "$w/help" && pass rfseekd-help || fail rfseekd-help
+expect_err rfseekd-bad-fit-early 2 "--fit-early: expected on or off, got yes" --map $map --fit-early yes
+expect_err rfseekd-bad-fit-budget 2 "--fit-budget: expected work units in \[0, 100000\], got -1" --map $map --fit-budget -1
+expect_err rfseekd-missing-fit-early 2 "missing value for option --fit-early" --map $map --fit-early
 expect_err rfseekd-unknown-option 2 "unknown option (see --help): --bogus" --bogus
 expect_err rfseekd-map-required 2 "--map MAP.yaml is required" --lcm memq://
 expect_err rfseekd-missing-map 1 "nope.yaml" --map "$w/nope.yaml" --lcm memq://
@@ -214,11 +218,27 @@ cmp -s "$w/live.txt" "$w/replay3.txt" && pass "two-process-replay-through-lcm-fi
     || fail two-process-replay-through-lcm-file-provider
 
 # The map-aware improvement on the Linux port: meta-path with the pathloss model.
-two_process path --model pathloss --strategy meta-path
+two_process path --model pathloss --strategy meta-path --log "$w/path.lcmlog"
 if [ $src -eq 0 ] && [ $drc -eq 0 ] && grep -q '"reached": true' "$w/summary-path.json" \
-    && grep -q "(strategy meta-path, model pathloss)\$" "$w/d-path.err"; then
+    && grep -q "(strategy meta-path, model pathloss, fit budget 0, fit_early off)\$" "$w/d-path.err"; then
     pass "two-process-meta-path-pathloss-reaches-source ($(grep -E '"(distance_travelled_m|iterations)"' "$w/summary-path.json" | tr -d ' \n'))"
 else
     fail "two-process-meta-path-pathloss-reaches-source (sim rc $src, rfseekd rc $drc: $(cat "$w/sim-path.err" "$w/d-path.err" | tail -3))"
+fi
+# --fit-early reaches the seeker with a fit budget (the path-loss model's MCU one, 150) and
+# changes the decisions made on the same inputs; whole fits ignore it.
+for fe in on off; do
+    for fb in 0 150; do
+        "$d" --map $map --replay "$w/path.lcmlog" --clock-lcm --model pathloss --strategy meta-path \
+            --fit-budget $fb --fit-early $fe > "$w/fe-$fb-$fe.txt" 2> "$w/fe-$fb-$fe.err" \
+            || fail "rfseekd-fit-early-replay-$fb-$fe"
+    done
+done
+if grep -q "(strategy meta-path, model pathloss, fit budget 150, fit_early on)\$" "$w/fe-150-on.err" \
+    && [ "$(wc -l < "$w/fe-150-on.txt")" -ge 3 ] && ! cmp -s "$w/fe-150-on.txt" "$w/fe-150-off.txt" \
+    && cmp -s "$w/fe-0-on.txt" "$w/fe-0-off.txt"; then
+    pass "rfseekd-fit-early-with-a-fit-budget ($(wc -l < "$w/fe-150-on.txt") / $(wc -l < "$w/fe-150-off.txt") decisions; whole fits alike)"
+else
+    fail "rfseekd-fit-early-with-a-fit-budget ($(tail -1 "$w/fe-150-on.err"))"
 fi
 exit $((fails > 0))

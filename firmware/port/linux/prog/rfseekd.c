@@ -58,6 +58,10 @@ static const char usage_text[] =
     "                    plane-gradient, chemotaxis (the simulator's baselines)\n"
     "  --p0-min DBM      pathloss only: floor on the fitted signal at 1 m (default -45); the\n"
     "                    node's EIRP - 52 when its power is known (docs/PATHLOSS.md)\n"
+    "  --fit-budget N    the model's work units a fit slice: one in each step, up to ten\n"
+    "                    after it, as on the STM32 image (default 0: whole fits)\n"
+    "  --fit-early on|off  relearns begun while the base brakes (default off; the STM32\n"
+    "                    image's on); only with --fit-budget N > 0: whole fits ignore it\n"
     "  --seed N          seed of the controller's random source (default 1)\n"
     "  --duration S      stop after S seconds of controller time (default: run until signalled)\n"
     "  --idle-exit MS    stop when no LCM message arrived for MS milliseconds\n"
@@ -302,7 +306,7 @@ static bool is_value_option(const char *a)
 {
     static const char *const opts[] = {"--map", "--lcm", "--can", "--replay", "--log", "--decisions", "--candump",
                                        "--target", "--res", "--seed", "--duration", "--idle-exit",
-                                       "--model", "--p0-min", "--strategy"};
+                                       "--model", "--p0-min", "--strategy", "--fit-budget", "--fit-early"};
     for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++) {
         if (strcmp(a, opts[i]) == 0) {
             return true;
@@ -320,6 +324,8 @@ typedef struct options {
     rfs_seek_strategy_t strategy;    /* --strategy: the paper's by default */
     double res;
     int64_t seed, duration_s, idle_ms;
+    int64_t fit_budget;              /* --fit-budget: 0, whole fits */
+    bool fit_early;                  /* --fit-early */
     bool can_over_lcm, clock_lcm;
 } options_t;
 
@@ -375,6 +381,15 @@ static int parse_value(options_t *o, const char *a, const char *v)
         if (!parse_i64(v, 0, INT64_MAX, &o->seed)) {
             return die("--seed: expected a non-negative integer, got ", v);
         }
+    } else if (strcmp(a, "--fit-budget") == 0) {
+        if (!parse_i64(v, 0, 100000, &o->fit_budget)) {
+            return die("--fit-budget: expected work units in [0, 100000], got ", v);
+        }
+    } else if (strcmp(a, "--fit-early") == 0) {
+        if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0) {
+            return die("--fit-early: expected on or off, got ", v);
+        }
+        o->fit_early = strcmp(v, "on") == 0;
     } else if (strcmp(a, "--duration") == 0) {
         if (!parse_i64(v, 1, 86400 * 365, &o->duration_s)) {
             return die("--duration: expected whole seconds >= 1, got ", v);
@@ -496,6 +511,8 @@ static int open_controller(daemon_t *d, const options_t *o)
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
     cfg.samples = samples;
     rfs_seek_cfg_use_strategy(&cfg.seek, o->strategy);
+    cfg.seek.fit_budget = (uint32_t)o->fit_budget;
+    cfg.seek.fit_early = o->fit_early;
     cfg.seed = (uint64_t)o->seed;
     cfg.target = strcmp(o->target, "bridge") == 0 ? RFS_APP_TARGET_BRIDGE : RFS_APP_TARGET_RSSI;
     if (lx_map_load(o->map_path, &d->map, err, sizeof err) != 0 ||
@@ -761,9 +778,10 @@ static int daemon_main(int argc, char **argv)
         if (rc == 0) { /* the counts of a run that went through; else its one error line */
             fprintf(stderr, "rfseekd: %" PRIu32 " steps, %" PRIu32 " decisions, %" PRIu32 " bad messages, %" PRIu32
                             " CAN send failures, %" PRIu32 " receiver heartbeats, seeker rejected %" PRIu32
-                            " inputs (strategy %s, model %s)\n",
+                            " inputs (strategy %s, model %s, fit budget %" PRIu32 ", fit_early %s)\n",
                     d.steps, d.decided, d.bad_msgs, d.can_fail, d.app->stats.receiver, d.app->stats.rejected,
-                    rfs_seek_strategy_name(d.app->seek.cfg.strategy), d.app->seek.model.ops->name);
+                    rfs_seek_strategy_name(d.app->seek.cfg.strategy), d.app->seek.model.ops->name,
+                    d.app->seek.cfg.fit_budget, d.app->seek.cfg.fit_early ? "on" : "off");
         }
     }
     return finish(&d, &o, rc);

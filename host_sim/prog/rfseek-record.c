@@ -290,7 +290,7 @@ static void usage(FILE *f)
             "  --heartbeat MODE     the receiver heartbeat (when the scenario has it):\n"
             "                       can (RX_STATUS frames, default), record (RECEIVER\n"
             "                       records) or off (packets only)\n"
-            "  --fit-budget N       the model's work units a control period (0: all; the MCU\n"
+            "  --fit-budget N       the model's work units a fit slice (0: whole fits; the MCU\n"
             "                       configuration uses each model's, 0 for the ridge)\n"
             "  --fit-early on|off   with a fit budget, relearns begun while the base brakes\n"
             "                       (the MCU configuration's; default: the scenario's\n"

@@ -186,7 +186,8 @@ static void usage(FILE *f)
                "  --seed N         seed of the controller's random source (default 1)\n"
                "  --target NAME    rssi (default) or bridge\n"
                "  --model NAME     ridge (default), mlp, knn, radius, pathloss\n"
-               "  --fit-budget N   the model's work units a control period (default 0: all)\n"
+               "  --fit-budget N   the model's work units a fit slice: one each step, up to ten\n"
+               "                   after it (default 0: whole fits)\n"
                "  --fit-early on|off  relearns begun while the base brakes (the STM32\n"
                "                   configuration's; default off)\n"
                "  -h, --help       this text\n");

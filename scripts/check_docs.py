@@ -5,8 +5,8 @@
 
 1. Every reference to a section, `docs/X.md, "Heading"` (also `X.md "Heading"`,
    `X.md ("Heading"`, broken across lines), in README.md and docs/*.md names a file that
-   exists and a Markdown heading that is, or begins with, "Heading"; every `docs/X.md`
-   named exists.
+   exists and a Markdown heading, or a bold run-in opening a paragraph or bullet, that is
+   or begins with "Heading"; every `docs/X.md` named exists.
 2. Scenario keys: every key host_sim/hs_scenario.c accepts is named in the page that
    documents its section (faults: docs/FAULTS.md, radio: docs/RADIO_MODEL.md or
    docs/SIMULATOR.md, the rest: docs/SIMULATOR.md); every key in SIMULATOR.md's example
@@ -36,6 +36,10 @@ def headings(text):
             fence = not fence
         elif not fence and line.startswith('#'):
             out.append(re.sub(r'\s+', ' ', line.lstrip('#').strip()))
+        elif not fence:  # a bold run-in opening a paragraph or bullet: "**Walls.** ..."
+            m = re.match(r'(?:- )?\*\*([^*]+?)[.:]?\*\*', line)
+            if m:
+                out.append(m.group(1))
     return out
 
 

@@ -11,3 +11,5 @@ lint: $(LCM_GEN_HDRS)
 	@LINT_JOBS=$(LINT_JOBS) scripts/lint/run_lint.sh $(BUILD) cppcheck clang-tidy
 
 $(eval $(call test_script,layers,scripts/check_layers.sh,))
+# The docs' section links and scenario keys against the code (scripts/check_docs.py).
+$(eval $(call test_script,docs,$(PYTHON) scripts/check_docs.py,))

@@ -564,6 +564,20 @@ static void seek_output_maps_to_status_and_wheels(void **state)
     out.state = RFS_SEEK_STALE;
     rfs_can_from_seek_out(&out, &s, &w);
     assert_int_equal(w.flags, RFS_CAN_WHEEL_STOP);
+    /* The baselines' kinds in the 2-bit field (docs/CAN.md, "0x180 STATUS"): probe 4 and
+     * tumble 7 explore (3, epsilon), gradient 5 and run 6 are directed (2, greedy). */
+    const struct { rfs_seek_kind_t k; uint8_t want; } map[] = {
+        {RFS_SEEK_NONE, 0}, {RFS_SEEK_INITIAL, 1}, {RFS_SEEK_GREEDY, 2}, {RFS_SEEK_EPSILON, 3},
+        {RFS_SEEK_PROBE, 3}, {RFS_SEEK_GRADIENT, 2}, {RFS_SEEK_RUN, 2}, {RFS_SEEK_TUMBLE, 3},
+    };
+    for (unsigned i = 0; i < sizeof map / sizeof map[0]; i++) {
+        out.decision.kind = map[i].k;
+        rfs_can_from_seek_out(&out, &s, &w);
+        assert_int_equal(s.kind, map[i].want);
+        rfs_can_frame_t f;
+        rfs_can_pack_status(&s, 0, &f);
+        assert_int_equal(f.data[1] & 0x3u, map[i].want);
+    }
 }
 
 /* RX_STATUS (0x121, docs/CAN.md): bytes from the Python reference (struct '<BI' + CRC-8 over

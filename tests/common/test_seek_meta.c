@@ -1,6 +1,6 @@
 /* test_seek_meta.c - the paper's choices (common/rfs_seek_meta.c): the epsilon schedule,
  * novelty, the greedy step's line search, and the meta-path variants (docs/STRATEGIES.md,
- * "meta-path's preset improvements"), each against a reference computed here in double
+ * "meta-path's presets"), each against a reference computed here in double
  * precision.
  */
 #include "rfs_test.h"

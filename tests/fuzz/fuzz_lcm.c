@@ -58,7 +58,7 @@ static void on_status(void *ctx, int64_t t_us, const rfs_seek_out_t *o)
 {
     (void)ctx;
     (void)t_us;
-    if ((unsigned)o->state > RFS_SEEK_DRIVING || (unsigned)o->decision.kind > RFS_SEEK_EPSILON ||
+    if ((unsigned)o->state > RFS_SEEK_DRIVING || (unsigned)o->decision.kind > RFS_SEEK_TUMBLE ||
         (unsigned)o->decision.prev > RFS_DRIVE_BLOCKED) {
         abort();
     }

@@ -241,4 +241,21 @@ if grep -q "(strategy meta-path, model pathloss, fit budget 150, fit_early on)\$
 else
     fail "rfseekd-fit-early-with-a-fit-budget ($(tail -1 "$w/fe-150-on.err"))"
 fi
+# The baselines on the Linux port: their decision kinds name themselves, and every status
+# message they publish decodes (one a step, none dropped as out of range).
+for st in chemotaxis plane-gradient; do
+    "$d" --map $map --replay "$w/path.lcmlog" --clock-lcm --strategy $st --lcm memq:// \
+        --log "$w/bl-$st.lcmlog" > "$w/bl-$st.txt" 2> "$w/bl-$st.err" || fail "rfseekd-baseline-$st-run"
+    "$tool" dump "$w/bl-$st.lcmlog" > "$w/bl-$st.dump" 2> "$w/bl-$st.dump.err"
+    steps=$(sed -n 's/^rfseekd: \([0-9]*\) steps.*/\1/p' "$w/bl-$st.err")
+    case $st in chemotaxis) kinds="run tumble" ;; *) kinds="gradient" ;; esac
+    ok=1
+    for k in $kinds; do grep -q " kind=$k " "$w/bl-$st.txt" || ok=0; done
+    if [ $ok -eq 1 ] && [ -n "$steps" ] && [ "$(grep -c '^STATUS ' "$w/bl-$st.dump")" -eq "$steps" ] \
+        && [ ! -s "$w/bl-$st.dump.err" ]; then
+        pass "rfseekd-baseline-$st-kinds-and-status ($steps steps, kinds: $(sed -n 's/.* kind=\([a-z]*\) .*/\1/p' "$w/bl-$st.txt" | sort -u | tr '\n' ' '))"
+    else
+        fail "rfseekd-baseline-$st-kinds-and-status ($(head -2 "$w/bl-$st.dump.err"))"
+    fi
+done
 exit $((fails > 0))

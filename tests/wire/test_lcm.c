@@ -339,6 +339,76 @@ static void status_string_length_checked_before_decoding(void **state)
     lx_lcm_close(l);
 }
 
+/* Every decision kind, the baseline strategies' too (rfseekd runs them), round trips with
+ * its name in the reason string (byte 38 holds the kind, 39 the reason's length); one past
+ * the last kind is dropped as out of range. */
+static void every_decision_kind_round_trips_with_its_reason(void **state)
+{
+    (void)state;
+    static const char *const names[] = {"none", "initial", "greedy", "epsilon",
+                                        "probe", "gradient", "run", "tumble"};
+    rx_t r;
+    lx_lcm_t *l = open_memq(&r);
+    char path[] = "/tmp/rfs_test_lcm_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    char err[200];
+    lx_lcm_log_t *log = lx_lcm_log_open(path, "w", err, sizeof err);
+    assert_non_null(log);
+    lx_lcm_record(l, log);
+    for (int k = 0; k < 8; k++) {
+        rfs_seek_out_t o;
+        memset(&o, 0, sizeof o);
+        o.decision.kind = (rfs_seek_kind_t)k;
+        o.decision.relearned = true;
+        assert_int_equal(lx_lcm_pub_status(l, 1000 + k, &o), 0);
+        drain(l);
+        assert_int_equal(r.statuses, k + 1);
+        assert_int_equal(r.status.decision.kind, k);
+        assert_true(r.status.decision.relearned);
+    }
+    lx_lcm_record(l, NULL);
+    assert_int_equal(lx_lcm_log_close(log), 0);
+    assert_int_equal(r.bads, 0);
+
+    log = lx_lcm_log_open(path, "r", err, sizeof err);
+    assert_non_null(log);
+    uint8_t last[512];
+    size_t last_len = 0;
+    int k = 0;
+    int64_t t, prev_t = -1;
+    char ch[32];
+    size_t len = 0;
+    /* The log holds each message as published and as received: one of each time. */
+    while (lx_lcm_log_next_raw(log, &t, ch, sizeof ch, last, sizeof last, &len) == 1) {
+        if (t == prev_t) {
+            continue;
+        }
+        prev_t = t;
+        assert_string_equal(ch, LX_LCM_CH_STATUS);
+        assert_int_equal(t, 1000 + k);
+        char want[40];
+        const int n = snprintf(want, sizeof want, "%s+relearn", names[k]);
+        assert_int_equal(last[38], k);
+        assert_memory_equal(last + 39, "\0\0\0", 3); /* the reason's big-endian length */
+        assert_int_equal(last[42], n + 1);          /* with its terminating zero */
+        assert_memory_equal(last + 43, want, (size_t)n + 1u);
+        last_len = len;
+        k++;
+    }
+    assert_int_equal(k, 8);
+    assert_int_equal(lx_lcm_log_close(log), 0);
+    remove(path);
+    last[38] = 8; /* one past RFS_SEEK_TUMBLE */
+    assert_int_equal(lx_lcm_pub_raw(l, 0, LX_LCM_CH_STATUS, last, last_len), 0);
+    drain(l);
+    assert_int_equal(r.statuses, 8);
+    assert_int_equal(r.bads, 1);
+    assert_string_equal(r.bad, "RFS_SEEKER_STATUS: a field is out of range or not finite (state 0)");
+    lx_lcm_close(l);
+}
+
 /* RFS_RSSI_STATUS. Reference bytes from the LCM wire format computed in Python
  * (tests/fuzz/make_corpus.py's lcm_hash of {int64_t utime, int32_t seq} = 0xc77a89abfd4c5ba6,
  * then utime and seq big-endian): utime -5,000,000,123, seq -7. */
@@ -430,6 +500,7 @@ int main(void)
         cmocka_unit_test(bad_url_and_unreadable_log_give_one_line),
         cmocka_unit_test(damaged_file_url_is_one_line),
         cmocka_unit_test(status_string_length_checked_before_decoding),
+        cmocka_unit_test(every_decision_kind_round_trips_with_its_reason),
         cmocka_unit_test(receiver_status_matches_reference_bytes_and_rejects_others),
         cmocka_unit_test(signal_during_wait_is_a_timeout),
     };

@@ -196,7 +196,7 @@ static bool status_of(const rfseek_seeker_status_t *m, rfs_seek_out_t *o)
 {
     memset(o, 0, sizeof *o);
     rfs_seek_decision_t *d = &o->decision;
-    bool ok = m->state >= 0 && m->state <= RFS_SEEK_DRIVING && m->kind >= 0 && m->kind <= RFS_SEEK_EPSILON &&
+    bool ok = m->state >= 0 && m->state <= RFS_SEEK_DRIVING && m->kind >= 0 && m->kind <= RFS_SEEK_TUMBLE &&
               m->prev >= 0 && m->prev <= RFS_DRIVE_BLOCKED && m->faults >= 0 && m->faults <= 0xFFFF &&
               q16_of(m->prediction, &d->prediction) && q16_of(m->mean, &d->mean) &&
               q16_of(m->epsilon, &d->epsilon) && q16_of(m->x, &d->x) && q16_of(m->y, &d->y) &&
@@ -564,13 +564,14 @@ int lx_lcm_pub_wheel(lx_lcm_t *l, int64_t t_us, const rfs_can_wheel_t *w)
 
 static const char *reason_of(const rfs_seek_decision_t *d)
 {
-    static const char *const names[4][2][2] = {
-        {{"none", "none+line-search"}, {"none+relearn", "none+relearn+line-search"}},
-        {{"initial", "initial+line-search"}, {"initial+relearn", "initial+relearn+line-search"}},
-        {{"greedy", "greedy+line-search"}, {"greedy+relearn", "greedy+relearn+line-search"}},
-        {{"epsilon", "epsilon+line-search"}, {"epsilon+relearn", "epsilon+relearn+line-search"}},
+#define REASONS(k) {{k, k "+line-search"}, {k "+relearn", k "+relearn+line-search"}}
+    /* rfs_seek_kind_t's order (rfs_seek_kind_name) */
+    static const char *const names[8][2][2] = {
+        REASONS("none"),  REASONS("initial"),  REASONS("greedy"), REASONS("epsilon"),
+        REASONS("probe"), REASONS("gradient"), REASONS("run"),    REASONS("tumble"),
     };
-    unsigned k = (unsigned)d->kind < 4 ? (unsigned)d->kind : 0;
+#undef REASONS
+    unsigned k = (unsigned)d->kind <= (unsigned)RFS_SEEK_TUMBLE ? (unsigned)d->kind : 0;
     return names[k][d->relearned ? 1 : 0][d->line_search ? 1 : 0];
 }
 

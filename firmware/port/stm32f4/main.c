@@ -35,8 +35,8 @@ static rfs_sample_t s_samples[RFS_APP_MAX_SAMPLES] __attribute__((section(".ccm"
 #define MODEL_BYTES (sizeof(rfs_pathloss_t) > sizeof(rfs_ridge_t) ? sizeof(rfs_pathloss_t) : sizeof(rfs_ridge_t))
 static uint64_t s_model[(MODEL_BYTES + 7u) / 8u];
 /* A fit slice's worst time: 429,409 instructions (make bench-firmware) at 168 MHz, with
- * room for more than one cycle an instruction. */
-#define SLICE_US 5000
+ * room for more than one cycle an instruction; scaled to the clock the board runs at. */
+#define SLICE_US 5000u
 
 /* bxCAN's FIFO-pending interrupts (vector table in startup.c), at the same priority:
  * neither preempts the other. */
@@ -65,6 +65,9 @@ int main(void)
         can_cfg.ts2_tq = 2u;
     }
     rfs_board_time_init(core_hz);
+    /* On the HSI fallback (16 MHz) a slice takes 52.5 ms, longer than a period: none runs
+     * and the periods keep their time (a relearn waits on the periods' own slices). */
+    const uint32_t slice_us = SLICE_US * (RFS_BOARD_SYSCLK_HZ / 1000000u) / (core_hz / 1000000u);
     rfs_board_can_pins();
     const bool can_ok = rfs_bxcan_init(&s_can, (rfs_bxcan_regs_t *)RFS_BXCAN1_BASE, &can_cfg,
                                        NULL, NULL) == 0;
@@ -107,7 +110,7 @@ int main(void)
         /* The period's spare time: slices of a fit the wheels wait for, the CAN queue read
          * between them, none within a slice's time of the next step (docs/FIRMWARE.md,
          * "Learning between periods"). */
-        if (slices < RFS_APP_BACKGROUND_SLICES && rfs_board_now_us() + SLICE_US < next_step) {
+        if (slices < RFS_APP_BACKGROUND_SLICES && rfs_board_now_us() + (int64_t)slice_us < next_step) {
             slices = rfs_app_background(&s_app) ? slices + 1u : RFS_APP_BACKGROUND_SLICES;
         }
         rfs_board_kick();

@@ -121,16 +121,6 @@ static int64_t realtime_us(void)
     return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 }
 
-static const char *kind_name(rfs_seek_kind_t k)
-{
-    switch (k) {
-    case RFS_SEEK_INITIAL: return "initial";
-    case RFS_SEEK_GREEDY: return "greedy";
-    case RFS_SEEK_EPSILON: return "epsilon";
-    default: return "none";
-    }
-}
-
 static void step(daemon_t *d, int64_t now_us)
 {
     if (d->done) {
@@ -207,7 +197,7 @@ static void step(daemon_t *d, int64_t now_us)
                 "decision t=%" PRId64 " n=%" PRIu32 " kind=%s relearn=%d line_search=%d prev=%d pred_q16=%" PRId32
                 " mean_q16=%" PRId32 " eps_q16=%" PRId32 " x_q16=%" PRId32 " y_q16=%" PRId32 " goal_q16=%" PRId32
                 ",%" PRId32 " samples=%u\n",
-                x->t_us, x->iteration, kind_name(x->kind), x->relearned, x->line_search, (int)x->prev,
+                x->t_us, x->iteration, rfs_seek_kind_name(x->kind), x->relearned, x->line_search, (int)x->prev,
                 x->prediction, x->mean, x->epsilon, x->x, x->y, x->goal_x, x->goal_y, (unsigned)x->samples);
     }
 }

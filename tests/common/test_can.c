@@ -570,6 +570,7 @@ static void seek_output_maps_to_status_and_wheels(void **state)
         {RFS_SEEK_NONE, 0}, {RFS_SEEK_INITIAL, 1}, {RFS_SEEK_GREEDY, 2}, {RFS_SEEK_EPSILON, 3},
         {RFS_SEEK_PROBE, 3}, {RFS_SEEK_GRADIENT, 2}, {RFS_SEEK_RUN, 2}, {RFS_SEEK_TUMBLE, 3},
     };
+    s.configured = false; /* the application's, not the output's */
     for (unsigned i = 0; i < sizeof map / sizeof map[0]; i++) {
         out.decision.kind = map[i].k;
         rfs_can_from_seek_out(&out, &s, &w);

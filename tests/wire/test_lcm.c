@@ -77,6 +77,20 @@ static void drain(lx_lcm_t *l)
     }
 }
 
+/* Record everything l publishes and receives into a new temporary log at path (a
+ * mkstemp template, filled in). */
+static lx_lcm_log_t *record_to_temp(lx_lcm_t *l, char *path)
+{
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    char err[200];
+    lx_lcm_log_t *log = lx_lcm_log_open(path, "w", err, sizeof err);
+    assert_non_null(log);
+    lx_lcm_record(l, log);
+    return log;
+}
+
 static void pose_round_trips_exactly_and_heading_is_normalised(void **state)
 {
     (void)state;
@@ -295,13 +309,8 @@ static void status_string_length_checked_before_decoding(void **state)
     rx_t r;
     lx_lcm_t *l = open_memq(&r);
     char path[] = "/tmp/rfs_test_lcm_XXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
     char err[200];
-    lx_lcm_log_t *log = lx_lcm_log_open(path, "w", err, sizeof err);
-    assert_non_null(log);
-    lx_lcm_record(l, log);
+    lx_lcm_log_t *log = record_to_temp(l, path);
     rfs_seek_out_t o;
     memset(&o, 0, sizeof o);
     o.decision.kind = RFS_SEEK_GREEDY;
@@ -350,13 +359,8 @@ static void every_decision_kind_round_trips_with_its_reason(void **state)
     rx_t r;
     lx_lcm_t *l = open_memq(&r);
     char path[] = "/tmp/rfs_test_lcm_XXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
     char err[200];
-    lx_lcm_log_t *log = lx_lcm_log_open(path, "w", err, sizeof err);
-    assert_non_null(log);
-    lx_lcm_record(l, log);
+    lx_lcm_log_t *log = record_to_temp(l, path);
     for (int k = 0; k < 8; k++) {
         rfs_seek_out_t o;
         memset(&o, 0, sizeof o);

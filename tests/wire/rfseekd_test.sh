@@ -205,6 +205,9 @@ if [ $src -eq 0 ] && [ $drc -eq 0 ] && grep -q '"reached": true' "$w/summary-pap
 else
     fail "two-process-run-reaches-source (sim rc $src, rfseekd rc $drc: $(cat "$w/sim-paper.err" "$w/d-paper.err" | head -5))"
 fi
+# The status over LCM has no plan_wait: the summary says unknown (null), not 0 waits.
+grep -q '"slow_decisions": null,' "$w/summary-paper.json" && grep -q '"plan_wait_max": null,' "$w/summary-paper.json" \
+    && pass two-process-plan-wait-unknown || fail "two-process-plan-wait-unknown ($(grep plan_wait "$w/summary-paper.json"))"
 "$d" --map $map --replay "$w/run.lcmlog" --clock-lcm > "$w/replay1.txt" 2>/dev/null
 "$d" --map $map --replay "$w/run.lcmlog" --clock-lcm > "$w/replay2.txt" 2>/dev/null
 if [ -s "$w/live.txt" ] && cmp -s "$w/live.txt" "$w/replay1.txt" && cmp -s "$w/replay1.txt" "$w/replay2.txt"; then

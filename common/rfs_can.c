@@ -392,6 +392,7 @@ void rfs_can_from_seek_out(const rfs_seek_out_t *out, rfs_can_status_t *status, 
     status->line_search = out->decision.line_search;
     status->faults = (uint8_t)out->faults;
     status->iteration = out->decision.iteration;
+    status->configured = false; /* the seeker knows of no CONFIG frame: the application's */
     wheel->left_mm_s = out->left_mm_s;
     wheel->right_mm_s = out->right_mm_s;
     wheel->flags = out->state == RFS_SEEK_DRIVING ? 0u : RFS_CAN_WHEEL_STOP;

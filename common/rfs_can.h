@@ -265,7 +265,8 @@ rfs_can_pose_t rfs_can_pose_from_core(const rfs_pose_t *pose);
 uint8_t rfs_can_status_kind(rfs_seek_kind_t k);
 
 /// Heartbeat and wheel command from one control period's output (a baseline strategy's
-/// decision kinds as greedy or epsilon: docs/CAN.md, "0x180 STATUS").
+/// decision kinds as greedy or epsilon: docs/CAN.md, "0x180 STATUS"); every field is
+/// written, configured false (the application knows whether a CONFIG was applied).
 void rfs_can_from_seek_out(const rfs_seek_out_t *out, rfs_can_status_t *status, rfs_can_wheel_t *wheel);
 
 /// Sender side: one rolling counter per message id.

@@ -174,7 +174,7 @@ typedef struct rfs_can_config {
 /// Controller heartbeat.
 typedef struct rfs_can_status {
     uint8_t state;       ///< rfs_seek_state_t, 0..3
-    uint8_t kind;        ///< rfs_seek_kind_t of the latest decision, 0..3
+    uint8_t kind;        ///< the latest decision's kind, 0..3 (rfs_can_status_kind)
     uint8_t prev;        ///< rfs_drive_status_t: how the previous goal ended, 0..4
     bool relearned;      ///< the latest decision relearnt the model
     bool line_search;    ///< the latest greedy goal came from the line search
@@ -259,8 +259,14 @@ rfs_pose_t rfs_can_pose_to_core(const rfs_can_pose_t *p, int64_t t_us);
 /// Core pose to the bus pose (rounded, saturated).
 rfs_can_pose_t rfs_can_pose_from_core(const rfs_pose_t *pose);
 
+/// The STATUS frame's 2-bit Kind of a decision kind: none, initial, greedy and epsilon as
+/// themselves, a baseline strategy's gradient and run as greedy, probe and tumble as
+/// epsilon (docs/CAN.md, "0x180 STATUS"); a value beyond the kinds as none.
+uint8_t rfs_can_status_kind(rfs_seek_kind_t k);
+
 /// Heartbeat and wheel command from one control period's output (a baseline strategy's
-/// decision kinds as greedy or epsilon: docs/CAN.md, "0x180 STATUS").
+/// decision kinds as greedy or epsilon: docs/CAN.md, "0x180 STATUS"); every field is
+/// written, configured false (the application knows whether a CONFIG was applied).
 void rfs_can_from_seek_out(const rfs_seek_out_t *out, rfs_can_status_t *status, rfs_can_wheel_t *wheel);
 
 /// Sender side: one rolling counter per message id.

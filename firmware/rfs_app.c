@@ -88,7 +88,7 @@ int rfs_app_cfg_choose(rfs_app_cfg_t *cfg, rfs_app_target_t target, rfs_seek_str
                        const rfs_models_entry_t *model, rfs_q16_t p0_min)
 {
     /* meta-global needs a map-wide model radius; the baselines' decision kinds (probe,
-     * gradient, run, tumble) fit neither the STATUS frame's nor the replay's kind field. */
+     * gradient, run, tumble) do not fit the replay's DECISION kind (none .. epsilon). */
     if ((uint32_t)target > (uint32_t)RFS_APP_TARGET_BRIDGE ||
         (strategy != RFS_SEEK_META && strategy != RFS_SEEK_META_PATH) || cfg->built.ops != NULL) {
         return -1;
@@ -364,7 +364,7 @@ rfs_can_err_t rfs_app_on_can(rfs_app_t *a, const rfs_can_frame_t *f, int64_t rx_
     return e;
 }
 
-uint8_t rfs_app_frames(rfs_app_t *a, const rfs_app_out_t *out, rfs_can_frame_t frames[2])
+rfs_can_wheel_t rfs_app_wheel(const rfs_app_out_t *out)
 {
     rfs_can_wheel_t wheel;
     wheel.left_mm_s = out->left_mm_s;
@@ -374,11 +374,17 @@ uint8_t rfs_app_frames(rfs_app_t *a, const rfs_app_out_t *out, rfs_can_frame_t f
     const bool moving = out->state == RFS_SEEK_DRIVING &&
                         (out->faults & 0xFF00u & ~(uint32_t)RFS_APP_FAULT_BAD_FRAME) == 0u;
     wheel.flags = moving ? 0u : RFS_CAN_WHEEL_STOP;
+    return wheel;
+}
+
+uint8_t rfs_app_frames(rfs_app_t *a, const rfs_app_out_t *out, rfs_can_frame_t frames[2])
+{
+    const rfs_can_wheel_t wheel = rfs_app_wheel(out);
 
     rfs_can_status_t st;
     memset(&st, 0, sizeof st);
     st.state = (uint8_t)out->state;
-    st.kind = (uint8_t)out->decision.kind;
+    st.kind = rfs_can_status_kind(out->decision.kind);
     st.prev = (uint8_t)out->decision.prev;
     st.relearned = out->decision.relearned;
     st.line_search = out->decision.line_search;

@@ -282,6 +282,11 @@ bool rfs_app_background(rfs_app_t *a);
 /// the decode result.
 rfs_can_err_t rfs_app_on_can(rfs_app_t *a, const rfs_can_frame_t *f, int64_t rx_us);
 
+/// A step's wheel command as WHEEL_CMD carries it: the speeds, and Stop whenever the
+/// seeker is not driving or a safety stop holds (lost inputs, bus-off, reset; a bad frame
+/// alone stops nothing). rfs_app_frames() and rfseekd's RFS_WHEEL_CMD copy both use it.
+rfs_can_wheel_t rfs_app_wheel(const rfs_app_out_t *out);
+
 /// Encode a step's output as its CAN frames, in sending order: frames[0] = WHEEL_CMD,
 /// frames[1] = STATUS. Advances the rolling counters. Returns 2.
 uint8_t rfs_app_frames(rfs_app_t *a, const rfs_app_out_t *out, rfs_can_frame_t frames[2]);

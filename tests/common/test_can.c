@@ -548,6 +548,8 @@ static void seek_output_maps_to_status_and_wheels(void **state)
     out.decision.relearned = true;
     rfs_can_status_t s;
     rfs_can_wheel_t w;
+    memset(&s, 0x5A, sizeof s); /* every field must be written (UBSan: bools read unset) */
+    memset(&w, 0x5A, sizeof w);
 
     rfs_can_from_seek_out(&out, &s, &w);
 
@@ -558,6 +560,7 @@ static void seek_output_maps_to_status_and_wheels(void **state)
     assert_false(s.line_search);
     assert_int_equal(s.faults, 4);
     assert_int_equal(s.iteration, 42);
+    assert_false(s.configured);
     assert_int_equal(w.left_mm_s, -300);
     assert_int_equal(w.right_mm_s, 450);
     assert_int_equal(w.flags, 0);

@@ -302,6 +302,78 @@ static void test_frames_decode_with_the_protocol_decoders(void **state)
     assert_int_equal(ctr, 1); /* rolling counter */
 }
 
+/* rfseekd's RFS_WHEEL_CMD copy and the WHEEL_CMD frame say Stop alike (docs/CAN.md: the
+ * controller is not driving, or lost inputs, bus-off, a reset stop it; a bad frame alone
+ * does not): the copy used to look at the state only. Byte 0 by hand: counter | Stop << 4. */
+static void test_wheel_stop_is_the_frames(void **state)
+{
+    (void)state;
+    const rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
+    const rfs_app_map_t m = room();
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    const struct { rfs_seek_state_t st; uint16_t faults; uint8_t stop; } cases[] = {
+        {RFS_SEEK_DRIVING, 0, 0},
+        {RFS_SEEK_DRIVING, RFS_APP_FAULT_POSE_LOST, 1},
+        {RFS_SEEK_DRIVING, RFS_APP_FAULT_RSSI_LOST, 1},
+        {RFS_SEEK_DRIVING, RFS_APP_FAULT_BUS_OFF, 1},
+        {RFS_SEEK_DRIVING, RFS_APP_FAULT_RESET, 1},
+        {RFS_SEEK_DRIVING, RFS_APP_FAULT_BAD_FRAME | RFS_SEEK_FAULT_NO_GOAL, 0},
+        {RFS_SEEK_LEARNING, 0, 1},
+    };
+    for (unsigned i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        rfs_app_out_t o;
+        memset(&o, 0, sizeof o);
+        o.state = cases[i].st;
+        o.faults = cases[i].faults;
+        o.left_mm_s = 10;
+        o.right_mm_s = -10;
+        rfs_can_frame_t f[2];
+
+        const rfs_can_wheel_t w = rfs_app_wheel(&o);
+        (void)rfs_app_frames(&s_app, &o, f);
+
+        assert_int_equal(w.flags, cases[i].stop);
+        assert_int_equal(w.left_mm_s, 10);
+        assert_int_equal(w.right_mm_s, -10);
+        assert_int_equal(f[0].data[0], (uint8_t)(i | (unsigned)cases[i].stop << 4));
+    }
+}
+
+/* rfseekd and the STM32 image send STATUS through rfs_app_frames: a baseline's kinds go
+ * out as docs/CAN.md's table says (tumble as epsilon 3, gradient as greedy 2), a value
+ * beyond the kinds as none, not masked to 2 bits (gradient 5 read as initial). Bytes by
+ * hand, CRC-8 from scripts/check_dbc.py's crc8_j1850: state 3, relearned, prev 2 (reached),
+ * iteration 77, counters 0, 1, 2. */
+static void test_status_frame_maps_baseline_kinds(void **state)
+{
+    (void)state;
+    const rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
+    const rfs_app_map_t m = room();
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    static const uint8_t want[3][8] = {
+        {0x30, 0x27, 0x00, 0x4D, 0x00, 0x00, 0x00, 0x39},
+        {0x31, 0x26, 0x00, 0x4D, 0x00, 0x00, 0x00, 0x22},
+        {0x32, 0x24, 0x00, 0x4D, 0x00, 0x00, 0x00, 0x49},
+    };
+    const rfs_seek_kind_t kinds[3] = {RFS_SEEK_TUMBLE, RFS_SEEK_GRADIENT, (rfs_seek_kind_t)8};
+    for (int i = 0; i < 3; i++) {
+        rfs_app_out_t o;
+        memset(&o, 0, sizeof o);
+        o.state = RFS_SEEK_DRIVING;
+        o.decision.iteration = 77;
+        o.decision.relearned = true;
+        o.decision.prev = RFS_DRIVE_REACHED;
+        o.decision.kind = kinds[i];
+        rfs_can_frame_t f[2];
+
+        assert_int_equal(rfs_app_frames(&s_app, &o, f), 2);
+
+        assert_int_equal(f[1].id, 0x180);
+        assert_int_equal(f[1].dlc, 8);
+        assert_memory_equal(f[1].data, want[i], 8);
+    }
+}
+
 static void test_can_inputs_are_decoded_or_counted(void **state)
 {
     (void)state;
@@ -379,6 +451,8 @@ int main(void)
         cmocka_unit_test(test_wheels_stop_within_200_ms_of_lost_inputs_and_resume),
         cmocka_unit_test(test_bus_off_stops_at_once_and_recovers),
         cmocka_unit_test(test_frames_decode_with_the_protocol_decoders),
+        cmocka_unit_test(test_status_frame_maps_baseline_kinds),
+        cmocka_unit_test(test_wheel_stop_is_the_frames),
         cmocka_unit_test(test_can_inputs_are_decoded_or_counted),
         cmocka_unit_test(test_dead_zone_heartbeat_keeps_driving),
         cmocka_unit_test(test_dead_zone_without_heartbeat_stops_within_200_ms),

@@ -205,6 +205,9 @@ if [ $src -eq 0 ] && [ $drc -eq 0 ] && grep -q '"reached": true' "$w/summary-pap
 else
     fail "two-process-run-reaches-source (sim rc $src, rfseekd rc $drc: $(cat "$w/sim-paper.err" "$w/d-paper.err" | head -5))"
 fi
+# The status over LCM has no plan_wait: the summary says unknown (null), not 0 waits.
+grep -q '"slow_decisions": null,' "$w/summary-paper.json" && grep -q '"plan_wait_max": null,' "$w/summary-paper.json" \
+    && pass two-process-plan-wait-unknown || fail "two-process-plan-wait-unknown ($(grep plan_wait "$w/summary-paper.json"))"
 "$d" --map $map --replay "$w/run.lcmlog" --clock-lcm > "$w/replay1.txt" 2>/dev/null
 "$d" --map $map --replay "$w/run.lcmlog" --clock-lcm > "$w/replay2.txt" 2>/dev/null
 if [ -s "$w/live.txt" ] && cmp -s "$w/live.txt" "$w/replay1.txt" && cmp -s "$w/replay1.txt" "$w/replay2.txt"; then
@@ -241,14 +244,21 @@ if grep -q "(strategy meta-path, model pathloss, fit budget 150, fit_early on)\$
 else
     fail "rfseekd-fit-early-with-a-fit-budget ($(tail -1 "$w/fe-150-on.err"))"
 fi
-# The baselines on the Linux port: their decision kinds name themselves, and every status
-# message they publish decodes (one a step, none dropped as out of range).
-for st in chemotaxis plane-gradient; do
+# The baselines on the Linux port: their decision kinds name themselves, every status
+# message they publish decodes (one a step, none dropped as out of range), and their CAN
+# STATUS frames carry docs/CAN.md's Kind codes (decoded in Python from --candump).
+for st in chemotaxis plane-gradient fd-gradient; do
     "$d" --map $map --replay "$w/path.lcmlog" --clock-lcm --strategy $st --lcm memq:// \
-        --log "$w/bl-$st.lcmlog" > "$w/bl-$st.txt" 2> "$w/bl-$st.err" || fail "rfseekd-baseline-$st-run"
+        --log "$w/bl-$st.lcmlog" --candump "$w/bl-$st.candump" > "$w/bl-$st.txt" 2> "$w/bl-$st.err" \
+        || fail "rfseekd-baseline-$st-run"
+    if out=$(/usr/bin/python3 tests/wire/status_kinds.py "$w/bl-$st.candump" "$w/bl-$st.txt"); then
+        pass "rfseekd-baseline-$st-can-status-kinds ($out)"
+    else
+        fail "rfseekd-baseline-$st-can-status-kinds ($(echo "$out" | tr '\n' ' '))"
+    fi
     "$tool" dump "$w/bl-$st.lcmlog" > "$w/bl-$st.dump" 2> "$w/bl-$st.dump.err"
     steps=$(sed -n 's/^rfseekd: \([0-9]*\) steps.*/\1/p' "$w/bl-$st.err")
-    case $st in chemotaxis) kinds="run tumble" ;; *) kinds="gradient" ;; esac
+    case $st in chemotaxis) kinds="run tumble" ;; fd-gradient) kinds="probe" ;; *) kinds="gradient" ;; esac
     ok=1
     for k in $kinds; do grep -q " kind=$k " "$w/bl-$st.txt" || ok=0; done
     if [ $ok -eq 1 ] && [ -n "$steps" ] && [ "$(grep -c '^STATUS ' "$w/bl-$st.dump")" -eq "$steps" ] \

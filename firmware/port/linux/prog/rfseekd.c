@@ -175,8 +175,7 @@ static void step(daemon_t *d, int64_t now_us)
     so.faults = out.faults;
     so.decided = out.decided;
     so.decision = out.decision;
-    rfs_can_wheel_t w = {out.left_mm_s, out.right_mm_s,
-                         (uint8_t)(out.state == RFS_SEEK_DRIVING ? 0u : RFS_CAN_WHEEL_STOP)};
+    const rfs_can_wheel_t w = rfs_app_wheel(&out); /* the WHEEL_CMD frame's, Stop included */
     if (d->lcm) {
         (void)lx_lcm_pub_wheel(d->lcm, now_us, &w);
         // The path-loss model's estimate and uncertainty when that is the model

@@ -373,15 +373,19 @@ rfs_can_pose_t rfs_can_pose_from_core(const rfs_pose_t *pose)
     return p;
 }
 
+uint8_t rfs_can_status_kind(rfs_seek_kind_t k)
+{
+    /* The field's 2 bits hold the meta strategies' kinds; a baseline's directed steps
+     * (gradient, run) go out as greedy, its exploring ones (probe, tumble) as epsilon. */
+    return (uint8_t)(k == RFS_SEEK_GRADIENT || k == RFS_SEEK_RUN ? RFS_SEEK_GREEDY
+                     : k == RFS_SEEK_PROBE || k == RFS_SEEK_TUMBLE ? RFS_SEEK_EPSILON
+                                                                   : k);
+}
+
 void rfs_can_from_seek_out(const rfs_seek_out_t *out, rfs_can_status_t *status, rfs_can_wheel_t *wheel)
 {
     status->state = (uint8_t)out->state;
-    /* The field's 2 bits hold the meta strategies' kinds; a baseline's directed steps
-     * (gradient, run) go out as greedy, its exploring ones (probe, tumble) as epsilon. */
-    const rfs_seek_kind_t k = out->decision.kind;
-    status->kind = (uint8_t)(k == RFS_SEEK_GRADIENT || k == RFS_SEEK_RUN ? RFS_SEEK_GREEDY
-                             : k == RFS_SEEK_PROBE || k == RFS_SEEK_TUMBLE ? RFS_SEEK_EPSILON
-                                                                           : k);
+    status->kind = rfs_can_status_kind(out->decision.kind);
     status->prev = (uint8_t)out->decision.prev;
     status->relearned = out->decision.relearned;
     status->line_search = out->decision.line_search;

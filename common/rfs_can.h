@@ -259,8 +259,12 @@ rfs_pose_t rfs_can_pose_to_core(const rfs_can_pose_t *p, int64_t t_us);
 /// Core pose to the bus pose (rounded, saturated).
 rfs_can_pose_t rfs_can_pose_from_core(const rfs_pose_t *pose);
 
-/// Heartbeat and wheel command from one control period's output (a baseline strategy's
-/// decision kinds as greedy or epsilon: docs/CAN.md, "0x180 STATUS").
+/// A decision kind as STATUS's 2-bit Kind: a baseline strategy's directed steps (gradient,
+/// run) as greedy, its exploring ones (probe, tumble) as epsilon (docs/CAN.md, "0x180 STATUS").
+uint8_t rfs_can_status_kind(rfs_seek_kind_t k);
+
+/// Heartbeat and wheel command from one control period's output (the kind as
+/// rfs_can_status_kind()).
 void rfs_can_from_seek_out(const rfs_seek_out_t *out, rfs_can_status_t *status, rfs_can_wheel_t *wheel);
 
 /// Sender side: one rolling counter per message id.

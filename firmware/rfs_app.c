@@ -378,7 +378,7 @@ uint8_t rfs_app_frames(rfs_app_t *a, const rfs_app_out_t *out, rfs_can_frame_t f
     rfs_can_status_t st;
     memset(&st, 0, sizeof st);
     st.state = (uint8_t)out->state;
-    st.kind = (uint8_t)out->decision.kind;
+    st.kind = rfs_can_status_kind(out->decision.kind);
     st.prev = (uint8_t)out->decision.prev;
     st.relearned = out->decision.relearned;
     st.line_search = out->decision.line_search;

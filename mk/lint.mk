@@ -13,3 +13,4 @@ lint: $(LCM_GEN_HDRS)
 $(eval $(call test_script,layers,scripts/check_layers.sh,))
 # The docs' section links and scenario keys against the code (scripts/check_docs.py).
 $(eval $(call test_script,docs,$(PYTHON) scripts/check_docs.py,))
+$(eval $(call test_script,docs_checker,tests/docs/check_docs_test.sh $(PYTHON),))

@@ -7,8 +7,8 @@
    `X.md ("Heading"`, broken across lines), in README.md and docs/*.md names a file that
    exists and a Markdown heading, or a bold run-in opening a paragraph or bullet, that is
    or begins with "Heading"; every `docs/X.md` named exists.
-2. Scenario keys: every key host_sim/hs_scenario.c accepts is named in the page that
-   documents its section (faults: docs/FAULTS.md, radio: docs/RADIO_MODEL.md or
+2. Scenario keys: every key host_sim/hs_scenario.c accepts is named, in a code span or a
+   fenced block, in the page that documents its section (faults: docs/FAULTS.md, radio: docs/RADIO_MODEL.md or
    docs/SIMULATOR.md, the rest: docs/SIMULATOR.md); every key in SIMULATOR.md's example
    scenario is accepted; every key named in its `seek:` paragraph is a seek key.
 
@@ -84,6 +84,14 @@ def scenario_keys(root):
     return out
 
 
+def named_code(text):
+    """The code a page names keys in: its `code spans` and its fenced blocks (without their
+    comments): a key that is an English word ("seed", "kind") is not named by prose."""
+    blocks = re.findall(r'```[^\n]*\n(.*?)```', text, re.S)
+    spans = re.findall(r'`([^`\n]+)`', re.sub(r'```.*?```', ' ', text, flags=re.S))
+    return [re.sub(r'#.*', '', b) for b in blocks] + spans
+
+
 def check_keys(root, n):
     bad = []
     keys = scenario_keys(root)
@@ -95,9 +103,11 @@ def check_keys(root, n):
     for where, ks in sorted(keys.items()):
         docs = pages.get(where, ['docs/SIMULATOR.md'] +
                          (['docs/RADIO_MODEL.md'] if where.startswith('radio') else []))
-        text = ' '.join(read(root, d) for d in docs)
-        for k in ks:
-            if not re.search(r'(?<![\w.-])%s(?![\w-])' % re.escape(k), text):
+        code = named_code(' '.join(read(root, d) for d in docs))
+        for k in ks:  # bare, or qualified by its section (`stop.goal`)
+            key = r'(?<![\w.-])(?:(?:\w+\.)*%s\.)?%s(?![\w-])' % (re.escape(where.split('.')[-1]),
+                                                                 re.escape(k))
+            if not any(re.search(key, c) for c in code):
                 bad.append('%s: key %s.%s accepted by hs_scenario.c is not named'
                            % (' or '.join(docs), where, k))
     every = set(k for ks in keys.values() for k in ks)

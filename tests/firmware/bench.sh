@@ -58,10 +58,12 @@ printf '%s\n%s\n' "$out" "$models" | awk -F'\t' '
             wl = int((m[ws] - me) / mper + 0.5); pp = int((m["predict_pathloss"] - me) / mper + 0.5)
             printf "driving period with a path-loss warm slice (%d units, 1,000 samples: %d) + the drive, tree grown (%d) + a prediction (%d): %s\n", wb, wl, ins[dg], pp, verdict(wl + ins[dg] + pp)
             # fit_early near a goal: every driving period also asks a prediction and the 1 s
-            # mean (rfs_seek_fit_early_asks), and the recheck a mean beside its prediction; each
-            # mean at its worst, scanning the window.
+            # mean (rfs_seek_fit_early_asks), and the recheck a mean beside its prediction; when
+            # the ask fails, the relearn begins (rfs_seek_fit_early_begin) with a prediction and
+            # a mean of its refutation (the goal within half a step of the maximum); each mean
+            # at its worst, scanning the window.
             am = ins["phase_averaging_mean_scan"]; if (ins["phase_averaging_mean"] > am) am = ins["phase_averaging_mean"]
-            printf "the same near a goal with fit_early: + a second prediction and two 1 s means (%d each): %s\n", am, verdict(wl + ins[dg] + 2 * pp + 2 * am)
+            printf "the same near a goal with fit_early: + two more predictions and three 1 s means (%d each): %s\n", am, verdict(wl + ins[dg] + 3 * pp + 3 * am)
         } else { printf "path-loss warm slice: not measured\n"; bad = bad " models_warm" }
         printf "boot periods (reachability flood fill in slices of %d points, then the first fit, first_iteration, %d periods): %s\n", 1000, v["first_iteration_periods"], verdict(ins["first_iteration"])
         # The scenario checks: each decision relearnt and decided as described, and the

@@ -300,6 +300,18 @@ static void test_frames_decode_with_the_protocol_decoders(void **state)
     rfs_app_frames(&s_app, &o, f);
     assert_int_equal(rfs_can_unpack_wheel(&f[0], &w, &ctr), RFS_CAN_OK);
     assert_int_equal(ctr, 1); /* rolling counter */
+    /* A baseline's kinds in the 2-bit Kind field (docs/CAN.md, "0x180 STATUS"): gradient
+     * and run as 2 (greedy), probe and tumble as 3 (epsilon), not their low two bits. */
+    const struct { rfs_seek_kind_t k; uint8_t want; } kinds[] = {
+        {RFS_SEEK_NONE, 0}, {RFS_SEEK_INITIAL, 1}, {RFS_SEEK_GREEDY, 2}, {RFS_SEEK_EPSILON, 3},
+        {RFS_SEEK_PROBE, 3}, {RFS_SEEK_GRADIENT, 2}, {RFS_SEEK_RUN, 2}, {RFS_SEEK_TUMBLE, 3},
+    };
+    for (unsigned i = 0; i < sizeof kinds / sizeof kinds[0]; i++) {
+        o.decision.kind = kinds[i].k;
+        rfs_app_frames(&s_app, &o, f);
+        assert_int_equal(rfs_can_unpack_status(&f[1], &st, &ctr), RFS_CAN_OK);
+        assert_int_equal(st.kind, kinds[i].want);
+    }
 }
 
 /* rfseekd's RFS_WHEEL_CMD copy and the WHEEL_CMD frame say Stop alike (docs/CAN.md: the

@@ -50,7 +50,7 @@ TOOL = os.path.join(BUILD, "tests", "wire", "lcm_tool")
 READER = [sys.executable, os.path.join(ROOT, "scripts", "lcm_log.py")]
 ROUTE = os.path.join(ROOT, "scripts", "lcm_route.sh")
 MAP = os.path.join(ROOT, "scenarios", "maps", "office.yaml")
-KINDS = {0: "none", 1: "initial", 2: "greedy", 3: "epsilon"}  # rfseekd.c's kind_name()
+KINDS = {0: "none", 1: "initial", 2: "greedy", 3: "epsilon"}  # the meta kinds (rfs_seek_kind_name)
 
 
 def walk(path):

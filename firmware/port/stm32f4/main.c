@@ -11,7 +11,7 @@
  *
  * Safety: the application zeroes the wheels when pose or RSSI frames stop for 150 ms
  * and while bxCAN is bus-off (the driver also aborts pending mailboxes then, so no stale
- * command goes out after recovery). The independent watchdog resets the MCU 100 ms after
+ * command goes out after recovery). The independent watchdog resets the MCU 500 ms after
  * the loop stops; after any reset the first command sent is zero (RFS_APP_FAULT_RESET).
  */
 #include <stddef.h>
@@ -77,8 +77,11 @@ int main(void)
     cfg.model_state_bytes = (uint32_t)sizeof s_model;
     cfg.models[RFS_CAN_MODEL_PATHLOSS] = &rfs_models_pathloss;
     if (rfs_app_init(&s_app, &cfg, &rfs_fw_map) != 0 || !can_ok) {
+        /* Unusable (e.g. bxCAN never left initialisation: no 11 recessive bits on RX): the
+         * watchdog, never kicked, resets the board to try again. Not started, it would not:
+         * a reset leaves the independent watchdog off. */
+        rfs_board_watchdog_start();
         for (;;) {
-            /* Unusable: no watchdog kick, the board resets and tries again. */
         }
     }
     NVIC_ISER0 = (1u << IRQ_CAN1_RX0) | (1u << IRQ_CAN1_RX1);

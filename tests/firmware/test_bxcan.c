@@ -299,7 +299,7 @@ static void test_rx_irq_enables_the_fifo_interrupts(void **state)
     assert_int_equal(hw->r.ier, 0u); /* polled: no interrupt */
     c.rx_irq = true;
     assert_int_equal(rfs_bxcan_init(d, &hw->r, &c, fake_tick, hw), 0);
-    /* FMPIE0 (bit 1) | FMPIE1 (bit 4) = 0x12 (RM0090 32.9.5, CAN_IER). */
+    /* FMPIE0 (bit 1) | FMPIE1 (bit 4) = 0x12 (RM0090 32.9.2, CAN_IER). */
     assert_int_equal(hw->r.ier, 0x12u);
 }
 

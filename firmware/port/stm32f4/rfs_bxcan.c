@@ -220,7 +220,7 @@ static bool fifo_take(rfs_bxcan_t *d, unsigned q, rfs_can_frame_t *f)
         const uint32_t hi = m->rdhr;
         *rfr = RFS_BXCAN_RFR_RFOM; /* release the output mailbox */
         hw_sync(d);
-        /* RFOM reads 1 until the hardware has moved the next frame in (RM0090 32.9.4):
+        /* RFOM reads 1 until the hardware has moved the next frame in (RM0090 32.9.2, CAN_RFxR):
          * read FMP again only then, or the same frame is read twice. */
         (void)wait_bits(d, rfr, RFS_BXCAN_RFR_RFOM, 0u);
         const uint8_t dlc = (uint8_t)(rdtr & 0xFu);

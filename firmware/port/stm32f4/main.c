@@ -113,7 +113,8 @@ int main(void)
         /* The period's spare time: slices of a fit the wheels wait for, the CAN queue read
          * between them, none within a slice's time of the next step (docs/FIRMWARE.md,
          * "Learning between periods"). */
-        if (slices < RFS_APP_BACKGROUND_SLICES && rfs_board_now_us() + (int64_t)slice_us < next_step) {
+        if (slices < RFS_APP_BACKGROUND_SLICES &&
+            rfs_board_now_us() + (int64_t)slice_us < next_step) {
             slices = rfs_app_background(&s_app) ? slices + 1u : RFS_APP_BACKGROUND_SLICES;
         }
         rfs_board_kick();

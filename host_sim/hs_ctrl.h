@@ -56,6 +56,9 @@ typedef struct hs_ctrl {
     /// Optional (may be NULL): the per-source fits when the controller's model runs as one
     /// fit per source (rfs_models_per_source(): pathloss under bridge), else NULL.
     const rfs_fields_t *(*fields)(void *self);
+    /// Optional (may be NULL): the path-loss estimate of a controller that reports it
+    /// without its model's state (over LCM); false when it has none. Else `pathloss`'s.
+    bool (*estimate)(void *self, rfs_pathloss_est_t *est);
 } hs_ctrl_t;
 
 /// Configuration of the in-process controller over rfs_seek.

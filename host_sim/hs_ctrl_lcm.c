@@ -23,6 +23,8 @@ typedef struct ctrl_lcm {
     rfs_seek_out_t status;       /* newest status */
     int64_t status_t_us;         /* its step time */
     bool have_status;
+    rfs_pathloss_est_t est;      /* the path-loss estimate the newest status carried */
+    bool have_est;
     uint32_t timeouts;
 } ctrl_lcm_t;
 
@@ -61,6 +63,24 @@ static void on_status(void *ctx, int64_t t_us, const rfs_seek_out_t *out)
     s->status = *out;
     s->status_t_us = t_us;
     s->have_status = true;
+    s->have_est = false; /* until on_estimate: this status may carry none */
+}
+
+static void on_estimate(void *ctx, int64_t t_us, const rfs_pathloss_est_t *est)
+{
+    (void)t_us;
+    ctrl_lcm_t *s = ctx;
+    s->est = *est;
+    s->have_est = true;
+}
+
+static bool lcm_estimate(void *self, rfs_pathloss_est_t *est)
+{
+    const ctrl_lcm_t *s = self;
+    if (s->have_est) {
+        *est = s->est;
+    }
+    return s->have_est;
 }
 
 /* One stderr line, "PROG: " first when the program gave its name (hs_ctrl_lcm_cfg_t). */
@@ -185,6 +205,7 @@ int hs_ctrl_lcm_open(hs_ctrl_t *c, const hs_ctrl_lcm_cfg_t *cfg, char *err, size
     memset(&h, 0, sizeof h);
     h.ctx = s;
     h.on_status = on_status;
+    h.on_estimate = on_estimate;
     h.on_can = cfg->can_iface ? NULL : on_can;
     h.on_bad = on_bad;
     s->lcm = lx_lcm_open(cfg->lcm_url, &h, err, errlen);
@@ -212,6 +233,7 @@ int hs_ctrl_lcm_open(hs_ctrl_t *c, const hs_ctrl_lcm_cfg_t *cfg, char *err, size
     c->step = cb_step;
     c->predict = NULL;
     c->close = cb_close;
+    c->estimate = lcm_estimate; /* the status's; the model stays in the controller */
     return 0;
 }
 

@@ -93,6 +93,9 @@ static double cpu_s(void)
 /// model is "pathloss" and has one.
 static bool pathloss_estimate(const hs_ctrl_t *ctrl, rfs_pathloss_est_t *est)
 {
+    if (ctrl->estimate) {
+        return ctrl->estimate(ctrl->self, est);
+    }
     const rfs_pathloss_t *pl = ctrl->pathloss ? ctrl->pathloss(ctrl->self) : NULL;
     return pl && rfs_pathloss_estimate(pl, est);
 }

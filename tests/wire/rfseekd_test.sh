@@ -228,6 +228,16 @@ if [ $src -eq 0 ] && [ $drc -eq 0 ] && grep -q '"reached": true' "$w/summary-pat
 else
     fail "two-process-meta-path-pathloss-reaches-source (sim rc $src, rfseekd rc $drc: $(cat "$w/sim-path.err" "$w/d-path.err" | tail -3))"
 fi
+# The path-loss estimate crosses LCM: rfseek-sim-lcm's summary holds the one the last status
+# in rfseekd's log carried (decoded by scripts/lcm_log.py).
+est_log=$(/usr/bin/python3 scripts/lcm_log.py "$w/path.lcmlog" --channel RFS_SEEKER_STATUS | tail -1 \
+    | /usr/bin/python3 -c 'import json, sys; m = json.loads(sys.stdin.read())["msg"]
+print("%.3f %.3f" % (m["est_x"], m["est_y"]) if m["est_valid"] else "none")')
+est_sum=$(/usr/bin/python3 -c 'import json, sys; s = json.load(open(sys.argv[1]))
+print("none" if s["est_src_x_m"] is None else "%.3f %.3f" % (s["est_src_x_m"], s["est_src_y_m"]))' \
+    "$w/summary-path.json")
+[ "$est_log" != none ] && [ "$est_log" = "$est_sum" ] && pass "two-process-estimate-in-summary ($est_sum)" \
+    || fail "two-process-estimate-in-summary (log: $est_log, summary: $est_sum)"
 # --fit-early reaches the seeker with a fit budget (the path-loss model's MCU one, 150) and
 # changes the decisions made on the same inputs; whole fits ignore it.
 for fe in on off; do

@@ -34,6 +34,9 @@ typedef struct rx {
     int64_t rx_t;
     uint32_t rx_seq;
     int rxs;
+    rfs_pathloss_est_t est;
+    int64_t est_t;
+    int ests;
 } rx_t;
 
 static void on_pose(void *c, const rfs_pose_t *p) { rx_t *r = c; r->pose = *p; r->poses++; }
@@ -54,10 +57,12 @@ static void on_bad(void *c, const char *why)
 }
 
 static void on_receiver(void *c, int64_t t, uint32_t q) { rx_t *r = c; r->rx_t = t; r->rx_seq = q; r->rxs++; }
+static void on_estimate(void *c, int64_t t, const rfs_pathloss_est_t *e) { rx_t *r = c; r->est = *e; r->est_t = t; r->ests++; }
 
 static lx_lcm_handlers_t handlers(rx_t *r)
 {
-    lx_lcm_handlers_t h = {r, on_pose, on_rssi, on_clock, on_wheel, on_status, on_can, on_bad, on_receiver};
+    lx_lcm_handlers_t h = {r,      on_pose, on_rssi,     on_clock,   on_wheel,
+                           on_status, on_can, on_bad, on_receiver, on_estimate};
     return h;
 }
 
@@ -413,6 +418,45 @@ static void every_decision_kind_round_trips_with_its_reason(void **state)
     lx_lcm_close(l);
 }
 
+/* A status's path-loss estimate reaches on_estimate after on_status, value for value
+ * (Q16.16 through the message's doubles exactly); a status without one calls only
+ * on_status. */
+static void status_estimate_reaches_its_handler(void **state)
+{
+    (void)state;
+    rx_t r;
+    lx_lcm_t *l = open_memq(&r);
+    rfs_seek_out_t o;
+    memset(&o, 0, sizeof o);
+    o.decision.kind = RFS_SEEK_GREEDY;
+    rfs_pathloss_est_t e;
+    memset(&e, 0, sizeof e);
+    e.sx = 1802240;   /* 27.5 m */
+    e.sy = -745472;   /* -11.375 m */
+    e.n = 196609;     /* 3 + 2^-16 */
+    e.w = 327680;     /* 5 dB */
+    e.p0 = -2621441;  /* -40 dB - 2^-16 */
+    e.rms = 65536 * 3 + 1;
+    e.spread_m2 = 65536 * 12;
+    assert_int_equal(lx_lcm_pub_status_est(l, 5000, &o, &e, NULL), 0);
+    drain(l);
+    assert_int_equal(r.statuses, 1);
+    assert_int_equal(r.ests, 1);
+    assert_int_equal(r.est_t, 5000);
+    assert_int_equal(r.est.sx, e.sx);
+    assert_int_equal(r.est.sy, e.sy);
+    assert_int_equal(r.est.n, e.n);
+    assert_int_equal(r.est.w, e.w);
+    assert_int_equal(r.est.p0, e.p0);
+    assert_int_equal(r.est.rms, e.rms);
+    assert_int_equal(r.est.spread_m2, e.spread_m2);
+    assert_int_equal(lx_lcm_pub_status(l, 6000, &o), 0);
+    drain(l);
+    assert_int_equal(r.statuses, 2);
+    assert_int_equal(r.ests, 1);
+    lx_lcm_close(l);
+}
+
 /* RFS_RSSI_STATUS. Reference bytes from the LCM wire format computed in Python
  * (tests/fuzz/make_corpus.py's lcm_hash of {int64_t utime, int32_t seq} = 0xc77a89abfd4c5ba6,
  * then utime and seq big-endian): utime -5,000,000,123, seq -7. */
@@ -505,6 +549,7 @@ int main(void)
         cmocka_unit_test(damaged_file_url_is_one_line),
         cmocka_unit_test(status_string_length_checked_before_decoding),
         cmocka_unit_test(every_decision_kind_round_trips_with_its_reason),
+        cmocka_unit_test(status_estimate_reaches_its_handler),
         cmocka_unit_test(receiver_status_matches_reference_bytes_and_rejects_others),
         cmocka_unit_test(signal_during_wait_is_a_timeout),
     };

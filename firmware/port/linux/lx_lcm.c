@@ -253,10 +253,20 @@ static void on_status_msg(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const c
         bad(s, h, ch, "a field is out of range or not finite (state %.0f)", m.state);
         return;
     }
+    /* Its fields were checked by est_ok() (status_of). */
+    rfs_pathloss_est_t est;
+    memset(&est, 0, sizeof est);
+    const bool have_est = m.est_valid && q16_of(m.est_x, &est.sx) && q16_of(m.est_y, &est.sy) &&
+                          q16_of(m.est_n, &est.n) && q16_of(m.est_w, &est.w) &&
+                          q16_of(m.est_p0, &est.p0) && q16_of(m.est_rms, &est.rms) &&
+                          q16_of(m.est_area, &est.spread_m2);
     int64_t t = m.utime;
     rfseek_seeker_status_t_decode_cleanup(&m);
     good(s);
     h->on_status(h->ctx, t, &o);
+    if (have_est && h->on_estimate) {
+        h->on_estimate(h->ctx, t, &est);
+    }
 }
 
 static void on_can_msg(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const char *ch, const void *data, int len)

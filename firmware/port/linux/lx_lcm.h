@@ -47,6 +47,9 @@ typedef struct lx_lcm_handlers {
     /// RFS_RSSI_STATUS: the receiver was listening up to capture time t_us (a heartbeat;
     /// seq is the sender's heartbeat count).
     void (*on_receiver)(void *ctx, int64_t t_us, uint32_t seq);
+    /// With on_status: the path-loss estimate a status carried (est_valid), delivered
+    /// after on_status for the same message. May be NULL.
+    void (*on_estimate)(void *ctx, int64_t t_us, const rfs_pathloss_est_t *est);
 } lx_lcm_handlers_t;
 
 /// Receive counters.

@@ -84,8 +84,16 @@ static void on_bad(void *ctx, const char *why)
     fuzz_check_err_line(why);
 }
 
-static const lx_lcm_handlers_t k_h = {NULL,     on_pose, on_rssi, on_clock,   on_wheel,
-                                      on_status, on_can, on_bad, on_receiver};
+/* A delivered estimate passed the decoder's checks: residual and area not negative. */
+static void on_estimate(void *ctx, int64_t t_us, const rfs_pathloss_est_t *est)
+{
+    (void)ctx;
+    (void)t_us;
+    if (est->rms < 0 || est->spread_m2 < 0) { abort(); }
+}
+
+static const lx_lcm_handlers_t k_h = {NULL,      on_pose, on_rssi, on_clock,    on_wheel,
+                                      on_status, on_can,  on_bad,  on_receiver, on_estimate};
 static lx_lcm_t *g_lcm;
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

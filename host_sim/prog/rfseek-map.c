@@ -49,7 +49,7 @@ static const char k_usage[] =
     "  --bench N      plan between N random pairs of legal lattice points (seeded) and\n"
     "                 print the planner's median time, expansions and queue use, and the\n"
     "                 median time to derive the legal grid\n"
-    "  --help         this text\n"
+    "  -h, --help     this text\n"
     "Exit 0 on success, 1 on a bad map or I/O error, 2 on bad options, 3 when --mcu finds\n"
     "that the map does not fit (the other outputs are written all the same).\n";
 

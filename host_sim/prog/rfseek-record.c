@@ -262,7 +262,7 @@ static int parse_window(const char *s, window_t *w)
     }
     const char *s2 = end + 1;
     const double b = strtod(s2, &end);
-    if (end == s2 || *end != '\0' || a < 0 || b <= a || b > 1e6) {
+    if (end == s2 || *end != '\0' || !(a >= 0) || !(b > a) || b > 1e6) { /* NaN: refused */
         return -1;
     }
     w->t0_us = (int64_t)(a * 1e6 + 0.5);
@@ -357,13 +357,18 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
 {
     char *end;
     switch (c) {
-    case 'o': o->out_path = optarg; break;
-    case 'l': o->live_path = optarg; break;
-    case 'c': o->candump_path = optarg; break;
+    case 'o':
+    case 'l':
+    case 'c':
+        if (*optarg == '\0') {
+            die_opt(c == 'o' ? "-o/--out" : c == 'l' ? "--live-out" : "--candump", optarg);
+        }
+        *(c == 'o' ? &o->out_path : c == 'l' ? &o->live_path : &o->candump_path) = optarg;
+        break;
     case 's':
         errno = 0;
-        o->seed = strtoull(optarg, &end, 0);
-        if (errno != 0 || end == optarg || *end != '\0') {
+        o->seed = strtoull(optarg, &end, 10); /* "-1" would wrap, "010" be octal */
+        if (errno != 0 || end == optarg || *end != '\0' || optarg[0] == '-') {
             die_opt("--seed", optarg);
         }
         o->have_seed = true;
@@ -380,7 +385,7 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
     case 'b': add_window(rec->busoff, &rec->nbusoff, "--bus-off", optarg); break;
     case 'f': {
         errno = 0;
-        const unsigned long v = strtoul(optarg, &end, 0);
+        const unsigned long v = strtoul(optarg, &end, 10);
         if (errno != 0 || end == optarg || *end != '\0' || v > 100000ul) {
             die_opt("--fit-budget", optarg);
         }
@@ -389,7 +394,7 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
     }
     case 'r': {
         const double t = strtod(optarg, &end);
-        if (rec->nreset == MAX_WINDOWS || end == optarg || *end != '\0' || t < 0 || t > 1e6) {
+        if (rec->nreset == MAX_WINDOWS || end == optarg || *end != '\0' || !(t >= 0 && t <= 1e6)) {
             die_opt("--reset", optarg);
         }
         rec->reset_us[rec->nreset++] = (int64_t)(t * 1e6 + 0.5);

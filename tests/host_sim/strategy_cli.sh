@@ -90,6 +90,19 @@ ref_ridge.py|/nonexistent.txt out.txt|/nonexistent.txt: No such file or director
 ref_xoshiro.py|1x|invalid literal for int()
 gen_captures.py|--bogus|usage: gen_captures.py OUTDIR
 LIST
+# The shell scripts: a bad argument is one line on stderr, exit 1, nothing written.
+while IFS='|' read -r script args want; do
+    # shellcheck disable=SC2086
+    bash "scripts/$script" $args >"$tmp/o" 2>"$tmp/e"
+    rc=$?
+    check "script-bad-arg-$script-${args%% *}" '[ $rc -eq 1 ] && [ "$(wc -l <"$tmp/e")" -eq 1 ] && [ ! -s "$tmp/o" ] && [ ! -e "$tmp/id" ] && grep -q -- "$want" "$tmp/e"'
+done <<LIST
+fw_budget.sh||usage: fw_budget.sh ELF
+fw_budget.sh|/nonexistent.elf|fw_budget.sh: /nonexistent.elf: no such file
+check_core_symbols.sh|nm|usage: check_core_symbols.sh NM LIB
+identity.sh|/nonexistent $tmp/id 1..1|identity.sh: /nonexistent: not an executable
+identity.sh|$sim $tmp/id 5|identity.sh: SEEDS: expected A..B, got '5'
+LIST
 # argparse's errors: one line (not its usage as well), exit 2.
 /usr/bin/python3 scripts/check_docs.py --bogus >"$tmp/o" 2>"$tmp/e"
 check script-argparse-one-line '[ $? -eq 2 ] && [ "$(wc -l <"$tmp/e")" -eq 1 ] && grep -q "^check_docs.py: unrecognized arguments: --bogus" "$tmp/e"'

@@ -496,7 +496,7 @@ static int parse_opts(int argc, char **argv, opts_t *o)
         return 2;
     }
     if (!(o->res > 0) || !(o->grid > 0)) {
-        lx_err_print(PROG, "--res and --grid must be > 0");
+        lx_err_print(PROG, "%s: must be > 0 metres", o->res > 0 ? "--grid" : "--res");
         return 2;
     }
     if (o->crop != NULL && !lx_map_save_image_path(o->crop, o->crop_image, sizeof(o->crop_image))) {

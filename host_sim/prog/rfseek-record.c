@@ -479,6 +479,21 @@ static int parse_options(int argc, char **argv, options_t *o, recorder_t *rec)
      * it stays quiet and the one line is ours. A leading ':' tells a missing value (':')
      * from an unknown option ('?'). */
     static const char shortopts[] = ":o:h";
+    /* getopt_long takes any unambiguous prefix ("--se 3" for --seed): only the names
+     * --help lists are options. A value given apart (-o X, --seed X) is skipped. */
+    for (int i = 1; i < argc && strcmp(argv[i], "--") != 0; i++) {
+        const char *a = argv[i];
+        const size_t n = strncmp(a, "--", 2) == 0 ? strcspn(a + 2, "=") : 0;
+        const struct option *m = NULL;
+        for (size_t k = 0; n > 0 && opts[k].name != NULL; k++) {
+            m = strlen(opts[k].name) == n && strncmp(opts[k].name, a + 2, n) == 0 ? &opts[k] : m;
+        }
+        if (n > 0 && m == NULL) {
+            lx_err_print(PROG, "unknown option '%s' (see --help)", a);
+            return 2;
+        }
+        i += (strcmp(a, "-o") == 0 || (m != NULL && m->has_arg == required_argument && a[2 + n] == '\0'));
+    }
     opterr = 0;
     int c;
     while ((c = getopt_long(argc, argv, shortopts, opts, NULL)) != -1) {

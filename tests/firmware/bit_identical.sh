@@ -214,6 +214,7 @@ one_err record-empty-candump rfseek-record 2 "--candump: bad value ''" $scn -o "
 # getopt_long's prefixes ("--se" for --seed) are not options: --help lists whole names.
 one_err record-prefix-option rfseek-record 2 "unknown option '--se'" $scn -o "$tmp/nl.rfsr" --se 1
 one_err record-prefix-flag rfseek-record 2 "unknown option '--config'" $scn -o "$tmp/nl.rfsr" --config --max-time 0.5
+one_err replay-fit-budget-units rfseek-replay 2 "--fit-budget: expected work units in [0, 100000], got '5x'" "$tmp/in.rfsr" --fit-budget 5x -o "$tmp/nl.rfso"
 one_err replay-empty-out rfseek-replay 2 "-o: empty value" "$tmp/in.rfsr" -o ""
 one_err replay-empty-map rfseek-replay 2 "--map: empty value" "$tmp/in.rfsr" --map "" -o "$tmp/nl.rfso"
 "$bin/rfseek-record" $scn -o "$tmp/s010.rfsr" --seed 010 --max-time 0.5 >/dev/null 2>&1

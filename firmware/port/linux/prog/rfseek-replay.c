@@ -265,7 +265,7 @@ static int parse_ctl(options_t *o, const char *a, const char *v)
     } else {
         const unsigned long n = strtoul(v, &end, 10);
         if (*v == '\0' || *v == '-' || *end != '\0' || errno != 0 || n > 100000ul) {
-            lx_err_print(PROG, "--fit-budget: expected samples in [0, 100000], got '%s'", v);
+            lx_err_print(PROG, "--fit-budget: expected work units in [0, 100000], got '%s'", v);
             return 2;
         }
         o->fit_budget = (uint32_t)n;

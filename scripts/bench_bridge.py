@@ -174,6 +174,7 @@ def main():
     ap.add_argument("--from", dest="from_dir", help="write from the tables --keep kept")
     ap.add_argument("--only", choices=[c[2] for c in CONFIGS],
                     help="with --keep: run only this configuration's tables, write nothing")
+    ap.error = lambda msg: ap.exit(2, "%s: %s (see --help)\n" % (ap.prog, msg))  # one line, no usage
     a = ap.parse_args()
     if a.smoke:
         a.seeds, a.no_write = "1..1", True

@@ -153,6 +153,7 @@ def main():
                     help="seeds 1..2, exact poses and AMCL-like on the default floor, the "
                          "section written to a temporary copy and checked; prints PASS/FAIL "
                          "bench-drive-smoke")
+    ap.error = lambda msg: ap.exit(2, "%s: %s (see --help)\n" % (ap.prog, msg))  # one line, no usage
     a = ap.parse_args()
     noise = NOISE
     if a.smoke:

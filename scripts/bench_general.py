@@ -222,6 +222,7 @@ def main():
     ap.add_argument("--only", default="",
                     help="run only this configuration (p: meta-path + pathloss, r: meta + ridge; "
                          "needs --no-write)")
+    ap.error = lambda msg: ap.exit(2, "%s: %s (see --help)\n" % (ap.prog, msg))  # one line, no usage
     a = ap.parse_args()
     if a.only not in ("", "p", "r"):
         sys.exit(f"bench_general: --only: expected p or r, not {a.only!r}")
@@ -234,8 +235,10 @@ def main():
         sys.exit("bench_general: --held-out-only: only placement seed 1 has held-out draws")
     if not (2 <= a.placements <= 100 and a.placements % 2 == 0):
         sys.exit("bench_general: --placements: expected an even number from 2 to 100")
-    if not re.fullmatch(r"\d+\.\.\d+", a.seeds):
-        sys.exit("bench_general: --seeds: expected A..B")
+    if not re.fullmatch(r"\d+\.\.\d+", a.seeds) or int(a.seeds.split("..")[0]) > int(a.seeds.split("..")[1]):
+        sys.exit("bench_general: --seeds: expected A..B with A <= B")
+    if not 1 <= a.jobs <= 1024:  # rfseek-sim's range: refused here, not in every batch
+        sys.exit("bench_general: --jobs: expected a number from 1 to 1024")
     floors = a.floors.split(",")
     for f in floors:
         if f not in REAL + SYNTHETIC:

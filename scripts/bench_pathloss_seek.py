@@ -182,7 +182,10 @@ def main():
                          "...'; needs --no-write)")
     ap.add_argument("--only-pathloss", action="store_true",
                     help="run only the meta-path + pathloss column, a line a row (needs --no-write)")
+    ap.error = lambda msg: ap.exit(2, "%s: %s (see --help)\n" % (ap.prog, msg))  # one line, no usage
     a = ap.parse_args()
+    if not os.access(a.sim, os.X_OK):
+        sys.exit(f"bench_pathloss_seek: {a.sim}: not an executable (make all)")
     if (a.seek or a.only_pathloss) and not a.no_write:
         sys.exit("bench_pathloss_seek: --seek and --only-pathloss need --no-write "
                  "(RESULTS.md holds the presets)")

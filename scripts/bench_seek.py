@@ -498,6 +498,7 @@ def main():
     ap.add_argument("--smoke", action="store_true",
                     help="2 seeds, default scenario only, output to a temporary directory; "
                          "prints PASS/FAIL bench-seek-smoke")
+    ap.error = lambda msg: ap.exit(2, "%s: %s (see --help)\n" % (ap.prog, msg))  # one line, no usage
     args = ap.parse_args()
     if not os.access(args.bin, os.X_OK):
         sys.stderr.write("bench_seek.py: %s: not an executable (build it first)\n" % args.bin)

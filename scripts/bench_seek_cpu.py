@@ -38,6 +38,7 @@ def main():
     ap.add_argument("old", help="rfseek-sim before")
     ap.add_argument("new", help="rfseek-sim after")
     ap.add_argument("--seeds", type=int, default=10, help="seeds 1..N of every batch")
+    ap.error = lambda msg: ap.exit(2, "%s: %s (see --help)\n" % (ap.prog, msg))  # one line, no usage
     args = ap.parse_args()
     for binp in (args.old, args.new):
         if not os.access(binp, os.X_OK):

@@ -135,6 +135,7 @@ def main():
     ap.add_argument("seeds")
     ap.add_argument("--sim", default="build/bin/rfseek-sim")
     ap.add_argument("--jobs", type=int, default=2)
+    ap.error = lambda msg: ap.exit(2, "%s: %s (see --help)\n" % (ap.prog, msg))  # one line, no usage
     a = ap.parse_args()
     m = re.fullmatch(r"(\d+)\.\.(\d+)", a.seeds)
     if not m:

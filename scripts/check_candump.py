@@ -153,10 +153,21 @@ def check_asc(path, frames, fails):
 
 
 def main(argv):
-    args = [a for a in argv[1:] if not a.startswith("--")]
-    if len(args) < 2 or "--help" in argv:
+    if "--help" in argv or "-h" in argv:
         print(__doc__.strip())
-        return 0 if "--help" in argv else 2
+        return 0
+    args, i = [], 1
+    while i < len(argv):
+        a = argv[i]
+        if a == "--asc" and i + 1 < len(argv):
+            i += 1
+        elif a.startswith("-") and a not in ("--sim", "--decode"):
+            sys.exit("check_candump.py: %s: unknown option or missing value (see --help)" % a)
+        elif not a.startswith("-"):
+            args.append(a)
+        i += 1
+    if len(args) != 2:
+        sys.exit("usage: check_candump.py DBC LOG [--sim] [--asc FILE] [--decode] (see --help)")
     logging.disable(logging.CRITICAL)
     global canmatrix
     import canmatrix
@@ -187,4 +198,7 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    try:
+        sys.exit(main(sys.argv))
+    except OSError as e:  # a missing or unreadable file: one line, not a traceback
+        sys.exit("%s: %s: %s" % (os.path.basename(sys.argv[0]), e.filename, e.strerror))

@@ -11,6 +11,7 @@ DLC compared with the DBC's frame size. Prints PASS/FAIL lines; exit 1 on any fa
 usage: check_dbc.py DBC VECTORS_FILE
 """
 import logging
+import os
 import sys
 
 
@@ -25,9 +26,11 @@ def crc8_j1850(data):
 
 
 def main(argv):
-    if len(argv) != 3 or argv[1] in ("-h", "--help"):
+    if len(argv) > 1 and argv[1] in ("-h", "--help"):
         print(__doc__.strip())
-        return 0 if len(argv) == 2 else 2
+        return 0
+    if len(argv) != 3:
+        sys.exit("usage: check_dbc.py DBC VECTORS_FILE (see --help)")
     logging.disable(logging.CRITICAL)
     import canmatrix.formats
     dbc_path, vec_path = argv[1], argv[2]
@@ -92,4 +95,7 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    try:
+        sys.exit(main(sys.argv))
+    except OSError as e:  # a missing or unreadable file: one line, not a traceback
+        sys.exit("%s: %s: %s" % (os.path.basename(sys.argv[0]), e.filename, e.strerror))

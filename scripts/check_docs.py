@@ -137,6 +137,7 @@ def main():
                                  epilog=__doc__.split('\n\n', 2)[2])
     ap.add_argument('--root', default=os.path.join(os.path.dirname(os.path.abspath(__file__)), '..'),
                     help="the repository (default: this script's parent directory)")
+    ap.error = lambda msg: ap.exit(2, "%s: %s (see --help)\n" % (ap.prog, msg))  # one line, no usage
     a = ap.parse_args()
     n = {'links': 0, 'keys': 0}
     bad = check_links(a.root, n) + check_keys(a.root, n)

@@ -81,7 +81,13 @@ def main():
     ap.add_argument("--seeds", type=int, default=200, help="seeds 1..N a configuration")
     ap.add_argument("--jobs", type=int, default=2, help="worker processes")
     ap.add_argument("--work", default="build/compare_plan", help="folder for the runs")
+    ap.error = lambda msg: ap.exit(2, "%s: %s (see --help)\n" % (ap.prog, msg))  # one line, no usage
     a = ap.parse_args()
+    for opt, sim in (("--base", a.base), ("--new", a.new)):
+        if not os.access(sim, os.X_OK):
+            sys.exit(f"compare_plan.py: {opt}: {sim}: not an executable")
+    if a.seeds < 1 or a.jobs < 1:
+        sys.exit("compare_plan.py: --seeds and --jobs: expected at least 1")
     print("| scenario, configuration | success base | success new | only base / new (p) | "
           "ratio base / new | paired | decisions > 100 ms | longest latency |")
     print("|---|---|---|---|---|---|---|---|")

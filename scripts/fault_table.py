@@ -72,9 +72,17 @@ def main():
     ap.add_argument('--seeds', type=int, default=50, help='seeds 1..N per fault (50)')
     ap.add_argument('--jobs', type=int, default=2, help='worker processes (2)')
     ap.add_argument('--maps', default='office,open', help='scenario prefixes (office,open)')
+    ap.error = lambda msg: ap.exit(2, "%s: %s (see --help)\n" % (ap.prog, msg))  # one line, no usage
     a = ap.parse_args()
     if a.seeds < 1:
         sys.exit('fault_table.py: --seeds: must be at least 1')
+    if a.jobs < 1:
+        sys.exit('fault_table.py: --jobs: must be at least 1')
+    if not os.access(a.sim, os.X_OK):
+        sys.exit('fault_table.py: --sim: %s: not an executable' % a.sim)
+    for m in a.maps.split(','):
+        if not glob.glob('scenarios/faults/%s-*.yaml' % m):
+            sys.exit('fault_table.py: --maps: no scenarios/faults/%s-*.yaml (run from the repository root)' % m)
     tmp = tempfile.mkdtemp(prefix='rfs_fault_table.')
     bad = 0
     try:

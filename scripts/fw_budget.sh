@@ -4,7 +4,8 @@
 # _rfs_ram_used, _rfs_ccm_used).
 set -euo pipefail
 case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
-elf=$1
+elf=${1:?usage: fw_budget.sh ELF}
+[ -r "$elf" ] || { echo "fw_budget.sh: $elf: no such file" >&2; exit 1; }
 sym() {
     local hex
     hex=$(arm-none-eabi-nm "$elf" | awk -v s="$1" '$3 == s { print $1 }')

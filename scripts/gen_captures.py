@@ -282,9 +282,11 @@ def gen_mixed(seed, n, kinds, style_fn, t0=1700000000123456):
 
 
 def main():
-    if len(sys.argv) != 2 or sys.argv[1] in ("-h", "--help"):
+    if len(sys.argv) == 2 and sys.argv[1] in ("-h", "--help"):
         print(__doc__)
-        return 0 if len(sys.argv) == 2 else 2
+        return 0
+    if len(sys.argv) != 2 or sys.argv[1].startswith("-"):  # "--x" is no folder to make
+        sys.exit("usage: gen_captures.py OUTDIR (see --help)")
     out = sys.argv[1]
     os.makedirs(os.path.join(out, "bad"), exist_ok=True)
     allk = ["mgmt", "data", "qos", "ctrl_ta", "ack", "cts", "cut"]
@@ -363,4 +365,7 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        sys.exit(main())
+    except OSError as e:  # a missing or unreadable file: one line, not a traceback
+        sys.exit("%s: %s: %s" % (os.path.basename(sys.argv[0]), e.filename, e.strerror))

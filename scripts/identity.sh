@@ -9,6 +9,9 @@ set -u
 case "${1:-}" in -h | --help) sed -n '2,/^[^#]/s/^# \{0,1\}//p' "$0"; exit 0 ;; esac
 sim=${1:?usage: identity.sh SIM OUTDIR [SEEDS]} out=${2:?usage: identity.sh SIM OUTDIR [SEEDS]}
 seeds=${3:-1..50}
+# Checked first: a bad SIM or SEEDS would fill every file with the same ERROR (diff: equal).
+[ -x "$sim" ] || { echo "identity.sh: $sim: not an executable" >&2; exit 1; }
+[[ $seeds =~ ^[0-9]+\.\.[0-9]+$ ]] || { echo "identity.sh: SEEDS: expected A..B, got '$seeds'" >&2; exit 1; }
 here=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$out"
 for model in ${MODELS:-ridge radius pathloss knn mlp}; do

@@ -149,6 +149,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("outdir", nargs="?", default="scenarios/maps",
                     help="where the PGM and YAML files go (default scenarios/maps)")
+    ap.error = lambda msg: ap.exit(2, "%s: %s (see --help)\n" % (ap.prog, msg))  # one line, no usage
     outdir = ap.parse_args().outdir
     os.makedirs(outdir, exist_ok=True)
     maps = {

@@ -92,6 +92,7 @@ def main():
     ap.add_argument("--box", nargs=2, type=float, metavar=("W", "H"))
     ap.add_argument("--res", type=float, default=0.1)
     ap.add_argument("-o", "--out", required=True)
+    ap.error = lambda msg: ap.exit(2, "%s: %s (see --help)\n" % (ap.prog, msg))  # one line, no usage
     a = ap.parse_args()
     if (a.yaml is None) == (a.box is None):
         die("give MAP.yaml or --box W H")
@@ -157,6 +158,8 @@ def main():
     out.append("    .free = k_free, .wall = k_wall,")
     out.append("};")
     d = os.path.dirname(os.path.abspath(a.out))
+    if not os.path.isdir(d) or os.path.isdir(a.out):
+        die(f"{a.out}: {'is a directory' if os.path.isdir(a.out) else 'its folder does not exist'}")
     fd, tmp = tempfile.mkstemp(dir=d, prefix=".map2c.")
     with os.fdopen(fd, "w") as fh:
         fh.write("\n".join(out) + "\n")

@@ -91,6 +91,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sim", default="build/bin/rfseek-sim")
     ap.add_argument("--seeds", default="1001..1012")
+    ap.error = lambda msg: ap.exit(2, "%s: %s (see --help)\n" % (ap.prog, msg))  # one line, no usage
     a = ap.parse_args()
     m = re.fullmatch(r"(\d+)\.\.(\d+)", a.seeds)
     if m is None or int(m.group(1)) > int(m.group(2)):

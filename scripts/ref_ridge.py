@@ -20,9 +20,11 @@ from sklearn.linear_model import Ridge
 
 
 def main(argv):
-    if len(argv) != 3 or argv[1] in ("-h", "--help"):
+    if len(argv) > 1 and argv[1] in ("-h", "--help"):
         print(__doc__.strip())
-        return 0 if len(argv) == 2 else 2
+        return 0
+    if len(argv) != 3:
+        sys.exit("usage: ref_ridge.py IN OUT (see --help)")
     with open(argv[1], "r", encoding="ascii") as f:
         toks = f.read().split()
     out = []
@@ -57,4 +59,7 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    try:
+        sys.exit(main(sys.argv))
+    except OSError as e:  # a missing or unreadable file: one line, not a traceback
+        sys.exit("%s: %s: %s" % (os.path.basename(sys.argv[0]), e.filename, e.strerror))

@@ -46,7 +46,10 @@ def main(argv):
     if len(argv) > 1 and argv[1] in ("-h", "--help"):
         print(__doc__.strip())
         return 0
-    seeds = [int(a, 0) for a in argv[1:]] or [0, 1, 20260521]
+    try:
+        seeds = [int(a, 0) for a in argv[1:]] or [0, 1, 20260521]
+    except ValueError as e:
+        sys.exit("ref_xoshiro.py: %s (see --help)" % e)
     for seed in seeds:
         print(seed, " ".join("0x%08x" % v for v in outputs(seed, 6)))
     return 0

@@ -81,7 +81,7 @@ static const char k_usage[] =
     "  --target T     replay: what the seeker maximises, overriding the scenario's: rssi, or\n"
     "                 pdr (the packet delivery ratio over 1 s from the 802.11 sequence numbers\n"
     "                 of the matching frames; samples.tsv then holds the percentages fed)\n"
-    "  --help         this text\n"
+    "  -h, --help     this text\n"
     "Exit 0 on success, 1 on a bad capture or I/O error, 2 on bad options, 3 when a --mac\n"
     "sent no frame (a warning line; the output is complete).\n";
 
@@ -623,6 +623,9 @@ static int parse_value(feed_opts_t *fo, const char *a, const char *v)
             opt_err("--format: '%s' is not supported (tsv)", v);
             return 2;
         }
+    } else if (*v == '\0' && strcmp(a, "--seed") != 0) { /* "" --lcm: liblcm's default */
+        opt_err("%s: empty value (see --help)", a);
+        return 2;
     } else if (strcmp(a, "--output") == 0) {
         fo->output = v;
     } else if (strcmp(a, "--lcm") == 0) {

@@ -49,7 +49,7 @@ static const char k_usage[] =
     "  --bench N      plan between N random pairs of legal lattice points (seeded) and\n"
     "                 print the planner's median time, expansions and queue use, and the\n"
     "                 median time to derive the legal grid\n"
-    "  --help         this text\n"
+    "  -h, --help     this text\n"
     "Exit 0 on success, 1 on a bad map or I/O error, 2 on bad options, 3 when --mcu finds\n"
     "that the map does not fit (the other outputs are written all the same).\n";
 
@@ -496,7 +496,7 @@ static int parse_opts(int argc, char **argv, opts_t *o)
         return 2;
     }
     if (!(o->res > 0) || !(o->grid > 0)) {
-        lx_err_print(PROG, "--res and --grid must be > 0");
+        lx_err_print(PROG, "%s: must be > 0 metres", o->res > 0 ? "--grid" : "--res");
         return 2;
     }
     if (o->crop != NULL && !lx_map_save_image_path(o->crop, o->crop_image, sizeof(o->crop_image))) {

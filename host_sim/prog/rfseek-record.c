@@ -262,7 +262,7 @@ static int parse_window(const char *s, window_t *w)
     }
     const char *s2 = end + 1;
     const double b = strtod(s2, &end);
-    if (end == s2 || *end != '\0' || a < 0 || b <= a || b > 1e6) {
+    if (end == s2 || *end != '\0' || !(a >= 0) || !(b > a) || b > 1e6) { /* NaN: refused */
         return -1;
     }
     w->t0_us = (int64_t)(a * 1e6 + 0.5);
@@ -357,13 +357,18 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
 {
     char *end;
     switch (c) {
-    case 'o': o->out_path = optarg; break;
-    case 'l': o->live_path = optarg; break;
-    case 'c': o->candump_path = optarg; break;
+    case 'o':
+    case 'l':
+    case 'c':
+        if (*optarg == '\0') {
+            die_opt(c == 'o' ? "-o/--out" : c == 'l' ? "--live-out" : "--candump", optarg);
+        }
+        *(c == 'o' ? &o->out_path : c == 'l' ? &o->live_path : &o->candump_path) = optarg;
+        break;
     case 's':
         errno = 0;
-        o->seed = strtoull(optarg, &end, 0);
-        if (errno != 0 || end == optarg || *end != '\0') {
+        o->seed = strtoull(optarg, &end, 10); /* "-1" would wrap, "010" be octal */
+        if (errno != 0 || end == optarg || *end != '\0' || optarg[0] == '-') {
             die_opt("--seed", optarg);
         }
         o->have_seed = true;
@@ -380,7 +385,7 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
     case 'b': add_window(rec->busoff, &rec->nbusoff, "--bus-off", optarg); break;
     case 'f': {
         errno = 0;
-        const unsigned long v = strtoul(optarg, &end, 0);
+        const unsigned long v = strtoul(optarg, &end, 10);
         if (errno != 0 || end == optarg || *end != '\0' || v > 100000ul) {
             die_opt("--fit-budget", optarg);
         }
@@ -389,7 +394,7 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
     }
     case 'r': {
         const double t = strtod(optarg, &end);
-        if (rec->nreset == MAX_WINDOWS || end == optarg || *end != '\0' || t < 0 || t > 1e6) {
+        if (rec->nreset == MAX_WINDOWS || end == optarg || *end != '\0' || !(t >= 0 && t <= 1e6)) {
             die_opt("--reset", optarg);
         }
         rec->reset_us[rec->nreset++] = (int64_t)(t * 1e6 + 0.5);
@@ -474,6 +479,21 @@ static int parse_options(int argc, char **argv, options_t *o, recorder_t *rec)
      * it stays quiet and the one line is ours. A leading ':' tells a missing value (':')
      * from an unknown option ('?'). */
     static const char shortopts[] = ":o:h";
+    /* getopt_long takes any unambiguous prefix ("--se 3" for --seed): only the names
+     * --help lists are options. A value given apart (-o X, --seed X) is skipped. */
+    for (int i = 1; i < argc && strcmp(argv[i], "--") != 0; i++) {
+        const char *a = argv[i];
+        const size_t n = strncmp(a, "--", 2) == 0 ? strcspn(a + 2, "=") : 0;
+        const struct option *m = NULL;
+        for (size_t k = 0; n > 0 && opts[k].name != NULL; k++) {
+            m = strlen(opts[k].name) == n && strncmp(opts[k].name, a + 2, n) == 0 ? &opts[k] : m;
+        }
+        if (n > 0 && m == NULL) {
+            lx_err_print(PROG, "unknown option '%s' (see --help)", a);
+            return 2;
+        }
+        i += (strcmp(a, "-o") == 0 || (m != NULL && m->has_arg == required_argument && a[2 + n] == '\0'));
+    }
     opterr = 0;
     int c;
     while ((c = getopt_long(argc, argv, shortopts, opts, NULL)) != -1) {

@@ -26,7 +26,7 @@ static const char usage_text[] =
     "  --seed N         run seed (default: the scenario's)\n"
     "  --timeout-ms N   wait this long for the controller's answer to a step (default 5000)\n"
     "  --max-time S     stop after S simulated seconds (overrides the scenario's stop time)\n"
-    "  --help           this text\n";
+    "  -h, --help       this text\n";
 
 static const char PROG[] = "rfseek-sim-lcm"; /* the prefix of its error lines (lx_err_print) */
 
@@ -46,8 +46,18 @@ static int sim_lcm_main(int argc, char **argv)
             return 0;
         } else if (a[0] != '-' && !scn) {
             scn = a;
+        } else if (a[0] != '-') {
+            lx_err_print(PROG, "unexpected argument '%s' (one SCENARIO only)", a);
+            return 2;
+        } else if (strcmp(a, "--lcm") != 0 && strcmp(a, "--can") != 0 && strcmp(a, "--seed") != 0 &&
+                   strcmp(a, "--max-time") != 0 && strcmp(a, "--timeout-ms") != 0) {
+            lx_err_print(PROG, "unknown option '%s' (see --help)", a);
+            return 2;
         } else if (!v) {
             lx_err_print(PROG, "missing value for %s (see --help)", a);
+            return 2;
+        } else if (*v == '\0') { /* "" for --lcm would be liblcm's default provider */
+            lx_err_print(PROG, "empty value for %s (see --help)", a);
             return 2;
         } else if (strcmp(a, "--lcm") == 0) {
             cfg.lcm_url = v, i++;
@@ -68,7 +78,7 @@ static int sim_lcm_main(int argc, char **argv)
                 return 2;
             }
             i++;
-        } else if (strcmp(a, "--timeout-ms") == 0) {
+        } else { /* --timeout-ms */
             long t = strtol(v, &end, 10);
             if (*end || t < 1 || t > 600000) {
                 lx_err_print(PROG, "--timeout-ms: '%s' is not in 1..600000", v);
@@ -76,9 +86,6 @@ static int sim_lcm_main(int argc, char **argv)
             }
             cfg.reply_timeout_ms = (int)t;
             i++;
-        } else {
-            lx_err_print(PROG, "unknown option '%s' (see --help)", a);
-            return 2;
         }
     }
     if (!scn) {

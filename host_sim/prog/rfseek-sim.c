@@ -84,7 +84,7 @@ static void usage(FILE *f)
             "  --quiet         no progress bar\n"
             "  --bench         with --seeds: run them one after another in this process without\n"
             "                  output files and print the real-time factor (make bench-sim)\n"
-            "  --help          this text\n"
+            "  -h, --help      this text\n"
             "Errors: one line on stderr, exit status 1, no output directory left behind.\n",
             prog);
 }
@@ -480,8 +480,8 @@ static int check_options(sim_opts_t *o)
 static int parse_xy(const char *t, bool theta, double v[3])
 {
     int n = 0;
+    char *end = NULL;
     while (n < 3) {
-        char *end;
         errno = 0;
         v[n] = strtod(t, &end);
         if (end == t || errno != 0 || !isfinite(v[n]) || fabs(v[n]) > (n == 2 ? 7.0 : 1e6)) {
@@ -496,7 +496,7 @@ static int parse_xy(const char *t, bool theta, double v[3])
         }
         t = end + 1;
     }
-    return (n == 2 || (theta && n == 3)) && (n < 3 || strchr(t, ',') == NULL) ? n : 0;
+    return (n == 2 || (theta && n == 3)) && *end == '\0' ? n : 0; /* "1,2,3,4": not 1,2,3 */
 }
 
 /* --start and --source into the scenario (the goal follows the first source unless the

@@ -63,6 +63,11 @@ expect bad_mac 2 "--mac: '02:aa:bb:cc:00' is not a MAC address" -- "$gen/ds.pcap
 expect bad_mac_hex 2 "--mac: '02:aa:bb:cc:00:0g' is not a MAC address" -- "$gen/ds.pcap" --mac 02:aa:bb:cc:00:0g
 expect bad_format 2 "--format: 'csv' is not supported" -- "$gen/ds.pcap" --mac $mac --format csv
 expect unknown_option 2 "unknown option '--frobnicate'" -- "$gen/ds.pcap" --mac $mac --frobnicate
+# "" as a file or URL: refused before any work (--output "" was read through, then not
+# renamed; --lcm "" would be liblcm's default provider, udpm)
+expect empty_output 2 "^rfseek-feed: --output: empty value" -- "$gen/ds.pcap" --mac $mac --output ""
+expect empty_lcm 2 "^rfseek-feed: --lcm: empty value" -- lo --live --lcm "" --mac $mac
+expect empty_out 2 "^rfseek-feed: --out: empty value" -- "$gen/ds.pcap" --pose "$tmp/p.csv" --scenario scenarios/default.yaml --out ""
 expect mac_missing_value 2 "--mac needs a value" -- "$gen/ds.pcap" --mac
 expect seed_newline 2 "--seed: '1\\?2' is not a non-negative integer" -- "$gen/ds.pcap" --mac $mac --pose x --seed $'1\n2'
 "$feed" --help | grep -q '^usage: rfseek-feed CAPTURE --mac MAC' && echo "PASS help" || { echo "FAIL help"; fail=1; }

@@ -203,4 +203,21 @@ one_err replay-newline-in rfseek-replay 1 "nl?none.rfsr: No such file" "$tmp/nl$
 one_err replay-newline-out rfseek-replay 1 "nl/a?b.rfso" "$tmp/in.rfsr" -o "$tmp/nl/a${nl}b.rfso"
 one_err replay-newline-second-input rfseek-replay 2 "a?b" "$tmp/in.rfsr" "a${nl}b" -o "$tmp/nl.rfso"
 one_err replay-missing-value rfseek-replay 2 "-o: missing value" "$tmp/in.rfsr" -o
+# Values that once passed: a negative seed (wrapped), NaN times, empty file names (the -o
+# stream was written, then the rename to "" failed); seeds are decimal ("010" is 10).
+one_err record-seed-negative rfseek-record 2 "--seed: bad value '-1'" $scn -o "$tmp/nl.rfsr" --seed -1
+one_err record-drop-nan rfseek-record 2 "--drop: bad value 'nan:1'" $scn -o "$tmp/nl.rfsr" --drop nan:1
+one_err record-reset-nan rfseek-record 2 "--reset: bad value 'nan'" $scn -o "$tmp/nl.rfsr" --reset nan
+one_err record-empty-out rfseek-record 2 "-o/--out: bad value ''" $scn -o ""
+one_err record-empty-live-out rfseek-record 2 "--live-out: bad value ''" $scn -o "$tmp/nl.rfsr" --live-out ""
+one_err record-empty-candump rfseek-record 2 "--candump: bad value ''" $scn -o "$tmp/nl.rfsr" --candump ""
+# getopt_long's prefixes ("--se" for --seed) are not options: --help lists whole names.
+one_err record-prefix-option rfseek-record 2 "unknown option '--se'" $scn -o "$tmp/nl.rfsr" --se 1
+one_err record-prefix-flag rfseek-record 2 "unknown option '--config'" $scn -o "$tmp/nl.rfsr" --config --max-time 0.5
+one_err replay-fit-budget-units rfseek-replay 2 "--fit-budget: expected work units in [0, 100000], got '5x'" "$tmp/in.rfsr" --fit-budget 5x -o "$tmp/nl.rfso"
+one_err replay-empty-out rfseek-replay 2 "-o: empty value" "$tmp/in.rfsr" -o ""
+one_err replay-empty-map rfseek-replay 2 "--map: empty value" "$tmp/in.rfsr" --map "" -o "$tmp/nl.rfso"
+"$bin/rfseek-record" $scn -o "$tmp/s010.rfsr" --seed 010 --max-time 0.5 >/dev/null 2>&1
+"$bin/rfseek-record" $scn -o "$tmp/s10.rfsr" --seed 10 --max-time 0.5 >/dev/null 2>&1
+check record-seed-decimal 'cmp -s "$tmp/s010.rfsr" "$tmp/s10.rfsr"'
 exit $((fails > 0))

@@ -36,7 +36,7 @@ start: {position: [5.0, 10.0]}
 '
 
 # --- help and usage --------------------------------------------------------------------
-if "$SIM" --help | grep -q -- '--seeds A..B'; then pass help; else fail help; fi
+if "$SIM" --help | grep -q -- '--seeds A..B' && "$SIM" -h | grep -q -- '-h, --help'; then pass help; else fail help; fi
 "$SIM" >/dev/null 2>&1; [ $? -eq 1 ] && pass no_args || fail no_args
 
 # --- bad input ---------------------------------------------------------------------------
@@ -48,6 +48,8 @@ bad malformed_scenario "syntax.yaml:2: YAML syntax error" "$T/syntax.yaml" --out
 scn p0.yaml "$BASE"
 bad p0_min_number "--p0-min: expected dBm in [-200, 100], got 'loud'" "$T/p0.yaml" --model pathloss --p0-min loud --out "$T/out"
 bad p0_min_range "--p0-min: expected dBm in [-200, 100], got '-300'" "$T/p0.yaml" --model pathloss --p0-min -300 --out "$T/out"
+bad start_extra "--start: expected X,Y[,THETA] (metres, radians), got '1,2,3,4'" "$T/p0.yaml" --start 1,2,3,4 --out "$T/out"
+bad source_trailing_comma "--source: expected X,Y (metres), got '15,10,'" "$T/p0.yaml" --source 15,10, --out "$T/out"
 bad p0_min_model "--p0-min: only with model pathloss (this run's is ridge)" "$T/p0.yaml" --p0-min -32 --out "$T/out"
 # --p0-min and the scenario's seek.p0_min_dbm are the same setting: same run, byte for byte.
 scn p0key.yaml "${BASE}model: pathloss

@@ -76,7 +76,36 @@ bench_pathloss_seek.py|--first-seed 0|--first-seed must be at least 1
 bench_pathloss_seek.py|--jobs -1|--jobs must be 0 (all cores) or more
 bench_pathloss_seek.py|--seek leg_m:2 --no-write|a space after each colon
 bench_pathloss_seek.py|--only-pathloss|--seek and --only-pathloss need --no-write
+bench_pathloss_seek.py|--sim /nonexistent|/nonexistent: not an executable
+bench_general.py|--seeds 5..1|--seeds: expected A..B with A <= B
+bench_general.py|--jobs 0|--jobs: expected a number from 1 to 1024
+fault_table.py|--sim /nonexistent|--sim: /nonexistent: not an executable
+fault_table.py|--sim /bin/true --maps nope|no scenarios/faults/nope-\*.yaml
+compare_plan.py|--base /nonexistent|--base: /nonexistent: not an executable
+map2c.py|scenarios/maps/office.yaml -o /nonexistent/x.c|/nonexistent/x.c: its folder does not exist
+check_candump.py|can/rfseek.dbc x.log --bogus|--bogus: unknown option
+check_candump.py|can/rfseek.dbc /nonexistent.log|/nonexistent.log: No such file or directory
+check_dbc.py|x|usage: check_dbc.py DBC VECTORS_FILE
+ref_ridge.py|/nonexistent.txt out.txt|/nonexistent.txt: No such file or directory
+ref_xoshiro.py|1x|invalid literal for int()
+gen_captures.py|--bogus|usage: gen_captures.py OUTDIR
 LIST
+# The shell scripts: a bad argument is one line on stderr, exit 1, nothing written.
+while IFS='|' read -r script args want; do
+    # shellcheck disable=SC2086
+    bash "scripts/$script" $args >"$tmp/o" 2>"$tmp/e"
+    rc=$?
+    check "script-bad-arg-$script-${args%% *}" '[ $rc -eq 1 ] && [ "$(wc -l <"$tmp/e")" -eq 1 ] && [ ! -s "$tmp/o" ] && [ ! -e "$tmp/id" ] && grep -q -- "$want" "$tmp/e"'
+done <<LIST
+fw_budget.sh||usage: fw_budget.sh ELF
+fw_budget.sh|/nonexistent.elf|fw_budget.sh: /nonexistent.elf: no such file
+check_core_symbols.sh|nm|usage: check_core_symbols.sh NM LIB
+identity.sh|/nonexistent $tmp/id 1..1|identity.sh: /nonexistent: not an executable
+identity.sh|$sim $tmp/id 5|identity.sh: SEEDS: expected A..B, got '5'
+LIST
+# argparse's errors: one line (not its usage as well), exit 2.
+/usr/bin/python3 scripts/check_docs.py --bogus >"$tmp/o" 2>"$tmp/e"
+check script-argparse-one-line '[ $? -eq 2 ] && [ "$(wc -l <"$tmp/e")" -eq 1 ] && grep -q "^check_docs.py: unrecognized arguments: --bogus" "$tmp/e"'
 
 # bench_pathloss_seek.py --only-pathloss --seek: one line a row, the meta-path + pathloss
 # column run with the variant: its default-office ratio is rfseek-sim's own for that seed.

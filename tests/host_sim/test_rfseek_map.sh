@@ -52,6 +52,8 @@ one_err() {
 }
 one_err newline-res 2 "--res: a non-negative number of metres expected, got '1?2'" \
     "$bad/ok.yaml" --res $'1\n2' --pgm "$tmp/nl.pgm"
+one_err res-zero-names-it 2 "rfseek-map: --res: must be > 0 metres" "$bad/ok.yaml" --res 0 --pgm "$tmp/nl.pgm"
+one_err grid-zero-names-it 2 "rfseek-map: --grid: must be > 0 metres" "$bad/ok.yaml" --grid 0 --pgm "$tmp/nl.pgm"
 one_err newline-bench 2 "--bench: a count 1..1000000 expected, got '5?6'" \
     "$bad/ok.yaml" --bench $'5\n6' --pgm "$tmp/nl.pgm"
 one_err newline-option 2 "--x?y: unknown option" "$bad/ok.yaml" $'--x\ny' --pgm "$tmp/nl.pgm"

@@ -26,6 +26,10 @@ expect_err rfseekd-bad-fit-early 2 "--fit-early: expected on or off, got yes" --
 expect_err rfseekd-bad-fit-budget 2 "--fit-budget: expected work units in \[0, 100000\], got -1" --map $map --fit-budget -1
 expect_err rfseekd-missing-fit-early 2 "missing value for option --fit-early" --map $map --fit-early
 expect_err rfseekd-unknown-option 2 "unknown option (see --help): --bogus" --bogus
+# "" as a file, URL or interface: refused before any work (it ran, then failed to rename
+# the output to ""; --lcm "" was liblcm's default provider)
+expect_err rfseekd-empty-decisions 2 "empty value for option --decisions" --map $map --lcm memq:// --decisions ""
+expect_err rfseekd-empty-lcm 2 "empty value for option --lcm" --map $map --lcm ""
 expect_err rfseekd-map-required 2 "--map MAP.yaml is required" --lcm memq://
 expect_err rfseekd-missing-map 1 "nope.yaml" --map "$w/nope.yaml" --lcm memq://
 expect_err rfseekd-bad-seed 2 "--seed: expected a non-negative integer, got x" --map $map --seed x
@@ -56,7 +60,12 @@ compgen -G "$w/nl*" > /dev/null && fail "rfseekd-newline-nothing-written ($(ls -
 # rfseek-sim-lcm: the same rule (it writes only summary.json, to stdout: none on error).
 sl=$build/bin/rfseek-sim-lcm scn=scenarios/default.yaml
 expect_err_of "$sl" sim-lcm-newline-option 2 "unknown option '--x?y'" $scn "--x${nl}y" 1
-expect_err_of "$sl" sim-lcm-newline-missing-value 2 "missing value for --x?y" $scn "--x${nl}y"
+expect_err_of "$sl" sim-lcm-newline-unknown-last 2 "unknown option '--x?y'" $scn "--x${nl}y"
+expect_err_of "$sl" sim-lcm-missing-value 2 "missing value for --seed" $scn --seed
+expect_err_of "$sl" sim-lcm-second-scenario 2 "unexpected argument 'b.yaml' (one SCENARIO only)" $scn b.yaml
+# "": not seed 0, not liblcm's default provider (udpm)
+expect_err_of "$sl" sim-lcm-empty-seed 2 "empty value for --seed" $scn --seed "" --lcm memq://
+expect_err_of "$sl" sim-lcm-empty-lcm 2 "empty value for --lcm" $scn --lcm ""
 expect_err_of "$sl" sim-lcm-newline-seed 2 "--seed: '1?2' is not" $scn --seed "1${nl}2"
 expect_err_of "$sl" sim-lcm-newline-max-time 2 "--max-time: '1?2' is not" $scn --max-time "1${nl}2"
 expect_err_of "$sl" sim-lcm-newline-timeout 2 "--timeout-ms: '1?2' is not" $scn --timeout-ms "1${nl}2"

@@ -79,6 +79,10 @@ int lx_err_same_file(const char *prog, const char *in, const char *out)
 int lx_err_check_dest(const char *prog, const char *path)
 {
     char dir[PATH_MAX];
+    if (*path == '\0') { /* "" would be renamed onto from ".tmp..." after all the work */
+        lx_err_print(prog, "an output file name is empty");
+        return -1;
+    }
     const char *slash = strrchr(path, '/');
     if (slash == NULL) {
         snprintf(dir, sizeof dir, ".");

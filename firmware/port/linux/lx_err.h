@@ -37,8 +37,8 @@ int lx_err_same_dest(const char *prog, const char *a, const char *b);
 
 /// Check before any work that `path` can be created: its directory exists, is a
 /// directory and is writable (the rename into place needs it), and `path` is not an
-/// existing directory, device or FIFO (the rename would fail or replace it). 0, or -1
-/// after "prog: PATH: REASON".
+/// existing directory, device or FIFO (the rename would fail or replace it), nor empty.
+/// 0, or -1 after "prog: PATH: REASON".
 int lx_err_check_dest(const char *prog, const char *path);
 
 #endif /* LX_ERR_H */

@@ -265,7 +265,7 @@ static int parse_ctl(options_t *o, const char *a, const char *v)
     } else {
         const unsigned long n = strtoul(v, &end, 10);
         if (*v == '\0' || *v == '-' || *end != '\0' || errno != 0 || n > 100000ul) {
-            lx_err_print(PROG, "--fit-budget: expected samples in [0, 100000], got '%s'", v);
+            lx_err_print(PROG, "--fit-budget: expected work units in [0, 100000], got '%s'", v);
             return 2;
         }
         o->fit_budget = (uint32_t)n;
@@ -298,6 +298,10 @@ static int parse_options(int argc, char **argv, options_t *o)
                 return 2;
             }
             const char *v = argv[++i];
+            if (*v == '\0' && (a[1] == 'o' || strcmp(a, "--map") == 0)) {
+                lx_err_print(PROG, "%s: empty value (see --help)", a);
+                return 2;
+            }
             if (a[1] == 'o') {
                 o->out_path = v;
             } else if (parse_ctl(o, a, v) != RUN) {

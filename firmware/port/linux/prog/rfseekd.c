@@ -65,7 +65,7 @@ static const char usage_text[] =
     "  --seed N          seed of the controller's random source (default 1)\n"
     "  --duration S      stop after S seconds of controller time (default: run until signalled)\n"
     "  --idle-exit MS    stop when no LCM message arrived for MS milliseconds\n"
-    "  --help            this text\n";
+    "  -h, --help        this text\n";
 
 typedef struct daemon {
     rfs_app_t *app;
@@ -416,6 +416,8 @@ static int parse_options(int argc, char **argv, options_t *o)
             return die("unknown option (see --help): ", a);
         } else if (v == NULL) {
             return die("missing value for option ", a);
+        } else if (*v == '\0') { /* "" for --lcm would be liblcm's default provider */
+            return die("empty value for option ", a);
         } else {
             const int rc = parse_value(o, a, v);
             if (rc != RUN) {

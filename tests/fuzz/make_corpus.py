@@ -23,6 +23,12 @@ import os
 import struct
 import sys
 
+if len(sys.argv) > 1 and sys.argv[1] in ("-h", "--help"):
+    print(__doc__.strip())
+    sys.exit(0)
+if len(sys.argv) > 2 or (len(sys.argv) > 1 and sys.argv[1].startswith("-")):
+    sys.exit("make_corpus.py: expected at most one argument, the corpus folder (--help), got "
+             + " ".join(sys.argv[1:]))
 OUT = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "corpus")
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 

@@ -473,6 +473,11 @@ void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t
 /// when another call would do more; false with no such fit (fit_budget 0, or none running).
 bool rfs_seek_background(rfs_seek_t *s, rfs_rng_t *rng);
 
+/// rfs_seek_background() up to n times, while it has more to do (a port without a clock to
+/// guard the next period: replays, rfseekd, the simulator). Returns the calls that left
+/// more to do.
+uint32_t rfs_seek_background_n(rfs_seek_t *s, rfs_rng_t *rng, uint32_t n);
+
 /// The in-leg relearn check on one miss |1 s mean - prediction| (target units Q16.16, >= 0):
 /// true when it fails, i.e. the miss exceeds error_threshold, or with recheck_adapt the
 /// larger of error_threshold and the RMS of the recent misses; *miss_ms (dB^2 Q16.16,

@@ -4,8 +4,6 @@
 #include "rfs_assert.h"
 #include "rfs_seek_internal.h"
 
-/* The model's input: the samples, map, reach bits, places ruled out and each source's
- * samples, queried at (qx, qy). */
 /* The settle phase a fit learns in (rfs_model_fit_in_t.settle). */
 static rfs_model_settle_t settle_phase(const rfs_seek_t *s)
 {
@@ -116,4 +114,13 @@ bool rfs_seek_background(rfs_seek_t *s, rfs_rng_t *rng)
     }
     s->fit_ended = true;
     return false;
+}
+
+uint32_t rfs_seek_background_n(rfs_seek_t *s, rfs_rng_t *rng, uint32_t n)
+{
+    uint32_t k = 0u;
+    while (k < n && rfs_seek_background(s, rng)) {
+        ++k;
+    }
+    return k;
 }

@@ -293,6 +293,11 @@ bool rfs_app_background(rfs_app_t *a)
     return rfs_seek_background(&a->seek, &a->rng);
 }
 
+void rfs_app_background_all(rfs_app_t *a)
+{
+    (void)rfs_seek_background_n(&a->seek, &a->rng, RFS_APP_BACKGROUND_SLICES);
+}
+
 void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out)
 {
     rfs_seek_out_t so;

@@ -277,6 +277,10 @@ void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out);
 /// RFS_APP_BACKGROUND_SLICES times a period (none when the next step is due).
 bool rfs_app_background(rfs_app_t *a);
 
+/// rfs_app_background() up to RFS_APP_BACKGROUND_SLICES times (rfs_seek_background_n()):
+/// the ports that run a period's slices without a clock to watch (replays, rfseekd).
+void rfs_app_background_all(rfs_app_t *a);
+
 /// A raw CAN frame arrived at local time rx_us: decoded with rfs_can (pose pairs, RSSI,
 /// receiver heartbeat, CONFIG; other ids counted as unknown) and fed to the seeker. Returns
 /// the decode result.

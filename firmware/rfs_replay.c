@@ -503,8 +503,7 @@ static void emit_step(rfs_replay_player_t *p, int64_t now_us)
 {
     rfs_app_out_t out;
     rfs_app_step(p->app, now_us, &out);
-    for (uint32_t k = 0u; k < RFS_APP_BACKGROUND_SLICES && rfs_app_background(p->app); ++k) {
-    }
+    rfs_app_background_all(p->app);
     uint8_t buf[2u * RFS_REPLAY_MAX_RECORD];
     uint32_t n = rfs_replay_encode_out(&out, buf, sizeof buf);
     p->write(p->write_ctx, buf, n);

@@ -81,8 +81,7 @@ static void ip_step(void *self, int64_t now_us, hs_ctrl_out_t *out)
 {
     inproc_t *p = self;
     rfs_seek_step(&p->seek, now_us, &p->rng, out);
-    for (uint32_t k = 0u; k < p->fit_slices && rfs_seek_background(&p->seek, &p->rng); ++k) {
-    }
+    (void)rfs_seek_background_n(&p->seek, &p->rng, p->fit_slices);
 }
 
 static bool ip_predict(void *self, rfs_q16_t x, rfs_q16_t y, rfs_q16_t *v)

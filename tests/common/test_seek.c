@@ -412,6 +412,7 @@ static void sliced_fit_run(uint32_t bg)
     cfg.fit_budget = 500;
     seek_make(&t, cfg, 5);
     assert_false(rfs_seek_background(&t.seek, &t.rng)); /* before any fit */
+    assert_int_equal(rfs_seek_background_n(&t.seek, &t.rng, 5u), 0u);
     double x = 5, y = 10, gx = 5, gy = 10;
     int64_t arrive = 0, begun = -1;
     uint32_t decisions = 0, relearned = 0, compared = 0, pkt = 0, bg_slices = 0, sooner = 0;
@@ -717,8 +718,7 @@ static early_run_t run_early(bool early, double recheck_m)
             began = began || (t.seek.early && !rfs_drive_at_rest(&t.seek.drive));
             began = began || (t.seek.early && t.seek.drive.status == RFS_DRIVE_RUNNING);
             assert_true(early || !t.seek.early);
-            for (int s = 0; s < 3 && rfs_seek_background(&t.seek, &t.rng); ++s) {
-            }
+            (void)rfs_seek_background_n(&t.seek, &t.rng, 3u);
             if (t.seek.fit_ended && n_fit == 0u) {
                 n_fit = t.seek.store.count;
             }

@@ -224,8 +224,7 @@ static int refute_abandoned(bool early, int *abandoned)
         rfs_seek_on_pose(&t.seek, &p, &t.rng);
         rfs_seek_out_t out;
         rfs_seek_step(&t.seek, r.t_us, &t.rng, &out);
-        for (int k = 0; k < 10 && rfs_seek_background(&t.seek, &t.rng); ++k) {
-        }
+        (void)rfs_seek_background_n(&t.seek, &t.rng, 10u);
         if (!out.decided) {
             continue;
         }

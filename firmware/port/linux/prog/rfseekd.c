@@ -148,8 +148,7 @@ static void step(daemon_t *d, int64_t now_us)
     rfs_app_out_t out;
     d->last_now_us = now_us;
     rfs_app_step(d->app, now_us, &out);
-    for (uint32_t k = 0u; k < RFS_APP_BACKGROUND_SLICES && rfs_app_background(d->app); ++k) {
-    }
+    rfs_app_background_all(d->app);
     d->steps++;
     rfs_can_frame_t fr[2];
     uint8_t n = rfs_app_frames(d->app, &out, fr);

@@ -46,6 +46,9 @@ from bench_pathloss_seek import commit, splice, wilson  # noqa: E402
 
 REAL = ["willow", "3ne", "intel", "gdc2", "gdc4", "house"]
 SYNTHETIC = ["default", "lshape", "open"]
+# Floors held out from all tuning (docs/RESULTS.md): none of their placements, tuning half
+# included, may choose an option or a value.
+UNSEEN = ["bookstore", "warehouse"]
 # (strategy, model, label, column prefix)
 CONFIGS = [("meta-path", "pathloss", "meta-path + pathloss", "p"),
            ("meta", "ridge", "meta + ridge", "r")]
@@ -170,8 +173,9 @@ def table(results, floors, parked=True):
             ([f"{c} parked"] if parked else [])
     L = ["| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
     rows = [(f, [f]) for f in floors]
-    if len([f for f in floors if f in REAL]) > 1:
-        rows.append(("**all real**", [f for f in floors if f in REAL]))
+    for label, kind in (("**all real**", REAL), ("**all unseen**", UNSEEN)):
+        if len([f for f in floors if f in kind]) > 1:
+            rows.append((label, [f for f in floors if f in kind]))
     for label, group in rows:
         st = [stats([r for f in group for r in results[(f, cfg)]]) for _, _, cfg, _ in configs]
         L.append(f"| {label} ({st[0]['n']}) | " + " | ".join(cells(x, parked) for x in st) + " |")
@@ -205,7 +209,7 @@ def main():
                                  formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     ap.add_argument("--placements", type=int, default=100, help="placements a floor (even: the first half tunes, the second is held out)")
     ap.add_argument("--seeds", default="1..2", help="simulator seeds a placement, A..B")
-    ap.add_argument("--floors", default=",".join(REAL + SYNTHETIC), help="comma-separated floors (scenarios/NAME.yaml)")
+    ap.add_argument("--floors", default=",".join(REAL + SYNTHETIC + UNSEEN), help="comma-separated floors (scenarios/NAME.yaml)")
     ap.add_argument("--sim", default="build/bin/rfseek-sim", help="the rfseek-sim to run")
     ap.add_argument("--jobs", type=int, default=1, help="worker processes a batch")
     ap.add_argument("--work", default="build/bench_general", help="folder for the batches' runs")
@@ -241,9 +245,9 @@ def main():
         sys.exit("bench_general: --jobs: expected a number from 1 to 1024")
     floors = a.floors.split(",")
     for f in floors:
-        if f not in REAL + SYNTHETIC:
+        if f not in REAL + SYNTHETIC + UNSEEN:
             sys.exit(f"bench_general: --floors: unknown floor {f!r} "
-                     f"(known: {', '.join(REAL + SYNTHETIC)})")
+                     f"(known: {', '.join(REAL + SYNTHETIC + UNSEEN)})")
     if not os.access(a.sim, os.X_OK):
         sys.exit(f"bench_general: {a.sim}: not an executable (make all)")
     if a.seek:  # checked once, before any batch

@@ -33,7 +33,7 @@ compare() {
     echo "$line"
 }
 if [ -n "${BENCH_SIM_ALL:-}" ]; then
-    for sc in ${FLOORS:-default intel willow 3ne gdc2 gdc4 house lshape open}; do
+    for sc in ${FLOORS:-default intel willow 3ne gdc2 gdc4 house lshape open bookstore warehouse}; do
         for st in meta meta-global fd-gradient plane-gradient chemotaxis meta-path; do
             for model in ridge pathloss; do compare "$sc" "$st" "$model"; done
         done

@@ -571,7 +571,8 @@ static void test_shipped_scenarios(void **state)
 {
     (void)state;
     static const char *const names[] = {"default", "open", "lshape", "bridge", "willow", "3ne",
-                                        "intel", "gdc2", "gdc4", "house"};
+                                        "intel", "gdc2", "gdc4", "house", "bookstore",
+                                        "warehouse"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
         char path[128];
         snprintf(path, sizeof path, "scenarios/%s.yaml", names[i]);

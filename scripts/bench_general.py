@@ -192,8 +192,8 @@ def section(cmd, at, minutes, nruns, seeds, held, floors, results):
         parked.append(f"{c} {sum(n for _, n in per)}" + (f" ({where})" if where else ""))
     L = [BEGIN, "## Generalisation: random placements", "",
          f"Written by `{cmd}` at commit {at} ({nruns} runs, {minutes:.0f} min): held-out "
-         f"placements {held} (1..50 tune; on the floors held out from all tuning, "
-         f"{', '.join(UNSEEN)}, none) of every shipped floor "
+         f"placements {held} (1..50 tune, but on {' and '.join(UNSEEN)} none: floors held "
+         "out from all tuning) of every shipped floor "
          "(docs/SIMULATOR.md, \"Placements\"), seeds "
          f"{seeds}; `p` meta-path + pathloss, `r` meta + ridge (the "
          "paper). Ratio: travel / shortest path, successful runs. Failures (first match; "

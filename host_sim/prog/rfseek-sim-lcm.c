@@ -70,6 +70,9 @@ static int sim_lcm_main(int argc, char **argv)
         } else if (strcmp(a, "--can") == 0) {
             cfg.can_iface = v, i++;
         } else if (strcmp(a, "--log") == 0) {
+            if (lx_err_path_opt(PROG, a, v) != 0) {
+                return 2;
+            }
             log_path = v, i++;
         } else if (strcmp(a, "--seed") == 0) {
             errno = 0;

@@ -323,6 +323,12 @@ enum { RUN = -1 }; /* parse_options: go on (else the exit status) */
 /* One option that takes a value v: RUN, or the exit status of a bad value. */
 static int parse_value(options_t *o, const char *a, const char *v)
 {
+    static const char *const paths[] = {"--map", "--replay", "--log", "--decisions", "--candump"};
+    for (size_t i = 0; i < sizeof paths / sizeof paths[0]; i++) {
+        if (strcmp(a, paths[i]) == 0 && lx_err_path_opt(PROG, a, v) != 0) {
+            return 2;
+        }
+    }
     if (strcmp(a, "--map") == 0) {
         o->map_path = v;
     } else if (strcmp(a, "--lcm") == 0) {

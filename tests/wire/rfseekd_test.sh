@@ -74,6 +74,9 @@ expect_err_of "$sl" sim-lcm-newline-lcm-url 1 "lcm: udpm://?q: cannot open this 
     $scn --lcm "udpm://${nl}q" --max-time 1
 expect_err_of "$sl" sim-lcm-newline-can 1 "can: rfsno?q" $scn --lcm memq:// --can "rfsno${nl}q" --max-time 1
 [ ! -s "$w/out" ] && pass sim-lcm-newline-no-summary || fail sim-lcm-newline-no-summary
+# --log: checked before any work (its folder, not the scenario itself).
+expect_err_of "$sl" sim-lcm-log-no-folder 1 "$w/nope/l.tsv: No such file or directory" $scn --lcm memq:// --log "$w/nope/l.tsv"
+expect_err_of "$sl" sim-lcm-log-is-scenario 1 "is the input" $scn --lcm memq:// --log $scn
 # liblcm's own stderr is folded by lx_lcm_open (firmware/port/linux/lx_lcm.c): its two lines
 # for a bad option of a missing log (lcm_logprov.c) become part of one error line, and a
 # warning on a provider that does open is one line before the end-of-run summary.

@@ -35,6 +35,33 @@ static const char usage_text[] =
 
 static const char PROG[] = "rfseek-sim-lcm"; /* the prefix of its error lines (lx_err_print) */
 
+/* One run, its decisions (log.tsv) written beside log_path (NULL: none) and renamed into
+ * place when the run ends, as the summary is printed: 0, or -1 with err. */
+static int run_logged(const hs_sim_env_t *env, uint64_t seed, hs_ctrl_t *ctrl, const char *log_path,
+                      hs_sim_result_t *res, char *err, size_t errlen)
+{
+    hs_sim_io_t io;
+    memset(&io, 0, sizeof io);
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", log_path ? log_path : "", (long)getpid());
+    if (log_path && !(io.log = fopen(tmp, "w"))) {
+        snprintf(err, errlen, "%s: cannot write: %s", log_path, strerror(errno));
+        return -1;
+    }
+    int rc = hs_sim_run(env, seed, ctrl, &io, res, err, errlen);
+    if (io.log) {
+        bool lost = fclose(io.log) != 0;
+        if (rc == 0 && (lost || rename(tmp, log_path) != 0)) {
+            snprintf(err, errlen, "%s: %s", log_path, lost ? "write failed" : strerror(errno));
+            rc = -1;
+        }
+        if (rc != 0) {
+            remove(tmp);
+        }
+    }
+    return rc;
+}
+
 static int sim_lcm_main(int argc, char **argv)
 {
     const char *scn = NULL;
@@ -131,29 +158,9 @@ static int sim_lcm_main(int argc, char **argv)
         lx_err_print(PROG, "%s", err);
     }
     hs_sim_result_t res;
-    hs_sim_io_t io;
-    memset(&io, 0, sizeof io);
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", log_path ? log_path : "", (long)getpid());
-    if (log_path && !(io.log = fopen(tmp, "w"))) {
-        lx_err_print(PROG, "%s: cannot write: %s", log_path, strerror(errno));
-        hs_ctrl_close(&ctrl);
-        hs_sim_env_close(&env);
-        return 1;
-    }
-    int rc = hs_sim_run(&env, seed >= 0 ? (uint64_t)seed : sc.seed, &ctrl, &io, &res, err, sizeof err);
+    int rc = run_logged(&env, seed >= 0 ? (uint64_t)seed : sc.seed, &ctrl, log_path, &res, err, sizeof err);
     uint32_t timeouts = hs_ctrl_lcm_timeouts(&ctrl);
     hs_ctrl_close(&ctrl);
-    if (io.log) { /* the log whenever the run ends, as the summary */
-        bool lost = fclose(io.log) != 0;
-        if (rc == 0 && (lost || rename(tmp, log_path) != 0)) {
-            snprintf(err, sizeof err, "%s: %s", log_path, lost ? "write failed" : strerror(errno));
-            rc = -1;
-        }
-        if (rc != 0) {
-            remove(tmp);
-        }
-    }
     if (rc != 0) {
         lx_err_print(PROG, "%s", err);
         hs_sim_env_close(&env);

@@ -34,8 +34,6 @@ typedef struct hs_ctrl {
     const char *name;   ///< short name for logs ("meta", "lcm", ...)
     void *self;         ///< implementation state, passed to every callback
     int64_t period_us;  ///< control period, microseconds (in-process default 50 ms, 20 Hz)
-    bool no_plan_wait;  ///< its decisions do not carry plan_wait (the LCM status has no
-                        ///< such field): summary.json's slow_decisions, plan_wait_max null
     /// A localisation pose (map frame, metres Q16.16, time in pose->t_us).
     void (*on_pose)(void *self, const rfs_pose_t *pose);
     /// A received packet from source `src` (index in scenario order) at t_us with dbm.

@@ -226,7 +226,6 @@ int hs_ctrl_lcm_open(hs_ctrl_t *c, const hs_ctrl_lcm_cfg_t *cfg, char *err, size
     c->name = cfg->can_iface ? "lcm+socketcan" : "lcm+can-over-lcm";
     c->self = s;
     c->period_us = cfg->period_us;
-    c->no_plan_wait = true; /* seeker_status_t carries no plan_wait */
     c->on_pose = cb_pose;
     c->on_rssi = cb_rssi;
     c->on_receiver = cb_receiver;

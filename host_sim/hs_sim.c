@@ -735,7 +735,6 @@ int hs_sim_run(const hs_sim_env_t *e, uint64_t seed, hs_ctrl_t *ctrl, const hs_s
     memset(res, 0, sizeof *res);
     res->seed = seed;
     res->bridge = strcmp(e->sc.target, "bridge") == 0;
-    res->no_plan_wait = ctrl->no_plan_wait;
     sim_run_t r;
     memset(&r, 0, sizeof r);
     r.e = e;

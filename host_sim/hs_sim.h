@@ -89,8 +89,6 @@ typedef struct hs_sim_result {
                                  ///< their search tree (rfs_seek_decision_t.plan_wait):
                                  ///< over 100 ms from the leg's end at 20 Hz
     uint32_t plan_wait_max;      ///< the longest such wait, control periods
-    bool no_plan_wait;           ///< the controller does not report plan_wait
-                                 ///< (hs_ctrl_t.no_plan_wait): the two above are unknown
     uint32_t decisions_over_100ms; ///< decisions whose latency (below) exceeded 100 ms
     double decision_wait_max_s;  ///< the longest decision latency: from the period a decision
                                  ///< began (a leg's end) to its wheel command, that period

@@ -53,12 +53,8 @@ void hs_sim_write_summary(FILE *f, const hs_sim_env_t *e, const hs_sim_result_t 
     fprintf(f, "  \"motor_timeouts\": %u,\n", r->motor_timeouts);
     fprintf(f, "  \"goal_timeouts\": %u,\n", r->goal_timeouts);
     fprintf(f, "  \"goal_blocked\": %u,\n", r->goal_blocked);
-    if (r->no_plan_wait) { // not reported (the LCM status): unknown, not 0
-        fprintf(f, "  \"slow_decisions\": null,\n  \"plan_wait_max\": null,\n");
-    } else {
-        fprintf(f, "  \"slow_decisions\": %u,\n", r->slow_decisions);
-        fprintf(f, "  \"plan_wait_max\": %u,\n", r->plan_wait_max);
-    }
+    fprintf(f, "  \"slow_decisions\": %u,\n", r->slow_decisions);
+    fprintf(f, "  \"plan_wait_max\": %u,\n", r->plan_wait_max);
     fprintf(f, "  \"decisions_over_100ms\": %u,\n", r->decisions_over_100ms);
     json_num(f, "decision_wait_max_s", r->decision_wait_max_s, false);
     json_num(f, "decision_wait_mean_s",

@@ -66,6 +66,8 @@ $(eval $(call test_script,placements,$(PYTHON) tests/host_sim/placements.py $(SI
 $(eval $(call test_script,greedy_extrap,$(PYTHON) tests/host_sim/greedy_extrap_check.py $(SIM),$(SIM) scripts/greedy_extrap.py))
 $(eval $(call test_script,faults,tests/host_sim/faults.sh $(SIM) 3,$(SIM)))
 $(eval $(call test_script,strategy_cli,tests/host_sim/strategy_cli.sh $(SIM),$(SIM)))
+# A path-valued option given an option as its value, in every program (lx_err_path_opt).
+$(eval $(call test_script,path_opts,tests/linux/path_opts.sh $(BUILD),$(SIM) $(BUILD)/bin/rfseek-sim-lcm $(BUILD)/bin/rfseekd $(BUILD)/bin/rfseek-feed $(BUILD)/bin/rfseek-record $(BUILD)/bin/rfseek-replay $(BUILD)/bin/rfseek-map))
 # Every program in scripts/ answers --help (exit 0, a usage text, nothing written).
 $(eval $(call test_script,scripts_help,tests/host_sim/scripts_help.sh $(PYTHON),))
 # bridge_bounds.py's tolerance reference against a brute-force walk of the grid.

@@ -626,6 +626,10 @@ static int parse_value(feed_opts_t *fo, const char *a, const char *v)
     } else if (*v == '\0' && strcmp(a, "--seed") != 0) { /* "" --lcm: liblcm's default */
         opt_err("%s: empty value (see --help)", a);
         return 2;
+    } else if ((strcmp(a, "--output") == 0 || strcmp(a, "--pose") == 0 || strcmp(a, "--scenario") == 0 ||
+                strcmp(a, "--out") == 0) &&
+               lx_err_path_opt("rfseek-feed", a, v) != 0) {
+        return 2;
     } else if (strcmp(a, "--output") == 0) {
         fo->output = v;
     } else if (strcmp(a, "--lcm") == 0) {

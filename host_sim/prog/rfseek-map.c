@@ -463,6 +463,9 @@ static int parse_opts(int argc, char **argv, opts_t *o)
                 lx_err_print(PROG, "%s: an output file name expected", a);
                 return 2;
             }
+            if (lx_err_path_opt(PROG, a, v) != 0) {
+                return 2;
+            }
             *(strcmp(a, "--pgm") == 0 ? &o->pgm : strcmp(a, "--png") == 0 ? &o->png : &o->crop) = v;
         } else if (strcmp(a, "--res") == 0 || strcmp(a, "--clearance") == 0 || strcmp(a, "--grid") == 0) {
             const char *v = i + 1 < argc ? argv[++i] : NULL;

@@ -363,6 +363,9 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
         if (*optarg == '\0') {
             die_opt(c == 'o' ? "-o/--out" : c == 'l' ? "--live-out" : "--candump", optarg);
         }
+        if (lx_err_path_opt(PROG, c == 'o' ? "-o/--out" : c == 'l' ? "--live-out" : "--candump", optarg) != 0) {
+            return 2;
+        }
         *(c == 'o' ? &o->out_path : c == 'l' ? &o->live_path : &o->candump_path) = optarg;
         break;
     case 's':

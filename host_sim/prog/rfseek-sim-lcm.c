@@ -1,17 +1,20 @@
 /* rfseek-sim-lcm.c - the simulator with the controller in a separate process.
  *
  *   rfseek-sim-lcm SCENARIO [--lcm URL] [--can IFACE] [--seed N] [--timeout-ms N] [--max-time S]
+ *                  [--log FILE]
  *
  * Runs the scenario like rfseek-sim, but the controller is rfseekd --clock-lcm in another
  * process: poses and RSSI go out on LCM, one RFS_CLOCK per control period, and the
  * simulated motor controller takes the wheel commands from CAN (SocketCAN with --can,
  * else the LCM fallback channel RFS_CAN_FALLBACK). Prints summary.json to stdout, checked
- * at exit like every program's (lx_err_close_stdout).
+ * at exit like every program's (lx_err_close_stdout); --log writes rfseek-sim's log.tsv,
+ * renamed into place when the run ends.
  */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "hs_ctrl_lcm.h"
 #include "lx_err.h"
@@ -20,15 +23,44 @@
 
 static const char usage_text[] =
     "usage: rfseek-sim-lcm SCENARIO [--lcm URL] [--can IFACE] [--seed N] [--timeout-ms N] [--max-time S]\n"
+    "                      [--log FILE]\n"
     "Simulate SCENARIO with the controller running as a separate process (rfseekd --clock-lcm).\n"
     "  --lcm URL        LCM provider shared with rfseekd (default: LCM's default)\n"
     "  --can IFACE      take wheel commands from SocketCAN (default: LCM channel RFS_CAN_FALLBACK)\n"
     "  --seed N         run seed (default: the scenario's)\n"
     "  --timeout-ms N   wait this long for the controller's answer to a step (default 5000)\n"
     "  --max-time S     stop after S simulated seconds (overrides the scenario's stop time)\n"
+    "  --log FILE       write the decisions as rfseek-sim's log.tsv (its flags, the estimate)\n"
     "  -h, --help       this text\n";
 
 static const char PROG[] = "rfseek-sim-lcm"; /* the prefix of its error lines (lx_err_print) */
+
+/* One run, its decisions (log.tsv) written beside log_path (NULL: none) and renamed into
+ * place when the run ends, as the summary is printed: 0, or -1 with err. */
+static int run_logged(const hs_sim_env_t *env, uint64_t seed, hs_ctrl_t *ctrl, const char *log_path,
+                      hs_sim_result_t *res, char *err, size_t errlen)
+{
+    hs_sim_io_t io;
+    memset(&io, 0, sizeof io);
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", log_path ? log_path : "", (long)getpid());
+    if (log_path && !(io.log = fopen(tmp, "w"))) {
+        snprintf(err, errlen, "%s: cannot write: %s", log_path, strerror(errno));
+        return -1;
+    }
+    int rc = hs_sim_run(env, seed, ctrl, &io, res, err, errlen);
+    if (io.log) {
+        bool lost = fclose(io.log) != 0;
+        if (rc == 0 && (lost || rename(tmp, log_path) != 0)) {
+            snprintf(err, errlen, "%s: %s", log_path, lost ? "write failed" : strerror(errno));
+            rc = -1;
+        }
+        if (rc != 0) {
+            remove(tmp);
+        }
+    }
+    return rc;
+}
 
 static int sim_lcm_main(int argc, char **argv)
 {
@@ -37,6 +69,7 @@ static int sim_lcm_main(int argc, char **argv)
     cfg.prog = PROG;
     long long seed = -1;
     double max_time = 0;
+    const char *log_path = NULL;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -50,7 +83,7 @@ static int sim_lcm_main(int argc, char **argv)
             lx_err_print(PROG, "unexpected argument '%s' (one SCENARIO only)", a);
             return 2;
         } else if (strcmp(a, "--lcm") != 0 && strcmp(a, "--can") != 0 && strcmp(a, "--seed") != 0 &&
-                   strcmp(a, "--max-time") != 0 && strcmp(a, "--timeout-ms") != 0) {
+                   strcmp(a, "--max-time") != 0 && strcmp(a, "--timeout-ms") != 0 && strcmp(a, "--log") != 0) {
             lx_err_print(PROG, "unknown option '%s' (see --help)", a);
             return 2;
         } else if (!v) {
@@ -63,6 +96,11 @@ static int sim_lcm_main(int argc, char **argv)
             cfg.lcm_url = v, i++;
         } else if (strcmp(a, "--can") == 0) {
             cfg.can_iface = v, i++;
+        } else if (strcmp(a, "--log") == 0) {
+            if (lx_err_path_opt(PROG, a, v) != 0) {
+                return 2;
+            }
+            log_path = v, i++;
         } else if (strcmp(a, "--seed") == 0) {
             errno = 0;
             seed = strtoll(v, &end, 10);
@@ -92,6 +130,9 @@ static int sim_lcm_main(int argc, char **argv)
         lx_err_print(PROG, "a SCENARIO file is required (see --help)");
         return 2;
     }
+    if (log_path && (lx_err_same_file(PROG, scn, log_path) != 0 || lx_err_check_dest(PROG, log_path) != 0)) {
+        return 1;
+    }
     char err[512];
     hs_scenario_t sc;
     if (hs_scenario_load(scn, &sc, err, sizeof err) != 0) {
@@ -117,9 +158,7 @@ static int sim_lcm_main(int argc, char **argv)
         lx_err_print(PROG, "%s", err);
     }
     hs_sim_result_t res;
-    hs_sim_io_t io;
-    memset(&io, 0, sizeof io);
-    int rc = hs_sim_run(&env, seed >= 0 ? (uint64_t)seed : sc.seed, &ctrl, &io, &res, err, sizeof err);
+    int rc = run_logged(&env, seed >= 0 ? (uint64_t)seed : sc.seed, &ctrl, log_path, &res, err, sizeof err);
     uint32_t timeouts = hs_ctrl_lcm_timeouts(&ctrl);
     hs_ctrl_close(&ctrl);
     if (rc != 0) {

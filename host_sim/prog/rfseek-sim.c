@@ -220,10 +220,16 @@ static int parse_options(int argc, char **argv, sim_opts_t *o)
             if (!more || !*argv[i + 1]) {
                 return die("--out: expected a directory%s%s", "", "");
             }
+            if (lx_err_path_opt(prog, a, argv[i + 1]) != 0) {
+                return 1;
+            }
             o->out = argv[++i];
         } else if (strcmp(a, "--pcap") == 0) {
             if (!more || !*argv[i + 1]) {
                 return die("--pcap: expected a file name%s%s", "", "");
+            }
+            if (lx_err_path_opt(prog, a, argv[i + 1]) != 0) {
+                return 1;
             }
             o->pcap = argv[++i];
         } else if (strcmp(a, "--seeds") == 0) {

@@ -16,8 +16,9 @@ convention, docs/SIMULATOR.md, the LCM wire format), not by the code under test:
   poses/     the pose CSV of rfseek-feed --pose (docs/FEEDER.md): good files and edge values
   candump/   candump -L log lines (can-utils' format, docs/CAN.md "CAN logs"): our frames,
              29-bit, remote, error and CAN FD frames, candump -x directions, padded names
-  lcm/       one message per channel, the receiver heartbeat included (LCM encoding: 8-byte fingerprint, big-endian fields;
-             fingerprints computed with lcm-gen's hash) and small LCM logs
+  lcm/       one message per channel, the receiver heartbeat and two seeker statuses included
+             (LCM encoding: 8-byte fingerprint, big-endian fields; fingerprints computed with
+             lcm-gen's hash) and small LCM logs
 """
 import os
 import struct
@@ -208,17 +209,49 @@ WHEEL = [("utime", "int64_t", 0), ("left_mm_s", "int16_t", 0), ("right_mm_s", "i
          ("stop", "boolean", 0)]
 CAN = [("utime", "int64_t", 0), ("id", "int32_t", 0), ("dlc", "int8_t", 0), ("data", "byte", 1)]
 RSSI_STATUS = [("utime", "int64_t", 0), ("seq", "int32_t", 0)]
+STATUS = ([("utime", "int64_t", 0), ("state", "int8_t", 0), ("faults", "int32_t", 0),
+           ("left_mm_s", "int16_t", 0), ("right_mm_s", "int16_t", 0), ("decided", "boolean", 0),
+           ("iteration", "int32_t", 0), ("decision_utime", "int64_t", 0), ("kind", "int8_t", 0),
+           ("reason", "string", 0)] +
+          [(n, "boolean", 0) for n in ("model_updated", "line_search", "model_valid", "mean_valid")] +
+          [("prev", "int8_t", 0)] +
+          [(n, "double", 0) for n in ("prediction", "mean", "epsilon", "x", "y", "goal_x", "goal_y",
+                                      "max_x", "max_y", "path_len")] +
+          [("samples", "int32_t", 0)] +
+          [(n, "boolean", 0) for n in ("sampled", "near", "hedged", "pinned", "refuted")] +
+          [("plan_wait", "int32_t", 0), ("est_valid", "boolean", 0)] +
+          [(n, "double", 0) for n in ("est_x", "est_y", "est_n", "est_w", "est_p0", "est_rms",
+                                      "est_area")] +
+          [("bridge_valid", "boolean", 0)] +
+          [(n, "double", 0) for n in ("bridge_x", "bridge_y", "bridge_f", "bridge_sigma",
+                                      "bridge_area")])
+
+
+def status(kind, reason, flags, plan_wait, est):
+    """A decided seeker_status_t (lcm/seeker_status_t.lcm): flags are sampled, near, hedged,
+    pinned, refuted; est the 7 path-loss values or None."""
+    r = reason.encode() + b"\0"
+    return (struct.pack(">Q", lcm_hash(STATUS)) +
+            struct.pack(">qbihhbiqb", 2_000_000, 3, 0, 250, 300, 1, 4, 2_000_000, kind) +
+            struct.pack(">i", len(r)) + r + struct.pack(">5b", 1, 0, 1, 1, 0) +
+            struct.pack(">10d", -60.5, -58.25, 0.25, 8.0, 6.0, 12.5, 6.0, 12.5, 6.0, 4.75) +
+            struct.pack(">i", 300) + struct.pack(">5bib", *flags, plan_wait, est is not None) +
+            struct.pack(">7d", *(est or [0.0] * 7)) + struct.pack(">b5d", 0, 0, 0, 0, 0, 0))
+
+
 msgs = {
     0: struct.pack(">Q", lcm_hash(POSE)) + struct.pack(">qddd", 1_000_000, 8.0, 6.0, 7.0),
     1: struct.pack(">Q", lcm_hash(RSSI)) + struct.pack(">qhhi", 1_000_000, 0, -60, 7),
     2: struct.pack(">Q", lcm_hash(CLOCK)) + struct.pack(">q", 2_000_000),
     3: struct.pack(">Q", lcm_hash(WHEEL)) + struct.pack(">qhhb", 1_000_000, 300, -300, 0),
+    4: status(2, "greedy+relearn", (0, 0, 0, 0, 1), 1, [27.875, 11.375, 2.5, 4.0, -20.0, 2.0, 3.0]),
     5: struct.pack(">Q", lcm_hash(CAN)) + struct.pack(">qib", 1_000_000, 0x120, 8) + bytes(range(8)),
     6: struct.pack(">Q", lcm_hash(RSSI_STATUS)) + struct.pack(">qi", 1_050_000, 21),
 }
 for sel, m in msgs.items():
     put("lcm", "msg_%d" % sel, bytes([sel]) + m)
 put("lcm", "msg_4_garbage", bytes([4]) + b"\x00" * 40)
+put("lcm", "msg_4_sampled", bytes([4]) + status(3, "epsilon+relearn", (1, 0, 0, 0, 0), 65535, None))
 put("lcm", "msg_6_clock", bytes([6]) + msgs[2])  # a clock_t on the heartbeat channel
 
 

@@ -56,6 +56,9 @@ def status(b):
     o += 80
     (m["samples"],) = struct.unpack_from(">i", b, o)
     o += 4
+    keys = ["sampled", "near", "hedged", "pinned", "refuted", "plan_wait"]
+    m.update(zip(keys, struct.unpack_from(">5bi", b, o)))
+    o += 9
     keys = ["est_valid", "est_x", "est_y", "est_n", "est_w", "est_p0", "est_rms", "est_area"]
     m.update(zip(keys, struct.unpack_from(">b7d", b, o)))
     o += 57

@@ -1,7 +1,8 @@
 /* test_status_est.c - the estimates in the LCM seeker status: lx_lcm_pub_status_est()
- * puts the path-loss estimate and then the per-node model's bridging point in the last
- * fields of rfseek.seeker_status_t, read back here from the recorded bytes by hand
- * (big-endian, the .lcm field order) rather than by the generated decoder;
+ * puts the decision's last fields (samples, the flags, plan_wait), the path-loss estimate
+ * and then the per-node model's bridging point at the end of rfseek.seeker_status_t, read
+ * back here from the recorded bytes by hand (big-endian, the .lcm field order) rather than
+ * by the generated decoder;
  * lx_lcm_pub_status() leaves them zero; the receiver drops a status whose estimate is not
  * finite, negative where it cannot be, or set without its valid flag. */
 #include "rfs_test.h"
@@ -71,6 +72,9 @@ static size_t status_bytes(const rfs_pathloss_est_t *est, const rfs_fields_est_t
     rfs_seek_out_t out;
     memset(&out, 0, sizeof out);
     out.decision.samples = 42;
+    out.decision.near = true;
+    out.decision.refuted = true;
+    out.decision.plan_wait = 0x1234;
     assert_int_equal(lx_lcm_pub_status_est(l, 1000, &out, est, bridge), 0);
     lx_lcm_record(l, NULL);
     lx_lcm_close(l);
@@ -113,9 +117,13 @@ static void estimate_is_in_the_last_fields(void **state)
     assert_true(be_double(e + 33) == -1490153.0 / 65536.0);
     assert_true(be_double(e + 41) == 190971.0 / 65536.0);
     assert_true(be_double(e + 49) == 4.0);
-    // The field before the estimate: samples, int32 big-endian.
-    const uint8_t *s = e - 4;
+    // The fields before the estimate: samples (int32 big-endian), sampled, near, hedged,
+    // pinned, refuted (one byte each), plan_wait (int32).
+    const uint8_t *s = e - 4 - 5 - 4;
     assert_int_equal((s[0] << 24) | (s[1] << 16) | (s[2] << 8) | s[3], 42);
+    const uint8_t flags[5] = {0, 1, 0, 0, 1};
+    assert_memory_equal(s + 4, flags, 5);
+    assert_int_equal((s[9] << 24) | (s[10] << 16) | (s[11] << 8) | s[12], 0x1234);
     // No bridging point: its fields are zero.
     for (int i = 0; i < BRIDGE_BYTES; i++) {
         assert_int_equal(e[EST_BYTES + i], 0);
@@ -222,6 +230,18 @@ static void bad_estimates_are_dropped_with_one_line(void **state)
     r = deliver(&b);
     assert_int_equal(r.statuses, 0);
     assert_int_equal(r.bads, 1);
+
+    b = m;
+    b.plan_wait = 65536; // rfs_seek_decision_t.plan_wait is 16 bits
+    r = deliver(&b);
+    assert_int_equal(r.statuses, 0);
+    assert_int_equal(r.bads, 1);
+    b.plan_wait = -1;
+    r = deliver(&b);
+    assert_int_equal(r.bads, 1);
+    b.plan_wait = 65535;
+    r = deliver(&b);
+    assert_int_equal(r.statuses, 1);
 
     b = m;
     b.bridge_valid = 1;

@@ -97,10 +97,12 @@ def q16(v):
 def decision_line(m):
     """rfseekd's --decisions line (rfseekd.c, step()) of a decided status decoded here."""
     return ("decision t=%d n=%d kind=%s relearn=%d line_search=%d prev=%d pred_q16=%s mean_q16=%s"
-            " eps_q16=%s x_q16=%s y_q16=%s goal_q16=%s,%s samples=%d" % (
+            " eps_q16=%s x_q16=%s y_q16=%s goal_q16=%s,%s samples=%d sampled=%d near=%d hedged=%d"
+            " pinned=%d refuted=%d plan_wait=%d" % (
                 m.decision_utime, m.iteration, KINDS.get(m.kind, "?"), m.model_updated,
                 m.line_search, m.prev, q16(m.prediction), q16(m.mean), q16(m.epsilon), q16(m.x),
-                q16(m.y), q16(m.goal_x), q16(m.goal_y), m.samples))
+                q16(m.y), q16(m.goal_x), q16(m.goal_y), m.samples, m.sampled, m.near, m.hedged,
+                m.pinned, m.refuted, m.plan_wait))
 
 
 def one_line_error(name, p, pattern, stdout_lines=None):

@@ -74,6 +74,9 @@ expect_err_of "$sl" sim-lcm-newline-lcm-url 1 "lcm: udpm://?q: cannot open this 
     $scn --lcm "udpm://${nl}q" --max-time 1
 expect_err_of "$sl" sim-lcm-newline-can 1 "can: rfsno?q" $scn --lcm memq:// --can "rfsno${nl}q" --max-time 1
 [ ! -s "$w/out" ] && pass sim-lcm-newline-no-summary || fail sim-lcm-newline-no-summary
+# --log: checked before any work (its folder, not the scenario itself).
+expect_err_of "$sl" sim-lcm-log-no-folder 1 "$w/nope/l.tsv: No such file or directory" $scn --lcm memq:// --log "$w/nope/l.tsv"
+expect_err_of "$sl" sim-lcm-log-is-scenario 1 "is the input" $scn --lcm memq:// --log $scn
 # liblcm's own stderr is folded by lx_lcm_open (firmware/port/linux/lx_lcm.c): its two lines
 # for a bad option of a missing log (lcm_logprov.c) become part of one error line, and a
 # warning on a provider that does open is one line before the end-of-run summary.
@@ -179,9 +182,11 @@ timeout 60 lcm-logplayer -l memq:// -s 1000 "$w/out1.lcmlog" > /dev/null 2>&1 \
 
 # Two processes over udpm://, only inside a network namespace we create and delete.
 # two_process TAG RFSEEKD-ARGS...: rfseekd (with the args) and rfseek-sim-lcm on the default
-# office in a fresh namespace; rfseekd's stderr in $w/d-TAG.err, the simulator's summary in
-# $w/summary-TAG.json and stderr in $w/sim-TAG.err; sets src and drc. Returns 2 when no
+# office in a fresh namespace (the simulator with the options in sim_args); rfseekd's stderr
+# in $w/d-TAG.err, the simulator's summary in $w/summary-TAG.json, its log.tsv in
+# $w/log-TAG.tsv and stderr in $w/sim-TAG.err; sets src and drc. Returns 2 when no
 # namespace can be made.
+sim_args=()
 url='udpm://239.255.76.67:7667?ttl=0'
 two_process() {
     local tag=$1
@@ -196,7 +201,7 @@ two_process() {
     local dpid=$!
     sleep 0.5
     ip netns exec "$ns" timeout 300 "$build/bin/rfseek-sim-lcm" scenarios/default.yaml --lcm "$url" \
-        > "$w/summary-$tag.json" 2> "$w/sim-$tag.err"
+        --log "$w/log-$tag.tsv" "${sim_args[@]}" > "$w/summary-$tag.json" 2> "$w/sim-$tag.err"
     src=$?
     wait $dpid
     drc=$?
@@ -214,9 +219,10 @@ if [ $src -eq 0 ] && [ $drc -eq 0 ] && grep -q '"reached": true' "$w/summary-pap
 else
     fail "two-process-run-reaches-source (sim rc $src, rfseekd rc $drc: $(cat "$w/sim-paper.err" "$w/d-paper.err" | head -5))"
 fi
-# The status over LCM has no plan_wait: the summary says unknown (null), not 0 waits.
-grep -q '"slow_decisions": null,' "$w/summary-paper.json" && grep -q '"plan_wait_max": null,' "$w/summary-paper.json" \
-    && pass two-process-plan-wait-unknown || fail "two-process-plan-wait-unknown ($(grep plan_wait "$w/summary-paper.json"))"
+# The decision flags and plan_wait cross LCM: rfseek-sim-lcm's log.tsv and summary as
+# rfseekd's own --decisions lines give them (tests/wire/decision_flags.py).
+out=$(/usr/bin/python3 tests/wire/decision_flags.py "$w/live.txt" "$w/log-paper.tsv" "$w/summary-paper.json" 2>&1) \
+    && pass "two-process-plan-wait ($out)" || fail "two-process-plan-wait ($out)"
 "$d" --map $map --replay "$w/run.lcmlog" --clock-lcm > "$w/replay1.txt" 2>/dev/null
 "$d" --map $map --replay "$w/run.lcmlog" --clock-lcm > "$w/replay2.txt" 2>/dev/null
 if [ -s "$w/live.txt" ] && cmp -s "$w/live.txt" "$w/replay1.txt" && cmp -s "$w/replay1.txt" "$w/replay2.txt"; then
@@ -236,6 +242,18 @@ if [ $src -eq 0 ] && [ $drc -eq 0 ] && grep -q '"reached": true' "$w/summary-pat
     pass "two-process-meta-path-pathloss-reaches-source ($(grep -E '"(distance_travelled_m|iterations)"' "$w/summary-path.json" | tr -d ' \n'))"
 else
     fail "two-process-meta-path-pathloss-reaches-source (sim rc $src, rfseekd rc $drc: $(cat "$w/sim-path.err" "$w/d-path.err" | tail -3))"
+fi
+# Simulator seed 8 with meta-path + pathloss: epsilon goals drawn from the model (sampled),
+# argmaxes ruled out (refuted) and decisions waiting a period for their tree (plan_wait).
+sim_args=(--seed 8)
+two_process flags --model pathloss --strategy meta-path --decisions "$w/flags.txt"
+sim_args=()
+out=$(/usr/bin/python3 tests/wire/decision_flags.py "$w/flags.txt" "$w/log-flags.tsv" "$w/summary-flags.json" 2>&1)
+if [ $? -eq 0 ] && [ $src -eq 0 ] && [ $drc -eq 0 ] && [[ $out == *"sampled "[1-9]* ]] \
+    && [[ $out == *"refuted "[1-9]* ]] && [[ $out == *"plan_wait_max "[1-9]* ]]; then
+    pass "two-process-decision-flags ($out)"
+else
+    fail "two-process-decision-flags (sim rc $src, rfseekd rc $drc: $out)"
 fi
 # The path-loss estimate crosses LCM: rfseek-sim-lcm's summary holds the one the last status
 # in rfseekd's log carried (decoded by scripts/lcm_log.py).

@@ -197,6 +197,38 @@ static void every_type_round_trips(void **state)
     lx_lcm_close(l);
 }
 
+/* Each decision flag alone, and plan_wait at its ends: a dropped or swapped field shows. */
+static void decision_flags_round_trip_one_at_a_time(void **state)
+{
+    (void)state;
+    rx_t r;
+    lx_lcm_t *l = open_memq(&r);
+    for (int k = 0; k < 7; k++) {
+        rfs_seek_out_t o;
+        memset(&o, 0, sizeof o);
+        o.decided = true;
+        o.decision.kind = k == 0 ? RFS_SEEK_EPSILON : RFS_SEEK_GREEDY;
+        o.decision.sampled = k == 0;
+        o.decision.near = k == 1;
+        o.decision.hedged = k == 2;
+        o.decision.pinned = k == 3;
+        o.decision.refuted = k == 4;
+        o.decision.plan_wait = k == 5 ? 65535u : k == 6 ? 1u : 0u;
+        assert_int_equal(lx_lcm_pub_status(l, 1000 + k, &o), 0);
+        drain(l);
+        assert_int_equal(r.statuses, k + 1);
+        const rfs_seek_decision_t *a = &r.status.decision;
+        assert_int_equal(a->sampled, k == 0);
+        assert_int_equal(a->near, k == 1);
+        assert_int_equal(a->hedged, k == 2);
+        assert_int_equal(a->pinned, k == 3);
+        assert_int_equal(a->refuted, k == 4);
+        assert_int_equal(a->plan_wait, k == 5 ? 65535u : k == 6 ? 1u : 0u);
+    }
+    assert_int_equal(r.bads, 0);
+    lx_lcm_close(l);
+}
+
 static void malformed_messages_are_dropped_and_described(void **state)
 {
     (void)state;
@@ -543,6 +575,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(pose_round_trips_exactly_and_heading_is_normalised),
         cmocka_unit_test(every_type_round_trips),
+        cmocka_unit_test(decision_flags_round_trip_one_at_a_time),
         cmocka_unit_test(malformed_messages_are_dropped_and_described),
         cmocka_unit_test(log_is_written_atomically_and_reads_back),
         cmocka_unit_test(bad_url_and_unreadable_log_give_one_line),

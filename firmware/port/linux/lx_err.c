@@ -146,3 +146,12 @@ int lx_err_same_dest(const char *prog, const char *a, const char *b)
     }
     return lx_err_same_file(prog, a, b);
 }
+
+int lx_err_path_opt(const char *prog, const char *opt, const char *value)
+{
+    if (value[0] != '-') {
+        return 0;
+    }
+    lx_err_print(prog, "%s: '%s' is an option, not a file name (./%s for a file)", opt, value, value);
+    return -1;
+}

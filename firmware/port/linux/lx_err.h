@@ -41,4 +41,10 @@ int lx_err_same_dest(const char *prog, const char *a, const char *b);
 /// 0, or -1 after "prog: PATH: REASON".
 int lx_err_check_dest(const char *prog, const char *path);
 
+/// Refuse a path-valued option's value that starts with '-': an option taken for the
+/// value (`-o --seed 3` would write a file named "--seed"); "./-x" still names such a
+/// file. Called while parsing, before any work. 0, or -1 after "prog: OPT: 'VALUE' is an
+/// option, not a file name (./VALUE for a file)".
+int lx_err_path_opt(const char *prog, const char *opt, const char *value);
+
 #endif /* LX_ERR_H */

@@ -202,7 +202,7 @@ static bool status_of(const rfseek_seeker_status_t *m, rfs_seek_out_t *o)
               q16_of(m->epsilon, &d->epsilon) && q16_of(m->x, &d->x) && q16_of(m->y, &d->y) &&
               q16_of(m->goal_x, &d->goal_x) && q16_of(m->goal_y, &d->goal_y) && q16_of(m->max_x, &d->max_x) &&
               q16_of(m->max_y, &d->max_y) && q16_of(m->path_len, &d->path_len) && m->samples >= 0 &&
-              m->samples <= 0xFFFF && est_ok(m);
+              m->samples <= 0xFFFF && m->plan_wait >= 0 && m->plan_wait <= 0xFFFF && est_ok(m);
     if (!ok) {
         return false;
     }
@@ -220,6 +220,12 @@ static bool status_of(const rfseek_seeker_status_t *m, rfs_seek_out_t *o)
     d->mean_valid = m->mean_valid;
     d->prev = (rfs_drive_status_t)m->prev;
     d->samples = (uint16_t)m->samples;
+    d->sampled = m->sampled;
+    d->near = m->near;
+    d->hedged = m->hedged;
+    d->pinned = m->pinned;
+    d->refuted = m->refuted;
+    d->plan_wait = (uint16_t)m->plan_wait;
     return true;
 }
 
@@ -622,6 +628,12 @@ int lx_lcm_pub_status_est(lx_lcm_t *l, int64_t t_us, const rfs_seek_out_t *out,
     m.max_y = dbl_of(d->max_y);
     m.path_len = dbl_of(d->path_len);
     m.samples = d->samples;
+    m.sampled = d->sampled;
+    m.near = d->near;
+    m.hedged = d->hedged;
+    m.pinned = d->pinned;
+    m.refuted = d->refuted;
+    m.plan_wait = d->plan_wait;
     if (est) { // the path-loss model's estimate (memset left them 0 otherwise)
         m.est_valid = true;
         m.est_x = dbl_of(est->sx);

@@ -302,6 +302,9 @@ static int parse_options(int argc, char **argv, options_t *o)
                 lx_err_print(PROG, "%s: empty value (see --help)", a);
                 return 2;
             }
+            if ((a[1] == 'o' || strcmp(a, "--map") == 0) && lx_err_path_opt(PROG, a, v) != 0) {
+                return 2;
+            }
             if (a[1] == 'o') {
                 o->out_path = v;
             } else if (parse_ctl(o, a, v) != RUN) {

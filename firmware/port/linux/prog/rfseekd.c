@@ -194,9 +194,10 @@ static void step(daemon_t *d, int64_t now_us)
         fprintf(d->decisions,
                 "decision t=%" PRId64 " n=%" PRIu32 " kind=%s relearn=%d line_search=%d prev=%d pred_q16=%" PRId32
                 " mean_q16=%" PRId32 " eps_q16=%" PRId32 " x_q16=%" PRId32 " y_q16=%" PRId32 " goal_q16=%" PRId32
-                ",%" PRId32 " samples=%u\n",
+                ",%" PRId32 " samples=%u sampled=%d near=%d hedged=%d pinned=%d refuted=%d plan_wait=%u\n",
                 x->t_us, x->iteration, rfs_seek_kind_name(x->kind), x->relearned, x->line_search, (int)x->prev,
-                x->prediction, x->mean, x->epsilon, x->x, x->y, x->goal_x, x->goal_y, (unsigned)x->samples);
+                x->prediction, x->mean, x->epsilon, x->x, x->y, x->goal_x, x->goal_y, (unsigned)x->samples,
+                x->sampled, x->near, x->hedged, x->pinned, x->refuted, (unsigned)x->plan_wait);
     }
 }
 
@@ -322,6 +323,12 @@ enum { RUN = -1 }; /* parse_options: go on (else the exit status) */
 /* One option that takes a value v: RUN, or the exit status of a bad value. */
 static int parse_value(options_t *o, const char *a, const char *v)
 {
+    static const char *const paths[] = {"--map", "--replay", "--log", "--decisions", "--candump"};
+    for (size_t i = 0; i < sizeof paths / sizeof paths[0]; i++) {
+        if (strcmp(a, paths[i]) == 0 && lx_err_path_opt(PROG, a, v) != 0) {
+            return 2;
+        }
+    }
     if (strcmp(a, "--map") == 0) {
         o->map_path = v;
     } else if (strcmp(a, "--lcm") == 0) {

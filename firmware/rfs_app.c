@@ -98,15 +98,15 @@ int rfs_app_cfg_choose(rfs_app_cfg_t *cfg, rfs_app_target_t target, rfs_seek_str
     if (model != NULL && model->per_source && app_target(target)->nsources > 1u) {
         return -1;
     }
-    rfs_app_cfg_t c = *cfg;
-    c.model = model;
-    if (!rfs_app_model_fits(&c)) {
+    /* Checked before cfg changes, without a copy of it (its 480 bytes are on the stack
+     * of a CONFIG frame's deepest path, docs/FIRMWARE.md "Build"). */
+    if (model != NULL && model->state_bytes > rfs_app_model_capacity(cfg)) {
         return -1;
     }
-    c.target = target;
-    rfs_seek_cfg_use_strategy(&c.seek, strategy);
-    c.pathloss.p0_min = p0_min;
-    *cfg = c;
+    cfg->model = model;
+    cfg->target = target;
+    rfs_seek_cfg_use_strategy(&cfg->seek, strategy);
+    cfg->pathloss.p0_min = p0_min;
     return 0;
 }
 

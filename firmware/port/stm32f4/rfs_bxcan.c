@@ -157,6 +157,15 @@ int rfs_bxcan_init(rfs_bxcan_t *d, rfs_bxcan_regs_t *regs, const rfs_bxcan_cfg_t
     return 0;
 }
 
+/* Let a host test's fake hardware react to a write (a no-op on hardware, where the
+ * controller reacts by itself). */
+static void hw_sync(rfs_bxcan_t *d)
+{
+    if (d->poll_hook != NULL) {
+        d->poll_hook(d->poll_ctx);
+    }
+}
+
 int rfs_bxcan_send(rfs_bxcan_t *d, const rfs_can_frame_t *f)
 {
     rfs_bxcan_regs_t *r = d->r;
@@ -168,7 +177,24 @@ int rfs_bxcan_send(rfs_bxcan_t *d, const rfs_can_frame_t *f)
         d->tx_no_mailbox++;
         return -1;
     }
-    const uint32_t tsr = r->tsr;
+    /* The frames sent are periodic states (WHEEL_CMD, STATUS): a newer one supersedes a
+     * request of its id still pending (held by a bus nobody acknowledges, or lost
+     * arbitration), which would otherwise go out late, before it, when the bus returns.
+     * ABRQ takes a pending mailbox back at once, one in transmission when that fails. */
+    uint32_t tsr = r->tsr;
+    uint32_t abort = 0u;
+    for (unsigned i = 0; i < 3u; i++) {
+        if ((tsr & RFS_BXCAN_TSR_TME(i)) == 0u &&
+            (r->tx[i].tir >> RFS_BXCAN_STID_SHIFT) == f->id) {
+            abort |= RFS_BXCAN_TSR_ABRQ(i);
+            d->tx_superseded++;
+        }
+    }
+    if (abort != 0u) {
+        r->tsr = abort; /* ABRQx are rs: writing 0 elsewhere has no effect */
+        hw_sync(d);
+        tsr = r->tsr;
+    }
     unsigned mb = 3u;
     for (unsigned i = 0; i < 3u; i++) {
         if ((tsr & RFS_BXCAN_TSR_TME(i)) != 0u) {
@@ -190,15 +216,6 @@ int rfs_bxcan_send(rfs_bxcan_t *d, const rfs_can_frame_t *f)
     m->tir |= RFS_BXCAN_TIR_TXRQ;
     d->tx_queued++;
     return 0;
-}
-
-/* Let a host test's fake hardware react to a write (a no-op on hardware, where the
- * controller reacts by itself). */
-static void hw_sync(rfs_bxcan_t *d)
-{
-    if (d->poll_hook != NULL) {
-        d->poll_hook(d->poll_ctx);
-    }
 }
 
 /* Take the next frame FIFO q holds into *f, releasing its mailbox (counting an overrun

@@ -328,6 +328,11 @@ void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out)
     }
     const bool stop = (faults & (RFS_APP_FAULT_POSE_LOST | RFS_APP_FAULT_RSSI_LOST |
                                  RFS_APP_FAULT_BUS_OFF | RFS_APP_FAULT_RESET)) != 0u;
+    if (stop) {
+        /* The drive must know: else, the stop over, its speed of before is commanded at
+         * once, without the acceleration ramp, and it reckons with wheels that turned. */
+        rfs_seek_hold(&a->seek, now_us);
+    }
 
     memset(out, 0, sizeof *out);
     out->t_us = now_us;

@@ -200,6 +200,34 @@ static void step(daemon_t *d, int64_t now_us)
     }
 }
 
+/* The end of a run that sent commands (signalled, --duration, --idle-exit, LCM failing):
+ * one more WHEEL_CMD, zero with Stop, so that no driving command stands until the motor
+ * controller's own timeout. */
+static void stop_wheels(daemon_t *d)
+{
+    if (d->replay || d->steps == 0u) {
+        return;
+    }
+    const rfs_can_wheel_t w = {0, 0, RFS_CAN_WHEEL_STOP};
+    const int64_t t = d->clock_lcm ? d->last_now_us : realtime_us();
+    rfs_can_frame_t f;
+    rfs_can_tx_wheel(&d->app->can_tx, &w, &f);
+    int r = 0;
+    if (d->can) {
+        r = lx_can_send(d->can, &f);
+    } else if (d->can_over_lcm && d->lcm) {
+        r = lx_lcm_pub_can(d->lcm, t, &f);
+    }
+    if (r != 0) {
+        fprintf(stderr, "rfseekd: the last wheel command (stop) could not be sent\n");
+    } else if (d->dump != NULL) {
+        lx_candump_write(d->dump, t, &f);
+    }
+    if (d->lcm) {
+        (void)lx_lcm_pub_wheel(d->lcm, t, &w);
+    }
+}
+
 /* Replay without clock messages: run every step whose time lies before t_us. */
 static void advance_to(daemon_t *d, int64_t t_us)
 {
@@ -765,6 +793,7 @@ static int daemon_main(int argc, char **argv)
         signal(SIGINT, on_signal);
         signal(SIGTERM, on_signal);
         rc = o.replay ? run_replay(&d, &o) : o.clock_lcm ? run_lockstep(&d, &o) : run_live(&d, &o);
+        stop_wheels(&d);
         if (rc == 0) { /* the counts of a run that went through; else its one error line */
             fprintf(stderr, "rfseekd: %" PRIu32 " steps, %" PRIu32 " decisions, %" PRIu32 " bad messages, %" PRIu32
                             " CAN send failures, %" PRIu32 " receiver heartbeats, seeker rejected %" PRIu32

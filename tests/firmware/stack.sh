@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # stack.sh BUILD - the hardware image's stack holds its deepest path: the main loop's worst
-# (a CONFIG frame re-initialising the application) plus the deepest receive interrupt and
-# two exception frames (the interrupt's, a fault's; 32 bytes each: no FPU context), by
+# (a CONFIG frame re-initialising the application) plus the deepest receive interrupt, the
+# fault handler and two exception frames (32 bytes each: no FPU context), by
 # scripts/fw_stack.py (-fstack-usage frames, the linked image's call graph). And the stack
 # sits at the bottom of SRAM, so an overflow faults instead of corrupting .data/.bss.
 set -uo pipefail
@@ -11,7 +11,7 @@ O=$F/obj
 elf=$F/firmware.elf
 fails=0
 sym() { echo $((16#$(arm-none-eabi-nm "$elf" | awk -v s="$1" '$3 == s { print $1 }'))); }
-out=$(/usr/bin/python3 scripts/fw_stack.py "$elf" Reset_Handler,CAN1_RX0_IRQHandler,CAN1_RX1_IRQHandler,SysTick_Handler,Default_Handler \
+out=$(/usr/bin/python3 scripts/fw_stack.py "$elf" Reset_Handler,CAN1_RX0_IRQHandler,CAN1_RX1_IRQHandler,SysTick_Handler,HardFault_Handler \
     "$O"/firmware/port/stm32f4/*.su "$O"/firmware/rfs_app.su "$O"/common/*.su "$O"/fw_map.su)
 rc=$?
 echo "$out"
@@ -21,11 +21,11 @@ isr=0
 for h in CAN1_RX0_IRQHandler CAN1_RX1_IRQHandler SysTick_Handler; do
     d=$(depth $h); [ "${d:-0}" -gt "$isr" ] && isr=$d
 done
-need=$((thread + isr + 32 + $(depth Default_Handler) + 32))
+need=$((thread + isr + 32 + $(depth HardFault_Handler) + 32))
 size=$(sym RFS_STACK_SIZE)
 if [ $rc -eq 0 ] && [ -n "$thread" ] && grep -q 'rfs_app_on_config' <<<"$out" && [ "$need" -le "$size" ]; then
-    echo "PASS stack bound $need B (loop $thread + interrupt $isr + 2 x 32) <= $size B"
-else echo "FAIL stack bound $need B (loop ${thread:-?} + interrupt $isr + 2 x 32) > $size B, or the analysis failed (rc $rc)"
+    echo "PASS stack bound $need B (loop $thread + interrupt $isr + fault $(depth HardFault_Handler) + 2 x 32) <= $size B"
+else echo "FAIL stack bound $need B (loop ${thread:-?} + interrupt $isr + fault $(depth HardFault_Handler) + 2 x 32) > $size B, or the analysis failed (rc $rc)"
     fails=$((fails + 1)); fi
 if [ "$(sym _sstack)" -eq $((0x20000000)) ] && [ "$(sym _estack)" -le "$(sym _sdata)" ]; then
     echo "PASS the stack is at the bottom of SRAM (0x20000000 .. $(printf 0x%x "$(sym _estack)")), below .data and .bss"

@@ -245,6 +245,35 @@ static void test_send_supersedes_a_pending_frame_of_its_id(void **state)
     assert_int_equal(d->tx_queued, 3u);
 }
 
+/* A fault handler's stop: every pending request aborted (ABRQ0..2: bits 7, 15, 23), the
+ * frame in the first mailbox that empties; none empties: -1, nothing written. */
+static void test_fault_send_aborts_pending_requests_and_sends(void **state)
+{
+    fake_hw_t *hw = ((void **)*state)[0];
+    rfs_bxcan_t *d = ((void **)*state)[1];
+    const rfs_bxcan_cfg_t c = rfs_bxcan_cfg_default();
+    assert_int_equal(rfs_bxcan_init(d, &hw->r, &c, fake_tick, hw), 0);
+    const rfs_can_frame_t stop = {0x100u, 6u, {0x13, 0, 0, 0, 0, 0x5A, 0, 0}};
+    hw->r.tx[0].tir = (0x100u << 21) | 1u; /* three pending requests */
+    hw->r.tx[1].tir = (0x180u << 21) | 1u;
+    hw->r.tx[2].tir = (0x100u << 21) | 1u;
+    hw->r.tsr = 0u;
+
+    assert_int_equal(rfs_bxcan_fault_send(&hw->r, &stop, 10u, NULL, NULL), -1);
+    assert_int_equal(hw->r.tsr, 0x00808080u); /* ABRQ0..2 written; no mailbox emptied */
+    assert_int_equal(hw->r.tx[0].tdlr, 0u);
+
+    hw->aborts = true;
+    hw->tme = 0u;
+    hw->r.tsr = 0u;
+    assert_int_equal(rfs_bxcan_fault_send(&hw->r, &stop, 10u, fake_tick, hw), 0);
+    assert_int_equal(hw->tme, 0x1C000000u); /* all three aborted */
+    assert_int_equal(hw->r.tx[0].tir, 0x20000001u);
+    assert_int_equal(hw->r.tx[0].tdtr, 6u);
+    assert_int_equal(hw->r.tx[0].tdlr, 0x00000013u);
+    assert_int_equal(hw->r.tx[0].tdhr, 0x00005A00u);
+}
+
 static void test_recv_reads_fifo0_first_and_releases_each_mailbox(void **state)
 {
     fake_hw_t *hw = ((void **)*state)[0];
@@ -444,6 +473,7 @@ int main(void)
         cmocka_unit_test_setup(test_init_fails_when_the_hardware_never_acknowledges, setup),
         cmocka_unit_test_setup(test_send_fills_free_mailboxes_in_order, setup),
         cmocka_unit_test_setup(test_send_supersedes_a_pending_frame_of_its_id, setup),
+        cmocka_unit_test_setup(test_fault_send_aborts_pending_requests_and_sends, setup),
         cmocka_unit_test_setup(test_recv_reads_fifo0_first_and_releases_each_mailbox, setup),
         cmocka_unit_test_setup(test_recv_drops_extended_and_remote_frames_and_counts_overruns,
                                setup),

@@ -11,8 +11,9 @@
  *
  * Safety: the application zeroes the wheels when pose or RSSI frames stop for 150 ms
  * and while bxCAN is bus-off (the driver also aborts pending mailboxes then, so no stale
- * command goes out after recovery). The independent watchdog resets the MCU 500 ms after
- * the loop stops; after any reset the first command sent is zero (RFS_APP_FAULT_RESET).
+ * command goes out after recovery). A fault sends a stop at once (HardFault_Handler). The
+ * independent watchdog resets the MCU 500 ms after the loop stops; after any reset the
+ * first command sent is zero (RFS_APP_FAULT_RESET).
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -49,6 +50,22 @@ void CAN1_RX0_IRQHandler(void)
 void CAN1_RX1_IRQHandler(void)
 {
     rfs_bxcan_isr(&s_can, 1u);
+}
+
+/* A fault (bad access, undefined instruction; MemManage, BusFault and UsageFault are off,
+ * so HardFault): a zero wheel command with Stop goes out at once, pending requests
+ * aborted, instead of the last command standing until the motor controller's 200 ms
+ * timeout; then the watchdog resets the board. A stack overflow locks the core up before
+ * this runs: the timeout and the watchdog alone then. */
+void HardFault_Handler(void);
+void HardFault_Handler(void)
+{
+    const rfs_can_wheel_t w = {0, 0, RFS_CAN_WHEEL_STOP};
+    rfs_can_frame_t f;
+    rfs_can_tx_wheel(&s_app.can_tx, &w, &f);
+    (void)rfs_bxcan_fault_send((rfs_bxcan_regs_t *)RFS_BXCAN1_BASE, &f, 100000u, NULL, NULL);
+    for (;;) {
+    }
 }
 
 /* Clocks, time base, CAN and the application: the fit slice's length at the clock the

@@ -178,6 +178,12 @@ int rfs_bxcan_init(rfs_bxcan_t *d, rfs_bxcan_regs_t *regs, const rfs_bxcan_cfg_t
 /// busy or the controller is bus-off.
 int rfs_bxcan_send(rfs_bxcan_t *d, const rfs_can_frame_t *f);
 
+/// For a fault handler (the driver's state not trusted): abort every pending request and
+/// put f in the first mailbox that is empty within max_polls reads of TSR (poll_hook, NULL
+/// on hardware, between them). Returns 0, or -1 when none emptied (or f is invalid).
+int rfs_bxcan_fault_send(rfs_bxcan_regs_t *r, const rfs_can_frame_t *f, uint32_t max_polls,
+                         void (*poll_hook)(void *ctx), void *poll_ctx);
+
 /// Take the next received frame: polled, FIFO 0 first, releasing its mailbox; with
 /// cfg.rx_irq, the oldest frame of the software queue. false when there is none. Frames
 /// the driver cannot represent are dropped and counted.

@@ -121,6 +121,15 @@ static int64_t realtime_us(void)
     return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 }
 
+/* The steps' schedule and --idle-exit: a clock that never jumps (CLOCK_REALTIME, the
+ * controller's clock, may be stepped back by NTP: no step would run until it caught up). */
+static int64_t monotonic_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
 static void step(daemon_t *d, int64_t now_us)
 {
     if (d->done) {
@@ -669,13 +678,13 @@ static int lcm_failed(const options_t *o)
 /* --clock-lcm: LCM's messages until signalled, done or idle (RFS_CLOCK steps). */
 static int run_lockstep(daemon_t *d, const options_t *o)
 {
-    int64_t idle_since = realtime_us();
+    int64_t idle_since = monotonic_us();
     while (!g_stop && !d->done) {
         int r = lx_lcm_handle(d->lcm, 100);
         if (r < 0) {
             return lcm_failed(o);
         }
-        int64_t now = realtime_us();
+        int64_t now = monotonic_us();
         if (r > 0) {
             idle_since = now;
         } else if (o->idle_ms > 0 && now - idle_since >= o->idle_ms * 1000) {
@@ -685,15 +694,17 @@ static int run_lockstep(daemon_t *d, const options_t *o)
     return 0;
 }
 
-/* Live: a step every period on the local clock, LCM's messages in between. */
+/* Live: a step every period (monotonic schedule, at the local real-time clock's time),
+ * LCM's messages in between. After the real-time clock is stepped back the steps go on:
+ * the inputs' stamps lie ahead of now, stale, and the wheels stop (docs/FAULTS.md). */
 static int run_live(daemon_t *d, const options_t *o)
 {
-    int64_t next = realtime_us();
+    int64_t next = monotonic_us();
     int64_t idle_since = next;
     while (!g_stop && !d->done) {
-        int64_t now = realtime_us();
+        int64_t now = monotonic_us();
         if (now >= next) {
-            step(d, now);
+            step(d, realtime_us());
             next += RFS_APP_PERIOD_US;
             if (next < now) {
                 next = now + RFS_APP_PERIOD_US; /* overrun: skip, do not burst */
@@ -705,8 +716,8 @@ static int run_live(daemon_t *d, const options_t *o)
             return lcm_failed(o);
         }
         if (r > 0) {
-            idle_since = realtime_us();
-        } else if (o->idle_ms > 0 && realtime_us() - idle_since >= o->idle_ms * 1000) {
+            idle_since = monotonic_us();
+        } else if (o->idle_ms > 0 && monotonic_us() - idle_since >= o->idle_ms * 1000) {
             break;
         }
     }

@@ -5,8 +5,9 @@
  * status to LCM, and runs recorded as LCM logs and its frames as candump -L logs. See
  * docs/CAN.md.
  *
- * Clocks: live, the controller steps at 20 Hz on CLOCK_REALTIME in microseconds (the
- * LCM utime convention: senders share the robot's synchronised clock). With --clock-lcm
+ * Clocks: live, the controller's time is CLOCK_REALTIME in microseconds (the LCM utime
+ * convention: senders share the robot's synchronised clock), its 20 Hz steps scheduled on
+ * CLOCK_MONOTONIC (a clock stepped back must not stop them). With --clock-lcm
  * it steps once per RFS_CLOCK message at that time (lock-step with a simulator). With
  * --replay LOG it reads the log instead of LCM: with --clock-lcm the recorded clock
  * messages drive the steps, otherwise a step runs at every 50 ms boundary of the event

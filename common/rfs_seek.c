@@ -710,6 +710,28 @@ static int64_t elapsed(int64_t a, int64_t b)
     return d > (uint64_t)INT64_MAX ? INT64_MAX : (int64_t)d;
 }
 
+/* The wheels stop this period: a goal being driven is kept, to be resumed when they may
+ * turn again (its legs driven so far and its driving time kept). */
+static void hold(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
+{
+    if (s->state == RFS_SEEK_DRIVING && s->drive.status == RFS_DRIVE_RUNNING) {
+        s->resume = true;
+        s->resume_path = s->drive.path;
+        s->resume_next = s->drive.next; /* the legs already driven are not driven again */
+        s->resume_start_us = elapsed(now_us, s->drive.start_us); /* driven so far */
+    }
+    if (s->state != RFS_SEEK_WAITING) {
+        s->state = RFS_SEEK_STALE;
+    }
+    stop_wheels(s, now_us, out);
+}
+
+void rfs_seek_hold(rfs_seek_t *s, int64_t now_us)
+{
+    rfs_seek_out_t out;
+    hold(s, now_us, &out);
+}
+
 /* This period's fault flags. true when an input is stale: the wheels are stopped and a
  * goal being driven is kept, to be resumed when the inputs return. */
 static bool inputs_stale(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
@@ -728,16 +750,7 @@ static bool inputs_stale(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     if (!pose_stale && !rssi_stale) {
         return false;
     }
-    if (s->state == RFS_SEEK_DRIVING && s->drive.status == RFS_DRIVE_RUNNING) {
-        s->resume = true;
-        s->resume_path = s->drive.path;
-        s->resume_next = s->drive.next; /* the legs already driven are not driven again */
-        s->resume_start_us = elapsed(now_us, s->drive.start_us); /* driven so far */
-    }
-    if (s->state != RFS_SEEK_WAITING) {
-        s->state = RFS_SEEK_STALE;
-    }
-    stop_wheels(s, now_us, out);
+    hold(s, now_us, out);
     return true;
 }
 

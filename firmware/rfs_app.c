@@ -98,15 +98,15 @@ int rfs_app_cfg_choose(rfs_app_cfg_t *cfg, rfs_app_target_t target, rfs_seek_str
     if (model != NULL && model->per_source && app_target(target)->nsources > 1u) {
         return -1;
     }
-    rfs_app_cfg_t c = *cfg;
-    c.model = model;
-    if (!rfs_app_model_fits(&c)) {
+    /* Checked before cfg changes, without a copy of it (its 480 bytes are on the stack
+     * of a CONFIG frame's deepest path, docs/FIRMWARE.md "Build"). */
+    if (model != NULL && model->state_bytes > rfs_app_model_capacity(cfg)) {
         return -1;
     }
-    c.target = target;
-    rfs_seek_cfg_use_strategy(&c.seek, strategy);
-    c.pathloss.p0_min = p0_min;
-    *cfg = c;
+    cfg->model = model;
+    cfg->target = target;
+    rfs_seek_cfg_use_strategy(&cfg->seek, strategy);
+    cfg->pathloss.p0_min = p0_min;
     return 0;
 }
 
@@ -328,6 +328,11 @@ void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out)
     }
     const bool stop = (faults & (RFS_APP_FAULT_POSE_LOST | RFS_APP_FAULT_RSSI_LOST |
                                  RFS_APP_FAULT_BUS_OFF | RFS_APP_FAULT_RESET)) != 0u;
+    if (stop) {
+        /* The drive must know: else, the stop over, its speed of before is commanded at
+         * once, without the acceleration ramp, and it reckons with wheels that turned. */
+        rfs_seek_hold(&a->seek, now_us);
+    }
 
     memset(out, 0, sizeof *out);
     out->t_us = now_us;

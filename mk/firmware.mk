@@ -23,7 +23,7 @@ ALL_TARGETS += $(FW_LIB)
 # --- the Cortex-M4 images ----------------------------------------------------------------
 FW_ARCH := -mcpu=cortex-m4 -mthumb -mfloat-abi=soft
 FW_OPT ?= -O2
-FW_CFLAGS := $(FW_ARCH) $(CSTD) $(WARN) $(FW_OPT) -g -ffreestanding -fno-common \
+FW_CFLAGS := $(FW_ARCH) $(CSTD) $(WARN) $(FW_OPT) -g -ffreestanding -fno-common -fstack-usage \
 	-ffunction-sections -fdata-sections $(INC_fw) -Ifirmware/port/stm32f4 -Ifirmware/port/qemu
 FW_LDFLAGS := $(FW_ARCH) -nostartfiles --specs=nano.specs -Wl,--gc-sections \
 	-T firmware/port/stm32f4/stm32f405.ld
@@ -59,8 +59,8 @@ $(FW_CORE_LIB): $(FW_CORE_OBJS)
 
 $(FW)/firmware.elf: $(FW_STM32_SRCS:%.c=$(FW)/obj/%.o) $(FW)/obj/fw_map.o $(FW_CORE_LIB) firmware/port/stm32f4/stm32f405.ld
 	$(ARM_CC) $(FW_LDFLAGS) -Wl,-Map=$(FW)/firmware.map -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
-# The emulator image: the hardware stack plus the player's ~1.5 KB, so an overflow of the
-# application's path faults here too (the stack sits below .data/.bss).
+# The emulator image: a 4 KB stack below .data/.bss, so an overflow faults here too (the
+# replay player's frames are not the hardware loop's: its bound is tests/firmware/stack.sh).
 $(FW)/qemu.elf: $(FW_QEMU_SRCS:%.c=$(FW)/obj/%.o) $(FW_CORE_LIB) firmware/port/stm32f4/stm32f405.ld
 	$(ARM_CC) $(FW_QEMU_LDFLAGS) -Wl,--defsym=RFS_STACK_SIZE=4K -o $@ $(filter %.o,$^) $(FW_CORE_LIB)
 $(FW)/bench.elf: $(FW_BENCH_SRCS:%.c=$(FW)/obj/%.o) $(FW_CORE_LIB) firmware/port/stm32f4/stm32f405.ld
@@ -138,6 +138,7 @@ FW_TEST_PROGS := $(FW_IMAGES) $(BUILD)/bin/rfseek-replay $(BUILD)/bin/rfseek-rec
 $(eval $(call test_script,bit_identical,tests/firmware/bit_identical.sh $(BUILD),$(FW_TEST_PROGS)))
 $(eval $(call test_script,safety,tests/firmware/safety.sh $(BUILD),$(FW_TEST_PROGS)))
 $(eval $(call test_script,budget,tests/firmware/budget.sh $(BUILD),$(FW_IMAGES)))
+$(eval $(call test_script,stack,tests/firmware/stack.sh $(BUILD),$(FW_IMAGES) scripts/fw_stack.py))
 # The model workload on the emulator against its host twin, and every model's registry fit
 # budget against the 200 ms deadline.
 $(eval $(call test_script,bench_models,tests/firmware/bench_models.sh check $(BUILD),$(FW)/bench_models.elf $(BUILD)/tests/bench_models_host))

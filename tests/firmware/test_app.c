@@ -265,6 +265,39 @@ static void test_bus_off_stops_at_once_and_recovers(void **state)
     assert_false(o.faults & RFS_APP_FAULT_BUS_OFF);
 }
 
+static int32_t fastest(const rfs_app_out_t *o)
+{
+    const int32_t l = o->left_mm_s < 0 ? -o->left_mm_s : o->left_mm_s;
+    const int32_t r = o->right_mm_s < 0 ? -o->right_mm_s : o->right_mm_s;
+    return l > r ? l : r;
+}
+
+/* A stop the seeker did not make (one period of bus-off; its inputs stay fresh) is a stop
+ * for the drive too: the wheels start again from rest at the acceleration limit (1 m/s^2:
+ * at most 50 mm/s a period), not at the speed the drive had before. */
+static void test_an_application_stop_restarts_the_drive_from_rest(void **state)
+{
+    (void)state;
+    const rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
+    const rfs_app_map_t m = room();
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    rfs_app_out_t o;
+    run(0, 2000000, true, true, &o);
+    assert_true(fastest(&o) > 100);
+
+    rfs_app_set_bus_off(&s_app, true);
+    run(2000000, 2050000, true, true, &o);
+    assert_int_equal(fastest(&o), 0);
+    rfs_app_set_bus_off(&s_app, false);
+    int32_t prev = 0;
+    for (int64_t t = 2050000; t < 2300000; t += RFS_APP_PERIOD_US) {
+        run(t, t + RFS_APP_PERIOD_US, true, true, &o);
+        assert_true(fastest(&o) <= prev + 50);
+        prev = fastest(&o);
+    }
+    assert_true(run(2300000, 5000000, true, true, &o) > 0); /* and it drives again */
+}
+
 static void test_frames_decode_with_the_protocol_decoders(void **state)
 {
     (void)state;
@@ -462,6 +495,7 @@ int main(void)
         cmocka_unit_test(test_first_step_after_reset_is_zero_and_flagged),
         cmocka_unit_test(test_wheels_stop_within_200_ms_of_lost_inputs_and_resume),
         cmocka_unit_test(test_bus_off_stops_at_once_and_recovers),
+        cmocka_unit_test(test_an_application_stop_restarts_the_drive_from_rest),
         cmocka_unit_test(test_frames_decode_with_the_protocol_decoders),
         cmocka_unit_test(test_status_frame_maps_baseline_kinds),
         cmocka_unit_test(test_wheel_stop_is_the_frames),

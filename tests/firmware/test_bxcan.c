@@ -26,6 +26,8 @@ typedef struct fake_hw {
     unsigned release_ticks; /* polls a mailbox release takes, RFOM reading 1 meanwhile */
     unsigned releasing[2];  /* polls left of a release under way */
     bool ack_modes;       /* false: a dead controller that never acknowledges */
+    bool aborts;          /* TSR modelled: an ABRQ write empties its (pending) mailbox */
+    uint32_t tme;         /* ... the TME bits then (TSR's others are not memory) */
     unsigned hook_calls;
 } fake_hw_t;
 
@@ -56,6 +58,14 @@ static void fake_tick(void *ctx)
         } else {
             hw->r.msr &= ~RFS_BXCAN_MSR_INAK;
         }
+    }
+    if (hw->aborts) {
+        for (unsigned i = 0; i < 3u; i++) {
+            if ((hw->r.tsr & RFS_BXCAN_TSR_ABRQ(i)) != 0u) {
+                hw->tme |= RFS_BXCAN_TSR_TME(i); /* RM0090 32.9.3: TME set once aborted */
+            }
+        }
+        hw->r.tsr = hw->tme;
     }
     /* A value in RFxR that differs from what the fake left there was written by the
      * driver: RFOM (rs) releases the mailbox, FOVR (rc_w1) clears the overrun flag. */
@@ -203,6 +213,65 @@ static void test_send_fills_free_mailboxes_in_order(void **state)
     assert_int_equal(rfs_bxcan_send(d, &f), -1);
     assert_int_equal(d->tx_no_mailbox, 1u);
     assert_int_equal(d->tx_queued, 2u);
+}
+
+/* A wheel command still pending (no node acknowledges, or it keeps losing arbitration)
+ * must not go out after the bus returns: the next one of its id takes its place. */
+static void test_send_supersedes_a_pending_frame_of_its_id(void **state)
+{
+    fake_hw_t *hw = ((void **)*state)[0];
+    rfs_bxcan_t *d = ((void **)*state)[1];
+    const rfs_bxcan_cfg_t c = rfs_bxcan_cfg_default();
+    assert_int_equal(rfs_bxcan_init(d, &hw->r, &c, fake_tick, hw), 0);
+    const rfs_can_frame_t old_cmd = {0x100u, 6u, {0x10, 0xF4, 0x01, 0xF4, 0x01, 0x00, 0, 0}};
+    const rfs_can_frame_t status = {0x180u, 8u, {1, 2, 3, 4, 5, 6, 7, 8}};
+    const rfs_can_frame_t stop = {0x100u, 6u, {0x11, 0, 0, 0, 0, 0x00, 0, 0}};
+    assert_int_equal(rfs_bxcan_send(d, &old_cmd), 0); /* mailbox 0 */
+    hw->r.tsr = 0x18000000u;                            /* TME1, TME2: mailbox 0 pending */
+    assert_int_equal(rfs_bxcan_send(d, &status), 0);    /* mailbox 1 */
+    hw->aborts = true;
+    hw->tme = 0x10000000u; /* TME2: mailboxes 0 and 1 pending */
+    hw->r.tsr = hw->tme;
+
+    assert_int_equal(rfs_bxcan_send(d, &stop), 0);
+
+    /* ABRQ0 (bit 7) aborted the old command; the new one took the freed mailbox 0:
+     * STID 0x100 << 21 | TXRQ, byte 0 = 0x11. The status (another id) still pending. */
+    assert_int_equal(hw->tme & 0x04000000u, 0x04000000u);
+    assert_int_equal(d->tx_superseded, 1u);
+    assert_int_equal(hw->r.tx[0].tir, 0x20000001u);
+    assert_int_equal(hw->r.tx[0].tdlr, 0x00000011u);
+    assert_int_equal(hw->r.tx[1].tir, (0x180u << 21) | 1u);
+    assert_int_equal(d->tx_queued, 3u);
+}
+
+/* A fault handler's stop: every pending request aborted (ABRQ0..2: bits 7, 15, 23), the
+ * frame in the first mailbox that empties; none empties: -1, nothing written. */
+static void test_fault_send_aborts_pending_requests_and_sends(void **state)
+{
+    fake_hw_t *hw = ((void **)*state)[0];
+    rfs_bxcan_t *d = ((void **)*state)[1];
+    const rfs_bxcan_cfg_t c = rfs_bxcan_cfg_default();
+    assert_int_equal(rfs_bxcan_init(d, &hw->r, &c, fake_tick, hw), 0);
+    const rfs_can_frame_t stop = {0x100u, 6u, {0x13, 0, 0, 0, 0, 0x5A, 0, 0}};
+    hw->r.tx[0].tir = (0x100u << 21) | 1u; /* three pending requests */
+    hw->r.tx[1].tir = (0x180u << 21) | 1u;
+    hw->r.tx[2].tir = (0x100u << 21) | 1u;
+    hw->r.tsr = 0u;
+
+    assert_int_equal(rfs_bxcan_fault_send(&hw->r, &stop, 10u, NULL, NULL), -1);
+    assert_int_equal(hw->r.tsr, 0x00808080u); /* ABRQ0..2 written; no mailbox emptied */
+    assert_int_equal(hw->r.tx[0].tdlr, 0u);
+
+    hw->aborts = true;
+    hw->tme = 0u;
+    hw->r.tsr = 0u;
+    assert_int_equal(rfs_bxcan_fault_send(&hw->r, &stop, 10u, fake_tick, hw), 0);
+    assert_int_equal(hw->tme, 0x1C000000u); /* all three aborted */
+    assert_int_equal(hw->r.tx[0].tir, 0x20000001u);
+    assert_int_equal(hw->r.tx[0].tdtr, 6u);
+    assert_int_equal(hw->r.tx[0].tdlr, 0x00000013u);
+    assert_int_equal(hw->r.tx[0].tdhr, 0x00005A00u);
 }
 
 static void test_recv_reads_fifo0_first_and_releases_each_mailbox(void **state)
@@ -403,6 +472,8 @@ int main(void)
         cmocka_unit_test_setup(test_init_programs_mode_timing_and_filters, setup),
         cmocka_unit_test_setup(test_init_fails_when_the_hardware_never_acknowledges, setup),
         cmocka_unit_test_setup(test_send_fills_free_mailboxes_in_order, setup),
+        cmocka_unit_test_setup(test_send_supersedes_a_pending_frame_of_its_id, setup),
+        cmocka_unit_test_setup(test_fault_send_aborts_pending_requests_and_sends, setup),
         cmocka_unit_test_setup(test_recv_reads_fifo0_first_and_releases_each_mailbox, setup),
         cmocka_unit_test_setup(test_recv_drops_extended_and_remote_frames_and_counts_overruns,
                                setup),

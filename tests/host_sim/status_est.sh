@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# status_est.sh - rfseekd puts the path-loss model's estimate in its LCM seeker status:
+# status_est.sh - rfseekd puts the path-loss model's estimate in its LCM seeker status
+# (and ends a run with a stop command, wheel_stop_check.py):
 # a two-process run (rfseek-sim-lcm + rfseekd --model pathloss, udpm:// inside a
 # network namespace we create and delete) recorded as an LCM log, decoded by hand in
 # tests/host_sim/status_est_check.py; the same inputs replayed with the ridge carry none.
@@ -33,6 +34,9 @@ ip netns del "$ns"
     || fail "status_est_two_process_run (sim rc $src, rfseekd rc $drc: $(head -3 "$w/sim.err" "$w/d.err"))"
 # The office map is 36 x 12 m.
 /usr/bin/python3 tests/host_sim/status_est_check.py "$w/run.lcmlog" pathloss 36 12 || fails=$((fails + 1))
+# Its end: a zero command with Stop after the last step (the motor controller's timeout
+# does not have to stop the wheels).
+/usr/bin/python3 tests/host_sim/wheel_stop_check.py "$w/run.lcmlog" || fails=$((fails + 1))
 "$d" --map $map --model ridge --replay "$w/run.lcmlog" --clock-lcm --lcm memq:// --log "$w/ridge.lcmlog" \
     > /dev/null 2> "$w/r.err" && pass status_est_ridge_replay || fail "status_est_ridge_replay ($(head -2 "$w/r.err"))"
 /usr/bin/python3 tests/host_sim/status_est_check.py "$w/ridge.lcmlog" none || fails=$((fails + 1))

@@ -57,6 +57,19 @@ expect_err rfseekd-newline-log 1 "nl/a?b: No such file or directory" --map $map 
 expect_err rfseekd-newline-replay 1 "nl?none.lcmlog" --map $map --replay "$w/nl${nl}none.lcmlog"
 compgen -G "$w/nl*" > /dev/null && fail "rfseekd-newline-nothing-written ($(ls -d "$w"/nl*))" \
     || pass rfseekd-newline-nothing-written
+# The real-time clock stepped back an hour 0.5 s into a live run (an LD_PRELOAD shim): the
+# steps go on at 20 Hz (scheduled on the monotonic clock; they stopped until the clock had
+# caught up), and the run, ended by SIGINT after 2 s, ends on a zero command with Stop.
+if cc -shared -fPIC -o "$w/clock_back.so" tests/wire/clock_back.c -ldl 2> "$w/cc.err"; then
+    RFS_CLOCK_AFTER_MS=500 RFS_CLOCK_BACK_S=3600 LD_PRELOAD="$w/clock_back.so" timeout -s INT 2 \
+        "$d" --map $map --lcm memq:// --can-over-lcm --log "$w/back.lcmlog" > /dev/null 2> "$w/back.err"
+    n=$(/usr/bin/python3 -c 'import sys; sys.path.insert(0, "tests/host_sim")
+from status_est_check import events
+print(sum(1 for _t, ch, _b in events(sys.argv[1]) if ch == "RFS_WHEEL_CMD"))' "$w/back.lcmlog" 2>&1)
+    [ "${n:-0}" -ge 30 ] 2>/dev/null && pass "rfseekd-clock-stepped-back ($n wheel commands in 2 s)" \
+        || fail "rfseekd-clock-stepped-back ($n wheel commands in 2 s, want >= 30: $(head -2 "$w/back.err"))"
+    /usr/bin/python3 tests/host_sim/wheel_stop_check.py "$w/back.lcmlog" live | sed 's/ wheel_stop/ rfseekd-clock-back-wheel_stop/'
+else fail "rfseekd-clock-stepped-back: cannot build the shim ($(head -1 "$w/cc.err"))"; fi
 # rfseek-sim-lcm: the same rule (it writes only summary.json, to stdout: none on error).
 sl=$build/bin/rfseek-sim-lcm scn=scenarios/default.yaml
 expect_err_of "$sl" sim-lcm-newline-option 2 "unknown option '--x?y'" $scn "--x${nl}y" 1

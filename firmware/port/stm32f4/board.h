@@ -6,11 +6,11 @@
  * rfs_board_now_us() combines the millisecond count with the current count down value.
  * The independent watchdog (LSI 32 kHz nominal, /8, reload 1999) fires after 500 ms
  * without rfs_board_kick() (340 .. 940 ms over the LSI's 17 .. 47 kHz range). It must
- * outlast the longest control iteration: the first one after boot runs the seeker's
- * reachability flood fill, 16.5 million instructions (~100 ms at 168 MHz; docs/
- * PERFORMANCE.md). While the loop is busy no command is sent and the motor controller's
- * own 200 ms command timeout stops the wheels; once the watchdog has fired, the image
- * boots (rfs_app_init: 7.6 million instructions, ~45 ms) and its first command is zero.
+ * outlast the longest loop iteration: a CONFIG frame's re-initialisation (rfs_app_init,
+ * 8.75 million instructions, ~55 ms at 168 MHz; the boot's flood fill is sliced, a period
+ * at most 500,000: docs/PERFORMANCE.md). While the loop is busy no command is sent and the
+ * motor controller's own 200 ms command timeout stops the wheels; once the watchdog has
+ * fired, the image boots (rfs_app_init again) and its first command is zero.
  */
 #ifndef RFS_BOARD_H
 #define RFS_BOARD_H

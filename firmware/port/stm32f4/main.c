@@ -11,8 +11,9 @@
  *
  * Safety: the application zeroes the wheels when pose or RSSI frames stop for 150 ms
  * and while bxCAN is bus-off (the driver also aborts pending mailboxes then, so no stale
- * command goes out after recovery). The independent watchdog resets the MCU 500 ms after
- * the loop stops; after any reset the first command sent is zero (RFS_APP_FAULT_RESET).
+ * command goes out after recovery). A fault sends a stop at once (HardFault_Handler). The
+ * independent watchdog resets the MCU 500 ms after the loop stops; after any reset the
+ * first command sent is zero (RFS_APP_FAULT_RESET).
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -51,10 +52,28 @@ void CAN1_RX1_IRQHandler(void)
     rfs_bxcan_isr(&s_can, 1u);
 }
 
-int main(void)
+/* A fault (bad access, undefined instruction; MemManage, BusFault and UsageFault are off,
+ * so HardFault): a zero wheel command with Stop goes out at once, pending requests
+ * aborted, instead of the last command standing until the motor controller's 200 ms
+ * timeout; then the watchdog resets the board. A stack overflow locks the core up before
+ * this runs: the timeout and the watchdog alone then. */
+void HardFault_Handler(void);
+void HardFault_Handler(void)
 {
-    const bool watchdog_reset = rfs_board_reset_was_watchdog();
-    (void)watchdog_reset; /* reported as RFS_APP_FAULT_RESET on the first status either way */
+    const rfs_can_wheel_t w = {0, 0, RFS_CAN_WHEEL_STOP};
+    rfs_can_frame_t f;
+    rfs_can_tx_wheel(&s_app.can_tx, &w, &f);
+    (void)rfs_bxcan_fault_send((rfs_bxcan_regs_t *)RFS_BXCAN1_BASE, &f, 100000u, NULL, NULL);
+    for (;;) {
+    }
+}
+
+/* Clocks, time base, CAN and the application: the fit slice's length at the clock the
+ * board runs at, or 0 when unusable. Not inlined: its configurations (~600 B) leave the
+ * stack before the loop, whose deepest path (a CONFIG frame) needs the room
+ * (scripts/fw_stack.py, tests/firmware/stack.sh). */
+static uint32_t __attribute__((noinline)) start(void)
+{
     uint32_t core_hz = RFS_BOARD_SYSCLK_HZ;
     rfs_bxcan_cfg_t can_cfg = rfs_bxcan_cfg_default();
     can_cfg.rx_irq = true;
@@ -65,9 +84,6 @@ int main(void)
         can_cfg.ts2_tq = 2u;
     }
     rfs_board_time_init(core_hz);
-    /* On the HSI fallback (16 MHz) a slice takes 52.5 ms, longer than a period: none runs
-     * and the periods keep their time (a relearn waits on the periods' own slices). */
-    const uint32_t slice_us = SLICE_US * (RFS_BOARD_SYSCLK_HZ / 1000000u) / (core_hz / 1000000u);
     rfs_board_can_pins();
     const bool can_ok = rfs_bxcan_init(&s_can, (rfs_bxcan_regs_t *)RFS_BXCAN1_BASE, &can_cfg,
                                        NULL, NULL) == 0;
@@ -77,6 +93,19 @@ int main(void)
     cfg.model_state_bytes = (uint32_t)sizeof s_model;
     cfg.models[RFS_CAN_MODEL_PATHLOSS] = &rfs_models_pathloss;
     if (rfs_app_init(&s_app, &cfg, &rfs_fw_map) != 0 || !can_ok) {
+        return 0u;
+    }
+    /* On the HSI fallback (16 MHz) a slice takes 52.5 ms, longer than a period: none runs
+     * and the periods keep their time (a relearn waits on the periods' own slices). */
+    return SLICE_US * (RFS_BOARD_SYSCLK_HZ / 1000000u) / (core_hz / 1000000u);
+}
+
+int main(void)
+{
+    const bool watchdog_reset = rfs_board_reset_was_watchdog();
+    (void)watchdog_reset; /* reported as RFS_APP_FAULT_RESET on the first status either way */
+    const uint32_t slice_us = start();
+    if (slice_us == 0u) {
         /* Unusable (e.g. bxCAN never left initialisation: no 11 recessive bits on RX): the
          * watchdog, never kicked, resets the board to try again. Not started, it would not:
          * a reset leaves the independent watchdog off. */

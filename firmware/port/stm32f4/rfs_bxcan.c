@@ -157,6 +157,27 @@ int rfs_bxcan_init(rfs_bxcan_t *d, rfs_bxcan_regs_t *regs, const rfs_bxcan_cfg_t
     return 0;
 }
 
+/* Let a host test's fake hardware react to a write (a no-op on hardware, where the
+ * controller reacts by itself). */
+static void hw_sync(rfs_bxcan_t *d)
+{
+    if (d->poll_hook != NULL) {
+        d->poll_hook(d->poll_ctx);
+    }
+}
+
+/* Fill an empty transmit mailbox with f and request its transmission. */
+static void mailbox_write(rfs_bxcan_txmb_t *m, const rfs_can_frame_t *f)
+{
+    m->tir = f->id << RFS_BXCAN_STID_SHIFT; /* standard id, data frame, TXRQ clear */
+    m->tdtr = f->dlc;
+    m->tdlr = (uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8) |
+              ((uint32_t)f->data[2] << 16) | ((uint32_t)f->data[3] << 24);
+    m->tdhr = (uint32_t)f->data[4] | ((uint32_t)f->data[5] << 8) |
+              ((uint32_t)f->data[6] << 16) | ((uint32_t)f->data[7] << 24);
+    m->tir |= RFS_BXCAN_TIR_TXRQ;
+}
+
 int rfs_bxcan_send(rfs_bxcan_t *d, const rfs_can_frame_t *f)
 {
     rfs_bxcan_regs_t *r = d->r;
@@ -168,7 +189,24 @@ int rfs_bxcan_send(rfs_bxcan_t *d, const rfs_can_frame_t *f)
         d->tx_no_mailbox++;
         return -1;
     }
-    const uint32_t tsr = r->tsr;
+    /* The frames sent are periodic states (WHEEL_CMD, STATUS): a newer one supersedes a
+     * request of its id still pending (held by a bus nobody acknowledges, or lost
+     * arbitration), which would otherwise go out late, before it, when the bus returns.
+     * ABRQ takes a pending mailbox back at once, one in transmission when that fails. */
+    uint32_t tsr = r->tsr;
+    uint32_t abort = 0u;
+    for (unsigned i = 0; i < 3u; i++) {
+        if ((tsr & RFS_BXCAN_TSR_TME(i)) == 0u &&
+            (r->tx[i].tir >> RFS_BXCAN_STID_SHIFT) == f->id) {
+            abort |= RFS_BXCAN_TSR_ABRQ(i);
+            d->tx_superseded++;
+        }
+    }
+    if (abort != 0u) {
+        r->tsr = abort; /* ABRQx are rs: writing 0 elsewhere has no effect */
+        hw_sync(d);
+        tsr = r->tsr;
+    }
     unsigned mb = 3u;
     for (unsigned i = 0; i < 3u; i++) {
         if ((tsr & RFS_BXCAN_TSR_TME(i)) != 0u) {
@@ -180,25 +218,37 @@ int rfs_bxcan_send(rfs_bxcan_t *d, const rfs_can_frame_t *f)
         d->tx_no_mailbox++;
         return -1;
     }
-    rfs_bxcan_txmb_t *m = &r->tx[mb];
-    m->tir = f->id << RFS_BXCAN_STID_SHIFT; /* standard id, data frame, TXRQ clear */
-    m->tdtr = f->dlc;
-    m->tdlr = (uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8) |
-              ((uint32_t)f->data[2] << 16) | ((uint32_t)f->data[3] << 24);
-    m->tdhr = (uint32_t)f->data[4] | ((uint32_t)f->data[5] << 8) |
-              ((uint32_t)f->data[6] << 16) | ((uint32_t)f->data[7] << 24);
-    m->tir |= RFS_BXCAN_TIR_TXRQ;
+    mailbox_write(&r->tx[mb], f);
     d->tx_queued++;
     return 0;
 }
 
-/* Let a host test's fake hardware react to a write (a no-op on hardware, where the
- * controller reacts by itself). */
-static void hw_sync(rfs_bxcan_t *d)
+int rfs_bxcan_fault_send(rfs_bxcan_regs_t *r, const rfs_can_frame_t *f, uint32_t max_polls,
+                         void (*poll_hook)(void *ctx), void *poll_ctx)
 {
-    if (d->poll_hook != NULL) {
-        d->poll_hook(d->poll_ctx);
+    const uint32_t tsr = r->tsr;
+    uint32_t abort = 0u;
+    for (unsigned i = 0; i < 3u; i++) {
+        if ((tsr & RFS_BXCAN_TSR_TME(i)) == 0u) {
+            abort |= RFS_BXCAN_TSR_ABRQ(i);
+        }
     }
+    if (abort != 0u) {
+        r->tsr = abort;
+    }
+    for (uint32_t n = 0; n < max_polls && f->id <= RFS_CAN_ID_MAX && f->dlc <= 8u; n++) {
+        if (poll_hook != NULL) {
+            poll_hook(poll_ctx);
+        }
+        const uint32_t t = r->tsr;
+        for (unsigned i = 0; i < 3u; i++) {
+            if ((t & RFS_BXCAN_TSR_TME(i)) != 0u) {
+                mailbox_write(&r->tx[i], f);
+                return 0;
+            }
+        }
+    }
+    return -1;
 }
 
 /* Take the next frame FIFO q holds into *f, releasing its mailbox (counting an overrun

@@ -10,7 +10,8 @@
  * FIFO-pending interrupts into a software queue the main loop reads: the hardware holds
  * three frames a FIFO, fewer than arrive while a fit slice runs. Recovery is the hardware's automatic bus-off management (ABOM: 128 x 11
  * recessive bits); on entering bus-off the pending mailboxes are aborted (ABRQ) so a
- * stale wheel command is never sent after recovery.
+ * stale wheel command is never sent after recovery; likewise a new frame aborts a pending
+ * one of its id (rfs_bxcan_send()).
  *
  * Waiting for the hardware (INAK after INRQ) is bounded by cfg.max_polls; `poll_hook`,
  * NULL on hardware, is called on each wait so a host test can play the hardware's part.
@@ -144,6 +145,7 @@ typedef struct rfs_bxcan {
     uint32_t tx_no_mailbox;       ///< frames refused: all three mailboxes busy
     uint32_t tx_refused_bus_off;  ///< frames refused while bus-off
     uint32_t tx_aborted;          ///< mailbox requests aborted on entering bus-off
+    uint32_t tx_superseded;       ///< pending requests aborted for a newer frame of their id
     uint32_t rx_frames;           ///< frames read from the FIFOs
     uint32_t rx_overruns;         ///< FIFO overruns seen (a frame was lost)
     uint32_t rx_bad;              ///< frames dropped: extended id, remote frame or DLC > 8
@@ -171,9 +173,16 @@ int rfs_bxcan_btr(const rfs_bxcan_cfg_t *cfg, uint32_t *btr);
 int rfs_bxcan_init(rfs_bxcan_t *d, rfs_bxcan_regs_t *regs, const rfs_bxcan_cfg_t *cfg,
                    void (*poll_hook)(void *ctx), void *poll_ctx);
 
-/// Queue a standard data frame in a free mailbox. Returns 0, or -1 (counted) when all
-/// three are busy or the controller is bus-off.
+/// Queue a standard data frame in a free mailbox, aborting a request of the same id still
+/// pending (a newer state supersedes it). Returns 0, or -1 (counted) when all three are
+/// busy or the controller is bus-off.
 int rfs_bxcan_send(rfs_bxcan_t *d, const rfs_can_frame_t *f);
+
+/// For a fault handler (the driver's state not trusted): abort every pending request and
+/// put f in the first mailbox that is empty within max_polls reads of TSR (poll_hook, NULL
+/// on hardware, between them). Returns 0, or -1 when none emptied (or f is invalid).
+int rfs_bxcan_fault_send(rfs_bxcan_regs_t *r, const rfs_can_frame_t *f, uint32_t max_polls,
+                         void (*poll_hook)(void *ctx), void *poll_ctx);
 
 /// Take the next received frame: polled, FIFO 0 first, releasing its mailbox; with
 /// cfg.rx_irq, the oldest frame of the software queue. false when there is none. Frames

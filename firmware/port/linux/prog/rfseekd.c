@@ -5,8 +5,9 @@
  * status to LCM, and runs recorded as LCM logs and its frames as candump -L logs. See
  * docs/CAN.md.
  *
- * Clocks: live, the controller steps at 20 Hz on CLOCK_REALTIME in microseconds (the
- * LCM utime convention: senders share the robot's synchronised clock). With --clock-lcm
+ * Clocks: live, the controller's time is CLOCK_REALTIME in microseconds (the LCM utime
+ * convention: senders share the robot's synchronised clock), its 20 Hz steps scheduled on
+ * CLOCK_MONOTONIC (a clock stepped back must not stop them). With --clock-lcm
  * it steps once per RFS_CLOCK message at that time (lock-step with a simulator). With
  * --replay LOG it reads the log instead of LCM: with --clock-lcm the recorded clock
  * messages drive the steps, otherwise a step runs at every 50 ms boundary of the event
@@ -121,6 +122,15 @@ static int64_t realtime_us(void)
     return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 }
 
+/* The steps' schedule and --idle-exit: a clock that never jumps (CLOCK_REALTIME, the
+ * controller's clock, may be stepped back by NTP: no step would run until it caught up). */
+static int64_t monotonic_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
 static void step(daemon_t *d, int64_t now_us)
 {
     if (d->done) {
@@ -198,6 +208,34 @@ static void step(daemon_t *d, int64_t now_us)
                 x->t_us, x->iteration, rfs_seek_kind_name(x->kind), x->relearned, x->line_search, (int)x->prev,
                 x->prediction, x->mean, x->epsilon, x->x, x->y, x->goal_x, x->goal_y, (unsigned)x->samples,
                 x->sampled, x->near, x->hedged, x->pinned, x->refuted, (unsigned)x->plan_wait);
+    }
+}
+
+/* The end of a run that sent commands (signalled, --duration, --idle-exit, LCM failing):
+ * one more WHEEL_CMD, zero with Stop, so that no driving command stands until the motor
+ * controller's own timeout. */
+static void stop_wheels(daemon_t *d)
+{
+    if (d->replay || d->steps == 0u) {
+        return;
+    }
+    const rfs_can_wheel_t w = {0, 0, RFS_CAN_WHEEL_STOP};
+    const int64_t t = d->clock_lcm ? d->last_now_us : realtime_us();
+    rfs_can_frame_t f;
+    rfs_can_tx_wheel(&d->app->can_tx, &w, &f);
+    int r = 0;
+    if (d->can) {
+        r = lx_can_send(d->can, &f);
+    } else if (d->can_over_lcm && d->lcm) {
+        r = lx_lcm_pub_can(d->lcm, t, &f);
+    }
+    if (r != 0) {
+        fprintf(stderr, "rfseekd: the last wheel command (stop) could not be sent\n");
+    } else if (d->dump != NULL) {
+        lx_candump_write(d->dump, t, &f);
+    }
+    if (d->lcm) {
+        (void)lx_lcm_pub_wheel(d->lcm, t, &w);
     }
 }
 
@@ -648,13 +686,13 @@ static int lcm_failed(const options_t *o)
 /* --clock-lcm: LCM's messages until signalled, done or idle (RFS_CLOCK steps). */
 static int run_lockstep(daemon_t *d, const options_t *o)
 {
-    int64_t idle_since = realtime_us();
+    int64_t idle_since = monotonic_us();
     while (!g_stop && !d->done) {
         int r = lx_lcm_handle(d->lcm, 100);
         if (r < 0) {
             return lcm_failed(o);
         }
-        int64_t now = realtime_us();
+        int64_t now = monotonic_us();
         if (r > 0) {
             idle_since = now;
         } else if (o->idle_ms > 0 && now - idle_since >= o->idle_ms * 1000) {
@@ -664,15 +702,17 @@ static int run_lockstep(daemon_t *d, const options_t *o)
     return 0;
 }
 
-/* Live: a step every period on the local clock, LCM's messages in between. */
+/* Live: a step every period (monotonic schedule, at the local real-time clock's time),
+ * LCM's messages in between. After the real-time clock is stepped back the steps go on:
+ * the inputs' stamps lie ahead of now, stale, and the wheels stop (docs/FAULTS.md). */
 static int run_live(daemon_t *d, const options_t *o)
 {
-    int64_t next = realtime_us();
+    int64_t next = monotonic_us();
     int64_t idle_since = next;
     while (!g_stop && !d->done) {
-        int64_t now = realtime_us();
+        int64_t now = monotonic_us();
         if (now >= next) {
-            step(d, now);
+            step(d, realtime_us());
             next += RFS_APP_PERIOD_US;
             if (next < now) {
                 next = now + RFS_APP_PERIOD_US; /* overrun: skip, do not burst */
@@ -684,8 +724,8 @@ static int run_live(daemon_t *d, const options_t *o)
             return lcm_failed(o);
         }
         if (r > 0) {
-            idle_since = realtime_us();
-        } else if (o->idle_ms > 0 && realtime_us() - idle_since >= o->idle_ms * 1000) {
+            idle_since = monotonic_us();
+        } else if (o->idle_ms > 0 && monotonic_us() - idle_since >= o->idle_ms * 1000) {
             break;
         }
     }
@@ -772,6 +812,7 @@ static int daemon_main(int argc, char **argv)
         signal(SIGINT, on_signal);
         signal(SIGTERM, on_signal);
         rc = o.replay ? run_replay(&d, &o) : o.clock_lcm ? run_lockstep(&d, &o) : run_live(&d, &o);
+        stop_wheels(&d);
         if (rc == 0) { /* the counts of a run that went through; else its one error line */
             fprintf(stderr, "rfseekd: %" PRIu32 " steps, %" PRIu32 " decisions, %" PRIu32 " bad messages, %" PRIu32
                             " CAN send failures, %" PRIu32 " receiver heartbeats, seeker rejected %" PRIu32

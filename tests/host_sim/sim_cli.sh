@@ -61,7 +61,7 @@ seek: {p0_min_dbm: -30}
 "$SIM" "$T/p0.yaml" --model pathloss --strategy meta-path --p0-min 0 --seed 3 >"$T/p0zero.json" 2>/dev/null
 same() { grep -vE '"(scenario|wall_time_s|cpu_time_s)"' "$1"; }
 if [ -s "$T/p0cli.json" ] && cmp -s <(same "$T/p0cli.json") <(same "$T/p0key.json") \
-    && ! cmp -s <(grep distance_travelled_m "$T/p0cli.json") \
+    && grep -q distance_travelled_m "$T/p0zero.json" && ! cmp -s <(grep distance_travelled_m "$T/p0cli.json") \
                 <(grep distance_travelled_m "$T/p0zero.json"); then
     pass p0_min_cli_equals_key
 else
@@ -137,7 +137,7 @@ seek: {leg_m: 2}
 "$SIM" "$T/legkey.yaml" --seed 3 >"$T/legkey.json" 2>/dev/null
 "$SIM" "$T/p0.yaml" --model pathloss --strategy meta-path --seed 3 >"$T/legnone.json" 2>/dev/null
 if [ -s "$T/legcli.json" ] && cmp -s <(same "$T/legcli.json") <(same "$T/legkey.json") \
-    && ! cmp -s <(same "$T/legcli.json") <(same "$T/legnone.json"); then
+    && grep -q distance_travelled_m "$T/legnone.json" && ! cmp -s <(same "$T/legcli.json") <(same "$T/legnone.json"); then
     pass seek_cli_equals_key
 else
     fail seek_cli_equals_key "$(head -c 300 "$T/legcli.json")"
@@ -155,7 +155,7 @@ key_reaches() { # NAME KEY SAME OTHER
             >"$T/$name$v.json" 2>/dev/null
     done
     if [ -s "$T/${name}def.json" ] && cmp -s <(same "$T/${name}def.json") <(same "$T/$name$sv.json") \
-        && ! cmp -s <(same "$T/${name}def.json") <(same "$T/$name$ov.json"); then
+        && grep -q distance_travelled_m "$T/$name$ov.json" && ! cmp -s <(same "$T/${name}def.json") <(same "$T/$name$ov.json"); then
         pass "$name"
     else
         fail "$name" "$(head -c 300 "$T/$name$ov.json")"

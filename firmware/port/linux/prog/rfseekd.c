@@ -123,8 +123,9 @@ static int64_t realtime_us(void)
     return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 }
 
-/* The steps' schedule and --idle-exit: a clock that never jumps (CLOCK_REALTIME, the
- * controller's clock, may be stepped back by NTP: no step would run until it caught up). */
+/* The live steps' schedule, --duration and --idle-exit: a clock that never jumps
+ * (CLOCK_REALTIME, the controller's clock, may be stepped back by NTP: no step would run
+ * until it caught up). */
 static int64_t monotonic_us(void)
 {
     struct timespec ts;

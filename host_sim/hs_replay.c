@@ -35,8 +35,6 @@ typedef struct rp_times {
 
 static rfs_q16_t rp_q16(double v) { return (rfs_q16_t)llround(v * 65536.0); }
 
-static double rp_d(rfs_q16_t v) { return (double)v / 65536.0; }
-
 static FILE *rp_open(const char *dir, const char *name)
 {
     char p[4096];
@@ -293,21 +291,7 @@ static void rp_step(hs_replay_t *rp, const rp_at_t *at)
     res->model_updates += d->relearned ? 1u : 0u;
     res->greedy += d->kind == RFS_SEEK_GREEDY ? 1u : 0u;
     res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
-    char reason[96];
-    snprintf(reason, sizeof(reason), "prev=%s%s%s%s%s%s", hs_sim_prev_name(d->prev),
-             d->line_search ? ",line_search" : "", d->sampled ? ",sampled" : "",
-             d->refuted ? ",refuted" : "",
-             d->model_valid ? "" : ",no_model",
-             d->mean_valid ? "" : ",no_mean");
-    fprintf(rp->flog,
-            "%u\t%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%s\t%s\t%d\t%.3f\t%.3f\t"
-            "%.4f\t%.3f\t%.3f\t%.3f\t%.3f\t%.3f\t%u\t%.3f",
-            d->iteration, at->te * 1e-6, at->ex, at->ey, at->eth, rp_d(d->x), rp_d(d->y), hs_sim_kind_name(d->kind),
-            reason, d->relearned ? 1 : 0, d->model_valid ? rp_d(d->prediction) : NAN,
-            d->mean_valid ? rp_d(d->mean) : NAN, rp_d(d->epsilon), rp_d(d->goal_x),
-            rp_d(d->goal_y), rp_d(d->max_x), rp_d(d->max_y), rp_d(d->path_len), d->samples,
-            at->etr);
-    hs_sim_log_estimate(rp->flog, &rp->ctrl); /* the path-loss estimate, or nan */
+    hs_sim_log_decision(rp->flog, &rp->ctrl, d, at->te * 1e-6, at->ex, at->ey, at->eth, at->etr);
 }
 
 /* Replay: packets, poses, receiver heartbeats and control periods in time order (equal

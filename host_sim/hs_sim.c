@@ -474,9 +474,8 @@ static void pose_event(sim_run_t *r, const event_t *ev, const tick_t *k)
     }
 }
 
-/* One log.tsv row: decision d at event ev with the robot's heading theta. */
-static void log_decision(FILE *f, const hs_ctrl_t *ctrl, const rfs_seek_decision_t *d,
-                         const event_t *ev, double theta)
+void hs_sim_log_decision(FILE *f, const hs_ctrl_t *ctrl, const rfs_seek_decision_t *d, double t_s,
+                         double x_m, double y_m, double theta, double travelled_m)
 {
     char reason[96];
     snprintf(reason, sizeof reason, "prev=%s%s%s%s%s%s%s", hs_sim_prev_name(d->prev),
@@ -490,11 +489,11 @@ static void log_decision(FILE *f, const hs_ctrl_t *ctrl, const rfs_seek_decision
     fprintf(f,
             "%u\t%.3f\t%.3f\t%.3f\t%.4f\t%.3f\t%.3f\t%s\t%s\t%d\t%.3f\t%.3f\t"
             "%.4f\t%.3f\t%.3f\t%.3f\t%.3f\t%.3f\t%u\t%.3f",
-            d->iteration, ev->te * 1e-6, ev->ex, ev->ey, theta,
+            d->iteration, t_s, x_m, y_m, theta,
             q16d(d->x), q16d(d->y), hs_sim_kind_name(d->kind), reason,
             d->relearned ? 1 : 0, pred, mean, q16d(d->epsilon),
             q16d(d->goal_x), q16d(d->goal_y), q16d(d->max_x), q16d(d->max_y),
-            q16d(d->path_len), d->samples, ev->etr);
+            q16d(d->path_len), d->samples, travelled_m);
     hs_sim_log_estimate(f, ctrl);
 }
 
@@ -539,7 +538,8 @@ static void ctrl_event(sim_run_t *r, const event_t *ev, const tick_t *k)
             r->belief_valid = true;
         }
         if (r->io && r->io->log) {
-            log_decision(r->io->log, ctrl, d, ev, wrap_pi(r->pth + ev->a * k->dth));
+            hs_sim_log_decision(r->io->log, ctrl, d, ev->te * 1e-6, ev->ex, ev->ey,
+                                wrap_pi(r->pth + ev->a * k->dth), ev->etr);
         }
     }
 }

@@ -178,6 +178,12 @@ const char *hs_sim_kind_name(rfs_seek_kind_t k);
 /// How the goal before a decision ended, as log.tsv's reason names it (prev=...).
 const char *hs_sim_prev_name(rfs_drive_status_t s);
 
+/// One log.tsv row (newline included): decision d made at t_s, the robot's true pose
+/// (x_m, y_m, theta) and distance travelled then; its reason column names the decision's
+/// flags (docs/SIMULATOR.md, "Outputs"). rfseek-sim's and rfseek-feed's logs alike.
+void hs_sim_log_decision(FILE *f, const hs_ctrl_t *ctrl, const rfs_seek_decision_t *d, double t_s,
+                         double x_m, double y_m, double theta, double travelled_m);
+
 /// End a log.tsv decision row: a tab, the HS_SIM_LOG_EST_COLUMNS values (source m, n,
 /// W dB, P0, spread area m^2) and a newline; "nan" unless the controller's model is
 /// "pathloss" and has a fit.

@@ -5,7 +5,8 @@ paper's meta + ridge on the same placements and seeds. Prints success, travel / 
 path and a failure taxonomy for the tuning draws (placements 1..50) and the held-out
 draws (51..100), and writes only the held-out half to its section of docs/RESULTS.md
 (between the markers below). --placement-seed S (not 1) draws other pairs, all of them
-fair tuning draws (nothing written); --only p or r runs one configuration.
+fair tuning draws (nothing written); --only p or r runs one configuration. The floors held
+out from all tuning (UNSEEN) run no tuning draws.
 
     /usr/bin/python3 scripts/bench_general.py [--placements 100] [--seeds 1..2]
         [--floors willow,3ne,...] [--sim build/bin/rfseek-sim] [--jobs 1]
@@ -249,6 +250,9 @@ def main():
         if f not in REAL + SYNTHETIC + UNSEEN:
             sys.exit(f"bench_general: --floors: unknown floor {f!r} "
                      f"(known: {', '.join(REAL + SYNTHETIC + UNSEEN)})")
+    if a.placement_seed != 1 and all(f in UNSEEN for f in floors):
+        sys.exit(f"bench_general: --floors: {', '.join(floors)}: held out from all tuning "
+                 "(no tuning draws; placement seed 1's held-out draws only)")
     if not os.access(a.sim, os.X_OK):
         sys.exit(f"bench_general: {a.sim}: not an executable (make all)")
     if a.seek:  # checked once, before any batch
@@ -264,6 +268,11 @@ def main():
         halves = [(f"tuning (placement seed {a.placement_seed})", 1, a.placements)]
     if a.held_out_only:
         halves = halves[1:]
+    # The floors each half runs: no tuning draw of a floor held out from all tuning.
+    on = {h: [f for f in floors if h == "held-out" or f not in UNSEEN] for h, _, _ in halves}
+    if any(f in UNSEEN for f in floors) and halves[0][0] != "held-out":
+        print(f"bench_general: {', '.join(f for f in floors if f in UNSEEN)}: held-out draws "
+              "only (held out from all tuning)", file=sys.stderr)
     t0, spent = time.time(), 0.0
     results = {h: {} for h, _, _ in halves}
     for f in floors:
@@ -271,6 +280,8 @@ def main():
             if a.only and c != a.only:
                 continue
             for h, first, last in halves:
+                if f not in on[h]:
+                    continue
                 results[h][(f, cfg)], el = batch(a, f, strategy, model, first, last, base)
                 spent += el
                 s = stats(results[h][(f, cfg)])
@@ -278,7 +289,7 @@ def main():
                       file=sys.stderr, flush=True)
     for h, first, last in halves:
         print(f"\n### {h} placements {first}..{last}, seeds {a.seeds}\n")
-        print("\n".join(table(results[h], floors)))
+        print("\n".join(table(results[h], on[h])))
     if not a.no_write:
         nice = os.nice(0)
         cmd = (f"nice -n {nice} " if nice else "") + "/usr/bin/python3 scripts/bench_general.py" + \

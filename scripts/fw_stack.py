@@ -10,8 +10,9 @@ refuse; bxCAN's poll_hook is NULL on hardware. An indirect call whose line names
 them may reach any of them. Recursion is an error (no bound). Frames of functions without
 a .su entry (newlib's memcpy/memset) count LIBC_FRAME bytes.
 
-Prints one line per root: its bound and the deepest path. Exit status 1 on recursion or
-an unknown frame (other than the C library's).
+Prints one line per root: its bound and the deepest path; then "indirect calls N", the
+call sites through a register it read (tests/firmware/stack.sh counts them apart). Exit
+status 1 on recursion or an unknown frame (other than the C library's).
 """
 import collections
 import os
@@ -69,7 +70,7 @@ def main(argv):
     dis = subprocess.run(['arm-none-eabi-objdump', '-d', '-l', '--no-show-raw-insn', elf],
                          capture_output=True, text=True, check=True).stdout
     funcs, calls, icalls = {}, collections.defaultdict(set), collections.defaultdict(set)
-    cur, src, sources, unknown = None, [], {}, []
+    cur, src, sources, unknown, nindirect = None, [], {}, [], 0
     for line in dis.splitlines():
         m = re.match(r'^([0-9a-f]+) <([^>]+)>:$', line)
         if m:
@@ -86,7 +87,9 @@ def main(argv):
         if m and m.group(2) != cur:  # a call, or a tail call (any branch to another function)
             calls[cur].add(m.group(2))
             continue
-        if re.search(r'\t(blx|bx)\s+r(\d|1[0-2])\b', line):
+        # Any register but lr (a return): r0..r12 print as ip, sl, fp and sb too.
+        if re.search(r'\t(blx|bx)\s+(r\d+|ip|sl|fp|sb)\b', line):
+            nindirect += 1
             text = ''
             if src:
                 if src[0] not in sources:
@@ -166,6 +169,7 @@ def main(argv):
             continue
         w, p = worst(r, ())
         print('%s %d %s' % (r, w, ' > '.join('%s(%d)' % (x, fr(x)) for x in p)))
+    print('indirect calls %d' % nindirect)
     for u in sorted(set(unknown)):
         print('fw_stack.py: indirect call of no known table (any may be reached): %s' % u,
               file=sys.stderr)

@@ -28,6 +28,7 @@ typedef struct fake_hw {
     bool ack_modes;       /* false: a dead controller that never acknowledges */
     bool aborts;          /* TSR modelled: an ABRQ write empties its (pending) mailbox */
     uint32_t tme;         /* ... the TME bits then (TSR's others are not memory) */
+    unsigned sending;     /* ... but not of these mailboxes (bit i): in transmission */
     unsigned hook_calls;
 } fake_hw_t;
 
@@ -61,7 +62,7 @@ static void fake_tick(void *ctx)
     }
     if (hw->aborts) {
         for (unsigned i = 0; i < 3u; i++) {
-            if ((hw->r.tsr & RFS_BXCAN_TSR_ABRQ(i)) != 0u) {
+            if ((hw->r.tsr & RFS_BXCAN_TSR_ABRQ(i)) != 0u && (hw->sending & (1u << i)) == 0u) {
                 hw->tme |= RFS_BXCAN_TSR_TME(i); /* RM0090 32.9.3: TME set once aborted */
             }
         }
@@ -243,6 +244,33 @@ static void test_send_supersedes_a_pending_frame_of_its_id(void **state)
     assert_int_equal(hw->r.tx[0].tdlr, 0x00000011u);
     assert_int_equal(hw->r.tx[1].tir, (0x180u << 21) | 1u);
     assert_int_equal(d->tx_queued, 3u);
+}
+
+/* The request of its id is in transmission: RM0090 32.7.1, the abort then waits for the
+ * transmission's end (the frame may still go out, before the new one). The new frame goes
+ * to an empty mailbox, never to the one being sent. */
+static void test_send_leaves_a_mailbox_in_transmission_alone(void **state)
+{
+    fake_hw_t *hw = ((void **)*state)[0];
+    rfs_bxcan_t *d = ((void **)*state)[1];
+    const rfs_bxcan_cfg_t c = rfs_bxcan_cfg_default();
+    assert_int_equal(rfs_bxcan_init(d, &hw->r, &c, fake_tick, hw), 0);
+    const rfs_can_frame_t stop = {0x100u, 6u, {0x11, 0, 0, 0, 0, 0x00, 0, 0}};
+    hw->r.tx[0].tir = (0x100u << 21) | 1u; /* the old command, in transmission */
+    hw->r.tx[0].tdlr = 0x01F4F410u;
+    hw->r.tx[1].tir = (0x180u << 21) | 1u; /* a status, pending */
+    hw->aborts = true;
+    hw->sending = 1u;
+    hw->tme = 0x10000000u; /* TME2 */
+    hw->r.tsr = hw->tme;
+
+    assert_int_equal(rfs_bxcan_send(d, &stop), 0);
+
+    assert_int_equal(hw->tme, 0x10000000u);  /* mailbox 0 still busy after ABRQ0 */
+    assert_int_equal(hw->r.tx[0].tdlr, 0x01F4F410u);
+    assert_int_equal(hw->r.tx[2].tir, 0x20000001u);
+    assert_int_equal(hw->r.tx[2].tdlr, 0x00000011u);
+    assert_int_equal(hw->r.tx[1].tir, (0x180u << 21) | 1u);
 }
 
 /* A fault handler's stop: every pending request aborted (ABRQ0..2: bits 7, 15, 23), the
@@ -473,6 +501,7 @@ int main(void)
         cmocka_unit_test_setup(test_init_fails_when_the_hardware_never_acknowledges, setup),
         cmocka_unit_test_setup(test_send_fills_free_mailboxes_in_order, setup),
         cmocka_unit_test_setup(test_send_supersedes_a_pending_frame_of_its_id, setup),
+        cmocka_unit_test_setup(test_send_leaves_a_mailbox_in_transmission_alone, setup),
         cmocka_unit_test_setup(test_fault_send_aborts_pending_requests_and_sends, setup),
         cmocka_unit_test_setup(test_recv_reads_fifo0_first_and_releases_each_mailbox, setup),
         cmocka_unit_test_setup(test_recv_drops_extended_and_remote_frames_and_counts_overruns,

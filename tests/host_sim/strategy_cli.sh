@@ -67,6 +67,7 @@ bench_general.py|--only x --no-write|--only: expected p or r
 bench_general.py|--placement-seed 0 --no-write|--placement-seed: expected a positive integer
 bench_general.py|--placement-seed 2|--placement-seed and --only need --no-write
 bench_general.py|--placement-seed 2 --no-write --held-out-only|only placement seed 1 has held-out draws
+bench_general.py|--placement-seed 2 --no-write --floors warehouse,bookstore --sim /nonexistent|warehouse, bookstore: held out from all tuning
 bench_bridge.py|--sim /nonexistent|/nonexistent: not an executable
 bench_bridge.py|--seeds x|--seeds: expected A..B
 bridge_bounds.py|--sim /nonexistent scenarios/bridge.yaml 1..2|/nonexistent: not an executable

@@ -726,6 +726,38 @@ static void test_dead_zone_heartbeat(void **state)
     assert_int_equal(deaf[0], 0);
 }
 
+/* A log.tsv row (rfseek-sim's and rfseek-feed's): the reason column names the decision's
+ * flags as docs/SIMULATOR.md lists them (one of sampled, near, hedged), the Q16.16 fields
+ * in metres and dB, and no estimate without a path-loss model. */
+static void test_log_row_names_the_flags(void **state)
+{
+    (void)state;
+    hs_ctrl_t ctrl;
+    memset(&ctrl, 0, sizeof ctrl);
+    rfs_seek_decision_t d;
+    memset(&d, 0, sizeof d);
+    d.iteration = 7;
+    d.kind = RFS_SEEK_GREEDY;
+    d.prev = RFS_DRIVE_REACHED;
+    d.model_valid = true;
+    d.mean_valid = true;
+    d.near = true;
+    d.hedged = true; /* not shown: near comes first */
+    d.refuted = true;
+    d.pinned = true;
+    d.prediction = -60 * 65536 - 32768; /* -60.5 dB */
+    d.goal_x = 3 * 65536 + 16384;       /* 3.25 m */
+    d.samples = 42;
+    char row[512];
+    FILE *f = fmemopen(row, sizeof row, "w");
+    assert_non_null(f);
+    hs_sim_log_decision(f, &ctrl, &d, 1.5, 2.0, 3.0, 0.25, 4.5);
+    fclose(f);
+    assert_string_equal(row, "7\t1.500\t2.000\t3.000\t0.2500\t0.000\t0.000\tgreedy\t"
+                             "prev=reached,near,refuted,pinned\t0\t-60.500\t0.000\t0.0000\t3.250\t"
+                             "0.000\t0.000\t0.000\t0.000\t42\t4.500\tnan\tnan\tnan\tnan\tnan\tnan\n");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -740,6 +772,7 @@ int main(void)
         cmocka_unit_test(test_shipped_scenarios),
         cmocka_unit_test(test_receiver_heartbeat_through_faults),
         cmocka_unit_test(test_dead_zone_heartbeat),
+        cmocka_unit_test(test_log_row_names_the_flags),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -60,6 +60,7 @@ compgen -G "$w/nl*" > /dev/null && fail "rfseekd-newline-nothing-written ($(ls -
 # The real-time clock stepped back an hour 0.5 s into a live run (an LD_PRELOAD shim): the
 # steps go on at 20 Hz (scheduled on the monotonic clock; they stopped until the clock had
 # caught up), and the run, ended by SIGINT after 2 s, ends on a zero command with Stop.
+# --duration counts monotonic time too: 2 s, not an hour more.
 if cc -shared -fPIC -o "$w/clock_back.so" tests/wire/clock_back.c -ldl 2> "$w/cc.err"; then
     RFS_CLOCK_AFTER_MS=500 RFS_CLOCK_BACK_S=3600 LD_PRELOAD="$w/clock_back.so" timeout -s INT 2 \
         "$d" --map $map --lcm memq:// --can-over-lcm --log "$w/back.lcmlog" > /dev/null 2> "$w/back.err"
@@ -69,6 +70,12 @@ print(sum(1 for _t, ch, _b in events(sys.argv[1]) if ch == "RFS_WHEEL_CMD"))' "$
     [ "${n:-0}" -ge 30 ] 2>/dev/null && pass "rfseekd-clock-stepped-back ($n wheel commands in 2 s)" \
         || fail "rfseekd-clock-stepped-back ($n wheel commands in 2 s, want >= 30: $(head -2 "$w/back.err"))"
     /usr/bin/python3 tests/host_sim/wheel_stop_check.py "$w/back.lcmlog" live | sed 's/ wheel_stop/ rfseekd-clock-back-wheel_stop/'
+    t0=$(date +%s%N)
+    RFS_CLOCK_AFTER_MS=500 RFS_CLOCK_BACK_S=3600 LD_PRELOAD="$w/clock_back.so" timeout -s INT 8 \
+        "$d" --map $map --lcm memq:// --duration 2 > /dev/null 2> "$w/dur.err"
+    rc=$? ms=$((($(date +%s%N) - t0) / 1000000))
+    [ $rc -eq 0 ] && [ $ms -ge 1900 ] && [ $ms -lt 4000 ] && pass "rfseekd-clock-back-duration (${ms} ms)" \
+        || fail "rfseekd-clock-back-duration (rc $rc after $ms ms, want 0 after 2 s: $(head -2 "$w/dur.err"))"
 else fail "rfseekd-clock-stepped-back: cannot build the shim ($(head -1 "$w/cc.err"))"; fi
 # rfseek-sim-lcm: the same rule (it writes only summary.json, to stdout: none on error).
 sl=$build/bin/rfseek-sim-lcm scn=scenarios/default.yaml

@@ -64,7 +64,8 @@ static const char usage_text[] =
     "  --fit-early on|off  relearns begun while the base brakes (default off; the STM32\n"
     "                    image's on); only with --fit-budget N > 0: whole fits ignore it\n"
     "  --seed N          seed of the controller's random source (default 1)\n"
-    "  --duration S      stop after S seconds of controller time (default: run until signalled)\n"
+    "  --duration S      stop after S seconds of controller time, live of the monotonic clock\n"
+    "                    (default: run until signalled)\n"
     "  --idle-exit MS    stop when no LCM message arrived for MS milliseconds\n"
     "  -h, --help        this text\n";
 
@@ -122,8 +123,9 @@ static int64_t realtime_us(void)
     return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 }
 
-/* The steps' schedule and --idle-exit: a clock that never jumps (CLOCK_REALTIME, the
- * controller's clock, may be stepped back by NTP: no step would run until it caught up). */
+/* The live steps' schedule, --duration and --idle-exit: a clock that never jumps
+ * (CLOCK_REALTIME, the controller's clock, may be stepped back by NTP: no step would run
+ * until it caught up). */
 static int64_t monotonic_us(void)
 {
     struct timespec ts;
@@ -140,7 +142,9 @@ static void step(daemon_t *d, int64_t now_us)
         d->started = true;
         d->start_us = now_us;
     }
-    if (d->duration_us > 0 && now_us - d->start_us >= d->duration_us) {
+    /* Live, --duration runs on the monotonic clock (run_live): a stepped clock would
+     * stretch or cut it. */
+    if (d->duration_us > 0 && (d->clock_lcm || d->replay) && now_us - d->start_us >= d->duration_us) {
         d->done = true;
         return;
     }
@@ -707,10 +711,14 @@ static int run_lockstep(daemon_t *d, const options_t *o)
  * the inputs' stamps lie ahead of now, stale, and the wheels stop (docs/FAULTS.md). */
 static int run_live(daemon_t *d, const options_t *o)
 {
-    int64_t next = monotonic_us();
+    const int64_t start = monotonic_us();
+    int64_t next = start;
     int64_t idle_since = next;
     while (!g_stop && !d->done) {
         int64_t now = monotonic_us();
+        if (d->duration_us > 0 && now - start >= d->duration_us) {
+            break;
+        }
         if (now >= next) {
             step(d, realtime_us());
             next += RFS_APP_PERIOD_US;

@@ -286,11 +286,7 @@ static void rp_step(hs_replay_t *rp, const rp_at_t *at)
         return;
     }
     const rfs_seek_decision_t *d = &out.decision;
-    hs_sim_result_t *res = &rp->res;
-    res->iterations++;
-    res->model_updates += d->relearned ? 1u : 0u;
-    res->greedy += d->kind == RFS_SEEK_GREEDY ? 1u : 0u;
-    res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
+    hs_sim_count_decision(&rp->res, d, at->te, rp->ctrl.period_us);
     hs_sim_log_decision(rp->flog, &rp->ctrl, d, at->te * 1e-6, at->ex, at->ey, at->eth, at->etr);
 }
 

@@ -497,6 +497,23 @@ void hs_sim_log_decision(FILE *f, const hs_ctrl_t *ctrl, const rfs_seek_decision
     hs_sim_log_estimate(f, ctrl);
 }
 
+void hs_sim_count_decision(hs_sim_result_t *res, const rfs_seek_decision_t *d, int64_t now_us,
+                           int64_t period_us)
+{
+    res->iterations++;
+    res->model_updates += d->relearned ? 1u : 0u;
+    res->greedy += d->kind == RFS_SEEK_GREEDY ? 1u : 0u;
+    res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
+    res->goal_timeouts += d->prev == RFS_DRIVE_TIMEOUT ? 1u : 0u;
+    res->goal_blocked += d->prev == RFS_DRIVE_BLOCKED ? 1u : 0u;
+    res->slow_decisions += d->plan_wait >= 2u ? 1u : 0u;
+    res->plan_wait_max = d->plan_wait > res->plan_wait_max ? d->plan_wait : res->plan_wait_max;
+    const int64_t wait_us = now_us - d->t_us + period_us; /* the deciding period too */
+    res->decisions_over_100ms += wait_us > 100000 ? 1u : 0u;
+    res->decision_wait_max_s = fmax(res->decision_wait_max_s, (double)wait_us * 1e-6);
+    res->decision_wait_sum_s += (double)wait_us * 1e-6;
+}
+
 /* A control period: the receiver heartbeat, the controller's step, its command through
  * the faults to the motor, and its decision counted and logged. */
 static void ctrl_event(sim_run_t *r, const event_t *ev, const tick_t *k)
@@ -519,19 +536,7 @@ static void ctrl_event(sim_run_t *r, const event_t *ev, const tick_t *k)
     }
     if (out.decided) {
         const rfs_seek_decision_t *d = &out.decision;
-        hs_sim_result_t *res = r->res;
-        res->iterations++;
-        res->model_updates += d->relearned ? 1u : 0u;
-        res->greedy += d->kind == RFS_SEEK_GREEDY ? 1u : 0u;
-        res->epsilon += d->kind == RFS_SEEK_EPSILON ? 1u : 0u;
-        res->goal_timeouts += d->prev == RFS_DRIVE_TIMEOUT ? 1u : 0u;
-        res->goal_blocked += d->prev == RFS_DRIVE_BLOCKED ? 1u : 0u;
-        res->slow_decisions += d->plan_wait >= 2u ? 1u : 0u;
-        res->plan_wait_max = d->plan_wait > res->plan_wait_max ? d->plan_wait : res->plan_wait_max;
-        const int64_t wait_us = ev->te - d->t_us + ctrl->period_us; /* the deciding period too */
-        res->decisions_over_100ms += wait_us > 100000 ? 1u : 0u;
-        res->decision_wait_max_s = fmax(res->decision_wait_max_s, (double)wait_us * 1e-6);
-        res->decision_wait_sum_s += (double)wait_us * 1e-6;
+        hs_sim_count_decision(r->res, d, ev->te, ctrl->period_us);
         if (d->kind == RFS_SEEK_GREEDY && d->model_valid) {
             r->belief_x = q16d(d->max_x);
             r->belief_y = q16d(d->max_y);

@@ -184,6 +184,12 @@ const char *hs_sim_prev_name(rfs_drive_status_t s);
 void hs_sim_log_decision(FILE *f, const hs_ctrl_t *ctrl, const rfs_seek_decision_t *d, double t_s,
                          double x_m, double y_m, double theta, double travelled_m);
 
+/// Decision d, made in the control period at now_us (period_us long), into r's counts:
+/// iterations, relearns, kinds, goals timed out or blocked, slow decisions and the
+/// decision waits (rfseek-sim's and rfseek-feed --pose's summary.json alike).
+void hs_sim_count_decision(hs_sim_result_t *r, const rfs_seek_decision_t *d, int64_t now_us,
+                           int64_t period_us);
+
 /// End a log.tsv decision row: a tab, the HS_SIM_LOG_EST_COLUMNS values (source m, n,
 /// W dB, P0, spread area m^2) and a newline; "nan" unless the controller's model is
 /// "pathloss" and has a fit.

@@ -121,6 +121,17 @@ def main():
     check("log: the simulator's header", log[0] == sim_header, str(log[0]))
     check("log: one row per decision, first the initial move",
           len(log) - 1 == sm["iterations"] and log[1][0] == "0" and log[1][7] == "initial", str(log[:2]))
+    # The summary's decision counts are the log's rows counted (as rfseek-sim's): kinds, how
+    # the goals before them ended, and a wait for each (the deciding period at least).
+    rows = log[1:]
+    counts = {"greedy": sum(r[7] == "greedy" for r in rows), "epsilon": sum(r[7] == "epsilon" for r in rows),
+              "goal_timeouts": sum(r[8].startswith("prev=timeout") for r in rows),
+              "goal_blocked": sum(r[8].startswith("prev=blocked") for r in rows)}
+    check("summary: decision counts from the log " + str(counts),
+          all(sm[k] == v for k, v in counts.items()) and counts["goal_timeouts"] + counts["greedy"] > 0,
+          str({k: sm[k] for k in counts}))
+    check("summary: decision waits counted", sm["decision_wait_max_s"] >= 0.05 and
+          sm["slow_decisions"] is not None and sm["plan_wait_max"] is not None, str(sm))
     check("stats: frames outside the poses counted",
           "not fed, before the first pose" in p.stderr and "not fed, after the last pose" in p.stderr, p.stderr)
 

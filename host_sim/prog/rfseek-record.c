@@ -632,6 +632,7 @@ static int start_player(recording_t *s)
         return 1;
     }
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.follow_epoch = true; /* as the STM32 image (rfs_app_cfg_mcu) */
     cfg.samples = s->samples;
     cfg.model_state = s->model_state;
     cfg.model_state_bytes = model_bytes;

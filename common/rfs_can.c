@@ -584,6 +584,17 @@ static int64_t epoch_note(rfs_can_rx_t *rx, rfs_can_err_t e, int64_t t, int64_t 
     return t + step;
 }
 
+/* A stamp in local time and its window check (time_check): the one path of every
+ * time-bearing frame. */
+static rfs_can_err_t rx_time(rfs_can_rx_t *rx, uint32_t raw, int64_t now_us, bool have_last,
+                             int64_t last, int64_t *t)
+{
+    *t = epoch_read(rx, raw, now_us);
+    const rfs_can_err_t e = time_check(rx, *t, now_us, have_last, last);
+    *t = epoch_note(rx, e, *t, now_us);
+    return e;
+}
+
 /* WHEEL_CMD: a counter check. */
 static rfs_can_err_t rx_wheel(rfs_can_rx_t *rx, const rfs_can_frame_t *f, rfs_can_msg_t *msg)
 {
@@ -659,9 +670,7 @@ static rfs_can_err_t rx_pose_th(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int6
     }
     int64_t t = 0;
     if (e == RFS_CAN_OK) {
-        t = epoch_read(rx, p.t_us32, now_us);
-        e = time_check(rx, t, now_us, rx->have_pose, rx->last_pose_us);
-        t = epoch_note(rx, e, t, now_us);
+        e = rx_time(rx, p.t_us32, now_us, rx->have_pose, rx->last_pose_us, &t);
     }
     if (e != RFS_CAN_OK) {
         if (e != RFS_CAN_E_PAIR && e != RFS_CAN_E_REPEAT) {
@@ -692,9 +701,7 @@ static rfs_can_err_t rx_rssi(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int64_t
     }
     int64_t t = 0;
     if (e == RFS_CAN_OK) {
-        t = epoch_read(rx, r.t_us32, now_us);
-        e = time_check(rx, t, now_us, (rx->have_rssi >> r.src) & 1u, rx->last_rssi_us[r.src]);
-        t = epoch_note(rx, e, t, now_us);
+        e = rx_time(rx, r.t_us32, now_us, (rx->have_rssi >> r.src) & 1u, rx->last_rssi_us[r.src], &t);
     }
     if (e != RFS_CAN_OK) {
         return drop(rx, e);
@@ -728,9 +735,7 @@ static rfs_can_err_t rx_receiver(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int
     }
     int64_t t = 0;
     if (e == RFS_CAN_OK) {
-        t = epoch_read(rx, r.t_us32, now_us);
-        e = time_check(rx, t, now_us, rx->have_receiver, rx->last_receiver_us);
-        t = epoch_note(rx, e, t, now_us);
+        e = rx_time(rx, r.t_us32, now_us, rx->have_receiver, rx->last_receiver_us, &t);
     }
     if (e != RFS_CAN_OK) {
         return drop(rx, e);

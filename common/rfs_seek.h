@@ -448,7 +448,7 @@ void rfs_seek_cfg_per_source(rfs_seek_cfg_t *cfg);
 int rfs_seek_init(rfs_seek_t *s, const rfs_seek_cfg_t *cfg, const rfs_map_t *map,
                   rfs_model_t model, const rfs_target_ops_t *target, const rfs_seek_mem_t *mem);
 
-/// A pose arrived. false when rejected (older than the latest).
+/// A pose arrived. false when rejected (not newer than the latest).
 bool rfs_seek_on_pose(rfs_seek_t *s, const rfs_pose_t *pose, rfs_rng_t *rng);
 
 /// A measurement from source `src` (index into the target's sources) arrived.

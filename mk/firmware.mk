@@ -44,10 +44,18 @@ FW_BENCH_SRCS := firmware/port/stm32f4/startup.c firmware/port/qemu/semihost.c \
 	firmware/port/qemu/bench_clock.c firmware/port/qemu/bench.c firmware/rfs_app.c
 FW_IMAGES := $(FW)/firmware.elf $(FW)/firmware.bin $(FW)/qemu.elf
 
-$(FW)/obj/%.o: %.c
+# The flags the objects were built with: a change rebuilds them all (an object built before
+# -fstack-usage has no .su file for tests/firmware/stack.sh).
+FW_FLAGS_STAMP := $(FW)/cflags.txt
+.PHONY: FORCE
+FORCE:
+$(FW_FLAGS_STAMP): FORCE
+	@mkdir -p $(@D)
+	@echo '$(ARM_CC) $(FW_CFLAGS)' | cmp -s - $@ || echo '$(ARM_CC) $(FW_CFLAGS)' > $@
+$(FW)/obj/%.o: %.c $(FW_FLAGS_STAMP)
 	@mkdir -p $(@D)
 	$(ARM_CC) $(FW_CFLAGS) $(DEPFLAGS) -c $< -o $@
-$(FW)/obj/fw_map.o: $(FW)/fw_map.c
+$(FW)/obj/fw_map.o: $(FW)/fw_map.c $(FW_FLAGS_STAMP)
 	@mkdir -p $(@D)
 	$(ARM_CC) $(FW_CFLAGS) $(DEPFLAGS) -c $< -o $@
 $(FW)/fw_map.c: scripts/map2c.py

@@ -3,7 +3,8 @@
 # line per job, tab-separated NAME, KIND (bin: a CMocka program; script: a command that
 # prints PASS/FAIL lines), SERIAL ("serial": run alone, after the others) and COMMAND).
 # Jobs run TEST_JOBS at a time (default: nproc), longest first by the last run's times;
-# each job's output goes to BUILD/test-logs/NAME.log. Prints one PASS/FAIL line per job in
+# each job's output goes to BUILD/test-logs/NAME.log. A job with no passed and no failed
+# check fails (unless it printed a "SKIP " line). Prints one PASS/FAIL line per job in
 # the file's order, then the closing "tests: N passed, N failed" line, last. Exits
 # non-zero when anything failed.
 #   scripts/run_tests.sh JOBFILE [--only NAME]    (--only: that job alone, its log shown)
@@ -50,6 +51,11 @@ run_job() {
         ok=$(grep -c '^PASS ' "$log")
         bad=$(grep -c '^FAIL ' "$log")
     fi
+    # A job that reports no check passed and none failed tested nothing (an empty glob, a
+    # loop that never ran): a failure, unless it says why it skipped (a "SKIP " line).
+    if [ "$ok" -eq 0 ] && [ "$bad" -eq 0 ] && ! grep -q '^SKIP ' "$log"; then
+        echo "FAIL ${names[$i]}: no PASS or FAIL line (nothing was checked)" >>"$log"; bad=1
+    fi
     if [ $rc -ne 0 ] && [ "$bad" -eq 0 ]; then bad=1; fi
     echo "$rc $ok $bad $(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN {printf "%.1f", b - a}')" >"$logdir/$s.res"
 }
@@ -88,7 +94,7 @@ for i in "${!names[@]}"; do
     else
         echo "FAIL $n (exit $rc; log $logdir/$s.log)"
         if [ "${kinds[$i]}" = bin ]; then
-            grep -E 'FAILED|ERROR|error|Sanitizer|runtime error' "$logdir/$s.log" | head -20
+            grep -E '^FAIL |FAILED|ERROR|error|Sanitizer|runtime error' "$logdir/$s.log" | head -20
         else
             grep -E '^FAIL|rror' "$logdir/$s.log" | head -20
         fi

@@ -431,6 +431,16 @@ static void rx_drops_stale_future_and_out_of_order_times(void **state)
     rfs_can_pack_rssi(&r, 4, &f);
     assert_int_equal(rfs_can_rx_frame(&rx, &f, now, &m), RFS_CAN_OK);
     assert_int_equal(m.rssi_src, 1);
+    /* The window's edges are inside it: only older than max_age, later than max_future drop. */
+    r.src = 2;
+    r.t_us32 = rfs_can_wrap_time(now - 1000000);
+    rfs_can_pack_rssi(&r, 5, &f);
+    assert_int_equal(rfs_can_rx_frame(&rx, &f, now, &m), RFS_CAN_OK);
+    r.src = 3;
+    r.t_us32 = rfs_can_wrap_time(now + 100000);
+    rfs_can_pack_rssi(&r, 6, &f);
+    assert_int_equal(rfs_can_rx_frame(&rx, &f, now, &m), RFS_CAN_OK);
+    assert_int_equal(m.rssi_t_us, now + 100000);
     assert_int_equal(rx.dropped[RFS_CAN_E_ORDER], 1);
     assert_int_equal(rx.dropped[RFS_CAN_E_STALE], 1);
     assert_int_equal(rx.dropped[RFS_CAN_E_FUTURE], 1);

@@ -332,6 +332,29 @@ static void test_random_polylines(void **state)
     assert_true(worst < 0.07);
 }
 
+/* A base far wider than the Kobuki's (1 m): steering while driving asks the outer wheel
+ * for more than v_max, so both wheels are scaled down; no command above v_max. */
+static void test_wide_base_keeps_the_speed_limit(void **state)
+{
+    (void)state;
+    rfs_drive_t d;
+    sim_t s;
+    int64_t end;
+    srand(11);
+    for (int k = 0; k < 20; k++) {
+        double th0;
+        rfs_path_t p = random_polyline(&th0);
+        start(&d, &s, 0.0, 0.0, th0);
+        rfs_drive_cfg_t cfg = rfs_drive_cfg_default();
+        cfg.wheel_base_mm = 1000;
+        assert_int_equal(rfs_drive_init(&d, &cfg), 0);
+        rfs_drive_set_path(&d, &p, 0);
+        assert_int_equal(run(&d, &s, &p, 120.0, false, &end), RFS_DRIVE_REACHED);
+        assert_int_equal(s.violations_speed, 0);
+        assert_int_equal(s.violations_accel, 0);
+    }
+}
+
 /* The same polylines with the simulator's default localisation noise (5 cm per axis,
  * 0.02 rad, 10 Hz) and with twice that: every goal reached (none abandoned), the true
  * robot within clearance - radius (0.25 - 0.177 m) of the polyline at 5 cm, and no more
@@ -748,6 +771,7 @@ int main(void)
         cmocka_unit_test(test_reaches_goals),
         cmocka_unit_test(test_follows_waypoints),
         cmocka_unit_test(test_random_polylines),
+        cmocka_unit_test(test_wide_base_keeps_the_speed_limit),
         cmocka_unit_test(test_noisy_polylines),
         cmocka_unit_test(test_pose_filter),
         cmocka_unit_test(test_dead_reckoning),

@@ -292,6 +292,27 @@ static void test_silence_floor_samples(void **state)
     assert_int_equal(floors, 0);
 }
 
+/* A pose no newer than the latest is rejected (rfs_seek_on_pose): the seeker keeps the
+ * latest pose, the store counts the rejection; a newer one is taken. */
+static void test_pose_order(void **state)
+{
+    (void)state;
+    world_t t;
+    rfs_seek_out_t out;
+    int64_t now = heartbeat_start(&t, &out);
+    rfs_pose_t same = pose_at(now, 7.0, 5.0, 0), older = pose_at(now - 1, 7.0, 5.0, 0);
+    rfs_pose_t newer = pose_at(now + 1, 6.0, 5.0, 0);
+
+    assert_false(rfs_seek_on_pose(&t.seek, &same, &t.rng));
+    assert_false(rfs_seek_on_pose(&t.seek, &older, &t.rng));
+    assert_int_equal(t.seek.pose.t_us, now);
+    assert_int_equal(t.seek.pose.x, Q(5.0));
+    assert_int_equal(t.seek.store.rejected_pose_order, 2);
+    assert_true(rfs_seek_on_pose(&t.seek, &newer, &t.rng));
+    assert_int_equal(t.seek.pose.x, Q(6.0));
+    world_free(&t);
+}
+
 /* Report stamps follow the measurements' rules (docs/FAULTS.md): older than the newest is
  * rejected, equal accepted; a newest report further ahead than the timeout (a clock jump)
  * is stale even while packets are fresh, until the clock reaches it. */
@@ -932,6 +953,7 @@ int main(void)
         cmocka_unit_test(test_heartbeat_keeps_goal_without_packets),
         cmocka_unit_test(test_no_packet_no_heartbeat_stops_wheels),
         cmocka_unit_test(test_heartbeat_never_makes_a_mean),
+        cmocka_unit_test(test_pose_order),
         cmocka_unit_test(test_heartbeat_stamps),
         cmocka_unit_test(test_silence_floor_samples),
         cmocka_unit_test(test_no_goal_backs_off),

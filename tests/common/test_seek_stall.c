@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "ref_geom.h"
+#include "rfs_seek_internal.h"
 #include "seek_run.h"
 
 /* refute_r (docs/STRATEGIES.md, "Stalls"): a model that knows its maximum, predicts -60
@@ -250,6 +251,56 @@ static void test_refute_after_early_relearn(void **state)
     assert_true(ab_off >= 15 && ab_on >= 15);
     assert_true(off >= ab_off - 2); /* every abandoned leg at its maximum rules it out */
     assert_true(on >= ab_on - 2);
+}
+
+/* fit_early's refutation as the base brakes (rfs_seek_fit_early_begin): the robot may
+ * still stop within half a step of the leg's maximum, so the rule allows for the braking
+ * distance at the base's speed v, v^2 / (2 a), plus the drive's goal tolerance. The robot
+ * at (4, 5) with 1 s of packets 7 dB weaker than the model's -60 dB, the maximum dist_m
+ * east of it. */
+static bool early_refutes(double dist_m, int32_t v_mm_s)
+{
+    world_t t;
+    refute_model_t m;
+    rfs_seek_cfg_t cfg = rfs_seek_cfg_default();
+    rfs_seek_cfg_use_strategy(&cfg, RFS_SEEK_META_PATH);
+    cfg.fit_budget = 100u;
+    cfg.fit_early = true;
+    refute_world(&t, cfg, &m);
+    assert_int_equal(t.seek.cfg.step, RFS_Q16_ONE); /* the reference's figures */
+    assert_int_equal(t.seek.drive.cfg.accel_mm_s2, 1000);
+    assert_int_equal(t.seek.drive.cfg.goal_tol, RFS_Q16_FRAC(1, 10));
+    for (int64_t now = 0; now <= 1000000; now += 10000) {
+        if (now % 50000 == 0) {
+            rfs_pose_t p = { now, Q(4.0), Q(5.0), 0 };
+            assert_true(rfs_seek_on_pose(&t.seek, &p, &t.rng));
+        }
+        assert_true(rfs_seek_on_rssi(&t.seek, 0, now, -67, &t.rng));
+    }
+    assert_true(t.seek.store.count > 0u);
+    m.base.mx = Q(4.0 + dist_m);
+    m.base.my = Q(5.0);
+    m.base.valid = true;
+    t.seek.drive.base_left = v_mm_s;
+    t.seek.drive.base_right = v_mm_s;
+    rfs_seek_fit_early_begin(&t.seek, 1000000);
+    assert_true(t.seek.fitting); /* the early relearn began */
+    const bool refuted = t.seek.early_refuted;
+    world_free(&t);
+    return refuted;
+}
+
+static void test_early_refute_allows_the_braking_distance(void **state)
+{
+    (void)state;
+    /* Reference in double: a = 1 m/s^2 and goal_tol = 0.1 m (rfs_drive_cfg_default), half
+     * a step 0.5 m: at rest within 0.6 m; at 0.7 m/s within 0.5 + 0.49 / 2 + 0.1 = 0.845 m. */
+    assert_true(early_refutes(0.58, 0));
+    assert_false(early_refutes(0.62, 0));
+    assert_true(early_refutes(0.62, 700));
+    assert_true(early_refutes(0.83, 700));
+    assert_false(early_refutes(0.86, 700));
+    assert_true(early_refutes(0.83, -700)); /* reversing brakes as far */
 }
 
 /* refute_reached: the mean exactly as predicted (no relearn of its own) still rules out
@@ -729,6 +780,7 @@ int main(void)
         cmocka_unit_test(test_refute_rules_out_the_argmax),
         cmocka_unit_test(test_refute_reached_moves_on),
         cmocka_unit_test(test_refute_after_early_relearn),
+        cmocka_unit_test(test_early_refute_allows_the_braking_distance),
         cmocka_unit_test(test_local_search_round_the_estimate),
         cmocka_unit_test(test_local_refute_rules_out_the_swept),
         cmocka_unit_test(test_local_gap_spaces_the_sweep),

@@ -220,6 +220,23 @@ static void test_first_step_after_reset_is_zero_and_flagged(void **state)
     assert_true(o.faults & RFS_APP_FAULT_POSE_LOST);
     rfs_app_step(&s_app, 50000, &o);
     assert_false(o.faults & RFS_APP_FAULT_RESET);
+
+    /* Inputs fresh before the first step (they came in as the image restarted): zero all
+     * the same, then driving. */
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    for (int64_t t = 0; t <= 1000000; t += 5000) {
+        if (t % 100000 == 0) {
+            const rfs_pose_t p = {.t_us = t, .x = RFS_Q16_INT(5), .y = RFS_Q16_INT(5), .theta = 0};
+            rfs_app_on_pose(&s_app, &p, t);
+        }
+        rfs_app_on_rssi(&s_app, 0, t, (int8_t)(-60 - (t / 5000) % 3), t);
+    }
+    rfs_app_step(&s_app, 1000000, &o);
+    assert_true(o.faults & RFS_APP_FAULT_RESET);
+    assert_false(o.faults & (RFS_APP_FAULT_POSE_LOST | RFS_APP_FAULT_RSSI_LOST));
+    assert_int_equal(o.left_mm_s, 0);
+    assert_int_equal(o.right_mm_s, 0);
+    assert_true(run(1000000, 3000000, true, true, &o) > 0);
 }
 
 static void test_wheels_stop_within_200_ms_of_lost_inputs_and_resume(void **state)
@@ -245,6 +262,59 @@ static void test_wheels_stop_within_200_ms_of_lost_inputs_and_resume(void **stat
     run(6000000, 6200000, true, false, &o);
     assert_int_equal(run(6200000, 7000000, true, false, &o), 0);
     assert_true(o.faults & RFS_APP_FAULT_RSSI_LOST);
+}
+
+/* The received-time watchdog alone (rfs_app.h: input_timeout_us, 150 ms of local time):
+ * every input is stamped 100 ms ahead of its arrival, so when one stream stops arriving the
+ * seeker's own staleness rule (its stamps 150 ms old) waits until 250 ms after the last
+ * arrival; the wheels must be zero from 150 ms on, flagged by the watchdog only. */
+static void watchdog_case(bool poses_stop)
+{
+    const rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
+    const rfs_app_map_t m = room();
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    const int64_t lead = 100000, stop = 2000000;
+    const uint16_t lost = poses_stop ? RFS_APP_FAULT_POSE_LOST : RFS_APP_FAULT_RSSI_LOST;
+    rfs_app_out_t o;
+    int64_t last_rx = -1;
+    int checked = 0, watchdog_only = 0;
+    for (int64_t t = 0; t < stop + 400000; t += 5000) {
+        const bool pose_on = !poses_stop || t < stop, rssi_on = poses_stop || t < stop;
+        if (pose_on && t % 100000 == 0) {
+            const rfs_pose_t p = {.t_us = t + lead, .x = RFS_Q16_INT(5), .y = RFS_Q16_INT(5), .theta = 0};
+            rfs_app_on_pose(&s_app, &p, t);
+            last_rx = poses_stop ? t : last_rx;
+        }
+        if (rssi_on) {
+            rfs_app_on_rssi(&s_app, 0, t + lead, (int8_t)(-60 - (t / 5000) % 3), t);
+            last_rx = poses_stop ? last_rx : t;
+        }
+        if (t % RFS_APP_PERIOD_US != 0) {
+            continue;
+        }
+        rfs_app_step(&s_app, t, &o);
+        if (t == stop - RFS_APP_PERIOD_US) {
+            assert_true(o.left_mm_s != 0 || o.right_mm_s != 0); /* driving when it stops */
+        }
+        if (t >= stop && t - last_rx > c.input_timeout_us) {
+            assert_true(o.faults & lost);
+            assert_int_equal(o.left_mm_s, 0);
+            assert_int_equal(o.right_mm_s, 0);
+            checked++;
+            watchdog_only += (o.faults & (RFS_SEEK_FAULT_POSE_STALE | RFS_SEEK_FAULT_RSSI_STALE)) == 0u;
+        } else if (t >= stop) {
+            assert_false(o.faults & lost);
+        }
+    }
+    assert_true(checked >= 5);
+    assert_true(watchdog_only >= 1); /* the seeker alone would still have driven then */
+}
+
+static void test_receive_watchdog_stops_inputs_stamped_ahead(void **state)
+{
+    (void)state;
+    watchdog_case(true);
+    watchdog_case(false);
 }
 
 static void test_bus_off_stops_at_once_and_recovers(void **state)
@@ -558,6 +628,7 @@ int main(void)
         cmocka_unit_test(test_config_frame_sets_fit_early),
         cmocka_unit_test(test_first_step_after_reset_is_zero_and_flagged),
         cmocka_unit_test(test_wheels_stop_within_200_ms_of_lost_inputs_and_resume),
+        cmocka_unit_test(test_receive_watchdog_stops_inputs_stamped_ahead),
         cmocka_unit_test(test_bus_off_stops_at_once_and_recovers),
         cmocka_unit_test(test_an_application_stop_restarts_the_drive_from_rest),
         cmocka_unit_test(test_frames_decode_with_the_protocol_decoders),

@@ -110,7 +110,7 @@ def main(argv):
     greedy = [m for m in after if m["decided"] and m["model_updated"] and m["kind"] == 2]
     far = [m for m in greedy
            if ((m["max_x"] - m["est_x"]) ** 2 + (m["max_y"] - m["est_y"]) ** 2) ** 0.5 > 1.5]
-    check("greedy_goal_at_the_estimate (%d greedy relearns)" % len(greedy), not far,
+    check("greedy_goal_at_the_estimate (%d greedy relearns)" % len(greedy), greedy and not far,
           str(far[:1]))
     last = after[-1]
     print("last estimate: (%.3f, %.3f) n %.3f W %.2f dB P0 %.2f rms %.2f dB area %.1f m^2"

@@ -111,8 +111,9 @@ check script-argparse-one-line '[ $? -eq 2 ] && [ "$(wc -l <"$tmp/e")" -eq 1 ] &
 (cd "$tmp" && /usr/bin/python3 "$OLDPWD/tests/fuzz/make_corpus.py" --bogus) >"$tmp/o" 2>"$tmp/e"
 check fuzz-corpus-bad-arg '[ $? -eq 1 ] && [ "$(wc -l <"$tmp/e")" -eq 1 ] && [ ! -e "$tmp/--bogus" ] && grep -q "^make_corpus.py: expected at most one argument" "$tmp/e"'
 /usr/bin/python3 tests/fuzz/make_corpus.py "$tmp/corpus" >/dev/null 2>&1
+rc=$?
 stale=$(cd "$tmp/corpus" && find . -type f | while read -r f; do cmp -s "$f" "$OLDPWD/tests/fuzz/corpus/$f" || echo "$f"; done)
-check fuzz-corpus-current '[ -d "$tmp/corpus/can" ] && [ -z "$stale" ]'
+check fuzz-corpus-current '[ $rc -eq 0 ] && [ -d "$tmp/corpus/can" ] && [ -z "$stale" ]'
 
 # bench_pathloss_seek.py --only-pathloss --seek: one line a row, the meta-path + pathloss
 # column run with the variant: its default-office ratio is rfseek-sim's own for that seed.

@@ -449,6 +449,8 @@ rfs_can_rx_cfg_t rfs_can_rx_cfg_default(void)
     rfs_can_rx_cfg_t c;
     c.max_age_us = 1000000;
     c.max_future_us = 100000;
+    c.follow_epoch = false;
+    c.resync_us = 2000000;
     return c;
 }
 
@@ -456,7 +458,7 @@ int rfs_can_rx_init(rfs_can_rx_t *rx, const rfs_can_rx_cfg_t *cfg)
 {
     const int64_t hour_us = 3600LL * 1000000LL;
     if (cfg->max_age_us <= 0 || cfg->max_age_us > hour_us || cfg->max_future_us < 0 ||
-        cfg->max_future_us > hour_us) {
+        cfg->max_future_us > hour_us || cfg->resync_us <= 0 || cfg->resync_us > hour_us) {
         return -1;
     }
     memset(rx, 0, sizeof(*rx));
@@ -513,6 +515,84 @@ static rfs_can_err_t time_check(const rfs_can_rx_t *rx, int64_t t, int64_t now_u
         return RFS_CAN_E_ORDER;
     }
     return RFS_CAN_OK;
+}
+
+/* The senders' epoch (follow_epoch; docs/CAN.md, "Time on the bus"). The offset follows
+ * the smallest latency seen: a frame from the future moves it at once, an older one pulls
+ * it back by at most 1/2048 of the local time elapsed (about 490 ppm, five times the
+ * crystals' 100 ppm), so a stream lagging 1 s (docs/FAULTS.md, pose_past) stays stale
+ * while others are on time. Only frames that passed every check but the time window get
+ * here. Scaling and overflow: times are within 2^60 (rfs_can_rx_frame); the allowance's
+ * elapsed time is capped at 2^21 us, a pull at 1,024 us. */
+#define EPOCH_PULL_SHIFT 11
+#define EPOCH_PULL_CAP_US ((int64_t)1 << 21)
+
+/* A stamp in local time: seeding the offset on the first frame, and re-seeding it when
+ * every time-bearing frame has missed the window for resync_us (the senders restarted). */
+static int64_t epoch_read(rfs_can_rx_t *rx, uint32_t raw, int64_t now_us)
+{
+    if (!rx->cfg.follow_epoch) {
+        return rfs_can_unwrap_time(now_us, raw);
+    }
+    int64_t t = rfs_can_unwrap_time(now_us, raw - rx->epoch_off);
+    const bool fresh = t >= now_us - rx->cfg.max_future_us && t <= now_us + rx->cfg.max_future_us;
+    const bool resync = rx->have_late && !fresh && now_us - rx->late_us >= rx->cfg.resync_us;
+    if (!rx->have_epoch || resync) {
+        if (rx->have_epoch) {
+            bump(&rx->resyncs, 1);
+        }
+        rx->epoch_off = raw - rfs_can_wrap_time(now_us);
+        rx->have_epoch = true;
+        rx->have_late = false;
+        rx->pull_us = now_us;
+        t = now_us;
+    }
+    return t;
+}
+
+/* After the window check of a stamp read by epoch_read: a dropped or late frame marks the
+ * start of missed frames; an accepted one moves the offset. Returns the accepted stamp as
+ * the moved offset reads it (never later than now: order within a stream is kept). */
+static int64_t epoch_note(rfs_can_rx_t *rx, rfs_can_err_t e, int64_t t, int64_t now_us)
+{
+    if (!rx->cfg.follow_epoch) {
+        return t;
+    }
+    const int64_t age = now_us - t;
+    if (e != RFS_CAN_OK || age > rx->cfg.max_future_us) {
+        if (!rx->have_late) {
+            rx->have_late = true;
+            rx->late_us = now_us;
+        }
+    } else {
+        rx->have_late = false;
+    }
+    if (e != RFS_CAN_OK) {
+        return t;
+    }
+    if (age < 0) {
+        rx->epoch_off += (uint32_t)(uint64_t)(-age);
+        rx->pull_us = now_us;
+        return now_us;
+    }
+    int64_t el = now_us - rx->pull_us;
+    el = el < 0 ? 0 : (el > EPOCH_PULL_CAP_US ? EPOCH_PULL_CAP_US : el);
+    int64_t step = el >> EPOCH_PULL_SHIFT;
+    step = step > age ? age : step;
+    rx->epoch_off -= (uint32_t)step;
+    rx->pull_us = now_us - el + (step << EPOCH_PULL_SHIFT);
+    return t + step;
+}
+
+/* A stamp in local time and its window check (time_check): the one path of every
+ * time-bearing frame. */
+static rfs_can_err_t rx_time(rfs_can_rx_t *rx, uint32_t raw, int64_t now_us, bool have_last,
+                             int64_t last, int64_t *t)
+{
+    *t = epoch_read(rx, raw, now_us);
+    const rfs_can_err_t e = time_check(rx, *t, now_us, have_last, last);
+    *t = epoch_note(rx, e, *t, now_us);
+    return e;
 }
 
 /* WHEEL_CMD: a counter check. */
@@ -590,8 +670,7 @@ static rfs_can_err_t rx_pose_th(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int6
     }
     int64_t t = 0;
     if (e == RFS_CAN_OK) {
-        t = rfs_can_unwrap_time(now_us, p.t_us32);
-        e = time_check(rx, t, now_us, rx->have_pose, rx->last_pose_us);
+        e = rx_time(rx, p.t_us32, now_us, rx->have_pose, rx->last_pose_us, &t);
     }
     if (e != RFS_CAN_OK) {
         if (e != RFS_CAN_E_PAIR && e != RFS_CAN_E_REPEAT) {
@@ -622,8 +701,7 @@ static rfs_can_err_t rx_rssi(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int64_t
     }
     int64_t t = 0;
     if (e == RFS_CAN_OK) {
-        t = rfs_can_unwrap_time(now_us, r.t_us32);
-        e = time_check(rx, t, now_us, (rx->have_rssi >> r.src) & 1u, rx->last_rssi_us[r.src]);
+        e = rx_time(rx, r.t_us32, now_us, (rx->have_rssi >> r.src) & 1u, rx->last_rssi_us[r.src], &t);
     }
     if (e != RFS_CAN_OK) {
         return drop(rx, e);
@@ -657,8 +735,7 @@ static rfs_can_err_t rx_receiver(rfs_can_rx_t *rx, const rfs_can_frame_t *f, int
     }
     int64_t t = 0;
     if (e == RFS_CAN_OK) {
-        t = rfs_can_unwrap_time(now_us, r.t_us32);
-        e = time_check(rx, t, now_us, rx->have_receiver, rx->last_receiver_us);
+        e = rx_time(rx, r.t_us32, now_us, rx->have_receiver, rx->last_receiver_us, &t);
     }
     if (e != RFS_CAN_OK) {
         return drop(rx, e);

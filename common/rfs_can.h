@@ -14,12 +14,14 @@
  * and accepts but counts a counter jump (frames were lost).
  *
  * Time: frames that carry a timestamp carry the low 32 bits of the sender's time in
- * microseconds (wraps every 71.6 minutes). Sender and receiver share an epoch (the
- * robot's synchronised clock); the receiver unwraps the field to the int64 time
- * nearest its own current time, so the clocks may disagree by up to +-35 minutes
- * (rfs_can_unwrap_time). Frames older than max_age_us, further than max_future_us
- * ahead, or older than the newest accepted frame of the same stream are dropped and
- * counted: the core then sees the inputs go stale and stops the wheels.
+ * microseconds (wraps every 71.6 minutes). The senders share one epoch; by default the
+ * receiver shares it too (one synchronised clock) and unwraps the field to the int64
+ * time nearest its own current time, so the clocks may disagree by up to +-35 minutes
+ * (rfs_can_unwrap_time). With follow_epoch (a microcontroller whose clock counts from
+ * boot) the receiver keeps the offset between the senders' epoch and its clock instead
+ * (docs/CAN.md, "Time on the bus"). Frames older than max_age_us, further than
+ * max_future_us ahead, or older than the newest accepted frame of the same stream are
+ * dropped and counted: the core then sees the inputs go stale and stops the wheels.
  *
  * Frames (id: sender -> receiver, DLC):
  *   0x100 WHEEL_CMD  controller -> motor controller, 6: wheel speeds mm/s
@@ -294,6 +296,15 @@ void rfs_can_tx_status(rfs_can_tx_t *tx, const rfs_can_status_t *s, rfs_can_fram
 typedef struct rfs_can_rx_cfg {
     int64_t max_age_us;     ///< drop timestamped frames older than now - this (1 s: the RSSI window)
     int64_t max_future_us;  ///< drop timestamped frames later than now + this (100 ms of clock skew)
+    /// false (default): the senders' stamps are in the receiver's own clock. true: in an
+    /// epoch of their own, followed as an offset to the receiver's clock: set by the first
+    /// time-bearing frame (its age 0), moved at once by a frame from the future (its age
+    /// made 0), back by at most 1/2048 of the elapsed time (about 490 ppm) towards an
+    /// older one, re-set after resync_us without a fresh frame (docs/CAN.md).
+    bool follow_epoch;
+    int64_t resync_us;      ///< follow_epoch: re-set the offset when every time-bearing frame
+                            ///< has missed the window (stale, future, order, or accepted
+                            ///< more than max_future_us old) for this long (2 s)
 } rfs_can_rx_cfg_t;
 
 /// Per-message receive statistics.
@@ -321,6 +332,13 @@ typedef struct rfs_can_rx {
     uint32_t rssi_seq_gaps;                    ///< radio packets missing by sequence number
     int64_t last_receiver_us;                  ///< newest accepted RX_STATUS time, microseconds
     bool have_receiver;                        ///< last_receiver_us is valid
+    uint32_t epoch_off;                        ///< follow_epoch: senders' minus local time, us mod 2^32
+    bool have_epoch;                           ///< follow_epoch: epoch_off is set
+    bool have_late;                            ///< a time-bearing frame missed the window since
+                                               ///< the last fresh one (late_us is valid)
+    int64_t late_us;                           ///< local time of the first such frame
+    int64_t pull_us;                           ///< local time the offset's pull-back allowance runs from
+    uint32_t resyncs;                          ///< offset re-set after resync_us of missed frames
 } rfs_can_rx_t;
 
 /// What a received frame produced.
@@ -348,11 +366,11 @@ typedef struct rfs_can_msg {
     rfs_can_config_t config; ///< RFS_CAN_MSG_CONFIG
 } rfs_can_msg_t;
 
-/// Defaults: max_age 1 s, max_future 100 ms.
+/// Defaults: max_age 1 s, max_future 100 ms, follow_epoch off, resync 2 s.
 rfs_can_rx_cfg_t rfs_can_rx_cfg_default(void);
 
-/// Initialise. Returns 0, or -1 when max_age_us is not in (0, 1 h] or max_future_us is
-/// not in [0, 1 h] (unwrapping is unambiguous only within +-35 minutes).
+/// Initialise. Returns 0, or -1 when max_age_us or resync_us is not in (0, 1 h] or
+/// max_future_us is not in [0, 1 h] (unwrapping is unambiguous only within +-35 minutes).
 int rfs_can_rx_init(rfs_can_rx_t *rx, const rfs_can_rx_cfg_t *cfg);
 
 /// Decode one received frame at receiver time now_us (microseconds). Cannot fail: every

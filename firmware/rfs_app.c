@@ -28,6 +28,7 @@ rfs_app_cfg_t rfs_app_cfg_mcu(void)
     c.seek.reach_budget = RFS_SEEK_REACH_BUDGET; /* the boot's flood fill in slices */
     c.seek.fit_early = true; /* docs/FIRMWARE.md, "Learning between periods" */
     c.fit_budget_by_model = true;
+    c.follow_epoch = true; /* its clock counts from boot: docs/CAN.md, "Time on the bus" */
     return c;
 }
 
@@ -161,7 +162,8 @@ int rfs_app_init(rfs_app_t *a, const rfs_app_cfg_t *cfg, const rfs_app_map_t *ma
     if (rfs_seek_init(&a->seek, &a->cfg.seek, &a->map, model, app_target(cfg->target), &mem) != 0) {
         return -1;
     }
-    const rfs_can_rx_cfg_t rx_cfg = rfs_can_rx_cfg_default();
+    rfs_can_rx_cfg_t rx_cfg = rfs_can_rx_cfg_default();
+    rx_cfg.follow_epoch = cfg->follow_epoch;
     if (rfs_can_rx_init(&a->can_rx, &rx_cfg) != 0) {
         return -1;
     }

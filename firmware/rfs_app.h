@@ -28,8 +28,8 @@
  * with RFS_APP_FAULT_RESET set. Driving resumes by itself when inputs return.
  *
  * Times: every *_us argument is int64 microseconds of ONE clock, the controller's. The
- * ports translate sender timestamps into it (rfs_can time unwrapping); in a replay the
- * recorded times are that clock.
+ * ports translate sender timestamps into it (rfs_can time unwrapping, and the senders'
+ * epoch with cfg.follow_epoch); in a replay the recorded times are that clock.
  */
 #ifndef RFS_APP_H
 #define RFS_APP_H
@@ -149,6 +149,10 @@ typedef struct rfs_app_cfg {
     /// so a port that sets `model` after taking the MCU defaults gets that model's slice
     /// size. false (rfs_app_cfg_default(), replays): seek.fit_budget is used as given.
     bool fit_budget_by_model;
+    /// The CAN receiver follows the senders' epoch (rfs_can_rx_cfg_t.follow_epoch): true in
+    /// rfs_app_cfg_mcu() and the replays of its image, whose clock counts from boot; false
+    /// (rfs_app_cfg_default(), rfseekd): the senders stamp in the controller's own clock.
+    bool follow_epoch;
 } rfs_app_cfg_t;
 
 /// What one control period produces (the content of the wheel command and status frames).
@@ -213,6 +217,7 @@ rfs_app_cfg_t rfs_app_cfg_default(void);
 /// deadline: fit_budget_by_model set, and seek.fit_budget = RFS_APP_MCU_FIT_BUDGET (the
 /// ridge's, a whole fit; rfs_app_init() takes another model's from the registry), and the
 /// boot's flood fill in slices. Decisions are the same; the wheels wait while a fit runs.
+/// The CAN receiver follows the senders' epoch (follow_epoch).
 rfs_app_cfg_t rfs_app_cfg_mcu(void);
 
 /// The fit budget (work units per control period) rfs_app_init() gives the seeker for

@@ -19,6 +19,8 @@
  *   --drop-pose T0:T1, --drop-rssi T0:T1   only the poses / only the RSSI frames stop
  *   --bus-off T0:T1 the controller's CAN is bus-off in [T0, T1): its frames do not leave
  *   --reset T       a watchdog reset at T: the application starts from scratch
+ * --sender-ahead S stamps the frames' Time fields S seconds ahead of the controller's clock
+ * (senders in an epoch of their own, docs/CAN.md "Time on the bus").
  *
  * --candump FILE also writes the bus as candump -L would log it on can0 (docs/CAN.md, "CAN
  * logs"): each input frame at its receive time and the controller's WHEEL_CMD and STATUS
@@ -75,6 +77,7 @@ typedef struct recorder {
     unsigned next_reset;
     bool bus_off;
     hb_mode_t heartbeat;
+    int64_t ahead_us;           /* --sender-ahead: the senders' clock minus the controller's */
     uint32_t records;
 } recorder_t;
 
@@ -173,7 +176,8 @@ static void on_pose(void *self, const rfs_pose_t *pose)
         in_window(r->drop_pose, r->ndrop_pose, pose->t_us)) {
         return;
     }
-    const rfs_can_pose_t p = rfs_can_pose_from_core(pose);
+    rfs_can_pose_t p = rfs_can_pose_from_core(pose);
+    p.t_us32 = rfs_can_wrap_time(pose->t_us + r->ahead_us);
     rfs_can_frame_t xy, th;
     rfs_can_tx_pose(&r->tx, &p, &xy, &th);
     feed_can(r, pose->t_us, &xy);
@@ -188,7 +192,7 @@ static void on_rssi(void *self, uint8_t src, int64_t t_us, int8_t dbm)
         return;
     }
     const rfs_can_rssi_t m = {.src = src, .dbm = dbm, .seq = r->rssi_seq[src]++,
-                              .t_us32 = rfs_can_wrap_time(t_us)};
+                              .t_us32 = rfs_can_wrap_time(t_us + r->ahead_us)};
     rfs_can_frame_t f;
     rfs_can_tx_rssi(&r->tx, &m, &f);
     feed_can(r, t_us, &f);
@@ -202,7 +206,7 @@ static void on_receiver(void *self, int64_t t_us)
         return;
     }
     if (r->heartbeat == HB_CAN) {
-        const rfs_can_receiver_t m = {.t_us32 = rfs_can_wrap_time(t_us)};
+        const rfs_can_receiver_t m = {.t_us32 = rfs_can_wrap_time(t_us + r->ahead_us)};
         rfs_can_frame_t f;
         rfs_can_tx_receiver(&r->tx, &m, &f);
         feed_can(r, t_us, &f);
@@ -287,6 +291,8 @@ static void usage(FILE *f)
             "                       [T0, T1) s\n"
             "  --bus-off T0:T1      the controller's CAN is bus-off in [T0, T1) s\n"
             "  --reset T            watchdog reset at T s\n"
+            "  --sender-ahead S     the senders stamp their frames S s ahead of the\n"
+            "                       controller's clock (an epoch of their own; default 0)\n"
             "  --heartbeat MODE     the receiver heartbeat (when the scenario has it):\n"
             "                       can (RX_STATUS frames, default), record (RECEIVER\n"
             "                       records) or off (packets only)\n"
@@ -395,6 +401,14 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
         o->fit_budget = (uint32_t)v;
         break;
     }
+    case 'A': {
+        const double a = strtod(optarg, &end);
+        if (end == optarg || *end != '\0' || !(a >= -1e6 && a <= 1e6)) {
+            die_opt("--sender-ahead (seconds in [-1e6, 1e6])", optarg);
+        }
+        rec->ahead_us = (int64_t)llround(a * 1e6);
+        break;
+    }
     case 'r': {
         const double t = strtod(optarg, &end);
         if (rec->nreset == MAX_WINDOWS || end == optarg || *end != '\0' || !(t >= 0 && t <= 1e6)) {
@@ -473,6 +487,7 @@ static int parse_options(int argc, char **argv, options_t *o, recorder_t *rec)
         {"heartbeat", required_argument, 0, 'H'},  {"candump", required_argument, 0, 'c'},
         {"strategy", required_argument, 0, 'S'},   {"p0-min", required_argument, 0, 'p'},
         {"config-frame", no_argument, 0, 'C'},     {"fit-early", required_argument, 0, 'E'},
+        {"sender-ahead", required_argument, 0, 'A'},
         {0, 0, 0, 0}};
     memset(o, 0, sizeof *o);
     o->max_time = -1;
@@ -632,6 +647,7 @@ static int start_player(recording_t *s)
         return 1;
     }
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.follow_epoch = true; /* as the STM32 image (rfs_app_cfg_mcu) */
     cfg.samples = s->samples;
     cfg.model_state = s->model_state;
     cfg.model_state_bytes = model_bytes;

@@ -557,6 +557,70 @@ static void test_can_receiver_frames_keep_a_dead_zone_driving(void **state)
     assert_int_equal(s_app.stats.bad_frames, 1u);
 }
 
+/* The image's CAN inputs from t0 to t_end of the board's clock, stamped ahead_us ahead of
+ * it (the senders' own epoch): 10 Hz poses at (5, 5) (1 ms of latency) and 200/s packets
+ * (2 ms), a step and its fit slices at 20 Hz. Returns the steps with non-zero wheels. */
+static int run_can(rfs_can_tx_t *tx, int64_t t0, int64_t t_end, int64_t ahead_us, rfs_app_out_t *last)
+{
+    int moving = 0;
+    for (int64_t t = t0; t < t_end; t += 5000) {
+        rfs_can_frame_t f, th;
+        if (t % 100000 == 0) {
+            const rfs_pose_t p = {.t_us = 0, .x = RFS_Q16_INT(5), .y = RFS_Q16_INT(5), .theta = 0};
+            rfs_can_pose_t cp = rfs_can_pose_from_core(&p);
+            cp.t_us32 = rfs_can_wrap_time(t + ahead_us - 1000);
+            rfs_can_tx_pose(tx, &cp, &f, &th);
+            (void)rfs_app_on_can(&s_app, &f, t);
+            (void)rfs_app_on_can(&s_app, &th, t);
+        }
+        const rfs_can_rssi_t r = {.src = 0, .dbm = (int8_t)(-60 - (t / 5000) % 3), .seq = (uint8_t)(t / 5000),
+                                  .t_us32 = rfs_can_wrap_time(t + ahead_us - 2000)};
+        rfs_can_tx_rssi(tx, &r, &f);
+        (void)rfs_app_on_can(&s_app, &f, t);
+        if (t % RFS_APP_PERIOD_US == 0) {
+            rfs_app_step(&s_app, t, last);
+            rfs_app_background_all(&s_app);
+            moving += (last->left_mm_s != 0 || last->right_mm_s != 0);
+        }
+    }
+    return moving;
+}
+
+/* On a robot the senders stamp in their own clock and the image's counts from boot
+ * (docs/CAN.md, "Time on the bus"): with the image's configuration it drives on senders
+ * 3 h ahead, and again after a watchdog reset restarts its clock at 0; with one clock
+ * assumed (follow_epoch off) every input is dropped and the wheels stay at zero. */
+static void test_image_follows_the_senders_epoch_through_a_reset(void **state)
+{
+    (void)state;
+    const rfs_app_map_t m = room();
+    rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_mcu());
+    assert_true(c.follow_epoch);
+    assert_false(rfs_app_cfg_default().follow_epoch);
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    rfs_can_tx_t tx;
+    rfs_can_tx_init(&tx);
+    rfs_app_out_t o;
+    const int64_t ahead = 3LL * 3600000000LL;
+
+    assert_true(run_can(&tx, 0, 3000000, ahead, &o) > 0);
+    assert_int_equal(rfs_can_rx_dropped_total(&s_app.can_rx), 0u);
+    assert_int_equal(s_app.stats.poses, 30u);
+
+    /* A watchdog reset at 3 s: the board's clock starts again at 0, the senders' goes on. */
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    assert_true(run_can(&tx, 0, 3000000, ahead + 3000000, &o) > 0);
+    assert_int_equal(rfs_can_rx_dropped_total(&s_app.can_rx), 0u);
+    assert_int_equal(s_app.can_rx.resyncs, 0u);
+
+    c.follow_epoch = false;
+    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    assert_int_equal(run_can(&tx, 0, 3000000, ahead + 6000000, &o), 0);
+    assert_int_equal(s_app.stats.poses + s_app.stats.rssi, 0u);
+    assert_int_equal(s_app.stats.bad_frames, 600u + 30u); /* every packet and pose */
+    assert_true(o.faults & RFS_APP_FAULT_POSE_LOST);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -575,6 +639,7 @@ int main(void)
         cmocka_unit_test(test_dead_zone_without_heartbeat_stops_within_200_ms),
         cmocka_unit_test(test_heartbeat_from_the_future_stops_like_a_packet),
         cmocka_unit_test(test_can_receiver_frames_keep_a_dead_zone_driving),
+        cmocka_unit_test(test_image_follows_the_senders_epoch_through_a_reset),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

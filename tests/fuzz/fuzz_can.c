@@ -5,7 +5,9 @@
  *   ctrl u8   bit 0: overwrite data[dlc-1] with the correct checksum (so the fuzzer gets
  *             past the CRC and reaches the range, counter, pairing and time checks);
  *             bits 1..3: id = one of our seven ids (0..6: wheel, pose xy, pose th, RSSI,
- *             status, receiver status, config) or the raw 11-bit id below (7)
+ *             status, receiver status, config) or the raw 11-bit id below (7);
+ *             bit 4 of the first record: the receiver follows the senders' epoch
+ *             (follow_epoch) for the whole input
  *   dt   u16  receiver time advance, units of 1 ms (0 .. 65.5 s), little-endian
  *   dlc  u8   taken mod 16 (values > 8 are invalid frames the decoder must reject)
  *   data 8 bytes (data[0..1] also give the raw id for ctrl ids 6..7)
@@ -15,7 +17,8 @@
  *     (the layout has no unused bits: anything else would be a lossy or lax decoder);
  *   - every frame is either accepted or counted in one drop reason (an accepted POSE_XY
  *     may also count the earlier unpaired one as a PAIR drop);
- *   - an accepted RSSI or receiver heartbeat lies inside [now - max_age, now + max_future];
+ *   - an accepted RSSI, heartbeat or pose time lies inside [now - max_age, now + max_future]
+ *     (with follow_epoch, never after now);
  *   - a complete pose lies inside the int24 millimetre range and (-pi, pi];
  *   - an accepted CONFIG holds a target, strategy, model and P0 floor of the layout.
  */
@@ -94,8 +97,10 @@ static void check_roundtrip(const rfs_can_frame_t *f)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     rfs_can_rx_t rx;
-    const rfs_can_rx_cfg_t cfg = rfs_can_rx_cfg_default();
+    rfs_can_rx_cfg_t cfg = rfs_can_rx_cfg_default();
+    cfg.follow_epoch = size >= 1u && (data[0] & 0x10u) != 0u;
     if (rfs_can_rx_init(&rx, &cfg) != 0) { abort(); }
+    const int64_t future = cfg.follow_epoch ? 0 : cfg.max_future_us;
     /* Start far from 0 so stale and wrapped time stamps are both reachable. */
     int64_t now = 5000000000LL;
     uint32_t n_ok = 0, n_bad = 0;
@@ -124,13 +129,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if ((unsigned)e >= RFS_CAN_NERR || rfs_can_err_str(e) == NULL) { abort(); }
         if (e != RFS_CAN_OK && msg.kind != RFS_CAN_MSG_NONE) { abort(); }
         if (msg.kind == RFS_CAN_MSG_RSSI) {
-            if (msg.rssi_t_us < now - cfg.max_age_us || msg.rssi_t_us > now + cfg.max_future_us ||
+            if (msg.rssi_t_us < now - cfg.max_age_us || msg.rssi_t_us > now + future ||
                 msg.rssi_src >= RFS_CAN_MAX_SOURCES) {
                 abort();
             }
         }
         if (msg.kind == RFS_CAN_MSG_RECEIVER &&
-            (msg.receiver_t_us < now - cfg.max_age_us || msg.receiver_t_us > now + cfg.max_future_us)) {
+            (msg.receiver_t_us < now - cfg.max_age_us || msg.receiver_t_us > now + future)) {
             abort();
         }
         if (msg.kind == RFS_CAN_MSG_CONFIG &&
@@ -144,7 +149,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             /* int24 mm is +-8388.6 m; theta within (-pi, pi] plus one Q2.13 step. */
             const int64_t lim = (int64_t)8389 << 16;
             if (msg.pose.x > lim || msg.pose.x < -lim || msg.pose.y > lim || msg.pose.y < -lim ||
-                msg.pose.theta > 205896 || msg.pose.theta < -205896) {
+                msg.pose.theta > 205896 || msg.pose.theta < -205896 ||
+                msg.pose.t_us < now - cfg.max_age_us || msg.pose.t_us > now + future) {
                 abort();
             }
         }

@@ -34,6 +34,7 @@ static void load_map(void)
 {
     static rfs_sample_t samples[RFS_APP_MAX_SAMPLES];
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.follow_epoch = true; /* as the emulator image and rfseek-replay play streams */
     cfg.samples = samples;
     cfg.map.grid = RFS_Q16_ONE;
     rfs_replay_player_init(&s_player, &s_app, &cfg, sink, NULL);

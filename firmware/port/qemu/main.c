@@ -128,6 +128,7 @@ int main(void)
         die("input: not an rfseek stream (bad header)");
     }
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.follow_epoch = true; /* as the STM32 image (rfs_app_cfg_mcu) */
     cfg.samples = s_samples;
     cfg.model_state = s_model;
     cfg.model_state_bytes = (uint32_t)sizeof s_model;

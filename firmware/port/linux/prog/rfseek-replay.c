@@ -499,6 +499,7 @@ static int start_player(rfs_replay_player_t *player, sink_ctx_t *sc)
     }
     static rfs_sample_t samples[RFS_APP_MAX_SAMPLES];
     rfs_app_cfg_t cfg = rfs_app_cfg_default();
+    cfg.follow_epoch = true; /* as the STM32 image (rfs_app_cfg_mcu) */
     cfg.samples = samples;
     cfg.model_state = model_state;
     cfg.model_state_bytes = mb;

@@ -136,6 +136,7 @@ $(BUILD)/asan/tests/test_bxcan: tests/firmware/test_bxcan.c $(BUILD)/asan/obj/fi
 TEST_BIN_NAMES += test_bxcan
 $(eval $(call cmocka_test,test_replay,tests/firmware/test_replay.c,fw))
 $(eval $(call cmocka_test,test_app,tests/firmware/test_app.c,fw))
+$(eval $(call cmocka_test,test_board,tests/firmware/test_board.c,fw))
 # The model chosen by configuration and the CFG record's model name (docs/MODELS.md,
 # "Choosing a model").
 $(eval $(call cmocka_test,test_app_models,tests/firmware/test_app_models.c,fw))

@@ -81,11 +81,11 @@ bool rfs_board_reset_was_watchdog(void)
     return wd;
 }
 
-void rfs_board_watchdog_start(void)
+void rfs_board_watchdog_start(uint32_t core_hz)
 {
     IWDG_KR = IWDG_KEY_START;
     IWDG_KR = IWDG_KEY_ACCESS;
-    IWDG_PR = RFS_BOARD_IWDG_PR;
+    IWDG_PR = rfs_board_iwdg_pr(core_hz);
     IWDG_RLR = RFS_BOARD_IWDG_RELOAD;
     for (uint32_t i = 0; i < 100000u && (IWDG_SR & 3u) != 0u; i++) {
     }

@@ -30,6 +30,7 @@ extern const rfs_app_map_t rfs_fw_map;
 
 static rfs_app_t s_app;
 static rfs_bxcan_t s_can;
+static uint32_t s_core_hz = RFS_BOARD_SYSCLK_HZ; /* the clock start() chose */
 /* The sample store: 60 KB of CPU-only data, in the core-coupled RAM (not DMA-reachable). */
 static rfs_sample_t s_samples[RFS_APP_MAX_SAMPLES] __attribute__((section(".ccm")));
 /* The model state, sized for the largest model the image holds (the path-loss model's). */
@@ -83,6 +84,7 @@ static uint32_t __attribute__((noinline)) start(void)
         can_cfg.ts1_tq = 13u;
         can_cfg.ts2_tq = 2u;
     }
+    s_core_hz = core_hz;
     rfs_board_time_init(core_hz);
     rfs_board_can_pins();
     const bool can_ok = rfs_bxcan_init(&s_can, (rfs_bxcan_regs_t *)RFS_BXCAN1_BASE, &can_cfg,
@@ -109,12 +111,12 @@ int main(void)
         /* Unusable (e.g. bxCAN never left initialisation: no 11 recessive bits on RX): the
          * watchdog, never kicked, resets the board to try again. Not started, it would not:
          * a reset leaves the independent watchdog off. */
-        rfs_board_watchdog_start();
+        rfs_board_watchdog_start(s_core_hz);
         for (;;) {
         }
     }
     NVIC_ISER0 = (1u << IRQ_CAN1_RX0) | (1u << IRQ_CAN1_RX1);
-    rfs_board_watchdog_start();
+    rfs_board_watchdog_start(s_core_hz);
 
     int64_t next_step = rfs_board_now_us();
     uint32_t slices = RFS_APP_BACKGROUND_SLICES; /* fit slices run since the last step */

@@ -148,6 +148,7 @@ $(eval $(call test_script,bit_identical,tests/firmware/bit_identical.sh $(BUILD)
 $(eval $(call test_script,safety,tests/firmware/safety.sh $(BUILD),$(FW_TEST_PROGS)))
 $(eval $(call test_script,budget,tests/firmware/budget.sh $(BUILD),$(FW_IMAGES)))
 $(eval $(call test_script,stack,tests/firmware/stack.sh $(BUILD),$(FW_IMAGES) scripts/fw_stack.py))
+$(eval $(call test_script,boot_order,tests/firmware/boot_order.sh $(BUILD),$(FW_IMAGES)))
 # The model workload on the emulator against its host twin, and every model's registry fit
 # budget against the 200 ms deadline.
 $(eval $(call test_script,bench_models,tests/firmware/bench_models.sh check $(BUILD),$(FW)/bench_models.elf $(BUILD)/tests/bench_models_host))

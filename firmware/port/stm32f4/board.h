@@ -23,6 +23,7 @@
 #define RFS_BOARD_HSE_HZ 8000000u ///< external crystal, Hz
 #endif
 #define RFS_BOARD_SYSCLK_HZ 168000000u ///< core clock, Hz
+#define RFS_BOARD_HSI_HZ 16000000u     ///< the internal oscillator: the clock without the PLL
 #define RFS_BOARD_PCLK1_HZ 42000000u   ///< APB1 clock (bxCAN), Hz
 #define RFS_BOARD_IWDG_RELOAD 1999u    ///< 2,000 LSI ticks after the prescaler
 #define RFS_BOARD_LSI_MAX_HZ 47000u    ///< the LSI's fastest (datasheet: 17 .. 47 kHz)

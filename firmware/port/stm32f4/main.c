@@ -79,8 +79,8 @@ static uint32_t __attribute__((noinline)) start(void)
     rfs_bxcan_cfg_t can_cfg = rfs_bxcan_cfg_default();
     can_cfg.rx_irq = true;
     if (rfs_board_clock_init() != 0) {
-        core_hz = 16000000u;          /* stayed on HSI */
-        can_cfg.pclk_hz = 16000000u;  /* 16 MHz / (500 k * 16 tq) = 2 */
+        core_hz = RFS_BOARD_HSI_HZ;         /* stayed on HSI */
+        can_cfg.pclk_hz = RFS_BOARD_HSI_HZ; /* 16 MHz / (500 k * 16 tq) = 2 */
         can_cfg.ts1_tq = 13u;
         can_cfg.ts2_tq = 2u;
     }
@@ -106,17 +106,18 @@ int main(void)
 {
     const bool watchdog_reset = rfs_board_reset_was_watchdog();
     (void)watchdog_reset; /* reported as RFS_APP_FAULT_RESET on the first status either way */
+    /* The watchdog first (a reset leaves it off), at the slowest clock's prescaler: a fault
+     * in start() (the handler spins) or a hang there resets the board too. */
+    rfs_board_watchdog_start(RFS_BOARD_HSI_HZ);
     const uint32_t slice_us = start();
     if (slice_us == 0u) {
         /* Unusable (e.g. bxCAN never left initialisation: no 11 recessive bits on RX): the
-         * watchdog, never kicked, resets the board to try again. Not started, it would not:
-         * a reset leaves the independent watchdog off. */
-        rfs_board_watchdog_start(s_core_hz);
+         * watchdog, never kicked, resets the board to try again. */
         for (;;) {
         }
     }
     NVIC_ISER0 = (1u << IRQ_CAN1_RX0) | (1u << IRQ_CAN1_RX1);
-    rfs_board_watchdog_start(s_core_hz);
+    rfs_board_watchdog_start(s_core_hz); /* the prescaler of the clock start() chose */
 
     int64_t next_step = rfs_board_now_us();
     uint32_t slices = RFS_APP_BACKGROUND_SLICES; /* fit slices run since the last step */

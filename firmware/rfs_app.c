@@ -340,7 +340,9 @@ void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out)
     out->t_us = now_us;
     out->left_mm_s = stop ? 0 : so.left_mm_s;
     out->right_mm_s = stop ? 0 : so.right_mm_s;
-    out->state = so.state;
+    /* A stop the seeker did not make shows in its state too: not DRIVING with the wheels
+     * held at zero. */
+    out->state = stop && so.state == RFS_SEEK_DRIVING ? RFS_SEEK_STALE : so.state;
     out->faults = faults;
     out->decided = so.decided;
     out->decision = so.decision;

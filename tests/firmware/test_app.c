@@ -302,6 +302,7 @@ static void watchdog_case(bool poses_stop)
             assert_int_equal(o.right_mm_s, 0);
             checked++;
             watchdog_only += (o.faults & (RFS_SEEK_FAULT_POSE_STALE | RFS_SEEK_FAULT_RSSI_STALE)) == 0u;
+            assert_int_equal(o.state, RFS_SEEK_STALE); /* held: not DRIVING, whoever stopped */
         } else if (t >= stop) {
             assert_false(o.faults & lost);
         }
@@ -330,6 +331,7 @@ static void test_bus_off_stops_at_once_and_recovers(void **state)
     rfs_app_set_bus_off(&s_app, true);
     assert_int_equal(run(2000000, 2500000, true, true, &o), 0);
     assert_true(o.faults & RFS_APP_FAULT_BUS_OFF);
+    assert_int_equal(o.state, RFS_SEEK_STALE);
     rfs_app_set_bus_off(&s_app, false);
     assert_true(run(2500000, 5000000, true, true, &o) > 0);
     assert_false(o.faults & RFS_APP_FAULT_BUS_OFF);

@@ -726,10 +726,10 @@ static void hold(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
     stop_wheels(s, now_us, out);
 }
 
-void rfs_seek_hold(rfs_seek_t *s, int64_t now_us)
+void rfs_seek_hold(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out)
 {
-    rfs_seek_out_t out;
-    hold(s, now_us, &out);
+    hold(s, now_us, out);
+    out->state = s->state;
 }
 
 /* This period's fault flags. true when an input is stale: the wheels are stopped and a

@@ -467,11 +467,12 @@ bool rfs_seek_on_receiver(rfs_seek_t *s, int64_t t_us);
 /// report. Cannot fail.
 void rfs_seek_step(rfs_seek_t *s, int64_t now_us, rfs_rng_t *rng, rfs_seek_out_t *out);
 
-/// After rfs_seek_step(): the wheels were held at zero from outside this period (a safety
+/// After rfs_seek_step(): the wheels are held at zero from outside this period (a safety
 /// stop of the caller's: bus-off, a receive-time watchdog). As for stale inputs, the drive
-/// stops (its next command ramps up from rest) and a goal being driven is resumed at the
-/// next step that finds the inputs fresh.
-void rfs_seek_hold(rfs_seek_t *s, int64_t now_us);
+/// stops (its next command ramps up from rest), a goal being driven is resumed at the
+/// next step that finds the inputs fresh, and *out (that step's output) says so: wheels
+/// zero, state as the seeker's own stale period reports it.
+void rfs_seek_hold(rfs_seek_t *s, int64_t now_us, rfs_seek_out_t *out);
 
 /// Spare time after a control period (docs/FIRMWARE.md, "Learning between periods"): one
 /// more fit_budget slice of a fit the wheels wait for, so that the decision it holds up is

@@ -331,18 +331,16 @@ void rfs_app_step(rfs_app_t *a, int64_t now_us, rfs_app_out_t *out)
     const bool stop = (faults & (RFS_APP_FAULT_POSE_LOST | RFS_APP_FAULT_RSSI_LOST |
                                  RFS_APP_FAULT_BUS_OFF | RFS_APP_FAULT_RESET)) != 0u;
     if (stop) {
-        /* The drive must know: else, the stop over, its speed of before is commanded at
-         * once, without the acceleration ramp, and it reckons with wheels that turned. */
-        rfs_seek_hold(&a->seek, now_us);
+        /* The drive must know (else, the stop over, its speed of before is commanded at
+         * once, without the acceleration ramp), and the period's output says it. */
+        rfs_seek_hold(&a->seek, now_us, &so);
     }
 
     memset(out, 0, sizeof *out);
     out->t_us = now_us;
-    out->left_mm_s = stop ? 0 : so.left_mm_s;
-    out->right_mm_s = stop ? 0 : so.right_mm_s;
-    /* A stop the seeker did not make shows in its state too: not DRIVING with the wheels
-     * held at zero. */
-    out->state = stop && so.state == RFS_SEEK_DRIVING ? RFS_SEEK_STALE : so.state;
+    out->left_mm_s = so.left_mm_s;
+    out->right_mm_s = so.right_mm_s;
+    out->state = so.state;
     out->faults = faults;
     out->decided = so.decided;
     out->decision = so.decision;

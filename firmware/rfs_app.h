@@ -160,8 +160,8 @@ typedef struct rfs_app_out {
     int64_t t_us;               ///< time of the step, microseconds
     int16_t left_mm_s;          ///< left wheel speed command, mm/s
     int16_t right_mm_s;         ///< right wheel speed command, mm/s
-    rfs_seek_state_t state;     ///< seeker state; RFS_SEEK_STALE, not DRIVING, while a stop
-                                ///< of the application's (lost inputs, bus-off) holds the wheels
+    rfs_seek_state_t state;     ///< seeker state (RFS_SEEK_STALE while any stop holds the wheels:
+                                ///< the seeker's own stale inputs or the application's stops)
     uint16_t faults;            ///< RFS_SEEK_FAULT_* | RFS_APP_FAULT_*
     bool decided;               ///< a new decision was made this period
     rfs_seek_decision_t decision; ///< the latest decision (new when `decided`)

@@ -166,6 +166,27 @@ static void hw_sync(rfs_bxcan_t *d)
     }
 }
 
+/* Any id: pending_abort() takes every pending mailbox. */
+#define ANY_ID UINT32_MAX
+
+/* Abort the transmit requests tsr shows pending (mailbox not empty), only those of `id`
+ * unless ANY_ID; *n counts them. Returns whether any was aborted. */
+static bool pending_abort(rfs_bxcan_regs_t *r, uint32_t tsr, uint32_t id, uint32_t *n)
+{
+    uint32_t abort = 0u;
+    for (unsigned i = 0; i < 3u; i++) {
+        if ((tsr & RFS_BXCAN_TSR_TME(i)) == 0u &&
+            (id == ANY_ID || (r->tx[i].tir >> RFS_BXCAN_STID_SHIFT) == id)) {
+            abort |= RFS_BXCAN_TSR_ABRQ(i);
+            (*n)++;
+        }
+    }
+    if (abort != 0u) {
+        r->tsr = abort; /* ABRQx are rs: writing 0 elsewhere has no effect */
+    }
+    return abort != 0u;
+}
+
 /* Fill an empty transmit mailbox with f and request its transmission. */
 static void mailbox_write(rfs_bxcan_txmb_t *m, const rfs_can_frame_t *f)
 {
@@ -194,16 +215,7 @@ int rfs_bxcan_send(rfs_bxcan_t *d, const rfs_can_frame_t *f)
      * arbitration), which would otherwise go out late, before it, when the bus returns.
      * ABRQ takes a pending mailbox back at once, one in transmission when that fails. */
     uint32_t tsr = r->tsr;
-    uint32_t abort = 0u;
-    for (unsigned i = 0; i < 3u; i++) {
-        if ((tsr & RFS_BXCAN_TSR_TME(i)) == 0u &&
-            (r->tx[i].tir >> RFS_BXCAN_STID_SHIFT) == f->id) {
-            abort |= RFS_BXCAN_TSR_ABRQ(i);
-            d->tx_superseded++;
-        }
-    }
-    if (abort != 0u) {
-        r->tsr = abort; /* ABRQx are rs: writing 0 elsewhere has no effect */
+    if (pending_abort(r, tsr, f->id, &d->tx_superseded)) {
         hw_sync(d);
         tsr = r->tsr;
     }
@@ -226,16 +238,8 @@ int rfs_bxcan_send(rfs_bxcan_t *d, const rfs_can_frame_t *f)
 int rfs_bxcan_fault_send(rfs_bxcan_regs_t *r, const rfs_can_frame_t *f, uint32_t max_polls,
                          void (*poll_hook)(void *ctx), void *poll_ctx)
 {
-    const uint32_t tsr = r->tsr;
-    uint32_t abort = 0u;
-    for (unsigned i = 0; i < 3u; i++) {
-        if ((tsr & RFS_BXCAN_TSR_TME(i)) == 0u) {
-            abort |= RFS_BXCAN_TSR_ABRQ(i);
-        }
-    }
-    if (abort != 0u) {
-        r->tsr = abort;
-    }
+    uint32_t aborted = 0u;
+    (void)pending_abort(r, r->tsr, ANY_ID, &aborted);
     for (uint32_t n = 0; n < max_polls && f->id <= RFS_CAN_ID_MAX && f->dlc <= 8u; n++) {
         if (poll_hook != NULL) {
             poll_hook(poll_ctx);
@@ -333,17 +337,7 @@ bool rfs_bxcan_poll(rfs_bxcan_t *d)
     const bool off = (r->esr & RFS_BXCAN_ESR_BOFF) != 0u;
     if (off && !d->bus_off) {
         d->bus_off_events++;
-        const uint32_t tsr = r->tsr;
-        uint32_t abort = 0u;
-        for (unsigned i = 0; i < 3u; i++) {
-            if ((tsr & RFS_BXCAN_TSR_TME(i)) == 0u) {
-                abort |= RFS_BXCAN_TSR_ABRQ(i);
-                d->tx_aborted++;
-            }
-        }
-        if (abort != 0u) {
-            r->tsr = abort; /* ABRQx are rs: writing 0 elsewhere has no effect */
-        }
+        (void)pending_abort(r, r->tsr, ANY_ID, &d->tx_aborted);
     }
     d->bus_off = off;
     return off;

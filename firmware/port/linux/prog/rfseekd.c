@@ -133,6 +133,22 @@ static int64_t monotonic_us(void)
     return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 }
 
+/* One frame at time t_us out on SocketCAN or as LCM (--can-over-lcm), written to the
+ * candump log when sent. 0, or non-zero when it could not be sent. */
+static int send_frame(daemon_t *d, int64_t t_us, const rfs_can_frame_t *f)
+{
+    int r = 0;
+    if (d->can) {
+        r = lx_can_send(d->can, f);
+    } else if (d->can_over_lcm && d->lcm) {
+        r = lx_lcm_pub_can(d->lcm, t_us, f);
+    }
+    if (r == 0 && d->dump != NULL) {
+        lx_candump_write(d->dump, t_us, f);
+    }
+    return r;
+}
+
 static void step(daemon_t *d, int64_t now_us)
 {
     if (d->done) {
@@ -167,17 +183,8 @@ static void step(daemon_t *d, int64_t now_us)
     rfs_can_frame_t fr[2];
     uint8_t n = rfs_app_frames(d->app, &out, fr);
     for (uint8_t i = 0; i < n; i++) {
-        int r = 0;
-        if (d->can) {
-            r = lx_can_send(d->can, &fr[i]);
-        } else if (d->can_over_lcm && d->lcm) {
-            r = lx_lcm_pub_can(d->lcm, now_us, &fr[i]);
-        }
-        if (r != 0 && d->can_fail++ == 0) {
+        if (send_frame(d, now_us, &fr[i]) != 0 && d->can_fail++ == 0) {
             fprintf(stderr, "rfseekd: a CAN frame could not be sent (counted; retrying with backoff)\n");
-        }
-        if (r == 0 && d->dump != NULL) {
-            lx_candump_write(d->dump, now_us, &fr[i]);
         }
     }
     rfs_seek_out_t so;
@@ -227,16 +234,8 @@ static void stop_wheels(daemon_t *d)
     const int64_t t = d->clock_lcm ? d->last_now_us : realtime_us();
     rfs_can_frame_t f;
     rfs_can_tx_wheel(&d->app->can_tx, &w, &f);
-    int r = 0;
-    if (d->can) {
-        r = lx_can_send(d->can, &f);
-    } else if (d->can_over_lcm && d->lcm) {
-        r = lx_lcm_pub_can(d->lcm, t, &f);
-    }
-    if (r != 0) {
+    if (send_frame(d, t, &f) != 0) {
         fprintf(stderr, "rfseekd: the last wheel command (stop) could not be sent\n");
-    } else if (d->dump != NULL) {
-        lx_candump_write(d->dump, t, &f);
     }
     if (d->lcm) {
         (void)lx_lcm_pub_wheel(d->lcm, t, &w);

@@ -87,18 +87,26 @@ static double dbl_of(rfs_q16_t q)
 }
 
 /* The estimates of a status: every field a Q16.16 value, areas and spreads not negative;
- * all zero when their valid flag is false. */
-static bool est_ok(const rfseek_seeker_status_t *m)
+ * all zero when their valid flag is false. The path-loss estimate's into *est. */
+static bool est_ok(const rfseek_seeker_status_t *m, rfs_pathloss_est_t *est)
 {
     const double v[12] = {m->est_x, m->est_y, m->est_n, m->est_w, m->est_p0, m->est_rms,
                           m->est_area, m->bridge_x, m->bridge_y, m->bridge_f,
                           m->bridge_sigma, m->bridge_area};
+    rfs_q16_t q[12];
     for (int i = 0; i < 12; i++) {
-        rfs_q16_t q;
-        if (!q16_of(v[i], &q) || (!(i < 7 ? m->est_valid : m->bridge_valid) && q != 0)) {
+        if (!q16_of(v[i], &q[i]) || (!(i < 7 ? m->est_valid : m->bridge_valid) && q[i] != 0)) {
             return false;
         }
     }
+    memset(est, 0, sizeof *est);
+    est->sx = q[0];
+    est->sy = q[1];
+    est->n = q[2];
+    est->w = q[3];
+    est->p0 = q[4];
+    est->rms = q[5];
+    est->spread_m2 = q[6];
     return m->est_area >= 0.0 && m->est_rms >= 0.0 && m->bridge_sigma >= 0.0 &&
            m->bridge_area >= 0.0;
 }
@@ -191,8 +199,9 @@ static void on_wheel_msg(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const ch
     h->on_wheel(h->ctx, m.utime, &w);
 }
 
-/* A decoded status's fields into *o: false when one is out of range or not finite. */
-static bool status_of(const rfseek_seeker_status_t *m, rfs_seek_out_t *o)
+/* A decoded status's fields into *o and its path-loss estimate into *est (all zero unless
+ * est_valid): false when one is out of range or not finite. */
+static bool status_of(const rfseek_seeker_status_t *m, rfs_seek_out_t *o, rfs_pathloss_est_t *est)
 {
     memset(o, 0, sizeof *o);
     rfs_seek_decision_t *d = &o->decision;
@@ -202,7 +211,7 @@ static bool status_of(const rfseek_seeker_status_t *m, rfs_seek_out_t *o)
               q16_of(m->epsilon, &d->epsilon) && q16_of(m->x, &d->x) && q16_of(m->y, &d->y) &&
               q16_of(m->goal_x, &d->goal_x) && q16_of(m->goal_y, &d->goal_y) && q16_of(m->max_x, &d->max_x) &&
               q16_of(m->max_y, &d->max_y) && q16_of(m->path_len, &d->path_len) && m->samples >= 0 &&
-              m->samples <= 0xFFFF && m->plan_wait >= 0 && m->plan_wait <= 0xFFFF && est_ok(m);
+              m->samples <= 0xFFFF && m->plan_wait >= 0 && m->plan_wait <= 0xFFFF && est_ok(m, est);
     if (!ok) {
         return false;
     }
@@ -254,18 +263,13 @@ static void on_status_msg(const lx_lcm_handlers_t *h, lx_lcm_stats_t *s, const c
         return;
     }
     rfs_seek_out_t o;
-    if (!status_of(&m, &o)) {
+    rfs_pathloss_est_t est;
+    if (!status_of(&m, &o, &est)) {
         rfseek_seeker_status_t_decode_cleanup(&m);
         bad(s, h, ch, "a field is out of range or not finite (state %.0f)", m.state);
         return;
     }
-    /* Its fields were checked by est_ok() (status_of). */
-    rfs_pathloss_est_t est;
-    memset(&est, 0, sizeof est);
-    const bool have_est = m.est_valid && q16_of(m.est_x, &est.sx) && q16_of(m.est_y, &est.sy) &&
-                          q16_of(m.est_n, &est.n) && q16_of(m.est_w, &est.w) &&
-                          q16_of(m.est_p0, &est.p0) && q16_of(m.est_rms, &est.rms) &&
-                          q16_of(m.est_area, &est.spread_m2);
+    const bool have_est = m.est_valid;
     int64_t t = m.utime;
     rfseek_seeker_status_t_decode_cleanup(&m);
     good(s);

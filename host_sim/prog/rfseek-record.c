@@ -365,15 +365,17 @@ static int parse_option(int c, char **argv, options_t *o, recorder_t *rec)
     switch (c) {
     case 'o':
     case 'l':
-    case 'c':
+    case 'c': {
+        const char *name = c == 'o' ? "-o/--out" : c == 'l' ? "--live-out" : "--candump";
         if (*optarg == '\0') {
-            die_opt(c == 'o' ? "-o/--out" : c == 'l' ? "--live-out" : "--candump", optarg);
+            die_opt(name, optarg);
         }
-        if (lx_err_path_opt(PROG, c == 'o' ? "-o/--out" : c == 'l' ? "--live-out" : "--candump", optarg) != 0) {
+        if (lx_err_path_opt(PROG, name, optarg) != 0) {
             return 2;
         }
         *(c == 'o' ? &o->out_path : c == 'l' ? &o->live_path : &o->candump_path) = optarg;
         break;
+    }
     case 's':
         errno = 0;
         o->seed = strtoull(optarg, &end, 10); /* "-1" would wrap, "010" be octal */

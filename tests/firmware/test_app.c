@@ -318,14 +318,20 @@ static void test_receive_watchdog_stops_inputs_stamped_ahead(void **state)
     watchdog_case(false);
 }
 
-static void test_bus_off_stops_at_once_and_recovers(void **state)
+/* The room's default configuration, inputs on for its first 2 s; *o the last step's. */
+static void drive_two_seconds(rfs_app_out_t *o)
 {
-    (void)state;
     const rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
     const rfs_app_map_t m = room();
     assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
+    run(0, 2000000, true, true, o);
+}
+
+static void test_bus_off_stops_at_once_and_recovers(void **state)
+{
+    (void)state;
     rfs_app_out_t o;
-    run(0, 2000000, true, true, &o);
+    drive_two_seconds(&o);
     assert_true(o.left_mm_s != 0 || o.right_mm_s != 0);
 
     rfs_app_set_bus_off(&s_app, true);
@@ -350,11 +356,8 @@ static int32_t fastest(const rfs_app_out_t *o)
 static void test_an_application_stop_restarts_the_drive_from_rest(void **state)
 {
     (void)state;
-    const rfs_app_cfg_t c = fx_cfg(rfs_app_cfg_default());
-    const rfs_app_map_t m = room();
-    assert_int_equal(rfs_app_init(&s_app, &c, &m), 0);
     rfs_app_out_t o;
-    run(0, 2000000, true, true, &o);
+    drive_two_seconds(&o);
     assert_true(fastest(&o) > 100);
 
     rfs_app_set_bus_off(&s_app, true);

@@ -450,6 +450,58 @@ static void every_decision_kind_round_trips_with_its_reason(void **state)
     lx_lcm_close(l);
 }
 
+/* plan_wait outside 0..65535 on the wire (the decoder's range, the field's uint16) is
+ * dropped as out of range: the field is found in the published bytes by its neighbours
+ * (flags 1 0 1 0 1, then big-endian 0x1234) and rewritten. */
+static void status_plan_wait_out_of_range_is_dropped(void **state)
+{
+    (void)state;
+    rx_t r;
+    lx_lcm_t *l = open_memq(&r);
+    char path[] = "/tmp/rfs_test_lcm_XXXXXX";
+    char err[200];
+    lx_lcm_log_t *log = record_to_temp(l, path);
+    rfs_seek_out_t o;
+    memset(&o, 0, sizeof o);
+    o.decision.sampled = true;
+    o.decision.hedged = true;
+    o.decision.refuted = true;
+    o.decision.plan_wait = 0x1234u;
+    assert_int_equal(lx_lcm_pub_status(l, 5000, &o), 0);
+    drain(l);
+    lx_lcm_record(l, NULL);
+    assert_int_equal(lx_lcm_log_close(log), 0);
+    assert_int_equal(r.statuses, 1);
+    log = lx_lcm_log_open(path, "r", err, sizeof err);
+    assert_non_null(log);
+    uint8_t msg[512];
+    size_t len = 0;
+    int64_t t;
+    char ch[32];
+    assert_int_equal(lx_lcm_log_next_raw(log, &t, ch, sizeof ch, msg, sizeof msg, &len), 1);
+    assert_int_equal(lx_lcm_log_close(log), 0);
+    remove(path);
+    static const uint8_t mark[] = {1, 0, 1, 0, 1, 0x00, 0x00, 0x12, 0x34};
+    size_t at = SIZE_MAX;
+    for (size_t i = 0; i + sizeof mark <= len; i++) {
+        if (memcmp(msg + i, mark, sizeof mark) == 0) {
+            assert_int_equal(at, SIZE_MAX); /* found once */
+            at = i + 5u;
+        }
+    }
+    assert_true(at != SIZE_MAX);
+    static const uint8_t bad[2][4] = {{0x00, 0x01, 0x00, 0x00}, {0xFF, 0xFF, 0xFF, 0xFF}}; /* 65536, -1 */
+    for (int k = 0; k < 2; k++) {
+        memcpy(msg + at, bad[k], 4);
+        assert_int_equal(lx_lcm_pub_raw(l, 0, LX_LCM_CH_STATUS, msg, len), 0);
+        drain(l);
+        assert_int_equal(r.statuses, 1);
+        assert_int_equal(r.bads, k + 1);
+        assert_string_equal(r.bad, "RFS_SEEKER_STATUS: a field is out of range or not finite (state 0)");
+    }
+    lx_lcm_close(l);
+}
+
 /* A status's path-loss estimate reaches on_estimate after on_status, value for value
  * (Q16.16 through the message's doubles exactly); a status without one calls only
  * on_status. */
@@ -582,6 +634,7 @@ int main(void)
         cmocka_unit_test(damaged_file_url_is_one_line),
         cmocka_unit_test(status_string_length_checked_before_decoding),
         cmocka_unit_test(every_decision_kind_round_trips_with_its_reason),
+        cmocka_unit_test(status_plan_wait_out_of_range_is_dropped),
         cmocka_unit_test(status_estimate_reaches_its_handler),
         cmocka_unit_test(receiver_status_matches_reference_bytes_and_rejects_others),
         cmocka_unit_test(signal_during_wait_is_a_timeout),
